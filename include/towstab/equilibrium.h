@@ -1,0 +1,84 @@
+/* towstab/equilibrium.h: steady configurations, straight tow and steady turn
+ * (MODEL.md section 5; Kamman & Nguyen eq. 55).
+ *
+ * An equilibrium is a state with q' = 0 and q''(q) = 0 for the kernel's
+ * frame (speed V, turn rate Omega). Convergence is judged on forces: the
+ * largest unbalanced nodal force max_k |M_k r''_k| must be below `tol`
+ * times the largest force in the system (largest link tension or nodal
+ * load); both are reported.
+ *
+ * Methods (doc/equilibrium.md):
+ *  - shooting: marching from the free ends, with Powell-hybrid shooting on
+ *    the free-end positions (3 unknowns per free end) and continuation in
+ *    turn rate when needed. O(nlinks) per march. Not for bending (EI > 0).
+ *  - newton: Newton on q''(q) = 0 over all angles with a central-difference
+ *    Jacobian (LAPACK dgesv), a backtracking line search and continuation in
+ *    turn rate, started from the straight-tow march. O(nlinks^2) per
+ *    Jacobian and O(nlinks^3) per solve: the general fallback.
+ *  - auto: shooting when it applies and converges, else newton.
+ */
+#ifndef TOWSTAB_EQUILIBRIUM_H
+#define TOWSTAB_EQUILIBRIUM_H
+
+#include "towstab/error.h"
+#include "towstab/kernel.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    TS_EQ_AUTO = 0,
+    TS_EQ_SHOOTING = 1,
+    TS_EQ_NEWTON = 2
+} ts_eq_method;
+
+typedef struct ts_equilibrium_opts {
+    double tol;           /* relative force residual, default 1e-10 */
+    int max_iter;         /* per continuation step, default 100 */
+    ts_eq_method method;  /* default TS_EQ_AUTO */
+} ts_equilibrium_opts;
+
+typedef struct ts_equilibrium {
+    int nlinks, nnodes;
+    int converged;        /* 1 only when residual <= tolerance */
+    int iterations;       /* solver iterations over all continuation steps */
+    long evaluations;     /* kernel evaluations plus marches */
+    int continuation_steps;
+    double residual;      /* max unbalanced nodal force / force_scale */
+    double force_scale;   /* largest force in the system, N */
+    double tolerance;     /* the target residual */
+    ts_eq_method method;  /* the method that produced the result */
+    double *y;            /* [4 nlinks] state in the kernel's charts */
+    double *directions;   /* [3 nlinks] link unit vectors */
+    double *positions;    /* [3 nnodes] node positions, m (M frame) */
+    double *tensions;     /* [nlinks] N */
+    double tow_force[3];  /* force of the cables on the tow point, N */
+    double top_tension;   /* |tow_force|, N */
+    double min_tension;   /* smallest link tension, N (< 0: compression) */
+} ts_equilibrium;
+
+TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);
+
+/* Allocate a result for a built system; NULL on failure. */
+TS_API ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys,
+                                            ts_err *err);
+TS_API void ts_equilibrium_free(ts_equilibrium *eq);
+
+/* Solve for the equilibrium of kernel k's system at k's frame (speed and
+ * turn rate; the frame's rates must be zero, and a turn cannot be steady in
+ * a current). On success returns TS_OK with eq->converged = 1, and leaves
+ * the kernel's charts consistent with eq->y. On failure returns TS_ECONV
+ * (message: how far it got), TS_ESINGULAR or TS_EDOMAIN, with
+ * eq->converged = 0; eq then holds the best iterate, for diagnosis only. */
+TS_API int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
+                                ts_equilibrium *eq, ts_err *err);
+
+/* Name of a method ("auto", "shooting", "newton"). */
+TS_API const char *ts_eq_method_name(ts_eq_method m);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,142 @@
+/* towstab/kernel.h: the one dynamics kernel, y' = f(y, u), of the rigid-link
+ * tree (MODEL.md sections 1-4; Kamman & Nguyen 1990, eqs. 4-11, 20-22, 43-44).
+ *
+ * State y[2 nq]: y[0..nq) the link angles (theta1, theta2 of link k at
+ * 2k, 2k+1, in the link's chart, rad), y[nq..2nq) their rates (rad/s);
+ * nq = 2 nlinks. Input u[TS_NINPUT]: the tow-point displacement (m),
+ * velocity (m/s) and acceleration (m/s^2) relative to its nominal position
+ * in the mean ship frame M, each as x, y, z. The motion of M (speed V, turn
+ * rate Omega and their rates) and the current are set with
+ * ts_kernel_set_frame() (default: the system's steady tow, no current
+ * rotation).
+ *
+ * Cost: O(nlinks) per evaluation; the link tensions come from a tree
+ * recursion (free ends to tow point and back) on 3x3 nodal mass matrices,
+ * never a dense matrix. Nothing is allocated after ts_kernel_alloc().
+ *
+ * Charts: link k's direction is n = R_k (-c1 c2, -s2, s1 c2) with R_k the
+ * identity by default. The chart is singular where cos(theta2) = 0; an
+ * evaluation with |cos(theta2)| < TS_CHART_MIN on any link returns TS_CHART
+ * and writes NaN to dydt. ts_kernel_rechart() moves links that come near
+ * (|cos theta2| below a threshold) to a chart centred on their current
+ * direction and rewrites y accordingly; positions and velocities are
+ * unchanged, so a solver may continue from the rewritten state.
+ */
+#ifndef TOWSTAB_KERNEL_H
+#define TOWSTAB_KERNEL_H
+
+#include "towstab/error.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TS_NINPUT 9
+#define TS_CHART_MIN 1e-6        /* |cos theta2| below which f refuses */
+#define TS_CHART_RECHART 0.25    /* default re-chart threshold */
+
+/* dy/dt = f(t, y, u). y[n_state], u[n_input], dydt[n_state]; SI units.
+ * Returns 0 on success, > 0 when the state is outside the model's chart
+ * (the caller may re-chart or retry with a smaller step), < 0 on a fatal
+ * error. */
+typedef int (*ts_rhs_fn)(double t, const double y[], const double u[],
+                         double dydt[], void *params);
+
+/* Motion of the mean ship frame and the water, in M. */
+typedef struct ts_frame {
+    double speed;        /* V, m/s */
+    double turn_rate;    /* Omega, rad/s */
+    double speed_rate;   /* dV/dt, m/s^2 */
+    double turn_accel;   /* dOmega/dt, rad/s^2 */
+    double current[3];   /* current in M components, m/s */
+} ts_frame;
+
+typedef struct ts_kernel ts_kernel;
+
+/* Allocate the kernel of a built system. The kernel keeps a pointer to
+ * `sys`, which must outlive it and must not be rebuilt meanwhile. */
+TS_API ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err);
+TS_API void ts_kernel_free(ts_kernel *k);
+
+TS_API const ts_system *ts_kernel_system(const ts_kernel *k);
+TS_API int ts_kernel_nq(const ts_kernel *k);      /* 2 nlinks */
+TS_API int ts_kernel_nstate(const ts_kernel *k);  /* 2 nq */
+TS_API int ts_kernel_ninput(const ts_kernel *k);  /* TS_NINPUT */
+
+/* Set / read the frame motion. The default is the system's tow (speed,
+ * turn rate, zero rates) with its current. */
+TS_API void ts_kernel_set_frame(ts_kernel *k, const ts_frame *f);
+TS_API void ts_kernel_get_frame(const ts_kernel *k, ts_frame *f);
+
+/* Evaluate f(y, u) into dydt[2 nq]. u may be NULL (all zero). Returns
+ * TS_OK, TS_CHART (a link too close to the chart singularity; dydt is
+ * NaN) or TS_ESINGULAR (a nodal mass matrix not positive definite). */
+TS_API int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
+                          double dydt[]);
+
+/* The same with the ts_rhs_fn signature; `params` is the kernel. */
+TS_API int ts_kernel_rhs(double t, const double y[], const double u[],
+                         double dydt[], void *params);
+
+/* Results of the last evaluation (valid until the next one):
+ * node positions [3 nnodes] (m, M frame, node 0 the tow point), node
+ * velocities relative to M [3 nnodes], link tensions [nlinks] (N, > 0 in
+ * tension), link unit directions [3 nlinks] (upper to lower node), node
+ * accelerations relative to M, r'' [3 nnodes], external loads on the nodes
+ * [3 nnodes] (N: weight, buoyancy, drag, bending). */
+TS_API const double *ts_kernel_positions(const ts_kernel *k);
+TS_API const double *ts_kernel_velocities(const ts_kernel *k);
+TS_API const double *ts_kernel_tensions(const ts_kernel *k);
+TS_API const double *ts_kernel_directions(const ts_kernel *k);
+TS_API const double *ts_kernel_rel_accelerations(const ts_kernel *k);
+TS_API const double *ts_kernel_loads(const ts_kernel *k);
+
+/* After an evaluation: the force the cables exert on the tow point (N, M
+ * frame), i.e. the tensions of the links leaving it plus the loads lumped
+ * at node 0 less its inertia. Returns its magnitude. */
+TS_API double ts_kernel_tow_force(const ts_kernel *k, double F[3]);
+
+/* After an evaluation: the largest unbalanced nodal force
+ * max_k |M_k r''_k| (N) and, in *scale, the largest force in the system
+ * (largest |link tension| or |nodal load|, N). At an equilibrium the
+ * first is zero; equilibrium residuals are reported relative to *scale. */
+TS_API double ts_kernel_unbalanced(const ts_kernel *k, double *scale);
+
+/* Kinetic energy relative to the inertial frame minus nothing else (J), and
+ * potential energy of gravity and bending (J, z down), of the last
+ * evaluation. Used to check energy conservation in vacuum. */
+TS_API double ts_kernel_kinetic_energy(const ts_kernel *k);
+TS_API double ts_kernel_potential_energy(const ts_kernel *k);
+
+/* Unit direction of link `link` for angles (t1, t2) in its chart. */
+TS_API void ts_kernel_direction(const ts_kernel *k, int link, double t1,
+                                double t2, double n[3]);
+
+/* Angles (and rates, when ndot and y's rate half are wanted: ndot may be
+ * NULL for zero rates) that reproduce unit directions n[3 nlinks] in the
+ * current charts; links whose |cos theta2| would fall below `threshold`
+ * are first moved to a chart centred on their direction. Writes y[2 nq].
+ * Returns the number of links re-charted. */
+TS_API int ts_kernel_set_directions(ts_kernel *k, const double n[],
+                                    const double ndot[], double threshold,
+                                    double y[]);
+
+/* Re-chart every link of state y with |cos theta2| < threshold and
+ * rewrite its angles and rates in place. Returns the number re-charted. */
+TS_API int ts_kernel_rechart(ts_kernel *k, double y[], double threshold);
+
+/* Restore the standard chart (R = I) on every link whose direction allows
+ * it (|cos theta2| >= threshold there) and rewrite y. Returns the number of
+ * links left in a non-standard chart. */
+TS_API int ts_kernel_reset_charts(ts_kernel *k, double y[], double threshold);
+
+/* Standard-chart angles of a unit direction n: theta1 = atan2(n_z, -n_x),
+ * theta2 = asin(-n_y) (rad). */
+TS_API void ts_direction_angles(const double n[3], double *theta1,
+                                double *theta2);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

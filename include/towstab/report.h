@@ -1,0 +1,58 @@
+/* towstab/report.h: results as JSON (jansson) and CSV, written atomically.
+ *
+ * Every number is SI (m, N, s) except angles, which carry their unit in the
+ * key (theta1_deg). Files are written to a temporary name in the same
+ * folder and renamed when complete, so a failed run never leaves a file
+ * that looks finished; "-" means standard output.
+ */
+#ifndef TOWSTAB_REPORT_H
+#define TOWSTAB_REPORT_H
+
+#include <jansson.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "towstab/equilibrium.h"
+#include "towstab/error.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Name of a node: "tow" for node 0, the body's name where a body sits,
+ * else "<cable>.<k>" for the lower end of link k of that cable. */
+TS_API void ts_report_node_name(const ts_system *sys, int node, char *buf,
+                                size_t size);
+
+/* The equilibrium as a new JSON object: converged, iterations, evaluations,
+ * residual, force_scale, tolerance, method, speed, turn_rate, wall_s,
+ * top_tension, tow_force, nodes [{name,x,y,z}] (tow point first), links
+ * [{cable,index,tension,theta1_deg,theta2_deg}], bodies [{name,x,y,z}].
+ * NULL on allocation failure. */
+TS_API json_t *ts_report_equilibrium_json(const ts_system *sys,
+                                          const ts_equilibrium *eq,
+                                          double wall_s);
+
+/* Write a JSON value to `path` ("-": stdout), indented, atomically. */
+TS_API int ts_report_write_json(const json_t *value, const char *path,
+                                ts_err *err);
+
+/* Write the node table "node,x_m,y_m,z_m,tension_above_N" as CSV. */
+TS_API int ts_report_equilibrium_csv(const ts_system *sys,
+                                     const ts_equilibrium *eq,
+                                     const char *path, ts_err *err);
+
+/* Open a file for atomic writing: returns a FILE on a temporary name that
+ * ts_report_commit() renames to `path` (or stdout for "-"), and
+ * ts_report_abandon() removes. `tmp` receives the temporary name. */
+TS_API FILE *ts_report_open(const char *path, char *tmp, size_t tmpsize,
+                            ts_err *err);
+TS_API int ts_report_commit(FILE *f, const char *path, const char *tmp,
+                            ts_err *err);
+TS_API void ts_report_abandon(FILE *f, const char *path, const char *tmp);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

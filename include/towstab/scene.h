@@ -1,0 +1,62 @@
+/* towstab/scene.h: scene files (YAML) -> ts_system plus a list of analyses.
+ *
+ * The format is documented in doc/scene-format.md. Every quantity may carry
+ * a unit (towstab/units.h). Every error names the key, the line and what was
+ * expected, e.g. "cables[1].length (line 14): must be > 0 m, got -3 m".
+ */
+#ifndef TOWSTAB_SCENE_H
+#define TOWSTAB_SCENE_H
+
+#include <stddef.h>
+
+#include "towstab/error.h"
+#include "towstab/system.h"
+#include "towstab/units.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* One option of an analysis entry, kept as text for the command that runs
+ * it to interpret (with units) and to refuse when unknown. */
+typedef struct ts_scene_option {
+    char key[TS_NAME_MAX];
+    char *value;            /* scalar text; owned by the scene */
+    int line;
+} ts_scene_option;
+
+typedef struct ts_scene_analysis {
+    char type[TS_NAME_MAX]; /* "equilibrium", ... */
+    int line;
+    int noptions;
+    ts_scene_option *options;
+} ts_scene_analysis;
+
+typedef struct ts_scene {
+    char path[512];         /* as given to ts_scene_load, "" for strings */
+    ts_system *system;      /* built (ts_system_build has run) */
+    int nanalyses;
+    ts_scene_analysis *analyses;
+} ts_scene;
+
+/* Read and build a scene from a file. On failure returns NULL, with the
+ * error in err (TS_EIO, TS_ESCENE, TS_EUNIT or TS_EINVAL). */
+TS_API ts_scene *ts_scene_load(const char *path, const ts_units *units,
+                               ts_err *err);
+
+/* The same from a buffer of `len` bytes (need not be NUL-terminated);
+ * `name` is used in messages. */
+TS_API ts_scene *ts_scene_parse(const char *text, size_t len, const char *name,
+                                const ts_units *units, ts_err *err);
+
+/* Free a scene and its system. ts_scene_free(NULL) does nothing. */
+TS_API void ts_scene_free(ts_scene *scene);
+
+/* The value of option `key` of an analysis, NULL if absent. */
+TS_API const ts_scene_option *
+ts_scene_analysis_option(const ts_scene_analysis *a, const char *key);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

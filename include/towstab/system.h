@@ -1,0 +1,139 @@
+/* towstab/system.h: the towed system as a tree of cables, links, nodes and
+ * bodies (MODEL.md sections 1-3, 8).
+ *
+ * A ts_system holds the description (environment, tow, cables, bodies) and,
+ * after ts_system_build(), its discretisation: links in topological order
+ * (every link after the link above it), node 0 the tow point and node k+1
+ * the lower end of link k. All quantities are SI: m, kg, s, N, rad.
+ * Frames: mean ship frame M, x forward, y starboard, z down (depth).
+ */
+#ifndef TOWSTAB_SYSTEM_H
+#define TOWSTAB_SYSTEM_H
+
+#include "towstab/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TS_NAME_MAX 64
+
+typedef enum { TS_DRAG_STANDARD = 0, TS_DRAG_LOADING = 1 } ts_drag_law;
+
+typedef enum { TS_BODY_SPHERE = 0, TS_BODY_JUNCTION = 1 } ts_body_type;
+
+typedef struct ts_environment {
+    double water_density;   /* rho, kg/m^3 (0: vacuum) */
+    double gravity;         /* g, m/s^2, along +z */
+    double current[3];      /* uniform current, inertial, m/s (M at t = 0) */
+} ts_environment;
+
+typedef struct ts_tow {
+    double speed;           /* V, m/s along +x_M */
+    double turn_rate;       /* Omega, rad/s about +z_M (> 0: starboard turn) */
+    double point[3];        /* nominal tow point in M, m (z < 0: above water) */
+} ts_tow;
+
+typedef struct ts_cable {
+    char name[TS_NAME_MAX];
+    int from_body;          /* index into bodies, -1 for the tow point */
+    int to_body;            /* index into bodies, -1 for a free end */
+    double length;          /* m */
+    double diameter;        /* m (hydrodynamic and buoyancy diameter) */
+    double mass_per_length; /* kg/m in air */
+    int nlinks;             /* number of rigid links */
+    double *link_fraction;  /* [nlinks] fractions of length summing to 1, or
+                               NULL for equal links; owned by the system */
+    double cdn;             /* normal drag coefficient */
+    double cdt;             /* tangential drag coefficient */
+    double can;             /* normal added-mass coefficient */
+    ts_drag_law drag_law;
+    double ei;              /* bending stiffness EI, N m^2 (0: none) */
+    int line;               /* scene line of the entry, 0 if none */
+} ts_cable;
+
+typedef struct ts_body {
+    char name[TS_NAME_MAX];
+    ts_body_type type;
+    double diameter;        /* m (sphere) */
+    double mass;            /* kg in air */
+    double cd;              /* drag coefficient on the frontal area */
+    double ca;              /* added-mass coefficient on the volume */
+    int line;
+} ts_body;
+
+/* One rigid link of the discretisation. */
+typedef struct ts_link {
+    int cable;              /* index into cables */
+    int index;              /* 1 at the top of its cable */
+    int upper;              /* upper node (closer to the tow point) */
+    int lower;              /* lower node, always link index + 1 */
+    int parent;             /* link whose lower node is `upper`, -1 at tow */
+    int next;               /* next link of the same cable, -1 at its end */
+    double length;          /* m */
+    double diameter;        /* m */
+    double mass;            /* kg */
+    double cdn, cdt, can;
+    ts_drag_law drag_law;
+    double ei;              /* of the joint at `lower` with `next`, N m^2 */
+} ts_link;
+
+typedef struct ts_node {
+    int body;               /* index into bodies, -1 if none */
+    int link;               /* link ending here, -1 for the tow point */
+    int child_begin;        /* children are child_links[child_begin..end) */
+    int child_end;
+    double mass;            /* lumped structural mass: half links + body, kg */
+} ts_node;
+
+typedef struct ts_system {
+    char name[TS_NAME_MAX];
+    ts_environment env;
+    ts_tow tow;
+    int ncables;
+    ts_cable *cables;
+    int nbodies;
+    ts_body *bodies;
+
+    /* Discretisation, filled by ts_system_build(). */
+    int nlinks;
+    int nnodes;             /* nlinks + 1 */
+    ts_link *links;         /* [nlinks] */
+    ts_node *nodes;         /* [nnodes] */
+    int *child_links;       /* [nlinks] link indices grouped by upper node */
+    int has_added_mass;     /* any can > 0 or body ca > 0 with rho > 0 */
+    int has_bending;        /* any ei > 0 */
+} ts_system;
+
+/* Allocate a system with `ncables` zeroed cables and `nbodies` zeroed
+ * bodies (environment: rho 1025 kg/m^3, g 9.80665 m/s^2). NULL on failure. */
+TS_API ts_system *ts_system_alloc(int ncables, int nbodies, ts_err *err);
+
+/* Free a system and everything it owns. ts_system_free(NULL) does nothing. */
+TS_API void ts_system_free(ts_system *sys);
+
+/* A deep copy (description and discretisation). NULL on failure. */
+TS_API ts_system *ts_system_copy(const ts_system *sys, ts_err *err);
+
+/* Validate the description and build links and nodes. Checks every value
+ * (finite, in range), that `from`/`to` form a tree rooted at the tow point,
+ * that each body ends exactly one cable, and that no cable is unreachable.
+ * May be called again after changing the description (e.g. nlinks).
+ * Returns TS_OK, TS_EINVAL or TS_ENOMEM. */
+TS_API int ts_system_build(ts_system *sys, ts_err *err);
+
+/* Index of the cable or body called `name`, -1 if none. */
+TS_API int ts_system_find_cable(const ts_system *sys, const char *name);
+TS_API int ts_system_find_body(const ts_system *sys, const char *name);
+
+/* Node at which body b sits (lower node of the cable that ends at it), or
+ * -1 before ts_system_build(). */
+TS_API int ts_system_body_node(const ts_system *sys, int b);
+
+/* Wet weight per length of a cable in N/m (weight minus buoyancy). */
+TS_API double ts_cable_wet_weight(const ts_system *sys, int c);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

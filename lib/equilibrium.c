@@ -1,0 +1,416 @@
+/* equilibrium.c: steady configurations (towstab/equilibrium.h,
+ * doc/equilibrium.md; MODEL.md section 5).
+ *
+ * The fast path marches from the free ends and shoots on their positions
+ * (march.c). The general path is Newton on q''(q) = 0 over all angles:
+ * central-difference Jacobian through the kernel, LU solve (LAPACK dgetrf/
+ * dgetrs), backtracking line search on |q''|, re-charting of links that
+ * approach cos(theta2) = 0. Turns are reached by continuation in turn rate
+ * from the straight tow, with the step refined when a step fails. Whatever
+ * the path, the answer is accepted only from the kernel's own verdict: the
+ * largest unbalanced nodal force relative to the largest force.
+ */
+#include "towstab/equilibrium.h"
+
+#include <gsl/gsl_errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lapack.h"
+#include "march.h"
+#include "vec3.h"
+
+/* Shooting mismatch target, relative to the total cable length: far below
+ * what moves a force by 1e-10 of the largest one. */
+#define SHOOT_POS_RTOL 1e-13
+/* Central-difference step on angles for the Newton Jacobian (rad):
+ * truncation ~h^2 and rounding ~eps/h balance near 1e-5 to 1e-6. */
+#define NEWTON_FD_STEP 1e-6
+#define NEWTON_ALPHA_MIN 1e-6
+
+void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
+{
+    o->tol = 1e-10;
+    o->max_iter = 100;
+    o->method = TS_EQ_AUTO;
+}
+
+const char *ts_eq_method_name(ts_eq_method m)
+{
+    switch (m) {
+    case TS_EQ_SHOOTING: return "shooting";
+    case TS_EQ_NEWTON: return "newton";
+    default: return "auto";
+    }
+}
+
+ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
+{
+    ts_equilibrium *eq = calloc(1, sizeof *eq);
+    if (!eq)
+        goto nomem;
+    eq->nlinks = sys->nlinks;
+    eq->nnodes = sys->nnodes;
+    size_t nl = (size_t)sys->nlinks, nn = (size_t)sys->nnodes;
+    eq->y = calloc(4 * nl, sizeof(double));
+    eq->directions = calloc(3 * nl, sizeof(double));
+    eq->positions = calloc(3 * nn, sizeof(double));
+    eq->tensions = calloc(nl, sizeof(double));
+    if (!eq->y || !eq->directions || !eq->positions || !eq->tensions)
+        goto nomem;
+    return eq;
+nomem:
+    ts_equilibrium_free(eq);
+    ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    return NULL;
+}
+
+void ts_equilibrium_free(ts_equilibrium *eq)
+{
+    if (!eq)
+        return;
+    free(eq->y);
+    free(eq->directions);
+    free(eq->positions);
+    free(eq->tensions);
+    free(eq);
+}
+
+/* Evaluate the kernel at y (rates zero) and record the result in eq. */
+static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
+                  double *dydt)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nl = sys->nlinks, nq = 2 * nl;
+    memcpy(eq->y, y, (size_t)nq * sizeof(double));
+    memset(eq->y + nq, 0, (size_t)nq * sizeof(double));
+    int rc = ts_kernel_eval(k, eq->y, NULL, dydt);
+    eq->evaluations++;
+    if (rc != TS_OK)
+        return rc;
+    memcpy(eq->directions, ts_kernel_directions(k),
+           3 * (size_t)nl * sizeof(double));
+    memcpy(eq->positions, ts_kernel_positions(k),
+           3 * (size_t)sys->nnodes * sizeof(double));
+    memcpy(eq->tensions, ts_kernel_tensions(k), (size_t)nl * sizeof(double));
+    eq->top_tension = ts_kernel_tow_force(k, eq->tow_force);
+    double scale;
+    double worst = ts_kernel_unbalanced(k, &scale);
+    eq->force_scale = scale;
+    eq->residual = scale > 0 ? worst / scale : worst;
+    eq->min_tension = INFINITY;
+    for (int l = 0; l < nl; l++)
+        if (eq->tensions[l] < eq->min_tension)
+            eq->min_tension = eq->tensions[l];
+    return TS_OK;
+}
+
+/* Work arrays of the general Newton. */
+typedef struct newton_ws {
+    int nq;
+    double *J, *R, *dq, *yt, *f1, *f2;
+    double *ystart; /* [2 nq] start of every continuation schedule */
+    int *ipiv;
+} newton_ws;
+
+static void newton_ws_free(newton_ws *w)
+{
+    free(w->J);
+    free(w->R);
+    free(w->dq);
+    free(w->yt);
+    free(w->f1);
+    free(w->f2);
+    free(w->ystart);
+    free(w->ipiv);
+}
+
+static int newton_ws_alloc(newton_ws *w, int nq)
+{
+    size_t n = (size_t)nq;
+    w->nq = nq;
+    w->J = malloc(n * n * sizeof(double));
+    w->R = malloc(2 * n * sizeof(double));
+    w->dq = malloc(n * sizeof(double));
+    w->yt = calloc(2 * n, sizeof(double));
+    w->f1 = malloc(2 * n * sizeof(double));
+    w->f2 = malloc(2 * n * sizeof(double));
+    w->ystart = calloc(2 * n, sizeof(double));
+    w->ipiv = malloc(n * sizeof(int));
+    return w->J && w->R && w->dq && w->yt && w->f1 && w->f2 && w->ystart &&
+           w->ipiv;
+}
+
+static double norm2(const double *v, int n)
+{
+    double s = 0;
+    for (int i = 0; i < n; i++)
+        s += v[i] * v[i];
+    return sqrt(s);
+}
+
+/* Newton on q''(q) = 0 from y (rates must be zero; y[2 nq]). */
+static int newton(ts_kernel *k, double *y, double tol, int max_iter,
+                  newton_ws *w, ts_equilibrium *eq, ts_err *err)
+{
+    int nq = w->nq, rc;
+    double rel = INFINITY;
+    for (int it = 0;; it++) {
+        rc = ts_kernel_eval(k, y, NULL, w->R);
+        eq->evaluations++;
+        if (rc != TS_OK)
+            return ts_fail(err, rc, "equilibrium: Newton start is outside "
+                                    "the model (%s)", ts_strerror(rc));
+        double scale, worst = ts_kernel_unbalanced(k, &scale);
+        rel = scale > 0 ? worst / scale : worst;
+        if (rel <= tol)
+            return TS_OK;
+        if (it >= max_iter)
+            break;
+        eq->iterations++;
+        /* Jacobian of q'' by central differences, column by column. */
+        for (int j = 0; j < nq; j++) {
+            double h = NEWTON_FD_STEP, y0 = y[j];
+            y[j] = y0 + h;
+            int r1 = ts_kernel_eval(k, y, NULL, w->f1);
+            y[j] = y0 - h;
+            int r2 = ts_kernel_eval(k, y, NULL, w->f2);
+            y[j] = y0;
+            eq->evaluations += 2;
+            if (r1 != TS_OK || r2 != TS_OK)
+                return ts_fail(err, TS_ECONV,
+                               "equilibrium: Newton Jacobian column %d left "
+                               "the model's chart",
+                               j);
+            double *col = w->J + (size_t)j * nq;
+            for (int i = 0; i < nq; i++)
+                col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
+        }
+        for (int i = 0; i < nq; i++)
+            w->dq[i] = -w->R[nq + i];
+        int one = 1, info = 0;
+        dgetrf_(&nq, &nq, w->J, &nq, w->ipiv, &info);
+        if (info == 0)
+            dgetrs_("N", &nq, &one, w->J, &nq, w->ipiv, w->dq, &nq, &info);
+        if (info != 0)
+            return ts_fail(err, TS_ESINGULAR,
+                           "equilibrium: singular Newton Jacobian (LAPACK "
+                           "dgetrf info %d) at relative residual %.3g",
+                           info, rel);
+        /* Backtracking line search on |q''|. */
+        double phi0 = norm2(w->R + nq, nq), alpha = 1.0;
+        int accepted = 0;
+        while (alpha >= NEWTON_ALPHA_MIN) {
+            for (int i = 0; i < nq; i++)
+                w->yt[i] = y[i] + alpha * w->dq[i];
+            rc = ts_kernel_eval(k, w->yt, NULL, w->f1);
+            eq->evaluations++;
+            if (rc == TS_OK && norm2(w->f1 + nq, nq) <=
+                                   (1.0 - 1e-4 * alpha) * phi0) {
+                accepted = 1;
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if (!accepted)
+            break;
+        memcpy(y, w->yt, (size_t)nq * sizeof(double));
+        ts_kernel_rechart(k, y, TS_CHART_RECHART);
+    }
+    return ts_fail(err, TS_ECONV,
+                   "equilibrium: Newton stopped after %d iterations at "
+                   "relative residual %.3g (target %.3g)",
+                   eq->iterations, rel, tol);
+}
+
+static double total_length(const ts_system *sys)
+{
+    double L = 0;
+    for (int l = 0; l < sys->nlinks; l++)
+        L += sys->links[l].length;
+    return L;
+}
+
+/* Shooting with continuation in turn rate: schedules of 1, 4, 16 steps. */
+static int solve_shooting(ts_kernel *k, tsi_march *m, const ts_frame *frame,
+                          const ts_equilibrium_opts *o, ts_equilibrium *eq,
+                          ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nu = tsi_march_nunknown(m), rc = TS_ECONV;
+    double *x = malloc((size_t)nu * sizeof(double));
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    double pos_tol = SHOOT_POS_RTOL * total_length(sys);
+    static const int schedule[] = {1, 4, 16};
+    int nsched = frame->turn_rate != 0 ? 3 : 1;
+    for (int s = 0; s < nsched; s++) {
+        int steps = schedule[s];
+        ts_frame f = *frame;
+        rc = TS_OK;
+        for (int j = (steps > 1 ? 0 : steps); j <= steps && rc == TS_OK; j++) {
+            f.turn_rate = frame->turn_rate * j / steps;
+            rc = tsi_march_solve(m, &f, x, j == 0 || steps == 1, pos_tol,
+                                 o->max_iter, &eq->iterations,
+                                 &eq->evaluations, err);
+            eq->continuation_steps++;
+        }
+        if (rc == TS_OK || rc == TS_ESINGULAR)
+            break;
+    }
+    free(x);
+    return rc;
+}
+
+int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
+                         ts_equilibrium *eq, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_equilibrium_opts o;
+    if (opts)
+        o = *opts;
+    else
+        ts_equilibrium_opts_default(&o);
+    if (!(o.tol > 0) || o.max_iter < 1)
+        return ts_fail(err, TS_EINVAL, "equilibrium: tolerance must be > 0 "
+                                       "and max_iter >= 1");
+    /* towstab checks every GSL status itself; GSL's default handler would
+     * abort the process (a process-wide GSL setting). */
+    gsl_set_error_handler_off();
+
+    ts_frame frame;
+    ts_kernel_get_frame(k, &frame);
+    eq->converged = 0;
+    eq->iterations = 0;
+    eq->evaluations = 0;
+    eq->continuation_steps = 0;
+    eq->tolerance = o.tol;
+    if (frame.speed_rate != 0 || frame.turn_accel != 0)
+        return ts_fail(err, TS_EDOMAIN, "equilibrium: the frame is "
+                                        "accelerating; set speed_rate and "
+                                        "turn_accel to 0");
+    if (frame.turn_rate != 0 &&
+        (frame.current[0] != 0 || frame.current[1] != 0))
+        return ts_fail(err, TS_EDOMAIN,
+                       "equilibrium: a turn (turn_rate %g rad/s) in a "
+                       "horizontal current has no steady state: the current "
+                       "rotates in the ship frame",
+                       frame.turn_rate);
+    if (o.method == TS_EQ_SHOOTING && sys->has_bending)
+        return ts_fail(err, TS_EDOMAIN,
+                       "equilibrium: method shooting does not apply to "
+                       "cables with bending stiffness (EI > 0); use newton "
+                       "or auto");
+
+    int nl = sys->nlinks, nq = 2 * nl, rc;
+    double *y = calloc(4 * (size_t)nl, sizeof(double));
+    double *dydt = malloc(4 * (size_t)nl * sizeof(double));
+    tsi_march *m = tsi_march_alloc(sys, err);
+    newton_ws w = {0};
+    if (!y || !dydt || !m) {
+        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+        goto out;
+    }
+
+    /* Fast path. */
+    int have_guess = 0;
+    if (!sys->has_bending && o.method != TS_EQ_NEWTON) {
+        ts_err serr = {0};
+        rc = solve_shooting(k, m, &frame, &o, eq, &serr);
+        if (rc == TS_OK) {
+            ts_kernel_set_directions(k, tsi_march_directions(m), NULL,
+                                     TS_CHART_RECHART, y);
+            have_guess = 1;
+            if ((rc = record(k, y, eq, dydt)) == TS_OK && eq->residual <= o.tol) {
+                eq->method = TS_EQ_SHOOTING;
+                eq->converged = 1;
+                goto out;
+            }
+        }
+        if (o.method == TS_EQ_SHOOTING || rc == TS_ESINGULAR) {
+            if (err)
+                *err = serr;
+            if (rc == TS_OK)
+                rc = ts_fail(err, TS_ECONV,
+                             "equilibrium: shooting converged but the kernel "
+                             "residual is %.3g (target %.3g)",
+                             eq->residual, o.tol);
+            goto out;
+        }
+    }
+
+    /* General Newton, from the straight-tow march (no bending) or from the
+     * shooting result, with continuation in turn rate. */
+    eq->method = TS_EQ_NEWTON;
+    if (!newton_ws_alloc(&w, nq)) {
+        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory for a "
+                                     "%d x %d Newton Jacobian",
+                     nq, nq);
+        goto out;
+    }
+    static const int schedule[] = {1, 4, 16, 64};
+    int nsched = frame.turn_rate != 0 && !have_guess ? 4 : 1;
+    double *y0 = w.ystart;
+    if (have_guess) {
+        memcpy(y0, y, (size_t)nq * sizeof(double));
+    } else {
+        ts_frame straight = frame;
+        straight.turn_rate = 0;
+        ts_err merr = {0};
+        int it = 0;
+        long ev = 0;
+        double *x = malloc((size_t)tsi_march_nunknown(m) * sizeof(double));
+        if (x && tsi_march_solve(m, &straight, x, 1,
+                                 SHOOT_POS_RTOL * total_length(sys),
+                                 o.max_iter, &it, &ev, &merr) == TS_OK) {
+            ts_kernel_set_directions(k, tsi_march_directions(m), NULL,
+                                     TS_CHART_RECHART, y0);
+        } else {
+            /* Hanging straight down. */
+            for (int l = 0; l < nl; l++) {
+                y0[2 * l] = M_PI / 2;
+                y0[2 * l + 1] = 0;
+            }
+        }
+        free(x);
+        eq->evaluations += ev;
+    }
+    for (int s = 0; s < nsched; s++) {
+        int steps = schedule[s];
+        memcpy(y, y0, (size_t)nq * sizeof(double));
+        memset(y + nq, 0, (size_t)nq * sizeof(double));
+        rc = TS_OK;
+        for (int j = 1; j <= steps && rc == TS_OK; j++) {
+            ts_frame f = frame;
+            f.turn_rate = frame.turn_rate * j / steps;
+            ts_kernel_set_frame(k, &f);
+            rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
+            eq->continuation_steps++;
+        }
+        ts_kernel_set_frame(k, &frame);
+        if (rc == TS_OK || rc == TS_ENOMEM)
+            break;
+    }
+    {
+        int rrc = record(k, y, eq, dydt);
+        if (rc == TS_OK && rrc != TS_OK)
+            rc = ts_fail(err, rrc, "equilibrium: final state is outside "
+                                   "the model (%s)",
+                         ts_strerror(rrc));
+    }
+    if (rc == TS_OK)
+        eq->converged = eq->residual <= o.tol;
+
+out:
+    ts_kernel_set_frame(k, &frame);
+    newton_ws_free(&w);
+    tsi_march_free(m);
+    free(y);
+    free(dydt);
+    if (rc == TS_OK && !eq->converged)
+        rc = ts_fail(err, TS_ECONV,
+                     "equilibrium: not converged, relative residual %.3g "
+                     "(target %.3g)",
+                     eq->residual, o.tol);
+    return rc;
+}

@@ -1,0 +1,50 @@
+/* march.h: the steady lumped rigid-link problem solved by marching from the
+ * free ends to the tow point, with shooting on the free-end positions
+ * (internal; MODEL.md section 5, doc/equilibrium.md).
+ *
+ * Given the position of every free end, each link's direction and tension
+ * follow from its lower node's force balance, one small root per link,
+ * free ends first. Where branches meet, and at the tow point, the marched
+ * positions must agree: the mismatches are the residual of a root problem
+ * in the 3 * (number of free ends) unknowns. A straight tow that stays on
+ * one side of the surface does not depend on those positions at all (the
+ * shape only translates), so one correction closes it exactly; turns and
+ * surface crossings take a few Powell hybrid iterations (GSL).
+ * Bending (EI > 0) couples a node to the link above it and is not marched.
+ */
+#ifndef TOWSTAB_MARCH_H
+#define TOWSTAB_MARCH_H
+
+#include "towstab/error.h"
+#include "towstab/kernel.h"
+#include "towstab/system.h"
+
+typedef struct tsi_march tsi_march;
+
+tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err);
+void tsi_march_free(tsi_march *m);
+
+/* Number of shooting unknowns and residuals: 3 per free end. */
+int tsi_march_nunknown(const tsi_march *m);
+
+/* March for free-end positions x[nunknown] (m) under frame f; writes the
+ * mismatches e[nunknown] (m). Returns TS_OK, TS_ECONV (a link's direction
+ * root failed) or TS_ESINGULAR (a link with no load to align with). */
+int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
+                   double e[], ts_err *err);
+
+/* Solve the shooting problem: on entry x is a guess (or NULL content
+ * filled by a hanging guess when *fresh), on exit the free-end positions
+ * with max |e| <= pos_tol. Counts iterations and marches. */
+int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
+                    double pos_tol, int max_iter, int *iterations,
+                    long *marches, ts_err *err);
+
+/* Results of the last march: link directions [3 nlinks], tensions. */
+const double *tsi_march_directions(const tsi_march *m);
+const double *tsi_march_tensions(const tsi_march *m);
+
+/* Largest |mismatch| of the last march, m. */
+double tsi_march_mismatch(const tsi_march *m);
+
+#endif

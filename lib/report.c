@@ -1,0 +1,179 @@
+/* report.c: JSON (jansson) and CSV output of results (towstab/report.h).
+ * Files are written under a temporary name and renamed into place only when
+ * complete, so no half-written file survives a failure. */
+#include "towstab/report.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "towstab/kernel.h"
+
+void ts_report_node_name(const ts_system *sys, int node, char *buf,
+                         size_t size)
+{
+    if (node == 0) {
+        snprintf(buf, size, "tow");
+        return;
+    }
+    const ts_node *nd = &sys->nodes[node];
+    if (nd->body >= 0) {
+        snprintf(buf, size, "%s", sys->bodies[nd->body].name);
+        return;
+    }
+    const ts_link *L = &sys->links[nd->link];
+    snprintf(buf, size, "%s.%d", sys->cables[L->cable].name, L->index);
+}
+
+/* A JSON number, or null for a value that is not finite. */
+static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
+
+json_t *ts_report_equilibrium_json(const ts_system *sys,
+                                   const ts_equilibrium *eq, double wall_s)
+{
+    json_t *o = json_object();
+    json_t *nodes = json_array(), *links = json_array(), *bodies = json_array();
+    if (!o || !nodes || !links || !bodies) {
+        json_decref(o);
+        json_decref(nodes);
+        json_decref(links);
+        json_decref(bodies);
+        return NULL;
+    }
+    json_object_set_new(o, "converged", json_boolean(eq->converged));
+    json_object_set_new(o, "iterations", json_integer(eq->iterations));
+    json_object_set_new(o, "evaluations", json_integer(eq->evaluations));
+    json_object_set_new(o, "residual", num(eq->residual));
+    json_object_set_new(o, "force_scale", num(eq->force_scale));
+    json_object_set_new(o, "tolerance", num(eq->tolerance));
+    json_object_set_new(o, "method", json_string(ts_eq_method_name(eq->method)));
+    json_object_set_new(o, "speed", num(sys->tow.speed));
+    json_object_set_new(o, "turn_rate", num(sys->tow.turn_rate));
+    json_object_set_new(o, "wall_s", num(wall_s));
+    json_object_set_new(o, "top_tension", num(eq->top_tension));
+    json_object_set_new(o, "min_tension", num(eq->min_tension));
+    json_object_set_new(o, "tow_force",
+                        json_pack("[o,o,o]", num(eq->tow_force[0]),
+                                  num(eq->tow_force[1]), num(eq->tow_force[2])));
+    char name[2 * TS_NAME_MAX];
+    for (int i = 0; i < sys->nnodes; i++) {
+        const double *r = eq->positions + 3 * i;
+        ts_report_node_name(sys, i, name, sizeof name);
+        json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name", name,
+                                               "x", num(r[0]), "y", num(r[1]),
+                                               "z", num(r[2])));
+    }
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        double t1, t2;
+        ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
+        json_array_append_new(
+            links, json_pack("{s:s,s:i,s:o,s:o,s:o}", "cable",
+                             sys->cables[L->cable].name, "index", L->index,
+                             "tension", num(eq->tensions[l]), "theta1_deg",
+                             num(t1 * 180 / M_PI), "theta2_deg",
+                             num(t2 * 180 / M_PI)));
+    }
+    for (int b = 0; b < sys->nbodies; b++) {
+        int k = ts_system_body_node(sys, b);
+        const double *r = eq->positions + 3 * k;
+        json_array_append_new(bodies, json_pack("{s:s,s:o,s:o,s:o}", "name",
+                                                sys->bodies[b].name, "x",
+                                                num(r[0]), "y", num(r[1]), "z",
+                                                num(r[2])));
+    }
+    json_object_set_new(o, "nodes", nodes);
+    json_object_set_new(o, "links", links);
+    json_object_set_new(o, "bodies", bodies);
+    return o;
+}
+
+FILE *ts_report_open(const char *path, char *tmp, size_t tmpsize, ts_err *err)
+{
+    if (strcmp(path, "-") == 0) {
+        tmp[0] = '\0';
+        return stdout;
+    }
+    int n = snprintf(tmp, tmpsize, "%s.partial-XXXXXX", path);
+    if (n < 0 || (size_t)n >= tmpsize) {
+        ts_fail(err, TS_EIO, "%s: path too long", path);
+        return NULL;
+    }
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(errno));
+        return NULL;
+    }
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        close(fd);
+        unlink(tmp);
+        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(errno));
+    }
+    return f;
+}
+
+int ts_report_commit(FILE *f, const char *path, const char *tmp, ts_err *err)
+{
+    if (f == stdout)
+        return fflush(stdout) == 0
+                   ? TS_OK
+                   : ts_fail(err, TS_EIO, "standard output: write failed");
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) {
+        unlink(tmp);
+        return ts_fail(err, TS_EIO, "%s: write failed", path);
+    }
+    if (rename(tmp, path) != 0) {
+        int e = errno;
+        unlink(tmp);
+        return ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(e));
+    }
+    return TS_OK;
+}
+
+void ts_report_abandon(FILE *f, const char *path, const char *tmp)
+{
+    (void)path;
+    if (!f || f == stdout)
+        return;
+    fclose(f);
+    unlink(tmp);
+}
+
+int ts_report_write_json(const json_t *value, const char *path, ts_err *err)
+{
+    char tmp[1024];
+    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
+    if (!f)
+        return TS_EIO;
+    if (json_dumpf(value, f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0 ||
+        fputc('\n', f) == EOF) {
+        ts_report_abandon(f, path, tmp);
+        return ts_fail(err, TS_EIO, "%s: write failed", path);
+    }
+    return ts_report_commit(f, path, tmp, err);
+}
+
+int ts_report_equilibrium_csv(const ts_system *sys, const ts_equilibrium *eq,
+                              const char *path, ts_err *err)
+{
+    char tmp[1024], name[2 * TS_NAME_MAX];
+    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
+    if (!f)
+        return TS_EIO;
+    fprintf(f, "node,x_m,y_m,z_m,tension_above_N\n");
+    for (int i = 0; i < sys->nnodes; i++) {
+        const double *r = eq->positions + 3 * i;
+        ts_report_node_name(sys, i, name, sizeof name);
+        if (i == 0)
+            fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
+                    eq->top_tension);
+        else
+            fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
+                    eq->tensions[i - 1]);
+    }
+    return ts_report_commit(f, path, tmp, err);
+}

@@ -1,0 +1,1180 @@
+/* scene.c: scene files (YAML) -> ts_system plus a list of analyses
+ * (see towstab/scene.h; the format is documented in doc/scene-format.md).
+ *
+ * Algorithm. libyaml's document API (yaml_parser_load) builds the whole
+ * node graph first, so every node keeps its start mark (0-based line,
+ * reported + 1). The graph is then walked along the fixed shape of the
+ * format: top-level mapping -> blocks -> lists of entries -> scalars. The
+ * walk never recurses on the input (its depth is that of the format, at
+ * most four levels), so deep or self-referential YAML (aliases) cannot
+ * exhaust the stack, and libyaml itself loads without recursion (0.2.x).
+ *
+ * Order of work: every mapping is first checked against its table of
+ * accepted keys (unknown and duplicate keys, keys that are not scalars),
+ * then its values are converted. Blocks are read in the order the
+ * conversions need, whatever their order in the file: environment (g and
+ * rho turn weights into masses), tow, bodies (names for the cables' from
+ * and to), cables, analyses. ts_system_build() then checks the tree (loops,
+ * bodies ending no cable or two) and builds links and nodes.
+ *
+ * Errors: TS_ESCENE for structure (YAML syntax, node types, missing,
+ * unknown and duplicate keys), TS_EUNIT for units, TS_EINVAL for values out
+ * of range, TS_EIO for files, TS_ENOMEM. Every message starts with the scene
+ * name, then the key path and the line: "s.yaml: cables[1].length (line
+ * 14): must be > 0 m, got -3 m". On every error path the scene and the
+ * libyaml document are freed.
+ *
+ * Limits against hostile input (fuzzing): at most MAX_ENTRIES entries in a
+ * list and MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES.
+ */
+#include "towstab/scene.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+/* Largest number of entries in any list (cables, bodies, analyses, options,
+ * link_lengths): far beyond a real scene, small enough for int counts. */
+#define MAX_ENTRIES 100000
+/* Largest number of rigid links in the whole system (sum over cables). */
+#define MAX_LINKS 100000
+/* Largest scene file read by ts_scene_load. */
+#define MAX_FILE_BYTES (16L * 1024 * 1024)
+/* Relative tolerance for link_lengths adding up to the cable length. */
+#define LINK_SUM_RTOL 1e-9
+/* Room for a key path such as "analyses[12].some_option". */
+#define PATH_LEN 160
+/* Longest user text (a key, a name) quoted in a message. */
+#define SHOW_MAX 40
+
+/* Defaults (doc/scene-format.md). */
+#define DEFAULT_CDN 1.2
+#define DEFAULT_CDT 0.01
+#define DEFAULT_CAN 1.0
+#define DEFAULT_SPHERE_CD 0.5
+#define DEFAULT_SPHERE_CA 0.5
+
+typedef struct ctx {
+    yaml_document_t *doc;
+    const ts_units *units;
+    ts_err *err;
+} ctx;
+
+/* One accepted key of a mapping and, after read_map(), its value. */
+typedef struct field {
+    const char *key;
+    yaml_node_t *value;     /* NULL when the key is absent */
+    int line;               /* line of the key, 1-based */
+} field;
+
+/* ------------------------------------------------------------------ */
+/* Small helpers                                                        */
+
+static int line_of(const yaml_node_t *n)
+{
+    size_t line = n->start_mark.line;
+    return line >= (size_t)INT_MAX ? INT_MAX : (int)line + 1;
+}
+
+static int mark_line(yaml_mark_t m)
+{
+    return m.line >= (size_t)INT_MAX ? INT_MAX : (int)m.line + 1;
+}
+
+static int mark_column(yaml_mark_t m)
+{
+    return m.column >= (size_t)INT_MAX ? INT_MAX : (int)m.column + 1;
+}
+
+static const char *kind_name(const yaml_node_t *n)
+{
+    switch (n->type) {
+    case YAML_SCALAR_NODE: return "a scalar";
+    case YAML_SEQUENCE_NODE: return "a list";
+    case YAML_MAPPING_NODE: return "a mapping";
+    default: return "an empty node";
+    }
+}
+
+static int seq_len(const yaml_node_t *n)
+{
+    ptrdiff_t len = n->data.sequence.items.top - n->data.sequence.items.start;
+    return len > INT_MAX ? INT_MAX : (int)len;
+}
+
+static yaml_node_t *seq_item(const ctx *c, const yaml_node_t *n, int i)
+{
+    return yaml_document_get_node(c->doc, n->data.sequence.items.start[i]);
+}
+
+/* YAML's null: an empty plain scalar, "~" or "null". */
+static int is_null(const yaml_node_t *n)
+{
+    if (n->type != YAML_SCALAR_NODE ||
+        n->data.scalar.style != YAML_PLAIN_SCALAR_STYLE)
+        return 0;
+    const char *v = (const char *)n->data.scalar.value;
+    return !strcmp(v, "") || !strcmp(v, "~") || !strcmp(v, "null") ||
+           !strcmp(v, "Null") || !strcmp(v, "NULL");
+}
+
+/* Copy user text for a message: printable ASCII kept, other bytes as
+ * "\xNN", at most SHOW_MAX characters. */
+static const char *show(const char *text, size_t len, char *buf, size_t size)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < len && n + 8 < size; i++) {
+        unsigned char ch = (unsigned char)text[i];
+        if (i >= SHOW_MAX) {
+            memcpy(buf + n, "...", 3);
+            n += 3;
+            break;
+        }
+        if (ch < 0x20 || ch >= 0x7f)
+            n += (size_t)snprintf(buf + n, size - n, "\\x%02x", ch);
+        else
+            buf[n++] = (char)ch;
+    }
+    buf[n] = '\0';
+    return buf;
+}
+
+#define SHOW_BUF (4 * SHOW_MAX + 16)
+
+/* "path (line N): " + message. Returns code. */
+#ifdef __GNUC__
+__attribute__((format(printf, 5, 6)))
+#endif
+static int fail_at(const ctx *c, int code, const char *path, int line,
+                   const char *fmt, ...)
+{
+    char what[TS_ERR_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return ts_fail(c->err, code, "%s (line %d): %s", path, line, what);
+}
+
+/* "parent.key" (or "key" at the top level) into out[PATH_LEN]. */
+static const char *join(char *out, const char *parent, const char *key)
+{
+    if (parent[0])
+        snprintf(out, PATH_LEN, "%s.%s", parent, key);
+    else
+        snprintf(out, PATH_LEN, "%s", key);
+    return out;
+}
+
+/* "parent[i]" into out[PATH_LEN]. */
+static const char *index_path(char *out, const char *parent, int i)
+{
+    snprintf(out, PATH_LEN, "%s[%d]", parent, i);
+    return out;
+}
+
+/* ------------------------------------------------------------------ */
+/* Mappings                                                             */
+
+/* Check that `map` is a mapping whose keys are all in fields[nf] (each at
+ * most once), and attach each value to its field. `path` names the
+ * mapping ("" at the top level), `what` says what it should contain. */
+static int read_map(const ctx *c, const yaml_node_t *map, const char *path,
+                    const char *what, field f[], int nf)
+{
+    const char *where = path[0] ? path : "top level";
+    for (int i = 0; i < nf; i++) {
+        f[i].value = NULL;
+        f[i].line = 0;
+    }
+    if (map->type != YAML_MAPPING_NODE)
+        return fail_at(c, TS_ESCENE, where, line_of(map),
+                       "expected a mapping (%s), got %s", what,
+                       kind_name(map));
+    char p[PATH_LEN], s[SHOW_BUF];
+    for (yaml_node_pair_t *pair = map->data.mapping.pairs.start;
+         pair < map->data.mapping.pairs.top; pair++) {
+        yaml_node_t *key = yaml_document_get_node(c->doc, pair->key);
+        yaml_node_t *value = yaml_document_get_node(c->doc, pair->value);
+        if (!key || !value)
+            return ts_fail(c->err, TS_ESCENE, "%s: broken YAML document",
+                           where);
+        if (key->type != YAML_SCALAR_NODE)
+            return fail_at(c, TS_ESCENE, where, line_of(key),
+                           "keys must be plain names, got %s as a key",
+                           kind_name(key));
+        const char *k = (const char *)key->data.scalar.value;
+        size_t klen = key->data.scalar.length;
+        int hit = -1;
+        for (int i = 0; i < nf && hit < 0; i++)
+            if (strlen(f[i].key) == klen && !memcmp(f[i].key, k, klen))
+                hit = i;
+        if (hit < 0) {
+            char keys[512];
+            size_t n = 0;
+            keys[0] = '\0';
+            for (int i = 0; i < nf && n < sizeof keys; i++)
+                n += (size_t)snprintf(keys + n, sizeof keys - n, "%s%s",
+                                      i ? ", " : "", f[i].key);
+            return fail_at(c, TS_ESCENE,
+                           join(p, path, show(k, klen, s, sizeof s)),
+                           line_of(key),
+                           "unknown key; expected one of %s", keys);
+        }
+        if (f[hit].value)
+            return fail_at(c, TS_ESCENE, join(p, path, f[hit].key),
+                           line_of(key), "duplicate key (first given on "
+                           "line %d)", f[hit].line);
+        if (is_null(value))
+            return fail_at(c, TS_ESCENE, join(p, path, f[hit].key),
+                           line_of(key), "no value; give one, or remove the "
+                           "key to use the default");
+        f[hit].value = value;
+        f[hit].line = line_of(key);
+    }
+    return TS_OK;
+}
+
+static int missing(const ctx *c, const char *path, const yaml_node_t *map,
+                   const char *key)
+{
+    return fail_at(c, TS_ESCENE, path[0] ? path : "top level", line_of(map),
+                   "missing key '%s'", key);
+}
+
+/* ------------------------------------------------------------------ */
+/* Scalars and quantities                                               */
+
+/* The scalar text of a field, refusing other node types and NUL bytes. */
+static int field_text(const ctx *c, const char *path, const field *f,
+                      const char *expected, const char **text)
+{
+    const yaml_node_t *n = f->value;
+    if (n->type != YAML_SCALAR_NODE)
+        return fail_at(c, TS_ESCENE, path, f->line, "expected %s, got %s",
+                       expected, kind_name(n));
+    const char *v = (const char *)n->data.scalar.value;
+    if (strlen(v) != n->data.scalar.length)
+        return fail_at(c, TS_ESCENE, path, f->line, "the value contains a "
+                       "NUL character");
+    *text = v;
+    return TS_OK;
+}
+
+/* A quantity in `si` from a scalar node (`line` for messages). */
+static int node_quantity(const ctx *c, const char *path, int line,
+                         const yaml_node_t *n, const char *si, double *value)
+{
+    if (n->type != YAML_SCALAR_NODE)
+        return fail_at(c, TS_ESCENE, path, line, "expected a number with an "
+                       "optional unit, got %s", kind_name(n));
+    const char *v = (const char *)n->data.scalar.value;
+    if (strlen(v) != n->data.scalar.length)
+        return fail_at(c, TS_ESCENE, path, line, "the value contains a NUL "
+                       "character");
+    char where[PATH_LEN + 32];
+    snprintf(where, sizeof where, "%s (line %d)", path, line);
+    return ts_units_parse(c->units, v, si, where, value, c->err);
+}
+
+static int field_quantity(const ctx *c, const char *path, const field *f,
+                          const char *si, double *value)
+{
+    return node_quantity(c, path, f->line, f->value, si, value);
+}
+
+/* Refuse v unless v > lo (strict) or v >= lo; names the value in SI and,
+ * when the scene wrote it with a unit, as written. */
+static int check_min(const ctx *c, const char *path, const field *f,
+                     double v, double lo, int strict, const char *si)
+{
+    if (strict ? v > lo : v >= lo)
+        return TS_OK;
+    const char *unit = strcmp(si, "1") ? si : "";
+    char written[SHOW_BUF + 16] = "";
+    if (f->value && f->value->type == YAML_SCALAR_NODE) {
+        char number[32], s[SHOW_BUF];
+        snprintf(number, sizeof number, "%g", v);
+        const char *t = (const char *)f->value->data.scalar.value;
+        if (strcmp(number, t))
+            snprintf(written, sizeof written, " (written \"%s\")",
+                     show(t, f->value->data.scalar.length, s, sizeof s));
+    }
+    return fail_at(c, TS_EINVAL, path, f->line,
+                   "must be %s %g%s%s, got %g%s%s%s", strict ? ">" : ">=",
+                   lo, unit[0] ? " " : "", unit, v, unit[0] ? " " : "", unit,
+                   written);
+}
+
+/* An optional quantity >= lo (or > lo) with a default. */
+static int optional_min(const ctx *c, const char *parent, const field *f,
+                        const char *si, double lo, int strict, double dflt,
+                        double *value)
+{
+    char p[PATH_LEN];
+    *value = dflt;
+    if (!f->value)
+        return TS_OK;
+    int rc = field_quantity(c, join(p, parent, f->key), f, si, value);
+    if (rc == TS_OK)
+        rc = check_min(c, p, f, *value, lo, strict, si);
+    return rc;
+}
+
+/* A list of exactly three quantities ("[x, y, z]"). */
+static int vector3(const ctx *c, const char *parent, const field *f,
+                   const char *si, double v[3])
+{
+    char p[PATH_LEN], pi[PATH_LEN];
+    join(p, parent, f->key);
+    const yaml_node_t *n = f->value;
+    if (n->type != YAML_SEQUENCE_NODE)
+        return fail_at(c, TS_ESCENE, p, f->line, "expected a list of 3 "
+                       "quantities [x, y, z], got %s", kind_name(n));
+    if (seq_len(n) != 3)
+        return fail_at(c, TS_ESCENE, p, f->line, "expected a list of 3 "
+                       "quantities [x, y, z], got %d entries", seq_len(n));
+    for (int j = 0; j < 3; j++) {
+        yaml_node_t *item = seq_item(c, n, j);
+        if (!item)
+            return ts_fail(c->err, TS_ESCENE, "%s: broken YAML document", p);
+        int rc = node_quantity(c, index_path(pi, p, j), line_of(item), item,
+                               si, &v[j]);
+        if (rc != TS_OK)
+            return rc;
+    }
+    return TS_OK;
+}
+
+/* A name: 1 to TS_NAME_MAX - 1 bytes, no control characters. */
+static int read_name(const ctx *c, const char *path, const field *f,
+                     char out[TS_NAME_MAX])
+{
+    const char *t;
+    int rc = field_text(c, path, f, "a name", &t);
+    if (rc != TS_OK)
+        return rc;
+    size_t len = strlen(t);
+    if (len == 0 || len >= TS_NAME_MAX)
+        return fail_at(c, TS_EINVAL, path, f->line, "a name must have 1 to "
+                       "%d characters, got %zu", TS_NAME_MAX - 1, len);
+    for (size_t i = 0; i < len; i++)
+        if ((unsigned char)t[i] < 0x20 || (unsigned char)t[i] == 0x7f)
+            return fail_at(c, TS_EINVAL, path, f->line, "a name must not "
+                           "contain control characters");
+    memcpy(out, t, len + 1);
+    return TS_OK;
+}
+
+/* A whole number in [1, max] ("20"; "20.0" is accepted, "2.5" is not). */
+static int read_count(const ctx *c, const char *path, const field *f,
+                      int max, int *out)
+{
+    const char *t;
+    char s[SHOW_BUF];
+    int rc = field_text(c, path, f, "an integer", &t);
+    if (rc != TS_OK)
+        return rc;
+    double x;
+    rc = ts_units_parse(c->units, t, "1", path, &x, NULL);
+    if (rc != TS_OK)
+        return fail_at(c, TS_EINVAL, path, f->line, "must be an integer "
+                       ">= 1, got \"%s\"",
+                       show(t, f->value->data.scalar.length, s, sizeof s));
+    if (x != floor(x))
+        return fail_at(c, TS_EINVAL, path, f->line, "must be an integer "
+                       ">= 1, got %g", x);
+    if (x < 1)
+        return fail_at(c, TS_EINVAL, path, f->line, "must be an integer "
+                       ">= 1, got %g", x);
+    if (x > max)
+        return fail_at(c, TS_EINVAL, path, f->line, "must be at most %d, "
+                       "got %g", max, x);
+    *out = (int)x;
+    return TS_OK;
+}
+
+/* Exactly one (required) or at most one of fields f[i] for i in idx[n]:
+ * returns the index present in *which (-1 if none). */
+static int one_of(const ctx *c, const char *path, const yaml_node_t *map,
+                  const field f[], const int idx[], int n, int required,
+                  int *which)
+{
+    *which = -1;
+    char names[160] = "", p[PATH_LEN];
+    size_t len = 0;
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(names + len, sizeof names - len, "%s%s",
+                                i == 0 ? "" : i == n - 1 ? " or " : ", ",
+                                f[idx[i]].key);
+    for (int i = 0; i < n; i++) {
+        const field *fi = &f[idx[i]];
+        if (!fi->value)
+            continue;
+        if (*which >= 0)
+            return fail_at(c, TS_ESCENE, join(p, path, fi->key), fi->line,
+                           "give only one of %s ('%s' is given on line %d)",
+                           names, f[*which].key, f[*which].line);
+        *which = idx[i];
+    }
+    if (required && *which < 0)
+        return fail_at(c, TS_ESCENE, path, line_of(map), "missing key: give "
+                       "one of %s", names);
+    return TS_OK;
+}
+
+/* Weight with g > 0 needed: refuse a weight when g is zero. */
+static int need_gravity(const ctx *c, const char *path, const field *f,
+                        double g, const char *mass_key)
+{
+    if (g > 0)
+        return TS_OK;
+    return fail_at(c, TS_EINVAL, path, f->line, "environment.gravity is 0, "
+                   "so a weight gives no mass: use '%s'", mass_key);
+}
+
+/* ------------------------------------------------------------------ */
+/* Blocks                                                               */
+
+static int parse_environment(const ctx *c, const yaml_node_t *n,
+                             ts_environment *env)
+{
+    enum { E_RHO, E_G, E_CURRENT, E_N };
+    field f[E_N] = {{"water_density", 0, 0}, {"gravity", 0, 0},
+                    {"current", 0, 0}};
+    int rc = read_map(c, n, "environment", "water_density, gravity, current",
+                      f, E_N);
+    if (rc == TS_OK)
+        rc = optional_min(c, "environment", &f[E_RHO], "kg/m^3", 0, 0,
+                          env->water_density, &env->water_density);
+    if (rc == TS_OK)
+        rc = optional_min(c, "environment", &f[E_G], "m/s^2", 0, 0,
+                          env->gravity, &env->gravity);
+    if (rc == TS_OK && f[E_CURRENT].value)
+        rc = vector3(c, "environment", &f[E_CURRENT], "m/s", env->current);
+    return rc;
+}
+
+static int parse_tow(const ctx *c, const yaml_node_t *n, ts_tow *tow)
+{
+    enum { T_SPEED, T_TURN, T_POINT, T_N };
+    field f[T_N] = {{"speed", 0, 0}, {"turn_rate", 0, 0}, {"point", 0, 0}};
+    char p[PATH_LEN];
+    int rc = read_map(c, n, "tow", "speed, turn_rate, point", f, T_N);
+    if (rc != TS_OK)
+        return rc;
+    if (!f[T_SPEED].value)
+        return missing(c, "tow", n, "speed");
+    rc = field_quantity(c, join(p, "tow", "speed"), &f[T_SPEED], "m/s",
+                        &tow->speed);
+    if (rc == TS_OK)
+        rc = check_min(c, p, &f[T_SPEED], tow->speed, 0, 0, "m/s");
+    if (rc == TS_OK && f[T_TURN].value)
+        rc = field_quantity(c, join(p, "tow", "turn_rate"), &f[T_TURN],
+                            "rad/s", &tow->turn_rate);
+    if (rc == TS_OK && f[T_POINT].value)
+        rc = vector3(c, "tow", &f[T_POINT], "m", tow->point);
+    return rc;
+}
+
+static int parse_body(const ctx *c, const yaml_node_t *n, int b,
+                      ts_system *sys)
+{
+    enum { B_NAME, B_TYPE, B_DIAM, B_WEIGHT, B_MASS, B_WET, B_DRAG, B_CA,
+           B_N };
+    field f[B_N] = {{"name", 0, 0}, {"type", 0, 0}, {"diameter", 0, 0},
+                    {"weight", 0, 0}, {"mass", 0, 0}, {"wet_weight", 0, 0},
+                    {"drag", 0, 0}, {"added_mass", 0, 0}};
+    char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
+    index_path(path, "bodies", b);
+    ts_body *body = &sys->bodies[b];
+    body->line = line_of(n);
+    int rc = read_map(c, n, path, "name, type, diameter, weight, ...", f, B_N);
+    if (rc != TS_OK)
+        return rc;
+    for (int k = 0; k <= B_TYPE; k++)
+        if (!f[k].value)
+            return missing(c, path, n, f[k].key);
+
+    rc = read_name(c, join(p, path, "name"), &f[B_NAME], body->name);
+    if (rc != TS_OK)
+        return rc;
+    if (!strcmp(body->name, "tow"))
+        return fail_at(c, TS_EINVAL, p, f[B_NAME].line, "'tow' is reserved "
+                       "for the tow point; choose another name");
+    for (int j = 0; j < b; j++)
+        if (!strcmp(sys->bodies[j].name, body->name))
+            return fail_at(c, TS_EINVAL, p, f[B_NAME].line, "duplicate body "
+                           "name '%s' (bodies[%d], line %d)", body->name, j,
+                           sys->bodies[j].line);
+
+    const char *type;
+    rc = field_text(c, join(p, path, "type"), &f[B_TYPE], "sphere or junction",
+                    &type);
+    if (rc != TS_OK)
+        return rc;
+    if (!strcmp(type, "sphere"))
+        body->type = TS_BODY_SPHERE;
+    else if (!strcmp(type, "junction"))
+        body->type = TS_BODY_JUNCTION;
+    else
+        return fail_at(c, TS_EINVAL, p, f[B_TYPE].line, "unknown body type "
+                       "\"%s\"; expected sphere or junction",
+                       show(type, f[B_TYPE].value->data.scalar.length, s,
+                            sizeof s));
+    int sphere = body->type == TS_BODY_SPHERE;
+
+    if (sphere && !f[B_DIAM].value)
+        return missing(c, path, n, "diameter");
+    rc = optional_min(c, path, &f[B_DIAM], "m", 0, sphere, 0.0,
+                      &body->diameter);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[B_DRAG], "1", 0, 0,
+                          sphere ? DEFAULT_SPHERE_CD : 0.0, &body->cd);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[B_CA], "1", 0, 0,
+                          sphere ? DEFAULT_SPHERE_CA : 0.0, &body->ca);
+    if (rc != TS_OK)
+        return rc;
+
+    /* Mass: exactly one of weight, mass, wet_weight for a sphere; at most
+     * one for a junction (default 0). */
+    static const int mass_keys[] = {B_WEIGHT, B_MASS, B_WET};
+    int which;
+    rc = one_of(c, path, n, f, mass_keys, 3, sphere, &which);
+    if (rc != TS_OK)
+        return rc;
+    const ts_environment *env = &sys->env;
+    double x = 0;
+    body->mass = 0;
+    if (which >= 0) {
+        const field *fm = &f[which];
+        const char *si = which == B_MASS ? "kg" : "N";
+        rc = field_quantity(c, join(p, path, fm->key), fm, si, &x);
+        if (rc == TS_OK && which != B_WET)
+            rc = check_min(c, p, fm, x, 0, 0, si);
+        if (rc == TS_OK && which != B_MASS)
+            rc = need_gravity(c, p, fm, env->gravity, "mass");
+        if (rc != TS_OK)
+            return rc;
+        double volume = M_PI * pow(body->diameter, 3) / 6.0;
+        if (which == B_MASS)
+            body->mass = x;
+        else if (which == B_WEIGHT)
+            body->mass = x / env->gravity;
+        else
+            body->mass = x / env->gravity + env->water_density * volume;
+        if (!(body->mass >= 0))
+            return fail_at(c, TS_EINVAL, p, fm->line, "%g N in water gives "
+                           "a negative mass in air (%g kg): the buoyancy "
+                           "rho g pi D^3/6 is only %g N", x, body->mass,
+                           env->water_density * env->gravity * volume);
+    }
+    return TS_OK;
+}
+
+/* Resolve a body name for cables[i].from/to; -1 for "tow" (from only). */
+static int resolve_body(const ctx *c, const char *path, const field *f,
+                        const ts_system *sys, int allow_tow, int *body)
+{
+    const char *t;
+    char s[SHOW_BUF];
+    int rc = field_text(c, path, f, "a body name", &t);
+    if (rc != TS_OK)
+        return rc;
+    if (!strcmp(t, "tow")) {
+        if (!allow_tow)
+            return fail_at(c, TS_EINVAL, path, f->line, "a cable cannot end "
+                           "at the tow point; omit 'to' for a free end");
+        *body = -1;
+        return TS_OK;
+    }
+    *body = ts_system_find_body(sys, t);
+    if (*body >= 0)
+        return TS_OK;
+    char list[400];
+    size_t n = 0;
+    list[0] = '\0';
+    for (int b = 0; b < sys->nbodies; b++) {
+        size_t need = strlen(sys->bodies[b].name) + 2;
+        if (n + need + 5 >= sizeof list) {
+            snprintf(list + n, sizeof list - n, ", ...");
+            break;
+        }
+        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s",
+                              b ? ", " : "", sys->bodies[b].name);
+    }
+    show(t, f->value->data.scalar.length, s, sizeof s);
+    if (sys->nbodies == 0)
+        return fail_at(c, TS_EINVAL, path, f->line, "no body named '%s' (no "
+                       "bodies are defined%s)", s,
+                       allow_tow ? "; use 'tow' for the tow point" : "");
+    return fail_at(c, TS_EINVAL, path, f->line, "no body named '%s' "
+                   "(bodies: %s)", s, list);
+}
+
+static int parse_link_lengths(const ctx *c, const char *path, const field *f,
+                              ts_cable *cable)
+{
+    char p[PATH_LEN], pi[PATH_LEN];
+    join(p, path, f->key);
+    const yaml_node_t *n = f->value;
+    if (n->type != YAML_SEQUENCE_NODE)
+        return fail_at(c, TS_ESCENE, p, f->line, "expected a list of link "
+                       "lengths, got %s", kind_name(n));
+    int len = seq_len(n);
+    if (len < 1)
+        return fail_at(c, TS_EINVAL, p, f->line, "needs at least one link "
+                       "length");
+    if (len > MAX_LINKS)
+        return fail_at(c, TS_EINVAL, p, f->line, "has %d entries, at most %d "
+                       "links are allowed", len, MAX_LINKS);
+    double *frac = malloc((size_t)len * sizeof *frac);
+    if (!frac)
+        return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", p);
+    double sum = 0;
+    for (int j = 0; j < len; j++) {
+        yaml_node_t *item = seq_item(c, n, j);
+        int rc = item ? TS_OK
+                      : ts_fail(c->err, TS_ESCENE, "%s: broken YAML document",
+                                p);
+        field fj = {"", item, item ? line_of(item) : 0};
+        if (rc == TS_OK)
+            rc = node_quantity(c, index_path(pi, p, j), fj.line, item, "m",
+                               &frac[j]);
+        if (rc == TS_OK)
+            rc = check_min(c, pi, &fj, frac[j], 0, 1, "m");
+        if (rc != TS_OK) {
+            free(frac);
+            return rc;
+        }
+        sum += frac[j];
+    }
+    if (!(isfinite(sum) &&
+          fabs(sum - cable->length) <= LINK_SUM_RTOL * cable->length)) {
+        free(frac);
+        return fail_at(c, TS_EINVAL, p, f->line, "the %d lengths add up to "
+                       "%.12g m, but the cable length is %.12g m (relative "
+                       "tolerance %g)", len, sum, cable->length,
+                       LINK_SUM_RTOL);
+    }
+    /* Normalised by their own sum, the fractions add up to 1 to rounding
+     * (ts_system_build checks 1e-9). */
+    for (int j = 0; j < len; j++)
+        frac[j] /= sum;
+    cable->link_fraction = frac;
+    cable->nlinks = len;
+    return TS_OK;
+}
+
+static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
+                       ts_system *sys)
+{
+    enum { C_NAME, C_FROM, C_TO, C_LENGTH, C_DIAM, C_WEIGHT, C_MPL, C_WET,
+           C_LINKS, C_LINK_LENGTHS, C_CDN, C_CDT, C_CAN, C_LAW, C_EI, C_N };
+    field f[C_N] = {{"name", 0, 0}, {"from", 0, 0}, {"to", 0, 0},
+                    {"length", 0, 0}, {"diameter", 0, 0}, {"weight", 0, 0},
+                    {"mass_per_length", 0, 0}, {"wet_weight", 0, 0},
+                    {"links", 0, 0}, {"link_lengths", 0, 0},
+                    {"normal_drag", 0, 0}, {"tangential_drag", 0, 0},
+                    {"added_mass", 0, 0}, {"drag_law", 0, 0}, {"EI", 0, 0}};
+    char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
+    index_path(path, "cables", i);
+    ts_cable *cable = &sys->cables[i];
+    cable->line = line_of(n);
+    int rc = read_map(c, n, path, "name, from, to, length, diameter, ...", f,
+                      C_N);
+    if (rc != TS_OK)
+        return rc;
+    static const int required[] = {C_NAME, C_FROM, C_LENGTH, C_DIAM};
+    for (int k = 0; k < 4; k++)
+        if (!f[required[k]].value)
+            return missing(c, path, n, f[required[k]].key);
+    if (!f[C_LINKS].value && !f[C_LINK_LENGTHS].value)
+        return missing(c, path, n, "links");
+
+    rc = read_name(c, join(p, path, "name"), &f[C_NAME], cable->name);
+    if (rc != TS_OK)
+        return rc;
+    for (int j = 0; j < i; j++)
+        if (!strcmp(sys->cables[j].name, cable->name))
+            return fail_at(c, TS_EINVAL, p, f[C_NAME].line, "duplicate cable "
+                           "name '%s' (cables[%d], line %d)", cable->name, j,
+                           sys->cables[j].line);
+    rc = resolve_body(c, join(p, path, "from"), &f[C_FROM], sys, 1,
+                      &cable->from_body);
+    if (rc == TS_OK && f[C_TO].value)
+        rc = resolve_body(c, join(p, path, "to"), &f[C_TO], sys, 0,
+                          &cable->to_body);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_LENGTH], "m", 0, 1, 0.0,
+                          &cable->length);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_DIAM], "m", 0, 1, 0.0,
+                          &cable->diameter);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_CDN], "1", 0, 0, DEFAULT_CDN,
+                          &cable->cdn);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_CDT], "1", 0, 0, DEFAULT_CDT,
+                          &cable->cdt);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_CAN], "1", 0, 0, DEFAULT_CAN,
+                          &cable->can);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_EI], "N*m^2", 0, 0, 0.0, &cable->ei);
+    if (rc != TS_OK)
+        return rc;
+
+    cable->drag_law = TS_DRAG_STANDARD;
+    if (f[C_LAW].value) {
+        const char *law;
+        rc = field_text(c, join(p, path, "drag_law"), &f[C_LAW],
+                        "standard or loading_functions", &law);
+        if (rc != TS_OK)
+            return rc;
+        if (!strcmp(law, "standard"))
+            cable->drag_law = TS_DRAG_STANDARD;
+        else if (!strcmp(law, "loading_functions"))
+            cable->drag_law = TS_DRAG_LOADING;
+        else
+            return fail_at(c, TS_EINVAL, p, f[C_LAW].line, "unknown drag law "
+                           "\"%s\"; expected standard or loading_functions",
+                           show(law, f[C_LAW].value->data.scalar.length, s,
+                                sizeof s));
+    }
+
+    /* Mass per length from exactly one of the three keys. */
+    static const int mass_keys[] = {C_WEIGHT, C_MPL, C_WET};
+    int which;
+    rc = one_of(c, path, n, f, mass_keys, 3, 1, &which);
+    if (rc != TS_OK)
+        return rc;
+    const field *fm = &f[which];
+    const char *si = which == C_MPL ? "kg/m" : "N/m";
+    const ts_environment *env = &sys->env;
+    double x;
+    rc = field_quantity(c, join(p, path, fm->key), fm, si, &x);
+    if (rc == TS_OK && which != C_WET)
+        rc = check_min(c, p, fm, x, 0, 0, si);
+    if (rc == TS_OK && which != C_MPL)
+        rc = need_gravity(c, p, fm, env->gravity, "mass_per_length");
+    if (rc != TS_OK)
+        return rc;
+    double area = M_PI * cable->diameter * cable->diameter / 4.0;
+    if (which == C_MPL)
+        cable->mass_per_length = x;
+    else if (which == C_WEIGHT)
+        cable->mass_per_length = x / env->gravity;
+    else
+        cable->mass_per_length = x / env->gravity + env->water_density * area;
+    if (!(cable->mass_per_length >= 0))
+        return fail_at(c, TS_EINVAL, p, fm->line, "%g N/m in water gives a "
+                       "negative mass per length in air (%g kg/m): the "
+                       "buoyancy rho g pi d^2/4 is only %g N/m", x,
+                       cable->mass_per_length,
+                       env->water_density * env->gravity * area);
+
+    /* Links: a count, a list of lengths, or both (then they must agree). */
+    int nlinks = 0;
+    if (f[C_LINKS].value) {
+        rc = read_count(c, join(p, path, "links"), &f[C_LINKS], MAX_LINKS,
+                        &nlinks);
+        if (rc != TS_OK)
+            return rc;
+        cable->nlinks = nlinks;
+    }
+    if (f[C_LINK_LENGTHS].value) {
+        rc = parse_link_lengths(c, path, &f[C_LINK_LENGTHS], cable);
+        if (rc != TS_OK)
+            return rc;
+        if (nlinks && nlinks != cable->nlinks)
+            return fail_at(c, TS_EINVAL, join(p, path, "links"),
+                           f[C_LINKS].line, "%d does not match the %d "
+                           "entries of link_lengths (line %d)", nlinks,
+                           cable->nlinks, f[C_LINK_LENGTHS].line);
+    }
+    return TS_OK;
+}
+
+/* An analysis: a bare type name, or a mapping with `type` and scalar
+ * options kept as text. */
+static int parse_analysis(const ctx *c, const yaml_node_t *n, int i,
+                          ts_scene_analysis *a)
+{
+    char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
+    index_path(path, "analyses", i);
+    a->line = line_of(n);
+    const yaml_node_t *type_node = n;
+    if (n->type == YAML_MAPPING_NODE) {
+        type_node = NULL;
+        for (yaml_node_pair_t *pr = n->data.mapping.pairs.start;
+             pr < n->data.mapping.pairs.top; pr++) {
+            yaml_node_t *k = yaml_document_get_node(c->doc, pr->key);
+            if (k && k->type == YAML_SCALAR_NODE &&
+                !strcmp((const char *)k->data.scalar.value, "type"))
+                type_node = yaml_document_get_node(c->doc, pr->value);
+        }
+        if (!type_node)
+            return missing(c, path, n, "type");
+        join(p, path, "type");
+    } else if (n->type == YAML_SCALAR_NODE) {
+        snprintf(p, sizeof p, "%s", path);
+    } else {
+        return fail_at(c, TS_ESCENE, path, line_of(n), "expected an analysis "
+                       "name or a mapping with 'type' and options, got %s",
+                       kind_name(n));
+    }
+    if (type_node->type != YAML_SCALAR_NODE)
+        return fail_at(c, TS_ESCENE, p, line_of(type_node), "expected an "
+                       "analysis name, got %s", kind_name(type_node));
+    const char *t = (const char *)type_node->data.scalar.value;
+    size_t tlen = type_node->data.scalar.length;
+    int ok = tlen > 0 && tlen < TS_NAME_MAX && strlen(t) == tlen;
+    for (size_t j = 0; ok && j < tlen; j++)
+        ok = (t[j] >= 'a' && t[j] <= 'z') || (t[j] >= 'A' && t[j] <= 'Z') ||
+             (t[j] >= '0' && t[j] <= '9') || t[j] == '_' || t[j] == '-';
+    if (!ok)
+        return fail_at(c, TS_EINVAL, p, line_of(type_node), "\"%s\" is not "
+                       "an analysis name (1 to %d letters, digits, '_', "
+                       "'-')", show(t, tlen, s, sizeof s), TS_NAME_MAX - 1);
+    memcpy(a->type, t, tlen + 1);
+    if (n->type != YAML_MAPPING_NODE)
+        return TS_OK;
+
+    ptrdiff_t npairs = n->data.mapping.pairs.top - n->data.mapping.pairs.start;
+    if (npairs > MAX_ENTRIES)
+        return fail_at(c, TS_EINVAL, path, line_of(n), "too many options "
+                       "(at most %d)", MAX_ENTRIES);
+    a->options = calloc((size_t)npairs, sizeof *a->options);
+    if (!a->options)
+        return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", path);
+    for (yaml_node_pair_t *pr = n->data.mapping.pairs.start;
+         pr < n->data.mapping.pairs.top; pr++) {
+        yaml_node_t *k = yaml_document_get_node(c->doc, pr->key);
+        yaml_node_t *v = yaml_document_get_node(c->doc, pr->value);
+        if (!k || !v)
+            return ts_fail(c->err, TS_ESCENE, "%s: broken YAML document",
+                           path);
+        if (k->type != YAML_SCALAR_NODE)
+            return fail_at(c, TS_ESCENE, path, line_of(k), "keys must be "
+                           "plain names, got %s as a key", kind_name(k));
+        const char *key = (const char *)k->data.scalar.value;
+        size_t klen = k->data.scalar.length;
+        if (!strcmp(key, "type"))
+            continue;
+        join(p, path, show(key, klen, s, sizeof s));
+        if (klen == 0 || klen >= TS_NAME_MAX || strlen(key) != klen)
+            return fail_at(c, TS_ESCENE, p, line_of(k), "an option name "
+                           "must have 1 to %d characters", TS_NAME_MAX - 1);
+        for (int j = 0; j < a->noptions; j++)
+            if (!strcmp(a->options[j].key, key))
+                return fail_at(c, TS_ESCENE, p, line_of(k), "duplicate key "
+                               "(first given on line %d)",
+                               a->options[j].line);
+        if (v->type != YAML_SCALAR_NODE)
+            return fail_at(c, TS_ESCENE, p, line_of(k), "an option value "
+                           "must be a scalar, got %s", kind_name(v));
+        if (is_null(v))
+            return fail_at(c, TS_ESCENE, p, line_of(k), "no value; give one, "
+                           "or remove the key");
+        size_t vlen = v->data.scalar.length;
+        if (strlen((const char *)v->data.scalar.value) != vlen)
+            return fail_at(c, TS_ESCENE, p, line_of(k), "the value contains "
+                           "a NUL character");
+        ts_scene_option *o = &a->options[a->noptions];
+        o->value = malloc(vlen + 1);
+        if (!o->value)
+            return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", p);
+        memcpy(o->value, v->data.scalar.value, vlen + 1);
+        memcpy(o->key, key, klen + 1);
+        o->line = line_of(k);
+        a->noptions++;
+    }
+    return TS_OK;
+}
+
+/* A list under a top-level key, its length in *n (0 when absent). */
+static int top_list(const ctx *c, const field *f, int *n)
+{
+    *n = 0;
+    if (!f->value)
+        return TS_OK;
+    if (f->value->type != YAML_SEQUENCE_NODE)
+        return fail_at(c, TS_ESCENE, f->key, f->line, "expected a list of "
+                       "entries (\"- ...\"), got %s", kind_name(f->value));
+    *n = seq_len(f->value);
+    if (*n > MAX_ENTRIES)
+        return fail_at(c, TS_EINVAL, f->key, f->line, "has %d entries, at "
+                       "most %d are allowed", *n, MAX_ENTRIES);
+    return TS_OK;
+}
+
+static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
+{
+    enum { K_NAME, K_ENV, K_TOW, K_CABLES, K_BODIES, K_ANALYSES, K_N };
+    field f[K_N] = {{"name", 0, 0}, {"environment", 0, 0}, {"tow", 0, 0},
+                    {"cables", 0, 0}, {"bodies", 0, 0}, {"analyses", 0, 0}};
+    int rc = read_map(c, root, "", "name, tow, cables, ...", f, K_N);
+    if (rc != TS_OK)
+        return rc;
+    static const int required[] = {K_NAME, K_TOW, K_CABLES};
+    for (int k = 0; k < 3; k++)
+        if (!f[required[k]].value)
+            return missing(c, "", root, f[required[k]].key);
+
+    int ncables, nbodies, nanalyses;
+    if ((rc = top_list(c, &f[K_CABLES], &ncables)) ||
+        (rc = top_list(c, &f[K_BODIES], &nbodies)) ||
+        (rc = top_list(c, &f[K_ANALYSES], &nanalyses)))
+        return rc;
+    if (ncables < 1)
+        return fail_at(c, TS_EINVAL, "cables", f[K_CABLES].line, "at least "
+                       "one cable is needed");
+
+    ts_system *sys = ts_system_alloc(ncables, nbodies, c->err);
+    if (!sys)
+        return c->err ? c->err->code : TS_ENOMEM;
+    scene->system = sys;
+    rc = read_name(c, "name", &f[K_NAME], sys->name);
+    if (rc == TS_OK && f[K_ENV].value)
+        rc = parse_environment(c, f[K_ENV].value, &sys->env);
+    if (rc == TS_OK)
+        rc = parse_tow(c, f[K_TOW].value, &sys->tow);
+    for (int b = 0; rc == TS_OK && b < nbodies; b++) {
+        yaml_node_t *item = seq_item(c, f[K_BODIES].value, b);
+        rc = item ? parse_body(c, item, b, sys)
+                  : ts_fail(c->err, TS_ESCENE, "bodies: broken YAML");
+    }
+    long total_links = 0;
+    for (int i = 0; rc == TS_OK && i < ncables; i++) {
+        yaml_node_t *item = seq_item(c, f[K_CABLES].value, i);
+        rc = item ? parse_cable(c, item, i, sys)
+                  : ts_fail(c->err, TS_ESCENE, "cables: broken YAML");
+        if (rc == TS_OK) {
+            total_links += sys->cables[i].nlinks;
+            if (total_links > MAX_LINKS)
+                rc = fail_at(c, TS_EINVAL, "cables", f[K_CABLES].line,
+                             "more than %d links in total", MAX_LINKS);
+        }
+    }
+    if (rc != TS_OK)
+        return rc;
+
+    if (nanalyses > 0) {
+        scene->analyses = calloc((size_t)nanalyses, sizeof *scene->analyses);
+        if (!scene->analyses)
+            return ts_fail(c->err, TS_ENOMEM, "analyses: out of memory");
+        scene->nanalyses = nanalyses;
+    }
+    for (int i = 0; rc == TS_OK && i < nanalyses; i++) {
+        yaml_node_t *item = seq_item(c, f[K_ANALYSES].value, i);
+        rc = item ? parse_analysis(c, item, i, &scene->analyses[i])
+                  : ts_fail(c->err, TS_ESCENE, "analyses: broken YAML");
+    }
+    if (rc == TS_OK)
+        rc = ts_system_build(sys, c->err);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Entry points                                                         */
+
+/* The libyaml error as a message. */
+static int yaml_failure(const yaml_parser_t *p, ts_err *err)
+{
+    const char *problem = p->problem ? p->problem : "unknown problem";
+    switch (p->error) {
+    case YAML_MEMORY_ERROR:
+        return ts_fail(err, TS_ENOMEM, "out of memory reading YAML");
+    case YAML_READER_ERROR:
+        if (p->problem_value != -1)
+            return ts_fail(err, TS_ESCENE, "YAML error at byte %zu: %s "
+                           "(#%X)", p->problem_offset, problem,
+                           (unsigned)p->problem_value);
+        return ts_fail(err, TS_ESCENE, "YAML error at byte %zu: %s",
+                       p->problem_offset, problem);
+    default:
+        if (p->context)
+            return ts_fail(err, TS_ESCENE, "YAML syntax error (line %d, "
+                           "column %d): %s (%s started on line %d, column "
+                           "%d)",
+                           mark_line(p->problem_mark),
+                           mark_column(p->problem_mark), problem, p->context,
+                           mark_line(p->context_mark),
+                           mark_column(p->context_mark));
+        return ts_fail(err, TS_ESCENE, "YAML syntax error (line %d, column "
+                       "%d): %s", mark_line(p->problem_mark),
+                       mark_column(p->problem_mark), problem);
+    }
+}
+
+/* Parse without the name prefix; returns the scene or NULL. */
+static ts_scene *parse(const char *text, size_t len, const ts_units *units,
+                       ts_err *err)
+{
+    yaml_parser_t parser;
+    yaml_document_t doc, extra;
+    if (!yaml_parser_initialize(&parser)) {
+        ts_fail(err, TS_ENOMEM, "out of memory starting the YAML parser");
+        return NULL;
+    }
+    /* libyaml reads exactly len bytes: no NUL terminator is needed. */
+    yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+    if (!yaml_parser_load(&parser, &doc)) {
+        yaml_failure(&parser, err);
+        yaml_parser_delete(&parser);
+        return NULL;
+    }
+    ts_scene *scene = NULL;
+    int rc = TS_OK;
+    yaml_node_t *root = yaml_document_get_root_node(&doc);
+    if (!root) {
+        rc = ts_fail(err, TS_ESCENE, "the scene is empty; expected a mapping "
+                     "with name, tow and cables");
+        goto done;
+    }
+    /* A second document would be silently ignored: refuse it, and report
+     * syntax errors after the first one. */
+    if (!yaml_parser_load(&parser, &extra)) {
+        rc = yaml_failure(&parser, err);
+        goto done;
+    }
+    yaml_node_t *extra_root = yaml_document_get_root_node(&extra);
+    if (extra_root)
+        rc = ts_fail(err, TS_ESCENE, "a second YAML document starts on line "
+                     "%d; a scene file holds one", line_of(extra_root));
+    yaml_document_delete(&extra);
+    if (rc != TS_OK)
+        goto done;
+
+    if (root->type != YAML_MAPPING_NODE) {
+        rc = ts_fail(err, TS_ESCENE, "top level (line %d): expected a mapping "
+                     "with name, tow and cables, got %s", line_of(root),
+                     kind_name(root));
+        goto done;
+    }
+    scene = calloc(1, sizeof *scene);
+    if (!scene) {
+        rc = ts_fail(err, TS_ENOMEM, "out of memory");
+        goto done;
+    }
+    ctx c = {&doc, units, err};
+    rc = parse_root(&c, root, scene);
+
+done:
+    yaml_document_delete(&doc);
+    yaml_parser_delete(&parser);
+    if (rc != TS_OK) {
+        ts_scene_free(scene);
+        return NULL;
+    }
+    return scene;
+}
+
+ts_scene *ts_scene_parse(const char *text, size_t len, const char *name,
+                         const ts_units *units, ts_err *err)
+{
+    if (!name)
+        name = "<string>";
+    if (!units || (!text && len > 0)) {
+        ts_fail(err, TS_EINVAL, "%s: ts_scene_parse called with a NULL %s",
+                name, units ? "text" : "unit system");
+        return NULL;
+    }
+    if (!text)
+        text = "";
+    ts_scene *scene = parse(text, len, units, err);
+    if (!scene)
+        ts_err_prefix(err, "%s: ", name);
+    return scene;
+}
+
+ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
+{
+    if (!path || !units) {
+        ts_fail(err, TS_EINVAL, "ts_scene_load called with a NULL %s",
+                path ? "unit system" : "path");
+        return NULL;
+    }
+    if (strlen(path) >= sizeof ((ts_scene *)0)->path) {
+        ts_fail(err, TS_EINVAL, "%s: path longer than %zu characters", path,
+                sizeof ((ts_scene *)0)->path - 1);
+        return NULL;
+    }
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        ts_fail(err, TS_EIO, "%s: cannot open: %s", path, strerror(errno));
+        return NULL;
+    }
+    /* Read the whole file, growing the buffer geometrically. */
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    int rc = buf ? TS_OK : ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+    while (rc == TS_OK) {
+        if (len == cap) {
+            if (cap >= (size_t)MAX_FILE_BYTES) {
+                rc = ts_fail(err, TS_EIO, "%s: larger than %ld bytes, not a "
+                             "scene file", path, MAX_FILE_BYTES);
+                break;
+            }
+            char *bigger = realloc(buf, cap * 2);
+            if (!bigger) {
+                rc = ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+                break;
+            }
+            buf = bigger;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - len, fp);
+        len += got;
+        if (got == 0) {
+            if (ferror(fp))
+                rc = ts_fail(err, TS_EIO, "%s: cannot read: %s", path,
+                             strerror(errno));
+            break;
+        }
+    }
+    fclose(fp);
+    ts_scene *scene = NULL;
+    if (rc == TS_OK) {
+        scene = parse(buf, len, units, err);
+        if (scene)
+            snprintf(scene->path, sizeof scene->path, "%s", path);
+        else
+            ts_err_prefix(err, "%s: ", path);
+    }
+    free(buf);
+    return scene;
+}
+
+void ts_scene_free(ts_scene *scene)
+{
+    if (!scene)
+        return;
+    for (int i = 0; i < scene->nanalyses; i++) {
+        ts_scene_analysis *a = &scene->analyses[i];
+        for (int j = 0; j < a->noptions; j++)
+            free(a->options[j].value);
+        free(a->options);
+    }
+    free(scene->analyses);
+    ts_system_free(scene->system);
+    free(scene);
+}
+
+const ts_scene_option *ts_scene_analysis_option(const ts_scene_analysis *a,
+                                                const char *key)
+{
+    if (!a || !key)
+        return NULL;
+    for (int j = 0; j < a->noptions; j++)
+        if (!strcmp(a->options[j].key, key))
+            return &a->options[j];
+    return NULL;
+}

@@ -1,0 +1,409 @@
+/* system.c: validation of a towed system and its discretisation into a tree
+ * of rigid links and lumped nodes (MODEL.md section 2).
+ *
+ * Cables are ordered breadth-first from the tow point, so every link comes
+ * after the link above it: a forward loop over links runs from the tow
+ * point to the free ends and a backward loop from the free ends up. Node 0
+ * is the tow point and node k+1 the lower end of link k. Each link's mass is
+ * split half to each end; a body's mass is added to the node it ends on.
+ */
+#include "towstab/system.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+ts_system *ts_system_alloc(int ncables, int nbodies, ts_err *err)
+{
+    if (ncables < 0 || nbodies < 0) {
+        ts_fail(err, TS_EINVAL, "ts_system_alloc: " "negative counts %d, %d",
+                ncables, nbodies);
+        return NULL;
+    }
+    ts_system *s = calloc(1, sizeof *s);
+    if (!s)
+        goto nomem;
+    s->ncables = ncables;
+    s->nbodies = nbodies;
+    s->cables = calloc(ncables > 0 ? ncables : 1, sizeof *s->cables);
+    s->bodies = calloc(nbodies > 0 ? nbodies : 1, sizeof *s->bodies);
+    if (!s->cables || !s->bodies)
+        goto nomem;
+    for (int i = 0; i < ncables; i++) {
+        s->cables[i].from_body = -1;
+        s->cables[i].to_body = -1;
+    }
+    s->env.water_density = 1025.0;
+    s->env.gravity = 9.80665;
+    return s;
+nomem:
+    ts_system_free(s);
+    ts_fail(err, TS_ENOMEM, "ts_system_alloc: " "out of memory");
+    return NULL;
+}
+
+static void free_discretisation(ts_system *s)
+{
+    free(s->links);
+    free(s->nodes);
+    free(s->child_links);
+    s->links = NULL;
+    s->nodes = NULL;
+    s->child_links = NULL;
+    s->nlinks = 0;
+    s->nnodes = 0;
+}
+
+void ts_system_free(ts_system *s)
+{
+    if (!s)
+        return;
+    free_discretisation(s);
+    if (s->cables)
+        for (int i = 0; i < s->ncables; i++)
+            free(s->cables[i].link_fraction);
+    free(s->cables);
+    free(s->bodies);
+    free(s);
+}
+
+ts_system *ts_system_copy(const ts_system *src, ts_err *err)
+{
+    ts_system *s = ts_system_alloc(src->ncables, src->nbodies, err);
+    if (!s)
+        return NULL;
+    memcpy(s->name, src->name, sizeof s->name);
+    s->env = src->env;
+    s->tow = src->tow;
+    memcpy(s->bodies, src->bodies, (size_t)src->nbodies * sizeof *s->bodies);
+    for (int i = 0; i < src->ncables; i++) {
+        s->cables[i] = src->cables[i];
+        s->cables[i].link_fraction = NULL;
+        if (src->cables[i].link_fraction) {
+            size_t n = (size_t)src->cables[i].nlinks;
+            s->cables[i].link_fraction = malloc(n * sizeof(double));
+            if (!s->cables[i].link_fraction) {
+                ts_system_free(s);
+                ts_fail(err, TS_ENOMEM, "ts_system_copy: " "out of memory");
+                return NULL;
+            }
+            memcpy(s->cables[i].link_fraction, src->cables[i].link_fraction,
+                   n * sizeof(double));
+        }
+    }
+    if (src->links && ts_system_build(s, err) != TS_OK) {
+        ts_system_free(s);
+        return NULL;
+    }
+    return s;
+}
+
+int ts_system_find_cable(const ts_system *s, const char *name)
+{
+    for (int i = 0; i < s->ncables; i++)
+        if (strcmp(s->cables[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
+int ts_system_find_body(const ts_system *s, const char *name)
+{
+    for (int i = 0; i < s->nbodies; i++)
+        if (strcmp(s->bodies[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
+int ts_system_body_node(const ts_system *s, int b)
+{
+    if (!s->nodes || b < 0 || b >= s->nbodies)
+        return -1;
+    for (int k = 1; k < s->nnodes; k++)
+        if (s->nodes[k].body == b)
+            return k;
+    return -1;
+}
+
+double ts_cable_wet_weight(const ts_system *s, int c)
+{
+    const ts_cable *cb = &s->cables[c];
+    double area = M_PI * cb->diameter * cb->diameter / 4.0;
+    return (cb->mass_per_length - s->env.water_density * area) * s->env.gravity;
+}
+
+/* " (line N)" for messages about a scene entry, "" when built in code;
+ * written into a buffer that lives for the enclosing statement. */
+#define at_line(line) line_text((line), (char[32]){0})
+static const char *line_text(int line, char *buf)
+{
+    if (line > 0)
+        snprintf(buf, 32, " (line %d)", line);
+    return buf;
+}
+
+/* A finite number >= lo (or > lo when strict). */
+static int check_min(ts_err *err, const char *kind, int i, int line,
+                     const char *key, double v, double lo, int strict,
+                     const char *unit)
+{
+    int ok = isfinite(v) && (strict ? v > lo : v >= lo);
+    if (!ok)
+        return ts_fail(err, TS_EINVAL, "%s[%d].%s%s: " "must be %s %g %s, got %g",
+                       kind, i, key, at_line(line), strict ? ">" : ">=", lo,
+                       unit, v);
+    return TS_OK;
+}
+
+static int validate(const ts_system *s, ts_err *err)
+{
+    const ts_environment *e = &s->env;
+    if (!(isfinite(e->water_density) && e->water_density >= 0))
+        return ts_fail(err, TS_EINVAL, "environment.water_density: "
+                       "must be >= 0 kg/m^3, got %g", e->water_density);
+    if (!(isfinite(e->gravity) && e->gravity >= 0))
+        return ts_fail(err, TS_EINVAL, "environment.gravity: "
+                       "must be >= 0 m/s^2, got %g", e->gravity);
+    for (int j = 0; j < 3; j++)
+        if (!isfinite(e->current[j]))
+            return ts_fail(err, TS_EINVAL, "environment.current: "
+                           "component %d must be finite", j);
+    if (!isfinite(s->tow.speed))
+        return ts_fail(err, TS_EINVAL, "tow.speed: " "must be finite");
+    if (!isfinite(s->tow.turn_rate))
+        return ts_fail(err, TS_EINVAL, "tow.turn_rate: " "must be finite");
+    for (int j = 0; j < 3; j++)
+        if (!isfinite(s->tow.point[j]))
+            return ts_fail(err, TS_EINVAL, "tow.point: "
+                           "component %d must be finite", j);
+    if (s->ncables < 1)
+        return ts_fail(err, TS_EINVAL, "cables: " "at least one cable needed");
+
+    int rc;
+    for (int i = 0; i < s->ncables; i++) {
+        const ts_cable *c = &s->cables[i];
+        if ((rc = check_min(err, "cables", i, c->line, "length", c->length, 0, 1, "m")) ||
+            (rc = check_min(err, "cables", i, c->line, "diameter", c->diameter, 0, 0,
+                            "m")) ||
+            (rc = check_min(err, "cables", i, c->line, "mass_per_length",
+                            c->mass_per_length, 0, 0, "kg/m")) ||
+            (rc = check_min(err, "cables", i, c->line, "normal_drag", c->cdn, 0, 0,
+                            "")) ||
+            (rc = check_min(err, "cables", i, c->line, "tangential_drag", c->cdt, 0, 0,
+                            "")) ||
+            (rc = check_min(err, "cables", i, c->line, "added_mass", c->can, 0, 0, "")) ||
+            (rc = check_min(err, "cables", i, c->line, "EI", c->ei, 0, 0, "N m^2")))
+            return rc;
+        if (c->nlinks < 1)
+            return ts_fail(err, TS_EINVAL, "cables[%d].links%s: "
+                           "must be >= 1, got %d", i, at_line(c->line), c->nlinks);
+        if (c->from_body < -1 || c->from_body >= s->nbodies)
+            return ts_fail(err, TS_EINVAL, "cables[%d].from%s: "
+                           "no such body (index %d)", i, at_line(c->line),
+                           c->from_body);
+        if (c->to_body < -1 || c->to_body >= s->nbodies)
+            return ts_fail(err, TS_EINVAL, "cables[%d].to%s: "
+                           "no such body (index %d)", i, at_line(c->line),
+                           c->to_body);
+        if (c->from_body >= 0 && c->from_body == c->to_body)
+            return ts_fail(err, TS_EINVAL, "cables[%d]%s: "
+                           "starts and ends at the same body '%s'", i,
+                           at_line(c->line),
+                           s->bodies[c->to_body].name);
+        if (c->link_fraction) {
+            double sum = 0;
+            for (int k = 0; k < c->nlinks; k++) {
+                if (!(c->link_fraction[k] > 0 && isfinite(c->link_fraction[k])))
+                    return ts_fail(err, TS_EINVAL, "cables[%d].link_lengths%s: "
+                                   "entry %d must be > 0", i,
+                                   at_line(c->line), k);
+                sum += c->link_fraction[k];
+            }
+            if (fabs(sum - 1.0) > 1e-9)
+                return ts_fail(err, TS_EINVAL, "cables[%d].link_lengths%s: "
+                               "must add up to the cable length", i,
+                               at_line(c->line));
+        }
+        if (c->ei > 0 && c->nlinks < 2)
+            return ts_fail(err, TS_EINVAL, "cables[%d].EI%s: "
+                           "bending needs at least 2 links, got %d", i,
+                           at_line(c->line), c->nlinks);
+    }
+    for (int b = 0; b < s->nbodies; b++) {
+        const ts_body *bd = &s->bodies[b];
+        if ((rc = check_min(err, "bodies", b, bd->line, "diameter", bd->diameter, 0, 0,
+                            "m")) ||
+            (rc = check_min(err, "bodies", b, bd->line, "mass", bd->mass, 0, 0, "kg")) ||
+            (rc = check_min(err, "bodies", b, bd->line, "drag", bd->cd, 0, 0, "")) ||
+            (rc = check_min(err, "bodies", b, bd->line, "added_mass", bd->ca, 0, 0, "")))
+            return rc;
+        if (bd->type == TS_BODY_SPHERE && !(bd->diameter > 0))
+            return ts_fail(err, TS_EINVAL, "bodies[%d].diameter%s: "
+                           "a sphere needs a diameter > 0 m, got %g", b,
+                           at_line(bd->line),
+                           bd->diameter);
+        int ends = 0;
+        for (int i = 0; i < s->ncables; i++)
+            ends += s->cables[i].to_body == b;
+        if (ends != 1)
+            return ts_fail(err, TS_EINVAL, "bodies[%d]%s: "
+                           "'%s' must end exactly one cable (the cable "
+                           "above it), it ends %d",
+                           b, at_line(bd->line), bd->name, ends);
+    }
+    return TS_OK;
+}
+
+int ts_system_build(ts_system *s, ts_err *err)
+{
+    int rc = validate(s, err);
+    if (rc != TS_OK)
+        return rc;
+    free_discretisation(s);
+
+    /* Breadth-first order of cables from the tow point. */
+    int nc = s->ncables;
+    int *order = malloc((size_t)nc * sizeof *order);
+    int *done = calloc((size_t)nc, sizeof *done);
+    if (!order || !done) {
+        free(order);
+        free(done);
+        return ts_fail(err, TS_ENOMEM, "ts_system_build: " "out of memory");
+    }
+    int norder = 0;
+    for (int i = 0; i < nc; i++)
+        if (s->cables[i].from_body == -1) {
+            order[norder++] = i;
+            done[i] = 1;
+        }
+    for (int head = 0; head < norder; head++) {
+        int body = s->cables[order[head]].to_body;
+        if (body < 0)
+            continue;
+        for (int i = 0; i < nc; i++)
+            if (!done[i] && s->cables[i].from_body == body) {
+                order[norder++] = i;
+                done[i] = 1;
+            }
+    }
+    if (norder < nc) {
+        int bad = 0;
+        while (done[bad])
+            bad++;
+        free(order);
+        free(done);
+        return ts_fail(err, TS_EINVAL, "cables[%d]%s: "
+                       "'%s' is not connected to the tow point: its 'from' "
+                       "body '%s' hangs on no cable reached from the tow "
+                       "(a loop or a detached branch)",
+                       bad, at_line(s->cables[bad].line), s->cables[bad].name,
+                       s->bodies[s->cables[bad].from_body].name);
+    }
+    free(done);
+
+    int nl = 0;
+    for (int i = 0; i < nc; i++)
+        nl += s->cables[i].nlinks;
+    s->nlinks = nl;
+    s->nnodes = nl + 1;
+    s->links = calloc((size_t)nl, sizeof *s->links);
+    s->nodes = calloc((size_t)nl + 1, sizeof *s->nodes);
+    s->child_links = calloc((size_t)nl, sizeof *s->child_links);
+    int *body_node = malloc((size_t)(s->nbodies + 1) * sizeof *body_node);
+    if (!s->links || !s->nodes || !s->child_links || !body_node) {
+        free(order);
+        free(body_node);
+        free_discretisation(s);
+        return ts_fail(err, TS_ENOMEM, "ts_system_build: " "out of memory");
+    }
+    for (int b = 0; b < s->nbodies; b++)
+        body_node[b] = -1;
+    for (int k = 0; k < s->nnodes; k++) {
+        s->nodes[k].body = -1;
+        s->nodes[k].link = k - 1;
+    }
+
+    double rho = s->env.water_density;
+    s->has_bending = 0;
+    s->has_added_mass = 0;
+    int k = 0;
+    for (int o = 0; o < nc; o++) {
+        int ci = order[o];
+        const ts_cable *c = &s->cables[ci];
+        /* Upper node of the first link: the tow point or the body node. */
+        int top = c->from_body < 0 ? 0 : body_node[c->from_body];
+        for (int j = 0; j < c->nlinks; j++, k++) {
+            ts_link *L = &s->links[k];
+            double frac = c->link_fraction ? c->link_fraction[j]
+                                           : 1.0 / c->nlinks;
+            L->cable = ci;
+            L->index = j + 1;
+            L->upper = j == 0 ? top : k;
+            L->lower = k + 1;
+            L->parent = L->upper == 0 ? -1 : L->upper - 1;
+            L->next = j + 1 < c->nlinks ? k + 1 : -1;
+            L->length = c->length * frac;
+            L->diameter = c->diameter;
+            L->mass = c->mass_per_length * L->length;
+            L->cdn = c->cdn;
+            L->cdt = c->cdt;
+            L->can = c->can;
+            L->drag_law = c->drag_law;
+            L->ei = L->next >= 0 ? c->ei : 0.0;
+            if (L->ei > 0)
+                s->has_bending = 1;
+            if (L->can > 0 && rho > 0 && L->diameter > 0)
+                s->has_added_mass = 1;
+            s->nodes[L->upper].mass += 0.5 * L->mass;
+            s->nodes[L->lower].mass += 0.5 * L->mass;
+        }
+        if (c->to_body >= 0) {
+            body_node[c->to_body] = k;
+            s->nodes[k].body = c->to_body;
+            s->nodes[k].mass += s->bodies[c->to_body].mass;
+            if (s->bodies[c->to_body].ca > 0 && rho > 0 &&
+                s->bodies[c->to_body].type == TS_BODY_SPHERE)
+                s->has_added_mass = 1;
+        }
+    }
+    free(order);
+    free(body_node);
+
+    /* Children grouped by upper node (counting sort keeps link order). */
+    for (int n = 0; n <= s->nnodes - 1; n++)
+        s->nodes[n].child_begin = s->nodes[n].child_end = 0;
+    int *count = calloc((size_t)s->nnodes + 1, sizeof *count);
+    if (!count) {
+        free_discretisation(s);
+        return ts_fail(err, TS_ENOMEM, "ts_system_build: " "out of memory");
+    }
+    for (int l = 0; l < nl; l++)
+        count[s->links[l].upper + 1]++;
+    for (int n = 0; n < s->nnodes; n++)
+        count[n + 1] += count[n];
+    for (int n = 0; n < s->nnodes; n++) {
+        s->nodes[n].child_begin = count[n];
+        s->nodes[n].child_end = count[n];
+    }
+    for (int l = 0; l < nl; l++) {
+        ts_node *nd = &s->nodes[s->links[l].upper];
+        s->child_links[nd->child_end++] = l;
+    }
+    free(count);
+
+    /* A node without mass cannot be accelerated by finite tensions: every
+     * free node needs structural mass (a junction between massless
+     * cables would make the tension system singular). */
+    for (int n = 1; n < s->nnodes; n++)
+        if (!(s->nodes[n].mass > 0)) {
+            const ts_link *L = &s->links[n - 1];
+            ts_fail(err, TS_EINVAL, "cables[%d]%s: "
+                    "'%s' link %d ends at a node with zero mass: give the "
+                    "cable a mass_per_length > 0 or the body a mass",
+                    L->cable, at_line(s->cables[L->cable].line),
+                    s->cables[L->cable].name, L->index);
+            free_discretisation(s);
+            return TS_EINVAL;
+        }
+    return TS_OK;
+}

@@ -1,0 +1,696 @@
+/* units.c: quantities with units at the edges (see towstab/units.h).
+ *
+ * Algorithm. A quantity is "<number> [<unit>]". The number is scanned by a
+ * small decimal grammar of our own ([+-] digits [. digits] [e [+-] digits];
+ * no hex floats, no NaN, no infinities, no YAML specials like ".inf"), then
+ * converted by strtod on exactly that lexeme. The unit text is parsed by
+ * udunits2 (ut_parse, ASCII) and converted to the SI unit the caller asks
+ * for with a udunits converter. No unit means SI.
+ *
+ * Dimensions are compared with ut_are_convertible. udunits treats radians
+ * as dimensionless, so on its own it would convert "1 Hz" to "1 rad/s" and
+ * "2 rad" to "2" (a factor 2 pi or a degree/radian mix-up waiting to
+ * happen); we therefore also require the ratio of the two units to carry no
+ * radian (its udunits definition must not mention "rad"). Offset units
+ * (degC, timestamps "s since ...") are refused: every quantity here is a
+ * plain scale of its SI unit.
+ *
+ * Messages name the dimension in words for the common cases (length, mass,
+ * force, speed, force per length, ...) and recognise the mass-versus-force
+ * confusion ("50 lb" where a weight in N is expected; "1 lb/ft" where N/m is
+ * expected) with a concrete suggestion ("50 lbf").
+ *
+ * Aliases added to the database at load time (udunits lacks them or reads
+ * them as something else): kn -> knot, deg -> degree, lbs -> lb,
+ * nmi -> nautical_mile (udunits reads "nmi" as nano-mile), mph -> mile/hour
+ * (udunits reads "mph" as milli-phot), and slug redefined exactly as
+ * lbf s^2/ft (udunits rounds it to 14.5939 kg, 2e-7 off).
+ *
+ * Thread safety: udunits' parser (ut_parse) keeps global state and its
+ * error handler is process-wide, so ts_units_parse and ts_units_from_si must
+ * not run concurrently in several threads, even on distinct ts_units.
+ */
+#include "towstab/units.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <udunits2.h>
+
+struct ts_units {
+    ut_system *sys;          /* owned; read-only after ts_units_alloc */
+};
+
+/* Longest unit text and number lexeme we accept (a scene value longer than
+ * this is certainly a mistake, and fixed buffers keep the code simple). */
+#define UNIT_TEXT_MAX 128
+#define NUMBER_TEXT_MAX 64
+/* Longest excerpt of user text quoted in a message. */
+#define QUOTE_MAX 60
+
+/* ------------------------------------------------------------------ */
+/* Loading                                                              */
+
+/* Map `alias` as a symbol for the unit `definition`. */
+static int add_alias(ut_system *sys, const char *alias, const char *definition,
+                     ts_err *err)
+{
+    ut_unit *unit = ut_parse(sys, definition, UT_ASCII);
+    if (!unit)
+        return ts_fail(err, TS_EUNIT, "ts_units_alloc: the unit database "
+                       "has no unit '%s' (for alias '%s')", definition, alias);
+    ut_status st = ut_map_symbol_to_unit(alias, UT_ASCII, unit);
+    ut_free(unit);
+    if (st != UT_SUCCESS)
+        return ts_fail(err, TS_EUNIT, "ts_units_alloc: cannot add the alias "
+                       "'%s' for '%s' (udunits status %d)", alias, definition,
+                       (int)st);
+    return TS_OK;
+}
+
+/* Replace the name `name` (and its plural) by `definition`. */
+static int redefine_name(ut_system *sys, const char *name, const char *plural,
+                         const char *definition, ts_err *err)
+{
+    ut_unit *unit = ut_parse(sys, definition, UT_ASCII);
+    if (!unit)
+        return ts_fail(err, TS_EUNIT, "ts_units_alloc: the unit database "
+                       "cannot read '%s' (to define '%s')", definition, name);
+    /* Unmapping a name that is not mapped is not an error. */
+    ut_unmap_name_to_unit(sys, name, UT_ASCII);
+    ut_unmap_name_to_unit(sys, plural, UT_ASCII);
+    ut_status st = ut_map_name_to_unit(name, UT_ASCII, unit);
+    if (st == UT_SUCCESS)
+        st = ut_map_name_to_unit(plural, UT_ASCII, unit);
+    ut_free(unit);
+    if (st != UT_SUCCESS)
+        return ts_fail(err, TS_EUNIT, "ts_units_alloc: cannot redefine '%s' "
+                       "as '%s' (udunits status %d)", name, definition,
+                       (int)st);
+    return TS_OK;
+}
+
+ts_units *ts_units_alloc(ts_err *err)
+{
+    /* udunits reports problems (and, while reading its XML database,
+     * harmless notes about overridden definitions) on stderr through a
+     * handler that is process-wide, not per ut_system. The library must not
+     * print, so we install ut_ignore for the whole process; every failure
+     * is still seen through ut_get_status() and reported in err. */
+    ut_set_error_message_handler(ut_ignore);
+
+    ts_units *u = calloc(1, sizeof *u);
+    if (!u) {
+        ts_fail(err, TS_ENOMEM, "ts_units_alloc: out of memory");
+        return NULL;
+    }
+    u->sys = ut_read_xml(NULL);
+    if (!u->sys) {
+        ut_status st = ut_get_status();
+        const char *env = getenv("UDUNITS2_XML_PATH");
+        ts_fail(err, st == UT_OS ? TS_EIO : TS_EUNIT,
+                "ts_units_alloc: cannot read the udunits2 database (%s%s, "
+                "udunits status %d)",
+                env ? "UDUNITS2_XML_PATH=" : "default path", env ? env : "",
+                (int)st);
+        free(u);
+        return NULL;
+    }
+    static const char *const alias[][2] = {
+        {"kn", "knot"},
+        {"deg", "degree"},
+        {"lbs", "lb"},
+        {"nmi", "nautical_mile"},
+        {"mph", "mile/hour"},
+    };
+    for (size_t i = 0; i < sizeof alias / sizeof alias[0]; i++)
+        if (add_alias(u->sys, alias[i][0], alias[i][1], err) != TS_OK) {
+            ts_units_free(u);
+            return NULL;
+        }
+    if (redefine_name(u->sys, "slug", "slugs", "lbf*s^2/ft", err) != TS_OK) {
+        ts_units_free(u);
+        return NULL;
+    }
+    return u;
+}
+
+void ts_units_free(ts_units *u)
+{
+    if (!u)
+        return;
+    ut_free_system(u->sys);
+    free(u);
+}
+
+/* ------------------------------------------------------------------ */
+/* Messages                                                             */
+
+/* Copy `text` into buf[size] in double quotes, escaping control and
+ * non-ASCII bytes and shortening it to QUOTE_MAX characters. */
+static const char *quote(const char *text, char *buf, size_t size)
+{
+    size_t n = 0;
+    if (size < 8)
+        return "";
+    buf[n++] = '"';
+    int shortened = 0;
+    size_t count = 0;
+    for (const unsigned char *p = (const unsigned char *)text; *p;
+         p++, count++) {
+        if (n + 8 >= size || count >= QUOTE_MAX) {
+            shortened = 1;
+            break;
+        }
+        if (*p == '"' || *p == '\\') {
+            buf[n++] = '\\';
+            buf[n++] = (char)*p;
+        } else if (*p < 0x20 || *p >= 0x7f) {
+            n += (size_t)snprintf(buf + n, size - n, "\\x%02x", *p);
+        } else {
+            buf[n++] = (char)*p;
+        }
+    }
+    if (shortened && n + 4 < size) {
+        memcpy(buf + n, "...", 3);
+        n += 3;
+    }
+    buf[n++] = '"';
+    buf[n] = '\0';
+    return buf;
+}
+
+#define QUOTE_BUF (4 * QUOTE_MAX + 16)
+
+/* Dimensions named in words, most common first. The SI unit is shown in
+ * parentheses. Entries are matched with units_match() below. */
+static const struct {
+    const char *si;
+    const char *words;
+} dimension_names[] = {
+    {"m", "a length"},
+    {"kg", "a mass"},
+    {"N", "a force"},
+    {"s", "a time"},
+    {"m/s", "a speed"},
+    {"m/s^2", "an acceleration"},
+    {"N/m", "a force per length"},
+    {"kg/m", "a mass per length"},
+    {"rad/s", "an angular rate"},
+    {"rad", "an angle"},
+    {"Hz", "a frequency"},
+    {"kg/m^3", "a density"},
+    {"N*m^2", "a bending stiffness (force times area)"},
+    {"m^2", "an area"},
+    {"m^3", "a volume"},
+    {"rad/s^2", "an angular acceleration"},
+    {"Pa", "a pressure"},
+    {"N*m", "an energy or a moment"},
+    {"W", "a power"},
+    {"kg/s", "a mass flow"},
+    {"N*s/m", "a damping (force per speed)"},
+    {"K", "a temperature"},
+    {"1", "a plain number"},
+};
+
+/* 1 when a and b have the same dimension, radians included.
+ * ut_are_convertible is not enough: it also accepts reciprocal units ("5 s"
+ * would become 0.2 Hz, "2 m" 0.5 m^-1) and ignores radians. Instead the
+ * ratio a/b must be dimensionless and its definition must not mention
+ * radians (udunits formats an angle ratio as "rad", a pure number as "1"). */
+static int units_match(const ut_unit *a, const ut_unit *b)
+{
+    ut_unit *ratio = ut_divide(a, b);
+    if (!ratio)
+        return 0;
+    int same = ut_are_convertible(ratio,
+                                  ut_get_dimensionless_unit_one(
+                                      ut_get_system(ratio)));
+    if (same) {
+        char def[256];
+        int n = ut_format(ratio, def, sizeof def, UT_ASCII | UT_DEFINITION);
+        same = n >= 0 && (size_t)n < sizeof def && !strstr(def, "rad");
+    }
+    ut_free(ratio);
+    return same;
+}
+
+/* "a mass (kg)" or, for an unnamed dimension, "a quantity in m-1.kg.s". */
+static const char *describe(const ut_system *sys, const ut_unit *unit,
+                            char *buf, size_t size)
+{
+    for (size_t i = 0; i < sizeof dimension_names / sizeof dimension_names[0];
+         i++) {
+        ut_unit *ref = ut_parse(sys, dimension_names[i].si, UT_ASCII);
+        if (!ref)
+            continue;
+        int same = units_match(unit, ref);
+        ut_free(ref);
+        if (same) {
+            snprintf(buf, size, "%s (%s)", dimension_names[i].words,
+                     dimension_names[i].si);
+            return buf;
+        }
+    }
+    char def[256];
+    int n = ut_format(unit, def, sizeof def, UT_ASCII | UT_DEFINITION);
+    if (n < 0 || (size_t)n >= sizeof def) {
+        snprintf(buf, size, "a quantity of another dimension");
+        return buf;
+    }
+    /* Drop the scale factor: "1.488 m-1.kg" -> "m-1.kg". */
+    const char *d = def;
+    if (isdigit((unsigned char)*d) || *d == '-' || *d == '.') {
+        while (*d && *d != ' ')
+            d++;
+        while (*d == ' ')
+            d++;
+    }
+    snprintf(buf, size, "a quantity in %s", *d ? d : "1");
+    return buf;
+}
+
+/* ------------------------------------------------------------------ */
+/* Scanning                                                             */
+
+/* Length of a decimal number at s: [+-] (d+ [. d*] | . d+) [(e|E) [+-] d+].
+ * 0 when s does not start with one. */
+static size_t scan_number(const char *s)
+{
+    size_t i = 0, digits = 0;
+    if (s[i] == '+' || s[i] == '-')
+        i++;
+    while (isdigit((unsigned char)s[i]))
+        i++, digits++;
+    if (s[i] == '.') {
+        i++;
+        while (isdigit((unsigned char)s[i]))
+            i++, digits++;
+    }
+    if (digits == 0)
+        return 0;
+    if (s[i] == 'e' || s[i] == 'E') {
+        size_t j = i + 1;
+        if (s[j] == '+' || s[j] == '-')
+            j++;
+        if (isdigit((unsigned char)s[j])) {
+            while (isdigit((unsigned char)s[j]))
+                j++;
+            i = j;
+        }
+    }
+    return i;
+}
+
+/* Case-insensitive prefix test. */
+static int starts_with_ci(const char *s, const char *prefix)
+{
+    for (; *prefix; s++, prefix++)
+        if (tolower((unsigned char)*s) != *prefix)
+            return 0;
+    return 1;
+}
+
+/* NaN and infinities in the spellings of C and YAML ("nan", ".NaN",
+ * "-inf", ".inf", "Infinity"). */
+static int is_nonfinite_word(const char *s)
+{
+    if (*s == '+' || *s == '-')
+        s++;
+    if (*s == '.')
+        s++;
+    return starts_with_ci(s, "nan") || starts_with_ci(s, "inf");
+}
+
+static int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+/* A number standing alone inside the unit ("ft 3", "2 m") would be read
+ * by udunits as a scale factor; it is almost always a typo, so refuse it.
+ * Digits are allowed as exponents ("m2", "s-1", "m^3") and in the unit
+ * "1/..." at the very start. Returns the offending position or NULL. */
+static const char *stray_number(const char *unit)
+{
+    for (const char *p = unit; *p; p++) {
+        if (!isdigit((unsigned char)*p))
+            continue;
+        if (p == unit) {
+            const char *q = p + 1;
+            while (*q == ' ')
+                q++;
+            if (*p == '1' && *q == '/')
+                continue;
+            return p;
+        }
+        const char *q = p - 1;
+        if (isdigit((unsigned char)*q))
+            continue;
+        if ((*q == '-' || *q == '+') && q > unit)
+            q--;
+        if (isalpha((unsigned char)*q) || *q == '^' || *q == '_')
+            continue;
+        return p;
+    }
+    return NULL;
+}
+
+/* ------------------------------------------------------------------ */
+/* Suggestions for the mass-versus-force confusion                      */
+
+/* Rewrite the unit replacing whole identifiers `from[i]` by `to[i]`;
+ * returns 1 if anything was replaced (and it fits in out[size]). */
+static int rewrite_unit(const char *unit, const char *const from[],
+                        const char *const to[], size_t nwords, char *out,
+                        size_t size)
+{
+    size_t n = 0;
+    int replaced = 0;
+    const char *p = unit;
+    while (*p) {
+        if (isalpha((unsigned char)*p) || *p == '_') {
+            const char *b = p;
+            while (isalpha((unsigned char)*p) || *p == '_')
+                p++;
+            size_t len = (size_t)(p - b);
+            const char *word = NULL;
+            for (size_t i = 0; i < nwords; i++)
+                if (strlen(from[i]) == len && memcmp(from[i], b, len) == 0) {
+                    word = to[i];
+                    replaced = 1;
+                }
+            size_t wl = word ? strlen(word) : len;
+            if (n + wl + 1 > size)
+                return 0;
+            memcpy(out + n, word ? word : b, wl);
+            n += wl;
+        } else {
+            if (n + 2 > size)
+                return 0;
+            out[n++] = *p++;
+        }
+    }
+    out[n] = '\0';
+    return replaced;
+}
+
+/* When `given` times (sign > 0) or divided by (sign < 0) an acceleration
+ * has the dimension of `want`, the quantity is a mass given as a force or
+ * the reverse. Returns 1 and writes into hint[size] a sentence to append. */
+static int mass_force_hint(const ut_system *sys, const ut_unit *given,
+                           const ut_unit *want, const char *number,
+                           const char *unit, char *hint, size_t size)
+{
+    ut_unit *accel = ut_parse(sys, "m/s^2", UT_ASCII);
+    if (!accel)
+        return 0;
+    ut_unit *as_force = ut_multiply(given, accel);
+    ut_unit *as_mass = ut_divide(given, accel);
+    ut_free(accel);
+    int mass_for_force = as_force && units_match(as_force, want);
+    int force_for_mass = as_mass && units_match(as_mass, want);
+    ut_free(as_force);
+    ut_free(as_mass);
+    if (!mass_for_force && !force_for_mass)
+        return 0;
+
+    static const char *const mass_words[] = {"lb", "lbs", "pound", "pounds",
+                                             "kg", "kilogram", "kilograms"};
+    static const char *const force_words[] = {"lbf", "lbf", "lbf", "lbf",
+                                              "kgf", "kgf", "kgf"};
+    static const char *const fmass_words[] = {"lbf", "kgf"};
+    static const char *const fforce_words[] = {"lb", "kg"};
+    char better[UNIT_TEXT_MAX + 32];
+    int ok = mass_for_force
+        ? rewrite_unit(unit, mass_words, force_words, 7, better, sizeof better)
+        : rewrite_unit(unit, fmass_words, fforce_words, 2, better,
+                       sizeof better);
+    if (ok) {
+        /* Offer the rewrite only if it really has the wanted dimension. */
+        ut_unit *b = ut_parse(sys, better, UT_ASCII);
+        ok = b && units_match(b, want);
+        ut_free(b);
+    }
+    if (mass_for_force) {
+        if (ok)
+            snprintf(hint, size, ": for a weight write \"%s %s\", or give it "
+                     "as a mass", number, better);
+        else
+            snprintf(hint, size, ": for a weight use a force unit (N, lbf, "
+                     "kgf), or give it as a mass");
+    } else {
+        if (ok)
+            snprintf(hint, size, ": for a mass write \"%s %s\", or give it "
+                     "as a weight", number, better);
+        else
+            snprintf(hint, size, ": for a mass use a mass unit (kg, lb), or "
+                     "give it as a weight");
+    }
+    return 1;
+}
+
+/* ------------------------------------------------------------------ */
+/* Conversion                                                           */
+
+/* Parse a unit from the database, NUL-terminated ASCII. */
+static ut_unit *parse_unit(const ts_units *u, const char *text)
+{
+    return ut_parse(u->sys, text, UT_ASCII);
+}
+
+/* The wrong-dimension message; returns TS_EUNIT. */
+static int wrong_dimension(const ts_units *u, const ut_unit *given,
+                           const ut_unit *want, const char *text,
+                           const char *number, const char *unit,
+                           const char *where, ts_err *err)
+{
+    char q[QUOTE_BUF], dg[160], dw[160], hint[UNIT_TEXT_MAX + 128];
+    describe(u->sys, given, dg, sizeof dg);
+    describe(u->sys, want, dw, sizeof dw);
+    hint[0] = '\0';
+    if (!mass_force_hint(u->sys, given, want, number, unit, hint, sizeof hint)
+        && ut_are_convertible(given, want)) {
+        /* Same dimension for udunits, but radians differ: an angle or
+         * angular rate given as a pure number or a frequency, or the
+         * reverse. */
+        if (strstr(dw, "angle") || strstr(dw, "angular"))
+            snprintf(hint, sizeof hint, ": give an angle unit (rad, deg, "
+                     "rad/s, deg/s; 1 Hz is 2 pi rad/s)");
+        else
+            snprintf(hint, sizeof hint, ": give it without an angle unit "
+                     "(1 Hz is 2 pi rad/s)");
+    }
+    return ts_fail(err, TS_EUNIT, "%s: %s is %s, expected %s%s", where,
+                   quote(text, q, sizeof q), dg, dw, hint);
+}
+
+int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
+                   const char *where, double *value, ts_err *err)
+{
+    char q[QUOTE_BUF];
+    if (!where)
+        where = "value";
+    if (!u || !si_unit || !value)
+        return ts_fail(err, TS_EINVAL, "%s: ts_units_parse called with a "
+                       "NULL %s", where,
+                       !u ? "unit system" : !si_unit ? "SI unit" : "result");
+    if (!text)
+        return ts_fail(err, TS_EINVAL, "%s: no value; expected a number with "
+                       "an optional unit", where);
+
+    ut_unit *want = parse_unit(u, si_unit);
+    if (!want)
+        return ts_fail(err, TS_EINVAL, "%s: ts_units_parse called with an "
+                       "unknown SI unit '%s'", where, si_unit);
+    /* The wanted dimension in words, for messages only (describing costs
+     * a few dozen ut_parse calls, so it is not done on success). */
+    char dw[160];
+
+    const char *s = text;
+    while (is_space(*s))
+        s++;
+    int rc = TS_OK;
+    ut_unit *given = NULL;
+    cv_converter *conv = NULL;
+
+    if (*s == '\0') {
+        rc = ts_fail(err, TS_EINVAL, "%s: empty value; expected %s, e.g. "
+                     "\"2.5 %s\"", where,
+                     describe(u->sys, want, dw, sizeof dw), si_unit);
+        goto done;
+    }
+    if (is_nonfinite_word(s)) {
+        rc = ts_fail(err, TS_EINVAL, "%s: %s is not a finite number; expected "
+                     "%s", where, quote(text, q, sizeof q),
+                     describe(u->sys, want, dw, sizeof dw));
+        goto done;
+    }
+    size_t nlen = scan_number(s);
+    if (nlen == 0) {
+        rc = ts_fail(err, TS_EINVAL, "%s: %s does not start with a number; "
+                     "expected %s, e.g. \"2.5 %s\"", where,
+                     quote(text, q, sizeof q),
+                     describe(u->sys, want, dw, sizeof dw), si_unit);
+        goto done;
+    }
+    if (nlen >= NUMBER_TEXT_MAX) {
+        rc = ts_fail(err, TS_EINVAL, "%s: the number in %s is too long "
+                     "(more than %d characters)", where,
+                     quote(text, q, sizeof q), NUMBER_TEXT_MAX - 1);
+        goto done;
+    }
+    if ((s[nlen] == 'x' || s[nlen] == 'X') &&
+        isxdigit((unsigned char)s[nlen + 1])) {
+        rc = ts_fail(err, TS_EINVAL, "%s: %s is not a decimal number; "
+                     "expected %s", where, quote(text, q, sizeof q),
+                     describe(u->sys, want, dw, sizeof dw));
+        goto done;
+    }
+    char number[NUMBER_TEXT_MAX];
+    memcpy(number, s, nlen);
+    number[nlen] = '\0';
+    char *end = NULL;
+    double x = strtod(number, &end);
+    if (end != number + nlen) {
+        /* Only a locale with another decimal point gets here. */
+        rc = ts_fail(err, TS_EINVAL, "%s: cannot read the number %s (is the "
+                     "C locale's decimal point in effect?)", where,
+                     quote(number, q, sizeof q));
+        goto done;
+    }
+    if (!isfinite(x)) {
+        rc = ts_fail(err, TS_EINVAL, "%s: %s is out of the range of a double",
+                     where, quote(text, q, sizeof q));
+        goto done;
+    }
+
+    /* The unit: the rest, trimmed. */
+    const char *ub = s + nlen;
+    while (is_space(*ub))
+        ub++;
+    size_t ulen = strlen(ub);
+    while (ulen > 0 && is_space(ub[ulen - 1]))
+        ulen--;
+    if (ulen == 0) {
+        *value = x;     /* no unit: SI */
+        goto done;
+    }
+    if (ulen >= UNIT_TEXT_MAX) {
+        rc = ts_fail(err, TS_EUNIT, "%s: the unit in %s is too long (more "
+                     "than %d characters)", where, quote(text, q, sizeof q),
+                     UNIT_TEXT_MAX - 1);
+        goto done;
+    }
+    char unit[UNIT_TEXT_MAX];
+    memcpy(unit, ub, ulen);
+    unit[ulen] = '\0';
+    for (size_t i = 0; i < ulen; i++)
+        if ((unsigned char)unit[i] < 0x20 || (unsigned char)unit[i] >= 0x7f) {
+            rc = ts_fail(err, TS_EUNIT, "%s: the unit in %s has a character "
+                         "that is not printable ASCII (write m^2, um)", where,
+                         quote(text, q, sizeof q));
+            goto done;
+        }
+    const char *stray = stray_number(unit);
+    if (stray) {
+        char q2[QUOTE_BUF];
+        rc = ts_fail(err, TS_EINVAL, "%s: unexpected number %s after the "
+                     "value in %s; write one number and one unit, e.g. "
+                     "\"2.5 %s\"", where, quote(stray, q2, sizeof q2),
+                     quote(text, q, sizeof q), si_unit);
+        goto done;
+    }
+
+    given = parse_unit(u, unit);
+    if (!given) {
+        char q2[QUOTE_BUF];
+        ut_status st = ut_get_status();
+        /* A well-formed expression naming an unknown unit is TS_EUNIT;
+         * anything else is trailing garbage (TS_EINVAL). udunits 2.2.28
+         * reports syntax errors with status UT_SUCCESS, not UT_SYNTAX, so
+         * test for UT_UNKNOWN. */
+        if (st != UT_UNKNOWN)
+            rc = ts_fail(err, TS_EINVAL, "%s: cannot read %s after the number "
+                         "in %s (not a unit expression); expected %s", where,
+                         quote(unit, q2, sizeof q2), quote(text, q, sizeof q),
+                         describe(u->sys, want, dw, sizeof dw));
+        else
+            rc = ts_fail(err, TS_EUNIT, "%s: unknown unit %s in %s; expected "
+                         "%s", where, quote(unit, q2, sizeof q2),
+                         quote(text, q, sizeof q),
+                         describe(u->sys, want, dw, sizeof dw));
+        goto done;
+    }
+    if (!units_match(given, want)) {
+        rc = wrong_dimension(u, given, want, text, number, unit, where, err);
+        goto done;
+    }
+    conv = ut_get_converter(given, want);
+    if (!conv) {
+        rc = ts_fail(err, TS_EUNIT, "%s: cannot convert %s to %s", where,
+                     quote(text, q, sizeof q), si_unit);
+        goto done;
+    }
+    if (cv_convert_double(conv, 0.0) != 0.0) {
+        rc = ts_fail(err, TS_EUNIT, "%s: %s uses a unit with an offset "
+                     "(like degC or a time since an epoch); give a plain "
+                     "multiple of %s", where, quote(text, q, sizeof q),
+                     si_unit);
+        goto done;
+    }
+    double si = cv_convert_double(conv, x);
+    if (!isfinite(si)) {
+        rc = ts_fail(err, TS_EINVAL, "%s: %s is out of the range of a double "
+                     "in %s", where, quote(text, q, sizeof q), si_unit);
+        goto done;
+    }
+    *value = si;
+
+done:
+    cv_free(conv);
+    ut_free(given);
+    ut_free(want);
+    return rc;
+}
+
+int ts_units_from_si(const ts_units *u, double si_value, const char *si_unit,
+                     const char *unit, double *out, ts_err *err)
+{
+    if (!u || !si_unit || !unit || !out)
+        return ts_fail(err, TS_EINVAL, "ts_units_from_si: called with a NULL "
+                       "argument");
+    char q[QUOTE_BUF];
+    ut_unit *from = parse_unit(u, si_unit);
+    ut_unit *to = parse_unit(u, unit);
+    cv_converter *conv = NULL;
+    int rc = TS_OK;
+    if (!from || !to) {
+        rc = ts_fail(err, TS_EUNIT, "ts_units_from_si: unknown unit %s",
+                     quote(!from ? si_unit : unit, q, sizeof q));
+        goto done;
+    }
+    if (!units_match(from, to)) {
+        char df[160], dt[160];
+        rc = ts_fail(err, TS_EUNIT, "ts_units_from_si: cannot express %s in "
+                     "%s: it is %s, not %s", si_unit, quote(unit, q, sizeof q),
+                     describe(u->sys, from, df, sizeof df),
+                     describe(u->sys, to, dt, sizeof dt));
+        goto done;
+    }
+    conv = ut_get_converter(from, to);
+    if (!conv) {
+        rc = ts_fail(err, TS_EUNIT, "ts_units_from_si: cannot convert %s to "
+                     "%s", si_unit, quote(unit, q, sizeof q));
+        goto done;
+    }
+    *out = cv_convert_double(conv, si_value);
+
+done:
+    cv_free(conv);
+    ut_free(to);
+    ut_free(from);
+    return rc;
+}

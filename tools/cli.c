@@ -1,0 +1,273 @@
+/* cli.c: helpers shared by the towstab subcommands (cli.h). */
+#include "cli.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "towstab/kernel.h"
+#include "towstab/report.h"
+
+double cli_wall_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int cli_exit_code(int rc)
+{
+    switch (rc) {
+    case TS_OK: return 0;
+    case TS_EINVAL:
+    case TS_ESCENE:
+    case TS_EUNIT:
+    case TS_EDOMAIN: return EXIT_BADINPUT;
+    default: return EXIT_FAILED;
+    }
+}
+
+int cli_report(const ts_err *err, int rc)
+{
+    fprintf(stderr, "towstab: error: %s\n",
+            err && err->msg[0] ? err->msg : ts_strerror(rc));
+    return cli_exit_code(rc);
+}
+
+int cli_open(const char *path, ts_units **units, ts_scene **scene)
+{
+    ts_err err = {0};
+    *scene = NULL;
+    *units = ts_units_alloc(&err);
+    if (!*units)
+        return cli_report(&err, err.code ? err.code : TS_EUNIT);
+    *scene = ts_scene_load(path, *units, &err);
+    if (!*scene) {
+        int rc = err.code ? err.code : TS_ESCENE;
+        ts_units_free(*units);
+        *units = NULL;
+        /* A missing or unreadable scene is bad input too. */
+        return cli_report(&err, rc == TS_EIO ? TS_ESCENE : rc);
+    }
+    return 0;
+}
+
+void cli_close(ts_units *units, ts_scene *scene)
+{
+    ts_scene_free(scene);
+    ts_units_free(units);
+}
+
+void cli_settings_from_options(cli_settings *s)
+{
+    snprintf(s->where[0], sizeof s->where[0], "--speed");
+    snprintf(s->where[1], sizeof s->where[1], "--turn-rate");
+    snprintf(s->where[2], sizeof s->where[2], "--method");
+    snprintf(s->where[3], sizeof s->where[3], "--tol");
+    snprintf(s->where[4], sizeof s->where[4], "--links");
+}
+
+int cli_settings_from_analysis(cli_settings *s, const ts_scene_analysis *a,
+                               int index, ts_err *err)
+{
+    static const char *const keys[5] = {"speed", "turn_rate", "method",
+                                        "tolerance", "links"};
+    const char **dst[4] = {&s->speed, &s->turn_rate, &s->method, &s->tol};
+    for (int j = 0; j < 5; j++) {
+        const ts_scene_option *o = ts_scene_analysis_option(a, keys[j]);
+        snprintf(s->where[j], sizeof s->where[j], "analyses[%d].%s (line %d)",
+                 index, keys[j], o ? o->line : a->line);
+        if (j < 4)
+            *dst[j] = o ? o->value : NULL;
+        else if (o) {
+            char *end;
+            long v = strtol(o->value, &end, 10);
+            if (end == o->value || *end || v < 1 || v > 10000000)
+                return ts_fail(err, TS_EINVAL,
+                               "%s: expected a whole number >= 1, got '%s'",
+                               s->where[4], o->value);
+            s->links = (int)v;
+        }
+    }
+    return TS_OK;
+}
+
+ts_system *cli_system(const ts_scene *scene, const ts_units *units,
+                      const cli_settings *s, ts_equilibrium_opts *eo,
+                      ts_err *err)
+{
+    ts_system *sys = ts_system_copy(scene->system, err);
+    if (!sys)
+        return NULL;
+    ts_equilibrium_opts_default(eo);
+    int rc = TS_OK;
+    if (s->speed)
+        rc = ts_units_parse(units, s->speed, "m/s", s->where[0],
+                            &sys->tow.speed, err);
+    if (!rc && s->turn_rate)
+        rc = ts_units_parse(units, s->turn_rate, "rad/s", s->where[1],
+                            &sys->tow.turn_rate, err);
+    if (!rc && s->method) {
+        if (strcmp(s->method, "auto") == 0)
+            eo->method = TS_EQ_AUTO;
+        else if (strcmp(s->method, "shooting") == 0)
+            eo->method = TS_EQ_SHOOTING;
+        else if (strcmp(s->method, "newton") == 0)
+            eo->method = TS_EQ_NEWTON;
+        else
+            rc = ts_fail(err, TS_EINVAL,
+                         "%s: '%s' is not a method; expected auto, shooting "
+                         "or newton",
+                         s->where[2], s->method);
+    }
+    if (!rc && s->tol) {
+        char *end;
+        double v = strtod(s->tol, &end);
+        if (end == s->tol || *end != '\0' || !(v > 0) || !(v < 1))
+            rc = ts_fail(err, TS_EINVAL,
+                         "%s: expected a number in (0, 1), got '%s'",
+                         s->where[3], s->tol);
+        else
+            eo->tol = v;
+    }
+    for (int c = 0; !rc && s->links > 0 && c < sys->ncables; c++) {
+        if (sys->cables[c].link_fraction)
+            rc = ts_fail(err, TS_EINVAL,
+                         "%s: cables[%d] '%s' has link_lengths; remove them "
+                         "to set the number of links",
+                         s->where[4], c, sys->cables[c].name);
+        sys->cables[c].nlinks = s->links;
+    }
+    if (!rc)
+        rc = ts_system_build(sys, err);
+    if (rc) {
+        ts_system_free(sys);
+        return NULL;
+    }
+    return sys;
+}
+
+int cli_check_keys(const ts_scene_analysis *a, const char *const keys[],
+                   int index, ts_err *err)
+{
+    for (int i = 0; i < a->noptions; i++) {
+        int ok = 0;
+        for (int j = 0; keys[j]; j++)
+            ok |= strcmp(a->options[i].key, keys[j]) == 0;
+        if (ok)
+            continue;
+        char list[512] = "";
+        for (int j = 0; keys[j]; j++) {
+            strncat(list, keys[j], sizeof list - strlen(list) - 1);
+            if (keys[j + 1])
+                strncat(list, ", ", sizeof list - strlen(list) - 1);
+        }
+        return ts_fail(err, TS_ESCENE,
+                       "analyses[%d].%s (line %d): unknown option for %s; "
+                       "expected one of %s",
+                       index, a->options[i].key, a->options[i].line, a->type,
+                       list);
+    }
+    return TS_OK;
+}
+
+const char *cli_option(const ts_scene_analysis *a, const char *key)
+{
+    const ts_scene_option *o = ts_scene_analysis_option(a, key);
+    return o ? o->value : NULL;
+}
+
+int cli_parse_int(const char *opt, const char *text, long lo, long hi,
+                  long *value)
+{
+    char *end;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end || v < lo || v > hi) {
+        fprintf(stderr, "towstab: %s: expected a whole number in [%ld, %ld], "
+                        "got '%s'\n",
+                opt, lo, hi, text);
+        return EXIT_BADINPUT;
+    }
+    *value = v;
+    return 0;
+}
+
+static void print_equilibrium(FILE *f, const ts_system *sys,
+                              const ts_equilibrium *eq, double wall_s,
+                              int quiet)
+{
+    fprintf(f, "speed %.6g m/s, turn rate %.6g rad/s, %d cable%s, %d links, "
+               "%d bod%s\n",
+            sys->tow.speed, sys->tow.turn_rate, sys->ncables,
+            sys->ncables == 1 ? "" : "s", sys->nlinks, sys->nbodies,
+            sys->nbodies == 1 ? "y" : "ies");
+    fprintf(f, "%s: %s, %d iterations, %ld evaluations, residual %.3g of "
+               "%.6g N (target %.3g), %.3f ms\n",
+            eq->converged ? "converged" : "NOT CONVERGED",
+            ts_eq_method_name(eq->method), eq->iterations, eq->evaluations,
+            eq->residual, eq->force_scale, eq->tolerance, wall_s * 1e3);
+    if (!eq->converged)
+        return;
+    char name[2 * TS_NAME_MAX];
+    if (!quiet) {
+        fprintf(f, "\n%-20s %14s %14s %14s\n", "node", "x [m]", "y [m]",
+                "z [m]");
+        for (int i = 0; i < sys->nnodes; i++) {
+            const double *r = eq->positions + 3 * i;
+            ts_report_node_name(sys, i, name, sizeof name);
+            fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", name, r[0], r[1], r[2]);
+        }
+        fprintf(f, "\n%-20s %6s %14s %14s %14s\n", "cable", "link",
+                "tension [N]", "theta1 [deg]", "theta2 [deg]");
+        for (int l = 0; l < sys->nlinks; l++) {
+            const ts_link *L = &sys->links[l];
+            double t1, t2;
+            ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
+            fprintf(f, "%-20s %6d %14.6f %14.6f %14.6f\n",
+                    sys->cables[L->cable].name, L->index, eq->tensions[l],
+                    t1 * 180 / M_PI, t2 * 180 / M_PI);
+        }
+    }
+    if (sys->nbodies > 0) {
+        fprintf(f, "\n%-20s %14s %14s %14s\n", "body", "x [m]", "y [m]",
+                "z [m] (depth)");
+        for (int b = 0; b < sys->nbodies; b++) {
+            const double *r = eq->positions + 3 * ts_system_body_node(sys, b);
+            fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", sys->bodies[b].name,
+                    r[0], r[1], r[2]);
+        }
+    }
+    fprintf(f, "\ntop tension %.6f N (force on the tow point %.6f, %.6f, "
+               "%.6f N)\n",
+            eq->top_tension, eq->tow_force[0], eq->tow_force[1],
+            eq->tow_force[2]);
+    if (eq->min_tension < 0)
+        fprintf(f, "warning: a link is in compression (%.6g N): a real cable "
+                   "would go slack there\n",
+                eq->min_tension);
+}
+
+int cli_equilibrium(const ts_system *sys, const ts_equilibrium_opts *eo,
+                    int quiet, ts_equilibrium **out, json_t **json,
+                    ts_err *err)
+{
+    *out = NULL;
+    ts_kernel *k = ts_kernel_alloc(sys, err);
+    ts_equilibrium *eq = k ? ts_equilibrium_alloc(sys, err) : NULL;
+    if (!k || !eq) {
+        ts_kernel_free(k);
+        return err->code;
+    }
+    double t0 = cli_wall_now();
+    int rc = ts_equilibrium_solve(k, eo, eq, err);
+    double wall = cli_wall_now() - t0;
+    if (rc != TS_EINVAL && rc != TS_EDOMAIN) {
+        print_equilibrium(stdout, sys, eq, wall, quiet);
+        if (json)
+            *json = ts_report_equilibrium_json(sys, eq, wall);
+    }
+    ts_kernel_free(k);
+    *out = eq;
+    return rc;
+}

@@ -1,0 +1,96 @@
+/* cli.h: what the towstab subcommands share (tools only; the library never
+ * prints). Each subcommand lives in tools/cmd_<name>.c and exports one
+ * cli_command; tools/towstab.c lists them. */
+#ifndef TOWSTAB_CLI_H
+#define TOWSTAB_CLI_H
+
+#include <jansson.h>
+#include <stdio.h>
+
+#include "towstab/equilibrium.h"
+#include "towstab/error.h"
+#include "towstab/scene.h"
+#include "towstab/system.h"
+#include "towstab/units.h"
+
+#define EXIT_FAILED 1   /* the analysis failed: no convergence, I/O */
+#define EXIT_BADINPUT 2 /* usage, scene, units, impossible configuration */
+
+/* What a scene analysis entry runs with. */
+typedef struct cli_ctx {
+    const ts_scene *scene;
+    const ts_units *units;
+    int quiet;
+} cli_ctx;
+
+typedef struct cli_command {
+    const char *name;
+    const char *summary;
+    /* `towstab NAME ...`: argv[0] is NAME. Returns the exit status. */
+    int (*main)(int argc, char **argv);
+    /* One `analyses:` entry of type NAME; appends its JSON result (with a
+     * "type" key) to `results`. NULL when the command is not an analysis. */
+    int (*run)(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
+               json_t *results);
+    /* Option keys the scene entry accepts (NULL-terminated). */
+    const char *const *keys;
+} cli_command;
+
+double cli_wall_now(void);
+
+/* Exit status for a library code. */
+int cli_exit_code(int rc);
+
+/* Print "towstab: error: <message>" and return the exit status. */
+int cli_report(const ts_err *err, int rc);
+
+/* Load units and a scene; on failure prints and returns NULL with *status
+ * set. Free with cli_close(). */
+int cli_open(const char *path, ts_units **units, ts_scene **scene);
+void cli_close(ts_units *units, ts_scene *scene);
+
+/* Settings that override a scene's tow or solver, as text with units.
+ * `where` names the origin of each for messages. */
+typedef struct cli_settings {
+    const char *speed, *turn_rate, *method, *tol;
+    int links;                  /* 0: keep the scene's */
+    char where[5][128];         /* speed, turn_rate, method, tol, links */
+} cli_settings;
+
+/* Settings named as command-line options (--speed, ...). */
+void cli_settings_from_options(cli_settings *s);
+
+/* Settings from a scene analysis entry (keys speed, turn_rate, method,
+ * tolerance, links). */
+int cli_settings_from_analysis(cli_settings *s, const ts_scene_analysis *a,
+                               int index, ts_err *err);
+
+/* A copy of the scene's system with the settings applied and rebuilt, and
+ * the solver options. NULL on failure (message in err). */
+ts_system *cli_system(const ts_scene *scene, const ts_units *units,
+                      const cli_settings *s, ts_equilibrium_opts *eo,
+                      ts_err *err);
+
+/* Refuse analysis options outside `keys`. */
+int cli_check_keys(const ts_scene_analysis *a, const char *const keys[],
+                   int index, ts_err *err);
+
+/* Text of option `key` of a scene analysis, or NULL. */
+const char *cli_option(const ts_scene_analysis *a, const char *key);
+
+/* Solve and print an equilibrium (summary always, tables unless quiet).
+ * *out receives the result (caller frees, may be partial on failure);
+ * *json, when not NULL, its JSON. Returns the library code. */
+int cli_equilibrium(const ts_system *sys, const ts_equilibrium_opts *eo,
+                    int quiet, ts_equilibrium **out, json_t **json,
+                    ts_err *err);
+
+/* Parse a whole number option value in [lo, hi]. */
+int cli_parse_int(const char *opt, const char *text, long lo, long hi,
+                  long *value);
+
+
+
+/* All subcommands, NULL-terminated (tools/towstab.c). */
+extern const cli_command *const cli_commands[];
+#endif

@@ -1,0 +1,48 @@
+/* towstab: the command line. One subcommand per analysis (tools/cmd_*.c);
+ * each prints a table and optionally writes JSON or CSV (SI units).
+ * Exit status: 0 success, 1 the analysis failed (no convergence, singular
+ * system, output not written), 2 bad input (usage, scene, units, an
+ * impossible configuration). The manual is doc/manual.md. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
+
+const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
+                                           NULL};
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: towstab COMMAND SCENE [options]\n\ncommands:\n");
+    for (int i = 0; cli_commands[i]; i++)
+        fprintf(f, "  %-12s %s\n", cli_commands[i]->name,
+                cli_commands[i]->summary);
+    fprintf(f, "\n'towstab COMMAND --help' lists a command's options.\n"
+               "Plain numbers are SI; strings may carry units ('100 ft').\n"
+               "Exit status: 0 ok, 1 analysis failed, 2 bad input.\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_BADINPUT;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
+        strcmp(argv[1], "help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("towstab 0.1.0\n");
+        return 0;
+    }
+    for (int i = 0; cli_commands[i]; i++)
+        if (strcmp(argv[1], cli_commands[i]->name) == 0)
+            return cli_commands[i]->main(argc - 1, argv + 1);
+    fprintf(stderr, "towstab: unknown command '%s' (towstab --help)\n",
+            argv[1]);
+    return EXIT_BADINPUT;
+}
