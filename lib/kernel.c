@@ -152,6 +152,17 @@ void ts_kernel_free(ts_kernel *k)
     free(k);
 }
 
+ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
+{
+    ts_kernel *c = ts_kernel_alloc(k->sys, err);
+    if (!c)
+        return NULL;
+    c->frame = k->frame;
+    memcpy(c->chart, k->chart, 9 * (size_t)k->nl * sizeof(double));
+    memcpy(c->charted, k->charted, (size_t)k->nl);
+    return c;
+}
+
 const ts_system *ts_kernel_system(const ts_kernel *k) { return k->sys; }
 int ts_kernel_nq(const ts_kernel *k) { return 2 * k->nl; }
 int ts_kernel_nstate(const ts_kernel *k) { return 4 * k->nl; }

@@ -59,6 +59,11 @@ typedef struct ts_kernel ts_kernel;
 TS_API ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err);
 TS_API void ts_kernel_free(ts_kernel *k);
 
+/* A new kernel on the same system with the same frame and charts (for
+ * evaluating from several threads: a kernel is not shared between
+ * threads). NULL on failure. */
+TS_API ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err);
+
 TS_API const ts_system *ts_kernel_system(const ts_kernel *k);
 TS_API int ts_kernel_nq(const ts_kernel *k);      /* 2 nlinks */
 TS_API int ts_kernel_nstate(const ts_kernel *k);  /* 2 nq */
