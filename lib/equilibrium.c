@@ -33,6 +33,7 @@ void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
     o->tol = 1e-10;
     o->max_iter = 100;
     o->method = TS_EQ_AUTO;
+    o->guess = NULL;
 }
 
 const char *ts_eq_method_name(ts_eq_method m)
@@ -351,7 +352,10 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     static const int schedule[] = {1, 4, 16, 64};
     int nsched = frame.turn_rate != 0 && !have_guess ? 4 : 1;
     double *y0 = w.ystart;
-    if (have_guess) {
+    if (o.guess) {
+        ts_kernel_set_directions(k, o.guess, NULL, TS_CHART_RECHART, y0);
+        have_guess = 1;
+    } else if (have_guess) {
         memcpy(y0, y, (size_t)nq * sizeof(double));
     } else {
         ts_frame straight = frame;

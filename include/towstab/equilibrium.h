@@ -38,6 +38,9 @@ typedef struct ts_equilibrium_opts {
     double tol;           /* relative force residual, default 1e-10 */
     int max_iter;         /* per continuation step, default 100 */
     ts_eq_method method;  /* default TS_EQ_AUTO */
+    const double *guess;  /* [3 nlinks] link unit directions for Newton to
+                             start from (method newton), or NULL for the
+                             straight-tow march; default NULL */
 } ts_equilibrium_opts;
 
 typedef struct ts_equilibrium {
