@@ -7,9 +7,9 @@
  * acceleration afr_i = (-W^2 x, W V - W^2 y, 0)) and F_l the load of link l
  * itself, which depends on its direction through drag, the submerged
  * fraction and the position of its upper end r_i - l n_l. So n_l is the
- * direction of the right-hand side H(n): two equations H.e1 = H.e2 = 0 in
- * two angles of a chart centred on a first guess, solved with GSL's hybrid
- * solver. Links are visited in decreasing index, which puts every child
+ * direction of the right-hand side H(n): the part of H normal to n must
+ * vanish, two equations in the two coordinates of a gnomonic chart centred
+ * on a first guess, solved with GSL's hybrid solver. Links are visited in decreasing index, which puts every child
  * before its parent (system.h).
  */
 #include "march.h"
@@ -26,6 +26,12 @@
 /* Local root: |H_perp| below this fraction of |H| (rounding is ~1e-16). */
 #define LOCAL_RTOL 1e-13
 #define LOCAL_MAXIT 60
+/* The local Newton: iterations before GSL's hybrid solver takes over, and
+ * its forward-difference step in chart coordinates (~ sqrt(eps)). */
+#define LOCAL_NEWTON_MAXIT 8
+#define LOCAL_FD_STEP 1e-8
+/* Translation corrections tried before the hybrid solver takes over. */
+#define MAX_CORRECTIONS 40
 
 struct tsi_march {
     const ts_system *sys;
@@ -33,6 +39,7 @@ struct tsi_march {
     int *leaf_node;     /* [nleaf] node of each free end */
     int *res_link;      /* [nleaf] link whose upper-end mismatch is residual j */
     char *member;       /* [nleaf * nleaf]: leaf b lies below residual a */
+    double *jac0;       /* [nu * nu] row-major d e / d x of a translation */
     int *res_of_link;   /* [nl] residual index or -1 */
 
     double *n, *t;      /* [3 nl], [nl] */
@@ -62,6 +69,7 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     m->leaf_node = calloc(nf, sizeof(int));
     m->res_link = calloc(nf, sizeof(int));
     m->member = calloc(nf * nf, 1);
+    m->jac0 = calloc(9 * nf * nf, sizeof(double));
     m->res_of_link = malloc(nl * sizeof(int));
     m->n = calloc(3 * nl, sizeof(double));
     m->t = calloc(nl, sizeof(double));
@@ -71,7 +79,8 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     m->Ma = calloc(6 * nn, sizeof(double));
     m->local = gsl_multiroot_fsolver_alloc(gsl_multiroot_fsolver_hybrids, 2);
     m->lx = gsl_vector_alloc(2);
-    if (!m->leaf_node || !m->res_link || !m->member || !m->res_of_link ||
+    if (!m->leaf_node || !m->res_link || !m->member || !m->jac0 ||
+        !m->res_of_link ||
         !m->n || !m->t || !m->r || !m->rset || !m->K || !m->Ma ||
         !m->local || !m->lx)
         goto nomem;
@@ -91,14 +100,34 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
                 m->res_of_link[sys->child_links[c]] = nres++;
             }
     }
+    /* Translating the free ends below a link translates the marched
+     * subtree: residual a grows by the shift of the ends below its link and
+     * shrinks by that of the ends below the sibling that fixed the branch
+     * node. That is the Jacobian wherever loads do not depend on position,
+     * and the shooting solver starts from it. */
     int f = 0;
+    size_t nu = 3 * nf;
     for (int i = 1; i < m->nn; i++)
         if (sys->nodes[i].child_begin == sys->nodes[i].child_end) {
             m->leaf_node[f] = i;
-            /* Walk up to the tow point, marking the residuals passed. */
-            for (int l = i - 1; l >= 0; l = sys->links[l].parent)
-                if (m->res_of_link[l] >= 0)
-                    m->member[(size_t)m->res_of_link[l] * nf + f] = 1;
+            for (int l = i - 1; l >= 0; l = sys->links[l].parent) {
+                int a = m->res_of_link[l];
+                if (a >= 0) {
+                    m->member[(size_t)a * nf + f] = 1;
+                    for (int j = 0; j < 3; j++)
+                        m->jac0[(3 * (size_t)a + j) * nu + 3 * f + j] += 1.0;
+                    continue;
+                }
+                const ts_node *up = &sys->nodes[sys->links[l].upper];
+                if (sys->links[l].upper == 0)
+                    continue;
+                for (int c = up->child_begin; c < up->child_end; c++) {
+                    int s = m->res_of_link[sys->child_links[c]];
+                    if (s >= 0)
+                        for (int j = 0; j < 3; j++)
+                            m->jac0[(3 * (size_t)s + j) * nu + 3 * f + j] -= 1.0;
+                }
+            }
             f++;
         }
     (void)nres;
@@ -116,6 +145,7 @@ void tsi_march_free(tsi_march *m)
     free(m->leaf_node);
     free(m->res_link);
     free(m->member);
+    free(m->jac0);
     free(m->res_of_link);
     free(m->n);
     free(m->t);
@@ -171,37 +201,102 @@ static void link_rhs(const link_problem *P, const double n[3], double H[3],
     }
 }
 
-static void chart_dir(const double R[9], double a, double b, double n[3],
-                      double e1[3], double e2[3])
+/* Gnomonic chart about the centre c of the local solve: n(a, b) is the unit
+ * vector along c + a u + b v, with (c, u, v) orthonormal (columns of R).
+ * No trigonometry, and regular for every direction in the hemisphere of
+ * c. */
+static void chart_dir(const double R[9], double a, double b, double n[3])
 {
-    double c1 = cos(a), s1 = sin(a), c2 = cos(b), s2 = sin(b);
-    double nh[3] = {-c1 * c2, -s2, s1 * c2};
-    double e1h[3] = {s1, 0.0, c1};
-    double e2h[3] = {c1 * s2, -c2, -s1 * s2};
-    mat3_mul(R, nh, n);
-    mat3_mul(R, e1h, e1);
-    mat3_mul(R, e2h, e2);
+    double x[3];
+    for (int j = 0; j < 3; j++)
+        x[j] = -R[3 * j] + a * R[3 * j + 1] + b * R[3 * j + 2];
+    double inv = 1.0 / v3_norm(x);
+    for (int j = 0; j < 3; j++)
+        n[j] = x[j] * inv;
 }
 
+/* Residual of the local root: the part of H normal to n, on the chart's
+ * tangent axes u and v. Zero exactly when H is parallel to n. */
 static int local_f(const gsl_vector *x, void *params, gsl_vector *out)
 {
     const link_problem *P = params;
-    double n[3], e1[3], e2[3], H[3], F[3];
-    chart_dir(P->R, gsl_vector_get(x, 0), gsl_vector_get(x, 1), n, e1, e2);
+    double n[3], H[3], F[3];
+    chart_dir(P->R, gsl_vector_get(x, 0), gsl_vector_get(x, 1), n);
     link_rhs(P, n, H, F);
-    gsl_vector_set(out, 0, v3_dot(H, e1));
-    gsl_vector_set(out, 1, v3_dot(H, e2));
+    double hn = v3_dot(H, n), hp[3];
+    for (int j = 0; j < 3; j++)
+        hp[j] = H[j] - hn * n[j];
+    gsl_vector_set(out, 0,
+                   hp[0] * P->R[1] + hp[1] * P->R[4] + hp[2] * P->R[7]);
+    gsl_vector_set(out, 1,
+                   hp[0] * P->R[2] + hp[1] * P->R[5] + hp[2] * P->R[8]);
     return GSL_SUCCESS;
+}
+
+/* Local residual at chart coordinates (a, b), as plain numbers. */
+static void local_eval(const link_problem *P, double a, double b, double r[2])
+{
+    double xv[2] = {a, b}, rv[2];
+    gsl_vector_const_view x = gsl_vector_const_view_array(xv, 2);
+    gsl_vector_view out = gsl_vector_view_array(rv, 2);
+    local_f(&x.vector, (void *)P, &out.vector);
+    r[0] = rv[0];
+    r[1] = rv[1];
+}
+
+/* Damped Newton on the 2x2 local problem with a forward-difference
+ * Jacobian. The direction moves little from one link, or one march, to the
+ * next, so this converges in a step or two; GSL's general hybrid solver
+ * (used when this does not converge within LOCAL_NEWTON_MAXIT) costs
+ * several times the physics for so small a system in the innermost loop.
+ * Returns 1 when |r| <= tol, with the coordinates in x. */
+static int local_newton(const link_problem *P, double tol, double x[2])
+{
+    double r[2], r1[2], r2[2];
+    local_eval(P, x[0], x[1], r);
+    double rn = hypot(r[0], r[1]);
+    for (int it = 0; it < LOCAL_NEWTON_MAXIT; it++) {
+        if (rn <= tol)
+            return 1;
+        double h = LOCAL_FD_STEP;
+        local_eval(P, x[0] + h, x[1], r1);
+        local_eval(P, x[0], x[1] + h, r2);
+        double j00 = (r1[0] - r[0]) / h, j10 = (r1[1] - r[1]) / h;
+        double j01 = (r2[0] - r[0]) / h, j11 = (r2[1] - r[1]) / h;
+        double det = j00 * j11 - j01 * j10;
+        if (!(fabs(det) > 0))
+            return 0;
+        double da = -(j11 * r[0] - j01 * r[1]) / det;
+        double db = -(-j10 * r[0] + j00 * r[1]) / det;
+        double lam = 1.0, trial[2], rt[2], rtn = INFINITY;
+        for (int k = 0; k < 6; k++, lam *= 0.5) {
+            trial[0] = x[0] + lam * da;
+            trial[1] = x[1] + lam * db;
+            local_eval(P, trial[0], trial[1], rt);
+            rtn = hypot(rt[0], rt[1]);
+            if (rtn < rn)
+                break;
+        }
+        if (!(rtn < rn))
+            return 0;
+        x[0] = trial[0];
+        x[1] = trial[1];
+        r[0] = rt[0];
+        r[1] = rt[1];
+        rn = rtn;
+    }
+    return rn <= tol;
 }
 
 /* Direction of link l: n_l parallel to H(n_l). `guess` is a unit vector. */
 static int solve_link(tsi_march *m, link_problem *P, int l,
-                      const double guess[3], ts_err *err)
+                      const double guess[3], int warm, ts_err *err)
 {
     double H[3], F[3], n[3];
     v3_copy(guess, n);
-    /* Two fixed-point sweeps put the chart centre near the root. */
-    for (int it = 0; it < 2; it++) {
+    /* Without a previous solution, two fixed-point sweeps put the chart
+     * centre near the root. */
+    for (int it = 0; it < (warm ? 0 : 2); it++) {
         link_rhs(P, n, H, F);
         double h = v3_norm(H);
         if (!(h > 0))
@@ -221,23 +316,27 @@ static int solve_link(tsi_march *m, link_problem *P, int l,
                        L->cable, m->sys->cables[L->cable].name, L->index, hn);
     }
     tsi_chart_centred(n, P->R);
-    gsl_multiroot_function fn = {local_f, 2, P};
-    gsl_vector_set(m->lx, 0, 0.0);
-    gsl_vector_set(m->lx, 1, 0.0);
-    gsl_multiroot_fsolver_set(m->local, &fn, m->lx);
-    double tol = LOCAL_RTOL * hn;
-    int status = gsl_multiroot_test_residual(m->local->f, tol);
-    for (int it = 0; status == GSL_CONTINUE && it < LOCAL_MAXIT; it++) {
-        if (gsl_multiroot_fsolver_iterate(m->local))
-            break;
-        status = gsl_multiroot_test_residual(m->local->f, tol);
+    double tol = LOCAL_RTOL * hn, xc[2] = {0.0, 0.0};
+    if (!local_newton(P, tol, xc)) {
+        gsl_multiroot_function fn = {local_f, 2, P};
+        gsl_vector_set(m->lx, 0, 0.0);
+        gsl_vector_set(m->lx, 1, 0.0);
+        gsl_multiroot_fsolver_set(m->local, &fn, m->lx);
+        int status = gsl_multiroot_test_residual(m->local->f, tol);
+        for (int it = 0; status == GSL_CONTINUE && it < LOCAL_MAXIT; it++) {
+            if (gsl_multiroot_fsolver_iterate(m->local))
+                break;
+            status = gsl_multiroot_test_residual(m->local->f, tol);
+        }
+        xc[0] = gsl_vector_get(m->local->x, 0);
+        xc[1] = gsl_vector_get(m->local->x, 1);
     }
-    double e1[3], e2[3];
-    chart_dir(P->R, gsl_vector_get(m->local->x, 0),
-              gsl_vector_get(m->local->x, 1), n, e1, e2);
+    chart_dir(P->R, xc[0], xc[1], n);
     link_rhs(P, n, H, F);
-    double perp = hypot(v3_dot(H, e1), v3_dot(H, e2));
-    double hnorm = v3_norm(H);
+    double hnorm = v3_norm(H), along = v3_dot(H, n), hp[3];
+    for (int j = 0; j < 3; j++)
+        hp[j] = H[j] - along * n[j];
+    double perp = v3_norm(hp);
     if (!(perp <= 1e3 * LOCAL_RTOL * hnorm)) {
         const ts_link *L = P->L;
         return ts_fail(err, TS_ECONV,
@@ -313,7 +412,7 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
             v3_copy(m->n + 3 * l, guess);
         else if (nd->child_begin < nd->child_end)
             v3_copy(m->n + 3 * sys->child_links[nd->child_end - 1], guess);
-        int rc = solve_link(m, &P, l, guess, err);
+        int rc = solve_link(m, &P, l, guess, m->have_n, err);
         if (rc != TS_OK) {
             m->have_n = 0;
             return rc;
@@ -370,6 +469,23 @@ static int shoot_f(const gsl_vector *x, void *params, gsl_vector *out)
     return c->rc == TS_OK ? GSL_SUCCESS : GSL_EBADFUNC;
 }
 
+/* The translation Jacobian: exact without position-dependent loads, and
+ * refined by the hybrid solver's rank-one updates otherwise. */
+static int shoot_df(const gsl_vector *x, void *params, gsl_matrix *J)
+{
+    (void)x;
+    const shoot_ctx *c = params;
+    memcpy(J->data, c->m->jac0, J->size1 * J->size2 * sizeof(double));
+    return GSL_SUCCESS;
+}
+
+static int shoot_fdf(const gsl_vector *x, void *params, gsl_vector *out,
+                     gsl_matrix *J)
+{
+    int rc = shoot_f(x, params, out);
+    return rc ? rc : shoot_df(x, params, J);
+}
+
 int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
                     double pos_tol, int max_iter, int *iterations,
                     long *marches, ts_err *err)
@@ -394,7 +510,7 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
     /* Translation corrections first: they close a straight tow exactly. */
     double last = INFINITY;
     int it = 0;
-    for (; it < 8; it++) {
+    for (; it < MAX_CORRECTIONS; it++) {
         (*marches)++;
         if ((rc = tsi_march_eval(m, f, x, e, err)) != TS_OK)
             goto out;
@@ -408,27 +524,28 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
     }
     {
         shoot_ctx ctx = {m, f, err, TS_OK, 0};
-        gsl_multiroot_function fn = {shoot_f, (size_t)nu, &ctx};
-        gsl_multiroot_fsolver *s =
-            gsl_multiroot_fsolver_alloc(gsl_multiroot_fsolver_hybrids,
-                                        (size_t)nu);
+        gsl_multiroot_function_fdf fn = {shoot_f, shoot_df, shoot_fdf,
+                                         (size_t)nu, &ctx};
+        gsl_multiroot_fdfsolver *s =
+            gsl_multiroot_fdfsolver_alloc(gsl_multiroot_fdfsolver_hybridsj,
+                                          (size_t)nu);
         gsl_vector_view xv = gsl_vector_view_array(x, (size_t)nu);
         if (!s) {
             rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
             goto out;
         }
-        int status = gsl_multiroot_fsolver_set(s, &fn, &xv.vector);
+        int status = gsl_multiroot_fdfsolver_set(s, &fn, &xv.vector);
         if (status == GSL_SUCCESS)
             status = GSL_CONTINUE;
         for (; status == GSL_CONTINUE && it < max_iter; it++) {
-            status = gsl_multiroot_fsolver_iterate(s);
+            status = gsl_multiroot_fdfsolver_iterate(s);
             if (status != GSL_SUCCESS)
                 break;
             status = gsl_multiroot_test_residual(s->f, pos_tol);
         }
         /* Re-march at the solver's best point so the stored shape is its. */
         memcpy(x, s->x->data, (size_t)nu * sizeof(double));
-        gsl_multiroot_fsolver_free(s);
+        gsl_multiroot_fdfsolver_free(s);
         *marches += ctx.marches + 1;
         if (ctx.rc != TS_OK && status != GSL_SUCCESS) {
             rc = ctx.rc;
