@@ -75,15 +75,15 @@ typedef struct field {
 /* ------------------------------------------------------------------ */
 /* Small helpers                                                        */
 
-static int line_of(const yaml_node_t *n)
-{
-    size_t line = n->start_mark.line;
-    return line >= (size_t)INT_MAX ? INT_MAX : (int)line + 1;
-}
-
+/* libyaml marks are 0-based; messages are 1-based. */
 static int mark_line(yaml_mark_t m)
 {
     return m.line >= (size_t)INT_MAX ? INT_MAX : (int)m.line + 1;
+}
+
+static int line_of(const yaml_node_t *n)
+{
+    return mark_line(n->start_mark);
 }
 
 static int mark_column(yaml_mark_t m)
@@ -161,21 +161,35 @@ static int fail_at(const ctx *c, int code, const char *path, int line,
     return ts_fail(c->err, code, "%s (line %d): %s", path, line, what);
 }
 
+/* Format a key path into out[PATH_LEN]; a path too long to fit (only
+ * with absurd user keys) ends in "...". */
+#ifdef __GNUC__
+__attribute__((format(printf, 2, 3)))
+#endif
+static const char *path_printf(char *out, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(out, PATH_LEN, fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        out[0] = '\0';
+    else if (n >= PATH_LEN)
+        memcpy(out + PATH_LEN - 4, "...", 4);
+    return out;
+}
+
 /* "parent.key" (or "key" at the top level) into out[PATH_LEN]. */
 static const char *join(char *out, const char *parent, const char *key)
 {
-    if (parent[0])
-        snprintf(out, PATH_LEN, "%s.%s", parent, key);
-    else
-        snprintf(out, PATH_LEN, "%s", key);
-    return out;
+    return parent[0] ? path_printf(out, "%s.%s", parent, key)
+                     : path_printf(out, "%s", key);
 }
 
 /* "parent[i]" into out[PATH_LEN]. */
 static const char *index_path(char *out, const char *parent, int i)
 {
-    snprintf(out, PATH_LEN, "%s[%d]", parent, i);
-    return out;
+    return path_printf(out, "%s[%d]", parent, i);
 }
 
 /* ------------------------------------------------------------------ */
@@ -355,7 +369,7 @@ static int vector3(const ctx *c, const char *parent, const field *f,
 static int read_name(const ctx *c, const char *path, const field *f,
                      char out[TS_NAME_MAX])
 {
-    const char *t;
+    const char *t = NULL;
     int rc = field_text(c, path, f, "a name", &t);
     if (rc != TS_OK)
         return rc;
@@ -375,17 +389,20 @@ static int read_name(const ctx *c, const char *path, const field *f,
 static int read_count(const ctx *c, const char *path, const field *f,
                       int max, int *out)
 {
-    const char *t;
+    const char *t = NULL;
     char s[SHOW_BUF];
     int rc = field_text(c, path, f, "an integer", &t);
     if (rc != TS_OK)
         return rc;
-    double x;
-    rc = ts_units_parse(c->units, t, "1", path, &x, NULL);
+    /* A plain number: no unit (ts_units_parse would take "2000 %" as 20). */
+    double x = 0;
+    size_t len = f->value->data.scalar.length;
+    rc = strspn(t, "0123456789+-.eE \t") == len
+             ? ts_units_parse(c->units, t, "1", path, &x, NULL)
+             : TS_EINVAL;
     if (rc != TS_OK)
         return fail_at(c, TS_EINVAL, path, f->line, "must be an integer "
-                       ">= 1, got \"%s\"",
-                       show(t, f->value->data.scalar.length, s, sizeof s));
+                       ">= 1, got \"%s\"", show(t, len, s, sizeof s));
     if (x != floor(x))
         return fail_at(c, TS_EINVAL, path, f->line, "must be an integer "
                        ">= 1, got %g", x);
@@ -513,7 +530,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                            "name '%s' (bodies[%d], line %d)", body->name, j,
                            sys->bodies[j].line);
 
-    const char *type;
+    const char *type = NULL;
     rc = field_text(c, join(p, path, "type"), &f[B_TYPE], "sphere or junction",
                     &type);
     if (rc != TS_OK)
@@ -582,7 +599,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
 static int resolve_body(const ctx *c, const char *path, const field *f,
                         const ts_system *sys, int allow_tow, int *body)
 {
-    const char *t;
+    const char *t = NULL;
     char s[SHOW_BUF];
     int rc = field_text(c, path, f, "a body name", &t);
     if (rc != TS_OK)
@@ -733,7 +750,7 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
 
     cable->drag_law = TS_DRAG_STANDARD;
     if (f[C_LAW].value) {
-        const char *law;
+        const char *law = NULL;
         rc = field_text(c, join(p, path, "drag_law"), &f[C_LAW],
                         "standard or loading_functions", &law);
         if (rc != TS_OK)
@@ -1118,18 +1135,23 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
     int rc = buf ? TS_OK : ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
     while (rc == TS_OK) {
         if (len == cap) {
-            if (cap >= (size_t)MAX_FILE_BYTES) {
+            /* The buffer grows to at most MAX_FILE_BYTES + 1: filling that
+             * proves the file is too large. */
+            if (cap > (size_t)MAX_FILE_BYTES) {
                 rc = ts_fail(err, TS_EIO, "%s: larger than %ld bytes, not a "
                              "scene file", path, MAX_FILE_BYTES);
                 break;
             }
-            char *bigger = realloc(buf, cap * 2);
+            size_t bigger_cap = cap * 2 > (size_t)MAX_FILE_BYTES
+                                    ? (size_t)MAX_FILE_BYTES + 1
+                                    : cap * 2;
+            char *bigger = realloc(buf, bigger_cap);
             if (!bigger) {
                 rc = ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
                 break;
             }
             buf = bigger;
-            cap *= 2;
+            cap = bigger_cap;
         }
         size_t got = fread(buf + len, 1, cap - len, fp);
         len += got;

@@ -301,9 +301,17 @@ int ts_system_build(ts_system *s, ts_err *err)
     }
     free(done);
 
-    int nl = 0;
+    long long total = 0;
     for (int i = 0; i < nc; i++)
-        nl += s->cables[i].nlinks;
+        total += s->cables[i].nlinks;
+    if (total > TS_MAX_LINKS) {
+        free(order);
+        return ts_fail(err, TS_EINVAL,
+                       "cables: %lld links in all, more than the %d a "
+                       "system may have",
+                       total, TS_MAX_LINKS);
+    }
+    int nl = (int)total;
     s->nlinks = nl;
     s->nnodes = nl + 1;
     s->links = calloc((size_t)nl, sizeof *s->links);

@@ -268,8 +268,9 @@ static const char *describe(const ut_system *sys, const ut_unit *unit,
         while (*d == ' ')
             d++;
     }
-    snprintf(buf, size, "a quantity in %s", *d ? d : "1");
-    return buf;
+    /* Unnamed dimensions are short ("m-1.kg.s"); a longer one is cut. */
+    int len = snprintf(buf, size, "a quantity in %.100s", *d ? d : "1");
+    return len < 0 ? "a quantity of another dimension" : buf;
 }
 
 /* ------------------------------------------------------------------ */
@@ -397,9 +398,12 @@ static int rewrite_unit(const char *unit, const char *const from[],
     return replaced;
 }
 
-/* When `given` times (sign > 0) or divided by (sign < 0) an acceleration
- * has the dimension of `want`, the quantity is a mass given as a force or
- * the reverse. Returns 1 and writes into hint[size] a sentence to append. */
+/* When `given` times an acceleration has the dimension of `want`, a mass
+ * was given where a force is expected (a weight written "50 lb"); when
+ * `given` divided by an acceleration has it, the reverse. Then returns 1
+ * and writes into hint[size] a sentence to append, with the rewritten
+ * quantity ("50 lbf") when replacing lb/kg by lbf/kgf (or back) works;
+ * returns 0 otherwise. */
 static int mass_force_hint(const ut_system *sys, const ut_unit *given,
                            const ut_unit *want, const char *number,
                            const char *unit, char *hint, size_t size)

@@ -1,21 +1,32 @@
 /* towstab/linearize.h: the linear model z' = A z + B v about a state
- * (MODEL.md section 6; Kamman & Nguyen eqs. 56-65).
+ * (MODEL.md section 6; Kamman & Nguyen eqs. 56-65; doc/linear.md).
  *
  * A = df/dy and B = df/du by second-order central differences through the
  * one kernel, column by column (columns are independent and computed in
- * parallel with OpenMP when available). The first nq rows of A are exactly
- * [0 I] and of B zero. The step of column j is h_j = rel_step *
- * max(|y_j|, scale_j) with rel_step ~ eps^(1/3); the truncation error is
- * estimated by comparing with steps 2 h_j and reported.
+ * parallel with OpenMP when available, one ts_kernel_clone per thread).
+ * The first nq rows of A are exactly [0 I] and of B zero. The step of
+ * column j is h_j = rel_step * max(|x_j|, scale_j) (x_j the coordinate
+ * perturbed), rounded so that x_j + h_j is exact; scale_j is 1 rad for an
+ * angle, (sqrt(g l) + |V|) / l for the rate of a link of length l, the top
+ * link's length for a tow displacement, sqrt(g l) + |V| for a tow velocity
+ * and g for a tow acceleration. The truncation error is estimated by
+ * differentiating again with steps 2 h_j: for a smooth f the error of the
+ * h result is (A(2h) - A(h)) / 3 to leading order.
  *
  * Inputs v (TS_NINPUT = 9): tow-point displacement x, y, z (m), velocity
  * (m/s), acceleration (m/s^2) in the mean ship frame, named tow.surge,
  * tow.sway, tow.heave for displacement (their velocity and acceleration
  * columns follow in the same order). Matrices are column-major: A[i + j n].
+ *
+ * Besides A and B the result holds what the mode and response reports map
+ * through: the tension Jacobians (optional) and the derivatives of every
+ * link direction with respect to its two angles, from which node
+ * displacements follow exactly (ts_linear_node_displacements).
  */
 #ifndef TOWSTAB_LINEARIZE_H
 #define TOWSTAB_LINEARIZE_H
 
+#include "towstab/equilibrium.h"
 #include "towstab/error.h"
 #include "towstab/kernel.h"
 
@@ -23,18 +34,49 @@
 extern "C" {
 #endif
 
+/* Input channels (columns of B). */
+enum {
+    TS_IN_DISP = 0,   /* tow displacement x, y, z: columns 0, 1, 2 */
+    TS_IN_VEL = 3,    /* tow velocity x, y, z: columns 3, 4, 5 */
+    TS_IN_ACC = 6     /* tow acceleration x, y, z: columns 6, 7, 8 */
+};
+
 typedef struct ts_linear {
     int nstate;        /* n = 2 nq */
+    int nq;            /* generalised coordinates, 2 nlinks */
     int ninput;        /* TS_NINPUT */
-    double *A;         /* [n * n] column-major */
-    double *B;         /* [n * ninput] column-major */
+    int nlinks, nnodes;
+    double *A;         /* [n * n] column-major; rows 0..nq-1 are [0 I] */
+    double *B;         /* [n * ninput] column-major; rows 0..nq-1 zero */
     double *y0;        /* [n] state linearized about (kernel's charts) */
-    double *u0;        /* [ninput] input linearized about */
-    double trunc_err;  /* max |A(h) - A(2h)| / 3 over entries, 1/s or 1/s^2 */
+    double u0[TS_NINPUT]; /* input linearized about */
+    double *f0;        /* [n] f(y0, u0): zero at an exact equilibrium */
+    double *r0;        /* [3 nnodes] node positions at y0, m */
+    double *t0;        /* [nlinks] link tensions at y0, N */
+    double *dn;        /* [6 nlinks] dn/dtheta1, dn/dtheta2 of each link at
+                          y0 (1/rad, M frame, in the link's chart) */
+    double *Ty;        /* [nlinks * n] dT/dy (N/rad, N s/rad) column-major,
+                          or NULL unless opts.tensions */
+    double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
+                          or NULL unless opts.tensions */
+    double *h;         /* [n + ninput] the step used for each column */
+    double trunc_err;  /* max |A(h) - A(2h)| / 3 over the lower block */
+    double trunc_norm; /* ||A(h) - A(2h)||_F / 3 over the lower block: the
+                          size of the error matrix dA used for eigenvalue
+                          error bounds (1/s, 1/s^2 mixed, as A) */
+    double b_trunc_err;/* max |B(h) - B(2h)| / 3 */
+    double t_trunc_err;/* max |T(h) - T(2h)| / 3 of the tension rows */
     double a_scale;    /* max |A_ij| of the lower block, for relative use */
-    int kinks;         /* nodes within a step of the water surface: f is
-                          not smooth there and A is the mean of one-sided
-                          derivatives (MODEL.md section 6) */
+    double a_norm;     /* ||A||_F (whole matrix) */
+    int kinks;         /* nodes (tow point included) within 2 steps of the
+                          water surface z = 0 while the fluid has density:
+                          f is not smooth there and the central difference
+                          is the mean of one-sided derivatives (MODEL.md
+                          section 6) */
+    int kink_tow;      /* 1 when the tow point is one of them: only B (and
+                          Tu) are affected, not A */
+    int kink_node;     /* first such node other than the tow point, or -1 */
+    int threads;       /* threads used */
     long evaluations;  /* kernel evaluations used */
 } ts_linear;
 
@@ -42,22 +84,48 @@ typedef struct ts_linearize_opts {
     double rel_step;   /* default cbrt(DBL_EPSILON) ~ 6.1e-6 */
     int estimate_error;/* 1 (default): also differentiate with 2h */
     int threads;       /* 0 (default): OpenMP's choice; 1: serial */
+    int tensions;      /* 1: also fill Ty and Tu (default 0) */
 } ts_linearize_opts;
 
 TS_API void ts_linearize_opts_default(ts_linearize_opts *o);
 
-TS_API ts_linear *ts_linear_alloc(int nstate, int ninput, ts_err *err);
+/* Allocate a result sized for kernel k's system: A is n x n doubles, so
+ * 8 n^2 bytes (n = 4 nlinks; 2000 links: 512 MB). NULL on failure. */
+TS_API ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err);
 TS_API void ts_linear_free(ts_linear *lin);
 
 /* Linearize kernel k about state y0[nstate] and input u0[ninput] (NULL:
- * zero). The kernel's charts must be those of y0. Returns TS_OK, TS_CHART
- * (a perturbed state left the chart: re-chart y0 first) or TS_ENOMEM. */
+ * zero). The kernel's charts must be those of y0; the kernel's frame is
+ * used as set. Cost: (2 or 4) (n + 9) kernel evaluations, O(nlinks) each,
+ * so O(nlinks^2), divided among the threads. On return the kernel's
+ * last-evaluation results are those of (y0, u0). Returns TS_OK, TS_CHART
+ * (a perturbed state left the chart: re-chart y0 first), TS_ESINGULAR (the
+ * kernel failed at a perturbed state), TS_EINVAL (sizes differ) or
+ * TS_ENOMEM. */
 TS_API int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                         const ts_linearize_opts *opts, ts_linear *lin,
                         ts_err *err);
 
+/* Linearize about a solved equilibrium: refuses one that did not converge
+ * (TS_ECONV, naming its residual and target); otherwise re-charts k from
+ * eq->directions (ts_kernel_set_directions with TS_CHART_RECHART, so any
+ * kernel of the system will do) and calls ts_linearize with zero rates
+ * and zero input. */
+TS_API int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
+                                    const ts_linearize_opts *opts,
+                                    ts_linear *lin, ts_err *err);
+
+/* Node displacements dr[3 nnodes] (m, M frame; node 0, the tow point, is 0)
+ * produced by angle perturbations dq[nq] (rad) about lin->y0, to first
+ * order: dr_k = dr_p + l_k (dn/dt1 dq1 + dn/dt2 dq2) down the tree.
+ * Exact geometry, O(nlinks). */
+TS_API void ts_linear_node_displacements(const ts_system *sys,
+                                         const ts_linear *lin,
+                                         const double dq[], double dr[]);
+
 /* Name of input column j ("tow.surge", "tow.sway", "tow.heave",
- * "tow.surge_velocity", ..., "tow.heave_acceleration"). */
+ * "tow.surge_velocity", ..., "tow.heave_acceleration"); NULL outside
+ * [0, TS_NINPUT). */
 TS_API const char *ts_input_name(int j);
 
 #ifdef __cplusplus

@@ -33,7 +33,8 @@ typedef struct ts_scene_analysis {
 } ts_scene_analysis;
 
 typedef struct ts_scene {
-    char path[512];         /* as given to ts_scene_load, "" for strings */
+    char path[512];         /* as given to ts_scene_load (a longer path is
+                               refused with TS_EINVAL), "" for strings */
     ts_system *system;      /* built (ts_system_build has run) */
     int nanalyses;
     ts_scene_analysis *analyses;

@@ -17,6 +17,7 @@ extern "C" {
 #endif
 
 #define TS_NAME_MAX 64
+#define TS_MAX_LINKS 10000000   /* links in one system */
 
 typedef enum { TS_DRAG_STANDARD = 0, TS_DRAG_LOADING = 1 } ts_drag_law;
 

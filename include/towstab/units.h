@@ -6,6 +6,9 @@
  * of another dimension is refused with a message naming both dimensions
  * (a mass given where a weight is expected says so and suggests lbf).
  * The unit system is read once by ts_units_alloc() and is read-only after.
+ * udunits2 keeps process-wide parser state and a process-wide message
+ * handler (towstab silences it): do not call these functions from several
+ * threads at once, even on separate ts_units objects.
  */
 #ifndef TOWSTAB_UNITS_H
 #define TOWSTAB_UNITS_H

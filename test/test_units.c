@@ -1,0 +1,263 @@
+/* test_units.c: quantities with units (towstab/units.h).
+ *
+ * References are independent of udunits: the exact definitions
+ * 1 ft = 0.3048 m, 1 in = 0.0254 m, 1 lb = 0.45359237 kg,
+ * 1 lbf = 1 lb * 9.80665 m/s^2, 1 knot = 1852 m / 3600 s,
+ * 1 slug = 1 lbf s^2 / ft, 1 deg = pi/180 rad.
+ * Every error path of ts_units_parse is provoked at least once. */
+#include "towstab/units.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+
+#define FT 0.3048
+#define INCH 0.0254
+#define LB 0.45359237
+#define G0 9.80665
+#define LBF (LB * G0)
+#define KNOT (1852.0 / 3600.0)
+#define SLUG (LBF / FT)
+#define DEG (M_PI / 180.0)
+
+/* Conversions are exact up to a few rounding errors. */
+#define RTOL 1e-14
+
+static void test_conversions(const ts_units *u)
+{
+    static const struct {
+        const char *text, *si;
+        double want;
+    } cases[] = {
+        {"100 ft", "m", 100 * FT},
+        {"10 in", "m", 10 * INCH},
+        {"2.385 m", "m", 2.385},
+        {"2.385 cm", "m", 0.02385},
+        {"2.385 mm", "m", 0.002385},
+        {"2.385 km", "m", 2385},
+        {"50 lb", "kg", 50 * LB},
+        {"2 lbs", "kg", 2 * LB},
+        {"50 lbf", "N", 50 * LBF},
+        {"1 lbf/ft", "N/m", LBF / FT},
+        {"1 lb/ft", "kg/m", LB / FT},
+        {"2.385 kg/m", "kg/m", 2.385},
+        {"2.385 N/m", "N/m", 2.385},
+        {"8.345 ft/s", "m/s", 8.345 * FT},
+        {"5 knot", "m/s", 5 * KNOT},
+        {"5 kn", "m/s", 5 * KNOT},
+        {"5 kt", "m/s", 5 * KNOT},
+        {"5 knots", "m/s", 5 * KNOT},
+        {"5 kts", "m/s", 5 * KNOT},
+        {"2.385 m/s", "m/s", 2.385},
+        {"0.5 rad/s", "rad/s", 0.5},
+        {"28.65 deg/s", "rad/s", 28.65 * DEG},
+        {"28.65 degree/s", "rad/s", 28.65 * DEG},
+        {"1.2 rad", "rad", 1.2},
+        {"30 deg", "rad", 30 * DEG},
+        {"0.25 Hz", "Hz", 0.25},
+        {"2 1/s", "Hz", 2},
+        {"1.6 s", "s", 1.6},
+        {"1025 kg/m^3", "kg/m^3", 1025},
+        {"1.9905 slug/ft^3", "kg/m^3", 1.9905 * SLUG / (FT * FT * FT)},
+        {"2.385 N", "N", 2.385},
+        {"2.385 kN", "N", 2385},
+        {"2.385 N*m^2", "N*m^2", 2.385},
+        {"1 lbf*ft^2", "N*m^2", LBF * FT * FT},
+        {"9.80665 m/s^2", "m/s^2", G0},
+        {"32.174 ft/s^2", "m/s^2", 32.174 * FT},
+        {"1 nmi", "m", 1852},
+        {"60 mph", "m/s", 60 * 1609.344 / 3600},
+        /* Bare numbers are SI; spacing and exponents are free. */
+        {"2.385", "m", 2.385},
+        {"-3.5e-2", "m/s", -0.035},
+        {"+7", "N", 7},
+        {".5", "1", 0.5},
+        {"  7 mm  ", "m", 0.007},
+        {"100ft", "m", 100 * FT},
+        {"1e3 mm", "m", 1},
+        {"5 %", "1", 0.05},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        ts_err err;
+        ts_err_clear(&err);
+        double v = NAN;
+        int rc = ts_units_parse(u, cases[i].text, cases[i].si, "q", &v, &err);
+        CHECK(rc == TS_OK, "\"%s\" -> %s accepted (%s)", cases[i].text,
+              cases[i].si, err.msg);
+        char name[96];
+        snprintf(name, sizeof name, "\"%s\" in %s", cases[i].text,
+                 cases[i].si);
+        CHECK_REL(v, cases[i].want, RTOL, name);
+    }
+    /* The values the brief quotes, to their printed digits. */
+    double v;
+    ts_units_parse(u, "1 lbf/ft", "N/m", "q", &v, NULL);
+    CHECK_NEAR(v, 14.5939029372, 1e-10, "1 lbf/ft = 14.5939029372 N/m");
+    ts_units_parse(u, "5 knot", "m/s", "q", &v, NULL);
+    CHECK_NEAR(v, 2.57222, 1e-5, "5 knot = 2.57222 m/s");
+    ts_units_parse(u, "100 ft", "m", "q", &v, NULL);
+    CHECK(v == 30.48, "100 ft is exactly 30.48 m (got %.17g)", v);
+}
+
+/* One refused input: its code and the pieces its message must contain. */
+static void refused(const ts_units *u, const char *text, const char *si,
+                    int code, const char *part1, const char *part2)
+{
+    ts_err err;
+    ts_err_clear(&err);
+    double v = 2.385;
+    int rc = ts_units_parse(u, text, si, "cables[0].weight (line 9)", &v,
+                            &err);
+    CHECK(rc == code && err.code == code, "\"%s\" as %s refused with %d "
+          "(got %d)", text ? text : "(null)", si, code, rc);
+    CHECK(v == 2.385, "\"%s\": the value is untouched", text ? text : "");
+    CHECK(strncmp(err.msg, "cables[0].weight (line 9): ", 27) == 0,
+          "\"%s\": message starts with where: %s", text ? text : "", err.msg);
+    if (part1)
+        CHECK(strstr(err.msg, part1) != NULL, "message has '%s'", part1);
+    if (part2)
+        CHECK(strstr(err.msg, part2) != NULL, "message has '%s'", part2);
+    /* The same with a NULL error record. */
+    rc = ts_units_parse(u, text, si, "x", &v, NULL);
+    CHECK(rc == code, "\"%s\": same code with err == NULL", text ? text : "");
+}
+
+static void test_wrong_dimensions(const ts_units *u)
+{
+    refused(u, "50 lb", "N", TS_EUNIT,
+            "\"50 lb\" is a mass (kg), expected a force (N)",
+            "write \"50 lbf\", or give it as a mass");
+    refused(u, "1 lb/ft", "N/m", TS_EUNIT,
+            "is a mass per length (kg/m), expected a force per length (N/m)",
+            "\"1 lbf/ft\"");
+    refused(u, "2 kg/m", "N/m", TS_EUNIT, "mass per length", "\"2 kgf/m\"");
+    refused(u, "50 lbf", "kg", TS_EUNIT,
+            "is a force (N), expected a mass (kg)", "\"50 lb\"");
+    refused(u, "1 lbf/ft", "kg/m", TS_EUNIT, "expected a mass per length",
+            "\"1 lb/ft\"");
+    refused(u, "3 ft", "m/s", TS_EUNIT,
+            "is a length (m), expected a speed (m/s)", NULL);
+    refused(u, "3 ft/s", "m", TS_EUNIT, "is a speed (m/s)", "a length (m)");
+    refused(u, "3 N", "N*m^2", TS_EUNIT, "a force (N)", "bending stiffness");
+    refused(u, "1 kg*m", "N", TS_EUNIT, "a quantity in m.kg", NULL);
+    refused(u, "9 ft/s^2", "kg/m^3", TS_EUNIT, "an acceleration",
+            "a density (kg/m^3)");
+    /* Radians: udunits calls them dimensionless, we do not. */
+    refused(u, "0.5 Hz", "rad/s", TS_EUNIT, "a frequency (Hz)",
+            "expected an angular rate (rad/s)");
+    refused(u, "0.5 rad/s", "Hz", TS_EUNIT, "an angular rate", "frequency");
+    refused(u, "3 m/m", "rad", TS_EUNIT, "a plain number", "an angle (rad)");
+    /* Reciprocal units: udunits converts 5 s to 0.2 Hz, we refuse. */
+    refused(u, "5 s", "Hz", TS_EUNIT, "a time (s)", "a frequency (Hz)");
+    refused(u, "2 m", "1/m", TS_EUNIT, "a length (m)", NULL);
+    /* Offsets. */
+    refused(u, "20 degC", "K", TS_EUNIT, "offset", NULL);
+    /* Unknown units. */
+    refused(u, "30 fathoms_deep", "m", TS_EUNIT, "unknown unit "
+            "\"fathoms_deep\"", "expected a length (m)");
+    refused(u, "3 m\xc2\xb2", "m^2", TS_EUNIT, "not printable ASCII",
+            "\\xc2\\xb2");
+}
+
+static void test_garbage(const ts_units *u)
+{
+    refused(u, "", "m", TS_EINVAL, "empty value", "a length (m)");
+    refused(u, "   ", "m", TS_EINVAL, "empty value", NULL);
+    refused(u, NULL, "m", TS_EINVAL, "no value", NULL);
+    refused(u, "ft", "m", TS_EINVAL, "\"ft\" does not start with a number",
+            NULL);
+    refused(u, "abc", "m", TS_EINVAL, "does not start with a number", NULL);
+    refused(u, "nan", "m", TS_EINVAL, "not a finite number", NULL);
+    refused(u, ".nan", "m", TS_EINVAL, "\".nan\" is not a finite number",
+            NULL);
+    refused(u, "NaN m", "m", TS_EINVAL, "not a finite number", NULL);
+    refused(u, "inf", "m", TS_EINVAL, "not a finite number", NULL);
+    refused(u, "-inf", "m", TS_EINVAL, "not a finite number", NULL);
+    refused(u, ".inf", "m", TS_EINVAL, "not a finite number", NULL);
+    refused(u, "Infinity", "m", TS_EINVAL, "not a finite number", NULL);
+    refused(u, "1e999", "m", TS_EINVAL, "out of the range", NULL);
+    refused(u, "1e308 km", "m", TS_EINVAL, "out of the range", NULL);
+    refused(u, "0x10", "m", TS_EINVAL, "not a decimal number", NULL);
+    refused(u, "12 ft 3", "m", TS_EINVAL, "unexpected number \"3\"", NULL);
+    refused(u, "1.2.3", "m", TS_EINVAL, "unexpected number", NULL);
+    refused(u, "12 m )", "m", TS_EINVAL, "cannot read \"m )\"", NULL);
+    refused(u, "5 ft//s", "m/s", TS_EINVAL, "not a unit expression", NULL);
+    refused(u, "--1", "m", TS_EINVAL, "does not start with a number", NULL);
+
+    /* An SI unit the caller should never pass. */
+    ts_err err;
+    double v;
+    int rc = ts_units_parse(u, "1", "furlongz", "x", &v, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "unknown SI unit"),
+          "a bad SI unit from the caller is TS_EINVAL: %s", err.msg);
+    rc = ts_units_parse(NULL, "1", "m", "x", &v, &err);
+    CHECK(rc == TS_EINVAL, "NULL unit system refused: %s", err.msg);
+    /* Very long text is quoted shortened, not copied whole. */
+    char longtext[4000];
+    memset(longtext, 'q', sizeof longtext - 1);
+    longtext[sizeof longtext - 1] = '\0';
+    longtext[0] = '1';
+    longtext[1] = ' ';
+    rc = ts_units_parse(u, longtext, "m", "x", &v, &err);
+    CHECK(rc == TS_EUNIT && strlen(err.msg) < 400 && strstr(err.msg, "..."),
+          "a 4000-character unit is refused briefly (%zu chars)",
+          strlen(err.msg));
+}
+
+static void test_from_si(const ts_units *u)
+{
+    static const struct {
+        const char *text, *si, *unit;
+    } trips[] = {
+        {"12.5 ft", "m", "ft"},
+        {"3 knot", "m/s", "knot"},
+        {"2.385 lbf/ft", "N/m", "lbf/ft"},
+        {"28.65 deg/s", "rad/s", "deg/s"},
+        {"50 lbf", "N", "lbf"},
+        {"1.9905 slug/ft^3", "kg/m^3", "slug/ft^3"},
+    };
+    for (size_t i = 0; i < sizeof trips / sizeof trips[0]; i++) {
+        double si = NAN, back = NAN, number = strtod(trips[i].text, NULL);
+        ts_err err;
+        int rc = ts_units_parse(u, trips[i].text, trips[i].si, "q", &si, &err);
+        rc = rc ? rc : ts_units_from_si(u, si, trips[i].si, trips[i].unit,
+                                        &back, &err);
+        CHECK(rc == TS_OK, "round trip of \"%s\" ok", trips[i].text);
+        char name[64];
+        snprintf(name, sizeof name, "round trip \"%s\"", trips[i].text);
+        CHECK_REL(back, number, RTOL, name);
+    }
+    double out = 2.385;
+    ts_err err;
+    int rc = ts_units_from_si(u, 30.48, "m", "ft", &out, &err);
+    CHECK(rc == TS_OK, "30.48 m to ft");
+    CHECK_REL(out, 100, RTOL, "30.48 m = 100 ft");
+    out = 2.385;
+    rc = ts_units_from_si(u, 3, "m", "lbf", &out, &err);
+    CHECK(rc == TS_EUNIT && out == 2.385 && strstr(err.msg, "a length (m)") &&
+          strstr(err.msg, "a force (N)"), "m to lbf refused: %s", err.msg);
+    rc = ts_units_from_si(u, 1, "rad/s", "Hz", &out, &err);
+    CHECK(rc == TS_EUNIT, "rad/s to Hz refused: %s", err.msg);
+    rc = ts_units_from_si(u, 1, "m", "furlongz", &out, &err);
+    CHECK(rc == TS_EUNIT && strstr(err.msg, "furlongz"),
+          "unknown unit refused: %s", err.msg);
+}
+
+int main(void)
+{
+    ts_err err;
+    ts_err_clear(&err);
+    ts_units *u = ts_units_alloc(&err);
+    if (!CHECK(u != NULL, "ts_units_alloc: %s", err.msg))
+        return tc_done();
+    test_conversions(u);
+    test_wrong_dimensions(u);
+    test_garbage(u);
+    test_from_si(u);
+    ts_units_free(u);
+    ts_units_free(NULL);
+    CHECK(1, "ts_units_free(NULL) does nothing");
+    return tc_done();
+}
