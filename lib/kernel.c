@@ -468,8 +468,9 @@ double ts_kernel_potential_energy(const ts_kernel *k)
 void ts_direction_angles(const double n[3], double *theta1, double *theta2)
 {
     double ny = n[1] > 1 ? 1 : (n[1] < -1 ? -1 : n[1]);
-    *theta2 = asin(-ny);
-    *theta1 = atan2(n[2], -n[0]);
+    /* + 0.0 turns a negative zero into zero for display. */
+    *theta2 = asin(-ny) + 0.0;
+    *theta1 = atan2(n[2], -n[0]) + 0.0;
 }
 
 /* Angles and rates of link l in its chart for direction n and rate nd. */
