@@ -23,8 +23,9 @@
 /* Shooting mismatch target, relative to the total cable length: far below
  * what moves a force by 1e-10 of the largest one. */
 #define SHOOT_POS_RTOL 1e-13
-/* Central-difference step on angles for the Newton Jacobian (rad):
- * truncation ~h^2 and rounding ~eps/h balance near 1e-5 to 1e-6. */
+/* Central-difference step for the Newton Jacobian, relative to each
+ * coordinate's size (1 rad for angles, 1e-3 for strains): truncation ~h^2 and rounding ~eps/h balance near 1e-5 to
+ * 1e-6. */
 #define NEWTON_FD_STEP 1e-6
 #define NEWTON_ALPHA_MIN 1e-6
 
@@ -53,7 +54,7 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
     eq->nlinks = sys->nlinks;
     eq->nnodes = sys->nnodes;
     size_t nl = (size_t)sys->nlinks, nn = (size_t)sys->nnodes;
-    eq->y = calloc(4 * nl, sizeof(double));
+    eq->y = calloc(6 * nl, sizeof(double)); /* up to 3 coordinates a link */
     eq->directions = calloc(3 * nl, sizeof(double));
     eq->positions = calloc(3 * nn, sizeof(double));
     eq->tensions = calloc(nl, sizeof(double));
@@ -82,7 +83,8 @@ static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
                   double *dydt)
 {
     const ts_system *sys = ts_kernel_system(k);
-    int nl = sys->nlinks, nq = 2 * nl;
+    int nl = sys->nlinks, nq = ts_kernel_nq(k);
+    eq->nstate = 2 * nq;
     memcpy(eq->y, y, (size_t)nq * sizeof(double));
     memset(eq->y + nq, 0, (size_t)nq * sizeof(double));
     int rc = ts_kernel_eval(k, eq->y, NULL, dydt);
@@ -110,6 +112,8 @@ static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
 typedef struct newton_ws {
     int nq;
     double *J, *R, *dq, *yt, *f1, *f2;
+    double *scale;  /* [nq] size of each coordinate: 1 rad for angles,
+                       1e-3 for an elastic link's strain */
     double *ystart; /* [2 nq] start of every continuation schedule */
     int *ipiv;
 } newton_ws;
@@ -123,13 +127,27 @@ static void newton_ws_free(newton_ws *w)
     free(w->f1);
     free(w->f2);
     free(w->ystart);
+    free(w->scale);
     free(w->ipiv);
 }
 
-static int newton_ws_alloc(newton_ws *w, int nq)
+static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
 {
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k);
     size_t n = (size_t)nq;
     w->nq = nq;
+    w->scale = malloc(n * sizeof(double));
+    if (w->scale)
+        for (int l = 0; l < sys->nlinks; l++) {
+            int o = ts_kernel_link_offset(k, l);
+            int e = sys->links[l].elastic;
+            w->scale[o] = w->scale[o + 1] = 1.0;
+            /* A strain's step: small against any strain a cable carries,
+             * large against rounding. */
+            if (e)
+                w->scale[o + 2] = 1e-3;
+        }
     w->J = malloc(n * n * sizeof(double));
     w->R = malloc(2 * n * sizeof(double));
     w->dq = malloc(n * sizeof(double));
@@ -139,7 +157,7 @@ static int newton_ws_alloc(newton_ws *w, int nq)
     w->ystart = calloc(2 * n, sizeof(double));
     w->ipiv = malloc(n * sizeof(int));
     return w->J && w->R && w->dq && w->yt && w->f1 && w->f2 && w->ystart &&
-           w->ipiv;
+           w->scale && w->ipiv;
 }
 
 static double norm2(const double *v, int n)
@@ -171,7 +189,7 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         eq->iterations++;
         /* Jacobian of q'' by central differences, column by column. */
         for (int j = 0; j < nq; j++) {
-            double h = NEWTON_FD_STEP, y0 = y[j];
+            double h = NEWTON_FD_STEP * w->scale[j], y0 = y[j];
             y[j] = y0 + h;
             int r1 = ts_kernel_eval(k, y, NULL, w->f1);
             y[j] = y0 - h;
@@ -303,12 +321,14 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                        "cables with bending stiffness (EI > 0); use newton "
                        "or auto");
 
-    int nl = sys->nlinks, nq = 2 * nl, rc;
-    double *y = calloc(4 * (size_t)nl, sizeof(double));
-    double *dydt = malloc(4 * (size_t)nl * sizeof(double));
+    int nl = sys->nlinks, nq = ts_kernel_nq(k), rc;
+    double *y = calloc(2 * (size_t)nq, sizeof(double));
+    double *dydt = malloc(2 * (size_t)nq * sizeof(double));
+    double *dvec = malloc(3 * (size_t)nl * sizeof(double));
+    double *strain = calloc((size_t)nl, sizeof(double));
     tsi_march *m = tsi_march_alloc(sys, err);
     newton_ws w = {0};
-    if (!y || !dydt || !m) {
+    if (!y || !dydt || !dvec || !strain || !m) {
         rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
         goto out;
     }
@@ -319,8 +339,9 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         ts_err serr = {0};
         rc = solve_shooting(k, m, &frame, &o, eq, &serr);
         if (rc == TS_OK) {
-            ts_kernel_set_directions(k, tsi_march_directions(m), NULL,
-                                     TS_CHART_RECHART, y);
+            tsi_march_strains(m, strain);
+            ts_kernel_set_shape(k, tsi_march_directions(m), strain, NULL,
+                                NULL, TS_CHART_RECHART, y);
             have_guess = 1;
             if ((rc = record(k, y, eq, dydt)) == TS_OK && eq->residual <= o.tol) {
                 eq->method = TS_EQ_SHOOTING;
@@ -343,7 +364,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     /* General Newton, from the straight-tow march (no bending) or from the
      * shooting result, with continuation in turn rate. */
     eq->method = TS_EQ_NEWTON;
-    if (!newton_ws_alloc(&w, nq)) {
+    if (!newton_ws_alloc(&w, k)) {
         rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory for a "
                                      "%d x %d Newton Jacobian",
                      nq, nq);
@@ -367,15 +388,17 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         if (x && tsi_march_solve(m, &straight, x, 1,
                                  SHOOT_POS_RTOL * total_length(sys),
                                  o.max_iter, &it, &ev, &merr) == TS_OK) {
-            ts_kernel_set_directions(k, tsi_march_directions(m), NULL,
-                                     TS_CHART_RECHART, y0);
+            tsi_march_strains(m, strain);
+            memcpy(dvec, tsi_march_directions(m),
+                   3 * (size_t)nl * sizeof(double));
         } else {
-            /* Hanging straight down. */
+            /* Hanging straight down, unstretched. */
             for (int l = 0; l < nl; l++) {
-                y0[2 * l] = M_PI / 2;
-                y0[2 * l + 1] = 0;
+                dvec[3 * l] = dvec[3 * l + 1] = 0.0;
+                dvec[3 * l + 2] = 1.0;
             }
         }
+        ts_kernel_set_shape(k, dvec, strain, NULL, NULL, TS_CHART_RECHART, y0);
         free(x);
         eq->evaluations += ev;
     }
@@ -411,6 +434,8 @@ out:
     tsi_march_free(m);
     free(y);
     free(dydt);
+    free(dvec);
+    free(strain);
     if (rc == TS_OK && !eq->converged)
         rc = ts_fail(err, TS_ECONV,
                      "equilibrium: not converged, relative residual %.3g "

@@ -33,6 +33,9 @@
 struct ts_kernel {
     const ts_system *sys;
     int nl, nn;
+    int nq;            /* generalised coordinates: 2 per rigid link, 3 per
+                          elastic link */
+    int *off;          /* [nl] offset of link l's coordinates in q */
     ts_frame frame;
 
     double *chart;     /* [9 nl] row-major rotation per link */
@@ -81,6 +84,7 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     k->sys = sys;
     k->nl = nl;
     k->nn = nn;
+    k->off = zalloc(snl, sizeof(int), &fail);
     k->chart = zalloc(9 * snl, sizeof(double), &fail);
     k->charted = zalloc(snl, 1, &fail);
     k->n = zalloc(3 * snl, sizeof(double), &fail);
@@ -114,6 +118,8 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     for (int l = 0; l < nl; l++) {
         double *R = k->chart + 9 * l;
         R[0] = R[4] = R[8] = 1.0;
+        k->off[l] = k->nq;
+        k->nq += sys->links[l].elastic ? 3 : 2;
     }
     k->frame.speed = sys->tow.speed;
     k->frame.turn_rate = sys->tow.turn_rate;
@@ -125,6 +131,7 @@ void ts_kernel_free(ts_kernel *k)
 {
     if (!k)
         return;
+    free(k->off);
     free(k->chart);
     free(k->charted);
     free(k->n);
@@ -164,8 +171,9 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
 }
 
 const ts_system *ts_kernel_system(const ts_kernel *k) { return k->sys; }
-int ts_kernel_nq(const ts_kernel *k) { return 2 * k->nl; }
-int ts_kernel_nstate(const ts_kernel *k) { return 4 * k->nl; }
+int ts_kernel_nq(const ts_kernel *k) { return k->nq; }
+int ts_kernel_nstate(const ts_kernel *k) { return 2 * k->nq; }
+int ts_kernel_link_offset(const ts_kernel *k, int link) { return k->off[link]; }
 int ts_kernel_ninput(const ts_kernel *k)
 {
     (void)k;
@@ -212,7 +220,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     const ts_system *sys = k->sys;
     const ts_link *links = sys->links;
     const ts_node *nodes = sys->nodes;
-    const int nl = k->nl, nn = k->nn, nq = 2 * nl;
+    const int nl = k->nl, nn = k->nn, nq = k->nq;
     const double *qd = y + nq;
     const double rho = sys->env.water_density, g = sys->env.gravity;
     const int added = sys->has_added_mass;
@@ -225,26 +233,44 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         k->r[j] = sys->tow.point[j] + u[j];
         k->rd[j] = u[3 + j];
     }
-    int chart_bad = 0;
+    int chart_bad = 0, slack_bad = 0;
     for (int l = 0; l < nl; l++) {
-        double *n = k->n + 3 * l, *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
+        const ts_link *L = &links[l];
+        const int o = k->off[l];
+        double *n = k->n + 3 * l, *nd = k->nd + 3 * l;
+        const double *rp = k->r + 3 * L->upper, *rdp = k->rd + 3 * L->upper;
+        double *rk = k->r + 3 * L->lower, *rdk = k->rd + 3 * L->lower;
+        double *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
         double c2, s2;
-        link_axes(k, l, y[2 * l], y[2 * l + 1], n, e1, e2, &c2, &s2);
+        link_axes(k, l, y[o], y[o + 1], n, e1, e2, &c2, &s2);
         k->c2[l] = c2;
         k->s2[l] = s2;
         if (!(fabs(c2) >= TS_CHART_MIN))
             chart_bad = 1;
-        double *nd = k->nd + 3 * l;
-        double a1 = c2 * qd[2 * l], a2 = qd[2 * l + 1];
+        double a1 = c2 * qd[o], a2 = qd[o + 1];
         for (int j = 0; j < 3; j++)
             nd[j] = a1 * e1[j] + a2 * e2[j];
-        const ts_link *L = &links[l];
-        const double *rp = k->r + 3 * L->upper, *rdp = k->rd + 3 * L->upper;
-        double *rk = k->r + 3 * L->lower, *rdk = k->rd + 3 * L->lower;
-        for (int j = 0; j < 3; j++) {
-            rk[j] = rp[j] + L->length * n[j];
-            rdk[j] = rdp[j] + L->length * nd[j];
+        /* An elastic link's third coordinate is its strain e: length
+         * l (1 + e), tension EA e + Cv l e', never compressive. */
+        double len = L->length, lrate = 0.0;
+        if (L->elastic) {
+            double e = y[o + 2], ed = qd[o + 2];
+            len = L->length * (1.0 + e);
+            lrate = L->length * ed;
+            if (!(len > 0))
+                slack_bad = 1;
+            double T = L->ea * e + L->damping * lrate;
+            k->t[l] = T > 0 ? T : 0.0;
         }
+        for (int j = 0; j < 3; j++) {
+            rk[j] = rp[j] + len * n[j];
+            rdk[j] = rdp[j] + len * nd[j] + lrate * n[j];
+        }
+    }
+    if (slack_bad) {
+        for (int i = 0; i < 2 * nq; i++)
+            dydt[i] = NAN;
+        return TS_ESINGULAR;
     }
     if (chart_bad) {
         for (int i = 0; i < 2 * nq; i++)
@@ -309,11 +335,19 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
     }
 
-    /* 3a. Free ends to tow point: articulated mass and load. */
+    /* 3a. Free ends to tow point: articulated mass and load. An elastic
+     * link passes no inertia up: its known tension pulls both ends. */
     for (int i = 1; i < nn; i++) {
         memcpy(k->Mh + 6 * i, k->M + 6 * i, 6 * sizeof(double));
         v3_copy(k->Q + 3 * i, k->Fh + 3 * i);
     }
+    if (sys->has_elastic)
+        for (int l = 0; l < nl; l++)
+            if (links[l].elastic) {
+                if (links[l].upper > 0)
+                    v3_axpy(k->t[l], k->n + 3 * l, k->Fh + 3 * links[l].upper);
+                v3_axpy(-k->t[l], k->n + 3 * l, k->Fh + 3 * links[l].lower);
+            }
     for (int l = nl - 1; l >= 0; l--) {
         const ts_link *L = &links[l];
         int i = L->lower, p = L->upper;
@@ -327,6 +361,8 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
         v3_copy(k->Fh + 3 * i, gi);
         sym3_chol_solve(Lc, gi);
+        if (L->elastic)
+            continue;
         v3_copy(n, wi);
         sym3_chol_solve(Lc, wi);
         double D = v3_dot(n, wi);
@@ -350,6 +386,10 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         const ts_link *L = &links[l];
         int i = L->lower, p = L->upper;
         const double *n = k->n + 3 * l;
+        if (L->elastic) {
+            v3_copy(k->g + 3 * i, k->a + 3 * i);
+            continue;
+        }
         double t = k->beta[l] - v3_dot(n, k->a + 3 * p) / k->D[l];
         k->t[l] = t;
         double *ai = k->a + 3 * i;
@@ -366,16 +406,31 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         const double *ri = k->rdd + 3 * L->lower, *rp = k->rdd + 3 * L->upper;
-        double ndd[3] = {(ri[0] - rp[0]) / L->length,
-                         (ri[1] - rp[1]) / L->length,
-                         (ri[2] - rp[2]) / L->length};
-        double t1d = qd[2 * l], t2d = qd[2 * l + 1];
+        const int o = k->off[l];
+        const double *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
+        double dd2[3] = {ri[0] - rp[0], ri[1] - rp[1], ri[2] - rp[2]};
+        double t1d = qd[o], t2d = qd[o + 1];
         double c2 = k->c2[l], s2 = k->s2[l];
-        dydt[2 * l] = t1d;
-        dydt[2 * l + 1] = t2d;
-        dydt[nq + 2 * l] =
-            (v3_dot(k->e1 + 3 * l, ndd) + 2.0 * s2 * t1d * t2d) / c2;
-        dydt[nq + 2 * l + 1] = v3_dot(k->e2 + 3 * l, ndd) - c2 * s2 * t1d * t1d;
+        /* d'' = len n'' + 2 len' n' + len'' n with n.n' = 0 and
+         * n.n'' = -|n'|^2: the e1, e2 parts of n'' and the strain's. */
+        double len = L->length, a1 = v3_dot(e1, dd2), a2 = v3_dot(e2, dd2);
+        if (L->elastic) {
+            double e = y[o + 2], ed = qd[o + 2];
+            len = L->length * (1.0 + e);
+            double lrate2 = 2.0 * L->length * ed;
+            a1 -= lrate2 * c2 * t1d;
+            a2 -= lrate2 * t2d;
+            const double *nd = k->nd + 3 * l;
+            dydt[o + 2] = ed;
+            dydt[nq + o + 2] = v3_dot(k->n + 3 * l, dd2) / L->length +
+                               (1.0 + e) * v3_dot(nd, nd);
+        }
+        a1 /= len;
+        a2 /= len;
+        dydt[o] = t1d;
+        dydt[o + 1] = t2d;
+        dydt[nq + o] = (a1 + 2.0 * s2 * t1d * t2d) / c2;
+        dydt[nq + o + 1] = a2 - c2 * s2 * t1d * t1d;
     }
     return TS_OK;
 }
@@ -457,6 +512,11 @@ double ts_kernel_potential_energy(const ts_kernel *k)
         U -= sys->nodes[i].mass * g * k->r[3 * i + 2];
     for (int l = 0; l < k->nl; l++) {
         const ts_link *L = &sys->links[l];
+        /* Strain energy 1/2 EA l e^2 while taut (t = EA e > 0). */
+        if (L->elastic && k->t[l] > 0) {
+            double e = k->t[l] / L->ea;
+            U += 0.5 * L->ea * L->length * e * e;
+        }
         if (L->ei > 0)
             U += tsi_bending_energy(L->ei, L->length,
                                     sys->links[L->next].length, k->n + 3 * l,
@@ -492,52 +552,100 @@ static void link_set(ts_kernel *k, int l, const double n[3],
     }
 }
 
-int ts_kernel_set_directions(ts_kernel *k, const double n[],
-                             const double ndot[], double threshold,
-                             double y[])
+/* Coordinates of link l for unit direction n, direction rate nd (NULL:
+ * zero), strain e and strain rate ed (elastic links; ignored for rigid
+ * ones). A link whose |cos theta2| would fall below threshold is first
+ * moved to a chart centred on n. Returns 1 when re-charted. */
+static int set_one_link(ts_kernel *k, int l, const double n[3],
+                        const double nd[3], double e, double ed,
+                        double threshold, double y[])
 {
-    int nq = 2 * k->nl, moved = 0;
+    const int o = k->off[l], nq = k->nq;
+    if (k->sys->links[l].elastic) {
+        y[o + 2] = e;
+        y[nq + o + 2] = ed;
+    }
+    double t1, t2, t1d, t2d;
+    int moved = 0;
+    link_set(k, l, n, nd, &t1, &t2, &t1d, &t2d);
+    if (fabs(cos(t2)) < threshold) {
+        tsi_chart_centred(n, k->chart + 9 * l);
+        k->charted[l] = 1;
+        link_set(k, l, n, nd, &t1, &t2, &t1d, &t2d);
+        moved = 1;
+    }
+    y[o] = t1;
+    y[o + 1] = t2;
+    y[nq + o] = t1d;
+    y[nq + o + 1] = t2d;
+    return moved;
+}
+
+int ts_kernel_set_shape(ts_kernel *k, const double n[], const double strain[],
+                        const double ndot[], const double strain_rate[],
+                        double threshold, double y[])
+{
+    int moved = 0;
+    for (int l = 0; l < k->nl; l++)
+        moved += set_one_link(k, l, n + 3 * l, ndot ? ndot + 3 * l : NULL,
+                              strain ? strain[l] : 0.0,
+                              strain_rate ? strain_rate[l] : 0.0, threshold,
+                              y);
+    return moved;
+}
+
+int ts_kernel_set_links(ts_kernel *k, const double d[], const double ddot[],
+                        double threshold, double y[])
+{
+    int moved = 0;
     for (int l = 0; l < k->nl; l++) {
-        const double *nl_ = n + 3 * l, *nd = ndot ? ndot + 3 * l : NULL;
-        double t1, t2, t1d, t2d;
-        link_set(k, l, nl_, nd, &t1, &t2, &t1d, &t2d);
-        if (fabs(cos(t2)) < threshold) {
-            tsi_chart_centred(nl_, k->chart + 9 * l);
-            k->charted[l] = 1;
-            link_set(k, l, nl_, nd, &t1, &t2, &t1d, &t2d);
-            moved++;
+        const ts_link *L = &k->sys->links[l];
+        const double *dl = d + 3 * l, *ddl = ddot ? ddot + 3 * l : NULL;
+        double len = v3_norm(dl), n[3], nd[3], along = 0.0;
+        for (int j = 0; j < 3; j++)
+            n[j] = dl[j] / len;
+        if (ddl) {
+            along = v3_dot(n, ddl);
+            for (int j = 0; j < 3; j++)
+                nd[j] = (ddl[j] - along * n[j]) / len;
         }
-        y[2 * l] = t1;
-        y[2 * l + 1] = t2;
-        y[nq + 2 * l] = t1d;
-        y[nq + 2 * l + 1] = t2d;
+        moved += set_one_link(k, l, n, ddl ? nd : NULL,
+                              len / L->length - 1.0, along / L->length,
+                              threshold, y);
     }
     return moved;
 }
 
-/* Direction and direction rate of link l for state y. */
+int ts_kernel_set_directions(ts_kernel *k, const double n[],
+                             const double ndot[], double threshold,
+                             double y[])
+{
+    return ts_kernel_set_shape(k, n, NULL, ndot, NULL, threshold, y);
+}
+
+/* Direction and direction rate of rigid link l for state y. */
 static void link_dir_rate(const ts_kernel *k, int l, const double y[],
                           double n[3], double nd[3])
 {
-    int nq = 2 * k->nl;
+    const int o = k->off[l], nq = k->nq;
     double e1[3], e2[3], c2, s2;
-    link_axes(k, l, y[2 * l], y[2 * l + 1], n, e1, e2, &c2, &s2);
+    link_axes(k, l, y[o], y[o + 1], n, e1, e2, &c2, &s2);
     for (int j = 0; j < 3; j++)
-        nd[j] = c2 * y[nq + 2 * l] * e1[j] + y[nq + 2 * l + 1] * e2[j];
+        nd[j] = c2 * y[nq + o] * e1[j] + y[nq + o + 1] * e2[j];
 }
 
 int ts_kernel_rechart(ts_kernel *k, double y[], double threshold)
 {
-    int nq = 2 * k->nl, moved = 0;
+    int nq = k->nq, moved = 0;
     for (int l = 0; l < k->nl; l++) {
-        if (fabs(cos(y[2 * l + 1])) >= threshold)
+        const int o = k->off[l];
+        if (fabs(cos(y[o + 1])) >= threshold)
             continue;
         double n[3], nd[3];
         link_dir_rate(k, l, y, n, nd);
         tsi_chart_centred(n, k->chart + 9 * l);
         k->charted[l] = 1;
-        link_set(k, l, n, nd, &y[2 * l], &y[2 * l + 1], &y[nq + 2 * l],
-                 &y[nq + 2 * l + 1]);
+        link_set(k, l, n, nd, &y[o], &y[o + 1], &y[nq + o], &y[nq + o + 1]);
         moved++;
     }
     return moved;
@@ -545,10 +653,11 @@ int ts_kernel_rechart(ts_kernel *k, double y[], double threshold)
 
 int ts_kernel_reset_charts(ts_kernel *k, double y[], double threshold)
 {
-    int nq = 2 * k->nl, left = 0;
+    int nq = k->nq, left = 0;
     for (int l = 0; l < k->nl; l++) {
         if (!k->charted[l])
             continue;
+        const int o = k->off[l];
         double n[3], nd[3], t1, t2;
         link_dir_rate(k, l, y, n, nd);
         ts_direction_angles(n, &t1, &t2);
@@ -557,8 +666,7 @@ int ts_kernel_reset_charts(ts_kernel *k, double y[], double threshold)
             continue;
         }
         k->charted[l] = 0;
-        link_set(k, l, n, nd, &y[2 * l], &y[2 * l + 1], &y[nq + 2 * l],
-                 &y[nq + 2 * l + 1]);
+        link_set(k, l, n, nd, &y[o], &y[o + 1], &y[nq + o], &y[nq + o + 1]);
     }
     return left;
 }

@@ -26,6 +26,10 @@
 /* Local root: |H_perp| below this fraction of |H| (rounding is ~1e-16). */
 #define LOCAL_RTOL 1e-13
 #define LOCAL_MAXIT 60
+/* Elastic link length: relative change at which the stretch has settled,
+ * and the most iterations allowed. */
+#define ELASTIC_LEN_RTOL 1e-15
+#define ELASTIC_MAXIT 200
 /* The local Newton: iterations before GSL's hybrid solver takes over, and
  * its forward-difference step in chart coordinates (~ sqrt(eps)). */
 #define LOCAL_NEWTON_MAXIT 8
@@ -43,6 +47,7 @@ struct tsi_march {
     int *res_of_link;   /* [nl] residual index or -1 */
 
     double *n, *t;      /* [3 nl], [nl] */
+    double *len;        /* [nl] link lengths (stretched when elastic) */
     int have_n;         /* n holds the last solution (warm start) */
     double *r;          /* [3 nn] marched positions */
     char *rset;         /* [nn] position known */
@@ -73,6 +78,7 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     m->res_of_link = malloc(nl * sizeof(int));
     m->n = calloc(3 * nl, sizeof(double));
     m->t = calloc(nl, sizeof(double));
+    m->len = calloc(nl, sizeof(double));
     m->r = calloc(3 * nn, sizeof(double));
     m->rset = calloc(nn, 1);
     m->K = calloc(3 * nn, sizeof(double));
@@ -81,7 +87,7 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     m->lx = gsl_vector_alloc(2);
     if (!m->leaf_node || !m->res_link || !m->member || !m->jac0 ||
         !m->res_of_link ||
-        !m->n || !m->t || !m->r || !m->rset || !m->K || !m->Ma ||
+        !m->n || !m->t || !m->len || !m->r || !m->rset || !m->K || !m->Ma ||
         !m->local || !m->lx)
         goto nomem;
 
@@ -149,6 +155,7 @@ void tsi_march_free(tsi_march *m)
     free(m->res_of_link);
     free(m->n);
     free(m->t);
+    free(m->len);
     free(m->r);
     free(m->rset);
     free(m->K);
@@ -163,6 +170,14 @@ void tsi_march_free(tsi_march *m)
 int tsi_march_nunknown(const tsi_march *m) { return 3 * m->nleaf; }
 const double *tsi_march_directions(const tsi_march *m) { return m->n; }
 const double *tsi_march_tensions(const tsi_march *m) { return m->t; }
+
+void tsi_march_strains(const tsi_march *m, double *e)
+{
+    for (int l = 0; l < m->nl; l++) {
+        const ts_link *L = &m->sys->links[l];
+        e[l] = L->elastic ? m->t[l] / L->ea : 0.0;
+    }
+}
 double tsi_march_mismatch(const tsi_march *m) { return m->mismatch; }
 
 /* The balance of one node, for the local root. */
@@ -171,6 +186,7 @@ typedef struct link_problem {
     const ts_link *L;
     const ts_frame *f;
     const double *ri;   /* lower node position */
+    double len;         /* link length (stretched when elastic) */
     double K[3];        /* known part of the right-hand side */
     double afr[3];      /* frame acceleration of the lower node */
     double R[9];        /* local chart */
@@ -183,7 +199,7 @@ static void link_rhs(const link_problem *P, const double n[3], double H[3],
     const ts_link *L = P->L;
     double rp[3], rm[3], w[3], zero[3] = {0, 0, 0}, s;
     for (int j = 0; j < 3; j++) {
-        rp[j] = P->ri[j] - L->length * n[j];
+        rp[j] = P->ri[j] - P->len * n[j];
         rm[j] = 0.5 * (rp[j] + P->ri[j]);
     }
     tsi_rel_velocity(P->f, rm, zero, w);
@@ -288,11 +304,13 @@ static int local_newton(const link_problem *P, double tol, double x[2])
     return rn <= tol;
 }
 
-/* Direction of link l: n_l parallel to H(n_l). `guess` is a unit vector. */
-static int solve_link(tsi_march *m, link_problem *P, int l,
-                      const double guess[3], int warm, ts_err *err)
+/* Direction n of link l parallel to H(n), its tension t = H.n and its load
+ * F, for the link length in P. `guess` is a unit vector. */
+static int solve_link(tsi_march *m, link_problem *P, const double guess[3],
+                      int warm, double n[3], double *t, double F[3],
+                      ts_err *err)
 {
-    double H[3], F[3], n[3];
+    double H[3];
     v3_copy(guess, n);
     /* Without a previous solution, two fixed-point sweeps put the chart
      * centre near the root. */
@@ -345,19 +363,53 @@ static int solve_link(tsi_march *m, link_problem *P, int l,
                        L->cable, m->sys->cables[L->cable].name, L->index,
                        perp, hnorm);
     }
-    v3_copy(n, m->n + 3 * l);
-    m->t[l] = v3_dot(H, n);
-    /* Pass the link's half load, tension and added mass up. */
+    *t = v3_dot(H, n);
+    return TS_OK;
+}
+
+/* Solve link l and pass its half load, tension and added mass up to its
+ * upper node. An elastic link's length follows its tension,
+ * l = l0 (1 + T / EA): iterated to rounding (the map contracts by about
+ * T / EA per step). */
+static int march_link(tsi_march *m, link_problem *P, int l,
+                      const double guess[3], ts_err *err)
+{
     const ts_link *L = P->L;
+    double n[3], F[3], t = 0.0;
+    P->len = L->elastic && m->have_n ? m->len[l] : L->length;
+    int rc = solve_link(m, P, guess, m->have_n, n, &t, F, err);
+    for (int it = 0; rc == TS_OK && L->elastic; it++) {
+        if (!(t > 0))
+            return ts_fail(err, TS_ESINGULAR,
+                           "equilibrium: elastic cables[%d] '%s' link %d is "
+                           "slack (tension %.3g N): no steady shape with a "
+                           "slack elastic link",
+                           L->cable, m->sys->cables[L->cable].name, L->index,
+                           t);
+        double len = L->length * (1.0 + t / L->ea); /* Hooke: e = T / EA */
+        if (fabs(len - P->len) <= ELASTIC_LEN_RTOL * len)
+            break;
+        if (it >= ELASTIC_MAXIT)
+            return ts_fail(err, TS_ECONV,
+                           "equilibrium: the stretch of cables[%d] '%s' link "
+                           "%d did not settle (EA %.3g N, tension %.3g N)",
+                           L->cable, m->sys->cables[L->cable].name, L->index,
+                           L->ea, t);
+        P->len = len;
+        rc = solve_link(m, P, n, 1, n, &t, F, err);
+    }
+    if (rc != TS_OK)
+        return rc;
+    v3_copy(n, m->n + 3 * l);
+    m->t[l] = t;
+    m->len[l] = P->len;
     int p = L->upper;
     double *Kp = m->K + 3 * p;
     for (int j = 0; j < 3; j++)
-        Kp[j] += 0.5 * F[j] + m->t[l] * n[j];
+        Kp[j] += 0.5 * F[j] + t * n[j];
     if (m->sys->has_added_mass && L->can > 0) {
-        double rp[3];
-        for (int j = 0; j < 3; j++)
-            rp[j] = P->ri[j] - L->length * n[j];
-        double s = tsi_link_submerged(rp[2], P->ri[2]);
+        double zp = P->ri[2] - P->len * n[2];
+        double s = tsi_link_submerged(zp, P->ri[2]);
         double rho = m->sys->env.water_density;
         double A = L->can * rho * M_PI * 0.25 * L->diameter * L->diameter *
                    L->length * s;
@@ -412,7 +464,7 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
             v3_copy(m->n + 3 * l, guess);
         else if (nd->child_begin < nd->child_end)
             v3_copy(m->n + 3 * sys->child_links[nd->child_end - 1], guess);
-        int rc = solve_link(m, &P, l, guess, m->have_n, err);
+        int rc = march_link(m, &P, l, guess, err);
         if (rc != TS_OK) {
             m->have_n = 0;
             return rc;
@@ -422,7 +474,7 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
         int p = L->upper;
         double rp[3];
         for (int j = 0; j < 3; j++)
-            rp[j] = ri[j] - L->length * m->n[3 * l + j];
+            rp[j] = ri[j] - m->len[l] * m->n[3 * l + j];
         int a = m->res_of_link[l];
         if (a >= 0) {
             const double *target = p == 0 ? sys->tow.point : m->r + 3 * p;

@@ -10,6 +10,7 @@
  * one side of the surface does not depend on those positions at all (the
  * shape only translates), so one correction closes it exactly; turns and
  * surface crossings take a few Powell hybrid iterations (GSL).
+ * Elastic links are marched too: their length follows their tension.
  * Bending (EI > 0) couples a node to the link above it and is not marched.
  */
 #ifndef TOWSTAB_MARCH_H
@@ -43,6 +44,10 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
 /* Results of the last march: link directions [3 nlinks], tensions. */
 const double *tsi_march_directions(const tsi_march *m);
 const double *tsi_march_tensions(const tsi_march *m);
+
+/* Strains e = T / EA of the last march into e[nlinks] (0 for rigid
+ * links). */
+void tsi_march_strains(const tsi_march *m, double *e);
 
 /* Largest |mismatch| of the last march, m. */
 double tsi_march_mismatch(const tsi_march *m);

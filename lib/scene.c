@@ -693,13 +693,15 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
                        ts_system *sys)
 {
     enum { C_NAME, C_FROM, C_TO, C_LENGTH, C_DIAM, C_WEIGHT, C_MPL, C_WET,
-           C_LINKS, C_LINK_LENGTHS, C_CDN, C_CDT, C_CAN, C_LAW, C_EI, C_N };
+           C_LINKS, C_LINK_LENGTHS, C_CDN, C_CDT, C_CAN, C_LAW, C_EI, C_EA,
+           C_DAMP, C_N };
     field f[C_N] = {{"name", 0, 0}, {"from", 0, 0}, {"to", 0, 0},
                     {"length", 0, 0}, {"diameter", 0, 0}, {"weight", 0, 0},
                     {"mass_per_length", 0, 0}, {"wet_weight", 0, 0},
                     {"links", 0, 0}, {"link_lengths", 0, 0},
                     {"normal_drag", 0, 0}, {"tangential_drag", 0, 0},
-                    {"added_mass", 0, 0}, {"drag_law", 0, 0}, {"EI", 0, 0}};
+                    {"added_mass", 0, 0}, {"drag_law", 0, 0}, {"EI", 0, 0},
+                    {"EA", 0, 0}, {"damping", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     index_path(path, "cables", i);
     ts_cable *cable = &sys->cables[i];
@@ -745,6 +747,15 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
                           &cable->can);
     if (rc == TS_OK)
         rc = optional_min(c, path, &f[C_EI], "N*m^2", 0, 0, 0.0, &cable->ei);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_EA], "N", 0, 0, 0.0, &cable->ea);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[C_DAMP], "N*s/m", 0, 0, 0.0,
+                          &cable->damping);
+    if (rc == TS_OK && f[C_DAMP].value && !(cable->ea > 0))
+        rc = fail_at(c, TS_EINVAL, join(p, path, "damping"), f[C_DAMP].line,
+                     "internal damping applies to an elastic cable: give EA "
+                     "> 0 as well");
     if (rc != TS_OK)
         return rc;
 

@@ -192,7 +192,10 @@ static int validate(const ts_system *s, ts_err *err)
             (rc = check_min(err, "cables", i, c->line, "tangential_drag", c->cdt, 0, 0,
                             "")) ||
             (rc = check_min(err, "cables", i, c->line, "added_mass", c->can, 0, 0, "")) ||
-            (rc = check_min(err, "cables", i, c->line, "EI", c->ei, 0, 0, "N m^2")))
+            (rc = check_min(err, "cables", i, c->line, "EI", c->ei, 0, 0, "N m^2")) ||
+            (rc = check_min(err, "cables", i, c->line, "EA", c->ea, 0, 0, "N")) ||
+            (rc = check_min(err, "cables", i, c->line, "damping", c->damping, 0,
+                            0, "N s/m")))
             return rc;
         if (c->nlinks < 1)
             return ts_fail(err, TS_EINVAL, "cables[%d].links%s: "
@@ -224,6 +227,10 @@ static int validate(const ts_system *s, ts_err *err)
                                "must add up to the cable length", i,
                                at_line(c->line));
         }
+        if (c->damping > 0 && !(c->ea > 0))
+            return ts_fail(err, TS_EINVAL, "cables[%d].damping%s: "
+                           "internal damping needs an elastic cable (EA > 0)",
+                           i, at_line(c->line));
         if (c->ei > 0 && c->nlinks < 2)
             return ts_fail(err, TS_EINVAL, "cables[%d].EI%s: "
                            "bending needs at least 2 links, got %d", i,
@@ -334,6 +341,7 @@ int ts_system_build(ts_system *s, ts_err *err)
     double rho = s->env.water_density;
     s->has_bending = 0;
     s->has_added_mass = 0;
+    s->has_elastic = 0;
     int k = 0;
     for (int o = 0; o < nc; o++) {
         int ci = order[o];
@@ -358,6 +366,11 @@ int ts_system_build(ts_system *s, ts_err *err)
             L->can = c->can;
             L->drag_law = c->drag_law;
             L->ei = L->next >= 0 ? c->ei : 0.0;
+            L->elastic = c->ea > 0;
+            L->ea = c->ea;
+            L->damping = c->damping;
+            if (L->elastic)
+                s->has_elastic = 1;
             if (L->ei > 0)
                 s->has_bending = 1;
             if (L->can > 0 && rho > 0 && L->diameter > 0)

@@ -53,7 +53,8 @@ typedef struct ts_equilibrium {
     double force_scale;   /* largest force in the system, N */
     double tolerance;     /* the target residual */
     ts_eq_method method;  /* the method that produced the result */
-    double *y;            /* [4 nlinks] state in the kernel's charts */
+    int nstate;           /* length of y: 2 ts_kernel_nq() */
+    double *y;            /* [nstate] state in the kernel's charts */
     double *directions;   /* [3 nlinks] link unit vectors */
     double *positions;    /* [3 nnodes] node positions, m (M frame) */
     double *tensions;     /* [nlinks] N */

@@ -1,9 +1,14 @@
 /* towstab/kernel.h: the one dynamics kernel, y' = f(y, u), of the rigid-link
  * tree (MODEL.md sections 1-4; Kamman & Nguyen 1990, eqs. 4-11, 20-22, 43-44).
  *
- * State y[2 nq]: y[0..nq) the link angles (theta1, theta2 of link k at
- * 2k, 2k+1, in the link's chart, rad), y[nq..2nq) their rates (rad/s);
- * nq = 2 nlinks. Input u[TS_NINPUT]: the tow-point displacement (m),
+ * State y[2 nq]: y[0..nq) the generalised coordinates, y[nq..2nq) their
+ * rates. A rigid link has two, its angles theta1, theta2 in its chart
+ * (rad); an elastic link (EA > 0, MODEL.md section 7) three, its angles
+ * and its strain e (length l (1 + e)). Link l's coordinates start at
+ * ts_kernel_link_offset(k, l); with rigid links only, nq = 2 nlinks and link
+ * l is at 2l. An elastic link's tension is EA e + Cv l e', never
+ * compressive (slack: 0); keeping the strain itself as a coordinate keeps
+ * that tension exact however stiff the link. Input u[TS_NINPUT]: the tow-point displacement (m),
  * velocity (m/s) and acceleration (m/s^2) relative to its nominal position
  * in the mean ship frame M, each as x, y, z. The motion of M (speed V, turn
  * rate Omega and their rates) and the current are set with
@@ -65,9 +70,11 @@ TS_API void ts_kernel_free(ts_kernel *k);
 TS_API ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err);
 
 TS_API const ts_system *ts_kernel_system(const ts_kernel *k);
-TS_API int ts_kernel_nq(const ts_kernel *k);      /* 2 nlinks */
+TS_API int ts_kernel_nq(const ts_kernel *k);      /* coordinates */
 TS_API int ts_kernel_nstate(const ts_kernel *k);  /* 2 nq */
 TS_API int ts_kernel_ninput(const ts_kernel *k);  /* TS_NINPUT */
+/* Offset of link `link`'s coordinates in q (2 for rigid, 3 for elastic). */
+TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 
 /* Set / read the frame motion. The default is the system's tow (speed,
  * turn rate, zero rates) with its current. */
@@ -76,7 +83,8 @@ TS_API void ts_kernel_get_frame(const ts_kernel *k, ts_frame *f);
 
 /* Evaluate f(y, u) into dydt[2 nq]. u may be NULL (all zero). Returns
  * TS_OK, TS_CHART (a link too close to the chart singularity; dydt is
- * NaN) or TS_ESINGULAR (a nodal mass matrix not positive definite). */
+ * NaN) or TS_ESINGULAR (a nodal mass matrix not positive definite, or an
+ * elastic link of zero length; dydt is NaN). */
 TS_API int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                           double dydt[]);
 
@@ -118,16 +126,32 @@ TS_API double ts_kernel_potential_energy(const ts_kernel *k);
 TS_API void ts_kernel_direction(const ts_kernel *k, int link, double t1,
                                 double t2, double n[3]);
 
-/* Angles (and rates, when ndot and y's rate half are wanted: ndot may be
- * NULL for zero rates) that reproduce unit directions n[3 nlinks] in the
- * current charts; links whose |cos theta2| would fall below `threshold`
- * are first moved to a chart centred on their direction. Writes y[2 nq].
- * Returns the number of links re-charted. */
+/* The state y[2 nq] of a shape given by unit link directions n[3 nlinks],
+ * strains strain[nlinks] of elastic links (NULL: zero; ignored for rigid
+ * links) and their rates ndot[3 nlinks] (1/s) and strain_rate[nlinks]
+ * (NULL: zero). Angles are in the current charts; a link whose
+ * |cos theta2| would fall below `threshold` is first moved to a chart
+ * centred on its direction. Returns the number of links re-charted. */
+TS_API int ts_kernel_set_shape(ts_kernel *k, const double n[],
+                               const double strain[], const double ndot[],
+                               const double strain_rate[], double threshold,
+                               double y[]);
+
+/* The same from link vectors d[3 nlinks] (r_lower - r_upper, m) and their
+ * rates ddot (NULL: at rest): rigid links take the direction only; an
+ * elastic link's strain is |d|/l - 1 (use ts_kernel_set_shape for stiff
+ * links, where that difference loses digits). */
+TS_API int ts_kernel_set_links(ts_kernel *k, const double d[],
+                               const double ddot[], double threshold,
+                               double y[]);
+
+/* The same from unit directions n[3 nlinks] and their rates (NULL: zero),
+ * every link at its unstretched length. */
 TS_API int ts_kernel_set_directions(ts_kernel *k, const double n[],
                                     const double ndot[], double threshold,
                                     double y[]);
 
-/* Re-chart every link of state y with |cos theta2| < threshold and
+/* Re-chart every rigid link of state y with |cos theta2| < threshold and
  * rewrite its angles and rates in place. Returns the number re-charted. */
 TS_API int ts_kernel_rechart(ts_kernel *k, double y[], double threshold);
 

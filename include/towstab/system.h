@@ -50,6 +50,8 @@ typedef struct ts_cable {
     double can;             /* normal added-mass coefficient */
     ts_drag_law drag_law;
     double ei;              /* bending stiffness EI, N m^2 (0: none) */
+    double ea;              /* axial stiffness EA, N (0: rigid links) */
+    double damping;         /* internal axial damping Cv, N s/m (elastic) */
     int line;               /* scene line of the entry, 0 if none */
 } ts_cable;
 
@@ -77,6 +79,9 @@ typedef struct ts_link {
     double cdn, cdt, can;
     ts_drag_law drag_law;
     double ei;              /* of the joint at `lower` with `next`, N m^2 */
+    int elastic;            /* 1: an elastic link (ea > 0), 0: rigid */
+    double ea;              /* N */
+    double damping;         /* N s/m */
 } ts_link;
 
 typedef struct ts_node {
@@ -104,6 +109,7 @@ typedef struct ts_system {
     int *child_links;       /* [nlinks] link indices grouped by upper node */
     int has_added_mass;     /* any can > 0 or body ca > 0 with rho > 0 */
     int has_bending;        /* any ei > 0 */
+    int has_elastic;        /* any elastic link */
 } ts_system;
 
 /* Allocate a system with `ncables` zeroed cables and `nbodies` zeroed
