@@ -128,29 +128,86 @@ static inline void tsi_link_load(const ts_link *L, double rho, double g,
     }
 }
 
-/* Load on a sphere body at depth z moving at w relative to the water:
- * weight, buoyancy and drag times the submerged fraction, written to
- * *frac. A junction carries its weight only. */
+/* Submerged fraction of a cylinder of diameter D whose axis is at depth
+ * z, taken as that of a horizontal one: the circular segment below z = 0,
+ * (R^2 acos((R - h)/R) - (R - h) sqrt(2 R h - h^2)) / (pi R^2), h = z + R
+ * clipped to [0, 2R]. Continuous, 0 in air and 1 under water. */
+static inline double tsi_cylinder_submerged(double z, double D)
+{
+    double R = 0.5 * D, h = z + R;
+    if (h <= 0)
+        return 0.0;
+    if (h >= 2 * R)
+        return 1.0;
+    double u = R - h;
+    return (R * R * acos(u / R) - u * sqrt(2 * R * h - h * h)) /
+           (M_PI * R * R);
+}
+
+/* Submerged fraction of a body whose node is at depth z. */
+static inline double tsi_body_submerged(const ts_body *b, double z)
+{
+    switch (b->type) {
+    case TS_BODY_SPHERE: return tsi_sphere_submerged(z, b->diameter);
+    case TS_BODY_CYLINDER: return tsi_cylinder_submerged(z, b->diameter);
+    default: return 0.0;
+    }
+}
+
+/* Load on a body at depth z moving at w relative to the water: weight,
+ * and buoyancy and drag times the submerged fraction (written to *frac).
+ * A sphere's drag is on its frontal area; a cylinder's is split along its
+ * unit axis `axis` (axial, on pi D^2/4) and across it (on D times its
+ * length). A junction carries its weight only. */
 static inline void tsi_body_load(const ts_body *b, double rho, double g,
-                                 double z, const double w[3], double F[3],
+                                 double z, const double w[3],
+                                 const double axis[3], double F[3],
                                  double *frac)
 {
     F[0] = 0.0;
     F[1] = 0.0;
     F[2] = b->mass * g;
     *frac = 0.0;
-    if (b->type != TS_BODY_SPHERE || !(rho > 0))
+    if (b->type == TS_BODY_JUNCTION || !(rho > 0))
         return;
     double D = b->diameter;
-    double fr = tsi_sphere_submerged(z, D);
+    double fr = tsi_body_submerged(b, z);
     *frac = fr;
     if (!(fr > 0))
         return;
-    F[2] -= fr * rho * g * M_PI * D * D * D / 6.0;
-    double c = 0.5 * rho * b->cd * (M_PI * 0.25 * D * D) * fr * v3_norm(w);
-    F[0] -= c * w[0];
-    F[1] -= c * w[1];
-    F[2] -= c * w[2];
+    F[2] -= fr * rho * g * ts_body_volume(b);
+    if (b->type == TS_BODY_SPHERE) {
+        double c = 0.5 * rho * b->cd * (M_PI * 0.25 * D * D) * fr * v3_norm(w);
+        v3_axpy(-c, w, F);
+        return;
+    }
+    double wa = v3_dot(w, axis), wc[3];
+    for (int j = 0; j < 3; j++)
+        wc[j] = w[j] - wa * axis[j];
+    double ca = 0.5 * rho * fr * b->cd * (M_PI * 0.25 * D * D) * fabs(wa);
+    double cc = 0.5 * rho * fr * b->cd_cross * D * b->length * v3_norm(wc);
+    for (int j = 0; j < 3; j++)
+        F[j] -= ca * wa * axis[j] + cc * wc[j];
+}
+
+/* Add a body's added-mass matrix to the symmetric S: Ca rho V f I for a
+ * sphere; f rho V (Ca a a^T + Ca_cross (I - a a^T)) for a cylinder of
+ * axis a. */
+static inline void tsi_body_added_mass(const ts_body *b, double rho,
+                                       double frac, const double axis[3],
+                                       double S[6])
+{
+    double m = frac * rho * ts_body_volume(b);
+    if (!(m > 0))
+        return;
+    if (b->type == TS_BODY_SPHERE) {
+        S[0] += b->ca * m;
+        S[1] += b->ca * m;
+        S[2] += b->ca * m;
+    } else if (b->type == TS_BODY_CYLINDER) {
+        sym3_add_normal(S, b->ca_cross * m, axis);
+        sym3_add_outer(S, b->ca * m, axis);
+    }
 }
 
 /* Bending at a joint between link a (above, direction na) and link b

@@ -57,7 +57,6 @@ struct ts_kernel {
     double *g, *w;            /* [3 nn] Mh^-1 Fh, Mh^-1 n */
     double *a;                /* [3 nn] inertial acceleration */
     double *rdd;              /* [3 nn] acceleration relative to M */
-    double *madd;             /* [nn] scalar added mass of spheres */
 };
 
 static void *zalloc(size_t n, size_t size, int *fail)
@@ -108,7 +107,6 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     k->w = zalloc(3 * snn, sizeof(double), &fail);
     k->a = zalloc(3 * snn, sizeof(double), &fail);
     k->rdd = zalloc(3 * snn, sizeof(double), &fail);
-    k->madd = zalloc(snn, sizeof(double), &fail);
     if (fail) {
         ts_kernel_free(k);
         ts_fail(err, TS_ENOMEM, "ts_kernel_alloc: out of memory for %d links",
@@ -155,7 +153,6 @@ void ts_kernel_free(ts_kernel *k)
     free(k->w);
     free(k->a);
     free(k->rdd);
-    free(k->madd);
     free(k);
 }
 
@@ -284,25 +281,19 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         v3_set(Q, 0, 0, 0);
         M[0] = M[1] = M[2] = nodes[i].mass;
         M[3] = M[4] = M[5] = 0.0;
-        k->madd[i] = 0.0;
         tsi_frame_accel(&k->frame, k->r + 3 * i, k->rd + 3 * i,
                         k->afr + 3 * i);
         int b = nodes[i].body;
         if (b >= 0) {
+            /* A cylinder's axis lies along the link that ends at it. */
+            const double *axis = k->n + 3 * nodes[i].link;
             double w[3], F[3], frac;
             tsi_rel_velocity(&k->frame, k->r + 3 * i, k->rd + 3 * i, w);
-            tsi_body_load(&sys->bodies[b], rho, g, k->r[3 * i + 2], w, F,
-                          &frac);
+            tsi_body_load(&sys->bodies[b], rho, g, k->r[3 * i + 2], w, axis,
+                          F, &frac);
             v3_axpy(1.0, F, Q);
-            const ts_body *bd = &sys->bodies[b];
-            if (added && bd->type == TS_BODY_SPHERE && bd->ca > 0) {
-                double D = bd->diameter;
-                double ma = frac * bd->ca * rho * M_PI * D * D * D / 6.0;
-                k->madd[i] = ma;
-                M[0] += ma;
-                M[1] += ma;
-                M[2] += ma;
-            }
+            if (added)
+                tsi_body_added_mass(&sys->bodies[b], rho, frac, axis, M);
         }
     }
     for (int l = 0; l < nl; l++) {

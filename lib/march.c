@@ -187,6 +187,8 @@ typedef struct link_problem {
     const ts_frame *f;
     const double *ri;   /* lower node position */
     double len;         /* link length (stretched when elastic) */
+    const ts_body *body;/* a cylinder at the lower node: its load and added
+                           mass turn with the link, NULL otherwise */
     double K[3];        /* known part of the right-hand side */
     double afr[3];      /* frame acceleration of the lower node */
     double R[9];        /* local chart */
@@ -207,6 +209,16 @@ static void link_rhs(const link_problem *P, const double n[3], double H[3],
                   rp[2], P->ri[2], w, F, &s);
     for (int j = 0; j < 3; j++)
         H[j] = P->K[j] + 0.5 * F[j];
+    if (P->body) {
+        double wb[3], Fb[3], frac, S[6] = {0, 0, 0, 0, 0, 0}, Sa[3];
+        tsi_rel_velocity(P->f, P->ri, zero, wb);
+        tsi_body_load(P->body, P->sys->env.water_density,
+                      P->sys->env.gravity, P->ri[2], wb, n, Fb, &frac);
+        tsi_body_added_mass(P->body, P->sys->env.water_density, frac, n, S);
+        sym3_mul(S, P->afr, Sa);
+        for (int j = 0; j < 3; j++)
+            H[j] += Fb[j] - Sa[j];
+    }
     if (P->sys->has_added_mass && L->can > 0 && s > 0) {
         double rho = P->sys->env.water_density;
         double A = L->can * rho * M_PI * 0.25 * L->diameter * L->diameter *
@@ -443,20 +455,29 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
         P.L = L;
         P.ri = ri;
         tsi_frame_accel(f, ri, zero, P.afr);
-        double mass = nd->mass, Fb[3] = {0, 0, 0};
+        double Fb[3] = {0, 0, 0}, *Mi = m->Ma + 6 * i;
+        P.body = NULL;
+        /* Structural mass, and a sphere's load and added mass, are known
+         * here; a cylinder's depend on this link's direction (link_rhs). */
+        Mi[0] += nd->mass;
+        Mi[1] += nd->mass;
+        Mi[2] += nd->mass;
         if (nd->body >= 0) {
-            double w[3], frac;
             const ts_body *bd = &sys->bodies[nd->body];
-            tsi_rel_velocity(f, ri, zero, w);
-            tsi_body_load(bd, rho, g, ri[2], w, Fb, &frac);
-            if (sys->has_added_mass && bd->type == TS_BODY_SPHERE)
-                mass += frac * bd->ca * rho * M_PI * bd->diameter *
-                        bd->diameter * bd->diameter / 6.0;
+            if (bd->type == TS_BODY_CYLINDER) {
+                P.body = bd;
+            } else {
+                double w[3], frac;
+                tsi_rel_velocity(f, ri, zero, w);
+                tsi_body_load(bd, rho, g, ri[2], w, NULL, Fb, &frac);
+                if (sys->has_added_mass)
+                    tsi_body_added_mass(bd, rho, frac, NULL, Mi);
+            }
         }
         double Maf[3];
-        sym3_mul(m->Ma + 6 * i, P.afr, Maf);
+        sym3_mul(Mi, P.afr, Maf);
         for (int j = 0; j < 3; j++)
-            P.K[j] = m->K[3 * i + j] + Fb[j] - mass * P.afr[j] - Maf[j];
+            P.K[j] = m->K[3 * i + j] + Fb[j] - Maf[j];
         /* First guess: this link's last direction, else its first child's,
          * else hanging straight down. */
         double guess[3] = {0, 0, 1};

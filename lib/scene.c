@@ -58,6 +58,13 @@
 #define DEFAULT_CAN 1.0
 #define DEFAULT_SPHERE_CD 0.5
 #define DEFAULT_SPHERE_CA 0.5
+/* Cylinder (towfish) defaults: a blunt-ended cylinder of length about ten
+ * diameters (Hoerner): axial drag on its end area, cross-flow drag on its
+ * side area; slender-body added mass, small along the axis. */
+#define DEFAULT_CYL_CD_AXIAL 0.8
+#define DEFAULT_CYL_CD_CROSS 1.2
+#define DEFAULT_CYL_CA_AXIAL 0.1
+#define DEFAULT_CYL_CA_CROSS 1.0
 
 typedef struct ctx {
     yaml_document_t *doc;
@@ -503,10 +510,11 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                       ts_system *sys)
 {
     enum { B_NAME, B_TYPE, B_DIAM, B_WEIGHT, B_MASS, B_WET, B_DRAG, B_CA,
-           B_N };
+           B_LEN, B_XDRAG, B_XCA, B_N };
     field f[B_N] = {{"name", 0, 0}, {"type", 0, 0}, {"diameter", 0, 0},
                     {"weight", 0, 0}, {"mass", 0, 0}, {"wet_weight", 0, 0},
-                    {"drag", 0, 0}, {"added_mass", 0, 0}};
+                    {"drag", 0, 0}, {"added_mass", 0, 0}, {"length", 0, 0},
+                    {"cross_drag", 0, 0}, {"cross_added_mass", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     index_path(path, "bodies", b);
     ts_body *body = &sys->bodies[b];
@@ -531,31 +539,56 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                            sys->bodies[j].line);
 
     const char *type = NULL;
-    rc = field_text(c, join(p, path, "type"), &f[B_TYPE], "sphere or junction",
-                    &type);
+    rc = field_text(c, join(p, path, "type"), &f[B_TYPE],
+                    "sphere, cylinder or junction", &type);
     if (rc != TS_OK)
         return rc;
     if (!strcmp(type, "sphere"))
         body->type = TS_BODY_SPHERE;
     else if (!strcmp(type, "junction"))
         body->type = TS_BODY_JUNCTION;
+    else if (!strcmp(type, "cylinder"))
+        body->type = TS_BODY_CYLINDER;
     else
         return fail_at(c, TS_EINVAL, p, f[B_TYPE].line, "unknown body type "
-                       "\"%s\"; expected sphere or junction",
+                       "\"%s\"; expected sphere, cylinder or junction",
                        show(type, f[B_TYPE].value->data.scalar.length, s,
                             sizeof s));
     int sphere = body->type == TS_BODY_SPHERE;
+    int cyl = body->type == TS_BODY_CYLINDER;
+    /* Keys of one body type only. */
+    static const int cyl_only[] = {B_LEN, B_XDRAG, B_XCA};
+    for (int k = 0; k < 3; k++)
+        if (!cyl && f[cyl_only[k]].value)
+            return fail_at(c, TS_ESCENE, join(p, path, f[cyl_only[k]].key),
+                           f[cyl_only[k]].line, "applies to a cylinder body "
+                           "only, not to a %s", type);
 
-    if (sphere && !f[B_DIAM].value)
+    if ((sphere || cyl) && !f[B_DIAM].value)
         return missing(c, path, n, "diameter");
-    rc = optional_min(c, path, &f[B_DIAM], "m", 0, sphere, 0.0,
+    if (cyl && !f[B_LEN].value)
+        return missing(c, path, n, "length");
+    rc = optional_min(c, path, &f[B_DIAM], "m", 0, sphere || cyl, 0.0,
                       &body->diameter);
     if (rc == TS_OK)
+        rc = optional_min(c, path, &f[B_LEN], "m", 0, cyl, 0.0,
+                          &body->length);
+    if (rc == TS_OK)
         rc = optional_min(c, path, &f[B_DRAG], "1", 0, 0,
-                          sphere ? DEFAULT_SPHERE_CD : 0.0, &body->cd);
+                          sphere ? DEFAULT_SPHERE_CD
+                                 : (cyl ? DEFAULT_CYL_CD_AXIAL : 0.0),
+                          &body->cd);
     if (rc == TS_OK)
         rc = optional_min(c, path, &f[B_CA], "1", 0, 0,
-                          sphere ? DEFAULT_SPHERE_CA : 0.0, &body->ca);
+                          sphere ? DEFAULT_SPHERE_CA
+                                 : (cyl ? DEFAULT_CYL_CA_AXIAL : 0.0),
+                          &body->ca);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[B_XDRAG], "1", 0, 0,
+                          cyl ? DEFAULT_CYL_CD_CROSS : 0.0, &body->cd_cross);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[B_XCA], "1", 0, 0,
+                          cyl ? DEFAULT_CYL_CA_CROSS : 0.0, &body->ca_cross);
     if (rc != TS_OK)
         return rc;
 
@@ -563,7 +596,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
      * one for a junction (default 0). */
     static const int mass_keys[] = {B_WEIGHT, B_MASS, B_WET};
     int which;
-    rc = one_of(c, path, n, f, mass_keys, 3, sphere, &which);
+    rc = one_of(c, path, n, f, mass_keys, 3, sphere || cyl, &which);
     if (rc != TS_OK)
         return rc;
     const ts_environment *env = &sys->env;
@@ -579,7 +612,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
             rc = need_gravity(c, p, fm, env->gravity, "mass");
         if (rc != TS_OK)
             return rc;
-        double volume = M_PI * pow(body->diameter, 3) / 6.0;
+        double volume = ts_body_volume(body);
         if (which == B_MASS)
             body->mass = x;
         else if (which == B_WEIGHT)
@@ -589,7 +622,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
         if (!(body->mass >= 0))
             return fail_at(c, TS_EINVAL, p, fm->line, "%g N in water gives "
                            "a negative mass in air (%g kg): the buoyancy "
-                           "rho g pi D^3/6 is only %g N", x, body->mass,
+                           "rho g V is only %g N", x, body->mass,
                            env->water_density * env->gravity * volume);
     }
     return TS_OK;

@@ -125,6 +125,16 @@ int ts_system_body_node(const ts_system *s, int b)
     return -1;
 }
 
+double ts_body_volume(const ts_body *b)
+{
+    double D = b->diameter;
+    switch (b->type) {
+    case TS_BODY_SPHERE: return M_PI * D * D * D / 6.0;
+    case TS_BODY_CYLINDER: return M_PI * 0.25 * D * D * b->length;
+    default: return 0.0;
+    }
+}
+
 double ts_cable_wet_weight(const ts_system *s, int c)
 {
     const ts_cable *cb = &s->cables[c];
@@ -242,8 +252,17 @@ static int validate(const ts_system *s, ts_err *err)
                             "m")) ||
             (rc = check_min(err, "bodies", b, bd->line, "mass", bd->mass, 0, 0, "kg")) ||
             (rc = check_min(err, "bodies", b, bd->line, "drag", bd->cd, 0, 0, "")) ||
-            (rc = check_min(err, "bodies", b, bd->line, "added_mass", bd->ca, 0, 0, "")))
+            (rc = check_min(err, "bodies", b, bd->line, "added_mass", bd->ca, 0, 0, "")) ||
+            (rc = check_min(err, "bodies", b, bd->line, "length", bd->length, 0, 0, "m")) ||
+            (rc = check_min(err, "bodies", b, bd->line, "cross_drag", bd->cd_cross, 0, 0, "")) ||
+            (rc = check_min(err, "bodies", b, bd->line, "cross_added_mass", bd->ca_cross, 0, 0, "")))
             return rc;
+        if (bd->type == TS_BODY_CYLINDER &&
+            !(bd->diameter > 0 && bd->length > 0))
+            return ts_fail(err, TS_EINVAL, "bodies[%d]%s: a cylinder needs a "
+                           "volume: diameter and length > 0 m, got %g m and "
+                           "%g m",
+                           b, at_line(bd->line), bd->diameter, bd->length);
         if (bd->type == TS_BODY_SPHERE && !(bd->diameter > 0))
             return ts_fail(err, TS_EINVAL, "bodies[%d].diameter%s: "
                            "a sphere needs a diameter > 0 m, got %g", b,
@@ -382,8 +401,9 @@ int ts_system_build(ts_system *s, ts_err *err)
             body_node[c->to_body] = k;
             s->nodes[k].body = c->to_body;
             s->nodes[k].mass += s->bodies[c->to_body].mass;
-            if (s->bodies[c->to_body].ca > 0 && rho > 0 &&
-                s->bodies[c->to_body].type == TS_BODY_SPHERE)
+            const ts_body *bd = &s->bodies[c->to_body];
+            if ((bd->ca > 0 || bd->ca_cross > 0) && rho > 0 &&
+                bd->type != TS_BODY_JUNCTION)
                 s->has_added_mass = 1;
         }
     }

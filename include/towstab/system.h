@@ -21,7 +21,14 @@ extern "C" {
 
 typedef enum { TS_DRAG_STANDARD = 0, TS_DRAG_LOADING = 1 } ts_drag_law;
 
-typedef enum { TS_BODY_SPHERE = 0, TS_BODY_JUNCTION = 1 } ts_body_type;
+/* A cylinder is a towfish lumped at its node: its axis lies along the link
+ * that ends at it (the cable pulls its nose), with axial and cross-flow drag
+ * and added mass (doc/kernel.md). */
+typedef enum {
+    TS_BODY_SPHERE = 0,
+    TS_BODY_JUNCTION = 1,
+    TS_BODY_CYLINDER = 2
+} ts_body_type;
 
 typedef struct ts_environment {
     double water_density;   /* rho, kg/m^3 (0: vacuum) */
@@ -58,12 +65,20 @@ typedef struct ts_cable {
 typedef struct ts_body {
     char name[TS_NAME_MAX];
     ts_body_type type;
-    double diameter;        /* m (sphere) */
+    double diameter;        /* m (sphere, cylinder) */
+    double length;          /* m (cylinder) */
     double mass;            /* kg in air */
-    double cd;              /* drag coefficient on the frontal area */
-    double ca;              /* added-mass coefficient on the volume */
+    double cd;              /* drag coefficient on the frontal area (sphere);
+                               axial, on pi D^2/4 (cylinder) */
+    double ca;              /* added-mass coefficient on the volume (sphere);
+                               axial (cylinder) */
+    double cd_cross;        /* cylinder: cross-flow drag on D * length */
+    double ca_cross;        /* cylinder: cross-flow added mass on the volume */
     int line;
 } ts_body;
+
+/* Volume of a body, m^3 (0 for a junction). */
+TS_API double ts_body_volume(const ts_body *b);
 
 /* One rigid link of the discretisation. */
 typedef struct ts_link {
