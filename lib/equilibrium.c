@@ -28,6 +28,10 @@
  * 1e-6. */
 #define NEWTON_FD_STEP 1e-6
 #define NEWTON_ALPHA_MIN 1e-6
+/* Continuation: the bending scale it starts from (bending nearly off), and
+ * the smallest step, as a fraction of the path, before it gives up. */
+#define BENDING_START 1e-4
+#define CONTINUATION_MIN_STEP (1.0 / 1024)
 
 void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
 {
@@ -114,7 +118,9 @@ typedef struct newton_ws {
     double *J, *R, *dq, *yt, *f1, *f2;
     double *scale;  /* [nq] size of each coordinate: 1 rad for angles,
                        1e-3 for an elastic link's strain */
-    double *ystart; /* [2 nq] start of every continuation schedule */
+    double *ystart; /* [2 nq] spare state */
+    double *dirs;   /* [3 nlinks] link directions of the last good state */
+    double *strains;/* [nlinks] its strains */
     int *ipiv;
 } newton_ws;
 
@@ -127,6 +133,8 @@ static void newton_ws_free(newton_ws *w)
     free(w->f1);
     free(w->f2);
     free(w->ystart);
+    free(w->dirs);
+    free(w->strains);
     free(w->scale);
     free(w->ipiv);
 }
@@ -155,9 +163,11 @@ static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
     w->f1 = malloc(2 * n * sizeof(double));
     w->f2 = malloc(2 * n * sizeof(double));
     w->ystart = calloc(2 * n, sizeof(double));
+    w->dirs = malloc(3 * (size_t)sys->nlinks * sizeof(double));
+    w->strains = malloc((size_t)sys->nlinks * sizeof(double));
     w->ipiv = malloc(n * sizeof(int));
     return w->J && w->R && w->dq && w->yt && w->f1 && w->f2 && w->ystart &&
-           w->scale && w->ipiv;
+           w->dirs && w->strains && w->scale && w->ipiv;
 }
 
 static double norm2(const double *v, int n)
@@ -240,6 +250,80 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                    "equilibrium: Newton stopped after %d iterations at "
                    "relative residual %.3g (target %.3g)",
                    eq->iterations, rel, tol);
+}
+
+/* A continuation path: sets the kernel's parameters for t in [0, 1]. */
+typedef struct path_ctx {
+    ts_kernel *k;
+    ts_frame frame;  /* the target frame */
+    double b0;       /* bending scale at the start */
+} path_ctx;
+typedef void (*path_fn)(const path_ctx *pc, double t);
+
+/* Turn rate from 0 to the target. */
+static void turn_path(const path_ctx *pc, double t)
+{
+    ts_frame f = pc->frame;
+    f.turn_rate *= t;
+    ts_kernel_set_frame(pc->k, &f);
+}
+
+/* Bending stiffness from b0 times its value to its value, geometrically. */
+static void bending_path(const path_ctx *pc, double t)
+{
+    ts_kernel_set_bending_scale(pc->k, pow(pc->b0, 1.0 - t));
+}
+
+/* Remember the shape of state y (directions and strains: chart-free). */
+static void save_shape(ts_kernel *k, const double *y, newton_ws *w)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_kernel_eval(k, y, NULL, w->f1);
+    memcpy(w->dirs, ts_kernel_directions(k),
+           3 * (size_t)sys->nlinks * sizeof(double));
+    for (int l = 0; l < sys->nlinks; l++)
+        w->strains[l] = sys->links[l].elastic
+                            ? y[ts_kernel_link_offset(k, l) + 2]
+                            : 0.0;
+}
+
+/* Newton along a parameter path t in [0, 1] from y, a state near the
+ * solution at t = 0: solve there, then step towards 1, doubling the step
+ * after a success and halving it after a failure (restarting from the last
+ * solution), down to CONTINUATION_MIN_STEP. */
+static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
+                        const path_ctx *pc, const ts_equilibrium_opts *o,
+                        ts_equilibrium *eq, ts_err *err)
+{
+    int nq = w->nq;
+    path(pc, 0.0);
+    int rc = newton(k, y, o->tol, o->max_iter, w, eq, err);
+    eq->continuation_steps++;
+    double t = 0.0, dt = 1.0;
+    while (rc == TS_OK && t < 1.0) {
+        if (t + dt > 1.0)
+            dt = 1.0 - t;
+        save_shape(k, y, w);
+        path(pc, t + dt);
+        rc = newton(k, y, o->tol, o->max_iter, w, eq, err);
+        eq->continuation_steps++;
+        if (rc == TS_OK) {
+            t += dt;
+            dt *= 2.0;
+            continue;
+        }
+        if (rc == TS_ENOMEM || dt <= CONTINUATION_MIN_STEP)
+            break;
+        dt *= 0.5;
+        ts_kernel_set_shape(k, w->dirs, w->strains, NULL, NULL,
+                            TS_CHART_RECHART, y);
+        memset(y + nq, 0, (size_t)nq * sizeof(double));
+        path(pc, t);
+        rc = TS_OK;
+    }
+    if (rc != TS_OK && rc != TS_ENOMEM)
+        ts_err_prefix(err, "continuation stopped at %.4g of the way: ", t);
+    return rc;
 }
 
 static double total_length(const ts_system *sys)
@@ -370,15 +454,17 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                      nq, nq);
         goto out;
     }
-    static const int schedule[] = {1, 4, 16, 64};
-    int nsched = frame.turn_rate != 0 && !have_guess ? 4 : 1;
-    double *y0 = w.ystart;
-    if (o.guess) {
-        ts_kernel_set_directions(k, o.guess, NULL, TS_CHART_RECHART, y0);
-        have_guess = 1;
-    } else if (have_guess) {
-        memcpy(y0, y, (size_t)nq * sizeof(double));
-    } else {
+    rc = TS_ECONV;
+    if (o.guess || have_guess) {
+        /* Straight from the guess at the full turn rate and bending. */
+        if (o.guess)
+            ts_kernel_set_directions(k, o.guess, NULL, TS_CHART_RECHART, y);
+        memset(y + nq, 0, (size_t)nq * sizeof(double));
+        rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
+        eq->continuation_steps++;
+    }
+    if (rc != TS_OK && rc != TS_ENOMEM) {
+        /* From the straight-tow march (bending ignored), or hanging. */
         ts_frame straight = frame;
         straight.turn_rate = 0;
         ts_err merr = {0};
@@ -392,31 +478,25 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
             memcpy(dvec, tsi_march_directions(m),
                    3 * (size_t)nl * sizeof(double));
         } else {
-            /* Hanging straight down, unstretched. */
             for (int l = 0; l < nl; l++) {
                 dvec[3 * l] = dvec[3 * l + 1] = 0.0;
                 dvec[3 * l + 2] = 1.0;
+                strain[l] = 0.0;
             }
         }
-        ts_kernel_set_shape(k, dvec, strain, NULL, NULL, TS_CHART_RECHART, y0);
         free(x);
         eq->evaluations += ev;
-    }
-    for (int s = 0; s < nsched; s++) {
-        int steps = schedule[s];
-        memcpy(y, y0, (size_t)nq * sizeof(double));
+        ts_kernel_set_shape(k, dvec, strain, NULL, NULL, TS_CHART_RECHART, y);
         memset(y + nq, 0, (size_t)nq * sizeof(double));
-        rc = TS_OK;
-        for (int j = 1; j <= steps && rc == TS_OK; j++) {
-            ts_frame f = frame;
-            f.turn_rate = frame.turn_rate * j / steps;
-            ts_kernel_set_frame(k, &f);
-            rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
-            eq->continuation_steps++;
-        }
+        /* Turn rate from 0 with bending nearly off, then bending up. */
+        double b0 = sys->has_bending ? BENDING_START : 1.0;
+        path_ctx pc = {k, frame, b0};
+        ts_kernel_set_bending_scale(k, b0);
+        rc = continuation(k, y, &w, turn_path, &pc, &o, eq, err);
+        if (rc == TS_OK && sys->has_bending)
+            rc = continuation(k, y, &w, bending_path, &pc, &o, eq, err);
+        ts_kernel_set_bending_scale(k, 1.0);
         ts_kernel_set_frame(k, &frame);
-        if (rc == TS_OK || rc == TS_ENOMEM)
-            break;
     }
     {
         int rrc = record(k, y, eq, dydt);

@@ -37,6 +37,7 @@ struct ts_kernel {
                           elastic link */
     int *off;          /* [nl] offset of link l's coordinates in q */
     ts_frame frame;
+    double bend_scale; /* multiplies every EI (continuation), default 1 */
 
     double *chart;     /* [9 nl] row-major rotation per link */
     char *charted;     /* [nl] 1 when chart is not the identity */
@@ -119,6 +120,7 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
         k->off[l] = k->nq;
         k->nq += sys->links[l].elastic ? 3 : 2;
     }
+    k->bend_scale = 1.0;
     k->frame.speed = sys->tow.speed;
     k->frame.turn_rate = sys->tow.turn_rate;
     memcpy(k->frame.current, sys->env.current, sizeof k->frame.current);
@@ -162,6 +164,7 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
     if (!c)
         return NULL;
     c->frame = k->frame;
+    c->bend_scale = k->bend_scale;
     memcpy(c->chart, k->chart, 9 * (size_t)k->nl * sizeof(double));
     memcpy(c->charted, k->charted, (size_t)k->nl);
     return c;
@@ -180,6 +183,11 @@ int ts_kernel_ninput(const ts_kernel *k)
 void ts_kernel_set_frame(ts_kernel *k, const ts_frame *f) { k->frame = *f; }
 
 void ts_kernel_get_frame(const ts_kernel *k, ts_frame *f) { *f = k->frame; }
+
+void ts_kernel_set_bending_scale(ts_kernel *k, double scale)
+{
+    k->bend_scale = scale;
+}
 
 /* Direction and chart axes of a link from its angles. */
 static inline void link_axes(const ts_kernel *k, int l, double t1, double t2,
@@ -318,8 +326,8 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         if (L->ei > 0) {
             const ts_link *B = &links[L->next];
             double Fi[3], Fj[3], Fk[3];
-            tsi_bending(L->ei, L->length, B->length, n, k->n + 3 * L->next,
-                        Fi, Fj, Fk);
+            tsi_bending(L->ei * k->bend_scale, L->length, B->length, n,
+                        k->n + 3 * L->next, Fi, Fj, Fk);
             v3_axpy(1.0, Fi, k->Q + 3 * L->upper);
             v3_axpy(1.0, Fj, k->Q + 3 * L->lower);
             v3_axpy(1.0, Fk, k->Q + 3 * B->lower);
@@ -509,7 +517,7 @@ double ts_kernel_potential_energy(const ts_kernel *k)
             U += 0.5 * L->ea * L->length * e * e;
         }
         if (L->ei > 0)
-            U += tsi_bending_energy(L->ei, L->length,
+            U += tsi_bending_energy(L->ei * k->bend_scale, L->length,
                                     sys->links[L->next].length, k->n + 3 * l,
                                     k->n + 3 * L->next);
     }

@@ -81,6 +81,10 @@ TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 TS_API void ts_kernel_set_frame(ts_kernel *k, const ts_frame *f);
 TS_API void ts_kernel_get_frame(const ts_kernel *k, ts_frame *f);
 
+/* Multiply every bending stiffness by `scale` (default 1): a homotopy
+ * parameter for continuation from the unbent shape, not physics. */
+TS_API void ts_kernel_set_bending_scale(ts_kernel *k, double scale);
+
 /* Evaluate f(y, u) into dydt[2 nq]. u may be NULL (all zero). Returns
  * TS_OK, TS_CHART (a link too close to the chart singularity; dydt is
  * NaN) or TS_ESINGULAR (a nodal mass matrix not positive definite, or an
