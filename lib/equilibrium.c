@@ -28,6 +28,12 @@
  * 1e-6. */
 #define NEWTON_FD_STEP 1e-6
 #define NEWTON_ALPHA_MIN 1e-6
+/* Largest Newton step of any coordinate, in units of its size: the angle
+ * accelerations come from the dynamic tension solve, whose conditioning
+ * degrades with the number of links, so a full step from a poor start can
+ * jump to a different branch (a zigzag on 20 hanging links was underrated
+ * tenfold and the step went 0.9 rad). */
+#define NEWTON_MAX_STEP 0.3
 /* Continuation: the bending scale it starts from (bending nearly off), and
  * the smallest step, as a fraction of the path, before it gives up. */
 #define BENDING_START 1e-4
@@ -226,6 +232,12 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                            "equilibrium: singular Newton Jacobian (LAPACK "
                            "dgetrf info %d) at relative residual %.3g",
                            info, rel);
+        double big = 0.0;
+        for (int i = 0; i < nq; i++)
+            big = fmax(big, fabs(w->dq[i]) / w->scale[i]);
+        if (big > NEWTON_MAX_STEP)
+            for (int i = 0; i < nq; i++)
+                w->dq[i] *= NEWTON_MAX_STEP / big;
         /* Backtracking line search on |q''|. */
         double phi0 = norm2(w->R + nq, nq), alpha = 1.0;
         int accepted = 0;
@@ -321,8 +333,14 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         path(pc, t);
         rc = TS_OK;
     }
-    if (rc != TS_OK && rc != TS_ENOMEM)
-        ts_err_prefix(err, "continuation stopped at %.4g of the way: ", t);
+    if (rc != TS_OK && rc != TS_ENOMEM) {
+        ts_frame f;
+        ts_kernel_get_frame(k, &f);
+        ts_err_prefix(err, "continuation stopped %.4g of the way (%s), at "
+                           "turn rate %.6g rad/s: ",
+                      t, path == turn_path ? "turn rate" : "bending stiffness",
+                      f.turn_rate);
+    }
     return rc;
 }
 
@@ -521,5 +539,7 @@ out:
                      "equilibrium: not converged, relative residual %.3g "
                      "(target %.3g)",
                      eq->residual, o.tol);
+    if (rc == TS_OK)
+        ts_err_clear(err); /* a failed first attempt leaves no message */
     return rc;
 }

@@ -32,7 +32,9 @@
 #define ELASTIC_MAXIT 200
 /* The local Newton: iterations before GSL's hybrid solver takes over, and
  * its forward-difference step in chart coordinates (~ sqrt(eps)). */
-#define LOCAL_NEWTON_MAXIT 8
+#define LOCAL_NEWTON_MAXIT 30
+/* Largest local Newton step in chart coordinates (tan 16.7 degrees). */
+#define LOCAL_MAX_STEP 0.3
 #define LOCAL_FD_STEP 1e-8
 /* Translation corrections tried before the hybrid solver takes over. */
 #define MAX_CORRECTIONS 40
@@ -296,6 +298,18 @@ static int local_newton(const link_problem *P, double tol, double x[2])
             return 0;
         double da = -(j11 * r[0] - j01 * r[1]) / det;
         double db = -(-j10 * r[0] + j00 * r[1]) / det;
+        /* A full step may leave the part of the chart that is useful:
+         * near its horizon (90 degrees from the centre, coordinates ->
+         * infinity) the part of H normal to n can point along the centre,
+         * where the residual's two components (on the centre's tangent
+         * axes) do not see it: a false root the solver runs to (a bare
+         * cable with Cdt = 0 did, from a centre 66 degrees off). Cap the
+         * step. */
+        double dn = hypot(da, db);
+        if (dn > LOCAL_MAX_STEP) {
+            da *= LOCAL_MAX_STEP / dn;
+            db *= LOCAL_MAX_STEP / dn;
+        }
         double lam = 1.0, trial[2], rt[2], rtn = INFINITY;
         for (int k = 0; k < 6; k++, lam *= 0.5) {
             trial[0] = x[0] + lam * da;
@@ -469,9 +483,12 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
             } else {
                 double w[3], frac;
                 tsi_rel_velocity(f, ri, zero, w);
-                tsi_body_load(bd, rho, g, ri[2], w, NULL, Fb, &frac);
+                /* A sphere's load has no axis: the link's last direction
+                 * stands in, unused. */
+                const double *axis = m->n + 3 * l;
+                tsi_body_load(bd, rho, g, ri[2], w, axis, Fb, &frac);
                 if (sys->has_added_mass)
-                    tsi_body_added_mass(bd, rho, frac, NULL, Mi);
+                    tsi_body_added_mass(bd, rho, frac, axis, Mi);
             }
         }
         double Maf[3];

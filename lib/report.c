@@ -84,6 +84,16 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
                                                 num(r[0]), "y", num(r[1]), "z",
                                                 num(r[2])));
     }
+    /* What an engineer must not overlook, in words. */
+    json_t *warn = json_array();
+    if (warn && eq->converged && eq->min_tension < 0) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "a link is in compression (%.6g N): a "
+                                  "real cable would go slack there",
+                 eq->min_tension);
+        json_array_append_new(warn, json_string(msg));
+    }
+    json_object_set_new(o, "warnings", warn ? warn : json_array());
     json_object_set_new(o, "nodes", nodes);
     json_object_set_new(o, "links", links);
     json_object_set_new(o, "bodies", bodies);

@@ -5,9 +5,44 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "towstab/kernel.h"
 #include "towstab/report.h"
+
+/* The descriptor JSON for "-" goes to, once standard output has been moved
+ * to standard error (cli_stdout_for_json); -1 otherwise. The command line
+ * is one process and one command: this is the tool's state, not the
+ * library's. */
+static int json_fd = -1;
+
+void cli_stdout_for_json(void)
+{
+    if (json_fd >= 0)
+        return;
+    fflush(stdout);
+    json_fd = dup(STDOUT_FILENO);
+    if (json_fd >= 0)
+        dup2(STDERR_FILENO, STDOUT_FILENO);
+}
+
+int cli_write_json(const json_t *value, const char *path, ts_err *err)
+{
+    if (strcmp(path, "-") != 0 || json_fd < 0)
+        return ts_report_write_json(value, path, err);
+    int fd = dup(json_fd);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!f) {
+        if (fd >= 0)
+            close(fd);
+        return ts_fail(err, TS_EIO, "standard output: cannot write JSON");
+    }
+    int bad = json_dumpf(value, f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) ||
+              fputc('\n', f) == EOF;
+    bad |= fclose(f) != 0;
+    return bad ? ts_fail(err, TS_EIO, "standard output: cannot write JSON")
+               : TS_OK;
+}
 
 double cli_wall_now(void)
 {
@@ -184,8 +219,8 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     char *end;
     long v = strtol(text, &end, 10);
     if (end == text || *end || v < lo || v > hi) {
-        fprintf(stderr, "towstab: %s: expected a whole number in [%ld, %ld], "
-                        "got '%s'\n",
+        fprintf(stderr, "towstab: error: %s: expected a whole number in "
+                        "[%ld, %ld], got '%s'\n",
                 opt, lo, hi, text);
         return EXIT_BADINPUT;
     }

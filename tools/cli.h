@@ -34,6 +34,11 @@ typedef struct cli_command {
                json_t *results);
     /* Option keys the scene entry accepts (NULL-terminated). */
     const char *const *keys;
+    /* Check an entry's option values (units, ranges, names) without
+     * running it, so `run` refuses a bad entry before the first runs.
+     * NULL when the keys are all there is to check. */
+    int (*check)(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
+                 ts_err *err);
 } cli_command;
 
 double cli_wall_now(void);
@@ -90,6 +95,15 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
                   long *value);
 
 
+
+/* Standard output for JSON. When a command is given `--json -`, main()
+ * moves standard output to standard error for the text report and keeps
+ * the original descriptor for the JSON, so that stdout is JSON alone:
+ * cli_stdout_for_json() does that once, before anything is printed. */
+void cli_stdout_for_json(void);
+
+/* Write JSON to `path` ("-": the JSON standard output), atomically. */
+int cli_write_json(const json_t *value, const char *path, ts_err *err);
 
 /* All subcommands, NULL-terminated (tools/towstab.c). */
 extern const cli_command *const cli_commands[];

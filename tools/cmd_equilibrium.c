@@ -95,7 +95,7 @@ static int eq_main(int argc, char **argv)
     if (rc)
         status = cli_report(&err, rc);
     ts_err werr = {0};
-    if (json && ts_report_write_json(json, json_path, &werr) != TS_OK)
+    if (json && cli_write_json(json, json_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
     if (csv_path && eq && eq->converged &&
         ts_report_equilibrium_csv(sys, eq, csv_path, &werr) != TS_OK)
@@ -134,6 +134,21 @@ static int eq_run(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
     return status;
 }
 
+/* An entry's settings parse and its system builds. */
+static int eq_check(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
+                    ts_err *err)
+{
+    cli_settings s = {0};
+    if (cli_settings_from_analysis(&s, a, index, err))
+        return err->code;
+    ts_equilibrium_opts eo;
+    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eo, err);
+    if (!sys)
+        return err->code;
+    ts_system_free(sys);
+    return TS_OK;
+}
+
 const cli_command cli_cmd_equilibrium = {
     "equilibrium", "steady shape at the scene's speed and turn rate",
-    eq_main, eq_run, eq_keys};
+    eq_main, eq_run, eq_keys, eq_check};

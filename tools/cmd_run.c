@@ -35,19 +35,19 @@ static int run_main(int argc, char **argv)
                    "  runs the scene's 'analyses' list in order\n");
             return 0;
         case ':':
-            fprintf(stderr, "towstab run: missing value for '%s'\n",
+            fprintf(stderr, "towstab: error: run: missing value for '%s'\n",
                     argv[optind - 1]);
             return EXIT_BADINPUT;
         default:
-            fprintf(stderr, "towstab run: unknown option '%s'; only --json "
-                            "and --quiet apply (the scene's analyses carry "
-                            "their own settings)\n",
+            fprintf(stderr, "towstab: error: run: unknown option '%s'; only "
+                            "--json and --quiet apply (the scene's analyses "
+                            "carry their own settings)\n",
                     argv[optind - 1]);
             return EXIT_BADINPUT;
         }
     }
     if (optind != argc - 1) {
-        fprintf(stderr, "towstab run: expected one scene file\n");
+        fprintf(stderr, "towstab: error: run: expected one scene file\n");
         return EXIT_BADINPUT;
     }
     ts_units *units;
@@ -57,8 +57,8 @@ static int run_main(int argc, char **argv)
         return status;
     ts_err err = {0};
     if (scene->nanalyses == 0) {
-        fprintf(stderr, "towstab run: %s lists no analyses: nothing to run "
-                        "(add an 'analyses' list)\n",
+        fprintf(stderr, "towstab: error: run: %s lists no analyses: nothing "
+                        "to run (add an 'analyses' list)\n",
                 scene->path);
         cli_close(units, scene);
         return EXIT_BADINPUT;
@@ -82,6 +82,10 @@ static int run_main(int argc, char **argv)
             status = cli_report(&err, TS_ESCENE);
         } else if (cli_check_keys(a, c->keys, i, &err)) {
             status = cli_report(&err, err.code);
+        } else if (c->check) {
+            cli_ctx cctx = {scene, units, quiet};
+            if (c->check(&cctx, a, i, &err))
+                status = cli_report(&err, err.code);
         }
     }
     json_t *all = json_object(), *list = json_array();
@@ -94,9 +98,11 @@ static int run_main(int argc, char **argv)
                scene->nanalyses, a->type, scene->system->name);
         status = find(a->type)->run(&ctx, a, i, list);
     }
+    /* Results only when every analysis succeeded: a file holding some of
+     * them would look complete. */
     ts_err werr = {0};
-    if (json_path && json_array_size(list) > 0 &&
-        ts_report_write_json(all, json_path, &werr) != TS_OK)
+    if (json_path && status == 0 &&
+        cli_write_json(all, json_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
     json_decref(all);
     cli_close(units, scene);
@@ -104,4 +110,4 @@ static int run_main(int argc, char **argv)
 }
 
 const cli_command cli_cmd_run = {"run", "the analyses the scene lists, in order",
-                                 run_main, NULL, NULL};
+                                 run_main, NULL, NULL, NULL};

@@ -39,10 +39,16 @@ int main(int argc, char **argv)
         printf("towstab 0.1.0\n");
         return 0;
     }
+    /* `--json -`: keep standard output for the JSON alone. */
+    for (int i = 2; i < argc; i++)
+        if ((strcmp(argv[i], "--json") == 0 && i + 1 < argc &&
+             strcmp(argv[i + 1], "-") == 0) ||
+            strcmp(argv[i], "--json=-") == 0)
+            cli_stdout_for_json();
     for (int i = 0; cli_commands[i]; i++)
         if (strcmp(argv[1], cli_commands[i]->name) == 0)
             return cli_commands[i]->main(argc - 1, argv + 1);
-    fprintf(stderr, "towstab: unknown command '%s' (towstab --help)\n",
+    fprintf(stderr, "towstab: error: unknown command '%s' (towstab --help)\n",
             argv[1]);
     return EXIT_BADINPUT;
 }

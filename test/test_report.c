@@ -1,0 +1,424 @@
+/* test_report.c: JSON and CSV writers (towstab/report.h).
+ *
+ * Content: an equilibrium filled by hand with awkward numbers (a branched
+ * system: tow point, cable nodes, a junction and two spheres) goes to JSON
+ * and CSV; every value must come back bit for bit (17 significant digits),
+ * names follow the documented rule, angles are the directions' angles in
+ * degrees, a non-finite number becomes null. Atomicity: a write that fails
+ * (folder missing, target is a folder, the stream fails before commit, an
+ * abandoned write) leaves no file and no temporary file behind, and a
+ * failed replacement leaves the old file as it was. "-" writes to standard
+ * output. Files go to a fresh folder under $TMPDIR (default /tmp). */
+#include "towstab/report.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "tcheck.h"
+
+static char dir[512];
+
+static int exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+/* Number of entries in the test folder whose name contains `part`. */
+static int count_in_dir(const char *part)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    if (!d)
+        return -1;
+    for (struct dirent *e; (e = readdir(d));)
+        if (strstr(e->d_name, part))
+            n++;
+    closedir(d);
+    return n;
+}
+
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return NULL;
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+/* Lead cable (2 links) to a junction, branches "up" (2 links) to sphere
+ * "s1" and "lo" (1 link) to sphere "s2". */
+static ts_system *branched(void)
+{
+    ts_system *s = ts_system_alloc(3, 3, NULL);
+    if (!s)
+        return NULL;
+    snprintf(s->name, sizeof s->name, "report test");
+    s->tow.speed = 1.2345678901234567;
+    s->tow.turn_rate = -0.0123456789;
+    const char *names[3] = {"lead", "up", "lo"};
+    int from[3] = {-1, 0, 0}, to[3] = {0, 1, 2}, nl[3] = {2, 2, 1};
+    for (int i = 0; i < 3; i++) {
+        ts_cable *c = &s->cables[i];
+        snprintf(c->name, sizeof c->name, "%s", names[i]);
+        c->from_body = from[i];
+        c->to_body = to[i];
+        c->length = 1.7 + i;
+        c->diameter = 0.01;
+        c->mass_per_length = 0.3;
+        c->nlinks = nl[i];
+        c->cdn = 1.2;
+    }
+    const char *bn[3] = {"junction", "s1", "s2"};
+    for (int b = 0; b < 3; b++) {
+        snprintf(s->bodies[b].name, sizeof s->bodies[b].name, "%s", bn[b]);
+        s->bodies[b].type = b ? TS_BODY_SPHERE : TS_BODY_JUNCTION;
+        s->bodies[b].diameter = b ? 0.1 : 0;
+        s->bodies[b].mass = 0.5;
+    }
+    ts_err err = {0};
+    if (ts_system_build(s, &err) != TS_OK) {
+        printf("build: %s\n", err.msg);
+        ts_system_free(s);
+        return NULL;
+    }
+    return s;
+}
+
+/* Fill an equilibrium with values that need all 17 digits. */
+static void fill(const ts_system *s, ts_equilibrium *eq)
+{
+    eq->converged = 1;
+    eq->iterations = 7;
+    eq->evaluations = 123456789012L;
+    eq->residual = 3.141592653589793e-13;
+    eq->force_scale = 2.718281828459045;
+    eq->tolerance = 1e-10;
+    eq->method = TS_EQ_NEWTON;
+    eq->top_tension = 12.345678901234567;
+    eq->min_tension = -0.1;
+    eq->tow_force[0] = -1.0 / 3;
+    eq->tow_force[1] = 2.0 / 7;
+    eq->tow_force[2] = 1e-300;
+    for (int i = 0; i < s->nnodes; i++)
+        for (int j = 0; j < 3; j++)
+            eq->positions[3 * i + j] = (i + 1) / 3.0 + j * M_PI - 1e-17 * i;
+    for (int l = 0; l < s->nlinks; l++) {
+        double t1 = 0.1 + 0.37 * l, t2 = 0.05 * (l % 3) - 0.04;
+        eq->directions[3 * l] = -cos(t1) * cos(t2);
+        eq->directions[3 * l + 1] = -sin(t2);
+        eq->directions[3 * l + 2] = sin(t1) * cos(t2);
+        eq->tensions[l] = 10.0 / (l + 3);
+    }
+}
+
+static double num(const json_t *o, const char *key)
+{
+    const json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
+{
+    json_t *o = ts_report_equilibrium_json(s, eq, 0.0625);
+    if (!CHECK(o != NULL, "json: object built"))
+        return;
+    CHECK(json_is_true(json_object_get(o, "converged")), "json: converged");
+    CHECK(json_integer_value(json_object_get(o, "iterations")) == 7 &&
+              json_integer_value(json_object_get(o, "evaluations")) ==
+                  123456789012L,
+          "json: iterations, evaluations (64-bit)");
+    CHECK(num(o, "residual") == eq->residual &&
+              num(o, "force_scale") == eq->force_scale &&
+              num(o, "tolerance") == eq->tolerance &&
+              num(o, "top_tension") == eq->top_tension &&
+              num(o, "min_tension") == eq->min_tension &&
+              num(o, "wall_s") == 0.0625,
+          "json: residual, force_scale, tolerance, top/min tension, wall_s "
+          "exact");
+    CHECK(num(o, "speed") == s->tow.speed &&
+              num(o, "turn_rate") == s->tow.turn_rate,
+          "json: speed, turn_rate from the system");
+    CHECK(!strcmp(json_string_value(json_object_get(o, "method")), "newton"),
+          "json: method name");
+    const json_t *tf = json_object_get(o, "tow_force");
+    CHECK(json_array_size(tf) == 3 &&
+              json_number_value(json_array_get(tf, 0)) == eq->tow_force[0] &&
+              json_number_value(json_array_get(tf, 1)) == eq->tow_force[1] &&
+              json_number_value(json_array_get(tf, 2)) == eq->tow_force[2],
+          "json: tow_force [3]");
+
+    /* Nodes: tow first, then in node order; names by the rule. */
+    const json_t *nodes = json_object_get(o, "nodes");
+    CHECK((int)json_array_size(nodes) == s->nnodes, "json: %d nodes",
+          s->nnodes);
+    static const char *want_names[] = {"tow",   "lead.1", "junction", "up.1",
+                                       "s1",    "s2"};
+    int names_ok = 1, pos_ok = 1;
+    for (int i = 0; i < s->nnodes && i < 6; i++) {
+        const json_t *n = json_array_get(nodes, (size_t)i);
+        const char *nm = json_string_value(json_object_get(n, "name"));
+        names_ok &= nm && !strcmp(nm, want_names[i]);
+        pos_ok &= num(n, "x") == eq->positions[3 * i] &&
+                  num(n, "y") == eq->positions[3 * i + 1] &&
+                  num(n, "z") == eq->positions[3 * i + 2];
+    }
+    CHECK(s->nnodes == 6 && names_ok, "json: node names tow, lead.1, "
+                                      "junction, up.1, s1, s2");
+    CHECK(pos_ok, "json: node positions exact");
+    char buf[64];
+    ts_report_node_name(s, 3, buf, sizeof buf);
+    CHECK(!strcmp(buf, "up.1"), "node_name: cable node 'up.1' (%s)", buf);
+    ts_report_node_name(s, 0, buf, 3);
+    CHECK(!strcmp(buf, "to"), "node_name: truncated to the buffer ('%s')",
+          buf);
+
+    /* Links: cable, index, tension, angles in degrees. */
+    const json_t *links = json_object_get(o, "links");
+    int links_ok = (int)json_array_size(links) == s->nlinks;
+    double worst = 0;
+    for (int l = 0; links_ok && l < s->nlinks; l++) {
+        const json_t *L = json_array_get(links, (size_t)l);
+        const ts_link *sl = &s->links[l];
+        links_ok &= !strcmp(json_string_value(json_object_get(L, "cable")),
+                            s->cables[sl->cable].name) &&
+                    json_integer_value(json_object_get(L, "index")) ==
+                        sl->index &&
+                    num(L, "tension") == eq->tensions[l];
+        double t1 = 0.1 + 0.37 * l, t2 = 0.05 * (l % 3) - 0.04;
+        worst = fmax(worst, fabs(num(L, "theta1_deg") - t1 * 180 / M_PI));
+        worst = fmax(worst, fabs(num(L, "theta2_deg") - t2 * 180 / M_PI));
+    }
+    CHECK(links_ok, "json: links carry cable, index, tension exactly");
+    /* Angles pass through cos/sin and atan2/asin: rounding, 1e-12 deg. */
+    CHECK(worst <= 1e-12, "json: theta1_deg, theta2_deg are the links' "
+                          "angles in degrees (%.2g deg)", worst);
+
+    /* Bodies: in body order at their nodes. */
+    const json_t *bodies = json_object_get(o, "bodies");
+    int bodies_ok = (int)json_array_size(bodies) == s->nbodies;
+    for (int b = 0; bodies_ok && b < s->nbodies; b++) {
+        const json_t *B = json_array_get(bodies, (size_t)b);
+        int k = ts_system_body_node(s, b);
+        bodies_ok &= !strcmp(json_string_value(json_object_get(B, "name")),
+                             s->bodies[b].name) &&
+                     num(B, "x") == eq->positions[3 * k] &&
+                     num(B, "y") == eq->positions[3 * k + 1] &&
+                     num(B, "z") == eq->positions[3 * k + 2];
+    }
+    CHECK(bodies_ok, "json: bodies named, at their nodes");
+
+    /* Written and read back: the same document, every number exact. */
+    char path[600];
+    snprintf(path, sizeof path, "%s/eq.json", dir);
+    ts_err err = {0};
+    int rc = ts_report_write_json(o, path, &err);
+    json_error_t je;
+    json_t *back = json_load_file(path, 0, &je);
+    CHECK(rc == TS_OK && back && json_equal(o, back),
+          "json: written file reads back equal, bit for bit (%s)",
+          back ? "parsed" : je.text);
+    CHECK(count_in_dir("partial") == 0, "json: no temporary file left");
+    const char *text = slurp(path);
+    CHECK(text && text[strlen(text) - 1] == '\n' && strstr(text, "\n  \""),
+          "json: indented, ends with a newline");
+    json_decref(back);
+    unlink(path);
+    json_decref(o);
+}
+
+static void test_json_nonfinite(const ts_system *s, ts_equilibrium *eq)
+{
+    double keep = eq->residual, kx = eq->positions[4];
+    eq->residual = NAN;
+    eq->positions[4] = INFINITY;
+    json_t *o = ts_report_equilibrium_json(s, eq, NAN);
+    const json_t *n1 = json_array_get(json_object_get(o, "nodes"), 1);
+    CHECK(o && json_is_null(json_object_get(o, "residual")) &&
+              json_is_null(json_object_get(o, "wall_s")) &&
+              json_is_null(json_object_get(n1, "y")),
+          "json: NaN and Inf become null (JSON has no such numbers)");
+    char path[600];
+    snprintf(path, sizeof path, "%s/nan.json", dir);
+    int rc = ts_report_write_json(o, path, NULL);
+    json_t *back = json_load_file(path, 0, NULL);
+    CHECK(rc == TS_OK && back != NULL, "json: such a document is valid JSON");
+    json_decref(back);
+    json_decref(o);
+    unlink(path);
+    eq->residual = keep;
+    eq->positions[4] = kx;
+}
+
+static void test_csv(const ts_system *s, const ts_equilibrium *eq)
+{
+    char path[600];
+    snprintf(path, sizeof path, "%s/eq.csv", dir);
+    ts_err err = {0};
+    int rc = ts_report_equilibrium_csv(s, eq, path, &err);
+    CHECK(rc == TS_OK, "csv: written (%s)", err.msg);
+    FILE *f = fopen(path, "r");
+    if (!CHECK(f != NULL, "csv: file exists"))
+        return;
+    char line[1024];
+    int row = -1, ok = 1;
+    while (fgets(line, sizeof line, f)) {
+        if (row < 0) {
+            CHECK(!strcmp(line, "node,x_m,y_m,z_m,tension_above_N\n"),
+                  "csv: header node,x_m,y_m,z_m,tension_above_N");
+            row++;
+            continue;
+        }
+        char name[128];
+        double v[4];
+        char *p = strchr(line, ',');
+        if (!p || row >= s->nnodes) {
+            ok = 0;
+            break;
+        }
+        snprintf(name, sizeof name, "%.*s", (int)(p - line), line);
+        for (int j = 0; j < 4; j++) {
+            char *end;
+            v[j] = strtod(p + 1, &end);
+            ok &= end != p + 1 && (*end == ',' || *end == '\n');
+            p = end;
+        }
+        char want[128];
+        ts_report_node_name(s, row, want, sizeof want);
+        double t = row == 0 ? eq->top_tension : eq->tensions[row - 1];
+        ok &= !strcmp(name, want) && v[0] == eq->positions[3 * row] &&
+              v[1] == eq->positions[3 * row + 1] &&
+              v[2] == eq->positions[3 * row + 2] && v[3] == t;
+        row++;
+    }
+    fclose(f);
+    CHECK(ok && row == s->nnodes,
+          "csv: one row per node (%d), names, positions and the tension "
+          "above each node (top tension at the tow point) exact", row);
+    unlink(path);
+}
+
+static void test_atomic(const ts_system *s, const ts_equilibrium *eq)
+{
+    json_t *o = ts_report_equilibrium_json(s, eq, 0);
+    char path[600], tmp[1024];
+    ts_err err = {0};
+
+    /* A folder that does not exist. */
+    snprintf(path, sizeof path, "%s/no/such/folder/eq.json", dir);
+    int rc = ts_report_write_json(o, path, &err);
+    CHECK(rc == TS_EIO && strstr(err.msg, path) && !exists(path),
+          "atomic: missing folder: TS_EIO naming the path, nothing written "
+          "(%s)", err.msg);
+    ts_err_clear(&err);
+    rc = ts_report_equilibrium_csv(s, eq, path, &err);
+    CHECK(rc == TS_EIO && !exists(path), "atomic: csv to a missing folder: "
+                                         "TS_EIO (%s)", err.msg);
+
+    /* The target is a folder: the rename fails, the temporary goes. */
+    snprintf(path, sizeof path, "%s/a_folder", dir);
+    mkdir(path, 0700);
+    ts_err_clear(&err);
+    rc = ts_report_write_json(o, path, &err);
+    CHECK(rc == TS_EIO && count_in_dir("partial") == 0,
+          "atomic: target is a folder: TS_EIO, no temporary left (%s)",
+          err.msg);
+    rmdir(path);
+
+    /* An existing file survives an abandoned replacement untouched. */
+    snprintf(path, sizeof path, "%s/old.json", dir);
+    FILE *f = fopen(path, "w");
+    fputs("{\"old\": true}\n", f);
+    fclose(f);
+    f = ts_report_open(path, tmp, sizeof tmp, &err);
+    CHECK(f != NULL && strstr(tmp, "old.json") && exists(tmp),
+          "atomic: open writes to a temporary beside the target (%s)", tmp);
+    if (f) {
+        fputs("{\"new\": ", f);
+        ts_report_abandon(f, path, tmp);
+    }
+    const char *text = slurp(path);
+    CHECK(text && !strcmp(text, "{\"old\": true}\n") &&
+              count_in_dir("partial") == 0,
+          "atomic: abandon keeps the old file and removes the temporary");
+
+    /* A stream that fails before commit (its descriptor is closed under
+     * it, so the final flush fails): error, old file intact, no
+     * temporary. */
+    f = ts_report_open(path, tmp, sizeof tmp, &err);
+    if (f) {
+        for (int i = 0; i < 2000; i++)
+            fputs("{\"half written\": 1234567890}\n", f);
+        close(fileno(f));
+        ts_err_clear(&err);
+        rc = ts_report_commit(f, path, tmp, &err);
+    }
+    text = slurp(path);
+    CHECK(f && rc == TS_EIO && text && !strcmp(text, "{\"old\": true}\n") &&
+              count_in_dir("partial") == 0,
+          "atomic: a failed write reports TS_EIO (%s), keeps the old file, "
+          "leaves no temporary", err.msg);
+
+    /* A successful replacement. */
+    rc = ts_report_write_json(o, path, &err);
+    json_t *back = json_load_file(path, 0, NULL);
+    CHECK(rc == TS_OK && back && json_equal(back, o) &&
+              count_in_dir("partial") == 0,
+          "atomic: replacement by a complete file");
+    json_decref(back);
+    unlink(path);
+
+    /* "-": standard output, no file. Capture fd 1 in a file. */
+    snprintf(path, sizeof path, "%s/stdout.txt", dir);
+    fflush(stdout);
+    int saved = dup(1);
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    dup2(fd, 1);
+    close(fd);
+    rc = ts_report_write_json(o, "-", &err);
+    fflush(stdout);
+    dup2(saved, 1);
+    close(saved);
+    back = json_load_file(path, 0, NULL);
+    CHECK(rc == TS_OK && back && json_equal(back, o) && !exists("-"),
+          "stdout: '-' writes the document to standard output only");
+    json_decref(back);
+    unlink(path);
+    json_decref(o);
+}
+
+int main(void)
+{
+    const char *t = getenv("TMPDIR");
+    snprintf(dir, sizeof dir, "%s/towstab-test-report-XXXXXX",
+             t && *t ? t : "/tmp");
+    if (!mkdtemp(dir)) {
+        printf("FAIL cannot make a folder under %s: %s\n", dir,
+               strerror(errno));
+        return 1;
+    }
+    ts_system *s = branched();
+    ts_equilibrium *eq = s ? ts_equilibrium_alloc(s, NULL) : NULL;
+    if (CHECK(s && eq, "system and result allocated")) {
+        fill(s, eq);
+        test_json_content(s, eq);
+        test_json_nonfinite(s, eq);
+        test_csv(s, eq);
+        test_atomic(s, eq);
+    }
+    ts_equilibrium_free(eq);
+    ts_system_free(s);
+    CHECK(count_in_dir("") == 2, "nothing left in the test folder");
+    rmdir(dir);
+    return tc_done();
+}
