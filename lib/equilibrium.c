@@ -226,7 +226,7 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         int one = 1, info = 0;
         dgetrf_(&nq, &nq, w->J, &nq, w->ipiv, &info);
         if (info == 0)
-            dgetrs_("N", &nq, &one, w->J, &nq, w->ipiv, w->dq, &nq, &info);
+            dgetrs_("N", &nq, &one, w->J, &nq, w->ipiv, w->dq, &nq, &info, 1);
         if (info != 0)
             return ts_fail(err, TS_ESINGULAR,
                            "equilibrium: singular Newton Jacobian (LAPACK "

@@ -36,9 +36,9 @@ typedef struct cli_command {
     const char *const *keys;
     /* Check an entry's option values (units, ranges, names) without
      * running it, so `run` refuses a bad entry before the first runs.
-     * NULL when the keys are all there is to check. */
-    int (*check)(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
-                 ts_err *err);
+     * Prints its message and returns the exit status (0: fine). NULL when
+     * the keys are all there is to check. */
+    int (*check)(const cli_ctx *ctx, const ts_scene_analysis *a, int index);
 } cli_command;
 
 double cli_wall_now(void);

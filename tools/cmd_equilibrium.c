@@ -135,18 +135,18 @@ static int eq_run(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
 }
 
 /* An entry's settings parse and its system builds. */
-static int eq_check(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
-                    ts_err *err)
+static int eq_check(const cli_ctx *ctx, const ts_scene_analysis *a, int index)
 {
+    ts_err err = {0};
     cli_settings s = {0};
-    if (cli_settings_from_analysis(&s, a, index, err))
-        return err->code;
+    if (cli_settings_from_analysis(&s, a, index, &err))
+        return cli_report(&err, err.code);
     ts_equilibrium_opts eo;
-    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eo, err);
+    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eo, &err);
     if (!sys)
-        return err->code;
+        return cli_report(&err, err.code);
     ts_system_free(sys);
-    return TS_OK;
+    return 0;
 }
 
 const cli_command cli_cmd_equilibrium = {

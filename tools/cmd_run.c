@@ -84,8 +84,7 @@ static int run_main(int argc, char **argv)
             status = cli_report(&err, err.code);
         } else if (c->check) {
             cli_ctx cctx = {scene, units, quiet};
-            if (c->check(&cctx, a, i, &err))
-                status = cli_report(&err, err.code);
+            status = c->check(&cctx, a, i);
         }
     }
     json_t *all = json_object(), *list = json_array();

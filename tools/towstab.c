@@ -9,8 +9,10 @@
 #include "cli.h"
 
 extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
+extern const cli_command cli_cmd_modes, cli_cmd_response;
 
 const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
+                                           &cli_cmd_modes, &cli_cmd_response,
                                            NULL};
 
 static void usage(FILE *f)

@@ -7,7 +7,9 @@
  * The first nq rows of A are exactly [0 I] and of B zero. The step of
  * column j is h_j = rel_step * max(|x_j|, scale_j) (x_j the coordinate
  * perturbed), rounded so that x_j + h_j is exact; scale_j is 1 rad for an
- * angle, (sqrt(g l) + |V|) / l for the rate of a link of length l, the top
+ * angle, 1e-4 for the strain of an elastic link (and the angle-rate scale
+ * times 1e-4 for its rate), (sqrt(g l) + |V|) / l for the rate of a link
+ * of length l, the top
  * link's length for a tow displacement, sqrt(g l) + |V| for a tow velocity
  * and g for a tow acceleration. The truncation error is estimated by
  * differentiating again with steps 2 h_j: for a smooth f the error of the
@@ -55,10 +57,20 @@ typedef struct ts_linear {
     double *t0;        /* [nlinks] link tensions at y0, N */
     double *dn;        /* [6 nlinks] dn/dtheta1, dn/dtheta2 of each link at
                           y0 (1/rad, M frame, in the link's chart) */
+    double *n0;        /* [3 nlinks] link unit directions at y0 */
+    double *len0;      /* [nlinks] link lengths at y0, l (1 + e), m */
+    int *qoff;         /* [nlinks] offset of each link's coordinates in q
+                          (ts_kernel_link_offset) */
+    char *elastic;     /* [nlinks] 1: the link's third coordinate is its
+                          strain e */
     double *Ty;        /* [nlinks * n] dT/dy (N/rad, N s/rad) column-major,
                           or NULL unless opts.tensions */
     double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
                           or NULL unless opts.tensions */
+    double *Aerr;      /* [nq * n] estimated error of the lower block of A,
+                          (A(2h) - A(h)) / 3, column-major with leading
+                          dimension nq (A(h) - Aerr is the Richardson
+                          value); NULL unless estimate_error */
     double *h;         /* [n + ninput] the step used for each column */
     double trunc_err;  /* max |A(h) - A(2h)| / 3 over the lower block */
     double trunc_norm; /* ||A(h) - A(2h)||_F / 3 over the lower block: the
@@ -83,7 +95,8 @@ typedef struct ts_linear {
 typedef struct ts_linearize_opts {
     double rel_step;   /* default cbrt(DBL_EPSILON) ~ 6.1e-6 */
     int estimate_error;/* 1 (default): also differentiate with 2h */
-    int threads;       /* 0 (default): OpenMP's choice; 1: serial */
+    int threads;       /* 0 (default): OpenMP's choice from 200 links on,
+                          serial below; 1: serial; k: k threads */
     int tensions;      /* 1: also fill Ty and Tu (default 0) */
 } ts_linearize_opts;
 
@@ -116,8 +129,9 @@ TS_API int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
                                     ts_linear *lin, ts_err *err);
 
 /* Node displacements dr[3 nnodes] (m, M frame; node 0, the tow point, is 0)
- * produced by angle perturbations dq[nq] (rad) about lin->y0, to first
- * order: dr_k = dr_p + l_k (dn/dt1 dq1 + dn/dt2 dq2) down the tree.
+ * produced by coordinate perturbations dq[nq] (angles, rad; strains) about
+ * lin->y0, to first order: dr_k = dr_p + l_k (dn/dt1 dq1 + dn/dt2 dq2)
+ * (+ l n de for an elastic link; l_k its length at y0) down the tree.
  * Exact geometry, O(nlinks). */
 TS_API void ts_linear_node_displacements(const ts_system *sys,
                                          const ts_linear *lin,

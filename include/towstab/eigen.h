@@ -1,0 +1,142 @@
+/* towstab/eigen.h: eigenvalues and mode shapes of a linear model
+ * z' = A z (MODEL.md section 6; doc/linear.md).
+ *
+ * Two methods:
+ *  - lapack: every eigenvalue and right eigenvector of the dense A (LAPACK
+ *    dgeevx with balancing), plus left eigenvectors and the eigenvalue
+ *    condition numbers. O(n^3) time,
+ *    O(n^2) memory (n = nstate).
+ *  - arpack: the eigenvalues nearest a shift sigma = i 2 pi target (target
+ *    in Hz; 0 gives the lowest modes, smallest |lambda|) by implicitly
+ *    restarted Arnoldi (ARPACK) in shift-invert mode, OP = (A - sigma I)^-1:
+ *    dnaupd/dneupd for a real shift, znaupd/zneupd for a complex one. The
+ *    operator uses the structure A = [[0, I], [K, C]]: (A - s I) x = b
+ *    reduces to one nq x nq solve with P(s) = K + s C - s^2 I, factored
+ *    once by LAPACK (dgetrf or zgetrf): O(nq^3) once, O(nq^2) per
+ *    application.
+ *  - auto: arpack when a number of modes is asked for and nstate >=
+ *    arpack_min_states, else lapack.
+ *
+ * A mode is one eigenvalue with Im >= 0: one of each complex-conjugate
+ * pair, or a real (non-oscillatory) eigenvalue. Units: lambda in 1/s,
+ * frequency in Hz, period and time constant in s.
+ */
+#ifndef TOWSTAB_EIGEN_H
+#define TOWSTAB_EIGEN_H
+
+#include <stddef.h>
+
+#include "towstab/error.h"
+#include "towstab/linearize.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    TS_EIG_AUTO = 0,
+    TS_EIG_LAPACK = 1,
+    TS_EIG_ARPACK = 2
+} ts_eig_method;
+
+typedef struct ts_eigen_opts {
+    ts_eig_method method;  /* default TS_EIG_AUTO */
+    int count;             /* modes wanted; 0 (default): all (lapack) */
+    double target_hz;      /* modes nearest i 2 pi target_hz (Hz, >= 0);
+                              default 0: the lowest modes */
+    int arpack_min_states; /* auto uses arpack from this size on when
+                              count > 0; default 1200 */
+    double arpack_tol;     /* relative Ritz tolerance; default 0: machine
+                              precision */
+    int arpack_max_iter;   /* restarts; default 1000 */
+    int vectors;           /* 1 (default): keep the right eigenvectors */
+} ts_eigen_opts;
+
+typedef struct ts_mode {
+    double re, im;          /* eigenvalue, 1/s; im >= 0 */
+    double freq_hz;         /* im / (2 pi); 0 for a real mode */
+    double period_s;        /* 1 / freq_hz; INFINITY for a real mode */
+    double damping_ratio;   /* -re / |lambda|: 1 for a decaying real mode,
+                               -1 for a growing one, 0 undamped */
+    double time_constant_s; /* -1 / re (< 0: growth time); INFINITY at 0 */
+    double condition;       /* eigenvalue condition number kappa (>= 1) of
+                               the balanced matrix (1 / RCONDE of LAPACK
+                               dgeevx); NaN when not computed (arpack) */
+    double error_bound;     /* error allowance of lambda (1/s): 10 times
+                               the first-order change of lambda by the
+                               linearization's error estimate E
+                               (ts_linear.Aerr), |u^H E v| / |u^H v|
+                               (lapack; ||E v|| / |v| with arpack, which
+                               has no left vector u), plus rounding
+                               kappa eps ||A_bal|| (lapack: the balanced
+                               matrix's 1-norm and condition number from
+                               dgeevx) or eps ||A||_F (arpack) */
+    double residual;        /* ||A v - lambda v|| / (||A||_F |v|); NaN when
+                               not computed (lapack: backward stable) */
+} ts_mode;
+
+typedef struct ts_eigen {
+    int nstate;
+    int nmodes;             /* modes stored */
+    int neig;               /* eigenvalues they stand for (2 per complex) */
+    int complete;           /* 1 when every eigenvalue of A is covered */
+    ts_eig_method method;   /* the method used */
+    double target_hz;
+    ts_mode *modes;         /* [nmodes] by frequency, then |lambda| */
+    double *vec_re, *vec_im;/* [nstate * nmodes] right eigenvectors, column
+                               m for mode m, unit 2-norm, largest entry
+                               real; NULL unless opts.vectors */
+    double max_real;        /* max Re lambda over the modes, 1/s */
+    double max_real_error;  /* error_bound of that mode, 1/s */
+    int verdict;            /* TS_STABLE, TS_UNSTABLE or TS_MARGINAL */
+    int arpack_iterations;  /* restarts used (arpack) */
+    int arpack_ops;         /* applications of OP (arpack) */
+    int arpack_nconv;       /* Ritz values converged (arpack) */
+} ts_eigen;
+
+/* Verdicts: stable when every mode has re + error_bound < 0; unstable
+ * when some mode has re - error_bound > 0; marginal otherwise (a margin
+ * smaller than its error, e.g. an undamped system). */
+enum { TS_STABLE = 0, TS_UNSTABLE = 1, TS_MARGINAL = 2 };
+
+TS_API void ts_eigen_opts_default(ts_eigen_opts *o);
+
+/* Modes of lin->A. On success *out is a new result (free with
+ * ts_eigen_free). Returns TS_OK, TS_EINVAL (bad options: count < 0 or
+ * above the number of modes possible, target < 0, arpack asked with
+ * count 0), TS_ELAPACK (LAPACK or ARPACK info, named in the message),
+ * TS_ESINGULAR (A - sigma I singular: move the target), TS_ECONV (ARPACK
+ * did not converge within arpack_max_iter) or TS_ENOMEM. */
+TS_API int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
+                          ts_eigen **out, ts_err *err);
+TS_API void ts_eigen_free(ts_eigen *e);
+
+/* Name of a method ("auto", "lapack", "arpack") and of a verdict
+ * ("stable", "unstable", "marginal"). */
+TS_API const char *ts_eig_method_name(ts_eig_method m);
+TS_API const char *ts_verdict_name(int verdict);
+
+/* Node displacements of mode m: amp[3 nnodes] (m per unit of the
+ * normalisation, >= 0) and phase[3 nnodes] (rad) for x, y, z of every
+ * node, from the angle part of the eigenvector through the link geometry
+ * (ts_linear_node_displacements). Normalised so that the largest
+ * component has amplitude 1 and phase 0. Needs vectors. Returns TS_OK or
+ * TS_EINVAL (no vectors, m out of range). */
+TS_API int ts_eigen_mode_shape(const ts_system *sys, const ts_linear *lin,
+                               const ts_eigen *e, int m, double amp[],
+                               double phase[], ts_err *err);
+
+/* One-line description of mode m's shape into buf: the motion's plane
+ * relative to the equilibrium's vertical plane (in-plane, out-of-plane or
+ * mixed with the out-of-plane share), the cable with the largest motion,
+ * its number of interior nodes (zero crossings) and mode order, and the
+ * node that moves most, e.g. "in-plane, cable 'cable' order 2 (1 node),
+ * largest at sphere". Needs vectors; writes "" otherwise. */
+TS_API void ts_eigen_describe(const ts_system *sys, const ts_linear *lin,
+                              const ts_eigen *e, int m, char *buf,
+                              size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,102 @@
+/* towstab/response.h: frequency response of the linear model to tow-point
+ * motion (MODEL.md section 6; doc/linear.md).
+ *
+ * For a tow-point displacement X(i w) along x, y or z (input tow.surge,
+ * tow.sway, tow.heave) the tow point also moves with velocity i w X and
+ * acceleration -w^2 X, so the state responds as
+ *   Z(i w) = (i w I - A)^-1 (B_x + i w B_v - w^2 B_a) X,
+ * B_x, B_v, B_a the input's displacement, velocity and acceleration columns
+ * of B. Outputs:
+ *  - a node's or body's displacement along x, y or z (m per m of input):
+ *    the tow displacement (every node moves with the tow point) plus the
+ *    node displacement of the angle response through the link geometry
+ *    (ts_linear_node_displacements);
+ *  - a link's tension (N per m): dT/dy Z + (dT/dx + i w dT/dv - w^2 dT/da) X
+ *    from the tension Jacobians of the linearization (needs
+ *    ts_linearize_opts.tensions = 1).
+ * Each frequency is one complex nq x nq LU (LAPACK zgetrf) of
+ * P = K + s C - s^2 I, s = i w, via the structure of A: O(nq^3) per point.
+ * At w = 0 the response is the static gain -C A^-1 B_x + D, which must equal
+ * the change of the equilibrium with the tow point displaced.
+ */
+#ifndef TOWSTAB_RESPONSE_H
+#define TOWSTAB_RESPONSE_H
+
+#include <stddef.h>
+
+#include "towstab/error.h"
+#include "towstab/linearize.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum { TS_OUT_POSITION = 0, TS_OUT_TENSION = 1 } ts_output_kind;
+
+/* An output channel. */
+typedef struct ts_output {
+    ts_output_kind kind;
+    int node;      /* position: node index (>= 1) */
+    int comp;      /* position: 0 x, 1 y, 2 z (M frame, z down) */
+    int link;      /* tension: link index */
+    char name[2 * TS_NAME_MAX + 16]; /* canonical name, e.g. "sphere.z" */
+    const char *unit; /* "m/m" or "N/m" */
+} ts_output;
+
+/* Input channel (0, 1, 2) of "tow.surge", "tow.sway" or "tow.heave".
+ * Returns TS_OK or TS_EINVAL with a message listing the valid names. */
+TS_API int ts_response_input_find(const char *name, int *channel,
+                                  ts_err *err);
+
+/* Parse an output name: "<node>.x|y|z" (node as ts_report_node_name
+ * writes it: a body's name or "<cable>.<k>", k = 1..links of that cable)
+ * or "<cable>.<k>.tension" (link k of the cable; "<body>.tension" is the
+ * link ending at the body). Returns TS_OK or TS_EINVAL with a message that
+ * lists the valid names (and says that tow is the input). */
+TS_API int ts_response_output_find(const ts_system *sys, const char *name,
+                                   ts_output *out, ts_err *err);
+
+/* Write the valid output names, compactly ("cable.1 .. cable.19, sphere"
+ * per cable), into buf. */
+TS_API void ts_response_output_names(const ts_system *sys, char *buf,
+                                     size_t size);
+
+/* Log-spaced frequencies freq[points] from `from` to `to` Hz inclusive.
+ * Refuses (TS_EINVAL) from <= 0, to <= from, non-finite values or
+ * points < 2. */
+TS_API int ts_response_logspace(double from, double to, int points,
+                                double freq[], ts_err *err);
+
+typedef struct ts_response {
+    int input;          /* channel 0..2 */
+    ts_output output;
+    int npoints;
+    double *freq_hz;    /* [npoints] Hz */
+    double *re, *im;    /* [npoints] complex gain, output unit per m */
+    double *magnitude;  /* [npoints] |gain| */
+    double *phase_deg;  /* [npoints] arg(gain), degrees in (-180, 180] */
+    double static_gain; /* the w = 0 limit (real) */
+} ts_response;
+
+/* Frequency response of output `out` to input channel `input` at
+ * freq_hz[npoints] (Hz, each >= 0). On success *res is new (free with
+ * ts_response_free). Returns TS_OK, TS_EINVAL (bad channel, negative
+ * frequency, tension output without tension Jacobians), TS_ESINGULAR (i w
+ * is an eigenvalue: an undamped resonance exactly on a point) or
+ * TS_ENOMEM. */
+TS_API int ts_response_compute(const ts_system *sys, const ts_linear *lin,
+                               int input, const ts_output *out,
+                               const double freq_hz[], int npoints,
+                               ts_response **res, ts_err *err);
+TS_API void ts_response_free(ts_response *r);
+
+/* The gain at one angular frequency w (rad/s, >= 0) into (*re, *im). */
+TS_API int ts_response_at(const ts_system *sys, const ts_linear *lin,
+                          int input, const ts_output *out, double omega,
+                          double *re, double *im, ts_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

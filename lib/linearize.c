@@ -1,0 +1,590 @@
+/* linearize.c: A = df/dy, B = df/du about a state (towstab/linearize.h;
+ * MODEL.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ *
+ * Algorithm. For every column j (n state columns, then TS_NINPUT input
+ * columns) the coordinate x_j is perturbed by +-h_j and the kernel is
+ * evaluated; column j of the lower block is (f(x+h) - f(x-h)) / (2h)
+ * (second-order central difference, error (h^2/6) f''' plus rounding
+ * ~eps |f| / h; h ~ eps^(1/3) scale balances the two at ~eps^(2/3)).
+ * With estimate_error the same column is formed again with 2h; for a smooth
+ * f, D(2h) - D(h) = 3 c h^2 + O(h^4), so |D(h) - D(2h)| / 3 estimates the
+ * truncation error of D(h) (rounding noise included). The link tensions
+ * returned by the kernel at the same perturbed states give dT/dy and dT/du
+ * at no extra evaluation.
+ *
+ * The upper block of A is [0 I] by the definition of the state (q' is the
+ * second half of y): it is written exactly, not differenced. Columns are
+ * independent: with OpenMP each thread differentiates a share of them on
+ * its own kernel clone (kernels keep per-call work arrays). Cost: 2 or 4
+ * evaluations of O(nlinks) per column, O(nlinks^2) in all, plus O(n^2)
+ * memory traffic to fill A.
+ *
+ * Non-smooth points: the submerged fraction of a link is kinked where one
+ * of its end nodes crosses z = 0 (lib/forces.h). A node closer to the
+ * surface than twice the largest step that moves it makes the difference
+ * straddle the kink; such nodes are counted in lin->kinks and reported.
+ *
+ * Direction derivatives: with n = R nh(t1, t2) (R the link's chart),
+ * dnh/dt2 = nh(t1, t2 + pi/2) and dnh/dt1 = nh(t1 + pi/2, t2)
+ * - sin t2 nh(0, pi/2), so both follow exactly from ts_kernel_direction.
+ */
+#include "towstab/linearize.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#ifdef _OPENMP
+/* Below this many links a column costs a few microseconds and starting a
+ * thread team costs more than it saves (measured: doc/performance-
+ * linear.md); opts.threads > 0 overrides. */
+#define TS_LINEARIZE_PARALLEL_LINKS 200
+#endif
+
+void ts_linearize_opts_default(ts_linearize_opts *o)
+{
+    o->rel_step = cbrt(DBL_EPSILON);
+    o->estimate_error = 1;
+    o->threads = 0;
+    o->tensions = 0;
+}
+
+ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_linear *lin = calloc(1, sizeof *lin);
+    if (!lin) {
+        ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory");
+        return NULL;
+    }
+    int n = ts_kernel_nstate(k), ni = TS_NINPUT;
+    size_t sn = (size_t)n;
+    lin->nstate = n;
+    lin->nq = ts_kernel_nq(k);
+    lin->ninput = ni;
+    lin->nlinks = sys->nlinks;
+    lin->nnodes = sys->nnodes;
+    lin->A = calloc(sn * sn, sizeof(double));
+    lin->B = calloc(sn * (size_t)ni, sizeof(double));
+    lin->y0 = calloc(sn, sizeof(double));
+    lin->f0 = calloc(sn, sizeof(double));
+    lin->r0 = calloc(3 * (size_t)sys->nnodes, sizeof(double));
+    lin->t0 = calloc((size_t)sys->nlinks, sizeof(double));
+    lin->dn = calloc(6 * (size_t)sys->nlinks, sizeof(double));
+    lin->n0 = calloc(3 * (size_t)sys->nlinks, sizeof(double));
+    lin->len0 = calloc((size_t)sys->nlinks, sizeof(double));
+    lin->qoff = calloc((size_t)sys->nlinks, sizeof(int));
+    lin->elastic = calloc((size_t)sys->nlinks, 1);
+    for (int l = 0; lin->qoff && lin->elastic && l < sys->nlinks; l++) {
+        lin->qoff[l] = ts_kernel_link_offset(k, l);
+        lin->elastic[l] = (char)(sys->links[l].elastic != 0);
+    }
+    lin->h = calloc(sn + (size_t)ni, sizeof(double));
+    lin->kink_node = -1;
+    if (!lin->A || !lin->B || !lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 ||
+        !lin->dn || !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic ||
+        !lin->h) {
+        ts_linear_free(lin);
+        ts_fail(err, TS_ENOMEM,
+                "ts_linear_alloc: out of memory for a %d x %d matrix A "
+                "(%.3g MB)",
+                n, n, 8e-6 * (double)sn * (double)sn);
+        return NULL;
+    }
+    return lin;
+}
+
+void ts_linear_free(ts_linear *lin)
+{
+    if (!lin)
+        return;
+    free(lin->A);
+    free(lin->B);
+    free(lin->y0);
+    free(lin->f0);
+    free(lin->r0);
+    free(lin->t0);
+    free(lin->dn);
+    free(lin->n0);
+    free(lin->len0);
+    free(lin->qoff);
+    free(lin->elastic);
+    free(lin->Ty);
+    free(lin->Tu);
+    free(lin->Aerr);
+    free(lin->h);
+    free(lin);
+}
+
+const char *ts_input_name(int j)
+{
+    static const char *const names[TS_NINPUT] = {
+        "tow.surge",
+        "tow.sway",
+        "tow.heave",
+        "tow.surge_velocity",
+        "tow.sway_velocity",
+        "tow.heave_velocity",
+        "tow.surge_acceleration",
+        "tow.sway_acceleration",
+        "tow.heave_acceleration"};
+    return j >= 0 && j < TS_NINPUT ? names[j] : NULL;
+}
+
+/* The step of one column: rel * max(|x|, scale), rounded so that x + h is
+ * a machine number (then (x + h) - x == h exactly). */
+static double step_for(double x, double scale, double rel)
+{
+    double h = rel * fmax(fabs(x), scale);
+    volatile double t = x + h;
+    return t - x;
+}
+
+/* Per-thread work: state and input copies, four f and tension vectors. */
+typedef struct col_ws {
+    ts_kernel *k;
+    double *y, *u;
+    double *f[4];   /* f(x+h), f(x-h), f(x+2h), f(x-2h) */
+    double *t[4];   /* tensions at the same states */
+} col_ws;
+
+static void col_ws_free(col_ws *w, const ts_kernel *owner)
+{
+    if (w->k && w->k != owner)
+        ts_kernel_free(w->k);
+    free(w->y);
+    free(w->u);
+    for (int i = 0; i < 4; i++) {
+        free(w->f[i]);
+        free(w->t[i]);
+    }
+}
+
+static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
+                        const double *u0, int n, int nl, ts_err *err)
+{
+    memset(w, 0, sizeof *w);
+    w->k = use_k ? k : ts_kernel_clone(k, err);
+    w->y = malloc((size_t)n * sizeof(double));
+    w->u = malloc(TS_NINPUT * sizeof(double));
+    int ok = w->k && w->y && w->u;
+    for (int i = 0; i < 4; i++) {
+        w->f[i] = malloc((size_t)n * sizeof(double));
+        w->t[i] = malloc((size_t)(nl > 0 ? nl : 1) * sizeof(double));
+        ok = ok && w->f[i] && w->t[i];
+    }
+    if (!ok)
+        return TS_ENOMEM;
+    memcpy(w->y, y0, (size_t)n * sizeof(double));
+    memcpy(w->u, u0, TS_NINPUT * sizeof(double));
+    return TS_OK;
+}
+
+/* Evaluate at the current (w->y, w->u) into f[slot] and t[slot]. */
+static int eval_into(col_ws *w, int slot, int nl)
+{
+    int rc = ts_kernel_eval(w->k, w->y, w->u, w->f[slot]);
+    if (rc == TS_OK)
+        memcpy(w->t[slot], ts_kernel_tensions(w->k),
+               (size_t)nl * sizeof(double));
+    return rc;
+}
+
+/* Column results beside A/B: error statistics of this column. */
+typedef struct col_err {
+    double max_a, sum2_a, max_t;
+} col_err;
+
+/* Differentiate column j (j < n: state, else input j - n). Writes the lower
+ * block of the column into `col` (nq entries, stride 1) and, when `tcol`
+ * is not NULL, the tension derivatives (nl entries). */
+static int column(col_ws *w, int j, int n, int nq, int nl, double h,
+                  int estimate, double *col, double *ecol, double *tcol,
+                  col_err *ce)
+{
+    double *x = j < n ? &w->y[j] : &w->u[j - n];
+    double x0 = *x;
+    static const double mult[4] = {1.0, -1.0, 2.0, -2.0};
+    int nev = estimate ? 4 : 2, rc = TS_OK;
+    for (int s = 0; s < nev && rc == TS_OK; s++) {
+        *x = x0 + mult[s] * h;
+        rc = eval_into(w, s, nl);
+    }
+    *x = x0;
+    if (rc != TS_OK)
+        return rc;
+    const double *fp = w->f[0] + nq, *fm = w->f[1] + nq;
+    double inv = 1.0 / (2.0 * h), inv2 = 1.0 / (4.0 * h);
+    ce->max_a = ce->sum2_a = ce->max_t = 0.0;
+    for (int i = 0; i < nq; i++) {
+        col[i] = (fp[i] - fm[i]) * inv;
+        if (estimate) {
+            double d2 = (w->f[2][nq + i] - w->f[3][nq + i]) * inv2;
+            double e = fabs(col[i] - d2) / 3.0;
+            if (ecol)
+                ecol[i] = (d2 - col[i]) / 3.0;
+            if (!(e <= ce->max_a))
+                ce->max_a = e;
+            ce->sum2_a += e * e;
+        }
+    }
+    if (tcol)
+        for (int l = 0; l < nl; l++) {
+            tcol[l] = (w->t[0][l] - w->t[1][l]) * inv;
+            if (estimate) {
+                double d2 = (w->t[2][l] - w->t[3][l]) * inv2;
+                double e = fabs(tcol[l] - d2) / 3.0;
+                if (!(e <= ce->max_t))
+                    ce->max_t = e;
+            }
+        }
+    return TS_OK;
+}
+
+/* Scale of a strain coordinate: equilibrium strains are ~T/EA, 1e-6 to
+ * 1e-3; the elastic force is linear in e, so the step only has to stay
+ * well above rounding. */
+#define STRAIN_SCALE 1e-4
+
+/* Scale of column j (see linearize.h); link[] maps a coordinate to its
+ * link, kind[] to 0 angle, 1 strain. */
+static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
+                           int nq, int n, const int *link, const char *kind)
+{
+    double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
+    double V = fabs(fr->speed);
+    if (j < n) {
+        int c = j < nq ? j : j - nq;
+        double l = sys->links[link[c]].length;
+        double s = kind[c] ? STRAIN_SCALE : 1.0;
+        return j < nq ? s : s * (sqrt(g * l) + V) / l;
+    }
+    double l0 = sys->links[0].length;
+    int c = j - n;
+    if (c < TS_IN_VEL)
+        return l0;
+    if (c < TS_IN_ACC)
+        return sqrt(g * l0) + V;
+    return g;
+}
+
+/* Count nodes within twice the largest step that moves them of z = 0. */
+static void find_kinks(const ts_system *sys, ts_linear *lin, int n)
+{
+    lin->kinks = 0;
+    lin->kink_tow = 0;
+    lin->kink_node = -1;
+    if (!(sys->env.water_density > 0))
+        return;
+    double hz = lin->h[n + TS_IN_DISP + 2];
+    double *reach = calloc((size_t)sys->nnodes, sizeof(double));
+    if (!reach)
+        return;
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        int o = lin->qoff[l];
+        double hl = lin->len0[l] * fmax(lin->h[o], lin->h[o + 1]);
+        if (lin->elastic[l])
+            hl = fmax(hl, L->length * lin->h[o + 2]);
+        reach[L->lower] = fmax(reach[L->upper], hl);
+    }
+    for (int i = 0; i < sys->nnodes; i++) {
+        double dz = 2.0 * fmax(reach[i], hz);
+        if (fabs(lin->r0[3 * i + 2]) <= dz) {
+            lin->kinks++;
+            if (i == 0)
+                lin->kink_tow = 1;
+            else if (lin->kink_node < 0)
+                lin->kink_node = i;
+        }
+    }
+    free(reach);
+}
+
+int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
+                 const ts_linearize_opts *opts, ts_linear *lin, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_linearize_opts o;
+    if (opts)
+        o = *opts;
+    else
+        ts_linearize_opts_default(&o);
+    int n = ts_kernel_nstate(k), nq = n / 2, nl = sys->nlinks;
+    int ni = TS_NINPUT, ncol = n + ni;
+    if (lin->nstate != n || lin->nlinks != nl)
+        return ts_fail(err, TS_EINVAL,
+                       "linearize: result sized for %d states, kernel has %d",
+                       lin->nstate, n);
+    if (!(o.rel_step > 0 && o.rel_step < 0.1))
+        return ts_fail(err, TS_EINVAL,
+                       "linearize: rel_step must be in (0, 0.1), got %g",
+                       o.rel_step);
+    static const double zero_u[TS_NINPUT] = {0};
+    if (!u0)
+        u0 = zero_u;
+    memcpy(lin->y0, y0, (size_t)n * sizeof(double));
+    memcpy(lin->u0, u0, sizeof lin->u0);
+    lin->evaluations = 0;
+    if (o.tensions && (!lin->Ty || !lin->Tu)) {
+        free(lin->Ty);
+        free(lin->Tu);
+        lin->Ty = malloc((size_t)nl * (size_t)n * sizeof(double));
+        lin->Tu = malloc((size_t)nl * (size_t)ni * sizeof(double));
+        if (!lin->Ty || !lin->Tu)
+            return ts_fail(err, TS_ENOMEM,
+                           "linearize: out of memory for the %d x %d tension "
+                           "Jacobian",
+                           nl, n);
+    }
+
+    if (o.estimate_error && !lin->Aerr) {
+        lin->Aerr = malloc((size_t)nq * (size_t)n * sizeof(double));
+        if (!lin->Aerr)
+            return ts_fail(err, TS_ENOMEM,
+                           "linearize: out of memory for the %d x %d error "
+                           "estimate (set estimate_error = 0)",
+                           nq, n);
+    }
+    if (!o.estimate_error) {
+        free(lin->Aerr);
+        lin->Aerr = NULL;
+    }
+
+    /* Base point: f0, positions, tensions, direction derivatives. */
+    int rc = ts_kernel_eval(k, y0, u0, lin->f0);
+    lin->evaluations++;
+    if (rc != TS_OK)
+        return ts_fail(err, rc, "linearize: the kernel fails at the state "
+                                "to linearize about (%s)",
+                       ts_strerror(rc));
+    memcpy(lin->r0, ts_kernel_positions(k),
+           3 * (size_t)sys->nnodes * sizeof(double));
+    memcpy(lin->t0, ts_kernel_tensions(k), (size_t)nl * sizeof(double));
+    const double *nk = ts_kernel_directions(k);
+    for (int l = 0; l < nl; l++) {
+        int qo = lin->qoff[l];
+        memcpy(lin->n0 + 3 * l, nk + 3 * l, 3 * sizeof(double));
+        lin->len0[l] = sys->links[l].length *
+                       (lin->elastic[l] ? 1.0 + y0[qo + 2] : 1.0);
+    }
+    for (int l = 0; l < nl; l++) {
+        int qo = lin->qoff[l];
+        double t1 = y0[qo], t2 = y0[qo + 1], a[3], b[3], ey[3];
+        double *d1 = lin->dn + 6 * l, *d2 = d1 + 3;
+        ts_kernel_direction(k, l, t1 + M_PI_2, t2, a);
+        ts_kernel_direction(k, l, 0.0, M_PI_2, ey);
+        ts_kernel_direction(k, l, t1, t2 + M_PI_2, b);
+        double s2 = sin(t2);
+        for (int c = 0; c < 3; c++) {
+            d1[c] = a[c] - s2 * ey[c];
+            d2[c] = b[c];
+        }
+    }
+
+    ts_frame fr;
+    ts_kernel_get_frame(k, &fr);
+    int *clink = malloc((size_t)nq * sizeof(int));
+    char *ckind = malloc((size_t)nq);
+    if (!clink || !ckind) {
+        free(clink);
+        free(ckind);
+        return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+    }
+    for (int l = 0; l < nl; l++) {
+        int qo = lin->qoff[l], nc = lin->elastic[l] ? 3 : 2;
+        for (int c = 0; c < nc && qo + c < nq; c++) {
+            clink[qo + c] = l;
+            ckind[qo + c] = (char)(c == 2);
+        }
+    }
+    for (int j = 0; j < ncol; j++) {
+        double x = j < n ? y0[j] : u0[j - n];
+        lin->h[j] = step_for(x, column_scale(sys, &fr, j, nq, n, clink, ckind),
+                             o.rel_step);
+    }
+    free(clink);
+    free(ckind);
+    find_kinks(sys, lin, n);
+
+    /* Upper blocks: [0 I] and 0, exactly. */
+    for (int j = 0; j < n; j++) {
+        double *colj = lin->A + (size_t)j * n;
+        memset(colj, 0, (size_t)nq * sizeof(double));
+        if (j >= nq)
+            colj[j - nq] = 1.0;
+    }
+    for (int j = 0; j < ni; j++)
+        memset(lin->B + (size_t)j * n, 0, (size_t)nq * sizeof(double));
+
+    int nthreads = 1;
+#ifdef _OPENMP
+    nthreads = o.threads > 0 ? o.threads
+               : (nl >= TS_LINEARIZE_PARALLEL_LINKS ? omp_get_max_threads()
+                                                    : 1);
+    if (nthreads > ncol)
+        nthreads = ncol;
+    if (nthreads < 1)
+        nthreads = 1;
+#endif
+    lin->threads = nthreads;
+    col_ws *ws = calloc((size_t)nthreads, sizeof *ws);
+    if (!ws)
+        return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+    for (int t = 0; t < nthreads && rc == TS_OK; t++)
+        rc = col_ws_alloc(&ws[t], k, t == 0, y0, u0, n, nl, err);
+    if (rc != TS_OK) {
+        for (int t = 0; t < nthreads; t++)
+            col_ws_free(&ws[t], k);
+        free(ws);
+        return ts_fail(err, TS_ENOMEM, "linearize: out of memory for %d "
+                                       "thread work areas",
+                       nthreads);
+    }
+
+    double max_a = 0, sum2_a = 0, max_b = 0, max_t = 0;
+    int bad_col = -1, bad_rc = TS_OK;
+    const int estimate = o.estimate_error != 0;
+    const int with_t = o.tensions != 0;
+#ifdef _OPENMP
+#pragma omp parallel num_threads(nthreads) reduction(max : max_a, max_b, max_t) \
+    reduction(+ : sum2_a)
+#endif
+    {
+        int tid = 0;
+#ifdef _OPENMP
+        tid = omp_get_thread_num();
+#endif
+        col_ws *w = &ws[tid];
+#ifdef _OPENMP
+#pragma omp for schedule(dynamic, 8)
+#endif
+        for (int j = 0; j < ncol; j++) {
+            double *col = j < n ? lin->A + (size_t)j * n + nq
+                                : lin->B + (size_t)(j - n) * n + nq;
+            double *tcol = NULL;
+            if (with_t)
+                tcol = j < n ? lin->Ty + (size_t)j * nl
+                             : lin->Tu + (size_t)(j - n) * nl;
+            double *ecol = estimate && j < n ? lin->Aerr + (size_t)j * nq
+                                             : NULL;
+            col_err ce;
+            int crc = column(w, j, n, nq, nl, lin->h[j], estimate, col, ecol,
+                             tcol, &ce);
+            if (crc != TS_OK) {
+#ifdef _OPENMP
+#pragma omp critical(ts_linearize_fail)
+#endif
+                if (bad_col < 0 || j < bad_col) {
+                    bad_col = j;
+                    bad_rc = crc;
+                }
+                continue;
+            }
+            if (j < n) {
+                max_a = fmax(max_a, ce.max_a);
+                sum2_a += ce.sum2_a;
+            } else {
+                max_b = fmax(max_b, ce.max_a);
+            }
+            max_t = fmax(max_t, ce.max_t);
+        }
+    }
+    for (int t = 0; t < nthreads; t++)
+        col_ws_free(&ws[t], k);
+    free(ws);
+    lin->evaluations += (long)ncol * (estimate ? 4 : 2);
+
+    /* Leave the kernel's results at the base point. */
+    double *ftmp = malloc((size_t)n * sizeof(double));
+    if (ftmp) {
+        ts_kernel_eval(k, y0, u0, ftmp);
+        lin->evaluations++;
+        free(ftmp);
+    }
+    if (bad_col >= 0) {
+        if (bad_col < n)
+            return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
+                           "linearize: state column %d (%s of q[%d]) "
+                           "perturbed by %.3g left the model (%s)",
+                           bad_col, bad_col < nq ? "coordinate" : "rate",
+                           bad_col % nq, lin->h[bad_col],
+                           ts_strerror(bad_rc));
+        return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
+                       "linearize: input %s perturbed by %.3g left the model "
+                       "(%s)",
+                       ts_input_name(bad_col - n), lin->h[bad_col],
+                       ts_strerror(bad_rc));
+    }
+    lin->trunc_err = estimate ? max_a : NAN;
+    lin->trunc_norm = estimate ? sqrt(sum2_a) : NAN;
+    lin->b_trunc_err = estimate ? max_b : NAN;
+    lin->t_trunc_err = estimate && with_t ? max_t : NAN;
+    double amax = 0, afro = 0;
+    for (int j = 0; j < n; j++) {
+        const double *colj = lin->A + (size_t)j * n;
+        for (int i = 0; i < n; i++) {
+            afro += colj[i] * colj[i];
+            if (i >= nq && fabs(colj[i]) > amax)
+                amax = fabs(colj[i]);
+        }
+    }
+    lin->a_scale = amax;
+    lin->a_norm = sqrt(afro);
+    return TS_OK;
+}
+
+int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
+                             const ts_linearize_opts *opts, ts_linear *lin,
+                             ts_err *err)
+{
+    if (!eq->converged)
+        return ts_fail(err, TS_ECONV,
+                       "linearize: the equilibrium did not converge "
+                       "(relative residual %.3g, target %.3g); a linear model "
+                       "about it would describe no steady state, so it is "
+                       "not linearized",
+                       eq->residual, eq->tolerance);
+    const ts_system *sys = ts_kernel_system(k);
+    int n = ts_kernel_nstate(k), nl = sys->nlinks;
+    double *y = calloc((size_t)n, sizeof(double));
+    double *strain = calloc((size_t)(nl > 0 ? nl : 1), sizeof(double));
+    if (!y || !strain) {
+        free(y);
+        free(strain);
+        return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+    }
+    /* Strains do not depend on the charts: take them from eq->y. */
+    for (int l = 0; l < nl; l++)
+        if (sys->links[l].elastic)
+            strain[l] = eq->y[ts_kernel_link_offset(k, l) + 2];
+    ts_kernel_set_shape(k, eq->directions, strain, NULL, NULL,
+                        TS_CHART_RECHART, y);
+    int rc = ts_linearize(k, y, NULL, opts, lin, err);
+    free(y);
+    free(strain);
+    return rc;
+}
+
+void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,
+                                  const double dq[], double dr[])
+{
+    dr[0] = dr[1] = dr[2] = 0.0;
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        const double *d1 = lin->dn + 6 * l, *d2 = d1 + 3;
+        const double *rp = dr + 3 * L->upper;
+        double *rk = dr + 3 * L->lower;
+        int o = lin->qoff[l];
+        double de = lin->elastic[l] ? dq[o + 2] : 0.0;
+        for (int c = 0; c < 3; c++)
+            rk[c] = rp[c] +
+                    lin->len0[l] * (d1[c] * dq[o] + d2[c] * dq[o + 1]) +
+                    L->length * lin->n0[3 * l + c] * de;
+    }
+}

@@ -1,0 +1,240 @@
+/* report_linear.c: JSON (jansson) and CSV output of linearizations, modes
+ * and frequency responses (towstab/report_linear.h). Every file goes
+ * through ts_report_open/commit/abandon, so a failed run leaves no file
+ * that looks finished. */
+#include "towstab/report_linear.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "towstab/report.h"
+
+/* A JSON number, or null for a value that is not finite. */
+static json_t *num(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+/* Rows of a column-major m x n matrix as a JSON array of arrays. */
+static json_t *matrix_rows(const double *a, int m, int n, int ld)
+{
+    json_t *rows = json_array();
+    for (int i = 0; rows && i < m; i++) {
+        json_t *row = json_array();
+        if (!row) {
+            json_decref(rows);
+            return NULL;
+        }
+        for (int j = 0; j < n; j++)
+            json_array_append_new(row, num(a[i + (size_t)j * ld]));
+        json_array_append_new(rows, row);
+    }
+    return rows;
+}
+
+json_t *ts_report_linear_json(const ts_linear *lin, int matrices)
+{
+    json_t *o = json_object(), *inputs = json_array();
+    if (!o || !inputs) {
+        json_decref(o);
+        json_decref(inputs);
+        return NULL;
+    }
+    for (int j = 0; j < lin->ninput; j++)
+        json_array_append_new(inputs, json_string(ts_input_name(j)));
+    json_object_set_new(o, "nstate", json_integer(lin->nstate));
+    json_object_set_new(o, "nq", json_integer(lin->nq));
+    json_object_set_new(o, "ninput", json_integer(lin->ninput));
+    json_object_set_new(o, "inputs", inputs);
+    json_object_set_new(o, "trunc_err", num(lin->trunc_err));
+    json_object_set_new(o, "trunc_norm", num(lin->trunc_norm));
+    json_object_set_new(o, "b_trunc_err", num(lin->b_trunc_err));
+    json_object_set_new(o, "a_scale", num(lin->a_scale));
+    json_object_set_new(o, "kinks", json_integer(lin->kinks));
+    json_object_set_new(o, "kink_tow", json_boolean(lin->kink_tow));
+    json_object_set_new(o, "evaluations", json_integer(lin->evaluations));
+    json_object_set_new(o, "threads", json_integer(lin->threads));
+    if (matrices) {
+        json_t *A = matrix_rows(lin->A, lin->nstate, lin->nstate,
+                                lin->nstate);
+        json_t *B = matrix_rows(lin->B, lin->nstate, lin->ninput,
+                                lin->nstate);
+        if (!A || !B) {
+            json_decref(A);
+            json_decref(B);
+            json_decref(o);
+            return NULL;
+        }
+        json_object_set_new(o, "A", A);
+        json_object_set_new(o, "B", B);
+    }
+    return o;
+}
+
+static json_t *shape_json(const ts_system *sys, const ts_linear *lin,
+                          const ts_eigen *e, int m, double *amp,
+                          double *phase)
+{
+    if (ts_eigen_mode_shape(sys, lin, e, m, amp, phase, NULL) != TS_OK)
+        return json_null();
+    json_t *arr = json_array();
+    char name[2 * TS_NAME_MAX];
+    for (int i = 0; arr && i < sys->nnodes; i++) {
+        const double *a = amp + 3 * i, *p = phase + 3 * i;
+        ts_report_node_name(sys, i, name, sizeof name);
+        json_array_append_new(
+            arr, json_pack("{s:s,s:o,s:o,s:o,s:o,s:o,s:o}", "node", name,
+                           "x_amp", num(a[0]), "x_phase_deg",
+                           num(p[0] * 180 / M_PI), "y_amp", num(a[1]),
+                           "y_phase_deg", num(p[1] * 180 / M_PI), "z_amp",
+                           num(a[2]), "z_phase_deg", num(p[2] * 180 / M_PI)));
+    }
+    return arr ? arr : json_null();
+}
+
+json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
+                             const ts_eigen *e, int shapes)
+{
+    json_t *o = json_object(), *modes = json_array();
+    double *amp = malloc(3 * (size_t)sys->nnodes * sizeof(double));
+    double *phase = malloc(3 * (size_t)sys->nnodes * sizeof(double));
+    if (!o || !modes || !amp || !phase) {
+        json_decref(o);
+        json_decref(modes);
+        free(amp);
+        free(phase);
+        return NULL;
+    }
+    json_object_set_new(o, "stable", json_boolean(e->verdict == TS_STABLE));
+    json_object_set_new(o, "verdict", json_string(ts_verdict_name(e->verdict)));
+    json_object_set_new(o, "max_real", num(e->max_real));
+    json_object_set_new(o, "max_real_error", num(e->max_real_error));
+    json_object_set_new(o, "complete", json_boolean(e->complete));
+    json_object_set_new(o, "method", json_string(ts_eig_method_name(e->method)));
+    json_object_set_new(o, "target_hz", num(e->target_hz));
+    json_object_set_new(o, "nstate", json_integer(e->nstate));
+    json_object_set_new(o, "nmodes", json_integer(e->nmodes));
+    json_object_set_new(o, "kinks", json_integer(lin->kinks));
+    json_object_set_new(o, "linearization_error", num(lin->trunc_norm));
+    char desc[256];
+    for (int m = 0; m < e->nmodes; m++) {
+        const ts_mode *md = &e->modes[m];
+        ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
+        json_t *j = json_pack(
+            "{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:s}", "re", num(md->re),
+            "im", num(md->im), "freq_hz", num(md->freq_hz), "period_s",
+            num(md->period_s), "damping_ratio", num(md->damping_ratio),
+            "time_constant_s", num(md->time_constant_s), "condition",
+            num(md->condition), "error_bound", num(md->error_bound),
+            "residual", num(md->residual), "description", desc);
+        if (j && shapes && e->vec_re)
+            json_object_set_new(j, "shape",
+                                shape_json(sys, lin, e, m, amp, phase));
+        json_array_append_new(modes, j);
+    }
+    json_object_set_new(o, "modes", modes);
+    free(amp);
+    free(phase);
+    return o;
+}
+
+int ts_report_modes_csv(const ts_system *sys, const ts_linear *lin,
+                        const ts_eigen *e, const char *path, ts_err *err)
+{
+    char tmp[1024], desc[256];
+    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
+    if (!f)
+        return TS_EIO;
+    fprintf(f, "mode,re_per_s,im_rad_per_s,freq_hz,period_s,damping_ratio,"
+               "time_constant_s,condition,error_bound,description\n");
+    for (int m = 0; m < e->nmodes; m++) {
+        const ts_mode *md = &e->modes[m];
+        ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
+        fprintf(f, "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%.6g,\"%s\"\n",
+                m + 1, md->re, md->im, md->freq_hz, md->period_s,
+                md->damping_ratio, md->time_constant_s, md->condition,
+                md->error_bound, desc);
+    }
+    return ts_report_commit(f, path, tmp, err);
+}
+
+int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
+                         const ts_eigen *e, const char *path, ts_err *err)
+{
+    if (!e->vec_re)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: no eigenvectors were kept, so no mode shapes",
+                       path);
+    double *amp = malloc(3 * (size_t)sys->nnodes * sizeof(double));
+    double *phase = malloc(3 * (size_t)sys->nnodes * sizeof(double));
+    if (!amp || !phase) {
+        free(amp);
+        free(phase);
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+    }
+    char tmp[1024], name[2 * TS_NAME_MAX];
+    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
+    if (!f) {
+        free(amp);
+        free(phase);
+        return TS_EIO;
+    }
+    fprintf(f, "mode,freq_hz,node,x_amp,x_phase_deg,y_amp,y_phase_deg,z_amp,"
+               "z_phase_deg\n");
+    int rc = TS_OK;
+    for (int m = 0; m < e->nmodes && rc == TS_OK; m++) {
+        rc = ts_eigen_mode_shape(sys, lin, e, m, amp, phase, err);
+        for (int i = 0; rc == TS_OK && i < sys->nnodes; i++) {
+            const double *a = amp + 3 * i, *p = phase + 3 * i;
+            ts_report_node_name(sys, i, name, sizeof name);
+            fprintf(f, "%d,%.17g,%s,%.10g,%.6f,%.10g,%.6f,%.10g,%.6f\n", m + 1,
+                    e->modes[m].freq_hz, name, a[0], p[0] * 180 / M_PI, a[1],
+                    p[1] * 180 / M_PI, a[2], p[2] * 180 / M_PI);
+        }
+    }
+    free(amp);
+    free(phase);
+    if (rc != TS_OK) {
+        ts_report_abandon(f, path, tmp);
+        return rc;
+    }
+    return ts_report_commit(f, path, tmp, err);
+}
+
+json_t *ts_report_response_json(const ts_response *r)
+{
+    json_t *o = json_object(), *pts = json_array();
+    if (!o || !pts) {
+        json_decref(o);
+        json_decref(pts);
+        return NULL;
+    }
+    json_object_set_new(o, "input", json_string(ts_input_name(r->input)));
+    json_object_set_new(o, "output", json_string(r->output.name));
+    json_object_set_new(o, "unit", json_string(r->output.unit));
+    json_object_set_new(o, "static_gain", num(r->static_gain));
+    for (int i = 0; i < r->npoints; i++)
+        json_array_append_new(
+            pts, json_pack("{s:o,s:o,s:o,s:o,s:o}", "freq_hz",
+                           num(r->freq_hz[i]), "magnitude",
+                           num(r->magnitude[i]), "phase_deg",
+                           num(r->phase_deg[i]), "re", num(r->re[i]), "im",
+                           num(r->im[i])));
+    json_object_set_new(o, "points", pts);
+    return o;
+}
+
+int ts_report_response_csv(const ts_response *r, const char *path,
+                           ts_err *err)
+{
+    char tmp[1024];
+    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
+    if (!f)
+        return TS_EIO;
+    fprintf(f, "freq_hz,magnitude,phase_deg,re,im\n");
+    for (int i = 0; i < r->npoints; i++)
+        fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", r->freq_hz[i],
+                r->magnitude[i], r->phase_deg[i], r->re[i], r->im[i]);
+    return ts_report_commit(f, path, tmp, err);
+}

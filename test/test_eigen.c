@@ -1,0 +1,368 @@
+/* test_eigen.c: modes (towstab/eigen.h) against independent references.
+ *
+ *  1. Hanging chain in vacuum (rho = 0, V = 0), 12 links: the small
+ *     oscillations of the discrete chain solve K phi = w^2 M phi with, for
+ *     link angles phi_k from the vertical, M_jk = l^2 sum_{i >= max(j,k)} m_i
+ *     and K = diag(g l sum_{i >= k} m_i) (m_i the node masses). Solved here
+ *     with GSL's generalized symmetric eigensolver, independently of the
+ *     kernel and LAPACK. The eigenvalues of A must be purely imaginary,
+ *     each frequency twice (in-plane and out-of-plane), equal to the
+ *     discrete frequencies to 1e-6 (relative; the linearization error is
+ *     ~1e-9).
+ *  2. Continuum limit: f_n = (j_0n / 2) sqrt(g/L) / (2 pi), j_0n the zeros
+ *     of J0 (GSL gsl_sf_bessel_zero_J0): the error of the 3 lowest
+ *     frequencies falls as the links go 10 -> 20 -> 40 and is below 1 % at
+ *     40 links for the lowest.
+ *  3. ARPACK and LAPACK agree (1e-8 relative) on the modes they share, for
+ *     a real shift (lowest modes) and a complex one (nearest 1.3 Hz), on a
+ *     towed cable with drag.
+ *  4. Every straight-tow example with drag (every scene in examples/, turn rate set
+ *     to 0) is stable, with every damping ratio > 0.
+ *  5. Mode shapes of the chain: the k-th in-plane mode has k - 1 nodes,
+ *     shape amplitude 1 at its largest component; the verdict of an
+ *     undamped chain is marginal.
+ *  6. Refusals: negative count, negative target, arpack without a count,
+ *     too many modes for arpack.
+ */
+#include "towstab/eigen.h"
+
+#include <glob.h>
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_sf_bessel.h>
+#include <gsl/gsl_sort_vector.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+#include "towstab/equilibrium.h"
+#include "towstab/scene.h"
+
+static ts_units *units;
+
+static ts_scene *scene_from(const char *yaml)
+{
+    ts_err err = {0};
+    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", units, &err);
+    if (!s)
+        printf("scene: %s\n", err.msg);
+    return s;
+}
+
+/* Solve, linearize; NULL on failure (reported). */
+static ts_linear *linearize(const ts_system *sys)
+{
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_linear *lin = NULL;
+    if (ts_equilibrium_solve(k, NULL, eq, &err) == TS_OK) {
+        lin = ts_linear_alloc(k, &err);
+        if (ts_linearize_equilibrium(k, eq, NULL, lin, &err) != TS_OK) {
+            ts_linear_free(lin);
+            lin = NULL;
+        }
+    }
+    if (!lin)
+        printf("linearize %s: %s\n", sys->name, err.msg);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    return lin;
+}
+
+static char *chain_yaml(int links, double length)
+{
+    static char buf[512];
+    snprintf(buf, sizeof buf,
+             "name: chain\n"
+             "environment: {water_density: 0, gravity: 9.80665}\n"
+             "tow: {speed: 0}\n"
+             "cables:\n"
+             "  - {name: chain, from: tow, length: %.17g, diameter: 0.01,\n"
+             "     mass_per_length: 1.37, links: %d}\n",
+             length, links);
+    return buf;
+}
+
+/* The discrete chain's angular frequencies, ascending, into w[N]. */
+static void chain_exact(const ts_system *sys, double *w)
+{
+    int N = sys->nlinks;
+    double g = sys->env.gravity;
+    gsl_matrix *M = gsl_matrix_alloc(N, N), *K = gsl_matrix_calloc(N, N);
+    double *below = calloc((size_t)N, sizeof(double));
+    for (int k = N - 1; k >= 0; k--)
+        below[k] = sys->nodes[sys->links[k].lower].mass +
+                   (k + 1 < N ? below[k + 1] : 0.0);
+    for (int j = 0; j < N; j++) {
+        double lj = sys->links[j].length;
+        gsl_matrix_set(K, j, j, g * lj * below[j]);
+        for (int k = 0; k < N; k++)
+            gsl_matrix_set(M, j, k,
+                           lj * sys->links[k].length * below[j > k ? j : k]);
+    }
+    gsl_vector *eval = gsl_vector_alloc(N);
+    gsl_eigen_gensymm_workspace *ws = gsl_eigen_gensymm_alloc(N);
+    gsl_eigen_gensymm(K, M, eval, ws);
+    gsl_sort_vector(eval);
+    for (int i = 0; i < N; i++)
+        w[i] = sqrt(gsl_vector_get(eval, i));
+    gsl_eigen_gensymm_free(ws);
+    gsl_vector_free(eval);
+    gsl_matrix_free(M);
+    gsl_matrix_free(K);
+    free(below);
+}
+
+static void test_chain(void)
+{
+    ts_scene *sc = scene_from(chain_yaml(12, 8.25));
+    const ts_system *sys = sc->system;
+    ts_linear *lin = linearize(sys);
+    ts_eigen *e = NULL;
+    ts_err err = {0};
+    int rc = ts_eigen_solve(lin, NULL, &e, &err);
+    CHECK(rc == TS_OK, "chain: lapack eigen (%s)", err.msg);
+    int N = sys->nlinks;
+    CHECK(e->nmodes == 2 * N && e->complete && e->neig == 4 * N,
+          "chain: %d modes cover all %d eigenvalues", e->nmodes, e->neig);
+    double w[64];
+    chain_exact(sys, w);
+    double re_worst = 0, f_worst = 0;
+    for (int m = 0; m < e->nmodes; m++) {
+        re_worst = fmax(re_worst, fabs(e->modes[m].re) / e->modes[m].im);
+        /* Sorted by frequency: modes 2i and 2i+1 are the pair of w[i]. */
+        f_worst = fmax(f_worst, fabs(e->modes[m].im - w[m / 2]) / w[m / 2]);
+    }
+    CHECK(re_worst < 1e-8, "chain: purely imaginary, max |Re|/Im %.3g < 1e-8",
+          re_worst);
+    CHECK(f_worst < 1e-6, "chain: every frequency twice and equal to the "
+                          "discrete chain's, max rel err %.3g < 1e-6",
+          f_worst);
+    CHECK(e->verdict == TS_MARGINAL,
+          "chain: undamped, verdict marginal (got %s)",
+          ts_verdict_name(e->verdict));
+
+    /* 5. Mode shapes: the lowest in-plane and out-of-plane pair. */
+    int nin = 0;
+    for (int m = 0; m < 6; m++) {
+        char d[256];
+        ts_eigen_describe(sys, lin, e, m, d, sizeof d);
+        int order = m / 2 + 1;
+        char want[32];
+        snprintf(want, sizeof want, "order %d (", order);
+        CHECK(strstr(d, want) != NULL, "chain mode %d: '%s' has %s", m + 1, d,
+              want);
+        nin += strstr(d, "in-plane") != NULL;
+    }
+    CHECK(nin == 3, "chain: one in-plane mode in each of the 3 lowest "
+                    "pairs (%d)",
+          nin);
+    double amp[3 * 13], ph[3 * 13];
+    rc = ts_eigen_mode_shape(sys, lin, e, 0, amp, ph, &err);
+    double big = 0, zbig = 0;
+    for (int i = 0; i < 3 * sys->nnodes; i++) {
+        big = fmax(big, amp[i]);
+        if (i % 3 == 2)
+            zbig = fmax(zbig, amp[i]);
+    }
+    CHECK(rc == TS_OK && fabs(big - 1) < 1e-12 && zbig < 1e-6,
+          "chain mode 1 shape: max amplitude 1 (%.15g), vertical motion "
+          "%.3g < 1e-6 (second order only)",
+          big, zbig);
+    ts_err_clear(&err);
+    rc = ts_eigen_mode_shape(sys, lin, e, e->nmodes, amp, ph, &err);
+    CHECK(rc == TS_EINVAL, "mode shape: out of range refused (%s)", err.msg);
+    ts_eigen_free(e);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+}
+
+static void test_continuum(void)
+{
+    static const int links[3] = {10, 20, 40};
+    double L = 9.3, err_prev[3] = {INFINITY, INFINITY, INFINITY};
+    int falling = 1;
+    double last1 = 0;
+    for (int t = 0; t < 3; t++) {
+        ts_scene *sc = scene_from(chain_yaml(links[t], L));
+        ts_linear *lin = linearize(sc->system);
+        ts_eigen *e = NULL;
+        ts_eigen_opts o;
+        ts_eigen_opts_default(&o);
+        o.count = 6;
+        ts_eigen_solve(lin, &o, &e, NULL);
+        double g = sc->system->env.gravity;
+        for (int j = 0; j < 3; j++) {
+            double fc = 0.5 * gsl_sf_bessel_zero_J0(j + 1) * sqrt(g / L) /
+                        (2 * M_PI);
+            double f = e->modes[2 * j].freq_hz;
+            double rel = fabs(f - fc) / fc;
+            printf("  %d links: f%d = %.9f Hz, continuum %.9f, rel err %.3g\n",
+                   links[t], j + 1, f, fc, rel);
+            falling &= rel < err_prev[j];
+            err_prev[j] = rel;
+            if (j == 0)
+                last1 = rel;
+        }
+        ts_eigen_free(e);
+        ts_linear_free(lin);
+        ts_scene_free(sc);
+    }
+    CHECK(falling, "chain: errors against the continuum fall with links");
+    CHECK(last1 < 0.01, "chain, 40 links: f1 within 1%% of the continuum "
+                        "(%.3g)",
+          last1);
+}
+
+static const char *towed_yaml =
+    "name: towed\n"
+    "tow: {speed: 2.1, point: [0, 0, 0.5]}\n"
+    "cables:\n"
+    "  - {name: cable, from: tow, to: fish, length: 40.3, diameter: 0.018,\n"
+    "     mass_per_length: 0.71, links: 40, normal_drag: 1.2,\n"
+    "     tangential_drag: 0.01, added_mass: 1.0}\n"
+    "bodies:\n"
+    "  - {name: fish, type: sphere, diameter: 0.4, mass: 63.0, drag: 0.5,\n"
+    "     added_mass: 0.5}\n";
+
+/* Nearest LAPACK mode to lambda: relative distance. */
+static double nearest(const ts_eigen *all, double re, double im)
+{
+    double best = INFINITY;
+    for (int m = 0; m < all->nmodes; m++)
+        best = fmin(best, hypot(all->modes[m].re - re, all->modes[m].im - im));
+    return best / hypot(re, im);
+}
+
+static void test_arpack_small(void)
+{
+    ts_scene *sc = scene_from(towed_yaml);
+    ts_linear *lin = linearize(sc->system);
+    ts_eigen *all = NULL, *ar = NULL, *lp = NULL;
+    ts_err err = {0};
+    ts_eigen_opts o;
+    ts_eigen_opts_default(&o);
+    int rc = ts_eigen_solve(lin, &o, &all, &err);
+    CHECK(rc == TS_OK, "towed: lapack all (%s)", err.msg);
+    for (int pass = 0; pass < 2; pass++) {
+        o.count = 8;
+        o.target_hz = pass ? 1.3 : 0.0;
+        o.method = TS_EIG_ARPACK;
+        rc = ts_eigen_solve(lin, &o, &ar, &err);
+        CHECK(rc == TS_OK && ar->method == TS_EIG_ARPACK && ar->nmodes == 8,
+              "towed: arpack %s shift, %d modes (%s)",
+              pass ? "complex" : "real", ar ? ar->nmodes : 0, err.msg);
+        o.method = TS_EIG_LAPACK;
+        rc = ts_eigen_solve(lin, &o, &lp, &err);
+        double worst = 0, resid = 0;
+        for (int m = 0; rc == TS_OK && ar && m < ar->nmodes; m++) {
+            worst = fmax(worst, hypot(ar->modes[m].re - lp->modes[m].re,
+                                      ar->modes[m].im - lp->modes[m].im) /
+                                    hypot(lp->modes[m].re, lp->modes[m].im));
+            worst = fmax(worst, nearest(all, ar->modes[m].re, ar->modes[m].im));
+            resid = fmax(resid, ar->modes[m].residual);
+        }
+        CHECK(rc == TS_OK && worst < 1e-8,
+              "towed, %s shift: arpack and lapack agree on the 8 modes "
+              "nearest the target, max rel diff %.3g < 1e-8",
+              pass ? "complex" : "real", worst);
+        CHECK(resid < 1e-10, "towed, %s shift: arpack residuals %.3g < 1e-10",
+              pass ? "complex" : "real", resid);
+        ts_eigen_free(ar);
+        ts_eigen_free(lp);
+        ar = lp = NULL;
+    }
+    /* Auto picks arpack only above the size threshold. */
+    o.method = TS_EIG_AUTO;
+    o.count = 4;
+    o.target_hz = 0;
+    o.arpack_min_states = lin->nstate;
+    rc = ts_eigen_solve(lin, &o, &ar, &err);
+    CHECK(rc == TS_OK && ar->method == TS_EIG_ARPACK,
+          "auto: arpack at the threshold size");
+    ts_eigen_free(ar);
+    o.arpack_min_states = lin->nstate + 1;
+    rc = ts_eigen_solve(lin, &o, &ar, &err);
+    CHECK(rc == TS_OK && ar->method == TS_EIG_LAPACK,
+          "auto: lapack below it");
+    ts_eigen_free(ar);
+
+    /* 6. Refusals. */
+    ts_eigen_opts_default(&o);
+    o.count = -1;
+    rc = ts_eigen_solve(lin, &o, &ar, &err);
+    CHECK(rc == TS_EINVAL && ar == NULL, "count -1 refused: %s", err.msg);
+    ts_eigen_opts_default(&o);
+    o.target_hz = -0.5;
+    rc = ts_eigen_solve(lin, &o, &ar, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "target"),
+          "negative target refused: %s", err.msg);
+    ts_eigen_opts_default(&o);
+    o.method = TS_EIG_ARPACK;
+    rc = ts_eigen_solve(lin, &o, &ar, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "count"),
+          "arpack without count refused: %s", err.msg);
+    o.count = lin->nstate / 2;
+    rc = ts_eigen_solve(lin, &o, &ar, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "lapack"),
+          "arpack with too many modes refused: %s", err.msg);
+    ts_eigen_free(all);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+}
+
+static void test_examples_stable(void)
+{
+    glob_t g;
+    int found = glob("examples/*.yaml", 0, NULL, &g) == 0 ? (int)g.gl_pathc
+                                                          : 0;
+    CHECK(found >= 1, "examples found: %d", found);
+    for (int i = 0; i < found; i++) {
+        ts_err err = {0};
+        ts_scene *sc = ts_scene_load(g.gl_pathv[i], units, &err);
+        if (!sc) {
+            CHECK(0, "%s: %s", g.gl_pathv[i], err.msg);
+            continue;
+        }
+        ts_system *sys = sc->system;
+        int has_drag = sys->env.water_density > 0;
+        if (!has_drag) {
+            ts_scene_free(sc);
+            continue;
+        }
+        sys->tow.turn_rate = 0;
+        ts_linear *lin = linearize(sys);
+        ts_eigen *e = NULL;
+        int rc = lin ? ts_eigen_solve(lin, NULL, &e, &err) : TS_ECONV;
+        double zmin = INFINITY;
+        for (int m = 0; rc == TS_OK && m < e->nmodes; m++)
+            zmin = fmin(zmin, e->modes[m].damping_ratio);
+        CHECK(rc == TS_OK && e->verdict == TS_STABLE && zmin > 0,
+              "%s, straight tow: %s, max Re %.4g 1/s, smallest damping "
+              "ratio %.4g > 0",
+              g.gl_pathv[i], e ? ts_verdict_name(e->verdict) : err.msg,
+              e ? e->max_real : NAN, zmin);
+        ts_eigen_free(e);
+        ts_linear_free(lin);
+        ts_scene_free(sc);
+    }
+    globfree(&g);
+}
+
+int main(void)
+{
+    ts_err err = {0};
+    units = ts_units_alloc(&err);
+    if (!units) {
+        printf("FAIL units: %s\n", err.msg);
+        return 1;
+    }
+    test_chain();
+    test_continuum();
+    test_arpack_small();
+    test_examples_stable();
+    ts_units_free(units);
+    return tc_done();
+}

@@ -1,0 +1,334 @@
+/* test_response.c: frequency response (towstab/response.h) against
+ * independent references.
+ *
+ *  1. Static gain, heave: Kamman's example 1 with the tow point 35 ft above
+ *     the water (the cable pierces the surface, so heaving the tow point
+ *     changes the wetted length and the shape: the gain is not 1). The
+ *     zero-frequency limit and the response at 1e-6 Hz must equal the
+ *     static gain from re-solving the equilibrium with the tow point
+ *     displaced by +-1 mm (central difference, error ~1e-8) to 1e-5, for
+ *     the sphere's depth and the top link's tension. No node is within
+ *     0.1 m of the waterline (checked), far from the kink.
+ *  2. Static gain, surge in a turn (Kamman ex. 3, 0.5 rad/s): moving the
+ *     tow point forward changes its radius, so the sphere moves sideways;
+ *     the same comparison for sphere.y.
+ *  3. Resonance: for a chain hanging in vacuum, tow.surge -> bottom node x
+ *     has a local maximum of |G| on a fine grid next to each of its three
+ *     lowest in-plane natural frequencies (from the eigen solver), none
+ *     elsewhere, and |G| > 1e3 at 1e-6 off each of them.
+ *  4. Names and ranges: inputs, outputs (aliases, tow refused, valid names
+ *     listed), log spacing refused for empty or negative ranges, tension
+ *     outputs need the tension Jacobians.
+ */
+#include "towstab/response.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+#include "towstab/eigen.h"
+#include "towstab/equilibrium.h"
+#include "towstab/scene.h"
+
+static ts_units *units;
+
+static ts_scene *scene_from(const char *yaml)
+{
+    ts_err err = {0};
+    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", units, &err);
+    if (!s)
+        printf("scene: %s\n", err.msg);
+    return s;
+}
+
+static const char *above_yaml =
+    "name: ex1_above\n"
+    "environment: {water_density: \"1.9905 slug/ft^3\", gravity: \"32.174 "
+    "ft/s^2\"}\n"
+    "tow: {speed: \"8.345 ft/s\", point: [0, 0, \"-35 ft\"]}\n"
+    "cables:\n"
+    "  - {name: cable, from: tow, to: sphere, length: \"100 ft\",\n"
+    "     diameter: \"1 in\", weight: \"1 lbf/ft\", links: 20,\n"
+    "     normal_drag: 1.2, tangential_drag: 0.01, added_mass: 1.0}\n"
+    "bodies:\n"
+    "  - {name: sphere, type: sphere, diameter: \"10 in\", weight: \"50 lbf\",\n"
+    "     drag: 0.5, added_mass: 0.5}\n";
+
+static const char *turn_yaml =
+    "name: ex3_turn\n"
+    "environment: {water_density: \"1.9905 slug/ft^3\", gravity: \"32.174 "
+    "ft/s^2\"}\n"
+    "tow: {speed: \"2.5 ft/s\", turn_rate: \"0.5 rad/s\"}\n"
+    "cables:\n"
+    "  - {name: cable, from: tow, to: sphere, length: \"6 ft\",\n"
+    "     diameter: \"0.163 in\", weight: \"0.008979 lbf/ft\", links: 20}\n"
+    "bodies:\n"
+    "  - {name: sphere, type: sphere, diameter: \"2 in\", weight: \"0.246 "
+    "lbf\"}\n";
+
+/* Equilibrium output value with the tow point displaced by d along axis. */
+static double displaced(ts_system *sys, int axis, double d,
+                        const ts_output *out, int *ok)
+{
+    ts_err err = {0};
+    double p0 = sys->tow.point[axis];
+    sys->tow.point[axis] = p0 + d;
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_equilibrium_opts o;
+    ts_equilibrium_opts_default(&o);
+    o.tol = 1e-12;
+    int rc = ts_equilibrium_solve(k, &o, eq, &err);
+    if (rc != TS_OK) {
+        printf("  displaced equilibrium: %s\n", err.msg);
+        *ok = 0;
+    }
+    double v = out->kind == TS_OUT_POSITION
+                   ? eq->positions[3 * out->node + out->comp]
+                   : eq->tensions[out->link];
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    sys->tow.point[axis] = p0;
+    return v;
+}
+
+static ts_linear *linearize(const ts_system *sys, int tensions,
+                            double *zmin)
+{
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_linear *lin = NULL;
+    ts_equilibrium_opts eo;
+    ts_equilibrium_opts_default(&eo);
+    eo.tol = 1e-12;
+    if (ts_equilibrium_solve(k, &eo, eq, &err) == TS_OK) {
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.tensions = tensions;
+        lin = ts_linear_alloc(k, &err);
+        if (ts_linearize_equilibrium(k, eq, &o, lin, &err) != TS_OK) {
+            ts_linear_free(lin);
+            lin = NULL;
+        }
+    }
+    if (!lin)
+        printf("linearize: %s\n", err.msg);
+    if (zmin) {
+        *zmin = INFINITY;
+        for (int i = 0; i < sys->nnodes; i++)
+            *zmin = fmin(*zmin, fabs(eq->positions[3 * i + 2]));
+    }
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    return lin;
+}
+
+static void static_case(ts_system *sys, ts_linear *lin, const char *in_name,
+                        const char *out_name, double not_trivial)
+{
+    ts_err err = {0};
+    int in;
+    ts_output out;
+    int rc = ts_response_input_find(in_name, &in, &err);
+    rc |= ts_response_output_find(sys, out_name, &out, &err);
+    CHECK(rc == TS_OK, "%s -> %s: names found (%s)", in_name, out_name,
+          err.msg);
+    double d = 1e-3;
+    int ok = 1;
+    double ref = (displaced(sys, in, d, &out, &ok) -
+                  displaced(sys, in, -d, &out, &ok)) /
+                 (2 * d);
+    double g0r, g0i, glr, gli;
+    rc = ts_response_at(sys, lin, in, &out, 0.0, &g0r, &g0i, &err);
+    rc |= ts_response_at(sys, lin, in, &out, 2 * M_PI * 1e-6, &glr, &gli,
+                         &err);
+    printf("  %s -> %s: re-solved %.10g, w = 0 %.10g, 1e-6 Hz %.10g%+.3gi\n",
+           in_name, out_name, ref, g0r, glr, gli);
+    CHECK(ok && rc == TS_OK, "%s -> %s: responses and displaced equilibria "
+                             "computed",
+          in_name, out_name);
+    /* 1e-5 relative: the central difference of the re-solved equilibria
+     * is good to ~1e-7, the linearization to ~1e-9. */
+    CHECK_REL(g0r, ref, 1e-5, "static gain at w = 0 vs re-solved");
+    CHECK_REL(hypot(glr, gli), fabs(ref), 1e-5,
+              "|gain| at 1e-6 Hz vs re-solved");
+    CHECK(g0i == 0.0, "gain at w = 0 is real");
+    CHECK(fabs(ref - round(ref)) > not_trivial,
+          "%s -> %s: the gain %.6g is not trivially an integer", in_name,
+          out_name, ref);
+}
+
+static void test_static_gain(void)
+{
+    ts_scene *sc = scene_from(above_yaml);
+    double zmin;
+    ts_linear *lin = linearize(sc->system, 1, &zmin);
+    CHECK(lin && zmin > 0.1, "above-water tow: every node %.3g m > 0.1 m "
+                             "from the waterline",
+          zmin);
+    CHECK(lin->kinks == 0, "above-water tow: no kinks");
+    static_case(sc->system, lin, "tow.heave", "sphere.z", 0.01);
+    static_case(sc->system, lin, "tow.heave", "cable.1.tension", 0.01);
+    static_case(sc->system, lin, "tow.heave", "cable.12.x", 0.001);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+
+    sc = scene_from(turn_yaml);
+    lin = linearize(sc->system, 1, NULL);
+    static_case(sc->system, lin, "tow.surge", "sphere.y", 0.01);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+}
+
+static void test_resonance(void)
+{
+    ts_scene *sc = scene_from(
+        "name: chain\n"
+        "environment: {water_density: 0, gravity: 9.80665}\n"
+        "tow: {speed: 0}\n"
+        "cables:\n"
+        "  - {name: chain, from: tow, length: 5.17, diameter: 0.01,\n"
+        "     mass_per_length: 1.9, links: 10}\n");
+    const ts_system *sys = sc->system;
+    ts_linear *lin = linearize(sys, 0, NULL);
+    ts_eigen *e = NULL;
+    ts_err err = {0};
+    ts_eigen_solve(lin, NULL, &e, &err);
+    double fn[3];
+    for (int j = 0; j < 3; j++)
+        fn[j] = e->modes[2 * j].freq_hz;
+    int in;
+    ts_output out;
+    ts_response_input_find("tow.surge", &in, &err);
+    int rc = ts_response_output_find(sys, "chain.10.x", &out, &err);
+    CHECK(rc == TS_OK, "chain.10.x found (%s)", err.msg);
+    int np = 600;
+    double *f = malloc((size_t)np * sizeof(double));
+    ts_response_logspace(0.6 * fn[0], 1.15 * fn[2], np, f, &err);
+    ts_response *r = NULL;
+    rc = ts_response_compute(sys, lin, in, &out, f, np, &r, &err);
+    CHECK(rc == TS_OK, "chain: response on %d points (%s)", np, err.msg);
+    double ratio = pow(1.15 * fn[2] / (0.6 * fn[0]), 1.0 / (np - 1));
+    int matched[3] = {0, 0, 0}, stray = 0;
+    for (int i = 1; rc == TS_OK && i + 1 < np; i++) {
+        if (!(r->magnitude[i] > r->magnitude[i - 1] &&
+              r->magnitude[i] > r->magnitude[i + 1]))
+            continue;
+        int hit = 0;
+        for (int j = 0; j < 3; j++)
+            if (r->freq_hz[i] / fn[j] < ratio && fn[j] / r->freq_hz[i] < ratio) {
+                matched[j]++;
+                hit = 1;
+            }
+        stray += !hit;
+    }
+    CHECK(matched[0] == 1 && matched[1] == 1 && matched[2] == 1 && stray == 0,
+          "chain: one peak next to each of f1, f2, f3 (%.5g, %.5g, %.5g Hz; "
+          "%d %d %d) and %d elsewhere",
+          fn[0], fn[1], fn[2], matched[0], matched[1], matched[2], stray);
+    for (int j = 0; j < 3; j++) {
+        double re, im;
+        ts_response_at(sys, lin, in, &out, 2 * M_PI * fn[j] * (1 + 1e-6), &re,
+                       &im, &err);
+        CHECK(hypot(re, im) > 1e3, "chain: |G| at f%d (1 + 1e-6) = %.3g > 1e3",
+              j + 1, hypot(re, im));
+    }
+    ts_response_free(r);
+    free(f);
+    ts_eigen_free(e);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+}
+
+static void test_names(void)
+{
+    ts_scene *sc = scene_from(above_yaml);
+    const ts_system *sys = sc->system;
+    ts_err err = {0};
+    ts_output out;
+    int in, rc;
+    rc = ts_response_output_find(sys, "sphere.z", &out, &err);
+    CHECK(rc == TS_OK && out.kind == TS_OUT_POSITION && out.node == 20 &&
+              out.comp == 2 && strcmp(out.name, "sphere.z") == 0,
+          "sphere.z: node 20 z");
+    rc = ts_response_output_find(sys, "cable.20.z", &out, &err);
+    CHECK(rc == TS_OK && out.node == 20 && strcmp(out.name, "sphere.z") == 0,
+          "cable.20.z is the sphere (canonical %s)", out.name);
+    rc = ts_response_output_find(sys, "cable.3.x", &out, &err);
+    CHECK(rc == TS_OK && out.node == 3 && out.comp == 0, "cable.3.x");
+    rc = ts_response_output_find(sys, "cable.3.tension", &out, &err);
+    CHECK(rc == TS_OK && out.kind == TS_OUT_TENSION && out.link == 2,
+          "cable.3.tension: link index 2");
+    rc = ts_response_output_find(sys, "sphere.tension", &out, &err);
+    CHECK(rc == TS_OK && out.link == 19 &&
+              strcmp(out.name, "cable.20.tension") == 0,
+          "sphere.tension is cable.20.tension");
+    static const char *bad[] = {"nosuch.z", "cable.21.x", "cable.0.x",
+                                "sphere.w", "cable", "cable.x.y", ".z"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ts_err_clear(&err);
+        rc = ts_response_output_find(sys, bad[i], &out, &err);
+        CHECK(rc == TS_EINVAL && strstr(err.msg, bad[i]) &&
+                  strstr(err.msg, "cable.1 .. cable.19, sphere") &&
+                  strstr(err.msg, "cable.1.tension .. cable.20.tension"),
+              "bad output '%s' refused, valid names listed: %s", bad[i],
+              err.msg);
+    }
+    ts_err_clear(&err);
+    rc = ts_response_output_find(sys, "tow.z", &out, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow is the input"),
+          "tow.z refused: %s", err.msg);
+    rc = ts_response_input_find("tow.heave", &in, &err);
+    CHECK(rc == TS_OK && in == 2, "tow.heave is channel 2");
+    rc = ts_response_input_find("sphere.z", &in, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow.surge, tow.sway or "
+                                             "tow.heave"),
+          "bad input refused: %s", err.msg);
+
+    double f[4];
+    rc = ts_response_logspace(0.01, 10, 4, f, &err);
+    CHECK(rc == TS_OK && f[0] == 0.01 && f[3] == 10 &&
+              fabs(f[1] - 0.1) < 1e-15 && fabs(f[2] - 1) < 1e-14,
+          "logspace 0.01..10 in 4: %g %g %g %g", f[0], f[1], f[2], f[3]);
+    static const double bad_range[][2] = {{0, 10}, {-1, 10}, {5, 5},
+                                          {10, 1}, {1, INFINITY}};
+    for (int i = 0; i < 5; i++) {
+        rc = ts_response_logspace(bad_range[i][0], bad_range[i][1], 10, f,
+                                  &err);
+        CHECK(rc == TS_EINVAL, "range %g..%g refused: %s", bad_range[i][0],
+              bad_range[i][1], err.msg);
+    }
+    rc = ts_response_logspace(1, 2, 1, f, &err);
+    CHECK(rc == TS_EINVAL, "1 point refused: %s", err.msg);
+
+    ts_linear *lin = linearize(sys, 0, NULL);
+    ts_response_output_find(sys, "cable.3.tension", &out, &err);
+    double re, im;
+    rc = ts_response_at(sys, lin, 2, &out, 1.0, &re, &im, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tension"),
+          "tension without Jacobians refused: %s", err.msg);
+    ts_response_output_find(sys, "sphere.z", &out, &err);
+    rc = ts_response_at(sys, lin, 3, &out, 1.0, &re, &im, &err);
+    CHECK(rc == TS_EINVAL, "channel 3 refused: %s", err.msg);
+    rc = ts_response_at(sys, lin, 2, &out, -1.0, &re, &im, &err);
+    CHECK(rc == TS_EINVAL, "negative frequency refused: %s", err.msg);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+}
+
+int main(void)
+{
+    ts_err err = {0};
+    units = ts_units_alloc(&err);
+    if (!units) {
+        printf("FAIL units: %s\n", err.msg);
+        return 1;
+    }
+    test_static_gain();
+    test_resonance();
+    test_names();
+    ts_units_free(units);
+    return tc_done();
+}

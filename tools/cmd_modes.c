@@ -1,0 +1,477 @@
+/* cmd_modes.c: `towstab modes SCENE` and the `modes` analysis of a scene:
+ * equilibrium, linearization, eigen analysis, mode table and stability
+ * verdict (doc/linear.md). Also defines cli_linear_setup(), which
+ * cmd_response.c shares. */
+#include <getopt.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "towstab/eigen.h"
+#include "towstab/linearize.h"
+#include "towstab/report.h"
+#include "towstab/report_linear.h"
+
+/* Modes shown when the system is large and no count is given. */
+#define DEFAULT_LARGE_COUNT 20
+/* Modes found around --near when no count is given. */
+#define DEFAULT_NEAR_COUNT 10
+
+int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
+                     int tensions, ts_equilibrium **eq, json_t **eqjson,
+                     ts_linear **lin, ts_err *err);
+
+/* Solve the equilibrium (printing its summary), then linearize about it
+ * with a fresh kernel re-charted from the equilibrium's directions. On
+ * failure returns the library code with the message in err; an
+ * equilibrium that did not converge is never linearized. */
+int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
+                     int tensions, ts_equilibrium **eq, json_t **eqjson,
+                     ts_linear **lin, ts_err *err)
+{
+    *lin = NULL;
+    int rc = cli_equilibrium(sys, eo, 1, eq, eqjson, err);
+    if (rc != TS_OK) {
+        if (*eq && !(*eq)->converged)
+            ts_err_prefix(err, "the equilibrium did not converge, so it is "
+                               "not linearized: ");
+        return rc;
+    }
+    ts_kernel *k = ts_kernel_alloc(sys, err);
+    if (!k)
+        return err->code;
+    ts_linear *l = ts_linear_alloc(k, err);
+    if (!l) {
+        ts_kernel_free(k);
+        return err->code;
+    }
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    lo.tensions = tensions;
+    double t0 = cli_wall_now();
+    rc = ts_linearize_equilibrium(k, *eq, &lo, l, err);
+    double wall = cli_wall_now() - t0;
+    ts_kernel_free(k);
+    if (rc != TS_OK) {
+        ts_linear_free(l);
+        return rc;
+    }
+    printf("linearized: %d states, %d inputs, %ld kernel evaluations on %d "
+           "thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
+           "||dA||_F %.3g)\n",
+           l->nstate, l->ninput, l->evaluations, l->threads,
+           l->threads == 1 ? "" : "s", wall * 1e3, l->trunc_err, l->a_scale,
+           l->trunc_norm);
+    if (l->kinks > l->kink_tow) {
+        char name[2 * TS_NAME_MAX];
+        ts_report_node_name(sys, l->kink_node, name, sizeof name);
+        printf("warning: %d node%s (first %s, depth %.3g m) within a step "
+               "of the water surface: f is not smooth there, A is the mean "
+               "of one-sided derivatives and the modes near it are not "
+               "trustworthy\n",
+               l->kinks - l->kink_tow, l->kinks - l->kink_tow == 1 ? "" : "s",
+               name, l->r0[3 * l->kink_node + 2]);
+    }
+    if (l->kink_tow)
+        printf("note: the tow point is at the water surface: the heave "
+               "input (column of B) is the mean of the one-sided "
+               "derivatives; the modes (A) are not affected\n");
+    *lin = l;
+    return TS_OK;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: towstab modes SCENE [options]\n"
+            "  stability verdict and mode table of the linearized system\n"
+            "  about the equilibrium at the scene's speed and turn rate\n"
+            "  --count N        modes to report (default: all; %d for large\n"
+            "                   systems; %d with --near)\n"
+            "  --near F         the modes nearest F (Hz, or with a unit)\n"
+            "  --method M       auto (default), lapack (all eigenvalues) or\n"
+            "                   arpack (shift-invert, needs a count)\n"
+            "  --json FILE      write the modes as JSON ('-' for stdout)\n"
+            "  --matrices       include A and B in the JSON\n"
+            "  --csv FILE       write the mode table as CSV\n"
+            "  --shapes FILE    write the mode shapes (CSV, or JSON when FILE\n"
+            "                   ends in .json)\n"
+            "  --speed Q        override tow.speed (e.g. '5 knot', 2.5)\n"
+            "  --turn-rate Q    override tow.turn_rate (e.g. '0.5 rad/s')\n"
+            "  --links N        use N links on every cable\n"
+            "  --eq-method M    equilibrium method: auto, shooting, newton\n"
+            "  --tol X          equilibrium relative force residual\n"
+            "  --quiet          print the summary and verdict only\n",
+            DEFAULT_LARGE_COUNT, DEFAULT_NEAR_COUNT);
+}
+
+/* What both entries (command line and scene) decide. */
+typedef struct modes_req {
+    ts_eigen_opts eo;
+    int count_given;
+    int near_given;
+} modes_req;
+
+static int parse_method(const char *text, const char *where,
+                        ts_eig_method *m, ts_err *err)
+{
+    if (strcmp(text, "auto") == 0)
+        *m = TS_EIG_AUTO;
+    else if (strcmp(text, "lapack") == 0)
+        *m = TS_EIG_LAPACK;
+    else if (strcmp(text, "arpack") == 0)
+        *m = TS_EIG_ARPACK;
+    else
+        return ts_fail(err, TS_EINVAL,
+                       "%s: '%s' is not an eigen method; expected auto, "
+                       "lapack or arpack",
+                       where, text);
+    return TS_OK;
+}
+
+static void print_modes(const ts_system *sys, const ts_linear *lin,
+                        const ts_eigen *e, double wall, int quiet)
+{
+    printf("eigen: %s, %d mode%s (%d of %d eigenvalues)%s, %.3f ms",
+           ts_eig_method_name(e->method), e->nmodes, e->nmodes == 1 ? "" : "s",
+           e->neig, e->nstate, e->complete ? "" : " nearest the target",
+           wall * 1e3);
+    if (e->method == TS_EIG_ARPACK)
+        printf(", %d restarts, %d operator applications", e->arpack_iterations,
+               e->arpack_ops);
+    printf("\n");
+    if (!quiet) {
+        char desc[256];
+        printf("\n%4s %14s %14s %12s %12s %10s  %s\n", "mode", "Re [1/s]",
+               "Im [rad/s]", "freq [Hz]", "period [s]", "damping",
+               "shape");
+        for (int m = 0; m < e->nmodes; m++) {
+            const ts_mode *md = &e->modes[m];
+            ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
+            printf("%4d %14.6g %14.6g %12.6g %12.6g %10.6f  %s\n", m + 1,
+                   md->re, md->im, md->freq_hz, md->period_s,
+                   md->damping_ratio, desc);
+        }
+        printf("\n");
+    }
+    const char *scope = e->complete ? "" : " among the modes computed";
+    switch (e->verdict) {
+    case TS_STABLE:
+        printf("verdict: stable%s: max Re(lambda) = %.6g 1/s, error bound "
+               "%.2g 1/s (the margin is %.3g times its error: trustworthy)\n",
+               scope, e->max_real, e->max_real_error,
+               e->max_real_error > 0 ? -e->max_real / e->max_real_error
+                                     : INFINITY);
+        break;
+    case TS_UNSTABLE:
+        printf("verdict: UNSTABLE%s: max Re(lambda) = %.6g 1/s > 0, error "
+               "bound %.2g 1/s\n",
+               scope, e->max_real, e->max_real_error);
+        break;
+    default:
+        printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s is within its "
+               "error bound %.2g 1/s of 0; the linear model does not decide "
+               "stability (undamped or nearly so)\n",
+               scope, e->max_real, e->max_real_error);
+    }
+    if (!e->complete)
+        printf("note: only %d of %d eigenvalues were computed (those nearest "
+               "%.6g Hz); modes elsewhere are not covered by the verdict\n",
+               e->neig, e->nstate, e->target_hz);
+    if (lin->kinks > lin->kink_tow)
+        printf("warning: a node sits at the water surface (kink in f): the "
+               "margin above is not trustworthy\n");
+}
+
+/* Everything after the system is built. *json receives the result. */
+static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
+                          modes_req *rq, int quiet, int matrices,
+                          json_t **json, ts_linear **lin_out,
+                          ts_eigen **eig_out, ts_err *err)
+{
+    ts_equilibrium *eq = NULL;
+    json_t *eqjson = NULL;
+    ts_linear *lin = NULL;
+    *json = NULL;
+    *lin_out = NULL;
+    *eig_out = NULL;
+    int rc = cli_linear_setup(sys, eqo, 0, &eq, &eqjson, &lin, err);
+    if (rc != TS_OK) {
+        json_decref(eqjson);
+        ts_equilibrium_free(eq);
+        return rc;
+    }
+    if (!rq->count_given) {
+        if (rq->near_given)
+            rq->eo.count = DEFAULT_NEAR_COUNT;
+        else if (rq->eo.method == TS_EIG_ARPACK ||
+                 (rq->eo.method == TS_EIG_AUTO &&
+                  lin->nstate >= rq->eo.arpack_min_states))
+            rq->eo.count = DEFAULT_LARGE_COUNT;
+    }
+    if (rq->eo.count > lin->nstate / 2 + 1)
+        rq->eo.count = 0; /* more than exist: all of them */
+    ts_eigen *e = NULL;
+    double t0 = cli_wall_now();
+    rc = ts_eigen_solve(lin, &rq->eo, &e, err);
+    double wall = cli_wall_now() - t0;
+    if (rc == TS_OK) {
+        print_modes(sys, lin, e, wall, quiet);
+        json_t *j = ts_report_modes_json(sys, lin, e, 0);
+        if (j) {
+            json_object_set_new(j, "linearization",
+                                ts_report_linear_json(lin, matrices));
+            if (eqjson)
+                json_object_set(j, "equilibrium", eqjson);
+        }
+        *json = j;
+    }
+    json_decref(eqjson);
+    ts_equilibrium_free(eq);
+    if (rc != TS_OK) {
+        ts_linear_free(lin);
+        return rc;
+    }
+    *lin_out = lin;
+    *eig_out = e;
+    return TS_OK;
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+static int modes_main(int argc, char **argv)
+{
+    cli_settings s = {0};
+    cli_settings_from_options(&s);
+    snprintf(s.where[2], sizeof s.where[2], "--eq-method");
+    const char *json_path = NULL, *csv_path = NULL, *shapes_path = NULL;
+    const char *near = NULL, *method = NULL;
+    int quiet = 0, matrices = 0;
+    modes_req rq = {0};
+    ts_eigen_opts_default(&rq.eo);
+    static const struct option longopts[] = {
+        {"count", required_argument, NULL, 'k'},
+        {"near", required_argument, NULL, 'f'},
+        {"method", required_argument, NULL, 'M'},
+        {"json", required_argument, NULL, 'j'},
+        {"matrices", no_argument, NULL, 'A'},
+        {"csv", required_argument, NULL, 'c'},
+        {"shapes", required_argument, NULL, 'S'},
+        {"speed", required_argument, NULL, 's'},
+        {"turn-rate", required_argument, NULL, 'w'},
+        {"links", required_argument, NULL, 'n'},
+        {"eq-method", required_argument, NULL, 'm'},
+        {"tol", required_argument, NULL, 't'},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    optind = 1;
+    opterr = 0;
+    int ch;
+    long v;
+    while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
+        switch (ch) {
+        case 'k':
+            if (cli_parse_int("--count", optarg, 1, 100000000, &v))
+                return EXIT_BADINPUT;
+            rq.eo.count = (int)v;
+            rq.count_given = 1;
+            break;
+        case 'f': near = optarg; break;
+        case 'M': method = optarg; break;
+        case 'j': json_path = optarg; break;
+        case 'A': matrices = 1; break;
+        case 'c': csv_path = optarg; break;
+        case 'S': shapes_path = optarg; break;
+        case 's': s.speed = optarg; break;
+        case 'w': s.turn_rate = optarg; break;
+        case 'm': s.method = optarg; break;
+        case 't': s.tol = optarg; break;
+        case 'q': quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'n':
+            if (cli_parse_int("--links", optarg, 1, 10000000, &v))
+                return EXIT_BADINPUT;
+            s.links = (int)v;
+            break;
+        case ':':
+            fprintf(stderr, "towstab modes: missing value for '%s'\n",
+                    argv[optind - 1]);
+            return EXIT_BADINPUT;
+        default:
+            fprintf(stderr, "towstab modes: unknown option '%s' (towstab "
+                            "modes --help)\n",
+                    argv[optind - 1]);
+            return EXIT_BADINPUT;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "towstab modes: expected one scene file\n");
+        usage(stderr);
+        return EXIT_BADINPUT;
+    }
+    ts_err err = {0};
+    if (method && parse_method(method, "--method", &rq.eo.method, &err))
+        return cli_report(&err, err.code);
+    ts_units *units;
+    ts_scene *scene;
+    int status = cli_open(argv[optind], &units, &scene);
+    if (status)
+        return status;
+    if (near) {
+        if (ts_units_parse(units, near, "Hz", "--near", &rq.eo.target_hz,
+                           &err) != TS_OK ||
+            (!(rq.eo.target_hz >= 0) &&
+             ts_fail(&err, TS_EINVAL, "--near: expected a frequency >= 0 Hz, "
+                                      "got '%s'",
+                     near))) {
+            status = cli_report(&err, err.code ? err.code : TS_EINVAL);
+            cli_close(units, scene);
+            return status;
+        }
+        rq.near_given = 1;
+    }
+    ts_equilibrium_opts eqo;
+    ts_system *sys = cli_system(scene, units, &s, &eqo, &err);
+    if (!sys) {
+        status = cli_report(&err, err.code);
+        cli_close(units, scene);
+        return status;
+    }
+    printf("towstab modes: %s (%s)\n", sys->name, scene->path);
+    json_t *json = NULL;
+    ts_linear *lin = NULL;
+    ts_eigen *e = NULL;
+    int rc = modes_analysis(sys, &eqo, &rq, quiet, matrices, &json, &lin, &e,
+                            &err);
+    if (rc != TS_OK)
+        status = cli_report(&err, rc);
+    ts_err werr = {0};
+    if (rc == TS_OK && json_path && json &&
+        cli_write_json(json, json_path, &werr) != TS_OK)
+        status = cli_report(&werr, werr.code);
+    if (rc == TS_OK && csv_path &&
+        ts_report_modes_csv(sys, lin, e, csv_path, &werr) != TS_OK)
+        status = cli_report(&werr, werr.code);
+    if (rc == TS_OK && shapes_path) {
+        int wrc;
+        if (ends_with(shapes_path, ".json")) {
+            json_t *sj = ts_report_modes_json(sys, lin, e, 1);
+            wrc = sj ? cli_write_json(sj, shapes_path, &werr)
+                     : ts_fail(&werr, TS_ENOMEM, "%s: out of memory",
+                               shapes_path);
+            json_decref(sj);
+        } else {
+            wrc = ts_report_shapes_csv(sys, lin, e, shapes_path, &werr);
+        }
+        if (wrc != TS_OK)
+            status = cli_report(&werr, werr.code);
+    }
+    json_decref(json);
+    ts_eigen_free(e);
+    ts_linear_free(lin);
+    ts_system_free(sys);
+    cli_close(units, scene);
+    return status;
+}
+
+static const char *const modes_keys[] = {
+    "speed", "turn_rate", "tolerance", "links", "equilibrium_method",
+    "method", "count", "near", NULL};
+
+/* One scene entry: parse and check its options, then (unless check_only)
+ * run it and append its JSON to results. Returns the exit status. */
+static int modes_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
+                       int index, json_t *results, int check_only)
+{
+    ts_err err = {0};
+    cli_settings s = {0};
+    if (cli_settings_from_analysis(&s, a, index, &err))
+        return cli_report(&err, err.code);
+    /* In a modes entry `method` is the eigen method; the equilibrium's is
+     * `equilibrium_method`. */
+    const ts_scene_option *om = ts_scene_analysis_option(a, "equilibrium_method");
+    s.method = om ? om->value : NULL;
+    snprintf(s.where[2], sizeof s.where[2],
+             "analyses[%d].equilibrium_method (line %d)", index,
+             om ? om->line : a->line);
+    modes_req rq = {0};
+    ts_eigen_opts_default(&rq.eo);
+    char where[160];
+    const ts_scene_option *o;
+    if ((o = ts_scene_analysis_option(a, "method"))) {
+        snprintf(where, sizeof where, "analyses[%d].method (line %d)", index,
+                 o->line);
+        if (parse_method(o->value, where, &rq.eo.method, &err))
+            return cli_report(&err, err.code);
+    }
+    if ((o = ts_scene_analysis_option(a, "count"))) {
+        char *end;
+        long c = strtol(o->value, &end, 10);
+        if (end == o->value || *end || c < 1 || c > 100000000) {
+            ts_fail(&err, TS_EINVAL,
+                    "analyses[%d].count (line %d): expected a whole number "
+                    ">= 1, got '%s'",
+                    index, o->line, o->value);
+            return cli_report(&err, err.code);
+        }
+        rq.eo.count = (int)c;
+        rq.count_given = 1;
+    }
+    if ((o = ts_scene_analysis_option(a, "near"))) {
+        snprintf(where, sizeof where, "analyses[%d].near (line %d)", index,
+                 o->line);
+        if (ts_units_parse(ctx->units, o->value, "Hz", where,
+                           &rq.eo.target_hz, &err) != TS_OK)
+            return cli_report(&err, err.code);
+        if (!(rq.eo.target_hz >= 0)) {
+            ts_fail(&err, TS_EINVAL, "%s: expected a frequency >= 0 Hz, got "
+                                     "'%s'",
+                    where, o->value);
+            return cli_report(&err, err.code);
+        }
+        rq.near_given = 1;
+    }
+    ts_equilibrium_opts eqo;
+    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eqo, &err);
+    if (!sys)
+        return cli_report(&err, err.code);
+    if (check_only) {
+        ts_system_free(sys);
+        return 0;
+    }
+    json_t *j = NULL;
+    ts_linear *lin = NULL;
+    ts_eigen *e = NULL;
+    int rc = modes_analysis(sys, &eqo, &rq, ctx->quiet, 0, &j, &lin, &e, &err);
+    int status = rc ? cli_report(&err, rc) : 0;
+    if (j) {
+        json_object_set_new(j, "type", json_string("modes"));
+        json_array_append_new(results, j);
+    }
+    ts_eigen_free(e);
+    ts_linear_free(lin);
+    ts_system_free(sys);
+    return status;
+}
+
+static int modes_run(const cli_ctx *ctx, const ts_scene_analysis *a,
+                     int index, json_t *results)
+{
+    return modes_entry(ctx, a, index, results, 0);
+}
+
+static int modes_check(const cli_ctx *ctx, const ts_scene_analysis *a,
+                       int index)
+{
+    return modes_entry(ctx, a, index, NULL, 1);
+}
+
+const cli_command cli_cmd_modes = {
+    "modes", "stability verdict and mode table of the linearized system",
+    modes_main, modes_run, modes_keys, modes_check};

@@ -1,0 +1,350 @@
+/* cmd_response.c: `towstab response SCENE` and the `response` analysis of
+ * a scene: how tow-point motion passes down to a node, a body or a link
+ * tension, over a log-spaced frequency list (doc/linear.md). */
+#include <getopt.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "towstab/linearize.h"
+#include "towstab/report.h"
+#include "towstab/report_linear.h"
+#include "towstab/response.h"
+
+/* Defined in cmd_modes.c: equilibrium (printed) and linearization. */
+int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
+                     int tensions, ts_equilibrium **eq, json_t **eqjson,
+                     ts_linear **lin, ts_err *err);
+
+#define DEFAULT_FROM_HZ 0.01
+#define DEFAULT_TO_HZ 10.0
+#define DEFAULT_POINTS 100
+#define MAX_POINTS 1000000
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: towstab response SCENE --output NAME [options]\n"
+            "  frequency response of a node, body or link tension to\n"
+            "  tow-point displacement, about the equilibrium\n"
+            "  --input NAME     tow.surge, tow.sway or tow.heave (default)\n"
+            "  --output NAME    <node>.x|y|z (e.g. sphere.z, cable.3.x) or\n"
+            "                   <cable>.<k>.tension (e.g. cable.3.tension)\n"
+            "  --from F         lowest frequency (default %g Hz; > 0)\n"
+            "  --to F           highest frequency (default %g Hz)\n"
+            "  --points N       log-spaced points (default %d)\n"
+            "  --json FILE      write the response as JSON ('-' for stdout)\n"
+            "  --csv FILE       write the response as CSV\n"
+            "  --speed Q        override tow.speed (e.g. '5 knot', 2.5)\n"
+            "  --turn-rate Q    override tow.turn_rate (e.g. '0.5 rad/s')\n"
+            "  --links N        use N links on every cable\n"
+            "  --eq-method M    equilibrium method: auto, shooting, newton\n"
+            "  --tol X          equilibrium relative force residual\n"
+            "  --quiet          print the summary only, not the table\n",
+            DEFAULT_FROM_HZ, DEFAULT_TO_HZ, DEFAULT_POINTS);
+}
+
+typedef struct resp_req {
+    const char *input, *output;
+    double from, to;
+    int points;
+} resp_req;
+
+static void print_response(const ts_response *r, int quiet)
+{
+    printf("response of %s to %s (%s): static gain %.9g\n", r->output.name,
+           ts_input_name(r->input), r->output.unit, r->static_gain);
+    int ib = 0;
+    for (int i = 1; i < r->npoints; i++)
+        if (r->magnitude[i] > r->magnitude[ib])
+            ib = i;
+    printf("largest magnitude %.6g at %.6g Hz (phase %.3f deg)\n",
+           r->magnitude[ib], r->freq_hz[ib], r->phase_deg[ib]);
+    if (quiet)
+        return;
+    printf("\n%14s %16s %12s\n", "freq [Hz]", "magnitude", "phase [deg]");
+    for (int i = 0; i < r->npoints; i++)
+        printf("%14.6g %16.9g %12.4f\n", r->freq_hz[i], r->magnitude[i],
+               r->phase_deg[i]);
+}
+
+/* Everything after the system is built; names are checked before the
+ * equilibrium is solved. */
+static int response_analysis(const ts_system *sys,
+                             const ts_equilibrium_opts *eqo,
+                             const resp_req *rq, int quiet, json_t **json,
+                             ts_response **res, ts_err *err)
+{
+    *json = NULL;
+    *res = NULL;
+    int input;
+    ts_output out;
+    int rc = ts_response_input_find(rq->input, &input, err);
+    if (rc == TS_OK)
+        rc = ts_response_output_find(sys, rq->output, &out, err);
+    double *freq = malloc((size_t)rq->points * sizeof(double));
+    if (rc == TS_OK && !freq)
+        rc = ts_fail(err, TS_ENOMEM, "response: out of memory");
+    if (rc == TS_OK)
+        rc = ts_response_logspace(rq->from, rq->to, rq->points, freq, err);
+    if (rc != TS_OK) {
+        free(freq);
+        return rc;
+    }
+    ts_equilibrium *eq = NULL;
+    json_t *eqjson = NULL;
+    ts_linear *lin = NULL;
+    rc = cli_linear_setup(sys, eqo, out.kind == TS_OUT_TENSION, &eq, &eqjson,
+                          &lin, err);
+    if (rc == TS_OK)
+        rc = ts_response_compute(sys, lin, input, &out, freq, rq->points, res,
+                                 err);
+    if (rc == TS_OK) {
+        if (lin->kink_tow && input == 2)
+            printf("warning: the tow point is at the water surface: the "
+                   "heave response uses the mean of the one-sided "
+                   "derivatives, and a real heave also shifts the mean "
+                   "depth at first order (MODEL.md section 6)\n");
+        print_response(*res, quiet);
+        json_t *j = ts_report_response_json(*res);
+        if (j && eqjson)
+            json_object_set(j, "equilibrium", eqjson);
+        *json = j;
+    }
+    free(freq);
+    json_decref(eqjson);
+    ts_equilibrium_free(eq);
+    ts_linear_free(lin);
+    return rc;
+}
+
+static int parse_freq(const ts_units *units, const char *text,
+                      const char *where, double *v, ts_err *err)
+{
+    return ts_units_parse(units, text, "Hz", where, v, err);
+}
+
+static int response_main(int argc, char **argv)
+{
+    cli_settings s = {0};
+    cli_settings_from_options(&s);
+    snprintf(s.where[2], sizeof s.where[2], "--eq-method");
+    const char *json_path = NULL, *csv_path = NULL;
+    const char *from = NULL, *to = NULL;
+    int quiet = 0;
+    resp_req rq = {"tow.heave", NULL, DEFAULT_FROM_HZ, DEFAULT_TO_HZ,
+                   DEFAULT_POINTS};
+    static const struct option longopts[] = {
+        {"input", required_argument, NULL, 'i'},
+        {"output", required_argument, NULL, 'o'},
+        {"from", required_argument, NULL, 'F'},
+        {"to", required_argument, NULL, 'T'},
+        {"points", required_argument, NULL, 'p'},
+        {"json", required_argument, NULL, 'j'},
+        {"csv", required_argument, NULL, 'c'},
+        {"speed", required_argument, NULL, 's'},
+        {"turn-rate", required_argument, NULL, 'w'},
+        {"links", required_argument, NULL, 'n'},
+        {"eq-method", required_argument, NULL, 'm'},
+        {"tol", required_argument, NULL, 't'},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    optind = 1;
+    opterr = 0;
+    int ch;
+    long v;
+    while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
+        switch (ch) {
+        case 'i': rq.input = optarg; break;
+        case 'o': rq.output = optarg; break;
+        case 'F': from = optarg; break;
+        case 'T': to = optarg; break;
+        case 'p':
+            if (cli_parse_int("--points", optarg, 2, MAX_POINTS, &v))
+                return EXIT_BADINPUT;
+            rq.points = (int)v;
+            break;
+        case 'j': json_path = optarg; break;
+        case 'c': csv_path = optarg; break;
+        case 's': s.speed = optarg; break;
+        case 'w': s.turn_rate = optarg; break;
+        case 'm': s.method = optarg; break;
+        case 't': s.tol = optarg; break;
+        case 'q': quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case 'n':
+            if (cli_parse_int("--links", optarg, 1, 10000000, &v))
+                return EXIT_BADINPUT;
+            s.links = (int)v;
+            break;
+        case ':':
+            fprintf(stderr, "towstab response: missing value for '%s'\n",
+                    argv[optind - 1]);
+            return EXIT_BADINPUT;
+        default:
+            fprintf(stderr, "towstab response: unknown option '%s' (towstab "
+                            "response --help)\n",
+                    argv[optind - 1]);
+            return EXIT_BADINPUT;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "towstab response: expected one scene file\n");
+        usage(stderr);
+        return EXIT_BADINPUT;
+    }
+    ts_units *units;
+    ts_scene *scene;
+    int status = cli_open(argv[optind], &units, &scene);
+    if (status)
+        return status;
+    ts_err err = {0};
+    int rc = TS_OK;
+    if (from)
+        rc = parse_freq(units, from, "--from", &rq.from, &err);
+    if (rc == TS_OK && to)
+        rc = parse_freq(units, to, "--to", &rq.to, &err);
+    ts_equilibrium_opts eqo;
+    ts_system *sys = NULL;
+    if (rc == TS_OK) {
+        sys = cli_system(scene, units, &s, &eqo, &err);
+        if (!sys)
+            rc = err.code;
+    }
+    if (rc == TS_OK && !rq.output) {
+        char list[768];
+        ts_response_output_names(sys, list, sizeof list);
+        rc = ts_fail(&err, TS_EINVAL, "--output: required; valid outputs: %s",
+                     list);
+    }
+    if (rc != TS_OK) {
+        status = cli_report(&err, rc);
+        ts_system_free(sys);
+        cli_close(units, scene);
+        return status;
+    }
+    printf("towstab response: %s (%s)\n", sys->name, scene->path);
+    json_t *json = NULL;
+    ts_response *res = NULL;
+    rc = response_analysis(sys, &eqo, &rq, quiet, &json, &res, &err);
+    if (rc != TS_OK)
+        status = cli_report(&err, rc);
+    ts_err werr = {0};
+    if (rc == TS_OK && json_path && json &&
+        cli_write_json(json, json_path, &werr) != TS_OK)
+        status = cli_report(&werr, werr.code);
+    if (rc == TS_OK && csv_path &&
+        ts_report_response_csv(res, csv_path, &werr) != TS_OK)
+        status = cli_report(&werr, werr.code);
+    json_decref(json);
+    ts_response_free(res);
+    ts_system_free(sys);
+    cli_close(units, scene);
+    return status;
+}
+
+static const char *const response_keys[] = {
+    "speed", "turn_rate", "tolerance", "links", "equilibrium_method",
+    "input", "output", "from", "to", "points", NULL};
+
+/* One scene entry: parse and check its options (units, ranges, input and
+ * output names), then (unless check_only) run it. Returns the exit
+ * status. */
+static int response_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
+                          int index, json_t *results, int check_only)
+{
+    ts_err err = {0};
+    cli_settings s = {0};
+    if (cli_settings_from_analysis(&s, a, index, &err))
+        return cli_report(&err, err.code);
+    const ts_scene_option *o = ts_scene_analysis_option(a, "equilibrium_method");
+    s.method = o ? o->value : NULL;
+    snprintf(s.where[2], sizeof s.where[2],
+             "analyses[%d].equilibrium_method (line %d)", index,
+             o ? o->line : a->line);
+    resp_req rq = {"tow.heave", NULL, DEFAULT_FROM_HZ, DEFAULT_TO_HZ,
+                   DEFAULT_POINTS};
+    char where[160];
+    if ((o = ts_scene_analysis_option(a, "input")))
+        rq.input = o->value;
+    if ((o = ts_scene_analysis_option(a, "output")))
+        rq.output = o->value;
+    static const char *const fkeys[2] = {"from", "to"};
+    double *fdst[2] = {&rq.from, &rq.to};
+    for (int i = 0; i < 2; i++)
+        if ((o = ts_scene_analysis_option(a, fkeys[i]))) {
+            snprintf(where, sizeof where, "analyses[%d].%s (line %d)", index,
+                     fkeys[i], o->line);
+            if (parse_freq(ctx->units, o->value, where, fdst[i], &err))
+                return cli_report(&err, err.code);
+        }
+    if ((o = ts_scene_analysis_option(a, "points"))) {
+        char *end;
+        long p = strtol(o->value, &end, 10);
+        if (end == o->value || *end || p < 2 || p > MAX_POINTS) {
+            ts_fail(&err, TS_EINVAL,
+                    "analyses[%d].points (line %d): expected a whole number "
+                    "in [2, %d], got '%s'",
+                    index, o->line, MAX_POINTS, o->value);
+            return cli_report(&err, err.code);
+        }
+        rq.points = (int)p;
+    }
+    ts_equilibrium_opts eqo;
+    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eqo, &err);
+    if (!sys)
+        return cli_report(&err, err.code);
+    if (!rq.output) {
+        char list[768];
+        ts_response_output_names(sys, list, sizeof list);
+        ts_fail(&err, TS_EINVAL,
+                "analyses[%d] (line %d): response needs an 'output'; valid "
+                "outputs: %s",
+                index, a->line, list);
+        ts_system_free(sys);
+        return cli_report(&err, err.code);
+    }
+    if (check_only) {
+        int channel;
+        ts_output out;
+        double f[2];
+        int rc = ts_response_input_find(rq.input, &channel, &err);
+        if (rc == TS_OK)
+            rc = ts_response_output_find(sys, rq.output, &out, &err);
+        if (rc == TS_OK)
+            rc = ts_response_logspace(rq.from, rq.to, 2, f, &err);
+        ts_system_free(sys);
+        if (rc != TS_OK)
+            ts_err_prefix(&err, "analyses[%d] (line %d): ", index, a->line);
+        return rc == TS_OK ? 0 : cli_report(&err, rc);
+    }
+    json_t *j = NULL;
+    ts_response *res = NULL;
+    int rc = response_analysis(sys, &eqo, &rq, ctx->quiet, &j, &res, &err);
+    int status = rc ? cli_report(&err, rc) : 0;
+    if (j) {
+        json_object_set_new(j, "type", json_string("response"));
+        json_array_append_new(results, j);
+    }
+    ts_response_free(res);
+    ts_system_free(sys);
+    return status;
+}
+
+static int response_run(const cli_ctx *ctx, const ts_scene_analysis *a,
+                        int index, json_t *results)
+{
+    return response_entry(ctx, a, index, results, 0);
+}
+
+static int response_check(const cli_ctx *ctx, const ts_scene_analysis *a,
+                          int index)
+{
+    return response_entry(ctx, a, index, NULL, 1);
+}
+
+const cli_command cli_cmd_response = {
+    "response", "frequency response to tow-point motion", response_main,
+    response_run, response_keys, response_check};
