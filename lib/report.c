@@ -4,6 +4,7 @@
 #include "towstab/report.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,21 +107,33 @@ FILE *ts_report_open(const char *path, char *tmp, size_t tmpsize, ts_err *err)
         tmp[0] = '\0';
         return stdout;
     }
-    int n = snprintf(tmp, tmpsize, "%s.partial-XXXXXX", path);
-    if (n < 0 || (size_t)n >= tmpsize) {
-        ts_fail(err, TS_EIO, "%s: path too long", path);
-        return NULL;
+    /* A fresh name beside the target, created exclusively with mode 0666 so
+     * that the user's umask applies as to any file (mkstemp would make it
+     * 0600). The process id and an attempt count make the name unique;
+     * O_EXCL makes sure. */
+    int fd = -1, e = 0;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        int n = snprintf(tmp, tmpsize, "%s.partial-%ld-%d", path,
+                         (long)getpid(), attempt);
+        if (n < 0 || (size_t)n >= tmpsize) {
+            ts_fail(err, TS_EIO, "%s: path too long", path);
+            return NULL;
+        }
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        e = errno;
+        if (fd < 0 && e != EEXIST)
+            break;
     }
-    int fd = mkstemp(tmp);
     if (fd < 0) {
-        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(errno));
+        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(e));
         return NULL;
     }
     FILE *f = fdopen(fd, "w");
     if (!f) {
+        e = errno;
         close(fd);
         unlink(tmp);
-        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(errno));
+        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(e));
     }
     return f;
 }

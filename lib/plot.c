@@ -1,0 +1,2181 @@
+/* plot.c: pictures of results with PLplot's cairo devices (towstab/plot.h,
+ * doc/plots.md).
+ *
+ * Algorithm, per call:
+ *  1. Validate every argument (sizes, finite data, positive values on log
+ *     axes, the file name) before anything is drawn or written, and make
+ *     sure the output directory exists.
+ *  2. For each requested format, make a private PLplot stream (plmkstrm),
+ *     point it at an in-memory FILE (open_memstream + plsfile, so PLplot
+ *     never opens a file by name: its plOpenFile would prompt on stdin and
+ *     finally exit() if a name could not be opened), select pngcairo or
+ *     svgcairo, set the page size in px (PNG) or pt (SVG), the palette and
+ *     a white background, draw, and end the stream with plend1, which
+ *     closes the FILE (cairo's tidy calls plCloseFile). The previously
+ *     current stream is made current again.
+ *  3. Write the bytes under a temporary name and rename (ts_report_open /
+ *     ts_report_commit), so no half-written picture is left behind. The
+ *     SVG gets a <title> element right after its root tag.
+ *
+ * Drawing: every number is converted to the requested unit system first
+ * (ts_plot_convert); axes carry "name [unit]". The side view flips the
+ * vertical axis so that depth grows downward (plwind with bottom > top),
+ * the top view flips it so that starboard is down the page (x forward to
+ * the right, z into the page: a right-handed view from above). Equal
+ * scales are made by widening the shorter data range to the viewport's
+ * physical aspect ratio (plgspa, plgvpd), so the plot box keeps its size.
+ * Legends go to the corner of the plot box that covers the fewest drawn
+ * points (points, markers weighted more, and samples along drawn segments
+ * and labels are counted per corner as they are drawn); time histories
+ * first raise the top of each panel's window to leave the legend's corner
+ * empty; cable shapes, which leave no corner reliably free, put it above
+ * the plot box. Tick labels are formatted by a label callback that also
+ * measures the widest y label, so that the axis title clears it.
+ *
+ * PLplot's state (stream table, current stream, the cairo driver's
+ * options) is global to the process: these functions are not thread-safe.
+ *
+ * References: PLplot 5.15 API (plmkstrm, plsfile, plspage, plvpor,
+ * plwind, plbox, pllegend); src/plctrl.c (plOpenFile, plCloseFile) and
+ * drivers/cairo.c (plD_init_pngcairo, plD_tidy_cairo) of PLplot 5.15;
+ * memo Figs. 7-12 (Kamman & Nguyen 1990) for what is drawn.
+ */
+#include "towstab/plot.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "towstab/report.h"
+
+#ifdef TS_HAVE_PLPLOT
+#include <plplot.h>
+#endif
+
+/* Exact definitions: international foot, pound-force, knot. */
+#define FT_M 0.3048
+#define LBF_N 4.4482216152605
+#define KNOT_MS (1852.0 / 3600.0)
+
+#define NO_PLPLOT_MSG                                                         \
+    "towstab was built without PLplot; install libplplot-dev and "           \
+    "plplot-driver-cairo and rebuild"
+
+void ts_plot_opts_default(ts_plot_opts *o)
+{
+    o->units = TS_PLOT_SI;
+    o->width = TS_PLOT_MIN_WIDTH;
+    o->height = TS_PLOT_MIN_HEIGHT;
+    o->formats = TS_PLOT_PNG | TS_PLOT_SVG;
+}
+
+double ts_plot_convert(ts_plot_quantity q, ts_plot_units u, double v)
+{
+    if (q == TS_PLOT_ANGLE)
+        return v * (180.0 / M_PI);
+    if (u != TS_PLOT_IMPERIAL)
+        return v;
+    switch (q) {
+    case TS_PLOT_LENGTH: return v / FT_M;
+    case TS_PLOT_FORCE: return v / LBF_N;
+    case TS_PLOT_SPEED: return v / KNOT_MS;
+    default: return v;
+    }
+}
+
+const char *ts_plot_unit(ts_plot_quantity q, ts_plot_units u)
+{
+    int imp = u == TS_PLOT_IMPERIAL;
+    switch (q) {
+    case TS_PLOT_LENGTH: return imp ? "ft" : "m";
+    case TS_PLOT_FORCE: return imp ? "lbf" : "N";
+    case TS_PLOT_SPEED: return imp ? "knot" : "m/s";
+    case TS_PLOT_TIME: return "s";
+    case TS_PLOT_FREQUENCY: return "Hz";
+    case TS_PLOT_RATE: return "1/s";
+    case TS_PLOT_ANGULAR_RATE: return "rad/s";
+    case TS_PLOT_ANGLE: return "deg";
+    default: return "-";
+    }
+}
+
+int ts_plot_prepare_dir(const char *dir, ts_err *err)
+{
+    if (!dir || !dir[0])
+        return ts_fail(err, TS_EINVAL, "plot directory: expected a path, "
+                                       "got an empty string");
+    size_t len = strlen(dir);
+    char *path = malloc(len + 1);
+    if (!path)
+        return ts_fail(err, TS_ENOMEM, "plot directory: out of memory");
+    memcpy(path, dir, len + 1);
+    /* Walk the prefixes "a", "a/b", ... and create those that are missing;
+     * a prefix that exists must be a directory. */
+    int rc = TS_OK;
+    for (size_t i = 1; i <= len && rc == TS_OK; i++) {
+        if (i < len && path[i] != '/')
+            continue;
+        char saved = path[i];
+        path[i] = '\0';
+        struct stat st;
+        if (stat(path, &st) == 0) {
+            if (!S_ISDIR(st.st_mode) && i == len)
+                rc = ts_fail(err, TS_EINVAL,
+                             "plot directory '%s': exists and is not a "
+                             "directory",
+                             dir);
+            else if (!S_ISDIR(st.st_mode))
+                rc = ts_fail(err, TS_EINVAL,
+                             "plot directory '%s': '%s' exists and is not a "
+                             "directory",
+                             dir, path);
+        } else if (errno == ENOENT) {
+            if (mkdir(path, 0777) != 0 && errno != EEXIST)
+                rc = ts_fail(err, TS_EIO,
+                             "plot directory '%s': cannot create '%s' (%s)",
+                             dir, path, strerror(errno));
+        } else {
+            rc = ts_fail(err, TS_EIO, "plot directory '%s': cannot use '%s' "
+                                      "(%s)",
+                         dir, path, strerror(errno));
+        }
+        path[i] = saved;
+    }
+    free(path);
+    if (rc == TS_OK && access(dir, W_OK | X_OK) != 0)
+        rc = ts_fail(err, TS_EIO, "plot directory '%s': not writable (%s)",
+                     dir, strerror(errno));
+    return rc;
+}
+
+#ifndef TS_HAVE_PLPLOT
+
+int ts_plot_check(ts_err *err)
+{
+    return ts_fail(err, TS_EDOMAIN, NO_PLPLOT_MSG);
+}
+
+int ts_plot_shapes(const char *dir, const char *name, const char *title,
+                   ts_plot_view view, int flags, int nshapes,
+                   const ts_plot_shape shapes[], const ts_plot_opts *opts,
+                   ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)view, (void)flags;
+    (void)nshapes, (void)shapes, (void)opts;
+    return ts_plot_check(err);
+}
+
+int ts_plot_mode_shapes(const char *dir, const char *name, const char *title,
+                        int flags, const ts_plot_shape *eq, int nmodes,
+                        const ts_plot_mode modes[], const ts_plot_opts *opts,
+                        ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)flags, (void)eq;
+    (void)nmodes, (void)modes, (void)opts;
+    return ts_plot_check(err);
+}
+
+int ts_plot_eigenvalues(const char *dir, const char *name, const char *title,
+                        int nsets, const ts_plot_series sets[],
+                        const ts_plot_eig_window *win,
+                        const ts_plot_opts *opts, ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)nsets, (void)sets, (void)win;
+    (void)opts;
+    return ts_plot_check(err);
+}
+
+int ts_plot_bode(const char *dir, const char *name, const char *title,
+                 const char *mag_label, ts_plot_quantity out_q,
+                 ts_plot_quantity in_q, int ncurves,
+                 const ts_plot_bode_curve curves[], int nnat,
+                 const double natural_hz[], const ts_plot_opts *opts,
+                 ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)mag_label, (void)out_q;
+    (void)in_q, (void)ncurves, (void)curves, (void)nnat, (void)natural_hz;
+    (void)opts;
+    return ts_plot_check(err);
+}
+
+int ts_plot_histories(const char *dir, const char *name, const char *title,
+                      int npanels, const ts_plot_axis panels[], int nseries,
+                      const ts_plot_series series[], const ts_plot_opts *opts,
+                      ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)npanels, (void)panels;
+    (void)nseries, (void)series, (void)opts;
+    return ts_plot_check(err);
+}
+
+int ts_plot_loglog(const char *dir, const char *name, const char *title,
+                   const ts_plot_axis *xaxis, const ts_plot_axis *yaxis,
+                   int nseries, const ts_plot_series series[],
+                   const ts_plot_opts *opts, ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)xaxis, (void)yaxis;
+    (void)nseries, (void)series, (void)opts;
+    return ts_plot_check(err);
+}
+
+#else /* TS_HAVE_PLPLOT */
+
+/* ---- palette (cmap0) ------------------------------------------------- */
+
+enum {
+    COL_BG = 0,      /* white background */
+    COL_FG = 1,      /* axes and text */
+    COL_GRID = 2,
+    COL_GREY = 3,    /* reference shapes, rays */
+    COL_WATER = 4,   /* water below the surface */
+    COL_SURFACE = 5, /* the water line */
+    COL_UNSTABLE = 6,
+    COL_CURVE0 = 7,  /* first of NCURVE curve colours */
+    NCURVE = 8,
+    NCOL0 = COL_CURVE0 + NCURVE
+};
+
+/* Curve colours: the Okabe-Ito set (distinct for colour-blind readers)
+ * without its yellow, plus a wine red. */
+static const int palette_rgb[NCOL0][3] = {
+    {255, 255, 255}, {0, 0, 0},       {222, 222, 222}, {140, 140, 140},
+    {222, 236, 250}, {50, 110, 190},  {252, 226, 226}, {0, 114, 178},
+    {213, 94, 0},    {0, 158, 115},   {204, 121, 167}, {230, 159, 0},
+    {86, 180, 233},  {80, 80, 80},    {136, 34, 85}};
+
+/* PLplot line styles (pllsty): 1 continuous, 2 short dashes, 3 long. */
+#define LSTY_SOLID 1
+#define LSTY_DOTTED 2
+#define LSTY_DASHED 3
+
+#define CURVE_WIDTH 2.2
+#define AXIS_WIDTH 1.0
+#define GRID_WIDTH 0.6
+
+/* At most this many legend entries are drawn per legend. */
+#define MAX_LEGEND 20
+/* Text passed to PLplot, after escaping. */
+#define TEXT_MAX 512
+
+static int color_index(int color, int ordinal)
+{
+    int k = color > 0 ? color - 1 : ordinal;
+    return COL_CURVE0 + ((k % NCURVE) + NCURVE) % NCURVE;
+}
+
+static int line_style(int style)
+{
+    return style == TS_PLOT_DASHED ? LSTY_DASHED
+           : style == TS_PLOT_DOTTED ? LSTY_DOTTED
+                                     : LSTY_SOLID;
+}
+
+/* Marker glyphs by ordinal (DejaVu Sans has them all). */
+static const char *marker_glyph(int ordinal)
+{
+    static const char *const g[] = {"●", "■", "▲", "◆", "▼", "✖", "★", "⬟"};
+    return g[((ordinal % 8) + 8) % 8];
+}
+
+/* PLplot text: '#' is its escape character, so a literal '#' is "##". */
+static void pl_text(char *dst, size_t size, const char *src)
+{
+    size_t j = 0;
+    for (size_t i = 0; src && src[i] && j + 2 < size; i++) {
+        if (src[i] == '#')
+            dst[j++] = '#';
+        dst[j++] = src[i];
+    }
+    dst[j] = '\0';
+}
+
+static void axis_label(char *dst, size_t size, const char *name,
+                       ts_plot_quantity q, ts_plot_units u)
+{
+    char raw[TEXT_MAX];
+    snprintf(raw, sizeof raw, "%s [%s]", name ? name : "",
+             ts_plot_unit(q, u));
+    pl_text(dst, size, raw);
+}
+
+/* ---- frame: world window and legend placement ------------------------ */
+
+/* Width of a digit or sign relative to the character height. */
+#define DIGIT_WIDTH 0.75
+/* Width of text relative to the character height, on average. */
+#define TEXT_WIDTH 0.8
+
+/* Physical size of the current viewport, mm. */
+static void viewport_mm(double *w, double *h)
+{
+    PLFLT sx0, sx1, sy0, sy1, vx0, vx1, vy0, vy1;
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    plgvpd(&vx0, &vx1, &vy0, &vy1);
+    *w = (vx1 - vx0) * (sx1 - sx0);
+    *h = (vy1 - vy0) * (sy1 - sy0);
+}
+
+/* Number of characters (UTF-8 code points) of a string. */
+static int text_chars(const char *s)
+{
+    int n = 0;
+    for (; s && *s; s++)
+        n += ((unsigned char)*s & 0xC0) != 0x80;
+    return n;
+}
+
+
+#define SEGMENT_SAMPLES 12
+
+typedef struct frame {
+    double left, right, bottom, top; /* as passed to plwind */
+    int logx, logy;                  /* axes in log10 of the value */
+    double ylabel_width;             /* widest y tick label, in character
+                                        heights (set while the box is
+                                        drawn) */
+    double corner_w, corner_h;       /* legend size, fractions of the
+                                        viewport */
+    long count[4];                   /* points in TR, BR, TL, BL corners */
+} frame;
+
+/* Set the world window of the current viewport. The legend's expected
+ * size (nlegend entries, the longest `label_chars` long) sets the corner
+ * regions in which drawn points are counted. */
+static void frame_set(frame *f, double left, double right, double bottom,
+                      double top, int nlegend, int label_chars)
+{
+    f->left = left;
+    f->right = right;
+    f->bottom = bottom;
+    f->top = top;
+    f->logx = f->logy = 0;
+    f->ylabel_width = 0;
+    double w, h;
+    PLFLT def, ht;
+    viewport_mm(&w, &h);
+    plgchr(&def, &ht);
+    /* pllegend below: text at 0.9 of the character size, 2 lines per
+     * entry, a line sample of 7 % of the width. */
+    f->corner_h = fmin(0.95, (2.0 * nlegend + 1.0) * 0.9 * ht / h + 0.03);
+    f->corner_w = fmin(0.95, 0.07 + 0.03 +
+                                 (TEXT_WIDTH * 0.9 * label_chars + 2.5) * ht /
+                                     w);
+    memset(f->count, 0, sizeof f->count);
+    plwind(left, right, bottom, top);
+}
+
+/* A drawn marker hides data if the legend covers it: it counts as many
+ * points as a drawn segment or label. */
+#define MARKER_WEIGHT 20
+
+static void frame_point_w(frame *f, double x, double y, int weight)
+{
+    double u = (x - f->left) / (f->right - f->left);
+    double v = (y - f->bottom) / (f->top - f->bottom);
+    if (!(u >= 0 && u <= 1 && v >= 0 && v <= 1))
+        return;
+    int right = u >= 1 - f->corner_w, left = u <= f->corner_w;
+    int top = v >= 1 - f->corner_h, bottom = v <= f->corner_h;
+    f->count[0] += weight * (right && top);
+    f->count[1] += weight * (right && bottom);
+    f->count[2] += weight * (left && top);
+    f->count[3] += weight * (left && bottom);
+}
+
+static void frame_point(frame *f, double x, double y)
+{
+    frame_point_w(f, x, y, 1);
+}
+
+/* Record a drawn segment (its ends and samples along it). */
+static void frame_segment(frame *f, double x0, double y0, double x1,
+                          double y1)
+{
+    for (int s = 0; s <= SEGMENT_SAMPLES; s++) {
+        double t = (double)s / SEGMENT_SAMPLES;
+        frame_point(f, x0 + t * (x1 - x0), y0 + t * (y1 - y0));
+    }
+}
+
+/* A polyline in the current colour and style, recorded in the frame. */
+static void draw_line(frame *f, int n, const double *x, const double *y)
+{
+    if (n >= 2)
+        plline(n, x, y);
+    for (int i = 0; i + 1 < n; i++)
+        frame_segment(f, x[i], y[i], x[i + 1], y[i + 1]);
+    if (n == 1)
+        frame_point(f, x[0], y[0]);
+}
+
+static void draw_markers(frame *f, int n, const double *x, const double *y,
+                         const char *glyph)
+{
+    plstring(n, x, y, glyph);
+    for (int i = 0; i < n; i++)
+        frame_point_w(f, x[i], y[i], MARKER_WEIGHT);
+}
+
+/* PLplot legend position of the emptiest corner. */
+static int frame_corner(const frame *f)
+{
+    static const int pos[4] = {PL_POSITION_TOP | PL_POSITION_RIGHT,
+                               PL_POSITION_BOTTOM | PL_POSITION_RIGHT,
+                               PL_POSITION_TOP | PL_POSITION_LEFT,
+                               PL_POSITION_BOTTOM | PL_POSITION_LEFT};
+    int best = 0;
+    for (int c = 1; c < 4; c++)
+        if (f->count[c] < f->count[best])
+            best = c;
+    return pos[best];
+}
+
+/* ---- legends --------------------------------------------------------- */
+
+/* Count a legend entry and its length (for the legend's expected size). */
+static void legend_count(const char *label, int *n, int *chars)
+{
+    if (!label || !label[0] || *n >= MAX_LEGEND)
+        return;
+    (*n)++;
+    int c = text_chars(label);
+    if (c > *chars)
+        *chars = c;
+}
+
+typedef struct legend {
+    int n;
+    PLINT opt[MAX_LEGEND];
+    PLINT color[MAX_LEGEND];
+    PLINT style[MAX_LEGEND];
+    PLFLT width[MAX_LEGEND];
+    PLFLT scale[MAX_LEGEND];
+    PLINT nsym[MAX_LEGEND];
+    PLINT textcol[MAX_LEGEND];
+    char text[MAX_LEGEND][TEXT_MAX];
+    const char *textp[MAX_LEGEND];
+    const char *sym[MAX_LEGEND];
+} legend;
+
+/* Add an entry (style: a TS_PLOT_ style; glyph for marker styles). */
+static void legend_add(legend *L, const char *label, int color, int style,
+                       const char *glyph)
+{
+    if (!label || !label[0] || L->n >= MAX_LEGEND)
+        return;
+    int i = L->n++;
+    int line = style != TS_PLOT_MARKERS;
+    int sym = style == TS_PLOT_MARKERS || style == TS_PLOT_LINE_MARKERS;
+    L->opt[i] = (line ? PL_LEGEND_LINE : 0) | (sym ? PL_LEGEND_SYMBOL : 0);
+    L->color[i] = color;
+    L->style[i] = line_style(style);
+    L->width[i] = CURVE_WIDTH;
+    L->scale[i] = 0.9;
+    L->nsym[i] = style == TS_PLOT_MARKERS ? 1 : 2;
+    L->textcol[i] = COL_FG;
+    pl_text(L->text[i], sizeof L->text[i], label);
+    L->textp[i] = L->text[i];
+    L->sym[i] = glyph ? glyph : "●";
+}
+
+/* Layout of a legend above the plot box: columns and rows that fit the
+ * page width `width_mm`, and the height it takes, mm. */
+typedef struct legend_layout {
+    int ncol, nrow;
+    double height_mm;
+} legend_layout;
+
+static legend_layout legend_plan(const legend *L, double width_mm)
+{
+    legend_layout g = {1, 0, 0};
+    if (L->n == 0)
+        return g;
+    PLFLT def, ht;
+    plgchr(&def, &ht);
+    int chars = 0;
+    for (int i = 0; i < L->n; i++)
+        if (text_chars(L->text[i]) > chars)
+            chars = text_chars(L->text[i]);
+    /* Sample, gap and text of the widest entry. */
+    double entry = 0.07 * width_mm + (TEXT_WIDTH * 0.9 * chars + 2.0) * ht;
+    g.ncol = (int)(0.98 * width_mm / entry);
+    if (g.ncol < 1)
+        g.ncol = 1;
+    if (g.ncol > L->n)
+        g.ncol = L->n;
+    g.nrow = (L->n + g.ncol - 1) / g.ncol;
+    g.height_mm = (2.0 * g.nrow + 0.6) * 0.9 * ht;
+    return g;
+}
+
+/* Draw the legend just above the current viewport, row by row. */
+static void legend_draw_above(const legend *L, legend_layout g)
+{
+    if (L->n == 0)
+        return;
+    PLFLT w, h;
+    pllsty(LSTY_SOLID);
+    pllegend(&w, &h,
+             PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX |
+                 PL_LEGEND_ROW_MAJOR,
+             PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT | PL_POSITION_TOP,
+             0.0, 0.012, 0.07, COL_BG, COL_GREY, LSTY_SOLID, g.nrow, g.ncol,
+             L->n, L->opt, 0.8, 0.9, 2.0, 0.0, L->textcol, L->textp, NULL,
+             NULL, NULL, NULL, L->color, L->style, L->width, L->color,
+             L->scale, L->nsym, L->sym);
+}
+
+static void legend_draw(const legend *L, const frame *f)
+{
+    if (L->n == 0)
+        return;
+    PLFLT w, h;
+    /* Room for a line sample, or a single marker. */
+    double sample = 0.03;
+    for (int i = 0; i < L->n; i++)
+        if (L->opt[i] & PL_LEGEND_LINE)
+            sample = 0.07;
+    pllsty(LSTY_SOLID);
+    pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_INSIDE | PL_POSITION_VIEWPORT | frame_corner(f),
+             0.015, 0.02, sample, COL_BG, COL_GREY, LSTY_SOLID, 0, 0, L->n,
+             L->opt, 0.8, 0.9, 2.0, 0.0, L->textcol, L->textp, NULL, NULL,
+             NULL, NULL, L->color, L->style, L->width, L->color, L->scale,
+             L->nsym, L->sym);
+}
+
+/* ---- axes, labels, title --------------------------------------------- */
+
+/* Format a tick value of a linear axis spanning [lo, hi] with as many
+ * decimals as ticks finer than a tenth of the span need (PLplot puts 3 to
+ * 10 ticks on an axis), trailing zeros removed: 29.6 and 29.8, not 29.6
+ * twice; values within rounding of zero print as 0. Very large or small
+ * magnitudes use the exponent form with as many digits. Returns the
+ * number of characters. */
+static int format_tick(char *label, size_t size, double value, double lo,
+                       double hi)
+{
+    double span = fabs(hi - lo), mag = fmax(fabs(lo), fabs(hi));
+    double tick = span / 10;
+    if (!(tick > 0))
+        return snprintf(label, size, "%g", value);
+    if (fabs(value) < 1e-9 * span)
+        value = 0;
+    int dec = (int)ceil(-log10(tick));
+    if (dec < 0)
+        dec = 0;
+    if (value == 0)
+        return snprintf(label, size, "0");
+    if (mag >= 1e7 || mag < 1e-4 || dec > 8) {
+        int digits = (int)ceil(log10(mag / tick));
+        digits = digits < 1 ? 1 : digits > 15 ? 15 : digits;
+        return snprintf(label, size, "%.*e", digits, value);
+    }
+    int n = snprintf(label, size, "%.*f", dec, value);
+    if (dec > 0 && n > 0 && (size_t)n < size) {
+        while (n > 0 && label[n - 1] == '0')
+            label[--n] = '\0';
+        if (n > 0 && label[n - 1] == '.')
+            label[--n] = '\0';
+    }
+    if (strcmp(label, "-0") == 0)
+        n = snprintf(label, size, "0");
+    return n;
+}
+
+/* Tick labels (plslabelfunc): "%.6g" of the value, exact zero for values
+ * within rounding of zero, and 10^k on log axes. Records the widest y
+ * label so that the axis title can be set clear of it. */
+static void tick_label(PLINT axis, PLFLT value, char *label, PLINT length,
+                       PLPointer data)
+{
+    frame *f = data;
+    int log = axis == PL_X_AXIS ? f->logx : f->logy;
+    double width;
+    if (log) {
+        long e = lround(value);
+        snprintf(label, (size_t)length, "10#u%ld#d", e);
+        char digits[24];
+        int nd = snprintf(digits, sizeof digits, "%ld", e);
+        width = (2 + 0.85 * nd) * DIGIT_WIDTH + 0.2;
+    } else {
+        double lo = axis == PL_X_AXIS ? f->left : f->bottom;
+        double hi = axis == PL_X_AXIS ? f->right : f->top;
+        width = DIGIT_WIDTH * format_tick(label, (size_t)length, value, lo, hi);
+    }
+    if (axis == PL_Y_AXIS && width > f->ylabel_width)
+        f->ylabel_width = width;
+}
+
+/* Width of the y tick labels of a window [lo, hi], in character heights:
+ * the labels of its ends and middle (ticks lie between; one digit more
+ * for safety). */
+static double tick_width(double lo, double hi, int log)
+{
+    if (log) {
+        char digits[24];
+        long e = fabs(lo) > fabs(hi) ? lround(floor(lo)) : lround(ceil(hi));
+        int nd = snprintf(digits, sizeof digits, "%ld", e);
+        return (2 + 0.85 * (nd + 1)) * DIGIT_WIDTH + 0.2;
+    }
+    char t[64];
+    int n = 0;
+    double v[3] = {lo, hi, 0.5 * (lo + hi)};
+    for (int i = 0; i < 3; i++) {
+        int k = format_tick(t, sizeof t, v[i], lo, hi);
+        n = k > n ? k : n;
+    }
+    return (n + 1) * DIGIT_WIDTH;
+}
+
+/* Left edge of the plot box (normalised page coordinate) that leaves room
+ * for y tick labels `width` character heights wide at character scale
+ * `scale`, the axis title and a margin; at least LEFT_MIN. */
+#define LEFT_MIN 0.085
+static double left_edge(double width, double scale)
+{
+    PLFLT sx0, sx1, sy0, sy1, def, ht;
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    plgchr(&def, &ht);
+    double mm = (width + 1.8 + 1.4) * def * scale;
+    double x = mm / (sx1 - sx0);
+    return x > LEFT_MIN ? x : LEFT_MIN;
+}
+
+/* Grid, then the box with ticks and labels; xopt/yopt as plbox ("l" for
+ * a log axis, "n" for labels). */
+static void frame_axes(frame *f, const char *xopt, const char *yopt,
+                       double ytick)
+{
+    char gx[16], gy[16], bx[32], by[32];
+    f->logx = strchr(xopt, 'l') != NULL;
+    f->logy = strchr(yopt, 'l') != NULL;
+    snprintf(gx, sizeof gx, "g%s", f->logx ? "hl" : "");
+    snprintf(gy, sizeof gy, "g%s", f->logy ? "hl" : "");
+    snprintf(bx, sizeof bx, "%so", xopt);
+    snprintf(by, sizeof by, "%sov", yopt);
+    plslabelfunc(tick_label, f);
+    plcol0(COL_GRID);
+    plwidth(GRID_WIDTH);
+    pllsty(LSTY_SOLID);
+    plbox(gx, 0, 0, gy, ytick, 0);
+    plcol0(COL_FG);
+    plwidth(AXIS_WIDTH);
+    f->ylabel_width = 0;
+    plbox(bx, 0, 0, by, ytick, 0);
+    plslabelfunc(NULL, NULL);
+}
+
+/* plmtex with the character size reduced, if needed, so that the text
+ * fits `avail_mm`. */
+static void mtex_fit(const char *side, double disp, double pos, double just,
+                     const char *text, double avail_mm, double scale)
+{
+    PLFLT def, ht;
+    plgchr(&def, &ht);
+    double need = TEXT_WIDTH * text_chars(text) * def * scale;
+    double s = need > avail_mm ? scale * avail_mm / need : scale;
+    plschr(0, s);
+    plmtex(side, disp * scale / s, pos, just, text);
+    plschr(0, 1.0);
+}
+
+/* Axis titles: x under the tick labels, y left of the widest y tick
+ * label; `scale` is the character size used for the ticks. */
+static void label_axes(const frame *f, const char *xlabel,
+                       const char *ylabel, double scale)
+{
+    double w, h;
+    viewport_mm(&w, &h);
+    plcol0(COL_FG);
+    if (xlabel)
+        mtex_fit("b", 3.0, 0.5, 0.5, xlabel, w, scale);
+    if (ylabel) {
+        /* Left of the widest tick label, but on the page: at most the
+         * margin left of the viewport less half a line. */
+        PLFLT sx0, sx1, sy0, sy1, vx0, vx1, vy0, vy1, def, ht;
+        plgspa(&sx0, &sx1, &sy0, &sy1);
+        plgvpd(&vx0, &vx1, &vy0, &vy1);
+        plgchr(&def, &ht);
+        double disp = 1.8 + f->ylabel_width;
+        double room = vx0 * (sx1 - sx0) / ht - 0.7;
+        mtex_fit("l", disp < room ? disp : room, 0.5, 0.5, ylabel, h, scale);
+    }
+}
+
+/* A small explanatory note above the top right corner of the viewport. */
+static void note(const char *text)
+{
+    plcol0(COL_FG);
+    plschr(0, 0.78);
+    plmtex("t", 0.6, 1.0, 1.0, text);
+    plschr(0, 1.0);
+}
+
+static void page_title(const char *title)
+{
+    char t[TEXT_MAX];
+    pl_text(t, sizeof t, title);
+    plvpor(0, 1, 0, 1);
+    plwind(0, 1, 0, 1);
+    plcol0(COL_FG);
+    double w, h;
+    viewport_mm(&w, &h);
+    mtex_fit("t", -1.7, 0.5, 0.5, t, 0.96 * w, 1.3);
+}
+
+/* Physical height / width of the current viewport (mm / mm). */
+static double viewport_aspect(void)
+{
+    double w, h;
+    viewport_mm(&w, &h);
+    return h / w;
+}
+
+/* Data range [lo, hi] padded by `pad` of its span; a zero span gets a
+ * width of `fallback`. */
+static void pad_range(double *lo, double *hi, double pad, double fallback)
+{
+    double span = *hi - *lo;
+    if (!(span > 0)) {
+        double w = fallback > 0 ? fallback : 1.0;
+        *lo -= 0.5 * w;
+        *hi += 0.5 * w;
+        return;
+    }
+    *lo -= pad * span;
+    *hi += pad * span;
+}
+
+/* Widen [x0,x1] or [y0,y1] about its centre so that world units per mm
+ * are equal on both axes of the current viewport. */
+static void equalize(double *x0, double *x1, double *y0, double *y1)
+{
+    double aspect = viewport_aspect();
+    double w = *x1 - *x0, h = *y1 - *y0;
+    if (h < aspect * w) {
+        double c = 0.5 * (*y0 + *y1), nh = aspect * w;
+        *y0 = c - 0.5 * nh;
+        *y1 = c + 0.5 * nh;
+    } else {
+        double c = 0.5 * (*x0 + *x1), nw = h / aspect;
+        *x0 = c - 0.5 * nw;
+        *x1 = c + 0.5 * nw;
+    }
+}
+
+/* ---- output: streams, memory, files ---------------------------------- */
+
+typedef int (*draw_fn)(const void *ctx, const ts_plot_opts *o, int height,
+                       ts_err *err);
+
+static void set_palette(void)
+{
+    PLINT r[NCOL0], g[NCOL0], b[NCOL0];
+    for (int i = 0; i < NCOL0; i++) {
+        r[i] = palette_rgb[i][0];
+        g[i] = palette_rgb[i][1];
+        b[i] = palette_rgb[i][2];
+    }
+    plscmap0n(NCOL0);
+    plscmap0(r, g, b, NCOL0);
+}
+
+/* Draw into memory with device `dev`; *buf (malloc'd) and *size on
+ * success. */
+static int render_one(const char *dev, int width, int height, draw_fn draw,
+                      const void *ctx, const ts_plot_opts *o, char **buf,
+                      size_t *size, ts_err *err)
+{
+    *buf = NULL;
+    *size = 0;
+    FILE *f = open_memstream(buf, size);
+    if (!f)
+        return ts_fail(err, TS_ENOMEM, "plot: cannot open a memory stream "
+                                       "(%s)",
+                       strerror(errno));
+    PLINT old, strm;
+    plgstrm(&old);
+    plmkstrm(&strm);
+    if (strm < 0) {
+        plsstrm(old);
+        fclose(f);
+        free(*buf);
+        *buf = NULL;
+        return ts_fail(err, TS_ENOMEM, "plot: PLplot has no free stream");
+    }
+    plsdev(dev);
+    plsfile(f);
+    plspage(0, 0, width, height, 0, 0);
+    set_palette();
+    plinit();
+    pladv(0);
+    plschr(0, 1.0);
+    int rc = draw(ctx, o, height, err);
+    plend1(); /* closes f: *buf and *size are final */
+    plsstrm(old);
+    if (rc == TS_OK && *size == 0)
+        rc = ts_fail(err, TS_EIO, "plot: PLplot's %s device wrote nothing",
+                     dev);
+    if (rc != TS_OK) {
+        free(*buf);
+        *buf = NULL;
+    }
+    return rc;
+}
+
+static void xml_escape(FILE *f, const char *s)
+{
+    for (; s && *s; s++) {
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        default: fputc(*s, f);
+        }
+    }
+}
+
+/* Write one picture to its temporary file (committed by the caller). */
+static int write_bytes(FILE *f, const char *path, const char *buf,
+                       size_t size, int svg, const char *title, ts_err *err)
+{
+    size_t head = 0;
+    if (svg) {
+        const char *root = NULL;
+        for (size_t i = 0; i + 4 < size && !root; i++)
+            if (memcmp(buf + i, "<svg", 4) == 0)
+                root = buf + i;
+        const char *end = root ? memchr(root, '>', size - (root - buf))
+                               : NULL;
+        if (!end)
+            return ts_fail(err, TS_EIO, "%s: svgcairo output has no <svg> "
+                                        "element",
+                           path);
+        head = (size_t)(end - buf) + 1;
+        fwrite(buf, 1, head, f);
+        fputs("\n<title>", f);
+        xml_escape(f, title);
+        fputs("</title>", f);
+    }
+    fwrite(buf + head, 1, size - head, f);
+    if (ferror(f))
+        return ts_fail(err, TS_EIO, "%s: write failed", path);
+    return TS_OK;
+}
+
+static int check_name(const char *name)
+{
+    if (!name || !name[0] || name[0] == '.')
+        return 0;
+    for (const char *p = name; *p; p++)
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+              (*p >= '0' && *p <= '9') || *p == '_' || *p == '-' ||
+              *p == '.'))
+            return 0;
+    return strlen(name) <= 200;
+}
+
+static int check_opts(const char *fn, const ts_plot_opts *o, ts_err *err)
+{
+    if (o->units != TS_PLOT_SI && o->units != TS_PLOT_IMPERIAL)
+        return ts_fail(err, TS_EINVAL, "%s: opts.units: expected SI or "
+                                       "imperial, got %d",
+                       fn, (int)o->units);
+    if (o->width < TS_PLOT_MIN_WIDTH || o->width > TS_PLOT_MAX_SIZE ||
+        o->height < TS_PLOT_MIN_HEIGHT || o->height > TS_PLOT_MAX_SIZE)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: opts size: expected %d..%d x %d..%d px, got "
+                       "%d x %d",
+                       fn, TS_PLOT_MIN_WIDTH, TS_PLOT_MAX_SIZE,
+                       TS_PLOT_MIN_HEIGHT, TS_PLOT_MAX_SIZE, o->width,
+                       o->height);
+    if (o->formats <= 0 || (o->formats & ~(TS_PLOT_PNG | TS_PLOT_SVG)))
+        return ts_fail(err, TS_EINVAL, "%s: opts.formats: expected "
+                                       "TS_PLOT_PNG and/or TS_PLOT_SVG, got "
+                                       "%d",
+                       fn, o->formats);
+    return TS_OK;
+}
+
+/* Check, draw every requested format, write the files. */
+static int render(const char *fn, const char *dir, const char *name,
+                  const char *title, const ts_plot_opts *o, int height,
+                  draw_fn draw, const void *ctx, ts_err *err)
+{
+    static const char *const dev[2] = {"pngcairo", "svgcairo"};
+    static const char *const ext[2] = {"png", "svg"};
+    int rc = ts_plot_prepare_dir(dir, err);
+    if (rc)
+        return rc;
+    char *buf[2] = {NULL, NULL};
+    size_t size[2] = {0, 0};
+    for (int k = 0; k < 2 && rc == TS_OK; k++)
+        if (o->formats & (1 << k))
+            rc = render_one(dev[k], o->width, height, draw, ctx, o, &buf[k],
+                            &size[k], err);
+    if (rc) {
+        ts_err_prefix(err, "%s: ", fn);
+        free(buf[0]);
+        free(buf[1]);
+        return rc;
+    }
+    /* Both temporary files first, then both renames. */
+    char path[2][1200], tmp[2][1300];
+    FILE *f[2] = {NULL, NULL};
+    for (int k = 0; k < 2 && rc == TS_OK; k++) {
+        if (!buf[k])
+            continue;
+        int n = snprintf(path[k], sizeof path[k], "%s/%s.%s", dir, name,
+                         ext[k]);
+        if (n < 0 || (size_t)n >= sizeof path[k]) {
+            rc = ts_fail(err, TS_EINVAL, "%s: path '%s/%s.%s' is too long",
+                         fn, dir, name, ext[k]);
+            break;
+        }
+        f[k] = ts_report_open(path[k], tmp[k], sizeof tmp[k], err);
+        if (!f[k])
+            rc = TS_EIO;
+        else
+            rc = write_bytes(f[k], path[k], buf[k], size[k], k == 1, title,
+                             err);
+    }
+    for (int k = 0; k < 2; k++) {
+        if (!f[k])
+            continue;
+        if (rc == TS_OK)
+            rc = ts_report_commit(f[k], path[k], tmp[k], err);
+        else
+            ts_report_abandon(f[k], path[k], tmp[k]);
+    }
+    free(buf[0]);
+    free(buf[1]);
+    return rc;
+}
+
+/* The devices this module needs. */
+int ts_plot_check(ts_err *err)
+{
+    enum { MAXDEV = 256 };
+    const char *menu_store[MAXDEV], *name_store[MAXDEV];
+    const char **menu = menu_store, **names = name_store;
+    int ndev = MAXDEV, have_png = 0, have_svg = 0;
+    plgDevs(&menu, &names, &ndev);
+    for (int i = 0; i < ndev; i++) {
+        have_png |= strcmp(names[i], "pngcairo") == 0;
+        have_svg |= strcmp(names[i], "svgcairo") == 0;
+    }
+    if (!have_png || !have_svg)
+        return ts_fail(err, TS_EDOMAIN,
+                       "PLplot's cairo driver (pngcairo, svgcairo) is not "
+                       "installed; install plplot-driver-cairo");
+    return TS_OK;
+}
+
+/* Common argument checks of every public drawing function. */
+static int begin(const char *fn, const char *dir, const char *name,
+                 const char *title, const ts_plot_opts **o,
+                 ts_plot_opts *defaults, ts_err *err)
+{
+    int rc = ts_plot_check(err);
+    if (rc)
+        return rc;
+    if (!*o) {
+        ts_plot_opts_default(defaults);
+        *o = defaults;
+    }
+    if (!dir || !dir[0])
+        return ts_fail(err, TS_EINVAL, "%s: dir: expected a directory, got "
+                                       "none",
+                       fn);
+    if (!check_name(name))
+        return ts_fail(err, TS_EINVAL,
+                       "%s: name: expected letters, digits, '_', '-' or "
+                       "'.' (not first), at most 200, got '%s'",
+                       fn, name ? name : "(null)");
+    if (!title)
+        return ts_fail(err, TS_EINVAL, "%s: title: expected text, got NULL",
+                       fn);
+    return check_opts(fn, *o, err);
+}
+
+static int check_array(const char *fn, const char *what, int index,
+                       const double *a, int n, int positive, ts_err *err)
+{
+    if (!a)
+        return ts_fail(err, TS_EINVAL, "%s: %s (item %d): expected an array "
+                                       "of %d values, got NULL",
+                       fn, what, index, n);
+    for (int i = 0; i < n; i++) {
+        if (!isfinite(a[i]))
+            return ts_fail(err, TS_EINVAL,
+                           "%s: %s[%d] (item %d): must be finite, got %g", fn,
+                           what, i, index, a[i]);
+        if (positive && !(a[i] > 0))
+            return ts_fail(err, TS_EINVAL,
+                           "%s: %s[%d] (item %d): must be > 0 on a log axis, "
+                           "got %g",
+                           fn, what, i, index, a[i]);
+    }
+    return TS_OK;
+}
+
+static int check_series(const char *fn, int nseries,
+                        const ts_plot_series s[], int xpos, int ypos,
+                        ts_err *err)
+{
+    if (nseries < 1 || !s)
+        return ts_fail(err, TS_EINVAL, "%s: expected at least one series, "
+                                       "got %d",
+                       fn, nseries);
+    for (int i = 0; i < nseries; i++) {
+        if (s[i].n < 1)
+            return ts_fail(err, TS_EINVAL, "%s: series[%d].n: must be >= 1, "
+                                           "got %d",
+                           fn, i, s[i].n);
+        int rc = check_array(fn, "x", i, s[i].x, s[i].n, xpos, err);
+        if (!rc)
+            rc = check_array(fn, "y", i, s[i].y, s[i].n, ypos, err);
+        if (rc)
+            return rc;
+        if (s[i].style < TS_PLOT_SOLID || s[i].style > TS_PLOT_LINE_MARKERS)
+            return ts_fail(err, TS_EINVAL, "%s: series[%d].style: unknown "
+                                           "style %d",
+                           fn, i, s[i].style);
+    }
+    return TS_OK;
+}
+
+static int check_quantity(const char *fn, const char *what,
+                          ts_plot_quantity q, ts_err *err)
+{
+    if ((int)q < TS_PLOT_NONE || (int)q > TS_PLOT_ANGLE)
+        return ts_fail(err, TS_EINVAL, "%s: %s: unknown quantity %d", fn,
+                       what, (int)q);
+    return TS_OK;
+}
+
+/* Draw a series' line and/or markers. */
+static void draw_series(frame *f, const ts_plot_series *s, int color,
+                        int ordinal, const double *x, const double *y)
+{
+    plcol0(color);
+    plwidth(CURVE_WIDTH);
+    pllsty(line_style(s->style));
+    if (s->style != TS_PLOT_MARKERS)
+        draw_line(f, s->n, x, y);
+    pllsty(LSTY_SOLID);
+    if (s->style == TS_PLOT_MARKERS || s->style == TS_PLOT_LINE_MARKERS ||
+        s->n == 1)
+        draw_markers(f, s->n, x, y, marker_glyph(ordinal));
+}
+
+/* ---- cable shapes ---------------------------------------------------- */
+
+/* Converted coordinates of one shape: h (horizontal), v (vertical) and
+ * depth z (for the water test), [nnodes] each. */
+typedef struct shape_xy {
+    double *h, *v, *z;
+} shape_xy;
+
+static int check_shape(const char *fn, const char *what, int i,
+                       const ts_plot_shape *s, ts_err *err)
+{
+    if (s->nnodes < 2)
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].nnodes: must be >= 2, got "
+                                       "%d",
+                       fn, what, i, s->nnodes);
+    int rc = check_array(fn, "pos", i, s->pos, 3 * s->nnodes, 0, err);
+    if (rc)
+        return rc;
+    for (int k = 0; s->link_upper && k < s->nnodes - 1; k++)
+        if (s->link_upper[k] < 0 || s->link_upper[k] > k)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: %s[%d].link_upper[%d]: must be in [0, %d] "
+                           "(a node above), got %d",
+                           fn, what, i, k, k, s->link_upper[k]);
+    if (s->nmarks < 0 || (s->nmarks > 0 && !s->marks))
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].marks: expected %d node "
+                                       "indices",
+                       fn, what, i, s->nmarks);
+    for (int m = 0; m < s->nmarks; m++)
+        if (s->marks[m] < 0 || s->marks[m] >= s->nnodes)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: %s[%d].marks[%d]: must be a node in [0, %d), "
+                           "got %d",
+                           fn, what, i, m, s->nnodes, s->marks[m]);
+    if (!isfinite(s->turn_radius))
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].turn_radius: must be "
+                                       "finite, got %g m",
+                       fn, what, i, s->turn_radius);
+    if (s->style != TS_PLOT_SOLID && s->style != TS_PLOT_DASHED)
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].style: expected solid or "
+                                       "dashed, got %d",
+                       fn, what, i, s->style);
+    return TS_OK;
+}
+
+/* Fill xy from pos (+ scale * disp when disp is not NULL). */
+static int shape_coords(const ts_plot_shape *s, const double *disp,
+                        double scale, ts_plot_view view, ts_plot_units u,
+                        shape_xy *xy)
+{
+    int n = s->nnodes;
+    xy->h = malloc(3 * (size_t)n * sizeof(double));
+    if (!xy->h)
+        return TS_ENOMEM;
+    xy->v = xy->h + n;
+    xy->z = xy->h + 2 * n;
+    for (int k = 0; k < n; k++) {
+        double r[3];
+        for (int j = 0; j < 3; j++)
+            r[j] = s->pos[3 * k + j] + (disp ? scale * disp[3 * k + j] : 0);
+        xy->h[k] = ts_plot_convert(TS_PLOT_LENGTH, u, r[0]);
+        xy->v[k] = ts_plot_convert(TS_PLOT_LENGTH, u,
+                                   view == TS_PLOT_SIDE ? r[2] : r[1]);
+        xy->z[k] = r[2];
+    }
+    return TS_OK;
+}
+
+/* Draw a run of points in one medium. */
+static void flush_run(frame *f, int n, const double *h, const double *v,
+                      int in_air, int style)
+{
+    pllsty(in_air ? LSTY_DASHED : line_style(style));
+    draw_line(f, n, h, v);
+}
+
+/* Draw the links of a shape as polylines: a link continues the previous
+ * polyline when its upper node is the previous link's lower node. With
+ * `water`, each polyline is split where it crosses z = 0 and the parts in
+ * air (z < 0) are dashed. `work` holds 2 (2 nnodes + 2) doubles. */
+static void draw_shape_links(frame *f, const ts_plot_shape *s,
+                             const shape_xy *xy, int water, double *work)
+{
+    int n = s->nnodes;
+    double *rh = work, *rv = work + 2 * n + 2;
+    int len = 0, air = 0;
+    for (int k = 0; k + 1 < n; k++) {
+        int a = s->link_upper ? s->link_upper[k] : k, b = k + 1;
+        int cont = k > 0 && a == k;
+        if (!cont) {
+            if (len >= 2)
+                flush_run(f, len, rh, rv, air, s->style);
+            len = 0;
+            rh[len] = xy->h[a];
+            rv[len++] = xy->v[a];
+            air = water && xy->z[a] < 0;
+        }
+        int b_air = water && xy->z[b] < 0;
+        if (b_air != air) {
+            /* The link crosses the surface (z = 0 counts as water): end
+             * the run at the crossing and start the next one there. The
+             * run's medium is that of node a, so z[a] != z[b]. */
+            double t = xy->z[a] / (xy->z[a] - xy->z[b]);
+            double ch = xy->h[a] + t * (xy->h[b] - xy->h[a]);
+            double cv = xy->v[a] + t * (xy->v[b] - xy->v[a]);
+            rh[len] = ch;
+            rv[len++] = cv;
+            flush_run(f, len, rh, rv, air, s->style);
+            len = 0;
+            rh[len] = ch;
+            rv[len++] = cv;
+            air = b_air;
+        }
+        rh[len] = xy->h[b];
+        rv[len++] = xy->v[b];
+    }
+    if (len >= 2)
+        flush_run(f, len, rh, rv, air, s->style);
+    pllsty(LSTY_SOLID);
+}
+
+static void draw_marks(frame *f, const ts_plot_shape *s, const shape_xy *xy,
+                       double size)
+{
+    plschr(0, size);
+    for (int m = 0; m < s->nmarks; m++)
+        draw_markers(f, 1, &xy->h[s->marks[m]], &xy->v[s->marks[m]], "●");
+    plschr(0, 1.0);
+}
+
+typedef struct shapes_ctx {
+    const char *title;
+    ts_plot_view view;
+    int flags;
+    int nshapes;
+    const ts_plot_shape *shapes;
+} shapes_ctx;
+
+#define CIRCLE_POINTS 721
+/* A turning circle larger than this many cable extents is not fitted into
+ * the window (it is clipped to the cable's surroundings). */
+#define CIRCLE_FIT 3.0
+
+static void bbox_update(double *lo, double *hi, double v)
+{
+    if (v < *lo)
+        *lo = v;
+    if (v > *hi)
+        *hi = v;
+}
+
+static void draw_water(frame *f, double x0, double x1, double zdeep,
+                       ts_plot_units u)
+{
+    if (zdeep > 0) {
+        double px[4] = {x0, x1, x1, x0}, pz[4] = {0, 0, zdeep, zdeep};
+        plcol0(COL_WATER);
+        plfill(4, px, pz);
+    }
+    plcol0(COL_SURFACE);
+    plwidth(1.6);
+    pllsty(LSTY_SOLID);
+    pljoin(x0, 0, x1, 0);
+    frame_segment(f, x0, 0, x1, 0);
+    char t[64];
+    snprintf(t, sizeof t, "water surface (z = 0 %s)",
+             ts_plot_unit(TS_PLOT_LENGTH, u));
+    plschr(0, 0.85);
+    /* Just above the line at the left end (depth axis points down). */
+    double ty = -0.03 * fabs(f->top - f->bottom);
+    plptex(x0 + 0.01 * (x1 - x0), ty, 1, 0, 0.0, t);
+    frame_segment(f, x0, ty, x0 + 0.3 * (x1 - x0), ty);
+    plschr(0, 1.0);
+}
+
+static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
+                       ts_err *err)
+{
+    (void)height;
+    const shapes_ctx *c = vctx;
+    ts_plot_units u = o->units;
+    int top = c->view == TS_PLOT_TOP;
+    int water = (c->flags & TS_PLOT_WATER) != 0;
+    shape_xy *xy = calloc((size_t)c->nshapes, sizeof *xy);
+    if (!xy)
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    int maxn = 0, rc = TS_OK;
+    double h0 = INFINITY, h1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    for (int i = 0; i < c->nshapes && rc == TS_OK; i++) {
+        rc = shape_coords(&c->shapes[i], NULL, 0, c->view, u, &xy[i]);
+        for (int k = 0; rc == TS_OK && k < c->shapes[i].nnodes; k++) {
+            bbox_update(&h0, &h1, xy[i].h[k]);
+            bbox_update(&v0, &v1, xy[i].v[k]);
+        }
+        if (c->shapes[i].nnodes > maxn)
+            maxn = c->shapes[i].nnodes;
+    }
+    double *work = rc ? NULL : malloc(4 * ((size_t)maxn + 1) * sizeof *work);
+    if (rc || !work) {
+        for (int i = 0; i < c->nshapes; i++)
+            free(xy[i].h);
+        free(xy);
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    }
+    double extent = fmax(h1 - h0, v1 - v0);
+    if (!(extent > 0))
+        extent = ts_plot_convert(TS_PLOT_LENGTH, u, 1.0);
+    if (top) {
+        /* The ship at the origin, and turning circles that are not much
+         * larger than the cable. */
+        bbox_update(&h0, &h1, 0);
+        bbox_update(&v0, &v1, 0);
+        for (int i = 0; i < c->nshapes; i++) {
+            double R = ts_plot_convert(TS_PLOT_LENGTH, u,
+                                       c->shapes[i].turn_radius);
+            if (R != 0 && fabs(R) <= CIRCLE_FIT * extent) {
+                bbox_update(&h0, &h1, -fabs(R));
+                bbox_update(&h0, &h1, fabs(R));
+                bbox_update(&v0, &v1, 0);
+                bbox_update(&v0, &v1, 2 * R);
+            }
+        }
+    } else if (water) {
+        /* Always show the surface with some air above it. */
+        bbox_update(&v0, &v1, 0);
+        bbox_update(&v0, &v1, -0.04 * extent);
+    }
+    pad_range(&h0, &h1, 0.06, extent);
+    pad_range(&v0, &v1, 0.08, extent);
+
+    /* The legend goes above the plot box (cable shapes leave no corner
+     * reliably free), with entries for the line styles in use. */
+    legend L = {0};
+    int in_air = 0, circles = 0;
+    for (int i = 0; i < c->nshapes; i++) {
+        const ts_plot_shape *s = &c->shapes[i];
+        legend_add(&L, s->label, color_index(s->color, i), s->style, NULL);
+        for (int k = 0; water && k < s->nnodes; k++)
+            in_air |= xy[i].z[k] < 0;
+        circles |= top && s->turn_radius != 0;
+    }
+    if (in_air)
+        legend_add(&L, "in air", COL_FG, TS_PLOT_DASHED, NULL);
+    if (circles)
+        legend_add(&L, "the ship's turning circle", COL_FG, TS_PLOT_DOTTED,
+                   NULL);
+    PLFLT sx0, sx1, sy0, sy1;
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    legend_layout lay = legend_plan(&L, 0.87 * (sx1 - sx0));
+    double box_top = 0.89 - (lay.height_mm > 0 ? lay.height_mm + 2.0 : 0) /
+                                (sy1 - sy0);
+    plvpor(left_edge(tick_width(v0, v1, 0), 1.0), 0.97, 0.11, box_top);
+    if (top || (c->flags & TS_PLOT_EQUAL))
+        equalize(&h0, &h1, &v0, &v1);
+    frame f;
+    /* Depth and starboard grow downward: bottom edge = largest value. */
+    frame_set(&f, h0, h1, v1, v0, 0, 0);
+
+    if (water && !top)
+        draw_water(&f, h0, h1, v1, u);
+    frame_axes(&f, "bcnst", "bcnst", 0);
+
+    if (top) {
+        /* Ship at the origin heading +x: a small grey arrowhead. */
+        double s = 0.025 * (h1 - h0);
+        double ax[3] = {s, -s, -s}, ay[3] = {0, -0.6 * s, 0.6 * s};
+        plcol0(COL_GREY);
+        plfill(3, ax, ay);
+        frame_point(&f, 0, 0);
+        plschr(0, 0.85);
+        plptex(0, -1.1 * s, 1, 0, 0.5, "ship");
+        plschr(0, 1.0);
+        for (int i = 0; i < c->nshapes; i++) {
+            double R = ts_plot_convert(TS_PLOT_LENGTH, u,
+                                       c->shapes[i].turn_radius);
+            if (R == 0)
+                continue;
+            double cx[CIRCLE_POINTS], cy[CIRCLE_POINTS];
+            for (int k = 0; k < CIRCLE_POINTS; k++) {
+                double a = 2 * M_PI * k / (CIRCLE_POINTS - 1);
+                cx[k] = fabs(R) * sin(a);
+                cy[k] = R - R * cos(a);
+            }
+            plcol0(color_index(c->shapes[i].color, i));
+            plwidth(1.2);
+            pllsty(LSTY_DOTTED);
+            draw_line(&f, CIRCLE_POINTS, cx, cy);
+            pllsty(LSTY_SOLID);
+            double zero = 0;
+            plschr(0, 0.9);
+            draw_markers(&f, 1, &zero, &R, "+");
+            plptex(0.02 * (h1 - h0), R, 1, 0, 0.0, "turn centre");
+            frame_segment(&f, 0, R, 0.15 * (h1 - h0), R);
+            plschr(0, 1.0);
+        }
+    }
+    for (int i = 0; i < c->nshapes; i++) {
+        const ts_plot_shape *s = &c->shapes[i];
+        plcol0(color_index(s->color, i));
+        plwidth(CURVE_WIDTH);
+        draw_shape_links(&f, s, &xy[i], water, work);
+        draw_marks(&f, s, &xy[i], 1.1);
+    }
+    char xl[TEXT_MAX], yl[TEXT_MAX];
+    axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, u);
+    axis_label(yl, sizeof yl, top ? "y, starboard" : "z, depth",
+               TS_PLOT_LENGTH, u);
+    label_axes(&f, xl, yl, 1.0);
+    legend_draw_above(&L, lay);
+    page_title(c->title);
+    for (int i = 0; i < c->nshapes; i++)
+        free(xy[i].h);
+    free(xy);
+    free(work);
+    return TS_OK;
+}
+
+int ts_plot_shapes(const char *dir, const char *name, const char *title,
+                   ts_plot_view view, int flags, int nshapes,
+                   const ts_plot_shape shapes[], const ts_plot_opts *opts,
+                   ts_err *err)
+{
+    static const char fn[] = "ts_plot_shapes";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc)
+        return rc;
+    if (view != TS_PLOT_SIDE && view != TS_PLOT_TOP)
+        return ts_fail(err, TS_EINVAL, "%s: view: expected side or top, got "
+                                       "%d",
+                       fn, (int)view);
+    if (flags & ~(TS_PLOT_WATER | TS_PLOT_EQUAL))
+        return ts_fail(err, TS_EINVAL, "%s: flags: unknown bits in %#x", fn,
+                       (unsigned)flags);
+    if (nshapes < 1 || !shapes)
+        return ts_fail(err, TS_EINVAL, "%s: expected at least one shape, got "
+                                       "%d",
+                       fn, nshapes);
+    for (int i = 0; i < nshapes; i++)
+        if ((rc = check_shape(fn, "shapes", i, &shapes[i], err)))
+            return rc;
+    shapes_ctx c = {title, view, flags, nshapes, shapes};
+    return render(fn, dir, name, title, opts, opts->height, draw_shapes, &c,
+                  err);
+}
+
+/* ---- mode shapes ----------------------------------------------------- */
+
+/* Largest displacement is this fraction of the cable's largest extent. */
+#define MODE_AMPLITUDE 0.15
+#define MODE_ROW_PX 220
+#define MODE_TOP_PX 95    /* title and note */
+#define MODE_TITLE_PX 55  /* the title alone */
+#define MODE_BOTTOM_PX 50 /* the x axis title */
+#define MODE_TEXT 0.8     /* character size in the small panels */
+#define MAX_MODES 8
+
+typedef struct modes_ctx {
+    const char *title;
+    int flags;
+    const ts_plot_shape *eq;
+    int nmodes;
+    const ts_plot_mode *modes;
+    const double *scale; /* [nmodes] */
+} modes_ctx;
+
+static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
+                      ts_err *err)
+{
+    const modes_ctx *c = vctx;
+    ts_plot_units u = o->units;
+    int water = (c->flags & TS_PLOT_WATER) != 0;
+    int n = c->eq->nnodes;
+    /* xy[view][0] equilibrium, [1 + 2m] +mode, [2 + 2m] -mode. */
+    int nsh = 1 + 2 * c->nmodes;
+    shape_xy *xy = calloc(2 * (size_t)nsh, sizeof *xy);
+    double *work = malloc(4 * ((size_t)n + 1) * sizeof *work);
+    int rc = xy && work ? TS_OK : TS_ENOMEM;
+    double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};
+    double hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
+    for (int view = 0; view < 2 && rc == TS_OK; view++)
+        for (int j = 0; j < nsh && rc == TS_OK; j++) {
+            int m = (j - 1) / 2;
+            double sgn = j == 0 ? 0 : (j % 2 ? 1 : -1);
+            shape_xy *s = &xy[view * nsh + j];
+            rc = shape_coords(c->eq, j ? c->modes[m].disp : NULL,
+                              j ? sgn * c->scale[m] : 0, (ts_plot_view)view,
+                              u, s);
+            for (int k = 0; rc == TS_OK && k < n; k++) {
+                bbox_update(&lo[view][0], &hi[view][0], s->h[k]);
+                bbox_update(&lo[view][1], &hi[view][1], s->v[k]);
+            }
+        }
+    if (rc) {
+        for (int j = 0; xy && j < 2 * nsh; j++)
+            free(xy[j].h);
+        free(xy);
+        free(work);
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    }
+    double extent = 0;
+    for (int view = 0; view < 2; view++)
+        for (int a = 0; a < 2; a++)
+            extent = fmax(extent, hi[view][a] - lo[view][a]);
+    if (!(extent > 0))
+        extent = ts_plot_convert(TS_PLOT_LENGTH, u, 1.0);
+    if (water) {
+        bbox_update(&lo[0][1], &hi[0][1], 0);
+        bbox_update(&lo[0][1], &hi[0][1], -0.04 * extent);
+    }
+    for (int view = 0; view < 2; view++) {
+        pad_range(&lo[view][0], &hi[view][0], 0.05, extent);
+        pad_range(&lo[view][1], &hi[view][1], 0.10, extent);
+    }
+    /* Rows from the top; normalised page coordinates. */
+    double top_frac = (double)MODE_TOP_PX / height;
+    double bottom_frac = (double)MODE_BOTTOM_PX / height;
+    double row = (1 - top_frac - bottom_frac) / c->nmodes;
+    char xl[TEXT_MAX], yl[2][TEXT_MAX], lab[TEXT_MAX];
+    axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, u);
+    axis_label(yl[0], sizeof yl[0], "z, depth", TS_PLOT_LENGTH, u);
+    axis_label(yl[1], sizeof yl[1], "y, starboard", TS_PLOT_LENGTH, u);
+    for (int m = 0; m < c->nmodes; m++) {
+        /* The box takes 68 % of the row; the rest is the mode's label
+         * above and the tick labels below. */
+        double y1 = 1 - top_frac - m * row - 0.12 * row;
+        double y0 = y1 - 0.68 * row;
+        for (int view = 0; view < 2; view++) {
+            double x0 = view ? 0.59 : 0.10, x1 = view ? 0.98 : 0.49;
+            plvpor(x0, x1, y0, y1);
+            double h0 = lo[view][0], h1 = hi[view][0];
+            double v0 = lo[view][1], v1 = hi[view][1];
+            if (view == 1 || (c->flags & TS_PLOT_EQUAL))
+                equalize(&h0, &h1, &v0, &v1);
+            frame f;
+            frame_set(&f, h0, h1, v1, v0, 0, 0);
+            if (water && view == 0) {
+                double px[4] = {h0, h1, h1, h0}, pz[4] = {0, 0, v1, v1};
+                if (v1 > 0) {
+                    plcol0(COL_WATER);
+                    plfill(4, px, pz);
+                }
+                plcol0(COL_SURFACE);
+                plwidth(1.4);
+                pljoin(h0, 0, h1, 0);
+            }
+            plschr(0, MODE_TEXT);
+            frame_axes(&f, "bcnst", "bcnst", 0);
+            label_axes(&f, m == c->nmodes - 1 ? xl : NULL, yl[view],
+                       MODE_TEXT);
+            plschr(0, 1.0);
+            const shape_xy *s = &xy[view * nsh];
+            plcol0(COL_GREY);
+            plwidth(1.6);
+            draw_shape_links(&f, c->eq, &s[0], water, work);
+            draw_marks(&f, c->eq, &s[0], 0.8);
+            int col = color_index(0, m);
+            for (int j = 1; j <= 2; j++) {
+                ts_plot_shape style = *c->eq;
+                style.style = j == 1 ? TS_PLOT_SOLID : TS_PLOT_DASHED;
+                plcol0(col);
+                plwidth(CURVE_WIDTH);
+                /* The -mode is dashed everywhere; in-air dashing would
+                 * not show on it, so only the +mode marks air parts. */
+                draw_shape_links(&f, &style, &s[2 * m + j], water && j == 1,
+                                 work);
+                draw_marks(&f, c->eq, &s[2 * m + j], 0.8);
+            }
+            if (view == 0) {
+                pl_text(lab, sizeof lab, c->modes[m].label);
+                plcol0(col);
+                plmtex("t", 0.6, 0.0, 0.0, lab);
+            }
+        }
+    }
+    page_title(c->title);
+    plvpor(0, 1, 0, 1 - (double)MODE_TITLE_PX / height);
+    plwind(0, 1, 0, 1);
+    plcol0(COL_FG);
+    plschr(0, 0.8);
+    snprintf(lab, sizeof lab,
+             "grey: equilibrium; solid, dashed: the mode at opposite phases, "
+             "largest displacement %.0f %% of the cable's extent",
+             100 * MODE_AMPLITUDE);
+    plschr(0, 1.0);
+    {
+        double w, h;
+        viewport_mm(&w, &h);
+        mtex_fit("t", -1.0, 0.5, 0.5, lab, 0.96 * w, 0.8);
+    }
+    for (int j = 0; j < 2 * nsh; j++)
+        free(xy[j].h);
+    free(xy);
+    free(work);
+    return TS_OK;
+}
+
+int ts_plot_mode_shapes(const char *dir, const char *name, const char *title,
+                        int flags, const ts_plot_shape *eq, int nmodes,
+                        const ts_plot_mode modes[], const ts_plot_opts *opts,
+                        ts_err *err)
+{
+    static const char fn[] = "ts_plot_mode_shapes";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc)
+        return rc;
+    if (flags & ~(TS_PLOT_WATER | TS_PLOT_EQUAL))
+        return ts_fail(err, TS_EINVAL, "%s: flags: unknown bits in %#x", fn,
+                       (unsigned)flags);
+    if (!eq)
+        return ts_fail(err, TS_EINVAL, "%s: eq: expected the equilibrium "
+                                       "shape, got NULL",
+                       fn);
+    ts_plot_shape e = *eq;
+    e.style = TS_PLOT_SOLID;
+    e.turn_radius = 0;
+    if ((rc = check_shape(fn, "eq", 0, &e, err)))
+        return rc;
+    if (nmodes < 1 || nmodes > MAX_MODES || !modes)
+        return ts_fail(err, TS_EINVAL, "%s: nmodes: expected 1..%d modes, got "
+                                       "%d",
+                       fn, MAX_MODES, nmodes);
+    double extent = 0, scale[MAX_MODES];
+    for (int a = 0; a < 3; a++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (int k = 0; k < eq->nnodes; k++)
+            bbox_update(&lo, &hi, eq->pos[3 * k + a]);
+        extent = fmax(extent, hi - lo);
+    }
+    if (!(extent > 0))
+        return ts_fail(err, TS_EINVAL, "%s: eq.pos: all nodes coincide", fn);
+    for (int m = 0; m < nmodes; m++) {
+        if ((rc = check_array(fn, "modes.disp", m, modes[m].disp,
+                              3 * eq->nnodes, 0, err)))
+            return rc;
+        double dmax = 0;
+        for (int k = 0; k < eq->nnodes; k++)
+            dmax = fmax(dmax, hypot(hypot(modes[m].disp[3 * k],
+                                          modes[m].disp[3 * k + 1]),
+                                    modes[m].disp[3 * k + 2]));
+        if (!(dmax > 0))
+            return ts_fail(err, TS_EINVAL, "%s: modes[%d].disp: all zero",
+                           fn, m);
+        scale[m] = MODE_AMPLITUDE * extent / dmax;
+    }
+    int height = MODE_TOP_PX + MODE_ROW_PX * nmodes + MODE_BOTTOM_PX;
+    if (height < opts->height)
+        height = opts->height;
+    if (height > TS_PLOT_MAX_SIZE)
+        height = TS_PLOT_MAX_SIZE;
+    modes_ctx c = {title, flags, &e, nmodes, modes, scale};
+    return render(fn, dir, name, title, opts, height, draw_modes, &c, err);
+}
+
+/* ---- eigenvalues ----------------------------------------------------- */
+
+typedef struct eig_ctx {
+    const char *title;
+    int nsets;
+    const ts_plot_series *sets;
+    ts_plot_eig_window win;
+} eig_ctx;
+
+static int draw_eigenvalues(const void *vctx, const ts_plot_opts *o,
+                            int height, ts_err *err)
+{
+    (void)o, (void)height, (void)err;
+    const eig_ctx *c = vctx;
+    double r0 = 0, r1 = 0, im = 0;
+    for (int s = 0; s < c->nsets; s++)
+        for (int i = 0; i < c->sets[s].n; i++) {
+            bbox_update(&r0, &r1, c->sets[s].x[i]);
+            im = fmax(im, fabs(c->sets[s].y[i]));
+        }
+    double span = r1 - r0;
+    if (!(span > 0))
+        span = im > 0 ? im : 1;
+    if (!(im > 0))
+        im = 0.5 * span;
+    r0 -= 0.08 * span;
+    /* Keep a visible strip of the unstable half-plane. */
+    r1 = fmax(r1 + 0.08 * span, 0.12 * span);
+    im *= 1.1;
+    if (c->win.re_min < 0)
+        r0 = c->win.re_min;
+    if (c->win.re_max > 0)
+        r1 = c->win.re_max;
+    if (c->win.im_max > 0)
+        im = c->win.im_max;
+
+    plvpor(left_edge(tick_width(-im, im, 0), 1.0), 0.97, 0.11, 0.89);
+    int nlegend = 0, lchars = 0;
+    for (int s = 0; s < c->nsets; s++)
+        legend_count(c->sets[s].label, &nlegend, &lchars);
+    frame f;
+    frame_set(&f, r0, r1, -im, im, nlegend, lchars);
+    double ux[4] = {0, r1, r1, 0}, uy[4] = {-im, -im, im, im};
+    plcol0(COL_UNSTABLE);
+    plfill(4, ux, uy);
+    frame_axes(&f, "bcnst", "bcnst", 0);
+    /* Rays of constant damping ratio from the origin into the left
+     * half-plane, each labelled inside the window where its upper half
+     * leaves it (top or left edge); labels closer than LABEL_GAP of the
+     * width to the previous one are left out. */
+    static const double zetas[] = {0.5, 0.2, 0.1, 0.05, 0.02};
+    const double LABEL_GAP = 0.07;
+    double w = r1 - r0, last_x = -INFINITY, last_y = INFINITY;
+    plwidth(1.0);
+    plschr(0, 0.8);
+    double reach = 4 * (fabs(r0) + fabs(r1) + im);
+    for (size_t z = 0; z < sizeof zetas / sizeof zetas[0]; z++) {
+        double zeta = zetas[z], wd = sqrt(1 - zeta * zeta);
+        double rx[3] = {-zeta * reach, 0, -zeta * reach};
+        double ry[3] = {wd * reach, 0, -wd * reach};
+        plcol0(COL_GREY);
+        pllsty(LSTY_DASHED);
+        plline(3, rx, ry);
+        pllsty(LSTY_SOLID);
+        double ex = -zeta / wd * im, ey = im;
+        if (ex < r0) {
+            ex = r0;
+            ey = -r0 * wd / zeta;
+        }
+        char t[32];
+        snprintf(t, sizeof t, "ζ=%g", zeta);
+        if (ey >= im) {
+            double x = ex - 0.008 * w, y = im - 0.045 * im;
+            if (x - last_x < LABEL_GAP * w)
+                continue;
+            plptex(x, y, 1, 0, 1.0, t);
+            frame_segment(&f, x - 0.06 * w, y, x, y);
+            last_x = x;
+        } else {
+            double x = r0 + 0.008 * w, y = ey + 0.05 * im;
+            if (fabs(last_y - y) < 0.08 * im)
+                continue;
+            plptex(x, y, 1, 0, 0.0, t);
+            frame_segment(&f, x, y, x + 0.06 * w, y);
+            last_y = y;
+            last_x = x + 0.06 * w;
+        }
+    }
+    plschr(0, 1.0);
+    plcol0(COL_GREY);
+    plwidth(1.0);
+    pljoin(r0, 0, r1, 0);
+    plcol0(COL_FG);
+    plwidth(1.8);
+    pljoin(0, -im, 0, im);
+    plschr(0, 0.85);
+    plptex(0.5 * r1, -0.93 * im, 1, 0, 0.5, "unstable");
+    frame_segment(&f, 0, -0.93 * im, r1, -0.93 * im);
+    frame_segment(&f, 0, -im, 0, im);
+    plschr(0, 1.0);
+    legend L = {0};
+    int outside = 0;
+    for (int s = 0; s < c->nsets; s++) {
+        const ts_plot_series *S = &c->sets[s];
+        int col = color_index(S->color, s);
+        plcol0(col);
+        plschr(0, 1.1);
+        draw_markers(&f, S->n, S->x, S->y, marker_glyph(s));
+        plschr(0, 1.0);
+        for (int i = 0; i < S->n; i++)
+            outside += S->x[i] < r0 || S->x[i] > r1 || fabs(S->y[i]) > im;
+        legend_add(&L, S->label, col, TS_PLOT_MARKERS, marker_glyph(s));
+    }
+    char xl[TEXT_MAX], yl[TEXT_MAX];
+    axis_label(xl, sizeof xl, "real part σ", TS_PLOT_RATE, o->units);
+    axis_label(yl, sizeof yl, "imaginary part ω", TS_PLOT_ANGULAR_RATE,
+               o->units);
+    label_axes(&f, xl, yl, 1.0);
+    char text[160];
+    if (outside)
+        snprintf(text, sizeof text, "dashed: constant damping ratio ζ; %d "
+                                    "eigenvalue%s outside the window",
+                 outside, outside == 1 ? "" : "s");
+    else
+        snprintf(text, sizeof text, "dashed: constant damping ratio ζ");
+    note(text);
+    legend_draw(&L, &f);
+    page_title(c->title);
+    return TS_OK;
+}
+
+int ts_plot_eigenvalues(const char *dir, const char *name, const char *title,
+                        int nsets, const ts_plot_series sets[],
+                        const ts_plot_eig_window *win,
+                        const ts_plot_opts *opts, ts_err *err)
+{
+    static const char fn[] = "ts_plot_eigenvalues";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc || (rc = check_series(fn, nsets, sets, 0, 0, err)))
+        return rc;
+    eig_ctx c = {title, nsets, sets, {0, 0, 0}};
+    if (win) {
+        if (!isfinite(win->re_min) || win->re_min > 0 ||
+            !isfinite(win->re_max) || win->re_max < 0 ||
+            !isfinite(win->im_max) || win->im_max < 0)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: win: expected re_min <= 0, re_max >= 0, "
+                           "im_max >= 0 (0: automatic), got %g, %g, %g",
+                           fn, win->re_min, win->re_max, win->im_max);
+        c.win = *win;
+    }
+    return render(fn, dir, name, title, opts, opts->height, draw_eigenvalues,
+                  &c, err);
+}
+
+/* ---- Bode ------------------------------------------------------------ */
+
+typedef struct bode_ctx {
+    const char *title, *mag_label;
+    ts_plot_quantity out_q, in_q;
+    int ncurves;
+    const ts_plot_bode_curve *curves;
+    int nnat;
+    const double *nat;
+} bode_ctx;
+
+static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
+                     ts_err *err)
+{
+    (void)height;
+    const bode_ctx *c = vctx;
+    ts_plot_units u = o->units;
+    double gain = ts_plot_convert(c->out_q, u, 1.0) /
+                  ts_plot_convert(c->in_q, u, 1.0);
+    int nmax = 0;
+    for (int i = 0; i < c->ncurves; i++)
+        if (c->curves[i].n > nmax)
+            nmax = c->curves[i].n;
+    double *lf = malloc(3 * (size_t)nmax * sizeof *lf);
+    if (!lf)
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    double *lm = lf + nmax, *ph = lf + 2 * nmax;
+    double f0 = INFINITY, f1 = -INFINITY, m0 = INFINITY, m1 = -INFINITY;
+    double p0 = INFINITY, p1 = -INFINITY;
+    for (int i = 0; i < c->ncurves; i++) {
+        const ts_plot_bode_curve *C = &c->curves[i];
+        double wrap = 0;
+        for (int k = 0; k < C->n; k++) {
+            bbox_update(&f0, &f1, log10(C->freq[k]));
+            bbox_update(&m0, &m1, log10(gain * C->mag[k]));
+            /* Unwrap: consecutive phases differ by at most pi. */
+            if (k > 0) {
+                double d = C->phase[k] - C->phase[k - 1];
+                wrap -= 2 * M_PI * floor((d + M_PI) / (2 * M_PI));
+            }
+            bbox_update(&p0, &p1, (C->phase[k] + wrap) * 180 / M_PI);
+        }
+    }
+    pad_range(&f0, &f1, 0.0, 1.0);
+    pad_range(&m0, &m1, 0.08, 1.0);
+    pad_range(&p0, &p1, 0.08, 90.0);
+    char xl[TEXT_MAX], ml[TEXT_MAX], raw[TEXT_MAX];
+    axis_label(xl, sizeof xl, "frequency", TS_PLOT_FREQUENCY, u);
+    snprintf(raw, sizeof raw, "%s [%s/%s]",
+             c->mag_label ? c->mag_label : "magnitude",
+             ts_plot_unit(c->out_q, u), ts_plot_unit(c->in_q, u));
+    pl_text(ml, sizeof ml, raw);
+    int nlegend = 0, lchars = 0;
+    for (int i = 0; i < c->ncurves; i++)
+        legend_count(c->curves[i].label, &nlegend, &lchars);
+    legend L = {0};
+    double left = fmax(left_edge(tick_width(m0, m1, 1), 1.0),
+                       left_edge(tick_width(p0, p1, 0), 1.0));
+    for (int panel = 0; panel < 2; panel++) {
+        if (panel == 0)
+            plvpor(left, 0.97, 0.52, 0.89);
+        else
+            plvpor(left, 0.97, 0.11, 0.46);
+        frame f;
+        if (panel == 0)
+            frame_set(&f, f0, f1, m0, m1, nlegend, lchars);
+        else
+            frame_set(&f, f0, f1, p0, p1, 0, 0);
+        /* Phase ticks at multiples of 90 or 45 degrees. */
+        double ptick = p1 - p0 > 200 ? 90 : p1 - p0 > 60 ? 45 : 0;
+        frame_axes(&f, panel ? "bcnstl" : "bcstl", panel ? "bcnst" : "bcnstl",
+                   panel ? ptick : 0);
+        /* Natural frequencies. */
+        plwidth(1.2);
+        for (int j = 0; j < c->nnat; j++) {
+            double x = log10(c->nat[j]);
+            if (x < f0 || x > f1)
+                continue;
+            plcol0(COL_GREY);
+            pllsty(LSTY_DOTTED);
+            pljoin(x, panel ? p0 : m0, x, panel ? p1 : m1);
+            pllsty(LSTY_SOLID);
+            if (panel == 0) {
+                char t[32];
+                snprintf(t, sizeof t, "f%d", j + 1);
+                plschr(0, 0.8);
+                plcol0(COL_FG);
+                double y = m1 - 0.06 * (m1 - m0);
+                plptex(x, y, 1, 0, -0.15, t);
+                frame_segment(&f, x, y, x + 0.03 * (f1 - f0), y);
+                plschr(0, 1.0);
+            }
+        }
+        for (int i = 0; i < c->ncurves; i++) {
+            const ts_plot_bode_curve *C = &c->curves[i];
+            double wrap = 0;
+            for (int k = 0; k < C->n; k++) {
+                lf[k] = log10(C->freq[k]);
+                lm[k] = log10(gain * C->mag[k]);
+                if (k > 0) {
+                    double d = C->phase[k] - C->phase[k - 1];
+                    wrap -= 2 * M_PI * floor((d + M_PI) / (2 * M_PI));
+                }
+                ph[k] = (C->phase[k] + wrap) * 180 / M_PI;
+            }
+            ts_plot_series s = {C->n, lf, panel ? ph : lm, C->label, 0,
+                                C->style, C->color};
+            int col = color_index(C->color, i);
+            draw_series(&f, &s, col, i, lf, panel ? ph : lm);
+            if (panel == 0)
+                legend_add(&L, C->label, col, C->style, marker_glyph(i));
+        }
+        if (panel == 0) {
+            label_axes(&f, NULL, ml, 1.0);
+            if (c->nnat > 0)
+                note("dotted: natural frequencies f1, f2, ...");
+            legend_draw(&L, &f);
+        } else {
+            char pl[TEXT_MAX];
+            axis_label(pl, sizeof pl, "phase", TS_PLOT_ANGLE, u);
+            label_axes(&f, xl, pl, 1.0);
+        }
+    }
+    page_title(c->title);
+    free(lf);
+    return TS_OK;
+}
+
+int ts_plot_bode(const char *dir, const char *name, const char *title,
+                 const char *mag_label, ts_plot_quantity out_q,
+                 ts_plot_quantity in_q, int ncurves,
+                 const ts_plot_bode_curve curves[], int nnat,
+                 const double natural_hz[], const ts_plot_opts *opts,
+                 ts_err *err)
+{
+    static const char fn[] = "ts_plot_bode";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc || (rc = check_quantity(fn, "out_q", out_q, err)) ||
+        (rc = check_quantity(fn, "in_q", in_q, err)))
+        return rc;
+    if (ncurves < 1 || !curves)
+        return ts_fail(err, TS_EINVAL, "%s: expected at least one curve, got "
+                                       "%d",
+                       fn, ncurves);
+    for (int i = 0; i < ncurves; i++) {
+        const ts_plot_bode_curve *C = &curves[i];
+        if (C->n < 2)
+            return ts_fail(err, TS_EINVAL, "%s: curves[%d].n: must be >= 2, "
+                                           "got %d",
+                           fn, i, C->n);
+        if ((rc = check_array(fn, "freq", i, C->freq, C->n, 1, err)) ||
+            (rc = check_array(fn, "mag", i, C->mag, C->n, 1, err)) ||
+            (rc = check_array(fn, "phase", i, C->phase, C->n, 0, err)))
+            return rc;
+        for (int k = 1; k < C->n; k++)
+            if (!(C->freq[k] > C->freq[k - 1]))
+                return ts_fail(err, TS_EINVAL,
+                               "%s: curves[%d].freq[%d]: must increase, got "
+                               "%g Hz after %g Hz",
+                               fn, i, k, C->freq[k], C->freq[k - 1]);
+        if (C->style < TS_PLOT_SOLID || C->style > TS_PLOT_LINE_MARKERS)
+            return ts_fail(err, TS_EINVAL, "%s: curves[%d].style: unknown "
+                                           "style %d",
+                           fn, i, C->style);
+    }
+    if (nnat < 0 || (nnat > 0 &&
+                     (rc = check_array(fn, "natural_hz", 0, natural_hz, nnat,
+                                       1, err))))
+        return rc ? rc
+                  : ts_fail(err, TS_EINVAL, "%s: nnat: must be >= 0, got %d",
+                            fn, nnat);
+    bode_ctx c = {title,   mag_label, out_q, in_q, ncurves,
+                  curves,  nnat,      natural_hz};
+    return render(fn, dir, name, title, opts, opts->height, draw_bode, &c,
+                  err);
+}
+
+/* ---- histories ------------------------------------------------------- */
+
+#define MAX_PANELS 6
+
+typedef struct hist_ctx {
+    const char *title;
+    int npanels;
+    const ts_plot_axis *panels;
+    int nseries;
+    const ts_plot_series *series;
+} hist_ctx;
+
+static int draw_histories(const void *vctx, const ts_plot_opts *o,
+                          int height, ts_err *err)
+{
+    (void)height;
+    const hist_ctx *c = vctx;
+    ts_plot_units u = o->units;
+    int nmax = 0;
+    for (int i = 0; i < c->nseries; i++)
+        if (c->series[i].n > nmax)
+            nmax = c->series[i].n;
+    double *yv = malloc((size_t)nmax * sizeof *yv);
+    if (!yv)
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    double t0 = INFINITY, t1 = -INFINITY;
+    for (int i = 0; i < c->nseries; i++)
+        for (int k = 0; k < c->series[i].n; k++)
+            bbox_update(&t0, &t1, c->series[i].x[k]);
+    pad_range(&t0, &t1, 0.0, 1.0);
+    double gap = 0.035, top = 0.89, bottom = 0.11;
+    double ph = (top - bottom - gap * (c->npanels - 1)) / c->npanels;
+    double cs = c->npanels > 2 ? 0.85 : 1.0;
+    /* The panels' windows first: the widest tick labels of any panel set
+     * the common left edge. */
+    double lo[MAX_PANELS], hi[MAX_PANELS], left = LEFT_MIN;
+    for (int p = 0; p < c->npanels; p++) {
+        ts_plot_quantity q = c->panels[p].quantity;
+        lo[p] = INFINITY;
+        hi[p] = -INFINITY;
+        for (int i = 0; i < c->nseries; i++)
+            for (int k = 0; c->series[i].panel == p && k < c->series[i].n;
+                 k++)
+                bbox_update(&lo[p], &hi[p],
+                            ts_plot_convert(q, u, c->series[i].y[k]));
+        /* A constant series gets a window of 10 % of its value (1 when
+         * it is 0). */
+        pad_range(&lo[p], &hi[p], 0.08, lo[p] != 0 ? 0.1 * fabs(lo[p]) : 1.0);
+        left = fmax(left, left_edge(tick_width(lo[p], hi[p], 0), cs));
+    }
+    plschr(0, cs);
+    for (int p = 0; p < c->npanels; p++) {
+        ts_plot_quantity q = c->panels[p].quantity;
+        double v0 = lo[p], v1 = hi[p];
+        int nlegend = 0, lchars = 0;
+        for (int i = 0; i < c->nseries; i++)
+            if (c->series[i].panel == p)
+                legend_count(c->series[i].label, &nlegend, &lchars);
+        double y1 = top - p * (ph + gap);
+        plvpor(left, 0.97, y1 - ph, y1);
+        int last = p == c->npanels - 1;
+        plschr(0, cs);
+        frame f;
+        frame_set(&f, t0, t1, v0, v1, nlegend, lchars);
+        /* Time histories fill the width: make room for the legend above
+         * the data instead of covering it. */
+        if (nlegend > 0 && f.corner_h < 0.6) {
+            v1 += f.corner_h / (1 - f.corner_h) * (v1 - v0);
+            frame_set(&f, t0, t1, v0, v1, nlegend, lchars);
+        }
+        frame_axes(&f, last ? "bcnst" : "bcst", "bcnst", 0);
+        legend L = {0};
+        int ord = 0;
+        for (int i = 0; i < c->nseries; i++) {
+            const ts_plot_series *S = &c->series[i];
+            if (S->panel != p)
+                continue;
+            for (int k = 0; k < S->n; k++)
+                yv[k] = ts_plot_convert(q, u, S->y[k]);
+            int col = color_index(S->color, ord);
+            draw_series(&f, S, col, ord, S->x, yv);
+            legend_add(&L, S->label, col, S->style, marker_glyph(ord));
+            ord++;
+        }
+        char yl[TEXT_MAX], xl[TEXT_MAX];
+        axis_label(yl, sizeof yl, c->panels[p].label, q, u);
+        axis_label(xl, sizeof xl, "time t", TS_PLOT_TIME, u);
+        label_axes(&f, last ? xl : NULL, yl, cs);
+        plschr(0, 1.0);
+        legend_draw(&L, &f);
+    }
+    page_title(c->title);
+    free(yv);
+    return TS_OK;
+}
+
+int ts_plot_histories(const char *dir, const char *name, const char *title,
+                      int npanels, const ts_plot_axis panels[], int nseries,
+                      const ts_plot_series series[], const ts_plot_opts *opts,
+                      ts_err *err)
+{
+    static const char fn[] = "ts_plot_histories";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc || (rc = check_series(fn, nseries, series, 0, 0, err)))
+        return rc;
+    if (npanels < 1 || npanels > MAX_PANELS || !panels)
+        return ts_fail(err, TS_EINVAL, "%s: npanels: expected 1..%d panels, "
+                                       "got %d",
+                       fn, MAX_PANELS, npanels);
+    int used[MAX_PANELS] = {0};
+    for (int p = 0; p < npanels; p++)
+        if ((rc = check_quantity(fn, "panels.quantity", panels[p].quantity,
+                                 err)))
+            return rc;
+    for (int i = 0; i < nseries; i++) {
+        if (series[i].panel < 0 || series[i].panel >= npanels)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: series[%d].panel: must be in [0, %d), got %d",
+                           fn, i, npanels, series[i].panel);
+        used[series[i].panel] = 1;
+    }
+    for (int p = 0; p < npanels; p++)
+        if (!used[p])
+            return ts_fail(err, TS_EINVAL, "%s: panels[%d]: no series is "
+                                           "drawn in it",
+                           fn, p);
+    hist_ctx c = {title, npanels, panels, nseries, series};
+    return render(fn, dir, name, title, opts, opts->height, draw_histories,
+                  &c, err);
+}
+
+/* ---- log-log --------------------------------------------------------- */
+
+typedef struct loglog_ctx {
+    const char *title;
+    const ts_plot_axis *xa, *ya;
+    int nseries;
+    const ts_plot_series *series;
+} loglog_ctx;
+
+static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
+                       ts_err *err)
+{
+    (void)height;
+    const loglog_ctx *c = vctx;
+    ts_plot_units u = o->units;
+    int nmax = 0, nlegend = 0, lchars = 0;
+    for (int i = 0; i < c->nseries; i++) {
+        if (c->series[i].n > nmax)
+            nmax = c->series[i].n;
+        legend_count(c->series[i].label, &nlegend, &lchars);
+    }
+    double *lx = malloc(2 * (size_t)nmax * sizeof *lx);
+    if (!lx)
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    double *ly = lx + nmax;
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (int i = 0; i < c->nseries; i++)
+        for (int k = 0; k < c->series[i].n; k++) {
+            bbox_update(&x0, &x1, log10(ts_plot_convert(c->xa->quantity, u,
+                                                        c->series[i].x[k])));
+            bbox_update(&y0, &y1, log10(ts_plot_convert(c->ya->quantity, u,
+                                                        c->series[i].y[k])));
+        }
+    pad_range(&x0, &x1, 0.06, 1.0);
+    pad_range(&y0, &y1, 0.06, 1.0);
+    plvpor(left_edge(tick_width(y0, y1, 1), 1.0), 0.97, 0.11, 0.89);
+    frame f;
+    frame_set(&f, x0, x1, y0, y1, nlegend, lchars);
+    frame_axes(&f, "bcnstl", "bcnstl", 0);
+    legend L = {0};
+    for (int i = 0; i < c->nseries; i++) {
+        const ts_plot_series *S = &c->series[i];
+        for (int k = 0; k < S->n; k++) {
+            lx[k] = log10(ts_plot_convert(c->xa->quantity, u, S->x[k]));
+            ly[k] = log10(ts_plot_convert(c->ya->quantity, u, S->y[k]));
+        }
+        int col = color_index(S->color, i);
+        draw_series(&f, S, col, i, lx, ly);
+        legend_add(&L, S->label, col, S->style, marker_glyph(i));
+    }
+    char xl[TEXT_MAX], yl[TEXT_MAX];
+    axis_label(xl, sizeof xl, c->xa->label, c->xa->quantity, u);
+    axis_label(yl, sizeof yl, c->ya->label, c->ya->quantity, u);
+    label_axes(&f, xl, yl, 1.0);
+    legend_draw(&L, &f);
+    page_title(c->title);
+    free(lx);
+    return TS_OK;
+}
+
+int ts_plot_loglog(const char *dir, const char *name, const char *title,
+                   const ts_plot_axis *xaxis, const ts_plot_axis *yaxis,
+                   int nseries, const ts_plot_series series[],
+                   const ts_plot_opts *opts, ts_err *err)
+{
+    static const char fn[] = "ts_plot_loglog";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc)
+        return rc;
+    if (!xaxis || !yaxis)
+        return ts_fail(err, TS_EINVAL, "%s: xaxis, yaxis: expected both "
+                                       "axes, got NULL",
+                       fn);
+    if ((rc = check_quantity(fn, "xaxis.quantity", xaxis->quantity, err)) ||
+        (rc = check_quantity(fn, "yaxis.quantity", yaxis->quantity, err)) ||
+        (rc = check_series(fn, nseries, series, 1, 1, err)))
+        return rc;
+    loglog_ctx c = {title, xaxis, yaxis, nseries, series};
+    return render(fn, dir, name, title, opts, opts->height, draw_loglog, &c,
+                  err);
+}
+
+#endif /* TS_HAVE_PLPLOT */

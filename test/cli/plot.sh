@@ -1,0 +1,150 @@
+#!/bin/bash
+# test/cli/plot.sh: `towstab equilibrium --plot DIR` as a user runs it.
+#
+#   plot.sh TOWSTAB yes|no     (yes: towstab was built with PLplot)
+#
+# Run from the project root (meson does, suite 'cli').
+# yes: --plot DIR writes side.png, side.svg, top.png, top.svg (PNG
+#   signature, 1000 x 700 px from the IHDR chunk, > 5 kB; SVG starting
+#   with <?xml and carrying the title naming the scene); a missing DIR is
+#   created; --units imperial works; overlays of speeds, turn rates and
+#   scenes add curves (one "overlay" line each); --plot into a path that
+#   is a file, a bad --units, --units or overlays without --plot, an
+#   overlay with a bad unit or a missing scene are refused with exit
+#   status 2 before anything is solved, and leave no picture.
+# no: --plot is refused with exit status 2 and the message naming the
+#   packages to install, while the analysis without --plot still runs.
+#
+# Prints one PASS/FAIL line per check and "N passed, N failed"; the exit
+# status is 0 only when nothing failed.
+set -u
+
+if [ $# -ne 2 ]; then
+    echo "usage: plot.sh TOWSTAB yes|no" >&2
+    exit 2
+fi
+TOWSTAB=$1
+HAVE=$2
+T=$(mktemp -d "${TMPDIR:-/tmp}/towstab-plot-XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
+
+npass=0
+nfail=0
+pass() { echo "PASS $*"; npass=$((npass + 1)); }
+fail() { echo "FAIL $*"; nfail=$((nfail + 1)); }
+check() { # check DESCRIPTION COMMAND...
+    local what=$1
+    shift
+    if "$@"; then pass "$what"; else fail "$what"; fi
+}
+
+ts() {
+    "$TOWSTAB" "$@" >"$T/out" 2>"$T/err"
+    status=$?
+}
+
+EX1=examples/kamman_ex1_above.yaml
+EX1S=examples/kamman_ex1_submerged.yaml
+EX2=examples/kamman_ex2_branched_turn.yaml
+
+# is_png FILE W H: signature, IHDR size, more than 5000 bytes.
+is_png() {
+    local sig size w h
+    sig=$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')
+    [ "$sig" = "89504e470d0a1a0a" ] || return 1
+    w=$((16#$(od -An -tx1 -j16 -N4 "$1" | tr -d ' \n')))
+    h=$((16#$(od -An -tx1 -j20 -N4 "$1" | tr -d ' \n')))
+    [ "$w" -eq "$2" ] && [ "$h" -eq "$3" ] || return 1
+    size=$(stat -c %s "$1")
+    [ "$size" -gt 5000 ]
+}
+
+# is_svg FILE TITLE: XML, the title element, complete, more than 5000 bytes.
+is_svg() {
+    head -c 5 "$1" | grep -q '^<?xml' &&
+        grep -qF "<title>$2</title>" "$1" &&
+        grep -q '</svg>' "$1" &&
+        [ "$(stat -c %s "$1")" -gt 5000 ]
+}
+
+four_pictures() { # four_pictures DIR TITLE_PREFIX
+    is_png "$1/side.png" 1000 700 && is_png "$1/top.png" 1000 700 &&
+        is_svg "$1/side.svg" "$2, side view" &&
+        is_svg "$1/top.svg" "$2, top view"
+}
+
+empty_dir() { [ -z "$(ls -A "$1" 2>/dev/null)" ]; }
+
+if [ "$HAVE" = no ]; then
+    mkdir "$T/p"
+    ts equilibrium "$EX1" --plot "$T/p"
+    check "without PLplot: --plot exits 2 (got $status)" [ $status -eq 2 ]
+    check "without PLplot: the message names the packages" \
+        grep -q "built without PLplot; install libplplot-dev and plplot-driver-cairo" "$T/err"
+    check "without PLplot: nothing solved, nothing written" \
+        bash -c "! grep -q converged '$T/out' && [ -z \"\$(ls -A '$T/p')\" ]"
+    ts equilibrium "$EX1" --quiet
+    check "without PLplot: the analysis still runs (exit $status)" \
+        bash -c "[ $status -eq 0 ] && grep -q '^converged' '$T/out'"
+    echo "$npass passed, $nfail failed"
+    [ $nfail -eq 0 ]
+    exit
+fi
+
+# The four pictures, in a directory that does not exist yet.
+ts equilibrium "$EX1" --quiet --plot "$T/p/new"
+check "--plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
+check "--plot: side and top PNG and SVG, titled with the scene" \
+    four_pictures "$T/p/new" "kamman_ex1_above: equilibrium"
+check "--plot: says where the pictures went" grep -q "wrote $T/p/new/side.png" "$T/out"
+check "--plot: no temporary file left" \
+    bash -c "[ \$(ls -A '$T/p/new' | wc -l) -eq 4 ]"
+
+# Imperial units and an overlaid scene.
+ts equilibrium "$EX1" --quiet --plot "$T/imp" --units imperial --overlay "$EX1S"
+check "--units imperial --overlay SCENE: exit 0 (got $status)" [ $status -eq 0 ]
+check "overlaid scenes: titles name both scenes" \
+    four_pictures "$T/imp" "kamman_ex1_above and kamman_ex1_submerged: equilibrium"
+check "overlaid scene: one overlay line" \
+    bash -c "[ \$(grep -c '^overlay ' '$T/out') -eq 1 ]"
+check "imperial pictures differ from SI ones" \
+    bash -c "! cmp -s '$T/imp/side.png' '$T/p/new/side.png'"
+
+# Overlays of speeds (unit of the last item) and turn rates.
+ts equilibrium "$EX1" --quiet --plot "$T/spd" --overlay-speeds "3,4, 6 knot"
+check "--overlay-speeds: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
+check "--overlay-speeds '3,4, 6 knot': three overlay lines, in knots" \
+    bash -c "[ \$(grep -c \"^overlay --overlay-speeds '[346] knot'\" '$T/out') -eq 3 ]"
+check "--overlay-speeds: four pictures" four_pictures "$T/spd" "kamman_ex1_above: equilibrium"
+ts equilibrium "$EX2" --quiet --plot "$T/turn" --overlay-turn-rates "0.5 rad/s"
+check "--overlay-turn-rates: exit 0 (got $status)" [ $status -eq 0 ]
+check "--overlay-turn-rates: four pictures" four_pictures "$T/turn" "kamman_ex2_branched: equilibrium"
+
+# Refusals: exit 2, nothing solved, no picture.
+touch "$T/afile"
+refused() { # refused DESCRIPTION ARGS...
+    local what=$1
+    shift
+    rm -rf "$T/r"
+    ts equilibrium "$@"
+    if [ $status -eq 2 ] && [ -s "$T/err" ] && ! grep -q converged "$T/out" &&
+        empty_dir "$T/r"; then
+        pass "$what: exit 2, $(head -n1 "$T/err")"
+    else
+        fail "$what: exit $status, stdout $(head -c 200 "$T/out"), stderr $(head -c 300 "$T/err")"
+    fi
+}
+refused "--plot into a file" "$EX1" --plot "$T/afile"
+check "--plot into a file: the message says so" grep -q "not a directory" "$T/err"
+refused "--plot under a file" "$EX1" --plot "$T/afile/sub"
+refused "--units furlong" "$EX1" --plot "$T/r" --units furlong
+refused "--units without --plot" "$EX1" --units imperial
+refused "--overlay-speeds without --plot" "$EX1" --overlay-speeds "2 knot"
+refused "--overlay-speeds with a wrong unit" "$EX1" --plot "$T/r" --overlay-speeds "2,3 lbf"
+refused "--overlay-speeds with an empty item" "$EX1" --plot "$T/r" --overlay-speeds "2,,3 knot"
+refused "--overlay-turn-rates with garbage" "$EX1" --plot "$T/r" --overlay-turn-rates "fast"
+refused "--overlay of a missing scene" "$EX1" --plot "$T/r" --overlay "$T/missing.yaml"
+refused "--plot without a value" "$EX1" --plot
+
+echo "$npass passed, $nfail failed"
+[ $nfail -eq 0 ]

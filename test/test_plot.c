@@ -1,0 +1,928 @@
+/* test_plot.c: pictures (towstab/plot.h).
+ *
+ * With PLplot: every drawing function writes DIR/NAME.png (PNG signature,
+ * the requested pixel size read from the IHDR chunk, more than 5 kB) and
+ * DIR/NAME.svg (XML, carrying the title). The geometry is checked in the
+ * SVG, whose paths cairo writes with the page coordinates: the side view's
+ * water lies below the surface at the depth the window puts it (depth
+ * grows downward), the top view has equal scales (the ship's arrowhead
+ * keeps its 0.6 height/width ratio, the turning circle is round) with
+ * starboard down the page, the unstable half-plane sits right of re = 0.
+ * Bad arguments (no points, NaN, zero on a log axis, bad names, a file
+ * where the directory should be, an unwritable directory) are refused
+ * with TS_EINVAL or TS_EIO, a message, and no file left behind. The
+ * caller's PLplot stream is current again after each call.
+ *
+ * Without PLplot (meson -Dplot=disabled): every drawing function returns
+ * TS_EDOMAIN with the message naming the packages, and writes nothing.
+ *
+ * Unit conversions are checked against udunits2 (ts_units_from_si), an
+ * independent implementation, to 1e-12 relative.
+ *
+ * Usage: test_plot [DIR] (pictures are kept in DIR when given, else made
+ * in a temporary directory that is removed).
+ */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "tcheck.h"
+#include "towstab/plot.h"
+#include "towstab/units.h"
+
+#ifdef TS_HAVE_PLPLOT
+#include <plplot.h>
+#endif
+
+static char dir[512];
+
+/* ---- files ----------------------------------------------------------- */
+
+#ifdef TS_HAVE_PLPLOT
+static char *slurp(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = malloc((size_t)n + 1);
+    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        buf = NULL;
+    }
+    fclose(f);
+    if (buf) {
+        buf[n] = '\0';
+        *size = (size_t)n;
+    }
+    return buf;
+}
+
+static int file_exists(const char *name, const char *ext)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s.%s", dir, name, ext);
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+#endif
+
+/* No file of the directory starts with `name` (no picture and no
+ * temporary file left behind). */
+static int nothing_named(const char *name)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0;
+    struct dirent *e;
+    int found = 0;
+    while ((e = readdir(d)))
+        found |= strncmp(e->d_name, name, strlen(name)) == 0;
+    closedir(d);
+    return !found;
+}
+
+#ifdef TS_HAVE_PLPLOT
+static unsigned be32(const unsigned char *p)
+{
+    return (unsigned)p[0] << 24 | (unsigned)p[1] << 16 | (unsigned)p[2] << 8 |
+           (unsigned)p[3];
+}
+
+/* Minimum size of a real picture, bytes: an empty 1000x700 white PNG is
+ * about 3 kB, a plot with axes and text well over 20 kB. */
+#define MIN_BYTES 5000
+
+/* PNG: signature, IHDR width x height, size. */
+static void check_png(const char *name, int width, int height)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s.png", dir, name);
+    size_t n = 0;
+    unsigned char *b = (unsigned char *)slurp(path, &n);
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G',
+                                         '\r', '\n', 0x1a, '\n'};
+    CHECK(b && n > 24 && memcmp(b, sig, 8) == 0, "%s.png has the PNG "
+                                                 "signature",
+          name);
+    CHECK(b && n > 24 && memcmp(b + 12, "IHDR", 4) == 0 &&
+              be32(b + 16) == (unsigned)width &&
+              be32(b + 20) == (unsigned)height,
+          "%s.png is %d x %d px (IHDR: %u x %u)", name, width, height,
+          b && n > 24 ? be32(b + 16) : 0, b && n > 24 ? be32(b + 20) : 0);
+    CHECK(n > MIN_BYTES, "%s.png has %zu bytes > %d", name, n, MIN_BYTES);
+    free(b);
+}
+
+/* SVG: XML start, the title element, size. Returns the text (caller
+ * frees) for geometry checks. */
+static char *check_svg(const char *name, const char *title)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s.svg", dir, name);
+    size_t n = 0;
+    char *b = slurp(path, &n);
+    CHECK(b && (strncmp(b, "<?xml", 5) == 0 || strncmp(b, "<svg", 4) == 0),
+          "%s.svg starts with <?xml or <svg", name);
+    char want[600];
+    snprintf(want, sizeof want, "<title>%s</title>", title);
+    CHECK(b && strstr(b, want), "%s.svg contains %s", name, want);
+    CHECK(b && strstr(b, "</svg>"), "%s.svg is complete (</svg>)", name);
+    CHECK(n > MIN_BYTES, "%s.svg has %zu bytes > %d", name, n, MIN_BYTES);
+    return b;
+}
+
+/* ---- SVG geometry ---------------------------------------------------- */
+
+/* Bounding box, in page coordinates (y down from the top), of the points
+ * of every <path> whose style contains `style`. cairo writes paths with
+ * transform="matrix(a,b,c,d,e,f)" (the page flip of PLplot's cairo
+ * driver) or none. Returns the number of paths. */
+typedef struct bbox {
+    double x0, x1, y0, y1;
+} bbox;
+
+static int svg_bbox(const char *svg, const char *style, bbox *bb)
+{
+    bb->x0 = bb->y0 = INFINITY;
+    bb->x1 = bb->y1 = -INFINITY;
+    int npath = 0;
+    for (const char *p = strstr(svg, "<path "); p;
+         p = strstr(p + 1, "<path ")) {
+        const char *end = strchr(p, '>');
+        const char *st = strstr(p, "style=\"");
+        if (!end || !st || st > end)
+            continue;
+        const char *st_end = strchr(st + 7, '"');
+        size_t len = strlen(style);
+        int match = 0;
+        for (const char *q = st + 7; q + len <= st_end && !match; q++)
+            match = strncmp(q, style, len) == 0;
+        if (!match)
+            continue;
+        double m[6] = {1, 0, 0, 1, 0, 0};
+        const char *tr = strstr(p, "transform=\"matrix(");
+        if (tr && tr < end)
+            sscanf(tr + 18, "%lf,%lf,%lf,%lf,%lf,%lf", &m[0], &m[1], &m[2],
+                   &m[3], &m[4], &m[5]);
+        const char *d = strstr(p, " d=\"");
+        if (!d || d > end)
+            continue;
+        npath++;
+        d += 4;
+        while (*d && *d != '"') {
+            if (*d == 'M' || *d == 'L') {
+                double x, y;
+                int used;
+                if (sscanf(d + 1, "%lf %lf%n", &x, &y, &used) == 2) {
+                    double X = m[0] * x + m[2] * y + m[4];
+                    double Y = m[1] * x + m[3] * y + m[5];
+                    bb->x0 = fmin(bb->x0, X);
+                    bb->x1 = fmax(bb->x1, X);
+                    bb->y0 = fmin(bb->y0, Y);
+                    bb->y1 = fmax(bb->y1, Y);
+                    d += used;
+                    continue;
+                }
+            }
+            d++;
+        }
+    }
+    return npath;
+}
+
+/* Palette entries as cairo writes them (percent of 255). */
+#define WATER_FILL "fill:rgb(87.058824%,92.54902%,98.039216%)"
+#define SHIP_FILL "fill:rgb(54.901961%,54.901961%,54.901961%)"
+#define UNSTABLE_FILL "fill:rgb(98.823529%,88.627451%,88.627451%)"
+#define CIRCLE_STROKE "stroke-width:1.2;"
+/* The plot box and its ticks (inside it): black lines 1 pt wide. */
+#define AXIS_STROKE                                                           \
+    "stroke-width:1;stroke-linecap:round;stroke-linejoin:bevel;"             \
+    "stroke:rgb(0%,0%,0%)"
+
+/* The plot box of single-panel pictures without a legend above it:
+ * normalised y 0.11..0.89 of a 1000 x 700 page, x from a left edge that
+ * depends on the tick labels' width (read from the SVG) to 0.97. */
+#define BOX_RIGHT 970.0
+#define BOX_TOP 77.0
+#define BOX_BOTTOM 623.0
+
+/* The plot box read from an SVG, checked against the fixed edges. */
+static bbox svg_box(const char *svg, const char *name)
+{
+    bbox box = {NAN, NAN, NAN, NAN};
+    int n = svg ? svg_bbox(svg, AXIS_STROKE, &box) : 0;
+    CHECK(n >= 4 && fabs(box.x1 - BOX_RIGHT) < 0.5 &&
+              fabs(box.y0 - BOX_TOP) < 0.5 &&
+              fabs(box.y1 - BOX_BOTTOM) < 0.5 && box.x0 > 80 &&
+              box.x0 < 160,
+          "%s: plot box %.1f..%.1f x %.1f..%.1f pt", name, box.x0, box.x1,
+          box.y0, box.y1);
+    return box;
+}
+/* Tolerance of positions read from the SVG, pt: PLplot maps the page to
+ * integer device units of 1/32 pt... cairo's coordinates are exact to
+ * 0.01 pt; half a point covers the rounding of PLplot's device grid. */
+#define POS_TOL 0.5
+
+#endif /* TS_HAVE_PLPLOT */
+
+/* ---- synthetic data -------------------------------------------------- */
+
+enum { N = 21 };
+/* A chain from a tow point 10 m above the water down to 30 m depth and
+ * 50 m aft, a sphere at its end. */
+static double chain[3 * N];
+/* The same chain swung to starboard (a turn). */
+static double chain_turn[3 * N];
+/* A chain towed from the surface down to 40 m depth, 50 m aft. */
+static double chain_sub[3 * N];
+static const int end_mark[1] = {N - 1};
+
+/* A branched tree: 6 links to a junction (node 6), then a branch of 4
+ * links (nodes 7-10) and one of 3 links (nodes 11-13) from node 6. */
+enum { NT = 14 };
+static double tree[3 * NT];
+#ifdef TS_HAVE_PLPLOT
+static const int tree_upper[NT - 1] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 6, 11, 12};
+static const int tree_marks[2] = {10, 13};
+#endif
+
+static void make_data(void)
+{
+    for (int k = 0; k < N; k++) {
+        double s = (double)k / (N - 1);
+        chain[3 * k] = -50 * s;
+        chain[3 * k + 1] = 0;
+        chain[3 * k + 2] = -10 + 50 * s - 10 * s * s;
+        chain_turn[3 * k] = -45 * s;
+        chain_turn[3 * k + 1] = 8.385 * s * s;
+        chain_turn[3 * k + 2] = -10 + 35 * s;
+        chain_sub[3 * k] = -50 * s;
+        chain_sub[3 * k + 1] = 0;
+        chain_sub[3 * k + 2] = 48 * s - 8 * s * s;
+    }
+    for (int k = 0; k < NT; k++) {
+        double x, z;
+        if (k <= 6) {
+            x = -2.0 * k;
+            z = 1.5 * k;
+        } else if (k <= 10) {
+            x = -12 - 3.0 * (k - 6);
+            z = 9 + 0.5 * (k - 6);
+        } else {
+            x = -12 - 1.5 * (k - 10);
+            z = 9 + 2.0 * (k - 10);
+        }
+        tree[3 * k] = x;
+        tree[3 * k + 1] = 0.1 * x;
+        tree[3 * k + 2] = z;
+    }
+}
+
+/* ---- with PLplot ----------------------------------------------------- */
+
+#ifdef TS_HAVE_PLPLOT
+
+static void test_shapes(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    /* Side view of a submerged chain without labels: no legend, so the
+     * plot box is known. */
+    ts_plot_shape one = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0};
+    int rc = ts_plot_shapes(dir, "side_si", "chain: side view", TS_PLOT_SIDE,
+                            TS_PLOT_WATER, 1, &one, &o, &err);
+    CHECK(rc == TS_OK, "side view drawn (%s)", err.msg);
+    check_png("side_si", 1000, 700);
+    char *svg = check_svg("side_si", "chain: side view");
+    /* Window: depth 0..40 m, with a strip of air of 4 % of the largest
+     * extent (50 m) above the surface: -2..40 m, padded by 8 % of 42 m
+     * = 3.36 m on both sides; depth downward, so the surface z = 0 is
+     * 5.36/48.72 of the box height below its top and the water fills the
+     * box below it. */
+    bbox water, box = svg_box(svg, "side view");
+    int nw = svg ? svg_bbox(svg, WATER_FILL, &water) : 0;
+    double surface = BOX_TOP + (BOX_BOTTOM - BOX_TOP) * 5.36 / 48.72;
+    CHECK(nw == 1, "side view: one water fill (%d)", nw);
+    CHECK_NEAR(water.y0, surface, POS_TOL, "water surface y, pt from top");
+    CHECK_NEAR(water.y1, BOX_BOTTOM, POS_TOL, "water reaches the box bottom");
+    CHECK_NEAR(water.x0, box.x0, POS_TOL, "water from the box's left");
+    CHECK_NEAR(water.x1, BOX_RIGHT, POS_TOL, "water to the box's right");
+
+    /* Imperial units: the same geometry, other labels. */
+    o.units = TS_PLOT_IMPERIAL;
+    rc = ts_plot_shapes(dir, "side_imp", "chain: side view", TS_PLOT_SIDE,
+                        TS_PLOT_WATER, 1, &one, &o, &err);
+    CHECK(rc == TS_OK, "imperial side view drawn (%s)", err.msg);
+    char *svg_imp = check_svg("side_imp", "chain: side view");
+    bbox w2;
+    if (svg_imp)
+        svg_bbox(svg_imp, WATER_FILL, &w2);
+    CHECK(svg_imp && fabs(w2.y0 - water.y0) < 0.05 &&
+              fabs(w2.y1 - water.y1) < 0.05,
+          "imperial: water at the same place (%.2f..%.2f vs %.2f..%.2f pt)",
+          svg_imp ? w2.y0 : NAN, svg_imp ? w2.y1 : NAN, water.y0, water.y1);
+    size_t n1 = 0, n2 = 0;
+    char p1[700], p2[700];
+    snprintf(p1, sizeof p1, "%s/side_si.png", dir);
+    snprintf(p2, sizeof p2, "%s/side_imp.png", dir);
+    char *b1 = slurp(p1, &n1), *b2 = slurp(p2, &n2);
+    CHECK(b1 && b2 && (n1 != n2 || memcmp(b1, b2, n1) != 0),
+          "imperial and SI pictures differ (axis labels in ft, not m)");
+    free(b1);
+    free(b2);
+    free(svg_imp);
+    free(svg);
+    o.units = TS_PLOT_SI;
+
+    /* Overlay: straight and turning, side and top, with labels. */
+    ts_plot_shape two[2] = {
+        {N, chain, NULL, 1, end_mark, 0, "5 knot, straight", TS_PLOT_SOLID,
+         0},
+        {N, chain_turn, NULL, 1, end_mark, 38.5, "5 knot, turn",
+         TS_PLOT_DASHED, 0}};
+    rc = ts_plot_shapes(dir, "side", "overlay: side view", TS_PLOT_SIDE,
+                        TS_PLOT_WATER | TS_PLOT_EQUAL, 2, two, &o, &err);
+    CHECK(rc == TS_OK, "side view of two shapes drawn (%s)", err.msg);
+    check_png("side", 1000, 700);
+    free(check_svg("side", "overlay: side view"));
+    rc = ts_plot_shapes(dir, "top", "overlay: top view", TS_PLOT_TOP,
+                        TS_PLOT_WATER, 2, two, &o, &err);
+    CHECK(rc == TS_OK, "top view drawn (%s)", err.msg);
+    check_png("top", 1000, 700);
+    svg = check_svg("top", "overlay: top view");
+    bbox ship, circle;
+    int ns = svg ? svg_bbox(svg, SHIP_FILL, &ship) : 0;
+    int nc = svg ? svg_bbox(svg, CIRCLE_STROKE, &circle) : 0;
+    CHECK(ns == 1, "top view: the ship is drawn (%d fill)", ns);
+    /* The arrowhead is 2 s long and 1.2 s wide in world units. */
+    CHECK_NEAR((ship.y1 - ship.y0) / (ship.x1 - ship.x0), 0.6, 0.005,
+               "top view equal scales: ship's width/length on the page");
+    CHECK(nc > 10, "top view: the turning circle is drawn (%d dots)", nc);
+    CHECK_NEAR((circle.y1 - circle.y0) / (circle.x1 - circle.x0), 1.0, 0.005,
+               "top view equal scales: the turning circle is round");
+    /* Starboard turn: centre (0, R) is below the ship on the page; the
+     * ship (origin) is the circle's top point. */
+    double ship_y = 0.5 * (ship.y0 + ship.y1);
+    CHECK_NEAR(circle.y0, ship_y, 1.5, "turning circle starts at the ship");
+    CHECK(circle.y1 > ship_y + 100, "starboard is down the page (circle "
+                                    "bottom %.1f pt, ship %.1f pt)",
+          circle.y1, ship_y);
+    free(svg);
+
+    /* A branched tree in both views. */
+    ts_plot_shape t = {NT, tree, tree_upper, 2, tree_marks, -20, "tree", 0, 3};
+    rc = ts_plot_shapes(dir, "tree_side", "tree", TS_PLOT_SIDE,
+                        TS_PLOT_WATER | TS_PLOT_EQUAL, 1, &t, &o, &err);
+    CHECK(rc == TS_OK, "branched tree, side view (%s)", err.msg);
+    rc = ts_plot_shapes(dir, "tree_top", "tree", TS_PLOT_TOP, 0, 1, &t, &o,
+                        &err);
+    CHECK(rc == TS_OK, "branched tree, top view, port turn (%s)", err.msg);
+    check_png("tree_top", 1000, 700);
+}
+
+static void test_modes(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    enum { NM = 4 };
+    static double disp[NM][3 * N];
+    ts_plot_mode modes[NM];
+    char label[NM][64];
+    for (int m = 0; m < NM; m++) {
+        for (int k = 0; k < N; k++) {
+            double s = (double)k / (N - 1);
+            double a = sin((m / 2 + 1) * M_PI * s * 0.9);
+            disp[m][3 * k] = 0.1 * a;
+            disp[m][3 * k + 1] = m % 2 ? a : 0;
+            disp[m][3 * k + 2] = m % 2 ? 0 : a;
+        }
+        snprintf(label[m], sizeof label[m], "mode %d: %.3f Hz", m + 1,
+                 0.2385 * (m + 1));
+        modes[m].disp = disp[m];
+        modes[m].label = label[m];
+    }
+    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    int rc = ts_plot_mode_shapes(dir, "modes", "chain: lowest modes",
+                                 TS_PLOT_WATER, &eq, NM, modes, &o, &err);
+    CHECK(rc == TS_OK, "mode shapes drawn (%s)", err.msg);
+    /* 95 px title, 220 px per mode, 50 px axis title. */
+    check_png("modes", 1000, 95 + 220 * NM + 50);
+    free(check_svg("modes", "chain: lowest modes"));
+    rc = ts_plot_mode_shapes(dir, "modes2", "two modes", TS_PLOT_WATER, &eq,
+                             2, modes, &o, &err);
+    CHECK(rc == TS_OK, "two mode shapes drawn (%s)", err.msg);
+    check_png("modes2", 1000, 700);
+
+    static double zero[3 * N];
+    ts_plot_mode bad = {zero, "nothing"};
+    ts_err_clear(&err);
+    rc = ts_plot_mode_shapes(dir, "modes_zero", "x", 0, &eq, 1, &bad, &o,
+                             &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "all zero"),
+          "a mode of zero displacement is refused: %s", err.msg);
+    rc = ts_plot_mode_shapes(dir, "modes_none", "x", 0, &eq, 0, modes, &o,
+                             &err);
+    CHECK(rc == TS_EINVAL, "nmodes = 0 is refused: %s", err.msg);
+    rc = ts_plot_mode_shapes(dir, "modes_many", "x", 0, &eq, 9, modes, &o,
+                             &err);
+    CHECK(rc == TS_EINVAL, "nmodes = 9 is refused: %s", err.msg);
+    CHECK(nothing_named("modes_"), "refused mode plots left no file");
+}
+
+static void test_eigenvalues(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    /* Pairs lambda = wn (-zeta +- i sqrt(1 - zeta^2)) and an unstable
+     * pair. */
+    static const double wn[4] = {0.5, 1.2, 2.0, 3.1},
+                        zeta[4] = {0.03, 0.08, 0.15, 0.4};
+    double re[8], im[8], ure[2] = {0.05, 0.05}, uim[2] = {0.8, -0.8};
+    for (int i = 0; i < 4; i++) {
+        re[2 * i] = re[2 * i + 1] = -zeta[i] * wn[i];
+        im[2 * i] = wn[i] * sqrt(1 - zeta[i] * zeta[i]);
+        im[2 * i + 1] = -im[2 * i];
+    }
+    ts_plot_series sets[2] = {{8, re, im, "2.385 m/s", 0, 0, 0},
+                              {2, ure, uim, "4 m/s", 0, 0, 0}};
+    int rc = ts_plot_eigenvalues(dir, "eig", "chain: eigenvalues", 2, sets,
+                                 NULL, &o, &err);
+    CHECK(rc == TS_OK, "eigenvalues drawn (%s)", err.msg);
+    check_png("eig", 1000, 700);
+    free(check_svg("eig", "chain: eigenvalues"));
+    /* A given window -2..0.5 1/s: the unstable half-plane is the right
+     * 0.5/2.5 of the box. */
+    ts_plot_eig_window win = {-2, 0.5, 3};
+    rc = ts_plot_eigenvalues(dir, "eig_win", "window", 2, sets, &win, &o,
+                             &err);
+    CHECK(rc == TS_OK, "eigenvalues in a given window (%s)", err.msg);
+    size_t n;
+    char path[700];
+    snprintf(path, sizeof path, "%s/eig_win.svg", dir);
+    char *svg = slurp(path, &n);
+    bbox shade, box = svg_box(svg, "eigenvalue window");
+    int nsh = svg ? svg_bbox(svg, UNSTABLE_FILL, &shade) : 0;
+    CHECK(nsh == 1, "one unstable shade (%d)", nsh);
+    CHECK_NEAR(shade.x0, box.x0 + (box.x1 - box.x0) * 2.0 / 2.5, POS_TOL,
+               "stability boundary re = 0 at 4/5 of the width");
+    CHECK_NEAR(shade.x1, BOX_RIGHT, POS_TOL, "shade to the box's right");
+    CHECK_NEAR(shade.y0, BOX_TOP, POS_TOL, "shade from the box's top");
+    CHECK_NEAR(shade.y1, BOX_BOTTOM, POS_TOL, "shade to the box's bottom");
+    free(svg);
+
+    ts_plot_eig_window badwin = {1, 0.5, 3};
+    rc = ts_plot_eigenvalues(dir, "eig_bad", "x", 2, sets, &badwin, &o, &err);
+    CHECK(rc == TS_EINVAL, "re_min > 0 is refused: %s", err.msg);
+    double nan_im[8];
+    memcpy(nan_im, im, sizeof nan_im);
+    nan_im[5] = NAN;
+    ts_plot_series nanset = {8, re, nan_im, "x", 0, 0, 0};
+    rc = ts_plot_eigenvalues(dir, "eig_nan", "x", 1, &nanset, NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "y[5]"),
+          "NaN imaginary part is refused, naming it: %s", err.msg);
+    CHECK(nothing_named("eig_bad") && nothing_named("eig_nan"),
+          "refused eigenvalue plots left no file");
+}
+
+static void test_bode(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    /* Two second-order sections in series, natural frequencies 0.3 and
+     * 2 Hz. */
+    enum { NF = 300 };
+    static double f[NF], mag[NF], ph[NF], mag1[NF], ph1[NF];
+    for (int i = 0; i < NF; i++) {
+        f[i] = 0.01 * pow(10, 3.0 * i / (NF - 1));
+        double w = 2 * M_PI * f[i], w1 = 2 * M_PI * 0.3, w2 = 2 * M_PI * 2;
+        double r1 = w1 * w1 - w * w, i1 = 2 * 0.05 * w1 * w;
+        double r2 = w2 * w2 - w * w, i2 = 2 * 0.1 * w2 * w;
+        mag1[i] = w1 * w1 / hypot(r1, i1);
+        mag[i] = mag1[i] * w2 * w2 / hypot(r2, i2);
+        ph1[i] = -atan2(i1, r1);
+        ph[i] = ph1[i] - atan2(i2, r2);
+    }
+    double nat[2] = {0.3, 2.0};
+    ts_plot_bode_curve c[2] = {{NF, f, mag, ph, "sphere", 0, 0},
+                               {NF, f, mag1, ph1, "midpoint", 1, 0}};
+    int rc = ts_plot_bode(dir, "bode", "chain: heave response", "heave / "
+                          "tow-point heave",
+                          TS_PLOT_LENGTH, TS_PLOT_LENGTH, 2, c, 2, nat, &o,
+                          &err);
+    CHECK(rc == TS_OK, "Bode plot drawn (%s)", err.msg);
+    check_png("bode", 1000, 700);
+    free(check_svg("bode", "chain: heave response"));
+
+    double fbad[3] = {0.1, 0.2, 0.2}, m3[3] = {1, 1, 1}, p3[3] = {0, 0, 0};
+    ts_plot_bode_curve bad = {3, fbad, m3, p3, "x", 0, 0};
+    rc = ts_plot_bode(dir, "bode_bad", "x", "x", TS_PLOT_LENGTH,
+                      TS_PLOT_LENGTH, 1, &bad, 0, NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "increase"),
+          "non-increasing frequencies are refused: %s", err.msg);
+    double mzero[3] = {1, 0, 1}, fok[3] = {0.1, 0.2, 0.3};
+    ts_plot_bode_curve bad2 = {3, fok, mzero, p3, "x", 0, 0};
+    rc = ts_plot_bode(dir, "bode_bad", "x", "x", TS_PLOT_LENGTH,
+                      TS_PLOT_LENGTH, 1, &bad2, 0, NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "log axis"),
+          "zero magnitude on the log axis is refused: %s", err.msg);
+    double natbad[1] = {-1};
+    ts_plot_bode_curve ok = {3, fok, m3, p3, "x", 0, 0};
+    rc = ts_plot_bode(dir, "bode_bad", "x", "x", TS_PLOT_LENGTH,
+                      TS_PLOT_LENGTH, 1, &ok, 1, natbad, &o, &err);
+    CHECK(rc == TS_EINVAL, "a negative natural frequency is refused: %s",
+          err.msg);
+    CHECK(nothing_named("bode_bad"), "refused Bode plots left no file");
+}
+
+static void test_histories(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    o.units = TS_PLOT_IMPERIAL;
+    ts_err err = {0};
+    enum { NS = 400, NS2 = 137 };
+    static double t[NS], d1[NS], f1[NS], t2[NS2], d2[NS2], f2[NS2];
+    for (int i = 0; i < NS; i++) {
+        t[i] = 20.0 * i / (NS - 1);
+        d1[i] = 9.144 + 0.15 * sin(1.3 * t[i]) * exp(-0.05 * t[i]);
+        f1[i] = 2000 + 100 * sin(1.3 * t[i]);
+    }
+    /* The nonlinear run on its own (adaptive) time grid. */
+    for (int i = 0; i < NS2; i++) {
+        t2[i] = 20.0 * pow((double)i / (NS2 - 1), 1.1);
+        d2[i] = 9.16 + 0.17 * sin(1.3 * t2[i]) * exp(-0.05 * t2[i]);
+        f2[i] = 2010 + 120 * sin(1.3 * t2[i]);
+    }
+    ts_plot_axis panels[2] = {{"sphere depth", TS_PLOT_LENGTH},
+                              {"top tension", TS_PLOT_FORCE}};
+    ts_plot_series s[4] = {{NS, t, d1, "linear", 0, TS_PLOT_DASHED, 1},
+                           {NS2, t2, d2, "nonlinear", 0, TS_PLOT_SOLID, 2},
+                           {NS, t, f1, "linear", 1, TS_PLOT_DASHED, 1},
+                           {NS2, t2, f2, "nonlinear", 1, TS_PLOT_SOLID, 2}};
+    int rc = ts_plot_histories(dir, "hist", "chain: heave 0.1 ft at 0.25 Hz",
+                               2, panels, 4, s, &o, &err);
+    CHECK(rc == TS_OK, "time histories drawn (%s)", err.msg);
+    check_png("hist", 1000, 700);
+    free(check_svg("hist", "chain: heave 0.1 ft at 0.25 Hz"));
+
+    ts_plot_series orphan = {NS, t, d1, "x", 2, 0, 0};
+    rc = ts_plot_histories(dir, "hist_bad", "x", 2, panels, 1, &orphan, &o,
+                           &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "panel"),
+          "a series in a panel that does not exist is refused: %s", err.msg);
+    rc = ts_plot_histories(dir, "hist_bad", "x", 2, panels, 2, s, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "panels[1]"),
+          "an empty panel is refused: %s", err.msg);
+    ts_plot_series empty = {0, t, d1, "x", 0, 0, 0};
+    rc = ts_plot_histories(dir, "hist_bad", "x", 1, panels, 1, &empty, &o,
+                           &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "n: must be >= 1"),
+          "a series of n = 0 points is refused: %s", err.msg);
+    double inf[3] = {1, INFINITY, 2};
+    ts_plot_series infs = {3, t, inf, "x", 0, 0, 0};
+    rc = ts_plot_histories(dir, "hist_bad", "x", 1, panels, 1, &infs, &o,
+                           &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "finite"),
+          "an infinite value is refused: %s", err.msg);
+    CHECK(nothing_named("hist_bad"), "refused histories left no file");
+}
+
+static void test_loglog(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    double rt[6], e1[6], rt2[6], e2[6];
+    for (int i = 0; i < 6; i++) {
+        rt[i] = 0.001 * pow(2, i);
+        rt2[i] = 0.003 * pow(2, i);
+        e1[i] = 1e-3 * pow(2, -2.0 * i);
+        e2[i] = 1e-2 * pow(2, -4.0 * i);
+    }
+    ts_plot_axis xa = {"run time", TS_PLOT_TIME},
+                 ya = {"error in sphere depth", TS_PLOT_LENGTH};
+    ts_plot_series s[2] = {{6, rt, e1, "RK45", 0, TS_PLOT_LINE_MARKERS, 0},
+                           {6, rt2, e2, "BDF", 0, TS_PLOT_LINE_MARKERS, 0}};
+    int rc = ts_plot_loglog(dir, "loglog", "chain: error against run time",
+                            &xa, &ya, 2, s, &o, &err);
+    CHECK(rc == TS_OK, "log-log plot drawn (%s)", err.msg);
+    check_png("loglog", 1000, 700);
+    free(check_svg("loglog", "chain: error against run time"));
+    /* A title with XML specials and PLplot's escape character '#'. */
+    rc = ts_plot_loglog(dir, "loglog_xml", "run #2: error & time <s>", &xa,
+                        &ya, 2, s, &o, &err);
+    CHECK(rc == TS_OK, "a title with '#', '&', '<' is drawn (%s)", err.msg);
+    free(check_svg("loglog_xml", "run #2: error &amp; time &lt;s&gt;"));
+    /* A bigger picture. */
+    o.width = 1600;
+    o.height = 1000;
+    o.formats = TS_PLOT_PNG;
+    rc = ts_plot_loglog(dir, "loglog_big", "big", &xa, &ya, 2, s, &o, &err);
+    CHECK(rc == TS_OK, "1600 x 1000 PNG only (%s)", err.msg);
+    check_png("loglog_big", 1600, 1000);
+    CHECK(!file_exists("loglog_big", "svg"), "no SVG when only PNG is asked");
+
+    double ezero[6] = {1e-3, 1e-4, 0, 1e-6, 1e-7, 1e-8};
+    ts_plot_series z = {6, rt, ezero, "x", 0, 0, 0};
+    ts_plot_opts_default(&o);
+    rc = ts_plot_loglog(dir, "loglog_bad", "x", &xa, &ya, 1, &z, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "y[2]") &&
+              strstr(err.msg, "log axis"),
+          "an error of 0 on a log axis is refused: %s", err.msg);
+    o.width = 640;
+    rc = ts_plot_loglog(dir, "loglog_bad", "x", &xa, &ya, 2, s, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "size"),
+          "a 640 px wide picture is refused: %s", err.msg);
+    CHECK(nothing_named("loglog_bad"), "refused log-log plots left no file");
+}
+
+/* Bad names, directories and shapes. */
+static void test_bad_places(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    static const char *const names[] = {"", ".hidden", "a/b", "x y", NULL};
+    for (int i = 0; names[i]; i++) {
+        ts_err_clear(&err);
+        int rc = ts_plot_shapes(dir, names[i], "t", TS_PLOT_SIDE, 0, 1, &one,
+                                &o, &err);
+        CHECK(rc == TS_EINVAL && strstr(err.msg, "name"),
+              "name '%s' is refused: %s", names[i], err.msg);
+    }
+    int rc = ts_plot_shapes(dir, "t_null", NULL, TS_PLOT_SIDE, 0, 1, &one, &o,
+                            &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "title"),
+          "a NULL title is refused: %s", err.msg);
+
+    /* A file where the directory should be. */
+    char file[700], sub[760];
+    snprintf(file, sizeof file, "%s/plain_file", dir);
+    FILE *f = fopen(file, "w");
+    if (f) {
+        fputs("not a directory\n", f);
+        fclose(f);
+    }
+    rc = ts_plot_shapes(file, "side", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "not a directory"),
+          "a file as the directory is refused: %s", err.msg);
+    snprintf(sub, sizeof sub, "%s/deeper", file);
+    rc = ts_plot_shapes(sub, "side", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "not a directory"),
+          "a directory under a file is refused: %s", err.msg);
+
+    /* Missing directories are created, parents included. */
+    snprintf(sub, sizeof sub, "%s/new/nested", dir);
+    rc = ts_plot_shapes(sub, "side", "created", TS_PLOT_SIDE, 0, 1, &one, &o,
+                        &err);
+    struct stat st;
+    char made[800];
+    snprintf(made, sizeof made, "%s/side.png", sub);
+    CHECK(rc == TS_OK && stat(made, &st) == 0 && st.st_size > MIN_BYTES,
+          "a missing nested directory is created and used (%s)", err.msg);
+
+    /* A directory that cannot be created: /proc does not take new
+     * directories, even from root. */
+    rc = ts_plot_shapes("/proc/towstab-plot-test", "side", "t", TS_PLOT_SIDE,
+                        0, 1, &one, &o, &err);
+    CHECK(rc == TS_EIO, "an uncreatable directory gives TS_EIO: %s", err.msg);
+    /* A read-only directory (root may write anywhere: then skipped). */
+    char ro[700];
+    snprintf(ro, sizeof ro, "%s/readonly", dir);
+    mkdir(ro, 0555);
+    chmod(ro, 0555);
+    if (geteuid() != 0) {
+        rc = ts_plot_shapes(ro, "side", "t", TS_PLOT_SIDE, 0, 1, &one, &o,
+                            &err);
+        CHECK(rc == TS_EIO && strstr(err.msg, "not writable"),
+              "a read-only directory gives TS_EIO: %s", err.msg);
+    } else {
+        printf("note: running as root, read-only directory check skipped\n");
+    }
+    chmod(ro, 0755);
+
+    /* Shapes that are not trees, bad marks, bad views. */
+    static const int up_bad[N - 1] = {0, 1, 5};
+    ts_plot_shape s = one;
+    s.link_upper = up_bad;
+    rc = ts_plot_shapes(dir, "bad_shape", "t", TS_PLOT_SIDE, 0, 1, &s, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "link_upper[2]"),
+          "a link from a node below is refused: %s", err.msg);
+    static const int mark_bad[1] = {N};
+    s = one;
+    s.marks = mark_bad;
+    rc = ts_plot_shapes(dir, "bad_shape", "t", TS_PLOT_SIDE, 0, 1, &s, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "marks[0]"),
+          "a mark outside the nodes is refused: %s", err.msg);
+    s = one;
+    s.nnodes = 1;
+    rc = ts_plot_shapes(dir, "bad_shape", "t", TS_PLOT_SIDE, 0, 1, &s, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL, "a shape of one node is refused: %s", err.msg);
+    double nanpos[3 * N];
+    memcpy(nanpos, chain, sizeof nanpos);
+    nanpos[3 * 7 + 2] = NAN;
+    s = one;
+    s.pos = nanpos;
+    rc = ts_plot_shapes(dir, "bad_shape", "t", TS_PLOT_SIDE, 0, 1, &s, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "pos[23]"),
+          "a NaN depth is refused, naming pos[23]: %s", err.msg);
+    rc = ts_plot_shapes(dir, "bad_shape", "t", (ts_plot_view)7, 0, 1, &one,
+                        &o, &err);
+    CHECK(rc == TS_EINVAL, "an unknown view is refused: %s", err.msg);
+    rc = ts_plot_shapes(dir, "bad_shape", "t", TS_PLOT_SIDE, 0, 0, &one, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL, "no shapes is refused: %s", err.msg);
+    CHECK(nothing_named("bad_shape") && nothing_named("t_null"),
+          "refused shapes left no file");
+}
+
+/* The caller's PLplot stream is current again after a call. */
+static void test_streams(void)
+{
+    PLINT mine, cur;
+    plmkstrm(&mine);
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    o.formats = TS_PLOT_PNG;
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_err err = {0};
+    int rc = ts_plot_shapes(dir, "stream", "t", TS_PLOT_TOP, 0, 1, &one, &o,
+                            &err);
+    plgstrm(&cur);
+    CHECK(rc == TS_OK && cur == mine,
+          "the caller's stream %d is current after a plot (%d)", (int)mine,
+          (int)cur);
+    rc = ts_plot_shapes(dir, "stream", "t", TS_PLOT_TOP, 0, 0, &one, &o,
+                        &err);
+    plgstrm(&cur);
+    CHECK(rc == TS_EINVAL && cur == mine,
+          "and after a refused call (%d)", (int)cur);
+    plend1();
+}
+
+#else /* no PLplot */
+
+static void test_without_plplot(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    CHECK(ts_plot_check(&err) == TS_EDOMAIN &&
+              strstr(err.msg, "built without PLplot") &&
+              strstr(err.msg, "libplplot-dev") &&
+              strstr(err.msg, "plplot-driver-cairo"),
+          "ts_plot_check names the missing packages: %s", err.msg);
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_mode mode = {chain, "m"};
+    double x[2] = {1, 2}, y[2] = {1, 2}, ph[2] = {0, 0}, nat[1] = {1};
+    ts_plot_series s = {2, x, y, "s", 0, 0, 0};
+    ts_plot_bode_curve b = {2, x, y, ph, "b", 0, 0};
+    ts_plot_axis a = {"a", TS_PLOT_NONE};
+    int rc[6];
+    rc[0] = ts_plot_shapes(dir, "n0", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
+    rc[1] = ts_plot_mode_shapes(dir, "n1", "t", 0, &one, 1, &mode, &o, &err);
+    rc[2] = ts_plot_eigenvalues(dir, "n2", "t", 1, &s, NULL, &o, &err);
+    rc[3] = ts_plot_bode(dir, "n3", "t", "m", TS_PLOT_LENGTH, TS_PLOT_LENGTH,
+                         1, &b, 1, nat, &o, &err);
+    rc[4] = ts_plot_histories(dir, "n4", "t", 1, &a, 1, &s, &o, &err);
+    rc[5] = ts_plot_loglog(dir, "n5", "t", &a, &a, 1, &s, &o, &err);
+    for (int i = 0; i < 6; i++)
+        CHECK(rc[i] == TS_EDOMAIN, "drawing function %d returns TS_EDOMAIN",
+              i);
+    CHECK(nothing_named("n"), "nothing was written");
+}
+
+#endif
+
+/* Conversions and unit names (no PLplot needed), against udunits2. */
+static void test_units(void)
+{
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    CHECK(u != NULL, "udunits loaded (%s)", err.msg);
+    if (!u)
+        return;
+    struct {
+        ts_plot_quantity q;
+        const char *si, *imp;
+    } cases[] = {{TS_PLOT_LENGTH, "m", "ft"},
+                 {TS_PLOT_FORCE, "N", "lbf"},
+                 {TS_PLOT_SPEED, "m/s", "knot"}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        double want = 0;
+        int rc = ts_units_from_si(u, 2.385, cases[i].si, cases[i].imp, &want,
+                                  &err);
+        CHECK(rc == TS_OK, "udunits converts %s to %s", cases[i].si,
+              cases[i].imp);
+        CHECK_REL(ts_plot_convert(cases[i].q, TS_PLOT_IMPERIAL, 2.385), want,
+                  1e-12, cases[i].imp);
+        CHECK(ts_plot_convert(cases[i].q, TS_PLOT_SI, 2.385) == 2.385,
+              "SI keeps %s", cases[i].si);
+        CHECK(strcmp(ts_plot_unit(cases[i].q, TS_PLOT_SI), cases[i].si) == 0 &&
+                  strcmp(ts_plot_unit(cases[i].q, TS_PLOT_IMPERIAL),
+                         cases[i].imp) == 0,
+              "unit names %s and %s", cases[i].si, cases[i].imp);
+    }
+    double deg = 0;
+    ts_units_from_si(u, 0.4321, "rad", "degree", &deg, &err);
+    CHECK_REL(ts_plot_convert(TS_PLOT_ANGLE, TS_PLOT_IMPERIAL, 0.4321), deg,
+              1e-12, "rad to deg (imperial)");
+    CHECK_REL(ts_plot_convert(TS_PLOT_ANGLE, TS_PLOT_SI, 0.4321), deg, 1e-12,
+              "rad to deg (SI)");
+    CHECK(ts_plot_convert(TS_PLOT_TIME, TS_PLOT_IMPERIAL, 2.385) == 2.385 &&
+              ts_plot_convert(TS_PLOT_FREQUENCY, TS_PLOT_IMPERIAL, 2.385) ==
+                  2.385,
+          "seconds and hertz in both systems");
+    CHECK(strcmp(ts_plot_unit(TS_PLOT_NONE, TS_PLOT_SI), "-") == 0 &&
+              strcmp(ts_plot_unit(TS_PLOT_RATE, TS_PLOT_IMPERIAL), "1/s") ==
+                  0,
+          "dimensionless '-', rates 1/s");
+    ts_units_free(u);
+
+    /* ts_plot_prepare_dir works without PLplot. */
+    char sub[700];
+    snprintf(sub, sizeof sub, "%s/prepared/a/b", dir);
+    struct stat st;
+    CHECK(ts_plot_prepare_dir(sub, &err) == TS_OK && stat(sub, &st) == 0 &&
+              S_ISDIR(st.st_mode),
+          "ts_plot_prepare_dir creates %s", sub);
+    CHECK(ts_plot_prepare_dir("", &err) == TS_EINVAL,
+          "an empty directory name is refused: %s", err.msg);
+}
+
+static void remove_tree(const char *path)
+{
+    DIR *d = opendir(path);
+    if (!d) {
+        unlink(path);
+        return;
+    }
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        char p[1024];
+        snprintf(p, sizeof p, "%s/%s", path, e->d_name);
+        remove_tree(p);
+    }
+    closedir(d);
+    rmdir(path);
+}
+
+int main(int argc, char **argv)
+{
+    int keep = argc > 1;
+    if (keep) {
+        snprintf(dir, sizeof dir, "%s", argv[1]);
+        mkdir(dir, 0777);
+    } else {
+        const char *tmp = getenv("TMPDIR");
+        snprintf(dir, sizeof dir, "%s/towstab-plot-XXXXXX",
+                 tmp && tmp[0] ? tmp : "/tmp");
+        if (!mkdtemp(dir)) {
+            printf("FAIL cannot make a temporary directory (%s)\n",
+                   strerror(errno));
+            return 1;
+        }
+    }
+    make_data();
+    test_units();
+#ifdef TS_HAVE_PLPLOT
+    ts_err err = {0};
+    CHECK(ts_plot_check(&err) == TS_OK,
+          "PLplot with its cairo devices is available (%s)", err.msg);
+    test_shapes();
+    test_modes();
+    test_eigenvalues();
+    test_bode();
+    test_histories();
+    test_loglog();
+    test_bad_places();
+    test_streams();
+#else
+    test_without_plplot();
+#endif
+    if (!keep)
+        remove_tree(dir);
+    return tc_done();
+}
