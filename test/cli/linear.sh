@@ -1,0 +1,124 @@
+#!/bin/bash
+# test/cli/linear.sh: `towstab modes` and `towstab response` as a user runs
+# them (suite 'cli').
+#
+#   linear.sh TOWSTAB CHECK_JSON
+#
+# modes: every example with water in straight tow is stable; the JSON has
+#   stable, max_real and modes with re, im, freq_hz, damping_ratio; --json -
+#   is JSON alone; --shapes writes the mode shapes; bad options exit 2 with
+#   a message and no file.
+# response: the JSON has input, output and points with freq_hz, magnitude,
+#   phase_deg; unknown input or output names exit 2 listing the valid ones;
+#   an empty or negative frequency range exits 2; an equilibrium that does
+#   not converge is not linearized (exit 1, no file).
+set -u
+if [ $# -ne 2 ]; then
+    echo "usage: linear.sh TOWSTAB CHECK_JSON" >&2
+    exit 2
+fi
+TOWSTAB=$1
+CHECK_JSON=$2
+T=$(mktemp -d "${TMPDIR:-/tmp}/towstab-linear-XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
+npass=0
+nfail=0
+pass() { echo "PASS $*"; npass=$((npass + 1)); }
+fail() { echo "FAIL $*"; nfail=$((nfail + 1)); }
+ts() {
+    "$TOWSTAB" "$@" >"$T/out" 2>"$T/err"
+    status=$?
+}
+has_keys() { # FILE KEY...: every "KEY": appears in FILE
+    local f=$1
+    shift
+    for k in "$@"; do
+        grep -q "\"$k\":" "$f" || return 1
+    done
+}
+
+# Straight tows with water are stable (drag damps every mode).
+for scene in examples/kamman_ex1_submerged.yaml examples/kamman_ex1_above.yaml \
+             examples/kamman_ex3_turn.yaml; do
+    rm -f "$T/m.json"
+    ts modes "$scene" --turn-rate 0 --json "$T/m.json" --quiet
+    if [ "$status" -eq 0 ] && "$CHECK_JSON" parse "$T/m.json" >/dev/null &&
+       has_keys "$T/m.json" stable max_real modes re im freq_hz damping_ratio &&
+       grep -q '"stable": true' "$T/m.json" &&
+       grep -q 'verdict: stable' "$T/out"; then
+        pass "modes $scene straight: stable, JSON complete"
+    else
+        fail "modes $scene straight: status $status; $(head -c 300 "$T/err")"
+    fi
+done
+
+ts modes examples/kamman_ex3_turn.yaml --count 3 --json - --quiet
+if [ "$status" -eq 0 ] && "$CHECK_JSON" parse "$T/out" >/dev/null &&
+   grep -q 'verdict' "$T/err"; then
+    pass "modes --json -: JSON alone on stdout, the report on stderr"
+else
+    fail "modes --json -: status $status"
+fi
+
+rm -f "$T/shapes.csv"
+ts modes examples/kamman_ex3_turn.yaml --count 2 --shapes "$T/shapes.csv" --quiet
+if [ "$status" -eq 0 ] && [ "$(wc -l < "$T/shapes.csv")" -gt 20 ]; then
+    pass "modes --shapes writes a table of node displacements"
+else
+    fail "modes --shapes: status $status"
+fi
+
+for bad in "--count 0" "--count x" "--near -1" "--near '5 m'" "--method foo" \
+           "--eq-method foo"; do
+    rm -rf "$T/o"
+    mkdir "$T/o"
+    eval ts modes examples/kamman_ex3_turn.yaml $bad --json "$T/o/m.json"
+    if [ "$status" -eq 2 ] && [ -s "$T/err" ] && [ -z "$(ls -A "$T/o")" ]; then
+        pass "modes $bad: exit 2, message, no file"
+    else
+        fail "modes $bad: status $status, files: $(ls "$T/o")"
+    fi
+done
+
+rm -f "$T/r.json" "$T/r.csv"
+ts response examples/kamman_ex1_above.yaml --output sphere.z --points 20 \
+    --json "$T/r.json" --csv "$T/r.csv" --quiet
+if [ "$status" -eq 0 ] && "$CHECK_JSON" parse "$T/r.json" >/dev/null &&
+   has_keys "$T/r.json" input output points freq_hz magnitude phase_deg &&
+   [ "$(wc -l < "$T/r.csv")" -eq 21 ]; then
+    pass "response: JSON and CSV with 20 points"
+else
+    fail "response: status $status; $(head -c 300 "$T/err")"
+fi
+
+for bad in "--output nowhere.z" "--output sphere.w" "--input tow.roll --output sphere.z" \
+           "--output sphere.z --from 1 --to 1" "--output sphere.z --from -1" \
+           "--output sphere.z --from 5 --to 1" "--output sphere.z --points 1"; do
+    rm -rf "$T/o"
+    mkdir "$T/o"
+    eval ts response examples/kamman_ex1_above.yaml $bad --json "$T/o/r.json"
+    if [ "$status" -eq 2 ] && [ -s "$T/err" ] && [ -z "$(ls -A "$T/o")" ]; then
+        pass "response $bad: exit 2, message, no file"
+    else
+        fail "response $bad: status $status, files: $(ls "$T/o")"
+    fi
+done
+ts response examples/kamman_ex1_above.yaml --output nowhere.z
+if grep -q "sphere" "$T/err"; then
+    pass "response: an unknown output lists the valid ones"
+else
+    fail "response: unknown output message: $(cat "$T/err")"
+fi
+
+rm -rf "$T/o"
+mkdir "$T/o"
+ts modes examples/kamman_ex3_turn.yaml --tol 1e-300 --json "$T/o/m.json"
+if [ "$status" -eq 1 ] && grep -q -i "converge" "$T/err" &&
+   [ -z "$(ls -A "$T/o")" ]; then
+    pass "modes: an unconverged equilibrium is not linearized (exit 1, no file)"
+else
+    fail "modes --tol 1e-300: status $status; $(cat "$T/err")"
+fi
+
+echo "$npass passed, $nfail failed"
+[ "$nfail" -eq 0 ]
