@@ -751,6 +751,17 @@ static void pad_range(double *lo, double *hi, double pad, double fallback)
     *hi += pad * span;
 }
 
+/* A logarithmic range [lo, hi] (log10 units) that holds no whole decade
+ * would get no tick label (PLplot labels decades only): widen it to the
+ * decades around it. */
+static void whole_decade(double *lo, double *hi)
+{
+    if (floor(*hi) < *lo) {
+        *lo = floor(*lo);
+        *hi = ceil(*hi);
+    }
+}
+
 /* Widen [x0,x1] or [y0,y1] about its centre so that world units per mm
  * are equal on both axes of the current viewport. */
 static void equalize(double *x0, double *x1, double *y0, double *y1)
@@ -1830,6 +1841,8 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
     }
     pad_range(&f0, &f1, 0.0, 1.0);
     pad_range(&m0, &m1, 0.08, 1.0);
+    whole_decade(&f0, &f1);
+    whole_decade(&m0, &m1);
     pad_range(&p0, &p1, 0.08, 90.0);
     char xl[TEXT_MAX], ml[TEXT_MAX], raw[TEXT_MAX];
     axis_label(xl, sizeof xl, "frequency", TS_PLOT_FREQUENCY, u);
@@ -2130,6 +2143,8 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
         }
     pad_range(&x0, &x1, 0.06, 1.0);
     pad_range(&y0, &y1, 0.06, 1.0);
+    whole_decade(&x0, &x1);
+    whole_decade(&y0, &y1);
     plvpor(left_edge(tick_width(y0, y1, 1), 1.0), 0.97, 0.11, 0.89);
     frame f;
     frame_set(&f, x0, x1, y0, y1, nlegend, lchars);

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "cli_plot.h"
 #include "towstab/eigen.h"
 #include "towstab/linearize.h"
 #include "towstab/report.h"
@@ -102,7 +103,10 @@ static void usage(FILE *f)
             "  --links N        use N links on every cable\n"
             "  --eq-method M    equilibrium method: auto, shooting, newton\n"
             "  --tol X          equilibrium relative force residual\n"
-            "  --quiet          print the summary and verdict only\n",
+            "  --quiet          print the summary and verdict only\n"
+            "  --plot DIR       draw the eigenvalue plane (eigenvalues.png/svg)\n"
+            "                   and the lowest mode shapes (modes.png/svg)\n"
+            "  --units U        units of the pictures: si or imperial\n",
             DEFAULT_LARGE_COUNT, DEFAULT_NEAR_COUNT);
 }
 
@@ -188,7 +192,7 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
 static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
                           modes_req *rq, int quiet, int matrices,
                           json_t **json, ts_linear **lin_out,
-                          ts_eigen **eig_out, ts_err *err)
+                          ts_eigen **eig_out, double **pos_out, ts_err *err)
 {
     ts_equilibrium *eq = NULL;
     json_t *eqjson = NULL;
@@ -228,8 +232,17 @@ static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
         *json = j;
     }
     json_decref(eqjson);
+    if (rc == TS_OK && pos_out) {
+        size_t bytes = 3 * (size_t)sys->nnodes * sizeof(double);
+        *pos_out = malloc(bytes);
+        if (*pos_out)
+            memcpy(*pos_out, eq->positions, bytes);
+        else
+            rc = ts_fail(err, TS_ENOMEM, "modes: out of memory");
+    }
     ts_equilibrium_free(eq);
     if (rc != TS_OK) {
+        ts_eigen_free(e);
         ts_linear_free(lin);
         return rc;
     }
@@ -242,6 +255,126 @@ static int ends_with(const char *s, const char *suffix)
 {
     size_t a = strlen(s), b = strlen(suffix);
     return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+/* Largest number of mode shapes drawn. */
+#define PLOT_MODES 4
+
+/* Real node displacements of mode m at the phase of largest excursion:
+ * with d = a + i b (node displacements of the real and imaginary parts of
+ * the eigenvector's coordinate half), Re(d e^{i phi}) = a cos phi -
+ * b sin phi is largest at tan 2 phi = -2 a.b / (|a|^2 - |b|^2). */
+static int mode_disp(const ts_system *sys, const ts_linear *lin,
+                     const ts_eigen *e, int m, double *out)
+{
+    int nq = lin->nq, nn = sys->nnodes;
+    double *dq = malloc((size_t)nq * sizeof(double));
+    double *b = malloc(3 * (size_t)nn * sizeof(double));
+    if (!dq || !b) {
+        free(dq);
+        free(b);
+        return -1;
+    }
+    const double *vr = e->vec_re + (size_t)m * e->nstate;
+    const double *vi = e->vec_im + (size_t)m * e->nstate;
+    memcpy(dq, vr, (size_t)nq * sizeof(double));
+    ts_linear_node_displacements(sys, lin, dq, out);
+    memcpy(dq, vi, (size_t)nq * sizeof(double));
+    ts_linear_node_displacements(sys, lin, dq, b);
+    double aa = 0, bb = 0, ab = 0;
+    for (int i = 0; i < 3 * nn; i++) {
+        aa += out[i] * out[i];
+        bb += b[i] * b[i];
+        ab += out[i] * b[i];
+    }
+    double phi = 0.5 * atan2(-2 * ab, aa - bb), c = cos(phi), sn = sin(phi);
+    for (int i = 0; i < 3 * nn; i++)
+        out[i] = out[i] * c - b[i] * sn;
+    free(dq);
+    free(b);
+    return 0;
+}
+
+/* --plot: the eigenvalue plane and the shapes of the lowest modes. */
+static int modes_plot(const ts_system *sys, const ts_linear *lin,
+                      const ts_eigen *e, const double *pos,
+                      const cli_plot *plot)
+{
+    ts_err err = {0};
+    int n = e->nmodes, status = 0;
+    double *re = malloc(2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+    double *im = malloc(2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (!re || !im) {
+        free(re);
+        free(im);
+        fprintf(stderr, "towstab: error: modes: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    int k = 0;
+    for (int m = 0; m < n; m++) {
+        re[k] = e->modes[m].re;
+        im[k++] = e->modes[m].im;
+        if (e->modes[m].im > 0) {
+            re[k] = e->modes[m].re;
+            im[k++] = -e->modes[m].im;
+        }
+    }
+    char title[256], label[96];
+    snprintf(title, sizeof title, "%s: eigenvalues", sys->name);
+    snprintf(label, sizeof label, "%d eigenvalues%s", k,
+             e->complete ? "" : " (nearest the target)");
+    ts_plot_series set = {k, re, im, label, 0, TS_PLOT_MARKERS, 0};
+    if (ts_plot_eigenvalues(plot->dir, "eigenvalues", title, 1, &set, NULL,
+                            &plot->opts, &err) != TS_OK)
+        status = cli_report(&err, err.code);
+    else
+        printf("wrote %s/eigenvalues.png and %s/eigenvalues.svg\n",
+               plot->dir, plot->dir);
+    free(re);
+    free(im);
+
+    int nm = n < PLOT_MODES ? n : PLOT_MODES;
+    if (nm < 1 || !e->vec_re || !e->vec_im)
+        return status;
+    cli_shape eqs;
+    double *disp = malloc((size_t)nm * 3 * (size_t)sys->nnodes * sizeof(double));
+    char labels[PLOT_MODES][128];
+    ts_plot_mode modes[PLOT_MODES];
+    if (!disp || cli_plot_shape(sys, pos, &eqs) != 0) {
+        free(disp);
+        fprintf(stderr, "towstab: error: modes: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    for (int m = 0; m < nm; m++) {
+        const ts_mode *md = &e->modes[m];
+        double *d = disp + (size_t)m * 3 * sys->nnodes;
+        if (mode_disp(sys, lin, e, m, d) != 0) {
+            status = EXIT_FAILED;
+            break;
+        }
+        if (md->im > 0)
+            snprintf(labels[m], sizeof labels[m],
+                     "mode %d: %.4g Hz, damping ratio %.3g", m + 1,
+                     md->freq_hz, md->damping_ratio);
+        else
+            snprintf(labels[m], sizeof labels[m],
+                     "mode %d: real, %.4g 1/s", m + 1, md->re);
+        modes[m].disp = d;
+        modes[m].label = labels[m];
+    }
+    snprintf(title, sizeof title, "%s: lowest mode shapes", sys->name);
+    if (status == 0) {
+        if (ts_plot_mode_shapes(plot->dir, "modes", title, TS_PLOT_WATER,
+                                &eqs.shape, nm, modes, &plot->opts,
+                                &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            printf("wrote %s/modes.png and %s/modes.svg\n", plot->dir,
+                   plot->dir);
+    }
+    cli_plot_shape_free(&eqs);
+    free(disp);
+    return status;
 }
 
 static int modes_main(int argc, char **argv)
@@ -268,14 +401,19 @@ static int modes_main(int argc, char **argv)
         {"eq-method", required_argument, NULL, 'm'},
         {"tol", required_argument, NULL, 't'},
         {"quiet", no_argument, NULL, 'q'},
+        {"plot", required_argument, NULL, 'p'},
+        {"units", required_argument, NULL, 'u'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
+    cli_plot plot = {0};
     optind = 1;
     opterr = 0;
     int ch;
     long v;
     while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
         switch (ch) {
+        case 'p': plot.dir = optarg; break;
+        case 'u': plot.units = optarg; break;
         case 'k':
             if (cli_parse_int("--count", optarg, 1, 100000000, &v))
                 return EXIT_BADINPUT;
@@ -318,6 +456,9 @@ static int modes_main(int argc, char **argv)
     ts_err err = {0};
     if (method && parse_method(method, "--method", &rq.eo.method, &err))
         return cli_report(&err, err.code);
+    int pstatus = cli_plot_begin(&plot, "modes");
+    if (pstatus)
+        return pstatus;
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);
@@ -347,8 +488,9 @@ static int modes_main(int argc, char **argv)
     json_t *json = NULL;
     ts_linear *lin = NULL;
     ts_eigen *e = NULL;
+    double *pos = NULL;
     int rc = modes_analysis(sys, &eqo, &rq, quiet, matrices, &json, &lin, &e,
-                            &err);
+                            plot.dir ? &pos : NULL, &err);
     if (rc != TS_OK)
         status = cli_report(&err, rc);
     ts_err werr = {0};
@@ -372,6 +514,12 @@ static int modes_main(int argc, char **argv)
         if (wrc != TS_OK)
             status = cli_report(&werr, werr.code);
     }
+    if (rc == TS_OK && plot.dir) {
+        int prc = modes_plot(sys, lin, e, pos, &plot);
+        if (prc)
+            status = prc;
+    }
+    free(pos);
     json_decref(json);
     ts_eigen_free(e);
     ts_linear_free(lin);
@@ -448,7 +596,8 @@ static int modes_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     json_t *j = NULL;
     ts_linear *lin = NULL;
     ts_eigen *e = NULL;
-    int rc = modes_analysis(sys, &eqo, &rq, ctx->quiet, 0, &j, &lin, &e, &err);
+    int rc = modes_analysis(sys, &eqo, &rq, ctx->quiet, 0, &j, &lin, &e, NULL,
+                            &err);
     int status = rc ? cli_report(&err, rc) : 0;
     if (j) {
         json_object_set_new(j, "type", json_string("modes"));

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "cli.h"
+#include "cli_plot.h"
+#include "towstab/eigen.h"
 #include "towstab/linearize.h"
 #include "towstab/report.h"
 #include "towstab/report_linear.h"
@@ -41,7 +43,10 @@ static void usage(FILE *f)
             "  --links N        use N links on every cable\n"
             "  --eq-method M    equilibrium method: auto, shooting, newton\n"
             "  --tol X          equilibrium relative force residual\n"
-            "  --quiet          print the summary only, not the table\n",
+            "  --quiet          print the summary only, not the table\n"
+            "  --plot DIR       draw the Bode plot (bode.png/svg) with the\n"
+            "                   natural frequencies marked\n"
+            "  --units U        units of the pictures: si or imperial\n",
             DEFAULT_FROM_HZ, DEFAULT_TO_HZ, DEFAULT_POINTS);
 }
 
@@ -71,10 +76,16 @@ static void print_response(const ts_response *r, int quiet)
 
 /* Everything after the system is built; names are checked before the
  * equilibrium is solved. */
+/* Natural frequencies marked on a Bode plot: at most this many. */
+#define PLOT_NATURAL 12
+
+/* nat (when not NULL): the natural frequencies (Hz, of the oscillatory
+ * modes nearest 0 Hz, as many as PLOT_NATURAL) for the Bode plot. */
 static int response_analysis(const ts_system *sys,
                              const ts_equilibrium_opts *eqo,
                              const resp_req *rq, int quiet, json_t **json,
-                             ts_response **res, ts_err *err)
+                             ts_response **res, double *nat, int *nnat,
+                             ts_err *err)
 {
     *json = NULL;
     *res = NULL;
@@ -107,6 +118,21 @@ static int response_analysis(const ts_system *sys,
                    "derivatives, and a real heave also shifts the mean "
                    "depth at first order (MODEL.md section 6)\n");
         print_response(*res, quiet);
+        if (nat) {
+            ts_eigen_opts o;
+            ts_eigen_opts_default(&o);
+            o.count = PLOT_NATURAL;
+            if (o.count > lin->nstate / 2)
+                o.count = 0;
+            ts_eigen *e = NULL;
+            *nnat = 0;
+            if (ts_eigen_solve(lin, &o, &e, err) == TS_OK)
+                for (int m = 0; m < e->nmodes && *nnat < PLOT_NATURAL; m++)
+                    if (e->modes[m].im > 0)
+                        nat[(*nnat)++] = e->modes[m].freq_hz;
+            ts_eigen_free(e);
+            ts_err_clear(err);
+        }
         json_t *j = ts_report_response_json(*res);
         if (j && eqjson)
             json_object_set(j, "equilibrium", eqjson);
@@ -135,6 +161,7 @@ static int response_main(int argc, char **argv)
     int quiet = 0;
     resp_req rq = {"tow.heave", NULL, DEFAULT_FROM_HZ, DEFAULT_TO_HZ,
                    DEFAULT_POINTS};
+    cli_plot plot = {0};
     static const struct option longopts[] = {
         {"input", required_argument, NULL, 'i'},
         {"output", required_argument, NULL, 'o'},
@@ -149,6 +176,8 @@ static int response_main(int argc, char **argv)
         {"eq-method", required_argument, NULL, 'm'},
         {"tol", required_argument, NULL, 't'},
         {"quiet", no_argument, NULL, 'q'},
+        {"plot", required_argument, NULL, 'P'},
+        {"units", required_argument, NULL, 'U'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     optind = 1;
@@ -173,6 +202,8 @@ static int response_main(int argc, char **argv)
         case 'm': s.method = optarg; break;
         case 't': s.tol = optarg; break;
         case 'q': quiet = 1; break;
+        case 'P': plot.dir = optarg; break;
+        case 'U': plot.units = optarg; break;
         case 'h': usage(stdout); return 0;
         case 'n':
             if (cli_parse_int("--links", optarg, 1, 10000000, &v))
@@ -195,6 +226,9 @@ static int response_main(int argc, char **argv)
         usage(stderr);
         return EXIT_BADINPUT;
     }
+    int pstatus = cli_plot_begin(&plot, "response");
+    if (pstatus)
+        return pstatus;
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);
@@ -228,7 +262,10 @@ static int response_main(int argc, char **argv)
     printf("towstab response: %s (%s)\n", sys->name, scene->path);
     json_t *json = NULL;
     ts_response *res = NULL;
-    rc = response_analysis(sys, &eqo, &rq, quiet, &json, &res, &err);
+    double nat[PLOT_NATURAL];
+    int nnat = 0;
+    rc = response_analysis(sys, &eqo, &rq, quiet, &json, &res,
+                           plot.dir ? nat : NULL, &nnat, &err);
     if (rc != TS_OK)
         status = cli_report(&err, rc);
     ts_err werr = {0};
@@ -238,6 +275,47 @@ static int response_main(int argc, char **argv)
     if (rc == TS_OK && csv_path &&
         ts_report_response_csv(res, csv_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
+    if (rc == TS_OK && plot.dir) {
+        /* Phase unwrapped for drawing, in radians. */
+        double *ph = malloc((size_t)res->npoints * sizeof(double));
+        if (!ph) {
+            fprintf(stderr, "towstab: error: response: --plot: out of "
+                            "memory\n");
+            status = EXIT_FAILED;
+        } else {
+            double shift = 0.0;
+            for (int i = 0; i < res->npoints; i++) {
+                double p = res->phase_deg[i] * M_PI / 180.0;
+                if (i > 0) {
+                    double prev = ph[i - 1] - shift;
+                    if (p - prev > M_PI)
+                        shift -= 2 * M_PI;
+                    else if (p - prev < -M_PI)
+                        shift += 2 * M_PI;
+                }
+                ph[i] = p + shift;
+            }
+            char title[256], mag_label[192];
+            snprintf(title, sizeof title, "%s: frequency response",
+                     sys->name);
+            snprintf(mag_label, sizeof mag_label, "%s / %s",
+                     res->output.name, ts_input_name(res->input));
+            ts_plot_bode_curve c = {res->npoints, res->freq_hz,
+                                    res->magnitude, ph, mag_label,
+                                    TS_PLOT_SOLID, 0};
+            int tension = res->output.kind == TS_OUT_TENSION;
+            ts_err perr = {0};
+            if (ts_plot_bode(plot.dir, "bode", title, mag_label,
+                             tension ? TS_PLOT_FORCE : TS_PLOT_LENGTH,
+                             TS_PLOT_LENGTH, 1, &c, nnat, nat, &plot.opts,
+                             &perr) != TS_OK)
+                status = cli_report(&perr, perr.code);
+            else
+                printf("wrote %s/bode.png and %s/bode.svg\n", plot.dir,
+                       plot.dir);
+            free(ph);
+        }
+    }
     json_decref(json);
     ts_response_free(res);
     ts_system_free(sys);
@@ -322,7 +400,8 @@ static int response_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     }
     json_t *j = NULL;
     ts_response *res = NULL;
-    int rc = response_analysis(sys, &eqo, &rq, ctx->quiet, &j, &res, &err);
+    int rc = response_analysis(sys, &eqo, &rq, ctx->quiet, &j, &res, NULL,
+                               NULL, &err);
     int status = rc ? cli_report(&err, rc) : 0;
     if (j) {
         json_object_set_new(j, "type", json_string("response"));

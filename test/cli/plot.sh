@@ -1,5 +1,6 @@
 #!/bin/bash
-# test/cli/plot.sh: `towstab equilibrium --plot DIR` as a user runs it.
+# test/cli/plot.sh: `towstab equilibrium|modes|response --plot DIR` as a
+# user runs them.
 #
 #   plot.sh TOWSTAB yes|no     (yes: towstab was built with PLplot)
 #
@@ -145,6 +146,23 @@ refused "--overlay-speeds with an empty item" "$EX1" --plot "$T/r" --overlay-spe
 refused "--overlay-turn-rates with garbage" "$EX1" --plot "$T/r" --overlay-turn-rates "fast"
 refused "--overlay of a missing scene" "$EX1" --plot "$T/r" --overlay "$T/missing.yaml"
 refused "--plot without a value" "$EX1" --plot
+
+# modes and response draw their pictures too.
+EX3=examples/kamman_ex3_turn.yaml
+ts modes "$EX3" --count 4 --quiet --plot "$T/modes"
+check "modes --plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
+check "modes --plot: eigenvalue plane 1000 x 700, titled" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/modes/eigenvalues.png' 1000 700 && is_svg '$T/modes/eigenvalues.svg' 'kamman_ex3: eigenvalues'"
+check "modes --plot: the four lowest mode shapes (95 + 220 x 4 + 50 px tall)" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/modes/modes.png' 1000 1025 && is_svg '$T/modes/modes.svg' 'kamman_ex3: lowest mode shapes'"
+ts response "$EX1" --output sphere.z --quiet --plot "$T/bode" --units imperial
+check "response --plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
+check "response --plot: Bode plot, PNG and SVG, titled" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/bode/bode.png' 1000 700 && is_svg '$T/bode/bode.svg' 'kamman_ex1_above: frequency response'"
+ts modes "$EX3" --plot "$T/afile"
+check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
+ts response "$EX1" --output sphere.z --units imperial
+check "response --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
 
 echo "$npass passed, $nfail failed"
 [ $nfail -eq 0 ]
