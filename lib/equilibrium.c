@@ -344,6 +344,55 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
     return rc;
 }
 
+/* Starting strains for Newton from link directions n[3 nlinks] alone
+ * (opts.guess): the tensions a rigid copy of the system carries in that
+ * shape at rest, over EA, into strain[nlinks] (0 for rigid links, and for
+ * a link the rigid model compresses). Starting at zero strain instead puts
+ * every elastic link at the slack kink, T = max(0, EA e): with no tension
+ * a link in air has no load that depends on its angles and the Jacobian is
+ * singular. One rigid kernel evaluation, O(nlinks). */
+static int rigid_strains(const ts_kernel *k, const double *n, double *strain,
+                         ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_system *r = ts_system_copy(sys, err);
+    if (!r)
+        return TS_ENOMEM;
+    for (int c = 0; c < r->ncables; c++) {
+        r->cables[c].ea = 0.0;
+        r->cables[c].damping = 0.0;
+    }
+    int rc = ts_system_build(r, err);
+    ts_kernel *kr = rc == TS_OK ? ts_kernel_alloc(r, err) : NULL;
+    double *y = kr ? calloc(4 * (size_t)sys->nlinks, sizeof(double)) : NULL;
+    double *dydt = kr ? malloc(4 * (size_t)sys->nlinks * sizeof(double))
+                      : NULL;
+    if (!y || !dydt) {
+        rc = rc == TS_OK ? ts_fail(err, TS_ENOMEM, "equilibrium: out of "
+                                                   "memory")
+                         : rc;
+    } else {
+        ts_frame f;
+        ts_kernel_get_frame(k, &f);
+        ts_kernel_set_frame(kr, &f);
+        ts_kernel_set_directions(kr, n, NULL, TS_CHART_RECHART, y);
+        rc = ts_kernel_eval(kr, y, NULL, dydt);
+        const double *t = ts_kernel_tensions(kr);
+        for (int l = 0; l < sys->nlinks; l++) {
+            const ts_link *L = &sys->links[l];
+            strain[l] = rc == TS_OK && L->elastic && t[l] > 0
+                            ? t[l] / L->ea
+                            : 0.0;
+        }
+        rc = TS_OK; /* a failed evaluation leaves zero strains: a start */
+    }
+    free(y);
+    free(dydt);
+    ts_kernel_free(kr);
+    ts_system_free(r);
+    return rc;
+}
+
 static double total_length(const ts_system *sys)
 {
     double L = 0;
@@ -475,8 +524,13 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     rc = TS_ECONV;
     if (o.guess || have_guess) {
         /* Straight from the guess at the full turn rate and bending. */
-        if (o.guess)
-            ts_kernel_set_directions(k, o.guess, NULL, TS_CHART_RECHART, y);
+        if (o.guess) {
+            if (sys->has_elastic &&
+                (rc = rigid_strains(k, o.guess, strain, err)) != TS_OK)
+                goto out;
+            ts_kernel_set_shape(k, o.guess, sys->has_elastic ? strain : NULL,
+                                NULL, NULL, TS_CHART_RECHART, y);
+        }
         memset(y + nq, 0, (size_t)nq * sizeof(double));
         rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
         eq->continuation_steps++;

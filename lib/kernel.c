@@ -47,6 +47,8 @@ struct ts_kernel {
     double *c2, *s2;          /* [nl] */
     double *sub;              /* [nl] submerged fraction */
     double *t;                /* [nl] tension */
+    double *strain;           /* [nl] strain e of an elastic link (0 for a
+                                 rigid one): its length is l (1 + e) */
     double *D, *beta;         /* [nl] articulated elimination */
     /* Per node. */
     double *r, *rd;           /* [3 nn] position, velocity relative to M */
@@ -95,6 +97,7 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     k->s2 = zalloc(snl, sizeof(double), &fail);
     k->sub = zalloc(snl, sizeof(double), &fail);
     k->t = zalloc(snl, sizeof(double), &fail);
+    k->strain = zalloc(snl, sizeof(double), &fail);
     k->D = zalloc(snl, sizeof(double), &fail);
     k->beta = zalloc(snl, sizeof(double), &fail);
     k->r = zalloc(3 * snn, sizeof(double), &fail);
@@ -142,6 +145,7 @@ void ts_kernel_free(ts_kernel *k)
     free(k->s2);
     free(k->sub);
     free(k->t);
+    free(k->strain);
     free(k->D);
     free(k->beta);
     free(k->r);
@@ -260,6 +264,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         double len = L->length, lrate = 0.0;
         if (L->elastic) {
             double e = y[o + 2], ed = qd[o + 2];
+            k->strain[l] = e;
             len = L->length * (1.0 + e);
             lrate = L->length * ed;
             if (!(len > 0))
@@ -324,10 +329,17 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
             sym3_add_normal(k->M + 6 * L->lower, 0.5 * A, n);
         }
         if (L->ei > 0) {
+            /* U = 1/2 (EI / lbar) alpha^2 with lbar from the unstretched
+             * lengths (a spring constant of the cable), so -dU/dr divides
+             * by the current lengths l (1 + e): tsi_bending takes the
+             * current lengths and EI scaled by their mean over lbar. */
             const ts_link *B = &links[L->next];
+            double la = L->length * (1.0 + k->strain[l]);
+            double lb = B->length * (1.0 + k->strain[L->next]);
+            double ei = L->ei * k->bend_scale * (la + lb) /
+                        (L->length + B->length);
             double Fi[3], Fj[3], Fk[3];
-            tsi_bending(L->ei * k->bend_scale, L->length, B->length, n,
-                        k->n + 3 * L->next, Fi, Fj, Fk);
+            tsi_bending(ei, la, lb, n, k->n + 3 * L->next, Fi, Fj, Fk);
             v3_axpy(1.0, Fi, k->Q + 3 * L->upper);
             v3_axpy(1.0, Fj, k->Q + 3 * L->lower);
             v3_axpy(1.0, Fk, k->Q + 3 * B->lower);
@@ -511,9 +523,10 @@ double ts_kernel_potential_energy(const ts_kernel *k)
         U -= sys->nodes[i].mass * g * k->r[3 * i + 2];
     for (int l = 0; l < k->nl; l++) {
         const ts_link *L = &sys->links[l];
-        /* Strain energy 1/2 EA l e^2 while taut (t = EA e > 0). */
-        if (L->elastic && k->t[l] > 0) {
-            double e = k->t[l] / L->ea;
+        /* Strain energy 1/2 EA l e^2 while taut (e > 0): the potential
+         * of the elastic part EA e of the tension, whatever the damping. */
+        if (L->elastic && k->strain[l] > 0) {
+            double e = k->strain[l];
             U += 0.5 * L->ea * L->length * e * e;
         }
         if (L->ei > 0)

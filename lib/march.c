@@ -26,6 +26,9 @@
 /* Local root: |H_perp| below this fraction of |H| (rounding is ~1e-16). */
 #define LOCAL_RTOL 1e-13
 #define LOCAL_MAXIT 60
+/* A link whose load is below this fraction of the forces that make it up
+ * (its own weight and what hangs below) carries none: rounding. */
+#define NO_LOAD_RTOL 1e-12
 /* Elastic link length: relative change at which the stretch has settled,
  * and the most iterations allowed. */
 #define ELASTIC_LEN_RTOL 1e-15
@@ -350,15 +353,18 @@ static int solve_link(tsi_march *m, link_problem *P, const double guess[3],
     }
     link_rhs(P, n, H, F);
     double hn = v3_norm(H);
-    if (!(hn > 0) || !isfinite(hn)) {
-        const ts_link *L = P->L;
+    /* No load to align with: zero, or a cancellation (weight against
+     * buoyancy) down at rounding level of the forces that cancel. */
+    const ts_link *L = P->L;
+    double gross = v3_norm(P->K) + L->mass * m->sys->env.gravity;
+    if (!(hn > NO_LOAD_RTOL * gross) || !isfinite(hn))
         return ts_fail(err, TS_ESINGULAR,
                        "equilibrium: cables[%d] '%s' link %d carries no load "
-                       "(|force| = %g N), so its direction is undefined: a "
-                       "neutrally buoyant free end without flow has no "
-                       "steady shape",
-                       L->cable, m->sys->cables[L->cable].name, L->index, hn);
-    }
+                       "(|force| = %.3g N against a weight of %.3g N), so its "
+                       "direction is undefined: a neutrally buoyant end "
+                       "without flow has no steady shape",
+                       L->cable, m->sys->cables[L->cable].name, L->index, hn,
+                       gross);
     tsi_chart_centred(n, P->R);
     double tol = LOCAL_RTOL * hn, xc[2] = {0.0, 0.0};
     if (!local_newton(P, tol, xc)) {
@@ -405,11 +411,17 @@ static int march_link(tsi_march *m, link_problem *P, int l,
     P->len = L->elastic && m->have_n ? m->len[l] : L->length;
     int rc = solve_link(m, P, guess, m->have_n, n, &t, F, err);
     for (int it = 0; rc == TS_OK && L->elastic; it++) {
+        /* A link aligned with its load carries |H| > 0; a negative
+         * tension is the local root's other branch, met from a poor
+         * shooting iterate, not a proof that no steady state exists (a link
+         * with no load at all is refused above, TS_ESINGULAR). So this is
+         * a failure to converge: the caller may continue in turn rate or
+         * fall back to Newton. */
         if (!(t > 0))
-            return ts_fail(err, TS_ESINGULAR,
-                           "equilibrium: elastic cables[%d] '%s' link %d is "
-                           "slack (tension %.3g N): no steady shape with a "
-                           "slack elastic link",
+            return ts_fail(err, TS_ECONV,
+                           "equilibrium: elastic cables[%d] '%s' link %d "
+                           "went slack in the march (tension %.3g N): the "
+                           "march needs every elastic link taut",
                            L->cable, m->sys->cables[L->cable].name, L->index,
                            t);
         double len = L->length * (1.0 + t / L->ea); /* Hooke: e = T / EA */

@@ -346,6 +346,19 @@ static void test_bad_fixtures(const ts_units *u)
          "not connected to the tow point"},
         {"bad_body_two_cables", TS_EINVAL, "bodies[0]", 21, "it ends 2"},
         {"bad_body_no_cable", TS_EINVAL, "bodies[0]", 13, "it ends 0"},
+        /* Elastic cables, bending, towfish (doc/elastic.md). */
+        {"bad_negative_ea", TS_EINVAL, "cables[0].EA", 13,
+         "must be >= 0 N, got -4.5e+06 N (written \"-4.5e6 N\")"},
+        {"bad_negative_ei", TS_EINVAL, "cables[0].EI", 13,
+         "must be >= 0 N*m^2, got -9.1 N*m^2"},
+        {"bad_negative_damping", TS_EINVAL, "cables[0].damping", 14,
+         "must be >= 0 N*s/m, got -50 N*s/m"},
+        {"bad_damping_rigid", TS_EINVAL, "cables[0].damping", 13,
+         "internal damping applies to an elastic cable: give EA > 0"},
+        {"bad_ea_zero_diameter", TS_EINVAL, "cables[0].diameter", 11,
+         "must be > 0 m, got 0 m"},
+        {"bad_towfish_no_volume", TS_EINVAL, "bodies[0].length", 18,
+         "must be > 0 m, got 0 m (written \"0 m\")"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         char file[256], prefix[512];
