@@ -39,7 +39,9 @@ typedef struct ts_equilibrium_opts {
     int max_iter;         /* per continuation step, default 100 */
     ts_eq_method method;  /* default TS_EQ_AUTO */
     const double *guess;  /* [3 nlinks] link unit directions for Newton to
-                             start from (method newton), or NULL for the
+                             start from (method newton; elastic links
+                             start at the strain of the tension a rigid
+                             copy carries there), or NULL for the
                              straight-tow march; default NULL */
 } ts_equilibrium_opts;
 
