@@ -359,6 +359,38 @@ static const char *stray_number(const char *unit)
     return NULL;
 }
 
+/* udunits' logarithmic-unit syntax, "lg(re 1 mW)": '(' then blanks then
+ * "re". Such a unit is no plain multiple of an SI unit, and udunits 2.2.28
+ * leaks a token when a product around one is malformed ("m lg(re m)ft";
+ * found by fuzzing, test/fuzz/fuzz_units.c), so it is refused before
+ * ut_parse. Returns the position of the '(' or NULL. */
+static const char *log_reference(const char *unit)
+{
+    for (const char *p = strchr(unit, '('); p; p = strchr(p + 1, '(')) {
+        const char *q = p + 1;
+        while (*q == ' ' || *q == '\t')
+            q++;
+        if ((q[0] == 'r' || q[0] == 'R') && (q[1] == 'e' || q[1] == 'E'))
+            return p;
+    }
+    return NULL;
+}
+
+/* Parentheses that do not pair up: udunits tolerates a trailing ')' ("1
+ * ft)" would read as 1 ft), which would let trailing garbage through.
+ * Returns 1 when they do not balance. */
+static int unbalanced(const char *unit)
+{
+    int depth = 0;
+    for (const char *p = unit; *p; p++) {
+        depth += *p == '(';
+        depth -= *p == ')';
+        if (depth < 0)
+            return 1;
+    }
+    return depth != 0;
+}
+
 /* ------------------------------------------------------------------ */
 /* Suggestions for the mass-versus-force confusion                      */
 
@@ -607,6 +639,17 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
                      quote(text, q, sizeof q), si_unit);
         goto done;
     }
+    if (unbalanced(unit)) {
+        rc = ts_fail(err, TS_EINVAL, "%s: the parentheses in %s do not "
+                     "pair up", where, quote(text, q, sizeof q));
+        goto done;
+    }
+    if (log_reference(unit)) {
+        rc = ts_fail(err, TS_EUNIT, "%s: %s uses a logarithmic unit "
+                     "(\"lg(re ...)\"); give a plain multiple of %s", where,
+                     quote(text, q, sizeof q), si_unit);
+        goto done;
+    }
 
     given = parse_unit(u, unit);
     if (!given) {
@@ -667,6 +710,24 @@ int ts_units_from_si(const ts_units *u, double si_value, const char *si_unit,
         return ts_fail(err, TS_EINVAL, "ts_units_from_si: called with a NULL "
                        "argument");
     char q[QUOTE_BUF];
+    /* The screening ts_units_parse applies before udunits sees the text:
+     * udunits' scanner echoes bytes it cannot match to stdout, and after
+     * some syntax errors ("0ft m", "m lg(re m)ft") leaks a token (found by
+     * fuzzing, test/fuzz/fuzz_units.c). */
+    size_t ulen = strlen(unit);
+    const char *bad = ulen >= UNIT_TEXT_MAX ? "is too long" : NULL;
+    for (size_t i = 0; !bad && i < ulen; i++)
+        if ((unsigned char)unit[i] < 0x20 || (unsigned char)unit[i] >= 0x7f)
+            bad = "has a character that is not printable ASCII";
+    if (!bad && strcmp(unit, "1") != 0 && stray_number(unit))
+        bad = "has a number that is not an exponent";
+    if (!bad && log_reference(unit))
+        bad = "is logarithmic (\"lg(re ...)\")";
+    if (!bad && unbalanced(unit))
+        bad = "has parentheses that do not pair up";
+    if (bad)
+        return ts_fail(err, TS_EUNIT, "ts_units_from_si: the unit %s %s",
+                       quote(unit, q, sizeof q), bad);
     ut_unit *from = parse_unit(u, si_unit);
     ut_unit *to = parse_unit(u, unit);
     cv_converter *conv = NULL;

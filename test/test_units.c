@@ -182,7 +182,10 @@ static void test_garbage(const ts_units *u)
     refused(u, "0x10", "m", TS_EINVAL, "not a decimal number", NULL);
     refused(u, "12 ft 3", "m", TS_EINVAL, "unexpected number \"3\"", NULL);
     refused(u, "1.2.3", "m", TS_EINVAL, "unexpected number", NULL);
-    refused(u, "12 m )", "m", TS_EINVAL, "cannot read \"m )\"", NULL);
+    refused(u, "12 m )", "m", TS_EINVAL, "parentheses", "do not pair up");
+    /* udunits alone reads a trailing ')' as nothing: "1 ft)" would pass. */
+    refused(u, "1 ft)", "m", TS_EINVAL, "parentheses", "\"1 ft)\"");
+    refused(u, "1 (ft", "m", TS_EINVAL, "parentheses", NULL);
     refused(u, "5 ft//s", "m/s", TS_EINVAL, "not a unit expression", NULL);
     refused(u, "--1", "m", TS_EINVAL, "does not start with a number", NULL);
 
