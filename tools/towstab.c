@@ -10,9 +10,11 @@
 
 extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
 extern const cli_command cli_cmd_modes, cli_cmd_response;
+extern const cli_command cli_cmd_simulate;
 
 const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
+                                           &cli_cmd_simulate,
                                            NULL};
 
 static void usage(FILE *f)

@@ -1,0 +1,94 @@
+/* towstab/compare.h: linear against nonlinear time histories, to show
+ * where the linear model can be trusted (doc/simulate.md, "Comparison";
+ * Kamman & Nguyen 1990, example 4).
+ *
+ * Over a window [t_discard, t_end] (the transient discarded) the chosen
+ * output (a node coordinate, e.g. sphere.z) of both runs is fitted by least
+ * squares at the excitation frequency f,
+ *   x(t) ~ c + a sin(2 pi f t) + b cos(2 pi f t),
+ * and so is the tow-point displacement along the excitation axis. The
+ * amplitude ratio is |(a, b)| of the output over that of the excitation
+ * (its fundamental: exactly the sine amplitude, or the crank radius, as
+ * the rod term of a slider crank has even harmonics only); the phase is
+ * the difference of the two phases (output leads when > 0); the mean
+ * offset is c less the output's equilibrium value. Differences are
+ * relative to the nonlinear run, taken as the truth:
+ *   amplitude_difference_pct = 100 (ratio_lin - ratio_nl) / ratio_nl,
+ *   mean_difference_pct = 100 (offset_lin - offset_nl) / |offset_nl|,
+ * and the RMS of x_lin - x_nl over the window (m). The linear
+ * frequency-response prediction at f comes from ts_response_at
+ * (towstab/response.h). Without a single periodic excitation the means
+ * are plain window averages and the amplitude fields are NaN.
+ */
+#ifndef TOWSTAB_COMPARE_H
+#define TOWSTAB_COMPARE_H
+
+#include "towstab/error.h"
+#include "towstab/excitation.h"
+#include "towstab/linearize.h"
+#include "towstab/response.h"
+#include "towstab/simulate.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Fewest samples per period the least-squares fit accepts. */
+#define TS_COMPARE_MIN_SAMPLES_PER_PERIOD 8
+
+typedef struct ts_compare_run {
+    double amplitude;        /* fitted output amplitude, m */
+    double amplitude_ratio;  /* amplitude / excitation amplitude */
+    double phase_deg;        /* output phase less the excitation's, deg */
+    double mean_offset;      /* mean (fitted constant) less equilibrium, m */
+    double half_range;       /* (max - min) / 2 over the window, m */
+} ts_compare_run;
+
+typedef struct ts_compare {
+    ts_output output;        /* what is compared */
+    int periodic;            /* 1: a single sine or crank excitation */
+    ts_axis exc_axis;        /* its axis */
+    ts_signal_type exc_type;
+    double exc_amplitude;    /* its nominal amplitude (crank radius), m */
+    double exc_frequency_hz; /* Hz */
+    double exc_fit_amplitude;/* fitted fundamental of the tow motion, m */
+    double t_from, t_to;     /* window, s */
+    int nsamples;            /* samples in the window */
+    double equilibrium;      /* output's equilibrium value, m */
+    ts_compare_run linear, nonlinear;
+    double pred_ratio;       /* |H(i w)| of the linear model */
+    double pred_phase_deg;   /* arg H(i w), deg */
+    double amplitude_difference_pct;
+    double mean_difference_pct;
+    double rms_difference;   /* m */
+    double rms_difference_ratio; /* rms / excitation amplitude */
+} ts_compare;
+
+/* Least-squares fit x[i] ~ c + a sin(w t[i]) + b cos(w t[i]) over n
+ * samples (w = 2 pi freq_hz, > 0): mean c, amplitude |(a, b)| and phase
+ * atan2(b, a) (rad). TS_EINVAL when n < 3 or the normal equations are
+ * singular (the samples do not resolve the frequency). */
+TS_API int ts_compare_fit_sinusoid(const double t[], const double x[],
+                                   int n, double freq_hz, double *mean,
+                                   double *amplitude, double *phase,
+                                   ts_err *err);
+
+/* Compare the position output `out` of the nonlinear history nl and the
+ * linear history li (same sample times) over t >= t_discard. lin is the
+ * linear model (its r0 gives the equilibrium value and it yields the
+ * frequency response), ex the excitation of both runs. Returns TS_OK or
+ * TS_EINVAL (different sample times, a window with fewer than 3 samples
+ * or shorter than one period, fewer than
+ * TS_COMPARE_MIN_SAMPLES_PER_PERIOD samples per period, a tension output,
+ * t_discard outside [0, t_end)). */
+TS_API int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
+                                const ts_excitation *ex,
+                                const ts_history *nl, const ts_history *li,
+                                const ts_output *out, double t_discard,
+                                ts_compare *c, ts_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

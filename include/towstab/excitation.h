@@ -1,0 +1,181 @@
+/* towstab/excitation.h: prescribed motions as functions of time, for the
+ * simulator (doc/simulate.md; MODEL.md sections 1 and 8).
+ *
+ * An excitation is a list of signals. A signal drives one axis:
+ *  - a tow-point axis (surge x, sway y, heave z of the mean ship frame M):
+ *    the signal is the tow point's displacement from its nominal position
+ *    (m); the kernel's input u[TS_NINPUT] (displacement, velocity,
+ *    acceleration, each x, y, z) is the sum of the signals on each axis with
+ *    their analytic first and second time derivatives;
+ *  - a manoeuvre axis (the speed V of M, or its turn rate Omega): the
+ *    signal is the change of V (m/s) or Omega (rad/s) from the base frame,
+ *    and the frame of time t carries the matching speed_rate / turn_accel
+ *    (MODEL.md section 1). The current, fixed in inertial space, rotates in
+ *    M by the heading change psi(t) = integral of Omega.
+ *
+ * Signal shapes (t in s; A the amplitude; w = 2 pi f):
+ *  - sine:   A sin(w t + phase), for all t >= 0;
+ *  - crank:  slider crank of radius A and rod l (MODEL.md section 8),
+ *            A cos(th) + l (1 - sqrt(1 - (A/l)^2 sin^2 th)), th = w t + phase;
+ *  - step:   0 before `start`, A after `start + rise`, in between the quintic
+ *            A S(xi), S(xi) = 10 xi^3 - 15 xi^4 + 6 xi^5, xi = (t-start)/rise:
+ *            displacement, velocity and acceleration are continuous;
+ *  - ramp:   0 before `start`, A after `start + duration + rise`, rising
+ *            linearly at A/duration in between, the two corners rounded
+ *            over `rise` (the rate itself follows S), so that the velocity
+ *            and acceleration are continuous and the final value is exactly A;
+ *  - series: a natural cubic spline through samples (t_i, x_i) (tow axes
+ *            only), defined on [t_0, t_last] with t_0 <= 0.
+ * A rigid-link cable cannot follow a tow point whose velocity jumps (it
+ * would need an impulsive tension), hence the rounded steps and ramps:
+ * `rise` must be > 0 (default TS_SIGNAL_RISE).
+ *
+ * Manoeuvre signals are steps or ramps only (their heading integral is
+ * closed-form). Their amplitude is the change of V or Omega, or, with
+ * `absolute` set, the final value (the change is then that value less the
+ * base frame's).
+ */
+#ifndef TOWSTAB_EXCITATION_H
+#define TOWSTAB_EXCITATION_H
+
+#include <stddef.h>
+
+#include "towstab/error.h"
+#include "towstab/kernel.h"
+#include "towstab/units.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TS_SIGNAL_RISE 0.1   /* default rise / corner time of steps, ramps, s */
+
+typedef enum {
+    TS_SIGNAL_SINE = 0,
+    TS_SIGNAL_CRANK = 1,
+    TS_SIGNAL_STEP = 2,
+    TS_SIGNAL_RAMP = 3,
+    TS_SIGNAL_SERIES = 4
+} ts_signal_type;
+
+typedef enum {
+    TS_AXIS_SURGE = 0,     /* tow point, x of M (forward) */
+    TS_AXIS_SWAY = 1,      /* tow point, y of M (starboard) */
+    TS_AXIS_HEAVE = 2,     /* tow point, z of M (down) */
+    TS_AXIS_SPEED = 3,     /* speed V of M */
+    TS_AXIS_TURN_RATE = 4  /* turn rate Omega of M */
+} ts_axis;
+
+/* One signal. Fields a type does not use are ignored. */
+typedef struct ts_signal {
+    ts_signal_type type;
+    ts_axis axis;
+    double amplitude;  /* m on tow axes, m/s on speed, rad/s on turn rate;
+                          the crank radius for a crank */
+    double frequency;  /* Hz, > 0 (sine, crank) */
+    double phase;      /* rad (sine, crank) */
+    double rod;        /* m, > amplitude (crank) */
+    double start;      /* s, >= 0 (step, ramp) */
+    double duration;   /* s, > 0 (ramp) */
+    double rise;       /* s, > 0 (step, ramp) */
+    int absolute;      /* manoeuvres: amplitude is the final value */
+} ts_signal;
+
+typedef struct ts_excitation ts_excitation;
+
+/* An empty excitation (no signal: u = 0, the frame unchanged). */
+TS_API ts_excitation *ts_excitation_alloc(ts_err *err);
+TS_API void ts_excitation_free(ts_excitation *ex);
+
+/* Add a copy of signal s after checking it (TS_EINVAL naming the field:
+ * frequency <= 0, negative start, rise <= 0, a crank rod not longer than
+ * its radius, a series or sine on a manoeuvre axis, a second absolute
+ * signal on one manoeuvre axis, non-finite values). */
+TS_API int ts_excitation_add(ts_excitation *ex, const ts_signal *s,
+                             ts_err *err);
+
+/* Add a series on tow axis `axis` through n >= 3 samples t[n] (s, strictly
+ * increasing, t[0] <= 0) and x[n] (m). The arrays are copied. */
+TS_API int ts_excitation_add_series(ts_excitation *ex, ts_axis axis, int n,
+                                    const double t[], const double x[],
+                                    ts_err *err);
+
+/* Read a series from a CSV file: two columns, time (s) and displacement
+ * (m); lines starting with '#' and a first line that is not numeric (a
+ * header) are skipped; further columns are ignored. TS_EIO when the file
+ * cannot be read, TS_EINVAL (with the line) for a bad number. */
+TS_API int ts_excitation_read_series(ts_excitation *ex, ts_axis axis,
+                                     const char *path, ts_err *err);
+
+/* Parse a signal description and add it:
+ *   AXIS[:key=value,key=value,...]
+ * AXIS is tow.surge (tow.x), tow.sway (tow.y), tow.heave (tow.z), speed or
+ * turn_rate. Keys: type (sine, crank, step, ramp, csv; default sine on tow
+ * axes, ramp on manoeuvres), amplitude, frequency or period, phase, rod,
+ * start, duration, rise, to (final value, manoeuvres), by (change,
+ * manoeuvres), file (csv). Values may carry units ("0.1ft", "0.25 Hz",
+ * "30deg", "0.5rad/s"); plain numbers are SI. `where` names the origin in
+ * messages ("--excite"). Unknown axes, types and keys, missing or
+ * conflicting keys and out-of-range values give TS_EINVAL or TS_EUNIT. */
+TS_API int ts_excitation_parse(ts_excitation *ex, const char *spec,
+                               const ts_units *units, const char *where,
+                               ts_err *err);
+
+TS_API int ts_excitation_nsignals(const ts_excitation *ex);
+/* Signal i, 0 <= i < nsignals (a series reports type TS_SIGNAL_SERIES). */
+TS_API const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i);
+
+/* 1 when any signal drives the speed or the turn rate. */
+TS_API int ts_excitation_has_manoeuvre(const ts_excitation *ex);
+
+/* The tow-point input at time t: u[0..3) displacement (m), u[3..6)
+ * velocity (m/s), u[6..9) acceleration (m/s^2), in M. */
+TS_API void ts_excitation_input(const ts_excitation *ex, double t,
+                                double u[TS_NINPUT]);
+
+/* The frame at time t, from the frame `base` of t = 0 (its speed, turn
+ * rate and current; its rates are ignored): speed, turn rate and their
+ * rates from the manoeuvre signals, current rotated by the heading change.
+ * f may alias base. */
+TS_API void ts_excitation_frame(const ts_excitation *ex, const ts_frame *base,
+                                double t, ts_frame *f);
+
+/* Heading change psi(t) = integral_0^t Omega dt (rad, about +z of M). */
+TS_API double ts_excitation_heading(const ts_excitation *ex,
+                                    const ts_frame *base, double t);
+
+/* Times in (0, t_end) where a signal is not smooth (ends of steps, ramp
+ * corners), sorted, without duplicates; writes at most `max` of them to
+ * out and returns how many there are. */
+TS_API int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
+                                     double out[], int max);
+
+/* The shortest time scale of the tow-point signals (s): 1/(2 pi f) for a
+ * sine, 1/(4 pi f) for a crank (its second harmonic), the rise of steps and
+ * ramps, the smallest sample spacing of a series; INFINITY without tow
+ * signals. The linear simulator sizes its steps on it. */
+TS_API double ts_excitation_time_scale(const ts_excitation *ex);
+
+/* Check that every series covers [0, t_end] (TS_EINVAL otherwise). */
+TS_API int ts_excitation_check_span(const ts_excitation *ex, double t_end,
+                                    ts_err *err);
+
+/* The single periodic tow excitation, for amplitude ratios: when exactly
+ * one signal is a sine or a crank, on a tow axis, returns 1 and its index;
+ * else 0. */
+TS_API int ts_excitation_periodic(const ts_excitation *ex, int *index);
+
+/* Names: "tow.surge", "tow.sway", "tow.heave", "speed", "turn_rate";
+ * "sine", "crank", "step", "ramp", "csv". */
+TS_API const char *ts_axis_name(ts_axis a);
+TS_API const char *ts_signal_type_name(ts_signal_type t);
+
+/* One-line description of signal i with SI values, e.g.
+ * "tow.heave sine amplitude 0.03048 m, frequency 0.25 Hz, phase 0 deg". */
+TS_API void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
+                                   size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,213 @@
+/* towstab/simulate.h: time-domain simulation, nonlinear y' = f(y, u(t))
+ * through the one kernel and linear z' = A z + B v about an equilibrium
+ * (doc/simulate.md; Kamman & Nguyen 1990, examples 3 to 5).
+ *
+ * Nonlinear: GSL odeiv2 (evolve/control/step under a driver) on the
+ * kernel's state y[2 nq] (link angles and rates, MODEL.md section 2), with
+ * the tow-point input u(t) and the frame motion of an excitation
+ * (towstab/excitation.h). Explicit adaptive Runge-Kutta (rk8pd, rkf45) or
+ * implicit methods for stiff scenes (rk4imp, bsimp, msbdf) whose Jacobian
+ * df/dy comes from the linearizer (towstab/linearize.h). Steps never
+ * straddle an output time or a breakpoint of the excitation. After every
+ * accepted step, links with |cos theta2| below the re-chart threshold are
+ * moved to a chart centred on their direction (ts_kernel_rechart) and the
+ * integrator restarts from the rewritten state: positions and velocities
+ * are continuous, the numbers in y are not.
+ *
+ * Linear: z = y - y0 and v = u - u0 about the linearization point of a
+ * ts_linear; either exact discretisation (matrix exponential of the
+ * Van Loan block matrix, the input interpolated by a cubic on each step,
+ * lib/expm.c) or the same GSL integrators on z' = A z + B v. Node positions
+ * are reconstructed as the equilibrium positions plus the first-order
+ * displacement of the angles plus the tow displacement (kinematics
+ * "linear"), or by the kernel's exact geometry at y0 + z (kinematics
+ * "nonlinear", the way DYNTOCABS-style codes draw a linear run).
+ *
+ * Outputs are sampled at t_i = i dt (i = 0..N-1) and t_end into a
+ * ts_history. Units SI throughout; angles in rad.
+ */
+#ifndef TOWSTAB_SIMULATE_H
+#define TOWSTAB_SIMULATE_H
+
+#include "towstab/error.h"
+#include "towstab/excitation.h"
+#include "towstab/kernel.h"
+#include "towstab/linearize.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    TS_INT_RK8PD = 0,   /* explicit Runge-Kutta Prince-Dormand 8(9) */
+    TS_INT_RKF45 = 1,   /* explicit Runge-Kutta-Fehlberg 4(5) */
+    TS_INT_RK4IMP = 2,  /* implicit Gauss 4th order (Jacobian) */
+    TS_INT_BSIMP = 3,   /* implicit Bulirsch-Stoer, Bader-Deuflhard (Jacobian) */
+    TS_INT_MSBDF = 4    /* variable-order BDF, stiff (Jacobian) */
+} ts_integrator;
+
+typedef enum {
+    TS_LINSIM_EXPM = 0, /* exact discretisation with cubic input hold */
+    TS_LINSIM_ODE = 1   /* the GSL integrator of ts_sim_opts.integrator */
+} ts_linsim_method;
+
+typedef enum {
+    TS_KIN_LINEAR = 0,    /* positions r0 + dr(z) + tow displacement */
+    TS_KIN_NONLINEAR = 1  /* positions of the state y0 + z (kernel) */
+} ts_kinematics;
+
+/* Smallest relative tolerance accepted: below ~100 eps the error
+ * estimates are rounding noise and steps can shrink without end. */
+#define TS_SIM_RTOL_MIN 1e-14
+
+typedef struct ts_sim_opts {
+    ts_integrator integrator; /* default TS_INT_RK8PD */
+    double t_end;       /* s, > 0; default 10 */
+    double dt_sample;   /* s, in (0, t_end]; default 0.1 */
+    double rel_tol;     /* relative local error per step, >=
+                           TS_SIM_RTOL_MIN; default 1e-6 */
+    double abs_tol;     /* absolute, rad and rad/s; default 1e-9 */
+    double h_init;      /* first step, s (at least h_min); default 1e-3 */
+    double h_min;       /* s; an accepted step below it (other than one cut
+                           short to land on an output time) fails the run;
+                           default 0: only GSL's machine-precision limit */
+    long max_steps;     /* accepted steps per run; 0 (default): no limit */
+    double rechart;     /* |cos theta2| re-chart threshold, default
+                           TS_CHART_RECHART */
+    ts_linsim_method linear_method;  /* default TS_LINSIM_EXPM */
+    ts_kinematics kinematics;        /* default TS_KIN_LINEAR */
+    int jacobian_threads; /* threads of the Jacobian (ts_linearize_opts);
+                           default 1 */
+} ts_sim_opts;
+
+TS_API void ts_sim_opts_default(ts_sim_opts *o);
+
+/* Check the options (TS_EINVAL naming the field: t_end <= 0, a sample
+ * interval <= 0 or longer than the run, tolerances <= 0, ...). */
+TS_API int ts_sim_opts_check(const ts_sim_opts *o, ts_err *err);
+
+/* Number of output samples: N + 1 with N = ceil(t_end / dt_sample), the
+ * last one at t_end (within 1e-9 of a multiple, t_end itself). */
+TS_API int ts_sim_nsamples(const ts_sim_opts *o);
+
+/* Time of sample i (0 <= i < ts_sim_nsamples). */
+TS_API double ts_sim_sample_time(const ts_sim_opts *o, int i);
+
+TS_API const char *ts_integrator_name(ts_integrator m);
+/* Parse "rk8pd", "rkf45", "rk4imp", "bsimp", "msbdf": 0 or -1. */
+TS_API int ts_integrator_parse(const char *name, ts_integrator *m);
+
+/* Work statistics of a run. */
+typedef struct ts_sim_stats {
+    long steps;         /* accepted steps (linear expm: discrete steps) */
+    long rejected;      /* rejected trial steps */
+    long evaluations;   /* f evaluations by the integrator (linear: input
+                           evaluations and matrix-vector products) */
+    long jacobians;     /* Jacobian evaluations (implicit methods) */
+    long recharts;      /* links moved to a new chart */
+    long restarts;      /* integrator restarts after re-charting */
+    double t_reached;   /* s: the time the run got to */
+    double h_last;      /* s: last step size */
+    double wall_s;      /* wall-clock seconds of the run */
+} ts_sim_stats;
+
+/* Sampled results. */
+typedef struct ts_history {
+    int nnodes, nlinks;
+    int capacity;        /* samples allocated */
+    int nsamples;        /* samples filled */
+    double *t;           /* [capacity] s */
+    double *positions;   /* [capacity][3 nnodes] m, M frame, node 0 = tow */
+    double *tensions;    /* [capacity][nlinks] N (NaN in linear runs) */
+    double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
+                            linear runs; ts_kernel_kinetic_energy) */
+    double *input;       /* [capacity][TS_NINPUT] u(t) */
+} ts_history;
+
+/* A history of `capacity` samples for system sys; NULL on failure. */
+TS_API ts_history *ts_history_alloc(const ts_system *sys, int capacity,
+                                    ts_err *err);
+TS_API void ts_history_free(ts_history *h);
+
+/* --- Nonlinear simulation: set / advance / read, and a driver. --- */
+
+typedef struct ts_sim ts_sim;
+
+/* A simulator on kernel k (which it uses, not owns, and must outlive it)
+ * with excitation ex (may be NULL: none; used, not owned). The kernel's
+ * frame at this call is the frame of t = 0; it is restored by
+ * ts_sim_free. NULL on failure (bad options, no memory). */
+TS_API ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
+                            const ts_sim_opts *o, ts_err *err);
+TS_API void ts_sim_free(ts_sim *s);
+
+/* Set time t (s) and state y[2 nq] in the kernel's current charts;
+ * re-charts links near the singularity (y is copied, then rewritten in
+ * the simulator). Resets the integrator. */
+TS_API int ts_sim_set_state(ts_sim *s, double t, const double y[],
+                            ts_err *err);
+
+/* Integrate to t1 (> current time). Returns TS_OK; TS_EINTEGRATOR when
+ * the step size underflows (below h_min or machine precision), the step
+ * limit is reached or the state stops being finite; TS_ESINGULAR when the
+ * kernel fails fatally. On failure the simulator holds the last accepted
+ * state and time (ts_sim_time). */
+TS_API int ts_sim_advance(ts_sim *s, double t1, ts_err *err);
+
+TS_API double ts_sim_time(const ts_sim *s);
+/* The current state [2 nq] in the kernel's current charts. */
+TS_API const double *ts_sim_state(const ts_sim *s);
+TS_API void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st);
+
+/* Evaluate the kernel at the current time and state (so that its
+ * accessors hold positions, tensions, energies) and append a sample to h
+ * (TS_EINVAL when h is full). */
+TS_API int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err);
+
+/* Driver: simulate from y0 (kernel charts) over [0, o->t_end], recording
+ * every output sample (h needs ts_sim_nsamples(o) samples). y_end[2 nq]
+ * (may be NULL) receives the final state in the kernel's charts, which
+ * may have changed. On failure the history holds the samples reached and
+ * *st the statistics so far. */
+TS_API int ts_simulate(ts_kernel *k, const ts_excitation *ex,
+                       const double y0[], const ts_sim_opts *o,
+                       ts_history *h, ts_sim_stats *st, double y_end[],
+                       ts_err *err);
+
+/* --- Linear simulation. --- */
+
+/* Simulate z' = A z + B (u(t) - u0) from z(0) = z0 (NULL: 0) over
+ * [0, o->t_end], recording positions into h (tensions and energies NaN).
+ * `k` must be the kernel lin was computed with, in the same charts (its
+ * frame too); it is used for the nonlinear kinematics only. The linear
+ * model has no frame inputs: an excitation with a manoeuvre is refused
+ * (TS_EDOMAIN). Cost per output interval: expm O(n^2) per step plus one
+ * O((n + 36)^3) exponential per distinct step size; ode: O(n^2) per
+ * evaluation. */
+TS_API int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
+                              const ts_excitation *ex, const double z0[],
+                              const ts_sim_opts *o, ts_history *h,
+                              ts_sim_stats *st, ts_err *err);
+
+/* --- Initial states. --- */
+
+/* A released shape: every link along the unit direction of angles
+ * (theta1, theta2) (rad; n = (-c1 c2, -s2, s1 c2): 0, 0 is straight aft,
+ * horizontal), at rest relative to M. Writes y[2 nq] in k's charts,
+ * re-charting links as needed. TS_EINVAL for non-finite angles. */
+TS_API int ts_sim_released_state(ts_kernel *k, double theta1, double theta2,
+                                 double y[], ts_err *err);
+
+/* A shape from node positions pos[3 nnodes] (m; node 0 the tow point,
+ * which only fixes the origin), at rest: link directions are the
+ * normalised node differences. Refuses (TS_EINVAL, naming the link) a
+ * link whose length differs from the system's by more than `rtol`
+ * relative. Writes y[2 nq] in k's charts (re-charting as needed). */
+TS_API int ts_sim_shape_state(ts_kernel *k, const double pos[], double rtol,
+                              double y[], ts_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

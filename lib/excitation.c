@@ -1,0 +1,888 @@
+/* excitation.c: tow-point excitations and manoeuvres as functions of time
+ * (towstab/excitation.h; doc/simulate.md section "Excitations").
+ *
+ * Every signal is evaluated with its first and second time derivatives in
+ * closed form, so the kernel's input u = (x, x', x'') is exactly consistent
+ * (a finite-difference velocity would break the rigid links' kinematics).
+ *  - sine: x = A sin th, th = w t + phase.
+ *  - slider crank (MODEL.md section 8): with S = sqrt(l^2 - A^2 sin^2 th),
+ *      x   = A cos th + l - S,
+ *      x'  = w (-A sin th + A^2 sin th cos th / S),
+ *      x'' = w^2 (-A cos th + A^2 cos 2th / S + (A^2 sin th cos th)^2 / S^3).
+ *  - step: x = A S5(xi), xi = (t - start)/rise, with the quintic
+ *    S5 = 10 xi^3 - 15 xi^4 + 6 xi^5 (clamped to [0, 1]); S5' and S5'' vanish
+ *    at both ends, so x, x', x'' are continuous.
+ *  - ramp: the rate is (A/T) [S5(xi1) - S5(xi2)], xi1 = (t - start)/rise,
+ *    xi2 = xi1 - T/rise (T the duration): a plateau at A/T with rounded
+ *    corners. Its integral uses I(xi) = int_0^xi S5 = 2.5 xi^4 - 3 xi^5 + xi^6
+ *    on [0, 1] and xi - 1/2 beyond, x = (A rise/T) [I(xi1) - I(xi2)], which
+ *    tends to exactly A.
+ *  - series: GSL natural cubic spline (gsl_spline, cspline): C2, so x, x'
+ *    and x'' are continuous; evaluated without an accelerator (binary
+ *    search) so that evaluation does not write and the excitation can be
+ *    shared read-only.
+ * Manoeuvres: V(t) = V0 + sum dV(t), Omega(t) = Omega0 + sum dOmega(t), with
+ * their rates from the same derivatives; the heading psi(t) = Omega0 t +
+ * sum int dOmega uses J(xi) = int_0^xi I = xi^5/2 - xi^6/2 + xi^7/7 on [0,1]
+ * and 1/7 + xi (xi - 1)/2 beyond. A current c fixed in inertial space has,
+ * in M rotated by psi about +z, the components R_z(psi)^T c.
+ */
+#include "towstab/excitation.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_spline.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Longest spec and key accepted by the parser (far beyond a real use). */
+#define SPEC_MAX 1024
+/* Longest CSV line. */
+#define LINE_MAX_CSV 4096
+/* A series may end this little before t_end (relative) and still cover. */
+#define SPAN_RTOL 1e-12
+
+struct ts_excitation {
+    int n, cap;
+    ts_signal *sig;        /* [cap] */
+    gsl_spline **spline;   /* [cap], non-NULL for series */
+    double *series_dt;     /* [cap] smallest sample spacing of a series */
+};
+
+ts_excitation *ts_excitation_alloc(ts_err *err)
+{
+    ts_excitation *ex = calloc(1, sizeof *ex);
+    if (!ex)
+        ts_fail(err, TS_ENOMEM, "ts_excitation_alloc: out of memory");
+    return ex;
+}
+
+void ts_excitation_free(ts_excitation *ex)
+{
+    if (!ex)
+        return;
+    for (int i = 0; i < ex->n; i++)
+        if (ex->spline[i])
+            gsl_spline_free(ex->spline[i]);
+    free(ex->sig);
+    free(ex->spline);
+    free(ex->series_dt);
+    free(ex);
+}
+
+const char *ts_axis_name(ts_axis a)
+{
+    switch (a) {
+    case TS_AXIS_SURGE: return "tow.surge";
+    case TS_AXIS_SWAY: return "tow.sway";
+    case TS_AXIS_HEAVE: return "tow.heave";
+    case TS_AXIS_SPEED: return "speed";
+    case TS_AXIS_TURN_RATE: return "turn_rate";
+    }
+    return "?";
+}
+
+const char *ts_signal_type_name(ts_signal_type t)
+{
+    switch (t) {
+    case TS_SIGNAL_SINE: return "sine";
+    case TS_SIGNAL_CRANK: return "crank";
+    case TS_SIGNAL_STEP: return "step";
+    case TS_SIGNAL_RAMP: return "ramp";
+    case TS_SIGNAL_SERIES: return "csv";
+    }
+    return "?";
+}
+
+static int is_tow_axis(int a) { return a >= TS_AXIS_SURGE && a <= TS_AXIS_HEAVE; }
+
+static int grow(ts_excitation *ex, ts_err *err)
+{
+    if (ex->n < ex->cap)
+        return TS_OK;
+    int cap = ex->cap ? 2 * ex->cap : 4;
+    ts_signal *s = realloc(ex->sig, (size_t)cap * sizeof *s);
+    if (s)
+        ex->sig = s;
+    gsl_spline **sp = realloc(ex->spline, (size_t)cap * sizeof *sp);
+    if (sp)
+        ex->spline = sp;
+    double *dt = realloc(ex->series_dt, (size_t)cap * sizeof *dt);
+    if (dt)
+        ex->series_dt = dt;
+    if (!s || !sp || !dt)
+        return ts_fail(err, TS_ENOMEM, "excitation: out of memory");
+    ex->cap = cap;
+    return TS_OK;
+}
+
+int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
+{
+    const char *an = ts_axis_name(s->axis), *tn = ts_signal_type_name(s->type);
+    if (!(s->axis >= TS_AXIS_SURGE && s->axis <= TS_AXIS_TURN_RATE))
+        return ts_fail(err, TS_EINVAL, "excitation: axis %d is not one of "
+                       "tow.surge, tow.sway, tow.heave, speed, turn_rate",
+                       (int)s->axis);
+    if (!(s->type >= TS_SIGNAL_SINE && s->type <= TS_SIGNAL_RAMP))
+        return ts_fail(err, TS_EINVAL, "excitation %s: type %d is not sine, "
+                       "crank, step or ramp (series: "
+                       "ts_excitation_add_series)", an, (int)s->type);
+    if (!is_tow_axis(s->axis) && s->type != TS_SIGNAL_STEP &&
+        s->type != TS_SIGNAL_RAMP)
+        return ts_fail(err, TS_EINVAL, "excitation %s: a manoeuvre is a step "
+                       "or a ramp, got %s", an, tn);
+    if (!isfinite(s->amplitude))
+        return ts_fail(err, TS_EINVAL, "excitation %s: amplitude must be "
+                       "finite, got %g", an, s->amplitude);
+    if (s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK) {
+        if (!(s->amplitude > 0))
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): amplitude "
+                           "must be > 0 m, got %g m", an, tn, s->amplitude);
+        if (!(s->frequency > 0) || !isfinite(s->frequency))
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): frequency "
+                           "must be > 0 Hz, got %g Hz", an, tn, s->frequency);
+        if (!isfinite(s->phase))
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): phase must "
+                           "be finite, got %g rad", an, tn, s->phase);
+    }
+    if (s->type == TS_SIGNAL_CRANK &&
+        (!(s->rod > s->amplitude) || !isfinite(s->rod)))
+        return ts_fail(err, TS_EINVAL, "excitation %s (crank): rod must be "
+                       "longer than the crank radius %g m, got %g m", an,
+                       s->amplitude, s->rod);
+    if (s->type == TS_SIGNAL_STEP || s->type == TS_SIGNAL_RAMP) {
+        if (!(s->start >= 0) || !isfinite(s->start))
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): start must "
+                           "be >= 0 s, got %g s", an, tn, s->start);
+        if (!(s->rise > 0) || !isfinite(s->rise))
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): rise must "
+                           "be > 0 s (a rigid cable cannot follow a jump in "
+                           "velocity), got %g s", an, tn, s->rise);
+    }
+    if (s->type == TS_SIGNAL_RAMP &&
+        (!(s->duration > 0) || !isfinite(s->duration)))
+        return ts_fail(err, TS_EINVAL, "excitation %s (ramp): duration must "
+                       "be > 0 s, got %g s", an, s->duration);
+    if (s->absolute) {
+        if (is_tow_axis(s->axis))
+            return ts_fail(err, TS_EINVAL, "excitation %s: a final value "
+                           "('to') applies to manoeuvres only", an);
+        for (int i = 0; i < ex->n; i++)
+            if (ex->sig[i].axis == s->axis && ex->sig[i].absolute)
+                return ts_fail(err, TS_EINVAL, "excitation %s: two signals "
+                               "set its final value ('to'); give one, or "
+                               "changes ('by')", an);
+    }
+    int rc = grow(ex, err);
+    if (rc)
+        return rc;
+    ex->sig[ex->n] = *s;
+    ex->spline[ex->n] = NULL;
+    ex->series_dt[ex->n] = INFINITY;
+    ex->n++;
+    return TS_OK;
+}
+
+int ts_excitation_add_series(ts_excitation *ex, ts_axis axis, int n,
+                             const double t[], const double x[], ts_err *err)
+{
+    const char *an = ts_axis_name(axis);
+    if (!is_tow_axis(axis))
+        return ts_fail(err, TS_EINVAL, "excitation %s: a series drives a "
+                       "tow-point axis (tow.surge, tow.sway, tow.heave) only",
+                       an);
+    if (n < 3)
+        return ts_fail(err, TS_EINVAL, "excitation %s (csv): a series needs "
+                       "at least 3 samples for a cubic spline, got %d", an, n);
+    double dtmin = INFINITY;
+    for (int i = 0; i < n; i++) {
+        if (!isfinite(t[i]) || !isfinite(x[i]))
+            return ts_fail(err, TS_EINVAL, "excitation %s (csv): sample %d "
+                           "is not finite (t = %g s, x = %g m)", an, i + 1,
+                           t[i], x[i]);
+        if (i > 0) {
+            if (!(t[i] > t[i - 1]))
+                return ts_fail(err, TS_EINVAL, "excitation %s (csv): times "
+                               "must increase, sample %d has t = %g s after "
+                               "%g s", an, i + 1, t[i], t[i - 1]);
+            if (t[i] - t[i - 1] < dtmin)
+                dtmin = t[i] - t[i - 1];
+        }
+    }
+    if (t[0] > 0)
+        return ts_fail(err, TS_EINVAL, "excitation %s (csv): the series must "
+                       "start at t <= 0 s (the run starts at 0), its first "
+                       "time is %g s", an, t[0]);
+    int rc = grow(ex, err);
+    if (rc)
+        return rc;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    gsl_spline *sp = gsl_spline_alloc(gsl_interp_cspline, (size_t)n);
+    int st = sp ? gsl_spline_init(sp, t, x, (size_t)n) : GSL_ENOMEM;
+    gsl_set_error_handler(old);
+    if (st) {
+        gsl_spline_free(sp);
+        return ts_fail(err, st == GSL_ENOMEM ? TS_ENOMEM : TS_EINVAL,
+                       "excitation %s (csv): the cubic spline failed (%s)",
+                       an, gsl_strerror(st));
+    }
+    ts_signal s = {0};
+    s.type = TS_SIGNAL_SERIES;
+    s.axis = axis;
+    s.start = t[0];
+    s.duration = t[n - 1] - t[0];
+    ex->sig[ex->n] = s;
+    ex->spline[ex->n] = sp;
+    ex->series_dt[ex->n] = dtmin;
+    ex->n++;
+    return TS_OK;
+}
+
+/* Skip blanks. */
+static const char *skip_ws(const char *s)
+{
+    while (*s == ' ' || *s == '\t' || *s == '\r')
+        s++;
+    return s;
+}
+
+/* Parse one CSV field as a number, advancing *s past it and a comma. */
+static int csv_number(const char **s, double *v)
+{
+    const char *p = skip_ws(*s);
+    char *end;
+    errno = 0;
+    *v = strtod(p, &end);
+    if (end == p || errno == ERANGE || !isfinite(*v))
+        return -1;
+    p = skip_ws(end);
+    if (*p == ',')
+        p++;
+    else if (*p != '\0' && *p != '\n')
+        return -1;
+    *s = p;
+    return 0;
+}
+
+int ts_excitation_read_series(ts_excitation *ex, ts_axis axis,
+                              const char *path, ts_err *err)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return ts_fail(err, TS_EIO, "excitation %s (csv): cannot read '%s': "
+                       "%s", ts_axis_name(axis), path, strerror(errno));
+    double *t = NULL, *x = NULL;
+    int n = 0, cap = 0, lineno = 0, data_lines = 0, rc = TS_OK;
+    char line[LINE_MAX_CSV];
+    while (fgets(line, sizeof line, f)) {
+        lineno++;
+        size_t len = strlen(line);
+        if (len == sizeof line - 1 && line[len - 1] != '\n') {
+            rc = ts_fail(err, TS_EINVAL, "%s line %d: longer than %d "
+                         "characters", path, lineno, LINE_MAX_CSV - 2);
+            break;
+        }
+        while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r'))
+            line[--len] = '\0';
+        const char *s = skip_ws(line);
+        if (*s == '#' || *s == '\0')
+            continue;
+        data_lines++;
+        const char *p = s;
+        double tv, xv;
+        if (csv_number(&p, &tv) || csv_number(&p, &xv)) {
+            if (data_lines == 1 && isalpha((unsigned char)*s))
+                continue; /* a header */
+            rc = ts_fail(err, TS_EINVAL, "%s line %d: expected two numbers "
+                         "'time_s,displacement_m', got '%.40s'", path,
+                         lineno, s);
+            break;
+        }
+        if (n == cap) {
+            cap = cap ? 2 * cap : 256;
+            double *nt = realloc(t, (size_t)cap * sizeof *t);
+            if (nt)
+                t = nt;
+            double *nx = realloc(x, (size_t)cap * sizeof *x);
+            if (nx)
+                x = nx;
+            if (!nt || !nx) {
+                rc = ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+                break;
+            }
+        }
+        t[n] = tv;
+        x[n] = xv;
+        n++;
+    }
+    if (!rc && ferror(f))
+        rc = ts_fail(err, TS_EIO, "%s: read error", path);
+    fclose(f);
+    if (!rc) {
+        rc = ts_excitation_add_series(ex, axis, n, t, x, err);
+        if (rc)
+            ts_err_prefix(err, "%s: ", path);
+    }
+    free(t);
+    free(x);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Parsing "AXIS:key=value,..."                                         */
+
+enum {
+    K_TYPE, K_AMPLITUDE, K_FREQUENCY, K_PERIOD, K_PHASE, K_ROD, K_START,
+    K_DURATION, K_RISE, K_TO, K_BY, K_FILE, K_N
+};
+static const char *const key_names[K_N] = {
+    "type", "amplitude", "frequency", "period", "phase", "rod", "start",
+    "duration", "rise", "to", "by", "file"};
+
+/* Keys each type accepts (besides `type`), as a bit set over K_*. */
+static unsigned keys_for(ts_signal_type t, int tow)
+{
+#define B(k) (1u << (k))
+    switch (t) {
+    case TS_SIGNAL_SINE:
+        return B(K_AMPLITUDE) | B(K_FREQUENCY) | B(K_PERIOD) | B(K_PHASE);
+    case TS_SIGNAL_CRANK:
+        return B(K_AMPLITUDE) | B(K_FREQUENCY) | B(K_PERIOD) | B(K_PHASE) |
+               B(K_ROD);
+    case TS_SIGNAL_STEP:
+        return (tow ? B(K_AMPLITUDE) : B(K_TO) | B(K_BY)) | B(K_START) |
+               B(K_RISE);
+    case TS_SIGNAL_RAMP:
+        return (tow ? B(K_AMPLITUDE) : B(K_TO) | B(K_BY)) | B(K_START) |
+               B(K_DURATION) | B(K_RISE);
+    case TS_SIGNAL_SERIES:
+        return B(K_FILE);
+    }
+    return 0;
+#undef B
+}
+
+static void key_list(unsigned set, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    for (int k = 0; k < K_N; k++)
+        if (set & (1u << k)) {
+            if (buf[0])
+                strncat(buf, ", ", size - strlen(buf) - 1);
+            strncat(buf, key_names[k], size - strlen(buf) - 1);
+        }
+}
+
+static int parse_axis(const char *name, ts_axis *a)
+{
+    static const struct { const char *name; ts_axis axis; } tab[] = {
+        {"tow.surge", TS_AXIS_SURGE}, {"tow.x", TS_AXIS_SURGE},
+        {"tow.sway", TS_AXIS_SWAY},   {"tow.y", TS_AXIS_SWAY},
+        {"tow.heave", TS_AXIS_HEAVE}, {"tow.z", TS_AXIS_HEAVE},
+        {"speed", TS_AXIS_SPEED},     {"turn_rate", TS_AXIS_TURN_RATE}};
+    for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++)
+        if (!strcmp(name, tab[i].name)) {
+            *a = tab[i].axis;
+            return 0;
+        }
+    return -1;
+}
+
+/* Trim blanks at both ends in place. */
+static char *trim(char *s)
+{
+    while (*s == ' ' || *s == '\t')
+        s++;
+    size_t n = strlen(s);
+    while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t'))
+        s[--n] = '\0';
+    return s;
+}
+
+int ts_excitation_parse(ts_excitation *ex, const char *spec,
+                        const ts_units *units, const char *where,
+                        ts_err *err)
+{
+    if (!where)
+        where = "excitation";
+    if (!spec || strlen(spec) >= SPEC_MAX)
+        return ts_fail(err, TS_EINVAL, "%s: expected AXIS[:key=value,...] "
+                       "of at most %d characters", where, SPEC_MAX - 1);
+    char buf[SPEC_MAX];
+    snprintf(buf, sizeof buf, "%s", spec);
+    char *colon = strchr(buf, ':');
+    if (colon)
+        *colon = '\0';
+    char *axis_name = trim(buf);
+    ts_axis axis;
+    if (parse_axis(axis_name, &axis))
+        return ts_fail(err, TS_EINVAL, "%s: unknown axis '%.60s'; expected "
+                       "tow.surge, tow.sway, tow.heave (or tow.x, tow.y, "
+                       "tow.z), speed or turn_rate", where, axis_name);
+    int tow = is_tow_axis(axis);
+    const char *an = ts_axis_name(axis);
+
+    /* Collect key=value pairs. */
+    char *val[K_N] = {0};
+    char *rest = colon ? colon + 1 : NULL;
+    while (rest && *trim(rest)) {
+        char *comma = strchr(rest, ',');
+        if (comma)
+            *comma = '\0';
+        char *item = trim(rest);
+        rest = comma ? comma + 1 : NULL;
+        if (!*item)
+            return ts_fail(err, TS_EINVAL, "%s: %s: empty item; expected "
+                           "key=value separated by commas", where, an);
+        char *eq = strchr(item, '=');
+        if (!eq)
+            return ts_fail(err, TS_EINVAL, "%s: %s: '%.60s' is not "
+                           "key=value", where, an, item);
+        *eq = '\0';
+        char *key = trim(item), *value = trim(eq + 1);
+        int k = 0;
+        while (k < K_N && strcmp(key, key_names[k]))
+            k++;
+        if (k == K_N) {
+            char list[256];
+            key_list((1u << K_N) - 1, list, sizeof list);
+            return ts_fail(err, TS_EINVAL, "%s: %s: unknown parameter "
+                           "'%.60s'; expected one of %s", where, an, key,
+                           list);
+        }
+        if (val[k])
+            return ts_fail(err, TS_EINVAL, "%s: %s: '%s' given twice", where,
+                           an, key);
+        if (!*value)
+            return ts_fail(err, TS_EINVAL, "%s: %s: '%s' has no value", where,
+                           an, key);
+        val[k] = value;
+    }
+
+    ts_signal s = {0};
+    s.axis = axis;
+    s.type = tow ? TS_SIGNAL_SINE : TS_SIGNAL_RAMP;
+    if (val[K_TYPE]) {
+        static const char *const types[] = {"sine", "crank", "step", "ramp",
+                                            "csv"};
+        int t = 0;
+        while (t < 5 && strcmp(val[K_TYPE], types[t]))
+            t++;
+        if (t == 5)
+            return ts_fail(err, TS_EINVAL, "%s: %s: unknown type '%.40s'; "
+                           "expected %s", where, an, val[K_TYPE],
+                           tow ? "sine, crank, step, ramp or csv"
+                               : "step or ramp");
+        s.type = (ts_signal_type)t;
+    }
+    unsigned allowed = keys_for(s.type, tow);
+    if (!tow && s.type != TS_SIGNAL_STEP && s.type != TS_SIGNAL_RAMP)
+        return ts_fail(err, TS_EINVAL, "%s: %s: a manoeuvre is a step or a "
+                       "ramp, got type %s", where, an,
+                       ts_signal_type_name(s.type));
+    for (int k = 1; k < K_N; k++)
+        if (val[k] && !(allowed & (1u << k))) {
+            char list[256];
+            key_list(allowed, list, sizeof list);
+            return ts_fail(err, TS_EINVAL, "%s: %s: parameter '%s' does not "
+                           "apply to type %s; expected %s", where, an,
+                           key_names[k], ts_signal_type_name(s.type), list);
+        }
+
+    if (s.type == TS_SIGNAL_SERIES) {
+        if (!val[K_FILE])
+            return ts_fail(err, TS_EINVAL, "%s: %s: type csv needs "
+                           "file=PATH", where, an);
+        int rc = ts_excitation_read_series(ex, axis, val[K_FILE], err);
+        if (rc)
+            ts_err_prefix(err, "%s: ", where);
+        return rc;
+    }
+
+    /* Quantities, each with its SI unit. */
+    const char *amp_unit = tow ? "m" : axis == TS_AXIS_SPEED ? "m/s" : "rad/s";
+    double period = 0;
+    const struct { int key; const char *unit; double *dst; } q[] = {
+        {K_AMPLITUDE, amp_unit, &s.amplitude}, {K_TO, amp_unit, &s.amplitude},
+        {K_BY, amp_unit, &s.amplitude},        {K_FREQUENCY, "Hz", &s.frequency},
+        {K_PERIOD, "s", &period},              {K_PHASE, "rad", &s.phase},
+        {K_ROD, "m", &s.rod},                  {K_START, "s", &s.start},
+        {K_DURATION, "s", &s.duration},        {K_RISE, "s", &s.rise}};
+    for (size_t i = 0; i < sizeof q / sizeof q[0]; i++) {
+        if (!val[q[i].key])
+            continue;
+        char w[160];
+        snprintf(w, sizeof w, "%s: %s: %s", where, an, key_names[q[i].key]);
+        int rc = ts_units_parse(units, val[q[i].key], q[i].unit, w, q[i].dst,
+                                err);
+        if (rc)
+            return rc;
+    }
+    int need_amp = !(s.type == TS_SIGNAL_STEP || s.type == TS_SIGNAL_RAMP) ||
+                   tow;
+    if (need_amp && !val[K_AMPLITUDE])
+        return ts_fail(err, TS_EINVAL, "%s: %s: type %s needs amplitude=",
+                       where, an, ts_signal_type_name(s.type));
+    if (!tow) {
+        if (!!val[K_TO] + !!val[K_BY] != 1)
+            return ts_fail(err, TS_EINVAL, "%s: %s: give exactly one of to= "
+                           "(final value) and by= (change)", where, an);
+        s.absolute = val[K_TO] != NULL;
+    }
+    if (s.type == TS_SIGNAL_SINE || s.type == TS_SIGNAL_CRANK) {
+        if (!!val[K_FREQUENCY] + !!val[K_PERIOD] != 1)
+            return ts_fail(err, TS_EINVAL, "%s: %s: give exactly one of "
+                           "frequency= and period=", where, an);
+        if (val[K_PERIOD]) {
+            if (!(period > 0))
+                return ts_fail(err, TS_EINVAL, "%s: %s: period must be > 0 "
+                               "s, got %g s", where, an, period);
+            s.frequency = 1.0 / period;
+        }
+    }
+    if (s.type == TS_SIGNAL_CRANK && !val[K_ROD])
+        return ts_fail(err, TS_EINVAL, "%s: %s: type crank needs rod= (the "
+                       "connecting rod length)", where, an);
+    if (s.type == TS_SIGNAL_RAMP && !val[K_DURATION])
+        return ts_fail(err, TS_EINVAL, "%s: %s: type ramp needs duration=",
+                       where, an);
+    if ((s.type == TS_SIGNAL_STEP || s.type == TS_SIGNAL_RAMP) &&
+        !val[K_RISE]) {
+        s.rise = TS_SIGNAL_RISE;
+        if (s.type == TS_SIGNAL_RAMP && s.duration > 0 &&
+            s.duration < s.rise)
+            s.rise = s.duration;
+    }
+    int rc = ts_excitation_add(ex, &s, err);
+    if (rc)
+        ts_err_prefix(err, "%s: ", where);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Evaluation                                                           */
+
+/* Quintic smooth step and its derivatives, clamped outside [0, 1]. */
+static double s5(double x)
+{
+    if (x <= 0)
+        return 0.0;
+    if (x >= 1)
+        return 1.0;
+    return x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
+}
+static double s5d(double x)
+{
+    if (x <= 0 || x >= 1)
+        return 0.0;
+    double y = x * (1.0 - x);
+    return 30.0 * y * y;
+}
+static double s5dd(double x)
+{
+    if (x <= 0 || x >= 1)
+        return 0.0;
+    return 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x);
+}
+/* I(x) = int_0^x s5, J(x) = int_0^x I. */
+static double s5i(double x)
+{
+    if (x <= 0)
+        return 0.0;
+    if (x >= 1)
+        return x - 0.5;
+    double x4 = x * x * x * x;
+    return x4 * (2.5 + x * (-3.0 + x));
+}
+static double s5ii(double x)
+{
+    if (x <= 0)
+        return 0.0;
+    if (x >= 1)
+        return 1.0 / 7.0 + 0.5 * x * (x - 1.0);
+    double x5 = x * x * x * x * x;
+    return x5 * (0.5 + x * (-0.5 + x / 7.0));
+}
+
+/* Value and first two derivatives of signal i at t, with the amplitude
+ * `amp` (the signal's own, or a manoeuvre's change). */
+static void signal_eval(const ts_excitation *ex, int i, double amp, double t,
+                        double *x, double *v, double *a)
+{
+    const ts_signal *s = &ex->sig[i];
+    switch (s->type) {
+    case TS_SIGNAL_SINE: {
+        double w = 2.0 * M_PI * s->frequency, th = w * t + s->phase;
+        double sn = sin(th), cs = cos(th);
+        *x = amp * sn;
+        *v = amp * w * cs;
+        *a = -amp * w * w * sn;
+        return;
+    }
+    case TS_SIGNAL_CRANK: {
+        double w = 2.0 * M_PI * s->frequency, th = w * t + s->phase;
+        double r = amp, l = s->rod, sn = sin(th), cs = cos(th);
+        double S = sqrt(l * l - r * r * sn * sn);
+        double g = r * r * sn * cs;
+        *x = r * cs + l - S;
+        *v = w * (-r * sn + g / S);
+        *a = w * w * (-r * cs + r * r * cos(2.0 * th) / S + g * g / (S * S * S));
+        return;
+    }
+    case TS_SIGNAL_STEP: {
+        double xi = (t - s->start) / s->rise;
+        *x = amp * s5(xi);
+        *v = amp * s5d(xi) / s->rise;
+        *a = amp * s5dd(xi) / (s->rise * s->rise);
+        return;
+    }
+    case TS_SIGNAL_RAMP: {
+        double tau = s->rise, T = s->duration;
+        double x1 = (t - s->start) / tau, x2 = x1 - T / tau;
+        *x = amp * tau / T * (s5i(x1) - s5i(x2));
+        *v = amp / T * (s5(x1) - s5(x2));
+        *a = amp / (T * tau) * (s5d(x1) - s5d(x2));
+        return;
+    }
+    case TS_SIGNAL_SERIES: {
+        const gsl_spline *sp = ex->spline[i];
+        double lo = s->start, hi = s->start + s->duration;
+        double tc = t < lo ? lo : (t > hi ? hi : t);
+        /* Outside its span a series holds its end value. */
+        *x = gsl_spline_eval(sp, tc, NULL);
+        *v = tc == t ? gsl_spline_eval_deriv(sp, tc, NULL) : 0.0;
+        *a = tc == t ? gsl_spline_eval_deriv2(sp, tc, NULL) : 0.0;
+        return;
+    }
+    }
+    *x = *v = *a = 0.0;
+}
+
+/* Integral over [0, t] of a step or ramp manoeuvre of amplitude amp. */
+static double signal_integral(const ts_signal *s, double amp, double t)
+{
+    if (s->type == TS_SIGNAL_STEP)
+        return amp * s->rise * s5i((t - s->start) / s->rise);
+    double tau = s->rise, T = s->duration;
+    double x1 = (t - s->start) / tau, x2 = x1 - T / tau;
+    return amp * tau * tau / T * (s5ii(x1) - s5ii(x2));
+}
+
+int ts_excitation_nsignals(const ts_excitation *ex) { return ex->n; }
+
+const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i)
+{
+    return i >= 0 && i < ex->n ? &ex->sig[i] : NULL;
+}
+
+int ts_excitation_has_manoeuvre(const ts_excitation *ex)
+{
+    for (int i = 0; i < ex->n; i++)
+        if (!is_tow_axis(ex->sig[i].axis))
+            return 1;
+    return 0;
+}
+
+void ts_excitation_input(const ts_excitation *ex, double t,
+                         double u[TS_NINPUT])
+{
+    for (int j = 0; j < TS_NINPUT; j++)
+        u[j] = 0.0;
+    for (int i = 0; i < ex->n; i++) {
+        int ax = ex->sig[i].axis;
+        if (!is_tow_axis(ax))
+            continue;
+        double x, v, a;
+        signal_eval(ex, i, ex->sig[i].amplitude, t, &x, &v, &a);
+        u[ax] += x;
+        u[3 + ax] += v;
+        u[6 + ax] += a;
+    }
+}
+
+/* The change a manoeuvre signal makes, given the base value. */
+static double manoeuvre_amp(const ts_signal *s, double base)
+{
+    return s->absolute ? s->amplitude - base : s->amplitude;
+}
+
+double ts_excitation_heading(const ts_excitation *ex, const ts_frame *base,
+                             double t)
+{
+    double psi = base->turn_rate * t;
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (s->axis == TS_AXIS_TURN_RATE)
+            psi += signal_integral(s, manoeuvre_amp(s, base->turn_rate), t);
+    }
+    return psi;
+}
+
+void ts_excitation_frame(const ts_excitation *ex, const ts_frame *base,
+                         double t, ts_frame *f)
+{
+    ts_frame b = *base;
+    ts_frame out = b;
+    out.speed_rate = 0.0;
+    out.turn_accel = 0.0;
+    double psi = b.turn_rate * t;
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (is_tow_axis(s->axis))
+            continue;
+        double b0 = s->axis == TS_AXIS_SPEED ? b.speed : b.turn_rate;
+        double amp = manoeuvre_amp(s, b0), x, v, a;
+        signal_eval(ex, i, amp, t, &x, &v, &a);
+        if (s->axis == TS_AXIS_SPEED) {
+            out.speed += x;
+            out.speed_rate += v;
+        } else {
+            out.turn_rate += x;
+            out.turn_accel += v;
+            psi += signal_integral(s, amp, t);
+        }
+    }
+    /* The current is fixed in inertial space: rotate it into M. */
+    double c = cos(psi), sn = sin(psi);
+    out.current[0] = c * b.current[0] + sn * b.current[1];
+    out.current[1] = -sn * b.current[0] + c * b.current[1];
+    out.current[2] = b.current[2];
+    *f = out;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
+                              double out[], int max)
+{
+    /* At most four per signal. */
+    double *all = malloc((size_t)(4 * ex->n + 1) * sizeof *all);
+    if (!all)
+        return 0;
+    int m = 0;
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (s->type == TS_SIGNAL_STEP) {
+            all[m++] = s->start;
+            all[m++] = s->start + s->rise;
+        } else if (s->type == TS_SIGNAL_RAMP) {
+            all[m++] = s->start;
+            all[m++] = s->start + s->rise;
+            all[m++] = s->start + s->duration;
+            all[m++] = s->start + s->duration + s->rise;
+        }
+    }
+    qsort(all, (size_t)m, sizeof *all, cmp_double);
+    int k = 0;
+    for (int i = 0; i < m; i++) {
+        if (!(all[i] > 0 && all[i] < t_end))
+            continue;
+        if (k > 0 && all[i] - all[k - 1] <= 1e-12 * (1.0 + all[i]))
+            continue;
+        all[k++] = all[i];
+    }
+    for (int i = 0; i < k && i < max; i++)
+        out[i] = all[i];
+    free(all);
+    return k;
+}
+
+double ts_excitation_time_scale(const ts_excitation *ex)
+{
+    double ts = INFINITY;
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (!is_tow_axis(s->axis))
+            continue;
+        double v = INFINITY;
+        switch (s->type) {
+        case TS_SIGNAL_SINE: v = 1.0 / (2.0 * M_PI * s->frequency); break;
+        case TS_SIGNAL_CRANK: v = 1.0 / (4.0 * M_PI * s->frequency); break;
+        case TS_SIGNAL_STEP:
+        case TS_SIGNAL_RAMP: v = s->rise; break;
+        case TS_SIGNAL_SERIES: v = ex->series_dt[i]; break;
+        }
+        if (v < ts)
+            ts = v;
+    }
+    return ts;
+}
+
+int ts_excitation_check_span(const ts_excitation *ex, double t_end,
+                             ts_err *err)
+{
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (s->type != TS_SIGNAL_SERIES)
+            continue;
+        double hi = s->start + s->duration;
+        if (hi < t_end * (1.0 - SPAN_RTOL))
+            return ts_fail(err, TS_EINVAL, "excitation %s (csv): the series "
+                           "ends at %g s, before the end of the run (%g s); "
+                           "extend it or shorten the run",
+                           ts_axis_name(s->axis), hi, t_end);
+    }
+    return TS_OK;
+}
+
+int ts_excitation_periodic(const ts_excitation *ex, int *index)
+{
+    int found = -1;
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK) {
+            if (found >= 0)
+                return 0;
+            found = i;
+        }
+    }
+    if (found < 0)
+        return 0;
+    *index = found;
+    return 1;
+}
+
+void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
+                            size_t size)
+{
+    const ts_signal *s = &ex->sig[i];
+    const char *an = ts_axis_name(s->axis);
+    const char *u = is_tow_axis(s->axis) ? "m"
+                    : s->axis == TS_AXIS_SPEED ? "m/s" : "rad/s";
+    const char *what = s->absolute ? "to" : is_tow_axis(s->axis)
+                                                ? "amplitude" : "by";
+    switch (s->type) {
+    case TS_SIGNAL_SINE:
+        snprintf(buf, size, "%s sine amplitude %.6g m, frequency %.6g Hz, "
+                 "phase %.6g deg", an, s->amplitude, s->frequency,
+                 s->phase * 180.0 / M_PI);
+        return;
+    case TS_SIGNAL_CRANK:
+        snprintf(buf, size, "%s slider crank radius %.6g m, rod %.6g m, "
+                 "frequency %.6g Hz, phase %.6g deg", an, s->amplitude,
+                 s->rod, s->frequency, s->phase * 180.0 / M_PI);
+        return;
+    case TS_SIGNAL_STEP:
+        snprintf(buf, size, "%s step %s %.6g %s at %.6g s, rise %.6g s", an,
+                 what, s->amplitude, u, s->start, s->rise);
+        return;
+    case TS_SIGNAL_RAMP:
+        snprintf(buf, size, "%s ramp %s %.6g %s from %.6g s over %.6g s, "
+                 "corners %.6g s", an, what, s->amplitude, u, s->start,
+                 s->duration, s->rise);
+        return;
+    case TS_SIGNAL_SERIES:
+        snprintf(buf, size, "%s series (cubic spline) on [%.6g, %.6g] s, "
+                 "spacing >= %.6g s", an, s->start, s->start + s->duration,
+                 ex->series_dt[i]);
+        return;
+    }
+    snprintf(buf, size, "%s ?", an);
+}

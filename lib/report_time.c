@@ -1,0 +1,210 @@
+/* report_time.c: JSON and CSV of time-domain results
+ * (towstab/report_time.h). Numbers are written with 17 significant digits
+ * (CSV %.17g; JSON through ts_report_write_json) so a history read back
+ * reproduces the run bit for bit; non-finite values are JSON null and CSV
+ * "nan". */
+#include "towstab/report_time.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "towstab/report.h"
+
+static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
+
+/* A JSON array of n values read with a stride. */
+static json_t *series(const double *base, int n, size_t stride)
+{
+    json_t *a = json_array();
+    for (int i = 0; a && i < n; i++)
+        json_array_append_new(a, num(base[stride * (size_t)i]));
+    return a;
+}
+
+json_t *ts_report_sim_stats_json(const ts_sim_stats *st, const char *method)
+{
+    double ratio = st->wall_s > 0 ? st->t_reached / st->wall_s : NAN;
+    return json_pack("{s:s,s:I,s:I,s:I,s:I,s:I,s:I,s:o,s:o,s:o,s:o}",
+                     "method", method, "steps", (json_int_t)st->steps,
+                     "rejected", (json_int_t)st->rejected, "evaluations",
+                     (json_int_t)st->evaluations, "jacobians",
+                     (json_int_t)st->jacobians, "recharts",
+                     (json_int_t)st->recharts, "restarts",
+                     (json_int_t)st->restarts, "t_reached",
+                     num(st->t_reached), "h_last", num(st->h_last), "wall_s",
+                     num(st->wall_s), "simulated_per_wall", num(ratio));
+}
+
+json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
+                               int node)
+{
+    json_t *o = json_object(), *nodes = json_array();
+    if (!o || !nodes) {
+        json_decref(o);
+        json_decref(nodes);
+        return NULL;
+    }
+    int n = h->nsamples;
+    size_t ps = 3 * (size_t)h->nnodes;
+    json_object_set_new(o, "t", series(h->t, n, 1));
+    char name[2 * TS_NAME_MAX];
+    for (int k = 0; k < h->nnodes; k++) {
+        if (node >= 0 && k != node)
+            continue;
+        ts_report_node_name(sys, k, name, sizeof name);
+        const double *p = h->positions + 3 * (size_t)k;
+        json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name",
+                                               name, "x", series(p, n, ps),
+                                               "y", series(p + 1, n, ps), "z",
+                                               series(p + 2, n, ps)));
+    }
+    json_object_set_new(o, "nodes", nodes);
+    int nonlinear = n > 0 && h->nlinks > 0 && isfinite(h->tensions[0]);
+    if (node < 0 && nonlinear) {
+        json_t *ten = json_array();
+        for (int l = 0; ten && l < h->nlinks; l++) {
+            const ts_link *L = &sys->links[l];
+            json_array_append_new(
+                ten, json_pack("{s:s,s:i,s:o}", "cable",
+                               sys->cables[L->cable].name, "index", L->index,
+                               "tension", series(h->tensions + l, n,
+                                                 (size_t)h->nlinks)));
+        }
+        json_object_set_new(o, "tensions", ten);
+        json_object_set_new(o, "energy",
+                            json_pack("{s:o,s:o}", "kinetic",
+                                      series(h->energy, n, 2), "potential",
+                                      series(h->energy + 1, n, 2)));
+    }
+    return o;
+}
+
+json_t *ts_report_compare_json(const ts_compare *c)
+{
+    json_t *exc = c->periodic
+        ? json_pack("{s:s,s:s,s:o,s:o,s:o}", "axis",
+                    ts_axis_name(c->exc_axis), "type",
+                    ts_signal_type_name(c->exc_type), "amplitude",
+                    num(c->exc_amplitude), "frequency_hz",
+                    num(c->exc_frequency_hz), "fitted_amplitude",
+                    num(c->exc_fit_amplitude))
+        : json_pack("{s:n,s:n,s:n,s:n}", "axis", "type", "amplitude",
+                    "frequency_hz");
+    json_t *runs[2];
+    const ts_compare_run *r[2] = {&c->linear, &c->nonlinear};
+    for (int i = 0; i < 2; i++)
+        runs[i] = json_pack("{s:o,s:o,s:o,s:o,s:o}", "amplitude_ratio",
+                            num(r[i]->amplitude_ratio), "phase_deg",
+                            num(r[i]->phase_deg), "mean_offset",
+                            num(r[i]->mean_offset), "amplitude",
+                            num(r[i]->amplitude), "half_range",
+                            num(r[i]->half_range));
+    return json_pack(
+        "{s:s,s:o,s:{s:o,s:o,s:i},s:o,s:o,s:o,s:{s:o,s:o},s:o,s:o,s:o,s:o}",
+        "output", c->output.name, "excitation", exc, "window", "from_s",
+        num(c->t_from), "to_s", num(c->t_to), "samples", c->nsamples,
+        "equilibrium", num(c->equilibrium), "linear", runs[0], "nonlinear",
+        runs[1], "response_prediction", "amplitude_ratio", num(c->pred_ratio),
+        "phase_deg", num(c->pred_phase_deg), "amplitude_difference_pct",
+        num(c->amplitude_difference_pct), "mean_difference_pct",
+        num(c->mean_difference_pct), "rms_difference",
+        num(c->rms_difference), "rms_difference_ratio",
+        num(c->rms_difference_ratio));
+}
+
+json_t *ts_report_excitation_json(const ts_excitation *ex)
+{
+    json_t *a = json_array();
+    int n = ex ? ts_excitation_nsignals(ex) : 0;
+    for (int i = 0; a && i < n; i++) {
+        const ts_signal *s = ts_excitation_signal(ex, i);
+        json_t *o = json_pack("{s:s,s:s}", "axis", ts_axis_name(s->axis),
+                              "type", ts_signal_type_name(s->type));
+        switch (s->type) {
+        case TS_SIGNAL_CRANK:
+            json_object_set_new(o, "rod", num(s->rod));
+            /* fall through */
+        case TS_SIGNAL_SINE:
+            json_object_set_new(o, "amplitude", num(s->amplitude));
+            json_object_set_new(o, "frequency_hz", num(s->frequency));
+            json_object_set_new(o, "phase_deg", num(s->phase * 180 / M_PI));
+            break;
+        case TS_SIGNAL_RAMP:
+            json_object_set_new(o, "duration", num(s->duration));
+            /* fall through */
+        case TS_SIGNAL_STEP:
+            json_object_set_new(o, s->absolute ? "to" : "amplitude",
+                                num(s->amplitude));
+            json_object_set_new(o, "start", num(s->start));
+            json_object_set_new(o, "rise", num(s->rise));
+            break;
+        case TS_SIGNAL_SERIES:
+            json_object_set_new(o, "from_s", num(s->start));
+            json_object_set_new(o, "to_s", num(s->start + s->duration));
+            break;
+        }
+        json_array_append_new(a, o);
+    }
+    return a;
+}
+
+static void csv_header(FILE *f, const ts_system *sys, const ts_history *h,
+                       const char *prefix)
+{
+    char name[2 * TS_NAME_MAX];
+    for (int k = 0; k < h->nnodes; k++) {
+        ts_report_node_name(sys, k, name, sizeof name);
+        fprintf(f, ",%s%s.x_m,%s%s.y_m,%s%s.z_m", prefix, name, prefix, name,
+                prefix, name);
+    }
+    if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0]))
+        for (int l = 0; l < h->nlinks; l++)
+            fprintf(f, ",%s%s.%d.tension_N", prefix,
+                    sys->cables[sys->links[l].cable].name,
+                    sys->links[l].index);
+}
+
+static void csv_row(FILE *f, const ts_history *h, int i)
+{
+    const double *p = h->positions + 3 * (size_t)h->nnodes * (size_t)i;
+    for (int k = 0; k < 3 * h->nnodes; k++)
+        fprintf(f, ",%.17g", p[k]);
+    if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0])) {
+        const double *t = h->tensions + (size_t)h->nlinks * (size_t)i;
+        for (int l = 0; l < h->nlinks; l++)
+            fprintf(f, ",%.17g", t[l]);
+    }
+}
+
+int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
+                          const ts_history *li, const char *path,
+                          ts_err *err)
+{
+    if (!nl && !li)
+        return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
+    char tmp[1024];
+    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
+    if (!f)
+        return TS_EIO;
+    int both = nl && li;
+    const ts_history *first = nl ? nl : li;
+    int rows = first->nsamples;
+    if (both && li->nsamples < rows)
+        rows = li->nsamples;
+    fprintf(f, "t_s");
+    if (nl)
+        csv_header(f, sys, nl, both ? "nonlinear." : "");
+    if (li)
+        csv_header(f, sys, li, both ? "linear." : "");
+    fputc('\n', f);
+    for (int i = 0; i < rows; i++) {
+        fprintf(f, "%.17g", first->t[i]);
+        if (nl)
+            csv_row(f, nl, i);
+        if (li)
+            csv_row(f, li, i);
+        fputc('\n', f);
+    }
+    return ts_report_commit(f, path, tmp, err);
+}

@@ -1,0 +1,973 @@
+/* simulate.c: nonlinear and linear time-domain simulation
+ * (towstab/simulate.h; doc/simulate.md).
+ *
+ * Nonlinear. GSL odeiv2 integrates y' = f(t, y) = kernel(y, u(t)) with the
+ * frame of time t (ts_excitation_frame: speed, turn rate, their rates, the
+ * current rotated into M). A GSL driver owns the stepper, the standard
+ * error control (|err_i| <= abs_tol + rel_tol |y_i|) and the evolve object;
+ * we call gsl_odeiv2_evolve_apply ourselves, one accepted step at a time,
+ * so that after each step we can
+ *   - re-chart links whose |cos theta2| fell below the threshold
+ *     (ts_kernel_rechart) and restart the stepper (gsl_odeiv2_driver_reset:
+ *     multistep histories and FSAL derivatives refer to the old numbers);
+ *   - stop exactly at output times and excitation breakpoints (the target
+ *     of evolve_apply), so no step straddles a kink of u(t);
+ *   - enforce h_min, the step limit and finiteness.
+ * The right-hand side returns GSL_FAILURE when the kernel refuses a trial
+ * state near the chart singularity (TS_CHART): evolve then retries with a
+ * smaller step. A fatal kernel error returns GSL_EBADFUNC, which evolve
+ * passes straight back. Implicit steppers get df/dy from ts_linearize
+ * (central differences through the kernel, O(nlinks^2)); df/dt, used by
+ * bsimp only, is a central difference of f in time.
+ *
+ * Linear, exact discretisation (Van Loan 1978, "Computing integrals
+ * involving the matrix exponential", IEEE TAC 23(3)). On a step of length
+ * h the input v(t) = u(t) - u0 is replaced by the cubic through its values
+ * at t + {0, 1/3, 2/3, 1} h, v(t + s) = p0 + p1 s + p2 s^2/2 + p3 s^3/6.
+ * Then z(t + h) = Phi z(t) + sum_k G_k p_k exactly, where Phi and G_k are
+ * the top blocks of exp(M h), M = [[A, B, 0, 0, 0], [0, 0, I, 0, 0],
+ * [0, 0, 0, I, 0], [0, 0, 0, 0, I], [0, 0, 0, 0, 0]] (order n + 4 m, m = 9).
+ * The only error is the input interpolation: for a harmonic of angular
+ * frequency w it is below 5.1e-4 (w h)^4 of its amplitude (the
+ * interpolation remainder w^4/4! max|prod (s - s_j)|, max 0.01227 h^4), so
+ * h is chosen as tau (rel_tol / 5.1e-4)^(1/4), tau the excitation's
+ * shortest time scale, and at most the output interval. Each distinct h
+ * costs one exponential (two at most per run: the regular interval and a
+ * shorter last one).
+ */
+#include "towstab/simulate.h"
+
+#include <float.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "expm.h"
+
+void dgemv_(const char *trans, const int *m, const int *n,
+            const double *alpha, const double *a, const int *lda,
+            const double *x, const int *incx, const double *beta, double *y,
+            const int *incy, size_t trans_len);
+
+/* Interpolation error constant of the cubic input hold (see above). */
+#define CUBIC_HOLD_ERR 5.1e-4
+/* Relative slack when deciding that t_end is a multiple of dt_sample. */
+#define SAMPLE_RTOL 1e-9
+/* Relative time step of the df/dt central difference (bsimp), times the
+ * excitation's time scale (capped at 1 s). */
+#define DFDT_REL_STEP 6e-6
+
+static double wall_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+void ts_sim_opts_default(ts_sim_opts *o)
+{
+    o->integrator = TS_INT_RK8PD;
+    o->t_end = 10.0;
+    o->dt_sample = 0.1;
+    o->rel_tol = 1e-6;
+    o->abs_tol = 1e-9;
+    o->h_init = 1e-3;
+    o->h_min = 0.0;
+    o->max_steps = 0;
+    o->rechart = TS_CHART_RECHART;
+    o->linear_method = TS_LINSIM_EXPM;
+    o->kinematics = TS_KIN_LINEAR;
+    o->jacobian_threads = 1;
+}
+
+static const char *const integrator_names[] = {"rk8pd", "rkf45", "rk4imp",
+                                               "bsimp", "msbdf"};
+
+const char *ts_integrator_name(ts_integrator m)
+{
+    return m >= TS_INT_RK8PD && m <= TS_INT_MSBDF ? integrator_names[m] : "?";
+}
+
+int ts_integrator_parse(const char *name, ts_integrator *m)
+{
+    for (int i = 0; i <= TS_INT_MSBDF; i++)
+        if (!strcmp(name, integrator_names[i])) {
+            *m = (ts_integrator)i;
+            return 0;
+        }
+    return -1;
+}
+
+int ts_sim_opts_check(const ts_sim_opts *o, ts_err *err)
+{
+    if (!(o->t_end > 0) || !isfinite(o->t_end))
+        return ts_fail(err, TS_EINVAL, "simulate: t_end must be > 0 s, got "
+                       "%g s", o->t_end);
+    if (!(o->dt_sample > 0) || !isfinite(o->dt_sample))
+        return ts_fail(err, TS_EINVAL, "simulate: the sample interval must "
+                       "be > 0 s, got %g s", o->dt_sample);
+    if (o->dt_sample > o->t_end * (1.0 + SAMPLE_RTOL))
+        return ts_fail(err, TS_EINVAL, "simulate: the sample interval %g s "
+                       "is longer than the run (t_end %g s)", o->dt_sample,
+                       o->t_end);
+    if (o->t_end / o->dt_sample > 1e8)
+        return ts_fail(err, TS_EINVAL, "simulate: %g samples (t_end %g s / "
+                       "interval %g s) is more than 1e8", o->t_end /
+                       o->dt_sample, o->t_end, o->dt_sample);
+    if (!(o->rel_tol >= TS_SIM_RTOL_MIN) || !(o->rel_tol < 1))
+        return ts_fail(err, TS_EINVAL, "simulate: the relative tolerance "
+                       "must be in [%g, 1), got %g", TS_SIM_RTOL_MIN,
+                       o->rel_tol);
+    if (!(o->abs_tol > 0) || !isfinite(o->abs_tol))
+        return ts_fail(err, TS_EINVAL, "simulate: the absolute tolerance "
+                       "must be > 0, got %g", o->abs_tol);
+    if (!(o->h_init > 0) || !isfinite(o->h_init))
+        return ts_fail(err, TS_EINVAL, "simulate: the first step must be > 0 "
+                       "s, got %g s", o->h_init);
+    if (!(o->h_min >= 0) || !isfinite(o->h_min))
+        return ts_fail(err, TS_EINVAL, "simulate: h_min must be >= 0 s, got "
+                       "%g s", o->h_min);
+    if (o->max_steps < 0)
+        return ts_fail(err, TS_EINVAL, "simulate: max_steps must be >= 0, "
+                       "got %ld", o->max_steps);
+    if (!(o->rechart > TS_CHART_MIN) || !(o->rechart < 1))
+        return ts_fail(err, TS_EINVAL, "simulate: the re-chart threshold "
+                       "must be in (%g, 1), got %g", TS_CHART_MIN, o->rechart);
+    if (!(o->integrator >= TS_INT_RK8PD && o->integrator <= TS_INT_MSBDF))
+        return ts_fail(err, TS_EINVAL, "simulate: unknown integrator %d",
+                       (int)o->integrator);
+    if (o->linear_method != TS_LINSIM_EXPM && o->linear_method != TS_LINSIM_ODE)
+        return ts_fail(err, TS_EINVAL, "simulate: unknown linear method %d",
+                       (int)o->linear_method);
+    if (o->kinematics != TS_KIN_LINEAR && o->kinematics != TS_KIN_NONLINEAR)
+        return ts_fail(err, TS_EINVAL, "simulate: unknown kinematics %d",
+                       (int)o->kinematics);
+    return TS_OK;
+}
+
+int ts_sim_nsamples(const ts_sim_opts *o)
+{
+    double r = o->t_end / o->dt_sample;
+    return (int)ceil(r - SAMPLE_RTOL * r) + 1;
+}
+
+double ts_sim_sample_time(const ts_sim_opts *o, int i)
+{
+    int last = ts_sim_nsamples(o) - 1;
+    if (i >= last)
+        return o->t_end;
+    return i * o->dt_sample;
+}
+
+/* ------------------------------------------------------------------ */
+/* History                                                              */
+
+ts_history *ts_history_alloc(const ts_system *sys, int capacity, ts_err *err)
+{
+    if (capacity < 1) {
+        ts_fail(err, TS_EINVAL, "ts_history_alloc: capacity must be >= 1, "
+                "got %d", capacity);
+        return NULL;
+    }
+    ts_history *h = calloc(1, sizeof *h);
+    if (!h)
+        goto nomem;
+    size_t c = (size_t)capacity;
+    h->nnodes = sys->nnodes;
+    h->nlinks = sys->nlinks;
+    h->capacity = capacity;
+    h->t = malloc(c * sizeof(double));
+    h->positions = malloc(c * 3 * (size_t)sys->nnodes * sizeof(double));
+    h->tensions = malloc(c * (size_t)sys->nlinks * sizeof(double));
+    h->energy = malloc(c * 2 * sizeof(double));
+    h->input = malloc(c * TS_NINPUT * sizeof(double));
+    if (!h->t || !h->positions || !h->tensions || !h->energy || !h->input)
+        goto nomem;
+    return h;
+nomem:
+    ts_history_free(h);
+    ts_fail(err, TS_ENOMEM, "ts_history_alloc: out of memory for %d samples",
+            capacity);
+    return NULL;
+}
+
+void ts_history_free(ts_history *h)
+{
+    if (!h)
+        return;
+    free(h->t);
+    free(h->positions);
+    free(h->tensions);
+    free(h->energy);
+    free(h->input);
+    free(h);
+}
+
+/* ------------------------------------------------------------------ */
+/* Nonlinear simulator                                                  */
+
+struct ts_sim {
+    ts_kernel *k;
+    const ts_system *sys;
+    const ts_excitation *ex;
+    ts_sim_opts o;
+    ts_frame orig;        /* the kernel's frame at alloc, restored at free */
+    ts_frame base;        /* the same with zero rates: the frame of t = 0 */
+    ts_excitation *own_ex;/* an empty excitation when the caller gave none */
+    int frame_varies;     /* the frame changes with time */
+    int n, nq, nl;
+    double t, h;
+    double *y;            /* [n] */
+    double *work;         /* [3 n]: kernel output and df/dt differences */
+    double *breaks;       /* [nbreaks] */
+    int nbreaks;
+    double dfdt_step;
+    gsl_odeiv2_system gsys;
+    gsl_odeiv2_driver *drv;
+    ts_linear *lin;       /* Jacobian (implicit methods) */
+    ts_linearize_opts lopts;
+    /* Statistics: evolve's counters are added in at each reset. */
+    long steps0, rejected0, nfev, njac, nrechart, nrestart;
+    double wall;
+    int fatal;            /* a kernel code < 0 met inside GSL */
+    long chart_refusals;  /* TS_CHART from trial states */
+};
+
+/* Frame and input of time t into the kernel; u[TS_NINPUT]. */
+static void prepare(ts_sim *s, double t, double u[TS_NINPUT])
+{
+    ts_excitation_input(s->ex, t, u);
+    if (s->frame_varies) {
+        ts_frame f;
+        ts_excitation_frame(s->ex, &s->base, t, &f);
+        ts_kernel_set_frame(s->k, &f);
+    }
+}
+
+static int rhs(double t, const double y[], double dydt[], void *params)
+{
+    ts_sim *s = params;
+    double u[TS_NINPUT];
+    s->nfev++;
+    prepare(s, t, u);
+    int rc = ts_kernel_eval(s->k, y, u, dydt);
+    if (rc == TS_OK)
+        return GSL_SUCCESS;
+    if (rc > 0) {
+        s->chart_refusals++;
+        return GSL_FAILURE; /* evolve retries with a smaller step */
+    }
+    s->fatal = rc;
+    return GSL_EBADFUNC;
+}
+
+static int jacobian(double t, const double y[], double *dfdy, double dfdt[],
+                    void *params)
+{
+    ts_sim *s = params;
+    double u[TS_NINPUT];
+    int n = s->n;
+    s->njac++;
+    prepare(s, t, u);
+    int rc = ts_linearize(s->k, y, u, &s->lopts, s->lin, NULL);
+    s->nfev += s->lin->evaluations;
+    if (rc > 0) {
+        s->chart_refusals++;
+        return GSL_FAILURE;
+    }
+    if (rc < 0) {
+        s->fatal = rc;
+        return GSL_EBADFUNC;
+    }
+    const double *A = s->lin->A;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            dfdy[(size_t)i * n + j] = A[i + (size_t)j * n];
+    if (s->o.integrator != TS_INT_BSIMP) {
+        for (int i = 0; i < n; i++)
+            dfdt[i] = 0.0; /* unused by rk4imp and msbdf */
+        return GSL_SUCCESS;
+    }
+    double dt = s->dfdt_step, *fp = s->work + n, *fm = s->work + 2 * n;
+    int r1 = rhs(t + dt, y, fp, s), r2 = rhs(t - dt, y, fm, s);
+    if (r1 != GSL_SUCCESS)
+        return r1;
+    if (r2 != GSL_SUCCESS)
+        return r2;
+    for (int i = 0; i < n; i++)
+        dfdt[i] = (fp[i] - fm[i]) / (2.0 * dt);
+    return GSL_SUCCESS;
+}
+
+static const gsl_odeiv2_step_type *step_type(ts_integrator m)
+{
+    switch (m) {
+    case TS_INT_RKF45: return gsl_odeiv2_step_rkf45;
+    case TS_INT_RK4IMP: return gsl_odeiv2_step_rk4imp;
+    case TS_INT_BSIMP: return gsl_odeiv2_step_bsimp;
+    case TS_INT_MSBDF: return gsl_odeiv2_step_msbdf;
+    default: return gsl_odeiv2_step_rk8pd;
+    }
+}
+
+static int needs_jacobian(ts_integrator m)
+{
+    return m == TS_INT_RK4IMP || m == TS_INT_BSIMP || m == TS_INT_MSBDF;
+}
+
+void ts_sim_free(ts_sim *s)
+{
+    if (!s)
+        return;
+    if (s->k)
+        ts_kernel_set_frame(s->k, &s->orig);
+    ts_excitation_free(s->own_ex);
+    if (s->drv)
+        gsl_odeiv2_driver_free(s->drv);
+    ts_linear_free(s->lin);
+    free(s->y);
+    free(s->work);
+    free(s->breaks);
+    free(s);
+}
+
+ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
+                     const ts_sim_opts *o, ts_err *err)
+{
+    if (ts_sim_opts_check(o, err))
+        return NULL;
+    ts_sim *s = calloc(1, sizeof *s);
+    if (!s) {
+        ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+        return NULL;
+    }
+    s->k = k;
+    s->sys = ts_kernel_system(k);
+    s->o = *o;
+    ts_kernel_get_frame(k, &s->orig);
+    s->base = s->orig;
+    s->base.speed_rate = 0.0;
+    s->base.turn_accel = 0.0;
+    if (!ex) {
+        /* Without signals the frame may still vary: a current rotates in
+         * M during a steady turn. */
+        s->own_ex = ts_excitation_alloc(err);
+        if (!s->own_ex) {
+            free(s);
+            return NULL;
+        }
+        ex = s->own_ex;
+    }
+    s->ex = ex;
+    s->n = ts_kernel_nstate(k);
+    s->nq = ts_kernel_nq(k);
+    s->nl = s->nq / 2;
+    int cur = s->base.current[0] != 0 || s->base.current[1] != 0;
+    s->frame_varies = ts_excitation_has_manoeuvre(ex) ||
+                      (s->base.turn_rate != 0 && cur);
+    s->h = o->h_init > o->h_min ? o->h_init : o->h_min;
+    double tau = ts_excitation_time_scale(ex);
+    s->dfdt_step = DFDT_REL_STEP * (tau < 1.0 ? tau : 1.0);
+    size_t n = (size_t)s->n;
+    s->y = calloc(n, sizeof(double));
+    s->work = calloc(3 * n, sizeof(double));
+    int nb = ts_excitation_breakpoints(ex, o->t_end, NULL, 0);
+    s->breaks = malloc((size_t)(nb + 1) * sizeof(double));
+    if (!s->y || !s->work || !s->breaks)
+        goto nomem;
+    s->nbreaks = ts_excitation_breakpoints(ex, o->t_end, s->breaks, nb);
+    if (needs_jacobian(o->integrator)) {
+        s->lin = ts_linear_alloc(k, err);
+        if (!s->lin) {
+            ts_sim_free(s);
+            return NULL;
+        }
+        ts_linearize_opts_default(&s->lopts);
+        s->lopts.estimate_error = 0;
+        s->lopts.threads = o->jacobian_threads;
+    }
+    s->gsys.function = rhs;
+    s->gsys.jacobian = needs_jacobian(o->integrator) ? jacobian : NULL;
+    s->gsys.dimension = n;
+    s->gsys.params = s;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    s->drv = gsl_odeiv2_driver_alloc_y_new(&s->gsys, step_type(o->integrator),
+                                           s->h, o->abs_tol, o->rel_tol);
+    gsl_set_error_handler(old);
+    if (!s->drv)
+        goto nomem;
+    return s;
+nomem:
+    ts_sim_free(s);
+    ts_fail(err, TS_ENOMEM, "simulate: out of memory for %d states",
+            (int)n);
+    return NULL;
+}
+
+/* Restart the integrator (after re-charting or a new state). */
+static void restart(ts_sim *s)
+{
+    s->steps0 += (long)s->drv->e->count;
+    s->rejected0 += (long)s->drv->e->failed_steps;
+    gsl_odeiv2_driver_reset(s->drv);
+}
+
+/* Re-chart links near the singularity; 1 when any moved. */
+static int maybe_rechart(ts_sim *s)
+{
+    int near = 0;
+    for (int l = 0; l < s->nl && !near; l++)
+        near = fabs(cos(s->y[2 * l + 1])) < s->o.rechart;
+    if (!near)
+        return 0;
+    int moved = ts_kernel_rechart(s->k, s->y, s->o.rechart);
+    s->nrechart += moved;
+    return moved > 0;
+}
+
+int ts_sim_set_state(ts_sim *s, double t, const double y[], ts_err *err)
+{
+    if (!isfinite(t))
+        return ts_fail(err, TS_EINVAL, "simulate: the start time must be "
+                       "finite, got %g s", t);
+    for (int i = 0; i < s->n; i++)
+        if (!isfinite(y[i]))
+            return ts_fail(err, TS_EINVAL, "simulate: the initial state has "
+                           "a non-finite entry y[%d] = %g", i, y[i]);
+    memcpy(s->y, y, (size_t)s->n * sizeof(double));
+    s->t = t;
+    maybe_rechart(s);
+    restart(s);
+    return TS_OK;
+}
+
+double ts_sim_time(const ts_sim *s) { return s->t; }
+const double *ts_sim_state(const ts_sim *s) { return s->y; }
+
+void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st)
+{
+    st->steps = s->steps0 + (long)s->drv->e->count;
+    st->rejected = s->rejected0 + (long)s->drv->e->failed_steps;
+    st->evaluations = s->nfev;
+    st->jacobians = s->njac;
+    st->recharts = s->nrechart;
+    st->restarts = s->nrestart;
+    st->t_reached = s->t;
+    st->h_last = s->drv->e->last_step;
+    st->wall_s = s->wall;
+}
+
+int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
+{
+    if (!(t1 > s->t))
+        return ts_fail(err, TS_EINVAL, "simulate: the target time %g s is "
+                       "not after the current time %g s", t1, s->t);
+    const char *name = ts_integrator_name(s->o.integrator);
+    double w0 = wall_now();
+    int rc = TS_OK;
+    while (s->t < t1) {
+        double target = t1;
+        for (int b = 0; b < s->nbreaks; b++)
+            if (s->breaks[b] > s->t && s->breaks[b] < target) {
+                target = s->breaks[b];
+                break;
+            }
+        long refusals = s->chart_refusals;
+        double t_before = s->t;
+        int st = gsl_odeiv2_evolve_apply(s->drv->e, s->drv->c, s->drv->s,
+                                         &s->gsys, &s->t, target, &s->h, s->y);
+        if (st == GSL_EBADFUNC) {
+            rc = ts_fail(err, s->fatal ? s->fatal : TS_ESINGULAR,
+                         "simulate: the kernel failed at t = %.9g s (%s): a "
+                         "nodal mass matrix is not positive definite",
+                         s->t, ts_strerror(s->fatal));
+            break;
+        }
+        if (st != GSL_SUCCESS) {
+            if (s->chart_refusals > refusals)
+                rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s cannot step "
+                             "past t = %.9g s: every trial step leaves the "
+                             "angle chart (a link turning sideways faster "
+                             "than the re-chart threshold %g can follow)",
+                             name, s->t, s->o.rechart);
+            else
+                rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
+                             "t = %.9g s: the step size underflowed (%.3g s) "
+                             "at relative tolerance %g, absolute %g; the "
+                             "scene may be stiff (try msbdf) or the "
+                             "tolerance too tight", name, s->t, s->h,
+                             s->o.rel_tol, s->o.abs_tol);
+            break;
+        }
+        if (s->t == t_before) {
+            /* An accepted step too small to change t: GSL does not catch
+             * this one (t + h == t in floating point). */
+            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
+                         "t = %.9g s: the step size underflowed (%.3g s is "
+                         "below the resolution of t)", name, s->t,
+                         fabs(s->h));
+            break;
+        }
+        int finite = 1;
+        for (int i = 0; i < s->n && finite; i++)
+            finite = isfinite(s->y[i]);
+        if (!finite) {
+            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s produced a "
+                         "non-finite state at t = %.9g s", name, s->t);
+            s->t = t_before;
+            break;
+        }
+        if (s->o.h_min > 0 && s->t < target && fabs(s->h) < s->o.h_min) {
+            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
+                         "t = %.9g s: the step size %.3g s fell below h_min "
+                         "%.3g s", name, s->t, fabs(s->h), s->o.h_min);
+            break;
+        }
+        if (s->o.max_steps > 0 &&
+            s->steps0 + (long)s->drv->e->count >= s->o.max_steps &&
+            s->t < t1) {
+            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the "
+                         "step limit %ld at t = %.9g s", name,
+                         s->o.max_steps, s->t);
+            break;
+        }
+        if (maybe_rechart(s)) {
+            restart(s);
+            s->nrestart++;
+        }
+    }
+    s->wall += wall_now() - w0;
+    return rc;
+}
+
+int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
+{
+    if (h->nsamples >= h->capacity)
+        return ts_fail(err, TS_EINVAL, "simulate: the history is full (%d "
+                       "samples)", h->capacity);
+    if (h->nnodes != s->sys->nnodes || h->nlinks != s->sys->nlinks)
+        return ts_fail(err, TS_EINVAL, "simulate: the history is sized for "
+                       "%d links, the system has %d", h->nlinks,
+                       s->sys->nlinks);
+    double u[TS_NINPUT];
+    prepare(s, s->t, u);
+    int rc = ts_kernel_eval(s->k, s->y, u, s->work);
+    if (rc)
+        return ts_fail(err, rc < 0 ? rc : TS_EINTEGRATOR, "simulate: the "
+                       "kernel refused the state at t = %.9g s (%s)", s->t,
+                       ts_strerror(rc));
+    size_t i = (size_t)h->nsamples, nn = (size_t)h->nnodes,
+           nl = (size_t)h->nlinks;
+    h->t[i] = s->t;
+    memcpy(h->positions + 3 * nn * i, ts_kernel_positions(s->k),
+           3 * nn * sizeof(double));
+    memcpy(h->tensions + nl * i, ts_kernel_tensions(s->k), nl * sizeof(double));
+    h->energy[2 * i] = ts_kernel_kinetic_energy(s->k);
+    h->energy[2 * i + 1] = ts_kernel_potential_energy(s->k);
+    memcpy(h->input + TS_NINPUT * i, u, sizeof u);
+    h->nsamples++;
+    return TS_OK;
+}
+
+int ts_simulate(ts_kernel *k, const ts_excitation *ex, const double y0[],
+                const ts_sim_opts *o, ts_history *h, ts_sim_stats *st,
+                double y_end[], ts_err *err)
+{
+    if (st)
+        memset(st, 0, sizeof *st);
+    int rc = ts_sim_opts_check(o, err);
+    if (rc)
+        return rc;
+    int N = ts_sim_nsamples(o);
+    if (h->capacity - h->nsamples < N)
+        return ts_fail(err, TS_EINVAL, "simulate: the history has room for "
+                       "%d samples, the run needs %d",
+                       h->capacity - h->nsamples, N);
+    if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err)))
+        return rc;
+    ts_sim *s = ts_sim_alloc(k, ex, o, err);
+    if (!s)
+        return err ? err->code : TS_ENOMEM;
+    rc = ts_sim_set_state(s, 0.0, y0, err);
+    if (!rc)
+        rc = ts_sim_record(s, h, err);
+    for (int i = 1; i < N && !rc; i++) {
+        rc = ts_sim_advance(s, ts_sim_sample_time(o, i), err);
+        int rr = ts_sim_record(s, h, rc ? NULL : err);
+        if (!rc)
+            rc = rr;
+    }
+    if (st)
+        ts_sim_get_stats(s, st);
+    if (y_end)
+        memcpy(y_end, s->y, (size_t)s->n * sizeof(double));
+    ts_sim_free(s);
+    return rc;
+}
+
+/* ------------------------------------------------------------------ */
+/* Initial states                                                       */
+
+int ts_sim_released_state(ts_kernel *k, double theta1, double theta2,
+                          double y[], ts_err *err)
+{
+    if (!isfinite(theta1) || !isfinite(theta2))
+        return ts_fail(err, TS_EINVAL, "released shape: angles must be "
+                       "finite, got theta1 %g rad, theta2 %g rad", theta1,
+                       theta2);
+    int nl = ts_kernel_nq(k) / 2;
+    double n[3] = {-cos(theta1) * cos(theta2), -sin(theta2),
+                   sin(theta1) * cos(theta2)};
+    double *dirs = malloc(3 * (size_t)nl * sizeof(double));
+    if (!dirs)
+        return ts_fail(err, TS_ENOMEM, "released shape: out of memory");
+    for (int l = 0; l < nl; l++)
+        memcpy(dirs + 3 * l, n, sizeof n);
+    ts_kernel_set_directions(k, dirs, NULL, TS_CHART_RECHART, y);
+    free(dirs);
+    return TS_OK;
+}
+
+int ts_sim_shape_state(ts_kernel *k, const double pos[], double rtol,
+                       double y[], ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nl = sys->nlinks;
+    double *dirs = malloc(3 * (size_t)nl * sizeof(double));
+    if (!dirs)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    char name[2 * TS_NAME_MAX];
+    for (int l = 0; l < nl; l++) {
+        const ts_link *L = &sys->links[l];
+        const double *a = pos + 3 * L->upper, *b = pos + 3 * L->lower;
+        double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(fabs(len - L->length) <= rtol * L->length)) {
+            snprintf(name, sizeof name, "%s", sys->cables[L->cable].name);
+            free(dirs);
+            return ts_fail(err, TS_EINVAL, "initial shape: link %d of cable "
+                           "'%s' spans %.9g m between its nodes, its length "
+                           "is %.9g m (tolerance %g relative)", L->index, name,
+                           len, L->length, rtol);
+        }
+        for (int j = 0; j < 3; j++)
+            dirs[3 * l + j] = d[j] / len;
+    }
+    ts_kernel_set_directions(k, dirs, NULL, TS_CHART_RECHART, y);
+    free(dirs);
+    return TS_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Linear simulation                                                    */
+
+typedef struct lin_hold {
+    double h;          /* step the blocks were computed for, 0: none */
+    double *Phi;       /* [n n] */
+    double *G;         /* [n 4m] */
+} lin_hold;
+
+typedef struct lin_sim {
+    const ts_linear *lin;
+    const ts_excitation *ex;
+    int n, m;
+    double *tmp;       /* [n] */
+    long nfev;
+} lin_sim;
+
+/* v = u(t) - u0. */
+static void lin_input(const lin_sim *L, double t, double v[TS_NINPUT])
+{
+    if (L->ex)
+        ts_excitation_input(L->ex, t, v);
+    else
+        for (int j = 0; j < TS_NINPUT; j++)
+            v[j] = 0.0;
+    for (int j = 0; j < TS_NINPUT; j++)
+        v[j] -= L->lin->u0[j];
+}
+
+/* Phi and G of step h: top blocks of exp(M h). */
+static int hold_compute(const ts_linear *lin, double h, lin_hold *H,
+                        ts_err *err)
+{
+    int n = lin->nstate, m = TS_NINPUT, N = n + 4 * m;
+    size_t NN = (size_t)N * (size_t)N;
+    double *M = calloc(NN, sizeof(double));
+    double *E = malloc(NN * sizeof(double));
+    if (!M || !E) {
+        free(M);
+        free(E);
+        return ts_fail(err, TS_ENOMEM, "simulate (linear): out of memory "
+                       "for the order-%d exponential", N);
+    }
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            M[i + (size_t)j * N] = h * lin->A[i + (size_t)j * n];
+    for (int j = 0; j < m; j++)
+        for (int i = 0; i < n; i++)
+            M[i + (size_t)(n + j) * N] = h * lin->B[i + (size_t)j * n];
+    for (int b = 0; b < 3; b++)
+        for (int j = 0; j < m; j++) {
+            int row = n + b * m + j, col = n + (b + 1) * m + j;
+            M[row + (size_t)col * N] = h;
+        }
+    int rc = tsi_expm(N, M, E, NULL, err);
+    if (!rc) {
+        for (int j = 0; j < n; j++)
+            memcpy(H->Phi + (size_t)j * n, E + (size_t)j * N,
+                   (size_t)n * sizeof(double));
+        for (int j = 0; j < 4 * m; j++)
+            memcpy(H->G + (size_t)j * n, E + (size_t)(n + j) * N,
+                   (size_t)n * sizeof(double));
+        H->h = h;
+    }
+    free(M);
+    free(E);
+    return rc;
+}
+
+/* One exact step of length h: z <- Phi z + G p, the cubic through
+ * v0..v3 (values at 0, h/3, 2h/3, h). */
+static void hold_step(const lin_hold *H, int n, const double v[4][TS_NINPUT],
+                      double *z, double *tmp)
+{
+    const int m = TS_NINPUT, m4 = 4 * m, one = 1;
+    double p[4 * TS_NINPUT];
+    double h = H->h;
+    for (int j = 0; j < m; j++) {
+        /* Newton forward differences on x = 3 s / h. */
+        double f0 = v[0][j], d1 = v[1][j] - f0,
+               d2 = v[2][j] - 2 * v[1][j] + f0,
+               d3 = v[3][j] - 3 * v[2][j] + 3 * v[1][j] - f0;
+        double c1 = d1 - d2 / 2 + d3 / 3, c2 = d2 / 2 - d3 / 2, c3 = d3 / 6;
+        p[j] = f0;
+        p[m + j] = 3.0 * c1 / h;
+        p[2 * m + j] = 2.0 * 9.0 * c2 / (h * h);
+        p[3 * m + j] = 6.0 * 27.0 * c3 / (h * h * h);
+    }
+    const double a1 = 1.0, b0 = 0.0;
+    dgemv_("N", &n, &n, &a1, H->Phi, &n, z, &one, &b0, tmp, &one, 1);
+    dgemv_("N", &n, &m4, &a1, H->G, &n, p, &one, &a1, tmp, &one, 1);
+    memcpy(z, tmp, (size_t)n * sizeof(double));
+}
+
+static int lin_rhs(double t, const double z[], double dz[], void *params)
+{
+    lin_sim *L = params;
+    const int n = L->n, m = TS_NINPUT, one = 1;
+    const double a1 = 1.0, b0 = 0.0;
+    double v[TS_NINPUT];
+    L->nfev++;
+    lin_input(L, t, v);
+    dgemv_("N", &n, &n, &a1, L->lin->A, &n, z, &one, &b0, dz, &one, 1);
+    dgemv_("N", &n, &m, &a1, L->lin->B, &n, v, &one, &a1, dz, &one, 1);
+    return GSL_SUCCESS;
+}
+
+static int lin_jac(double t, const double z[], double *dfdy, double dfdt[],
+                   void *params)
+{
+    lin_sim *L = params;
+    const int n = L->n, m = TS_NINPUT, one = 1;
+    (void)z;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            dfdy[(size_t)i * n + j] = L->lin->A[i + (size_t)j * n];
+    /* df/dt = B dv/dt by a central difference of the input. */
+    double tau = L->ex ? ts_excitation_time_scale(L->ex) : INFINITY;
+    double dt = DFDT_REL_STEP * (tau < 1.0 ? tau : 1.0);
+    double vp[TS_NINPUT], vm[TS_NINPUT];
+    lin_input(L, t + dt, vp);
+    lin_input(L, t - dt, vm);
+    for (int j = 0; j < m; j++)
+        vp[j] = (vp[j] - vm[j]) / (2 * dt);
+    const double a1 = 1.0, b0 = 0.0;
+    dgemv_("N", &n, &m, &a1, L->lin->B, &n, vp, &one, &b0, dfdt, &one, 1);
+    return GSL_SUCCESS;
+}
+
+/* Append a linear sample: positions from z. */
+static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
+                      const ts_sim_opts *o, double t, const double *z,
+                      ts_history *h, double *ywork, double *dr, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    size_t i = (size_t)h->nsamples, nn = (size_t)h->nnodes,
+           nl = (size_t)h->nlinks;
+    double u[TS_NINPUT];
+    lin_input(L, t, u);
+    for (int j = 0; j < TS_NINPUT; j++)
+        u[j] += lin->u0[j];
+    double *pos = h->positions + 3 * nn * i;
+    if (o->kinematics == TS_KIN_LINEAR) {
+        ts_linear_node_displacements(sys, lin, z, dr);
+        for (size_t a = 0; a < nn; a++)
+            for (int c = 0; c < 3; c++)
+                pos[3 * a + c] = lin->r0[3 * a + c] + dr[3 * a + c] +
+                                 (u[c] - lin->u0[c]);
+    } else {
+        int n = lin->nstate;
+        for (int j = 0; j < n; j++)
+            ywork[j] = lin->y0[j] + z[j];
+        int rc = ts_kernel_eval(k, ywork, u, ywork + n);
+        if (rc)
+            return ts_fail(err, rc < 0 ? rc : TS_EDOMAIN, "simulate "
+                           "(linear): the state y0 + z at t = %.9g s is "
+                           "outside the kernel's chart; use linear "
+                           "kinematics", t);
+        memcpy(pos, ts_kernel_positions(k), 3 * nn * sizeof(double));
+    }
+    h->t[i] = t;
+    for (size_t l = 0; l < nl; l++)
+        h->tensions[nl * i + l] = NAN;
+    h->energy[2 * i] = h->energy[2 * i + 1] = NAN;
+    memcpy(h->input + TS_NINPUT * i, u, sizeof u);
+    h->nsamples++;
+    return TS_OK;
+}
+
+int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
+                       const ts_excitation *ex, const double z0[],
+                       const ts_sim_opts *o, ts_history *h, ts_sim_stats *st,
+                       ts_err *err)
+{
+    ts_sim_stats stats = {0};
+    if (st)
+        *st = stats;
+    int rc = ts_sim_opts_check(o, err);
+    if (rc)
+        return rc;
+    int n = lin->nstate;
+    if (n != ts_kernel_nstate(k) || h->nlinks != lin->nlinks)
+        return ts_fail(err, TS_EINVAL, "simulate (linear): the model has %d "
+                       "states, the kernel %d and the history %d links", n,
+                       ts_kernel_nstate(k), h->nlinks);
+    if (ex && ts_excitation_has_manoeuvre(ex))
+        return ts_fail(err, TS_EDOMAIN, "simulate (linear): the linear model "
+                       "has no frame inputs: a speed or turn-rate manoeuvre "
+                       "can only be simulated nonlinearly");
+    if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err)))
+        return rc;
+    int N = ts_sim_nsamples(o);
+    if (h->capacity - h->nsamples < N)
+        return ts_fail(err, TS_EINVAL, "simulate (linear): the history has "
+                       "room for %d samples, the run needs %d",
+                       h->capacity - h->nsamples, N);
+    double w0 = wall_now();
+    size_t sn = (size_t)n;
+    double *z = calloc(sn, sizeof(double));
+    double *tmp = calloc(sn, sizeof(double));
+    double *ywork = calloc(2 * sn, sizeof(double));
+    double *dr = calloc(3 * (size_t)lin->nnodes, sizeof(double));
+    lin_hold H[2];
+    for (int c = 0; c < 2; c++) {
+        H[c].h = 0.0;
+        H[c].Phi = malloc(sn * sn * sizeof(double));
+        H[c].G = malloc(sn * 4 * TS_NINPUT * sizeof(double));
+    }
+    lin_sim L = {lin, ex, n, TS_NINPUT, tmp, 0};
+    gsl_odeiv2_driver *drv = NULL;
+    gsl_odeiv2_system gsys = {lin_rhs, lin_jac, sn, &L};
+    if (!z || !tmp || !ywork || !dr || !H[0].Phi || !H[0].G || !H[1].Phi ||
+        !H[1].G) {
+        rc = ts_fail(err, TS_ENOMEM, "simulate (linear): out of memory for "
+                     "%d states", n);
+        goto done;
+    }
+    if (z0)
+        memcpy(z, z0, sn * sizeof(double));
+    if (o->linear_method == TS_LINSIM_ODE) {
+        gsl_error_handler_t *old = gsl_set_error_handler_off();
+        drv = gsl_odeiv2_driver_alloc_y_new(&gsys, step_type(o->integrator),
+                                            o->h_init, o->abs_tol,
+                                            o->rel_tol);
+        gsl_set_error_handler(old);
+        if (!drv) {
+            rc = ts_fail(err, TS_ENOMEM, "simulate (linear): out of memory");
+            goto done;
+        }
+    }
+    double tau = ex ? ts_excitation_time_scale(ex) : INFINITY;
+    double h_max = tau * pow(o->rel_tol / CUBIC_HOLD_ERR, 0.25);
+    rc = lin_record(k, lin, &L, o, 0.0, z, h, ywork, dr, err);
+    double t = 0.0, hode = o->h_init;
+    for (int i = 1; i < N && !rc; i++) {
+        double t1 = ts_sim_sample_time(o, i);
+        if (o->linear_method == TS_LINSIM_ODE) {
+            gsl_error_handler_t *old = gsl_set_error_handler_off();
+            while (t < t1 && !rc) {
+                int s = gsl_odeiv2_evolve_apply(drv->e, drv->c, drv->s, &gsys,
+                                                &t, t1, &hode, z);
+                if (s != GSL_SUCCESS)
+                    rc = ts_fail(err, TS_EINTEGRATOR, "simulate (linear): "
+                                 "%s failed at t = %.9g s (step %.3g s)",
+                                 ts_integrator_name(o->integrator), t, hode);
+            }
+            gsl_set_error_handler(old);
+            if (rc)
+                break;
+        } else {
+            double dt = t1 - t;
+            long steps = (long)ceil(dt / h_max - 1e-9);
+            if (steps < 1)
+                steps = 1;
+            double hs = dt / (double)steps;
+            lin_hold *Hc = NULL;
+            for (int c = 0; c < 2 && !Hc; c++)
+                if (H[c].h > 0 && fabs(H[c].h - hs) <= 1e-12 * hs)
+                    Hc = &H[c];
+            if (!Hc) {
+                Hc = H[0].h == 0 ? &H[0] : &H[1];
+                if ((rc = hold_compute(lin, hs, Hc, err)))
+                    break;
+            }
+            double v[4][TS_NINPUT];
+            lin_input(&L, t, v[0]);
+            for (long s = 0; s < steps; s++) {
+                double ts = t + (double)s * hs;
+                for (int j = 1; j <= 3; j++)
+                    lin_input(&L, ts + j * hs / 3.0, v[j]);
+                hold_step(Hc, n, (const double(*)[TS_NINPUT])v, z, tmp);
+                memcpy(v[0], v[3], sizeof v[0]);
+                L.nfev += 3;
+                stats.steps++;
+                stats.h_last = hs;
+            }
+            t = t1;
+        }
+        int finite = 1;
+        for (int j = 0; j < n && finite; j++)
+            finite = isfinite(z[j]);
+        if (!finite) {
+            rc = ts_fail(err, TS_EINTEGRATOR, "simulate (linear): the state "
+                         "is not finite at t = %.9g s", t1);
+            break;
+        }
+        rc = lin_record(k, lin, &L, o, t1, z, h, ywork, dr, err);
+    }
+done:
+    if (drv) {
+        stats.steps = (long)drv->e->count;
+        stats.rejected = (long)drv->e->failed_steps;
+        stats.h_last = drv->e->last_step;
+        gsl_odeiv2_driver_free(drv);
+    }
+    stats.evaluations = L.nfev;
+    stats.t_reached = h->nsamples > 0 ? h->t[h->nsamples - 1] : 0.0;
+    stats.wall_s = wall_now() - w0;
+    if (st)
+        *st = stats;
+    for (int c = 0; c < 2; c++) {
+        free(H[c].Phi);
+        free(H[c].G);
+    }
+    free(z);
+    free(tmp);
+    free(ywork);
+    free(dr);
+    return rc;
+}

@@ -1,0 +1,492 @@
+/* test_excitation.c: tow-point excitations and manoeuvres
+ * (towstab/excitation.h) against references written out here.
+ *
+ *  1. Every shape's velocity and acceleration against central differences
+ *     of its displacement and velocity (they must be exact derivatives, or
+ *     the rigid-link kinematics would be inconsistent).
+ *  2. Closed-form values: sine, the slider crank of MODEL.md section 8,
+ *     the end values and midpoint of steps and ramps, the ramp's plateau
+ *     rate and its linear part x = A/T (t - start - rise/2).
+ *  3. Series: a sampled sinusoid through the cubic spline, its
+ *     derivatives within the spline's error; CSV reading (header, comments)
+ *     and every CSV error.
+ *  4. Manoeuvres: turn rate and speed with to= and by=, their rates by
+ *     differences, the heading against a Simpson integral of the turn rate,
+ *     the current rotated into the turning frame (a current along +x at
+ *     t = 0, seen from the ship after a quarter turn to starboard, flows
+ *     to port, along -y).
+ *  5. Breakpoints, time scales, the periodic signal.
+ *  6. The spec parser: units, defaults, and every refusal with its message.
+ * Tolerances are stated at each check. */
+#include "towstab/excitation.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tcheck.h"
+
+/* Largest |v - dx/dt| and |a - dv/dt| over n points in [t0, t1], each
+ * relative to `vscale` and `ascale`; central differences with step h
+ * (error h^2/6 |x'''| + eps |x| / h). */
+static void fd_check(const ts_excitation *ex, int axis, double t0, double t1,
+                     int n, double h, double *ev, double *ea)
+{
+    *ev = *ea = 0.0;
+    for (int i = 0; i < n; i++) {
+        double t = t0 + (t1 - t0) * (i + 0.37) / n;
+        double u[9], up[9], um[9];
+        ts_excitation_input(ex, t, u);
+        ts_excitation_input(ex, t + h, up);
+        ts_excitation_input(ex, t - h, um);
+        double dv = fabs(u[3 + axis] - (up[axis] - um[axis]) / (2 * h));
+        double da = fabs(u[6 + axis] - (up[3 + axis] - um[3 + axis]) / (2 * h));
+        if (dv > *ev)
+            *ev = dv;
+        if (da > *ea)
+            *ea = da;
+    }
+}
+
+static ts_excitation *one(const ts_signal *s)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    if (ts_excitation_add(ex, s, &err))
+        printf("note: add failed: %s\n", err.msg);
+    return ex;
+}
+
+static void test_shapes(void)
+{
+    /* FD step 1e-5 s: for these signals (|x'''| <= ~A w^3 ~ 10) the
+     * truncation error is below 2e-9 and rounding below 1e-10. */
+    const double h = 1e-5;
+    double ev, ea;
+
+    ts_signal s = {0};
+    s.type = TS_SIGNAL_SINE;
+    s.axis = TS_AXIS_HEAVE;
+    s.amplitude = 0.03048;
+    s.frequency = 0.8375;
+    s.phase = 0.4;
+    ts_excitation *ex = one(&s);
+    double u[9], w = 2 * M_PI * s.frequency, t = 2.385;
+    ts_excitation_input(ex, t, u);
+    CHECK_NEAR(u[2], s.amplitude * sin(w * t + 0.4), 1e-16, "sine x");
+    CHECK_NEAR(u[5], s.amplitude * w * cos(w * t + 0.4), 1e-15, "sine v");
+    CHECK_NEAR(u[8], -s.amplitude * w * w * sin(w * t + 0.4), 1e-14,
+               "sine a");
+    CHECK(u[0] == 0 && u[1] == 0 && u[3] == 0 && u[7] == 0,
+          "sine drives its own axis only");
+    fd_check(ex, 2, 0.0, 7.0, 50, h, &ev, &ea);
+    CHECK(ev < 1e-8 && ea < 1e-8, "sine v, a are the derivatives (max err "
+          "%.2g, %.2g m/s, m/s^2 < 1e-8)", ev, ea);
+    ts_excitation_free(ex);
+
+    /* Slider crank, MODEL.md section 8: z = r cos th + l (1 - sqrt(1 -
+     * (r/l)^2 sin^2 th)), with awkward r/l so that the rod term matters. */
+    s.type = TS_SIGNAL_CRANK;
+    s.axis = TS_AXIS_SURGE;
+    s.amplitude = 0.1;
+    s.rod = 0.35;
+    s.frequency = 1.0 / 1.6;
+    s.phase = -0.3;
+    ex = one(&s);
+    double maxd = 0;
+    for (int i = 0; i < 40; i++) {
+        double tt = 0.123 + 0.1 * i, th = 2 * M_PI * tt / 1.6 - 0.3;
+        double r = 0.1, l = 0.35, sn = sin(th);
+        double z = r * cos(th) + l * (1 - sqrt(1 - (r / l) * (r / l) * sn * sn));
+        ts_excitation_input(ex, tt, u);
+        maxd = fmax(maxd, fabs(u[0] - z));
+    }
+    CHECK(maxd < 1e-15, "crank displacement is MODEL.md's formula (max err "
+          "%.2g m < 1e-15)", maxd);
+    fd_check(ex, 0, 0.0, 3.2, 60, h, &ev, &ea);
+    CHECK(ev < 1e-8 && ea < 1e-7, "crank v, a are the derivatives (max err "
+          "%.2g m/s < 1e-8, %.2g m/s^2 < 1e-7)", ev, ea);
+    ts_excitation_free(ex);
+
+    /* Step: 0 before, A after, A/2 at mid-rise (S5 is odd about 1/2),
+     * continuous derivatives at both ends. */
+    s = (ts_signal){0};
+    s.type = TS_SIGNAL_STEP;
+    s.axis = TS_AXIS_SWAY;
+    s.amplitude = -0.2385;
+    s.start = 1.25;
+    s.rise = 0.4;
+    ex = one(&s);
+    ts_excitation_input(ex, 1.25 - 1e-9, u);
+    CHECK(u[1] == 0 && u[4] == 0 && u[7] == 0, "step: zero before start");
+    ts_excitation_input(ex, 1.45, u);
+    CHECK_NEAR(u[1], -0.2385 / 2, 1e-15, "step: half way at mid-rise");
+    ts_excitation_input(ex, 1.65 + 1e-12, u);
+    CHECK(u[1] == -0.2385 && u[4] == 0 && u[7] == 0,
+          "step: exactly A, at rest, after start + rise");
+    ts_excitation_input(ex, 1.65 - 1e-6, u);
+    CHECK(fabs(u[7]) < 1e-3, "step: acceleration continuous at the end "
+          "(%.2g m/s^2 1 us before; peak ~%.2g)", u[7],
+          0.2385 * 5.77 / (0.4 * 0.4));
+    fd_check(ex, 1, 1.25, 1.65, 40, 1e-6, &ev, &ea);
+    CHECK(ev < 1e-7 && ea < 1e-5, "step v, a are the derivatives (max err "
+          "%.2g m/s < 1e-7, %.2g m/s^2 < 1e-5; step 1e-6 s)", ev, ea);
+    ts_excitation_free(ex);
+
+    /* Ramp with rise < duration: plateau rate A/T and x = A/T (t - start -
+     * rise/2) in the linear part; final value exactly A. */
+    s = (ts_signal){0};
+    s.type = TS_SIGNAL_RAMP;
+    s.axis = TS_AXIS_HEAVE;
+    s.amplitude = 0.75;
+    s.start = 0.5;
+    s.duration = 3.0;
+    s.rise = 0.6;
+    ex = one(&s);
+    ts_excitation_input(ex, 2.2, u);
+    CHECK_NEAR(u[5], 0.75 / 3.0, 1e-15, "ramp: plateau rate A/T");
+    CHECK_NEAR(u[2], 0.75 / 3.0 * (2.2 - 0.5 - 0.3), 1e-15,
+               "ramp: linear part A/T (t - start - rise/2)");
+    CHECK(u[8] == 0, "ramp: no acceleration on the plateau");
+    ts_excitation_input(ex, 0.5 + 3.0 + 0.6, u);
+    CHECK_NEAR(u[2], 0.75, 1e-15, "ramp: final value A at start + T + rise");
+    CHECK(u[5] == 0 && u[8] == 0, "ramp: at rest after the ramp");
+    fd_check(ex, 2, 0.3, 4.4, 80, 1e-6, &ev, &ea);
+    CHECK(ev < 1e-8 && ea < 1e-6, "ramp v, a are the derivatives (max err "
+          "%.2g m/s < 1e-8, %.2g m/s^2 < 1e-6)", ev, ea);
+    ts_excitation_free(ex);
+
+    /* Ramp with rise > duration still ends at exactly A. */
+    s.duration = 0.2;
+    s.rise = 0.7;
+    ex = one(&s);
+    ts_excitation_input(ex, 0.5 + 0.2 + 0.7 + 1e-12, u);
+    CHECK_NEAR(u[2], 0.75, 1e-14, "ramp with rise > duration ends at A");
+    fd_check(ex, 2, 0.4, 1.5, 60, 1e-6, &ev, &ea);
+    CHECK(ev < 1e-8 && ea < 1e-5, "short ramp v, a are the derivatives "
+          "(%.2g, %.2g)", ev, ea);
+    ts_excitation_free(ex);
+
+    /* Sums: two signals on one axis add. */
+    ts_err err = {0};
+    ex = ts_excitation_alloc(&err);
+    ts_signal a = {0}, b = {0};
+    a.type = b.type = TS_SIGNAL_SINE;
+    a.axis = b.axis = TS_AXIS_HEAVE;
+    a.amplitude = 0.1;
+    a.frequency = 0.3;
+    b.amplitude = 0.05;
+    b.frequency = 1.1;
+    ts_excitation_add(ex, &a, &err);
+    ts_excitation_add(ex, &b, &err);
+    ts_excitation_input(ex, 1.7, u);
+    CHECK_NEAR(u[2], 0.1 * sin(2 * M_PI * 0.3 * 1.7) +
+                         0.05 * sin(2 * M_PI * 1.1 * 1.7), 1e-16,
+               "two sines on one axis add");
+    int idx = -1;
+    CHECK(!ts_excitation_periodic(ex, &idx), "two periodic signals: no "
+          "single excitation frequency");
+    ts_excitation_free(ex);
+}
+
+static void test_series(void)
+{
+    ts_err err = {0};
+    /* sin(w t) sampled every 0.01 s on [0, 10]; natural end conditions
+     * hold exactly (x'' = 0 at t = 0 and at w t = 6 pi). Spline errors for
+     * spacing d: x ~ d^4 w^4 / 384, x' ~ d^3 w^4 / 24, x'' ~ d^2 w^4 / 12:
+     * with w = 1.885, d = 0.01: 3e-11, 5e-7, 1.1e-4 (relative). */
+    int n = 1001;
+    double w = 2 * M_PI * 0.3, A = 0.4;
+    double *t = malloc(n * sizeof *t), *x = malloc(n * sizeof *x);
+    for (int i = 0; i < n; i++) {
+        t[i] = 0.01 * i;
+        x[i] = A * sin(w * t[i]);
+    }
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    CHECK(ts_excitation_add_series(ex, TS_AXIS_SURGE, n, t, x, &err) == TS_OK,
+          "series accepted");
+    double ex_, ev = 0, ea = 0;
+    ex_ = 0;
+    for (int i = 0; i < 97; i++) {
+        double tt = 0.3 + 9.4 * i / 96.0, u[9];
+        ts_excitation_input(ex, tt, u);
+        ex_ = fmax(ex_, fabs(u[0] - A * sin(w * tt)));
+        ev = fmax(ev, fabs(u[3] - A * w * cos(w * tt)));
+        ea = fmax(ea, fabs(u[6] + A * w * w * sin(w * tt)));
+    }
+    CHECK(ex_ < 1e-9 * A && ev < 1e-6 * A * w && ea < 2e-4 * A * w * w,
+          "series spline x, v, a within the spline error (%.2g, %.2g, %.2g "
+          "relative)", ex_ / A, ev / (A * w), ea / (A * w * w));
+    CHECK(ts_excitation_check_span(ex, 10.0, &err) == TS_OK,
+          "series covers [0, 10] s");
+    CHECK(ts_excitation_check_span(ex, 10.5, &err) == TS_EINVAL &&
+              strstr(err.msg, "ends at 10 s"),
+          "a run beyond the series is refused: %s", err.msg);
+    CHECK(ts_excitation_time_scale(ex) == 0.01 * 1 ||
+              fabs(ts_excitation_time_scale(ex) - 0.01) < 1e-15,
+          "series time scale is its spacing");
+    ts_excitation_free(ex);
+
+    /* CSV round trip with a header and a comment. */
+    char path[] = "/tmp/towstab_test_excitation_XXXXXX";
+    int fd = mkstemp(path);
+    FILE *f = fdopen(fd, "w");
+    fprintf(f, "# tow heave record\ntime_s,heave_m\n");
+    for (int i = 0; i < 201; i++)
+        fprintf(f, "%.17g, %.17g\n", t[i], x[i]);
+    fclose(f);
+    ex = ts_excitation_alloc(&err);
+    int rc = ts_excitation_read_series(ex, TS_AXIS_HEAVE, path, &err);
+    CHECK(rc == TS_OK, "CSV with header and comment read");
+    double u[9];
+    ts_excitation_input(ex, 1.005, u);
+    CHECK_NEAR(u[2], A * sin(w * 1.005), 1e-9, "CSV series value");
+    ts_excitation_free(ex);
+
+    struct { const char *text; const char *want; } bad[] = {
+        {"t,x\n0,1\n0.1,2\n", "at least 3 samples"},
+        {"0,1\n0.2,2\n0.1,3\n", "times must increase"},
+        {"0,1\n0.1,2\n0.2,abc\n", "line 3"},
+        {"0.5,1\n0.6,2\n0.7,3\n", "start at t <= 0"},
+        {"0,1\n0.1,inf\n0.2,3\n", "line 2"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        f = fopen(path, "w");
+        fputs(bad[i].text, f);
+        fclose(f);
+        ex = ts_excitation_alloc(&err);
+        ts_err_clear(&err);
+        rc = ts_excitation_read_series(ex, TS_AXIS_HEAVE, path, &err);
+        CHECK(rc == TS_EINVAL && strstr(err.msg, bad[i].want),
+              "bad CSV %zu refused: %s", i, err.msg);
+        ts_excitation_free(ex);
+    }
+    unlink(path);
+    ex = ts_excitation_alloc(&err);
+    rc = ts_excitation_read_series(ex, TS_AXIS_HEAVE,
+                                   "/nonexistent/heave.csv", &err);
+    CHECK(rc == TS_EIO && strstr(err.msg, "cannot read"),
+          "missing CSV: %s", err.msg);
+    rc = ts_excitation_add_series(ex, TS_AXIS_SPEED, 3, t, x, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow-point axis"),
+          "series on a manoeuvre axis refused: %s", err.msg);
+    ts_excitation_free(ex);
+    free(t);
+    free(x);
+}
+
+static void test_manoeuvres(void)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_signal s = {0};
+    s.type = TS_SIGNAL_RAMP;
+    s.axis = TS_AXIS_TURN_RATE;
+    s.amplitude = 0.5;
+    s.absolute = 1;
+    s.start = 0.7;
+    s.duration = 2.0;
+    s.rise = 0.5;
+    CHECK(ts_excitation_add(ex, &s, &err) == TS_OK, "turn ramp accepted");
+    ts_signal v = {0};
+    v.type = TS_SIGNAL_STEP;
+    v.axis = TS_AXIS_SPEED;
+    v.amplitude = -0.3;
+    v.start = 1.1;
+    v.rise = 0.9;
+    CHECK(ts_excitation_add(ex, &v, &err) == TS_OK, "speed step accepted");
+    CHECK(ts_excitation_has_manoeuvre(ex), "has a manoeuvre");
+
+    ts_frame base = {0.762, 0.1, 0.0, 0.0, {0.2, -0.1, 0.05}}, f, fp, fm;
+    ts_excitation_frame(ex, &base, 10.0, &f);
+    CHECK_NEAR(f.turn_rate, 0.5, 1e-15, "turn rate reaches to= 0.5 rad/s "
+               "(from a base of 0.1)");
+    CHECK_NEAR(f.speed, 0.762 - 0.3, 1e-15, "speed changes by by= -0.3 m/s");
+    CHECK(f.turn_accel == 0 && f.speed_rate == 0, "rates zero after both");
+    double maxr = 0;
+    for (int i = 0; i < 50; i++) {
+        double t = 0.5 + 3.0 * i / 49.0, h = 1e-6;
+        ts_excitation_frame(ex, &base, t, &f);
+        ts_excitation_frame(ex, &base, t + h, &fp);
+        ts_excitation_frame(ex, &base, t - h, &fm);
+        maxr = fmax(maxr, fabs(f.turn_accel - (fp.turn_rate - fm.turn_rate) /
+                                                  (2 * h)));
+        maxr = fmax(maxr, fabs(f.speed_rate - (fp.speed - fm.speed) / (2 * h)));
+    }
+    CHECK(maxr < 1e-8, "turn_accel and speed_rate are the derivatives (max "
+          "err %.2g < 1e-8)", maxr);
+
+    /* Heading: Simpson's rule on Omega(t) over [0, 4.2] with 4200
+     * intervals (error ~ h^4 |Omega''''| << 1e-12 on the smooth pieces;
+     * the breakpoints fall on nodes). */
+    int m = 4200;
+    double T = 4.2, hs = T / m, sum = 0;
+    for (int i = 0; i <= m; i++) {
+        ts_excitation_frame(ex, &base, hs * i, &f);
+        double wgt = (i == 0 || i == m) ? 1 : (i % 2 ? 4 : 2);
+        sum += wgt * f.turn_rate;
+    }
+    double psi_ref = sum * hs / 3;
+    CHECK_NEAR(ts_excitation_heading(ex, &base, T), psi_ref, 1e-10,
+               "heading = integral of the turn rate");
+    ts_excitation_frame(ex, &base, T, &f);
+    double psi = psi_ref, c = cos(psi), sn = sin(psi);
+    CHECK(fabs(f.current[0] - (c * 0.2 + sn * -0.1)) < 1e-10 &&
+              fabs(f.current[1] - (-sn * 0.2 + c * -0.1)) < 1e-10 &&
+              f.current[2] == 0.05,
+          "current rotated by -psi into M (%.6f, %.6f, %.6f)", f.current[0],
+          f.current[1], f.current[2]);
+    ts_excitation_free(ex);
+
+    /* A current from ahead seen after a quarter turn to starboard, with a
+     * steady base turn and no signal: it flows to port. */
+    ex = ts_excitation_alloc(&err);
+    ts_frame b2 = {1.0, 0.25, 0, 0, {1.0, 0.0, 0.0}};
+    ts_excitation_frame(ex, &b2, M_PI / 2 / 0.25, &f);
+    CHECK(fabs(f.current[0]) < 1e-15 && fabs(f.current[1] + 1.0) < 1e-15,
+          "after a 90 deg starboard turn a current along +x is along -y "
+          "(%.3g, %.3g)", f.current[0], f.current[1]);
+    ts_excitation_free(ex);
+}
+
+static void test_meta(void)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_signal s = {0};
+    s.type = TS_SIGNAL_RAMP;
+    s.axis = TS_AXIS_HEAVE;
+    s.amplitude = 0.1;
+    s.start = 1.0;
+    s.duration = 2.0;
+    s.rise = 0.5;
+    ts_excitation_add(ex, &s, &err);
+    s.type = TS_SIGNAL_STEP;
+    s.start = 3.0; /* its start coincides with the ramp's plateau end */
+    s.rise = 0.25;
+    ts_excitation_add(ex, &s, &err);
+    double bp[8];
+    int nb = ts_excitation_breakpoints(ex, 10.0, bp, 8);
+    CHECK(nb == 5 && bp[0] == 1.0 && bp[1] == 1.5 && bp[2] == 3.0 &&
+              bp[3] == 3.25 && bp[4] == 3.5,
+          "breakpoints sorted, deduplicated (%d: %g %g %g %g %g)", nb, bp[0],
+          bp[1], bp[2], bp[3], bp[4]);
+    CHECK(ts_excitation_breakpoints(ex, 3.2, bp, 8) == 3,
+          "breakpoints limited to (0, t_end)");
+    CHECK(ts_excitation_time_scale(ex) == 0.25, "time scale: shortest rise");
+    int idx;
+    CHECK(!ts_excitation_periodic(ex, &idx), "no periodic signal");
+    s.type = TS_SIGNAL_CRANK;
+    s.amplitude = 0.1;
+    s.rod = 0.35;
+    s.frequency = 0.625;
+    s.phase = 0;
+    ts_excitation_add(ex, &s, &err);
+    CHECK(ts_excitation_periodic(ex, &idx) && idx == 2,
+          "the single crank is the periodic signal");
+    CHECK_NEAR(ts_excitation_time_scale(ex), 1 / (4 * M_PI * 0.625), 1e-17,
+               "time scale: the crank's 1/(4 pi f) = 0.127 s (second "
+               "harmonic) undercuts the step's 0.25 s");
+    char d[256];
+    ts_excitation_describe(ex, 2, d, sizeof d);
+    CHECK(strstr(d, "tow.heave slider crank radius 0.1 m, rod 0.35 m") != NULL,
+          "describe: %s", d);
+    ts_excitation_free(ex);
+}
+
+static void test_parse(void)
+{
+    ts_err err = {0};
+    ts_units *units = ts_units_alloc(&err);
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    int rc = ts_excitation_parse(ex, "tow.heave:amplitude=0.1ft,"
+                                 "frequency=0.25Hz", units, "--excite", &err);
+    const ts_signal *s = ts_excitation_signal(ex, 0);
+    CHECK(rc == TS_OK && s->type == TS_SIGNAL_SINE &&
+              s->axis == TS_AXIS_HEAVE && s->amplitude == 0.1 * 0.3048 &&
+              s->frequency == 0.25 && s->phase == 0,
+          "issue example parsed: sine, heave, 0.03048 m, 0.25 Hz (%s)",
+          err.msg);
+    rc = ts_excitation_parse(ex, " tow.x : type = crank , amplitude = 10 cm,"
+                             " rod=0.35, period=1.6 s, phase=90deg", units,
+                             "--excite", &err);
+    s = ts_excitation_signal(ex, 1);
+    CHECK(rc == TS_OK && s->type == TS_SIGNAL_CRANK &&
+              s->axis == TS_AXIS_SURGE && fabs(s->amplitude - 0.1) < 1e-16 &&
+              s->rod == 0.35 && fabs(s->frequency - 0.625) < 1e-15 &&
+              fabs(s->phase - M_PI / 2) < 1e-15,
+          "crank with blanks, period and degrees (%s)", err.msg);
+    rc = ts_excitation_parse(ex, "turn_rate:to=0.5rad/s,duration=2s", units,
+                             "--manoeuvre", &err);
+    s = ts_excitation_signal(ex, 2);
+    CHECK(rc == TS_OK && s->type == TS_SIGNAL_RAMP && s->absolute &&
+              s->amplitude == 0.5 && s->duration == 2 &&
+              s->rise == TS_SIGNAL_RISE && s->start == 0,
+          "manoeuvre defaults: ramp, start 0, rise %g s (%s)",
+          TS_SIGNAL_RISE, err.msg);
+    rc = ts_excitation_parse(ex, "speed:type=step,by=-1knot,start=3", units,
+                             "--manoeuvre", &err);
+    s = ts_excitation_signal(ex, 3);
+    CHECK(rc == TS_OK && s->type == TS_SIGNAL_STEP && !s->absolute &&
+              fabs(s->amplitude + 1852.0 / 3600) < 1e-15 && s->start == 3,
+          "speed step by -1 knot");
+    rc = ts_excitation_parse(ex, "tow.sway:type=ramp,amplitude=1,"
+                             "duration=0.05", units, "x", &err);
+    s = ts_excitation_signal(ex, 4);
+    CHECK(rc == TS_OK && s->rise == 0.05,
+          "a ramp shorter than the default rise gets rise = duration");
+
+    struct { const char *spec; int code; const char *want; } bad[] = {
+        {"tow.roll:amplitude=1,frequency=1", TS_EINVAL, "unknown axis 'tow.roll'"},
+        {"tow.heave:amplitud=1,frequency=1", TS_EINVAL, "unknown parameter 'amplitud'"},
+        {"tow.heave:amplitude=1,frequency=1,rod=2", TS_EINVAL, "'rod' does not apply to type sine"},
+        {"tow.heave:amplitude=1,frequency=-1Hz", TS_EINVAL, "frequency must be > 0 Hz, got -1"},
+        {"tow.heave:amplitude=1,period=-2", TS_EINVAL, "period must be > 0 s"},
+        {"tow.heave:type=step,amplitude=1,start=-1", TS_EINVAL, "start must be >= 0 s, got -1"},
+        {"tow.heave:type=step,amplitude=1,rise=0", TS_EINVAL, "rise must be > 0 s"},
+        {"tow.heave:type=ramp,amplitude=1,duration=-3", TS_EINVAL, "duration must be > 0 s"},
+        {"tow.heave:type=ramp,amplitude=1", TS_EINVAL, "needs duration="},
+        {"tow.heave:frequency=1", TS_EINVAL, "needs amplitude="},
+        {"tow.heave:amplitude=1,frequency=1,period=1", TS_EINVAL, "exactly one of frequency= and period="},
+        {"tow.heave:amplitude=1", TS_EINVAL, "exactly one of frequency= and period="},
+        {"tow.heave:type=crank,amplitude=1,frequency=1", TS_EINVAL, "needs rod="},
+        {"tow.heave:type=crank,amplitude=1,frequency=1,rod=0.5", TS_EINVAL, "rod must be longer"},
+        {"tow.heave:type=square,amplitude=1", TS_EINVAL, "unknown type 'square'"},
+        {"tow.heave:amplitude=1 s,frequency=1", TS_EUNIT, "amplitude"},
+        {"tow.heave:amplitude,frequency=1", TS_EINVAL, "is not key=value"},
+        {"tow.heave:amplitude=1,,frequency=1", TS_EINVAL, "empty item"},
+        {"tow.heave:amplitude=1,amplitude=2,frequency=1", TS_EINVAL, "given twice"},
+        {"tow.heave:amplitude=,frequency=1", TS_EINVAL, "has no value"},
+        {"turn_rate:type=sine,amplitude=1,frequency=1", TS_EINVAL, "a manoeuvre is a step or a ramp"},
+        {"turn_rate:duration=2", TS_EINVAL, "exactly one of to="},
+        {"turn_rate:to=1,by=1,duration=2", TS_EINVAL, "exactly one of to="},
+        {"turn_rate:to=0.1rad/s,duration=2", TS_EINVAL, "two signals set its final value"},
+        {"speed:amplitude=1,duration=1", TS_EINVAL, "'amplitude' does not apply"},
+        {"tow.heave:type=csv", TS_EINVAL, "needs file=PATH"},
+        {"tow.heave:type=csv,file=/nonexistent.csv", TS_EIO, "cannot read"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ts_err_clear(&err);
+        rc = ts_excitation_parse(ex, bad[i].spec, units, "--excite", &err);
+        CHECK(rc == bad[i].code && strstr(err.msg, bad[i].want) &&
+                  strncmp(err.msg, "--excite", 8) == 0,
+              "refused '%s': %s", bad[i].spec, err.msg);
+    }
+    CHECK(ts_excitation_nsignals(ex) == 5, "refused specs added nothing "
+          "(%d signals)", ts_excitation_nsignals(ex));
+    ts_excitation_free(ex);
+    ts_units_free(units);
+}
+
+int main(void)
+{
+    test_shapes();
+    test_series();
+    test_manoeuvres();
+    test_meta();
+    test_parse();
+    return tc_done();
+}
