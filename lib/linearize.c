@@ -246,10 +246,15 @@ static int column(col_ws *w, int j, int n, int nq, int nl, double h,
     return TS_OK;
 }
 
-/* Scale of a strain coordinate: equilibrium strains are ~T/EA, 1e-6 to
- * 1e-3; the elastic force is linear in e, so the step only has to stay
- * well above rounding. */
+/* Scale of a strain rate's column: equilibrium strains are ~T/EA, 1e-10
+ * to 1e-3, and their rates zero. */
 #define STRAIN_SCALE 1e-4
+/* Floor of a strain's own scale: its step is rel_step |e|, so that a taut
+ * link stays taut on both sides (T = max(0, EA e) has its kink at e = 0;
+ * at EA = 1e12 N the equilibrium strain is ~4e-10, below any fixed step
+ * worth taking). The tension is EA e exactly, with no cancellation, so a
+ * relative step loses nothing to rounding. */
+#define STRAIN_FLOOR 1e-14
 
 /* Scale of column j (see linearize.h); link[] maps a coordinate to its
  * link, kind[] to 0 angle, 1 strain. */
@@ -261,7 +266,7 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
     if (j < n) {
         int c = j < nq ? j : j - nq;
         double l = sys->links[link[c]].length;
-        double s = kind[c] ? STRAIN_SCALE : 1.0;
+        double s = kind[c] ? (j < nq ? STRAIN_FLOOR : STRAIN_SCALE) : 1.0;
         return j < nq ? s : s * (sqrt(g * l) + V) / l;
     }
     double l0 = sys->links[0].length;

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "forces.h"
+#include "lapack.h"
 #include "vec3.h"
 
 /* Local root: |H_perp| below this fraction of |H| (rounding is ~1e-16). */
@@ -39,6 +40,9 @@
 /* Largest local Newton step in chart coordinates (tan 16.7 degrees). */
 #define LOCAL_MAX_STEP 0.3
 #define LOCAL_FD_STEP 1e-8
+/* Relative step of the forward-difference shooting Jacobian (~sqrt(eps)):
+ * it only feeds a condition estimate. */
+#define FD_JAC_RSTEP 1.5e-8
 /* Translation corrections tried before the hybrid solver takes over. */
 #define MAX_CORRECTIONS 40
 
@@ -49,6 +53,11 @@ struct tsi_march {
     int *res_link;      /* [nleaf] link whose upper-end mismatch is residual j */
     char *member;       /* [nleaf * nleaf]: leaf b lies below residual a */
     double *jac0;       /* [nu * nu] row-major d e / d x of a translation */
+    double *jlast;      /* [nu * nu] Jacobian for the condition estimate */
+    double *xlast;      /* [nu] free-end positions the last solve ended at */
+    double *elast;      /* [nu] and its mismatches */
+    ts_frame flast;     /* and its frame */
+    int hybrid;         /* the last solve needed the hybrid solver */
     int *res_of_link;   /* [nl] residual index or -1 */
 
     double *n, *t;      /* [3 nl], [nl] */
@@ -80,6 +89,9 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     m->res_link = calloc(nf, sizeof(int));
     m->member = calloc(nf * nf, 1);
     m->jac0 = calloc(9 * nf * nf, sizeof(double));
+    m->jlast = calloc(9 * nf * nf, sizeof(double));
+    m->xlast = calloc(3 * nf, sizeof(double));
+    m->elast = calloc(3 * nf, sizeof(double));
     m->res_of_link = malloc(nl * sizeof(int));
     m->n = calloc(3 * nl, sizeof(double));
     m->t = calloc(nl, sizeof(double));
@@ -91,6 +103,7 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     m->local = gsl_multiroot_fsolver_alloc(gsl_multiroot_fsolver_hybrids, 2);
     m->lx = gsl_vector_alloc(2);
     if (!m->leaf_node || !m->res_link || !m->member || !m->jac0 ||
+        !m->jlast || !m->xlast || !m->elast ||
         !m->res_of_link ||
         !m->n || !m->t || !m->len || !m->r || !m->rset || !m->K || !m->Ma ||
         !m->local || !m->lx)
@@ -157,6 +170,9 @@ void tsi_march_free(tsi_march *m)
     free(m->res_link);
     free(m->member);
     free(m->jac0);
+    free(m->jlast);
+    free(m->xlast);
+    free(m->elast);
     free(m->res_of_link);
     free(m->n);
     free(m->t);
@@ -184,6 +200,86 @@ void tsi_march_strains(const tsi_march *m, double *e)
     }
 }
 double tsi_march_mismatch(const tsi_march *m) { return m->mismatch; }
+
+/* Forward-difference Jacobian of the mismatches at x, where they are e0,
+ * into m->jlast (row-major): nu marches; e is scratch. */
+static int fd_jacobian(tsi_march *m, const ts_frame *f, double x[],
+                       const double e0[], double e[], long *marches,
+                       ts_err *err)
+{
+    int nu = 3 * m->nleaf, rc = TS_OK;
+    double L = 0.0;
+    for (int l = 0; l < m->nl; l++)
+        L += m->sys->links[l].length;
+    for (int j = 0; rc == TS_OK && j < nu; j++) {
+        double xj = x[j], h = FD_JAC_RSTEP * fmax(fabs(xj), L);
+        x[j] = xj + h;
+        rc = tsi_march_eval(m, f, x, e, err);
+        (*marches)++;
+        x[j] = xj;
+        for (int i = 0; rc == TS_OK && i < nu; i++)
+            m->jlast[(size_t)i * nu + j] = (e[i] - e0[i]) / h;
+    }
+    return rc;
+}
+
+int tsi_march_condition(tsi_march *m, double *condition, double *shape_error,
+                        long *marches)
+{
+    int n = 3 * m->nleaf, info = 0;
+    *condition = NAN;
+    *shape_error = NAN;
+    /* Where the translation corrections closed the solve, the translation
+     * Jacobian is exact; otherwise it is formed by forward differences
+     * (the hybrid solver keeps its updates in QR factors, not in a
+     * Jacobian one can read). The marches leave the stored shape at a
+     * perturbed point: take the solution out first. */
+    if (m->hybrid) {
+        double *e = malloc((size_t)n * sizeof(double));
+        ts_err ferr = {0};
+        int frc = e ? fd_jacobian(m, &m->flast, m->xlast, m->elast, e,
+                                  marches, &ferr)
+                    : TS_ENOMEM;
+        free(e);
+        if (frc != TS_OK)
+            return frc;
+    } else {
+        memcpy(m->jlast, m->jac0, (size_t)n * n * sizeof(double));
+    }
+    size_t nn = (size_t)n * (size_t)n;
+    double *a = malloc(nn * sizeof(double));
+    double *work = malloc(4 * (size_t)n * sizeof(double));
+    int *iwork = malloc((size_t)n * sizeof(int)), *ipiv = malloc((size_t)n * sizeof(int));
+    if (!a || !work || !iwork || !ipiv) {
+        free(a);
+        free(work);
+        free(iwork);
+        free(ipiv);
+        return TS_ENOMEM;
+    }
+    /* The row-major J read column-major is J^T, whose infinity-norm
+     * condition is J's 1-norm condition. */
+    memcpy(a, m->jlast, nn * sizeof(double));
+    double anorm = dlange_("I", &n, &n, a, &n, work, 1);
+    dgetrf_(&n, &n, a, &n, ipiv, &info);
+    double rcond = 0.0;
+    if (info == 0)
+        dgecon_("I", &n, a, &n, &anorm, &rcond, work, iwork, &info, 1);
+    if (info == 0) {
+        *condition = rcond > 0 ? 1.0 / rcond : INFINITY;
+        /* Free-end positions move by about |J^-1| |mismatch|, at the
+         * solution (the perturbed marches changed m->mismatch). */
+        double mis = 0.0;
+        for (int k = 0; k < n; k++)
+            mis = fmax(mis, fabs(m->elast[k]));
+        *shape_error = rcond > 0 ? mis / (rcond * anorm) : INFINITY;
+    }
+    free(a);
+    free(work);
+    free(iwork);
+    free(ipiv);
+    return info == 0 ? TS_OK : TS_ELAPACK;
+}
 
 /* The balance of one node, for the local root. */
 typedef struct link_problem {
@@ -299,6 +395,10 @@ static int local_newton(const link_problem *P, double tol, double x[2])
         double det = j00 * j11 - j01 * j10;
         if (!(fabs(det) > 0))
             return 0;
+        /* Where the residual turns much faster than H is long (huge normal
+         * drag) rounding in the direction alone leaves eps |J| of it. */
+        tol = fmax(tol, LOCAL_RTOL * fmax(fmax(fabs(j00), fabs(j01)),
+                                          fmax(fabs(j10), fabs(j11))));
         double da = -(j11 * r[0] - j01 * r[1]) / det;
         double db = -(-j10 * r[0] + j00 * r[1]) / det;
         /* A full step may leave the part of the chart that is useful:
@@ -387,6 +487,17 @@ static int solve_link(tsi_march *m, link_problem *P, const double guess[3],
     for (int j = 0; j < 3; j++)
         hp[j] = H[j] - along * n[j];
     double perp = v3_norm(hp);
+    if (!(perp <= 1e3 * LOCAL_RTOL * hnorm)) {
+        /* The floor rounding sets: eps times how fast the residual turns
+         * with the direction, when that exceeds |H| (huge normal drag). */
+        double r0[2], r1[2], r2[2], h = LOCAL_FD_STEP;
+        local_eval(P, xc[0], xc[1], r0);
+        local_eval(P, xc[0] + h, xc[1], r1);
+        local_eval(P, xc[0], xc[1] + h, r2);
+        double jn = fmax(hypot(r1[0] - r0[0], r1[1] - r0[1]),
+                         hypot(r2[0] - r0[0], r2[1] - r0[1])) / h;
+        hnorm = fmax(hnorm, jn);
+    }
     if (!(perp <= 1e3 * LOCAL_RTOL * hnorm)) {
         const ts_link *L = P->L;
         return ts_fail(err, TS_ECONV,
@@ -588,6 +699,7 @@ static int shoot_fdf(const gsl_vector *x, void *params, gsl_vector *out,
     return rc ? rc : shoot_df(x, params, J);
 }
 
+
 int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
                     double pos_tol, int max_iter, int *iterations,
                     long *marches, ts_err *err)
@@ -610,6 +722,8 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
         }
     }
     /* Translation corrections first: they close a straight tow exactly. */
+    m->hybrid = 0;
+    m->flast = *f;
     double last = INFINITY;
     int it = 0;
     for (; it < MAX_CORRECTIONS; it++) {
@@ -653,6 +767,7 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
             rc = ctx.rc;
             goto out;
         }
+        m->hybrid = 1;
         if ((rc = tsi_march_eval(m, f, x, e, err)) != TS_OK)
             goto out;
         if (!(m->mismatch <= pos_tol))
@@ -662,6 +777,10 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
                          it, m->mismatch, pos_tol);
     }
 out:
+    if (rc == TS_OK) {
+        memcpy(m->xlast, x, (size_t)nu * sizeof(double));
+        memcpy(m->elast, e, (size_t)nu * sizeof(double));
+    }
     *iterations += it;
     free(e);
     return rc;

@@ -49,6 +49,15 @@ const double *tsi_march_tensions(const tsi_march *m);
  * links). */
 void tsi_march_strains(const tsi_march *m, double *e);
 
+/* Condition number (1-norm) of the shooting Jacobian at the last solve's
+ * solution (the translation Jacobian where translation corrections closed
+ * it, else a forward-difference one: 3 marches per free end, counted in
+ * *marches, which leave the stored shape at a perturbed point: read the
+ * solution out first), and the free-end position error it implies,
+ * |J^-1| |mismatch| (m). NaN when it cannot be formed. */
+int tsi_march_condition(tsi_march *m, double *condition, double *shape_error,
+                        long *marches);
+
 /* Largest |mismatch| of the last march, m. */
 double tsi_march_mismatch(const tsi_march *m);
 

@@ -10,7 +10,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "towstab/health.h"
 #include "towstab/kernel.h"
+#include "towstab/report_converge.h"
 
 void ts_report_node_name(const ts_system *sys, int node, char *buf,
                          size_t size)
@@ -85,16 +87,17 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
                                                 num(r[0]), "y", num(r[1]), "z",
                                                 num(r[2])));
     }
-    /* What an engineer must not overlook, in words. */
-    json_t *warn = json_array();
-    if (warn && eq->converged && eq->min_tension < 0) {
-        char msg[160];
-        snprintf(msg, sizeof msg, "a link is in compression (%.6g N): a "
-                                  "real cable would go slack there",
-                 eq->min_tension);
-        json_array_append_new(warn, json_string(msg));
+    json_object_set_new(o, "condition", num(eq->condition));
+    json_object_set_new(o, "shape_error", num(eq->shape_error));
+    /* What an engineer must not overlook: trustworthy, reasons, notes. */
+    ts_trust t;
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    json_t *tj = ts_report_trust_json(&t);
+    if (tj) {
+        json_object_update(o, tj);
+        json_decref(tj);
     }
-    json_object_set_new(o, "warnings", warn ? warn : json_array());
     json_object_set_new(o, "nodes", nodes);
     json_object_set_new(o, "links", links);
     json_object_set_new(o, "bodies", bodies);

@@ -7,6 +7,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "towstab/health.h"
 #include "towstab/kernel.h"
 #include "towstab/report.h"
 
@@ -277,10 +278,20 @@ static void print_equilibrium(FILE *f, const ts_system *sys,
                "%.6f N)\n",
             eq->top_tension, eq->tow_force[0], eq->tow_force[1],
             eq->tow_force[2]);
-    if (eq->min_tension < 0)
-        fprintf(f, "warning: a link is in compression (%.6g N): a real cable "
-                   "would go slack there\n",
-                eq->min_tension);
+    fprintf(f, "solver Jacobian condition %.3g, shape error estimate %.3g "
+               "m\n",
+            eq->condition, eq->shape_error);
+    ts_trust t;
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    if (t.trustworthy)
+        fprintf(f, "trustworthy: yes\n");
+    else
+        fprintf(f, "trustworthy: NO\n");
+    for (int i = 0; i < t.nreasons; i++)
+        fprintf(f, "  reason: %s\n", t.reasons[i]);
+    for (int i = 0; i < t.nnotes; i++)
+        fprintf(f, "  note: %s\n", t.notes[i]);
 }
 
 int cli_equilibrium(const ts_system *sys, const ts_equilibrium_opts *eo,

@@ -10,8 +10,10 @@
 #include "cli.h"
 #include "cli_plot.h"
 #include "towstab/eigen.h"
+#include "towstab/health.h"
 #include "towstab/linearize.h"
 #include "towstab/report.h"
+#include "towstab/report_converge.h"
 #include "towstab/report_linear.h"
 
 /* Modes shown when the system is large and no count is given. */
@@ -135,7 +137,8 @@ static int parse_method(const char *text, const char *where,
 }
 
 static void print_modes(const ts_system *sys, const ts_linear *lin,
-                        const ts_eigen *e, double wall, int quiet)
+                        const ts_eigen *e, const ts_mode_health *mh,
+                        const ts_trust *trust, double wall, int quiet)
 {
     printf("eigen: %s, %d mode%s (%d of %d eigenvalues)%s, %.3f ms",
            ts_eig_method_name(e->method), e->nmodes, e->nmodes == 1 ? "" : "s",
@@ -153,9 +156,20 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
         for (int m = 0; m < e->nmodes; m++) {
             const ts_mode *md = &e->modes[m];
             ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
-            printf("%4d %14.6g %14.6g %12.6g %12.6g %10.6f  %s\n", m + 1,
+            printf("%4d %14.6g %14.6g %12.6g %12.6g %10.6f  %s", m + 1,
                    md->re, md->im, md->freq_hz, md->period_s,
                    md->damping_ratio, desc);
+            /* Health labels (towstab/health.h). */
+            if (!mh[m].trustworthy)
+                printf(" [NOT TRUSTWORTHY: damping +-%.2g]",
+                       mh[m].damping_error);
+            if (!mh[m].shape_resolved) {
+                if (mh[m].nearest >= 0)
+                    printf(" [shape mixes with mode %d]", mh[m].nearest + 1);
+                else
+                    printf(" [shape not resolved: nearly real]");
+            }
+            printf("\n");
         }
         printf("\n");
     }
@@ -183,9 +197,14 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
         printf("note: only %d of %d eigenvalues were computed (those nearest "
                "%.6g Hz); modes elsewhere are not covered by the verdict\n",
                e->neig, e->nstate, e->target_hz);
-    if (lin->kinks > lin->kink_tow)
-        printf("warning: a node sits at the water surface (kink in f): the "
-               "margin above is not trustworthy\n");
+    if (trust->trustworthy)
+        printf("trustworthy: yes\n");
+    else
+        printf("trustworthy: NO\n");
+    for (int i = 0; i < trust->nreasons; i++)
+        printf("  reason: %s\n", trust->reasons[i]);
+    for (int i = 0; i < trust->nnotes; i++)
+        printf("  note: %s\n", trust->notes[i]);
 }
 
 /* Everything after the system is built. *json receives the result. */
@@ -220,9 +239,26 @@ static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
     double t0 = cli_wall_now();
     rc = ts_eigen_solve(lin, &rq->eo, &e, err);
     double wall = cli_wall_now() - t0;
+    /* Health: the equilibrium's, then the modes' (towstab/health.h). */
+    ts_mode_health *mh = NULL;
+    ts_trust trust;
+    ts_trust_init(&trust);
     if (rc == TS_OK) {
-        print_modes(sys, lin, e, wall, quiet);
+        ts_trust et;
+        ts_trust_init(&et);
+        ts_health_equilibrium(sys, eq, &et);
+        ts_trust_merge(&trust, "equilibrium: ", &et);
+        mh = malloc((size_t)(e->nmodes > 0 ? e->nmodes : 1) * sizeof *mh);
+        rc = mh ? ts_health_modes(sys, lin, e, mh, &trust, err)
+                : ts_fail(err, TS_ENOMEM, "modes: out of memory");
+    }
+    if (rc == TS_OK) {
+        print_modes(sys, lin, e, mh, &trust, wall, quiet);
         json_t *j = ts_report_modes_json(sys, lin, e, 0);
+        if (j && ts_report_modes_health_json(j, e, mh, &trust) != TS_OK) {
+            json_decref(j);
+            j = NULL;
+        }
         if (j) {
             json_object_set_new(j, "linearization",
                                 ts_report_linear_json(lin, matrices));
@@ -231,6 +267,7 @@ static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
         }
         *json = j;
     }
+    free(mh);
     json_decref(eqjson);
     if (rc == TS_OK && pos_out) {
         size_t bytes = 3 * (size_t)sys->nnodes * sizeof(double);

@@ -11,10 +11,12 @@
 extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
 extern const cli_command cli_cmd_modes, cli_cmd_response;
 extern const cli_command cli_cmd_simulate;
+extern const cli_command cli_cmd_converge;
 
 const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
                                            &cli_cmd_simulate,
+                                           &cli_cmd_converge,
                                            NULL};
 
 static void usage(FILE *f)

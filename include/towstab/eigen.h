@@ -73,6 +73,27 @@ typedef struct ts_mode {
                                dgeevx) or eps ||A||_F (arpack) */
     double residual;        /* ||A v - lambda v|| / (||A||_F |v|); NaN when
                                not computed (lapack: backward stable) */
+    double vector_condition;/* conditioning of the right eigenvector: the
+                               largest kappa_k ||A_bal||_1 / |lambda -
+                               lambda_k| over the other eigenvalues k
+                               (conjugates included; kappa_k their
+                               condition numbers), the sensitivity of the
+                               shape to relative changes of A from its
+                               nearest neighbour (~ 1 / RCONDV of
+                               dgeevx); NaN with arpack */
+    double vector_error;    /* error allowance of the unit eigenvector (an
+                               angle, rad) from first-order perturbation
+                               theory: sqrt(sum |c_k|^2) over the 8
+                               eigenvalues nearest (conjugates included),
+                               c_k = |u_k^H E v| / (|lambda - lambda_k|
+                               |u_k^H v_k|) with E the linearization's
+                               error estimate, plus rounding (lapack);
+                               (the first-order eigenvalue change + eps
+                               ||A||_F) / distance to the nearest other
+                               computed eigenvalue (arpack). Large for
+                               close modes, whose shapes can mix
+                               (towstab/health.h); INFINITY for an
+                               exactly double eigenvalue */
 } ts_mode;
 
 typedef struct ts_eigen {

@@ -63,6 +63,12 @@ typedef struct ts_equilibrium {
     double tow_force[3];  /* force of the cables on the tow point, N */
     double top_tension;   /* |tow_force|, N */
     double min_tension;   /* smallest link tension, N (< 0: compression) */
+    double condition;     /* 1-norm condition number of the solver's last
+                             Jacobian (shooting: d mismatch / d free-end
+                             positions; Newton: d q'' / d q); NaN if none */
+    double shape_error;   /* node position error it implies, m: Newton
+                             |J^-1 q''| times the cable length, shooting
+                             |J^-1| |mismatch|; NaN if none */
 } ts_equilibrium;
 
 TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);

@@ -27,7 +27,8 @@ TS_API void ts_report_node_name(const ts_system *sys, int node, char *buf,
 
 /* The equilibrium as a new JSON object: converged, iterations, evaluations,
  * residual, force_scale, tolerance, method, speed, turn_rate, wall_s,
- * top_tension, min_tension, tow_force, warnings [text], nodes
+ * top_tension, min_tension, tow_force, condition, shape_error,
+ * trustworthy, reasons [text], notes [text] (towstab/health.h), nodes
  * [{name,x,y,z}] (tow point first), links
  * [{cable,index,tension,theta1_deg,theta2_deg}], bodies [{name,x,y,z}].
  * NULL on allocation failure. */

@@ -1,0 +1,313 @@
+/* health.c: trustworthiness of results (towstab/health.h; doc/converge.md,
+ * "Numerical health").
+ *
+ * The checks compare what a solver reports about its own accuracy with
+ * the size of the result it qualifies:
+ *  - equilibrium: the force residual against its target; links in
+ *    compression (a rigid link may push, a cable cannot);
+ *  - modes: each eigenvalue's error allowance (ts_mode.error_bound: the
+ *    first-order change by the linearization's error estimate plus
+ *    rounding, lib/eigen.c) against its damping, |Re lambda|: the damping
+ *    ratio is resolved when its allowance error_bound / |lambda| is within
+ *    10 % of it (or below 1e-6 absolute); each eigenvector's allowance
+ *    (ts_mode.vector_error, first-order perturbation theory) against 0.1
+ *    rad: two modes closer than their errors allow have shapes that can
+ *    mix (Stewart & Sun, Matrix Perturbation Theory, 1990, ch. V); the
+ *    stability margin against its error; nodes at the water surface, where
+ *    A is the mean of one-sided derivatives (MODEL.md section 6); ARPACK
+ *    residuals.
+ * The verdict is a ts_trust: trustworthy or not, with reasons and notes as
+ * sentences that name the quantity, its size and the limit.
+ */
+#include "towstab/health.h"
+
+#include <complex.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "towstab/report.h"
+
+/* An ARPACK Ritz pair with a larger residual (relative to ||A||_F |v|)
+ * is not an eigenpair to trust. */
+#define ARPACK_RESIDUAL_MAX 1e-8
+/* Modes listed by name in one aggregated reason. */
+#define LIST_MAX 4
+
+void ts_trust_init(ts_trust *t)
+{
+    memset(t, 0, sizeof *t);
+    t->trustworthy = 1;
+}
+
+static void add(ts_trust *t, int reason, const char *prefix, const char *fmt,
+                va_list ap)
+{
+    int *n = reason ? &t->nreasons : &t->nnotes;
+    char(*list)[TS_TRUST_TEXT] = reason ? t->reasons : t->notes;
+    if (reason)
+        t->trustworthy = 0;
+    if (*n >= TS_TRUST_MAX) {
+        t->dropped++;
+        return;
+    }
+    size_t len = 0;
+    if (prefix) {
+        snprintf(list[*n], TS_TRUST_TEXT, "%s", prefix);
+        len = strlen(list[*n]);
+    }
+    vsnprintf(list[*n] + len, TS_TRUST_TEXT - len, fmt, ap);
+    (*n)++;
+}
+
+void ts_trust_fail(ts_trust *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(t, 1, NULL, fmt, ap);
+    va_end(ap);
+}
+
+void ts_trust_note(ts_trust *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(t, 0, NULL, fmt, ap);
+    va_end(ap);
+}
+
+/* add() with a fixed text and a prefix. */
+static void add_text(ts_trust *t, int reason, const char *prefix,
+                     const char *text, ...)
+{
+    va_list ap;
+    va_start(ap, text);
+    add(t, reason, prefix, text, ap);
+    va_end(ap);
+}
+
+void ts_trust_merge(ts_trust *dst, const char *prefix, const ts_trust *src)
+{
+    for (int i = 0; i < src->nreasons; i++)
+        add_text(dst, 1, prefix, "%s", src->reasons[i]);
+    for (int i = 0; i < src->nnotes; i++)
+        add_text(dst, 0, prefix, "%s", src->notes[i]);
+    dst->dropped += src->dropped;
+    if (!src->trustworthy)
+        dst->trustworthy = 0;
+}
+
+void ts_health_equilibrium(const ts_system *sys, const ts_equilibrium *eq,
+                           ts_trust *t)
+{
+    if (!eq->converged) {
+        ts_trust_fail(t, "the equilibrium did not converge: residual %.3g "
+                         "of the largest force %.6g N (target %.3g)",
+                      eq->residual, eq->force_scale, eq->tolerance);
+        return;
+    }
+    if (eq->min_tension < 0) {
+        int worst = 0;
+        for (int l = 1; l < eq->nlinks; l++)
+            if (eq->tensions[l] < eq->tensions[worst])
+                worst = l;
+        const ts_link *L = &sys->links[worst];
+        ts_trust_fail(t, "cables[%d] '%s' link %d is in compression (%.6g "
+                         "N): a rigid link can push, a cable cannot, so "
+                         "the shape is not physical there",
+                      L->cable, sys->cables[L->cable].name, L->index,
+                      eq->min_tension);
+    }
+    if (eq->residual > TS_HEALTH_RESIDUAL_NOTE * eq->tolerance)
+        ts_trust_note(t, "the residual %.3g is within a factor %.3g of its "
+                         "target %.3g",
+                      eq->residual, eq->tolerance / eq->residual,
+                      eq->tolerance);
+    double L = 0.0;
+    for (int l = 0; l < sys->nlinks; l++)
+        L += sys->links[l].length;
+    if (eq->condition > TS_HEALTH_CONDITION_FAIL)
+        ts_trust_fail(t, "the solver's Jacobian is nearly singular "
+                         "(condition %.3g > %.3g): the shape is not "
+                         "determined to working accuracy",
+                      eq->condition, TS_HEALTH_CONDITION_FAIL);
+    else if (eq->condition > TS_HEALTH_CONDITION_NOTE)
+        ts_trust_note(t, "the solver's Jacobian is ill-conditioned "
+                         "(condition %.3g)",
+                      eq->condition);
+    if (eq->shape_error > TS_HEALTH_SHAPE_RTOL * L)
+        ts_trust_fail(t, "node positions are uncertain by %.3g m, more than "
+                         "%.3g of the cable length %.6g m",
+                      eq->shape_error, TS_HEALTH_SHAPE_RTOL, L);
+}
+
+/* Distance from mode m to the nearest other eigenvalue among the computed
+ * modes and their conjugates (its own conjugate included: a complex pair
+ * close to the real axis is about to split). *who = -1 for its own
+ * conjugate. */
+static double nearest_mode(const ts_eigen *e, int m, int *who)
+{
+    double complex lm = e->modes[m].re + I * e->modes[m].im;
+    double gap = e->modes[m].im > 0 ? 2.0 * e->modes[m].im : INFINITY;
+    *who = -1;
+    for (int k = 0; k < e->nmodes; k++) {
+        if (k == m)
+            continue;
+        double complex lk = e->modes[k].re + I * e->modes[k].im;
+        double d = fmin(cabs(lm - lk), cabs(lm - conj(lk)));
+        if (d < gap) {
+            gap = d;
+            *who = k;
+        }
+    }
+    return gap;
+}
+
+int ts_health_modes(const ts_system *sys, const ts_linear *lin,
+                    const ts_eigen *e, ts_mode_health mh[], ts_trust *t,
+                    ts_err *err)
+{
+    int nm = e->nmodes;
+    ts_mode_health *h = mh ? mh : malloc((size_t)(nm > 0 ? nm : 1) *
+                                          sizeof *h);
+    if (!h)
+        return ts_fail(err, TS_ENOMEM, "health: out of memory for %d modes",
+                       nm);
+    int nbad = 0, nres = 0, list[LIST_MAX];
+    for (int m = 0; m < nm; m++) {
+        const ts_mode *md = &e->modes[m];
+        ts_mode_health *x = &h[m];
+        double mag = hypot(md->re, md->im);
+        x->freq_error_hz = md->error_bound / (2.0 * M_PI);
+        x->damping_error = mag > 0 ? md->error_bound / mag : INFINITY;
+        x->damping_resolved =
+            x->damping_error <=
+            fmax(TS_HEALTH_DAMPING_RTOL * fabs(md->damping_ratio),
+                 TS_HEALTH_DAMPING_ATOL);
+        x->gap = nearest_mode(e, m, &x->nearest);
+        x->vector_error = md->vector_error;
+        x->shape_resolved = md->vector_error <= TS_HEALTH_VECTOR_ERROR;
+        x->trustworthy = x->damping_resolved;
+        if (!x->damping_resolved) {
+            if (nbad < LIST_MAX)
+                list[nbad] = m;
+            nbad++;
+        }
+        if (e->method == TS_EIG_ARPACK &&
+            !(md->residual <= ARPACK_RESIDUAL_MAX)) {
+            x->trustworthy = 0;
+            nres++;
+        }
+    }
+
+    if (lin->kinks > lin->kink_tow) {
+        char name[2 * TS_NAME_MAX];
+        if (sys)
+            ts_report_node_name(sys, lin->kink_node, name, sizeof name);
+        else
+            snprintf(name, sizeof name, "node %d", lin->kink_node);
+        ts_trust_fail(t, "%d node%s (first %s, depth %.3g m) within a "
+                         "linearization step of the water surface: f is "
+                         "not smooth there and A is the mean of one-sided "
+                         "derivatives",
+                      lin->kinks - lin->kink_tow,
+                      lin->kinks - lin->kink_tow == 1 ? "" : "s", name,
+                      lin->r0[3 * lin->kink_node + 2]);
+    }
+    if (nbad > 0) {
+        char buf[TS_TRUST_TEXT] = "";
+        for (int i = 0; i < nbad && i < LIST_MAX; i++) {
+            const ts_mode *md = &e->modes[list[i]];
+            size_t len = strlen(buf);
+            snprintf(buf + len, sizeof buf - len,
+                     "%smode %d (%.4g Hz): %.3g +- %.2g", i ? "; " : "",
+                     list[i] + 1, md->freq_hz, md->damping_ratio,
+                     h[list[i]].damping_error);
+        }
+        ts_trust_fail(t, "%d mode%s ha%s a damping ratio not resolved by "
+                         "the linearization error (%s%s)",
+                      nbad, nbad == 1 ? "" : "s", nbad == 1 ? "s" : "ve", buf,
+                      nbad > LIST_MAX ? "; ..." : "");
+    }
+    if (nres > 0)
+        ts_trust_fail(t, "%d ARPACK Ritz pair%s with a residual above %.0e "
+                         "of ||A||",
+                      nres, nres == 1 ? "" : "s", ARPACK_RESIDUAL_MAX);
+
+    /* The stability margin: the linearization error against the smallest
+     * damping. */
+    if (nm > 0 && isfinite(e->max_real)) {
+        double ratio = e->max_real_error > 0
+                           ? fabs(e->max_real) / e->max_real_error
+                           : INFINITY;
+        if (e->verdict == TS_MARGINAL)
+            ts_trust_note(t, "stability is not decided: the smallest "
+                             "damping, max Re(lambda) = %.3g 1/s, is within "
+                             "its error bound %.2g 1/s",
+                          e->max_real, e->max_real_error);
+        else if (ratio < TS_HEALTH_MARGIN_NOTE)
+            ts_trust_note(t, "the stability margin max Re(lambda) = %.3g 1/s "
+                             "is only %.3g times its error bound %.2g 1/s",
+                          e->max_real, ratio, e->max_real_error);
+    }
+    /* Close modes: each pair once. */
+    for (int m = 0; m < nm; m++) {
+        const ts_mode_health *x = &h[m];
+        if (x->shape_resolved)
+            continue;
+        int k = x->nearest;
+        if (k >= 0 && k < m && !h[k].shape_resolved && h[k].nearest == m)
+            continue;
+        if (k < 0)
+            ts_trust_note(t, "mode %d (%.4g Hz) is a complex pair close to "
+                             "the real axis (Im %.3g 1/s): its shape is not "
+                             "resolved (eigenvector error allowance %.2g "
+                             "rad)",
+                          m + 1, e->modes[m].freq_hz, e->modes[m].im,
+                          x->vector_error);
+        else
+            ts_trust_note(t, "modes %d and %d (%.6g and %.6g Hz) are %.3g "
+                             "1/s apart, closer than their errors allow "
+                             "(eigenvector error allowance %.2g rad): each "
+                             "shape may be any mix of the two; together "
+                             "they are determined",
+                          m < k ? m + 1 : k + 1, m < k ? k + 1 : m + 1,
+                          e->modes[m < k ? m : k].freq_hz,
+                          e->modes[m < k ? k : m].freq_hz, x->gap,
+                          x->vector_error);
+    }
+    /* Coinciding modes (a symmetric pair: in-plane and out-of-plane of a
+     * hanging chain): the eigenvalue is double within its error, so any
+     * mix of the two shapes is a mode too, whatever the shapes printed. */
+    int ncoinc = 0, first = -1;
+    for (int m = 0; m < nm; m++) {
+        int k = h[m].nearest;
+        if (k > m && h[m].gap <= fmax(e->modes[m].error_bound,
+                                      e->modes[k].error_bound)) {
+            if (first < 0)
+                first = m;
+            ncoinc++;
+        }
+    }
+    if (ncoinc > 0)
+        ts_trust_note(t, "%d pair%s of modes coincide within their error "
+                         "bounds (first: modes %d and %d, %.6g Hz): any mix "
+                         "of a pair's shapes is also a mode",
+                      ncoinc, ncoinc == 1 ? "" : "s", first + 1,
+                      h[first].nearest + 1, e->modes[first].freq_hz);
+    if (lin->a_scale > 0 &&
+        lin->trunc_err > TS_HEALTH_LINEAR_NOTE * lin->a_scale)
+        ts_trust_note(t, "the linearization error estimate is %.2g of max "
+                         "|A| (%.3g of %.6g)",
+                      lin->trunc_err / lin->a_scale, lin->trunc_err,
+                      lin->a_scale);
+    if (!e->complete)
+        ts_trust_note(t, "only %d of %d eigenvalues were computed (those "
+                         "nearest %.6g Hz): the verdict covers those only",
+                      e->neig, e->nstate, e->target_hz);
+    if (!mh)
+        free(h);
+    return TS_OK;
+}

@@ -1,0 +1,617 @@
+/* test_converge.c: resolution sweeps, error estimates, observed orders and
+ * recommendations (towstab/converge.h, report_converge.h).
+ *
+ *  1. The observed-order formula on sequences f = f* + C h^p with known p
+ *     and refinement ratios that are not constant (7, 10, 23, 41 links):
+ *     p recovered to 1e-9 (Brent tolerance 1e-13; rounding in the
+ *     differences of values ~1 is ~1e-16 relative, amplified by the
+ *     ratio of differences ~1e2); refusals (sign change, zero
+ *     difference, unordered h).
+ *  2. A synthetic study f = 3.25 + 0.7 h^2 exactly: order 2 to 1e-9,
+ *     Richardson reference 3.25 to 1e-13 relative, each row's estimated
+ *     error 0.7 h^2 to 1e-9 relative; the recommendation is the coarsest
+ *     row whose error (and every finer row's) is below the target, and
+ *     none with an untrustworthy or failed finer row; the predicted
+ *     setting for a target no row meets follows from h (target / e)^(1/p).
+ *  3. A sequence with a higher-order term, f* + h^2 + 5 h^3: the estimate
+ *     of the finest row's error is at least the true error and at most 3
+ *     times it (Richardson removes the h^2 term; what is left is O(h^3)).
+ *  4. Noise, divergence and oscillation: values equal within their noise
+ *     are "converged"; differences that grow are "diverging" (no
+ *     recommendation); alternating shrinking differences are "finest"
+ *     with the geometric tail as uncertainty.
+ *  5. Two series (a work-precision comparison): the reference comes from
+ *     the more accurate series, and the recommendation is the cheaper of
+ *     the two series' recommendations.
+ *  6. Settings and table refusals (duplicate, non-integer links,
+ *     tolerance >= 1, step > 0.1, unknown series, full table).
+ *  7. The equilibrium sweep on Kamman ex. 1 (submerged): the observed
+ *     order at the finest triple of 40, 80, 160, 320 links is 2 within
+ *     0.03 for the sphere's x, z and the top tension (measured 1.984,
+ *     1.997, 1.998). Why 2: the lumped model puts half of each link's
+ *     weight and drag at its ends and evaluates the drag at the link
+ *     midpoint, a midpoint/trapezoid quadrature of the continuous cable's
+ *     loads, whose error is O(l^2) = O(1/N^2). The orders are lower on
+ *     coarse grids (sphere.x: 0.77 at 5-10-20 links, 1.38, 1.78, 1.94 at
+ *     40-80-160: pre-asymptotic; the drag on the steep upper links
+ *     changes most). Against an independent 2560-link solution (whose own
+ *     error is 1/64 of the 320-link one): the Richardson reference is at
+ *     least 20 times closer than the 320-link value, and the 320-link
+ *     error estimate is within a factor 2 of the truth. For a target no
+ *     run meets (2e-6), the predicted link count, solved, meets it.
+ *  8. The modes sweep on Kamman ex. 4 (10, 20, 40, 80 links): the two
+ *     lowest oscillatory modes converge at order 2 (within 0.1) in
+ *     frequency and damping ratio; the third mode's orders (0.93 at
+ *     10-20-40, 2.0 at 20-40-80) disagree, so its reference is the finest
+ *     run and no link count is predicted: 10 links is not yet
+ *     asymptotic for it.
+ *  9. JSON and CSV of a study: the required keys, one CSV line per run.
+ */
+#include "towstab/converge.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tcheck.h"
+#include "towstab/report_converge.h"
+#include "towstab/scene.h"
+
+/* ---- helpers ------------------------------------------------------------ */
+
+/* A study of one value "f" (scale 0: relative to the reference) over the
+ * given settings, f from fn(h). */
+static ts_convergence *synthetic(ts_conv_param p, const double *settings,
+                                 int n, double (*fn)(double h), double noise,
+                                 double scale)
+{
+    ts_conv_value v = {0};
+    snprintf(v.name, sizeof v.name, "f");
+    snprintf(v.unit, sizeof v.unit, "1");
+    v.scale = scale;
+    ts_err err = {0};
+    ts_convergence *c = ts_convergence_alloc("synthetic", p, 1, &v, 16, &err);
+    if (!c || ts_convergence_add_series(c, "", &err) != 0) {
+        printf("     alloc: %s\n", err.msg);
+        ts_convergence_free(c);
+        return NULL;
+    }
+    for (int i = 0; i < n; i++) {
+        double h = ts_conv_resolution(p, settings[i]);
+        double f = fn(h);
+        ts_convergence_add_row(c, 0, settings[i], TS_OK, NULL,
+                               1e-3 * (i + 1), 10 * (i + 1), NULL, &f,
+                               &noise, &err);
+    }
+    return c;
+}
+
+static double f_quadratic(double h) { return 3.25 + 0.7 * h * h; }
+static double f_cubic(double h) { return 1.0 + h * h + 5 * h * h * h; }
+static double f_growing(double h) { return 1.0 / h; }
+static double f_alternating(double h)
+{
+    /* 1 + (-1)^k 2^-k for h = 2^-k: differences alternate and halve. */
+    double k = -log2(h);
+    return 1.0 + (fmod(k, 2.0) == 0 ? 1 : -1) * h;
+}
+static double f_flat(double h) { return 2.0 + 1e-14 * h; }
+
+/* Row of setting s in series 0. */
+static const ts_conv_row *row_at(const ts_convergence *c, double s)
+{
+    for (int i = 0; i < c->nrows; i++)
+        if (c->rows[i].setting == s)
+            return &c->rows[i];
+    return NULL;
+}
+
+/* ---- 1. observed order ---------------------------------------------------- */
+
+static void test_order(void)
+{
+    static const double N[4] = {7, 10, 23, 41};
+    static const double P[3] = {1.0, 1.5, 2.0};
+    for (int k = 0; k < 3; k++) {
+        for (int i = 0; i + 2 < 4; i++) {
+            double h[3], f[3], p;
+            for (int j = 0; j < 3; j++) {
+                h[j] = 1.0 / N[i + j];
+                f[j] = 1.5 - 2.2 * pow(h[j], P[k]);
+            }
+            int rc = ts_conv_observed_order(h, f, &p);
+            CHECK(rc == TS_OK && fabs(p - P[k]) <= 1e-9,
+                  "order %.1f from links %g, %g, %g: got %.12g", P[k],
+                  N[i], N[i + 1], N[i + 2], p);
+        }
+    }
+    double h[3] = {0.1, 0.05, 0.025}, p;
+    double fs[3] = {1.0, 1.1, 1.05};
+    CHECK(ts_conv_observed_order(h, fs, &p) == TS_EDOMAIN && isnan(p),
+          "order: differences of opposite sign are refused (EDOMAIN, NaN)");
+    double fz[3] = {1.0, 1.0, 1.0};
+    CHECK(ts_conv_observed_order(h, fz, &p) == TS_EDOMAIN,
+          "order: zero differences are refused");
+    double fg[3] = {1.0, 1.1, 1.3};
+    CHECK(ts_conv_observed_order(h, fg, &p) == TS_EDOMAIN,
+          "order: growing differences are refused");
+    double hu[3] = {0.05, 0.1, 0.025};
+    double fq[3] = {1.0, 1.1, 1.15};
+    CHECK(ts_conv_observed_order(hu, fq, &p) == TS_EINVAL,
+          "order: unordered resolutions are refused");
+    CHECK_NEAR(ts_conv_extrapolate(0.2, 1.04, 0.1, 1.01, 2.0), 1.0, 1e-15,
+               "extrapolate 1 + h^2 from h = 0.2, 0.1 at order 2");
+}
+
+/* ---- 2. a synthetic study -------------------------------------------- */
+
+static void test_synthetic(void)
+{
+    static const double N[5] = {5, 10, 20, 40, 80};
+    ts_convergence *c =
+        synthetic(TS_CONV_LINKS, N, 5, f_quadratic, 0.0, 0.0);
+    ts_err err = {0};
+    if (!CHECK(c && ts_convergence_estimate(c, 1e-3, &err) == TS_OK,
+               "synthetic study estimates (%s)", err.msg)) {
+        ts_convergence_free(c);
+        return;
+    }
+    const ts_conv_value *V = &c->values[0];
+    CHECK(V->ref_kind == TS_CONV_REF_RICHARDSON, "reference is Richardson");
+    CHECK_NEAR(V->order, 2.0, 1e-9, "observed order of 3.25 + 0.7 h^2");
+    CHECK_REL(V->reference, 3.25, 1e-13, "Richardson reference");
+    double worst = 0;
+    for (int i = 0; i < 5; i++) {
+        const ts_conv_row *r = row_at(c, N[i]);
+        double want = 0.7 / (N[i] * N[i]);
+        worst = fmax(worst, fabs(r->errors[0] - want) / want);
+    }
+    CHECK(worst <= 1e-9, "every row's estimated error is 0.7 h^2 (worst "
+                         "relative deviation %.3g <= 1e-9)",
+          worst);
+    /* Relative to 3.25: errors 8.6e-3, 2.2e-3, 5.4e-4, ... */
+    CHECK(c->recommended >= 0 && c->rows[c->recommended].setting == 20,
+          "target 1e-3: recommended 20 links (error 5.4e-4), got %g",
+          c->recommended >= 0 ? c->rows[c->recommended].setting : -1.0);
+    CHECK(isnan(c->predicted_setting), "no prediction when a row qualifies");
+
+    /* A target no row meets: e(h) = 0.7 h^2 / 3.25 = 1e-7 at
+     * N = sqrt(0.7 / 3.25e-7) = 1467.6 -> 1468. */
+    ts_convergence_estimate(c, 1e-7, &err);
+    CHECK(c->recommended < 0 && c->predicted_setting == 1468,
+          "target 1e-7: none qualifies, 1468 links predicted (got %g)",
+          c->predicted_setting);
+    CHECK(isfinite(c->predicted_wall_s) && c->predicted_wall_s > 5e-3,
+          "the predicted run time is extrapolated beyond the finest run's "
+          "(%.3g s)",
+          c->predicted_wall_s);
+    ts_convergence_free(c);
+
+    /* An untrustworthy finest row: nothing coarser may be recommended. */
+    c = synthetic(TS_CONV_LINKS, N, 4, f_quadratic, 0.0, 0.0);
+    ts_trust bad;
+    ts_trust_init(&bad);
+    ts_trust_fail(&bad, "test: a link in compression");
+    double f80 = f_quadratic(1.0 / 80);
+    ts_convergence_add_row(c, 0, 80, TS_OK, NULL, 0.01, 50, &bad, &f80, NULL,
+                           &err);
+    ts_convergence_estimate(c, 1e-3, &err);
+    CHECK(c->recommended < 0 && !row_at(c, 80)->meets_target,
+          "an untrustworthy finer row blocks the recommendation");
+    ts_convergence_free(c);
+
+    /* A failed coarse row does not matter; a failed finer row does. */
+    c = synthetic(TS_CONV_LINKS, N + 1, 4, f_quadratic, 0.0, 0.0);
+    ts_convergence_add_row(c, 0, 5, TS_ECONV, "did not converge", 0.001, 9,
+                           NULL, NULL, NULL, &err);
+    ts_convergence_estimate(c, 1e-3, &err);
+    CHECK(c->recommended >= 0 && c->rows[c->recommended].setting == 20 &&
+              row_at(c, 5)->status == TS_ECONV &&
+              isnan(row_at(c, 5)->errors[0]),
+          "a failed coarse row keeps its status and has no error; 20 links "
+          "still recommended");
+    ts_convergence_free(c);
+}
+
+/* ---- 3. higher-order terms ------------------------------------------ */
+
+static void test_cubic(void)
+{
+    static const double N[5] = {4, 8, 16, 32, 64};
+    ts_convergence *c = synthetic(TS_CONV_LINKS, N, 5, f_cubic, 0.0, 1.0);
+    ts_err err = {0};
+    ts_convergence_estimate(c, 1e-3, &err);
+    const ts_conv_row *fin = row_at(c, 64);
+    double truth = f_cubic(1.0 / 64) - 1.0;
+    CHECK(fin->errors[0] >= truth && fin->errors[0] <= 3 * truth,
+          "f* + h^2 + 5 h^3: finest error estimate %.4g within [1, 3] x the "
+          "true error %.4g",
+          fin->errors[0], truth);
+    CHECK(fabs(c->values[0].order - 2.0) < 0.3,
+          "f* + h^2 + 5 h^3: order near 2 at 16, 32, 64 links (%.4f)",
+          c->values[0].order);
+    ts_convergence_free(c);
+}
+
+/* ---- 4. noise, divergence, oscillation -------------------------------- */
+
+static void test_kinds(void)
+{
+    static const double N[4] = {10, 20, 40, 80};
+    ts_err err = {0};
+    ts_convergence *c = synthetic(TS_CONV_LINKS, N, 4, f_flat, 1e-12, 0.0);
+    ts_convergence_estimate(c, 1e-6, &err);
+    CHECK(c->values[0].ref_kind == TS_CONV_REF_CONVERGED &&
+              c->recommended >= 0 && c->rows[c->recommended].setting == 10,
+          "values equal within their noise: converged, the coarsest is "
+          "recommended");
+    ts_convergence_free(c);
+
+    c = synthetic(TS_CONV_LINKS, N, 4, f_growing, 0.0, 0.0);
+    ts_convergence_estimate(c, 0.5, &err);
+    CHECK(c->values[0].ref_kind == TS_CONV_REF_DIVERGING &&
+              c->recommended < 0,
+          "growing differences: diverging, nothing recommended (kind %s)",
+          ts_conv_ref_name(c->values[0].ref_kind));
+    ts_convergence_free(c);
+
+    static const double T[4] = {0.25, 0.125, 0.0625, 0.03125};
+    c = synthetic(TS_CONV_TOLERANCE, T, 4, f_alternating, 0.0, 1.0);
+    ts_convergence_estimate(c, 1e-3, &err);
+    /* Differences -0.375, 0.1875, -0.09375: rho = 1/2, tail = |d|. */
+    CHECK(c->values[0].ref_kind == TS_CONV_REF_FINEST &&
+              fabs(c->values[0].reference_error - 0.09375) < 1e-15,
+          "alternating differences: finest reference with the geometric "
+          "tail |d| rho / (1 - rho) = 0.09375 (got %s, %.6g)",
+          ts_conv_ref_name(c->values[0].ref_kind),
+          c->values[0].reference_error);
+    ts_convergence_free(c);
+}
+
+/* ---- 5. two series ---------------------------------------------------- */
+
+static void test_series(void)
+{
+    ts_conv_value v = {0};
+    snprintf(v.name, sizeof v.name, "amplitude_ratio");
+    v.scale = 0.0;
+    ts_err err = {0};
+    ts_convergence *c =
+        ts_convergence_alloc("synthetic", TS_CONV_TOLERANCE, 1, &v, 16, &err);
+    int a = ts_convergence_add_series(c, "slow", &err);
+    int b = ts_convergence_add_series(c, "fast", &err);
+    static const double T[4] = {1e-3, 1e-5, 1e-7, 1e-9};
+    for (int i = 0; i < 4; i++) {
+        /* "slow": error 10 tol, run time 1 ms / tol^0.2;
+         * "fast": error 0.1 tol^0.5, cheaper. */
+        double fa = 0.2 + 10 * T[i], fb = 0.2 + 0.1 * sqrt(T[i]);
+        ts_convergence_add_row(c, a, T[i], TS_OK, NULL,
+                               1e-3 * pow(T[i], -0.2), 100, NULL, &fa, NULL,
+                               &err);
+        ts_convergence_add_row(c, b, T[i], TS_OK, NULL,
+                               1e-4 * pow(T[i], -0.2), 10, NULL, &fb, NULL,
+                               &err);
+    }
+    ts_convergence_estimate(c, 1e-3, &err);
+    CHECK(c->reference_series == a, "the reference comes from the series "
+                                    "whose reference is most accurate "
+                                    "(slow: %d, fast: %d, got %d)",
+          a, b, c->reference_series);
+    CHECK(fabs(c->values[0].reference - 0.2) <= 1e-9,
+          "common reference 0.2 (got %.12g)", c->values[0].reference);
+    /* slow meets 1e-3 (relative to 0.2: 2e-4) from tol 1e-5 on; fast
+     * (0.1 sqrt(tol) / 0.2) from 1e-7 on; fast is ten times cheaper. */
+    const ts_conv_row *rec =
+        c->recommended >= 0 ? &c->rows[c->recommended] : NULL;
+    CHECK(rec && rec->series == b && rec->setting == 1e-7,
+          "work-precision: the cheapest qualifying run is fast at 1e-7 "
+          "(got %s %g)",
+          rec ? c->series[rec->series].name : "none",
+          rec ? rec->setting : 0.0);
+    CHECK(c->series[a].recommended >= 0 &&
+              c->rows[c->series[a].recommended].setting == 1e-5,
+          "each series keeps its own recommendation (slow: 1e-5)");
+    ts_convergence_free(c);
+}
+
+/* ---- 6. refusals ------------------------------------------------------- */
+
+static void test_refusals(void)
+{
+    ts_err err = {0};
+    double dup[3] = {5, 10, 5}, frac[2] = {5, 7.5}, tol[2] = {1e-3, 1.0};
+    double step[1] = {0.2}, many[65];
+    for (int i = 0; i < 65; i++)
+        many[i] = i + 1;
+    CHECK(ts_conv_check_settings(TS_CONV_LINKS, dup, 3, "--links", &err) ==
+                  TS_EINVAL &&
+              strstr(err.msg, "--links") && strstr(err.msg, "twice"),
+          "duplicate setting refused: %s", err.msg);
+    CHECK(ts_conv_check_settings(TS_CONV_LINKS, frac, 2, "--links", &err) ==
+              TS_EINVAL,
+          "non-integer links refused: %s", err.msg);
+    CHECK(ts_conv_check_settings(TS_CONV_TOLERANCE, tol, 2, "--tolerances",
+                                 &err) == TS_EINVAL,
+          "tolerance 1 refused: %s", err.msg);
+    CHECK(ts_conv_check_settings(TS_CONV_STEP, step, 1, "--steps", &err) ==
+              TS_EINVAL,
+          "step 0.2 refused: %s", err.msg);
+    CHECK(ts_conv_check_settings(TS_CONV_LINKS, many, 65, "--links", &err) ==
+              TS_EINVAL,
+          "65 settings refused: %s", err.msg);
+    ts_conv_value v[2];
+    memset(v, 0, sizeof v);
+    snprintf(v[0].name, sizeof v[0].name, "a");
+    snprintf(v[1].name, sizeof v[1].name, "a");
+    CHECK(!ts_convergence_alloc("x", TS_CONV_LINKS, 2, v, 4, &err) &&
+              err.code == TS_EINVAL,
+          "duplicate value names refused: %s", err.msg);
+    ts_convergence *c = ts_convergence_alloc("x", TS_CONV_LINKS, 1, v, 1,
+                                             &err);
+    double f = 1;
+    CHECK(ts_convergence_add_row(c, 0, 5, TS_OK, NULL, 0, 0, NULL, &f, NULL,
+                                 &err) == TS_EINVAL,
+          "a row in a series that does not exist is refused");
+    ts_convergence_add_series(c, "", &err);
+    ts_convergence_add_row(c, 0, 5, TS_OK, NULL, 0, 0, NULL, &f, NULL, &err);
+    CHECK(ts_convergence_add_row(c, 0, 10, TS_OK, NULL, 0, 0, NULL, &f, NULL,
+                                 &err) == TS_ENOMEM,
+          "a full table is refused: %s", err.msg);
+    CHECK(ts_convergence_estimate(c, 0.0, &err) == TS_EINVAL,
+          "target 0 refused");
+    ts_convergence_free(c);
+}
+
+/* ---- 7. equilibrium sweep on Kamman ex. 1 ---------------------------- */
+
+static ts_scene *load(const char *path, ts_units **u)
+{
+    ts_err err = {0};
+    *u = ts_units_alloc(&err);
+    ts_scene *s = *u ? ts_scene_load(path, *u, &err) : NULL;
+    if (!s)
+        printf("     %s: %s\n", path, err.msg);
+    return s;
+}
+
+/* Sphere x, z and top tension of a system with N links per cable. */
+static int solve_ex(const ts_system *base, int links, double out[3])
+{
+    ts_err err = {0};
+    ts_system *s = ts_conv_system_with_links(base, links, &err);
+    ts_kernel *k = s ? ts_kernel_alloc(s, &err) : NULL;
+    ts_equilibrium *eq = k ? ts_equilibrium_alloc(s, &err) : NULL;
+    int rc = eq ? ts_equilibrium_solve(k, NULL, eq, &err) : TS_ENOMEM;
+    if (rc == TS_OK) {
+        int node = ts_system_body_node(s, 0);
+        out[0] = eq->positions[3 * node];
+        out[1] = eq->positions[3 * node + 2];
+        out[2] = eq->top_tension;
+    } else {
+        printf("     %d links: %s\n", links, err.msg);
+    }
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_system_free(s);
+    return rc;
+}
+
+static int value_index(const ts_convergence *c, const char *name)
+{
+    for (int v = 0; v < c->nvalues; v++)
+        if (strcmp(c->values[v].name, name) == 0)
+            return v;
+    return -1;
+}
+
+static void test_equilibrium_sweep(void)
+{
+    ts_units *u;
+    ts_scene *sc = load("examples/kamman_ex1_submerged.yaml", &u);
+    if (!CHECK(sc, "load Kamman ex. 1")) {
+        ts_units_free(u);
+        return;
+    }
+    ts_err err = {0};
+    ts_conv_analysis an;
+    int rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
+    ts_convergence *c =
+        rc ? NULL
+           : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
+                                  an.values, 8, &err);
+    static const double N[4] = {40, 80, 160, 320};
+    rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
+    if (rc == 0)
+        rc = ts_convergence_sweep(c, 0, &an, N, 4, &err);
+    if (rc == TS_OK)
+        rc = ts_convergence_estimate(c, 1e-3, &err);
+    if (!CHECK(rc == TS_OK, "ex. 1 sweep over 40..320 links (%s)", err.msg)) {
+        ts_conv_analysis_free(&an);
+        ts_convergence_free(c);
+        ts_scene_free(sc);
+        ts_units_free(u);
+        return;
+    }
+    static const char *const names[3] = {"sphere.x", "sphere.z",
+                                         "top_tension"};
+    for (int i = 0; i < 3; i++) {
+        int v = value_index(c, names[i]);
+        CHECK(v >= 0 && fabs(c->values[v].order - 2.0) <= 0.03 &&
+                  c->values[v].ref_kind == TS_CONV_REF_RICHARDSON,
+              "ex. 1 %s: observed order %.4f = 2 +- 0.03 (lumped loads: a "
+              "midpoint quadrature), Richardson reference",
+              names[i], v >= 0 ? c->values[v].order : NAN);
+    }
+    int vy = value_index(c, "sphere.y");
+    CHECK(vy >= 0 && c->values[vy].ref_kind == TS_CONV_REF_CONVERGED &&
+              c->values[vy].reference == 0.0,
+          "ex. 1 sphere.y is 0 at every resolution (straight tow): "
+          "converged");
+    CHECK(c->recommended >= 0 && c->rows[c->recommended].setting == 40,
+          "ex. 1 target 1e-3: 40 links recommended (top tension error "
+          "3.3e-4 at 40), got %g",
+          c->recommended >= 0 ? c->rows[c->recommended].setting : -1.0);
+    /* Independent: the 2560-link solution. */
+    double fine[3];
+    if (CHECK(solve_ex(sc->system, 2560, fine) == TS_OK,
+              "ex. 1 at 2560 links")) {
+        const ts_conv_row *r320 = row_at(c, 320);
+        for (int i = 0; i < 3; i++) {
+            int v = value_index(c, names[i]);
+            double eref = fabs(c->values[v].reference - fine[i]);
+            double e320 = fabs(r320->values[v] - fine[i]);
+            CHECK(eref * 20 <= e320,
+                  "ex. 1 %s: the Richardson reference is within %.3g of "
+                  "the 2560-link value, the 320-link value within %.3g "
+                  "(>= 20 times closer)",
+                  names[i], eref, e320);
+            CHECK(r320->errors[v] >= 0.5 * e320 &&
+                      r320->errors[v] <= 2 * e320,
+                  "ex. 1 %s: the 320-link error estimate %.3g is within a "
+                  "factor 2 of its distance %.3g from the 2560-link value",
+                  names[i], r320->errors[v], e320);
+        }
+        /* A target no run meets: the predicted link count meets it. */
+        ts_convergence_estimate(c, 2e-6, &err);
+        double np = c->predicted_setting, at[3];
+        int lv = c->limiting_value;
+        if (CHECK(c->recommended < 0 && np > 320 && np < 2560 && lv >= 0,
+                  "ex. 1 target 2e-6: none of 40..320 meets it, %g links "
+                  "predicted (limited by %s)",
+                  np, lv >= 0 ? c->values[lv].name : "?") &&
+            solve_ex(sc->system, (int)np, at) == TS_OK) {
+            double worst = 0;
+            for (int i = 0; i < 3; i++) {
+                int v = value_index(c, names[i]);
+                worst = fmax(worst,
+                             fabs(at[i] - fine[i]) / c->values[v].rel_scale);
+            }
+            CHECK(worst <= 2e-6,
+                  "ex. 1: solved at the predicted %g links, the largest "
+                  "relative error against 2560 links is %.3g <= 2e-6",
+                  np, worst);
+        }
+    }
+
+    /* JSON and CSV (at the 1e-3 target, which 40 links meets). */
+    ts_convergence_estimate(c, 1e-3, &err);
+    json_t *j = ts_report_convergence_json(c);
+    json_t *rows = j ? json_object_get(j, "rows") : NULL;
+    json_t *r0 = rows ? json_array_get(rows, 0) : NULL;
+    CHECK(j && json_is_string(json_object_get(j, "analysis")) &&
+              json_is_object(json_object_get(j, "order")) &&
+              json_array_size(rows) == 4 && r0 &&
+              json_is_integer(json_object_get(r0, "setting")) &&
+              json_is_object(json_object_get(r0, "values")) &&
+              json_is_object(json_object_get(r0, "errors")) &&
+              json_is_real(json_object_get(r0, "wall_s")) &&
+              json_is_integer(json_object_get(r0, "evaluations")) &&
+              json_is_integer(json_object_get(j, "recommended")) &&
+              json_is_array(json_object_get(j, "work_precision")),
+          "JSON: analysis, order, 4 rows with setting, values, errors, "
+          "wall_s, evaluations; recommended; work_precision");
+    json_decref(j);
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/test_converge_%ld.csv", (long)getpid());
+    int lines = 0;
+    if (ts_report_convergence_csv(c, path, &err) == TS_OK) {
+        FILE *f = fopen(path, "r");
+        for (int ch; f && (ch = fgetc(f)) != EOF;)
+            lines += ch == '\n';
+        if (f)
+            fclose(f);
+        remove(path);
+    }
+    CHECK(lines == 5, "CSV: a header and one line per run (%d lines)", lines);
+    ts_conv_analysis_free(&an);
+    ts_convergence_free(c);
+
+    /* A tolerance sweep: positions stop changing once the residual is
+     * below what moves them. */
+    rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
+    c = ts_convergence_alloc(an.name, TS_CONV_TOLERANCE, an.nvalues,
+                             an.values, 4, &err);
+    static const double T[3] = {1e-6, 1e-9, 1e-12};
+    ts_convergence_add_series(c, "", &err);
+    rc = ts_convergence_sweep(c, 0, &an, T, 3, &err);
+    ts_convergence_estimate(c, 1e-9, &err);
+    int ok = rc == TS_OK;
+    for (int i = 0; i < c->nrows; i++)
+        ok &= c->rows[i].status == TS_OK && c->rows[i].trust.trustworthy;
+    CHECK(ok && c->recommended >= 0,
+          "ex. 1 tolerance sweep 1e-6..1e-12: every run converges and one "
+          "meets 1e-9 (shooting closes a straight tow exactly)");
+    ts_conv_analysis_free(&an);
+    ts_convergence_free(c);
+    ts_scene_free(sc);
+    ts_units_free(u);
+}
+
+/* ---- 8. modes sweep on Kamman ex. 4 ---------------------------------- */
+
+static void test_modes_sweep(void)
+{
+    ts_units *u;
+    ts_scene *sc = load("examples/kamman_ex4.yaml", &u);
+    if (!CHECK(sc, "load Kamman ex. 4")) {
+        ts_units_free(u);
+        return;
+    }
+    ts_err err = {0};
+    ts_conv_analysis an;
+    int rc = ts_conv_modes_analysis(sc->system, NULL, NULL, NULL, 3, &an,
+                                    &err);
+    ts_convergence *c =
+        rc ? NULL
+           : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
+                                  an.values, 8, &err);
+    static const double N[4] = {10, 20, 40, 80};
+    rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
+    if (rc == 0)
+        rc = ts_convergence_sweep(c, 0, &an, N, 4, &err);
+    if (rc == TS_OK)
+        rc = ts_convergence_estimate(c, 1e-3, &err);
+    if (CHECK(rc == TS_OK && c->nvalues == 6, "ex. 4 modes sweep (%s)",
+              err.msg)) {
+        for (int v = 0; v < 4; v++)
+            CHECK(fabs(c->values[v].order - 2.0) <= 0.1 &&
+                      c->values[v].ref_kind == TS_CONV_REF_RICHARDSON,
+                  "ex. 4 %s: order %.4f = 2 +- 0.1 at 20, 40, 80 links, "
+                  "Richardson reference",
+                  c->values[v].name, c->values[v].order);
+        int ok = 1;
+        for (int i = 0; i < c->nrows; i++)
+            ok &= c->rows[i].status == TS_OK &&
+                  c->rows[i].evaluations > 0;
+        CHECK(ok, "ex. 4: every run succeeded and counted its evaluations");
+        int lv = c->limiting_value;
+        CHECK(c->recommended < 0 && lv == 4 &&
+                  c->values[4].ref_kind == TS_CONV_REF_FINEST &&
+                  isnan(c->predicted_setting),
+              "ex. 4 target 1e-3: no run meets it, limited by mode3.freq_hz "
+              "(got %s) whose reference is the finest run (orders %.3g and "
+              "%.3g disagree): no prediction",
+              lv >= 0 ? c->values[lv].name : "none",
+              row_at(c, 40)->order[4], row_at(c, 80)->order[4]);
+    }
+    ts_conv_analysis_free(&an);
+    ts_convergence_free(c);
+    ts_scene_free(sc);
+    ts_units_free(u);
+}
+
+int main(void)
+{
+    test_order();
+    test_synthetic();
+    test_cubic();
+    test_kinds();
+    test_series();
+    test_refusals();
+    test_equilibrium_sweep();
+    test_modes_sweep();
+    return tc_done();
+}

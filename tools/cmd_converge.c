@@ -1,0 +1,616 @@
+/* cmd_converge.c: `towstab converge SCENE` and the `converge` analysis of a
+ * scene: how accurate are the numbers, and what do they cost? Reruns an
+ * analysis (equilibrium or modes) at increasing resolution (links per
+ * cable, solver tolerance, linearization step) and prints, per value, the
+ * value, its estimated error against a Richardson-extrapolated (or the
+ * finest) reference, the observed order, wall time and kernel
+ * evaluations, then the cheapest setting that meets a target relative
+ * error (doc/converge.md). */
+#include <getopt.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "towstab/converge.h"
+#include "towstab/report.h"
+#include "towstab/report_converge.h"
+
+#define DEFAULT_TARGET 1e-3
+#define DEFAULT_MODES 3
+#define MAX_MODES 100
+/* Default sweeps. */
+static const char *const default_eq_links = "5,10,20,40,80,160,320";
+static const char *const default_modes_links = "10,20,40,80";
+
+/* What both entries (command line and scene) decide. */
+typedef struct conv_req {
+    const char *analysis;   /* "equilibrium" or "modes" */
+    ts_conv_param param;
+    double settings[TS_CONV_MAX_SETTINGS];
+    int nsettings;
+    double target;
+    int nmodes;
+} conv_req;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: towstab converge SCENE [options]\n"
+            "  reruns an analysis at increasing resolution and reports each\n"
+            "  value's estimated error, the observed order of convergence,\n"
+            "  the run time and kernel evaluations, and the cheapest setting\n"
+            "  whose error is below the target\n"
+            "  --analysis A     equilibrium (default) or modes\n"
+            "  --links LIST     links per cable, e.g. 5,10,20,40 (default\n"
+            "                   %s; modes: %s)\n"
+            "  --tolerances LIST  the equilibrium's residual target, e.g.\n"
+            "                   1e-4,1e-6,1e-8\n"
+            "  --steps LIST     relative linearization steps (modes), e.g.\n"
+            "                   1e-3,1e-4,1e-5\n"
+            "  --target X       relative error wanted (default %g)\n"
+            "  --modes K        lowest oscillatory modes to follow (modes;\n"
+            "                   default %d)\n"
+            "  --json FILE      write the study as JSON ('-' for stdout)\n"
+            "  --csv FILE       write the runs as CSV\n"
+            "  --speed Q        override tow.speed (e.g. '5 knot', 2.5)\n"
+            "  --turn-rate Q    override tow.turn_rate (e.g. '0.5 rad/s')\n"
+            "  --eq-method M    equilibrium method: auto, shooting, newton\n"
+            "  --tol X          equilibrium relative force residual\n"
+            "  --quiet          print the summary table only\n",
+            default_eq_links, default_modes_links, DEFAULT_TARGET,
+            DEFAULT_MODES);
+}
+
+/* "5,10,20" into settings; plain numbers only (counts, tolerances and
+ * steps have no unit). */
+static int parse_list(const char *where, const char *text, double *out,
+                      int *n, ts_err *err)
+{
+    char buf[2048];
+    if (strlen(text) >= sizeof buf)
+        return ts_fail(err, TS_EINVAL, "%s: list too long", where);
+    strcpy(buf, text);
+    *n = 0;
+    for (char *tok = buf, *next; tok; tok = next) {
+        next = strchr(tok, ',');
+        if (next)
+            *next++ = '\0';
+        while (*tok == ' ')
+            tok++;
+        char *end;
+        double v = strtod(tok, &end);
+        while (*end == ' ')
+            end++;
+        if (end == tok || *end || *n == TS_CONV_MAX_SETTINGS)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: expected 1 to %d comma-separated numbers "
+                           "like '5,10,20', got '%s'",
+                           where, TS_CONV_MAX_SETTINGS, text);
+        out[(*n)++] = v;
+    }
+    return TS_OK;
+}
+
+/* Fill the sweep of rq from the option texts (at most one of links,
+ * tolerances, steps; none: the default links) and check it. */
+static int request_sweep(conv_req *rq, const char *links, const char *tols,
+                         const char *steps, const char *where[3],
+                         ts_err *err)
+{
+    int given = (links != NULL) + (tols != NULL) + (steps != NULL);
+    if (given > 1)
+        return ts_fail(err, TS_EINVAL,
+                       "%s, %s and %s: give one of them (a study sweeps one "
+                       "parameter)",
+                       where[0], where[1], where[2]);
+    const char *text = links, *w = where[0];
+    rq->param = TS_CONV_LINKS;
+    if (tols) {
+        text = tols;
+        w = where[1];
+        rq->param = TS_CONV_TOLERANCE;
+    } else if (steps) {
+        text = steps;
+        w = where[2];
+        rq->param = TS_CONV_STEP;
+        if (strcmp(rq->analysis, "modes") != 0)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: the linearization step applies to the modes "
+                           "analysis, not to %s",
+                           w, rq->analysis);
+    } else if (!links) {
+        text = strcmp(rq->analysis, "modes") == 0 ? default_modes_links
+                                                  : default_eq_links;
+    }
+    int rc = parse_list(w, text, rq->settings, &rq->nsettings, err);
+    if (rc)
+        return rc;
+    return ts_conv_check_settings(rq->param, rq->settings, rq->nsettings, w,
+                                  err);
+}
+
+static int parse_analysis(const char *text, const char *where, conv_req *rq,
+                          ts_err *err)
+{
+    if (strcmp(text, "equilibrium") == 0 || strcmp(text, "modes") == 0) {
+        rq->analysis = strcmp(text, "modes") == 0 ? "modes" : "equilibrium";
+        return TS_OK;
+    }
+    return ts_fail(err, TS_EINVAL,
+                   "%s: '%s' is not an analysis to converge; expected "
+                   "equilibrium or modes",
+                   where, text);
+}
+
+static int parse_target(const char *text, const char *where, double *t,
+                        ts_err *err)
+{
+    char *end;
+    double v = strtod(text, &end);
+    if (end == text || *end || !(v > 0 && v < 1))
+        return ts_fail(err, TS_EINVAL,
+                       "%s: expected a relative error in (0, 1), got '%s'",
+                       where, text);
+    *t = v;
+    return TS_OK;
+}
+
+static int parse_modes(const char *text, const char *where, int *k,
+                       ts_err *err)
+{
+    char *end;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end || v < 1 || v > MAX_MODES)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: expected a whole number in [1, %d], got '%s'",
+                       where, MAX_MODES, text);
+    *k = (int)v;
+    return TS_OK;
+}
+
+static void print_setting(const ts_convergence *c, double s, int width)
+{
+    if (c->param == TS_CONV_LINKS)
+        printf("%*d", width, (int)s);
+    else
+        printf("%*.3g", width, s);
+}
+
+static const char *param_heading(ts_conv_param p)
+{
+    switch (p) {
+    case TS_CONV_LINKS: return "links";
+    case TS_CONV_TOLERANCE: return "tol";
+    default: return "step";
+    }
+}
+
+/* Print an error that may be NaN. */
+static void print_g(double v, int width)
+{
+    if (isfinite(v))
+        printf(" %*.3g", width, v);
+    else
+        printf(" %*s", width, "-");
+}
+
+/* Value v is the same in every successful run (e.g. a y of 0 in a
+ * straight tow). */
+static int constant_value(const ts_convergence *c, int v)
+{
+    int seen = 0;
+    double first = 0;
+    for (int i = 0; i < c->nrows; i++) {
+        const ts_conv_row *r = &c->rows[i];
+        if (r->status != TS_OK || !isfinite(r->values[v]))
+            continue;
+        if (seen && r->values[v] != first)
+            return 0;
+        first = r->values[v];
+        seen = 1;
+    }
+    return seen;
+}
+
+static void print_converge(const ts_convergence *c, const int *idx,
+                           int quiet)
+{
+    const char *ph = param_heading(c->param);
+    printf("%s against %s: %d run%s, target relative error %.3g\n",
+           c->analysis, ts_conv_param_name(c->param), c->nrows,
+           c->nrows == 1 ? "" : "s", c->target);
+    for (int v = 0; v < c->nvalues && !quiet; v++) {
+        const ts_conv_value *V = &c->values[v];
+        if (constant_value(c, v)) {
+            double x = NAN;
+            for (int i = 0; i < c->nrows && isnan(x); i++)
+                if (c->rows[i].status == TS_OK)
+                    x = c->rows[i].values[v];
+            printf("\n%s: %.10g %s in every run\n", V->name, x, V->unit);
+            continue;
+        }
+        printf("\n%s [%s]: observed order ", V->name, V->unit);
+        if (isfinite(V->order))
+            printf("%.3g", V->order);
+        else
+            printf("-");
+        printf(", reference %.10g +- %.2g (%s)\n", V->reference,
+               V->reference_error, ts_conv_ref_name(V->ref_kind));
+        printf("%8s", ph);
+        if (c->nseries > 1)
+            printf(" %-10s", "series");
+        printf(" %18s %11s %11s %7s\n", "value", "est. error", "rel. error",
+               "order");
+        for (int i = 0; i < c->nrows; i++) {
+            const ts_conv_row *r = &c->rows[idx[i]];
+            print_setting(c, r->setting, 8);
+            if (c->nseries > 1)
+                printf(" %-10.10s", c->series[r->series].name);
+            if (r->status != TS_OK) {
+                printf(" %18s\n", "failed");
+                continue;
+            }
+            printf(" %18.10g", r->values[v]);
+            print_g(r->errors[v], 11);
+            print_g(r->rel_errors[v], 11);
+            if (isfinite(r->order[v]))
+                printf(" %7.3f\n", r->order[v]);
+            else
+                printf(" %7s\n", "-");
+        }
+    }
+    printf("\n%8s", ph);
+    if (c->nseries > 1)
+        printf(" %-10s", "series");
+    printf(" %14s %12s %12s  %s\n", "max rel. err", "wall [ms]",
+           "evaluations", "result");
+    for (int i = 0; i < c->nrows; i++) {
+        const ts_conv_row *r = &c->rows[idx[i]];
+        print_setting(c, r->setting, 8);
+        if (c->nseries > 1)
+            printf(" %-10.10s", c->series[r->series].name);
+        print_g(r->max_rel_error, 14);
+        printf(" %12.3f %12ld  ", r->wall_s * 1e3, r->evaluations);
+        if (r->status != TS_OK)
+            printf("FAILED: %s\n", r->message);
+        else if (!r->trust.trustworthy)
+            printf("NOT TRUSTWORTHY: %s%s\n", r->trust.reasons[0],
+                   r->trust.nreasons > 1 ? " (and more: see the JSON)" : "");
+        else
+            printf("%s\n", r->meets_target ? "meets target" : "ok");
+    }
+    /* Notes of the finest run (the same limits apply to the others). */
+    if (c->nrows > 0) {
+        const ts_conv_row *fin = &c->rows[idx[c->nrows - 1]];
+        for (int k = 0; k < fin->trust.nnotes; k++)
+            printf("note (finest run): %s\n", fin->trust.notes[k]);
+    }
+    printf("\n");
+    if (c->recommended >= 0) {
+        const ts_conv_row *r = &c->rows[c->recommended];
+        printf("recommended: ");
+        print_setting(c, r->setting, 0);
+        printf(" %s%s%s%s: largest estimated relative error %.2g <= %.3g "
+               "here and at every finer setting; %.3f ms, %ld evaluations\n",
+               ts_conv_param_name(c->param),
+               c->nseries > 1 ? " (" : "", c->series[r->series].name,
+               c->nseries > 1 ? ")" : "", r->max_rel_error, c->target,
+               r->wall_s * 1e3, r->evaluations);
+        return;
+    }
+    printf("recommended: none: no trustworthy setting meets %.3g", c->target);
+    if (c->limiting_value >= 0)
+        printf(" (limited by %s)", c->values[c->limiting_value].name);
+    printf("\n");
+    if (isfinite(c->predicted_setting)) {
+        printf("prediction: at the observed order %.3g, ",
+               c->values[c->limiting_value].order);
+        print_setting(c, c->predicted_setting, 0);
+        printf(" %s would meet it", ts_conv_param_name(c->param));
+        if (isfinite(c->predicted_wall_s))
+            printf(", in about %.3g s (run time extrapolated from the two "
+                   "finest runs)",
+                   c->predicted_wall_s);
+        printf("\n");
+    } else if (c->limiting_value >= 0 &&
+               c->values[c->limiting_value].ref_kind ==
+                   TS_CONV_REF_CONVERGED) {
+        printf("the finest runs agree within their own noise (solver "
+               "tolerance, rounding): a finer %s will not help\n",
+               ts_conv_param_name(c->param));
+    }
+}
+
+/* A link sweep needs equal links on every cable: refuse link_lengths
+ * before the first run. */
+static int check_links(const ts_system *sys, const char *where, ts_err *err)
+{
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].link_fraction)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: cables[%d] '%s' has link_lengths; a link "
+                           "sweep needs equal links (remove link_lengths, or "
+                           "sweep --tolerances)",
+                           where, c, sys->cables[c].name);
+    return TS_OK;
+}
+
+/* Run the study on sys. *json receives its JSON, *out the table. */
+static int converge_analysis(const ts_system *sys,
+                             const ts_equilibrium_opts *eqo,
+                             const conv_req *rq, int quiet, json_t **json,
+                             ts_convergence **out, ts_err *err)
+{
+    *json = NULL;
+    *out = NULL;
+    ts_conv_analysis an;
+    int rc;
+    if (strcmp(rq->analysis, "modes") == 0)
+        rc = ts_conv_modes_analysis(sys, eqo, NULL, NULL, rq->nmodes, &an,
+                                    err);
+    else
+        rc = ts_conv_equilibrium_analysis(sys, eqo, &an, err);
+    if (rc)
+        return rc;
+    ts_convergence *c = ts_convergence_alloc(an.name, rq->param, an.nvalues,
+                                             an.values, rq->nsettings, err);
+    if (!c) {
+        ts_conv_analysis_free(&an);
+        return err->code ? err->code : TS_ENOMEM;
+    }
+    int s = ts_convergence_add_series(c, "", err);
+    rc = s < 0 ? s
+               : ts_convergence_sweep(c, s, &an, rq->settings, rq->nsettings,
+                                      err);
+    ts_conv_analysis_free(&an);
+    if (rc == TS_OK)
+        rc = ts_convergence_estimate(c, rq->target, err);
+    if (rc != TS_OK) {
+        ts_convergence_free(c);
+        return rc;
+    }
+    int *idx = malloc((size_t)c->nrows * sizeof(int));
+    if (!idx) {
+        ts_convergence_free(c);
+        return ts_fail(err, TS_ENOMEM, "converge: out of memory");
+    }
+    ts_convergence_sorted_rows(c, idx);
+    print_converge(c, idx, quiet);
+    free(idx);
+    /* Every run failed: nothing was learnt. */
+    int nok = 0;
+    for (int i = 0; i < c->nrows; i++)
+        nok += c->rows[i].status == TS_OK;
+    if (nok == 0) {
+        rc = ts_fail(err, TS_ECONV,
+                     "converge: every run failed (first: %s)",
+                     c->rows[0].message);
+        ts_convergence_free(c);
+        return rc;
+    }
+    *json = ts_report_convergence_json(c);
+    if (!*json) {
+        ts_convergence_free(c);
+        return ts_fail(err, TS_ENOMEM, "converge: out of memory");
+    }
+    *out = c;
+    return TS_OK;
+}
+
+static int conv_main(int argc, char **argv)
+{
+    cli_settings s = {0};
+    cli_settings_from_options(&s);
+    snprintf(s.where[2], sizeof s.where[2], "--eq-method");
+    const char *json_path = NULL, *csv_path = NULL;
+    const char *links = NULL, *tols = NULL, *steps = NULL;
+    const char *analysis = "equilibrium", *target = NULL, *modes = NULL;
+    int quiet = 0;
+    static const struct option longopts[] = {
+        {"analysis", required_argument, NULL, 'a'},
+        {"links", required_argument, NULL, 'n'},
+        {"tolerances", required_argument, NULL, 'T'},
+        {"steps", required_argument, NULL, 'H'},
+        {"target", required_argument, NULL, 'g'},
+        {"modes", required_argument, NULL, 'k'},
+        {"json", required_argument, NULL, 'j'},
+        {"csv", required_argument, NULL, 'c'},
+        {"speed", required_argument, NULL, 's'},
+        {"turn-rate", required_argument, NULL, 'w'},
+        {"eq-method", required_argument, NULL, 'm'},
+        {"tol", required_argument, NULL, 't'},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    optind = 1;
+    opterr = 0;
+    int ch;
+    while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
+        switch (ch) {
+        case 'a': analysis = optarg; break;
+        case 'n': links = optarg; break;
+        case 'T': tols = optarg; break;
+        case 'H': steps = optarg; break;
+        case 'g': target = optarg; break;
+        case 'k': modes = optarg; break;
+        case 'j': json_path = optarg; break;
+        case 'c': csv_path = optarg; break;
+        case 's': s.speed = optarg; break;
+        case 'w': s.turn_rate = optarg; break;
+        case 'm': s.method = optarg; break;
+        case 't': s.tol = optarg; break;
+        case 'q': quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case ':':
+            fprintf(stderr, "towstab converge: missing value for '%s'\n",
+                    argv[optind - 1]);
+            return EXIT_BADINPUT;
+        default:
+            fprintf(stderr, "towstab converge: unknown option '%s' "
+                            "(towstab converge --help)\n",
+                    argv[optind - 1]);
+            return EXIT_BADINPUT;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "towstab converge: expected one scene file\n");
+        usage(stderr);
+        return EXIT_BADINPUT;
+    }
+    ts_err err = {0};
+    conv_req rq = {0};
+    rq.target = DEFAULT_TARGET;
+    rq.nmodes = DEFAULT_MODES;
+    static const char *const where[3] = {"--links", "--tolerances",
+                                         "--steps"};
+    if (parse_analysis(analysis, "--analysis", &rq, &err) ||
+        (target && parse_target(target, "--target", &rq.target, &err)) ||
+        (modes && parse_modes(modes, "--modes", &rq.nmodes, &err)) ||
+        request_sweep(&rq, links, tols, steps, (const char **)where, &err))
+        return cli_report(&err, err.code);
+    if (modes && strcmp(rq.analysis, "modes") != 0) {
+        fprintf(stderr, "towstab: error: --modes: applies to --analysis "
+                        "modes\n");
+        return EXIT_BADINPUT;
+    }
+    ts_units *units;
+    ts_scene *scene;
+    int status = cli_open(argv[optind], &units, &scene);
+    if (status)
+        return status;
+    ts_equilibrium_opts eqo;
+    ts_system *sys = cli_system(scene, units, &s, &eqo, &err);
+    if (!sys || (rq.param == TS_CONV_LINKS &&
+                 check_links(sys, "--links", &err) != TS_OK)) {
+        status = cli_report(&err, err.code);
+        ts_system_free(sys);
+        cli_close(units, scene);
+        return status;
+    }
+    printf("towstab converge: %s (%s)\n", sys->name, scene->path);
+    json_t *json = NULL;
+    ts_convergence *c = NULL;
+    int rc = converge_analysis(sys, &eqo, &rq, quiet, &json, &c, &err);
+    if (rc != TS_OK)
+        status = cli_report(&err, rc);
+    ts_err werr = {0};
+    if (rc == TS_OK && json_path &&
+        cli_write_json(json, json_path, &werr) != TS_OK)
+        status = cli_report(&werr, werr.code);
+    if (rc == TS_OK && csv_path &&
+        ts_report_convergence_csv(c, csv_path, &werr) != TS_OK)
+        status = cli_report(&werr, werr.code);
+    json_decref(json);
+    ts_convergence_free(c);
+    ts_system_free(sys);
+    cli_close(units, scene);
+    return status;
+}
+
+static const char *const conv_keys[] = {
+    "analysis", "links", "tolerances", "steps", "target", "modes", "speed",
+    "turn_rate", "tolerance", "equilibrium_method", NULL};
+
+/* One scene entry: parse and check its options, then (unless check_only)
+ * run it and append its JSON to results. Returns the exit status. */
+static int conv_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
+                      int index, json_t *results, int check_only)
+{
+    ts_err err = {0};
+    cli_settings s = {0};
+    /* The shared settings reader takes `links` as one number and `method`
+     * as the equilibrium's: give it a view without them. */
+    ts_scene_analysis view = *a;
+    ts_scene_option opts[64];
+    view.noptions = 0;
+    view.options = opts;
+    if (a->noptions > 64) {
+        ts_fail(&err, TS_ESCENE, "analyses[%d] (line %d): %d options; a "
+                                 "converge entry takes at most 10",
+                index, a->line, a->noptions);
+        return cli_report(&err, err.code);
+    }
+    for (int i = 0; i < a->noptions; i++)
+        if (strcmp(a->options[i].key, "links") != 0)
+            opts[view.noptions++] = a->options[i];
+    if (cli_settings_from_analysis(&s, &view, index, &err))
+        return cli_report(&err, err.code);
+    const ts_scene_option *om =
+        ts_scene_analysis_option(a, "equilibrium_method");
+    s.method = om ? om->value : NULL;
+    snprintf(s.where[2], sizeof s.where[2],
+             "analyses[%d].equilibrium_method (line %d)", index,
+             om ? om->line : a->line);
+    conv_req rq = {0};
+    rq.target = DEFAULT_TARGET;
+    rq.nmodes = DEFAULT_MODES;
+    rq.analysis = "equilibrium";
+    char w[5][160];
+    const ts_scene_option *o;
+    static const char *const keys[5] = {"analysis", "target", "modes",
+                                        "links", "tolerances"};
+    for (int j = 0; j < 5; j++) {
+        o = ts_scene_analysis_option(a, keys[j]);
+        snprintf(w[j], sizeof w[j], "analyses[%d].%s (line %d)", index,
+                 keys[j], o ? o->line : a->line);
+    }
+    const char *lt = cli_option(a, "links"), *tt = cli_option(a, "tolerances");
+    const char *st = cli_option(a, "steps"), *mt = cli_option(a, "modes");
+    char wsteps[160];
+    o = ts_scene_analysis_option(a, "steps");
+    snprintf(wsteps, sizeof wsteps, "analyses[%d].steps (line %d)", index,
+             o ? o->line : a->line);
+    const char *where[3] = {w[3], w[4], wsteps};
+    if ((cli_option(a, "analysis") &&
+         parse_analysis(cli_option(a, "analysis"), w[0], &rq, &err)) ||
+        (cli_option(a, "target") &&
+         parse_target(cli_option(a, "target"), w[1], &rq.target, &err)) ||
+        (mt && parse_modes(mt, w[2], &rq.nmodes, &err)) ||
+        request_sweep(&rq, lt, tt, st, where, &err))
+        return cli_report(&err, err.code);
+    if (mt && strcmp(rq.analysis, "modes") != 0) {
+        ts_fail(&err, TS_EINVAL, "%s: applies to analysis modes", w[2]);
+        return cli_report(&err, err.code);
+    }
+    ts_equilibrium_opts eqo;
+    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eqo, &err);
+    if (!sys)
+        return cli_report(&err, err.code);
+    if (rq.param == TS_CONV_LINKS && check_links(sys, w[3], &err) != TS_OK) {
+        ts_system_free(sys);
+        return cli_report(&err, err.code);
+    }
+    if (check_only) {
+        ts_system_free(sys);
+        return 0;
+    }
+    json_t *j = NULL;
+    ts_convergence *c = NULL;
+    int rc = converge_analysis(sys, &eqo, &rq, ctx->quiet, &j, &c, &err);
+    int status = rc ? cli_report(&err, rc) : 0;
+    if (j) {
+        json_object_set_new(j, "type", json_string("converge"));
+        json_array_append_new(results, j);
+    }
+    ts_convergence_free(c);
+    ts_system_free(sys);
+    return status;
+}
+
+static int conv_run(const cli_ctx *ctx, const ts_scene_analysis *a,
+                    int index, json_t *results)
+{
+    return conv_entry(ctx, a, index, results, 0);
+}
+
+static int conv_check(const cli_ctx *ctx, const ts_scene_analysis *a,
+                      int index)
+{
+    return conv_entry(ctx, a, index, NULL, 1);
+}
+
+const cli_command cli_cmd_converge = {
+    "converge",
+    "accuracy and cost against resolution (links, tolerance, step)",
+    conv_main, conv_run, conv_keys, conv_check};
