@@ -32,7 +32,11 @@
  * The built-in analyses rebuild the system with N links per cable
  * (ts_conv_system_with_links) or change a tolerance or step, and report
  * values that keep their meaning across resolutions: bodies and free ends
- * (not node indices), the top tension, the k-th lowest oscillatory mode.
+ * (not node indices), the top tension, the k-th lowest oscillatory mode,
+ * and for a simulation the amplitude ratio, mean offset and phase of a
+ * named output under a periodic excitation, fitted by least squares at
+ * the excitation frequency over the window after the transient
+ * (ts_compare_fit_sinusoid; Kamman & Nguyen 1990, example 4).
  */
 #include "towstab/converge.h"
 
@@ -44,6 +48,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include "towstab/compare.h"
+#include "towstab/response.h"
 
 /* The finest two observed orders agree (asymptotic range) when they
  * differ by at most this fraction of the finer one. */
@@ -1090,6 +1097,271 @@ int ts_conv_modes_analysis(const ts_system *sys,
         snprintf(z->name, sizeof z->name, "mode%d.damping_ratio", m + 1);
         snprintf(z->unit, sizeof z->unit, "1");
         z->scale = 1.0;
+    }
+    return TS_OK;
+}
+
+/* ---- simulate ---------------------------------------------------------- */
+
+/* Rounding noise of a simulated value: this many eps per sqrt(step). */
+#define SIM_ROUND_EPS 16.0
+/* Integrator noise of a simulated value in a links sweep: this many
+ * times rel_tol of the value's scale. */
+#define SIM_TOL_NOISE 10.0
+
+typedef struct sim_ctx {
+    ts_system *sys;
+    ts_equilibrium_opts eo;
+    ts_sim_opts so;
+    const ts_excitation *ex;
+    char output[2 * TS_NAME_MAX + 16];
+    double transient;
+    int exc_index;
+    double length;
+} sim_ctx;
+
+static void sim_ctx_free(void *p)
+{
+    sim_ctx *x = p;
+    ts_system_free(x->sys);
+    free(x);
+}
+
+static double wrap_deg(double d)
+{
+    d = fmod(d, 360.0);
+    if (d > 180.0)
+        d -= 360.0;
+    if (d <= -180.0)
+        d += 360.0;
+    return d;
+}
+
+/* Fit the output and the excitation over the window of history h. */
+static int sim_fit(const sim_ctx *x, const ts_history *h,
+                   const ts_output *out, double eq_value, double values[],
+                   ts_err *err)
+{
+    const ts_signal *sg = ts_excitation_signal(x->ex, x->exc_index);
+    int first = 0;
+    while (first < h->nsamples && h->t[first] < x->transient - 1e-12)
+        first++;
+    int n = h->nsamples - first;
+    if (n < 3)
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: %d samples after the transient (%g s)", n,
+                       x->transient);
+    double *buf = malloc(3 * (size_t)n * sizeof(double));
+    if (!buf)
+        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
+    double *t = buf, *xo = buf + n, *xe = buf + 2 * n;
+    size_t stride = 3 * (size_t)h->nnodes;
+    for (int i = 0; i < n; i++) {
+        size_t s = (size_t)(first + i);
+        t[i] = h->t[s];
+        xo[i] = h->positions[stride * s + 3 * (size_t)out->node + out->comp];
+        xe[i] = h->input[TS_NINPUT * s + sg->axis];
+    }
+    double c, a, ph, ce, ae, phe;
+    int rc = ts_compare_fit_sinusoid(t, xe, n, sg->frequency, &ce, &ae, &phe,
+                                     err);
+    if (rc == TS_OK)
+        rc = ts_compare_fit_sinusoid(t, xo, n, sg->frequency, &c, &a, &ph,
+                                     err);
+    if (rc == TS_OK) {
+        values[0] = a / ae;
+        values[1] = c - eq_value;
+        values[2] = wrap_deg((ph - phe) * 180.0 / M_PI);
+    }
+    free(buf);
+    return rc;
+}
+
+/* Health of a run from its statistics. */
+static void sim_health(const ts_sim_opts *o, const ts_sim_stats *st,
+                       ts_trust *trust)
+{
+    if (st->steps > 0 &&
+        (double)st->rejected > TS_CONV_SIM_REJECT_NOTE * (double)st->steps)
+        ts_trust_note(trust,
+                      "%s rejected %ld trial steps for %ld accepted: the "
+                      "tolerance %.3g is near what the method delivers, or "
+                      "the scene is stiff for it",
+                      ts_integrator_name(o->integrator), st->rejected,
+                      st->steps, o->rel_tol);
+    if (st->recharts > 0)
+        ts_trust_note(trust,
+                      "%ld re-chart%s of links near the angle singularity, "
+                      "each restarting the integrator",
+                      st->recharts, st->recharts == 1 ? "" : "s");
+    double mean = st->steps > 0 ? st->t_reached / (double)st->steps : NAN;
+    if (st->steps > 0 && mean < TS_CONV_SIM_STEP_FAIL * o->t_end)
+        ts_trust_fail(trust,
+                      "mean accepted step %.3g s is below %.0e of the run "
+                      "(%g s): rounding of the time, not the tolerance, "
+                      "sets the error",
+                      mean, TS_CONV_SIM_STEP_FAIL, o->t_end);
+}
+
+static int sim_run(void *ctx, ts_conv_param p, double setting,
+                   double values[], double noise[], long *evaluations,
+                   ts_trust *trust, ts_err *err)
+{
+    sim_ctx *x = ctx;
+    if (p == TS_CONV_STEP)
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: there is no linearization step to sweep; "
+                       "sweep tolerances or links");
+    ts_sim_opts o = x->so;
+    if (p == TS_CONV_TOLERANCE) {
+        o.abs_tol = x->so.abs_tol * (setting / x->so.rel_tol);
+        o.rel_tol = setting;
+    }
+    ts_system *sys = run_system(x->sys, p, setting, err);
+    if (!sys)
+        return err && err->code ? err->code : TS_EINVAL;
+    ts_output out;
+    ts_kernel *k = NULL;
+    ts_equilibrium *eq = NULL;
+    ts_history *h = NULL;
+    ts_sim_stats st;
+    memset(&st, 0, sizeof st);
+    int rc = ts_response_output_find(sys, x->output, &out, err);
+    if (rc == TS_OK) {
+        k = ts_kernel_alloc(sys, err);
+        eq = k ? ts_equilibrium_alloc(sys, err) : NULL;
+        rc = eq ? ts_equilibrium_solve(k, &x->eo, eq, err) : TS_ENOMEM;
+        if (eq) {
+            *evaluations += eq->evaluations;
+            ts_trust eqt;
+            ts_trust_init(&eqt);
+            ts_health_equilibrium(sys, eq, &eqt);
+            ts_trust_merge(trust, "equilibrium: ", &eqt);
+        }
+        if (rc != TS_OK)
+            ts_err_prefix(err, "simulate: the initial equilibrium: ");
+    }
+    if (rc == TS_OK) {
+        h = ts_history_alloc(sys, ts_sim_nsamples(&o), err);
+        rc = h ? ts_simulate(k, x->ex, eq->y, &o, h, &st, NULL, err)
+               : TS_ENOMEM;
+        *evaluations += st.evaluations;
+        sim_health(&o, &st, trust);
+    }
+    if (rc == TS_OK)
+        rc = sim_fit(x, h, &out, eq->positions[3 * out.node + out.comp],
+                     values, err);
+    if (rc == TS_OK) {
+        double eq_noise = EQ_NOISE_FACTOR *
+                          fmax(eq->residual, EQ_NOISE_MIN_REL) * x->length;
+        double scale[3] = {fabs(values[0]), x->length, 360.0};
+        double round = SIM_ROUND_EPS * DBL_EPSILON *
+                       sqrt((double)(st.steps + st.rejected + 1));
+        for (int v = 0; v < 3; v++) {
+            noise[v] = round * scale[v];
+            if (p == TS_CONV_LINKS)
+                noise[v] += SIM_TOL_NOISE * o.rel_tol * scale[v];
+        }
+        noise[1] += eq_noise;
+    }
+    ts_history_free(h);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    if (sys != x->sys)
+        ts_system_free(sys);
+    return rc;
+}
+
+int ts_conv_simulate_analysis(const ts_system *sys,
+                              const ts_equilibrium_opts *eo,
+                              const ts_sim_opts *so, const ts_excitation *ex,
+                              const char *output, double transient,
+                              ts_conv_analysis *an, ts_err *err)
+{
+    memset(an, 0, sizeof *an);
+    int idx;
+    if (!ex || !ts_excitation_periodic(ex, &idx))
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: the convergence of an amplitude ratio "
+                       "needs a single periodic tow-point excitation (one "
+                       "sine or crank on tow.surge, tow.sway or tow.heave)");
+    ts_sim_opts o;
+    if (so)
+        o = *so;
+    else
+        ts_sim_opts_default(&o);
+    int rc = ts_sim_opts_check(&o, err);
+    if (rc)
+        return rc;
+    ts_output out;
+    if (!output ||
+        (rc = ts_response_output_find(sys, output, &out, err)) != TS_OK)
+        return rc ? rc
+                  : ts_fail(err, TS_EINVAL, "simulate: no output named");
+    if (out.kind != TS_OUT_POSITION)
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: output '%s' is a tension; the amplitude "
+                       "ratio is of a position <node>.x|y|z",
+                       output);
+    const ts_signal *sg = ts_excitation_signal(ex, idx);
+    double period = 1.0 / sg->frequency;
+    if (!(transient >= 0) || !(transient < o.t_end))
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: the transient must be in [0, %g) s (the "
+                       "run), got %g s",
+                       o.t_end, transient);
+    if (o.t_end - transient < period * (1.0 - 1e-9))
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: %g s are left after the transient, less "
+                       "than one period (%g s) of the %g Hz excitation",
+                       o.t_end - transient, period, sg->frequency);
+    if (o.dt_sample >
+        period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD * (1.0 + 1e-9))
+        return ts_fail(err, TS_EINVAL,
+                       "simulate: the sample interval %g s is too coarse "
+                       "for %g Hz; at most %g s (%d samples per period)",
+                       o.dt_sample, sg->frequency,
+                       period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
+                       TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
+    if ((rc = ts_excitation_check_span(ex, o.t_end, err)))
+        return rc;
+    sim_ctx *x = calloc(1, sizeof *x);
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
+    x->sys = ts_system_copy(sys, err);
+    if (!x->sys) {
+        free(x);
+        return err && err->code ? err->code : TS_ENOMEM;
+    }
+    if (eo)
+        x->eo = *eo;
+    else
+        ts_equilibrium_opts_default(&x->eo);
+    x->so = o;
+    x->ex = ex;
+    snprintf(x->output, sizeof x->output, "%s", out.name);
+    x->transient = transient;
+    x->exc_index = idx;
+    x->length = total_length(sys);
+    snprintf(an->name, sizeof an->name, "simulate");
+    an->ctx = x;
+    an->free_ctx = sim_ctx_free;
+    an->run = sim_run;
+    an->nvalues = 3;
+    an->values = calloc(3, sizeof *an->values);
+    if (!an->values) {
+        ts_conv_analysis_free(an);
+        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
+    }
+    static const char *const suffix[3] = {"amplitude_ratio", "mean_offset",
+                                          "phase_deg"};
+    static const char *const unit[3] = {"1", "m", "deg"};
+    double scale[3] = {0.0, sg->amplitude, 360.0};
+    for (int v = 0; v < 3; v++) {
+        ts_conv_value *V = &an->values[v];
+        snprintf(V->name, sizeof V->name, "%.70s.%s", out.name, suffix[v]);
+        snprintf(V->unit, sizeof V->unit, "%s", unit[v]);
+        V->scale = scale[v];
     }
     return TS_OK;
 }

@@ -5,16 +5,22 @@
  * value, its estimated error against a Richardson-extrapolated (or the
  * finest) reference, the observed order, wall time and kernel
  * evaluations, then the cheapest setting that meets a target relative
- * error (doc/converge.md). */
+ * error (doc/converge.md). The simulate analysis reruns the scene's
+ * simulation (settings as `towstab simulate` reads them, tools/cli_sim.h)
+ * at each integrator tolerance or link count, one series per integrator:
+ * a work-precision comparison. --plot draws the error against run time. */
 #include <getopt.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
+#include "cli_plot.h"
+#include "cli_sim.h"
 #include "towstab/converge.h"
 #include "towstab/report.h"
 #include "towstab/report_converge.h"
+#include "towstab/report_time.h"
 
 #define DEFAULT_TARGET 1e-3
 #define DEFAULT_MODES 3
@@ -22,15 +28,21 @@
 /* Default sweeps. */
 static const char *const default_eq_links = "5,10,20,40,80,160,320";
 static const char *const default_modes_links = "10,20,40,80";
+static const char *const default_sim_tols = "1e-3,1e-5,1e-7,1e-9";
+/* Integrators of one simulate study. */
+#define MAX_INTEGRATORS 5
 
 /* What both entries (command line and scene) decide. */
 typedef struct conv_req {
-    const char *analysis;   /* "equilibrium" or "modes" */
+    const char *analysis;   /* "equilibrium", "modes" or "simulate" */
     ts_conv_param param;
     double settings[TS_CONV_MAX_SETTINGS];
     int nsettings;
     double target;
     int nmodes;
+    ts_integrator integrators[MAX_INTEGRATORS]; /* simulate: one series
+                                                   each */
+    int nintegrators;       /* 0: the simulation's own integrator */
 } conv_req;
 
 static void usage(FILE *f)
@@ -41,11 +53,21 @@ static void usage(FILE *f)
             "  value's estimated error, the observed order of convergence,\n"
             "  the run time and kernel evaluations, and the cheapest setting\n"
             "  whose error is below the target\n"
-            "  --analysis A     equilibrium (default) or modes\n"
+            "  --analysis A     equilibrium (default), modes or simulate\n"
             "  --links LIST     links per cable, e.g. 5,10,20,40 (default\n"
             "                   %s; modes: %s)\n"
             "  --tolerances LIST  the equilibrium's residual target, e.g.\n"
-            "                   1e-4,1e-6,1e-8\n"
+            "                   1e-4,1e-6,1e-8; simulate: the integrator's\n"
+            "                   relative tolerance (default %s;\n"
+            "                   the absolute one scales with it)\n"
+            "  --integrators LIST  simulate: one series per integrator,\n"
+            "                   e.g. rk8pd,rkf45,msbdf (work precision)\n"
+            "  simulate takes the simulation's settings from the scene's\n"
+            "  first 'simulate' entry, or from --excite SPEC, --output NAME,\n"
+            "  --t-end T, --sample DT, --transient T (the fit's window\n"
+            "  starts there), --rtol X, --atol X, --integrator M (as for\n"
+            "  'towstab simulate'); it reports <output>.amplitude_ratio,\n"
+            "  .mean_offset and .phase_deg against the periodic excitation\n"
             "  --steps LIST     relative linearization steps (modes), e.g.\n"
             "                   1e-3,1e-4,1e-5\n"
             "  --target X       relative error wanted (default %g)\n"
@@ -57,9 +79,12 @@ static void usage(FILE *f)
             "  --turn-rate Q    override tow.turn_rate (e.g. '0.5 rad/s')\n"
             "  --eq-method M    equilibrium method: auto, shooting, newton\n"
             "  --tol X          equilibrium relative force residual\n"
+            "  --plot DIR       draw the error against run time\n"
+            "                   (error_time.png/svg), a line per series\n"
+            "  --units U        units of the pictures: si or imperial\n"
             "  --quiet          print the summary table only\n",
-            default_eq_links, default_modes_links, DEFAULT_TARGET,
-            DEFAULT_MODES);
+            default_eq_links, default_modes_links, default_sim_tols,
+            DEFAULT_TARGET, DEFAULT_MODES);
 }
 
 /* "5,10,20" into settings; plain numbers only (counts, tolerances and
@@ -119,6 +144,10 @@ static int request_sweep(conv_req *rq, const char *links, const char *tols,
                            "%s: the linearization step applies to the modes "
                            "analysis, not to %s",
                            w, rq->analysis);
+    } else if (!links && strcmp(rq->analysis, "simulate") == 0) {
+        text = default_sim_tols;
+        w = where[1];
+        rq->param = TS_CONV_TOLERANCE;
     } else if (!links) {
         text = strcmp(rq->analysis, "modes") == 0 ? default_modes_links
                                                   : default_eq_links;
@@ -133,14 +162,56 @@ static int request_sweep(conv_req *rq, const char *links, const char *tols,
 static int parse_analysis(const char *text, const char *where, conv_req *rq,
                           ts_err *err)
 {
-    if (strcmp(text, "equilibrium") == 0 || strcmp(text, "modes") == 0) {
-        rq->analysis = strcmp(text, "modes") == 0 ? "modes" : "equilibrium";
-        return TS_OK;
-    }
+    static const char *const names[3] = {"equilibrium", "modes",
+                                         "simulate"};
+    for (int i = 0; i < 3; i++)
+        if (strcmp(text, names[i]) == 0) {
+            rq->analysis = names[i];
+            return TS_OK;
+        }
     return ts_fail(err, TS_EINVAL,
                    "%s: '%s' is not an analysis to converge; expected "
-                   "equilibrium or modes",
+                   "equilibrium, modes or simulate",
                    where, text);
+}
+
+/* "rk8pd,rkf45,msbdf" into rq's integrators (simulate only). */
+static int parse_integrators(const char *text, const char *where,
+                             conv_req *rq, ts_err *err)
+{
+    if (strcmp(rq->analysis, "simulate") != 0)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: applies to the simulate analysis, not to %s",
+                       where, rq->analysis);
+    char buf[256];
+    if (strlen(text) >= sizeof buf)
+        return ts_fail(err, TS_EINVAL, "%s: list too long", where);
+    strcpy(buf, text);
+    rq->nintegrators = 0;
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, ", ", &save); tok;
+         tok = strtok_r(NULL, ", ", &save)) {
+        ts_integrator m;
+        if (ts_integrator_parse(tok, &m) != 0)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: '%s' is not an integrator; expected rk8pd, "
+                           "rkf45, rk4imp, bsimp or msbdf",
+                           where, tok);
+        for (int i = 0; i < rq->nintegrators; i++)
+            if (rq->integrators[i] == m)
+                return ts_fail(err, TS_EINVAL, "%s: %s is given twice",
+                               where, tok);
+        if (rq->nintegrators == MAX_INTEGRATORS)
+            return ts_fail(err, TS_EINVAL, "%s: at most %d integrators",
+                           where, MAX_INTEGRATORS);
+        rq->integrators[rq->nintegrators++] = m;
+    }
+    if (rq->nintegrators == 0)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: expected integrators like 'rk8pd,rkf45', got "
+                       "'%s'",
+                       where, text);
+    return TS_OK;
 }
 
 static int parse_target(const char *text, const char *where, double *t,
@@ -294,7 +365,8 @@ static void print_converge(const ts_convergence *c, const int *idx,
         printf(" %s%s%s%s: largest estimated relative error %.2g <= %.3g "
                "here and at every finer setting; %.3f ms, %ld evaluations\n",
                ts_conv_param_name(c->param),
-               c->nseries > 1 ? " (" : "", c->series[r->series].name,
+               c->nseries > 1 ? " (" : "",
+               c->nseries > 1 ? c->series[r->series].name : "",
                c->nseries > 1 ? ")" : "", r->max_rel_error, c->target,
                r->wall_s * 1e3, r->evaluations);
         return;
@@ -336,34 +408,77 @@ static int check_links(const ts_system *sys, const char *where, ts_err *err)
     return TS_OK;
 }
 
-/* Run the study on sys. *json receives its JSON, *out the table. */
+/* The analysis of series k (simulate: with integrator k). */
+static int make_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
+                         const conv_req *rq, const cli_sim_prep *sp, int k,
+                         ts_conv_analysis *an, char *series, size_t size,
+                         ts_err *err)
+{
+    series[0] = '\0';
+    if (strcmp(rq->analysis, "modes") == 0)
+        return ts_conv_modes_analysis(sys, eqo, NULL, NULL, rq->nmodes, an,
+                                      err);
+    if (strcmp(rq->analysis, "simulate") != 0)
+        return ts_conv_equilibrium_analysis(sys, eqo, an, err);
+    ts_sim_opts o = sp->s.o;
+    if (rq->nintegrators > 0)
+        o.integrator = rq->integrators[k];
+    snprintf(series, size, "%s", ts_integrator_name(o.integrator));
+    return ts_conv_simulate_analysis(sp->sys, &sp->eo, &o, sp->ex,
+                                     sp->s.out.name, sp->s.transient, an,
+                                     err);
+}
+
+/* What a simulate study runs, in one line. */
+static void print_sim_setup(const cli_sim_prep *sp)
+{
+    char d[256];
+    int idx = 0;
+    ts_excitation_periodic(sp->ex, &idx);
+    ts_excitation_describe(sp->ex, idx, d, sizeof d);
+    printf("simulate: %s from the equilibrium, t = 0 .. %g s, sample %g s; "
+           "%s fitted over t >= %g s; base tolerances rtol %g, atol %g\n",
+           d, sp->s.o.t_end, sp->s.o.dt_sample, sp->s.out.name,
+           sp->s.transient, sp->s.o.rel_tol, sp->s.o.abs_tol);
+}
+
+/* Run the study on sys (simulate: on sp's system). *json receives its
+ * JSON, *out the table. */
 static int converge_analysis(const ts_system *sys,
                              const ts_equilibrium_opts *eqo,
-                             const conv_req *rq, int quiet, json_t **json,
-                             ts_convergence **out, ts_err *err)
+                             const conv_req *rq, const cli_sim_prep *sp,
+                             int quiet, json_t **json, ts_convergence **out,
+                             ts_err *err)
 {
     *json = NULL;
     *out = NULL;
-    ts_conv_analysis an;
-    int rc;
-    if (strcmp(rq->analysis, "modes") == 0)
-        rc = ts_conv_modes_analysis(sys, eqo, NULL, NULL, rq->nmodes, &an,
-                                    err);
-    else
-        rc = ts_conv_equilibrium_analysis(sys, eqo, &an, err);
-    if (rc)
-        return rc;
-    ts_convergence *c = ts_convergence_alloc(an.name, rq->param, an.nvalues,
-                                             an.values, rq->nsettings, err);
-    if (!c) {
+    int simulate = strcmp(rq->analysis, "simulate") == 0;
+    int nseries = simulate && rq->nintegrators > 0 ? rq->nintegrators : 1;
+    if (simulate)
+        print_sim_setup(sp);
+    ts_convergence *c = NULL;
+    int rc = TS_OK;
+    for (int k = 0; k < nseries && rc == TS_OK; k++) {
+        ts_conv_analysis an;
+        char series[TS_CONV_NAME_MAX];
+        rc = make_analysis(sys, eqo, rq, sp, k, &an, series, sizeof series,
+                           err);
+        if (rc)
+            break;
+        if (!c)
+            c = ts_convergence_alloc(an.name, rq->param, an.nvalues,
+                                     an.values, rq->nsettings * nseries,
+                                     err);
+        if (!c) {
+            ts_conv_analysis_free(&an);
+            return err->code ? err->code : TS_ENOMEM;
+        }
+        int s = ts_convergence_add_series(c, series, err);
+        rc = s < 0 ? s
+                   : ts_convergence_sweep(c, s, &an, rq->settings,
+                                          rq->nsettings, err);
         ts_conv_analysis_free(&an);
-        return err->code ? err->code : TS_ENOMEM;
     }
-    int s = ts_convergence_add_series(c, "", err);
-    rc = s < 0 ? s
-               : ts_convergence_sweep(c, s, &an, rq->settings, rq->nsettings,
-                                      err);
-    ts_conv_analysis_free(&an);
     if (rc == TS_OK)
         rc = ts_convergence_estimate(c, rq->target, err);
     if (rc != TS_OK) {
@@ -394,9 +509,168 @@ static int converge_analysis(const ts_system *sys,
         ts_convergence_free(c);
         return ts_fail(err, TS_ENOMEM, "converge: out of memory");
     }
+    if (simulate) {
+        json_t *o = json_pack("{s:s,s:f,s:f,s:f,s:f,s:f}", "output",
+                              sp->s.out.name, "t_end", sp->s.o.t_end,
+                              "sample", sp->s.o.dt_sample, "transient",
+                              sp->s.transient, "rel_tol", sp->s.o.rel_tol,
+                              "abs_tol", sp->s.o.abs_tol);
+        json_t *ej = ts_report_excitation_json(sp->ex);
+        if (o && ej)
+            json_object_set_new(o, "excitation", ej);
+        else
+            json_decref(ej);
+        if (!o || json_object_set_new(*json, "simulation", o) != 0) {
+            json_decref(*json);
+            *json = NULL;
+            ts_convergence_free(c);
+            return ts_fail(err, TS_ENOMEM, "converge: out of memory");
+        }
+    }
     *out = c;
     return TS_OK;
 }
+
+/* --plot: the largest estimated relative error of every run against its
+ * wall time, log-log, one line per series (memo Fig. 12). Runs without a
+ * positive error or time (failed, not estimated) are left out. */
+static int converge_plot(const ts_convergence *c, const char *scene,
+                         const cli_plot *plot)
+{
+    int n = c->nrows;
+    int *idx = malloc((size_t)n * sizeof(int));
+    double *x = malloc((size_t)n * sizeof(double));
+    double *y = malloc((size_t)n * sizeof(double));
+    ts_plot_series *ser = malloc((size_t)c->nseries * sizeof *ser);
+    char(*labels)[160] = malloc((size_t)c->nseries * sizeof *labels);
+    if (!idx || !x || !y || !ser || !labels) {
+        free(idx);
+        free(x);
+        free(y);
+        free(ser);
+        free(labels);
+        fprintf(stderr, "towstab: error: converge: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    ts_convergence_sorted_rows(c, idx);
+    int m = 0, ns = 0;
+    for (int s = 0; s < c->nseries; s++) {
+        int first = m;
+        double lo = INFINITY, hi = -INFINITY;
+        for (int i = 0; i < n; i++) {
+            const ts_conv_row *r = &c->rows[idx[i]];
+            if (r->series != s || r->status != TS_OK ||
+                !(r->max_rel_error > 0) || !isfinite(r->max_rel_error) ||
+                !(r->wall_s > 0))
+                continue;
+            x[m] = r->wall_s;
+            y[m++] = r->max_rel_error;
+            lo = fmin(lo, r->setting);
+            hi = fmax(hi, r->setting);
+        }
+        if (m == first)
+            continue;
+        const char *pn = ts_conv_param_name(c->param);
+        if (c->param == TS_CONV_LINKS)
+            snprintf(labels[ns], sizeof labels[ns], "%s%s%d to %d %s",
+                     c->series[s].name, c->series[s].name[0] ? ": " : "",
+                     (int)lo, (int)hi, pn);
+        else
+            snprintf(labels[ns], sizeof labels[ns], "%s%s%s %.3g to %.3g",
+                     c->series[s].name, c->series[s].name[0] ? ": " : "",
+                     pn, hi, lo);
+        ts_plot_series ps = {m - first, x + first, y + first, labels[ns], 0,
+                             TS_PLOT_LINE_MARKERS, 0};
+        ser[ns++] = ps;
+    }
+    int status = 0;
+    if (ns == 0) {
+        fprintf(stderr, "towstab: error: converge: --plot: no run has an "
+                        "estimated error to draw\n");
+        status = EXIT_FAILED;
+    } else {
+        char title[256];
+        snprintf(title, sizeof title, "%s: %s, error against run time (%s "
+                 "sweep)", scene, c->analysis, ts_conv_param_name(c->param));
+        ts_plot_axis xa = {"wall time of the run", TS_PLOT_TIME};
+        ts_plot_axis ya = {"largest estimated relative error",
+                           TS_PLOT_NONE};
+        ts_err err = {0};
+        if (ts_plot_loglog(plot->dir, "error_time", title, &xa, &ya, ns, ser,
+                           &plot->opts, &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            printf("wrote %s/error_time.png and %s/error_time.svg\n",
+                   plot->dir, plot->dir);
+    }
+    free(idx);
+    free(x);
+    free(y);
+    free(ser);
+    free(labels);
+    return status;
+}
+
+/* The settings of a simulate study: the command line's, else those of the
+ * scene's first simulate entry (checked against its keys). */
+static int sim_settings(const ts_scene *scene, cli_sim_args *a, ts_err *err)
+{
+    for (int i = 0; i < scene->nanalyses; i++) {
+        const ts_scene_analysis *e = &scene->analyses[i];
+        if (strcmp(e->type, "simulate") != 0)
+            continue;
+        const cli_command *cmd = NULL;
+        for (int j = 0; cli_commands[j]; j++)
+            if (strcmp(cli_commands[j]->name, "simulate") == 0)
+                cmd = cli_commands[j];
+        if (cmd && cli_check_keys(e, cmd->keys, i, err) != TS_OK)
+            return err->code;
+        cli_sim_args_from_entry(a, e, i);
+        break;
+    }
+    return TS_OK;
+}
+
+/* Prepare the simulation of a simulate study and refuse what it cannot
+ * sweep. */
+static int sim_prepare(const cli_ctx *ctx, const cli_sim_args *a,
+                       const cli_settings *s, cli_sim_prep *sp, ts_err *err)
+{
+    int rc = cli_sim_prepare(ctx, a, s, sp, err);
+    if (rc)
+        return rc;
+    if (sp->s.init != SIM_INIT_EQ)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: the simulate study starts from the equilibrium "
+                       "(its values are the steady response to a periodic "
+                       "excitation); got '%s'",
+                       a->where[SIM_A_INITIAL], a->val[SIM_A_INITIAL]);
+    if (sp->s.linear_only)
+        return ts_fail(err, TS_EINVAL,
+                       "%s: the simulate study sweeps the nonlinear "
+                       "integrator; drop linear",
+                       a->where[SIM_A_LINEAR]);
+    int idx;
+    if (!ts_excitation_periodic(sp->ex, &idx))
+        return ts_fail(err, TS_EINVAL,
+                       "%s: the simulate study needs a single periodic "
+                       "tow-point excitation (one sine or crank), e.g. "
+                       "--excite tow.heave:amplitude=0.1ft,frequency=1Hz",
+                       a->where[SIM_A_EXCITE]);
+    /* Check the window and sampling as the runs will. */
+    ts_conv_analysis an;
+    rc = ts_conv_simulate_analysis(sp->sys, &sp->eo, &sp->s.o, sp->ex,
+                                   sp->s.out.name, sp->s.transient, &an, err);
+    ts_conv_analysis_free(&an);
+    return rc;
+}
+
+/* Simulation options converge takes from the command line. */
+static const int sim_opt_index[] = {
+    SIM_A_T_END, SIM_A_SAMPLE, SIM_A_INTEGRATOR, SIM_A_RTOL, SIM_A_ATOL,
+    SIM_A_TRANSIENT, SIM_A_OUTPUT, SIM_A_EXCITE};
+#define NSIM_OPTS ((int)(sizeof sim_opt_index / sizeof sim_opt_index[0]))
+enum { O_SIM = 1000, O_PLOT = 1100, O_UNITS, O_INTEGRATORS };
 
 static int conv_main(int argc, char **argv)
 {
@@ -406,8 +680,15 @@ static int conv_main(int argc, char **argv)
     const char *json_path = NULL, *csv_path = NULL;
     const char *links = NULL, *tols = NULL, *steps = NULL;
     const char *analysis = "equilibrium", *target = NULL, *modes = NULL;
+    const char *integrators = NULL;
     int quiet = 0;
-    static const struct option longopts[] = {
+    cli_plot plot = {0};
+    cli_sim_args sa;
+    memset(&sa, 0, sizeof sa);
+    for (int i = 0; i < SIM_A_N; i++)
+        snprintf(sa.where[i], sizeof sa.where[i], "%s", cli_sim_arg_opts[i]);
+    int given_sim = 0;
+    struct option longopts[32] = {
         {"analysis", required_argument, NULL, 'a'},
         {"links", required_argument, NULL, 'n'},
         {"tolerances", required_argument, NULL, 'T'},
@@ -422,11 +703,35 @@ static int conv_main(int argc, char **argv)
         {"tol", required_argument, NULL, 't'},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+        {"plot", required_argument, NULL, O_PLOT},
+        {"units", required_argument, NULL, O_UNITS},
+        {"integrators", required_argument, NULL, O_INTEGRATORS}};
+    int nlong = 17;
+    for (int i = 0; i < NSIM_OPTS; i++) {
+        struct option o = {cli_sim_arg_opts[sim_opt_index[i]] + 2,
+                           required_argument, NULL, O_SIM + sim_opt_index[i]};
+        longopts[nlong++] = o;
+    }
+    memset(&longopts[nlong], 0, sizeof longopts[nlong]);
     optind = 1;
     opterr = 0;
     int ch;
     while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
+        if (ch >= O_SIM && ch < O_SIM + SIM_A_N) {
+            int k = ch - O_SIM;
+            given_sim = 1;
+            if (k == SIM_A_EXCITE) {
+                if (sa.nspecs[0] == CLI_SIM_MAX_SPECS) {
+                    fprintf(stderr, "towstab converge: --excite: at most "
+                                    "%d\n", CLI_SIM_MAX_SPECS);
+                    return EXIT_BADINPUT;
+                }
+                sa.specs[0][sa.nspecs[0]++] = optarg;
+            } else {
+                sa.val[k] = optarg;
+            }
+            continue;
+        }
         switch (ch) {
         case 'a': analysis = optarg; break;
         case 'n': links = optarg; break;
@@ -441,6 +746,9 @@ static int conv_main(int argc, char **argv)
         case 'm': s.method = optarg; break;
         case 't': s.tol = optarg; break;
         case 'q': quiet = 1; break;
+        case O_PLOT: plot.dir = optarg; break;
+        case O_UNITS: plot.units = optarg; break;
+        case O_INTEGRATORS: integrators = optarg; break;
         case 'h': usage(stdout); return 0;
         case ':':
             fprintf(stderr, "towstab converge: missing value for '%s'\n",
@@ -467,6 +775,8 @@ static int conv_main(int argc, char **argv)
     if (parse_analysis(analysis, "--analysis", &rq, &err) ||
         (target && parse_target(target, "--target", &rq.target, &err)) ||
         (modes && parse_modes(modes, "--modes", &rq.nmodes, &err)) ||
+        (integrators &&
+         parse_integrators(integrators, "--integrators", &rq, &err)) ||
         request_sweep(&rq, links, tols, steps, (const char **)where, &err))
         return cli_report(&err, err.code);
     if (modes && strcmp(rq.analysis, "modes") != 0) {
@@ -474,24 +784,47 @@ static int conv_main(int argc, char **argv)
                         "modes\n");
         return EXIT_BADINPUT;
     }
+    int simulate = strcmp(rq.analysis, "simulate") == 0;
+    if (given_sim && !simulate) {
+        fprintf(stderr, "towstab: error: --excite, --output, --t-end, "
+                        "--sample, --transient, --rtol, --atol and "
+                        "--integrator apply to --analysis simulate\n");
+        return EXIT_BADINPUT;
+    }
+    int pstatus = cli_plot_begin(&plot, "converge");
+    if (pstatus)
+        return pstatus;
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);
     if (status)
         return status;
     ts_equilibrium_opts eqo;
-    ts_system *sys = cli_system(scene, units, &s, &eqo, &err);
+    ts_system *sys = NULL;
+    cli_sim_prep sp;
+    memset(&sp, 0, sizeof sp);
+    cli_ctx ctx = {scene, units, quiet};
+    if (simulate) {
+        if (sim_settings(scene, &sa, &err) == TS_OK &&
+            sim_prepare(&ctx, &sa, &s, &sp, &err) == TS_OK) {
+            sys = ts_system_copy(sp.sys, &err);
+            eqo = sp.eo;
+        }
+    } else {
+        sys = cli_system(scene, units, &s, &eqo, &err);
+    }
     if (!sys || (rq.param == TS_CONV_LINKS &&
                  check_links(sys, "--links", &err) != TS_OK)) {
-        status = cli_report(&err, err.code);
+        status = cli_report(&err, err.code ? err.code : TS_EINVAL);
         ts_system_free(sys);
+        cli_sim_prep_free(&sp);
         cli_close(units, scene);
         return status;
     }
     printf("towstab converge: %s (%s)\n", sys->name, scene->path);
     json_t *json = NULL;
     ts_convergence *c = NULL;
-    int rc = converge_analysis(sys, &eqo, &rq, quiet, &json, &c, &err);
+    int rc = converge_analysis(sys, &eqo, &rq, &sp, quiet, &json, &c, &err);
     if (rc != TS_OK)
         status = cli_report(&err, rc);
     ts_err werr = {0};
@@ -501,16 +834,22 @@ static int conv_main(int argc, char **argv)
     if (rc == TS_OK && csv_path &&
         ts_report_convergence_csv(c, csv_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
+    if (rc == TS_OK && plot.dir) {
+        int prc = converge_plot(c, sys->name, &plot);
+        if (prc && !status)
+            status = prc;
+    }
     json_decref(json);
     ts_convergence_free(c);
     ts_system_free(sys);
+    cli_sim_prep_free(&sp);
     cli_close(units, scene);
     return status;
 }
 
 static const char *const conv_keys[] = {
     "analysis", "links", "tolerances", "steps", "target", "modes", "speed",
-    "turn_rate", "tolerance", "equilibrium_method", NULL};
+    "turn_rate", "tolerance", "equilibrium_method", "integrators", NULL};
 
 /* One scene entry: parse and check its options, then (unless check_only)
  * run it and append its JSON to results. Returns the exit status. */
@@ -573,21 +912,53 @@ static int conv_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
         ts_fail(&err, TS_EINVAL, "%s: applies to analysis modes", w[2]);
         return cli_report(&err, err.code);
     }
+    const char *it = cli_option(a, "integrators");
+    if (it) {
+        char wi[160];
+        o = ts_scene_analysis_option(a, "integrators");
+        snprintf(wi, sizeof wi, "analyses[%d].integrators (line %d)", index,
+                 o ? o->line : a->line);
+        if (parse_integrators(it, wi, &rq, &err))
+            return cli_report(&err, err.code);
+    }
     ts_equilibrium_opts eqo;
-    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eqo, &err);
-    if (!sys)
-        return cli_report(&err, err.code);
+    ts_system *sys = NULL;
+    cli_sim_prep sp;
+    memset(&sp, 0, sizeof sp);
+    if (strcmp(rq.analysis, "simulate") == 0) {
+        /* The simulation of the scene's first simulate entry. */
+        cli_sim_args sa;
+        memset(&sa, 0, sizeof sa);
+        for (int i = 0; i < SIM_A_N; i++)
+            snprintf(sa.where[i], sizeof sa.where[i],
+                     "analyses[%d] (simulate settings: %s)", index,
+                     cli_sim_arg_keys[i]);
+        if (sim_settings(ctx->scene, &sa, &err) == TS_OK &&
+            sim_prepare(ctx, &sa, &s, &sp, &err) == TS_OK) {
+            sys = ts_system_copy(sp.sys, &err);
+            eqo = sp.eo;
+        }
+    } else {
+        sys = cli_system(ctx->scene, ctx->units, &s, &eqo, &err);
+    }
+    if (!sys) {
+        cli_sim_prep_free(&sp);
+        return cli_report(&err, err.code ? err.code : TS_EINVAL);
+    }
     if (rq.param == TS_CONV_LINKS && check_links(sys, w[3], &err) != TS_OK) {
         ts_system_free(sys);
+        cli_sim_prep_free(&sp);
         return cli_report(&err, err.code);
     }
     if (check_only) {
         ts_system_free(sys);
+        cli_sim_prep_free(&sp);
         return 0;
     }
     json_t *j = NULL;
     ts_convergence *c = NULL;
-    int rc = converge_analysis(sys, &eqo, &rq, ctx->quiet, &j, &c, &err);
+    int rc = converge_analysis(sys, &eqo, &rq, &sp, ctx->quiet, &j, &c,
+                               &err);
     int status = rc ? cli_report(&err, rc) : 0;
     if (j) {
         json_object_set_new(j, "type", json_string("converge"));
@@ -595,6 +966,7 @@ static int conv_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     }
     ts_convergence_free(c);
     ts_system_free(sys);
+    cli_sim_prep_free(&sp);
     return status;
 }
 

@@ -13,6 +13,8 @@
 #include <string.h>
 
 #include "cli.h"
+#include "cli_plot.h"
+#include "cli_sim.h"
 #include "towstab/compare.h"
 #include "towstab/equilibrium.h"
 #include "towstab/excitation.h"
@@ -22,43 +24,8 @@
 #include "towstab/response.h"
 #include "towstab/simulate.h"
 
-/* Default sample interval when none is given, and the samples per period
- * it guarantees for a periodic excitation. */
-#define DEFAULT_SAMPLE 0.05
-#define DEFAULT_SAMPLES_PER_PERIOD 16
-#define DEFAULT_T_END 10.0
 /* Largest number of table rows printed (longer runs are strided). */
 #define TABLE_ROWS 60
-/* Link lengths of a shape file must match the scene's to this (relative). */
-#define SHAPE_RTOL 1e-6
-#define MAX_SPECS 32
-
-enum {
-    A_T_END, A_SAMPLE, A_INITIAL, A_INTEGRATOR, A_RTOL, A_ATOL, A_H_MIN,
-    A_MAX_STEPS, A_TRANSIENT, A_OUTPUT, A_LINEAR_METHOD, A_KINEMATICS,
-    A_EXCITE, A_MANOEUVRE, A_COMPARE, A_LINEAR, A_CSV, A_N
-};
-/* Scene option keys, in the order above. */
-static const char *const arg_keys[A_N] = {
-    "t_end", "sample", "initial", "integrator", "rtol", "atol", "h_min",
-    "max_steps", "transient", "output", "linear_method", "kinematics",
-    "excite", "manoeuvre", "compare", "linear", "csv"};
-/* The same as command-line options. */
-static const char *const arg_opts[A_N] = {
-    "--t-end", "--sample", "--initial", "--integrator", "--rtol", "--atol",
-    "--h-min", "--max-steps", "--transient", "--output", "--linear-method",
-    "--kinematics", "--excite", "--manoeuvre", "--compare", "--linear",
-    "--csv"};
-
-typedef struct sim_args {
-    const char *val[A_N];
-    char where[A_N][128];
-    /* --excite and --manoeuvre may repeat (and hold ';'-separated lists). */
-    const char *specs[2][MAX_SPECS];
-    int nspecs[2];
-    int quiet;
-    const char *json;   /* command line only */
-} sim_args;
 
 static void usage(FILE *f)
 {
@@ -96,70 +63,14 @@ static void usage(FILE *f)
         "  --csv FILE         histories as CSV\n"
         "  --speed Q, --turn-rate Q, --links N, --method M, --tol X\n"
         "                     as for 'towstab equilibrium'\n"
+        "  --plot DIR         draw the time histories (histories.png/svg)\n"
+        "                     and snapshots of the cable (snapshots_side,\n"
+        "                     snapshots_top)\n"
+        "  --units U          units of the pictures: si or imperial\n"
+        "  --snapshot-interval T  time between snapshots (default t_end/10)\n"
         "  --quiet            summary only\n",
-        DEFAULT_T_END, DEFAULT_SAMPLE, DEFAULT_SAMPLES_PER_PERIOD);
-}
-
-/* ---- parsing helpers --------------------------------------------------- */
-
-static int parse_q(const cli_ctx *ctx, const sim_args *a, int i,
-                   const char *unit, double *v, ts_err *err)
-{
-    return ts_units_parse(ctx->units, a->val[i], unit, a->where[i], v, err);
-}
-
-static int parse_flag(const sim_args *a, int i, int *v, ts_err *err)
-{
-    const char *s = a->val[i];
-    if (!s) {
-        *v = 0;
-        return TS_OK;
-    }
-    if (!strcmp(s, "true") || !strcmp(s, "yes") || !strcmp(s, "1"))
-        *v = 1;
-    else if (!strcmp(s, "false") || !strcmp(s, "no") || !strcmp(s, "0"))
-        *v = 0;
-    else
-        return ts_fail(err, TS_EINVAL, "%s: expected true or false, got '%s'",
-                       a->where[i], s);
-    return TS_OK;
-}
-
-/* Add every ';'-separated spec of `text` to ex. */
-static int add_specs(ts_excitation *ex, const char *text, const char *where,
-                     int manoeuvre, const ts_units *units, ts_err *err)
-{
-    char *copy = strdup(text);
-    if (!copy)
-        return ts_fail(err, TS_ENOMEM, "%s: out of memory", where);
-    int rc = TS_OK;
-    char *save = NULL;
-    for (char *p = strtok_r(copy, ";", &save); p && !rc;
-         p = strtok_r(NULL, ";", &save)) {
-        while (*p == ' ')
-            p++;
-        if (!*p)
-            continue;
-        int n = ts_excitation_nsignals(ex);
-        rc = ts_excitation_parse(ex, p, units, where, err);
-        if (rc == TS_EIO)
-            rc = err->code = TS_EINVAL; /* a missing series file is bad
-                                           input, like a missing scene */
-        if (!rc) {
-            const ts_signal *s = ts_excitation_signal(ex, n);
-            int is_man = s->axis == TS_AXIS_SPEED ||
-                         s->axis == TS_AXIS_TURN_RATE;
-            if (is_man != manoeuvre)
-                rc = ts_fail(err, TS_EINVAL, "%s: '%s' is %s; give it with "
-                             "%s", where, ts_axis_name(s->axis),
-                             is_man ? "a manoeuvre of the ship"
-                                    : "a tow-point excitation",
-                             is_man ? "--manoeuvre (scene key manoeuvre)"
-                                    : "--excite (scene key excite)");
-        }
-    }
-    free(copy);
-    return rc;
+        CLI_SIM_DEFAULT_T_END, CLI_SIM_DEFAULT_SAMPLE,
+        CLI_SIM_DEFAULT_SAMPLES_PER_PERIOD);
 }
 
 /* Read "node,x_m,y_m,z_m[,...]" rows (a header first) into pos[3 nnodes],
@@ -225,178 +136,6 @@ static int read_shape(const ts_system *sys, const char *path,
 }
 
 /* ---- the run ----------------------------------------------------------- */
-
-typedef struct sim_setup {
-    ts_sim_opts o;
-    double transient;
-    int compare, linear_only;
-    enum { INIT_EQ, INIT_RELEASED, INIT_SHAPE } init;
-    double theta1, theta2;
-    char init_text[256];
-    const char *shape_path;
-    ts_output out;
-} sim_setup;
-
-static int parse_initial(const cli_ctx *ctx, const sim_args *a, sim_setup *s,
-                         ts_err *err)
-{
-    const char *v = a->val[A_INITIAL], *w = a->where[A_INITIAL];
-    s->init = INIT_EQ;
-    snprintf(s->init_text, sizeof s->init_text, "equilibrium");
-    if (!v || !strcmp(v, "equilibrium"))
-        return TS_OK;
-    if (!strncmp(v, "shape:", 6)) {
-        s->init = INIT_SHAPE;
-        s->shape_path = v + 6;
-        snprintf(s->init_text, sizeof s->init_text, "shape from %s", v + 6);
-        return *s->shape_path ? TS_OK
-                              : ts_fail(err, TS_EINVAL, "%s: shape: needs a "
-                                        "file name", w);
-    }
-    if (strncmp(v, "released", 8) || (v[8] != '\0' && v[8] != ':'))
-        return ts_fail(err, TS_EINVAL, "%s: '%s' is not an initial state; "
-                       "expected equilibrium, released[:theta1=A,theta2=B] "
-                       "or shape:FILE", w, v);
-    s->init = INIT_RELEASED;
-    s->theta1 = s->theta2 = 0.0;
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", v[8] ? v + 9 : "");
-    char *save = NULL;
-    for (char *p = strtok_r(buf, ",", &save); p;
-         p = strtok_r(NULL, ",", &save)) {
-        char *eq = strchr(p, '=');
-        if (eq)
-            *eq = '\0';
-        double *dst = !strcmp(p, "theta1") ? &s->theta1
-                      : !strcmp(p, "theta2") ? &s->theta2 : NULL;
-        if (!eq || !dst)
-            return ts_fail(err, TS_EINVAL, "%s: released: expected theta1= "
-                           "and/or theta2= (angles), got '%s'", w, p);
-        char where[160];
-        snprintf(where, sizeof where, "%s: released: %s", w, p);
-        int rc = ts_units_parse(ctx->units, eq + 1, "rad", where, dst, err);
-        if (rc)
-            return rc;
-    }
-    snprintf(s->init_text, sizeof s->init_text,
-             "released straight at rest, theta1 %.6g deg, theta2 %.6g deg",
-             s->theta1 * 180 / M_PI, s->theta2 * 180 / M_PI);
-    return TS_OK;
-}
-
-/* Options into a setup (system-independent parts). */
-static int parse_setup(const cli_ctx *ctx, const sim_args *a,
-                       const ts_excitation *ex, sim_setup *s, ts_err *err)
-{
-    ts_sim_opts_default(&s->o);
-    s->o.t_end = DEFAULT_T_END;
-    int rc = TS_OK;
-    if (a->val[A_T_END] &&
-        (rc = parse_q(ctx, a, A_T_END, "s", &s->o.t_end, err)))
-        return rc;
-    if (!(s->o.t_end > 0))
-        return ts_fail(err, TS_EINVAL, "%s: the run length must be > 0 s, "
-                       "got %g s", a->where[A_T_END], s->o.t_end);
-    if (a->val[A_SAMPLE]) {
-        if ((rc = parse_q(ctx, a, A_SAMPLE, "s", &s->o.dt_sample, err)))
-            return rc;
-        if (!(s->o.dt_sample > 0))
-            return ts_fail(err, TS_EINVAL, "%s: the sample interval must be "
-                           "> 0 s, got %g s", a->where[A_SAMPLE],
-                           s->o.dt_sample);
-        if (s->o.dt_sample > s->o.t_end)
-            return ts_fail(err, TS_EINVAL, "%s: the sample interval %g s is "
-                           "longer than the run (%g s)", a->where[A_SAMPLE],
-                           s->o.dt_sample, s->o.t_end);
-    } else {
-        double dt = DEFAULT_SAMPLE;
-        int idx;
-        if (ts_excitation_periodic(ex, &idx)) {
-            double f = ts_excitation_signal(ex, idx)->frequency;
-            dt = fmin(dt, 1.0 / (DEFAULT_SAMPLES_PER_PERIOD * f));
-        }
-        s->o.dt_sample = fmin(dt, s->o.t_end);
-    }
-    if (a->val[A_INTEGRATOR] &&
-        ts_integrator_parse(a->val[A_INTEGRATOR], &s->o.integrator))
-        return ts_fail(err, TS_EINVAL, "%s: '%s' is not an integrator; "
-                       "expected rk8pd, rkf45, rk4imp, bsimp or msbdf",
-                       a->where[A_INTEGRATOR], a->val[A_INTEGRATOR]);
-    struct { int i; double *dst; double lo; int strict; } nums[] = {
-        {A_RTOL, &s->o.rel_tol, TS_SIM_RTOL_MIN, 0},
-        {A_ATOL, &s->o.abs_tol, 0, 1}};
-    for (int j = 0; j < 2; j++) {
-        const char *t = a->val[nums[j].i];
-        if (!t)
-            continue;
-        char *end;
-        double v = strtod(t, &end);
-        int ok = end != t && *end == '\0' && isfinite(v) && v < 1 &&
-                 (nums[j].strict ? v > nums[j].lo : v >= nums[j].lo);
-        if (!ok)
-            return ts_fail(err, TS_EINVAL, "%s: expected a number in %s%g, "
-                           "1), got '%s'", a->where[nums[j].i],
-                           nums[j].strict ? "(" : "[", nums[j].lo, t);
-        *nums[j].dst = v;
-    }
-    if (a->val[A_H_MIN]) {
-        if ((rc = parse_q(ctx, a, A_H_MIN, "s", &s->o.h_min, err)))
-            return rc;
-        if (!(s->o.h_min >= 0))
-            return ts_fail(err, TS_EINVAL, "%s: must be >= 0 s, got %g s",
-                           a->where[A_H_MIN], s->o.h_min);
-    }
-    if (a->val[A_MAX_STEPS]) {
-        char *end;
-        long v = strtol(a->val[A_MAX_STEPS], &end, 10);
-        if (end == a->val[A_MAX_STEPS] || *end || v < 1)
-            return ts_fail(err, TS_EINVAL, "%s: expected a whole number >= "
-                           "1, got '%s'", a->where[A_MAX_STEPS],
-                           a->val[A_MAX_STEPS]);
-        s->o.max_steps = v;
-    }
-    if (a->val[A_LINEAR_METHOD]) {
-        const char *m = a->val[A_LINEAR_METHOD];
-        if (!strcmp(m, "expm"))
-            s->o.linear_method = TS_LINSIM_EXPM;
-        else if (!strcmp(m, "ode"))
-            s->o.linear_method = TS_LINSIM_ODE;
-        else
-            return ts_fail(err, TS_EINVAL, "%s: '%s' is not a linear method; "
-                           "expected expm or ode", a->where[A_LINEAR_METHOD],
-                           m);
-    }
-    if (a->val[A_KINEMATICS]) {
-        const char *m = a->val[A_KINEMATICS];
-        if (!strcmp(m, "linear"))
-            s->o.kinematics = TS_KIN_LINEAR;
-        else if (!strcmp(m, "nonlinear"))
-            s->o.kinematics = TS_KIN_NONLINEAR;
-        else
-            return ts_fail(err, TS_EINVAL, "%s: '%s' is not a kinematics; "
-                           "expected linear or nonlinear",
-                           a->where[A_KINEMATICS], m);
-    }
-    if ((rc = parse_flag(a, A_COMPARE, &s->compare, err)) ||
-        (rc = parse_flag(a, A_LINEAR, &s->linear_only, err)))
-        return rc;
-    if (s->compare && s->linear_only)
-        return ts_fail(err, TS_EINVAL, "%s: --linear runs the linear model "
-                       "alone; --compare runs both: give one",
-                       a->where[A_LINEAR]);
-    s->transient = s->o.t_end / 2;
-    if (a->val[A_TRANSIENT]) {
-        if ((rc = parse_q(ctx, a, A_TRANSIENT, "s", &s->transient, err)))
-            return rc;
-        if (!(s->transient >= 0) || !(s->transient < s->o.t_end))
-            return ts_fail(err, TS_EINVAL, "%s: must be in [0, %g) s (the "
-                           "run length), got %g s", a->where[A_TRANSIENT],
-                           s->o.t_end, s->transient);
-    }
-    if ((rc = ts_sim_opts_check(&s->o, err)))
-        return rc;
-    return parse_initial(ctx, a, s, err);
-}
 
 static void print_stats(const char *what, const ts_sim_stats *st,
                         const char *method)
@@ -467,112 +206,205 @@ static void print_compare(const ts_compare *c)
            c->rms_difference, 100 * c->rms_difference_ratio);
 }
 
-/* Everything a run needs that can be checked without running. */
-typedef struct sim_prep {
-    ts_system *sys;
-    ts_equilibrium_opts eo;
-    ts_excitation *ex;
-    sim_setup s;
-} sim_prep;
+/* ---- pictures (--plot) ------------------------------------------------- */
 
-static void prep_free(sim_prep *p)
+/* Snapshots of the cable drawn at most. */
+#define MAX_SNAPSHOTS 21
+
+/* What --plot draws with: the directory and units, and the interval of
+ * the snapshots (s; 0: t_end / 10). */
+typedef struct sim_plot {
+    const cli_plot *plot;
+    double snapshot;
+} sim_plot;
+
+/* Sample of h nearest time t. */
+static int nearest_sample(const ts_history *h, double t)
 {
-    ts_excitation_free(p->ex);
-    ts_system_free(p->sys);
+    int best = 0;
+    for (int i = 1; i < h->nsamples; i++)
+        if (fabs(h->t[i] - t) < fabs(h->t[best] - t))
+            best = i;
+    return best;
 }
 
-/* Build the system and parse every setting. Prints nothing; the message
- * is in err. */
-static int prepare(const cli_ctx *ctx, const sim_args *a,
-                   const cli_settings *cs, sim_prep *p, ts_err *err)
+/* Time histories: the output (nonlinear solid, linear dashed), the
+ * tow-point displacement on every excited tow axis, and the top link's
+ * tension (nonlinear run). */
+static int plot_histories(const ts_system *sys, const cli_sim_setup *s,
+                          const ts_excitation *ex, const ts_history *hn,
+                          const ts_history *hl, const cli_plot *plot)
 {
-    memset(p, 0, sizeof *p);
-    sim_setup *s = &p->s;
-    p->sys = cli_system(ctx->scene, ctx->units, cs, &p->eo, err);
-    if (!p->sys)
-        return err->code ? err->code : TS_ENOMEM;
-    ts_system *sys = p->sys;
-    p->ex = ts_excitation_alloc(err);
-    if (!p->ex)
-        return TS_ENOMEM;
-    int rc = TS_OK;
-    for (int m = 0; m < 2 && !rc; m++)
-        for (int i = 0; i < a->nspecs[m] && !rc; i++)
-            rc = add_specs(p->ex, a->specs[m][i],
-                           a->where[m ? A_MANOEUVRE : A_EXCITE], m,
-                           ctx->units, err);
-    if (!rc)
-        rc = parse_setup(ctx, a, p->ex, s, err);
-    if (!rc && (rc = ts_excitation_check_span(p->ex, s->o.t_end, err)))
-        ts_err_prefix(err, "%s: ", a->where[A_EXCITE]);
-    if (!rc) {
-        char def[2 * TS_NAME_MAX + 4];
-        const char *name = a->val[A_OUTPUT];
-        if (!name) {
-            int node = sys->nnodes - 1;
-            for (int b = sys->nbodies - 1; b >= 0; b--)
-                if (sys->bodies[b].type == TS_BODY_SPHERE)
-                    node = ts_system_body_node(sys, b);
-            ts_report_node_name(sys, node, def, sizeof def - 2);
-            strcat(def, ".z");
-            name = def;
+    const ts_history *hf = hn ? hn : hl;
+    int n = hf->nsamples;
+    double *buf = malloc(7 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (!buf) {
+        fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    double *xn = buf, *xl = buf + n, *tens = buf + 2 * n, *tow = buf + 3 * n;
+    ts_plot_axis panels[3];
+    ts_plot_series ser[6];
+    int np = 0, ns = 0;
+    char outlabel[160], towlabel[3][64];
+    snprintf(outlabel, sizeof outlabel, "%s", s->out.name);
+    panels[np].label = outlabel;
+    panels[np].quantity = TS_PLOT_LENGTH;
+    size_t st = 3 * (size_t)hf->nnodes;
+    size_t off = 3 * (size_t)s->out.node + (size_t)s->out.comp;
+    if (hn) {
+        for (int i = 0; i < hn->nsamples; i++)
+            xn[i] = hn->positions[st * (size_t)i + off];
+        ts_plot_series a = {hn->nsamples, hn->t, xn, "nonlinear", np,
+                            TS_PLOT_SOLID, 1};
+        ser[ns++] = a;
+    }
+    if (hl) {
+        for (int i = 0; i < hl->nsamples; i++)
+            xl[i] = hl->positions[st * (size_t)i + off];
+        ts_plot_series a = {hl->nsamples, hl->t, xl, "linear", np,
+                            TS_PLOT_DASHED, 2};
+        ser[ns++] = a;
+    }
+    np++;
+    /* Tow axes some signal drives. */
+    int used[3] = {0, 0, 0}, nused = 0;
+    for (int i = 0; i < ts_excitation_nsignals(ex); i++) {
+        ts_axis ax = ts_excitation_signal(ex, i)->axis;
+        if (ax <= TS_AXIS_HEAVE && !used[ax]) {
+            used[ax] = 1;
+            nused++;
         }
-        rc = ts_response_output_find(sys, name, &s->out, err);
-        if (rc)
-            ts_err_prefix(err, "%s: ", a->where[A_OUTPUT]);
-        else if (s->out.kind != TS_OUT_POSITION)
-            rc = ts_fail(err, TS_EINVAL, "%s: '%s' is a tension; the "
-                         "simulation reports positions <node>.x|y|z",
-                         a->where[A_OUTPUT], name);
     }
-    int use_linear = s->compare || s->linear_only;
-    const char *lw = a->where[s->compare ? A_COMPARE : A_LINEAR];
-    if (!rc && use_linear && s->init != INIT_EQ)
-        rc = ts_fail(err, TS_EINVAL, "%s: the linear model starts at the "
-                     "equilibrium, so %s needs the initial state "
-                     "'equilibrium'", a->where[A_INITIAL], lw);
-    if (!rc && use_linear && ts_excitation_has_manoeuvre(p->ex))
-        rc = ts_fail(err, TS_EINVAL, "%s: the linear model has no frame "
-                     "inputs; a manoeuvre can only be simulated nonlinearly "
-                     "(drop %s)", a->where[A_MANOEUVRE], lw);
-    /* What the comparison will need, checked before anything runs. */
-    int idx;
-    if (!rc && s->compare && ts_excitation_periodic(p->ex, &idx)) {
-        double f = ts_excitation_signal(p->ex, idx)->frequency;
-        double period = 1.0 / f;
-        if (s->o.dt_sample > period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD)
-            rc = ts_fail(err, TS_EINVAL, "%s: the sample interval %g s is "
-                         "too coarse to compare at %g Hz; at most %g s (%d "
-                         "samples per period)", a->where[A_SAMPLE],
-                         s->o.dt_sample, f,
-                         period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
-                         TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
-        else if (s->o.t_end - s->transient < period)
-            rc = ts_fail(err, TS_EINVAL, "%s: %g s are left after the "
-                         "transient, less than one period (%g s) of the %g "
-                         "Hz excitation", a->where[A_TRANSIENT],
-                         s->o.t_end - s->transient, period, f);
+    if (nused > 0) {
+        panels[np].label = "tow point";
+        panels[np].quantity = TS_PLOT_LENGTH;
+        for (int ax = 0, k = 0; ax < 3; ax++) {
+            if (!used[ax])
+                continue;
+            double *d = tow + (size_t)k * n;
+            for (int i = 0; i < n; i++)
+                d[i] = hf->input[TS_NINPUT * (size_t)i + (size_t)ax];
+            snprintf(towlabel[k], sizeof towlabel[k], "%s",
+                     ts_axis_name((ts_axis)ax));
+            ts_plot_series a = {n, hf->t, d, towlabel[k], np, TS_PLOT_SOLID,
+                                3 + k};
+            ser[ns++] = a;
+            k++;
+        }
+        np++;
     }
-    return rc;
+    if (hn && hn->nlinks > 0) {
+        for (int i = 0; i < hn->nsamples; i++)
+            tens[i] = hn->tensions[(size_t)hn->nlinks * (size_t)i];
+        panels[np].label = "top tension";
+        panels[np].quantity = TS_PLOT_FORCE;
+        ts_plot_series a = {hn->nsamples, hn->t, tens, "nonlinear", np,
+                            TS_PLOT_SOLID, 1};
+        ser[ns++] = a;
+        np++;
+    }
+    char title[256];
+    snprintf(title, sizeof title, "%s: time histories%s", sys->name,
+             hn && hl ? ", linear and nonlinear" : hl ? ", linear model" : "");
+    ts_err err = {0};
+    int status = 0;
+    if (ts_plot_histories(plot->dir, "histories", title, np, panels, ns, ser,
+                          &plot->opts, &err) != TS_OK)
+        status = cli_report(&err, err.code);
+    else
+        printf("wrote %s/histories.png and %s/histories.svg\n", plot->dir,
+               plot->dir);
+    free(buf);
+    return status;
+}
+
+/* Snapshots of the cable every `interval` s from t = 0 (side and top
+ * views, memo Figs. 9 and 11). */
+static int plot_snapshots(const ts_system *sys, const ts_history *h,
+                          double interval, const cli_plot *plot)
+{
+    double t_end = h->t[h->nsamples - 1];
+    int nsnap = 0;
+    int idx[MAX_SNAPSHOTS];
+    for (int k = 0; k < MAX_SNAPSHOTS; k++) {
+        double t = k * interval;
+        if (t > t_end * (1 + 1e-9) + 1e-12)
+            break;
+        int i = nearest_sample(h, t);
+        if (nsnap > 0 && idx[nsnap - 1] == i)
+            continue;
+        idx[nsnap++] = i;
+    }
+    cli_shape shapes[MAX_SNAPSHOTS];
+    ts_plot_shape ps[MAX_SNAPSHOTS];
+    int status = 0, made = 0;
+    for (int k = 0; k < nsnap && !status; k++) {
+        const double *pos = h->positions +
+                            3 * (size_t)h->nnodes * (size_t)idx[k];
+        if (cli_plot_shape(sys, pos, &shapes[k]) != 0) {
+            fprintf(stderr,
+                    "towstab: error: simulate: --plot: out of memory\n");
+            status = EXIT_FAILED;
+            break;
+        }
+        made++;
+        snprintf(shapes[k].label, sizeof shapes[k].label, "t = %.4g s",
+                 h->t[idx[k]]);
+        ps[k] = shapes[k].shape;
+        ps[k].style = k < 8 ? TS_PLOT_SOLID : TS_PLOT_DASHED;
+        ps[k].color = k + 1;
+    }
+    static const char *const names[2] = {"snapshots_side", "snapshots_top"};
+    static const char *const views[2] = {"side view", "top view"};
+    for (int v = 0; v < 2 && !status; v++) {
+        char title[256];
+        snprintf(title, sizeof title, "%s: cable every %.4g s, %s",
+                 sys->name, interval, views[v]);
+        ts_err err = {0};
+        if (ts_plot_shapes(plot->dir, names[v], title,
+                           v == 0 ? TS_PLOT_SIDE : TS_PLOT_TOP,
+                           TS_PLOT_WATER, nsnap, ps, &plot->opts,
+                           &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            printf("wrote %s/%s.png and %s/%s.svg\n", plot->dir, names[v],
+                   plot->dir, names[v]);
+    }
+    for (int k = 0; k < made; k++)
+        cli_plot_shape_free(&shapes[k]);
+    return status;
 }
 
 /* The whole analysis. *result receives the JSON (caller frees). With
  * `full`, histories of every node; else of the output node only. */
-static int simulate(const cli_ctx *ctx, const sim_args *a,
-                    const cli_settings *cs, int full, json_t **result)
+static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
+                    const cli_settings *cs, int full, const sim_plot *sp,
+                    json_t **result)
 {
     ts_err err = {0}, werr = {0};
     *result = NULL;
-    sim_prep prep;
-    int rc = prepare(ctx, a, cs, &prep, &err);
+    cli_sim_prep prep;
+    int rc = cli_sim_prepare(ctx, a, cs, &prep, &err);
+    double snap = sp ? sp->snapshot : 0;
+    if (!rc && sp && snap == 0)
+        snap = prep.s.o.t_end / 10;
+    if (!rc && sp && snap * (MAX_SNAPSHOTS - 1) < prep.s.o.t_end * (1 - 1e-9))
+        rc = ts_fail(&err, TS_EINVAL, "--snapshot-interval: %g s gives more "
+                     "than %d snapshots of the %g s run; at least %g s",
+                     snap, MAX_SNAPSHOTS, prep.s.o.t_end,
+                     prep.s.o.t_end / (MAX_SNAPSHOTS - 1));
+    if (!rc && sp && snap > prep.s.o.t_end)
+        rc = ts_fail(&err, TS_EINVAL, "--snapshot-interval: %g s is longer "
+                     "than the run (%g s)", snap, prep.s.o.t_end);
     if (rc) {
-        prep_free(&prep);
+        cli_sim_prep_free(&prep);
         return cli_report(&err, rc);
     }
     ts_system *sys = prep.sys;
     ts_excitation *ex = prep.ex;
     ts_equilibrium_opts eo = prep.eo;
-    sim_setup s = prep.s;
+    cli_sim_setup s = prep.s;
     ts_kernel *k = ts_kernel_alloc(sys, &err), *knl = NULL;
     ts_equilibrium *eq = NULL;
     ts_linear *lin = NULL;
@@ -605,7 +437,7 @@ static int simulate(const cli_ctx *ctx, const sim_args *a,
         printf("input: %s\n", d);
     }
     /* Initial state. */
-    if (s.init == INIT_EQ) {
+    if (s.init == SIM_INIT_EQ) {
         eq = ts_equilibrium_alloc(sys, &err);
         rc = eq ? ts_equilibrium_solve(k, &eo, eq, &err) : TS_ENOMEM;
         if (rc) {
@@ -616,15 +448,15 @@ static int simulate(const cli_ctx *ctx, const sim_args *a,
         memcpy(y0, eq->y, (size_t)n * sizeof *y0);
         printf("initial state: equilibrium (%s, residual %.3g of %.6g N)\n",
                ts_eq_method_name(eq->method), eq->residual, eq->force_scale);
-    } else if (s.init == INIT_RELEASED) {
+    } else if (s.init == SIM_INIT_RELEASED) {
         rc = ts_sim_released_state(k, s.theta1, s.theta2, y0, &err);
         printf("initial state: %s\n", s.init_text);
     } else {
-        rc = read_shape(sys, s.shape_path, a->where[A_INITIAL], pos, &err);
+        rc = read_shape(sys, s.shape_path, a->where[SIM_A_INITIAL], pos, &err);
         if (!rc) {
-            rc = ts_sim_shape_state(k, pos, SHAPE_RTOL, y0, &err);
+            rc = ts_sim_shape_state(k, pos, CLI_SIM_SHAPE_RTOL, y0, &err);
             if (rc)
-                ts_err_prefix(&err, "%s: %s: ", a->where[A_INITIAL],
+                ts_err_prefix(&err, "%s: %s: ", a->where[SIM_A_INITIAL],
                               s.shape_path);
         }
         printf("initial state: %s, at rest\n", s.init_text);
@@ -694,7 +526,7 @@ static int simulate(const cli_ctx *ctx, const sim_args *a,
         rc = ts_compare_histories(sys, lin, ex, hn, hl, &s.out, s.transient,
                                   &cmp, &err);
         if (rc) {
-            ts_err_prefix(&err, "%s: ", a->where[A_COMPARE]);
+            ts_err_prefix(&err, "%s: ", a->where[SIM_A_COMPARE]);
             status = cli_report(&err, rc);
         } else {
             have_cmp = 1;
@@ -758,11 +590,18 @@ static int simulate(const cli_ctx *ctx, const sim_args *a,
         json_object_set_new(j, "final_t", json_real(hf->t[hf->nsamples - 1]));
         json_object_set_new(j, "final_bodies", bodies);
     }
-    if (a->val[A_CSV] && (hn || hl) &&
-        ts_report_history_csv(sys, hn, hl, a->val[A_CSV], &werr) != TS_OK) {
+    if (a->val[SIM_A_CSV] && (hn || hl) &&
+        ts_report_history_csv(sys, hn, hl, a->val[SIM_A_CSV], &werr) != TS_OK) {
         int st2 = cli_report(&werr, werr.code);
         if (!status)
             status = st2;
+    }
+    if (sp && (hn || hl) && (hn ? hn : hl)->nsamples > 1) {
+        int ps = plot_histories(sys, &s, ex, hn, hl, sp->plot);
+        if (!ps)
+            ps = plot_snapshots(sys, hn ? hn : hl, snap, sp->plot);
+        if (ps && !status)
+            status = ps;
     }
     *result = j;
     j = NULL;
@@ -776,32 +615,10 @@ done:
     ts_kernel_free(k);
     free(y0);
     free(pos);
-    prep_free(&prep);
+    cli_sim_prep_free(&prep);
     return status;
 }
 
-/* Fill arguments missing from the command line with the entry's. */
-static void args_from_entry(sim_args *a, const ts_scene_analysis *e,
-                            int index)
-{
-    for (int i = 0; i < A_N; i++) {
-        const ts_scene_option *o = ts_scene_analysis_option(e, arg_keys[i]);
-        if (!o)
-            continue;
-        if (i == A_EXCITE || i == A_MANOEUVRE) {
-            int m = i == A_MANOEUVRE;
-            if (a->nspecs[m] > 0)
-                continue; /* the command line replaces the scene's */
-            a->specs[m][a->nspecs[m]++] = o->value;
-        } else if (a->val[i]) {
-            continue;
-        } else {
-            a->val[i] = o->value;
-        }
-        snprintf(a->where[i], sizeof a->where[i], "analyses[%d].%s (line %d)",
-                 index, arg_keys[i], o->line);
-    }
-}
 
 static const char *const sim_keys[] = {
     "t_end", "sample", "initial", "integrator", "rtol", "atol", "h_min",
@@ -811,32 +628,34 @@ static const char *const sim_keys[] = {
 
 static int sim_main(int argc, char **argv)
 {
-    sim_args a;
+    cli_sim_args a;
     memset(&a, 0, sizeof a);
-    for (int i = 0; i < A_N; i++)
-        snprintf(a.where[i], sizeof a.where[i], "%s", arg_opts[i]);
+    for (int i = 0; i < SIM_A_N; i++)
+        snprintf(a.where[i], sizeof a.where[i], "%s", cli_sim_arg_opts[i]);
     cli_settings cs = {0};
     cli_settings_from_options(&cs);
+    cli_plot plot = {0};
+    const char *snap_text = NULL;
     enum { O_JSON = 1000, O_QUIET, O_HELP, O_SPEED, O_TURN, O_LINKS,
-           O_METHOD, O_TOL };
+           O_METHOD, O_TOL, O_PLOT, O_UNITS, O_SNAP };
     static const struct option longopts[] = {
-        {"t-end", required_argument, NULL, A_T_END},
-        {"sample", required_argument, NULL, A_SAMPLE},
-        {"initial", required_argument, NULL, A_INITIAL},
-        {"integrator", required_argument, NULL, A_INTEGRATOR},
-        {"rtol", required_argument, NULL, A_RTOL},
-        {"atol", required_argument, NULL, A_ATOL},
-        {"h-min", required_argument, NULL, A_H_MIN},
-        {"max-steps", required_argument, NULL, A_MAX_STEPS},
-        {"transient", required_argument, NULL, A_TRANSIENT},
-        {"output", required_argument, NULL, A_OUTPUT},
-        {"linear-method", required_argument, NULL, A_LINEAR_METHOD},
-        {"kinematics", required_argument, NULL, A_KINEMATICS},
-        {"excite", required_argument, NULL, A_EXCITE},
-        {"manoeuvre", required_argument, NULL, A_MANOEUVRE},
-        {"compare", no_argument, NULL, A_COMPARE},
-        {"linear", no_argument, NULL, A_LINEAR},
-        {"csv", required_argument, NULL, A_CSV},
+        {"t-end", required_argument, NULL, SIM_A_T_END},
+        {"sample", required_argument, NULL, SIM_A_SAMPLE},
+        {"initial", required_argument, NULL, SIM_A_INITIAL},
+        {"integrator", required_argument, NULL, SIM_A_INTEGRATOR},
+        {"rtol", required_argument, NULL, SIM_A_RTOL},
+        {"atol", required_argument, NULL, SIM_A_ATOL},
+        {"h-min", required_argument, NULL, SIM_A_H_MIN},
+        {"max-steps", required_argument, NULL, SIM_A_MAX_STEPS},
+        {"transient", required_argument, NULL, SIM_A_TRANSIENT},
+        {"output", required_argument, NULL, SIM_A_OUTPUT},
+        {"linear-method", required_argument, NULL, SIM_A_LINEAR_METHOD},
+        {"kinematics", required_argument, NULL, SIM_A_KINEMATICS},
+        {"excite", required_argument, NULL, SIM_A_EXCITE},
+        {"manoeuvre", required_argument, NULL, SIM_A_MANOEUVRE},
+        {"compare", no_argument, NULL, SIM_A_COMPARE},
+        {"linear", no_argument, NULL, SIM_A_LINEAR},
+        {"csv", required_argument, NULL, SIM_A_CSV},
         {"json", required_argument, NULL, O_JSON},
         {"quiet", no_argument, NULL, O_QUIET},
         {"help", no_argument, NULL, O_HELP},
@@ -845,23 +664,26 @@ static int sim_main(int argc, char **argv)
         {"links", required_argument, NULL, O_LINKS},
         {"method", required_argument, NULL, O_METHOD},
         {"tol", required_argument, NULL, O_TOL},
+        {"plot", required_argument, NULL, O_PLOT},
+        {"units", required_argument, NULL, O_UNITS},
+        {"snapshot-interval", required_argument, NULL, O_SNAP},
         {NULL, 0, NULL, 0}};
     optind = 1;
     opterr = 0;
     int ch;
     long v;
     while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
-        if (ch >= 0 && ch < A_N) {
-            if (ch == A_EXCITE || ch == A_MANOEUVRE) {
-                int m = ch == A_MANOEUVRE;
-                if (a.nspecs[m] == MAX_SPECS) {
+        if (ch >= 0 && ch < SIM_A_N) {
+            if (ch == SIM_A_EXCITE || ch == SIM_A_MANOEUVRE) {
+                int m = ch == SIM_A_MANOEUVRE;
+                if (a.nspecs[m] == CLI_SIM_MAX_SPECS) {
                     fprintf(stderr, "towstab simulate: %s: at most %d\n",
-                            arg_opts[ch], MAX_SPECS);
+                            cli_sim_arg_opts[ch], CLI_SIM_MAX_SPECS);
                     return EXIT_BADINPUT;
                 }
                 a.specs[m][a.nspecs[m]++] = optarg;
             } else {
-                a.val[ch] = ch == A_COMPARE || ch == A_LINEAR ? "true"
+                a.val[ch] = ch == SIM_A_COMPARE || ch == SIM_A_LINEAR ? "true"
                                                               : optarg;
             }
             continue;
@@ -874,6 +696,9 @@ static int sim_main(int argc, char **argv)
         case O_TURN: cs.turn_rate = optarg; break;
         case O_METHOD: cs.method = optarg; break;
         case O_TOL: cs.tol = optarg; break;
+        case O_PLOT: plot.dir = optarg; break;
+        case O_UNITS: plot.units = optarg; break;
+        case O_SNAP: snap_text = optarg; break;
         case O_LINKS:
             if (cli_parse_int("--links", optarg, 1, 10000000, &v))
                 return EXIT_BADINPUT;
@@ -895,6 +720,14 @@ static int sim_main(int argc, char **argv)
         usage(stderr);
         return EXIT_BADINPUT;
     }
+    if (snap_text && !plot.dir) {
+        fprintf(stderr, "towstab simulate: --snapshot-interval sets the "
+                        "snapshots of the --plot pictures; add --plot DIR\n");
+        return EXIT_BADINPUT;
+    }
+    int pstatus = cli_plot_begin(&plot, "simulate");
+    if (pstatus)
+        return pstatus;
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);
@@ -911,7 +744,7 @@ static int sim_main(int argc, char **argv)
             cli_close(units, scene);
             return status;
         }
-        args_from_entry(&a, e, i);
+        cli_sim_args_from_entry(&a, e, i);
         cli_settings es;
         memset(&es, 0, sizeof es);
         if (cli_settings_from_analysis(&es, e, i, &err)) {
@@ -934,7 +767,18 @@ static int sim_main(int argc, char **argv)
     }
     cli_ctx ctx = {scene, units, a.quiet};
     json_t *j = NULL;
-    status = simulate(&ctx, &a, &cs, 1, &j);
+    sim_plot sp = {&plot, 0};
+    if (snap_text &&
+        (ts_units_parse(units, snap_text, "s", "--snapshot-interval",
+                        &sp.snapshot, &err) != TS_OK ||
+         (!(sp.snapshot > 0) &&
+          ts_fail(&err, TS_EINVAL, "--snapshot-interval: expected a time "
+                  "> 0 s, got '%s'", snap_text) != TS_OK))) {
+        status = cli_report(&err, err.code ? err.code : TS_EINVAL);
+        cli_close(units, scene);
+        return status;
+    }
+    status = simulate(&ctx, &a, &cs, 1, plot.dir ? &sp : NULL, &j);
     ts_err werr = {0};
     if (j && a.json) {
         json_object_set_new(j, "type", json_string("simulate"));
@@ -953,18 +797,18 @@ static int sim_run(const cli_ctx *ctx, const ts_scene_analysis *e, int index,
                    json_t *results)
 {
     ts_err err = {0};
-    sim_args a;
+    cli_sim_args a;
     memset(&a, 0, sizeof a);
-    args_from_entry(&a, e, index);
-    for (int i = 0; i < A_N; i++)
+    cli_sim_args_from_entry(&a, e, index);
+    for (int i = 0; i < SIM_A_N; i++)
         if (!a.where[i][0])
             snprintf(a.where[i], sizeof a.where[i], "analyses[%d].%s",
-                     index, arg_keys[i]);
+                     index, cli_sim_arg_keys[i]);
     cli_settings cs = {0};
     if (cli_settings_from_analysis(&cs, e, index, &err))
         return cli_report(&err, err.code);
     json_t *j = NULL;
-    int status = simulate(ctx, &a, &cs, 0, &j);
+    int status = simulate(ctx, &a, &cs, 0, NULL, &j);
     if (j) {
         json_object_set_new(j, "type", json_string("simulate"));
         json_array_append_new(results, j);
@@ -976,19 +820,19 @@ static int sim_check(const cli_ctx *ctx, const ts_scene_analysis *e,
                      int index)
 {
     ts_err err = {0};
-    sim_args a;
+    cli_sim_args a;
     memset(&a, 0, sizeof a);
-    args_from_entry(&a, e, index);
-    for (int i = 0; i < A_N; i++)
+    cli_sim_args_from_entry(&a, e, index);
+    for (int i = 0; i < SIM_A_N; i++)
         if (!a.where[i][0])
             snprintf(a.where[i], sizeof a.where[i], "analyses[%d].%s",
-                     index, arg_keys[i]);
+                     index, cli_sim_arg_keys[i]);
     cli_settings cs = {0};
     if (cli_settings_from_analysis(&cs, e, index, &err))
         return cli_report(&err, err.code);
-    sim_prep prep;
-    int rc = prepare(ctx, &a, &cs, &prep, &err);
-    prep_free(&prep);
+    cli_sim_prep prep;
+    int rc = cli_sim_prepare(ctx, &a, &cs, &prep, &err);
+    cli_sim_prep_free(&prep);
     return rc ? cli_report(&err, rc) : 0;
 }
 

@@ -51,3 +51,39 @@ run equilibrium_ex2 examples/kamman_ex2_branched_turn.yaml \
 # Example 1 at several speeds, SI units.
 run equilibrium_speeds examples/kamman_ex1_above.yaml \
     --speed "3 knot" --overlay-speeds "5,8 knot"
+
+# pic NAME PICTURE COMMAND ARGS...: towstab COMMAND ARGS --plot $T/NAME,
+# then copy $T/NAME/PICTURE.png to doc/img/NAME.png.
+pic() {
+    local name=$1 picture=$2
+    shift 2
+    "$TOWSTAB" "$@" --quiet --plot "$T/$name" >"$T/$name.log"
+    install -m 0644 "$T/$name/$picture.png" "$OUT/$name.png"
+    local size
+    size=$(stat -c %s "$OUT/$name.png")
+    if [ "$size" -gt $MAX_BYTES ]; then
+        echo "make_doc_plots.sh: $OUT/$name.png is $size bytes (> $MAX_BYTES)" >&2
+        exit 1
+    fi
+    echo "doc/img/$name.png ($size bytes)"
+}
+
+# Modes of example 3 in its 0.5 rad/s turn: the eigenvalue plane and the
+# three lowest mode shapes (four would exceed 150 kB).
+pic modes_ex3_eigenvalues eigenvalues modes examples/kamman_ex3_turn.yaml --count 4
+pic modes_ex3_shapes modes modes examples/kamman_ex3_turn.yaml --count 3
+# Frequency response of example 1's sphere depth to tow-point heave (ft/ft).
+pic response_ex1_bode bode response examples/kamman_ex1_above.yaml \
+    --output sphere.z --units imperial
+# Example 4, tow point heaved 0.1 ft at 1 Hz: linear (dashed) against
+# nonlinear (solid) over 20 s.
+pic simulate_ex4_histories histories simulate examples/kamman_ex4.yaml \
+    --excite tow.heave:amplitude=0.1ft,frequency=1Hz --compare \
+    --t-end 20 --transient 10 --units imperial
+# Example 5, the drop test: the cable every 3 s (memo Fig. 11).
+pic simulate_ex5_snapshots snapshots_side simulate \
+    examples/kamman_ex5_drop.yaml --snapshot-interval 3s --units imperial
+# Example 1 (submerged tow point), 5 to 320 links: error against run time
+# (memo Fig. 12).
+pic converge_ex1_error_time error_time converge \
+    examples/kamman_ex1_submerged.yaml --links 5,10,20,40,80,160,320

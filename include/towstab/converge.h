@@ -28,9 +28,10 @@
  * accurate. Nothing here prints; report_converge.h writes JSON and CSV.
  *
  * Analyses plug in through ts_conv_analysis (a run callback with its value
- * names). Built in: the equilibrium (ts_conv_equilibrium_analysis) and
- * the modes (ts_conv_modes_analysis); others, such as a time-domain
- * simulation, provide the same callback.
+ * names). Built in: the equilibrium (ts_conv_equilibrium_analysis), the
+ * modes (ts_conv_modes_analysis) and a time-domain simulation under a
+ * periodic excitation (ts_conv_simulate_analysis); others provide the same
+ * callback.
  */
 #ifndef TOWSTAB_CONVERGE_H
 #define TOWSTAB_CONVERGE_H
@@ -38,8 +39,10 @@
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
+#include "towstab/excitation.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
+#include "towstab/simulate.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
@@ -284,6 +287,54 @@ TS_API int ts_conv_modes_analysis(const ts_system *sys,
                                   const ts_linearize_opts *lo,
                                   const ts_eigen_opts *eig, int nmodes,
                                   ts_conv_analysis *an, ts_err *err);
+
+/* Run statistics a simulate run judges (ts_conv_simulate_analysis):
+ * more than TS_CONV_SIM_REJECT_NOTE rejected trial steps per accepted step
+ * is a note (the tolerance is near what the method can deliver, or the
+ * scene is stiff for it); any re-chart is a note (each restarts the
+ * integrator); a mean accepted step below TS_CONV_SIM_STEP_FAIL t_end
+ * makes the run untrustworthy (the steps approach the resolution of time
+ * itself: rounding of t + h, not the tolerance, sets the error). */
+#define TS_CONV_SIM_REJECT_NOTE 1.0
+#define TS_CONV_SIM_STEP_FAIL 1e-10
+
+/* A nonlinear simulation (ts_simulate) under a single periodic tow-point
+ * excitation ex (a sine or a slider crank; used, not owned: it must
+ * outlive the analysis), from the equilibrium of sys (solved with eo,
+ * NULL: defaults) with the integrator options so (its integrator, t_end,
+ * dt_sample, tolerances; NULL: defaults). Over the window t >= transient
+ * (s, in [0, t_end)) the output `output` (a position name as
+ * ts_response_output_find takes it, "sphere.z"; resolved again for every
+ * link count) and the tow-point motion along the excitation axis are fitted
+ * by c + a sin(w t) + b cos(w t) (ts_compare_fit_sinusoid). Values:
+ *   "<output>.amplitude_ratio"  (1, relative to itself): output amplitude
+ *       over the fitted excitation amplitude;
+ *   "<output>.mean_offset"  (m, scale the excitation amplitude): c less
+ *       the output's equilibrium value;
+ *   "<output>.phase_deg"  (deg, scale 360): output phase less the
+ *       excitation's, wrapped to (-180, 180].
+ * Parameters: tolerance (the integrator's rel_tol = setting, abs_tol
+ * scaled with it: abs_tol = setting so->abs_tol / so->rel_tol) and links
+ * (N per cable). Noise: in a tolerance sweep the equilibrium's residual
+ * (10 max(residual, 16 eps) times the cable length for the mean offset)
+ * plus rounding 16 eps sqrt(steps) times each value's scale; in a links
+ * sweep, in addition, the integrator's error 10 rel_tol times each value's
+ * scale (|ratio|, the cable length, 360 deg). Evaluations: the
+ * equilibrium's plus the integrator's (Jacobians included). Health: the
+ * equilibrium's (ts_health_equilibrium, prefixed "equilibrium: "), and the
+ * run statistics against TS_CONV_SIM_REJECT_NOTE and TS_CONV_SIM_STEP_FAIL.
+ * TS_EINVAL (before any run) when ex has no single periodic tow excitation,
+ * the output is not a position of sys, the window [transient, t_end] is
+ * shorter than one period or has fewer than
+ * TS_COMPARE_MIN_SAMPLES_PER_PERIOD samples per period, or the options are
+ * bad; else TS_OK or TS_ENOMEM. A run whose simulation fails becomes a
+ * failed row (its status and message). */
+TS_API int ts_conv_simulate_analysis(const ts_system *sys,
+                                     const ts_equilibrium_opts *eo,
+                                     const ts_sim_opts *so,
+                                     const ts_excitation *ex,
+                                     const char *output, double transient,
+                                     ts_conv_analysis *an, ts_err *err);
 
 /* A copy of sys with every cable cut into `links` equal links, built.
  * TS_EINVAL for a cable with link_lengths or links outside

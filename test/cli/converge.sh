@@ -13,6 +13,15 @@
 #   output file; a cable with link_lengths refuses a link sweep but takes
 #   a tolerance sweep; a study in which every run fails exits 1 without a
 #   file.
+# converge --analysis simulate: the issue's command (Kamman ex. 4, its
+#   first simulate entry, tolerances 1e-3..1e-9) exits 0 with JSON rows,
+#   order, recommended, work_precision and the three fitted values; two
+#   integrators give two series; simulate settings from the command line
+#   replace the scene's; a converge scene entry with analysis simulate
+#   runs; a bad or repeated integrator, --integrators or --excite with
+#   another analysis, a transient past the run, a step sweep, a released
+#   initial state and a scene without a periodic excitation exit 2 with
+#   the option named and no file.
 # modes: the JSON carries "trustworthy", "reasons", "notes" and per-mode
 #   health; a chain hanging in still water (the linearized drag at rest
 #   is the step's artefact) is labelled not trustworthy in the table and
@@ -207,6 +216,96 @@ if [ "$status" -eq 0 ] && grep -q '"trustworthy": false' "$T/o/m.json" &&
     pass "modes: a chain hanging in still water is labelled not trustworthy"
 else
     fail "modes still water: status $status; $(tail -5 "$T/out")"
+fi
+
+# The simulate analysis (issue 6): the issue's command.
+fresh
+ts converge "$EX4" --analysis simulate --tolerances 1e-3,1e-5,1e-7,1e-9 \
+    --json "$T/o/s.json" --quiet
+if [ "$status" -eq 0 ] && "$CHECK_JSON" parse "$T/o/s.json" >/dev/null &&
+   has_keys "$T/o/s.json" rows order recommended work_precision \
+       sphere.z.amplitude_ratio sphere.z.mean_offset sphere.z.phase_deg \
+       simulation &&
+   grep -q '"analysis": "simulate"' "$T/o/s.json" &&
+   grep -q '"parameter": "tolerance"' "$T/o/s.json" &&
+   [ "$(grep -c '"setting":' "$T/o/s.json")" -ge 8 ] &&
+   grep -q 'simulate against tolerance: 4 runs' "$T/out"; then
+    pass "converge --analysis simulate --tolerances 1e-3..1e-9: JSON rows, order, recommended, work_precision"
+else
+    fail "converge --analysis simulate: status $status; $(head -c 400 "$T/err")"
+fi
+
+# Two integrators on a shorter run at 1 Hz given on the command line.
+fresh
+ts converge "$EX4" --analysis simulate --integrators rk8pd,rkf45 \
+    --tolerances 1e-4,1e-6,1e-8 --excite tow.heave:amplitude=0.1ft,frequency=1Hz \
+    --t-end 12 --transient 6 --json "$T/o/w.json" --quiet
+if [ "$status" -eq 0 ] && grep -q 'frequency 1 Hz' "$T/out" &&
+   grep -q '"series": "rkf45"' "$T/o/w.json" &&
+   grep -q '"series": "rk8pd"' "$T/o/w.json" &&
+   grep -q '   1e-08 rkf45' "$T/out"; then
+    pass "converge --integrators rk8pd,rkf45: one series each, settings from the command line"
+else
+    fail "converge --integrators: status $status; $(head -c 400 "$T/err")"
+fi
+
+# A scene entry of type converge with analysis simulate.
+sed '/^analyses:/,$d' "$EX4" > "$T/ex4entry.yaml"
+cat >> "$T/ex4entry.yaml" <<'EOF'
+analyses:
+  - type: simulate
+    excite: "tow.heave:amplitude=0.1ft,frequency=1Hz"
+    t_end: 8 s
+    transient: 4 s
+    output: sphere.z
+  - type: converge
+    analysis: simulate
+    tolerances: "1e-4,1e-6,1e-8"
+    integrators: "rk8pd"
+EOF
+fresh
+ts run "$T/ex4entry.yaml" --json "$T/o/r.json" --quiet
+if [ "$status" -eq 0 ] && grep -q '"type": "converge"' "$T/o/r.json" &&
+   grep -q '"analysis": "simulate"' "$T/o/r.json"; then
+    pass "run: a converge entry with analysis simulate runs"
+else
+    fail "run converge simulate entry: status $status; $(head -c 300 "$T/err")"
+fi
+
+for bad in "--analysis simulate --integrators rk9" \
+           "--analysis simulate --integrators rk8pd,rk8pd" \
+           "--integrators rk8pd" "--excite tow.heave:amplitude=1,frequency=1" \
+           "--analysis simulate --transient 70" \
+           "--analysis simulate --steps 1e-3"; do
+    fresh
+    eval ts converge "$EX4" $bad --json "$T/o/c.json"
+    case "$bad" in
+        *--integrators*) opt=--integrators ;;
+        *--transient*) opt=transient ;;
+        *--steps*) opt=--steps ;;
+        *) opt=--excite ;;
+    esac
+    if [ "$status" -eq 2 ] && grep -q -- "$opt" "$T/err" &&
+       [ -z "$(ls -A "$T/o")" ]; then
+        pass "converge $bad: exit 2 naming $opt, no file"
+    else
+        fail "converge $bad: status $status; $(cat "$T/err")"
+    fi
+done
+fresh
+ts converge examples/kamman_ex5_drop.yaml --analysis simulate --json "$T/o/c.json"
+if [ "$status" -eq 2 ] && grep -q 'initial' "$T/err" && [ -z "$(ls -A "$T/o")" ]; then
+    pass "converge --analysis simulate of the drop test (released): exit 2 naming initial"
+else
+    fail "converge simulate drop test: status $status; $(cat "$T/err")"
+fi
+sed 's/    initial: released//' examples/kamman_ex5_drop.yaml > "$T/drop_eq.yaml"
+fresh
+ts converge "$T/drop_eq.yaml" --analysis simulate --json "$T/o/c.json"
+if [ "$status" -eq 2 ] && grep -q 'periodic' "$T/err" && [ -z "$(ls -A "$T/o")" ]; then
+    pass "converge --analysis simulate without a periodic excitation: exit 2"
+else
+    fail "converge simulate without excitation: status $status; $(cat "$T/err")"
 fi
 
 echo "$npass passed, $nfail failed"

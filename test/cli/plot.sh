@@ -1,6 +1,6 @@
 #!/bin/bash
-# test/cli/plot.sh: `towstab equilibrium|modes|response --plot DIR` as a
-# user runs them.
+# test/cli/plot.sh: `towstab equilibrium|modes|response|simulate|converge
+# --plot DIR` as a user runs them.
 #
 #   plot.sh TOWSTAB yes|no     (yes: towstab was built with PLplot)
 #
@@ -12,7 +12,13 @@
 #   scenes add curves (one "overlay" line each); --plot into a path that
 #   is a file, a bad --units, --units or overlays without --plot, an
 #   overlay with a bad unit or a missing scene are refused with exit
-#   status 2 before anything is solved, and leave no picture.
+#   status 2 before anything is solved, and leave no picture. modes and
+#   response write their pictures; simulate writes histories,
+#   snapshots_side and snapshots_top (PNG and SVG, titled, six files),
+#   with --snapshot-interval in the title; converge writes error_time;
+#   simulate and converge refuse --plot into a file (exit 2, nothing run),
+#   --snapshot-interval without --plot or giving too many snapshots, and
+#   --units without --plot.
 # no: --plot is refused with exit status 2 and the message naming the
 #   packages to install, while the analysis without --plot still runs.
 #
@@ -163,6 +169,43 @@ ts modes "$EX3" --plot "$T/afile"
 check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
 ts response "$EX1" --output sphere.z --units imperial
 check "response --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+
+# simulate and converge draw their pictures too.
+EX4=examples/kamman_ex4.yaml
+ts simulate "$EX4" --quiet --excite tow.heave:amplitude=0.1ft,frequency=1Hz \
+    --compare --t-end 6 --transient 3 --plot "$T/sim" --units imperial
+check "simulate --plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
+check "simulate --plot: histories 1000 x 700, titled linear and nonlinear" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/sim/histories.png' 1000 700 && is_svg '$T/sim/histories.svg' 'kamman_ex4: time histories, linear and nonlinear'"
+check "simulate --plot: snapshots side and top (every 0.6 s = t_end/10)" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/sim/snapshots_side.png' 1000 700 && is_png '$T/sim/snapshots_top.png' 1000 700 && is_svg '$T/sim/snapshots_side.svg' 'kamman_ex4: cable every 0.6 s, side view' && is_svg '$T/sim/snapshots_top.svg' 'kamman_ex4: cable every 0.6 s, top view'"
+check "simulate --plot: six files, nothing else" \
+    bash -c "[ \$(ls -A '$T/sim' | wc -l) -eq 6 ]"
+ts simulate examples/kamman_ex5_drop.yaml --quiet --plot "$T/drop" --snapshot-interval 5s
+check "simulate --plot --snapshot-interval 5s (drop test): exit 0 (got $status)" [ $status -eq 0 ]
+check "simulate --snapshot-interval 5s: snapshots every 5 s" \
+    bash -c "$(declare -f is_png is_svg); is_svg '$T/drop/snapshots_side.svg' 'kamman_ex5_drop: cable every 5 s, side view'"
+ts converge examples/kamman_ex1_submerged.yaml --links 5,10,20,40 --quiet --plot "$T/conv"
+check "converge --plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
+check "converge --plot: error against run time, PNG and SVG, titled" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/conv/error_time.png' 1000 700 && is_svg '$T/conv/error_time.svg' 'kamman_ex1_submerged: equilibrium, error against run time (links sweep)'"
+for cmd in "simulate $EX4 --t-end 2" "converge examples/kamman_ex1_submerged.yaml --links 5,10"; do
+    rm -f "$T/afile"; touch "$T/afile"
+    eval ts $cmd --plot "$T/afile"
+    if [ $status -eq 2 ] && grep -q "not a directory" "$T/err" && [ ! -s "$T/afile" ] &&
+        ! grep -q "wrote" "$T/out"; then
+        pass "${cmd%% *} --plot into a file: exit 2, nothing run"
+    else
+        fail "${cmd%% *} --plot into a file: exit $status; $(head -c 300 "$T/err")"
+    fi
+done
+ts simulate "$EX4" --t-end 2 --snapshot-interval 1
+check "simulate --snapshot-interval without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz --plot "$T/r2" --snapshot-interval 0.01
+check "simulate --snapshot-interval 0.01 s on a 2 s run (too many): exit 2 (got $status)" \
+    bash -c "[ $status -eq 2 ] && grep -q snapshot-interval '$T/err'"
+ts converge examples/kamman_ex1_submerged.yaml --links 5,10 --units imperial
+check "converge --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
 
 echo "$npass passed, $nfail failed"
 [ $nfail -eq 0 ]
