@@ -441,7 +441,7 @@ static void test_energy(void)
     CHECK(ok, "energy: RK4 ran through all three step sizes");
     CHECK(emin > 0, "energy: no link went slack (smallest strain %.3g > 0)",
           emin);
-    /* The brief's target: conserved to 1e-6 relative over the run. */
+    /* The required bound: conserved to 1e-6 relative over the run. */
     CHECK(drift[2] < 1e-6 && drift[2] > 1e-15,
           "energy: finest drift %.3g relative (1e-15 < drift < 1e-6)",
           drift[2]);

@@ -91,7 +91,7 @@ static void test_conversions(const ts_units *u)
                  cases[i].si);
         CHECK_REL(v, cases[i].want, RTOL, name);
     }
-    /* The values the brief quotes, to their printed digits. */
+    /* The reference values, to their printed digits. */
     double v;
     ts_units_parse(u, "1 lbf/ft", "N/m", "q", &v, NULL);
     CHECK_NEAR(v, 14.5939029372, 1e-10, "1 lbf/ft = 14.5939029372 N/m");
