@@ -1177,32 +1177,6 @@ static int sim_fit(const sim_ctx *x, const ts_history *h,
     return rc;
 }
 
-/* Health of a run from its statistics. */
-static void sim_health(const ts_sim_opts *o, const ts_sim_stats *st,
-                       ts_trust *trust)
-{
-    if (st->steps > 0 &&
-        (double)st->rejected > TS_CONV_SIM_REJECT_NOTE * (double)st->steps)
-        ts_trust_note(trust,
-                      "%s rejected %ld trial steps for %ld accepted: the "
-                      "tolerance %.3g is near what the method delivers, or "
-                      "the scene is stiff for it",
-                      ts_integrator_name(o->integrator), st->rejected,
-                      st->steps, o->rel_tol);
-    if (st->recharts > 0)
-        ts_trust_note(trust,
-                      "%ld re-chart%s of links near the angle singularity, "
-                      "each restarting the integrator",
-                      st->recharts, st->recharts == 1 ? "" : "s");
-    double mean = st->steps > 0 ? st->t_reached / (double)st->steps : NAN;
-    if (st->steps > 0 && mean < TS_CONV_SIM_STEP_FAIL * o->t_end)
-        ts_trust_fail(trust,
-                      "mean accepted step %.3g s is below %.0e of the run "
-                      "(%g s): rounding of the time, not the tolerance, "
-                      "sets the error",
-                      mean, TS_CONV_SIM_STEP_FAIL, o->t_end);
-}
-
 static int sim_run(void *ctx, ts_conv_param p, double setting,
                    double values[], double noise[], long *evaluations,
                    ts_trust *trust, ts_err *err)
@@ -1246,7 +1220,7 @@ static int sim_run(void *ctx, ts_conv_param p, double setting,
         rc = h ? ts_simulate(k, x->ex, eq->y, &o, h, &st, NULL, err)
                : TS_ENOMEM;
         *evaluations += st.evaluations;
-        sim_health(&o, &st, trust);
+        ts_health_simulation(&o, &st, trust);
     }
     if (rc == TS_OK)
         rc = sim_fit(x, h, &out, eq->positions[3 * out.node + out.comp],

@@ -143,6 +143,31 @@ void ts_health_equilibrium(const ts_system *sys, const ts_equilibrium *eq,
                       eq->shape_error, TS_HEALTH_SHAPE_RTOL, L);
 }
 
+void ts_health_simulation(const ts_sim_opts *o, const ts_sim_stats *st,
+                          ts_trust *trust)
+{
+    if (st->steps > 0 &&
+        (double)st->rejected > TS_HEALTH_SIM_REJECT_NOTE * (double)st->steps)
+        ts_trust_note(trust,
+                      "%s rejected %ld trial steps for %ld accepted: the "
+                      "tolerance %.3g is near what the method delivers, or "
+                      "the scene is stiff for it",
+                      ts_integrator_name(o->integrator), st->rejected,
+                      st->steps, o->rel_tol);
+    if (st->recharts > 0)
+        ts_trust_note(trust,
+                      "%ld re-chart%s of links near the angle singularity, "
+                      "each restarting the integrator",
+                      st->recharts, st->recharts == 1 ? "" : "s");
+    double mean = st->steps > 0 ? st->t_reached / (double)st->steps : NAN;
+    if (st->steps > 0 && mean < TS_HEALTH_SIM_STEP_FAIL * o->t_end)
+        ts_trust_fail(trust,
+                      "mean accepted step %.3g s is below %.0e of the run "
+                      "(%g s): rounding of the time, not the tolerance, "
+                      "sets the error",
+                      mean, TS_HEALTH_SIM_STEP_FAIL, o->t_end);
+}
+
 /* Distance from mode m to the nearest other eigenvalue among the computed
  * modes and their conjugates (its own conjugate included: a complex pair
  * close to the real axis is about to split). *who = -1 for its own

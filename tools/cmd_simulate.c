@@ -13,6 +13,8 @@
 #include <string.h>
 
 #include "cli.h"
+#include "towstab/report_converge.h"
+#include "towstab/health.h"
 #include "cli_plot.h"
 #include "cli_sim.h"
 #include "towstab/compare.h"
@@ -522,6 +524,31 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
     }
     if (!ctx->quiet)
         print_table(sys, &s.out, hn, hl);
+    /* Is the result trustworthy? The start, the linear model's kinks and
+     * the integrations' statistics (towstab/health.h). */
+    ts_trust trust;
+    ts_trust_init(&trust);
+    if (eq) {
+        ts_trust te;
+        ts_trust_init(&te);
+        ts_health_equilibrium(sys, eq, &te);
+        ts_trust_merge(&trust, "initial equilibrium: ", &te);
+    }
+    if (lin && lin->kink_tow && s.compare)
+        ts_trust_note(&trust, "the tow point is at the water surface: a "
+                              "heave shifts the mean depth at first order, "
+                              "which the linear model cannot show");
+    if (hn)
+        ts_health_simulation(&s.o, &st_nl, &trust);
+    if (hl && s.o.linear_method != TS_LINSIM_EXPM)
+        ts_health_simulation(&s.o, &st_lin, &trust);
+    if (ran) {
+        printf("trustworthy: %s\n", trust.trustworthy ? "yes" : "NO");
+        for (int i = 0; i < trust.nreasons; i++)
+            printf("  reason: %s\n", trust.reasons[i]);
+        for (int i = 0; i < trust.nnotes; i++)
+            printf("  note: %s\n", trust.notes[i]);
+    }
     if (s.compare && !status) {
         rc = ts_compare_histories(sys, lin, ex, hn, hl, &s.out, s.transient,
                                   &cmp, &err);
@@ -544,6 +571,13 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
     json_object_set_new(j, "initial", json_string(s.init_text));
     json_object_set_new(j, "excitation", ts_report_excitation_json(ex));
     json_object_set_new(j, "completed", json_boolean(ran && !status));
+    {
+        json_t *tj = ts_report_trust_json(&trust);
+        if (tj) {
+            json_object_update(j, tj);
+            json_decref(tj);
+        }
+    }
     if (status)
         json_object_set_new(j, "error", json_string(err.msg));
     if (hn) {

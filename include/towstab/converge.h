@@ -295,8 +295,8 @@ TS_API int ts_conv_modes_analysis(const ts_system *sys,
  * integrator); a mean accepted step below TS_CONV_SIM_STEP_FAIL t_end
  * makes the run untrustworthy (the steps approach the resolution of time
  * itself: rounding of t + h, not the tolerance, sets the error). */
-#define TS_CONV_SIM_REJECT_NOTE 1.0
-#define TS_CONV_SIM_STEP_FAIL 1e-10
+#define TS_CONV_SIM_REJECT_NOTE TS_HEALTH_SIM_REJECT_NOTE
+#define TS_CONV_SIM_STEP_FAIL TS_HEALTH_SIM_STEP_FAIL
 
 /* A nonlinear simulation (ts_simulate) under a single periodic tow-point
  * excitation ex (a sine or a slider crank; used, not owned: it must

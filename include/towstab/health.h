@@ -22,6 +22,7 @@
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
 #include "towstab/linearize.h"
+#include "towstab/simulate.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
@@ -100,6 +101,20 @@ TS_API void ts_trust_merge(ts_trust *dst, const char *prefix,
  * initialised. */
 TS_API void ts_health_equilibrium(const ts_system *sys,
                                   const ts_equilibrium *eq, ts_trust *t);
+
+/* A time integration: more than TS_HEALTH_SIM_REJECT_NOTE rejected trial
+ * steps per accepted step is a note (the tolerance is near what the method
+ * delivers, or the scene is stiff for it), and so is any re-chart; a mean
+ * accepted step below TS_HEALTH_SIM_STEP_FAIL of the run makes it
+ * untrustworthy (rounding of the time, not the tolerance, sets the
+ * error). */
+#define TS_HEALTH_SIM_REJECT_NOTE 1.0
+#define TS_HEALTH_SIM_STEP_FAIL 1e-10
+
+/* Health of a simulation run from its options and statistics (O(1)).
+ * Writes into t, which the caller initialised. */
+TS_API void ts_health_simulation(const ts_sim_opts *o,
+                                 const ts_sim_stats *st, ts_trust *t);
 
 /* Per-mode health. */
 typedef struct ts_mode_health {

@@ -139,5 +139,18 @@ else
     fail "--json -: exit $status, standard output starts '$(head -c 40 "$T/out")'"
 fi
 
+# Every run says whether it is trustworthy, in the table and in JSON.
+"$TOWSTAB" simulate examples/kamman_ex4.yaml \
+    --excite tow.heave:amplitude=0.1ft,frequency=1Hz --t-end 60 --compare \
+    --output sphere.z --quiet --json "$T/trust.json" >"$T/out" 2>"$T/err"
+status=$?
+if [ "$status" -eq 0 ] && grep -q '^trustworthy: yes' "$T/out" &&
+   grep -q '"trustworthy": true' "$T/trust.json" &&
+   grep -q 'tow point is at the water surface' "$T/trust.json"; then
+    pass "health: trustworthy, with the waterline note, in the table and JSON"
+else
+    fail "health: status $status, $(grep trustworthy "$T/out")"
+fi
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
