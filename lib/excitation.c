@@ -428,7 +428,7 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
     /* Collect key=value pairs. */
     char *val[K_N] = {0};
     char *rest = colon ? colon + 1 : NULL;
-    while (rest && *trim(rest)) {
+    for (int first = 1; rest && *trim(rest); first = 0) {
         char *comma = strchr(rest, ',');
         if (comma)
             *comma = '\0';
@@ -438,11 +438,22 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
             return ts_fail(err, TS_EINVAL, "%s: %s: empty item; expected "
                            "key=value separated by commas", where, an);
         char *eq = strchr(item, '=');
-        if (!eq)
+        char *key, *value;
+        if (!eq && first) {
+            /* A bare first item is the type: "tow.heave:crank,...". */
+            key = (char *)"type";
+            value = item;
+        } else if (!eq) {
             return ts_fail(err, TS_EINVAL, "%s: %s: '%.60s' is not "
                            "key=value", where, an, item);
-        *eq = '\0';
-        char *key = trim(item), *value = trim(eq + 1);
+        } else {
+            *eq = '\0';
+            key = trim(item);
+            value = trim(eq + 1);
+        }
+        /* Aliases: r and radius for a crank's amplitude (its radius). */
+        if (!strcmp(key, "r") || !strcmp(key, "radius"))
+            key = (char *)"amplitude";
         int k = 0;
         while (k < K_N && strcmp(key, key_names[k]))
             k++;
@@ -471,6 +482,8 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
         int t = 0;
         while (t < 5 && strcmp(val[K_TYPE], types[t]))
             t++;
+        if (!strcmp(val[K_TYPE], "slider_crank"))
+            t = TS_SIGNAL_CRANK;
         if (t == 5)
             return ts_fail(err, TS_EINVAL, "%s: %s: unknown type '%.40s'; "
                            "expected %s", where, an, val[K_TYPE],

@@ -234,7 +234,66 @@ struct ts_sim {
     double wall;
     int fatal;            /* a kernel code < 0 met inside GSL */
     long chart_refusals;  /* TS_CHART from trial states */
+    long collapse_refusals; /* trial states with an elastic link of zero
+                             or negative length (strain <= -1) */
+    double t_start;       /* time of the last ts_sim_set_state */
+    long steps_start;     /* accepted steps before it */
 };
+
+static int needs_jacobian(ts_integrator m);
+
+/* 1 when state y has an elastic link of zero or negative length. */
+static int collapsed(const ts_sim *s, const double y[])
+{
+    for (int l = 0; l < s->sys->nlinks; l++)
+        if (s->sys->links[l].elastic &&
+            !(y[ts_kernel_link_offset(s->k, l) + 2] > -1.0))
+            return 1;
+    return 0;
+}
+
+/* The shortest axial period of the elastic links, pi sqrt(l m / EA) (s;
+ * the highest mode of a spring-mass chain of links of length l and mass m
+ * is at most 2 sqrt(EA / (l m)) rad/s, doc/elastic.md), and the link that
+ * sets it in *which; INFINITY without elastic links. */
+static double axial_period(const ts_system *sys, int *which)
+{
+    double best = INFINITY;
+    *which = -1;
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        if (!L->elastic || !(L->mass > 0))
+            continue;
+        double p = M_PI * sqrt(L->length * L->mass / L->ea);
+        if (p < best) {
+            best = p;
+            *which = l;
+        }
+    }
+    return best;
+}
+
+/* After a failed run of an explicit integrator on a scene with elastic
+ * links: append to err's message the step the integrator needed (its
+ * last step and its mean step) against the shortest axial period, and
+ * name stiffness and the implicit integrator. */
+static void stiffness_note(const ts_sim *s, ts_err *err)
+{
+    int l;
+    double per = axial_period(s->sys, &l);
+    if (!err || needs_jacobian(s->o.integrator) || l < 0)
+        return;
+    long steps = s->steps0 + (long)s->drv->e->count - s->steps_start;
+    double mean = steps > 0 ? (s->t - s->t_start) / (double)steps : NAN;
+    size_t len = strlen(err->msg);
+    snprintf(err->msg + len, sizeof err->msg - len, "; %s needed steps of "
+             "%.2g s (last accepted %.2g s, mean %.2g s over %ld steps) "
+             "against a shortest axial period of the elastic links of "
+             "%.2g s (link %d of cable '%s'): the system is stiff, use "
+             "--integrator msbdf", ts_integrator_name(s->o.integrator),
+             fabs(s->h), s->drv->e->last_step, mean, steps, per,
+             s->sys->links[l].index, s->sys->cables[s->sys->links[l].cable].name);
+}
 
 /* Frame and input of time t into the kernel; u[TS_NINPUT]. */
 static void prepare(ts_sim *s, double t, double u[TS_NINPUT])
@@ -259,6 +318,12 @@ static int rhs(double t, const double y[], double dydt[], void *params)
     if (rc > 0) {
         s->chart_refusals++;
         return GSL_FAILURE; /* evolve retries with a smaller step */
+    }
+    if (rc == TS_ESINGULAR && collapsed(s, y)) {
+        /* A trial state of a step too long for a stiff elastic link: not
+         * fatal, evolve retries with a smaller step. */
+        s->collapse_refusals++;
+        return GSL_FAILURE;
     }
     s->fatal = rc;
     return GSL_EBADFUNC;
@@ -364,7 +429,7 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     s->ex = ex;
     s->n = ts_kernel_nstate(k);
     s->nq = ts_kernel_nq(k);
-    s->nl = s->nq / 2;
+    s->nl = ts_kernel_system(k)->nlinks;
     int cur = s->base.current[0] != 0 || s->base.current[1] != 0;
     s->frame_varies = ts_excitation_has_manoeuvre(ex) ||
                       (s->base.turn_rate != 0 && cur);
@@ -419,8 +484,9 @@ static void restart(ts_sim *s)
 static int maybe_rechart(ts_sim *s)
 {
     int near = 0;
-    for (int l = 0; l < s->nl && !near; l++)
-        near = fabs(cos(s->y[2 * l + 1])) < s->o.rechart;
+    for (int l = 0; l < s->sys->nlinks && !near; l++)
+        near = fabs(cos(s->y[ts_kernel_link_offset(s->k, l) + 1])) <
+               s->o.rechart;
     if (!near)
         return 0;
     int moved = ts_kernel_rechart(s->k, s->y, s->o.rechart);
@@ -439,8 +505,10 @@ int ts_sim_set_state(ts_sim *s, double t, const double y[], ts_err *err)
                            "a non-finite entry y[%d] = %g", i, y[i]);
     memcpy(s->y, y, (size_t)s->n * sizeof(double));
     s->t = t;
+    s->t_start = t;
     maybe_rechart(s);
     restart(s);
+    s->steps_start = s->steps0;
     return TS_OK;
 }
 
@@ -467,7 +535,7 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
                        "not after the current time %g s", t1, s->t);
     const char *name = ts_integrator_name(s->o.integrator);
     double w0 = wall_now();
-    int rc = TS_OK;
+    int rc = TS_OK, step_failed = 0;
     while (s->t < t1) {
         double target = t1;
         for (int b = 0; b < s->nbreaks; b++)
@@ -494,7 +562,7 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
                              "than the re-chart threshold %g can follow)",
                              name, s->t, s->o.rechart);
             else
-                rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
+                rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
                              "t = %.9g s: the step size underflowed (%.3g s) "
                              "at relative tolerance %g, absolute %g; the "
                              "scene may be stiff (try msbdf) or the "
@@ -505,7 +573,7 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
         if (s->t == t_before) {
             /* An accepted step too small to change t: GSL does not catch
              * this one (t + h == t in floating point). */
-            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
+            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
                          "t = %.9g s: the step size underflowed (%.3g s is "
                          "below the resolution of t)", name, s->t,
                          fabs(s->h));
@@ -515,13 +583,13 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
         for (int i = 0; i < s->n && finite; i++)
             finite = isfinite(s->y[i]);
         if (!finite) {
-            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s produced a "
+            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s produced a "
                          "non-finite state at t = %.9g s", name, s->t);
             s->t = t_before;
             break;
         }
         if (s->o.h_min > 0 && s->t < target && fabs(s->h) < s->o.h_min) {
-            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
+            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
                          "t = %.9g s: the step size %.3g s fell below h_min "
                          "%.3g s", name, s->t, fabs(s->h), s->o.h_min);
             break;
@@ -529,7 +597,7 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
         if (s->o.max_steps > 0 &&
             s->steps0 + (long)s->drv->e->count >= s->o.max_steps &&
             s->t < t1) {
-            rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the "
+            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the "
                          "step limit %ld at t = %.9g s", name,
                          s->o.max_steps, s->t);
             break;
@@ -539,6 +607,8 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
             s->nrestart++;
         }
     }
+    if (step_failed)
+        stiffness_note(s, err);
     s->wall += wall_now() - w0;
     return rc;
 }
@@ -618,7 +688,7 @@ int ts_sim_released_state(ts_kernel *k, double theta1, double theta2,
         return ts_fail(err, TS_EINVAL, "released shape: angles must be "
                        "finite, got theta1 %g rad, theta2 %g rad", theta1,
                        theta2);
-    int nl = ts_kernel_nq(k) / 2;
+    int nl = ts_kernel_system(k)->nlinks;
     double n[3] = {-cos(theta1) * cos(theta2), -sin(theta2),
                    sin(theta1) * cos(theta2)};
     double *dirs = malloc(3 * (size_t)nl * sizeof(double));

@@ -11,7 +11,7 @@
  *     kamman_ex1_elastic.yaml and kamman_ex1_submerged.yaml): straight at
  *     20 and 100 links, in a turn, and with the tow point 35 ft above the
  *     water. The elastic shape differs from the rigid one by O(1/EA): at
- *     EA = 1e9 N by ~2e-7 of the cable length (the issue asks for 1e-4),
+ *     EA = 1e9 N by ~2e-7 of the cable length (1e-4 is required),
  *     and the log-log slope over EA = 1e6..1e10 is -1. Every elastic link
  *     obeys Hooke, |r_k - r_p| = l (1 + T / EA). Newton started from the
  *     rigid solution's directions agrees with the march.
@@ -345,7 +345,7 @@ static void test_rigid_limit(const ts_units *u)
                    "tension %.4e relative (%s)\n", cs->name, eas[i], dpos[i],
                    dten[i], ts_eq_method_name(eqe->method));
             if (eas[i] == 1e9) {
-                /* The issue's requirement: 1e-4 relative. The stretch is
+                /* The requirement: 1e-4 relative. The stretch is
                  * T / EA ~ 3e-7 at the top, so ~2e-7 is expected. */
                 CHECK(dpos[i] < 1e-4 && dpos[i] < 1e-6,
                       "%s: EA 1e9 N within %.3g of the cable length of the "
@@ -531,7 +531,7 @@ static void test_modes(const ts_units *u)
     CHECK(extra_ok, "modes: each of the %d links adds one oscillatory "
                     "(axial) mode", N);
     CHECK(stable, "modes: every elastic case is stable");
-    /* The issue's order of magnitude at 1e9 N: ~1e-6 (1/EA from 1.4e-3 at
+    /* The expected order of magnitude at 1e9 N: ~1e-6 (1/EA from 1.4e-3 at
      * 1e6 N). The linearization's own error (~1e-8 relative here) is far
      * below. */
     CHECK(diff[4] < 1e-5, "modes: at EA 1e9 N the %d lowest rigid modes are "

@@ -408,7 +408,7 @@ static void test_parse(void)
     CHECK(rc == TS_OK && s->type == TS_SIGNAL_SINE &&
               s->axis == TS_AXIS_HEAVE && s->amplitude == 0.1 * 0.3048 &&
               s->frequency == 0.25 && s->phase == 0,
-          "issue example parsed: sine, heave, 0.03048 m, 0.25 Hz (%s)",
+          "documented example parsed: sine, heave, 0.03048 m, 0.25 Hz (%s)",
           err.msg);
     rc = ts_excitation_parse(ex, " tow.x : type = crank , amplitude = 10 cm,"
                              " rod=0.35, period=1.6 s, phase=90deg", units,
@@ -419,6 +419,22 @@ static void test_parse(void)
               s->rod == 0.35 && fabs(s->frequency - 0.625) < 1e-15 &&
               fabs(s->phase - M_PI / 2) < 1e-15,
           "crank with blanks, period and degrees (%s)", err.msg);
+    {
+        /* The two-part tow's command: a bare type word and r for radius. */
+        ts_excitation *ex2 = ts_excitation_alloc(&err);
+        int rc2 = ex2 ? ts_excitation_parse(ex2, "tow.heave:slider_crank,"
+                                            "r=0.1m,rod=0.35m,period=1.6s",
+                                            units, "--excite", &err)
+                      : TS_ENOMEM;
+        const ts_signal *c = rc2 == TS_OK ? ts_excitation_signal(ex2, 0) : NULL;
+        CHECK(c && c->type == TS_SIGNAL_CRANK && c->axis == TS_AXIS_HEAVE &&
+                  fabs(c->amplitude - 0.1) < 1e-16 && c->rod == 0.35 &&
+                  fabs(c->frequency - 0.625) < 1e-15,
+              "slider_crank,r=0.1m,rod=0.35m,period=1.6s parsed as a crank "
+              "(%s)",
+              err.msg);
+        ts_excitation_free(ex2);
+    }
     rc = ts_excitation_parse(ex, "turn_rate:to=0.5rad/s,duration=2s", units,
                              "--manoeuvre", &err);
     s = ts_excitation_signal(ex, 2);
@@ -456,7 +472,9 @@ static void test_parse(void)
         {"tow.heave:type=crank,amplitude=1,frequency=1,rod=0.5", TS_EINVAL, "rod must be longer"},
         {"tow.heave:type=square,amplitude=1", TS_EINVAL, "unknown type 'square'"},
         {"tow.heave:amplitude=1 s,frequency=1", TS_EUNIT, "amplitude"},
-        {"tow.heave:amplitude,frequency=1", TS_EINVAL, "is not key=value"},
+        /* A bare first word is the type ("tow.heave:crank,..."). */
+        {"tow.heave:amplitude,frequency=1", TS_EINVAL, "unknown type 'amplitude'"},
+        {"tow.heave:amplitude=1,frequency,phase=0", TS_EINVAL, "is not key=value"},
         {"tow.heave:amplitude=1,,frequency=1", TS_EINVAL, "empty item"},
         {"tow.heave:amplitude=1,amplitude=2,frequency=1", TS_EINVAL, "given twice"},
         {"tow.heave:amplitude=,frequency=1", TS_EINVAL, "has no value"},

@@ -1,4 +1,4 @@
-/* test_extreme.c: extreme and stiff cases (project issue 6, part 2). Each
+/* test_extreme.c: extreme and stiff cases. Each
  * case asserts either a correct answer, checked by something that does
  * not come from the solver (an invariant, a symmetry, a limit, an
  * independent computation), or a clear refusal. Per case, what is

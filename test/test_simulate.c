@@ -825,7 +825,7 @@ static void test_misc(void)
     CHECK(rc == TS_EDOMAIN && strstr(err.msg, "no frame inputs"),
           "a manoeuvre in a linear run is refused: %s", err.msg);
 
-    /* Reports: the comparison JSON has the keys; the CSV header. */
+    /* Reports: the comparison JSON has the required keys; the CSV header. */
     ts_compare cmp;
     ts_history *hn, *hl;
     ts_sim_opts_default(&o);

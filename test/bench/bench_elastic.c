@@ -6,7 +6,7 @@
  *    straight and in a turn of radius 2 L by the default method (marching
  *    with Hooke's stretch, and shooting), and by Newton started from the
  *    rigid solution's directions (opts.guess; the rigid solve is not
- *    timed). The issue's target: 100 links straight under 20 ms.
+ *    timed). The target: 100 links straight under 20 ms.
  * 2. The two-part tow (examples/two_part_tow.yaml): 35 elastic links with
  *    bending, Newton with continuation in turn rate and bending stiffness.
  * 3. One kernel evaluation, elastic against rigid, at 100 and 1000 links.

@@ -16,7 +16,7 @@
  * the figure is that over the wall time (setup included). rk4imp and
  * bsimp (a Jacobian and LU factorisations every step) are also stopped
  * after IMPLICIT_STEP_CAP steps, which the output says. Then the target of
- * the issue is timed on its own: ex1, 100 links, perturbed equilibrium,
+ * the target is timed on its own: ex1, 100 links, perturbed equilibrium,
  * rk8pd at rtol 1e-6 over 30 s (three repetitions, the best reported):
  * at least 30 simulated seconds per wall second. Finally the linear
  * simulation (expm and ode) of ex4 over 60 s.

@@ -13,7 +13,7 @@
 #   output file; a cable with link_lengths refuses a link sweep but takes
 #   a tolerance sweep; a study in which every run fails exits 1 without a
 #   file.
-# converge --analysis simulate: the issue's command (Kamman ex. 4, its
+# converge --analysis simulate: the documented command (Kamman ex. 4, its
 #   first simulate entry, tolerances 1e-3..1e-9) exits 0 with JSON rows,
 #   order, recommended, work_precision and the three fitted values; two
 #   integrators give two series; simulate settings from the command line
@@ -218,7 +218,7 @@ else
     fail "modes still water: status $status; $(tail -5 "$T/out")"
 fi
 
-# The simulate analysis (issue 6): the issue's command.
+# The simulate analysis : the documented command.
 fresh
 ts converge "$EX4" --analysis simulate --tolerances 1e-3,1e-5,1e-7,1e-9 \
     --json "$T/o/s.json" --quiet

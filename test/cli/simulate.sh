@@ -4,7 +4,7 @@
 #   simulate.sh TOWSTAB
 #
 # Run from the project root (meson does). Checks:
-#  - the three commands of the issue succeed: the example-4 comparison
+#  - the three documented commands succeed: the example-4 comparison
 #    (prints the comparison table, JSON with the summary keys), the turn
 #    manoeuvre with --csv (one row per 0.5 s sample, the scene's
 #    interval), the drop test every 3 s (11 rows, from the scene's
@@ -39,7 +39,7 @@ EX3=examples/kamman_ex3_into_turn.yaml
 EX4=examples/kamman_ex4.yaml
 EX5=examples/kamman_ex5_drop.yaml
 
-# 1. Example 4, the issue's first command.
+# 1. Example 4, the first documented command.
 fresh
 ts simulate "$EX4" --excite tow.heave:amplitude=0.1ft,frequency=0.25Hz \
     --t-end 60 --compare --output sphere.z --json "$T/o/c.json" --quiet

@@ -1,0 +1,400 @@
+/* test_elastic_sim.c: time-domain simulation of elastic cables (MODEL.md
+ * section 7; doc/elastic.md section 7; doc/two-part-tow.md), against the
+ * rigid model and the linear frequency response, which do not come from
+ * the elastic simulation itself.
+ *
+ *  1. Rigid limit in time: Kamman example 1 (examples/kamman_ex1_submerged.
+ *     yaml, 10 links, tow point 1 ft deep so that no link crosses the
+ *     surface), the tow point stepped 0.3 m down over 1 s. The elastic run
+ *     (msbdf, EA = 1e8 and 1e9 N) is compared with the rigid run (same
+ *     scene, EA = 0, rk8pd at 1e-10) node by node at every sample: the
+ *     difference is the cable's stretch, O(1/EA), so it must fall ten times
+ *     from 1e8 to 1e9 N and sit near the static stretch T L / EA.
+ *  2. Stiffness and the explicit integrator: the same scene at EA = 1e10 N.
+ *     rk8pd completes a short run (its steps shrink to the axial stability
+ *     limit; it agrees with msbdf), and with a step limit it fails with a
+ *     message that names stiffness, the step it needed, the axial period
+ *     and msbdf.
+ *  3. Slack during a run: the tow point of a soft elastic cable moved
+ *     2 m down toward the body in 0.4 s: links go slack (tension exactly 0)
+ *     and the run stays finite.
+ *  4. The two-part tow (examples/two_part_tow.yaml, coarser: 10 + 2 + 6
+ *     links) under the slider crank (r 0.1 m, rod 0.35 m, 1.6 s): the run
+ *     completes, and the towfish/tow-point heave ratio at the crank
+ *     frequency is compared with the linear frequency response at that
+ *     frequency (ts_response_at), an independent estimate.
+ * Run from the project root (it reads examples/). */
+#include "towstab/equilibrium.h"
+#include "towstab/excitation.h"
+#include "towstab/compare.h"
+#include "towstab/kernel.h"
+#include "towstab/linearize.h"
+#include "towstab/response.h"
+#include "towstab/scene.h"
+#include "towstab/simulate.h"
+#include "towstab/units.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+
+#define FT 0.3048
+
+static ts_scene *load(const ts_units *u, const char *path)
+{
+    ts_err err = {0};
+    ts_scene *s = ts_scene_load(path, u, &err);
+    CHECK(s != NULL, "%s loads (%s)", path, s ? "ok" : err.msg);
+    return s;
+}
+
+/* A run from the equilibrium of sys: the history (caller frees), the
+ * code, the statistics and the error. */
+static ts_history *run(const ts_system *sys, const ts_excitation *ex,
+                       const ts_sim_opts *o, int *rc, ts_sim_stats *st,
+                       ts_err *err)
+{
+    ts_kernel *k = ts_kernel_alloc(sys, err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, err);
+    ts_history *h = ts_history_alloc(sys, ts_sim_nsamples(o), err);
+    ts_equilibrium_opts eo;
+    ts_equilibrium_opts_default(&eo);
+    *rc = k && eq && h ? ts_equilibrium_solve(k, &eo, eq, err) : TS_ENOMEM;
+    if (*rc == TS_OK)
+        *rc = ts_simulate(k, ex, eq->y, o, h, st, NULL, err);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    return h;
+}
+
+/* Largest node position difference over all common samples, m. */
+static double hist_diff(const ts_history *a, const ts_history *b)
+{
+    double d = 0;
+    int n = a->nsamples < b->nsamples ? a->nsamples : b->nsamples;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 3 * a->nnodes; j++)
+            d = fmax(d, fabs(a->positions[3 * a->nnodes * i + j] -
+                             b->positions[3 * b->nnodes * i + j]));
+    return d;
+}
+
+static int hist_finite(const ts_history *h)
+{
+    for (int i = 0; i < h->nsamples; i++) {
+        for (int j = 0; j < 3 * h->nnodes; j++)
+            if (!isfinite(h->positions[3 * h->nnodes * i + j]))
+                return 0;
+        for (int j = 0; j < h->nlinks; j++)
+            if (!isfinite(h->tensions[h->nlinks * i + j]))
+                return 0;
+    }
+    return 1;
+}
+
+/* ---- 1 and 2: rigid limit and stiffness ------------------------------- */
+
+static void set_ea(ts_system *s, double ea, double cv)
+{
+    s->cables[0].ea = ea;
+    s->cables[0].damping = ea > 0 ? cv : 0.0;
+    ts_err err = {0};
+    int rc = ts_system_build(s, &err);
+    CHECK(rc == TS_OK, "rebuild at EA %g N (%s)", ea, err.msg);
+}
+
+static void test_rigid_limit(const ts_units *u)
+{
+    ts_scene *sc = load(u, "examples/kamman_ex1_submerged.yaml");
+    if (!sc)
+        return;
+    ts_system *s = sc->system;
+    s->cables[0].nlinks = 10;
+    s->tow.point[2] = 1.0 * FT;
+    double L = s->cables[0].length;
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_signal sig = {0};
+    sig.type = TS_SIGNAL_STEP;
+    sig.axis = TS_AXIS_HEAVE;
+    sig.amplitude = 0.3;
+    sig.start = 0.0;
+    sig.rise = 1.0;
+    ts_excitation_add(ex, &sig, &err);
+
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    o.t_end = 2.0;
+    o.dt_sample = 0.1;
+    o.rel_tol = 1e-10;
+    o.abs_tol = 1e-12;
+    int rc;
+    ts_sim_stats st;
+    set_ea(s, 0.0, 0.0);
+    ts_history *hr = run(s, ex, &o, &rc, &st, &err);
+    CHECK(rc == TS_OK, "rigid run completes (%s)", err.msg);
+    double T0 = hr->tensions[0]; /* top tension at t = 0, N */
+
+    /* Elastic, implicit. Tolerances: rel 1e-9 keeps the integration error
+     * (about 1e-9 of the 30 m positions, 3e-8 m) far below the stretch at
+     * EA = 1e9 N (T L / EA ~ 1e-5 m); abs 1e-7 on the rates lets msbdf
+     * step over the axial ringing, whose strain-rate amplitude is ~1e-7
+     * here (doc/elastic.md section 7). */
+    ts_sim_opts oi = o;
+    oi.integrator = TS_INT_MSBDF;
+    oi.rel_tol = 1e-9;
+    oi.abs_tol = 1e-7;
+    double d[2];
+    const double eas[2] = {1e8, 1e9};
+    for (int i = 0; i < 2; i++) {
+        set_ea(s, eas[i], 4000.0);
+        ts_history *he = run(s, ex, &oi, &rc, &st, &err);
+        CHECK(rc == TS_OK, "msbdf at EA %g N completes (%s; %ld steps)",
+              eas[i], err.msg, st.steps);
+        d[i] = hist_diff(hr, he);
+        /* The static stretch of the cable is about T0 L / EA (the tension
+         * falls along the cable, so the sum of the stretches is below
+         * that); the dynamic part of the tension is a few per cent of T0. */
+        double stretch = T0 * L / eas[i];
+        CHECK(d[i] < 2.0 * stretch && d[i] > 0.1 * stretch,
+              "EA %g N: elastic - rigid %.3e m, within [0.1, 2] of the "
+              "stretch T0 L / EA = %.3e m", eas[i], d[i], stretch);
+        ts_history_free(he);
+    }
+    /* O(1/EA): the ratio is 10 up to terms of relative size strain
+     * (~1e-6) and the integration error (3e-8 m against d = 1e-5 m). */
+    CHECK(d[0] / d[1] > 9.0 && d[0] / d[1] < 11.0,
+          "elastic - rigid falls like 1/EA: %.3e m at 1e8 N, %.3e m at 1e9 "
+          "N, ratio %.3f in [9, 11]", d[0], d[1], d[0] / d[1]);
+    CHECK(d[1] < 1e-4 * L, "EA 1e9 N: within 1e-4 of the length of the "
+          "rigid run (%.2e of L)", d[1] / L);
+
+    /* 2. EA = 1e10 N, explicit. A short run completes and agrees with
+     * msbdf; with a step limit rk8pd fails and says why. */
+    set_ea(s, 1e10, 4000.0);
+    ts_sim_opts oe = o;
+    oe.t_end = 0.02;
+    oe.dt_sample = 0.01;
+    oe.rel_tol = 1e-9;
+    oe.abs_tol = 1e-7;
+    ts_history *he = run(s, ex, &oe, &rc, &st, &err);
+    CHECK(rc == TS_OK, "rk8pd at EA 1e10 N completes 0.02 s (%ld steps)",
+          st.steps);
+    /* 20 links' worth of axial frequency: pi sqrt(l m / EA) is the
+     * shortest axial period; rk8pd's stability limit is a fraction of it,
+     * so the mean step must be below it. */
+    const ts_link *l0 = &s->links[0];
+    double per = M_PI * sqrt(l0->length * l0->mass / l0->ea);
+    double mean = oe.t_end / (double)st.steps;
+    CHECK(mean < per, "rk8pd's mean step %.2e s is set by stiffness: below "
+          "the axial period %.2e s", mean, per);
+    ts_sim_opts oim = oe;
+    oim.integrator = TS_INT_MSBDF;
+    ts_history *hm = run(s, ex, &oim, &rc, &st, &err);
+    CHECK(rc == TS_OK, "msbdf at EA 1e10 N completes (%s)", err.msg);
+    double dd = hist_diff(he, hm);
+    CHECK(dd < 1e-6, "rk8pd and msbdf agree at EA 1e10 N: %.2e m (both "
+          "at 1e-9 relative of 30 m positions)", dd);
+    ts_history_free(hm);
+    ts_history_free(he);
+
+    oe.max_steps = 200;
+    ts_err e2 = {0};
+    he = run(s, ex, &oe, &rc, &st, &e2);
+    CHECK(rc == TS_EINTEGRATOR, "rk8pd with a 200-step limit fails: %s",
+          ts_strerror(rc));
+    CHECK(strstr(e2.msg, "stiff") && strstr(e2.msg, "needed steps of") &&
+              strstr(e2.msg, "axial period") && strstr(e2.msg, "msbdf"),
+          "the message names stiffness, the step needed, the axial period "
+          "and msbdf: \"%s\"", e2.msg);
+    /* The step it quotes: "needed steps of X s". */
+    const char *p = strstr(e2.msg, "needed steps of ");
+    double hq = p ? strtod(p + strlen("needed steps of "), NULL) : NAN;
+    CHECK(hq > 0 && hq < per, "the quoted step %.2e s is below the axial "
+          "period %.2e s", hq, per);
+    ts_history_free(he);
+
+    ts_history_free(hr);
+    ts_excitation_free(ex);
+    ts_scene_free(sc);
+}
+
+/* ---- 3: slack --------------------------------------------------------- */
+
+static void test_slack(const ts_units *u)
+{
+    ts_scene *sc = load(u, "examples/kamman_ex1_elastic.yaml");
+    if (!sc)
+        return;
+    ts_system *s = sc->system;
+    s->cables[0].nlinks = 10;
+    s->tow.point[2] = 1.0 * FT;
+    set_ea(s, 1e6, 400.0);
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_signal sig = {0};
+    sig.type = TS_SIGNAL_STEP;
+    sig.axis = TS_AXIS_HEAVE;
+    sig.amplitude = 2.0;   /* 2 m down, toward the sphere (12 m deeper) */
+    sig.start = 0.1;
+    sig.rise = 0.4;        /* peak 9.4 m/s: faster than the sphere sinks */
+    ts_excitation_add(ex, &sig, &err);
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    o.t_end = 3.0;
+    o.dt_sample = 0.01;
+    o.integrator = TS_INT_RK8PD;
+    o.abs_tol = 1e-7;
+    int rc;
+    ts_sim_stats st;
+    ts_history *h = run(s, ex, &o, &rc, &st, &err);
+    CHECK(rc == TS_OK, "slack run completes (%s; %ld steps)", err.msg,
+          st.steps);
+    CHECK(hist_finite(h), "positions and tensions finite at all %d samples",
+          h->nsamples);
+    int slack = 0;
+    double tmin = INFINITY;
+    for (int i = 0; i < h->nsamples * h->nlinks; i++) {
+        slack += h->tensions[i] == 0.0;
+        tmin = fmin(tmin, h->tensions[i]);
+    }
+    CHECK(slack > 0, "links went slack: %d link-samples at exactly zero "
+          "tension", slack);
+    CHECK(tmin >= 0.0, "no compressive tension (smallest %g N)", tmin);
+    ts_history_free(h);
+    ts_excitation_free(ex);
+    ts_scene_free(sc);
+}
+
+/* ---- 4: the two-part tow ---------------------------------------------- */
+
+/* One crank run of radius r (rod 3.5 r, period 1.6 s) on the coarse
+ * two-part tow: heave ratio (fundamental of towfish z over that of the
+ * tow point, least squares over the second half of the run) and the
+ * peak-to-peak ratio; *H the linear frequency response at the crank
+ * frequency. Returns the run's code. */
+static int two_part_ratio(ts_system *s, double r, double t_end,
+                          double *ratio, double *pp, double *H)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_signal sig = {0};
+    sig.type = TS_SIGNAL_CRANK;
+    sig.axis = TS_AXIS_HEAVE;
+    sig.amplitude = r;
+    sig.rod = 3.5 * r;
+    sig.frequency = 1.0 / 1.6;
+    ts_excitation_add(ex, &sig, &err);
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    o.t_end = t_end;
+    o.dt_sample = 0.05;
+    int rc;
+    ts_sim_stats st;
+    ts_history *h = run(s, ex, &o, &rc, &st, &err);
+    CHECK(rc == TS_OK, "two-part crank r = %g m: run completes (%s; %ld "
+          "steps)", r, err.msg, st.steps);
+    CHECK(hist_finite(h), "two-part crank r = %g m: history finite", r);
+    ts_output out;
+    ts_response_output_find(s, "towfish.z", &out, &err);
+    int n0 = (int)(0.5 * t_end / o.dt_sample + 0.5), n = h->nsamples - n0;
+    double *t = malloc((size_t)n * sizeof(double));
+    double *zf = malloc((size_t)n * sizeof(double));
+    double *zt = malloc((size_t)n * sizeof(double));
+    double pmin = INFINITY, pmax = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        t[i] = h->t[n0 + i];
+        zf[i] = h->positions[3 * h->nnodes * (n0 + i) + 3 * out.node + 2];
+        zt[i] = h->positions[3 * h->nnodes * (n0 + i) + 2];
+        pmin = fmin(pmin, zf[i]);
+        pmax = fmax(pmax, zf[i]);
+    }
+    double cf, af, phf, ct, at, pht;
+    ts_compare_fit_sinusoid(t, zf, n, sig.frequency, &cf, &af, &phf, &err);
+    ts_compare_fit_sinusoid(t, zt, n, sig.frequency, &ct, &at, &pht, &err);
+    /* The rod term of the crank has even harmonics only: the tow
+     * point's fundamental is the crank radius, up to the fit's leakage of
+     * the even harmonics (the window is 5 periods plus one sample, and the
+     * second harmonic is (r/l)^2/4 = 2 % of r: ~1e-3 of r). */
+    CHECK(fabs(at - r) < 2e-3 * r, "tow-point fundamental %.9g m = crank "
+          "radius %g m", at, r);
+    *ratio = af / at;
+    *pp = (pmax - pmin) / (2 * r); /* the crank's peak-to-peak is 2 r */
+
+    ts_kernel *k = ts_kernel_alloc(s, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(s, &err);
+    ts_equilibrium_opts eo;
+    ts_equilibrium_opts_default(&eo);
+    ts_equilibrium_solve(k, &eo, eq, &err);
+    ts_linear *lin = ts_linear_alloc(k, &err);
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    int lrc = ts_linearize_equilibrium(k, eq, &lo, lin, &err);
+    CHECK(lrc == TS_OK, "two-part linearization (%s)", err.msg);
+    double re, im;
+    ts_response_at(s, lin, 2, &out, 2 * M_PI * sig.frequency, &re, &im,
+                   &err);
+    *H = hypot(re, im);
+    printf("  two-part (coarse), crank r = %g m: heave ratio %.4f "
+           "(fundamental), %.4f (peak-to-peak), linear response %.4f\n", r,
+           *ratio, *pp, *H);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    free(t);
+    free(zf);
+    free(zt);
+    ts_history_free(h);
+    ts_excitation_free(ex);
+    return rc;
+}
+
+static void test_two_part(const ts_units *u)
+{
+    ts_scene *sc = load(u, "examples/two_part_tow.yaml");
+    if (!sc)
+        return;
+    ts_system *s = sc->system;
+    s->cables[0].nlinks = 10;
+    s->cables[1].nlinks = 2;
+    s->cables[2].nlinks = 6;
+    ts_err err = {0};
+    CHECK(ts_system_build(s, &err) == TS_OK, "coarse two-part tow builds");
+    double rs, pps, Hs, rl, ppl, Hl;
+    two_part_ratio(s, 0.005, 16.0, &rs, &pps, &Hs);
+    two_part_ratio(s, 0.1, 16.0, &rl, &ppl, &Hl);
+    /* Small crank (5 mm): the heave velocity (0.02 m/s) is 1 % of the tow
+     * speed, so the drag is linear in it to 1 %; the tow point at the
+     * waterline (a kink, MODEL.md section 6) shifts the mean, not the
+     * fundamental; 5 % allows for these and for a transient of the slowest
+     * heave mode not quite decayed at 8 s. */
+    CHECK(fabs(rs - Hs) < 0.05 * Hs, "5 mm crank: heave ratio %.4f within "
+          "5 %% of the linear response %.4f", rs, Hs);
+    /* Lalu's crank (0.1 m): heave velocity 0.39 m/s, 22 % of the tow
+     * speed: the quadratic drag damps the towfish's heave more than its
+     * linearization; the ratio must be below the linear one, and the gap
+     * larger than at 5 mm. */
+    CHECK(rl < Hl && fabs(rl - Hl) > fabs(rs - Hs),
+          "0.1 m crank: heave ratio %.4f below the linear response %.4f, "
+          "further than at 5 mm (nonlinear drag)", rl, Hl);
+    CHECK(rl > 0.3 * Hl, "0.1 m crank: heave ratio %.4f within a factor "
+          "0.3 of the linear response %.4f", rl, Hl);
+    ts_scene_free(sc);
+}
+
+int main(void)
+{
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    if (!u) {
+        printf("FAIL units: %s\n", err.msg);
+        return 1;
+    }
+    test_rigid_limit(u);
+    test_slack(u);
+    test_two_part(u);
+    ts_units_free(u);
+    return tc_done();
+}
