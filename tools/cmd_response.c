@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "cli.h"
+#include "towstab/report_converge.h"
+#include "towstab/health.h"
 #include "cli_plot.h"
 #include "towstab/eigen.h"
 #include "towstab/linearize.h"
@@ -133,7 +135,35 @@ static int response_analysis(const ts_system *sys,
             ts_eigen_free(e);
             ts_err_clear(err);
         }
+        /* Is it trustworthy? The equilibrium linearized about, and the
+         * waterline kink for a heave input (towstab/health.h). */
+        ts_trust trust, te;
+        ts_trust_init(&trust);
+        ts_trust_init(&te);
+        ts_health_equilibrium(sys, eq, &te);
+        ts_trust_merge(&trust, "equilibrium: ", &te);
+        if (lin->kink_tow && input == 2)
+            ts_trust_note(&trust, "the tow point is at the water surface: "
+                                  "a real heave also shifts the mean depth "
+                                  "at first order, which a frequency "
+                                  "response cannot show");
+        if (lin->kinks && !(lin->kink_tow && lin->kinks == 1))
+            ts_trust_note(&trust, "%d node%s within a linearization step of "
+                                  "the water surface: f is not smooth there",
+                          lin->kinks, lin->kinks == 1 ? "" : "s");
+        printf("trustworthy: %s\n", trust.trustworthy ? "yes" : "NO");
+        for (int i = 0; i < trust.nreasons; i++)
+            printf("  reason: %s\n", trust.reasons[i]);
+        for (int i = 0; i < trust.nnotes; i++)
+            printf("  note: %s\n", trust.notes[i]);
         json_t *j = ts_report_response_json(*res);
+        if (j) {
+            json_t *tj = ts_report_trust_json(&trust);
+            if (tj) {
+                json_object_update(j, tj);
+                json_decref(tj);
+            }
+        }
         if (j && eqjson)
             json_object_set(j, "equilibrium", eqjson);
         *json = j;

@@ -84,9 +84,10 @@ rm -f "$T/r.json" "$T/r.csv"
 ts response examples/kamman_ex1_above.yaml --output sphere.z --points 20 \
     --json "$T/r.json" --csv "$T/r.csv" --quiet
 if [ "$status" -eq 0 ] && "$CHECK_JSON" parse "$T/r.json" >/dev/null &&
-   has_keys "$T/r.json" input output points freq_hz magnitude phase_deg &&
+   has_keys "$T/r.json" input output points freq_hz magnitude phase_deg \
+            trustworthy reasons notes &&
    [ "$(wc -l < "$T/r.csv")" -eq 21 ]; then
-    pass "response: JSON and CSV with 20 points"
+    pass "response: JSON (with its trust verdict) and CSV with 20 points"
 else
     fail "response: status $status; $(head -c 300 "$T/err")"
 fi
