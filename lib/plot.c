@@ -8,7 +8,7 @@
  *  2. For each requested format, make a private PLplot stream (plmkstrm),
  *     point it at an in-memory FILE (open_memstream + plsfile, so PLplot
  *     never opens a file by name: its plOpenFile would prompt on stdin and
- *     finally exit() if a name could not be opened), select pngcairo or
+ *     finally end the process if a name could not be opened), select pngcairo or
  *     svgcairo, set the page size in px (PNG) or pt (SVG), the palette and
  *     a white background, draw, and end the stream with plend1, which
  *     closes the FILE (cairo's tidy calls plCloseFile). The previously

@@ -18,7 +18,7 @@ if [ ! -x "$TOWSTAB" ]; then
 fi
 OUT=$ROOT/doc/img
 MAX_BYTES=153600
-T=$(mktemp -d "${TMPDIR:-/tmp}/towstab-docplots-XXXXXX")
+T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 mkdir -p "$OUT"
 cd "$ROOT"

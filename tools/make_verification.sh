@@ -23,8 +23,8 @@ for exe in "$suite" "$tool"; do
     fi
 done
 
-out=$(mktemp "${TMPDIR:-/tmp}/verification-XXXXXX")
-page=$(mktemp doc/.verification.md.XXXXXX)
+out=$(mktemp)
+page=$(mktemp -p doc)
 trap 'rm -f "$out" "$out.study" "$page"' EXIT
 
 status=0

@@ -26,7 +26,7 @@ JOBS=${3:-2}
 SCENE=examples/two_part_tow.yaml
 [ -x "$TOWSTAB" ] || { echo "two_part_table.sh: no towstab at $TOWSTAB" >&2; exit 2; }
 [ -r "$SCENE" ] || { echo "two_part_table.sh: run from the project root ($SCENE)" >&2; exit 2; }
-DIR=$(mktemp -d "${TMPDIR:-/tmp}/two_part.XXXXXX")
+DIR=$(mktemp -d)
 echo "two_part_table.sh: work in $DIR" >&2
 
 for d in $DIAMS; do
