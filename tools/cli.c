@@ -214,6 +214,18 @@ const char *cli_option(const ts_scene_analysis *a, const char *key)
     return o ? o->value : NULL;
 }
 
+int cli_option_error(const char *cmd, int ch, const char *arg)
+{
+    if (ch == ':')
+        fprintf(stderr, "towstab: error: %s: missing value for '%s'\n", cmd,
+                arg);
+    else
+        fprintf(stderr, "towstab: error: %s: unknown option '%s' (towstab %s "
+                        "--help)\n",
+                cmd, arg, cmd);
+    return EXIT_BADINPUT;
+}
+
 int cli_parse_int(const char *opt, const char *text, long lo, long hi,
                   long *value)
 {

@@ -90,6 +90,11 @@ int cli_equilibrium(const ts_system *sys, const ts_equilibrium_opts *eo,
                     int quiet, ts_equilibrium **out, json_t **json,
                     ts_err *err);
 
+/* Report a getopt failure of command `cmd` (ch ':' for a missing value,
+ * anything else an unknown option; `arg` the offending argument) and
+ * return EXIT_BADINPUT. */
+int cli_option_error(const char *cmd, int ch, const char *arg);
+
 /* Parse a whole number option value in [lo, hi]. */
 int cli_parse_int(const char *opt, const char *text, long lo, long hi,
                   long *value);

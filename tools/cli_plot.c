@@ -13,7 +13,7 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
     ts_plot_opts_default(&p->opts);
     if (!p->dir) {
         if (p->units) {
-            fprintf(stderr, "towstab %s: --units sets the units of the "
+            fprintf(stderr, "towstab: error: %s: --units sets the units of the "
                             "--plot pictures; add --plot DIR\n",
                     cmd);
             return EXIT_BADINPUT;
@@ -22,7 +22,7 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
     }
     ts_err err = {0};
     if (ts_plot_check(&err) != TS_OK) {
-        fprintf(stderr, "towstab %s: --plot: %s\n", cmd, err.msg);
+        fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
         return EXIT_BADINPUT;
     }
     if (p->units) {
@@ -31,7 +31,7 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
         else if (strcmp(p->units, "imperial") == 0)
             p->opts.units = TS_PLOT_IMPERIAL;
         else {
-            fprintf(stderr, "towstab %s: --units: expected si or imperial, "
+            fprintf(stderr, "towstab: error: %s: --units: expected si or imperial, "
                             "got '%s'\n",
                     cmd, p->units);
             return EXIT_BADINPUT;
@@ -39,7 +39,7 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
     }
     int rc = ts_plot_prepare_dir(p->dir, &err);
     if (rc != TS_OK) {
-        fprintf(stderr, "towstab %s: --plot: %s\n", cmd, err.msg);
+        fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
         return rc == TS_EINVAL ? EXIT_BADINPUT : EXIT_FAILED;
     }
     return 0;

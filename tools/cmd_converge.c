@@ -722,7 +722,7 @@ static int conv_main(int argc, char **argv)
             given_sim = 1;
             if (k == SIM_A_EXCITE) {
                 if (sa.nspecs[0] == CLI_SIM_MAX_SPECS) {
-                    fprintf(stderr, "towstab converge: --excite: at most "
+                    fprintf(stderr, "towstab: error: converge: --excite: at most "
                                     "%d\n", CLI_SIM_MAX_SPECS);
                     return EXIT_BADINPUT;
                 }
@@ -751,18 +751,12 @@ static int conv_main(int argc, char **argv)
         case O_INTEGRATORS: integrators = optarg; break;
         case 'h': usage(stdout); return 0;
         case ':':
-            fprintf(stderr, "towstab converge: missing value for '%s'\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
         default:
-            fprintf(stderr, "towstab converge: unknown option '%s' "
-                            "(towstab converge --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+            return cli_option_error("converge", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
-        fprintf(stderr, "towstab converge: expected one scene file\n");
+        fprintf(stderr, "towstab: error: converge: expected one scene file\n");
         usage(stderr);
         return EXIT_BADINPUT;
     }

@@ -34,7 +34,7 @@ static int split_list(const char *opt, const char *text,
 {
     char buf[MAX_OVERLAYS * ITEM_MAX];
     if (strlen(text) >= sizeof buf) {
-        fprintf(stderr, "towstab equilibrium: %s: list too long\n", opt);
+        fprintf(stderr, "towstab: error: equilibrium: %s: list too long\n", opt);
         return -1;
     }
     strcpy(buf, text);
@@ -50,7 +50,7 @@ static int split_list(const char *opt, const char *text,
         while (len > 0 && tok[len - 1] == ' ')
             tok[--len] = '\0';
         if (len == 0 || len >= ITEM_MAX || n == max) {
-            fprintf(stderr, "towstab equilibrium: %s: expected 1 to %d "
+            fprintf(stderr, "towstab: error: equilibrium: %s: expected 1 to %d "
                             "comma-separated values like '2,4,6 knot', got "
                             "'%s'\n",
                     opt, max, text);
@@ -59,7 +59,7 @@ static int split_list(const char *opt, const char *text,
         strcpy(items[n++], tok);
     }
     if (n == 0) {
-        fprintf(stderr, "towstab equilibrium: %s: expected values like "
+        fprintf(stderr, "towstab: error: equilibrium: %s: expected values like "
                         "'2,4,6 knot', got '%s'\n",
                 opt, text);
         return -1;
@@ -152,7 +152,7 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
         if (!c->eq || !c->eq->converged)
             continue;
         if (cli_plot_shape(c->sys, c->eq->positions, &shapes[n]) != 0) {
-            fprintf(stderr, "towstab equilibrium: --plot: out of memory\n");
+            fprintf(stderr, "towstab: error: equilibrium: --plot: out of memory\n");
             status = EXIT_FAILED;
             break;
         }
@@ -175,7 +175,7 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
         n++;
     }
     if (n == 0 && status == 0) {
-        fprintf(stderr, "towstab equilibrium: --plot: no converged "
+        fprintf(stderr, "towstab: error: equilibrium: --plot: no converged "
                         "equilibrium to draw\n");
         status = EXIT_FAILED;
     }
@@ -273,7 +273,7 @@ static int eq_main(int argc, char **argv)
         case 'W': overlay_turns = optarg; break;
         case 'O':
             if (noverlay_scenes == MAX_OVERLAYS) {
-                fprintf(stderr, "towstab equilibrium: --overlay: at most %d "
+                fprintf(stderr, "towstab: error: equilibrium: --overlay: at most %d "
                                 "scenes\n",
                         MAX_OVERLAYS);
                 return EXIT_BADINPUT;
@@ -287,18 +287,12 @@ static int eq_main(int argc, char **argv)
             s.links = (int)v;
             break;
         case ':':
-            fprintf(stderr, "towstab equilibrium: missing value for '%s'\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
         default:
-            fprintf(stderr, "towstab equilibrium: unknown option '%s' "
-                            "(towstab equilibrium --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+            return cli_option_error("equilibrium", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
-        fprintf(stderr, "towstab equilibrium: expected one scene file\n");
+        fprintf(stderr, "towstab: error: equilibrium: expected one scene file\n");
         usage(stderr);
         return EXIT_BADINPUT;
     }
@@ -306,7 +300,7 @@ static int eq_main(int argc, char **argv)
     char turn_items[MAX_OVERLAYS][ITEM_MAX];
     int nspeeds = 0, nturns = 0;
     if ((overlay_speeds || overlay_turns || noverlay_scenes) && !plot.dir) {
-        fprintf(stderr, "towstab equilibrium: --overlay-speeds, "
+        fprintf(stderr, "towstab: error: equilibrium: --overlay-speeds, "
                         "--overlay-turn-rates and --overlay add curves to the "
                         "--plot pictures; add --plot DIR\n");
         return EXIT_BADINPUT;
@@ -320,7 +314,7 @@ static int eq_main(int argc, char **argv)
                                               MAX_OVERLAYS)) < 0)
         return EXIT_BADINPUT;
     if (nspeeds + nturns + noverlay_scenes > MAX_OVERLAYS) {
-        fprintf(stderr, "towstab equilibrium: at most %d overlay curves in "
+        fprintf(stderr, "towstab: error: equilibrium: at most %d overlay curves in "
                         "all, got %d\n",
                 MAX_OVERLAYS, nspeeds + nturns + noverlay_scenes);
         return EXIT_BADINPUT;

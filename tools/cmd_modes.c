@@ -475,18 +475,12 @@ static int modes_main(int argc, char **argv)
             s.links = (int)v;
             break;
         case ':':
-            fprintf(stderr, "towstab modes: missing value for '%s'\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
         default:
-            fprintf(stderr, "towstab modes: unknown option '%s' (towstab "
-                            "modes --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+            return cli_option_error("modes", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
-        fprintf(stderr, "towstab modes: expected one scene file\n");
+        fprintf(stderr, "towstab: error: modes: expected one scene file\n");
         usage(stderr);
         return EXIT_BADINPUT;
     }

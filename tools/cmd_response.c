@@ -241,18 +241,12 @@ static int response_main(int argc, char **argv)
             s.links = (int)v;
             break;
         case ':':
-            fprintf(stderr, "towstab response: missing value for '%s'\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
         default:
-            fprintf(stderr, "towstab response: unknown option '%s' (towstab "
-                            "response --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+            return cli_option_error("response", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
-        fprintf(stderr, "towstab response: expected one scene file\n");
+        fprintf(stderr, "towstab: error: response: expected one scene file\n");
         usage(stderr);
         return EXIT_BADINPUT;
     }

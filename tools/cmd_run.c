@@ -35,9 +35,7 @@ static int run_main(int argc, char **argv)
                    "  runs the scene's 'analyses' list in order\n");
             return 0;
         case ':':
-            fprintf(stderr, "towstab: error: run: missing value for '%s'\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+            return cli_option_error("run", ch, argv[optind - 1]);
         default:
             fprintf(stderr, "towstab: error: run: unknown option '%s'; only "
                             "--json and --quiet apply (the scene's analyses "

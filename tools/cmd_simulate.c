@@ -711,7 +711,7 @@ static int sim_main(int argc, char **argv)
             if (ch == SIM_A_EXCITE || ch == SIM_A_MANOEUVRE) {
                 int m = ch == SIM_A_MANOEUVRE;
                 if (a.nspecs[m] == CLI_SIM_MAX_SPECS) {
-                    fprintf(stderr, "towstab simulate: %s: at most %d\n",
+                    fprintf(stderr, "towstab: error: simulate: %s: at most %d\n",
                             cli_sim_arg_opts[ch], CLI_SIM_MAX_SPECS);
                     return EXIT_BADINPUT;
                 }
@@ -739,23 +739,17 @@ static int sim_main(int argc, char **argv)
             cs.links = (int)v;
             break;
         case ':':
-            fprintf(stderr, "towstab simulate: missing value for '%s'\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
         default:
-            fprintf(stderr, "towstab simulate: unknown option '%s' (towstab "
-                            "simulate --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+            return cli_option_error("simulate", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
-        fprintf(stderr, "towstab simulate: expected one scene file\n");
+        fprintf(stderr, "towstab: error: simulate: expected one scene file\n");
         usage(stderr);
         return EXIT_BADINPUT;
     }
     if (snap_text && !plot.dir) {
-        fprintf(stderr, "towstab simulate: --snapshot-interval sets the "
+        fprintf(stderr, "towstab: error: simulate: --snapshot-interval sets the "
                         "snapshots of the --plot pictures; add --plot DIR\n");
         return EXIT_BADINPUT;
     }
