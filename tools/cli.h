@@ -28,17 +28,16 @@ typedef struct cli_command {
     const char *summary;
     /* `towstab NAME ...`: argv[0] is NAME. Returns the exit status. */
     int (*main)(int argc, char **argv);
-    /* One `analyses:` entry of type NAME; appends its JSON result (with a
-     * "type" key) to `results`. NULL when the command is not an analysis. */
-    int (*run)(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
-               json_t *results);
+    /* One `analyses:` entry of type NAME. With result == NULL it only
+     * checks the entry's option values (units, ranges, names), so that
+     * `run` refuses a bad entry before the first runs; otherwise it runs
+     * the entry and sets *result to its JSON (NULL when there is none).
+     * Prints its messages; returns the exit status. NULL when the command
+     * is not an analysis. */
+    int (*entry)(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
+                 json_t **result);
     /* Option keys the scene entry accepts (NULL-terminated). */
     const char *const *keys;
-    /* Check an entry's option values (units, ranges, names) without
-     * running it, so `run` refuses a bad entry before the first runs.
-     * Prints its message and returns the exit status (0: fine). NULL when
-     * the keys are all there is to check. */
-    int (*check)(const cli_ctx *ctx, const ts_scene_analysis *a, int index);
 } cli_command;
 
 double cli_wall_now(void);

@@ -845,10 +845,10 @@ static const char *const conv_keys[] = {
     "analysis", "links", "tolerances", "steps", "target", "modes", "speed",
     "turn_rate", "tolerance", "equilibrium_method", "integrators", NULL};
 
-/* One scene entry: parse and check its options, then (unless check_only)
- * run it and append its JSON to results. Returns the exit status. */
+/* One scene entry (cli_command.entry): parse and check its options, and
+ * with a result slot run it. Returns the exit status. */
 static int conv_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
-                      int index, json_t *results, int check_only)
+                      int index, json_t **result)
 {
     ts_err err = {0};
     cli_settings s = {0};
@@ -944,39 +944,22 @@ static int conv_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
         cli_sim_prep_free(&sp);
         return cli_report(&err, err.code);
     }
-    if (check_only) {
+    if (!result) {
         ts_system_free(sys);
         cli_sim_prep_free(&sp);
         return 0;
     }
-    json_t *j = NULL;
     ts_convergence *c = NULL;
-    int rc = converge_analysis(sys, &eqo, &rq, &sp, ctx->quiet, &j, &c,
+    int rc = converge_analysis(sys, &eqo, &rq, &sp, ctx->quiet, result, &c,
                                &err);
     int status = rc ? cli_report(&err, rc) : 0;
-    if (j) {
-        json_object_set_new(j, "type", json_string("converge"));
-        json_array_append_new(results, j);
-    }
     ts_convergence_free(c);
     ts_system_free(sys);
     cli_sim_prep_free(&sp);
     return status;
 }
 
-static int conv_run(const cli_ctx *ctx, const ts_scene_analysis *a,
-                    int index, json_t *results)
-{
-    return conv_entry(ctx, a, index, results, 0);
-}
-
-static int conv_check(const cli_ctx *ctx, const ts_scene_analysis *a,
-                      int index)
-{
-    return conv_entry(ctx, a, index, NULL, 1);
-}
-
 const cli_command cli_cmd_converge = {
     "converge",
     "accuracy and cost against resolution (links, tolerance, step)",
-    conv_main, conv_run, conv_keys, conv_check};
+    conv_main, conv_entry, conv_keys};

@@ -407,8 +407,8 @@ static int eq_main(int argc, char **argv)
 static const char *const eq_keys[] = {"speed", "turn_rate", "method",
                                       "tolerance", "links", NULL};
 
-static int eq_run(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
-                  json_t *results)
+static int eq_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
+                    int index, json_t **result)
 {
     ts_err err = {0};
     cli_settings s = {0};
@@ -418,34 +418,17 @@ static int eq_run(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
     ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eo, &err);
     if (!sys)
         return cli_report(&err, err.code);
-    ts_equilibrium *eq = NULL;
-    json_t *j = NULL;
-    int rc = cli_equilibrium(sys, &eo, ctx->quiet, &eq, &j, &err);
-    int status = rc ? cli_report(&err, rc) : 0;
-    if (j) {
-        json_object_set_new(j, "type", json_string("equilibrium"));
-        json_array_append_new(results, j);
+    int status = 0;
+    if (result) {
+        ts_equilibrium *eq = NULL;
+        int rc = cli_equilibrium(sys, &eo, ctx->quiet, &eq, result, &err);
+        status = rc ? cli_report(&err, rc) : 0;
+        ts_equilibrium_free(eq);
     }
-    ts_equilibrium_free(eq);
     ts_system_free(sys);
     return status;
 }
 
-/* An entry's settings parse and its system builds. */
-static int eq_check(const cli_ctx *ctx, const ts_scene_analysis *a, int index)
-{
-    ts_err err = {0};
-    cli_settings s = {0};
-    if (cli_settings_from_analysis(&s, a, index, &err))
-        return cli_report(&err, err.code);
-    ts_equilibrium_opts eo;
-    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eo, &err);
-    if (!sys)
-        return cli_report(&err, err.code);
-    ts_system_free(sys);
-    return 0;
-}
-
 const cli_command cli_cmd_equilibrium = {
     "equilibrium", "steady shape at the scene's speed and turn rate",
-    eq_main, eq_run, eq_keys, eq_check};
+    eq_main, eq_entry, eq_keys};

@@ -563,10 +563,10 @@ static const char *const modes_keys[] = {
     "speed", "turn_rate", "tolerance", "links", "equilibrium_method",
     "method", "count", "near", NULL};
 
-/* One scene entry: parse and check its options, then (unless check_only)
- * run it and append its JSON to results. Returns the exit status. */
+/* One scene entry (cli_command.entry): parse and check its options, and
+ * with a result slot run it. Returns the exit status. */
 static int modes_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
-                       int index, json_t *results, int check_only)
+                       int index, json_t **result)
 {
     ts_err err = {0};
     cli_settings s = {0};
@@ -620,38 +620,21 @@ static int modes_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eqo, &err);
     if (!sys)
         return cli_report(&err, err.code);
-    if (check_only) {
+    if (!result) {
         ts_system_free(sys);
         return 0;
     }
-    json_t *j = NULL;
     ts_linear *lin = NULL;
     ts_eigen *e = NULL;
-    int rc = modes_analysis(sys, &eqo, &rq, ctx->quiet, 0, &j, &lin, &e, NULL,
-                            &err);
+    int rc = modes_analysis(sys, &eqo, &rq, ctx->quiet, 0, result, &lin, &e,
+                            NULL, &err);
     int status = rc ? cli_report(&err, rc) : 0;
-    if (j) {
-        json_object_set_new(j, "type", json_string("modes"));
-        json_array_append_new(results, j);
-    }
     ts_eigen_free(e);
     ts_linear_free(lin);
     ts_system_free(sys);
     return status;
 }
 
-static int modes_run(const cli_ctx *ctx, const ts_scene_analysis *a,
-                     int index, json_t *results)
-{
-    return modes_entry(ctx, a, index, results, 0);
-}
-
-static int modes_check(const cli_ctx *ctx, const ts_scene_analysis *a,
-                       int index)
-{
-    return modes_entry(ctx, a, index, NULL, 1);
-}
-
 const cli_command cli_cmd_modes = {
     "modes", "stability verdict and mode table of the linearized system",
-    modes_main, modes_run, modes_keys, modes_check};
+    modes_main, modes_entry, modes_keys};

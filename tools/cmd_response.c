@@ -352,10 +352,10 @@ static const char *const response_keys[] = {
     "input", "output", "from", "to", "points", NULL};
 
 /* One scene entry: parse and check its options (units, ranges, input and
- * output names), then (unless check_only) run it. Returns the exit
+ * output names), and with a result slot run it. Returns the exit
  * status. */
 static int response_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
-                          int index, json_t *results, int check_only)
+                          int index, json_t **result)
 {
     ts_err err = {0};
     cli_settings s = {0};
@@ -408,7 +408,7 @@ static int response_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
         ts_system_free(sys);
         return cli_report(&err, err.code);
     }
-    if (check_only) {
+    if (!result) {
         int channel;
         ts_output out;
         double f[2];
@@ -422,32 +422,15 @@ static int response_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
             ts_err_prefix(&err, "analyses[%d] (line %d): ", index, a->line);
         return rc == TS_OK ? 0 : cli_report(&err, rc);
     }
-    json_t *j = NULL;
     ts_response *res = NULL;
-    int rc = response_analysis(sys, &eqo, &rq, ctx->quiet, &j, &res, NULL,
+    int rc = response_analysis(sys, &eqo, &rq, ctx->quiet, result, &res, NULL,
                                NULL, &err);
     int status = rc ? cli_report(&err, rc) : 0;
-    if (j) {
-        json_object_set_new(j, "type", json_string("response"));
-        json_array_append_new(results, j);
-    }
     ts_response_free(res);
     ts_system_free(sys);
     return status;
 }
 
-static int response_run(const cli_ctx *ctx, const ts_scene_analysis *a,
-                        int index, json_t *results)
-{
-    return response_entry(ctx, a, index, results, 0);
-}
-
-static int response_check(const cli_ctx *ctx, const ts_scene_analysis *a,
-                          int index)
-{
-    return response_entry(ctx, a, index, NULL, 1);
-}
-
 const cli_command cli_cmd_response = {
     "response", "frequency response to tow-point motion", response_main,
-    response_run, response_keys, response_check};
+    response_entry, response_keys};

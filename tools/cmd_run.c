@@ -9,7 +9,7 @@
 static const cli_command *find(const char *type)
 {
     for (int i = 0; cli_commands[i]; i++)
-        if (cli_commands[i]->run && strcmp(cli_commands[i]->name, type) == 0)
+        if (cli_commands[i]->entry && strcmp(cli_commands[i]->name, type) == 0)
             return cli_commands[i];
     return NULL;
 }
@@ -63,7 +63,7 @@ static int run_main(int argc, char **argv)
     }
     char types[256] = "";
     for (int i = 0; cli_commands[i]; i++)
-        if (cli_commands[i]->run) {
+        if (cli_commands[i]->entry) {
             if (types[0])
                 strncat(types, ", ", sizeof types - strlen(types) - 1);
             strncat(types, cli_commands[i]->name,
@@ -80,9 +80,9 @@ static int run_main(int argc, char **argv)
             status = cli_report(&err, TS_ESCENE);
         } else if (cli_check_keys(a, c->keys, i, &err)) {
             status = cli_report(&err, err.code);
-        } else if (c->check) {
+        } else {
             cli_ctx cctx = {scene, units, quiet};
-            status = c->check(&cctx, a, i);
+            status = c->entry(&cctx, a, i, NULL);
         }
     }
     json_t *all = json_object(), *list = json_array();
@@ -93,7 +93,12 @@ static int run_main(int argc, char **argv)
         const ts_scene_analysis *a = &scene->analyses[i];
         printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
                scene->nanalyses, a->type, scene->system->name);
-        status = find(a->type)->run(&ctx, a, i, list);
+        json_t *j = NULL;
+        status = find(a->type)->entry(&ctx, a, i, &j);
+        if (j) {
+            json_object_set_new(j, "type", json_string(a->type));
+            json_array_append_new(list, j);
+        }
     }
     /* Results only when every analysis succeeded: a file holding some of
      * them would look complete. */
@@ -107,4 +112,4 @@ static int run_main(int argc, char **argv)
 }
 
 const cli_command cli_cmd_run = {"run", "the analyses the scene lists, in order",
-                                 run_main, NULL, NULL, NULL};
+                                 run_main, NULL, NULL};

@@ -821,8 +821,11 @@ static int sim_main(int argc, char **argv)
     return status;
 }
 
-static int sim_run(const cli_ctx *ctx, const ts_scene_analysis *e, int index,
-                   json_t *results)
+/* One scene entry (cli_command.entry): without a result slot, check that
+ * the entry prepares (options, excitation, output, initial state); with
+ * one, run it. */
+static int sim_entry(const cli_ctx *ctx, const ts_scene_analysis *e,
+                     int index, json_t **result)
 {
     ts_err err = {0};
     cli_sim_args a;
@@ -835,29 +838,8 @@ static int sim_run(const cli_ctx *ctx, const ts_scene_analysis *e, int index,
     cli_settings cs = {0};
     if (cli_settings_from_analysis(&cs, e, index, &err))
         return cli_report(&err, err.code);
-    json_t *j = NULL;
-    int status = simulate(ctx, &a, &cs, 0, NULL, &j);
-    if (j) {
-        json_object_set_new(j, "type", json_string("simulate"));
-        json_array_append_new(results, j);
-    }
-    return status;
-}
-
-static int sim_check(const cli_ctx *ctx, const ts_scene_analysis *e,
-                     int index)
-{
-    ts_err err = {0};
-    cli_sim_args a;
-    memset(&a, 0, sizeof a);
-    cli_sim_args_from_entry(&a, e, index);
-    for (int i = 0; i < SIM_A_N; i++)
-        if (!a.where[i][0])
-            snprintf(a.where[i], sizeof a.where[i], "analyses[%d].%s",
-                     index, cli_sim_arg_keys[i]);
-    cli_settings cs = {0};
-    if (cli_settings_from_analysis(&cs, e, index, &err))
-        return cli_report(&err, err.code);
+    if (result)
+        return simulate(ctx, &a, &cs, 0, NULL, result);
     cli_sim_prep prep;
     int rc = cli_sim_prepare(ctx, &a, &cs, &prep, &err);
     cli_sim_prep_free(&prep);
@@ -866,4 +848,4 @@ static int sim_check(const cli_ctx *ctx, const ts_scene_analysis *e,
 
 const cli_command cli_cmd_simulate = {
     "simulate", "nonlinear and linear time-domain simulation, comparison",
-    sim_main, sim_run, sim_keys, sim_check};
+    sim_main, sim_entry, sim_keys};
