@@ -214,6 +214,23 @@ const char *cli_option(const ts_scene_analysis *a, const char *key)
     return o ? o->value : NULL;
 }
 
+int cli_settings_option(cli_settings *s, int ch, const char *arg)
+{
+    long v;
+    switch (ch) {
+    case 's': s->speed = arg; return 1;
+    case 'w': s->turn_rate = arg; return 1;
+    case 'm': s->method = arg; return 1;
+    case 't': s->tol = arg; return 1;
+    case 'n':
+        if (cli_parse_int("--links", arg, 1, 10000000, &v))
+            return -1;
+        s->links = (int)v;
+        return 1;
+    default: return 0;
+    }
+}
+
 int cli_option_error(const char *cmd, int ch, const char *arg)
 {
     if (ch == ':')

@@ -89,6 +89,20 @@ int cli_equilibrium(const ts_system *sys, const ts_equilibrium_opts *eo,
                     int quiet, ts_equilibrium **out, json_t **json,
                     ts_err *err);
 
+/* The getopt entries of the shared settings: --speed, --turn-rate,
+ * --links, the equilibrium method's option (named `method`) and --tol,
+ * with the codes cli_settings_option() takes. */
+#define CLI_SETTINGS_LONGOPTS(method)                                        \
+    {"speed", required_argument, NULL, 's'},                                 \
+        {"turn-rate", required_argument, NULL, 'w'},                         \
+        {"links", required_argument, NULL, 'n'},                             \
+        {method, required_argument, NULL, 'm'},                              \
+        {"tol", required_argument, NULL, 't'}
+
+/* Take a shared setting (getopt code ch, value arg) into s: 1 when ch was
+ * one, 0 when not, -1 (message printed) when its value is bad. */
+int cli_settings_option(cli_settings *s, int ch, const char *arg);
+
 /* Report a getopt failure of command `cmd` (ch ':' for a missing value,
  * anything else an unknown option; `arg` the offending argument) and
  * return EXIT_BADINPUT. */

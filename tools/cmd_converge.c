@@ -741,18 +741,18 @@ static int conv_main(int argc, char **argv)
         case 'k': modes = optarg; break;
         case 'j': json_path = optarg; break;
         case 'c': csv_path = optarg; break;
-        case 's': s.speed = optarg; break;
-        case 'w': s.turn_rate = optarg; break;
-        case 'm': s.method = optarg; break;
-        case 't': s.tol = optarg; break;
         case 'q': quiet = 1; break;
         case O_PLOT: plot.dir = optarg; break;
         case O_UNITS: plot.units = optarg; break;
         case O_INTEGRATORS: integrators = optarg; break;
         case 'h': usage(stdout); return 0;
-        case ':':
-        default:
-            return cli_option_error("converge", ch, argv[optind - 1]);
+        default: {
+            int r = cli_settings_option(&s, ch, optarg);
+            if (r < 0)
+                return EXIT_BADINPUT;
+            if (r == 0)
+                return cli_option_error("converge", ch, argv[optind - 1]);
+        }
         }
     }
     if (optind != argc - 1) {

@@ -241,11 +241,7 @@ static int eq_main(int argc, char **argv)
     static const struct option longopts[] = {
         {"json", required_argument, NULL, 'j'},
         {"csv", required_argument, NULL, 'c'},
-        {"speed", required_argument, NULL, 's'},
-        {"turn-rate", required_argument, NULL, 'w'},
-        {"links", required_argument, NULL, 'n'},
-        {"method", required_argument, NULL, 'm'},
-        {"tol", required_argument, NULL, 't'},
+        CLI_SETTINGS_LONGOPTS("method"),
         {"quiet", no_argument, NULL, 'q'},
         {"plot", required_argument, NULL, 'p'},
         {"units", required_argument, NULL, 'u'},
@@ -257,15 +253,10 @@ static int eq_main(int argc, char **argv)
     optind = 1;
     opterr = 0;
     int ch;
-    long v;
     while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
         switch (ch) {
         case 'j': json_path = optarg; break;
         case 'c': csv_path = optarg; break;
-        case 's': s.speed = optarg; break;
-        case 'w': s.turn_rate = optarg; break;
-        case 'm': s.method = optarg; break;
-        case 't': s.tol = optarg; break;
         case 'q': quiet = 1; break;
         case 'p': plot.dir = optarg; break;
         case 'u': plot.units = optarg; break;
@@ -281,14 +272,13 @@ static int eq_main(int argc, char **argv)
             overlay_scenes[noverlay_scenes++] = optarg;
             break;
         case 'h': usage(stdout); return 0;
-        case 'n':
-            if (cli_parse_int("--links", optarg, 1, 10000000, &v))
+        default: {
+            int r = cli_settings_option(&s, ch, optarg);
+            if (r < 0)
                 return EXIT_BADINPUT;
-            s.links = (int)v;
-            break;
-        case ':':
-        default:
-            return cli_option_error("equilibrium", ch, argv[optind - 1]);
+            if (r == 0)
+                return cli_option_error("equilibrium", ch, argv[optind - 1]);
+        }
         }
     }
     if (optind != argc - 1) {

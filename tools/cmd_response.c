@@ -200,11 +200,7 @@ static int response_main(int argc, char **argv)
         {"points", required_argument, NULL, 'p'},
         {"json", required_argument, NULL, 'j'},
         {"csv", required_argument, NULL, 'c'},
-        {"speed", required_argument, NULL, 's'},
-        {"turn-rate", required_argument, NULL, 'w'},
-        {"links", required_argument, NULL, 'n'},
-        {"eq-method", required_argument, NULL, 'm'},
-        {"tol", required_argument, NULL, 't'},
+        CLI_SETTINGS_LONGOPTS("eq-method"),
         {"quiet", no_argument, NULL, 'q'},
         {"plot", required_argument, NULL, 'P'},
         {"units", required_argument, NULL, 'U'},
@@ -227,22 +223,17 @@ static int response_main(int argc, char **argv)
             break;
         case 'j': json_path = optarg; break;
         case 'c': csv_path = optarg; break;
-        case 's': s.speed = optarg; break;
-        case 'w': s.turn_rate = optarg; break;
-        case 'm': s.method = optarg; break;
-        case 't': s.tol = optarg; break;
         case 'q': quiet = 1; break;
         case 'P': plot.dir = optarg; break;
         case 'U': plot.units = optarg; break;
         case 'h': usage(stdout); return 0;
-        case 'n':
-            if (cli_parse_int("--links", optarg, 1, 10000000, &v))
+        default: {
+            int r = cli_settings_option(&s, ch, optarg);
+            if (r < 0)
                 return EXIT_BADINPUT;
-            s.links = (int)v;
-            break;
-        case ':':
-        default:
-            return cli_option_error("response", ch, argv[optind - 1]);
+            if (r == 0)
+                return cli_option_error("response", ch, argv[optind - 1]);
+        }
         }
     }
     if (optind != argc - 1) {
