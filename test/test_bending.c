@@ -36,6 +36,7 @@
 
 #include "forces.h"
 #include "tcheck.h"
+#include "tmodel.h"
 
 /* ---- helpers ------------------------------------------------------------ */
 
@@ -347,28 +348,6 @@ static void test_kernel_gradient(void)
 
 /* ---- 3. energy in vacuum ------------------------------------------------ */
 
-static int rk4(ts_kernel *k, double *y, double h, int n, double *w)
-{
-    double *k1 = w, *k2 = w + n, *k3 = w + 2 * n, *k4 = w + 3 * n,
-           *yt = w + 4 * n;
-    int rc = ts_kernel_eval(k, y, NULL, k1);
-    for (int i = 0; i < n && !rc; i++)
-        yt[i] = y[i] + 0.5 * h * k1[i];
-    if (!rc)
-        rc = ts_kernel_eval(k, yt, NULL, k2);
-    for (int i = 0; i < n && !rc; i++)
-        yt[i] = y[i] + 0.5 * h * k2[i];
-    if (!rc)
-        rc = ts_kernel_eval(k, yt, NULL, k3);
-    for (int i = 0; i < n && !rc; i++)
-        yt[i] = y[i] + h * k3[i];
-    if (!rc)
-        rc = ts_kernel_eval(k, yt, NULL, k4);
-    for (int i = 0; i < n && !rc; i++)
-        y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
-    return rc;
-}
-
 static void test_energy(void)
 {
     ts_system *s = mixed_tree(9.80665);
@@ -419,7 +398,7 @@ static void test_energy(void)
         double worst = 0;
         int rc = TS_OK;
         for (int n = 0; n < steps && rc == TS_OK; n++) {
-            rc = rk4(k, y, h, ns, w);
+            rc = rk4_step(k, y, h, ns, w);
             recharts += ts_kernel_rechart(k, y, TS_CHART_RECHART);
             if (rc == TS_OK)
                 rc = ts_kernel_eval(k, y, NULL, w);

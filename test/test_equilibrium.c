@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tmodel.h"
 
 #define FT 0.3048
 #define INCH 0.0254
@@ -174,25 +175,6 @@ static double max_pos_diff(const ts_equilibrium *a, const ts_equilibrium *b,
                 m = d;
         }
     return m;
-}
-
-static double link_sub(double za, double zb)
-{
-    if (za >= 0 && zb >= 0)
-        return 1;
-    if (za <= 0 && zb <= 0)
-        return 0;
-    return fmax(za, zb) / fabs(za - zb);
-}
-
-static double sphere_sub(double z, double D)
-{
-    double R = D / 2, h = z + R;
-    if (h <= 0)
-        return 0;
-    if (h >= D)
-        return 1;
-    return h * h * (3 * R - h) / (4 * R * R * R);
 }
 
 /* ---- 1. no flow ------------------------------------------------------ */

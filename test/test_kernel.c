@@ -31,6 +31,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tmodel.h"
 
 /* ---- building systems ------------------------------------------------ */
 
@@ -215,27 +216,6 @@ static double maxabs(const double *a, int n)
         if (fabs(a[i]) > m)
             m = fabs(a[i]);
     return m;
-}
-
-/* Submerged fraction of a link from its end depths, and of a sphere
- * (spherical cap), as MODEL.md section 3 and doc/kernel.md define them. */
-static double link_sub(double za, double zb)
-{
-    if (za >= 0 && zb >= 0)
-        return 1;
-    if (za <= 0 && zb <= 0)
-        return 0;
-    return fmax(za, zb) / fabs(za - zb);
-}
-
-static double sphere_sub(double z, double D)
-{
-    double R = D / 2, h = z + R;
-    if (h <= 0)
-        return 0;
-    if (h >= D)
-        return 1;
-    return h * h * (3 * R - h) / (4 * R * R * R);
 }
 
 /* ---- 1. loads -------------------------------------------------------- */
@@ -696,27 +676,6 @@ static void test_newton_nodes(gsl_rng *rng)
 
 /* ---- 5. energy in vacuum, RK4 ---------------------------------------- */
 
-static int rk4(ts_kernel *k, double *y, double h, int n, double *k1,
-               double *k2, double *k3, double *k4, double *yt)
-{
-    int rc = ts_kernel_eval(k, y, NULL, k1);
-    for (int i = 0; i < n && !rc; i++)
-        yt[i] = y[i] + 0.5 * h * k1[i];
-    if (!rc)
-        rc = ts_kernel_eval(k, yt, NULL, k2);
-    for (int i = 0; i < n && !rc; i++)
-        yt[i] = y[i] + 0.5 * h * k2[i];
-    if (!rc)
-        rc = ts_kernel_eval(k, yt, NULL, k3);
-    for (int i = 0; i < n && !rc; i++)
-        yt[i] = y[i] + h * k3[i];
-    if (!rc)
-        rc = ts_kernel_eval(k, yt, NULL, k4);
-    for (int i = 0; i < n && !rc; i++)
-        y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
-    return rc;
-}
-
 static double energy(ts_kernel *k, const double *y, double *dydt)
 {
     if (ts_kernel_eval(k, y, NULL, dydt) != TS_OK)
@@ -733,9 +692,7 @@ static void test_energy(gsl_rng *rng)
     int nl = s->nlinks, ns = 4 * nl;
     double *y0 = calloc((size_t)ns, sizeof(double));
     double *y = calloc((size_t)ns, sizeof(double));
-    double *w[5];
-    for (int i = 0; i < 5; i++)
-        w[i] = calloc((size_t)ns, sizeof(double));
+    double *w = calloc(5 * (size_t)ns, sizeof(double));
     random_state(rng, nl, y0, 0.6, 1.2);
     const double T = 1.0;
     double drift[3], Escale = 0;
@@ -745,15 +702,15 @@ static void test_energy(gsl_rng *rng)
         double h = T / steps;
         ts_kernel *k = ts_kernel_alloc(s, NULL);
         memcpy(y, y0, (size_t)ns * sizeof(double));
-        double E0 = energy(k, y, w[0]);
+        double E0 = energy(k, y, w);
         Escale = ts_kernel_kinetic_energy(k) +
                  fabs(ts_kernel_potential_energy(k));
         double worst = 0;
         int rc = TS_OK;
         for (int n = 0; n < steps && rc == TS_OK; n++) {
-            rc = rk4(k, y, h, ns, w[0], w[1], w[2], w[3], w[4]);
+            rc = rk4_step(k, y, h, ns, w);
             recharts += ts_kernel_rechart(k, y, TS_CHART_RECHART);
-            worst = fmax(worst, fabs(energy(k, y, w[0]) - E0));
+            worst = fmax(worst, fabs(energy(k, y, w) - E0));
         }
         CHECK(rc == TS_OK, "energy: RK4 with h = %.4g s ran", h);
         drift[run] = worst / Escale;
@@ -774,8 +731,7 @@ static void test_energy(gsl_rng *rng)
           drift[2]);
     free(y0);
     free(y);
-    for (int i = 0; i < 5; i++)
-        free(w[i]);
+    free(w);
     ts_system_free(s);
 }
 
