@@ -132,7 +132,6 @@ typedef struct newton_ws {
     double anorm;
     double *scale;  /* [nq] size of each coordinate: 1 rad for angles,
                        1e-3 for an elastic link's strain */
-    double *ystart; /* [2 nq] spare state */
     double *dirs;   /* [3 nlinks] link directions of the last good state */
     double *strains;/* [nlinks] its strains */
     int *ipiv;
@@ -148,7 +147,6 @@ static void newton_ws_free(newton_ws *w)
     free(w->f2);
     free(w->work);
     free(w->iwork);
-    free(w->ystart);
     free(w->dirs);
     free(w->strains);
     free(w->scale);
@@ -180,12 +178,11 @@ static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
     w->f2 = malloc(2 * n * sizeof(double));
     w->work = malloc(4 * n * sizeof(double));
     w->iwork = malloc(n * sizeof(int));
-    w->ystart = calloc(2 * n, sizeof(double));
     w->dirs = malloc(3 * (size_t)sys->nlinks * sizeof(double));
     w->strains = malloc((size_t)sys->nlinks * sizeof(double));
     w->ipiv = malloc(n * sizeof(int));
     return w->J && w->R && w->dq && w->yt && w->f1 && w->f2 && w->work &&
-           w->iwork && w->ystart &&
+           w->iwork &&
            w->dirs && w->strains && w->scale && w->ipiv;
 }
 
