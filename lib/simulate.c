@@ -20,6 +20,16 @@
  * (central differences through the kernel, O(nlinks^2)); df/dt, used by
  * bsimp only, is a central difference of f in time.
  *
+ * The integrator esdirk is not GSL's: SUNDIALS ARKODE's L-stable ESDIRK
+ * 5(4) (lib/esdirk.h), with the same Jacobian, the kernel's refusals
+ * passed on as recoverable failures, re-initialised after a re-chart. Its
+ * steps stop at breakpoints but not at output times: cutting a step
+ * changes gamma h and costs a new LU of I - gamma h J (3-4 times the run
+ * time at 10 outputs per second on 100 links); an output inside a step is
+ * ARKODE's interpolant, and re-charting waits for the step's end, after
+ * the outputs before it, so that every output is in the charts it was
+ * computed in.
+ *
  * Linear, exact discretisation (Van Loan 1978, "Computing integrals
  * involving the matrix exponential", IEEE TAC 23(3)). On a step of length
  * h the input v(t) = u(t) - u0 is replaced by the cubic through its values
@@ -45,6 +55,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "esdirk.h"
 #include "expm.h"
 
 void dgemv_(const char *trans, const int *m, const int *n,
@@ -84,16 +95,16 @@ void ts_sim_opts_default(ts_sim_opts *o)
 }
 
 static const char *const integrator_names[] = {"rk8pd", "rkf45", "rk4imp",
-                                               "bsimp", "msbdf"};
+                                               "bsimp", "msbdf", "esdirk"};
 
 const char *ts_integrator_name(ts_integrator m)
 {
-    return m >= TS_INT_RK8PD && m <= TS_INT_MSBDF ? integrator_names[m] : "?";
+    return m >= TS_INT_RK8PD && m <= TS_INT_ESDIRK ? integrator_names[m] : "?";
 }
 
 int ts_integrator_parse(const char *name, ts_integrator *m)
 {
-    for (int i = 0; i <= TS_INT_MSBDF; i++)
+    for (int i = 0; i <= TS_INT_ESDIRK; i++)
         if (!strcmp(name, integrator_names[i])) {
             *m = (ts_integrator)i;
             return 0;
@@ -136,7 +147,7 @@ int ts_sim_opts_check(const ts_sim_opts *o, ts_err *err)
     if (!(o->rechart > TS_CHART_MIN) || !(o->rechart < 1))
         return ts_fail(err, TS_EINVAL, "simulate: the re-chart threshold "
                        "must be in (%g, 1), got %g", TS_CHART_MIN, o->rechart);
-    if (!(o->integrator >= TS_INT_RK8PD && o->integrator <= TS_INT_MSBDF))
+    if (!(o->integrator >= TS_INT_RK8PD && o->integrator <= TS_INT_ESDIRK))
         return ts_fail(err, TS_EINVAL, "simulate: unknown integrator %d",
                        (int)o->integrator);
     if (o->linear_method != TS_LINSIM_EXPM && o->linear_method != TS_LINSIM_ODE)
@@ -226,7 +237,11 @@ struct ts_sim {
     int nbreaks;
     double dfdt_step;
     gsl_odeiv2_system gsys;
-    gsl_odeiv2_driver *drv;
+    gsl_odeiv2_driver *drv; /* GSL integrators */
+    tsi_esdirk *sd;         /* esdirk (drv is NULL) */
+    int ahead;              /* esdirk has stepped to t_int > t */
+    double t_int;
+    double *y_int;          /* [n] esdirk's state at t_int */
     ts_linear *lin;       /* Jacobian (implicit methods) */
     ts_linearize_opts lopts;
     /* Statistics: evolve's counters are added in at each reset. */
@@ -241,6 +256,18 @@ struct ts_sim {
 };
 
 static int needs_jacobian(ts_integrator m);
+
+/* Accepted steps since the last restart of the GSL driver, or in all
+ * (esdirk keeps its own count across restarts). */
+static long steps_now(const ts_sim *s)
+{
+    if (s->sd) {
+        tsi_esdirk_stats st;
+        tsi_esdirk_get_stats(s->sd, &st);
+        return st.steps;
+    }
+    return s->steps0 + (long)s->drv->e->count;
+}
 
 /* 1 when state y has an elastic link of zero or negative length. */
 static int collapsed(const ts_sim *s, const double y[])
@@ -283,14 +310,14 @@ static void stiffness_note(const ts_sim *s, ts_err *err)
     double per = axial_period(s->sys, &l);
     if (!err || needs_jacobian(s->o.integrator) || l < 0)
         return;
-    long steps = s->steps0 + (long)s->drv->e->count - s->steps_start;
+    long steps = steps_now(s) - s->steps_start;
     double mean = steps > 0 ? (s->t - s->t_start) / (double)steps : NAN;
     size_t len = strlen(err->msg);
     snprintf(err->msg + len, sizeof err->msg - len, "; %s needed steps of "
              "%.2g s (last accepted %.2g s, mean %.2g s over %ld steps) "
              "against a shortest axial period of the elastic links of "
              "%.2g s (link %d of cable '%s'): the system is stiff, use "
-             "--integrator msbdf", ts_integrator_name(s->o.integrator),
+             "--integrator esdirk", ts_integrator_name(s->o.integrator),
              fabs(s->h), s->drv->e->last_step, mean, steps, per,
              s->sys->links[l].index, s->sys->cables[s->sys->links[l].cable].name);
 }
@@ -329,12 +356,11 @@ static int rhs(double t, const double y[], double dydt[], void *params)
     return GSL_EBADFUNC;
 }
 
-static int jacobian(double t, const double y[], double *dfdy, double dfdt[],
-                    void *params)
+/* df/dy at (t, y) into s->lin->A (column-major): GSL_SUCCESS,
+ * GSL_FAILURE (a refused state) or GSL_EBADFUNC (fatal). */
+static int linearize_at(ts_sim *s, double t, const double y[])
 {
-    ts_sim *s = params;
     double u[TS_NINPUT];
-    int n = s->n;
     s->njac++;
     prepare(s, t, u);
     int rc = ts_linearize(s->k, y, u, &s->lopts, s->lin, NULL);
@@ -347,6 +373,16 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[],
         s->fatal = rc;
         return GSL_EBADFUNC;
     }
+    return GSL_SUCCESS;
+}
+
+static int jacobian(double t, const double y[], double *dfdy, double dfdt[],
+                    void *params)
+{
+    ts_sim *s = params;
+    int n = s->n, rc = linearize_at(s, t, y);
+    if (rc != GSL_SUCCESS)
+        return rc;
     const double *A = s->lin->A;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++)
@@ -367,6 +403,27 @@ static int jacobian(double t, const double y[], double *dfdy, double dfdt[],
     return GSL_SUCCESS;
 }
 
+/* GSL's return codes as lib/esdirk.h's: 0, > 0 retry, < 0 fatal. */
+static int esdirk_code(int gsl_rc)
+{
+    return gsl_rc == GSL_SUCCESS ? 0 : (gsl_rc == GSL_FAILURE ? 1 : -1);
+}
+
+static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
+{
+    return esdirk_code(rhs(t, y, dydt, params));
+}
+
+static int jacobian_esdirk(double t, const double y[], double J[],
+                           void *params)
+{
+    ts_sim *s = params;
+    int rc = linearize_at(s, t, y);
+    if (rc == GSL_SUCCESS)
+        memcpy(J, s->lin->A, (size_t)s->n * (size_t)s->n * sizeof(double));
+    return esdirk_code(rc);
+}
+
 static const gsl_odeiv2_step_type *step_type(ts_integrator m)
 {
     switch (m) {
@@ -380,7 +437,8 @@ static const gsl_odeiv2_step_type *step_type(ts_integrator m)
 
 static int needs_jacobian(ts_integrator m)
 {
-    return m == TS_INT_RK4IMP || m == TS_INT_BSIMP || m == TS_INT_MSBDF;
+    return m == TS_INT_RK4IMP || m == TS_INT_BSIMP || m == TS_INT_MSBDF ||
+           m == TS_INT_ESDIRK;
 }
 
 void ts_sim_free(ts_sim *s)
@@ -392,8 +450,10 @@ void ts_sim_free(ts_sim *s)
     ts_excitation_free(s->own_ex);
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);
+    tsi_esdirk_free(s->sd);
     ts_linear_free(s->lin);
     free(s->y);
+    free(s->y_int);
     free(s->work);
     free(s->breaks);
     free(s);
@@ -458,6 +518,18 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     s->gsys.jacobian = needs_jacobian(o->integrator) ? jacobian : NULL;
     s->gsys.dimension = n;
     s->gsys.params = s;
+    if (o->integrator == TS_INT_ESDIRK) {
+        s->sd = tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk, s,
+                                 o->rel_tol, o->abs_tol, s->h, err);
+        s->y_int = s->sd ? calloc(n, sizeof(double)) : NULL;
+        if (s->sd && !s->y_int)
+            goto nomem;
+        if (!s->sd) {
+            ts_sim_free(s);
+            return NULL;
+        }
+        return s;
+    }
     gsl_error_handler_t *old = gsl_set_error_handler_off();
     s->drv = gsl_odeiv2_driver_alloc_y_new(&s->gsys, step_type(o->integrator),
                                            s->h, o->abs_tol, o->rel_tol);
@@ -473,11 +545,15 @@ nomem:
 }
 
 /* Restart the integrator (after re-charting or a new state). */
-static void restart(ts_sim *s)
+static int restart(ts_sim *s, ts_err *err)
 {
+    s->ahead = 0;
+    if (s->sd)
+        return tsi_esdirk_reset(s->sd, s->t, s->y, err);
     s->steps0 += (long)s->drv->e->count;
     s->rejected0 += (long)s->drv->e->failed_steps;
     gsl_odeiv2_driver_reset(s->drv);
+    return TS_OK;
 }
 
 /* Re-chart links near the singularity; 1 when any moved. */
@@ -507,9 +583,9 @@ int ts_sim_set_state(ts_sim *s, double t, const double y[], ts_err *err)
     s->t = t;
     s->t_start = t;
     maybe_rechart(s);
-    restart(s);
-    s->steps_start = s->steps0;
-    return TS_OK;
+    int rc = restart(s, err);
+    s->steps_start = steps_now(s);
+    return rc;
 }
 
 double ts_sim_time(const ts_sim *s) { return s->t; }
@@ -517,15 +593,99 @@ const double *ts_sim_state(const ts_sim *s) { return s->y; }
 
 void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st)
 {
-    st->steps = s->steps0 + (long)s->drv->e->count;
-    st->rejected = s->rejected0 + (long)s->drv->e->failed_steps;
+    if (s->sd) {
+        tsi_esdirk_stats sd;
+        tsi_esdirk_get_stats(s->sd, &sd);
+        st->steps = sd.steps;
+        st->rejected = sd.rejected;
+        st->h_last = sd.h_last;
+    } else {
+        st->steps = s->steps0 + (long)s->drv->e->count;
+        st->rejected = s->rejected0 + (long)s->drv->e->failed_steps;
+        st->h_last = s->drv->e->last_step;
+    }
     st->evaluations = s->nfev;
     st->jacobians = s->njac;
     st->recharts = s->nrechart;
     st->restarts = s->nrestart;
     st->t_reached = s->t;
-    st->h_last = s->drv->e->last_step;
     st->wall_s = s->wall;
+}
+
+/* ts_sim_advance for esdirk (see the head of this file): step from the
+ * integrator's time towards the next breakpoint or t_end, not t1; hand
+ * out the interpolant at t1 when a step passes it. */
+static int advance_esdirk(ts_sim *s, double t1, ts_err *err)
+{
+    const size_t bytes = (size_t)s->n * sizeof(double);
+    while (s->t < t1) {
+        if (s->ahead) {
+            if (s->t_int > t1) {
+                int rc = tsi_esdirk_interpolate(s->sd, t1, s->y, err);
+                if (!rc)
+                    s->t = t1;
+                return rc;
+            }
+            /* Move to the step's end, then re-chart there if needed. */
+            s->t = s->t_int;
+            memcpy(s->y, s->y_int, bytes);
+            s->ahead = 0;
+            if (maybe_rechart(s)) {
+                int rc = restart(s, err);
+                if (rc)
+                    return rc;
+                s->nrestart++;
+            }
+            continue;
+        }
+        double stop = s->o.t_end > t1 ? s->o.t_end : t1;
+        for (int b = 0; b < s->nbreaks; b++)
+            if (s->breaks[b] > s->t && s->breaks[b] < stop) {
+                stop = s->breaks[b];
+                break;
+            }
+        long refusals = s->chart_refusals;
+        double t = s->t;
+        ts_err esd = {0};
+        int failed = tsi_esdirk_step(s->sd, stop, &t, s->y_int, &esd);
+        tsi_esdirk_stats sd;
+        tsi_esdirk_get_stats(s->sd, &sd);
+        s->h = sd.h_next;
+        if (failed && s->fatal)
+            return ts_fail(err, s->fatal, "simulate: the kernel failed at "
+                           "t = %.9g s (%s): a nodal mass matrix is not "
+                           "positive definite", s->t, ts_strerror(s->fatal));
+        if (failed && s->chart_refusals > refusals)
+            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk cannot step "
+                           "past t = %.9g s: every trial step leaves the "
+                           "angle chart (a link turning sideways faster than "
+                           "the re-chart threshold %g can follow)", s->t,
+                           s->o.rechart);
+        if (failed)
+            return ts_fail(err, TS_EINTEGRATOR, "simulate: %s (relative "
+                           "tolerance %g, absolute %g)", esd.msg,
+                           s->o.rel_tol, s->o.abs_tol);
+        if (!(t > s->t))
+            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk failed at "
+                           "t = %.9g s: the step size underflowed (%.3g s is "
+                           "below the resolution of t)", s->t, sd.h_last);
+        for (int i = 0; i < s->n; i++)
+            if (!isfinite(s->y_int[i]))
+                return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk "
+                               "produced a non-finite state at t = %.9g s",
+                               t);
+        if (s->o.h_min > 0 && t < stop && sd.h_last < s->o.h_min)
+            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk failed at "
+                           "t = %.9g s: the step size %.3g s fell below h_min "
+                           "%.3g s", s->t, sd.h_last, s->o.h_min);
+        s->t_int = t;
+        s->ahead = 1;
+        if (s->o.max_steps > 0 && sd.steps >= s->o.max_steps && t < t1)
+            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk reached "
+                           "the step limit %ld at t = %.9g s", s->o.max_steps,
+                           t);
+    }
+    return TS_OK;
 }
 
 int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
@@ -533,6 +693,12 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
     if (!(t1 > s->t))
         return ts_fail(err, TS_EINVAL, "simulate: the target time %g s is "
                        "not after the current time %g s", t1, s->t);
+    if (s->sd) {
+        double w0 = wall_now();
+        int rc = advance_esdirk(s, t1, err);
+        s->wall += wall_now() - w0;
+        return rc;
+    }
     const char *name = ts_integrator_name(s->o.integrator);
     double w0 = wall_now();
     int rc = TS_OK, step_failed = 0;
@@ -546,7 +712,8 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
         long refusals = s->chart_refusals;
         double t_before = s->t;
         int st = gsl_odeiv2_evolve_apply(s->drv->e, s->drv->c, s->drv->s,
-                                         &s->gsys, &s->t, target, &s->h, s->y);
+                                         &s->gsys, &s->t, target, &s->h,
+                                         s->y);
         if (st == GSL_EBADFUNC) {
             rc = ts_fail(err, s->fatal ? s->fatal : TS_ESINGULAR,
                          "simulate: the kernel failed at t = %.9g s (%s): a "
@@ -594,8 +761,7 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
                          "%.3g s", name, s->t, fabs(s->h), s->o.h_min);
             break;
         }
-        if (s->o.max_steps > 0 &&
-            s->steps0 + (long)s->drv->e->count >= s->o.max_steps &&
+        if (s->o.max_steps > 0 && steps_now(s) >= s->o.max_steps &&
             s->t < t1) {
             rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the "
                          "step limit %ld at t = %.9g s", name,
@@ -603,7 +769,8 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
             break;
         }
         if (maybe_rechart(s)) {
-            restart(s);
+            if ((rc = restart(s, err)))
+                break;
             s->nrestart++;
         }
     }
@@ -860,6 +1027,22 @@ static int lin_jac(double t, const double z[], double *dfdy, double dfdt[],
     return GSL_SUCCESS;
 }
 
+static int lin_rhs_esdirk(double t, const double z[], double dz[],
+                          void *params)
+{
+    return esdirk_code(lin_rhs(t, z, dz, params));
+}
+
+static int lin_jac_esdirk(double t, const double z[], double J[],
+                          void *params)
+{
+    const lin_sim *L = params;
+    (void)t;
+    (void)z;
+    memcpy(J, L->lin->A, (size_t)L->n * (size_t)L->n * sizeof(double));
+    return 0;
+}
+
 /* Append a linear sample: positions from z. */
 static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
                       const ts_sim_opts *o, double t, const double *z,
@@ -941,6 +1124,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     }
     lin_sim L = {lin, ex, n, TS_NINPUT, tmp, 0};
     gsl_odeiv2_driver *drv = NULL;
+    tsi_esdirk *sd = NULL;
     gsl_odeiv2_system gsys = {lin_rhs, lin_jac, sn, &L};
     if (!z || !tmp || !ywork || !dr || !H[0].Phi || !H[0].G || !H[1].Phi ||
         !H[1].G) {
@@ -950,7 +1134,15 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     }
     if (z0)
         memcpy(z, z0, sn * sizeof(double));
-    if (o->linear_method == TS_LINSIM_ODE) {
+    if (o->linear_method == TS_LINSIM_ODE &&
+        o->integrator == TS_INT_ESDIRK) {
+        sd = tsi_esdirk_alloc(n, lin_rhs_esdirk, lin_jac_esdirk, &L,
+                              o->rel_tol, o->abs_tol, o->h_init, err);
+        if (!sd || (rc = tsi_esdirk_reset(sd, 0.0, z, err))) {
+            rc = rc ? rc : TS_ENOMEM;
+            goto done;
+        }
+    } else if (o->linear_method == TS_LINSIM_ODE) {
         gsl_error_handler_t *old = gsl_set_error_handler_off();
         drv = gsl_odeiv2_driver_alloc_y_new(&gsys, step_type(o->integrator),
                                             o->h_init, o->abs_tol,
@@ -967,7 +1159,13 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     double t = 0.0, hode = o->h_init;
     for (int i = 1; i < N && !rc; i++) {
         double t1 = ts_sim_sample_time(o, i);
-        if (o->linear_method == TS_LINSIM_ODE) {
+        if (sd) {
+            while (t < t1 && !rc)
+                if (tsi_esdirk_step(sd, t1, &t, z, err))
+                    rc = TS_EINTEGRATOR;
+            if (rc)
+                break;
+        } else if (o->linear_method == TS_LINSIM_ODE) {
             gsl_error_handler_t *old = gsl_set_error_handler_off();
             while (t < t1 && !rc) {
                 int s = gsl_odeiv2_evolve_apply(drv->e, drv->c, drv->s, &gsys,
@@ -1025,6 +1223,14 @@ done:
         stats.rejected = (long)drv->e->failed_steps;
         stats.h_last = drv->e->last_step;
         gsl_odeiv2_driver_free(drv);
+    }
+    if (sd) {
+        tsi_esdirk_stats sds;
+        tsi_esdirk_get_stats(sd, &sds);
+        stats.steps = sds.steps;
+        stats.rejected = sds.rejected;
+        stats.h_last = sds.h_last;
+        tsi_esdirk_free(sd);
     }
     stats.evaluations = L.nfev;
     stats.t_reached = h->nsamples > 0 ? h->t[h->nsamples - 1] : 0.0;

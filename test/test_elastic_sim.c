@@ -6,15 +6,15 @@
  *  1. Rigid limit in time: Kamman example 1 (examples/kamman_ex1_submerged.
  *     yaml, 10 links, tow point 1 ft deep so that no link crosses the
  *     surface), the tow point stepped 0.3 m down over 1 s. The elastic run
- *     (msbdf, EA = 1e8 and 1e9 N) is compared with the rigid run (same
+ *     (esdirk, EA = 1e8 and 1e9 N) is compared with the rigid run (same
  *     scene, EA = 0, rk8pd at 1e-10) node by node at every sample: the
  *     difference is the cable's stretch, O(1/EA), so it must fall ten times
  *     from 1e8 to 1e9 N and sit near the static stretch T L / EA.
  *  2. Stiffness and the explicit integrator: the same scene at EA = 1e10 N.
  *     rk8pd completes a short run (its steps shrink to the axial stability
- *     limit; it agrees with msbdf), and with a step limit it fails with a
- *     message that names stiffness, the step it needed, the axial period
- *     and msbdf.
+ *     limit; it agrees with msbdf and esdirk), and with a step limit it
+ *     fails with a message that names stiffness, the step it needed, the
+ *     axial period and esdirk.
  *  3. Slack during a run: the tow point of a soft elastic cable moved
  *     2 m down toward the body in 0.4 s: links go slack (tension exactly 0)
  *     and the run stays finite.
@@ -139,11 +139,11 @@ static void test_rigid_limit(const ts_units *u)
 
     /* Elastic, implicit. Tolerances: rel 1e-9 keeps the integration error
      * (about 1e-9 of the 30 m positions, 3e-8 m) far below the stretch at
-     * EA = 1e9 N (T L / EA ~ 1e-5 m); abs 1e-7 on the rates lets msbdf
-     * step over the axial ringing, whose strain-rate amplitude is ~1e-7
-     * here (doc/elastic.md section 7). */
+     * EA = 1e9 N (T L / EA ~ 1e-5 m); abs 1e-7 on the rates: the axial
+     * ringing has strain-rate amplitudes of ~1e-7 here (doc/elastic.md
+     * section 7), which esdirk, L-stable, damps instead of resolving. */
     ts_sim_opts oi = o;
-    oi.integrator = TS_INT_MSBDF;
+    oi.integrator = TS_INT_ESDIRK;
     oi.rel_tol = 1e-9;
     oi.abs_tol = 1e-7;
     double d[2];
@@ -151,7 +151,7 @@ static void test_rigid_limit(const ts_units *u)
     for (int i = 0; i < 2; i++) {
         set_ea(s, eas[i], 4000.0);
         ts_history *he = run(s, ex, &oi, &rc, &st, &err);
-        CHECK(rc == TS_OK, "msbdf at EA %g N completes (%s; %ld steps)",
+        CHECK(rc == TS_OK, "esdirk at EA %g N completes (%s; %ld steps)",
               eas[i], err.msg, st.steps);
         d[i] = hist_diff(hr, he);
         /* The static stretch of the cable is about T0 L / EA (the tension
@@ -198,6 +198,13 @@ static void test_rigid_limit(const ts_units *u)
     CHECK(dd < 1e-6, "rk8pd and msbdf agree at EA 1e10 N: %.2e m (both "
           "at 1e-9 relative of 30 m positions)", dd);
     ts_history_free(hm);
+    oim.integrator = TS_INT_ESDIRK;
+    hm = run(s, ex, &oim, &rc, &st, &err);
+    CHECK(rc == TS_OK, "esdirk at EA 1e10 N completes (%s)", err.msg);
+    dd = hist_diff(he, hm);
+    CHECK(dd < 1e-6, "rk8pd and esdirk agree at EA 1e10 N: %.2e m (both "
+          "at 1e-9 relative of 30 m positions)", dd);
+    ts_history_free(hm);
     ts_history_free(he);
 
     oe.max_steps = 200;
@@ -206,9 +213,9 @@ static void test_rigid_limit(const ts_units *u)
     CHECK(rc == TS_EINTEGRATOR, "rk8pd with a 200-step limit fails: %s",
           ts_strerror(rc));
     CHECK(strstr(e2.msg, "stiff") && strstr(e2.msg, "needed steps of") &&
-              strstr(e2.msg, "axial period") && strstr(e2.msg, "msbdf"),
+              strstr(e2.msg, "axial period") && strstr(e2.msg, "esdirk"),
           "the message names stiffness, the step needed, the axial period "
-          "and msbdf: \"%s\"", e2.msg);
+          "and esdirk: \"%s\"", e2.msg);
     /* The step it quotes: "needed steps of X s". */
     const char *p = strstr(e2.msg, "needed steps of ");
     double hq = p ? strtod(p + strlen("needed steps of "), NULL) : NAN;

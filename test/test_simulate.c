@@ -18,7 +18,7 @@
  *     between linear and nonlinear runs (the relative difference halves).
  *  6. Kamman example 3: straight tow into the 0.5 rad/s turn settles onto
  *     the steady-turn equilibrium (1e-6 of the cable length).
- *  7. Implicit integrators (rk4imp, bsimp, msbdf; Jacobian from the
+ *  7. Implicit integrators (rk4imp, bsimp, msbdf, esdirk; Jacobian from the
  *     linearizer) agree with rk8pd.
  *  8. Initial shapes, sample times, the sinusoid fit, reports, and every
  *     refusal: options, a history too small, step-size underflow (history
@@ -607,8 +607,9 @@ static void test_implicit(void)
     ts_sim_stats st;
     ts_simulate(kr, ex, eq->y, &o, ref, &st, NULL, &err);
     double L = cable_length(sys);
-    ts_integrator m[3] = {TS_INT_RK4IMP, TS_INT_BSIMP, TS_INT_MSBDF};
-    for (int i = 0; i < 3; i++) {
+    ts_integrator m[4] = {TS_INT_RK4IMP, TS_INT_BSIMP, TS_INT_MSBDF,
+                          TS_INT_ESDIRK};
+    for (int i = 0; i < 4; i++) {
         ts_history *h = ts_history_alloc(sys, N, &err);
         ts_kernel *kc = ts_kernel_clone(k, &err);
         o.integrator = m[i];

@@ -168,7 +168,7 @@ static int parse_setup(const cli_ctx *ctx, const cli_sim_args *a,
     if (a->val[SIM_A_INTEGRATOR] &&
         ts_integrator_parse(a->val[SIM_A_INTEGRATOR], &s->o.integrator))
         return ts_fail(err, TS_EINVAL, "%s: '%s' is not an integrator; "
-                       "expected rk8pd, rkf45, rk4imp, bsimp or msbdf",
+                       "expected rk8pd, rkf45, rk4imp, bsimp, msbdf or esdirk",
                        a->where[SIM_A_INTEGRATOR], a->val[SIM_A_INTEGRATOR]);
     struct { int i; double *dst; double lo; int strict; } nums[] = {
         {SIM_A_RTOL, &s->o.rel_tol, TS_SIM_RTOL_MIN, 0},

@@ -195,7 +195,7 @@ static int parse_integrators(const char *text, const char *where,
         if (ts_integrator_parse(tok, &m) != 0)
             return ts_fail(err, TS_EINVAL,
                            "%s: '%s' is not an integrator; expected rk8pd, "
-                           "rkf45, rk4imp, bsimp or msbdf",
+                           "rkf45, rk4imp, bsimp, msbdf or esdirk",
                            where, tok);
         for (int i = 0; i < rq->nintegrators; i++)
             if (rq->integrators[i] == m)

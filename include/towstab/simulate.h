@@ -6,8 +6,10 @@
  * kernel's state y[2 nq] (link angles and rates, MODEL.md section 2), with
  * the tow-point input u(t) and the frame motion of an excitation
  * (towstab/excitation.h). Explicit adaptive Runge-Kutta (rk8pd, rkf45) or
- * implicit methods for stiff scenes (rk4imp, bsimp, msbdf) whose Jacobian
- * df/dy comes from the linearizer (towstab/linearize.h). Steps never
+ * implicit methods for stiff scenes (GSL's rk4imp, bsimp, msbdf, and
+ * esdirk: SUNDIALS ARKODE's L-stable ESDIRK 5(4), the one for elastic
+ * cables) whose Jacobian df/dy comes from the linearizer
+ * (towstab/linearize.h). Steps never
  * straddle an output time or a breakpoint of the excitation. After every
  * accepted step, links with |cos theta2| below the re-chart threshold are
  * moved to a chart centred on their direction (ts_kernel_rechart) and the
@@ -44,7 +46,9 @@ typedef enum {
     TS_INT_RKF45 = 1,   /* explicit Runge-Kutta-Fehlberg 4(5) */
     TS_INT_RK4IMP = 2,  /* implicit Gauss 4th order (Jacobian) */
     TS_INT_BSIMP = 3,   /* implicit Bulirsch-Stoer, Bader-Deuflhard (Jacobian) */
-    TS_INT_MSBDF = 4    /* variable-order BDF, stiff (Jacobian) */
+    TS_INT_MSBDF = 4,   /* variable-order BDF, stiff (Jacobian) */
+    TS_INT_ESDIRK = 5   /* L-stable ESDIRK 5(4), SUNDIALS ARKODE, stiff and
+                           lightly damped: elastic cables (Jacobian) */
 } ts_integrator;
 
 typedef enum {
@@ -95,7 +99,7 @@ TS_API int ts_sim_nsamples(const ts_sim_opts *o);
 TS_API double ts_sim_sample_time(const ts_sim_opts *o, int i);
 
 TS_API const char *ts_integrator_name(ts_integrator m);
-/* Parse "rk8pd", "rkf45", "rk4imp", "bsimp", "msbdf": 0 or -1. */
+/* Parse "rk8pd", "rkf45", "rk4imp", "bsimp", "msbdf", "esdirk": 0 or -1. */
 TS_API int ts_integrator_parse(const char *name, ts_integrator *m);
 
 /* Work statistics of a run. */

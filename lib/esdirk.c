@@ -1,0 +1,329 @@
+/* lib/esdirk.c: the L-stable ESDIRK 5(4) stepper of lib/esdirk.h.
+ *
+ * SUNDIALS ARKODE's ARKStep, fully implicit (no explicit part), table
+ * ARKODE_ARK548L2SA_DIRK_8_4_5 (Kennedy & Carpenter, "Higher-order
+ * additive Runge-Kutta schemes for ordinary differential equations",
+ * Appl. Numer. Math. 136, 2019), ARKODE's default error controller and
+ * modified Newton iteration. ARKODE drives a linear solver through the
+ * SUNLinearSolver interface; Debian's SUNDIALS has no LAPACK-backed dense
+ * solver, so the one here is a SUNLinearSolver of our own whose setup is
+ * LAPACK's blocked dgetrf (with the system's BLAS) and whose solve is
+ * dgetrs: on 600 states it is about 4 times faster in total than the
+ * built-in column LU (doc/performance.md, "Elastic cables").
+ *
+ * Two settings beyond ARKODE's defaults, both found by test_esdirk:
+ *  - the Newton convergence-rate estimate is not carried over between
+ *    stages (ARKStepSetNonlinCRDown 1): ARKODE otherwise reuses a rate
+ *    measured against an earlier matrix, and on nearly linear problems
+ *    accepts a stage after one iteration with an out-of-date matrix (errors
+ *    up to 1000 times the tolerance);
+ *  - ARKODE evaluates f once more at each accepted stage, outside Newton,
+ *    and takes a refusal there as fatal (ARK_UNREC_RHSFUNC_ERR); the kernel
+ *    refuses states near the angle chart's singularity or with a collapsed
+ *    elastic link, which is a matter of step length: the step is retried
+ *    from the last accepted state with a first step of a quarter of the
+ *    last one, up to RETRIES times.
+ *
+ * ARKODE reports failures through an error handler: the last message is
+ * kept in the stepper (nothing is printed) and handed on in ts_err.
+ * Written against SUNDIALS 6 (Debian 12); every object hangs off a
+ * SUNContext owned by the stepper, so steppers are independent. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <arkode/arkode_arkstep.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_linearsolver.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include "esdirk.h"
+#include "lapack.h"
+
+/* Retries of a step whose accepted stage f refused (see above). */
+#define RETRIES 4
+
+struct tsi_esdirk {
+    int n;
+    tsi_ode_fn f;
+    tsi_ode_jac jac;
+    void *params;
+    SUNContext ctx;
+    N_Vector y, yi;       /* state; interpolated output */
+    SUNMatrix A;
+    SUNLinearSolver ls;
+    void *mem;
+    double h_init;
+    char msg[400];          /* ARKODE's last error message */
+    /* Counters of earlier runs (ARKStepReInit zeroes ARKODE's own). */
+    long steps0, rejected0, setups0;
+};
+
+/* --- The LAPACK dense linear solver ----------------------------------- */
+
+typedef struct lu_content {
+    int n;
+    double *lu;   /* [n n] column-major factors of I - gamma h J */
+    int *piv;     /* [n] */
+} lu_content;
+
+static SUNLinearSolver_Type lu_gettype(SUNLinearSolver S)
+{
+    (void)S;
+    return SUNLINEARSOLVER_DIRECT;
+}
+
+static SUNLinearSolver_ID lu_getid(SUNLinearSolver S)
+{
+    (void)S;
+    return SUNLINEARSOLVER_CUSTOM;
+}
+
+/* Factor the iteration matrix: > 0 (recoverable: ARKODE retries with a
+ * shorter step) when it is singular. */
+static int lu_setup(SUNLinearSolver S, SUNMatrix A)
+{
+    lu_content *c = S->content;
+    int n = c->n, info = 0;
+    memcpy(c->lu, SUNDenseMatrix_Data(A), (size_t)n * (size_t)n *
+           sizeof(double));
+    dgetrf_(&n, &n, c->lu, &n, c->piv, &info);
+    return info == 0 ? 0 : (info > 0 ? 1 : -1);
+}
+
+static int lu_solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b,
+                    sunrealtype tol)
+{
+    (void)A;
+    (void)tol;
+    lu_content *c = S->content;
+    int n = c->n, one = 1, info = 0;
+    N_VScale(1.0, b, x);
+    dgetrs_("N", &n, &one, c->lu, &n, c->piv, N_VGetArrayPointer(x), &n,
+            &info, 1);
+    return info == 0 ? 0 : -1;
+}
+
+static int lu_free(SUNLinearSolver S)
+{
+    if (!S)
+        return 0;
+    lu_content *c = S->content;
+    if (c) {
+        free(c->lu);
+        free(c->piv);
+        free(c);
+        S->content = NULL;
+    }
+    SUNLinSolFreeEmpty(S);
+    return 0;
+}
+
+static SUNLinearSolver lu_new(int n, SUNContext ctx)
+{
+    SUNLinearSolver S = SUNLinSolNewEmpty(ctx);
+    if (!S)
+        return NULL;
+    lu_content *c = calloc(1, sizeof *c);
+    S->content = c;
+    S->ops->gettype = lu_gettype;
+    S->ops->getid = lu_getid;
+    S->ops->setup = lu_setup;
+    S->ops->solve = lu_solve;
+    S->ops->free = lu_free;
+    if (!c) {
+        SUNLinSolFreeEmpty(S);
+        return NULL;
+    }
+    c->n = n;
+    c->lu = malloc((size_t)n * (size_t)n * sizeof(double));
+    c->piv = malloc((size_t)n * sizeof(int));
+    if (!c->lu || !c->piv) {
+        lu_free(S);
+        return NULL;
+    }
+    return S;
+}
+
+/* --- ARKODE callbacks ------------------------------------------------- */
+
+static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *ud)
+{
+    tsi_esdirk *s = ud;
+    return s->f(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot),
+                s->params);
+}
+
+static int jacobian(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix J,
+                    void *ud, N_Vector t1, N_Vector t2, N_Vector t3)
+{
+    (void)fy;
+    (void)t1;
+    (void)t2;
+    (void)t3;
+    tsi_esdirk *s = ud;
+    return s->jac(t, N_VGetArrayPointer(y), SUNDenseMatrix_Data(J),
+                  s->params);
+}
+
+static void on_error(int code, const char *module, const char *function,
+                     char *msg, void *ud)
+{
+    (void)code;
+    (void)module;
+    (void)function;
+    tsi_esdirk *s = ud;
+    snprintf(s->msg, sizeof s->msg, "%s", msg ? msg : "");
+}
+
+/* --- The stepper ------------------------------------------------------ */
+
+void tsi_esdirk_free(tsi_esdirk *s)
+{
+    if (!s)
+        return;
+    if (s->mem)
+        ARKStepFree(&s->mem);
+    if (s->ls)
+        SUNLinSolFree(s->ls);
+    if (s->A)
+        SUNMatDestroy(s->A);
+    if (s->y)
+        N_VDestroy(s->y);
+    if (s->yi)
+        N_VDestroy(s->yi);
+    if (s->ctx)
+        SUNContext_Free(&s->ctx);
+    free(s);
+}
+
+tsi_esdirk *tsi_esdirk_alloc(int n, tsi_ode_fn f, tsi_ode_jac jac,
+                             void *params, double rtol, double atol,
+                             double h_init, ts_err *err)
+{
+    tsi_esdirk *s = calloc(1, sizeof *s);
+    if (!s) {
+        ts_fail(err, TS_ENOMEM, "esdirk: out of memory");
+        return NULL;
+    }
+    s->n = n;
+    s->f = f;
+    s->jac = jac;
+    s->params = params;
+    s->h_init = h_init;
+    if (SUNContext_Create(NULL, &s->ctx) != 0 ||
+        !(s->y = N_VNew_Serial(n, s->ctx)) ||
+        !(s->yi = N_VNew_Serial(n, s->ctx)) ||
+        !(s->A = SUNDenseMatrix(n, n, s->ctx)) ||
+        !(s->ls = lu_new(n, s->ctx))) {
+        tsi_esdirk_free(s);
+        ts_fail(err, TS_ENOMEM, "esdirk: out of memory for %d states", n);
+        return NULL;
+    }
+    N_VConst(0.0, s->y);
+    s->mem = ARKStepCreate(NULL, rhs, 0.0, s->y, s->ctx);
+    if (!s->mem) {
+        tsi_esdirk_free(s);
+        ts_fail(err, TS_ENOMEM, "esdirk: ARKODE could not be set up for %d "
+                "states", n);
+        return NULL;
+    }
+    int bad = 0;
+    bad |= ARKStepSetErrHandlerFn(s->mem, on_error, s);
+    bad |= ARKStepSetUserData(s->mem, s);
+    bad |= ARKStepSStolerances(s->mem, rtol, atol);
+    bad |= ARKStepSetTableNum(s->mem, ARKODE_ARK548L2SA_DIRK_8_4_5,
+                              ARKODE_ERK_NONE);
+    bad |= ARKStepSetLinearSolver(s->mem, s->ls, s->A);
+    bad |= ARKStepSetJacFn(s->mem, jacobian);
+    bad |= ARKStepSetInitStep(s->mem, h_init);
+    bad |= ARKStepSetNonlinCRDown(s->mem, 1.0);
+    if (bad) {
+        ts_fail(err, TS_EINVAL, "esdirk: ARKODE refused the options (rtol "
+                "%g, atol %g, first step %g s): %s", rtol, atol, h_init,
+                s->msg);
+        tsi_esdirk_free(s);
+        return NULL;
+    }
+    return s;
+}
+
+int tsi_esdirk_reset(tsi_esdirk *s, double t, const double y[], ts_err *err)
+{
+    long v = 0;
+    if (ARKStepGetNumSteps(s->mem, &v) == 0)
+        s->steps0 += v;
+    long etf = 0, ncf = 0;
+    ARKStepGetNumErrTestFails(s->mem, &etf);
+    ARKStepGetNumNonlinSolvConvFails(s->mem, &ncf);
+    s->rejected0 += etf + ncf;
+    if (ARKStepGetNumLinSolvSetups(s->mem, &v) == 0)
+        s->setups0 += v;
+    memcpy(N_VGetArrayPointer(s->y), y, (size_t)s->n * sizeof(double));
+    if (ARKStepReInit(s->mem, NULL, rhs, t, s->y) != 0)
+        return ts_fail(err, TS_EINTEGRATOR, "esdirk: restart at t = %.9g s "
+                       "failed: %s", t, s->msg);
+    return TS_OK;
+}
+
+int tsi_esdirk_step(tsi_esdirk *s, double tstop, double *t, double y[],
+                    ts_err *err)
+{
+    s->msg[0] = '\0';
+    sunrealtype tret = *t;
+    int flag = ARKStepSetStopTime(s->mem, tstop);
+    if (flag == 0)
+        flag = ARKStepEvolve(s->mem, tstop, s->y, &tret, ARK_ONE_STEP);
+    sunrealtype h = 0;
+    ARKStepGetLastStep(s->mem, &h);
+    for (int r = 0; r < RETRIES && flag == ARK_UNREC_RHSFUNC_ERR; r++) {
+        /* Back to the last accepted state, with a shorter first step. */
+        h = (h > 0 ? h : s->h_init) / 4.0;
+        memcpy(N_VGetArrayPointer(s->y), y, (size_t)s->n * sizeof(double));
+        s->msg[0] = '\0';
+        flag = ARKStepSetInitStep(s->mem, h);
+        if (flag == 0)
+            flag = ARKStepReset(s->mem, *t, s->y);
+        if (flag == 0)
+            flag = ARKStepSetStopTime(s->mem, tstop);
+        if (flag == 0)
+            flag = ARKStepEvolve(s->mem, tstop, s->y, &tret, ARK_ONE_STEP);
+        ARKStepSetInitStep(s->mem, s->h_init);
+    }
+    if (flag < 0) {
+        char *name = ARKStepGetReturnFlagName(flag);
+        ts_fail(err, TS_EINTEGRATOR, "esdirk failed at t = %.9g s (%s): %s",
+                *t, name ? name : "?", s->msg[0] ? s->msg : "no reason given");
+        free(name);
+        return TS_EINTEGRATOR;
+    }
+    *t = tret;
+    memcpy(y, N_VGetArrayPointer(s->y), (size_t)s->n * sizeof(double));
+    return TS_OK;
+}
+
+int tsi_esdirk_interpolate(tsi_esdirk *s, double t, double y[], ts_err *err)
+{
+    if (ARKStepGetDky(s->mem, t, 0, s->yi) != 0)
+        return ts_fail(err, TS_EINTEGRATOR, "esdirk: no solution to "
+                       "interpolate at t = %.9g s: %s", t, s->msg);
+    memcpy(y, N_VGetArrayPointer(s->yi), (size_t)s->n * sizeof(double));
+    return TS_OK;
+}
+
+void tsi_esdirk_get_stats(const tsi_esdirk *s, tsi_esdirk_stats *st)
+{
+    long steps = 0, etf = 0, ncf = 0, setups = 0;
+    sunrealtype hl = 0, hc = 0;
+    ARKStepGetNumSteps(s->mem, &steps);
+    ARKStepGetNumErrTestFails(s->mem, &etf);
+    ARKStepGetNumNonlinSolvConvFails(s->mem, &ncf);
+    ARKStepGetNumLinSolvSetups(s->mem, &setups);
+    ARKStepGetLastStep(s->mem, &hl);
+    ARKStepGetCurrentStep(s->mem, &hc);
+    st->steps = s->steps0 + steps;
+    st->rejected = s->rejected0 + etf + ncf;
+    st->setups = s->setups0 + setups;
+    st->h_last = hl;
+    st->h_next = hc;
+}

@@ -1,0 +1,68 @@
+/* lib/esdirk.h (internal): an L-stable implicit Runge-Kutta stepper for
+ * stiff, lightly damped systems, y' = f(t, y), one step at a time.
+ *
+ * SUNDIALS ARKODE (ARKStep, fully implicit) with the ESDIRK 5(4) table
+ * ARK548L2SA (Kennedy & Carpenter 2019: 8 stages, order 5, embedded
+ * order 4, L-stable and stiffly accurate), modified Newton on each stage
+ * with the user's dense Jacobian, and the iteration matrix I - gamma h J
+ * factored by LAPACK (dgetrf/dgetrs; all stages share gamma, so one LU
+ * serves a step and usually many). ARKODE re-evaluates the Jacobian and
+ * refactors only when the Newton iteration slows or gamma h drifts.
+ *
+ * Why this method (doc/simulate.md, "Stiff integrators"): the stiffness of
+ * an elastic cable is its axial modes, kHz and nearly undamped. BDF of
+ * order 3-5 is unstable near the imaginary axis and must resolve them;
+ * an A-stable but not L-stable method (Gauss, rk4imp) carries them
+ * undamped; an L-stable method steps over them, damping what the
+ * tolerance does not ask it to resolve.
+ *
+ * Callbacks: f returns 0, > 0 for a state it refuses (the step is retried
+ * shorter) or < 0 for a fatal failure; jac writes df/dy column-major into
+ * J[n * n] with the same return convention. Costs per step: 7 implicit
+ * stages of a few Newton iterations, each one f and one O(n^2) LU solve;
+ * an O(n^3) LU and a Jacobian now and then. */
+#ifndef TOWSTAB_LIB_ESDIRK_H
+#define TOWSTAB_LIB_ESDIRK_H
+
+#include "towstab/error.h"
+
+typedef int (*tsi_ode_fn)(double t, const double y[], double dydt[],
+                          void *params);
+typedef int (*tsi_ode_jac)(double t, const double y[], double J[],
+                           void *params);
+
+typedef struct tsi_esdirk tsi_esdirk;
+
+typedef struct tsi_esdirk_stats {
+    long steps;       /* accepted steps */
+    long rejected;    /* error-test and Newton-convergence failures */
+    long setups;      /* LU factorisations */
+    double h_last;    /* s: last step taken */
+    double h_next;    /* s: step planned next */
+} tsi_esdirk_stats;
+
+/* A stepper for n equations, relative and absolute tolerances rtol and
+ * atol (ARKODE's weighted RMS norm), first step h_init (> 0). NULL with
+ * err set on failure. Call tsi_esdirk_reset before the first step. */
+tsi_esdirk *tsi_esdirk_alloc(int n, tsi_ode_fn f, tsi_ode_jac jac,
+                             void *params, double rtol, double atol,
+                             double h_init, ts_err *err);
+void tsi_esdirk_free(tsi_esdirk *s);
+
+/* Start again from (t, y): step-size history, Jacobian and factorisation
+ * are dropped; the statistics keep counting. */
+int tsi_esdirk_reset(tsi_esdirk *s, double t, const double y[], ts_err *err);
+
+/* One step from *t towards tstop (> *t), never past it: *t and y[n] are
+ * advanced. TS_EINTEGRATOR with ARKODE's reason in err on failure (*t and
+ * y unchanged). */
+int tsi_esdirk_step(tsi_esdirk *s, double tstop, double *t, double y[],
+                    ts_err *err);
+
+/* The solution at t inside the last step (ARKODE's Hermite interpolant,
+ * degree 4 for this order-5 method) into y[n]. */
+int tsi_esdirk_interpolate(tsi_esdirk *s, double t, double y[], ts_err *err);
+
+void tsi_esdirk_get_stats(const tsi_esdirk *s, tsi_esdirk_stats *st);
+
+#endif
