@@ -61,7 +61,7 @@ static void usage(FILE *f)
             "                   relative tolerance (default %s;\n"
             "                   the absolute one scales with it)\n"
             "  --integrators LIST  simulate: one series per integrator,\n"
-            "                   e.g. rk8pd,rkf45,msbdf (work precision)\n"
+            "                   e.g. rk8pd,msbdf,esdirk (work precision)\n"
             "  simulate takes the simulation's settings from the scene's\n"
             "  first 'simulate' entry, or from --excite SPEC, --output NAME,\n"
             "  --t-end T, --sample DT, --transient T (the fit's window\n"
