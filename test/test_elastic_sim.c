@@ -22,7 +22,8 @@
  *     links) under the slider crank (r 0.1 m, rod 0.35 m, 1.6 s): the run
  *     completes, and the towfish/tow-point heave ratio at the crank
  *     frequency is compared with the linear frequency response at that
- *     frequency (ts_response_at), an independent estimate.
+ *     frequency (ts_response_at), an independent estimate; a towfish
+ *     5 N buoyant instead of neutral heaves several times more, in both.
  * Run from the project root (it reads examples/). */
 #include "towstab/equilibrium.h"
 #include "towstab/excitation.h"
@@ -278,11 +279,22 @@ static void test_slack(const ts_units *u)
 /* ---- 4: the two-part tow ---------------------------------------------- */
 
 /* One crank run of radius r (rod 3.5 r, period 1.6 s) on the coarse
- * two-part tow: heave ratio (fundamental of towfish z over that of the
- * tow point, least squares over the second half of the run) and the
- * peak-to-peak ratio; *H the linear frequency response at the crank
- * frequency. Returns the run's code. */
-static int two_part_ratio(ts_system *s, double r, double t_end,
+ * two-part tow, esdirk at rtol 1e-4 and atol 1e-4 r (rad, rad/s, strain,
+ * 1/s: scaled with the crank, whose motion sets the size of the
+ * perturbation; at r = 0.1 m the ratio agrees with that at rtol 1e-7,
+ * atol 1e-8 to 4e-5 relative, and esdirk at the diameter table's
+ * tolerances gives rk8pd's ratios on the full example to 4 significant
+ * figures: doc/two-part-tow.md): heave ratio (fundamental of
+ * towfish z over that of the tow point, least squares over t = 20..40 s)
+ * and the peak-to-peak ratio; *H the linear frequency response at the
+ * crank frequency. Why 40 s and not less: the run starts from the
+ * equilibrium with the crank at bottom dead centre, which rings the
+ * towfish's slow in-plane mode (-0.27 +- 0.65i 1/s here: the neutral
+ * towfish is held vertically only by its cable and its drag); after 20 s it
+ * has decayed to 0.5 % of its start (after 8 s, 12 %: with an 8..16 s
+ * window the 5 mm run's fundamental was 8 % off and its peak-to-peak
+ * three times the fundamental). Returns the run's code. */
+static int two_part_ratio(ts_system *s, const char *what, double r,
                           double *ratio, double *pp, double *H)
 {
     ts_err err = {0};
@@ -296,17 +308,21 @@ static int two_part_ratio(ts_system *s, double r, double t_end,
     ts_excitation_add(ex, &sig, &err);
     ts_sim_opts o;
     ts_sim_opts_default(&o);
-    o.t_end = t_end;
+    o.integrator = TS_INT_ESDIRK;
+    o.rel_tol = 1e-4;
+    o.abs_tol = 1e-4 * r;
+    o.t_end = 40.0;
     o.dt_sample = 0.05;
     int rc;
     ts_sim_stats st;
     ts_history *h = run(s, ex, &o, &rc, &st, &err);
-    CHECK(rc == TS_OK, "two-part crank r = %g m: run completes (%s; %ld "
-          "steps)", r, err.msg, st.steps);
-    CHECK(hist_finite(h), "two-part crank r = %g m: history finite", r);
+    CHECK(rc == TS_OK, "two-part (%s) crank r = %g m: run completes (%s; "
+          "%ld steps)", what, r, err.msg, st.steps);
+    CHECK(hist_finite(h), "two-part (%s) crank r = %g m: history finite",
+          what, r);
     ts_output out;
     ts_response_output_find(s, "towfish.z", &out, &err);
-    int n0 = (int)(0.5 * t_end / o.dt_sample + 0.5), n = h->nsamples - n0;
+    int n0 = (int)(20.0 / o.dt_sample + 0.5), n = h->nsamples - n0;
     double *t = malloc((size_t)n * sizeof(double));
     double *zf = malloc((size_t)n * sizeof(double));
     double *zt = malloc((size_t)n * sizeof(double));
@@ -323,8 +339,8 @@ static int two_part_ratio(ts_system *s, double r, double t_end,
     ts_compare_fit_sinusoid(t, zt, n, sig.frequency, &ct, &at, &pht, &err);
     /* The rod term of the crank has even harmonics only: the tow
      * point's fundamental is the crank radius, up to the fit's leakage of
-     * the even harmonics (the window is 5 periods plus one sample, and the
-     * second harmonic is (r/l)^2/4 = 2 % of r: ~1e-3 of r). */
+     * the even harmonics (the window is 12.5 periods plus one sample, and
+     * the second harmonic is (r/l)^2/4 = 2 % of r: ~1e-3 of r). */
     CHECK(fabs(at - r) < 2e-3 * r, "tow-point fundamental %.9g m = crank "
           "radius %g m", at, r);
     *ratio = af / at;
@@ -339,14 +355,15 @@ static int two_part_ratio(ts_system *s, double r, double t_end,
     ts_linearize_opts lo;
     ts_linearize_opts_default(&lo);
     int lrc = ts_linearize_equilibrium(k, eq, &lo, lin, &err);
-    CHECK(lrc == TS_OK, "two-part linearization (%s)", err.msg);
+    CHECK(lrc == TS_OK, "two-part (%s) linearization (%s)", what, err.msg);
     double re, im;
     ts_response_at(s, lin, 2, &out, 2 * M_PI * sig.frequency, &re, &im,
                    &err);
     *H = hypot(re, im);
-    printf("  two-part (coarse), crank r = %g m: heave ratio %.4f "
-           "(fundamental), %.4f (peak-to-peak), linear response %.4f\n", r,
-           *ratio, *pp, *H);
+    printf("  two-part (coarse, %s), crank r = %g m: heave ratio %.6f "
+           "(fundamental), %.6f (peak-to-peak), linear response %.6f "
+           "(ratio / response - 1 = %+.2e; %ld steps)\n", what, r, *ratio,
+           *pp, *H, *ratio / *H - 1, st.steps);
     ts_linear_free(lin);
     ts_equilibrium_free(eq);
     ts_kernel_free(k);
@@ -370,24 +387,59 @@ static void test_two_part(const ts_units *u)
     ts_err err = {0};
     CHECK(ts_system_build(s, &err) == TS_OK, "coarse two-part tow builds");
     double rs, pps, Hs, rl, ppl, Hl;
-    two_part_ratio(s, 0.005, 16.0, &rs, &pps, &Hs);
-    two_part_ratio(s, 0.1, 16.0, &rl, &ppl, &Hl);
+    two_part_ratio(s, "neutral", 0.005, &rs, &pps, &Hs);
+    two_part_ratio(s, "neutral", 0.1, &rl, &ppl, &Hl);
     /* Small crank (5 mm): the heave velocity (0.02 m/s) is 1 % of the tow
-     * speed, so the drag is linear in it to 1 %; the tow point at the
+     * speed, so the drag is linear in it to ~1 %; the tow point at the
      * waterline (a kink, MODEL.md section 6) shifts the mean, not the
-     * fundamental; 5 % allows for these and for a transient of the slowest
-     * heave mode not quite decayed at 8 s. */
-    CHECK(fabs(rs - Hs) < 0.05 * Hs, "5 mm crank: heave ratio %.4f within "
-          "5 %% of the linear response %.4f", rs, Hs);
+     * fundamental; the start's transient is down to 0.5 % (above). 2 %
+     * allows for these (observed 3e-5). */
+    CHECK(fabs(rs - Hs) < 0.02 * Hs, "5 mm crank: heave ratio %.5f within "
+          "2 %% of the linear response %.5f", rs, Hs);
     /* Lalu's crank (0.1 m): heave velocity 0.39 m/s, 22 % of the tow
      * speed: the quadratic drag damps the towfish's heave more than its
-     * linearization; the ratio must be below the linear one, and the gap
-     * larger than at 5 mm. */
+     * linearization, so the ratio is below the linear one and further
+     * than at 5 mm. Here the margin is small (observed 0.8 %, 1e-2 of the
+     * ratio against an integration error of 4e-5), because the neutral
+     * towfish's drag also drives its heave at second order in the
+     * amplitude (doc/two-part-tow.md: with thin cables that term makes the
+     * nonlinear ratio several times the linear one). */
     CHECK(rl < Hl && fabs(rl - Hl) > fabs(rs - Hs),
-          "0.1 m crank: heave ratio %.4f below the linear response %.4f, "
+          "0.1 m crank: heave ratio %.5f below the linear response %.5f, "
           "further than at 5 mm (nonlinear drag)", rl, Hl);
-    CHECK(rl > 0.3 * Hl, "0.1 m crank: heave ratio %.4f within a factor "
-          "0.3 of the linear response %.4f", rl, Hl);
+    /* A loose floor: the towfish's own heave velocity (~8 mm/s) is far
+     * below the tow speed, so the drag cannot suppress most of the linear
+     * response (observed 0.99 of it). */
+    CHECK(rl > 0.3 * Hl, "0.1 m crank: heave ratio %.5f within a factor "
+          "0.3 of the linear response %.5f", rl, Hl);
+    /* The towfish 5 N buoyant: it flies at an incidence (-7.4 deg on the
+     * full example, against +2.0 deg when neutral) where the slope of its
+     * cross-flow drag in the incidence is no longer nearly zero, which
+     * couples the secondary cable's pitching to its heave at first order
+     * (doc/two-part-tow.md). The linear response
+     * predicts a ratio six times the neutral one (0.118 against 0.0196 on
+     * this model); require more than three times in both, and the
+     * nonlinear 5 mm ratio within 2 % of its linear response, as above
+     * (observed 7e-4). */
+    int fish = -1;
+    for (int b = 0; b < s->nbodies; b++)
+        if (strcmp(s->bodies[b].name, "towfish") == 0)
+            fish = b;
+    if (!CHECK(fish >= 0, "the two-part tow has a body 'towfish'")) {
+        ts_scene_free(sc);
+        return;
+    }
+    ts_body *tf = &s->bodies[fish];
+    tf->mass = s->env.water_density * ts_body_volume(tf) -
+               5.0 / s->env.gravity; /* wet weight -5 N */
+    CHECK(ts_system_build(s, &err) == TS_OK, "buoyant towfish builds");
+    double rb, ppb, Hb;
+    two_part_ratio(s, "5 N buoyant", 0.005, &rb, &ppb, &Hb);
+    CHECK(fabs(rb - Hb) < 0.02 * Hb, "buoyant, 5 mm crank: heave ratio "
+          "%.5f within 2 %% of the linear response %.5f", rb, Hb);
+    CHECK(Hb > 3 * Hs && rb > 3 * rs, "buoyant towfish heaves more than "
+          "three times the neutral one: linear %.5f against %.5f, "
+          "nonlinear %.5f against %.5f", Hb, Hs, rb, rs);
     ts_scene_free(sc);
 }
 
