@@ -8,8 +8,8 @@
  * SUNLinearSolver interface; Debian's SUNDIALS has no LAPACK-backed dense
  * solver, so the one here is a SUNLinearSolver of our own whose setup is
  * LAPACK's blocked dgetrf (with the system's BLAS) and whose solve is
- * dgetrs: on 600 states it is about 4 times faster in total than the
- * built-in column LU (doc/performance.md, "Elastic cables").
+ * dgetrs (blocked, through the system's BLAS, where SUNDIALS' own dense LU
+ * is column by column).
  *
  * Two settings beyond ARKODE's defaults, both found by test_esdirk:
  *  - the Newton convergence-rate estimate is not carried over between

@@ -24,8 +24,8 @@
  * 5(4) (lib/esdirk.h), with the same Jacobian, the kernel's refusals
  * passed on as recoverable failures, re-initialised after a re-chart. Its
  * steps stop at breakpoints but not at output times: cutting a step
- * changes gamma h and costs a new LU of I - gamma h J (3-4 times the run
- * time at 10 outputs per second on 100 links); an output inside a step is
+ * changes gamma h and costs a new LU of I - gamma h J; an output inside a
+ * step is
  * ARKODE's interpolant, and re-charting waits for the step's end, after
  * the outputs before it, so that every output is in the charts it was
  * computed in.
@@ -514,22 +514,21 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         s->lopts.estimate_error = 0;
         s->lopts.threads = o->jacobian_threads;
     }
-    s->gsys.function = rhs;
-    s->gsys.jacobian = needs_jacobian(o->integrator) ? jacobian : NULL;
-    s->gsys.dimension = n;
-    s->gsys.params = s;
     if (o->integrator == TS_INT_ESDIRK) {
         s->sd = tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk, s,
                                  o->rel_tol, o->abs_tol, s->h, err);
-        s->y_int = s->sd ? calloc(n, sizeof(double)) : NULL;
-        if (s->sd && !s->y_int)
-            goto nomem;
         if (!s->sd) {
             ts_sim_free(s);
             return NULL;
         }
+        if (!(s->y_int = calloc(n, sizeof(double))))
+            goto nomem;
         return s;
     }
+    s->gsys.function = rhs;
+    s->gsys.jacobian = needs_jacobian(o->integrator) ? jacobian : NULL;
+    s->gsys.dimension = n;
+    s->gsys.params = s;
     gsl_error_handler_t *old = gsl_set_error_handler_off();
     s->drv = gsl_odeiv2_driver_alloc_y_new(&s->gsys, step_type(o->integrator),
                                            s->h, o->abs_tol, o->rel_tol);
@@ -612,6 +611,69 @@ void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st)
     st->wall_s = s->wall;
 }
 
+/* The first excitation breakpoint after the current time and before
+ * limit, else limit: where the next step must stop. */
+static double next_stop(const ts_sim *s, double limit)
+{
+    for (int b = 0; b < s->nbreaks; b++)
+        if (s->breaks[b] > s->t && s->breaks[b] < limit)
+            return s->breaks[b];
+    return limit;
+}
+
+static int finite_state(const double y[], int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(y[i]))
+            return 0;
+    return 1;
+}
+
+/* A step that failed inside the kernel (fatal) or on the angle chart. */
+static int fail_kernel(const ts_sim *s, ts_err *err)
+{
+    return ts_fail(err, s->fatal ? s->fatal : TS_ESINGULAR, "simulate: the "
+                   "kernel failed at t = %.9g s (%s): a nodal mass matrix "
+                   "is not positive definite", s->t, ts_strerror(s->fatal));
+}
+
+static int fail_chart(const ts_sim *s, ts_err *err)
+{
+    return ts_fail(err, TS_EINTEGRATOR, "simulate: %s cannot step past "
+                   "t = %.9g s: every trial step leaves the angle chart (a "
+                   "link turning sideways faster than the re-chart "
+                   "threshold %g can follow)",
+                   ts_integrator_name(s->o.integrator), s->t, s->o.rechart);
+}
+
+/* Checks of an accepted step from t_before to t (state y; step size h,
+ * s; towards stop, on the way to the caller's t1; `steps` accepted so
+ * far): the step changed t, the state is finite, h is not below h_min
+ * unless the step was cut to land on stop, the step limit. TS_OK or
+ * TS_EINTEGRATOR naming the integrator. */
+static int check_step(const ts_sim *s, double t_before, double t,
+                      const double y[], double h, double stop, double t1,
+                      long steps, ts_err *err)
+{
+    const char *name = ts_integrator_name(s->o.integrator);
+    if (t == t_before)
+        /* t + h == t in floating point: GSL does not catch this one. */
+        return ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at t = "
+                       "%.9g s: the step size underflowed (%.3g s is below "
+                       "the resolution of t)", name, t, h);
+    if (!finite_state(y, s->n))
+        return ts_fail(err, TS_EINTEGRATOR, "simulate: %s produced a "
+                       "non-finite state at t = %.9g s", name, t);
+    if (s->o.h_min > 0 && t < stop && h < s->o.h_min)
+        return ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at t = "
+                       "%.9g s: the step size %.3g s fell below h_min %.3g s",
+                       name, t, h, s->o.h_min);
+    if (s->o.max_steps > 0 && steps >= s->o.max_steps && t < t1)
+        return ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the step "
+                       "limit %ld at t = %.9g s", name, s->o.max_steps, t);
+    return TS_OK;
+}
+
 /* ts_sim_advance for esdirk (see the head of this file): step from the
  * integrator's time towards the next breakpoint or t_end, not t1; hand
  * out the interpolant at t1 when a step passes it. */
@@ -638,12 +700,7 @@ static int advance_esdirk(ts_sim *s, double t1, ts_err *err)
             }
             continue;
         }
-        double stop = s->o.t_end > t1 ? s->o.t_end : t1;
-        for (int b = 0; b < s->nbreaks; b++)
-            if (s->breaks[b] > s->t && s->breaks[b] < stop) {
-                stop = s->breaks[b];
-                break;
-            }
+        double stop = next_stop(s, s->o.t_end > t1 ? s->o.t_end : t1);
         long refusals = s->chart_refusals;
         double t = s->t;
         ts_err esd = {0};
@@ -652,38 +709,19 @@ static int advance_esdirk(ts_sim *s, double t1, ts_err *err)
         tsi_esdirk_get_stats(s->sd, &sd);
         s->h = sd.h_next;
         if (failed && s->fatal)
-            return ts_fail(err, s->fatal, "simulate: the kernel failed at "
-                           "t = %.9g s (%s): a nodal mass matrix is not "
-                           "positive definite", s->t, ts_strerror(s->fatal));
+            return fail_kernel(s, err);
         if (failed && s->chart_refusals > refusals)
-            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk cannot step "
-                           "past t = %.9g s: every trial step leaves the "
-                           "angle chart (a link turning sideways faster than "
-                           "the re-chart threshold %g can follow)", s->t,
-                           s->o.rechart);
+            return fail_chart(s, err);
         if (failed)
             return ts_fail(err, TS_EINTEGRATOR, "simulate: %s (relative "
                            "tolerance %g, absolute %g)", esd.msg,
                            s->o.rel_tol, s->o.abs_tol);
-        if (!(t > s->t))
-            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk failed at "
-                           "t = %.9g s: the step size underflowed (%.3g s is "
-                           "below the resolution of t)", s->t, sd.h_last);
-        for (int i = 0; i < s->n; i++)
-            if (!isfinite(s->y_int[i]))
-                return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk "
-                               "produced a non-finite state at t = %.9g s",
-                               t);
-        if (s->o.h_min > 0 && t < stop && sd.h_last < s->o.h_min)
-            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk failed at "
-                           "t = %.9g s: the step size %.3g s fell below h_min "
-                           "%.3g s", s->t, sd.h_last, s->o.h_min);
+        int rc = check_step(s, s->t, t, s->y_int, sd.h_last, stop, t1,
+                            sd.steps, err);
+        if (rc)
+            return rc;
         s->t_int = t;
         s->ahead = 1;
-        if (s->o.max_steps > 0 && sd.steps >= s->o.max_steps && t < t1)
-            return ts_fail(err, TS_EINTEGRATOR, "simulate: esdirk reached "
-                           "the step limit %ld at t = %.9g s", s->o.max_steps,
-                           t);
     }
     return TS_OK;
 }
@@ -699,73 +737,37 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
         s->wall += wall_now() - w0;
         return rc;
     }
-    const char *name = ts_integrator_name(s->o.integrator);
     double w0 = wall_now();
     int rc = TS_OK, step_failed = 0;
     while (s->t < t1) {
-        double target = t1;
-        for (int b = 0; b < s->nbreaks; b++)
-            if (s->breaks[b] > s->t && s->breaks[b] < target) {
-                target = s->breaks[b];
-                break;
-            }
+        double target = next_stop(s, t1);
         long refusals = s->chart_refusals;
         double t_before = s->t;
         int st = gsl_odeiv2_evolve_apply(s->drv->e, s->drv->c, s->drv->s,
                                          &s->gsys, &s->t, target, &s->h,
                                          s->y);
         if (st == GSL_EBADFUNC) {
-            rc = ts_fail(err, s->fatal ? s->fatal : TS_ESINGULAR,
-                         "simulate: the kernel failed at t = %.9g s (%s): a "
-                         "nodal mass matrix is not positive definite",
-                         s->t, ts_strerror(s->fatal));
+            rc = fail_kernel(s, err);
             break;
         }
         if (st != GSL_SUCCESS) {
             if (s->chart_refusals > refusals)
-                rc = ts_fail(err, TS_EINTEGRATOR, "simulate: %s cannot step "
-                             "past t = %.9g s: every trial step leaves the "
-                             "angle chart (a link turning sideways faster "
-                             "than the re-chart threshold %g can follow)",
-                             name, s->t, s->o.rechart);
+                rc = fail_chart(s, err);
             else
-                rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
-                             "t = %.9g s: the step size underflowed (%.3g s) "
-                             "at relative tolerance %g, absolute %g; the "
-                             "scene may be stiff (try msbdf) or the "
-                             "tolerance too tight", name, s->t, s->h,
+                rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: "
+                             "%s failed at t = %.9g s: the step size "
+                             "underflowed (%.3g s) at relative tolerance %g, "
+                             "absolute %g; the scene may be stiff (try "
+                             "esdirk) or the tolerance too tight",
+                             ts_integrator_name(s->o.integrator), s->t, s->h,
                              s->o.rel_tol, s->o.abs_tol);
             break;
         }
-        if (s->t == t_before) {
-            /* An accepted step too small to change t: GSL does not catch
-             * this one (t + h == t in floating point). */
-            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
-                         "t = %.9g s: the step size underflowed (%.3g s is "
-                         "below the resolution of t)", name, s->t,
-                         fabs(s->h));
-            break;
-        }
-        int finite = 1;
-        for (int i = 0; i < s->n && finite; i++)
-            finite = isfinite(s->y[i]);
-        if (!finite) {
-            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s produced a "
-                         "non-finite state at t = %.9g s", name, s->t);
-            s->t = t_before;
-            break;
-        }
-        if (s->o.h_min > 0 && s->t < target && fabs(s->h) < s->o.h_min) {
-            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at "
-                         "t = %.9g s: the step size %.3g s fell below h_min "
-                         "%.3g s", name, s->t, fabs(s->h), s->o.h_min);
-            break;
-        }
-        if (s->o.max_steps > 0 && steps_now(s) >= s->o.max_steps &&
-            s->t < t1) {
-            rc = step_failed = ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the "
-                         "step limit %ld at t = %.9g s", name,
-                         s->o.max_steps, s->t);
+        if ((rc = step_failed = check_step(s, t_before, s->t, s->y,
+                                           fabs(s->h), target, t1,
+                                           steps_now(s), err))) {
+            if (!finite_state(s->y, s->n))
+                s->t = t_before;
             break;
         }
         if (maybe_rechart(s)) {
