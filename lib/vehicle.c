@@ -353,6 +353,13 @@ int ts_vehicle_check(const ts_vehicle *v, double mass, const char *where,
             if (!strcmp(lp->name, v->loop[d].name))
                 return ts_fail(err, TS_EINVAL, "%s.name: duplicate "
                                "controller name '%s'", w, lp->name);
+        /* Loops and surfaces name the vehicle's inputs together. */
+        for (int c = 0; c < v->ncomponents; c++)
+            if (!strcmp(lp->name, v->component[c].name))
+                return ts_fail(err, TS_EINVAL, "%s.name: '%s' is also a "
+                               "component's name; inputs are named "
+                               "<vehicle>.<surface> and <vehicle>.<loop>",
+                               w, lp->name);
     }
     return TS_OK;
 }
@@ -431,6 +438,46 @@ void tsi_vehicle_ws_free(tsi_vehicle_ws *w)
             gsl_interp_free(w->cd[c]);
     }
     free(w);
+}
+
+/* ------------------------------------------------------------------ */
+/* 6x6 solves: the kernel's per-vehicle elimination, O(1), in the hot     */
+/* loop (a LAPACK call costs more than the 6x6 factorisation itself).    */
+
+int tsi_chol6(const double A[36], double L[36])
+{
+    for (int j = 0; j < 6; j++) {
+        double d = A[7 * j];
+        for (int k = 0; k < j; k++)
+            d -= L[6 * j + k] * L[6 * j + k];
+        if (!(d > 0))
+            return -1;
+        d = sqrt(d);
+        L[7 * j] = d;
+        for (int i = j + 1; i < 6; i++) {
+            double s = A[6 * i + j];
+            for (int k = 0; k < j; k++)
+                s -= L[6 * i + k] * L[6 * j + k];
+            L[6 * i + j] = s / d;
+        }
+    }
+    return 0;
+}
+
+void tsi_chol6_solve(const double L[36], double b[6])
+{
+    for (int i = 0; i < 6; i++) {
+        double s = b[i];
+        for (int k = 0; k < i; k++)
+            s -= L[6 * i + k] * b[k];
+        b[i] = s / L[7 * i];
+    }
+    for (int i = 5; i >= 0; i--) {
+        double s = b[i];
+        for (int k = i + 1; k < 6; k++)
+            s -= L[6 * k + i] * b[k];
+        b[i] = s / L[7 * i];
+    }
 }
 
 /* ------------------------------------------------------------------ */
@@ -678,7 +725,7 @@ void tsi_surface_coefficients(const ts_vehicle *v, const tsi_vehicle_ws *w,
  * axes, relative to the water). */
 static void surface_load(const ts_vehicle *v, const tsi_vehicle_ws *ws,
                          int ci, double qrho, const double w[3],
-                         double delta, tsi_component_load *out)
+                         double delta, ts_component_load *out)
 {
     const ts_component *c = &v->component[ci];
     double en[3] = {0, -sin(c->roll), cos(c->roll)};
@@ -704,7 +751,7 @@ static void surface_load(const ts_vehicle *v, const tsi_vehicle_ws *ws,
 /* Axial and cross-flow drag of a hull. */
 static void hull_load(const ts_vehicle *v, const tsi_vehicle_ws *ws, int ci,
                       double qrho, const double wc[3], const double om[3],
-                      tsi_component_load *out)
+                      ts_component_load *out)
 {
     const ts_component *c = &v->component[ci];
     v3_set(out->force, 0, 0, 0);
@@ -736,14 +783,14 @@ static void hull_load(const ts_vehicle *v, const tsi_vehicle_ws *ws, int ci,
 void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
                        double rho, double frac, const double wO_b[3],
                        const double om_b[3], const double delta[],
-                       double F[3], double Mo[3], tsi_component_load *each)
+                       double F[3], double Mo[3], ts_component_load *each)
 {
     v3_set(F, 0, 0, 0);
     v3_set(Mo, 0, 0, 0);
     double qrho = rho * frac;
     for (int c = 0; c < v->ncomponents; c++) {
         const ts_component *cp = &v->component[c];
-        tsi_component_load ld;
+        ts_component_load ld;
         double wp[3], x[3];
         v3_cross(om_b, cp->position, x);
         for (int j = 0; j < 3; j++)

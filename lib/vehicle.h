@@ -89,14 +89,6 @@ void tsi_vehicle_point(const ts_vehicle *v, const tsi_vehicle_state *st,
 void tsi_vehicle_mass6(const ts_vehicle *v, double mass,
                        const tsi_vehicle_state *st, double M6[36]);
 
-/* Loads of one component (body axes): force, moment about O, the
- * effective angle of attack (surfaces; the hull's angle of attack) and
- * the speed of the flow past it. */
-typedef struct tsi_component_load {
-    double force[3], moment[3];
-    double alpha, speed;
-} tsi_component_load;
-
 /* Lift and drag coefficients of surface c (index ci of v) at effective
  * angle of attack alpha (rad, any value: wrapped into (-pi, pi]). */
 void tsi_surface_coefficients(const ts_vehicle *v, const tsi_vehicle_ws *w,
@@ -110,7 +102,7 @@ void tsi_surface_coefficients(const ts_vehicle *v, const tsi_vehicle_ws *w,
 void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
                        double rho, double frac, const double wO_b[3],
                        const double om_b[3], const double delta[],
-                       double F[3], double Mo[3], tsi_component_load *each);
+                       double F[3], double Mo[3], ts_component_load *each);
 
 /* Everything on the body but the joint and the child cables, as the
  * generalised force about A in body axes, G[6] = (force, moment): weight
@@ -172,6 +164,12 @@ void tsi_vehicle_control(const ts_vehicle *v, const double value[4],
 /* Error of loop l: measured - setpoint, a heading wrapped into
  * (-pi, pi]. */
 double tsi_loop_error(const ts_loop *l, const double value[4]);
+
+/* Cholesky factor of a symmetric positive definite 6x6 A (row-major) into
+ * the lower triangle of L; 0, or -1 when A is not positive definite. */
+int tsi_chol6(const double A[36], double L[36]);
+/* Solve (L L^T) x = b in place. */
+void tsi_chol6_solve(const double L[36], double b[6]);
 
 /* Largest distance of a described point (mass and buoyancy centres,
  * components and hull ends, child attach points) from the attach point,

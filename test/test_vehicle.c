@@ -293,7 +293,7 @@ static void test_loads(void)
     tsi_vehicle_ws *w = tsi_vehicle_ws_alloc(v, &err);
     double rho = 1025, om[3] = {0, 0, 0};
     double F[3], Mo[3];
-    tsi_component_load ld;
+    ts_component_load ld;
     int ok = 1;
     for (int t = 0; t < 12; t++) {
         double al = -0.6 + 0.1 * t, U = 2.3, delta[1] = {0.05 - 0.01 * t};
@@ -663,6 +663,11 @@ static void test_bad(void)
     CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
               strstr(err.msg, "not a control surface"),
           "loop driving a fixed surface: %s", err.msg);
+    c->control = 1;
+    snprintf(v->loop[0].name, sizeof v->loop[0].name, "wing");
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+              strstr(err.msg, "also a component's name"),
+          "loop named as a surface: %s", err.msg);
     free(v);
 }
 

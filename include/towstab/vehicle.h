@@ -132,6 +132,45 @@ typedef struct ts_vehicle {
     ts_loop loop[TS_VEHICLE_MAX_LOOPS];
 } ts_vehicle;
 
+/* Loads of one component (body axes): force (N), moment about the body
+ * origin O (N m), its angle of attack (a surface: with incidence and
+ * deflection; the hull: of the flow at its centre, atan2(w_z, w_x)) and
+ * the speed of the flow past it (m/s; a surface: in its chord-normal
+ * plane). */
+typedef struct ts_component_load {
+    double force[3], moment[3];
+    double alpha, speed;
+} ts_component_load;
+
+/* A vehicle at one state (ts_kernel_vehicle_result). Angles in rad. */
+typedef struct ts_vehicle_result {
+    int body;             /* body index */
+    double R[9];          /* attitude: body to M, row-major */
+    double yaw, pitch, roll; /* Z-Y-X angles relative to M: yaw > 0 to
+                             starboard, pitch > 0 nose up, roll > 0
+                             starboard down */
+    double alpha, beta;   /* angle of attack atan2(w_z, w_x) and sideslip
+                             asin(w_y / |w|) of the flow at O, w the
+                             velocity of O relative to the water (body
+                             axes) */
+    double speed;         /* |w|, m/s */
+    double origin[3];     /* O in M, m (origin[2] is the depth) */
+    double mass_centre[3];/* G in M, m */
+    double omega[3];      /* angular velocity relative to M, body axes */
+    double submerged;     /* fraction under water */
+    double joint_force[3];/* force of the cable's end node on the vehicle
+                             through the joint, M frame, N */
+    double hydro_force[3], hydro_moment[3]; /* all components, body axes,
+                             moment about O */
+    double munk[3];       /* the added mass's -v x p moment, body axes */
+    int ncomponents;
+    double delta[TS_VEHICLE_MAX_COMPONENTS];      /* deflections, rad */
+    ts_component_load load[TS_VEHICLE_MAX_COMPONENTS];
+    int nloops;
+    double loop_error[TS_VEHICLE_MAX_LOOPS];  /* measured - setpoint */
+    double loop_output[TS_VEHICLE_MAX_LOOPS]; /* the law's value, rad */
+} ts_vehicle_result;
+
 /* Defaults of a component of `type` (doc/vehicle.md): hull Cd axial 0.2,
  * cross 1.2; surface lifting line, Helmbold slope, stall 15 deg, width 3
  * deg, cd0 0.01, efficiency 0.9, cn90 1.2, no limits, ideal actuator. */
