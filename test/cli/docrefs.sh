@@ -2,7 +2,8 @@
 # docrefs.sh: the project carries its own model (doc/model.md).
 #  1. No file other than doc/model.md names the model by another file name
 #     (an upper-case MODEL file) or points outside the project at the papers
-#     or notes it was started from (a ../shared or /work path, seed files).
+#     or notes it was started from (paths of the shared folder or of the
+#     working machine, the papers' file names).
 #  2. Every "doc/model.md section N" (also "sections N-M", "N and M",
 #     "N, M", across a line break or a comment marker) names a section that
 #     doc/model.md has, as a heading "## N. ...".
@@ -39,7 +40,7 @@ if [ -n "$hits" ]; then
     echo "$hits"
     fail=1
 else
-    echo "PASS: no file but $model names the model's brief, its papers' copies or machine paths (${#others[@]} files)"
+    echo "PASS: no file but $model refers outside the project (${#others[@]} files)"
 fi
 
 # Sections doc/model.md has.
