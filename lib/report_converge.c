@@ -1,6 +1,6 @@
 /* report_converge.c: JSON (jansson) and CSV of convergence studies and of
  * health verdicts (towstab/report_converge.h). Files go through
- * ts_report_open/commit/abandon, so a failed run leaves no file that
+ * tsi_outfile (lib/outfile.h), so a failed run leaves no file that
  * looks finished. */
 #include "towstab/report_converge.h"
 
@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "towstab/report.h"
 
 /* A JSON number, or null for a value that is not finite. */
@@ -218,12 +219,13 @@ int ts_report_convergence_csv(const ts_convergence *c, const char *path,
     int *idx = malloc((size_t)(c->nrows > 0 ? c->nrows : 1) * sizeof(int));
     if (!idx)
         return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
-    char tmp[4096];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f) {
+    tsi_outfile out;
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK) {
         free(idx);
-        return err && err->code ? err->code : TS_EIO;
+        return orc;
     }
+    FILE *f = out.f;
     fprintf(f, "series,setting,h,status,wall_s,evaluations,trustworthy,"
                "max_relative_error");
     for (int v = 0; v < c->nvalues; v++)
@@ -246,5 +248,5 @@ int ts_report_convergence_csv(const ts_convergence *c, const char *path,
         fprintf(f, "\n");
     }
     free(idx);
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }

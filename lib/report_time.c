@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "towstab/report.h"
 
 static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
@@ -183,10 +184,11 @@ int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
 {
     if (!nl && !li)
         return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
-    char tmp[1024];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f)
-        return TS_EIO;
+    tsi_outfile out;
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK)
+        return orc;
+    FILE *f = out.f;
     int both = nl && li;
     const ts_history *first = nl ? nl : li;
     int rows = first->nsamples;
@@ -206,5 +208,5 @@ int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
             csv_row(f, li, i);
         fputc('\n', f);
     }
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }

@@ -543,13 +543,6 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
         ts_health_simulation(&s.o, &st_nl, &trust);
     if (hl && s.o.linear_method != TS_LINSIM_EXPM)
         ts_health_simulation(&s.o, &st_lin, &trust);
-    if (ran) {
-        printf("trustworthy: %s\n", trust.trustworthy ? "yes" : "NO");
-        for (int i = 0; i < trust.nreasons; i++)
-            printf("  reason: %s\n", trust.reasons[i]);
-        for (int i = 0; i < trust.nnotes; i++)
-            printf("  note: %s\n", trust.notes[i]);
-    }
     if (s.compare && !status) {
         rc = ts_compare_histories(sys, lin, ex, hn, hl, &s.out, s.transient,
                                   &cmp, &err);
@@ -558,9 +551,20 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
             status = cli_report(&err, rc);
         } else {
             have_cmp = 1;
-            print_compare(&cmp);
         }
     }
+    /* A failed run is not trustworthy, whatever its statistics say. */
+    if (status)
+        ts_trust_fail(&trust, "the run failed: %s", err.msg);
+    if (ran) {
+        printf("trustworthy: %s\n", trust.trustworthy ? "yes" : "NO");
+        for (int i = 0; i < trust.nreasons; i++)
+            printf("  reason: %s\n", trust.reasons[i]);
+        for (int i = 0; i < trust.nnotes; i++)
+            printf("  note: %s\n", trust.notes[i]);
+    }
+    if (have_cmp)
+        print_compare(&cmp);
 
     /* Results, also after a failed run (the history so far). */
     j = json_object();
@@ -793,6 +797,16 @@ static int sim_main(int argc, char **argv)
             memcpy(cs.where[4], es.where[4], sizeof cs.where[4]);
         }
         break;
+    }
+    static const char *const what[2] = {"--json", "--csv"};
+    static const char *const pictures[] = {"histories", "snapshots_side",
+                                           "snapshots_top", NULL};
+    const char *paths[2] = {a.json, a.val[SIM_A_CSV]};
+    status = cli_check_outputs("simulate", 2, what, paths, plot.dir,
+                               pictures);
+    if (status) {
+        cli_close(units, scene);
+        return status;
     }
     cli_ctx ctx = {scene, units, a.quiet};
     json_t *j = NULL;

@@ -1,8 +1,8 @@
 /* towstab/report_converge.h: convergence tables and health verdicts as JSON
  * (jansson) and CSV (doc/converge.md). SI units (the unit of each value is
  * named with it); numbers that are not finite are JSON null and "nan" in
- * CSV. Files are written atomically (ts_report_open / commit,
- * towstab/report.h).
+ * CSV. Files are written as towstab/report.h describes
+ * (atomically, devices in place).
  */
 #ifndef TOWSTAB_REPORT_CONVERGE_H
 #define TOWSTAB_REPORT_CONVERGE_H
