@@ -11,26 +11,30 @@
 #include "outfile.h"
 #include "towstab/health.h"
 #include "towstab/kernel.h"
-#include "towstab/report_converge.h"
-
-void ts_report_node_name(const ts_system *sys, int node, char *buf,
-                         size_t size)
-{
-    if (node == 0) {
-        snprintf(buf, size, "tow");
-        return;
-    }
-    const ts_node *nd = &sys->nodes[node];
-    if (nd->body >= 0) {
-        snprintf(buf, size, "%s", sys->bodies[nd->body].name);
-        return;
-    }
-    const ts_link *L = &sys->links[nd->link];
-    snprintf(buf, size, "%s.%d", sys->cables[L->cable].name, L->index);
-}
 
 /* A JSON number, or null for a value that is not finite. */
 static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
+
+json_t *ts_report_trust_json(const ts_trust *t)
+{
+    json_t *o = json_object(), *r = json_array(), *n = json_array();
+    if (!o || !r || !n) {
+        json_decref(o);
+        json_decref(r);
+        json_decref(n);
+        return NULL;
+    }
+    for (int i = 0; i < t->nreasons; i++)
+        json_array_append_new(r, json_string(t->reasons[i]));
+    for (int i = 0; i < t->nnotes; i++)
+        json_array_append_new(n, json_string(t->notes[i]));
+    json_object_set_new(o, "trustworthy", json_boolean(t->trustworthy));
+    json_object_set_new(o, "reasons", r);
+    json_object_set_new(o, "notes", n);
+    if (t->dropped)
+        json_object_set_new(o, "dropped", json_integer(t->dropped));
+    return o;
+}
 
 json_t *ts_report_equilibrium_json(const ts_system *sys,
                                    const ts_equilibrium *eq, double wall_s)
@@ -62,7 +66,7 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     char name[2 * TS_NAME_MAX];
     for (int i = 0; i < sys->nnodes; i++) {
         const double *r = eq->positions + 3 * i;
-        ts_report_node_name(sys, i, name, sizeof name);
+        ts_system_node_name(sys, i, name, sizeof name);
         json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name", name,
                                                "x", num(r[0]), "y", num(r[1]),
                                                "z", num(r[2])));
@@ -160,7 +164,7 @@ int ts_report_equilibrium_csv(const ts_system *sys, const ts_equilibrium *eq,
     fprintf(f, "node,x_m,y_m,z_m,tension_above_N\n");
     for (int i = 0; i < sys->nnodes; i++) {
         const double *r = eq->positions + 3 * i;
-        ts_report_node_name(sys, i, name, sizeof name);
+        ts_system_node_name(sys, i, name, sizeof name);
         if (i == 0)
             fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
                     eq->top_tension);

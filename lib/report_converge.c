@@ -26,27 +26,6 @@ static json_t *setting_json(const ts_convergence *c, double s)
                                      : json_real(s);
 }
 
-json_t *ts_report_trust_json(const ts_trust *t)
-{
-    json_t *o = json_object(), *r = json_array(), *n = json_array();
-    if (!o || !r || !n) {
-        json_decref(o);
-        json_decref(r);
-        json_decref(n);
-        return NULL;
-    }
-    for (int i = 0; i < t->nreasons; i++)
-        json_array_append_new(r, json_string(t->reasons[i]));
-    for (int i = 0; i < t->nnotes; i++)
-        json_array_append_new(n, json_string(t->notes[i]));
-    json_object_set_new(o, "trustworthy", json_boolean(t->trustworthy));
-    json_object_set_new(o, "reasons", r);
-    json_object_set_new(o, "notes", n);
-    if (t->dropped)
-        json_object_set_new(o, "dropped", json_integer(t->dropped));
-    return o;
-}
-
 int ts_report_modes_health_json(json_t *modes, const ts_eigen *e,
                                 const ts_mode_health mh[], const ts_trust *t)
 {

@@ -83,7 +83,7 @@ static json_t *shape_json(const ts_system *sys, const ts_linear *lin,
     char name[2 * TS_NAME_MAX];
     for (int i = 0; arr && i < sys->nnodes; i++) {
         const double *a = amp + 3 * i, *p = phase + 3 * i;
-        ts_report_node_name(sys, i, name, sizeof name);
+        ts_system_node_name(sys, i, name, sizeof name);
         json_array_append_new(
             arr, json_pack("{s:s,s:o,s:o,s:o,s:o,s:o,s:o}", "node", name,
                            "x_amp", num(a[0]), "x_phase_deg",
@@ -192,7 +192,7 @@ int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
         rc = ts_eigen_mode_shape(sys, lin, e, m, amp, phase, err);
         for (int i = 0; rc == TS_OK && i < sys->nnodes; i++) {
             const double *a = amp + 3 * i, *p = phase + 3 * i;
-            ts_report_node_name(sys, i, name, sizeof name);
+            ts_system_node_name(sys, i, name, sizeof name);
             fprintf(f, "%d,%.17g,%s,%.10g,%.6f,%.10g,%.6f,%.10g,%.6f\n", m + 1,
                     e->modes[m].freq_hz, name, a[0], p[0] * 180 / M_PI, a[1],
                     p[1] * 180 / M_PI, a[2], p[2] * 180 / M_PI);

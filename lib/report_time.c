@@ -53,7 +53,7 @@ json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
     for (int k = 0; k < h->nnodes; k++) {
         if (node >= 0 && k != node)
             continue;
-        ts_report_node_name(sys, k, name, sizeof name);
+        ts_system_node_name(sys, k, name, sizeof name);
         const double *p = h->positions + 3 * (size_t)k;
         json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name",
                                                name, "x", series(p, n, ps),
@@ -155,7 +155,7 @@ static void csv_header(FILE *f, const ts_system *sys, const ts_history *h,
 {
     char name[2 * TS_NAME_MAX];
     for (int k = 0; k < h->nnodes; k++) {
-        ts_report_node_name(sys, k, name, sizeof name);
+        ts_system_node_name(sys, k, name, sizeof name);
         fprintf(f, ",%s%s.x_m,%s%s.y_m,%s%s.z_m", prefix, name, prefix, name,
                 prefix, name);
     }

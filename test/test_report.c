@@ -142,9 +142,9 @@ static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
                                       "junction, up.1, s1, s2");
     CHECK(pos_ok, "json: node positions exact");
     char buf[64];
-    ts_report_node_name(s, 3, buf, sizeof buf);
+    ts_system_node_name(s, 3, buf, sizeof buf);
     CHECK(!strcmp(buf, "up.1"), "node_name: cable node 'up.1' (%s)", buf);
-    ts_report_node_name(s, 0, buf, 3);
+    ts_system_node_name(s, 0, buf, 3);
     CHECK(!strcmp(buf, "to"), "node_name: truncated to the buffer ('%s')",
           buf);
 
@@ -259,7 +259,7 @@ static void test_csv(const ts_system *s, const ts_equilibrium *eq)
             p = end;
         }
         char want[128];
-        ts_report_node_name(s, row, want, sizeof want);
+        ts_system_node_name(s, row, want, sizeof want);
         double t = row == 0 ? eq->top_tension : eq->tensions[row - 1];
         ok &= !strcmp(name, want) && v[0] == eq->positions[3 * row] &&
               v[1] == eq->positions[3 * row + 1] &&

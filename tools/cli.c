@@ -367,7 +367,7 @@ static void print_equilibrium(FILE *f, const ts_system *sys,
                 "z [m]");
         for (int i = 0; i < sys->nnodes; i++) {
             const double *r = eq->positions + 3 * i;
-            ts_report_node_name(sys, i, name, sizeof name);
+            ts_system_node_name(sys, i, name, sizeof name);
             fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", name, r[0], r[1], r[2]);
         }
         fprintf(f, "\n%-20s %6s %14s %14s %14s\n", "cable", "link",

@@ -68,7 +68,7 @@ int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
            l->trunc_norm);
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
-        ts_report_node_name(sys, l->kink_node, name, sizeof name);
+        ts_system_node_name(sys, l->kink_node, name, sizeof name);
         printf("warning: %d node%s (first %s, depth %.3g m) within a step "
                "of the water surface: f is not smooth there, A is the mean "
                "of one-sided derivatives and the modes near it are not "

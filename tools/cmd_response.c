@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "cli.h"
-#include "towstab/report_converge.h"
 #include "towstab/health.h"
 #include "cli_plot.h"
 #include "towstab/eigen.h"

@@ -13,7 +13,6 @@
 #include <string.h>
 
 #include "cli.h"
-#include "towstab/report_converge.h"
 #include "towstab/health.h"
 #include "cli_plot.h"
 #include "cli_sim.h"
@@ -113,7 +112,7 @@ static int read_shape(const ts_system *sys, const char *path,
         }
         int k = 0;
         for (; !rc && k < sys->nnodes; k++) {
-            ts_report_node_name(sys, k, name, sizeof name);
+            ts_system_node_name(sys, k, name, sizeof name);
             if (!strcmp(name, line))
                 break;
         }
@@ -128,7 +127,7 @@ static int read_shape(const ts_system *sys, const char *path,
     fclose(f);
     for (int k = 1; !rc && k < sys->nnodes; k++)
         if (!seen[k]) {
-            ts_report_node_name(sys, k, name, sizeof name);
+            ts_system_node_name(sys, k, name, sizeof name);
             rc = ts_fail(err, TS_EINVAL, "%s: %s has no row for node '%s'",
                          where, path, name);
         }
@@ -158,7 +157,7 @@ static void print_table(const ts_system *sys, const ts_output *out,
     if (!h || h->nsamples == 0)
         return;
     char name[2 * TS_NAME_MAX];
-    ts_report_node_name(sys, out->node, name, sizeof name);
+    ts_system_node_name(sys, out->node, name, sizeof name);
     int stride = (h->nsamples + TABLE_ROWS - 1) / TABLE_ROWS;
     printf("\n%10s %16s %16s %16s", "t [s]", "x [m]", "y [m]", "z [m]");
     if (nl && li)

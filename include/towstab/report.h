@@ -16,16 +16,17 @@
 
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
+#include "towstab/health.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Name of a node: "tow" for node 0, the body's name where a body sits,
- * else "<cable>.<k>" for the lower end of link k of that cable. */
-TS_API void ts_report_node_name(const ts_system *sys, int node, char *buf,
-                                size_t size);
+/* {"trustworthy": bool, "reasons": [text], "notes": [text]} plus
+ * "dropped": n when reasons or notes were dropped. NULL on allocation
+ * failure. */
+TS_API json_t *ts_report_trust_json(const ts_trust *t);
 
 /* The equilibrium as a new JSON object: converged, iterations, evaluations,
  * residual, force_scale, tolerance, method, speed, turn_rate, wall_s,
