@@ -1,5 +1,5 @@
 /* system.c: validation of a towed system and its discretisation into a tree
- * of rigid links and lumped nodes (MODEL.md section 2).
+ * of rigid links and lumped nodes (doc/model.md section 2).
  *
  * Cables are ordered breadth-first from the tow point, so every link comes
  * after the link above it: a forward loop over links runs from the tow

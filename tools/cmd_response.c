@@ -117,7 +117,7 @@ static int response_analysis(const ts_system *sys,
             printf("warning: the tow point is at the water surface: the "
                    "heave response uses the mean of the one-sided "
                    "derivatives, and a real heave also shifts the mean "
-                   "depth at first order (MODEL.md section 6)\n");
+                   "depth at first order (doc/model.md section 6)\n");
         print_response(*res, quiet);
         if (nat) {
             ts_eigen_opts o;

@@ -481,7 +481,7 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
         if (lin->kinks)
             printf("note: %d node%s within a step of the water surface "
                    "(%s): f is not smooth there, and the linear model uses "
-                   "the mean of the one-sided derivatives (MODEL.md "
+                   "the mean of the one-sided derivatives (doc/model.md "
                    "section 6)\n", lin->kinks, lin->kinks == 1 ? " sits" :
                    "s sit", lin->kink_tow ? "the tow point among them"
                                           : "not the tow point");

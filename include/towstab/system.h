@@ -1,5 +1,5 @@
 /* towstab/system.h: the towed system as a tree of cables, links, nodes and
- * bodies (MODEL.md sections 1-3, 8).
+ * bodies (doc/model.md sections 1-3, 8).
  *
  * A ts_system holds the description (environment, tow, cables, bodies) and,
  * after ts_system_build(), its discretisation: links in topological order
