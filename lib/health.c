@@ -28,7 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 /* An ARPACK Ritz pair with a larger residual (relative to ||A||_F |v|)
  * is not an eigenpair to trust. */
@@ -230,7 +230,7 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
     if (lin->kinks > lin->kink_tow) {
         char name[2 * TS_NAME_MAX];
         if (sys)
-            ts_report_node_name(sys, lin->kink_node, name, sizeof name);
+            ts_system_node_name(sys, lin->kink_node, name, sizeof name);
         else
             snprintf(name, sizeof name, "node %d", lin->kink_node);
         ts_trust_fail(t, "%d node%s (first %s, depth %.3g m) within a "

@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "eigen_impl.h"
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 static const char *const input_names[3] = {"tow.surge", "tow.sway",
                                            "tow.heave"};
@@ -158,7 +158,7 @@ int ts_response_output_find(const ts_system *sys, const char *name,
         out->comp = comp;
         out->unit = "m/m";
         char nm[2 * TS_NAME_MAX];
-        ts_report_node_name(sys, out->node, nm, sizeof nm);
+        ts_system_node_name(sys, out->node, nm, sizeof nm);
         snprintf(out->name, sizeof out->name, "%s.%c", nm, "xyz"[comp]);
     }
     return TS_OK;

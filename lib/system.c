@@ -115,6 +115,22 @@ int ts_system_find_body(const ts_system *s, const char *name)
     return -1;
 }
 
+void ts_system_node_name(const ts_system *sys, int node, char *buf,
+                         size_t size)
+{
+    if (node == 0) {
+        snprintf(buf, size, "tow");
+        return;
+    }
+    const ts_node *nd = &sys->nodes[node];
+    if (nd->body >= 0) {
+        snprintf(buf, size, "%s", sys->bodies[nd->body].name);
+        return;
+    }
+    const ts_link *L = &sys->links[nd->link];
+    snprintf(buf, size, "%s.%d", sys->cables[L->cable].name, L->index);
+}
+
 int ts_system_body_node(const ts_system *s, int b)
 {
     if (!s->nodes || b < 0 || b >= s->nbodies)
