@@ -461,8 +461,19 @@ static void link_lever(const veh *V, const ts_link *L, double rho[3])
 static int vehicle_kinematics(ts_kernel *k, veh *V, const double y[])
 {
     const double *th = y + V->qoff, *thd = y + k->nq + V->qoff;
-    tsi_vehicle_kinematics(V->d, V->chart, th, thd, &k->frame,
+    tsi_vehicle_kinematics(V->d, V->chart, th, thd, k->frame.turn_rate,
                            k->r + 3 * V->node, k->rd + 3 * V->node, &V->st);
+    /* The flow past the body origin, and how much of the body is under
+     * water: the circular segment of a horizontal cylinder of the hull's
+     * height centred at the buoyancy centre (wholly submerged below one
+     * radius). */
+    double w[3], rB[3], rdB[3];
+    tsi_rel_velocity(&k->frame, V->st.rO, V->st.rdO, w);
+    mat3_tmul(V->st.R, w, V->st.wO_b);
+    tsi_vehicle_point(V->d, &V->st, V->d->buoyancy_centre, rB, rdB);
+    V->st.frac = V->d->surface_diameter > 0
+                     ? tsi_cylinder_submerged(rB[2], V->d->surface_diameter)
+                     : (rB[2] > 0 ? 1.0 : 0.0);
     const ts_node *nd = &k->sys->nodes[V->node];
     for (int c = nd->child_begin; c < nd->child_end; c++) {
         int l = k->sys->child_links[c];
@@ -933,7 +944,8 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         const double *th = y + V->qoff, *thd = qd + V->qoff;
         for (int j = 0; j < 3; j++)
             dydt[V->qoff + j] = thd[j];
-        tsi_vehicle_angle_accel(&V->st, th, thd, &k->frame, V->alpha_m,
+        tsi_vehicle_angle_accel(&V->st, th, thd, k->frame.turn_rate,
+                                k->frame.turn_accel, V->alpha_m,
                                 dydt + nq + V->qoff);
         for (int l = 0; l < V->d->nloops; l++)
             if (V->xi_off[l] >= 0)
@@ -999,7 +1011,8 @@ double ts_kernel_unbalanced(const ts_kernel *k, double *scale)
         const veh *V = &k->veh[v];
         double ar[3], af[3], r6[6], x6[6];
         const double *rdd = k->rdd + 3 * V->node;
-        tsi_vehicle_frame_alpha(&V->st, &k->frame, af);
+        tsi_vehicle_frame_alpha(&V->st, k->frame.turn_rate,
+                                k->frame.turn_accel, af);
         for (int j = 0; j < 3; j++)
             af[j] = V->alpha_m[j] - af[j];
         mat3_tmul(V->st.R, rdd, ar);

@@ -28,7 +28,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "forces.h"
 #include "vec3.h"
 
 /* Gauss-Legendre points along a hull for its cross-flow drag: the
@@ -562,7 +561,7 @@ static void mat3_mulmat(const double A[9], const double B[9], double C[9])
 
 void tsi_vehicle_kinematics(const ts_vehicle *v, const double C[9],
                             const double th[3], const double thd[3],
-                            const ts_frame *f, const double rA[3],
+                            double turn_rate, const double rA[3],
                             const double rdA[3], tsi_vehicle_state *st)
 {
     double R123[9], ez[3] = {0, 0, 1}, w[3];
@@ -573,21 +572,11 @@ void tsi_vehicle_kinematics(const ts_vehicle *v, const double C[9],
     mat3_mul(st->E, thd, st->om_rel_b);
     mat3_tmul(st->R, ez, w);
     for (int j = 0; j < 3; j++) {
-        st->om_b[j] = st->om_rel_b[j] + f->turn_rate * w[j];
+        st->om_b[j] = st->om_rel_b[j] + turn_rate * w[j];
         st->rA[j] = rA[j];
         st->rdA[j] = rdA[j];
     }
     tsi_vehicle_point(v, st, (const double[3]){0, 0, 0}, st->rO, st->rdO);
-    tsi_rel_velocity(f, st->rO, st->rdO, w);
-    mat3_tmul(st->R, w, st->wO_b);
-    /* The hull's height decides how much is under water near z = 0: the
-     * circular segment of a horizontal cylinder centred at the buoyancy
-     * centre (lib/forces.h); wholly submerged below one radius. */
-    double rB[3], rdB[3];
-    tsi_vehicle_point(v, st, v->buoyancy_centre, rB, rdB);
-    st->frac = v->surface_diameter > 0
-                   ? tsi_cylinder_submerged(rB[2], v->surface_diameter)
-                   : (rB[2] > 0 ? 1.0 : 0.0);
 }
 
 void tsi_vehicle_point(const ts_vehicle *v, const tsi_vehicle_state *st,
@@ -606,11 +595,12 @@ void tsi_vehicle_point(const ts_vehicle *v, const tsi_vehicle_state *st,
 }
 
 void tsi_vehicle_angle_accel(const tsi_vehicle_state *st, const double th[3],
-                             const double thd[3], const ts_frame *f,
-                             const double alpha_m[3], double thdd[3])
+                             const double thd[3], double turn_rate,
+                             double turn_accel, const double alpha_m[3],
+                             double thdd[3])
 {
     double fr[3], a[3], omd_b[3], kap[3];
-    tsi_vehicle_frame_alpha(st, f, fr);
+    tsi_vehicle_frame_alpha(st, turn_rate, turn_accel, fr);
     for (int j = 0; j < 3; j++)
         a[j] = alpha_m[j] - fr[j];
     mat3_tmul(st->R, a, omd_b);
@@ -620,15 +610,15 @@ void tsi_vehicle_angle_accel(const tsi_vehicle_state *st, const double th[3],
     tsi_rates_from_omega(th, omd_b, thdd);
 }
 
-void tsi_vehicle_frame_alpha(const tsi_vehicle_state *st, const ts_frame *f,
-                             double alpha_m[3])
+void tsi_vehicle_frame_alpha(const tsi_vehicle_state *st, double turn_rate,
+                             double turn_accel, double alpha_m[3])
 {
     double om_m[3];
     mat3_mul(st->R, st->om_rel_b, om_m);
     /* W' e_z + W e_z x omega_rel */
-    alpha_m[0] = -f->turn_rate * om_m[1];
-    alpha_m[1] = f->turn_rate * om_m[0];
-    alpha_m[2] = f->turn_accel;
+    alpha_m[0] = -turn_rate * om_m[1];
+    alpha_m[1] = turn_rate * om_m[0];
+    alpha_m[2] = turn_accel;
 }
 
 /* ------------------------------------------------------------------ */

@@ -26,8 +26,6 @@
 #ifndef TOWSTAB_VEHICLE_IMPL_H
 #define TOWSTAB_VEHICLE_IMPL_H
 
-#include "towstab/kernel.h"
-#include "towstab/system.h"
 #include "towstab/vehicle.h"
 
 /* Work areas that outlive one evaluation: interpolators of tabulated
@@ -47,9 +45,10 @@ typedef struct tsi_vehicle_state {
     double rA[3], rdA[3]; /* attach point, M frame, position and velocity
                              relative to M */
     double rO[3], rdO[3]; /* body origin */
-    double wO_b[3];     /* velocity of O relative to the water, body axes */
+    double wO_b[3];     /* velocity of O relative to the water, body axes
+                           (the kernel's, from the frame and the current) */
     double frac;        /* submerged fraction (buoyancy, fluid forces,
-                           added mass) */
+                           added mass; the kernel's) */
 } tsi_vehicle_state;
 
 /* Rotation of the 1-2-3 sequence: R123 = R1(t1) R2(t2) R3(t3), body to
@@ -73,11 +72,11 @@ void tsi_ypr_rates(const double ypr[3], const double om_b[3],
                    double yprd[3]);
 
 /* Kinematics: chart C (row-major, body-chart to M), angles th and rates
- * thd, the frame, and the attach point's position and velocity (M,
- * relative to M). Fills st (the water's density only decides frac). */
+ * thd, the frame's turn rate W (rad/s), and the attach point's position
+ * and velocity (M, relative to M). Fills st but wO_b and frac. */
 void tsi_vehicle_kinematics(const ts_vehicle *v, const double C[9],
                             const double th[3], const double thd[3],
-                            const ts_frame *f, const double rA[3],
+                            double turn_rate, const double rA[3],
                             const double rdA[3], tsi_vehicle_state *st);
 
 /* Position and velocity relative to M of body point p_b (from O). */
@@ -118,16 +117,18 @@ void tsi_vehicle_loads(const ts_vehicle *v, const tsi_vehicle_ws *w,
                        double G[6], double munk[3]);
 
 /* Angle accelerations from the inertial angular acceleration alpha_m (M
- * components): omega_rel_b' = R^T (alpha - W' e_z - W e_z x omega_rel),
+ * components), the frame's turn rate W and its rate W' (rad/s, rad/s^2):
+ * omega_rel_b' = R^T (alpha - W' e_z - W e_z x omega_rel),
  * theta'' = E^-1 (omega_rel_b' - kappa). */
 void tsi_vehicle_angle_accel(const tsi_vehicle_state *st, const double th[3],
-                             const double thd[3], const ts_frame *f,
-                             const double alpha_m[3], double thdd[3]);
+                             const double thd[3], double turn_rate,
+                             double turn_accel, const double alpha_m[3],
+                             double thdd[3]);
 
 /* The frame part of the angular acceleration, W' e_z + W e_z x
  * omega_rel_m (what alpha is when the attitude is steady in M). */
-void tsi_vehicle_frame_alpha(const tsi_vehicle_state *st, const ts_frame *f,
-                             double alpha_m[3]);
+void tsi_vehicle_frame_alpha(const tsi_vehicle_state *st, double turn_rate,
+                             double turn_accel, double alpha_m[3]);
 
 /* Measurements (ts_measure order: depth, pitch, roll, heading) and their
  * rates: depth is z of O, the angles yaw-pitch-roll relative to M. */

@@ -1,5 +1,5 @@
 /* towstab/kernel.h: the one dynamics kernel, y' = f(y, u), of the rigid-link
- * tree (doc/model.md sections 1-4, 8; Kamman & Nguyen 1990, eqs. 4-11,
+ * tree (doc/model.md sections 1-4, 7 and 8; Kamman & Nguyen 1990, eqs. 4-11,
  * 12-22, 43-44).
  *
  * State y[2 nq + nc]: y[0..nq) the generalised coordinates, y[nq..2nq)
