@@ -82,6 +82,11 @@ int cli_check_keys(const ts_scene_analysis *a, const char *const keys[],
 /* Text of option `key` of a scene analysis, or NULL. */
 const char *cli_option(const ts_scene_analysis *a, const char *key);
 
+/* The vehicles' attitudes, flow angles and depths, their control
+ * deflections and (unless quiet) their components' loads. */
+void cli_print_vehicles(FILE *f, const ts_system *sys,
+                        const ts_vehicle_result *vr, int nv, int quiet);
+
 /* Solve and print an equilibrium (summary always, tables unless quiet).
  * *out receives the result (caller frees, may be partial on failure);
  * *json, when not NULL, its JSON. Returns the library code. */
