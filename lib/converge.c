@@ -361,6 +361,10 @@ int ts_convergence_add_row(ts_convergence *c, int series, double setting,
         r->trust = *trust;
     else
         ts_trust_init(&r->trust);
+    /* A failed run is not trustworthy, whatever its statistics say. */
+    if (status != TS_OK)
+        ts_trust_fail(&r->trust, "the run failed: %s",
+                      message && message[0] ? message : ts_strerror(status));
     for (size_t i = 0; i < nv; i++) {
         r->values[i] = status == TS_OK && values ? values[i] : NAN;
         r->noise[i] = noise && noise[i] >= 0 ? noise[i] : 0.0;

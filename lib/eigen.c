@@ -1,5 +1,5 @@
 /* eigen.c: modes of the linear model z' = A z (towstab/eigen.h;
- * MODEL.md section 6; doc/linear.md).
+ * doc/model.md section 6; doc/linear.md).
  *
  * lapack: dgeevx on a copy of A (balancing, Hessenberg QR; ~25 n^3 flops
  * with both eigenvector sets) gives every eigenvalue with its right
@@ -35,7 +35,7 @@
 #include "arpack.h"
 #include "eigen_impl.h"
 #include "lapack.h"
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 /* |Im lambda| below this fraction of |lambda| makes an eigenvalue from the
  * complex solver real (its imaginary part is rounding). */
@@ -1189,7 +1189,7 @@ void ts_eigen_describe(const ts_system *sys, const ts_linear *lin,
     else
         snprintf(plane, sizeof plane, "mixed (%.0f%% out-of-plane)",
                  100 * share);
-    ts_report_node_name(sys, inode, node, sizeof node);
+    ts_system_node_name(sys, inode, node, sizeof node);
     snprintf(buf, size, "%s%s, cable '%s' order %d (%d node%s), largest at %s",
              e->modes[m].im > 0 ? "" : "real: ", plane, sys->cables[cb].name,
              crossings + 1, crossings, crossings == 1 ? "" : "s", node);

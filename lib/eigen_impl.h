@@ -1,6 +1,6 @@
 /* eigen_impl.h: what eigen.c shares with response.c (internal): the
- * LAPACK/BLAS routines beyond lib/lapack.h, and the structured solver of
- * (A - s I) x = b for A = [[0, I], [K, C]] (doc/linear.md).
+ * structured solver of (A - s I) x = b for A = [[0, I], [K, C]]
+ * (doc/linear.md).
  *
  * With x = (x1, x2) and b = (b1, b2) (nq each): x2 = b1 + s x1 and
  * P(s) x1 = b2 - C b1 + s b1 with P(s) = K + s C - s^2 I. P is factored
@@ -12,35 +12,9 @@
 
 #include <complex.h>
 
+#include "lapack.h"
 #include "towstab/error.h"
 #include "towstab/linearize.h"
-
-/* LAPACK / BLAS (Fortran; hidden CHARACTER lengths trail, size_t). */
-void dgeev_(const char *jobvl, const char *jobvr, const int *n, double *a,
-            const int *lda, double *wr, double *wi, double *vl,
-            const int *ldvl, double *vr, const int *ldvr, double *work,
-            const int *lwork, int *info, size_t jobvl_len, size_t jobvr_len);
-void dgeevx_(const char *balanc, const char *jobvl, const char *jobvr,
-             const char *sense, const int *n, double *a, const int *lda,
-             double *wr, double *wi, double *vl, const int *ldvl, double *vr,
-             const int *ldvr, int *ilo, int *ihi, double *scale,
-             double *abnrm, double *rconde, double *rcondv, double *work,
-             const int *lwork, int *iwork, int *info, size_t balanc_len,
-             size_t jobvl_len, size_t jobvr_len, size_t sense_len);
-void zgetrf_(const int *m, const int *n, double complex *a, const int *lda,
-             int *ipiv, int *info);
-void zgetrs_(const char *trans, const int *n, const int *nrhs,
-             const double complex *a, const int *lda, const int *ipiv,
-             double complex *b, const int *ldb, int *info, size_t trans_len);
-void dgemv_(const char *trans, const int *m, const int *n,
-            const double *alpha, const double *a, const int *lda,
-            const double *x, const int *incx, const double *beta, double *y,
-            const int *incy, size_t trans_len);
-void dgemm_(const char *transa, const char *transb, const int *m,
-            const int *n, const int *k, const double *alpha, const double *a,
-            const int *lda, const double *b, const int *ldb,
-            const double *beta, double *c, const int *ldc, size_t transa_len,
-            size_t transb_len);
 
 /* A factored P(s) of a linear model. */
 typedef struct tsi_shift {

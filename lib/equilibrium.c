@@ -1,5 +1,5 @@
 /* equilibrium.c: steady configurations (towstab/equilibrium.h,
- * doc/equilibrium.md; MODEL.md section 5).
+ * doc/equilibrium.md; doc/model.md section 5).
  *
  * The fast path marches from the free ends and shoots on their positions
  * (march.c). The general path is Newton on q''(q) = 0 over all angles:

@@ -5,7 +5,7 @@
  * closed form, so the kernel's input u = (x, x', x'') is exactly consistent
  * (a finite-difference velocity would break the rigid links' kinematics).
  *  - sine: x = A sin th, th = w t + phase.
- *  - slider crank (MODEL.md section 8): with S = sqrt(l^2 - A^2 sin^2 th),
+ *  - slider crank (doc/model.md section 8): with S = sqrt(l^2 - A^2 sin^2 th),
  *      x   = A cos th + l - S,
  *      x'  = w (-A sin th + A^2 sin th cos th / S),
  *      x'' = w^2 (-A cos th + A^2 cos 2th / S + (A^2 sin th cos th)^2 / S^3).

@@ -14,7 +14,7 @@
  *    rad: two modes closer than their errors allow have shapes that can
  *    mix (Stewart & Sun, Matrix Perturbation Theory, 1990, ch. V); the
  *    stability margin against its error; nodes at the water surface, where
- *    A is the mean of one-sided derivatives (MODEL.md section 6); ARPACK
+ *    A is the mean of one-sided derivatives (doc/model.md section 6); ARPACK
  *    residuals.
  * The verdict is a ts_trust: trustworthy or not, with reasons and notes as
  * sentences that name the quantity, its size and the limit.
@@ -28,7 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 /* An ARPACK Ritz pair with a larger residual (relative to ||A||_F |v|)
  * is not an eigenpair to trust. */
@@ -230,7 +230,7 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
     if (lin->kinks > lin->kink_tow) {
         char name[2 * TS_NAME_MAX];
         if (sys)
-            ts_report_node_name(sys, lin->kink_node, name, sizeof name);
+            ts_system_node_name(sys, lin->kink_node, name, sizeof name);
         else
             snprintf(name, sizeof name, "node %d", lin->kink_node);
         ts_trust_fail(t, "%d node%s (first %s, depth %.3g m) within a "

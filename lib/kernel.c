@@ -1,4 +1,4 @@
-/* kernel.c: f(y, u) of the rigid-link tree (MODEL.md sections 1-4).
+/* kernel.c: f(y, u) of the rigid-link tree (doc/model.md sections 1-4).
  *
  * Algorithm, O(nlinks) per call:
  *  1. Kinematics, tow point to free ends: link directions n, e1, e2 and

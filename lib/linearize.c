@@ -1,5 +1,5 @@
 /* linearize.c: A = df/dy, B = df/du about a state (towstab/linearize.h;
- * MODEL.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
  *
  * Algorithm. For every column j (n state columns, then TS_NINPUT input
  * columns) the coordinate x_j is perturbed by +-h_j and the kernel is

@@ -1,5 +1,5 @@
 /* response.c: frequency response to tow-point motion (towstab/response.h;
- * MODEL.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
  *
  * Algorithm, per frequency w: s = i w; b = B_x + s B_v + s^2 B_a (lower
  * half only: the upper nq rows of B are zero); Z = (s I - A)^-1 b
@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "eigen_impl.h"
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 static const char *const input_names[3] = {"tow.surge", "tow.sway",
                                            "tow.heave"};
@@ -158,7 +158,7 @@ int ts_response_output_find(const ts_system *sys, const char *name,
         out->comp = comp;
         out->unit = "m/m";
         char nm[2 * TS_NAME_MAX];
-        ts_report_node_name(sys, out->node, nm, sizeof nm);
+        ts_system_node_name(sys, out->node, nm, sizeof nm);
         snprintf(out->name, sizeof out->name, "%s.%c", nm, "xyz"[comp]);
     }
     return TS_OK;

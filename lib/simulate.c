@@ -57,11 +57,7 @@
 
 #include "esdirk.h"
 #include "expm.h"
-
-void dgemv_(const char *trans, const int *m, const int *n,
-            const double *alpha, const double *a, const int *lda,
-            const double *x, const int *incx, const double *beta, double *y,
-            const int *incy, size_t trans_len);
+#include "lapack.h"
 
 /* Interpolation error constant of the cubic input hold (see above). */
 #define CUBIC_HOLD_ERR 5.1e-4

@@ -1,5 +1,5 @@
 /* system.c: validation of a towed system and its discretisation into a tree
- * of rigid links and lumped nodes (MODEL.md section 2).
+ * of rigid links and lumped nodes (doc/model.md section 2).
  *
  * Cables are ordered breadth-first from the tow point, so every link comes
  * after the link above it: a forward loop over links runs from the tow
@@ -113,6 +113,22 @@ int ts_system_find_body(const ts_system *s, const char *name)
         if (strcmp(s->bodies[i].name, name) == 0)
             return i;
     return -1;
+}
+
+void ts_system_node_name(const ts_system *sys, int node, char *buf,
+                         size_t size)
+{
+    if (node == 0) {
+        snprintf(buf, size, "tow");
+        return;
+    }
+    const ts_node *nd = &sys->nodes[node];
+    if (nd->body >= 0) {
+        snprintf(buf, size, "%s", sys->bodies[nd->body].name);
+        return;
+    }
+    const ts_link *L = &sys->links[nd->link];
+    snprintf(buf, size, "%s.%d", sys->cables[L->cable].name, L->index);
 }
 
 int ts_system_body_node(const ts_system *s, int b)

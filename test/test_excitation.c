@@ -4,7 +4,7 @@
  *  1. Every shape's velocity and acceleration against central differences
  *     of its displacement and velocity (they must be exact derivatives, or
  *     the rigid-link kinematics would be inconsistent).
- *  2. Closed-form values: sine, the slider crank of MODEL.md section 8,
+ *  2. Closed-form values: sine, the slider crank of doc/model.md section 8,
  *     the end values and midpoint of steps and ramps, the ramp's plateau
  *     rate and its linear part x = A/T (t - start - rise/2).
  *  3. Series: a sampled sinusoid through the cubic spline, its
@@ -90,7 +90,7 @@ static void test_shapes(void)
           "%.2g, %.2g m/s, m/s^2 < 1e-8)", ev, ea);
     ts_excitation_free(ex);
 
-    /* Slider crank, MODEL.md section 8: z = r cos th + l (1 - sqrt(1 -
+    /* Slider crank, doc/model.md section 8: z = r cos th + l (1 - sqrt(1 -
      * (r/l)^2 sin^2 th)), with awkward r/l so that the rod term matters. */
     s.type = TS_SIGNAL_CRANK;
     s.axis = TS_AXIS_SURGE;
@@ -107,7 +107,7 @@ static void test_shapes(void)
         ts_excitation_input(ex, tt, u);
         maxd = fmax(maxd, fabs(u[0] - z));
     }
-    CHECK(maxd < 1e-15, "crank displacement is MODEL.md's formula (max err "
+    CHECK(maxd < 1e-15, "crank displacement is doc/model.md section 8's (max err "
           "%.2g m < 1e-15)", maxd);
     fd_check(ex, 0, 0.0, 3.2, 60, h, &ev, &ea);
     CHECK(ev < 1e-8 && ea < 1e-7, "crank v, a are the derivatives (max err "

@@ -1,6 +1,7 @@
 /* cli.c: helpers shared by the towstab subcommands (cli.h). */
 #include "cli.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,6 +44,92 @@ int cli_write_json(const json_t *value, const char *path, ts_err *err)
     bad |= fclose(f) != 0;
     return bad ? ts_fail(err, TS_EIO, "standard output: cannot write JSON")
                : TS_OK;
+}
+
+void cli_json_mark(json_t *j, int status, const char *msg)
+{
+    if (!j)
+        return;
+    json_object_set_new(j, "completed", json_boolean(status == 0));
+    if (status == 0)
+        return;
+    json_object_set_new(j, "error", json_string(msg && msg[0] ? msg
+                                                             : "failed"));
+    json_object_set_new(j, "trustworthy", json_false());
+    json_object_set_new(j, "reasons",
+                        json_pack("[s]", msg && msg[0] ? msg : "failed"));
+    if (!json_object_get(j, "notes"))
+        json_object_set_new(j, "notes", json_array());
+}
+
+json_t *cli_json_failed(const char *msg)
+{
+    json_t *j = json_object();
+    cli_json_mark(j, EXIT_FAILED, msg);
+    return j;
+}
+
+int cli_write_result(json_t *j, const char *path, int status,
+                     const char *msg)
+{
+    if (!path || status == EXIT_BADINPUT || (status && !j))
+        return status;
+    ts_err werr = {0};
+    if (!j)
+        ts_fail(&werr, TS_ENOMEM, "%s: out of memory", path);
+    cli_json_mark(j, status, msg);
+    if (!j || cli_write_json(j, path, &werr) != TS_OK) {
+        int st = cli_report(&werr, werr.code);
+        status = status ? status : st;
+    }
+    return status;
+}
+
+int cli_check_outputs(const char *cmd, int n, const char *const what[],
+                      const char *const paths[], const char *plot_dir,
+                      const char *const plot_names[])
+{
+    enum { MAX_OUT = 32 };
+    const char *w[MAX_OUT], *p[MAX_OUT];
+    char files[MAX_OUT][1200];
+    int m = 0;
+    for (int i = 0; i < n && m < MAX_OUT; i++, m++) {
+        w[m] = what[i];
+        p[m] = paths[i];
+    }
+    static const char *const ext[2] = {"png", "svg"};
+    for (int i = 0; plot_dir && plot_names && plot_names[i]; i++)
+        for (int k = 0; k < 2 && m < MAX_OUT; k++, m++) {
+            snprintf(files[m], sizeof files[m], "%s/%s.%s", plot_dir,
+                     plot_names[i], ext[k]);
+            w[m] = "--plot";
+            p[m] = files[m];
+        }
+    ts_err err = {0};
+    if (ts_report_check_targets(m, w, p, &err) != TS_OK) {
+        fprintf(stderr, "towstab: error: %s: %s\n", cmd, err.msg);
+        return EXIT_BADINPUT;
+    }
+    return 0;
+}
+
+int cli_finish(int status)
+{
+    int e = 0, bad = ferror(stdout);
+    if (fflush(stdout) != 0)
+        e = errno;
+    if (fclose(stdout) != 0 && !e)
+        e = errno;
+    if (bad || e) {
+        fprintf(stderr, "towstab: error: standard output: write failed%s%s%s"
+                        "\n",
+                e ? " (" : "", e ? strerror(e) : "", e ? ")" : "");
+        if (status == 0)
+            status = EXIT_FAILED;
+    }
+    if ((fflush(stderr) != 0 || ferror(stderr)) && status == 0)
+        status = EXIT_FAILED;
+    return status;
 }
 
 double cli_wall_now(void)
@@ -280,7 +367,7 @@ static void print_equilibrium(FILE *f, const ts_system *sys,
                 "z [m]");
         for (int i = 0; i < sys->nnodes; i++) {
             const double *r = eq->positions + 3 * i;
-            ts_report_node_name(sys, i, name, sizeof name);
+            ts_system_node_name(sys, i, name, sizeof name);
             fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", name, r[0], r[1], r[2]);
         }
         fprintf(f, "\n%-20s %6s %14s %14s %14s\n", "cable", "link",

@@ -120,8 +120,40 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
  * cli_stdout_for_json() does that once, before anything is printed. */
 void cli_stdout_for_json(void);
 
-/* Write JSON to `path` ("-": the JSON standard output), atomically. */
+/* Write JSON to `path` ("-": the JSON standard output), as
+ * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
+
+/* Mark a result: "completed": true, or for a failed run (status != 0)
+ * "completed": false, "error": msg (the text standard error got) and the
+ * verdict "trustworthy": false with msg as its reason. */
+void cli_json_mark(json_t *j, int status, const char *msg);
+
+/* The JSON of a run that failed before it had a result: {"completed":
+ * false, "error", "trustworthy": false, "reasons": [msg], "notes": []}. */
+json_t *cli_json_failed(const char *msg);
+
+/* Write the result j of a run that ended with `status` and message `msg`
+ * to `path` (may be NULL): a failed analysis (status 1) writes what it has
+ * (j, may be NULL: then nothing) marked as incomplete (cli_json_mark);
+ * bad input (status 2) writes nothing. Returns the new status (1 when the
+ * write failed, after printing). */
+int cli_write_result(json_t *j, const char *path, int status,
+                     const char *msg);
+
+/* Refuse, before anything runs, outputs that name the same file
+ * (ts_report_check_targets): the n options what[i] with paths[i] (NULL
+ * when not given), and the pictures `plot_names` (NULL-terminated, each
+ * written as NAME.png and NAME.svg) that --plot writes into plot_dir (may
+ * be NULL). Prints and returns EXIT_BADINPUT, or 0. */
+int cli_check_outputs(const char *cmd, int n, const char *const what[],
+                      const char *const paths[], const char *plot_dir,
+                      const char *const plot_names[]);
+
+/* At the end of main: flush and close standard output and standard error,
+ * checking both; a failed write turns status 0 into EXIT_FAILED (with a
+ * message naming standard output). Returns the status. */
+int cli_finish(int status);
 
 /* All subcommands, NULL-terminated (tools/towstab.c). */
 extern const cli_command *const cli_commands[];

@@ -285,7 +285,7 @@ int cli_sim_prepare(const cli_ctx *ctx, const cli_sim_args *a,
             for (int b = sys->nbodies - 1; b >= 0; b--)
                 if (sys->bodies[b].type == TS_BODY_SPHERE)
                     node = ts_system_body_node(sys, b);
-            ts_report_node_name(sys, node, def, sizeof def - 2);
+            ts_system_node_name(sys, node, def, sizeof def - 2);
             strcat(def, ".z");
             name = def;
         }

@@ -785,7 +785,13 @@ static int conv_main(int argc, char **argv)
                         "--integrator apply to --analysis simulate\n");
         return EXIT_BADINPUT;
     }
-    int pstatus = cli_plot_begin(&plot, "converge");
+    static const char *const what[2] = {"--json", "--csv"};
+    static const char *const pictures[] = {"error_time", NULL};
+    const char *paths[2] = {json_path, csv_path};
+    int pstatus = cli_check_outputs("converge", 2, what, paths, plot.dir,
+                                    pictures);
+    if (!pstatus)
+        pstatus = cli_plot_begin(&plot, "converge");
     if (pstatus)
         return pstatus;
     ts_units *units;
@@ -821,10 +827,8 @@ static int conv_main(int argc, char **argv)
     int rc = converge_analysis(sys, &eqo, &rq, &sp, quiet, &json, &c, &err);
     if (rc != TS_OK)
         status = cli_report(&err, rc);
+    status = cli_write_result(json, json_path, status, err.msg);
     ts_err werr = {0};
-    if (rc == TS_OK && json_path &&
-        cli_write_json(json, json_path, &werr) != TS_OK)
-        status = cli_report(&werr, werr.code);
     if (rc == TS_OK && csv_path &&
         ts_report_convergence_csv(c, csv_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
@@ -953,6 +957,9 @@ static int conv_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     int rc = converge_analysis(sys, &eqo, &rq, &sp, ctx->quiet, result, &c,
                                &err);
     int status = rc ? cli_report(&err, rc) : 0;
+    if (status && !*result)
+        *result = cli_json_failed(err.msg);
+    cli_json_mark(*result, status, err.msg);
     ts_convergence_free(c);
     ts_system_free(sys);
     cli_sim_prep_free(&sp);

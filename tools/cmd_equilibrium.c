@@ -309,7 +309,13 @@ static int eq_main(int argc, char **argv)
                 MAX_OVERLAYS, nspeeds + nturns + noverlay_scenes);
         return EXIT_BADINPUT;
     }
-    int status = cli_plot_begin(&plot, "equilibrium");
+    static const char *const what[2] = {"--json", "--csv"};
+    static const char *const pictures[] = {"side", "top", NULL};
+    const char *paths[2] = {json_path, csv_path};
+    int status = cli_check_outputs("equilibrium", 2, what, paths, plot.dir,
+                                   pictures);
+    if (!status)
+        status = cli_plot_begin(&plot, "equilibrium");
     if (status)
         return status;
     ts_units *units;
@@ -363,9 +369,8 @@ static int eq_main(int argc, char **argv)
                                  json_path ? &json : NULL, &err);
         if (rc)
             status = cli_report(&err, rc);
+        status = cli_write_result(json, json_path, status, err.msg);
         ts_err werr = {0};
-        if (json && cli_write_json(json, json_path, &werr) != TS_OK)
-            status = cli_report(&werr, werr.code);
         if (csv_path && eq && eq->converged &&
             ts_report_equilibrium_csv(sys, eq, csv_path, &werr) != TS_OK)
             status = cli_report(&werr, werr.code);
@@ -413,6 +418,7 @@ static int eq_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
         ts_equilibrium *eq = NULL;
         int rc = cli_equilibrium(sys, &eo, ctx->quiet, &eq, result, &err);
         status = rc ? cli_report(&err, rc) : 0;
+        cli_json_mark(*result, status, err.msg);
         ts_equilibrium_free(eq);
     }
     ts_system_free(sys);

@@ -68,7 +68,7 @@ int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
            l->trunc_norm);
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
-        ts_report_node_name(sys, l->kink_node, name, sizeof name);
+        ts_system_node_name(sys, l->kink_node, name, sizeof name);
         printf("warning: %d node%s (first %s, depth %.3g m) within a step "
                "of the water surface: f is not smooth there, A is the mean "
                "of one-sided derivatives and the modes near it are not "
@@ -478,7 +478,13 @@ static int modes_main(int argc, char **argv)
     ts_err err = {0};
     if (method && parse_method(method, "--method", &rq.eo.method, &err))
         return cli_report(&err, err.code);
-    int pstatus = cli_plot_begin(&plot, "modes");
+    static const char *const what[3] = {"--json", "--csv", "--shapes"};
+    static const char *const pictures[] = {"eigenvalues", "modes", NULL};
+    const char *paths[3] = {json_path, csv_path, shapes_path};
+    int pstatus = cli_check_outputs("modes", 3, what, paths, plot.dir,
+                                    pictures);
+    if (!pstatus)
+        pstatus = cli_plot_begin(&plot, "modes");
     if (pstatus)
         return pstatus;
     ts_units *units;
@@ -515,10 +521,8 @@ static int modes_main(int argc, char **argv)
                             plot.dir ? &pos : NULL, &err);
     if (rc != TS_OK)
         status = cli_report(&err, rc);
+    status = cli_write_result(json, json_path, status, err.msg);
     ts_err werr = {0};
-    if (rc == TS_OK && json_path && json &&
-        cli_write_json(json, json_path, &werr) != TS_OK)
-        status = cli_report(&werr, werr.code);
     if (rc == TS_OK && csv_path &&
         ts_report_modes_csv(sys, lin, e, csv_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
@@ -620,6 +624,9 @@ static int modes_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     int rc = modes_analysis(sys, &eqo, &rq, ctx->quiet, 0, result, &lin, &e,
                             NULL, &err);
     int status = rc ? cli_report(&err, rc) : 0;
+    if (status && !*result)
+        *result = cli_json_failed(err.msg);
+    cli_json_mark(*result, status, err.msg);
     ts_eigen_free(e);
     ts_linear_free(lin);
     ts_system_free(sys);

@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "cli.h"
-#include "towstab/report_converge.h"
 #include "towstab/health.h"
 #include "cli_plot.h"
 #include "towstab/eigen.h"
@@ -118,7 +117,7 @@ static int response_analysis(const ts_system *sys,
             printf("warning: the tow point is at the water surface: the "
                    "heave response uses the mean of the one-sided "
                    "derivatives, and a real heave also shifts the mean "
-                   "depth at first order (MODEL.md section 6)\n");
+                   "depth at first order (doc/model.md section 6)\n");
         print_response(*res, quiet);
         if (nat) {
             ts_eigen_opts o;
@@ -241,7 +240,13 @@ static int response_main(int argc, char **argv)
         usage(stderr);
         return EXIT_BADINPUT;
     }
-    int pstatus = cli_plot_begin(&plot, "response");
+    static const char *const what[2] = {"--json", "--csv"};
+    static const char *const pictures[] = {"bode", NULL};
+    const char *paths[2] = {json_path, csv_path};
+    int pstatus = cli_check_outputs("response", 2, what, paths, plot.dir,
+                                    pictures);
+    if (!pstatus)
+        pstatus = cli_plot_begin(&plot, "response");
     if (pstatus)
         return pstatus;
     ts_units *units;
@@ -283,10 +288,8 @@ static int response_main(int argc, char **argv)
                            plot.dir ? nat : NULL, &nnat, &err);
     if (rc != TS_OK)
         status = cli_report(&err, rc);
+    status = cli_write_result(json, json_path, status, err.msg);
     ts_err werr = {0};
-    if (rc == TS_OK && json_path && json &&
-        cli_write_json(json, json_path, &werr) != TS_OK)
-        status = cli_report(&werr, werr.code);
     if (rc == TS_OK && csv_path &&
         ts_report_response_csv(res, csv_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
@@ -417,6 +420,9 @@ static int response_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
     int rc = response_analysis(sys, &eqo, &rq, ctx->quiet, result, &res, NULL,
                                NULL, &err);
     int status = rc ? cli_report(&err, rc) : 0;
+    if (status && !*result)
+        *result = cli_json_failed(err.msg);
+    cli_json_mark(*result, status, err.msg);
     ts_response_free(res);
     ts_system_free(sys);
     return status;

@@ -100,12 +100,14 @@ static int run_main(int argc, char **argv)
             json_array_append_new(list, j);
         }
     }
-    /* Results only when every analysis succeeded: a file holding some of
-     * them would look complete. */
-    ts_err werr = {0};
-    if (json_path && status == 0 &&
-        cli_write_json(all, json_path, &werr) != TS_OK)
-        status = cli_report(&werr, werr.code);
+    /* After a failure the results so far, marked as incomplete with the
+     * failed analysis' message; nothing after bad input. */
+    const char *msg = NULL;
+    size_t nres = json_array_size(list);
+    if (status && nres > 0)
+        msg = json_string_value(
+            json_object_get(json_array_get(list, nres - 1), "error"));
+    status = cli_write_result(all, json_path, status, msg);
     json_decref(all);
     cli_close(units, scene);
     return status;

@@ -13,7 +13,6 @@
 #include <string.h>
 
 #include "cli.h"
-#include "towstab/report_converge.h"
 #include "towstab/health.h"
 #include "cli_plot.h"
 #include "cli_sim.h"
@@ -113,7 +112,7 @@ static int read_shape(const ts_system *sys, const char *path,
         }
         int k = 0;
         for (; !rc && k < sys->nnodes; k++) {
-            ts_report_node_name(sys, k, name, sizeof name);
+            ts_system_node_name(sys, k, name, sizeof name);
             if (!strcmp(name, line))
                 break;
         }
@@ -128,7 +127,7 @@ static int read_shape(const ts_system *sys, const char *path,
     fclose(f);
     for (int k = 1; !rc && k < sys->nnodes; k++)
         if (!seen[k]) {
-            ts_report_node_name(sys, k, name, sizeof name);
+            ts_system_node_name(sys, k, name, sizeof name);
             rc = ts_fail(err, TS_EINVAL, "%s: %s has no row for node '%s'",
                          where, path, name);
         }
@@ -158,7 +157,7 @@ static void print_table(const ts_system *sys, const ts_output *out,
     if (!h || h->nsamples == 0)
         return;
     char name[2 * TS_NAME_MAX];
-    ts_report_node_name(sys, out->node, name, sizeof name);
+    ts_system_node_name(sys, out->node, name, sizeof name);
     int stride = (h->nsamples + TABLE_ROWS - 1) / TABLE_ROWS;
     printf("\n%10s %16s %16s %16s", "t [s]", "x [m]", "y [m]", "z [m]");
     if (nl && li)
@@ -482,7 +481,7 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
         if (lin->kinks)
             printf("note: %d node%s within a step of the water surface "
                    "(%s): f is not smooth there, and the linear model uses "
-                   "the mean of the one-sided derivatives (MODEL.md "
+                   "the mean of the one-sided derivatives (doc/model.md "
                    "section 6)\n", lin->kinks, lin->kinks == 1 ? " sits" :
                    "s sit", lin->kink_tow ? "the tow point among them"
                                           : "not the tow point");
@@ -543,13 +542,6 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
         ts_health_simulation(&s.o, &st_nl, &trust);
     if (hl && s.o.linear_method != TS_LINSIM_EXPM)
         ts_health_simulation(&s.o, &st_lin, &trust);
-    if (ran) {
-        printf("trustworthy: %s\n", trust.trustworthy ? "yes" : "NO");
-        for (int i = 0; i < trust.nreasons; i++)
-            printf("  reason: %s\n", trust.reasons[i]);
-        for (int i = 0; i < trust.nnotes; i++)
-            printf("  note: %s\n", trust.notes[i]);
-    }
     if (s.compare && !status) {
         rc = ts_compare_histories(sys, lin, ex, hn, hl, &s.out, s.transient,
                                   &cmp, &err);
@@ -558,9 +550,20 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
             status = cli_report(&err, rc);
         } else {
             have_cmp = 1;
-            print_compare(&cmp);
         }
     }
+    /* A failed run is not trustworthy, whatever its statistics say. */
+    if (status)
+        ts_trust_fail(&trust, "the run failed: %s", err.msg);
+    if (ran) {
+        printf("trustworthy: %s\n", trust.trustworthy ? "yes" : "NO");
+        for (int i = 0; i < trust.nreasons; i++)
+            printf("  reason: %s\n", trust.reasons[i]);
+        for (int i = 0; i < trust.nnotes; i++)
+            printf("  note: %s\n", trust.notes[i]);
+    }
+    if (have_cmp)
+        print_compare(&cmp);
 
     /* Results, also after a failed run (the history so far). */
     j = json_object();
@@ -793,6 +796,16 @@ static int sim_main(int argc, char **argv)
             memcpy(cs.where[4], es.where[4], sizeof cs.where[4]);
         }
         break;
+    }
+    static const char *const what[2] = {"--json", "--csv"};
+    static const char *const pictures[] = {"histories", "snapshots_side",
+                                           "snapshots_top", NULL};
+    const char *paths[2] = {a.json, a.val[SIM_A_CSV]};
+    status = cli_check_outputs("simulate", 2, what, paths, plot.dir,
+                               pictures);
+    if (status) {
+        cli_close(units, scene);
+        return status;
     }
     cli_ctx ctx = {scene, units, a.quiet};
     json_t *j = NULL;

@@ -2,7 +2,9 @@
  * each prints a table and optionally writes JSON or CSV (SI units).
  * Exit status: 0 success, 1 the analysis failed (no convergence, singular
  * system, output not written), 2 bad input (usage, scene, units, an
- * impossible configuration). The manual is doc/manual.md. */
+ * impossible configuration). Standard output and standard error are
+ * checked when the command ends: a table that could not be written is a
+ * failure too. The manual is doc/manual.md. */
 #include <stdio.h>
 #include <string.h>
 
@@ -34,16 +36,16 @@ int main(int argc, char **argv)
 {
     if (argc < 2) {
         usage(stderr);
-        return EXIT_BADINPUT;
+        return cli_finish(EXIT_BADINPUT);
     }
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
         strcmp(argv[1], "help") == 0) {
         usage(stdout);
-        return 0;
+        return cli_finish(0);
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("towstab 0.1.0\n");
-        return 0;
+        return cli_finish(0);
     }
     /* `--json -`: keep standard output for the JSON alone. */
     for (int i = 2; i < argc; i++)
@@ -53,8 +55,8 @@ int main(int argc, char **argv)
             cli_stdout_for_json();
     for (int i = 0; cli_commands[i]; i++)
         if (strcmp(argv[1], cli_commands[i]->name) == 0)
-            return cli_commands[i]->main(argc - 1, argv + 1);
+            return cli_finish(cli_commands[i]->main(argc - 1, argv + 1));
     fprintf(stderr, "towstab: error: unknown command '%s' (towstab --help)\n",
             argv[1]);
-    return EXIT_BADINPUT;
+    return cli_finish(EXIT_BADINPUT);
 }

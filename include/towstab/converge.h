@@ -165,7 +165,8 @@ TS_API int ts_convergence_add_series(ts_convergence *c, const char *name,
 /* Add a row to series `series`: the run at `setting` ended with `status`
  * (message: its error text or NULL) after wall_s seconds and
  * `evaluations` evaluations; values[nvalues] and noise[nvalues] (NULL:
- * zero) as the run gave them, trust its health (NULL: trustworthy).
+ * zero) as the run gave them, trust its health (NULL: trustworthy; a
+ * failed run is made untrustworthy with its message as the reason).
  * TS_EINVAL for a setting outside the parameter's range or already in the
  * series, TS_ENOMEM when the table is full or memory runs out. */
 TS_API int ts_convergence_add_row(ts_convergence *c, int series,

@@ -1,5 +1,5 @@
 /* towstab/equilibrium.h: steady configurations, straight tow and steady turn
- * (MODEL.md section 5; Kamman & Nguyen eq. 55).
+ * (doc/model.md section 5; Kamman & Nguyen eq. 55).
  *
  * An equilibrium is a state with q' = 0 and q''(q) = 0 for the kernel's
  * frame (speed V, turn rate Omega). Convergence is judged on forces: the

@@ -1,5 +1,5 @@
 /* towstab/excitation.h: prescribed motions as functions of time, for the
- * simulator (doc/simulate.md; MODEL.md sections 1 and 8).
+ * simulator (doc/simulate.md; doc/model.md sections 1 and 8).
  *
  * An excitation is a list of signals. A signal drives one axis:
  *  - a tow-point axis (surge x, sway y, heave z of the mean ship frame M):
@@ -10,12 +10,12 @@
  *  - a manoeuvre axis (the speed V of M, or its turn rate Omega): the
  *    signal is the change of V (m/s) or Omega (rad/s) from the base frame,
  *    and the frame of time t carries the matching speed_rate / turn_accel
- *    (MODEL.md section 1). The current, fixed in inertial space, rotates in
- *    M by the heading change psi(t) = integral of Omega.
+ *    (doc/model.md sections 1 and 10). The current, fixed in inertial
+ *    space, rotates in M by the heading change psi(t) = integral of Omega.
  *
  * Signal shapes (t in s; A the amplitude; w = 2 pi f):
  *  - sine:   A sin(w t + phase), for all t >= 0;
- *  - crank:  slider crank of radius A and rod l (MODEL.md section 8),
+ *  - crank:  slider crank of radius A and rod l (doc/model.md section 8),
  *            A cos(th) + l (1 - sqrt(1 - (A/l)^2 sin^2 th)), th = w t + phase;
  *  - step:   0 before `start`, A after `start + rise`, in between the quintic
  *            A S(xi), S(xi) = 10 xi^3 - 15 xi^4 + 6 xi^5, xi = (t-start)/rise:

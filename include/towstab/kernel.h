@@ -1,9 +1,10 @@
 /* towstab/kernel.h: the one dynamics kernel, y' = f(y, u), of the rigid-link
- * tree (MODEL.md sections 1-4; Kamman & Nguyen 1990, eqs. 4-11, 20-22, 43-44).
+ * tree (doc/model.md sections 1-4 and 7; Kamman & Nguyen 1990, eqs. 4-11,
+ * 20-22, 43-44).
  *
  * State y[2 nq]: y[0..nq) the generalised coordinates, y[nq..2nq) their
  * rates. A rigid link has two, its angles theta1, theta2 in its chart
- * (rad); an elastic link (EA > 0, MODEL.md section 7) three, its angles
+ * (rad); an elastic link (EA > 0, doc/model.md section 7) three, its angles
  * and its strain e (length l (1 + e)). Link l's coordinates start at
  * ts_kernel_link_offset(k, l); with rigid links only, nq = 2 nlinks and link
  * l is at 2l. An elastic link's tension is EA e + Cv l e', never

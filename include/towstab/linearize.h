@@ -1,5 +1,5 @@
 /* towstab/linearize.h: the linear model z' = A z + B v about a state
- * (MODEL.md section 6; Kamman & Nguyen eqs. 56-65; doc/linear.md).
+ * (doc/model.md section 6; Kamman & Nguyen eqs. 56-65; doc/linear.md).
  *
  * A = df/dy and B = df/du by second-order central differences through the
  * one kernel, column by column (columns are independent and computed in
@@ -83,7 +83,7 @@ typedef struct ts_linear {
     int kinks;         /* nodes (tow point included) within 2 steps of the
                           water surface z = 0 while the fluid has density:
                           f is not smooth there and the central difference
-                          is the mean of one-sided derivatives (MODEL.md
+                          is the mean of one-sided derivatives (doc/model.md
                           section 6) */
     int kink_tow;      /* 1 when the tow point is one of them: only B (and
                           Tu) are affected, not A */

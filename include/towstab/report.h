@@ -1,29 +1,32 @@
-/* towstab/report.h: results as JSON (jansson) and CSV, written atomically.
+/* towstab/report.h: results as JSON (jansson) and CSV, written safely.
  *
  * Every number is SI (m, N, s) except angles, which carry their unit in the
- * key (theta1_deg). Files are written to a temporary name in the same
- * folder and renamed when complete, so a failed run never leaves a file
- * that looks finished; "-" means standard output.
+ * key (theta1_deg). A regular file (or a new one) is written to a
+ * temporary name in the same folder and renamed when complete, so a failed
+ * run never leaves a file that looks finished; a device or FIFO
+ * (/dev/null, a named pipe) is written in place and never replaced; a
+ * symbolic link is followed and kept; "-" means standard output. Every
+ * write, the flush and the close are checked (TS_EIO naming the file).
  */
 #ifndef TOWSTAB_REPORT_H
 #define TOWSTAB_REPORT_H
 
 #include <jansson.h>
 #include <stddef.h>
-#include <stdio.h>
 
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
+#include "towstab/health.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Name of a node: "tow" for node 0, the body's name where a body sits,
- * else "<cable>.<k>" for the lower end of link k of that cable. */
-TS_API void ts_report_node_name(const ts_system *sys, int node, char *buf,
-                                size_t size);
+/* {"trustworthy": bool, "reasons": [text], "notes": [text]} plus
+ * "dropped": n when reasons or notes were dropped. NULL on allocation
+ * failure. */
+TS_API json_t *ts_report_trust_json(const ts_trust *t);
 
 /* The equilibrium as a new JSON object: converged, iterations, evaluations,
  * residual, force_scale, tolerance, method, speed, turn_rate, wall_s,
@@ -36,7 +39,7 @@ TS_API json_t *ts_report_equilibrium_json(const ts_system *sys,
                                           const ts_equilibrium *eq,
                                           double wall_s);
 
-/* Write a JSON value to `path` ("-": stdout), indented, atomically. */
+/* Write a JSON value to `path` ("-": stdout), indented, as above. */
 TS_API int ts_report_write_json(const json_t *value, const char *path,
                                 ts_err *err);
 
@@ -45,14 +48,14 @@ TS_API int ts_report_equilibrium_csv(const ts_system *sys,
                                      const ts_equilibrium *eq,
                                      const char *path, ts_err *err);
 
-/* Open a file for atomic writing: returns a FILE on a temporary name that
- * ts_report_commit() renames to `path` (or stdout for "-"), and
- * ts_report_abandon() removes. `tmp` receives the temporary name. */
-TS_API FILE *ts_report_open(const char *path, char *tmp, size_t tmpsize,
-                            ts_err *err);
-TS_API int ts_report_commit(FILE *f, const char *path, const char *tmp,
-                            ts_err *err);
-TS_API void ts_report_abandon(FILE *f, const char *path, const char *tmp);
+/* Refuse outputs that name the same file: paths[n] (NULL entries are
+ * skipped) are compared by what they resolve to (device and inode, links
+ * followed; for a file still to be made, its directory and name), so
+ * "out.json" and "./out.json" are the same. what[i] names each in the
+ * message ("--json"). Devices (/dev/null) may be shared; standard output
+ * ("-", /dev/stdout) may not. Returns TS_OK or TS_EINVAL. */
+TS_API int ts_report_check_targets(int n, const char *const what[],
+                                   const char *const paths[], ts_err *err);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,7 @@
  * (doc/simulate.md; Kamman & Nguyen 1990, examples 3 to 5).
  *
  * Nonlinear: GSL odeiv2 (evolve/control/step under a driver) on the
- * kernel's state y[2 nq] (link angles and rates, MODEL.md section 2), with
+ * kernel's state y[2 nq] (link angles and rates, doc/model.md section 2), with
  * the tow-point input u(t) and the frame motion of an excitation
  * (towstab/excitation.h). Explicit adaptive Runge-Kutta (rk8pd, rkf45) or
  * implicit methods for stiff scenes (GSL's rk4imp, bsimp, msbdf, and

@@ -1,5 +1,5 @@
 /* towstab/system.h: the towed system as a tree of cables, links, nodes and
- * bodies (MODEL.md sections 1-3, 8).
+ * bodies (doc/model.md sections 1-3, 8).
  *
  * A ts_system holds the description (environment, tow, cables, bodies) and,
  * after ts_system_build(), its discretisation: links in topological order
@@ -9,6 +9,8 @@
  */
 #ifndef TOWSTAB_SYSTEM_H
 #define TOWSTAB_SYSTEM_H
+
+#include <stddef.h>
 
 #include "towstab/error.h"
 
@@ -151,6 +153,13 @@ TS_API int ts_system_find_body(const ts_system *sys, const char *name);
 /* Node at which body b sits (lower node of the cable that ends at it), or
  * -1 before ts_system_build(). */
 TS_API int ts_system_body_node(const ts_system *sys, int b);
+
+/* Name of node `node` (built system) into buf[size] (cut to fit): "tow"
+ * for node 0, the body's name where a body sits, else "<cable>.<k>" for
+ * the lower end of link k of that cable. The names every output uses
+ * (tables, JSON, CSV, response outputs). */
+TS_API void ts_system_node_name(const ts_system *sys, int node, char *buf,
+                                size_t size);
 
 /* Wet weight per length of a cable in N/m (weight minus buoyancy). */
 TS_API double ts_cable_wet_weight(const ts_system *sys, int c);
