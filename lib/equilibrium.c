@@ -333,6 +333,90 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
     eq->shape_error = big * total_length(ts_kernel_system(k));
 }
 
+/* Where the kernel's last evaluation has its largest load or tension
+ * (the first one that is not finite, if any), as a scene key path: a
+ * vehicle "bodies[b] 'name'", a body at a node, or "cables[c] 'name' link
+ * i"; and that magnitude (N) in *big. */
+static void largest_load(const ts_kernel *k, char *buf, size_t size,
+                         double *big)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    const double *Q = ts_kernel_loads(k), *t = ts_kernel_tensions(k);
+    int where = -1, veh = -1;
+    *big = 0.0;
+    /* "+ 0.0 * x" keeps a NaN, which fmax would drop. */
+    for (int i = 1; i < sys->nnodes && isfinite(*big); i++) {
+        double m = fabs(t[i - 1]);
+        for (int j = 0; j < 3; j++)
+            m = fmax(m, fabs(Q[3 * i + j])) + 0.0 * Q[3 * i + j];
+        if (!(m <= *big)) {
+            *big = m;
+            where = i;
+        }
+    }
+    for (int v = 0; v < ts_kernel_nvehicles(k) && isfinite(*big); v++) {
+        ts_vehicle_result r;
+        ts_kernel_vehicle_result(k, v, &r);
+        double m = 0;
+        for (int j = 0; j < 3; j++)
+            m = fmax(m, fabs(r.hydro_force[j])) + 0.0 * r.hydro_force[j];
+        if (!(m <= *big)) {
+            *big = m;
+            veh = r.body;
+        }
+    }
+    if (veh >= 0) {
+        snprintf(buf, size, "bodies[%d] '%s'", veh, sys->bodies[veh].name);
+    } else if (where > 0 && sys->nodes[where].body >= 0) {
+        int b = sys->nodes[where].body;
+        snprintf(buf, size, "bodies[%d] '%s'", b, sys->bodies[b].name);
+    } else if (where > 0) {
+        const ts_link *L = &sys->links[sys->nodes[where].link];
+        snprintf(buf, size, "cables[%d] '%s' link %d", L->cable,
+                 sys->cables[L->cable].name, L->index);
+    } else {
+        buf[0] = '\0';
+    }
+}
+
+/* The Jacobian of (q'', c') at y by central differences, column by
+ * column, and its LU and condition in w (w->R holds f(y)). */
+static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
+                    ts_err *err)
+{
+    int nq = w->nq, nu = w->nu;
+    for (int j = 0; j < nu; j++) {
+        int yj = unknown(w, j);
+        double h = NEWTON_FD_STEP * w->scale[j], y0 = y[yj];
+        y[yj] = y0 + h;
+        int r1 = ts_kernel_eval(k, y, NULL, w->f1);
+        y[yj] = y0 - h;
+        int r2 = ts_kernel_eval(k, y, NULL, w->f2);
+        y[yj] = y0;
+        eq->evaluations += 2;
+        if (r1 != TS_OK || r2 != TS_OK)
+            return ts_fail(err, TS_ECONV,
+                           "equilibrium: Newton Jacobian column %d left "
+                           "the model's chart",
+                           j);
+        double *col = w->J + (size_t)j * nu;
+        for (int i = 0; i < nu; i++)
+            col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
+    }
+    int info = 0;
+    w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
+    dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
+    w->have_lu = info == 0;
+    if (info == 0) {
+        int cinfo = 0;
+        dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
+                w->iwork, &cinfo, 1);
+        if (cinfo != 0)
+            w->rcond = NAN;
+    }
+    return info == 0 ? TS_OK : -info;
+}
+
 /* Newton on (q'', c')(q, c) = 0 from y (rates must be zero; y[n]). */
 static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                   newton_ws *w, ts_equilibrium *eq, ts_err *err)
@@ -349,46 +433,39 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         rel = scale > 0 ? worst / scale : worst;
         crel = control_residual_of(k, w->R);
         if (rel <= tol && crel <= tol) {
+            /* A start that is already the answer (a straight tow with
+             * vehicles) still gets the Jacobian its health needs. */
+            if (!w->have_lu && jacobian(k, y, w, eq, err) == TS_ECONV)
+                ts_err_clear(err);
             newton_health(k, y, w, eq);
             return TS_OK;
+        }
+        if (!isfinite(rel) || !isfinite(crel)) {
+            char place[2 * TS_NAME_MAX + 32], size[64];
+            double big;
+            largest_load(k, place, sizeof place, &big);
+            if (isfinite(big))
+                snprintf(size, sizeof size, "largest %.3g N", big);
+            else
+                snprintf(size, sizeof size, "a load is not finite");
+            return ts_fail(err, TS_EDOMAIN,
+                           "equilibrium: %s%sthe forces overflow (%s) after "
+                           "%d Newton iterations: an input beyond the "
+                           "model's range (a speed, length or coefficient "
+                           "too large?)",
+                           place, place[0] ? ": " : "", size, it);
         }
         if (it >= max_iter)
             break;
         eq->iterations++;
-        /* Jacobian of (q'', c') by central differences, column by
-         * column. */
-        for (int j = 0; j < nu; j++) {
-            int yj = unknown(w, j);
-            double h = NEWTON_FD_STEP * w->scale[j], y0 = y[yj];
-            y[yj] = y0 + h;
-            int r1 = ts_kernel_eval(k, y, NULL, w->f1);
-            y[yj] = y0 - h;
-            int r2 = ts_kernel_eval(k, y, NULL, w->f2);
-            y[yj] = y0;
-            eq->evaluations += 2;
-            if (r1 != TS_OK || r2 != TS_OK)
-                return ts_fail(err, TS_ECONV,
-                               "equilibrium: Newton Jacobian column %d left "
-                               "the model's chart",
-                               j);
-            double *col = w->J + (size_t)j * nu;
-            for (int i = 0; i < nu; i++)
-                col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
-        }
+        rc = jacobian(k, y, w, eq, err);
+        if (rc == TS_ECONV)
+            return rc;
+        int one = 1, info = -rc;
         for (int i = 0; i < nu; i++)
             w->dq[i] = -w->R[nq + i];
-        int one = 1, info = 0;
-        w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
-        dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
-        w->have_lu = info == 0;
-        if (info == 0) {
-            int cinfo = 0;
-            dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
-                    w->iwork, &cinfo, 1);
-            if (cinfo != 0)
-                w->rcond = NAN;
+        if (info == 0)
             dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
-        }
         if (info != 0)
             return ts_fail(err, TS_ESINGULAR,
                            "equilibrium: singular Newton Jacobian (LAPACK "
