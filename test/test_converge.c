@@ -72,6 +72,7 @@
 #include <unistd.h>
 
 #include "tcheck.h"
+#include "towstab/analysis.h"
 #include "towstab/compare.h"
 #include "towstab/report_converge.h"
 #include "towstab/scene.h"
@@ -423,6 +424,20 @@ static int value_index(const ts_convergence *c, const char *name)
     return -1;
 }
 
+/* A sweep of the pipeline of `analysis` (towstab/analysis.h) with the
+ * request's defaults; extra settings from *rq when given. */
+static int pipeline_sweep(const ts_system *sys, ts_analysis_kind analysis,
+                          ts_request *rq, ts_conv_analysis *an, ts_err *err)
+{
+    ts_request own;
+    if (!rq) {
+        ts_request_init(&own, TS_ANALYSIS_CONVERGE);
+        rq = &own;
+    }
+    rq->converge.analysis = analysis;
+    return ts_analysis_sweep(sys, rq, 0, an, err);
+}
+
 static void test_equilibrium_sweep(void)
 {
     ts_units *u;
@@ -433,7 +448,7 @@ static void test_equilibrium_sweep(void)
     }
     ts_err err = {0};
     ts_conv_analysis an;
-    int rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
+    int rc = pipeline_sweep(sc->system, TS_ANALYSIS_EQUILIBRIUM, NULL, &an, &err);
     ts_convergence *c =
         rc ? NULL
            : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
@@ -547,7 +562,7 @@ static void test_equilibrium_sweep(void)
 
     /* A tolerance sweep: positions stop changing once the residual is
      * below what moves them. */
-    rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
+    rc = pipeline_sweep(sc->system, TS_ANALYSIS_EQUILIBRIUM, NULL, &an, &err);
     c = ts_convergence_alloc(an.name, TS_CONV_TOLERANCE, an.nvalues,
                              an.values, 4, &err);
     static const double T[3] = {1e-6, 1e-9, 1e-12};
@@ -578,8 +593,7 @@ static void test_modes_sweep(void)
     }
     ts_err err = {0};
     ts_conv_analysis an;
-    int rc = ts_conv_modes_analysis(sc->system, NULL, NULL, NULL, 3, &an,
-                                    &err);
+    int rc = pipeline_sweep(sc->system, TS_ANALYSIS_MODES, NULL, &an, &err);
     ts_convergence *c =
         rc ? NULL
            : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
@@ -680,9 +694,15 @@ static void test_simulate_sweep(void)
     o.dt_sample = 0.05;
     ts_conv_analysis an;
     memset(&an, 0, sizeof an);
+    /* The request borrows ex: it is not cleared. */
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_CONVERGE);
+    rq.simulate.sim = o;
+    rq.simulate.excitation = ex;
+    rq.simulate.transient = 4.0;
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
     if (rc == TS_OK)
-        rc = ts_conv_simulate_analysis(sc->system, NULL, &o, ex, "sphere.z",
-                                       4.0, &an, &err);
+        rc = pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an, &err);
     static const double tol[4] = {1e-3, 1e-4, 1e-5, 1e-6};
     ts_convergence *c =
         rc ? NULL
@@ -765,16 +785,20 @@ static void test_simulate_sweep(void)
     ts_conv_analysis_free(&an);
     /* Refusals. */
     ts_excitation *none = ts_excitation_alloc(&err);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, none, "sphere.z",
-                                    4.0, &an, &err) == TS_EINVAL &&
+    rq.simulate.excitation = none;
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL &&
               strstr(err.msg, "periodic"),
           "no periodic excitation refused: %s", err.msg);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, ex,
-                                    "sphere.tension", 4.0, &an,
-                                    &err) == TS_EINVAL,
+    rq.simulate.excitation = ex;
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.tension");
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL,
           "a tension output refused: %s", err.msg);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, ex, "sphere.z",
-                                    7.5, &an, &err) == TS_EINVAL &&
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
+    rq.simulate.transient = 7.5;
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL &&
               strstr(err.msg, "period"),
           "a window shorter than a period refused: %s", err.msg);
     ts_excitation_free(none);
