@@ -541,7 +541,10 @@ static int check_response(const ts_system *sys, const ts_response_opts *o,
                        "points: expected a whole number in [2, %d], got %d",
                        TS_RESPONSE_MAX_POINTS, o->points);
     double f[2];
-    return ts_response_logspace(o->from_hz, o->to_hz, 2, f, err);
+    rc = ts_response_logspace(o->from_hz, o->to_hz, 2, f, err);
+    if (rc != TS_OK)
+        ts_err_prefix(err, "to: ");
+    return rc;
 }
 
 static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
@@ -886,6 +889,10 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     if (rc != TS_OK)
         return rc;
     ts_sim_opts *o = &r->sim;
+    if (!o->progress) {
+        o->progress = rq->progress;
+        o->progress_data = rq->progress_data;
+    }
     ts_excitation *none = NULL;
     const ts_excitation *ex = s->excitation;
     if (!ex) {
@@ -1249,10 +1256,15 @@ static int pipeline_converge(ts_result *r, const ts_request *rq,
         rc = ts_analysis_sweep(base, &sub, k, &an, err);
         if (rc)
             break;
-        if (!r->convergence)
+        if (!r->convergence) {
             r->convergence = ts_convergence_alloc(an.name, param, an.nvalues,
                                                   an.values, n * nseries,
                                                   err);
+            if (r->convergence) {
+                r->convergence->progress = rq->progress;
+                r->convergence->progress_data = rq->progress_data;
+            }
+        }
         if (!r->convergence) {
             ts_conv_analysis_free(&an);
             return err && err->code ? err->code : TS_ENOMEM;
@@ -1269,10 +1281,21 @@ static int pipeline_converge(ts_result *r, const ts_request *rq,
                                           err);
         ts_conv_analysis_free(&an);
     }
+    /* Stopped on request: the runs so far, estimated as far as they go,
+     * are the result, marked incomplete by the status. */
+    ts_err stop = {0};
+    if (rc == TS_ECANCEL && r->convergence && r->convergence->nrows > 0) {
+        stop = *err;
+        rc = TS_OK;
+    }
     if (rc == TS_OK)
         rc = ts_convergence_estimate(r->convergence, c->target, err);
     if (rc != TS_OK)
         return rc;
+    if (stop.code) {
+        *err = stop;
+        return stop.code;
+    }
     const ts_convergence *cv = r->convergence;
     int nok = 0;
     for (int i = 0; i < cv->nrows; i++) {

@@ -1,5 +1,5 @@
 /* eigen.c: modes of the linear model z' = A z (towstab/eigen.h;
- * MODEL.md section 6; doc/linear.md).
+ * doc/model.md section 6; doc/linear.md).
  *
  * lapack: dgeevx on a copy of A (balancing, Hessenberg QR; ~25 n^3 flops
  * with both eigenvector sets) gives every eigenvalue with its right

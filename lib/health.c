@@ -14,7 +14,7 @@
  *    rad: two modes closer than their errors allow have shapes that can
  *    mix (Stewart & Sun, Matrix Perturbation Theory, 1990, ch. V); the
  *    stability margin against its error; nodes at the water surface, where
- *    A is the mean of one-sided derivatives (MODEL.md section 6); ARPACK
+ *    A is the mean of one-sided derivatives (doc/model.md section 6); ARPACK
  *    residuals.
  * The verdict is a ts_trust: trustworthy or not, with reasons and notes as
  * sentences that name the quantity, its size and the limit.

@@ -1,6 +1,6 @@
 /* march.h: the steady lumped rigid-link problem solved by marching from the
  * free ends to the tow point, with shooting on the free-end positions
- * (internal; MODEL.md section 5, doc/equilibrium.md).
+ * (internal; doc/model.md section 5, doc/equilibrium.md).
  *
  * Given the position of every free end, each link's direction and tension
  * follow from its lower node's force balance, one small root per link,

@@ -1,5 +1,5 @@
 /* response.c: frequency response to tow-point motion (towstab/response.h;
- * MODEL.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
  *
  * Algorithm, per frequency w: s = i w; b = B_x + s B_v + s^2 B_a (lower
  * half only: the upper nq rows of B are zero); Z = (s I - A)^-1 b

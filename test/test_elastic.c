@@ -1,4 +1,4 @@
-/* test_elastic.c: elastic cables (MODEL.md section 7; doc/elastic.md)
+/* test_elastic.c: elastic cables (doc/model.md section 7; doc/elastic.md)
  * against the rigid model, invariants and limits that do not come from the
  * elastic code itself.
  *

@@ -1,4 +1,4 @@
-/* test_elastic_sim.c: time-domain simulation of elastic cables (MODEL.md
+/* test_elastic_sim.c: time-domain simulation of elastic cables (doc/model.md
  * section 7; doc/elastic.md section 7; doc/two-part-tow.md), against the
  * rigid model and the linear frequency response, which do not come from
  * the elastic simulation itself.
@@ -384,7 +384,7 @@ static void test_two_part(const ts_units *u)
     two_part_ratio(s, "neutral", 0.1, &rl, &ppl, &Hl);
     /* Small crank (5 mm): the heave velocity (0.02 m/s) is 1 % of the tow
      * speed, so the drag is linear in it to ~1 %; the tow point at the
-     * waterline (a kink, MODEL.md section 6) shifts the mean, not the
+     * waterline (a kink, doc/model.md section 6) shifts the mean, not the
      * fundamental; the start's transient is down to 0.5 % (above). 2 %
      * allows for these (observed 3e-5). */
     CHECK(fabs(rs - Hs) < 0.02 * Hs, "5 mm crank: heave ratio %.5f within "

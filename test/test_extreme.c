@@ -153,7 +153,7 @@ typedef struct spec {
     double bD, bm, bcd, bca;
 } spec;
 
-/* Kamman ex. 1 in SI (MODEL.md section 9) at 2.5 m/s, 20 links. */
+/* Kamman ex. 1 in SI (doc/model.md section 9) at 2.5 m/s, 20 links. */
 static spec ex1(void)
 {
     spec s = {RHO, 2.5, 0, 0, {0, 0, 0}, 30.48, 0.0254, 1.488, 20,

@@ -16,6 +16,7 @@
 #include "towstab/analysis.h"
 #include "towstab/error.h"
 #include "towstab/options.h"
+#include "towstab/progress.h"
 #include "towstab/scene.h"
 #include "towstab/system.h"
 #include "towstab/units.h"
@@ -137,7 +138,33 @@ void cli_stdout_for_json(void);
  * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
 
-/* Refuse, before anything runs, outputs that name the same file
+/* ---- Interruption and progress (doc/manual.md, "Long runs") ----------
+ * main() installs handlers for SIGINT and SIGTERM. A run that takes
+ * cli_progress as its progress callback (simulations, convergence sweeps)
+ * polls them: the first signal makes it stop at its next step, write what
+ * it has marked incomplete, and exit with 128 + the signal (130 for
+ * SIGINT, 143 for SIGTERM). A second signal, or one that comes while
+ * nothing polls (reading the scene, an equilibrium, an eigensolver), ends
+ * the process at once with the same status. */
+void cli_signals_install(void);
+
+/* The signal that asked to stop, 0 if none came, and its name ("SIGINT",
+ * "SIGTERM"; NULL if none). */
+int cli_stop_signal(void);
+const char *cli_stop_signal_name(void);
+
+/* A ts_progress_fn: nonzero once SIGINT or SIGTERM came. When standard
+ * error is a terminal and the run has lasted a second, it also shows one
+ * line there, rewritten at most four times a second: what is done of how
+ * much, the rate and the time left. Quiet when standard error is not a
+ * terminal. `data` is unused. */
+int cli_progress(const ts_progress *p, void *data);
+
+/* Clear the progress line, if one is shown; a run that polled is over. */
+void cli_progress_done(void);
+
+/* Refuse, before anything runs, an empty output name and outputs that
+ * name the same file
  * (ts_report_check_targets): the n options what[i] with paths[i] (NULL
  * when not given), and the pictures `plot_names` (NULL-terminated, each
  * written as NAME.png and NAME.svg) that --plot writes into plot_dir (may

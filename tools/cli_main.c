@@ -189,15 +189,20 @@ int cli_prepare(cli_run *c)
     }
     if (rc)
         return cli_report(&err, rc);
+    /* Long runs poll SIGINT and SIGTERM and show their progress. */
+    c->rq.progress = cli_progress;
     return c->cmd->prepare ? c->cmd->prepare(c) : 0;
 }
 
-/* A failed run writes its JSON when it has a result of its own kind to
- * show (an equilibrium that did not converge, the history so far). */
+/* A failed run writes its JSON and CSV when it has a result of its own
+ * kind to show (an equilibrium that did not converge, the history so far,
+ * the runs of a study stopped on request). */
 static int has_partial(const ts_result *r)
 {
     return (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->eq_attempted) ||
-           (r->kind == TS_ANALYSIS_SIMULATE && (r->nonlinear || r->linear));
+           (r->kind == TS_ANALYSIS_SIMULATE && (r->nonlinear || r->linear)) ||
+           (r->kind == TS_ANALYSIS_CONVERGE && r->status == TS_ECANCEL &&
+            r->convergence && r->convergence->estimated);
 }
 
 int cli_execute(cli_run *c, json_t **result)
@@ -205,6 +210,7 @@ int cli_execute(cli_run *c, json_t **result)
     ts_err err = {0};
     ts_result *r = NULL;
     int rc = ts_analysis_run(c->scene->system, &c->rq, &r, &err);
+    cli_progress_done();
     if (!r)
         return cli_report(&err, rc);
     c->cmd->print(c, r);
@@ -217,6 +223,9 @@ int cli_execute(cli_run *c, json_t **result)
     int write = status == 0 || has_partial(r);
     if ((c->json && write) || result) {
         json_t *j = ts_report_result_json(r, c->json_flags);
+        if (j && cli_stop_signal_name())
+            json_object_set_new(j, "interrupted",
+                                json_string(cli_stop_signal_name()));
         if (!j) {
             ts_fail(&werr, TS_ENOMEM, "%s: out of memory for the JSON",
                     c->json ? c->json : ts_analysis_name(r->kind));
@@ -231,7 +240,7 @@ int cli_execute(cli_run *c, json_t **result)
         else
             json_decref(j);
     }
-    if (c->csv && write && (status == 0 || r->kind == TS_ANALYSIS_SIMULATE) &&
+    if (c->csv && write && (status == 0 || has_partial(r)) &&
         ts_report_result_csv(r, c->csv, &werr) != TS_OK) {
         int st = cli_report(&werr, werr.code);
         status = status ? status : st;

@@ -86,6 +86,15 @@ static int run_main(int argc, char **argv)
         fprintf(stderr, "towstab: error: run: expected one scene file\n");
         return EXIT_BADINPUT;
     }
+    const char *given[3] = {json_path, csv_dir, plot_dir};
+    static const char *const opt[3] = {"--json", "--csv", "--plot"};
+    for (int k = 0; k < 3; k++)
+        if (given[k] && !given[k][0]) {
+            fprintf(stderr, "towstab: error: run: %s: expected a %s name, "
+                            "got an empty one\n",
+                    opt[k], k ? "directory" : "file");
+            return EXIT_BADINPUT;
+        }
     if (plot_units && !plot_dir) {
         fprintf(stderr, "towstab: error: run: --units sets the units of the "
                         "--plot pictures; add --plot DIR\n");
@@ -185,7 +194,8 @@ static int run_main(int argc, char **argv)
     /* After a failure the results so far, marked as incomplete with the
      * failed analysis' message; nothing after bad input found before the
      * first run. */
-    if (json_path && (status == 0 || (ran && status == EXIT_FAILED))) {
+    if (json_path &&
+        (status == 0 || (ran && status != EXIT_BADINPUT))) {
         size_t nres = json_array_size(list);
         const char *msg = status && nres > 0
                               ? json_string_value(json_object_get(
@@ -197,6 +207,9 @@ static int run_main(int argc, char **argv)
                                                               : "failed"));
             json_object_set_new(all, "trustworthy", json_false());
         }
+        if (cli_stop_signal_name())
+            json_object_set_new(all, "interrupted",
+                                json_string(cli_stop_signal_name()));
         ts_err werr = {0};
         if (cli_write_json(all, json_path, &werr) != TS_OK) {
             int st = cli_report(&werr, werr.code);

@@ -30,6 +30,7 @@
 #include "towstab/excitation.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
+#include "towstab/progress.h"
 #include "towstab/response.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
@@ -182,6 +183,12 @@ typedef struct ts_request {
     ts_response_opts response;
     ts_simulate_opts simulate;
     ts_converge_opts converge;
+    /* Called by the long runs (every integrator step of a simulation,
+     * every run of a sweep; towstab/progress.h); nonzero stops the
+     * analysis with TS_ECANCEL, keeping what it has. NULL (default):
+     * none. A simulation's own sim.progress, when set, wins. */
+    ts_progress_fn progress;
+    void *progress_data;
 } ts_request;
 
 /* Every default (as documented above). Release with ts_request_clear. */
@@ -281,9 +288,10 @@ TS_API int ts_analysis_check(const ts_system *sys, const ts_request *rq,
 /* Run the analysis of `rq` on a copy of `sys`. *out receives the result
  * (caller frees with ts_result_free), also after a failure, with what was
  * computed so far; NULL only when memory ran out. Returns the result's
- * status: TS_OK, a code from ts_analysis_check (nothing ran), or the
- * failure of a solver (result->error holds the message, also copied to
- * err). */
+ * status: TS_OK, a code from ts_analysis_check (nothing ran), the failure
+ * of a solver (result->error holds the message, also copied to err), or
+ * TS_ECANCEL when rq->progress asked to stop (a simulation keeps its
+ * history so far, a study its runs so far, estimated). */
 TS_API int ts_analysis_run(const ts_system *sys, const ts_request *rq,
                            ts_result **out, ts_err *err);
 

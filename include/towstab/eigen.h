@@ -1,5 +1,5 @@
 /* towstab/eigen.h: eigenvalues and mode shapes of a linear model
- * z' = A z (MODEL.md section 6; doc/linear.md).
+ * z' = A z (doc/model.md section 6; doc/linear.md).
  *
  * Two methods:
  *  - lapack: every eigenvalue and right eigenvector of the dense A (LAPACK

@@ -1,5 +1,5 @@
 /* towstab/response.h: frequency response of the linear model to tow-point
- * motion (MODEL.md section 6; doc/linear.md).
+ * motion (doc/model.md section 6; doc/linear.md).
  *
  * For a tow-point displacement X(i w) along x, y or z (input tow.surge,
  * tow.sway, tow.heave) the tow point also moves with velocity i w X and
