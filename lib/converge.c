@@ -708,6 +708,12 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
     }
     for (int i = 0; i < n && rc == TS_OK; i++) {
+        ts_progress p = {"sweep", i, n, "runs"};
+        if (c->progress && c->progress(&p, c->progress_data)) {
+            rc = ts_fail(err, TS_ECANCEL, "convergence: stopped on request "
+                         "after %d of %d runs", i, n);
+            break;
+        }
         for (int v = 0; v < c->nvalues; v++) {
             val[v] = NAN;
             noise[v] = 0.0;
@@ -731,6 +737,11 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         rc = ts_convergence_add_row(c, series, settings[i], st,
                                     st == TS_OK ? NULL : rerr.msg, wall,
                                     evals, &trust, val, noise, err);
+        if (rc == TS_OK && st == TS_ECANCEL) {
+            if (err)
+                *err = rerr;
+            rc = st;
+        }
     }
     free(val);
     free(noise);

@@ -62,6 +62,7 @@ const char *ts_strerror(int code)
     case TS_ESINGULAR: return "singular system";
     case TS_EDOMAIN: return "outside the model's domain";
     case TS_EINTEGRATOR: return "integrator failure";
+    case TS_ECANCEL: return "stopped on request";
     default: return "unknown error";
     }
 }

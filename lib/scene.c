@@ -25,7 +25,10 @@
  * libyaml document are freed.
  *
  * Limits against hostile input (fuzzing): at most MAX_ENTRIES entries in a
- * list and MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES.
+ * list and MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES;
+ * flow collections ([...], {...}) nested at most MAX_FLOW_DEPTH deep,
+ * checked by a scan before libyaml sees the text: libyaml's scanner takes
+ * time quadratic in that depth (100 000 '[' took 40 s).
  */
 #include "towstab/scene.h"
 
@@ -43,6 +46,8 @@
 #define MAX_ENTRIES 100000
 /* Largest number of rigid links in the whole system (sum over cables). */
 #define MAX_LINKS 100000
+/* Deepest nesting of flow collections: the format needs two levels. */
+#define MAX_FLOW_DEPTH 64
 /* Largest scene file read by ts_scene_load. */
 #define MAX_FILE_BYTES (16L * 1024 * 1024)
 /* Relative tolerance for link_lengths adding up to the cable length. */
@@ -1075,12 +1080,61 @@ static int yaml_failure(const yaml_parser_t *p, ts_err *err)
     }
 }
 
+/* Refuse flow collections nested deeper than MAX_FLOW_DEPTH. A scan of
+ * the YAML text that skips comments and quoted scalars and counts an
+ * opening bracket or brace only where a flow collection can start (at the
+ * start of a token), so that a plain scalar such as "a[1" is not one. */
+static int check_flow_depth(const char *t, size_t len, ts_err *err)
+{
+    int depth = 0, line = 1;
+    char prev = '\n'; /* the last character outside quotes and comments */
+    for (size_t i = 0; i < len; i++) {
+        char ch = t[i];
+        int token_start = prev == '\n' || prev == ' ' || prev == '\t' ||
+                          prev == '[' || prev == '{' || prev == ',';
+        if (ch == '\n') {
+            line++;
+        } else if (ch == '#' && token_start) {
+            while (i + 1 < len && t[i + 1] != '\n')
+                i++;
+            continue;
+        } else if ((ch == '"' || ch == '\'') && token_start) {
+            /* Skip the quoted scalar: "..." with backslash escapes, '...'
+             * with '' for a quote. */
+            for (i++; i < len; i++) {
+                if (t[i] == '\n')
+                    line++;
+                if (ch == '"' && t[i] == '\\')
+                    i++;
+                else if (t[i] == ch && !(ch == '\'' && i + 1 < len &&
+                                         t[i + 1] == '\''))
+                    break;
+                else if (t[i] == ch)
+                    i++;
+            }
+            prev = ch;
+            continue;
+        } else if ((ch == '[' || ch == '{') && token_start) {
+            if (++depth > MAX_FLOW_DEPTH)
+                return ts_fail(err, TS_ESCENE, "line %d: lists or mappings "
+                               "nested more than %d deep; a scene needs two "
+                               "levels", line, MAX_FLOW_DEPTH);
+        } else if ((ch == ']' || ch == '}') && depth > 0) {
+            depth--;
+        }
+        prev = ch;
+    }
+    return TS_OK;
+}
+
 /* Parse without the name prefix; returns the scene or NULL. */
 static ts_scene *parse(const char *text, size_t len, const ts_units *units,
                        ts_err *err)
 {
     yaml_parser_t parser;
     yaml_document_t doc, extra;
+    if (check_flow_depth(text, len, err) != TS_OK)
+        return NULL;
     if (!yaml_parser_initialize(&parser)) {
         ts_fail(err, TS_ENOMEM, "out of memory starting the YAML parser");
         return NULL;

@@ -88,6 +88,8 @@ void ts_sim_opts_default(ts_sim_opts *o)
     o->linear_method = TS_LINSIM_EXPM;
     o->kinematics = TS_KIN_LINEAR;
     o->jacobian_threads = 1;
+    o->progress = NULL;
+    o->progress_data = NULL;
 }
 
 static const char *const integrator_names[] = {"rk8pd", "rkf45", "rk4imp",
@@ -625,6 +627,20 @@ static int finite_state(const double y[], int n)
     return 1;
 }
 
+/* Report progress at simulated time t (run `what`) to the caller's
+ * callback: TS_ECANCEL when it asks to stop, else TS_OK. */
+static int report_progress(const ts_sim_opts *o, const char *what, double t,
+                           ts_err *err)
+{
+    if (!o->progress)
+        return TS_OK;
+    ts_progress p = {what, t, o->t_end, "s"};
+    if (!o->progress(&p, o->progress_data))
+        return TS_OK;
+    return ts_fail(err, TS_ECANCEL, "simulate (%s): stopped on request at "
+                   "t = %.6g s of %.6g s", what, t, o->t_end);
+}
+
 /* A step that failed inside the kernel (fatal) or on the angle chart. */
 static int fail_kernel(const ts_sim *s, ts_err *err)
 {
@@ -664,7 +680,10 @@ static int check_step(const ts_sim *s, double t_before, double t,
         return ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at t = "
                        "%.9g s: the step size %.3g s fell below h_min %.3g s",
                        name, t, h, s->o.h_min);
-    if (s->o.max_steps > 0 && steps >= s->o.max_steps && t < t1)
+    /* The limit counts over the run: reached anywhere before its end (or
+     * the caller's target beyond it) it fails, also at an output time. */
+    if (s->o.max_steps > 0 && steps >= s->o.max_steps &&
+        t < fmax(t1, s->o.t_end))
         return ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the step "
                        "limit %ld at t = %.9g s", name, s->o.max_steps, t);
     return TS_OK;
@@ -718,6 +737,9 @@ static int advance_esdirk(ts_sim *s, double t1, ts_err *err)
             return rc;
         s->t_int = t;
         s->ahead = 1;
+        /* Stopping here keeps s->t, the last state handed out. */
+        if ((rc = report_progress(&s->o, "nonlinear", t, err)))
+            return rc;
     }
     return TS_OK;
 }
@@ -771,6 +793,8 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
                 break;
             s->nrestart++;
         }
+        if ((rc = report_progress(&s->o, "nonlinear", s->t, err)))
+            break;
     }
     if (step_failed)
         stiffness_note(s, err);
@@ -1214,6 +1238,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
             break;
         }
         rc = lin_record(k, lin, &L, o, t1, z, h, ywork, dr, err);
+        if (!rc)
+            rc = report_progress(o, "linear", t1, err);
     }
 done:
     if (drv) {

@@ -46,6 +46,8 @@
  *     run and no link count is predicted: 10 links is not yet
  *     asymptotic for it.
  *  9. JSON and CSV of a study: the required keys, one CSV line per run.
+ * 11. A sweep stopped by its progress callback before the third run keeps
+ *     the two rows so far (TS_ECANCEL), which still estimate.
  * 10. The simulate analysis on Kamman ex. 4 (tow point heaved 0.1 ft at
  *     1 Hz, 8 s, fitted over 4..8 s), rk8pd at tolerances 1e-3 .. 1e-6:
  *     the true error of the amplitude ratio and of the phase (against an
@@ -393,6 +395,19 @@ static ts_scene *load(const char *path, ts_units **u)
     return s;
 }
 
+/* The equilibrium analysis of sys (into *an) and a links table of 8 rows
+ * for it; NULL on failure (an is then safe to free). */
+static ts_convergence *equilibrium_links_table(const ts_system *sys,
+                                               ts_conv_analysis *an,
+                                               ts_err *err)
+{
+    memset(an, 0, sizeof *an);
+    if (ts_conv_equilibrium_analysis(sys, NULL, an, err) != TS_OK)
+        return NULL;
+    return ts_convergence_alloc(an->name, TS_CONV_LINKS, an->nvalues,
+                                an->values, 8, err);
+}
+
 /* Sphere x, z and top tension of a system with N links per cable. */
 static int solve_ex(const ts_system *base, int links, double out[3])
 {
@@ -433,13 +448,9 @@ static void test_equilibrium_sweep(void)
     }
     ts_err err = {0};
     ts_conv_analysis an;
-    int rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
-    ts_convergence *c =
-        rc ? NULL
-           : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
-                                  an.values, 8, &err);
+    ts_convergence *c = equilibrium_links_table(sc->system, &an, &err);
     static const double N[4] = {40, 80, 160, 320};
-    rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
+    int rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
     if (rc == 0)
         rc = ts_convergence_sweep(c, 0, &an, N, 4, &err);
     if (rc == TS_OK)
@@ -783,6 +794,50 @@ static void test_simulate_sweep(void)
     ts_units_free(u);
 }
 
+/* A progress callback that stops the sweep before run `stop_before`. */
+static int stop_sweep(const ts_progress *p, void *data)
+{
+    int *calls = data;
+    (*calls)++;
+    return p->done >= 2 && !strcmp(p->unit, "runs");
+}
+
+/* 10. Stopping a sweep: the callback is called before each run with the
+ * runs done; its nonzero return stops the sweep with TS_ECANCEL and the
+ * rows so far, which still estimate. */
+static void test_stop(void)
+{
+    ts_units *u;
+    ts_scene *sc = load("examples/kamman_ex1_submerged.yaml", &u);
+    if (!CHECK(sc, "load Kamman ex. 1")) {
+        ts_units_free(u);
+        return;
+    }
+    ts_err err = {0};
+    ts_conv_analysis an;
+    ts_convergence *c = equilibrium_links_table(sc->system, &an, &err);
+    static const double N[5] = {5, 10, 20, 40, 80};
+    int calls = 0;
+    if (c) {
+        c->progress = stop_sweep;
+        c->progress_data = &calls;
+    }
+    int rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
+    if (rc == 0)
+        rc = ts_convergence_sweep(c, 0, &an, N, 5, &err);
+    CHECK(rc == TS_ECANCEL && c->nrows == 2 && calls == 3 &&
+              strstr(err.msg, "after 2 of 5 runs"),
+          "a sweep stopped before its third run keeps 2 rows (%d calls): %s",
+          calls, err.msg);
+    CHECK(c && c->nrows == 2 &&
+              ts_convergence_estimate(c, 1e-3, &err) == TS_OK,
+          "the rows so far still estimate");
+    ts_conv_analysis_free(&an);
+    ts_convergence_free(c);
+    ts_scene_free(sc);
+    ts_units_free(u);
+}
+
 int main(void)
 {
     test_order();
@@ -794,5 +849,6 @@ int main(void)
     test_equilibrium_sweep();
     test_modes_sweep();
     test_simulate_sweep();
+    test_stop();
     return tc_done();
 }

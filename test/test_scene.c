@@ -465,6 +465,42 @@ static void test_buffers(const ts_units *u)
                                "]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]\n";
     s = ts_scene_parse(deep, sizeof deep - 1, "deep", u, &err);
     CHECK(!s && err.code == TS_ESCENE, "deep nesting: %s", err.msg);
+    /* Flow collections nested 65 deep are refused before libyaml scans
+     * them (its time grows with the square of the depth); 64 is allowed,
+     * and brackets inside quotes, comments and plain scalars do not
+     * count. */
+    char nest[512];
+    for (int depth = 64; depth <= 65; depth++) {
+        int n = snprintf(nest, sizeof nest, "name: n\ntow: {speed: 1}\n"
+                         "cables: ");
+        for (int i = 0; i < depth; i++)
+            nest[n++] = '[';
+        for (int i = 0; i < depth; i++)
+            nest[n++] = ']';
+        nest[n++] = '\n';
+        s = ts_scene_parse(nest, (size_t)n, "nest.yaml", u, &err);
+        if (depth == 64)
+            CHECK(!s && !strstr(err.msg, "nested more than"),
+                  "64 levels reach the reader: %s", err.msg);
+        else
+            CHECK(!s && err.code == TS_ESCENE &&
+                  strstr(err.msg, "nest.yaml: line 3: lists or mappings "
+                                  "nested more than 64 deep"),
+                  "65 levels are refused with the line: %s", err.msg);
+    }
+    {
+        char q[1024];
+        int n = snprintf(q, sizeof q, "name: \"q%s\"  # %s\n"
+                         "description: '%s'\ntow: {speed: 1}\n",
+                         "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[["
+                         "[[[[[[[[[[[[[[[[", "{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{"
+                         "{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{{",
+                         "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[["
+                         "[[[[[[[[[[[[[[[[[[[");
+        s = ts_scene_parse(q, (size_t)n, "quoted.yaml", u, &err);
+        CHECK(!s && !strstr(err.msg, "nested more than"),
+              "brackets in quotes and comments do not count: %s", err.msg);
+    }
 
     s = ts_scene_load(DIR "no_such_file.yaml", u, &err);
     CHECK(!s && err.code == TS_EIO && strstr(err.msg, "no_such_file.yaml: "),

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -139,10 +140,116 @@ double cli_wall_now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+/* ---- interruption and progress ---------------------------------------- */
+
+/* The tool's state (one process, one command), not the library's: the
+ * signal that asked to stop, whether a running analysis polls it, and the
+ * progress line. */
+static volatile sig_atomic_t stop_signal, polled;
+static int progress_tty;
+/* A progress line appears once a run has lasted PROGRESS_DELAY s and is
+ * rewritten at most every PROGRESS_INTERVAL s. */
+#define PROGRESS_DELAY 1.0
+#define PROGRESS_INTERVAL 0.25
+static struct {
+    const char *what;      /* the run being shown */
+    double start, last;    /* wall time of its start and of the last line */
+    double done0;          /* its progress at the start */
+    int shown;             /* characters of the line on the terminal */
+} line;
+
+static void on_signal(int sig)
+{
+    /* A second signal, or nothing that polls the first: stop now. */
+    if (stop_signal || !polled)
+        _exit(128 + sig);
+    stop_signal = sig;
+}
+
+void cli_signals_install(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    progress_tty = isatty(STDERR_FILENO);
+}
+
+int cli_stop_signal(void) { return stop_signal; }
+
+const char *cli_stop_signal_name(void)
+{
+    return stop_signal == SIGINT    ? "SIGINT"
+           : stop_signal == SIGTERM ? "SIGTERM"
+                                    : NULL;
+}
+
+/* A duration for the progress line: "42 s", "3.5 min", "2.1 h". */
+static void duration_text(double s, char *buf, size_t size)
+{
+    if (!isfinite(s))
+        snprintf(buf, size, "unknown");
+    else if (s < 120)
+        snprintf(buf, size, "%.0f s", s);
+    else if (s < 7200)
+        snprintf(buf, size, "%.1f min", s / 60);
+    else
+        snprintf(buf, size, "%.1f h", s / 3600);
+}
+
+int cli_progress(const ts_progress *p, void *data)
+{
+    (void)data;
+    polled = 1;
+    if (stop_signal)
+        return 1;
+    if (!progress_tty)
+        return 0;
+    double now = cli_wall_now();
+    if (line.what != p->what || p->done < line.done0) {
+        line.what = p->what;
+        line.start = line.last = now;
+        line.done0 = p->done;
+        return 0;
+    }
+    double elapsed = now - line.start;
+    if (elapsed < PROGRESS_DELAY || now - line.last < PROGRESS_INTERVAL)
+        return 0;
+    line.last = now;
+    double rate = (p->done - line.done0) / elapsed;
+    char left[32], text[160];
+    duration_text(rate > 0 ? (p->total - p->done) / rate : INFINITY, left,
+                  sizeof left);
+    int n = snprintf(text, sizeof text, "towstab: %s: %.6g of %.6g %s "
+                     "(%.0f%%), %.3g %s%s per s, %s left", p->what, p->done,
+                     p->total, p->unit, 100 * p->done / p->total, rate,
+                     strcmp(p->unit, "s") ? "" : "simulated ", p->unit,
+                     left);
+    fprintf(stderr, "\r%s%*s", text, line.shown > n ? line.shown - n : 0,
+            "");
+    fflush(stderr);
+    line.shown = n;
+    return 0;
+}
+
+void cli_progress_done(void)
+{
+    if (line.shown > 0) {
+        fprintf(stderr, "\r%*s\r", line.shown, "");
+        fflush(stderr);
+    }
+    line.shown = 0;
+    line.what = NULL;
+    polled = 0;
+}
+
 int cli_exit_code(int rc)
 {
     switch (rc) {
     case TS_OK: return 0;
+    case TS_ECANCEL: return 128 + (stop_signal ? stop_signal : SIGINT);
     case TS_EINVAL:
     case TS_ESCENE:
     case TS_EUNIT:
@@ -153,8 +260,13 @@ int cli_exit_code(int rc)
 
 int cli_report(const ts_err *err, int rc)
 {
-    fprintf(stderr, "towstab: error: %s\n",
-            err && err->msg[0] ? err->msg : ts_strerror(rc));
+    cli_progress_done();
+    if (rc == TS_ECANCEL)
+        fprintf(stderr, "towstab: error: interrupted (%s): ",
+                cli_stop_signal_name() ? cli_stop_signal_name() : "stop");
+    else
+        fprintf(stderr, "towstab: error: ");
+    fprintf(stderr, "%s\n", err && err->msg[0] ? err->msg : ts_strerror(rc));
     return cli_exit_code(rc);
 }
 

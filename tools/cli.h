@@ -9,6 +9,7 @@
 
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
+#include "towstab/progress.h"
 #include "towstab/scene.h"
 #include "towstab/system.h"
 #include "towstab/units.h"
@@ -123,6 +124,31 @@ void cli_stdout_for_json(void);
 /* Write JSON to `path` ("-": the JSON standard output), as
  * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
+
+/* ---- Interruption and progress (doc/manual.md, "Long runs") ----------
+ * main() installs handlers for SIGINT and SIGTERM. A run that takes
+ * cli_progress as its progress callback (simulations, convergence sweeps)
+ * polls them: the first signal makes it stop at its next step, write what
+ * it has marked incomplete, and exit with 128 + the signal (130 for
+ * SIGINT, 143 for SIGTERM). A second signal, or one that comes while
+ * nothing polls (reading the scene, an equilibrium, an eigensolver), ends
+ * the process at once with the same status. */
+void cli_signals_install(void);
+
+/* The signal that asked to stop, 0 if none came, and its name ("SIGINT",
+ * "SIGTERM"; NULL if none). */
+int cli_stop_signal(void);
+const char *cli_stop_signal_name(void);
+
+/* A ts_progress_fn: nonzero once SIGINT or SIGTERM came. When standard
+ * error is a terminal and the run has lasted a second, it also shows one
+ * line there, rewritten at most four times a second: what is done of how
+ * much, the rate and the time left. Quiet when standard error is not a
+ * terminal. `data` is unused. */
+int cli_progress(const ts_progress *p, void *data);
+
+/* Clear the progress line, if one is shown; a run that polled is over. */
+void cli_progress_done(void);
 
 /* Mark a result: "completed": true, or for a failed run (status != 0)
  * "completed": false, "error": msg (the text standard error got) and the

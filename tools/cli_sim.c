@@ -137,6 +137,7 @@ static int parse_setup(const cli_ctx *ctx, const cli_sim_args *a,
 {
     ts_sim_opts_default(&s->o);
     s->o.t_end = CLI_SIM_DEFAULT_T_END;
+    s->o.progress = cli_progress; /* SIGINT and SIGTERM stop the run */
     int rc = TS_OK;
     if (a->val[SIM_A_T_END] &&
         (rc = parse_q(ctx, a, SIM_A_T_END, "s", &s->o.t_end, err)))

@@ -465,10 +465,13 @@ static int converge_analysis(const ts_system *sys,
                            err);
         if (rc)
             break;
-        if (!c)
+        if (!c) {
             c = ts_convergence_alloc(an.name, rq->param, an.nvalues,
                                      an.values, rq->nsettings * nseries,
                                      err);
+            if (c)
+                c->progress = cli_progress; /* SIGINT, SIGTERM stop it */
+        }
         if (!c) {
             ts_conv_analysis_free(&an);
             return err->code ? err->code : TS_ENOMEM;
@@ -478,6 +481,14 @@ static int converge_analysis(const ts_system *sys,
                    : ts_convergence_sweep(c, s, &an, rq->settings,
                                           rq->nsettings, err);
         ts_conv_analysis_free(&an);
+    }
+    cli_progress_done();
+    /* Interrupted: the runs so far, estimated as far as they go, are the
+     * result, marked incomplete. */
+    ts_err stop = {0};
+    if (rc == TS_ECANCEL && c && c->nrows > 0) {
+        stop = *err;
+        rc = TS_OK;
     }
     if (rc == TS_OK)
         rc = ts_convergence_estimate(c, rq->target, err);
@@ -497,7 +508,7 @@ static int converge_analysis(const ts_system *sys,
     int nok = 0;
     for (int i = 0; i < c->nrows; i++)
         nok += c->rows[i].status == TS_OK;
-    if (nok == 0) {
+    if (nok == 0 && !stop.code) {
         rc = ts_fail(err, TS_ECONV,
                      "converge: every run failed (first: %s)",
                      c->rows[0].message);
@@ -527,8 +538,16 @@ static int converge_analysis(const ts_system *sys,
             return ts_fail(err, TS_ENOMEM, "converge: out of memory");
         }
     }
+    json_object_set_new(*json, "completed", json_boolean(!stop.code));
+    if (stop.code) {
+        json_object_set_new(*json, "error", json_string(stop.msg));
+        if (cli_stop_signal_name())
+            json_object_set_new(*json, "interrupted",
+                                json_string(cli_stop_signal_name()));
+        *err = stop;
+    }
     *out = c;
-    return TS_OK;
+    return stop.code ? stop.code : TS_OK;
 }
 
 /* --plot: the largest estimated relative error of every run against its
@@ -828,8 +847,11 @@ static int conv_main(int argc, char **argv)
     if (rc != TS_OK)
         status = cli_report(&err, rc);
     status = cli_write_result(json, json_path, status, err.msg);
+    /* An interrupted study still has its runs so far (the JSON marked
+     * incomplete above). */
+    int have = rc == TS_OK || (rc == TS_ECANCEL && c);
     ts_err werr = {0};
-    if (rc == TS_OK && csv_path &&
+    if (have && csv_path &&
         ts_report_convergence_csv(c, csv_path, &werr) != TS_OK)
         status = cli_report(&werr, werr.code);
     if (rc == TS_OK && plot.dir) {

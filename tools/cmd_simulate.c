@@ -522,6 +522,7 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
         if (rc_nl)
             status = cli_report(&err, rc_nl);
     }
+    cli_progress_done();
     if (!ctx->quiet)
         print_table(sys, &s.out, hn, hl);
     /* Is the result trustworthy? The start, the linear model's kinks and
@@ -584,6 +585,9 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
     }
     if (status)
         json_object_set_new(j, "error", json_string(err.msg));
+    if (cli_stop_signal_name())
+        json_object_set_new(j, "interrupted",
+                            json_string(cli_stop_signal_name()));
     if (hn) {
         json_t *o = json_object();
         char m[32];

@@ -29,7 +29,8 @@ static void usage(FILE *f)
                 cli_commands[i]->summary);
     fprintf(f, "\n'towstab COMMAND --help' lists a command's options.\n"
                "Plain numbers are SI; strings may carry units ('100 ft').\n"
-               "Exit status: 0 ok, 1 analysis failed, 2 bad input.\n");
+               "Exit status: 0 ok, 1 analysis failed, 2 bad input,\n"
+               "130 or 143 stopped by SIGINT or SIGTERM.\n");
 }
 
 int main(int argc, char **argv)
@@ -47,6 +48,7 @@ int main(int argc, char **argv)
         printf("towstab 0.1.0\n");
         return cli_finish(0);
     }
+    cli_signals_install();
     /* `--json -`: keep standard output for the JSON alone. */
     for (int i = 2; i < argc; i++)
         if ((strcmp(argv[i], "--json") == 0 && i + 1 < argc &&

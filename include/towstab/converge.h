@@ -42,6 +42,7 @@
 #include "towstab/excitation.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
+#include "towstab/progress.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
 
@@ -146,6 +147,12 @@ typedef struct ts_convergence {
                                 finest rows (wall ~ h^-q); NaN */
     int limiting_value;      /* value with the largest finest-row error of
                                 the reference series, -1 */
+    /* Set by the caller (ts_convergence_alloc leaves them NULL): called by
+     * ts_convergence_sweep before each run with the runs done of the
+     * sweep's ("sweep", unit "runs"); nonzero stops the sweep
+     * (towstab/progress.h). */
+    ts_progress_fn progress;
+    void *progress_data;
 } ts_convergence;
 
 /* A table for `nvalues` values (names, units and scales copied from
@@ -202,7 +209,10 @@ TS_API void ts_conv_analysis_free(ts_conv_analysis *an);
  * ts_conv_check_settings) into series `series` of c, timing each run
  * (CLOCK_MONOTONIC). c must have been allocated with an's values. Returns
  * TS_OK when every run was recorded (failed runs included), TS_EINVAL
- * (bad settings, mismatched values) or TS_ENOMEM. */
+ * (bad settings, mismatched values) or TS_ENOMEM; TS_ECANCEL when
+ * c->progress asked to stop before a run, or a run returned TS_ECANCEL
+ * (its own progress callback asked: that run is recorded with the
+ * status), the rows so far kept. */
 TS_API int ts_convergence_sweep(ts_convergence *c, int series,
                                 const ts_conv_analysis *an,
                                 const double settings[], int n, ts_err *err);

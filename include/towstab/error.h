@@ -33,7 +33,8 @@ enum {
     TS_ELAPACK = -7,     /* LAPACK or ARPACK reported a failure */
     TS_ESINGULAR = -8,   /* a singular system (zero mass, zero tension, ...) */
     TS_EDOMAIN = -9,     /* a request the model cannot represent */
-    TS_EINTEGRATOR = -10 /* the time integrator failed */
+    TS_EINTEGRATOR = -10, /* the time integrator failed */
+    TS_ECANCEL = -11     /* stopped on request (towstab/progress.h) */
 };
 
 #define TS_ERR_MSG_MAX 1024
