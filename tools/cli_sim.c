@@ -278,6 +278,27 @@ int cli_sim_prepare(const cli_ctx *ctx, const cli_sim_args *a,
         rc = parse_setup(ctx, a, p->ex, s, err);
     if (!rc && (rc = ts_excitation_check_span(p->ex, s->o.t_end, err)))
         ts_err_prefix(err, "%s: ", a->where[SIM_A_EXCITE]);
+    /* Loads the excitation or a manoeuvre makes overflow: refused here,
+     * naming the option (the library refuses them too, naming only the
+     * input). */
+    if (!rc) {
+        ts_frame f0 = {sys->tow.speed, sys->tow.turn_rate, 0, 0,
+                       {sys->env.current[0], sys->env.current[1],
+                        sys->env.current[2]}};
+        ts_motion_bound mb;
+        ts_excitation_bound(p->ex, &f0, &mb);
+        if ((rc = ts_system_check_loads(sys, &mb, err))) {
+            mb.tow_speed = mb.tow_accel = 0.0;
+            ts_motion_bound st;
+            ts_motion_bound_steady(sys, &st);
+            int i = ts_system_check_loads(sys, &mb, NULL) ? SIM_A_MANOEUVRE
+                                                          : SIM_A_EXCITE;
+            if (ts_system_check_loads(sys, &st, NULL))
+                ts_err_prefix(err, "simulate: ");
+            else
+                ts_err_prefix(err, "%s: ", a->where[i]);
+        }
+    }
     if (!rc) {
         char def[2 * TS_NAME_MAX + 4];
         const char *name = a->val[SIM_A_OUTPUT];

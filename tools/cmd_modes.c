@@ -117,6 +117,7 @@ typedef struct modes_req {
     ts_eigen_opts eo;
     int count_given;
     int near_given;
+    char count_where[64]; /* where the count came from, for messages */
 } modes_req;
 
 static int parse_method(const char *text, const char *where,
@@ -219,22 +220,37 @@ static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
     *json = NULL;
     *lin_out = NULL;
     *eig_out = NULL;
-    int rc = cli_linear_setup(sys, eqo, 0, &eq, &eqjson, &lin, err);
-    if (rc != TS_OK) {
-        json_decref(eqjson);
-        ts_equilibrium_free(eq);
-        return rc;
-    }
+    /* The count and method against the number of states, before anything
+     * runs. */
+    ts_kernel *k0 = ts_kernel_alloc(sys, err);
+    if (!k0)
+        return err->code;
+    int nstate = ts_kernel_nstate(k0);
+    ts_kernel_free(k0);
     if (!rq->count_given) {
         if (rq->near_given)
             rq->eo.count = DEFAULT_NEAR_COUNT;
         else if (rq->eo.method == TS_EIG_ARPACK ||
                  (rq->eo.method == TS_EIG_AUTO &&
-                  lin->nstate >= rq->eo.arpack_min_states))
+                  nstate >= rq->eo.arpack_min_states))
             rq->eo.count = DEFAULT_LARGE_COUNT;
     }
-    if (rq->eo.count > lin->nstate / 2 + 1)
-        rq->eo.count = 0; /* more than exist: all of them */
+    /* More than exist: all of them (ARPACK finds a few; it says how many
+     * it can). */
+    if (rq->eo.count > nstate / 2 + 1 && rq->eo.method != TS_EIG_ARPACK)
+        rq->eo.count = 0;
+    int rc = ts_eigen_check(nstate, &rq->eo, err);
+    if (rc != TS_OK) {
+        if (rq->count_given)
+            ts_err_prefix(err, "%s %d: ", rq->count_where, rq->eo.count);
+        return rc;
+    }
+    rc = cli_linear_setup(sys, eqo, 0, &eq, &eqjson, &lin, err);
+    if (rc != TS_OK) {
+        json_decref(eqjson);
+        ts_equilibrium_free(eq);
+        return rc;
+    }
     ts_eigen *e = NULL;
     double t0 = cli_wall_now();
     rc = ts_eigen_solve(lin, &rq->eo, &e, err);
@@ -452,6 +468,7 @@ static int modes_main(int argc, char **argv)
                 return EXIT_BADINPUT;
             rq.eo.count = (int)v;
             rq.count_given = 1;
+            snprintf(rq.count_where, sizeof rq.count_where, "--count");
             break;
         case 'f': near = optarg; break;
         case 'M': method = optarg; break;
@@ -596,6 +613,8 @@ static int modes_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
         }
         rq.eo.count = (int)c;
         rq.count_given = 1;
+        snprintf(rq.count_where, sizeof rq.count_where,
+                 "analyses[%d].count (line %d)", index, o->line);
     }
     if ((o = ts_scene_analysis_option(a, "near"))) {
         snprintf(where, sizeof where, "analyses[%d].near (line %d)", index,
