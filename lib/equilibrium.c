@@ -54,6 +54,23 @@ void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
     o->guess = NULL;
 }
 
+int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
+                              double y[], ts_err *err)
+{
+    int nv = ts_kernel_nvehicles(k), nc = ts_kernel_ncontrol(k);
+    int nq = ts_kernel_nq(k);
+    if (nv != eq->nvehicles || nc != eq->ncontrol)
+        return ts_fail(err, TS_EINVAL,
+                       "equilibrium: solved with %d vehicles and %d "
+                       "controller states, the kernel has %d and %d",
+                       eq->nvehicles, eq->ncontrol, nv, nc);
+    for (int v = 0; v < nv; v++)
+        ts_kernel_set_vehicle(k, v, eq->attitudes + 9 * v, NULL,
+                              TS_CHART_RECHART, y);
+    memcpy(y + 2 * nq, eq->controls, (size_t)nc * sizeof(double));
+    return TS_OK;
+}
+
 const char *ts_eq_method_name(ts_eq_method m)
 {
     switch (m) {
@@ -71,11 +88,24 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
     eq->nlinks = sys->nlinks;
     eq->nnodes = sys->nnodes;
     size_t nl = (size_t)sys->nlinks, nn = (size_t)sys->nnodes;
-    eq->y = calloc(6 * nl, sizeof(double)); /* up to 3 coordinates a link */
+    /* Controller states: at most an integrator per loop and an actuator
+     * per surface. */
+    size_t maxc = 0;
+    for (int b = 0; b < sys->nbodies; b++)
+        if (sys->bodies[b].vehicle)
+            maxc += (size_t)(sys->bodies[b].vehicle->nloops +
+                             sys->bodies[b].vehicle->ncomponents);
+    eq->nvehicles = sys->nvehicles;
+    /* up to 3 coordinates a link, 3 a vehicle, and their rates */
+    eq->y = calloc(6 * nl + 6 * (size_t)sys->nvehicles + maxc,
+                   sizeof(double));
     eq->directions = calloc(3 * nl, sizeof(double));
     eq->positions = calloc(3 * nn, sizeof(double));
     eq->tensions = calloc(nl, sizeof(double));
-    if (!eq->y || !eq->directions || !eq->positions || !eq->tensions)
+    eq->attitudes = calloc(9 * (size_t)sys->nvehicles + 1, sizeof(double));
+    eq->controls = calloc(maxc + 1, sizeof(double));
+    if (!eq->y || !eq->directions || !eq->positions || !eq->tensions ||
+        !eq->attitudes || !eq->controls)
         goto nomem;
     return eq;
 nomem:
@@ -92,6 +122,8 @@ void ts_equilibrium_free(ts_equilibrium *eq)
     free(eq->directions);
     free(eq->positions);
     free(eq->tensions);
+    free(eq->attitudes);
+    free(eq->controls);
     free(eq);
 }
 
@@ -100,10 +132,15 @@ static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
                   double *dydt)
 {
     const ts_system *sys = ts_kernel_system(k);
-    int nl = sys->nlinks, nq = ts_kernel_nq(k);
-    eq->nstate = 2 * nq;
+    int nl = sys->nlinks, nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
+    eq->nstate = 2 * nq + nc;
     memcpy(eq->y, y, (size_t)nq * sizeof(double));
     memset(eq->y + nq, 0, (size_t)nq * sizeof(double));
+    memcpy(eq->y + 2 * nq, y + 2 * nq, (size_t)nc * sizeof(double));
+    eq->ncontrol = nc;
+    memcpy(eq->controls, y + 2 * nq, (size_t)nc * sizeof(double));
+    for (int v = 0; v < eq->nvehicles; v++)
+        ts_kernel_get_vehicle(k, v, eq->y, eq->attitudes + 9 * v, NULL);
     int rc = ts_kernel_eval(k, eq->y, NULL, dydt);
     eq->evaluations++;
     if (rc != TS_OK)

@@ -144,6 +144,13 @@ json_t *ts_report_excitation_json(const ts_excitation *ex)
             json_object_set_new(o, "from_s", num(s->start));
             json_object_set_new(o, "to_s", num(s->start + s->duration));
             break;
+        case TS_SIGNAL_SUM:
+            json_object_set_new(o, "rms", num(s->amplitude));
+            json_object_set_new(o, "components",
+                                json_integer(ts_excitation_sum_components(ex, i)));
+            json_object_set_new(o, "max_frequency_hz", num(s->frequency));
+            json_object_set_new(o, "fade_in_s", num(s->rise));
+            break;
         }
         json_array_append_new(a, o);
     }

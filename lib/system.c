@@ -63,9 +63,29 @@ void ts_system_free(ts_system *s)
     if (s->cables)
         for (int i = 0; i < s->ncables; i++)
             free(s->cables[i].link_fraction);
+    if (s->bodies)
+        for (int b = 0; b < s->nbodies; b++)
+            free(s->bodies[b].vehicle);
     free(s->cables);
     free(s->bodies);
     free(s);
+}
+
+ts_vehicle *ts_body_set_vehicle(ts_system *s, int b, ts_err *err)
+{
+    if (b < 0 || b >= s->nbodies) {
+        ts_fail(err, TS_EINVAL, "ts_body_set_vehicle: no body %d", b);
+        return NULL;
+    }
+    ts_vehicle *v = calloc(1, sizeof *v);
+    if (!v) {
+        ts_fail(err, TS_ENOMEM, "ts_body_set_vehicle: out of memory");
+        return NULL;
+    }
+    free(s->bodies[b].vehicle);
+    s->bodies[b].vehicle = v;
+    s->bodies[b].type = TS_BODY_VEHICLE;
+    return v;
 }
 
 ts_system *ts_system_copy(const ts_system *src, ts_err *err)
@@ -77,6 +97,19 @@ ts_system *ts_system_copy(const ts_system *src, ts_err *err)
     s->env = src->env;
     s->tow = src->tow;
     memcpy(s->bodies, src->bodies, (size_t)src->nbodies * sizeof *s->bodies);
+    for (int b = 0; b < src->nbodies; b++) {
+        s->bodies[b].vehicle = NULL;
+        if (!src->bodies[b].vehicle)
+            continue;
+        s->bodies[b].vehicle = malloc(sizeof(ts_vehicle));
+        if (!s->bodies[b].vehicle) {
+            ts_system_free(s);
+            ts_fail(err, TS_ENOMEM, "ts_system_copy: " "out of memory");
+            return NULL;
+        }
+        memcpy(s->bodies[b].vehicle, src->bodies[b].vehicle,
+               sizeof(ts_vehicle));
+    }
     for (int i = 0; i < src->ncables; i++) {
         s->cables[i] = src->cables[i];
         s->cables[i].link_fraction = NULL;
@@ -115,6 +148,23 @@ int ts_system_find_body(const ts_system *s, const char *name)
     return -1;
 }
 
+int ts_system_set_links(ts_system *sys, int links, ts_err *err)
+{
+    if (links < 1 || links > TS_MAX_LINKS)
+        return ts_fail(err, TS_EINVAL,
+                       "links: expected 1 to %d per cable, got %d",
+                       TS_MAX_LINKS, links);
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].link_fraction)
+            return ts_fail(err, TS_EINVAL,
+                           "links: cables[%d] '%s' has link_lengths; remove "
+                           "them to set the number of links",
+                           c, sys->cables[c].name);
+    for (int c = 0; c < sys->ncables; c++)
+        sys->cables[c].nlinks = links;
+    return ts_system_build(sys, err);
+}
+
 void ts_system_node_name(const ts_system *sys, int node, char *buf,
                          size_t size)
 {
@@ -147,6 +197,7 @@ double ts_body_volume(const ts_body *b)
     switch (b->type) {
     case TS_BODY_SPHERE: return M_PI * D * D * D / 6.0;
     case TS_BODY_CYLINDER: return M_PI * 0.25 * D * D * b->length;
+    case TS_BODY_VEHICLE: return b->vehicle ? b->vehicle->volume : 0.0;
     default: return 0.0;
     }
 }
@@ -419,6 +470,18 @@ static int validate(const ts_system *s, ts_err *err)
                                "must add up to the cable length", i,
                                at_line(c->line));
         }
+        if (c->has_from_point) {
+            if (c->from_body < 0 ||
+                s->bodies[c->from_body].type != TS_BODY_VEHICLE)
+                return ts_fail(err, TS_EINVAL, "cables[%d].at%s: "
+                               "a starting point on a body needs a vehicle "
+                               "as 'from'", i, at_line(c->line));
+            for (int j = 0; j < 3; j++)
+                if (!isfinite(c->from_point[j]))
+                    return ts_fail(err, TS_EINVAL, "cables[%d].at%s: "
+                                   "component %d must be finite", i,
+                                   at_line(c->line), j);
+        }
         if (c->damping > 0 && !(c->ea > 0))
             return ts_fail(err, TS_EINVAL, "cables[%d].damping%s: "
                            "internal damping needs an elastic cable (EA > 0)",
@@ -445,6 +508,18 @@ static int validate(const ts_system *s, ts_err *err)
                            "volume: diameter and length > 0 m, got %g m and "
                            "%g m",
                            b, at_line(bd->line), bd->diameter, bd->length);
+        if (bd->type == TS_BODY_VEHICLE) {
+            char where[64];
+            snprintf(where, sizeof where, "bodies[%d]", b);
+            if (!bd->vehicle)
+                return ts_fail(err, TS_EINVAL, "%s%s: a vehicle without a "
+                               "description", where, at_line(bd->line));
+            if ((rc = ts_vehicle_check(bd->vehicle, bd->mass, where, err)))
+                return rc;
+        } else if (bd->vehicle) {
+            return ts_fail(err, TS_EINVAL, "bodies[%d]%s: only a vehicle "
+                           "has a vehicle description", b, at_line(bd->line));
+        }
         if (bd->type == TS_BODY_SPHERE && !(bd->diameter > 0))
             return ts_fail(err, TS_EINVAL, "bodies[%d].diameter%s: "
                            "a sphere needs a diameter > 0 m, got %g", b,
@@ -543,6 +618,9 @@ int ts_system_build(ts_system *s, ts_err *err)
     s->has_bending = 0;
     s->has_added_mass = 0;
     s->has_elastic = 0;
+    s->nvehicles = 0;
+    for (int b = 0; b < s->nbodies; b++)
+        s->nvehicles += s->bodies[b].type == TS_BODY_VEHICLE;
     int k = 0;
     for (int o = 0; o < nc; o++) {
         int ci = order[o];
@@ -570,22 +648,35 @@ int ts_system_build(ts_system *s, ts_err *err)
             L->elastic = c->ea > 0;
             L->ea = c->ea;
             L->damping = c->damping;
+            /* The first link of a cable from a vehicle starts at a point of
+             * the vehicle, which carries half the link's mass. */
+            L->up_body = -1;
+            if (j == 0 && c->from_body >= 0 &&
+                s->bodies[c->from_body].type == TS_BODY_VEHICLE) {
+                const ts_vehicle *v = s->bodies[c->from_body].vehicle;
+                L->up_body = c->from_body;
+                for (int q = 0; q < 3; q++)
+                    L->up_point[q] = c->has_from_point ? c->from_point[q]
+                                                       : v->attach[q];
+            }
             if (L->elastic)
                 s->has_elastic = 1;
             if (L->ei > 0)
                 s->has_bending = 1;
             if (L->can > 0 && rho > 0 && L->diameter > 0)
                 s->has_added_mass = 1;
-            s->nodes[L->upper].mass += 0.5 * L->mass;
+            if (L->up_body < 0)
+                s->nodes[L->upper].mass += 0.5 * L->mass;
             s->nodes[L->lower].mass += 0.5 * L->mass;
         }
         if (c->to_body >= 0) {
             body_node[c->to_body] = k;
             s->nodes[k].body = c->to_body;
-            s->nodes[k].mass += s->bodies[c->to_body].mass;
             const ts_body *bd = &s->bodies[c->to_body];
+            if (bd->type != TS_BODY_VEHICLE)
+                s->nodes[k].mass += bd->mass;
             if ((bd->ca > 0 || bd->ca_cross > 0) && rho > 0 &&
-                bd->type != TS_BODY_JUNCTION)
+                bd->type != TS_BODY_JUNCTION && bd->type != TS_BODY_VEHICLE)
                 s->has_added_mass = 1;
         }
     }
@@ -616,9 +707,12 @@ int ts_system_build(ts_system *s, ts_err *err)
 
     /* A node without mass cannot be accelerated by finite tensions: every
      * free node needs structural mass (a junction between massless
-     * cables would make the tension system singular). */
+     * cables would make the tension system singular). A vehicle lends its
+     * node the inertia of its body. */
     for (int n = 1; n < s->nnodes; n++)
-        if (!(s->nodes[n].mass > 0)) {
+        if (!(s->nodes[n].mass > 0) &&
+            !(s->nodes[n].body >= 0 &&
+              s->bodies[s->nodes[n].body].type == TS_BODY_VEHICLE)) {
             const ts_link *L = &s->links[n - 1];
             ts_fail(err, TS_EINVAL, "cables[%d]%s: "
                     "'%s' link %d ends at a node with zero mass: give the "

@@ -17,6 +17,10 @@
  *     to port, along -y).
  *  5. Breakpoints, time scales, the periodic signal.
  *  6. The spec parser: units, defaults, and every refusal with its message.
+ *  7. Sums (an irregular sea's tow-point motion): the closed-form value
+ *     at full amplitude, the derivatives by differences during and after
+ *     the fade-in (whose end is a breakpoint), one signal per driven axis
+ *     sharing the components, the rms and the time scale, refusals.
  * Tolerances are stated at each check. */
 #include "towstab/excitation.h"
 
@@ -499,8 +503,99 @@ static void test_parse(void)
     ts_units_free(units);
 }
 
+static void test_sum(void)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    /* Three components; sway is not driven. */
+    const double w[3] = {0.43, -0.91, 1.7};
+    const double re[9] = {0.3, 0, -0.2, 0.1, 0, 0.05, -0.02, 0, 0.07};
+    const double im[9] = {0.1, 0, 0.4, -0.2, 0, 0.01, 0.03, 0, -0.06};
+    int rc = ts_excitation_add_sum(ex, 3, w, re, im, 5.0, &err);
+    CHECK(rc == TS_OK && ts_excitation_nsignals(ex) == 2,
+          "sum: one signal per driven axis (%d): %s",
+          ts_excitation_nsignals(ex), err.msg);
+    const ts_signal *s0 = ts_excitation_signal(ex, 0);
+    const ts_signal *s1 = ts_excitation_signal(ex, 1);
+    CHECK(s0->type == TS_SIGNAL_SUM && s0->axis == TS_AXIS_SURGE &&
+              s1->axis == TS_AXIS_HEAVE &&
+              ts_excitation_sum_components(ex, 1) == 3,
+          "sum signals on surge and heave, 3 components");
+    CHECK_NEAR(s1->amplitude,
+               sqrt(0.5 * (0.2 * 0.2 + 0.4 * 0.4 + 0.05 * 0.05 +
+                           0.01 * 0.01 + 0.07 * 0.07 + 0.06 * 0.06)),
+               1e-15, "sum: heave rms sqrt(sum |c|^2 / 2)");
+    /* Full amplitude after the fade-in: x = sum Re(c e^(i w t)). */
+    double t = 11.3, u[9];
+    ts_excitation_input(ex, t, u);
+    double x0 = 0, x2 = 0;
+    for (int k = 0; k < 3; k++) {
+        x0 += re[3 * k] * cos(w[k] * t) - im[3 * k] * sin(w[k] * t);
+        x2 += re[3 * k + 2] * cos(w[k] * t) - im[3 * k + 2] * sin(w[k] * t);
+    }
+    CHECK(fabs(u[0] - x0) < 1e-15 && fabs(u[2] - x2) < 1e-15 &&
+              u[1] == 0 && u[4] == 0 && u[7] == 0,
+          "sum after the fade-in: the closed form; sway untouched");
+    ts_excitation_input(ex, 0.0, u);
+    CHECK(u[0] == 0 && u[3] == 0 && u[6] == 0 && u[2] == 0,
+          "sum at t = 0: faded in from rest");
+    /* Derivatives by central differences (step 1e-5 s: |x'''| < 1, so
+     * truncation below 1e-10), in and after the fade-in. */
+    double ev, ea, worst = 0;
+    for (int ax = 0; ax < 3; ax += 2) {
+        fd_check(ex, ax, 0.01, 4.99, 40, 1e-5, &ev, &ea);
+        worst = fmax(worst, fmax(ev, ea));
+        fd_check(ex, ax, 5.01, 30, 40, 1e-5, &ev, &ea);
+        worst = fmax(worst, fmax(ev, ea));
+    }
+    CHECK(worst < 1e-8, "sum: velocity and acceleration are the "
+          "derivatives (max diff %.2g)", worst);
+    double bp[4];
+    CHECK(ts_excitation_breakpoints(ex, 20, bp, 4) == 1 && bp[0] == 5.0,
+          "sum: the end of the fade-in is a breakpoint");
+    CHECK_NEAR(ts_excitation_time_scale(ex), 1 / 1.7, 1e-15,
+               "sum: time scale 1 / max |w|");
+    int idx;
+    CHECK(!ts_excitation_periodic(ex, &idx), "a sum is not periodic");
+    char d[256];
+    ts_excitation_describe(ex, 1, d, sizeof d);
+    CHECK(strstr(d, "tow.heave sum of 3 sinusoids") != NULL, "describe: %s",
+          d);
+    ts_excitation_free(ex);
+    /* Refusals add nothing. */
+    ex = ts_excitation_alloc(&err);
+    const double zero[9] = {0};
+    const double bad_w[1] = {NAN};
+    ts_err e = {0};
+    CHECK(ts_excitation_add_sum(ex, 3, w, zero, zero, 0, &e) == TS_EINVAL,
+          "sum of zeros refused: %s", e.msg);
+    CHECK(ts_excitation_add_sum(ex, 1, bad_w, re, im, 0, &e) == TS_EINVAL,
+          "non-finite frequency refused: %s", e.msg);
+    CHECK(ts_excitation_add_sum(ex, 3, w, re, im, -1, &e) == TS_EINVAL,
+          "negative fade-in refused: %s", e.msg);
+    CHECK(ts_excitation_add_sum(ex, 0, w, re, im, 0, &e) == TS_EINVAL,
+          "no component refused");
+    CHECK(ts_excitation_nsignals(ex) == 0, "refused sums added nothing");
+    /* Many signals before: the sum's signals still fit. */
+    ts_signal sg = {0};
+    sg.type = TS_SIGNAL_SINE;
+    sg.axis = TS_AXIS_SWAY;
+    sg.amplitude = 0.1;
+    sg.frequency = 0.2;
+    for (int i = 0; i < 4; i++)
+        ts_excitation_add(ex, &sg, &e);
+    CHECK(ts_excitation_add_sum(ex, 3, w, re, im, 0, &e) == TS_OK &&
+              ts_excitation_nsignals(ex) == 6,
+          "a sum after four signals (table full): %s", e.msg);
+    ts_excitation_input(ex, 2.0, u);
+    CHECK(fabs(u[1] - 4 * 0.1 * sin(2 * M_PI * 0.2 * 2.0)) < 1e-15,
+          "the sines still add up beside the sum");
+    ts_excitation_free(ex);
+}
+
 int main(void)
 {
+    test_sum();
     test_shapes();
     test_series();
     test_manoeuvres();
