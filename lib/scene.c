@@ -25,7 +25,7 @@
  * libyaml document are freed.
  *
  * Limits against hostile input (fuzzing): at most MAX_ENTRIES entries in a
- * list and MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES;
+ * list and TS_MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES;
  * flow collections ([...], {...}) nested at most MAX_FLOW_DEPTH deep,
  * checked by a scan before libyaml sees the text: libyaml's scanner takes
  * time quadratic in that depth (100 000 '[' took 40 s).
@@ -44,8 +44,7 @@
 /* Largest number of entries in any list (cables, bodies, analyses, options,
  * link_lengths): far beyond a real scene, small enough for int counts. */
 #define MAX_ENTRIES 100000
-/* Largest number of rigid links in the whole system (sum over cables). */
-#define MAX_LINKS 100000
+/* Links in the whole system (sum over cables): TS_MAX_LINKS, towstab/system.h. */
 /* Deepest nesting of flow collections: the format needs two levels. */
 #define MAX_FLOW_DEPTH 64
 /* Largest scene file read by ts_scene_load. */
@@ -686,9 +685,9 @@ static int parse_link_lengths(const ctx *c, const char *path, const field *f,
     if (len < 1)
         return fail_at(c, TS_EINVAL, p, f->line, "needs at least one link "
                        "length");
-    if (len > MAX_LINKS)
+    if (len > TS_MAX_LINKS)
         return fail_at(c, TS_EINVAL, p, f->line, "has %d entries, at most %d "
-                       "links are allowed", len, MAX_LINKS);
+                       "links are allowed", len, TS_MAX_LINKS);
     double *frac = malloc((size_t)len * sizeof *frac);
     if (!frac)
         return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", p);
@@ -849,7 +848,7 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
     /* Links: a count, a list of lengths, or both (then they must agree). */
     int nlinks = 0;
     if (f[C_LINKS].value) {
-        rc = read_count(c, join(p, path, "links"), &f[C_LINKS], MAX_LINKS,
+        rc = read_count(c, join(p, path, "links"), &f[C_LINKS], TS_MAX_LINKS,
                         &nlinks);
         if (rc != TS_OK)
             return rc;
@@ -1024,9 +1023,9 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
                   : ts_fail(c->err, TS_ESCENE, "cables: broken YAML");
         if (rc == TS_OK) {
             total_links += sys->cables[i].nlinks;
-            if (total_links > MAX_LINKS)
+            if (total_links > TS_MAX_LINKS)
                 rc = fail_at(c, TS_EINVAL, "cables", f[K_CABLES].line,
-                             "more than %d links in total", MAX_LINKS);
+                             "more than %d links in total", TS_MAX_LINKS);
         }
     }
     if (rc != TS_OK)

@@ -148,6 +148,23 @@ int ts_system_find_body(const ts_system *s, const char *name)
     return -1;
 }
 
+int ts_system_set_links(ts_system *sys, int links, ts_err *err)
+{
+    if (links < 1 || links > TS_MAX_LINKS)
+        return ts_fail(err, TS_EINVAL,
+                       "links: expected 1 to %d per cable, got %d",
+                       TS_MAX_LINKS, links);
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].link_fraction)
+            return ts_fail(err, TS_EINVAL,
+                           "links: cables[%d] '%s' has link_lengths; remove "
+                           "them to set the number of links",
+                           c, sys->cables[c].name);
+    for (int c = 0; c < sys->ncables; c++)
+        sys->cables[c].nlinks = links;
+    return ts_system_build(sys, err);
+}
+
 void ts_system_node_name(const ts_system *sys, int node, char *buf,
                          size_t size)
 {

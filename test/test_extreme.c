@@ -80,6 +80,7 @@
 #include <time.h>
 
 #include "tcheck.h"
+#include "towstab/analysis.h"
 #include "towstab/converge.h"
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
@@ -899,7 +900,9 @@ static void case_mm(void)
     ts_err err = {0};
     ts_conv_analysis an;
     ts_convergence *c = NULL;
-    int rc = s ? ts_conv_equilibrium_analysis(s, NULL, &an, &err) : TS_ENOMEM;
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_CONVERGE);
+    int rc = s ? ts_analysis_sweep(s, &rq, 0, &an, &err) : TS_ENOMEM;
     if (rc == TS_OK) {
         c = ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
                                  an.values, 3, &err);

@@ -20,7 +20,9 @@ extern "C" {
 #endif
 
 #define TS_NAME_MAX 64
-#define TS_MAX_LINKS 10000000   /* links in one system */
+/* Links in one system, and so on any cable: the one limit of the scene
+ * format, the command line and the convergence sweeps. */
+#define TS_MAX_LINKS 100000
 
 typedef enum { TS_DRAG_STANDARD = 0, TS_DRAG_LOADING = 1 } ts_drag_law;
 
@@ -180,6 +182,11 @@ TS_API int ts_system_find_body(const ts_system *sys, const char *name);
 /* Node at which body b sits (lower node of the cable that ends at it), or
  * -1 before ts_system_build(). */
 TS_API int ts_system_body_node(const ts_system *sys, int b);
+
+/* Cut every cable into `links` equal links and rebuild. TS_EINVAL for
+ * links outside [1, TS_MAX_LINKS] or a cable with link_lengths (the
+ * message starts with "links: " and names the cable), TS_ENOMEM. */
+TS_API int ts_system_set_links(ts_system *sys, int links, ts_err *err);
 
 /* Name of node `node` (built system) into buf[size] (cut to fit): "tow"
  * for node 0, the body's name where a body sits, else "<cable>.<k>" for

@@ -22,26 +22,9 @@ if [ $# -ne 2 ]; then
 fi
 TOWSTAB=$1
 CHECK_JSON=$2
-T=$(mktemp -d "${TMPDIR:-/tmp}/towstab-outputs-XXXXXX") || exit 2
-trap 'rm -rf "$T"' EXIT
+. "$(dirname "$0")/common.sh"
 EX=examples/kamman_ex3_turn.yaml
 EX5=examples/kamman_ex5_drop.yaml
-
-npass=0
-nfail=0
-pass() { echo "PASS $*"; npass=$((npass + 1)); }
-fail() { echo "FAIL $*"; nfail=$((nfail + 1)); }
-check() { # check DESCRIPTION WHY
-    if [ -z "$2" ]; then pass "$1"; else fail "$1:$2"; fi
-}
-ts() {
-    "$TOWSTAB" "$@" >"$T/out" 2>"$T/err"
-    status=$?
-}
-fresh() {
-    rm -rf "$T/o"
-    mkdir "$T/o"
-}
 # device_id PATH: type, inode and device numbers, to compare before/after.
 device_id() { stat -c '%F %i %t:%T' "$1"; }
 
@@ -186,5 +169,4 @@ grep -q '"completed": false' "$T/o/r.json" || why="$why not completed false;"
 grep -q '"error"' "$T/o/r.json" || why="$why no error;"
 check "run with a failing analysis: JSON marked incomplete" "$why"
 
-echo "$npass passed, $nfail failed"
-[ "$nfail" -eq 0 ]
+finish
