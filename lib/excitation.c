@@ -31,6 +31,10 @@
  * sum int dOmega uses J(xi) = int_0^xi I = xi^5/2 - xi^6/2 + xi^7/7 on [0,1]
  * and 1/7 + xi (xi - 1)/2 beyond. A current c fixed in inertial space has,
  * in M rotated by psi about +z, the components R_z(psi)^T c.
+ *
+ * One module, though long: the signal types share one evaluation of
+ * displacement, velocity and acceleration, one spec parser and one
+ * description; a signal is a few dozen lines of each.
  */
 #include "towstab/excitation.h"
 

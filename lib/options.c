@@ -975,20 +975,24 @@ int ts_optset_apply(const ts_optset *s, int max_priority, const ts_units *u,
 {
 #define winner(s, i) winner_below(s, i, max_priority)
     /* Groups: the highest source wins; one source giving two is refused. */
-    int skip[256] = {0};
-    for (int i = 0; i < s->n && i < 256; i++) {
+    char *skip = calloc((size_t)s->n, 1);
+    if (!skip)
+        return ts_fail(err, TS_ENOMEM, "options: out of memory");
+    for (int i = 0; i < s->n; i++) {
         int pi = winner(s, i);
         if (!s->table[i].group || pi < 0)
             continue;
-        for (int j = i + 1; j < s->n && j < 256; j++) {
+        for (int j = i + 1; j < s->n; j++) {
             int pj = winner(s, j);
             if (s->table[j].group != s->table[i].group || pj < 0)
                 continue;
-            if (pi == pj)
+            if (pi == pj) {
+                free(skip);
                 return ts_fail(err, TS_EINVAL, "%s and %s: give one of them "
                                "(%s or %s)", s->g[i][pi].where,
                                s->g[j][pj].where, s->table[i].name,
                                s->table[j].name);
+            }
             skip[pi > pj ? j : i] = 1;
         }
     }
@@ -1001,12 +1005,15 @@ int ts_optset_apply(const ts_optset *s, int max_priority, const ts_units *u,
         for (int k = 0; k < g->ntext; k++) {
             int rc = ts_option_set(&s->table[i], rq, g->text[k], g->where, u,
                                    err);
-            if (rc)
+            if (rc) {
+                free(skip);
                 return rc;
+            }
         }
         if (s->table[i].offset == offsetof(ts_request, converge.analysis))
             study = rq->converge.analysis;
     }
+    free(skip);
     /* Options of a study that do not apply to its analysis. */
     if (s->kind == TS_ANALYSIS_CONVERGE) {
         if (study < 0)
