@@ -49,6 +49,10 @@
  * times its lever, and the hybrid solver's iterations. */
 #define TRIM_RTOL 1e-12
 #define TRIM_MAXIT 200
+/* A relative force residual this small is rounding in the sums of the
+ * nodal balances (about 1000 machine epsilons): Newton stalling there has
+ * converged as far as double precision goes. */
+#define ROUNDING_RESIDUAL 2e-13
 
 void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
 {
@@ -379,6 +383,40 @@ static void largest_load(const ts_kernel *k, char *buf, size_t size,
     }
 }
 
+/* The part of the system state y[i] (a coordinate or a controller
+ * state) belongs to, as a scene key path. */
+static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k);
+    if (i >= 2 * nq) {
+        ts_control_state cs;
+        ts_kernel_control_state(k, i - 2 * nq, &cs);
+        int b = ts_kernel_vehicle_body(k, cs.vehicle);
+        const ts_vehicle *v = sys->bodies[b].vehicle;
+        snprintf(buf, size, "bodies[%d] '%s' %s '%s'", b, sys->bodies[b].name,
+                 cs.actuator ? "control surface" : "controller",
+                 cs.actuator ? v->component[cs.index].name
+                             : v->loop[cs.index].name);
+        return;
+    }
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        int o = ts_kernel_vehicle_offset(k, v);
+        if (i >= o && i < o + 3) {
+            int b = ts_kernel_vehicle_body(k, v);
+            snprintf(buf, size, "bodies[%d] '%s' (its attitude)", b,
+                     sys->bodies[b].name);
+            return;
+        }
+    }
+    int l = 0;
+    while (l + 1 < sys->nlinks && ts_kernel_link_offset(k, l + 1) <= i)
+        l++;
+    const ts_link *L = &sys->links[l];
+    snprintf(buf, size, "cables[%d] '%s' link %d", L->cable,
+             sys->cables[L->cable].name, L->index);
+}
+
 /* The Jacobian of (q'', c') at y by central differences, column by
  * column, and its LU and condition in w (w->R holds f(y)). */
 static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
@@ -466,11 +504,16 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             w->dq[i] = -w->R[nq + i];
         if (info == 0)
             dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
-        if (info != 0)
+        if (info != 0) {
+            char place[2 * TS_NAME_MAX + 64];
+            singular_place(k, unknown(w, info - 1), place, sizeof place);
             return ts_fail(err, TS_ESINGULAR,
-                           "equilibrium: singular Newton Jacobian (LAPACK "
-                           "dgetrf info %d) at relative residual %.3g",
-                           info, rel);
+                           "equilibrium: singular Newton Jacobian at "
+                           "relative residual %.3g: nothing restores %s "
+                           "(LAPACK dgetrf info %d), as with neutral "
+                           "buoyancy and no flow past it",
+                           rel, place, info);
+        }
         double big = 0.0;
         for (int i = 0; i < nu; i++)
             big = fmax(big, fabs(w->dq[i]) / w->scale[i]);
@@ -505,9 +548,16 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                        "(controller residual %.3g, target %.3g): a set "
                        "point out of reach of the surfaces' limits?",
                        eq->iterations, crel, tol);
+    if (rel <= ROUNDING_RESIDUAL)
+        return ts_fail(err, TS_ECONV,
+                       "equilibrium: Newton stopped after %d iterations at "
+                       "relative residual %.3g, which is rounding: the "
+                       "tolerance %.3g is below what double precision "
+                       "reaches (about %g)",
+                       eq->iterations, rel, tol, ROUNDING_RESIDUAL);
     return ts_fail(err, TS_ECONV,
                    "equilibrium: Newton stopped after %d iterations at "
-                   "relative residual %.3g (target %.3g)",
+                   "relative residual %.3g (tolerance %.3g)",
                    eq->iterations, rel, tol);
 }
 
@@ -593,13 +643,20 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         path(pc, t);
         rc = TS_OK;
     }
+    /* Name the continuation only where there was one: a straight tow has
+     * no turn-rate path (its first Newton solve is the whole of it). */
     if (rc != TS_OK && rc != TS_ENOMEM) {
         ts_frame f;
         ts_kernel_get_frame(k, &f);
-        ts_err_prefix(err, "continuation stopped %.4g of the way (%s), at "
-                           "turn rate %.6g rad/s: ",
-                      t, path == turn_path ? "turn rate" : "bending stiffness",
-                      f.turn_rate);
+        if (path == bending_path)
+            ts_err_prefix(err, "continuation in bending stiffness (EI "
+                               "scaled up from %g of its value) stopped "
+                               "%.4g of the way: ", pc->b0, t);
+        else if (pc->frame.turn_rate != 0)
+            ts_err_prefix(err, "continuation in turn rate towards %.6g "
+                               "rad/s stopped %.4g of the way, at %.6g "
+                               "rad/s: ", pc->frame.turn_rate, t,
+                          f.turn_rate);
     }
     return rc;
 }
@@ -896,6 +953,13 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                        "equilibrium: method shooting does not apply to "
                        "vehicles (the march has no attitudes); use newton "
                        "or auto");
+    /* Loads that overflow are the input's fault: say which input. */
+    ts_motion_bound mb = {fabs(frame.speed), fabs(frame.turn_rate), 0, 0};
+    int lrc = ts_system_check_loads(sys, &mb, err);
+    if (lrc != TS_OK) {
+        ts_err_prefix(err, "equilibrium: ");
+        return lrc;
+    }
 
     int nl = sys->nlinks, nq = ts_kernel_nq(k), rc;
     int n = ts_kernel_nstate(k), nv = sys->nvehicles;

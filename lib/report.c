@@ -9,7 +9,6 @@
 #include <string.h>
 
 #include "outfile.h"
-#include "towstab/health.h"
 #include "towstab/kernel.h"
 
 /* A JSON number, or null for a value that is not finite. */
@@ -94,7 +93,8 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
 }
 
 json_t *ts_report_equilibrium_json(const ts_system *sys,
-                                   const ts_equilibrium *eq, double wall_s)
+                                   const ts_equilibrium *eq, double wall_s,
+                                   const ts_trust *trust)
 {
     json_t *o = json_object();
     json_t *nodes = json_array(), *links = json_array(), *bodies = json_array();
@@ -150,10 +150,7 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     json_object_set_new(o, "condition", num(eq->condition));
     json_object_set_new(o, "shape_error", num(eq->shape_error));
     /* What an engineer must not overlook: trustworthy, reasons, notes. */
-    ts_trust t;
-    ts_trust_init(&t);
-    ts_health_equilibrium(sys, eq, &t);
-    json_t *tj = ts_report_trust_json(&t);
+    json_t *tj = trust ? ts_report_trust_json(trust) : NULL;
     if (tj) {
         json_object_update(o, tj);
         json_decref(tj);

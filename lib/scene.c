@@ -25,10 +25,15 @@
  * libyaml document are freed.
  *
  * Limits against hostile input (fuzzing): at most MAX_ENTRIES entries in a
- * list and MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES;
+ * list and TS_MAX_LINKS links in the whole system; files up to MAX_FILE_BYTES;
  * flow collections ([...], {...}) nested at most MAX_FLOW_DEPTH deep,
  * checked by a scan before libyaml sees the text: libyaml's scanner takes
  * time quadratic in that depth (100 000 '[' took 40 s).
+ *
+ * One module, though long: every block (environment, tow, cables, bodies,
+ * analyses) is read with the same node walkers, key tables, quantity
+ * parsing and line-numbered messages; the blocks apart, each would need
+ * those internals.
  */
 #include "towstab/scene.h"
 
@@ -44,8 +49,7 @@
 /* Largest number of entries in any list (cables, bodies, analyses, options,
  * link_lengths): far beyond a real scene, small enough for int counts. */
 #define MAX_ENTRIES 100000
-/* Largest number of rigid links in the whole system (sum over cables). */
-#define MAX_LINKS 100000
+/* Links in the whole system (sum over cables): TS_MAX_LINKS, towstab/system.h. */
 /* Deepest nesting of flow collections: the format needs two levels. */
 #define MAX_FLOW_DEPTH 64
 /* Largest scene file read by ts_scene_load. */
@@ -1243,9 +1247,9 @@ static int parse_link_lengths(const ctx *c, const char *path, const field *f,
     if (len < 1)
         return fail_at(c, TS_EINVAL, p, f->line, "needs at least one link "
                        "length");
-    if (len > MAX_LINKS)
+    if (len > TS_MAX_LINKS)
         return fail_at(c, TS_EINVAL, p, f->line, "has %d entries, at most %d "
-                       "links are allowed", len, MAX_LINKS);
+                       "links are allowed", len, TS_MAX_LINKS);
     double *frac = malloc((size_t)len * sizeof *frac);
     if (!frac)
         return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", p);
@@ -1416,7 +1420,7 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
     /* Links: a count, a list of lengths, or both (then they must agree). */
     int nlinks = 0;
     if (f[C_LINKS].value) {
-        rc = read_count(c, join(p, path, "links"), &f[C_LINKS], MAX_LINKS,
+        rc = read_count(c, join(p, path, "links"), &f[C_LINKS], TS_MAX_LINKS,
                         &nlinks);
         if (rc != TS_OK)
             return rc;
@@ -1591,9 +1595,9 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
                   : ts_fail(c->err, TS_ESCENE, "cables: broken YAML");
         if (rc == TS_OK) {
             total_links += sys->cables[i].nlinks;
-            if (total_links > MAX_LINKS)
+            if (total_links > TS_MAX_LINKS)
                 rc = fail_at(c, TS_EINVAL, "cables", f[K_CABLES].line,
-                             "more than %d links in total", MAX_LINKS);
+                             "more than %d links in total", TS_MAX_LINKS);
         }
     }
     if (rc != TS_OK)
@@ -1789,7 +1793,10 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
                 sizeof ((ts_scene *)0)->path - 1);
         return NULL;
     }
-    FILE *fp = fopen(path, "rb");
+    /* "-" is standard input, as in other Unix tools. */
+    int from_stdin = strcmp(path, "-") == 0;
+    const char *name = from_stdin ? "standard input" : path;
+    FILE *fp = from_stdin ? stdin : fopen(path, "rb");
     if (!fp) {
         ts_fail(err, TS_EIO, "%s: cannot open: %s", path, strerror(errno));
         return NULL;
@@ -1797,14 +1804,16 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
     /* Read the whole file, growing the buffer geometrically. */
     size_t cap = 4096, len = 0;
     char *buf = malloc(cap);
-    int rc = buf ? TS_OK : ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+    int rc = buf ? TS_OK
+                 : ts_fail(err, TS_ENOMEM, "%s: out of memory for %zu bytes",
+                           name, cap);
     while (rc == TS_OK) {
         if (len == cap) {
             /* The buffer grows to at most MAX_FILE_BYTES + 1: filling that
              * proves the file is too large. */
             if (cap > (size_t)MAX_FILE_BYTES) {
                 rc = ts_fail(err, TS_EIO, "%s: larger than %ld bytes, not a "
-                             "scene file", path, MAX_FILE_BYTES);
+                             "scene file", name, MAX_FILE_BYTES);
                 break;
             }
             size_t bigger_cap = cap * 2 > (size_t)MAX_FILE_BYTES
@@ -1812,7 +1821,8 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
                                     : cap * 2;
             char *bigger = realloc(buf, bigger_cap);
             if (!bigger) {
-                rc = ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+                rc = ts_fail(err, TS_ENOMEM, "%s: out of memory for %zu "
+                             "bytes", name, bigger_cap);
                 break;
             }
             buf = bigger;
@@ -1822,19 +1832,20 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
         len += got;
         if (got == 0) {
             if (ferror(fp))
-                rc = ts_fail(err, TS_EIO, "%s: cannot read: %s", path,
+                rc = ts_fail(err, TS_EIO, "%s: cannot read: %s", name,
                              strerror(errno));
             break;
         }
     }
-    fclose(fp);
+    if (!from_stdin)
+        fclose(fp);
     ts_scene *scene = NULL;
     if (rc == TS_OK) {
         scene = parse(buf, len, units, err);
         if (scene)
             snprintf(scene->path, sizeof scene->path, "%s", path);
         else
-            ts_err_prefix(err, "%s: ", path);
+            ts_err_prefix(err, "%s: ", name);
     }
     free(buf);
     return scene;

@@ -228,27 +228,55 @@ static int alloc_result(ts_seastate *s, int np, int nin)
            s->input_im && s->gain_re && s->gain_im && s->density;
 }
 
-/* Statistics from m0, m2 and their errors. */
+/* The errors of sigma, 2 sigma, Tz and the most probable maximum caused
+ * by errors e0 of m0 and e2 of m2 (first order). */
+static void stat_errors(const ts_seastate *s, double e0, double e2,
+                        double out[4])
+{
+    double m0 = s->m0.value, m2 = s->m2.value, sigma = sqrt(m0);
+    double es = sigma > 0 ? e0 / (2 * sigma) : sqrt(e0);
+    double rel_tz = 0.5 * (e0 / m0 + e2 / m2);
+    out[0] = es;
+    out[1] = 2 * es;
+    out[2] = s->tz.value * rel_tz;
+    if (s->cycles > 1) {
+        double q = sqrt(2 * log(s->cycles));
+        out[3] = es * q + sigma / q * rel_tz;
+    } else {
+        out[3] = NAN;
+    }
+}
+
+static void stat_total(ts_stat *t)
+{
+    t->error = t->grid + t->band + t->discretisation;
+}
+
+/* Statistics from m0, m2 and their errors' parts. */
 static void statistics(ts_seastate *s)
 {
     double m0 = s->m0.value, m2 = s->m2.value;
-    double e0 = s->m0.error, e2 = s->m2.error;
     double sigma = sqrt(m0);
     s->sigma.value = sigma;
-    s->sigma.error = sigma > 0 ? e0 / (2 * sigma) : sqrt(e0);
     s->significant.value = 2 * sigma;
-    s->significant.error = 2 * s->sigma.error;
-    double rel_tz = 0.5 * (e0 / m0 + e2 / m2);
     s->tz.value = m2 > 0 ? 2 * M_PI * sqrt(m0 / m2) : NAN;
-    s->tz.error = s->tz.value * rel_tz;
     s->cycles = s->duration / s->tz.value;
-    if (s->cycles > 1) {
-        double q = sqrt(2 * log(s->cycles));
-        s->mpm.value = sigma * q;
-        s->mpm.error = s->sigma.error * q + sigma / q * rel_tz;
-    } else {
-        s->mpm.value = s->mpm.error = NAN;
+    s->mpm.value = s->cycles > 1 ? sigma * sqrt(2 * log(s->cycles)) : NAN;
+    double g[4], b[4];
+    stat_errors(s, s->m0_grid_error, s->m2_grid_error, g);
+    stat_errors(s, s->m0_band_error, s->m2_band_error, b);
+    ts_stat *st[4] = {&s->sigma, &s->significant, &s->tz, &s->mpm};
+    for (int i = 0; i < 4; i++) {
+        st[i]->grid = g[i];
+        st[i]->band = b[i];
+        stat_total(st[i]);
     }
+    s->m0.grid = s->m0_grid_error;
+    s->m0.band = s->m0_band_error;
+    s->m2.grid = s->m2_grid_error;
+    s->m2.band = s->m2_band_error;
+    stat_total(&s->m0);
+    stat_total(&s->m2);
 }
 
 int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
@@ -370,8 +398,8 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
     s->m2_band_error = g0 * we0 * we0 * below + gn * wen * wen * above;
     s->wave_m0_band = inside;
     s->wave_m0_out = below + above;
-    s->m0.error = s->m0_grid_error + s->m0_band_error;
-    s->m2.error = s->m2_grid_error + s->m2_band_error;
+    s->disc_order = NAN;
+    s->disc_links_needed = NAN;
     statistics(s);
 
     /* Verdict. */
@@ -391,7 +419,11 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
                       "the band %.4g to %.4g rad/s (its estimated share of "
                       "the output variance is in the band error)",
                       100 * s->wave_m0_out / si.m0, lo, hi);
-    if (!(s->cycles >= CYCLES_NOTE))
+    if (!(s->m0.value > 0))
+        ts_trust_note(&s->trust, "%s does not respond to this sea (sigma "
+                      "= 0): Tz and the most probable maximum are not "
+                      "defined", s->output.name);
+    else if (s->cycles < CYCLES_NOTE)
         ts_trust_note(&s->trust, "only %.3g response cycles in %g s: the "
                       "most probable maximum sigma sqrt(2 ln N) assumes many",
                       s->cycles, s->duration);
@@ -548,11 +580,12 @@ int ts_record_stats_compute(const double x[], int n, double dt,
         return TS_OK;
     }
     /* Sokal's window on tau2(M) = dt (1 + 2 sum_1^M rho_k^2). */
-    double sum = 1.0;
+    double sum = 1.0, sum1 = 1.0;
     int M = n / 2, k;
     for (k = 1; k < n / 2; k++) {
         double rho = a[k] / n / r0;
         sum += 2.0 * rho * rho;
+        sum1 += 2.0 * rho;
         if (k >= TS_SEA_SOKAL * sum) {
             M = k;
             break;
@@ -561,6 +594,8 @@ int ts_record_stats_compute(const double x[], int n, double dt,
     free(a);
     st->window_lags = M;
     st->corr_time = dt * sum;
+    st->mean_error = st->sigma.value * sqrt(dt * fmax(sum1, 1.0) /
+                                            st->duration);
     st->independent = st->duration / st->corr_time;
     st->sigma.error = st->sigma.value * sqrt(st->corr_time /
                                              (2.0 * st->duration));
@@ -605,4 +640,241 @@ int ts_record_from_history(const ts_history *h, const ts_output *out,
     }
     *dt = step;
     return TS_OK;
+}
+
+/* --- Discretisation -------------------------------------------------- */
+
+typedef struct conv_ctx {
+    ts_system *sys;
+    ts_equilibrium_opts eo;
+    const ts_sea *sea;
+    const ts_rao *rao;
+    double reference[3];
+    char output[2 * TS_NAME_MAX + 16];
+    ts_seastate_opts o;
+} conv_ctx;
+
+static void conv_ctx_free(void *p)
+{
+    conv_ctx *x = p;
+    ts_system_free(x->sys);
+    free(x);
+}
+
+static int conv_run(void *ctx, ts_conv_param p, double setting,
+                    double values[], double noise[], long *evaluations,
+                    ts_trust *trust, ts_err *err)
+{
+    conv_ctx *x = ctx;
+    ts_equilibrium_opts eo = x->eo;
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    if (p == TS_CONV_TOLERANCE)
+        eo.tol = setting;
+    if (p == TS_CONV_STEP)
+        lo.rel_step = setting;
+    ts_system *sys = p == TS_CONV_LINKS
+                         ? ts_conv_system_with_links(x->sys, (int)setting, err)
+                         : x->sys;
+    if (!sys)
+        return err && err->code ? err->code : TS_EINVAL;
+    ts_output out;
+    int rc = ts_response_output_find(sys, x->output, &out, err);
+    lo.tensions = out.kind == TS_OUT_TENSION;
+    ts_kernel *k = rc ? NULL : ts_kernel_alloc(sys, err);
+    ts_equilibrium *eq = k ? ts_equilibrium_alloc(sys, err) : NULL;
+    ts_linear *lin = NULL;
+    ts_seastate *r = NULL;
+    if (!rc)
+        rc = eq ? ts_equilibrium_solve(k, &eo, eq, err) : TS_ENOMEM;
+    if (eq) {
+        *evaluations += eq->evaluations;
+        ts_health_equilibrium(sys, eq, trust);
+    }
+    if (!rc) {
+        lin = ts_linear_alloc(k, err);
+        rc = lin ? ts_linearize_equilibrium(k, eq, &lo, lin, err) : TS_ENOMEM;
+        if (lin)
+            *evaluations += lin->evaluations;
+    }
+    ts_seaway w;
+    if (!rc)
+        rc = ts_seaway_init(&w, sys, x->sea, x->rao, x->reference, err);
+    if (!rc)
+        rc = ts_seastate_compute(sys, lin, &w, &out, &x->o, &r, err);
+    if (!rc) {
+        const ts_stat *st[3] = {&r->sigma, &r->tz, &r->mpm};
+        for (int i = 0; i < 3; i++) {
+            values[i] = st[i]->value;
+            noise[i] = st[i]->grid + st[i]->band;
+        }
+        ts_trust_merge(trust, "", &r->trust);
+    }
+    ts_seastate_free(r);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    if (sys != x->sys)
+        ts_system_free(sys);
+    return rc;
+}
+
+int ts_seastate_conv_analysis(const ts_system *sys,
+                              const ts_equilibrium_opts *eo,
+                              const ts_sea *sea, const ts_rao *rao,
+                              const double reference[3], const char *output,
+                              const ts_seastate_opts *o, ts_conv_analysis *an,
+                              ts_err *err)
+{
+    memset(an, 0, sizeof *an);
+    ts_output out;
+    int rc = ts_response_output_find(sys, output, &out, err);
+    if (rc)
+        return rc;
+    conv_ctx *x = calloc(1, sizeof *x);
+    an->values = calloc(3, sizeof *an->values);
+    if (x)
+        x->sys = ts_system_copy(sys, err);
+    if (!x || !x->sys || !an->values) {
+        if (x)
+            ts_system_free(x->sys);
+        free(x);
+        free(an->values);
+        an->values = NULL;
+        return ts_fail(err, TS_ENOMEM, "sea state: out of memory");
+    }
+    if (eo)
+        x->eo = *eo;
+    else
+        ts_equilibrium_opts_default(&x->eo);
+    if (o)
+        x->o = *o;
+    else
+        ts_seastate_opts_default(&x->o);
+    x->sea = sea;
+    x->rao = rao;
+    for (int c = 0; c < 3; c++)
+        x->reference[c] = reference ? reference[c] : 0.0;
+    snprintf(x->output, sizeof x->output, "%s", out.name);
+    snprintf(an->name, sizeof an->name, "seastate");
+    an->nvalues = 3;
+    static const char *const what[3] = {"sigma", "tz", "mpm"};
+    const char *unit = out.kind == TS_OUT_TENSION ? "N" : "m";
+    for (int i = 0; i < 3; i++) {
+        snprintf(an->values[i].name, sizeof an->values[i].name, "%.80s.%s",
+                 out.name, what[i]);
+        snprintf(an->values[i].unit, sizeof an->values[i].unit, "%s",
+                 i == 1 ? "s" : unit);
+        an->values[i].scale = 0.0;
+    }
+    an->ctx = x;
+    an->free_ctx = conv_ctx_free;
+    an->run = conv_run;
+    return TS_OK;
+}
+
+int ts_seastate_discretisation(const ts_system *sys,
+                               const ts_equilibrium_opts *eo,
+                               const ts_seaway *w, const ts_seastate_opts *o,
+                               ts_seastate *r, ts_err *err)
+{
+    int N = sys->ncables > 0 ? sys->cables[0].nlinks : 0;
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].nlinks != N || sys->cables[c].link_fraction)
+            return ts_fail(err, TS_EDOMAIN, "sea state: the discretisation "
+                           "error needs every cable at the same number of "
+                           "equal links (cable '%s' has %d%s)",
+                           sys->cables[c].name, sys->cables[c].nlinks,
+                           sys->cables[c].link_fraction ? ", unequal" : "");
+    if (N < TS_SEASTATE_DISC_LINKS_MIN)
+        return ts_fail(err, TS_EDOMAIN, "sea state: the discretisation error "
+                       "needs at least %d links per cable (halved twice: the "
+                       "coarsest run must keep 2), got %d",
+                       TS_SEASTATE_DISC_LINKS_MIN, N);
+    double reference[3];
+    for (int c = 0; c < 3; c++)
+        reference[c] = sys->tow.point[c] - w->lever[c];
+    ts_conv_analysis an;
+    int rc = ts_seastate_conv_analysis(sys, eo, w->sea, w->rao, reference,
+                                       r->output.name, o, &an, err);
+    if (rc)
+        return rc;
+    ts_convergence *cv = ts_convergence_alloc("seastate", TS_CONV_LINKS, 3,
+                                              an.values, 3, err);
+    if (!cv) {
+        ts_conv_analysis_free(&an);
+        return err && err->code ? err->code : TS_ENOMEM;
+    }
+    double settings[2] = {(N + 3) / 4, (N + 1) / 2};
+    const ts_stat *st[3] = {&r->sigma, &r->tz, &r->mpm};
+    double values[3], noise[3];
+    for (int i = 0; i < 3; i++) {
+        values[i] = st[i]->value;
+        noise[i] = st[i]->grid + st[i]->band;
+    }
+    rc = ts_convergence_add_series(cv, "", err);
+    if (rc >= 0)
+        rc = ts_convergence_sweep(cv, 0, &an, settings, 2, err);
+    for (int i = 0; rc == TS_OK && i < cv->nrows; i++)
+        if (cv->rows[i].status != TS_OK)
+            rc = ts_fail(err, cv->rows[i].status, "sea state, %g links per "
+                         "cable: %s", cv->rows[i].setting,
+                         cv->rows[i].message);
+    if (rc == TS_OK)
+        rc = ts_convergence_add_row(cv, 0, N, TS_OK, NULL, 0.0, 0,
+                                    &r->trust, values, noise, err);
+    if (rc == TS_OK)
+        rc = ts_convergence_estimate(cv, TS_SEASTATE_RTOL, err);
+    if (rc == TS_OK) {
+        int fine = -1;
+        double wall = 0;
+        for (int i = 0; i < cv->nrows; i++) {
+            if (cv->rows[i].setting == N)
+                fine = i;
+            else
+                wall += cv->rows[i].wall_s;
+        }
+        const ts_conv_row *row = &cv->rows[fine];
+        double e[3];
+        for (int i = 0; i < 3; i++)
+            e[i] = isfinite(row->errors[i]) ? row->errors[i] : 0.0;
+        r->sigma.discretisation = e[0];
+        r->significant.discretisation = 2 * e[0];
+        r->tz.discretisation = e[1];
+        r->mpm.discretisation = isfinite(r->mpm.value) ? e[2] : NAN;
+        stat_total(&r->sigma);
+        stat_total(&r->significant);
+        stat_total(&r->tz);
+        stat_total(&r->mpm);
+        r->disc_estimated = 1;
+        r->disc_links[0] = (int)settings[0];
+        r->disc_links[1] = (int)settings[1];
+        r->disc_links[2] = N;
+        r->disc_order = cv->series[0].order[0];
+        r->disc_wall_s = wall;
+        double rel = r->sigma.value > 0 ? e[0] / r->sigma.value : 0;
+        if (!isfinite(row->errors[0]))
+            ts_trust_note(&r->trust, "the discretisation error of sigma "
+                          "could not be estimated from %d, %d and %d links "
+                          "(%s)", r->disc_links[0], r->disc_links[1], N,
+                          ts_conv_ref_name(cv->series[0].ref_kind[0]));
+        else if (rel > TS_SEASTATE_RTOL) {
+            r->disc_links_needed = cv->predicted_setting;
+            if (isfinite(cv->predicted_setting))
+                ts_trust_fail(&r->trust, "sigma's discretisation error is "
+                              "%.2g %% with %d links per cable (target %.2g "
+                              "%%); the observed order %.2g says about %.0f "
+                              "links would meet it", 100 * rel, N,
+                              100 * TS_SEASTATE_RTOL, r->disc_order,
+                              ceil(cv->predicted_setting));
+            else
+                ts_trust_fail(&r->trust, "sigma's discretisation error is "
+                              "%.2g %% with %d links per cable (target %.2g "
+                              "%%): use more links", 100 * rel, N,
+                              100 * TS_SEASTATE_RTOL);
+        }
+    }
+    ts_convergence_free(cv);
+    ts_conv_analysis_free(&an);
+    return rc;
 }

@@ -74,6 +74,7 @@
 #include <unistd.h>
 
 #include "tcheck.h"
+#include "towstab/analysis.h"
 #include "towstab/compare.h"
 #include "towstab/report_converge.h"
 #include "towstab/scene.h"
@@ -395,6 +396,20 @@ static ts_scene *load(const char *path, ts_units **u)
     return s;
 }
 
+/* A sweep of the pipeline of `analysis` (towstab/analysis.h) with the
+ * request's defaults; extra settings from *rq when given. */
+static int pipeline_sweep(const ts_system *sys, ts_analysis_kind analysis,
+                          ts_request *rq, ts_conv_analysis *an, ts_err *err)
+{
+    ts_request own;
+    if (!rq) {
+        ts_request_init(&own, TS_ANALYSIS_CONVERGE);
+        rq = &own;
+    }
+    rq->converge.analysis = analysis;
+    return ts_analysis_sweep(sys, rq, 0, an, err);
+}
+
 /* The equilibrium analysis of sys (into *an) and a links table of 8 rows
  * for it; NULL on failure (an is then safe to free). */
 static ts_convergence *equilibrium_links_table(const ts_system *sys,
@@ -402,7 +417,7 @@ static ts_convergence *equilibrium_links_table(const ts_system *sys,
                                                ts_err *err)
 {
     memset(an, 0, sizeof *an);
-    if (ts_conv_equilibrium_analysis(sys, NULL, an, err) != TS_OK)
+    if (pipeline_sweep(sys, TS_ANALYSIS_EQUILIBRIUM, NULL, an, err) != TS_OK)
         return NULL;
     return ts_convergence_alloc(an->name, TS_CONV_LINKS, an->nvalues,
                                 an->values, 8, err);
@@ -437,6 +452,7 @@ static int value_index(const ts_convergence *c, const char *name)
             return v;
     return -1;
 }
+
 
 static void test_equilibrium_sweep(void)
 {
@@ -558,7 +574,7 @@ static void test_equilibrium_sweep(void)
 
     /* A tolerance sweep: positions stop changing once the residual is
      * below what moves them. */
-    rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
+    rc = pipeline_sweep(sc->system, TS_ANALYSIS_EQUILIBRIUM, NULL, &an, &err);
     c = ts_convergence_alloc(an.name, TS_CONV_TOLERANCE, an.nvalues,
                              an.values, 4, &err);
     static const double T[3] = {1e-6, 1e-9, 1e-12};
@@ -589,8 +605,7 @@ static void test_modes_sweep(void)
     }
     ts_err err = {0};
     ts_conv_analysis an;
-    int rc = ts_conv_modes_analysis(sc->system, NULL, NULL, NULL, 3, &an,
-                                    &err);
+    int rc = pipeline_sweep(sc->system, TS_ANALYSIS_MODES, NULL, &an, &err);
     ts_convergence *c =
         rc ? NULL
            : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
@@ -691,9 +706,15 @@ static void test_simulate_sweep(void)
     o.dt_sample = 0.05;
     ts_conv_analysis an;
     memset(&an, 0, sizeof an);
+    /* The request borrows ex: it is not cleared. */
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_CONVERGE);
+    rq.simulate.sim = o;
+    rq.simulate.excitation = ex;
+    rq.simulate.transient = 4.0;
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
     if (rc == TS_OK)
-        rc = ts_conv_simulate_analysis(sc->system, NULL, &o, ex, "sphere.z",
-                                       4.0, &an, &err);
+        rc = pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an, &err);
     static const double tol[4] = {1e-3, 1e-4, 1e-5, 1e-6};
     ts_convergence *c =
         rc ? NULL
@@ -776,16 +797,20 @@ static void test_simulate_sweep(void)
     ts_conv_analysis_free(&an);
     /* Refusals. */
     ts_excitation *none = ts_excitation_alloc(&err);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, none, "sphere.z",
-                                    4.0, &an, &err) == TS_EINVAL &&
+    rq.simulate.excitation = none;
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL &&
               strstr(err.msg, "periodic"),
           "no periodic excitation refused: %s", err.msg);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, ex,
-                                    "sphere.tension", 4.0, &an,
-                                    &err) == TS_EINVAL,
+    rq.simulate.excitation = ex;
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.tension");
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL,
           "a tension output refused: %s", err.msg);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, ex, "sphere.z",
-                                    7.5, &an, &err) == TS_EINVAL &&
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
+    rq.simulate.transient = 7.5;
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL &&
               strstr(err.msg, "period"),
           "a window shorter than a period refused: %s", err.msg);
     ts_excitation_free(none);

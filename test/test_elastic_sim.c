@@ -40,16 +40,9 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tscene.h"
 
 #define FT 0.3048
-
-static ts_scene *load(const ts_units *u, const char *path)
-{
-    ts_err err = {0};
-    ts_scene *s = ts_scene_load(path, u, &err);
-    CHECK(s != NULL, "%s loads (%s)", path, s ? "ok" : err.msg);
-    return s;
-}
 
 /* A run from the equilibrium of sys: the history (caller frees), the
  * code, the statistics and the error. */
@@ -108,7 +101,7 @@ static void set_ea(ts_system *s, double ea, double cv)
 
 static void test_rigid_limit(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/kamman_ex1_submerged.yaml");
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;
@@ -233,7 +226,7 @@ static void test_rigid_limit(const ts_units *u)
 
 static void test_slack(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;
@@ -377,7 +370,7 @@ static int two_part_ratio(ts_system *s, const char *what, double r,
 
 static void test_two_part(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/two_part_tow.yaml");
+    ts_scene *sc = tscene_load(u, "examples/two_part_tow.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;

@@ -95,7 +95,7 @@ static double num(const json_t *o, const char *key)
 
 static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
 {
-    json_t *o = ts_report_equilibrium_json(s, eq, 0.0625);
+    json_t *o = ts_report_equilibrium_json(s, eq, 0.0625, NULL);
     if (!CHECK(o != NULL, "json: object built"))
         return;
     CHECK(json_is_true(json_object_get(o, "converged")), "json: converged");
@@ -207,7 +207,7 @@ static void test_json_nonfinite(const ts_system *s, ts_equilibrium *eq)
     double keep = eq->residual, kx = eq->positions[4];
     eq->residual = NAN;
     eq->positions[4] = INFINITY;
-    json_t *o = ts_report_equilibrium_json(s, eq, NAN);
+    json_t *o = ts_report_equilibrium_json(s, eq, NAN, NULL);
     const json_t *n1 = json_array_get(json_object_get(o, "nodes"), 1);
     CHECK(o && json_is_null(json_object_get(o, "residual")) &&
               json_is_null(json_object_get(o, "wall_s")) &&
@@ -278,7 +278,7 @@ static void test_csv(const ts_system *s, const ts_equilibrium *eq)
  * writes the document. */
 static void test_write(const ts_system *s, const ts_equilibrium *eq)
 {
-    json_t *o = ts_report_equilibrium_json(s, eq, 0);
+    json_t *o = ts_report_equilibrium_json(s, eq, 0, NULL);
     char path[600];
     ts_err err = {0};
 

@@ -16,7 +16,14 @@
  *     - symmetry: heave and pitch alone (head seas) give no sway of the
  *       fish (sigma below 1e-12 of the heave's);
  *     - linearity: sigma doubles with Hs to 1e-12;
- *     - the statistics from m0 and m2 by their formulas.
+ *     - the statistics from m0 and m2 by their formulas;
+ *     - the JSON and CSV reports carry the same numbers;
+ *     - the discretisation error (ts_seastate_discretisation) at 8 and 16
+ *       links per cable bounds the difference to 32 links (whose own
+ *       error is below a tenth of 16 links': the sequence 8, 16, 32, 64
+ *       converges to 1e-4), within a factor 30: the convergence in links
+ *       is irregular (the top link crosses the waterline); refusals for
+ *       too few and unequal links.
  *  3. Time domain:
  *     - a realisation is reproducible from its seed, and differs with it;
  *     - the record statistics of a sinusoid: sigma = A / sqrt 2, Tz its
@@ -38,9 +45,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "tcheck.h"
 #include "towstab/equilibrium.h"
+#include "towstab/report_seastate.h"
 #include "towstab/scene.h"
 
 static ts_units *units;
@@ -262,6 +271,53 @@ static double qag_integrand(double w, void *p)
     return creal(g * conj(g)) * ts_sea_density(q->w->sea, w);
 }
 
+static void test_report(const ts_seastate *r, const ts_seaway *w)
+{
+    ts_err err = {0};
+    json_t *j = ts_report_seastate_json(r, w, 1);
+    json_t *st = j ? json_object_get(j, "statistics") : NULL;
+    json_t *sg = st ? json_object_get(st, "sigma") : NULL;
+    json_t *mx = st ? json_object_get(st, "most_probable_largest") : NULL;
+    json_t *pts = j ? json_object_get(j, "points") : NULL;
+    CHECK(sg && json_real_value(json_object_get(sg, "value")) ==
+                    r->sigma.value &&
+              json_real_value(json_object_get(sg, "error")) ==
+                  r->sigma.error &&
+              json_real_value(json_object_get(mx, "value")) ==
+                  r->mean + r->mpm.value &&
+              json_array_size(pts) == (size_t)r->npoints &&
+              !strcmp(json_string_value(json_object_get(j, "unit")), "m") &&
+              json_is_true(json_object_get(j, "trustworthy")),
+          "JSON: sigma, its error, the largest value, the points, the "
+          "verdict");
+    json_decref(j);
+    char path[] = "/tmp/towstab_test_seastate_XXXXXX";
+    int fd = mkstemp(path);
+    if (fd >= 0)
+        close(fd);
+    int rc = ts_report_seastate_csv(r, path, &err);
+    FILE *f = rc == TS_OK ? fopen(path, "r") : NULL;
+    int lines = 0, commas = -1;
+    char line[4096];
+    while (f && fgets(line, sizeof line, f)) {
+        int c = 0;
+        for (char *p = line; *p; p++)
+            c += *p == ',';
+        if (lines == 0)
+            commas = c;
+        else if (c != commas)
+            commas = -2;
+        lines++;
+    }
+    if (f)
+        fclose(f);
+    unlink(path);
+    CHECK(rc == TS_OK && lines == r->npoints + 1 &&
+              commas == 3 + 2 * r->ninputs + 3,
+          "CSV: header and one row per point, %d columns (%s)", commas + 1,
+          err.msg);
+}
+
 static void test_spectral(setup *s)
 {
     ts_err err = {0};
@@ -358,6 +414,7 @@ static void test_spectral(setup *s)
     CHECK_REL(r->mean, s->eq->positions[3 * out.node + 2], 1e-12,
               "mean: the equilibrium depth");
     double sigma1 = r->sigma.value;
+    test_report(r, &w);
     ts_seastate_free(r);
 
     /* Linearity. */
@@ -411,6 +468,83 @@ static void test_spectral(setup *s)
     ts_seastate_free(r);
     ts_sea_free(fol);
     ship_case_close(&c);
+}
+
+static void test_discretisation(setup *s)
+{
+    ts_err err = {0};
+    ts_rao *rao = ship_rao();
+    ts_sea *sea = ts_sea_jonswap(2.0, 7.5, 3.3, M_PI, &err);
+    ts_seastate_opts o;
+    ts_seastate_opts_default(&o);
+    o.intervals = 64;
+    double sigma[3], est[2];
+    static const int links[3] = {8, 16, 32};
+    for (int i = 0; i < 3; i++) {
+        ts_system *sys = ts_conv_system_with_links(s->scene->system,
+                                                   links[i], &err);
+        ts_kernel *k = ts_kernel_alloc(sys, &err);
+        ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+        ts_equilibrium_opts eo;
+        ts_equilibrium_opts_default(&eo);
+        ts_linearize_opts lo;
+        ts_linearize_opts_default(&lo);
+        ts_linear *lin = ts_linear_alloc(k, &err);
+        ts_seaway w;
+        ts_output out;
+        ts_seastate *r = NULL;
+        int rc = ts_equilibrium_solve(k, &eo, eq, &err);
+        if (!rc)
+            rc = ts_linearize_equilibrium(k, eq, &lo, lin, &err);
+        if (!rc)
+            rc = ts_seaway_init(&w, sys, sea, rao, reference_point, &err);
+        if (!rc)
+            rc = ts_response_output_find(sys, "fish.z", &out, &err);
+        if (!rc)
+            rc = ts_seastate_compute(sys, lin, &w, &out, &o, &r, &err);
+        if (!rc && i < 2)
+            rc = ts_seastate_discretisation(sys, &eo, &w, &o, r, &err);
+        if (CHECK(rc == TS_OK, "%d links: %s", links[i], err.msg)) {
+            sigma[i] = r->sigma.value;
+            if (i < 2) {
+                est[i] = r->sigma.discretisation;
+                CHECK(r->disc_estimated && r->disc_links[0] == links[i] / 4 &&
+                          r->disc_links[1] == links[i] / 2 &&
+                          fabs(r->sigma.error - (r->sigma.grid +
+                                                 r->sigma.band + est[i])) <=
+                              1e-15 * r->sigma.error,
+                      "%d links: discretisation from %d and %d links, in "
+                      "the error", links[i], r->disc_links[0],
+                      r->disc_links[1]);
+            } else {
+                ts_err e = {0};
+                ts_system *odd = ts_system_copy(sys, &err);
+                odd->cables[0].nlinks = 5;
+                ts_system_build(odd, &err);
+                CHECK(ts_seastate_discretisation(odd, &eo, &w, &o, r, &e) ==
+                              TS_EDOMAIN &&
+                          strstr(e.msg, "at least 8"),
+                      "too few links refused: %s", e.msg);
+                ts_system_free(odd);
+            }
+        }
+        ts_seastate_free(r);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        ts_system_free(sys);
+    }
+    for (int i = 0; i < 2; i++) {
+        double truth = fabs(sigma[i] - sigma[2]);
+        printf("  %d links: sigma %.6g m, discretisation error %.3g "
+               "estimated, %.3g against 32 links\n", links[i], sigma[i],
+               est[i], truth);
+        CHECK(est[i] >= truth && est[i] <= 30 * truth, "%d links: the "
+              "estimate bounds the error, within a factor 30 (%.3g)",
+              links[i], est[i] / truth);
+    }
+    ts_sea_free(sea);
+    ts_rao_free(rao);
 }
 
 static void test_record(void)
@@ -602,6 +736,7 @@ int main(void)
     }
     test_seaway(&s);
     test_spectral(&s);
+    test_discretisation(&s);
     test_record();
     test_realisation(&s);
     test_cross_check(&s);

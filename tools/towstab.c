@@ -15,11 +15,28 @@ extern const cli_command cli_cmd_modes, cli_cmd_response;
 extern const cli_command cli_cmd_simulate;
 extern const cli_command cli_cmd_converge;
 
+/* `towstab options`: every analysis' option table as markdown, the
+ * reference of doc/manual.md. */
+static int options_main(int argc, char **argv)
+{
+    (void)argv;
+    if (argc != 1) {
+        fprintf(stderr, "towstab: error: options: takes no arguments\n");
+        return EXIT_BADINPUT;
+    }
+    cli_options_markdown(stdout);
+    return 0;
+}
+
+static const cli_command cli_cmd_options = {
+    "options", "every option of the analyses, as a markdown reference", -1,
+    options_main, NULL, NULL, NULL, NULL, NULL, NULL};
+
 const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
                                            &cli_cmd_simulate,
                                            &cli_cmd_converge,
-                                           NULL};
+                                           &cli_cmd_options, NULL};
 
 static void usage(FILE *f)
 {
@@ -36,6 +53,8 @@ static void usage(FILE *f)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
+        fprintf(stderr, "towstab: error: no command given (a COMMAND and a "
+                        "SCENE file)\n");
         usage(stderr);
         return cli_finish(EXIT_BADINPUT);
     }
@@ -57,7 +76,10 @@ int main(int argc, char **argv)
             cli_stdout_for_json();
     for (int i = 0; cli_commands[i]; i++)
         if (strcmp(argv[1], cli_commands[i]->name) == 0)
-            return cli_finish(cli_commands[i]->main(argc - 1, argv + 1));
+            return cli_finish(
+                cli_commands[i]->main
+                    ? cli_commands[i]->main(argc - 1, argv + 1)
+                    : cli_main(cli_commands[i], argc - 1, argv + 1));
     fprintf(stderr, "towstab: error: unknown command '%s' (towstab --help)\n",
             argv[1]);
     return cli_finish(EXIT_BADINPUT);

@@ -30,16 +30,16 @@ TS_API json_t *ts_report_trust_json(const ts_trust *t);
 
 /* The equilibrium as a new JSON object: converged, iterations, evaluations,
  * residual, force_scale, tolerance, method, speed, turn_rate, wall_s,
- * top_tension, min_tension, tow_force, condition, shape_error,
- * trustworthy, reasons [text], notes [text] (towstab/health.h), nodes
- * [{name,x,y,z}] (tow point first), links
- * [{cable,index,tension,theta1_deg,theta2_deg}], bodies [{name,x,y,z}],
- * and with vehicles, vehicles [ts_report_vehicle_json] and
- * control_residual.
- * NULL on allocation failure. */
+ * top_tension, min_tension, tow_force, condition, shape_error, with a
+ * verdict `trust` (may be NULL: left out) trustworthy, reasons [text],
+ * notes [text] (towstab/health.h), nodes [{name,x,y,z}] (tow point
+ * first), links [{cable,index,tension,theta1_deg,theta2_deg}], bodies
+ * [{name,x,y,z}], and with vehicles, vehicles [ts_report_vehicle_json]
+ * and control_residual. NULL on allocation failure. */
 TS_API json_t *ts_report_equilibrium_json(const ts_system *sys,
                                           const ts_equilibrium *eq,
-                                          double wall_s);
+                                          double wall_s,
+                                          const ts_trust *trust);
 
 /* A vehicle's state as a new JSON object: name, x, y, depth (its origin,
  * m, M frame), pitch_deg, roll_deg, yaw_deg (yaw-pitch-roll relative to

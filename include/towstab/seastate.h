@@ -58,6 +58,7 @@
 #ifndef TOWSTAB_SEASTATE_H
 #define TOWSTAB_SEASTATE_H
 
+#include "towstab/converge.h"
 #include "towstab/error.h"
 #include "towstab/excitation.h"
 #include "towstab/health.h"
@@ -130,9 +131,14 @@ typedef struct ts_seastate_opts {
 
 TS_API void ts_seastate_opts_default(ts_seastate_opts *o);
 
-/* A statistic and its estimated error (>= 0, same unit). */
+/* A statistic and its estimated error (>= 0, same unit). For a spectral
+ * result, the error is the sum of the parts from the frequency grid, the
+ * band and the discretisation (links; 0 until ts_seastate_discretisation
+ * estimates it); for a record (ts_record_stats) it is the statistical
+ * error and the parts are 0. */
 typedef struct ts_stat {
     double value, error;
+    double grid, band, discretisation;
 } ts_stat;
 
 typedef struct ts_seastate {
@@ -164,6 +170,15 @@ typedef struct ts_seastate {
     double m0_grid_error, m0_band_error, m2_grid_error, m2_band_error;
     double order_m0, order_m2;  /* observed orders (NaN: none) */
     double band_lo, band_hi;    /* rad/s */
+    /* Discretisation (ts_seastate_discretisation). */
+    int disc_estimated;   /* 1 when estimated (the parts are then in the
+                             statistics' errors) */
+    int disc_links[3];    /* links per cable of the runs: coarse to fine */
+    double disc_order;    /* observed order of sigma (NaN: none) */
+    double disc_wall_s;   /* seconds the two coarser runs took */
+    double disc_links_needed; /* links per cable the error model says meet
+                                 TS_SEASTATE_RTOL for sigma (NaN: met, or
+                                 unknown) */
     double wave_m0_band;  /* wave m0 on the grid, m^2 */
     double wave_m0_out;   /* wave m0 outside the band, m^2 */
     double wave_hs;       /* the sea's Hs, m */
@@ -185,6 +200,48 @@ TS_API int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
                                const ts_seastate_opts *o, ts_seastate **res,
                                ts_err *err);
 TS_API void ts_seastate_free(ts_seastate *s);
+
+/* Fewest links per cable for ts_seastate_discretisation: its coarsest
+ * run has a quarter of them, and one link per cable tells nothing. */
+#define TS_SEASTATE_DISC_LINKS_MIN 8
+
+/* The discretisation error of r, a result computed (with options o,
+ * NULL: defaults) on sys, every cable of which has the same number
+ * N >= TS_SEASTATE_DISC_LINKS_MIN of equal links: the analysis is repeated on copies with ceil(N/2) and
+ * ceil(N/4) links (the same sea, RAOs and reference point, the
+ * equilibrium solved with eo, NULL: defaults) and ts_convergence_estimate
+ * gives the error of the N-link values (Richardson at the observed order,
+ * or its fallbacks: towstab/converge.h). The parts go into the
+ * statistics' errors (`discretisation`), the trust verdict fails when
+ * sigma's discretisation error exceeds TS_SEASTATE_RTOL (saying how many
+ * links would meet it), and r->disc_* record the runs. Cost: the two
+ * coarser analyses, about (1/8 + 1/64) of the first with dense gains.
+ * Returns TS_OK; TS_EDOMAIN (r unchanged) when the links do not allow it
+ * (unequal link counts, link_lengths, too few links); a failure of a
+ * coarser run (its code and message). */
+TS_API int ts_seastate_discretisation(const ts_system *sys,
+                                      const ts_equilibrium_opts *eo,
+                                      const ts_seaway *w,
+                                      const ts_seastate_opts *o,
+                                      ts_seastate *r, ts_err *err);
+
+/* The spectral analysis as a convergence study's analysis
+ * (towstab/converge.h): the equilibrium of sys (a copy is kept; eo, NULL:
+ * defaults), its linearization, and the response of `output` to the sea
+ * and RAOs (used, not owned: they must outlive it) with the RAO reference
+ * point `reference` (NULL: M's origin) and options o (NULL: defaults).
+ * Values "<output>.sigma" (m or N), "<output>.tz" (s) and "<output>.mpm"
+ * (m or N), each relative to itself; noise: their grid and band errors.
+ * Parameters: links (every cable N equal links), tolerance (the
+ * equilibrium's), step (the linearization's). Health: the equilibrium's
+ * and the spectral result's. TS_EINVAL for an unknown output, TS_ENOMEM. */
+TS_API int ts_seastate_conv_analysis(const ts_system *sys,
+                                     const ts_equilibrium_opts *eo,
+                                     const ts_sea *sea, const ts_rao *rao,
+                                     const double reference[3],
+                                     const char *output,
+                                     const ts_seastate_opts *o,
+                                     ts_conv_analysis *an, ts_err *err);
 
 /* --- Time domain ----------------------------------------------------- */
 
@@ -213,6 +270,9 @@ typedef struct ts_record_stats {
     int nsamples;
     double duration;      /* s: (nsamples - 1) dt */
     double mean;          /* unit */
+    double mean_error;    /* its statistical error: sigma sqrt(tau1 / L),
+                             tau1 = int R dtau / R(0) over the same lags
+                             (at least one sample interval) */
     ts_stat sigma;        /* standard deviation, its statistical error */
     double corr_time;     /* s: int R^2 dtau / R(0)^2 over all lags */
     double independent;   /* duration / corr_time: independent samples */

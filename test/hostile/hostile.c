@@ -820,7 +820,7 @@ static void gen_cli_misuse(void)
     hcase *c;
     const int R = E_BADINPUT;
     /* The program and its commands. */
-    misuse(R, NULL, NULL);
+    misuse(R, "no command", NULL);
     misuse(R, "bogus", "bogus", EX1, NULL);
     misuse(E_RUN, NULL, "--help", NULL);
     misuse(E_RUN, NULL, "--version", NULL);
@@ -861,8 +861,8 @@ static void gen_cli_misuse(void)
         {"--links", "", E_BADINPUT},
         {"--links", "1e9", E_BADINPUT},
         {"--links", "10000000", E_BADINPUT},
-        {"--method", "bogus", E_BADINPUT},
-        {"--method", "", E_BADINPUT},
+        {"--equilibrium-method", "bogus", E_BADINPUT},
+        {"--equilibrium-method", "", E_BADINPUT},
         {"--tol", "0", E_BADINPUT},
         {"--tol", "1", E_BADINPUT},
         {"--tol", "nan", E_BADINPUT},
@@ -870,9 +870,12 @@ static void gen_cli_misuse(void)
         {"--tol", "1e-300", E_REFUSE},
     };
     for (size_t i = 0; i < sizeof settings / sizeof settings[0]; i++) {
+        /* The option, or the quantity it sets ("turn rate"). */
         const char *must = settings[i].expect == E_RUN ||
                                    settings[i].expect == E_ANY
                                ? NULL
+                           : !strcmp(settings[i].opt, "--turn-rate")
+                               ? "turn"
                                : settings[i].opt + 2;
         misuse(settings[i].expect, must, "equilibrium", EX1, "--quiet",
                settings[i].opt, settings[i].val, NULL);
@@ -890,16 +893,18 @@ static void gen_cli_misuse(void)
     c->stdin_path = xstrdup(EX1);
     c = misuse(R, "standard input", "equilibrium", "-", NULL);
     /* modes */
-    misuse(R, "80 states", "modes", EX1, "--quiet", "--method", "arpack",
-           "--count", "79", NULL);
+    misuse(R, "80 states", "modes", EX1, "--quiet", "--eigen-method",
+           "arpack", "--count", "79", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "0", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "-3", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "abc", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "1000000000", NULL);
-    misuse(R, "--method", "modes", EX1, "--method", "bogus", NULL);
+    misuse(R, "--eigen-method", "modes", EX1, "--eigen-method", "bogus",
+           NULL);
     misuse(R, "--near", "modes", EX1, "--near", "nan", NULL);
     misuse(R, "--near", "modes", EX1, "--near", "3 kg", NULL);
-    misuse(R, "--eq-method", "modes", EX1, "--eq-method", "bogus", NULL);
+    misuse(R, "--equilibrium-method", "modes", EX1, "--equilibrium-method",
+           "bogus", NULL);
     /* response */
     misuse(R, "--input", "response", EX1, "--output", "sphere.z", "--input",
            "bogus", NULL);
