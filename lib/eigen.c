@@ -98,17 +98,58 @@ void ts_eigen_free(ts_eigen *e)
 
 /* ---- Structured shift solver (eigen_impl.h) ---------------------------- */
 
+/* A failed LU of the shifted matrix (LAPACK `what`, its info). */
+static int factor_failed(int info, const char *what, double complex s,
+                         ts_err *err)
+{
+    if (info < 0)
+        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d", what,
+                       info);
+    return ts_fail(err, TS_ESINGULAR,
+                   "eigen: A - s I is singular at s = %g%+gi 1/s (an "
+                   "eigenvalue sits on the shift; move the target slightly)",
+                   creal(s), cimag(s));
+}
+
+/* The whole A - s I, factored (complex LU): the fallback when the
+ * controller block H - s I is singular. */
+static int full_factor(tsi_shift *sh, ts_err *err)
+{
+    int n = sh->n, info = 0;
+    const double *A = sh->lin->A;
+    sh->full = malloc((size_t)n * (size_t)n * sizeof(double complex));
+    sh->fpiv = malloc((size_t)n * sizeof(int));
+    if (!sh->full || !sh->fpiv) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory for the %d x "
+                       "%d shifted matrix", n, n);
+    }
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++)
+        sh->full[i] = A[i];
+    for (int i = 0; i < n; i++)
+        sh->full[(size_t)i * n + i] -= sh->s;
+    zgetrf_(&n, &n, sh->full, &n, sh->fpiv, &info);
+    if (info != 0) {
+        double complex s = sh->s;
+        tsi_shift_free(sh);
+        return factor_failed(info, "zgetrf", s, err);
+    }
+    return TS_OK;
+}
+
 int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                      ts_err *err)
 {
     memset(sh, 0, sizeof *sh);
-    int nq = lin->nq, n = lin->nstate, info = 0;
+    int nq = lin->nq, n = lin->nstate, nc = n - 2 * nq, info = 0;
     size_t nn = (size_t)nq * (size_t)nq;
     sh->lin = lin;
     sh->nq = nq;
     sh->n = n;
+    sh->nc = nc;
     sh->s = s;
-    sh->is_complex = cimag(s) != 0.0;
+    /* Controller states: the Schur complement is complex in general. */
+    sh->is_complex = cimag(s) != 0.0 || nc > 0;
     sh->ipiv = malloc((size_t)nq * sizeof(int));
     sh->w = malloc((size_t)nq * sizeof(double complex));
     sh->wr = malloc(2 * (size_t)nq * sizeof(double));
@@ -116,13 +157,22 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
         sh->zlu = malloc(nn * sizeof(double complex));
     else
         sh->lu = malloc(nn * sizeof(double));
-    if (!sh->ipiv || !sh->w || !sh->wr || (!sh->zlu && !sh->lu)) {
+    double complex *MF = NULL;
+    if (nc > 0) {
+        sh->hlu = malloc((size_t)nc * (size_t)nc * sizeof(double complex));
+        sh->hpiv = malloc((size_t)nc * sizeof(int));
+        sh->wc = malloc(2 * (size_t)nc * sizeof(double complex));
+        MF = malloc((size_t)nc * (size_t)nq * sizeof(double complex));
+    }
+    if (!sh->ipiv || !sh->w || !sh->wr || (!sh->zlu && !sh->lu) ||
+        (nc > 0 && (!sh->hlu || !sh->hpiv || !sh->wc || !MF))) {
+        free(MF);
         tsi_shift_free(sh);
         return ts_fail(err, TS_ENOMEM,
                        "eigen: out of memory for the %d x %d shifted matrix",
                        nq, nq);
     }
-    /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
+    /* P = K + s C - s^2 I; K = A[nq:2nq, :nq], C = A[nq:2nq, nq:2nq]. */
     const double *A = lin->A;
     double complex s2 = s * s;
     for (int j = 0; j < nq; j++) {
@@ -141,22 +191,51 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
             Pj[j] -= sr * sr;
         }
     }
+    if (nc > 0) {
+        /* H - s I, factored; MF = (H - sI)^-1 (F + s G), then
+         * P -= E MF with E = A[nq:2nq, 2nq:], F = A[2nq:, :nq],
+         * G = A[2nq:, nq:2nq], H = A[2nq:, 2nq:]. */
+        for (int j = 0; j < nc; j++)
+            for (int i = 0; i < nc; i++)
+                sh->hlu[(size_t)j * nc + i] =
+                    A[(size_t)(2 * nq + j) * n + 2 * nq + i] -
+                    (i == j ? s : 0.0);
+        zgetrf_(&nc, &nc, sh->hlu, &nc, sh->hpiv, &info);
+        if (info == 0) {
+            for (int j = 0; j < nq; j++)
+                for (int i = 0; i < nc; i++)
+                    MF[(size_t)j * nc + i] =
+                        A[(size_t)j * n + 2 * nq + i] +
+                        s * A[(size_t)(nq + j) * n + 2 * nq + i];
+            zgetrs_("N", &nc, &nq, sh->hlu, &nc, sh->hpiv, MF, &nc, &info,
+                    1);
+        }
+        for (int j = 0; info == 0 && j < nq; j++) {
+            double complex *Pj = sh->zlu + (size_t)j * nq;
+            for (int k = 0; k < nc; k++) {
+                double complex m = MF[(size_t)j * nc + k];
+                const double *Ek = A + (size_t)(2 * nq + k) * n + nq;
+                for (int i = 0; i < nq; i++)
+                    Pj[i] -= Ek[i] * m;
+            }
+        }
+        free(MF);
+        if (info < 0) {
+            tsi_shift_free(sh);
+            return ts_fail(err, TS_ELAPACK, "eigen: LAPACK zgetrf info %d "
+                           "on the controller block", info);
+        }
+        if (info > 0)
+            return full_factor(sh, err);
+    }
     if (sh->is_complex)
         zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
     else
         dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
-    if (info < 0) {
+    if (info != 0) {
+        const char *what = sh->is_complex ? "zgetrf" : "dgetrf";
         tsi_shift_free(sh);
-        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d",
-                       sh->is_complex ? "zgetrf" : "dgetrf", info);
-    }
-    if (info > 0) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ESINGULAR,
-                       "eigen: A - s I is singular at s = %g%+gi 1/s (an "
-                       "eigenvalue sits on the shift; move the target "
-                       "slightly)",
-                       creal(s), cimag(s));
+        return factor_failed(info, what, s, err);
     }
     return TS_OK;
 }
@@ -168,12 +247,35 @@ void tsi_shift_free(tsi_shift *sh)
     free(sh->ipiv);
     free(sh->w);
     free(sh->wr);
+    free(sh->hlu);
+    free(sh->hpiv);
+    free(sh->wc);
+    free(sh->full);
+    free(sh->fpiv);
     memset(sh, 0, sizeof *sh);
 }
 
 void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
 {
     int nq = sh->nq, n = sh->n, one = 1, info = 0;
+    if (sh->nc > 0) {
+        /* Complex factors (the Schur complement); real s, real answer. */
+        double complex *bc = malloc((size_t)n * sizeof(double complex));
+        double complex *xc = malloc((size_t)n * sizeof(double complex));
+        if (bc && xc) {
+            for (int i = 0; i < n; i++)
+                bc[i] = b[i];
+            tsi_shift_solve(sh, bc, xc);
+            for (int i = 0; i < n; i++)
+                x[i] = creal(xc[i]);
+        } else {
+            for (int i = 0; i < n; i++)
+                x[i] = NAN;
+        }
+        free(bc);
+        free(xc);
+        return;
+    }
     double sr = creal(sh->s), mone = -1.0, pone = 1.0;
     const double *b1 = b, *b2 = b + nq;
     double *x1 = x, *x2 = x + nq;
@@ -187,13 +289,33 @@ void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
         x2[i] = b1[i] + sr * x1[i];
 }
 
+/* y[nc] = M x for the real block M of A at rows 2nq.., columns c0..c0+m
+ * (y += when acc). */
+static void ctl_rows(const tsi_shift *sh, int c0, int m,
+                     const double complex *x, double complex *y, int acc)
+{
+    int n = sh->n, r0 = 2 * sh->nq;
+    const double *A = sh->lin->A;
+    for (int i = 0; i < sh->nc; i++) {
+        double complex sum = acc ? y[i] : 0.0;
+        for (int j = 0; j < m; j++)
+            sum += A[(size_t)(c0 + j) * n + r0 + i] * x[j];
+        y[i] = sum;
+    }
+}
+
 void tsi_shift_solve(tsi_shift *sh, const double complex *b,
                      double complex *x)
 {
-    int nq = sh->nq, n = sh->n, one = 1, two = 2, info = 0;
+    int nq = sh->nq, n = sh->n, nc = sh->nc, one = 1, two = 2, info = 0;
+    if (sh->full) {
+        memcpy(x, b, (size_t)n * sizeof(double complex));
+        zgetrs_("N", &n, &one, sh->full, &n, sh->fpiv, x, &n, &info, 1);
+        return;
+    }
     double complex s = sh->s;
-    const double complex *b1 = b, *b2 = b + nq;
-    double complex *x1 = x, *x2 = x + nq;
+    const double complex *b1 = b, *b2 = b + nq, *b3 = b + 2 * nq;
+    double complex *x1 = x, *x2 = x + nq, *x3 = x + 2 * nq;
     /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
      * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
     double pone = 1.0, zero = 0.0;
@@ -202,6 +324,20 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
            1, 1);
     for (int i = 0; i < nq; i++)
         x1[i] = b2[i] + s * b1[i] - sh->w[i];
+    if (nc > 0) {
+        /* t3 = (H - sI)^-1 (b3 - G b1); x1 -= E t3. */
+        double complex *t3 = sh->wc;
+        ctl_rows(sh, nq, nq, b1, t3, 0);
+        for (int i = 0; i < nc; i++)
+            t3[i] = b3[i] - t3[i];
+        zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, t3, &nc, &info, 1);
+        const double *A = sh->lin->A;
+        for (int k = 0; k < nc; k++) {
+            const double *Ek = A + (size_t)(2 * nq + k) * n + nq;
+            for (int i = 0; i < nq; i++)
+                x1[i] -= Ek[i] * t3[k];
+        }
+    }
     if (sh->is_complex) {
         zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
     } else {
@@ -217,6 +353,14 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
     }
     for (int i = 0; i < nq; i++)
         x2[i] = b1[i] + s * x1[i];
+    if (nc > 0) {
+        /* x3 = (H - sI)^-1 (b3 - F x1 - G x2). */
+        ctl_rows(sh, 0, nq, x1, x3, 0);
+        ctl_rows(sh, nq, nq, x2, x3, 1);
+        for (int i = 0; i < nc; i++)
+            x3[i] = b3[i] - x3[i];
+        zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, x3, &nc, &info, 1);
+    }
 }
 
 /* ---- Candidate modes ----------------------------------------------------- */
@@ -343,7 +487,7 @@ static void vector_health(const ts_linear *lin, const double *vl,
                           const double *rconde, const double *kap0,
                           const double *ev, double abnrm, int j, cand *c)
 {
-    int n = lin->nstate, nq = lin->nq;
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
     double complex lj = eig_at(wr, wi, j);
     int near[VECTOR_NEIGHBOURS], nn = 0;
     double gaps[VECTOR_NEIGHBOURS], vcond = 0.0;
@@ -365,8 +509,8 @@ static void vector_health(const ts_linear *lin, const double *vl,
         }
     }
     double sum2 = 0.0;
-    const double *er = ev ? ev + (size_t)j * nq : NULL;
-    const double *ei = ev && wi[j] != 0.0 ? ev + (size_t)(j + 1) * nq : NULL;
+    const double *er = ev ? ev + (size_t)j * nlow : NULL;
+    const double *ei = ev && wi[j] != 0.0 ? ev + (size_t)(j + 1) * nlow : NULL;
     for (int m = 0; m < nn; m++) {
         int k = near[m];
         double gap = gaps[m];
@@ -380,7 +524,7 @@ static void vector_health(const ts_linear *lin, const double *vl,
                                         : vl + (size_t)(wi[k] < 0 ? k : k + 1) *
                                                    n + nq;
         double sg = wi[k] < 0 ? -1.0 : 1.0, sr = 0.0, si = 0.0;
-        for (int i = 0; er && i < nq; i++) {
+        for (int i = 0; er && i < nlow; i++) {
             /* conj(a + i b) (x + i y) = (a x + b y) + i (a y - b x) */
             double a = ur[i], b = ui ? sg * ui[i] : 0.0;
             double x = er[i], y = ei ? ei[i] : 0.0;
@@ -453,14 +597,14 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
         goto out;
     }
     /* EV = E VR: the estimated error of A (lower block) on every right
-     * eigenvector, one BLAS product, 2 nq n^2 flops. */
-    int nq = lin->nq;
+     * eigenvector, one BLAS product, 2 (n - nq) n^2 flops. */
+    int nq = lin->nq, nlow = n - nq;
     if (lin->Aerr) {
-        ev = malloc((size_t)nq * (size_t)n * sizeof(double));
+        ev = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (ev) {
             double pone = 1.0, zero = 0.0;
-            dgemm_("N", "N", &nq, &n, &n, &pone, lin->Aerr, &nq, vr, &n,
-                   &zero, ev, &nq, 1, 1);
+            dgemm_("N", "N", &nlow, &n, &n, &pone, lin->Aerr, &nlow, vr, &n,
+                   &zero, ev, &nlow, 1, 1);
         }
     }
     /* 1 / |u_k^H v_k| of every eigenvalue (unit vectors): O(n^2). */
@@ -477,7 +621,7 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     }
     for (int j = 0; j < n; j++) {
         const double *vrj = vr + (size_t)j * n, *vlj = vl + (size_t)j * n;
-        const double *evj = ev ? ev + (size_t)j * nq : NULL;
+        const double *evj = ev ? ev + (size_t)j * nlow : NULL;
         if (wi[j] == 0.0) {
             double uv = 0, uu = 0, vv = 0, uev = 0;
             for (int i = 0; i < n; i++) {
@@ -485,7 +629,7 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
                 uu += vlj[i] * vlj[i];
                 vv += vrj[i] * vrj[i];
             }
-            for (int i = 0; evj && i < nq; i++)
+            for (int i = 0; evj && i < nlow; i++)
                 uev += vlj[nq + i] * evj[i];
             (void)uu;
             (void)vv;
@@ -505,9 +649,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
                 uu += vlj[i] * vlj[i] + vlk[i] * vlk[i];
                 vv += vrj[i] * vrj[i] + vrk[i] * vrk[i];
             }
-            for (int i = 0; evj && i < nq; i++)
+            for (int i = 0; evj && i < nlow; i++)
                 uev += conj(vlj[nq + i] + I * vlk[nq + i]) *
-                       (evj[i] + I * evj[nq + i]);
+                       (evj[i] + I * evj[nlow + i]);
             (void)uu;
             (void)vv;
             cand_add(L, wr[j] + I * wi[j], vrj, vrk, 1.0 / rconde[j], NAN,
@@ -543,12 +687,12 @@ out:
  * streaming them once per vector would dominate ARPACK's own cost. */
 static int batch_checks(const ts_linear *lin, cand_list *L)
 {
-    int n = lin->nstate, nq = lin->nq, m = 2 * L->n;
+    int n = lin->nstate, nlow = n - lin->nq, m = 2 * L->n;
     if (L->n == 0)
         return TS_OK;
     double *W = calloc((size_t)n * (size_t)m, sizeof(double));
     double *AW = malloc((size_t)n * (size_t)m * sizeof(double));
-    double *EW = lin->Aerr ? malloc((size_t)nq * (size_t)m * sizeof(double))
+    double *EW = lin->Aerr ? malloc((size_t)nlow * (size_t)m * sizeof(double))
                            : NULL;
     if (!W || !AW || (lin->Aerr && !EW)) {
         free(W);
@@ -567,8 +711,8 @@ static int batch_checks(const ts_linear *lin, cand_list *L)
     dgemm_("N", "N", &n, &m, &n, &pone, lin->A, &n, W, &n, &zero, AW, &n, 1,
            1);
     if (EW)
-        dgemm_("N", "N", &nq, &m, &n, &pone, lin->Aerr, &nq, W, &n, &zero, EW,
-               &nq, 1, 1);
+        dgemm_("N", "N", &nlow, &m, &n, &pone, lin->Aerr, &nlow, W, &n, &zero,
+               EW, &nlow, 1, 1);
     for (int c = 0; c < L->n; c++) {
         double complex lam = L->c[c].lam;
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
@@ -581,8 +725,8 @@ static int batch_checks(const ts_linear *lin, cand_list *L)
         }
         L->c[c].resid = sqrt(r2 / v2) / lin->a_norm;
         if (EW) {
-            const double *er = EW + (size_t)(2 * c) * nq, *ei = er + nq;
-            for (int i = 0; i < nq; i++)
+            const double *er = EW + (size_t)(2 * c) * nlow, *ei = er + nlow;
+            for (int i = 0; i < nlow; i++)
                 e2 += er[i] * er[i] + ei[i] * ei[i];
             L->c[c].dlam = sqrt(e2 / v2);
         }

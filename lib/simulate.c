@@ -235,6 +235,10 @@ struct ts_sim {
     double t, h;
     double *y;            /* [n] */
     double *work;         /* [3 n]: kernel output and df/dt differences */
+    double *u;            /* [ninput] the kernel's input at the time of the
+                             last prepare(): the tow channels from the
+                             excitation, the vehicles' inputs zero */
+    int ninput;
     double *breaks;       /* [nbreaks] */
     int nbreaks;
     double dfdt_step;
@@ -324,7 +328,8 @@ static void stiffness_note(const ts_sim *s, ts_err *err)
              s->sys->links[l].index, s->sys->cables[s->sys->links[l].cable].name);
 }
 
-/* Frame and input of time t into the kernel; u[TS_NINPUT]. */
+/* Frame and input of time t into the kernel; u[TS_NINPUT] (the tow
+ * channels; the caller passes s->u, whose vehicle channels stay zero). */
 static void prepare(ts_sim *s, double t, double u[TS_NINPUT])
 {
     ts_excitation_input(s->ex, t, u);
@@ -338,7 +343,7 @@ static void prepare(ts_sim *s, double t, double u[TS_NINPUT])
 static int rhs(double t, const double y[], double dydt[], void *params)
 {
     ts_sim *s = params;
-    double u[TS_NINPUT];
+    double *u = s->u;
     s->nfev++;
     prepare(s, t, u);
     int rc = ts_kernel_eval(s->k, y, u, dydt);
@@ -362,7 +367,7 @@ static int rhs(double t, const double y[], double dydt[], void *params)
  * GSL_FAILURE (a refused state) or GSL_EBADFUNC (fatal). */
 static int linearize_at(ts_sim *s, double t, const double y[])
 {
-    double u[TS_NINPUT];
+    double *u = s->u;
     s->njac++;
     prepare(s, t, u);
     int rc = ts_linearize(s->k, y, u, &s->lopts, s->lin, NULL);
@@ -457,6 +462,7 @@ void ts_sim_free(ts_sim *s)
     free(s->y);
     free(s->y_int);
     free(s->work);
+    free(s->u);
     free(s->breaks);
     free(s);
 }
@@ -512,9 +518,11 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     size_t n = (size_t)s->n;
     s->y = calloc(n, sizeof(double));
     s->work = calloc(3 * n, sizeof(double));
+    s->ninput = ts_kernel_ninput(k);
+    s->u = calloc((size_t)s->ninput, sizeof(double));
     int nb = ts_excitation_breakpoints(ex, o->t_end, NULL, 0);
     s->breaks = malloc((size_t)(nb + 1) * sizeof(double));
-    if (!s->y || !s->work || !s->breaks)
+    if (!s->y || !s->work || !s->breaks || !s->u)
         goto nomem;
     s->nbreaks = ts_excitation_breakpoints(ex, o->t_end, s->breaks, nb);
     if (needs_jacobian(o->integrator)) {
@@ -826,7 +834,7 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
         return ts_fail(err, TS_EINVAL, "simulate: the history is sized for "
                        "%d links, the system has %d", h->nlinks,
                        s->sys->nlinks);
-    double u[TS_NINPUT];
+    double *u = s->u;
     prepare(s, s->t, u);
     int rc = ts_kernel_eval(s->k, s->y, u, s->work);
     if (rc)
@@ -841,7 +849,7 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
     memcpy(h->tensions + nl * i, ts_kernel_tensions(s->k), nl * sizeof(double));
     h->energy[2 * i] = ts_kernel_kinetic_energy(s->k);
     h->energy[2 * i + 1] = ts_kernel_potential_energy(s->k);
-    memcpy(h->input + TS_NINPUT * i, u, sizeof u);
+    memcpy(h->input + TS_NINPUT * i, u, TS_NINPUT * sizeof(double));
     h->nsamples++;
     return TS_OK;
 }
@@ -1101,9 +1109,12 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
                                  (u[c] - lin->u0[c]);
     } else {
         int n = lin->nstate;
+        double *ufull = ywork + 2 * n;
         for (int j = 0; j < n; j++)
             ywork[j] = lin->y0[j] + z[j];
-        int rc = ts_kernel_eval(k, ywork, u, ywork + n);
+        for (int j = 0; j < lin->ninput; j++)
+            ufull[j] = j < TS_NINPUT ? u[j] : lin->u0[j];
+        int rc = ts_kernel_eval(k, ywork, ufull, ywork + n);
         if (rc)
             return ts_fail(err, rc < 0 ? rc : TS_EDOMAIN, "simulate "
                            "(linear): the state y0 + z at t = %.9g s is "
@@ -1151,7 +1162,9 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     size_t sn = (size_t)n;
     double *z = calloc(sn, sizeof(double));
     double *tmp = calloc(sn, sizeof(double));
-    double *ywork = calloc(2 * sn, sizeof(double));
+    /* y0 + z, f there, and the whole input (the vehicles' channels at
+     * their linearization values). */
+    double *ywork = calloc(2 * sn + (size_t)lin->ninput, sizeof(double));
     double *dr = calloc(3 * (size_t)lin->nnodes, sizeof(double));
     lin_hold H[2];
     for (int c = 0; c < 2; c++) {

@@ -943,36 +943,36 @@ void tsi_vehicle_measure(const tsi_vehicle_state *st, double value[4],
     rate[TS_MEASURE_HEADING] = yd[0];
 }
 
-double tsi_loop_error(const ts_loop *l, const double value[4])
+double tsi_loop_error(const ts_loop *l, const double value[4], double sp)
 {
-    double e = value[l->measure] - l->setpoint;
+    double e = value[l->measure] - sp;
     return l->measure == TS_MEASURE_HEADING ? wrap_pi(e) : e;
 }
 
-void tsi_vehicle_control(const ts_vehicle *v, const double value[4],
-                         const double rate[4], const double xi[],
-                         const double act[], const double u_surf[],
-                         const double u_loop[], const int mode[],
-                         const double frozen[], double out[], double delta[],
-                         double xi_dot[], double act_dot[])
+void tsi_vehicle_control(const ts_vehicle *v, const tsi_control_in *in,
+                         double out[], double delta[], double xi_dot[],
+                         double act_dot[])
 {
     double cmd[TS_VEHICLE_MAX_COMPONENTS];
     for (int c = 0; c < v->ncomponents; c++)
-        cmd[c] = v->component[c].deflection + (u_surf ? u_surf[c] : 0.0);
+        cmd[c] = v->component[c].deflection +
+                 (in->u_surf ? in->u_surf[c] : 0.0);
     for (int l = 0; l < v->nloops; l++) {
         const ts_loop *lp = &v->loop[l];
-        int m = mode ? mode[l] : TSI_LOOP_CLOSED;
-        double e = tsi_loop_error(lp, value);
-        double x = lp->ki != 0 && m != TSI_LOOP_FROZEN && xi ? xi[l] : 0.0;
-        out[l] = lp->kp * e + lp->ki * x + lp->kd * rate[lp->measure];
+        int m = in->mode ? in->mode[l] : TS_LOOP_CLOSED;
+        double sp = in->setpoint ? in->setpoint[l] : lp->setpoint;
+        double e = tsi_loop_error(lp, in->value, sp);
+        double x = lp->ki != 0 && m != TS_LOOP_OPEN && in->xi ? in->xi[l]
+                                                              : 0.0;
+        out[l] = lp->kp * e + lp->ki * x + lp->kd * in->rate[lp->measure];
         if (xi_dot)
             xi_dot[l] = e;
-        double in = u_loop ? u_loop[l] : 0.0;
-        double s = m == TSI_LOOP_CLOSED   ? out[l] + in
-                   : m == TSI_LOOP_FROZEN ? (frozen ? frozen[l] : 0.0) + in
-                                          : in;
+        double u = in->u_loop ? in->u_loop[l] : 0.0;
+        double sig = m == TS_LOOP_CLOSED ? out[l] + u
+                     : m == TS_LOOP_OPEN ? (in->frozen ? in->frozen[l] : 0.0) + u
+                                         : u;
         for (int k = 0; k < lp->nsurfaces; k++)
-            cmd[lp->surface[k]] += lp->gain[k] * s;
+            cmd[lp->surface[k]] += lp->gain[k] * sig;
     }
     for (int c = 0; c < v->ncomponents; c++) {
         const ts_component *cp = &v->component[c];
@@ -986,10 +986,13 @@ void tsi_vehicle_control(const ts_vehicle *v, const double value[4],
          * rate saturates). */
         double d = fmax(-cp->limit, fmin(cp->limit, cmd[c]));
         if (cp->time_constant > 0) {
-            double r = (d - act[c]) / cp->time_constant;
+            double a = in->act ? in->act[c] : d;
+            double r = (d - a) / cp->time_constant;
             if (act_dot)
-                act_dot[c] = fmax(-cp->rate_limit, fmin(cp->rate_limit, r));
-            delta[c] = act[c];
+                act_dot[c] = in->steady ? r
+                                        : fmax(-cp->rate_limit,
+                                               fmin(cp->rate_limit, r));
+            delta[c] = a;
         } else {
             delta[c] = d;
             if (act_dot)

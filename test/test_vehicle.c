@@ -581,8 +581,8 @@ static void test_control(void)
     double val[4] = {10.4, 0.05, -0.02, -3.0}, rate[4] = {-0.1, 0, 0, 0};
     double xi[2] = {0.7, 99.0}, act[3] = {0, 0.1, 0}, us[3] = {0.01, 0, 0};
     double ul[2] = {0, 0}, out[2], delta[3], xd[2], ad[3];
-    tsi_vehicle_control(v, val, rate, xi, act, us, ul, NULL, NULL, out, delta,
-                        xd, ad);
+    tsi_control_in in = {val, rate, xi, act, us, ul, NULL, NULL, NULL, 0};
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
     double e_d = 0.4, v_d = 0.2 * 0.4 + 0.03 * 0.7 + 0.5 * -0.1;
     /* heading error -3 - 3 = -6 rad wraps to -6 + 2 pi */
     double e_h = -6.0 + 2 * M_PI, v_h = 1.5 * e_h;
@@ -599,16 +599,27 @@ static void test_control(void)
     CHECK(delta[2] == 0 && ad[2] == 0, "a fixed surface does not deflect");
     /* Saturation of the deflection. */
     us[0] = 1.0;
-    tsi_vehicle_control(v, val, rate, xi, act, us, ul, NULL, NULL, out, delta,
-                        xd, ad);
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
     CHECK(delta[0] == 0.3, "deflection limited to 0.3 rad");
+    in.steady = 1;
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
+    CHECK_NEAR(ad[1], (v_h - 0.1) / 0.05, 1e-12,
+               "steady: the actuator's rate is not limited");
+    in.steady = 0;
+    double sp[2] = {10.25, 3.0};
+    in.setpoint = sp;
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
+    CHECK_NEAR(xd[0], 0.15, 1e-15, "a set point in force other than the "
+                                   "scene's: e = 10.4 - 10.25");
+    in.setpoint = NULL;
     us[0] = 0.0;
     /* Frozen (open) and broken loops. */
-    int mode[2] = {TSI_LOOP_FROZEN, TSI_LOOP_BROKEN};
+    int mode[2] = {TS_LOOP_OPEN, TS_LOOP_BROKEN};
     double frozen[2] = {0.011, 0.0};
     ul[1] = 0.07;
-    tsi_vehicle_control(v, val, rate, xi, act, us, ul, mode, frozen, out,
-                        delta, xd, ad);
+    in.mode = mode;
+    in.frozen = frozen;
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
     CHECK_NEAR(delta[0], 0.02 + 0.011 - 0.5 * 0.07, 1e-15,
                "frozen loop holds its trim output, a broken loop passes its "
                "input");

@@ -26,6 +26,9 @@ void cli_print_linearization(const ts_result *r)
            l->nstate, l->ninput, l->evaluations, l->threads,
            l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->trunc_err,
            l->a_scale, l->trunc_norm);
+    if (r->open_loop)
+        printf("open loop: the vehicles' controller loops are open, their "
+               "surfaces held at the trim's deflections\n");
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
         ts_system_node_name(r->sys, l->kink_node, name, sizeof name);
@@ -233,6 +236,40 @@ static int modes_plot(const ts_system *sys, const ts_linear *lin,
 }
 
 
+/* The loops' gain and phase margins, one loop broken at a time. */
+static void print_margins(const ts_result *r)
+{
+    if (r->nmargins == 0)
+        return;
+    printf("\nloop margins, each loop broken at its output with the others "
+           "closed (%g to %g Hz, %.3f ms):\n", TS_MARGINS_FROM_HZ,
+           TS_MARGINS_TO_HZ, r->margins_wall_s * 1e3);
+    printf("%-28s %12s %10s %14s %14s %14s\n", "loop", "gain margin", "[dB]",
+           "at [Hz]", "phase margin", "at [Hz]");
+    for (int i = 0; i < r->nmargins; i++) {
+        const ts_loop_margin *m = &r->margins[i];
+        char gm[32], db[32], gf[32], pm[32], pf[32];
+        if (isfinite(m->gain_margin)) {
+            snprintf(gm, sizeof gm, "%.4g", m->gain_margin);
+            snprintf(db, sizeof db, "%.2f", 20 * log10(m->gain_margin));
+            snprintf(gf, sizeof gf, "%.4g", m->phase_crossover_hz);
+        } else {
+            snprintf(gm, sizeof gm, "infinite");
+            snprintf(db, sizeof db, "-");
+            snprintf(gf, sizeof gf, "-");
+        }
+        if (isfinite(m->phase_margin_deg)) {
+            snprintf(pm, sizeof pm, "%.2f deg", m->phase_margin_deg);
+            snprintf(pf, sizeof pf, "%.4g", m->gain_crossover_hz);
+        } else {
+            snprintf(pm, sizeof pm, "no crossover");
+            snprintf(pf, sizeof pf, "-");
+        }
+        printf("%-28s %12s %10s %14s %14s %14s\n", m->name, gm, db, gf, pm,
+               pf);
+    }
+}
+
 static void modes_print(const cli_run *c, const ts_result *r)
 {
     cli_print_equilibrium(r, 1);
@@ -240,6 +277,7 @@ static void modes_print(const cli_run *c, const ts_result *r)
     if (r->eigen && r->mode_health)
         print_modes(r->sys, r->lin, r->eigen, r->mode_health, &r->trust,
                     r->eigen_wall_s, c->quiet);
+    print_margins(r);
 }
 
 /* The extras. */

@@ -8,10 +8,30 @@
 #include "cli.h"
 #include "cli_plot.h"
 
+/* The plot quantities of a response's unit "OUT/IN" (m, N or rad). */
+static ts_plot_quantity unit_quantity(const char *u, size_t len)
+{
+    if (len == 1 && u[0] == 'N')
+        return TS_PLOT_FORCE;
+    if (len == 3 && strncmp(u, "rad", 3) == 0)
+        return TS_PLOT_ANGLE;
+    return TS_PLOT_LENGTH;
+}
+
+static void unit_quantities(const char *unit, ts_plot_quantity *out_q,
+                            ts_plot_quantity *in_q)
+{
+    const char *slash = strchr(unit, '/');
+    size_t lo = slash ? (size_t)(slash - unit) : strlen(unit);
+    *out_q = unit_quantity(unit, lo);
+    *in_q = slash ? unit_quantity(slash + 1, strlen(slash + 1))
+                  : TS_PLOT_LENGTH;
+}
+
 static void print_response(const ts_response *r, int quiet)
 {
     printf("response of %s to %s (%s): static gain %.9g\n", r->output.name,
-           ts_input_name(r->input), r->output.unit, r->static_gain);
+           r->input_name, r->unit, r->static_gain);
     int ib = 0;
     for (int i = 1; i < r->npoints; i++)
         if (r->magnitude[i] > r->magnitude[ib])
@@ -158,19 +178,19 @@ static int response_draw(cli_run *c, const ts_result *r)
                 }
                 ph[i] = p + shift;
             }
-            char title[256], mag_label[192];
+            char title[256], mag_label[2 * TS_IO_NAME + 8];
             snprintf(title, sizeof title, "%s: frequency response",
                      r->sys->name);
             snprintf(mag_label, sizeof mag_label, "%s / %s",
-                     res->output.name, ts_input_name(res->input));
+                     res->output.name, res->input_name);
             ts_plot_bode_curve bc = {res->npoints, res->freq_hz,
                                      res->magnitude, ph, mag_label,
                                      TS_PLOT_SOLID, 0};
-            int tension = res->output.kind == TS_OUT_TENSION;
+            ts_plot_quantity out_q, in_q;
+            unit_quantities(res->unit, &out_q, &in_q);
             ts_err perr = {0};
-            if (ts_plot_bode(plot->dir, "bode", title, mag_label,
-                             tension ? TS_PLOT_FORCE : TS_PLOT_LENGTH,
-                             TS_PLOT_LENGTH, 1, &bc, r->nnatural,
+            if (ts_plot_bode(plot->dir, "bode", title, mag_label, out_q,
+                             in_q, 1, &bc, r->nnatural,
                              r->natural_hz, &plot->opts, &perr) != TS_OK)
                 status = cli_report(&perr, perr.code);
             else
@@ -185,6 +205,6 @@ static int response_draw(cli_run *c, const ts_result *r)
 static const char *const response_pictures[] = {"bode", NULL};
 
 const cli_command cli_cmd_response = {
-    "response", "frequency response to tow-point motion",
+    "response", "frequency response to tow-point motion or a vehicle's input",
     TS_ANALYSIS_RESPONSE, NULL, response_prepare, response_print,
     response_draw, NULL, response_pictures, NULL};

@@ -25,6 +25,7 @@
 #include <stddef.h>
 
 #include "towstab/error.h"
+#include "towstab/kernel.h"
 #include "towstab/linearize.h"
 #include "towstab/system.h"
 
@@ -32,7 +33,12 @@
 extern "C" {
 #endif
 
-typedef enum { TS_OUT_POSITION = 0, TS_OUT_TENSION = 1 } ts_output_kind;
+typedef enum {
+    TS_OUT_POSITION = 0,
+    TS_OUT_TENSION = 1,
+    TS_OUT_VEHICLE = 2  /* a vehicle's depth, pitch, roll, yaw or loop
+                           output (ts_kernel_output_name) */
+} ts_output_kind;
 
 /* An output channel. */
 typedef struct ts_output {
@@ -40,6 +46,7 @@ typedef struct ts_output {
     int node;      /* position: node index (>= 1) */
     int comp;      /* position: 0 x, 1 y, 2 z (M frame, z down) */
     int link;      /* tension: link index */
+    int index;     /* vehicle: the output's row in ts_linear.Vy */
     char name[2 * TS_NAME_MAX + 16]; /* canonical name, e.g. "sphere.z" */
     const char *unit; /* "m/m" or "N/m" */
 } ts_output;
@@ -62,6 +69,19 @@ TS_API int ts_response_output_find(const ts_system *sys, const char *name,
 TS_API void ts_response_output_names(const ts_system *sys, char *buf,
                                      size_t size);
 
+/* The same with a vehicle's inputs: a tow displacement, or one of the
+ * kernel's vehicle inputs (ts_kernel_input_name: "<vehicle>.<surface>",
+ * "<vehicle>.<loop>", "<vehicle>.<loop>.setpoint"); k is any kernel of
+ * the system. TS_OK or TS_EINVAL listing the valid names. */
+TS_API int ts_response_input_lookup(const ts_kernel *k, const char *name,
+                                    int *channel, ts_err *err);
+
+/* The same for outputs: ts_response_output_find's names, or a vehicle's
+ * outputs ("<vehicle>.depth", ".pitch", ".roll", ".yaw",
+ * "<vehicle>.<loop>.output"). */
+TS_API int ts_response_output_lookup(const ts_kernel *k, const char *name,
+                                     ts_output *out, ts_err *err);
+
 /* Log-spaced frequencies freq[points] from `from` to `to` Hz inclusive.
  * Refuses (TS_EINVAL) from <= 0, to <= from, non-finite values or
  * points < 2. */
@@ -69,7 +89,10 @@ TS_API int ts_response_logspace(double from, double to, int points,
                                 double freq[], ts_err *err);
 
 typedef struct ts_response {
-    int input;          /* channel 0..2 */
+    int input;          /* channel: 0..2 a tow displacement, from
+                           TS_NINPUT on a vehicle's input */
+    char input_name[TS_IO_NAME];
+    char unit[32];      /* output unit per input unit, e.g. "m/rad" */
     ts_output output;
     int npoints;
     double *freq_hz;    /* [npoints] Hz */
@@ -80,7 +103,9 @@ typedef struct ts_response {
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at
- * freq_hz[npoints] (Hz, each >= 0). On success *res is new (free with
+ * freq_hz[npoints] (Hz, each >= 0). A tow displacement input (0..2)
+ * brings its velocity and acceleration; a vehicle input (>= TS_NINPUT)
+ * is its column of B alone. On success *res is new (free with
  * ts_response_free). Returns TS_OK, TS_EINVAL (bad channel, negative
  * frequency, tension output without tension Jacobians), TS_ESINGULAR (i w
  * is an eigenvalue: an undamped resonance exactly on a point) or

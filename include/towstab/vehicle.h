@@ -114,6 +114,18 @@ typedef struct ts_loop {
     int line;
 } ts_loop;
 
+/* How a loop drives its surfaces (ts_kernel_set_loop_mode). */
+enum {
+    TS_LOOP_CLOSED = 0, /* its output plus its input (a disturbance at the
+                           loop's output) drives its surfaces */
+    TS_LOOP_OPEN = 1,   /* its surfaces see a frozen output (the trim's)
+                           plus its input; no integrator state: the open
+                           loop plant */
+    TS_LOOP_BROKEN = 2  /* its surfaces see its input alone, the other
+                           loops staying closed: the loop broken at its
+                           output, for its gain and phase margins */
+};
+
 typedef struct ts_vehicle {
     double inertia[6];    /* about the mass centre, body axes, kg m^2:
                              Ixx, Iyy, Izz, Ixy, Ixz, Iyz (products as
