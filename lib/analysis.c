@@ -472,8 +472,10 @@ static ts_eigen_opts modes_eigen_opts(const ts_modes_opts *m, int n)
                  (o.method == TS_EIG_AUTO && n >= o.arpack_min_states))
             o.count = large;
     }
-    if (o.count > n / 2 + 1)
-        o.count = 0; /* more than exist: all of them */
+    /* More than exist: all of them. ARPACK finds a few near a target and
+     * says how many it can (ts_eigen_check). */
+    if (o.count > n / 2 + 1 && o.method != TS_EIG_ARPACK)
+        o.count = 0;
     return o;
 }
 
@@ -871,6 +873,27 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
     }
     if ((rc = sim_output(sys, s->output, out, err)))
         return rc;
+    /* Loads an excitation or a manoeuvre makes overflow: refused here,
+     * naming the option that brought them (the simulator refuses them
+     * too, naming only the input). */
+    {
+        ts_frame f0 = {sys->tow.speed, sys->tow.turn_rate, 0, 0,
+                       {sys->env.current[0], sys->env.current[1],
+                        sys->env.current[2]}};
+        ts_motion_bound mb, st;
+        ts_excitation_bound(ex, &f0, &mb);
+        if ((rc = ts_system_check_loads(sys, &mb, err))) {
+            ts_motion_bound_steady(sys, &st);
+            mb.tow_speed = mb.tow_accel = 0.0;
+            if (ts_system_check_loads(sys, &st, NULL))
+                ts_err_prefix(err, "simulate: ");
+            else if (ts_system_check_loads(sys, &mb, NULL))
+                ts_err_prefix(err, "manoeuvre: ");
+            else
+                ts_err_prefix(err, "excite: ");
+            return rc;
+        }
+    }
     int use_linear = s->compare || s->linear;
     const char *lw = s->compare ? "compare" : "linear";
     if (use_linear && s->initial != TS_INITIAL_EQUILIBRIUM)
@@ -1581,7 +1604,20 @@ static int check_kind(const ts_system *sys, const ts_request *rq,
             !isfinite(rq->modes.eigen.target_hz))
             return ts_fail(err, TS_EINVAL, "near: expected a frequency >= 0 "
                            "Hz, got %g Hz", rq->modes.eigen.target_hz);
-        return TS_OK;
+        {
+            /* The count and method against the number of states, before
+             * the equilibrium runs. */
+            ts_kernel *k = ts_kernel_alloc(sys, err);
+            if (!k)
+                return err && err->code ? err->code : TS_ENOMEM;
+            int n = ts_kernel_nstate(k);
+            ts_kernel_free(k);
+            ts_eigen_opts o = modes_eigen_opts(&rq->modes, n);
+            int rc = ts_eigen_check(n, &o, err);
+            if (rc != TS_OK)
+                ts_err_prefix(err, "count: ");
+            return rc;
+        }
     case TS_ANALYSIS_RESPONSE: {
         int input;
         ts_output out;

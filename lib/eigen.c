@@ -593,6 +593,47 @@ static int batch_checks(const ts_linear *lin, cand_list *L)
     return TS_OK;
 }
 
+/* The method ts_eigen_solve uses for n states. */
+static ts_eig_method method_for(int n, const ts_eigen_opts *o)
+{
+    if (o->method != TS_EIG_AUTO)
+        return o->method;
+    return o->count > 0 && n >= o->arpack_min_states ? TS_EIG_ARPACK
+                                                      : TS_EIG_LAPACK;
+}
+
+static int arpack_sizes(int n, int count, int *nev, int *ncv, ts_err *err);
+
+int ts_eigen_check(int n, const ts_eigen_opts *opts, ts_err *err)
+{
+    ts_eigen_opts o;
+    if (opts)
+        o = *opts;
+    else
+        ts_eigen_opts_default(&o);
+    if (o.count < 0 || o.count > n)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: count must be in [0, %d] (0: all modes; the "
+                       "system has %d states), got %d",
+                       n, n, o.count);
+    if (!(o.target_hz >= 0) || !isfinite(o.target_hz))
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: target must be a frequency >= 0 Hz, got %g",
+                       o.target_hz);
+    if (!(o.arpack_tol >= 0) || o.arpack_max_iter < 1)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: arpack_tol must be >= 0 and arpack_max_iter "
+                       ">= 1");
+    if (method_for(n, &o) != TS_EIG_ARPACK)
+        return TS_OK;
+    if (o.count == 0)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method arpack needs a number of modes (count "
+                       "> 0); it finds the modes nearest a target, not all");
+    int nev, ncv;
+    return arpack_sizes(n, o.count, &nev, &ncv, err);
+}
+
 static int arpack_sizes(int n, int count, int *nev, int *ncv, ts_err *err)
 {
     *nev = 2 * count + 1;
@@ -854,27 +895,10 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         ts_eigen_opts_default(&o);
     *out = NULL;
     int n = lin->nstate;
-    if (o.count < 0 || o.count > n)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: count must be in [0, %d] (0: all modes), got "
-                       "%d",
-                       n, o.count);
-    if (!(o.target_hz >= 0) || !isfinite(o.target_hz))
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: target must be a frequency >= 0 Hz, got %g",
-                       o.target_hz);
-    if (!(o.arpack_tol >= 0) || o.arpack_max_iter < 1)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: arpack_tol must be >= 0 and arpack_max_iter "
-                       ">= 1");
-    ts_eig_method m = o.method;
-    if (m == TS_EIG_AUTO)
-        m = o.count > 0 && n >= o.arpack_min_states ? TS_EIG_ARPACK
-                                                     : TS_EIG_LAPACK;
-    if (m == TS_EIG_ARPACK && o.count == 0)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: method arpack needs a number of modes (count "
-                       "> 0); it finds the modes nearest a target, not all");
+    int rc = ts_eigen_check(n, &o, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_eig_method m = method_for(n, &o);
     ts_eigen *e = calloc(1, sizeof *e);
     if (!e)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
@@ -882,7 +906,6 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     e->method = m;
     e->target_hz = o.target_hz;
     cand_list L = {0};
-    int rc;
     if (m == TS_EIG_LAPACK)
         rc = solve_lapack(lin, &L, err);
     else if (o.target_hz == 0.0)

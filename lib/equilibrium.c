@@ -41,6 +41,10 @@
  * the smallest step, as a fraction of the path, before it gives up. */
 #define BENDING_START 1e-4
 #define CONTINUATION_MIN_STEP (1.0 / 1024)
+/* A relative force residual this small is rounding in the sums of the
+ * nodal balances (about 1000 machine epsilons): Newton stalling there has
+ * converged as far as double precision goes. */
+#define ROUNDING_RESIDUAL 2e-13
 
 void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
 {
@@ -278,6 +282,12 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                                     "the model (%s)", ts_strerror(rc));
         double scale, worst = ts_kernel_unbalanced(k, &scale);
         rel = scale > 0 ? worst / scale : worst;
+        if (!isfinite(rel))
+            return ts_fail(err, TS_ECONV, "equilibrium: the forces overflowed "
+                           "(are not finite) at Newton iteration %d: an "
+                           "extreme value of the scene (a stiffness, mass or "
+                           "drag coefficient) drove a tension or strain out "
+                           "of range", eq->iterations);
         if (rel <= tol) {
             newton_health(k, y, w, eq);
             return TS_OK;
@@ -317,11 +327,22 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                 w->rcond = NAN;
             dgetrs_("N", &nq, &one, w->J, &nq, w->ipiv, w->dq, &nq, &info, 1);
         }
-        if (info != 0)
+        if (info != 0) {
+            /* Name the link of the coordinate that nothing restores. */
+            const ts_system *sys = ts_kernel_system(k);
+            int l = 0;
+            while (l + 1 < sys->nlinks &&
+                   ts_kernel_link_offset(k, l + 1) <= info - 1)
+                l++;
+            const ts_link *L = &sys->links[l];
             return ts_fail(err, TS_ESINGULAR,
-                           "equilibrium: singular Newton Jacobian (LAPACK "
-                           "dgetrf info %d) at relative residual %.3g",
-                           info, rel);
+                           "equilibrium: singular Newton Jacobian at "
+                           "relative residual %.3g: nothing restores "
+                           "cables[%d] '%s' link %d (LAPACK dgetrf info %d), "
+                           "as with neutral buoyancy and no flow past it",
+                           rel, L->cable, sys->cables[L->cable].name,
+                           L->index, info);
+        }
         double big = 0.0;
         for (int i = 0; i < nq; i++)
             big = fmax(big, fabs(w->dq[i]) / w->scale[i]);
@@ -348,9 +369,16 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         memcpy(y, w->yt, (size_t)nq * sizeof(double));
         ts_kernel_rechart(k, y, TS_CHART_RECHART);
     }
+    if (rel <= ROUNDING_RESIDUAL)
+        return ts_fail(err, TS_ECONV,
+                       "equilibrium: Newton stopped after %d iterations at "
+                       "relative residual %.3g, which is rounding: the "
+                       "tolerance %.3g is below what double precision "
+                       "reaches (about %g)",
+                       eq->iterations, rel, tol, ROUNDING_RESIDUAL);
     return ts_fail(err, TS_ECONV,
                    "equilibrium: Newton stopped after %d iterations at "
-                   "relative residual %.3g (target %.3g)",
+                   "relative residual %.3g (tolerance %.3g)",
                    eq->iterations, rel, tol);
 }
 
@@ -423,13 +451,20 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         path(pc, t);
         rc = TS_OK;
     }
+    /* Name the continuation only where there was one: a straight tow has
+     * no turn-rate path (its first Newton solve is the whole of it). */
     if (rc != TS_OK && rc != TS_ENOMEM) {
         ts_frame f;
         ts_kernel_get_frame(k, &f);
-        ts_err_prefix(err, "continuation stopped %.4g of the way (%s), at "
-                           "turn rate %.6g rad/s: ",
-                      t, path == turn_path ? "turn rate" : "bending stiffness",
-                      f.turn_rate);
+        if (path == bending_path)
+            ts_err_prefix(err, "continuation in bending stiffness (EI "
+                               "scaled up from %g of its value) stopped "
+                               "%.4g of the way: ", pc->b0, t);
+        else if (pc->frame.turn_rate != 0)
+            ts_err_prefix(err, "continuation in turn rate towards %.6g "
+                               "rad/s stopped %.4g of the way, at %.6g "
+                               "rad/s: ", pc->frame.turn_rate, t,
+                          f.turn_rate);
     }
     return rc;
 }
@@ -556,6 +591,13 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                        "equilibrium: method shooting does not apply to "
                        "cables with bending stiffness (EI > 0); use newton "
                        "or auto");
+    /* Loads that overflow are the input's fault: say which input. */
+    ts_motion_bound mb = {fabs(frame.speed), fabs(frame.turn_rate), 0, 0};
+    int lrc = ts_system_check_loads(sys, &mb, err);
+    if (lrc != TS_OK) {
+        ts_err_prefix(err, "equilibrium: ");
+        return lrc;
+    }
 
     int nl = sys->nlinks, nq = ts_kernel_nq(k), rc;
     double *y = calloc(2 * (size_t)nq, sizeof(double));

@@ -457,7 +457,15 @@ static int solve_link(tsi_march *m, link_problem *P, const double guess[3],
      * buoyancy) down at rounding level of the forces that cancel. */
     const ts_link *L = P->L;
     double gross = v3_norm(P->K) + L->mass * m->sys->env.gravity;
-    if (!(hn > NO_LOAD_RTOL * gross) || !isfinite(hn))
+    /* Forces that overflowed: say so where it happens (the loads were
+     * checked against TS_LOAD_MAX before, so an iterate far off the
+     * solution made them). */
+    if (!isfinite(hn) || !isfinite(gross))
+        return ts_fail(err, TS_ECONV,
+                       "equilibrium: the forces on cables[%d] '%s' link %d "
+                       "overflowed (are not finite) in the march",
+                       L->cable, m->sys->cables[L->cable].name, L->index);
+    if (!(hn > NO_LOAD_RTOL * gross))
         return ts_fail(err, TS_ESINGULAR,
                        "equilibrium: cables[%d] '%s' link %d carries no load "
                        "(|force| = %.3g N against a weight of %.3g N), so its "

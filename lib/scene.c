@@ -1226,7 +1226,10 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
                 sizeof ((ts_scene *)0)->path - 1);
         return NULL;
     }
-    FILE *fp = fopen(path, "rb");
+    /* "-" is standard input, as in other Unix tools. */
+    int from_stdin = strcmp(path, "-") == 0;
+    const char *name = from_stdin ? "standard input" : path;
+    FILE *fp = from_stdin ? stdin : fopen(path, "rb");
     if (!fp) {
         ts_fail(err, TS_EIO, "%s: cannot open: %s", path, strerror(errno));
         return NULL;
@@ -1234,14 +1237,16 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
     /* Read the whole file, growing the buffer geometrically. */
     size_t cap = 4096, len = 0;
     char *buf = malloc(cap);
-    int rc = buf ? TS_OK : ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+    int rc = buf ? TS_OK
+                 : ts_fail(err, TS_ENOMEM, "%s: out of memory for %zu bytes",
+                           name, cap);
     while (rc == TS_OK) {
         if (len == cap) {
             /* The buffer grows to at most MAX_FILE_BYTES + 1: filling that
              * proves the file is too large. */
             if (cap > (size_t)MAX_FILE_BYTES) {
                 rc = ts_fail(err, TS_EIO, "%s: larger than %ld bytes, not a "
-                             "scene file", path, MAX_FILE_BYTES);
+                             "scene file", name, MAX_FILE_BYTES);
                 break;
             }
             size_t bigger_cap = cap * 2 > (size_t)MAX_FILE_BYTES
@@ -1249,7 +1254,8 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
                                     : cap * 2;
             char *bigger = realloc(buf, bigger_cap);
             if (!bigger) {
-                rc = ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+                rc = ts_fail(err, TS_ENOMEM, "%s: out of memory for %zu "
+                             "bytes", name, bigger_cap);
                 break;
             }
             buf = bigger;
@@ -1259,19 +1265,20 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
         len += got;
         if (got == 0) {
             if (ferror(fp))
-                rc = ts_fail(err, TS_EIO, "%s: cannot read: %s", path,
+                rc = ts_fail(err, TS_EIO, "%s: cannot read: %s", name,
                              strerror(errno));
             break;
         }
     }
-    fclose(fp);
+    if (!from_stdin)
+        fclose(fp);
     ts_scene *scene = NULL;
     if (rc == TS_OK) {
         scene = parse(buf, len, units, err);
         if (scene)
             snprintf(scene->path, sizeof scene->path, "%s", path);
         else
-            ts_err_prefix(err, "%s: ", path);
+            ts_err_prefix(err, "%s: ", name);
     }
     free(buf);
     return scene;

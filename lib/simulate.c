@@ -466,6 +466,17 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
 {
     if (ts_sim_opts_check(o, err))
         return NULL;
+    /* Loads that overflow under the excitation's motion are the input's
+     * fault: refuse them before a single step, naming the input (a step
+     * size would otherwise shrink towards zero chasing them). */
+    ts_frame f0;
+    ts_motion_bound mb;
+    ts_kernel_get_frame(k, &f0);
+    ts_excitation_bound(ex, &f0, &mb);
+    if (ts_system_check_loads(ts_kernel_system(k), &mb, err) != TS_OK) {
+        ts_err_prefix(err, "simulate: ");
+        return NULL;
+    }
     ts_sim *s = calloc(1, sizeof *s);
     if (!s) {
         ts_fail(err, TS_ENOMEM, "simulate: out of memory");

@@ -507,6 +507,18 @@ static void test_buffers(const ts_units *u)
           "missing file: %s", err.msg);
     s = ts_scene_load(DIR, u, &err);
     CHECK(!s && err.code == TS_EIO, "a directory: %s", err.msg);
+    /* "-" reads standard input; messages name it. */
+    if (freopen(DIR "good_minimal.yaml", "rb", stdin)) {
+        s = ts_scene_load("-", u, &err);
+        CHECK(s && !strcmp(s->path, "-"), "'-' reads a scene from standard "
+              "input (%s)", s ? "" : err.msg);
+        ts_scene_free(s);
+    }
+    if (freopen(DIR "bad_empty.yaml", "rb", stdin)) {
+        s = ts_scene_load("-", u, &err);
+        CHECK(!s && !strncmp(err.msg, "standard input: ", 16),
+              "a bad scene on standard input is named so: %s", err.msg);
+    }
     ts_scene_free(NULL);
     CHECK(1, "ts_scene_free(NULL) does nothing");
     CHECK(ts_scene_analysis_option(NULL, "x") == NULL, "option of NULL");

@@ -230,15 +230,45 @@ int cli_exit_code(int rc)
     }
 }
 
-int cli_report(const ts_err *err, int rc)
+/* The scene file the command read (cli_open), for messages: its path, or
+ * "standard input". The tool's state, like json_fd. */
+static char scene_label[512];
+
+/* Whether a message about the scene's analysis should be prefixed with
+ * the scene file: an analysis that failed (its message names the part,
+ * not the file), or an option of an `analyses` entry; not a message about
+ * a command-line option or one that names the file already. */
+static int needs_scene(const char *msg, int rc)
+{
+    if (!scene_label[0] || !strncmp(msg, "--", 2) || strstr(msg, scene_label))
+        return 0;
+    if (!strncmp(msg, "analyses[", 9))
+        return 1;
+    switch (rc) {
+    case TS_ECONV:
+    case TS_ESINGULAR:
+    case TS_ELAPACK:
+    case TS_EINTEGRATOR:
+    case TS_ENOMEM:
+    case TS_EDOMAIN: return 1;
+    default: return 0;
+    }
+}
+
+int cli_report(ts_err *err, int rc)
 {
     cli_progress_done();
+    /* The prefix goes into the record, so that a JSON written after this
+     * gives the same reason as standard error. */
+    if (err && err->msg[0] && needs_scene(err->msg, rc))
+        ts_err_prefix(err, "%s: ", scene_label);
+    const char *msg = err && err->msg[0] ? err->msg : ts_strerror(rc);
     if (rc == TS_ECANCEL)
         fprintf(stderr, "towstab: error: interrupted (%s): ",
                 cli_stop_signal_name() ? cli_stop_signal_name() : "stop");
     else
         fprintf(stderr, "towstab: error: ");
-    fprintf(stderr, "%s\n", err && err->msg[0] ? err->msg : ts_strerror(rc));
+    fprintf(stderr, "%s\n", msg);
     return cli_exit_code(rc);
 }
 
@@ -250,6 +280,9 @@ int cli_open(const char *path, ts_units **units, ts_scene **scene)
     if (!*units)
         return cli_report(&err, err.code ? err.code : TS_EUNIT);
     *scene = ts_scene_load(path, *units, &err);
+    if (*scene)
+        snprintf(scene_label, sizeof scene_label, "%s",
+                 strcmp(path, "-") ? path : "standard input");
     if (!*scene) {
         int rc = err.code ? err.code : TS_ESCENE;
         ts_units_free(*units);

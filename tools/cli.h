@@ -80,8 +80,11 @@ double cli_wall_now(void);
 /* Exit status for a library code. */
 int cli_exit_code(int rc);
 
-/* Print "towstab: error: <message>" and return the exit status. */
-int cli_report(const ts_err *err, int rc);
+/* Print "towstab: error: <message>" and return the exit status. A message
+ * about the scene's analysis (a failed analysis, an option of an
+ * `analyses` entry) gets the scene file in front, in err too, so that a
+ * JSON written afterwards gives the same reason. */
+int cli_report(ts_err *err, int rc);
 
 /* Load units and a scene; on failure prints and returns the status. Free
  * with cli_close(). */

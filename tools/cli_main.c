@@ -218,6 +218,9 @@ int cli_execute(cli_run *c, json_t **result)
     if (rc != TS_OK) {
         ts_optset_locate(c->opts, &err);
         status = cli_report(&err, rc);
+        /* The JSON gives the reason standard error gave (the option and
+         * the scene file located in it). */
+        snprintf(r->error, sizeof r->error, "%s", err.msg);
     }
     ts_err werr = {0};
     int write = status == 0 || has_partial(r);

@@ -194,11 +194,18 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
             sys->tow.speed, sys->tow.turn_rate, sys->ncables,
             sys->ncables == 1 ? "" : "s", sys->nlinks, sys->nbodies,
             sys->nbodies == 1 ? "y" : "ies");
-    fprintf(f, "%s: %s, %d iterations, %ld evaluations, residual %.3g of "
-               "%.6g N (target %.3g), %.3f ms\n",
+    /* A failed solve may end on forces that overflowed: no "nan". */
+    char res[64];
+    if (isfinite(eq->residual) && isfinite(eq->force_scale))
+        snprintf(res, sizeof res, "%.3g of %.6g N", eq->residual,
+                 eq->force_scale);
+    else
+        snprintf(res, sizeof res, "not finite");
+    fprintf(f, "%s: %s, %d iterations, %ld evaluations, residual %s "
+               "(target %.3g), %.3f ms\n",
             eq->converged ? "converged" : "NOT CONVERGED",
             ts_eq_method_name(eq->method), eq->iterations, eq->evaluations,
-            eq->residual, eq->force_scale, eq->tolerance, wall_s * 1e3);
+            res, eq->tolerance, wall_s * 1e3);
     if (!eq->converged) {
         if (r->kind == TS_ANALYSIS_EQUILIBRIUM)
             cli_print_trust(t);

@@ -40,8 +40,9 @@ typedef struct ts_scene {
     ts_scene_analysis *analyses;
 } ts_scene;
 
-/* Read and build a scene from a file. On failure returns NULL, with the
- * error in err (TS_EIO, TS_ESCENE, TS_EUNIT or TS_EINVAL). */
+/* Read and build a scene from a file; path "-" reads standard input to
+ * its end (messages then name "standard input"). On failure returns NULL,
+ * with the error in err (TS_EIO, TS_ESCENE, TS_EUNIT or TS_EINVAL). */
 TS_API ts_scene *ts_scene_load(const char *path, const ts_units *units,
                                ts_err *err);
 

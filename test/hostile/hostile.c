@@ -820,7 +820,7 @@ static void gen_cli_misuse(void)
     hcase *c;
     const int R = E_BADINPUT;
     /* The program and its commands. */
-    misuse(R, NULL, NULL);
+    misuse(R, "no command", NULL);
     misuse(R, "bogus", "bogus", EX1, NULL);
     misuse(E_RUN, NULL, "--help", NULL);
     misuse(E_RUN, NULL, "--version", NULL);
@@ -870,9 +870,12 @@ static void gen_cli_misuse(void)
         {"--tol", "1e-300", E_REFUSE},
     };
     for (size_t i = 0; i < sizeof settings / sizeof settings[0]; i++) {
+        /* The option, or the quantity it sets ("turn rate"). */
         const char *must = settings[i].expect == E_RUN ||
                                    settings[i].expect == E_ANY
                                ? NULL
+                           : !strcmp(settings[i].opt, "--turn-rate")
+                               ? "turn"
                                : settings[i].opt + 2;
         misuse(settings[i].expect, must, "equilibrium", EX1, "--quiet",
                settings[i].opt, settings[i].val, NULL);
