@@ -10,7 +10,7 @@
  *     (20 links, rk8pd, 20 s, at rest in its equilibrium) and example 4
  *     under its 1 Hz heave (3 s), the estimated steps and evaluations are
  *     at most those the run took, and more than 1/50 of them (a bound
- *     worth saying); the estimated run time is at most the measured one.
+ *     worth saying). Times are not compared (they depend on the load).
  *     Modes: 30 n^3 flops and 6 n^2 doubles for LAPACK, none for ARPACK.
  *  3. A simulation request whose default sample interval (16 per period)
  *     would take more than TS_SIMULATE_AUTO_SAMPLES_MAX samples is
@@ -94,13 +94,14 @@ static void bound_check(const ts_units *u, const char *path,
               "%s: estimated and run (%s)", path, err.msg)) {
         const ts_sim_stats *st = &r->nonlinear_stats;
         double accepted = (double)(st->steps - st->rejected);
+        /* Counts only: times depend on the machine's load (the estimate
+         * times the kernel; benchmarks, not tests, compare times). */
         CHECK(c.steps <= accepted && c.steps > accepted / 50 &&
                   c.evaluations <= (double)st->evaluations &&
-                  c.seconds <= st->wall_s,
-              "%s: estimate %.4g steps, %.4g evaluations, %.3g s <= the "
-              "run's %.4g accepted steps, %ld evaluations, %.3g s",
-              path, c.steps, c.evaluations, c.seconds, accepted,
-              st->evaluations, st->wall_s);
+                  c.seconds > 0 && c.eval_s > 0,
+              "%s: estimate %.4g steps, %.4g evaluations <= the run's %.4g "
+              "accepted steps, %ld evaluations", path, c.steps,
+              c.evaluations, accepted, st->evaluations);
     }
     ts_result_free(r);
     ts_request_clear(&rq);
