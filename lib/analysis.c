@@ -19,12 +19,17 @@
  *   response     the same linearization (with tension Jacobians for a
  *                tension output) -> frequency response at log-spaced
  *                frequencies (and optionally the lowest natural ones);
+ *                with a sea, the spectral response to it instead
+ *                (towstab/seastate.h) and its discretisation error;
  *   simulate     initial state (equilibrium, released or a shape file)
  *                -> the linear model about the equilibrium (linearized
  *                with the equilibrium's own kernel, whose charts both runs
  *                then start from) and/or the nonlinear integration ->
  *                comparison and the fit of the output's amplitude ratio,
  *                mean offset and phase against a periodic excitation;
+ *                with a sea, a realisation of it added to the
+ *                excitation, the records' statistics and the spectral
+ *                prediction over the realisation's band;
  *   converge     one of the above rerun at every setting of a resolution
  *                sweep (towstab/converge.h estimates errors and orders),
  *                one series per integrator for a simulation.
@@ -102,6 +107,12 @@ void ts_request_init(ts_request *rq, ts_analysis_kind kind)
     rq->response.from_hz = TS_RESPONSE_FROM_HZ;
     rq->response.to_hz = TS_RESPONSE_TO_HZ;
     rq->response.points = TS_RESPONSE_POINTS;
+    rq->response.intervals = TS_SEASTATE_INTERVALS;
+    rq->response.duration = TS_SEASTATE_DURATION;
+    rq->response.discretisation = 1;
+    rq->simulate.seed = 1;
+    rq->simulate.components = TS_SEA_COMPONENTS;
+    rq->simulate.fade_in = NAN;
     ts_sim_opts_default(&rq->simulate.sim);
     rq->simulate.sim.t_end = TS_SIMULATE_T_END;
     rq->simulate.sim.dt_sample = 0;
@@ -114,6 +125,10 @@ void ts_request_init(ts_request *rq, ts_analysis_kind kind)
 void ts_request_clear(ts_request *rq)
 {
     ts_excitation_free(rq->simulate.excitation);
+    ts_sea_free(rq->response.sea.sea);
+    ts_rao_free(rq->response.sea.rao);
+    ts_sea_free(rq->simulate.sea.sea);
+    ts_rao_free(rq->simulate.sea.rao);
     ts_request_init(rq, rq->kind);
 }
 
@@ -226,6 +241,8 @@ void ts_result_free(ts_result *r)
     ts_eigen_free(r->eigen);
     free(r->mode_health);
     ts_response_free(r->response);
+    ts_seastate_free(r->seastate);
+    ts_excitation_free(r->sea_excitation);
     ts_history_free(r->nonlinear);
     ts_history_free(r->linear);
     ts_convergence_free(r->convergence);
@@ -520,9 +537,47 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
 
 /* ---- response ---------------------------------------------------------- */
 
+/* A sea's seaway on sys: the message names the option at fault. */
+static int sea_seaway(const ts_system *sys, const ts_sea_opts *so,
+                      ts_seaway *w, ts_err *err)
+{
+    int rc = ts_seaway_init(w, sys, so->sea, so->rao, so->reference, err);
+    if (rc)
+        ts_err_prefix(err, "sea: ");
+    return rc;
+}
+
+static int check_response_sea(const ts_system *sys, const ts_response_opts *o,
+                              ts_output *out, ts_err *err)
+{
+    if (o->frequency_given)
+        return ts_fail(err, TS_EINVAL, "sea: the sea drives every tow-point "
+                       "axis over its own frequencies: input, from, to and "
+                       "points do not apply (leave them out)");
+    if (!o->output[0]) {
+        char list[768];
+        ts_response_output_names(sys, list, sizeof list);
+        return ts_fail(err, TS_EINVAL, "output: required; valid outputs: %s",
+                       list);
+    }
+    int rc = ts_response_output_find(sys, o->output, out, err);
+    if (rc != TS_OK) {
+        ts_err_prefix(err, "output: ");
+        return rc;
+    }
+    if (o->intervals < 16 || o->intervals % 8)
+        return ts_fail(err, TS_EINVAL, "intervals: expected a multiple of 8 "
+                       "from 16 on (the grid is halved twice for its error "
+                       "estimate), got %d", o->intervals);
+    ts_seaway w;
+    return sea_seaway(sys, &o->sea, &w, err);
+}
+
 static int check_response(const ts_system *sys, const ts_response_opts *o,
                           int *input, ts_output *out, ts_err *err)
 {
+    if (o->sea.sea)
+        return check_response_sea(sys, o, out, err);
     int rc = ts_response_input_find(o->input, input, err);
     if (rc != TS_OK) {
         ts_err_prefix(err, "input: ");
@@ -550,9 +605,79 @@ static int check_response(const ts_system *sys, const ts_response_opts *o,
     return rc;
 }
 
+/* Key values of a spectral result: <output>.sigma, .tz, .mpm with the
+ * discretisation error (NAN when not estimated) and the grid and band
+ * errors as the solver's. */
+static int sea_values(ts_result *r, const ts_seastate *s, ts_err *err)
+{
+    int rc = values_alloc(r, 3, err);
+    if (rc)
+        return rc;
+    static const char *const suffix[3] = {"sigma", "tz", "mpm"};
+    const ts_stat *st[3] = {&s->sigma, &s->tz, &s->mpm};
+    for (int v = 0; v < 3; v++) {
+        value_name(&r->values[v], v == 1 ? "s" : s->unit, 0.0, "%.70s.%s",
+                   s->output.name, suffix[v]);
+        r->values[v].value = st[v]->value;
+        r->values[v].error.solver = st[v]->grid + st[v]->band;
+        r->values[v].error.discretisation =
+            s->disc_estimated ? st[v]->discretisation : NAN;
+    }
+    return TS_OK;
+}
+
+static int pipeline_response_sea(ts_result *r, const ts_request *rq,
+                                 ts_err *err)
+{
+    const ts_response_opts *o = &rq->response;
+    ts_output out;
+    int rc = check_response_sea(r->sys, o, &out, err);
+    if (rc == TS_OK)
+        rc = sea_seaway(r->sys, &o->sea, &r->seaway, err);
+    if (rc != TS_OK)
+        return rc;
+    r->has_sea = 1;
+    snprintf(r->rao_file, sizeof r->rao_file, "%s", o->sea.rao_file);
+    ts_linearize_opts lo = rq->modes.linearize;
+    lo.tensions = out.kind == TS_OUT_TENSION;
+    rc = equilibrium_then_linear(r, rq, &lo, err);
+    ts_seastate_opts so;
+    ts_seastate_opts_default(&so);
+    so.intervals = o->intervals;
+    so.duration = o->duration;
+    if (rc == TS_OK)
+        rc = ts_seastate_compute(r->sys, r->lin, &r->seaway, &out, &so,
+                                 &r->seastate, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_seastate *s = r->seastate;
+    if (o->discretisation) {
+        ts_err de = {0};
+        int drc = ts_seastate_discretisation(r->sys, &rq->setup.equilibrium,
+                                             &r->seaway, &so, s, &de);
+        if (drc == TS_EDOMAIN)
+            ts_trust_note(&s->trust, "the discretisation error was not "
+                          "estimated (%s); towstab converge can sweep "
+                          "the links", de.msg);
+        else if (drc != TS_OK)
+            return ts_fail(err, drc, "sea: the discretisation estimate: %s",
+                           de.msg);
+    }
+    ts_trust_merge(&r->trust, NULL, &s->trust);
+    const ts_linear *lin = r->lin;
+    if (lin->kink_tow && s->sigma.value > 0)
+        ts_trust_note(&r->trust, "the tow point is at the water surface: a "
+                                 "real heave also shifts the mean depth at "
+                                 "first order, which the linear model "
+                                 "cannot show");
+    return sea_values(r, s, err);
+}
+
 static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
 {
     const ts_response_opts *o = &rq->response;
+    if (o->sea.sea)
+        return pipeline_response_sea(r, rq, err);
     int input;
     ts_output out;
     int rc = check_response(r->sys, o, &input, &out, err);
@@ -856,7 +981,22 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
                            "the %g Hz excitation", o->t_end - *transient,
                            period, f);
     }
-    if (s->need_values) {
+    if (s->sea.sea) {
+        ts_seaway w;
+        if ((rc = sea_seaway(sys, &s->sea, &w, err)))
+            return rc;
+        if (s->initial != TS_INITIAL_EQUILIBRIUM)
+            return ts_fail(err, TS_EINVAL, "initial: a sea state starts from "
+                           "the equilibrium (its statistics and spectral "
+                           "prediction are about it)");
+        if (s->components < 1)
+            return ts_fail(err, TS_EINVAL, "components: expected a whole "
+                           "number >= 1, got %d", s->components);
+        if (!isnan(s->fade_in) && !(s->fade_in >= 0 && isfinite(s->fade_in)))
+            return ts_fail(err, TS_EINVAL, "fade_in: expected a time >= 0 "
+                           "s, got %g s", s->fade_in);
+    }
+    if (s->need_values && !s->sea.sea) {
         if (!ex || !ts_excitation_periodic(ex, &idx))
             return ts_fail(err, TS_EINVAL, "excite: the amplitude ratio, "
                            "mean offset and phase need a single periodic "
@@ -963,12 +1103,112 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     return TS_OK;
 }
 
+/* The realisation of a simulation's sea, added to a copy of the request's
+ * excitation (r->sea_excitation, which r->excitation then points to). */
+static int sea_realise(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+{
+    int rc = sea_seaway(r->sys, &s->sea, &r->seaway, err);
+    if (rc)
+        return rc;
+    r->has_sea = 1;
+    r->sea_excitation = ts_excitation_copy(s->excitation, err);
+    if (!r->sea_excitation)
+        return err && err->code ? err->code : TS_ENOMEM;
+    ts_sea_realisation real;
+    ts_sea_realisation_default(&r->seaway, &real);
+    real.seed = s->seed;
+    real.components = s->components;
+    if (!isnan(s->fade_in))
+        real.rise = s->fade_in;
+    r->realisation = real;
+    snprintf(r->rao_file, sizeof r->rao_file, "%s", s->sea.rao_file);
+    rc = ts_seaway_excitation(&r->seaway, &real, r->sea_excitation, NULL,
+                              err);
+    if (rc)
+        ts_err_prefix(err, "sea: ");
+    r->excitation = r->sea_excitation;
+    return rc;
+}
+
+/* After a simulation with a sea: the records' statistics over t >=
+ * transient, their key values (<output>.sigma and .mean_offset, with the
+ * statistical error as the solver's), and the spectral prediction over
+ * the realisation's band. */
+static int sea_records(ts_result *r, ts_err *err)
+{
+    const ts_history *h[2] = {r->nonlinear, r->linear};
+    ts_record_stats *st[2] = {&r->record_nonlinear, &r->record_linear};
+    int n = r->nonlinear ? r->nonlinear->nsamples : r->linear->nsamples;
+    double *x = malloc((size_t)(n > 0 ? n : 1) * sizeof *x);
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    int rc = TS_OK;
+    for (int i = 0; i < 2 && rc == TS_OK; i++) {
+        if (!h[i])
+            continue;
+        int m;
+        double dt;
+        rc = ts_record_from_history(h[i], &r->output, r->transient, x, &m,
+                                    &dt, err);
+        if (rc == TS_OK)
+            rc = ts_record_stats_compute(x, m, dt, st[i], err);
+        if (rc == TS_OK)
+            r->has_records |= 1 << i;
+        else
+            ts_err_prefix(err, "transient: the record after %g s: ",
+                          r->transient);
+    }
+    free(x);
+    if (rc == TS_OK && r->lin) {
+        double lo, hi;
+        ts_seastate_opts so;
+        ts_seastate_opts_default(&so);
+        rc = ts_seaway_band(&r->seaway, TS_SEA_REALISATION_TAIL, &lo, &hi,
+                            err);
+        so.omega_lo = lo;
+        so.omega_hi = hi;
+        so.duration = r->sim.t_end - r->transient;
+        if (rc == TS_OK)
+            rc = ts_seastate_compute(r->sys, r->lin, &r->seaway, &r->output,
+                                     &so, &r->seastate, err);
+        if (rc == TS_OK)
+            ts_trust_merge(&r->trust, "spectral prediction: ",
+                           &r->seastate->trust);
+    }
+    if (rc != TS_OK)
+        return rc;
+    const ts_record_stats *use =
+        r->has_records & 1 ? &r->record_nonlinear : &r->record_linear;
+    rc = values_alloc(r, 2, err);
+    if (rc)
+        return rc;
+    value_name(&r->values[0], "m", 0.0, "%.70s.sigma", r->output.name);
+    value_name(&r->values[1], "m", total_length(r->sys), "%.70s.mean_offset",
+               r->output.name);
+    r->values[0].value = use->sigma.value;
+    r->values[0].error.solver = use->sigma.error;
+    double eqv = r->eq ? r->eq->positions[3 * r->output.node +
+                                          r->output.comp]
+                       : NAN;
+    r->values[1].value = use->mean - eqv;
+    r->values[1].error.solver = use->mean_error;
+    double window = r->sim.t_end - r->transient;
+    if (use->corr_time > 0 && window < 20 * use->corr_time)
+        ts_trust_note(&r->trust, "the record after the transient is %g s, "
+                      "%.3g correlation times: sigma's statistical error is "
+                      "%.2g %%", window, window / use->corr_time,
+                      100 * use->sigma.error / use->sigma.value);
+    return TS_OK;
+}
+
 static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
 {
     const ts_simulate_opts *s = &rq->simulate;
     const ts_system *sys = r->sys;
     r->excitation = s->excitation;
     int rc = check_simulate(sys, s, &r->sim, &r->transient, &r->output, err);
+    if (rc == TS_OK && s->sea.sea)
+        rc = sea_realise(r, s, err);
     if (rc != TS_OK)
         return rc;
     ts_sim_opts *o = &r->sim;
@@ -977,7 +1217,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         o->progress_data = rq->progress_data;
     }
     ts_excitation *none = NULL;
-    const ts_excitation *ex = s->excitation;
+    const ts_excitation *ex = r->excitation;
     if (!ex) {
         ex = none = ts_excitation_alloc(err);
         if (!ex)
@@ -1019,9 +1259,10 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         }
     }
     int N = ts_sim_nsamples(o);
-    if (rc == TS_OK && (s->compare || s->linear)) {
+    if (rc == TS_OK && (s->compare || s->linear || r->has_sea)) {
         /* The linear model about the equilibrium, with its kernel: both
-         * runs then start from the linearization's charts. */
+         * runs then start from the linearization's charts (a sea's
+         * spectral prediction needs it too). */
         r->lin = ts_linear_alloc(k, err);
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
@@ -1031,15 +1272,16 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         r->lin_wall_s = wall_now() - t0;
         if (r->lin)
             r->evaluations += r->lin->evaluations;
-        if (rc == TS_OK) {
+        if (rc == TS_OK && (s->compare || s->linear)) {
             r->linear = ts_history_alloc(sys, N, err);
             rc = r->linear ? ts_simulate_linear(k, r->lin, ex, NULL, o,
                                                 r->linear, &r->linear_stats,
                                                 err)
                            : (err && err->code ? err->code : TS_ENOMEM);
             r->evaluations += r->linear_stats.evaluations;
-            memcpy(y0, r->lin->y0, (size_t)n * sizeof *y0);
         }
+        if (rc == TS_OK)
+            memcpy(y0, r->lin->y0, (size_t)n * sizeof *y0);
     }
     if (rc == TS_OK && !s->linear) {
         knl = ts_kernel_clone(k, err);
@@ -1068,7 +1310,9 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         else
             r->compared = 1;
     }
-    if (rc == TS_OK)
+    if (rc == TS_OK && r->has_sea)
+        rc = sea_records(r, err);
+    else if (rc == TS_OK)
         rc = sim_values(r, s->need_values, err);
     else if (s->need_values)
         sim_values(r, 0, NULL); /* names, NAN values */

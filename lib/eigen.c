@@ -23,6 +23,10 @@
  * Conjugate pairs found by the complex solver are matched one to one, so a
  * double eigenvalue (the in-plane and out-of-plane modes of a hanging
  * chain) stays two modes.
+ *
+ * One module, though long: LAPACK and ARPACK answer the same request with
+ * the same mode table, error bounds, verdict and descriptions, which are
+ * most of the file.
  */
 #include "towstab/eigen.h"
 

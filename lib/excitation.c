@@ -31,6 +31,10 @@
  * sum int dOmega uses J(xi) = int_0^xi I = xi^5/2 - xi^6/2 + xi^7/7 on [0,1]
  * and 1/7 + xi (xi - 1)/2 beyond. A current c fixed in inertial space has,
  * in M rotated by psi about +z, the components R_z(psi)^T c.
+ *
+ * One module, though long: the signal types share one evaluation of
+ * displacement, velocity and acceleration, one spec parser and one
+ * description; a signal is a few dozen lines of each.
  */
 #include "towstab/excitation.h"
 
@@ -102,6 +106,48 @@ void ts_excitation_free(ts_excitation *ex)
     free(ex->sum);
     free(ex->sum_lead);
     free(ex);
+}
+
+ts_excitation *ts_excitation_copy(const ts_excitation *ex, ts_err *err)
+{
+    ts_excitation *c = ts_excitation_alloc(err);
+    if (!c || !ex)
+        return c;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    int rc = TS_OK;
+    for (int i = 0; i < ex->n && rc == TS_OK; i++) {
+        if (ex->sum[i] && !ex->sum_lead[i])
+            continue; /* added with its group's lead */
+        if (ex->sum[i]) {
+            const sum_group *g = ex->sum[i];
+            double *re = malloc(3 * (size_t)g->n * sizeof *re);
+            double *im = malloc(3 * (size_t)g->n * sizeof *im);
+            if (!re || !im)
+                rc = ts_fail(err, TS_ENOMEM, "excitation: out of memory");
+            for (int k = 0; rc == TS_OK && k < g->n; k++)
+                for (int j = 0; j < 3; j++) {
+                    re[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j] : 0.0;
+                    im[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j + 1] : 0.0;
+                }
+            if (rc == TS_OK)
+                rc = ts_excitation_add_sum(c, g->n, g->omega, re, im, g->rise,
+                                           err);
+            free(re);
+            free(im);
+        } else if (ex->spline[i]) {
+            const gsl_spline *sp = ex->spline[i];
+            rc = ts_excitation_add_series(c, ex->sig[i].axis, (int)sp->size,
+                                          sp->x, sp->y, err);
+        } else {
+            rc = ts_excitation_add(c, &ex->sig[i], err);
+        }
+    }
+    gsl_set_error_handler(old);
+    if (rc != TS_OK) {
+        ts_excitation_free(c);
+        return NULL;
+    }
+    return c;
 }
 
 const char *ts_axis_name(ts_axis a)

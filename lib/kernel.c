@@ -35,6 +35,11 @@
  * F_j = W^-1 (a_A - a_free) gives the body's accelerations and the
  * accelerations of the points its child cables start from. Controller
  * states (integrators, actuators) follow q' in y.
+ *
+ * One module, though long: f(y, u) is one recursion over the tree (down
+ * for the kinematics, up for the articulated masses, down again for the
+ * accelerations) whose rigid, elastic, bending and vehicle parts share
+ * every per-node and per-link array of one pass.
  */
 #include "towstab/kernel.h"
 

@@ -100,6 +100,91 @@ static int parse_initial(const ts_option *o, ts_request *rq, const char *v,
     return TS_OK;
 }
 
+/* The sea state of a response or a simulation: the row's offset is its
+ * ts_sea_opts. A file that cannot be read is bad input, like a missing
+ * scene (TS_EINVAL, not TS_EIO). */
+static ts_sea_opts *sea_opts(const ts_option *o, ts_request *rq)
+{
+    return (ts_sea_opts *)((char *)rq + o->offset);
+}
+
+static int unreadable_is_bad_input(int rc, ts_err *err)
+{
+    if (rc == TS_EIO) {
+        if (err)
+            err->code = TS_EINVAL;
+        return TS_EINVAL;
+    }
+    return rc;
+}
+
+static int parse_sea(const ts_option *o, ts_request *rq, const char *text,
+                     const char *w, const ts_units *u, ts_err *err)
+{
+    ts_sea *sea = ts_sea_parse(text, u, w, err);
+    if (!sea)
+        return unreadable_is_bad_input(err && err->code ? err->code
+                                                        : TS_EINVAL,
+                                       err);
+    ts_sea_opts *so = sea_opts(o, rq);
+    ts_sea_free(so->sea);
+    so->sea = sea;
+    return TS_OK;
+}
+
+static int parse_rao(const ts_option *o, ts_request *rq, const char *text,
+                     const char *w, const ts_units *u, ts_err *err)
+{
+    ts_sea_opts *so = sea_opts(o, rq);
+    if (strlen(text) >= sizeof so->rao_file)
+        return ts_fail(err, TS_EINVAL, "%s: the file name is longer than %zu "
+                       "characters", w, sizeof so->rao_file - 1);
+    ts_rao *rao = ts_rao_read_csv(text, u, err);
+    if (!rao) {
+        ts_err_prefix(err, "%s: ", w);
+        return unreadable_is_bad_input(err && err->code ? err->code
+                                                        : TS_EINVAL,
+                                       err);
+    }
+    ts_rao_free(so->rao);
+    so->rao = rao;
+    snprintf(so->rao_file, sizeof so->rao_file, "%s", text);
+    return TS_OK;
+}
+
+/* "x,y,z": three lengths. */
+static int parse_reference(const ts_option *o, ts_request *rq,
+                           const char *text, const char *w,
+                           const ts_units *u, ts_err *err)
+{
+    char buf[256];
+    if (strlen(text) >= sizeof buf)
+        return ts_fail(err, TS_EINVAL, "%s: too long", w);
+    strcpy(buf, text);
+    double v[3];
+    int n = 0;
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, ",", &save); tok;
+         tok = strtok_r(NULL, ",", &save)) {
+        if (n == 3)
+            return ts_fail(err, TS_EINVAL, "%s: expected three lengths "
+                           "x,y,z (m, in M: x forward, y starboard, z "
+                           "down), got '%s'", w, text);
+        char where[WHERE_MAX + 8];
+        snprintf(where, sizeof where, "%s: %c", w, "xyz"[n]);
+        int rc = ts_units_parse(u, tok, "m", where, &v[n], err);
+        if (rc)
+            return rc;
+        n++;
+    }
+    if (n != 3)
+        return ts_fail(err, TS_EINVAL, "%s: expected three lengths x,y,z "
+                       "(m, in M: x forward, y starboard, z down), got '%s'",
+                       w, text);
+    memcpy(sea_opts(o, rq)->reference, v, sizeof v);
+    return TS_OK;
+}
+
 /* A sweep: links, tolerances or steps of a convergence study. */
 static int parse_sweep(const ts_option *o, ts_request *rq, const char *text,
                        const char *w, const ts_units *u, ts_err *err)
@@ -280,6 +365,24 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
      NOLIM, .offset = OFF(simulate.linear), .group = 2, .only = o,            \
      .help = "run the linear model only"}
 
+/* The sea state of a response or a simulation (section `sec`, the
+ * ts_sea_opts at `field`). */
+#define SEA_ROWS(sec, field)                                                  \
+    {.name = "sea", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,             \
+     .offset = OFF(field), .parse = parse_sea, .arg = "SPEC",                 \
+     .help = "irregular sea: Hs=4m,Tp=10s[,gamma=3.3][,heading=150deg], "     \
+             "type=pm,Hs=..,Tp=.. or file=SPECTRUM.csv",                      \
+     .deftext = "none"},                                                      \
+    {.name = "rao", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,             \
+     .offset = OFF(field), .parse = parse_rao, .arg = "FILE",                 \
+     .help = "the ship's RAOs (CSV, doc/seastate.md)",                        \
+     .deftext = "none: the tow point follows the water surface"},             \
+    {.name = "rao_reference", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,   \
+     .offset = OFF(field), .parse = parse_reference, .arg = "X,Y,Z",          \
+     .help = "the RAOs' reference point in M (the lever arm is the tow "      \
+             "point less it)",                                                \
+     .deftext = "0,0,0 m (M's origin)"}
+
 static const ts_option eq_rows[] = {SETUP_ROWS, LINKS_ROW};
 
 static const ts_option modes_rows[] = {
@@ -305,7 +408,8 @@ static const ts_option response_rows[] = {
     LINKS_ROW,
     {.name = "input", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .choices = inputs, .offset = OFF(response.input),
-     .size = SZ(response.input), .arg = "NAME",
+     .size = SZ(response.input),
+     .flag_offset = OFF(response.frequency_given), .arg = "NAME",
      .help = "the tow point's motion"},
     {.name = "output", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.output), .size = SZ(response.output),
@@ -314,18 +418,50 @@ static const ts_option response_rows[] = {
      .deftext = "required"},
     {.name = "from", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
      .unit = "Hz", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
-     .offset = OFF(response.from_hz), .arg = "F",
+     .offset = OFF(response.from_hz),
+     .flag_offset = OFF(response.frequency_given), .arg = "F",
      .help = "lowest frequency"},
     {.name = "to", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
      .unit = "Hz", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
-     .offset = OFF(response.to_hz), .arg = "F", .help = "highest frequency"},
+     .offset = OFF(response.to_hz),
+     .flag_offset = OFF(response.frequency_given), .arg = "F",
+     .help = "highest frequency"},
     {.name = "points", .type = TS_OPT_INT, .section = TS_SEC_RESPONSE,
      .min = 2, .max = TS_RESPONSE_MAX_POINTS, .offset = OFF(response.points),
-     .arg = "N", .help = "log-spaced frequencies"},
+     .flag_offset = OFF(response.frequency_given), .arg = "N",
+     .help = "log-spaced frequencies"},
+    SEA_ROWS(TS_SEC_RESPONSE, response.sea),
+    {.name = "intervals", .type = TS_OPT_INT, .section = TS_SEC_RESPONSE,
+     .min = 16, .max = 1 << 20, .offset = OFF(response.intervals),
+     .arg = "N", .help = "with sea: intervals of the spectral grid, a "
+                         "multiple of 8"},
+    {.name = "duration", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
+     .unit = "s", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
+     .offset = OFF(response.duration), .arg = "T",
+     .help = "with sea: the duration of the most probable maximum"},
+    {.name = "discretisation", .type = TS_OPT_BOOL,
+     .section = TS_SEC_RESPONSE, NOLIM,
+     .offset = OFF(response.discretisation),
+     .help = "with sea: estimate the discretisation error from runs at a "
+             "half and a quarter of the links"},
 };
 
-static const ts_option simulate_rows[] = {SETUP_ROWS, LINKS_ROW,
-                                          SIM_ROWS(0)};
+static const ts_option simulate_rows[] = {
+    SETUP_ROWS,
+    LINKS_ROW,
+    SIM_ROWS(0),
+    SEA_ROWS(TS_SEC_SIMULATE, simulate.sea),
+    {.name = "seed", .type = TS_OPT_LONG, .section = TS_SEC_SIMULATE,
+     .min = 0, .max = 4294967295.0, .offset = OFF(simulate.seed), .arg = "N",
+     .help = "the sea realisation's random seed"},
+    {.name = "components", .type = TS_OPT_INT, .section = TS_SEC_SIMULATE,
+     .min = 1, .max = 1000000, .offset = OFF(simulate.components),
+     .arg = "N", .help = "sinusoids of the sea realisation"},
+    {.name = "fade_in", .type = TS_OPT_QUANTITY, .section = TS_SEC_SIMULATE,
+     .unit = "s", .min = 0, .max = INFINITY,
+     .offset = OFF(simulate.fade_in), .arg = "T",
+     .help = "the sea's fade-in from rest", .deftext = "2 Tp"},
+};
 
 static const ts_option converge_rows[] = {
     {.name = "analysis", .type = TS_OPT_ENUM, .section = TS_SEC_CONVERGE,
@@ -839,20 +975,24 @@ int ts_optset_apply(const ts_optset *s, int max_priority, const ts_units *u,
 {
 #define winner(s, i) winner_below(s, i, max_priority)
     /* Groups: the highest source wins; one source giving two is refused. */
-    int skip[256] = {0};
-    for (int i = 0; i < s->n && i < 256; i++) {
+    char *skip = calloc((size_t)s->n, 1);
+    if (!skip)
+        return ts_fail(err, TS_ENOMEM, "options: out of memory");
+    for (int i = 0; i < s->n; i++) {
         int pi = winner(s, i);
         if (!s->table[i].group || pi < 0)
             continue;
-        for (int j = i + 1; j < s->n && j < 256; j++) {
+        for (int j = i + 1; j < s->n; j++) {
             int pj = winner(s, j);
             if (s->table[j].group != s->table[i].group || pj < 0)
                 continue;
-            if (pi == pj)
+            if (pi == pj) {
+                free(skip);
                 return ts_fail(err, TS_EINVAL, "%s and %s: give one of them "
                                "(%s or %s)", s->g[i][pi].where,
                                s->g[j][pj].where, s->table[i].name,
                                s->table[j].name);
+            }
             skip[pi > pj ? j : i] = 1;
         }
     }
@@ -865,12 +1005,15 @@ int ts_optset_apply(const ts_optset *s, int max_priority, const ts_units *u,
         for (int k = 0; k < g->ntext; k++) {
             int rc = ts_option_set(&s->table[i], rq, g->text[k], g->where, u,
                                    err);
-            if (rc)
+            if (rc) {
+                free(skip);
                 return rc;
+            }
         }
         if (s->table[i].offset == offsetof(ts_request, converge.analysis))
             study = rq->converge.analysis;
     }
+    free(skip);
     /* Options of a study that do not apply to its analysis. */
     if (s->kind == TS_ANALYSIS_CONVERGE) {
         if (study < 0)

@@ -39,6 +39,11 @@
  * plwind, plbox, pllegend); src/plctrl.c (plOpenFile, plCloseFile) and
  * drivers/cairo.c (plD_init_pngcairo, plD_tidy_cairo) of PLplot 5.15;
  * memo Figs. 7-12 (Kamman & Nguyen 1990) for what is drawn.
+ *
+ * One module, though long: every picture goes through the same stream
+ * handling, page set-up, unit conversion, axes and legend code, and only
+ * its draw callback differs (a few dozen lines each); split by picture,
+ * each file would repeat or export that machinery.
  */
 #include "towstab/plot.h"
 

@@ -10,6 +10,7 @@
 #include "towstab/report.h"
 #include "towstab/report_converge.h"
 #include "towstab/report_linear.h"
+#include "towstab/report_seastate.h"
 #include "towstab/report_time.h"
 
 /* A JSON number, or null for a value that is not finite. */
@@ -50,6 +51,47 @@ static json_t *modes_json(const ts_result *r, int flags)
         json_object_set_new(j, "linearization",
                             ts_report_linear_json(r->lin,
                                                   flags & TS_REPORT_MATRICES));
+    return j;
+}
+
+/* The sea state of a response or a simulation: the spectral result with
+ * the RAO file (and, with `points`, the spectra). */
+static json_t *sea_json(const ts_result *r, int points)
+{
+    json_t *j = r->seastate
+                    ? ts_report_seastate_json(r->seastate, &r->seaway, points)
+                    : json_object();
+    if (j) {
+        json_object_set_new(j, "rao_file", json_string(r->rao_file));
+        if (!json_object_get(j, "sea"))
+            json_object_set_new(j, "sea", ts_report_sea_json(r->seaway.sea));
+    }
+    return j;
+}
+
+/* A simulation's sea: the realisation, the records' statistics and the
+ * spectral prediction over the realisation's band. */
+static json_t *sim_sea_json(const ts_result *r)
+{
+    json_t *j = json_object(), *rec = json_object();
+    if (!j || !rec) {
+        json_decref(j);
+        json_decref(rec);
+        return NULL;
+    }
+    if (r->has_records & 1)
+        json_object_set_new(rec, "nonlinear",
+                            ts_report_record_json(&r->record_nonlinear));
+    if (r->has_records & 2)
+        json_object_set_new(rec, "linear",
+                            ts_report_record_json(&r->record_linear));
+    json_object_set_new(j, "seed", json_integer((json_int_t)r->realisation.seed));
+    json_object_set_new(j, "components",
+                        json_integer(r->realisation.components));
+    json_object_set_new(j, "fade_in_s", num(r->realisation.rise));
+    json_object_set_new(j, "transient_s", num(r->transient));
+    json_object_set_new(j, "records", rec);
+    json_object_set_new(j, "spectral", sea_json(r, 0));
     return j;
 }
 
@@ -100,6 +142,8 @@ static json_t *simulate_json(const ts_result *r, int flags)
     }
     if (r->compared)
         json_object_set_new(j, "compare", ts_report_compare_json(&r->compare));
+    if (r->has_sea)
+        json_object_set_new(j, "sea", sim_sea_json(r));
     /* Final positions of the bodies (the nonlinear run when there is
      * one). */
     const ts_history *hf = r->nonlinear ? r->nonlinear : r->linear;
@@ -170,8 +214,9 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
         break;
     case TS_ANALYSIS_MODES: j = modes_json(r, flags); break;
     case TS_ANALYSIS_RESPONSE:
-        j = r->response ? ts_report_response_json(r->response)
-                        : json_object();
+        j = r->has_sea    ? sea_json(r, 1)
+            : r->response ? ts_report_response_json(r->response)
+                          : json_object();
         break;
     case TS_ANALYSIS_SIMULATE: j = simulate_json(r, flags); break;
     case TS_ANALYSIS_CONVERGE: j = converge_json(r); break;
@@ -204,6 +249,8 @@ int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
             return ts_report_modes_csv(r->sys, r->lin, r->eigen, path, err);
         break;
     case TS_ANALYSIS_RESPONSE:
+        if (r->seastate)
+            return ts_report_seastate_csv(r->seastate, path, err);
         if (r->response)
             return ts_report_response_csv(r->response, path, err);
         break;

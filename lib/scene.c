@@ -29,6 +29,11 @@
  * flow collections ([...], {...}) nested at most MAX_FLOW_DEPTH deep,
  * checked by a scan before libyaml sees the text: libyaml's scanner takes
  * time quadratic in that depth (100 000 '[' took 40 s).
+ *
+ * One module, though long: every block (environment, tow, cables, bodies,
+ * analyses) is read with the same node walkers, key tables, quantity
+ * parsing and line-numbered messages; the blocks apart, each would need
+ * those internals.
  */
 #include "towstab/scene.h"
 

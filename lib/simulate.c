@@ -44,6 +44,10 @@
  * shortest time scale, and at most the output interval. Each distinct h
  * costs one exponential (two at most per run: the regular interval and a
  * shorter last one).
+ *
+ * One module, though long: the nonlinear and the linear runs share the
+ * options, the sampling into a history, the step checks, the re-charting
+ * and the statistics.
  */
 #include "towstab/simulate.h"
 

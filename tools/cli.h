@@ -192,4 +192,6 @@ const cli_command *cli_command_of(int kind);
 /* Printing shared by the commands (cmd_equilibrium.c, cmd_modes.c). */
 void cli_print_equilibrium(const ts_result *r, int quiet);
 void cli_print_linearization(const ts_result *r);
+/* The sea state and its statistics (cmd_response.c; simulate too). */
+void cli_print_seastate(const ts_result *r, int quiet);
 #endif

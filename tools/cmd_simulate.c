@@ -300,6 +300,41 @@ static int sim_prepare(cli_run *c)
     return 0;
 }
 
+/* A record's statistics beside the spectral prediction. */
+static void print_record(const char *what, const ts_record_stats *st)
+{
+    char tz[32] = "none", ind[32] = "none";
+    if (isfinite(st->tz))
+        snprintf(tz, sizeof tz, "%.4g", st->tz);
+    if (isfinite(st->independent))
+        snprintf(ind, sizeof ind, "%.4g", st->independent);
+    printf("  %-10s %14.6g +- %-10.2g %14.6g +- %-10.2g %10s %8s %8.4g\n",
+           what, st->sigma.value, st->sigma.error, st->mean, st->mean_error,
+           tz, ind, st->maximum);
+}
+
+static void print_sea(const ts_result *r)
+{
+    printf("\nirregular sea, realisation: seed %lu, %d sinusoids, fade-in "
+           "%.6g s\n", r->realisation.seed, r->realisation.components,
+           r->realisation.rise);
+    cli_print_seastate(r, 1);
+    if (!r->has_records)
+        return;
+    printf("records of %s over t = %.6g .. %.6g s:\n", r->output.name,
+           r->transient, r->sim.t_end);
+    printf("  %-10s %14s    %-10s %14s    %-10s %10s %8s %8s\n", "", "sigma [m]",
+           "(stat.)", "mean [m]", "(stat.)", "Tz [s]", "indep.", "max [m]");
+    if (r->has_records & 2)
+        print_record("linear", &r->record_linear);
+    if (r->has_records & 1)
+        print_record("nonlinear", &r->record_nonlinear);
+    if (r->seastate)
+        printf("  %-10s %14.6g +- %-10.2g %14.6g\n", "spectral",
+               r->seastate->sigma.value, r->seastate->sigma.error,
+               r->seastate->mean);
+}
+
 static void sim_print(const cli_run *c, const ts_result *r)
 {
     const ts_system *sys = r->sys;
@@ -349,9 +384,12 @@ static void sim_print(const cli_run *c, const ts_result *r)
     }
     if (!c->quiet)
         print_table(sys, &r->output, r->nonlinear, r->linear);
+    if (r->has_sea)
+        print_sea(r);
     if (r->nonlinear || r->linear)
         cli_print_trust(&r->trust);
-    if (r->compared)
+    /* Under a sea the records' table above is the comparison. */
+    if (r->compared && !r->has_sea)
         print_compare(&r->compare);
 }
 

@@ -33,6 +33,7 @@
 #include "towstab/linearize.h"
 #include "towstab/progress.h"
 #include "towstab/response.h"
+#include "towstab/seastate.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
 
@@ -102,6 +103,18 @@ typedef struct ts_modes_opts {
 /* Natural frequencies a response result carries, at most. */
 #define TS_RESPONSE_NATURAL 12
 
+/* The sea state of a response or a simulation (towstab/seastate.h,
+ * doc/seastate.md). */
+typedef struct ts_sea_opts {
+    ts_sea *sea;           /* owned by the request; NULL: no sea */
+    ts_rao *rao;           /* owned; NULL: the tow point follows the water
+                              surface (heave only) */
+    char rao_file[TS_REQUEST_PATH_MAX]; /* the RAO file read, "" without */
+    double reference[3];   /* the RAOs' reference point in M, m (default
+                              M's origin): the lever arm is the tow point
+                              less it */
+} ts_sea_opts;
+
 typedef struct ts_response_opts {
     char input[TS_REQUEST_NAME_MAX];  /* tow.surge, tow.sway, tow.heave
                                          (default) */
@@ -112,6 +125,20 @@ typedef struct ts_response_opts {
     int natural;                      /* 1: also the natural frequencies
                                          (modes nearest 0 Hz), e.g. to
                                          mark them on a Bode plot */
+    /* With a sea (sea.sea set) the response is the spectral response to
+     * the sea (ts_seastate_compute): every tow axis is an input, so
+     * input, from, to and points do not apply (giving one is refused). */
+    ts_sea_opts sea;
+    int frequency_given;              /* input, from, to or points given */
+    int intervals;                    /* the spectral grid (default
+                                         TS_SEASTATE_INTERVALS) */
+    double duration;                  /* s, for the most probable maximum
+                                         (default TS_SEASTATE_DURATION) */
+    int discretisation;               /* 1 (default): estimate the
+                                         discretisation error from runs at
+                                         a half and a quarter of the links
+                                         (ts_seastate_discretisation) when
+                                         the links allow it */
 } ts_response_opts;
 
 /* Simulation defaults: run length (s), sample interval (s) and the samples
@@ -157,6 +184,14 @@ typedef struct ts_simulate_opts {
                               (owned by the request; NULL: none) */
     int need_values;       /* 1: the key values (fit over the window) are
                               required: a run whose fit fails fails */
+    /* With a sea (sea.sea set), one realisation of it
+     * (ts_seaway_excitation) drives the tow point besides `excitation`;
+     * the output's statistics over t >= transient are the key values, and
+     * the spectral prediction of the same band is computed beside them. */
+    ts_sea_opts sea;
+    long seed;             /* the realisation's seed, >= 0 (default 1) */
+    int components;        /* its sinusoids (default TS_SEA_COMPONENTS) */
+    double fade_in;        /* s, >= 0; NAN (default): 2 Tp */
 } ts_simulate_opts;
 
 /* Integrators of one convergence study, at most (one series each). */
@@ -265,6 +300,19 @@ typedef struct ts_result {
     double eigen_wall_s;
     /* response */
     ts_response *response;
+    /* response or simulate with a sea: the seaway (its sea and RAOs are
+     * the request's) and the spectral result (of simulate: over the
+     * realisation's band) */
+    int has_sea;
+    ts_seaway seaway;
+    char rao_file[TS_REQUEST_PATH_MAX]; /* the request's, "" without */
+    ts_seastate *seastate;
+    ts_sea_realisation realisation; /* simulate: the one run */
+    /* simulate with a sea: the realisation with the request's signals
+     * (owned; `excitation` points to it) and the records' statistics */
+    ts_excitation *sea_excitation;
+    int has_records;            /* bit 0: nonlinear, bit 1: linear */
+    ts_record_stats record_nonlinear, record_linear;
     int nnatural;
     double natural_hz[TS_RESPONSE_NATURAL]; /* lowest natural frequencies,
                                                Hz */

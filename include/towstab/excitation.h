@@ -95,6 +95,11 @@ typedef struct ts_excitation ts_excitation;
 TS_API ts_excitation *ts_excitation_alloc(ts_err *err);
 TS_API void ts_excitation_free(ts_excitation *ex);
 
+/* A deep copy of ex (NULL: an empty excitation), to add signals to
+ * without changing ex. NULL on failure (TS_ENOMEM). */
+TS_API ts_excitation *ts_excitation_copy(const ts_excitation *ex,
+                                         ts_err *err);
+
 /* Add a copy of signal s after checking it (TS_EINVAL naming the field:
  * frequency <= 0, negative start, rise <= 0, a crank rod not longer than
  * its radius, a series or sine on a manoeuvre axis, a second absolute
