@@ -41,6 +41,9 @@
  * the smallest step, as a fraction of the path, before it gives up. */
 #define BENDING_START 1e-4
 #define CONTINUATION_MIN_STEP (1.0 / 1024)
+/* Newton iterations one solve may take along a continuation path, in
+ * units of max_iter (the examples take at most 29 with max_iter 100). */
+#define CONTINUATION_MAX_ITER 10
 /* A relative force residual this small is rounding in the sums of the
  * nodal balances (about 1000 machine epsilons): Newton stalling there has
  * converged as far as double precision goes. */
@@ -110,7 +113,9 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
     return eq;
 nomem:
     ts_equilibrium_free(eq);
-    ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    ts_fail_nomem(err, 8.0 * (10.0 * sys->nlinks + 3.0 * sys->nnodes),
+                  "fewer links", "equilibrium: out of memory for the result "
+                  "of %d links", sys->nlinks);
     return NULL;
 }
 
@@ -444,6 +449,16 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         }
         if (rc == TS_ENOMEM || dt <= CONTINUATION_MIN_STEP)
             break;
+        /* A path that keeps failing can halve its step ten times, each
+         * try up to max_iter Newton iterations: bound the whole. */
+        if (eq->iterations > CONTINUATION_MAX_ITER * o->max_iter) {
+            rc = ts_fail(err, TS_ECONV, "equilibrium: %d Newton iterations "
+                         "without reaching the end of the path, more than "
+                         "the %d (%d times max_iter) a solve may take",
+                         eq->iterations, CONTINUATION_MAX_ITER * o->max_iter,
+                         CONTINUATION_MAX_ITER);
+            break;
+        }
         dt *= 0.5;
         ts_kernel_set_shape(k, w->dirs, w->strains, NULL, NULL,
                             TS_CHART_RECHART, y);
@@ -606,8 +621,14 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     double *strain = calloc((size_t)nl, sizeof(double));
     tsi_march *m = tsi_march_alloc(sys, err);
     newton_ws w = {0};
-    if (!y || !dydt || !dvec || !strain || !m) {
-        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    if (!m) {
+        rc = err ? err->code : TS_ENOMEM; /* the march named its size */
+        goto out;
+    }
+    if (!y || !dydt || !dvec || !strain) {
+        rc = ts_fail_nomem(err, 8.0 * (4.0 * nq + 4.0 * nl), "fewer links",
+                           "equilibrium: out of memory for the state of %d "
+                           "links", nl);
         goto out;
     }
 
@@ -651,9 +672,10 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
      * shooting result, with continuation in turn rate. */
     eq->method = TS_EQ_NEWTON;
     if (!newton_ws_alloc(&w, k)) {
-        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory for a "
-                                     "%d x %d Newton Jacobian",
-                     nq, nq);
+        rc = ts_fail_nomem(err, 8.0 * nq * (double)nq, "fewer links "
+                           "(Newton is used for bending stiffness, and "
+                           "where shooting fails)", "equilibrium: out of "
+                           "memory for a %d x %d Newton Jacobian", nq, nq);
         goto out;
     }
     rc = TS_ECONV;
