@@ -44,6 +44,9 @@
  * the smallest step, as a fraction of the path, before it gives up. */
 #define BENDING_START 1e-4
 #define CONTINUATION_MIN_STEP (1.0 / 1024)
+/* Newton iterations one solve may take along a continuation path, in
+ * units of max_iter (the examples take at most 29 with max_iter 100). */
+#define CONTINUATION_MAX_ITER 10
 /* A vehicle's attitude alone on its joint in the straight tow (the
  * Newton start): moment residual relative to its weight and flow forces
  * times its lever, and the hybrid solver's iterations. */
@@ -139,7 +142,9 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
     return eq;
 nomem:
     ts_equilibrium_free(eq);
-    ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    ts_fail_nomem(err, 8.0 * (10.0 * sys->nlinks + 3.0 * sys->nnodes),
+                  "fewer links", "equilibrium: out of memory for the result "
+                  "of %d links", sys->nlinks);
     return NULL;
 }
 
@@ -692,6 +697,35 @@ static void restore_shape(ts_kernel *k, double *y, newton_ws *w)
     memcpy(y + 2 * w->nq, w->ctl, (size_t)w->nc * sizeof(double));
 }
 
+/* ", with <vehicle>.<surface> at its limit" for the first control
+ * surface at its deflection limit in state y, else "". */
+static void saturated(ts_kernel *k, const double *y, char *buf, size_t size)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    double *f = malloc((size_t)ts_kernel_nstate(k) * sizeof(double));
+    buf[0] = '\0';
+    if (!f || ts_kernel_eval(k, y, NULL, f) != TS_OK) {
+        free(f);
+        return;
+    }
+    free(f);
+    for (int v = 0; v < ts_kernel_nvehicles(k) && !buf[0]; v++) {
+        ts_vehicle_result r;
+        ts_kernel_vehicle_result(k, v, &r);
+        const ts_body *b = &sys->bodies[r.body];
+        for (int c = 0; c < b->vehicle->ncomponents; c++) {
+            const ts_component *cp = &b->vehicle->component[c];
+            if (cp->control && isfinite(cp->limit) &&
+                fabs(r.delta[c]) >= cp->limit * (1 - 1e-9)) {
+                snprintf(buf, size, ", with %s.%s at its limit %.4g deg: a "
+                         "set point out of the surfaces' reach?", b->name,
+                         cp->name, cp->limit * 180 / M_PI);
+                break;
+            }
+        }
+    }
+}
+
 /* Newton along a parameter path t in [0, 1] from y, a state near the
  * solution at t = 0: solve there, then step towards 1, doubling the step
  * after a success and halving it after a failure (restarting from the last
@@ -718,6 +752,16 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         }
         if (rc == TS_ENOMEM || dt <= CONTINUATION_MIN_STEP)
             break;
+        /* A path that keeps failing can halve its step ten times, each
+         * try up to max_iter Newton iterations: bound the whole. */
+        if (eq->iterations > CONTINUATION_MAX_ITER * o->max_iter) {
+            rc = ts_fail(err, TS_ECONV, "equilibrium: %d Newton iterations "
+                         "without reaching the end of the path, more than "
+                         "the %d (%d times max_iter) a solve may take",
+                         eq->iterations, CONTINUATION_MAX_ITER * o->max_iter,
+                         CONTINUATION_MAX_ITER);
+            break;
+        }
         dt *= 0.5;
         restore_shape(k, y, w);
         path(pc, t);
@@ -732,6 +776,14 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             ts_err_prefix(err, "continuation in bending stiffness (EI "
                                "scaled up from %g of its value) stopped "
                                "%.4g of the way: ", pc->b0, t);
+        else if (path == setpoint_path) {
+            char sat[2 * TS_NAME_MAX + 96];
+            saturated(k, y, sat, sizeof sat);
+            ts_err_prefix(err, "continuation in the controllers' set points "
+                               "(from where the loops idle to their "
+                               "targets) stopped %.4g of the way%s: ", t,
+                          sat);
+        }
         else if (pc->frame.turn_rate != 0)
             ts_err_prefix(err, "continuation in turn rate towards %.6g "
                                "rad/s stopped %.4g of the way, at %.6g "
@@ -1069,9 +1121,15 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     double *att = malloc((9 * (size_t)nv + 1) * sizeof(double));
     tsi_march *m = tsi_march_alloc(sys, err);
     newton_ws w = {0};
-    if (!y || !dydt || !dvec || !strain || !att || !m || !sp0 || !sp1 ||
+    if (!m) {
+        rc = err ? err->code : TS_ENOMEM; /* the march named its size */
+        goto out;
+    }
+    if (!y || !dydt || !dvec || !strain || !att || !sp0 || !sp1 ||
         !sp_entry) {
-        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+        rc = ts_fail_nomem(err, 8.0 * (4.0 * nq + 4.0 * nl), "fewer links",
+                           "equilibrium: out of memory for the state of %d "
+                           "links", nl);
         goto out;
     }
 
@@ -1115,9 +1173,11 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
      * shooting result, with continuation in turn rate. */
     eq->method = TS_EQ_NEWTON;
     if (!newton_ws_alloc(&w, k)) {
-        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory for a "
-                                     "%d x %d Newton Jacobian",
-                     nq + ts_kernel_ncontrol(k), nq + ts_kernel_ncontrol(k));
+        int nj = nq + ts_kernel_ncontrol(k);
+        rc = ts_fail_nomem(err, 8.0 * nj * (double)nj, "fewer links "
+                           "(Newton is used for bending stiffness, and "
+                           "where shooting fails)", "equilibrium: out of "
+                           "memory for a %d x %d Newton Jacobian", nj, nj);
         goto out;
     }
     rc = TS_ECONV;

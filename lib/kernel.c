@@ -237,8 +237,8 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     }
     if (fail) {
         ts_kernel_free(k);
-        ts_fail(err, TS_ENOMEM, "ts_kernel_alloc: out of memory for %d links",
-                nl);
+        ts_fail_nomem(err, 8.0 * 60.0 * nl, "fewer links", "kernel: out of "
+                      "memory for %d links", nl);
         return NULL;
     }
     for (int l = 0; l < nl; l++) {

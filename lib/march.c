@@ -158,8 +158,19 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     (void)nres;
     return m;
 nomem:
-    tsi_march_free(m);
-    ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    {
+        /* What the march holds: two dense 3f x 3f Jacobians of the f free
+         * ends (the shooting problem) dominate. */
+        double f = m ? m->nleaf : 0, n = sys->nnodes;
+        double bytes = 8 * (18 * f * f + 6 * f) + f * f +
+                       8 * (13 * n + 5 * n);
+        tsi_march_free(m);
+        ts_fail_nomem(err, bytes, "fewer cables with free ends (bodies "
+                      "or junctions joining them)",
+                      "equilibrium: out of memory for the shooting problem "
+                      "of %.0f free ends and %.0f nodes, two %.0f x %.0f "
+                      "Jacobians", f, n, 3 * f, 3 * f);
+    }
     return NULL;
 }
 

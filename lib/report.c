@@ -181,6 +181,20 @@ int ts_report_write_json(const json_t *value, const char *path, ts_err *err)
     return tsi_outfile_commit(&out, err);
 }
 
+int ts_report_write_text(const char *text, size_t len, const char *path,
+                         ts_err *err)
+{
+    tsi_outfile out;
+    int rc = tsi_outfile_open(&out, path, err);
+    if (rc != TS_OK)
+        return rc;
+    if (len > 0 && fwrite(text, 1, len, out.f) != len) {
+        tsi_outfile_abandon(&out);
+        return ts_fail(err, TS_EIO, "%s: write failed", path);
+    }
+    return tsi_outfile_commit(&out, err);
+}
+
 int ts_report_check_targets(int n, const char *const what[],
                             const char *const paths[], ts_err *err)
 {

@@ -46,6 +46,8 @@
 #include <string.h>
 #include <yaml.h>
 
+#include "scene_set.h"
+
 /* Largest number of entries in any list (cables, bodies, analyses, options,
  * link_lengths): far beyond a real scene, small enough for int counts. */
 #define MAX_ENTRIES 100000
@@ -107,7 +109,7 @@ static int mark_column(yaml_mark_t m)
     return m.column >= (size_t)INT_MAX ? INT_MAX : (int)m.column + 1;
 }
 
-static const char *kind_name(const yaml_node_t *n)
+const char *tsi_scene_kind_name(const yaml_node_t *n)
 {
     switch (n->type) {
     case YAML_SCALAR_NODE: return "a scalar";
@@ -225,7 +227,7 @@ static int read_map(const ctx *c, const yaml_node_t *map, const char *path,
     if (map->type != YAML_MAPPING_NODE)
         return fail_at(c, TS_ESCENE, where, line_of(map),
                        "expected a mapping (%s), got %s", what,
-                       kind_name(map));
+                       tsi_scene_kind_name(map));
     char p[PATH_LEN], s[SHOW_BUF];
     for (yaml_node_pair_t *pair = map->data.mapping.pairs.start;
          pair < map->data.mapping.pairs.top; pair++) {
@@ -237,7 +239,7 @@ static int read_map(const ctx *c, const yaml_node_t *map, const char *path,
         if (key->type != YAML_SCALAR_NODE)
             return fail_at(c, TS_ESCENE, where, line_of(key),
                            "keys must be plain names, got %s as a key",
-                           kind_name(key));
+                           tsi_scene_kind_name(key));
         const char *k = (const char *)key->data.scalar.value;
         size_t klen = key->data.scalar.length;
         int hit = -1;
@@ -287,7 +289,7 @@ static int field_text(const ctx *c, const char *path, const field *f,
     const yaml_node_t *n = f->value;
     if (n->type != YAML_SCALAR_NODE)
         return fail_at(c, TS_ESCENE, path, f->line, "expected %s, got %s",
-                       expected, kind_name(n));
+                       expected, tsi_scene_kind_name(n));
     const char *v = (const char *)n->data.scalar.value;
     if (strlen(v) != n->data.scalar.length)
         return fail_at(c, TS_ESCENE, path, f->line, "the value contains a "
@@ -302,7 +304,7 @@ static int node_quantity(const ctx *c, const char *path, int line,
 {
     if (n->type != YAML_SCALAR_NODE)
         return fail_at(c, TS_ESCENE, path, line, "expected a number with an "
-                       "optional unit, got %s", kind_name(n));
+                       "optional unit, got %s", tsi_scene_kind_name(n));
     const char *v = (const char *)n->data.scalar.value;
     if (strlen(v) != n->data.scalar.length)
         return fail_at(c, TS_ESCENE, path, line, "the value contains a NUL "
@@ -365,7 +367,7 @@ static int vector3(const ctx *c, const char *parent, const field *f,
     const yaml_node_t *n = f->value;
     if (n->type != YAML_SEQUENCE_NODE)
         return fail_at(c, TS_ESCENE, p, f->line, "expected a list of 3 "
-                       "quantities [x, y, z], got %s", kind_name(n));
+                       "quantities [x, y, z], got %s", tsi_scene_kind_name(n));
     if (seq_len(n) != 3)
         return fail_at(c, TS_ESCENE, p, f->line, "expected a list of 3 "
                        "quantities [x, y, z], got %d entries", seq_len(n));
@@ -524,7 +526,7 @@ static int field_list(const ctx *c, const char *path, const field *f,
 {
     if (f->value->type != YAML_SEQUENCE_NODE)
         return fail_at(c, TS_ESCENE, path, f->line, "expected a list of %s, "
-                       "got %s", what, kind_name(f->value));
+                       "got %s", what, tsi_scene_kind_name(f->value));
     *n = seq_len(f->value);
     if (*n > max)
         return fail_at(c, TS_EINVAL, path, f->line, "has %d entries, at "
@@ -874,7 +876,7 @@ static int parse_loop(const ctx *c, const yaml_node_t *n, const char *parent,
     }
     return fail_at(c, TS_ESCENE, p, f[L_SURF].line, "expected a list of "
                    "surface names or a mapping of names to gains, got %s",
-                   kind_name(sn));
+                   tsi_scene_kind_name(sn));
 }
 
 /* added_mass of a vehicle: "spheroid" (of its first hull), "none", a
@@ -1230,7 +1232,7 @@ static int parse_link_lengths(const ctx *c, const char *path, const field *f,
     const yaml_node_t *n = f->value;
     if (n->type != YAML_SEQUENCE_NODE)
         return fail_at(c, TS_ESCENE, p, f->line, "expected a list of link "
-                       "lengths, got %s", kind_name(n));
+                       "lengths, got %s", tsi_scene_kind_name(n));
     int len = seq_len(n);
     if (len < 1)
         return fail_at(c, TS_EINVAL, p, f->line, "needs at least one link "
@@ -1453,11 +1455,11 @@ static int parse_analysis(const ctx *c, const yaml_node_t *n, int i,
     } else {
         return fail_at(c, TS_ESCENE, path, line_of(n), "expected an analysis "
                        "name or a mapping with 'type' and options, got %s",
-                       kind_name(n));
+                       tsi_scene_kind_name(n));
     }
     if (type_node->type != YAML_SCALAR_NODE)
         return fail_at(c, TS_ESCENE, p, line_of(type_node), "expected an "
-                       "analysis name, got %s", kind_name(type_node));
+                       "analysis name, got %s", tsi_scene_kind_name(type_node));
     const char *t = (const char *)type_node->data.scalar.value;
     size_t tlen = type_node->data.scalar.length;
     int ok = tlen > 0 && tlen < TS_NAME_MAX && strlen(t) == tlen;
@@ -1488,7 +1490,7 @@ static int parse_analysis(const ctx *c, const yaml_node_t *n, int i,
                            path);
         if (k->type != YAML_SCALAR_NODE)
             return fail_at(c, TS_ESCENE, path, line_of(k), "keys must be "
-                           "plain names, got %s as a key", kind_name(k));
+                           "plain names, got %s as a key", tsi_scene_kind_name(k));
         const char *key = (const char *)k->data.scalar.value;
         size_t klen = k->data.scalar.length;
         if (!strcmp(key, "type"))
@@ -1504,7 +1506,7 @@ static int parse_analysis(const ctx *c, const yaml_node_t *n, int i,
                                a->options[j].line);
         if (v->type != YAML_SCALAR_NODE)
             return fail_at(c, TS_ESCENE, p, line_of(k), "an option value "
-                           "must be a scalar, got %s", kind_name(v));
+                           "must be a scalar, got %s", tsi_scene_kind_name(v));
         if (is_null(v))
             return fail_at(c, TS_ESCENE, p, line_of(k), "no value; give one, "
                            "or remove the key");
@@ -1532,7 +1534,7 @@ static int top_list(const ctx *c, const field *f, int *n)
         return TS_OK;
     if (f->value->type != YAML_SEQUENCE_NODE)
         return fail_at(c, TS_ESCENE, f->key, f->line, "expected a list of "
-                       "entries (\"- ...\"), got %s", kind_name(f->value));
+                       "entries (\"- ...\"), got %s", tsi_scene_kind_name(f->value));
     *n = seq_len(f->value);
     if (*n > MAX_ENTRIES)
         return fail_at(c, TS_EINVAL, f->key, f->line, "has %d entries, at "
@@ -1687,8 +1689,48 @@ static int check_flow_depth(const char *t, size_t len, ts_err *err)
 }
 
 /* Parse without the name prefix; returns the scene or NULL. */
+/* The text and settings a scene keeps: text[len] copied, the settings of
+ * `base` (may be NULL) then keys[i] = values[i], each key once (a key set
+ * again replaces its earlier setting). TS_OK or TS_ENOMEM. */
+static int keep_source(ts_scene *scene, const char *text, size_t len,
+                       const ts_scene *base, int n, const char *const keys[],
+                       const char *const values[], ts_err *err)
+{
+    scene->text = malloc(len + 1);
+    int cap = (base ? base->nsettings : 0) + n;
+    scene->settings = cap > 0 ? calloc((size_t)cap, sizeof *scene->settings)
+                              : NULL;
+    if (!scene->text || (cap > 0 && !scene->settings))
+        return ts_fail(err, TS_ENOMEM, "out of memory for the scene's text");
+    if (len > 0)
+        memcpy(scene->text, text, len);
+    scene->text[len] = '\0';
+    scene->text_len = len;
+    for (int i = 0; i < cap; i++) {
+        const char *k = i < cap - n ? base->settings[i].key : keys[i - (cap - n)];
+        const char *v = i < cap - n ? base->settings[i].value
+                                    : (values ? values[i - (cap - n)] : NULL);
+        int later = 0;
+        for (int j = i + 1; j < cap && !later; j++)
+            later = !strcmp(k, j < cap - n ? base->settings[j].key
+                                           : keys[j - (cap - n)]);
+        if (later)
+            continue;
+        ts_scene_setting *t = &scene->settings[scene->nsettings++];
+        t->key = strdup(k);
+        t->value = v ? strdup(v) : NULL;
+        if (!t->key || (v && !t->value))
+            return ts_fail(err, TS_ENOMEM, "out of memory for the scene's "
+                           "settings");
+    }
+    return TS_OK;
+}
+
+/* Read text[len] into a scene, after setting keys[i] = values[i] (i < n)
+ * in its YAML document. */
 static ts_scene *parse(const char *text, size_t len, const ts_units *units,
-                       ts_err *err)
+                       int n, const char *const keys[],
+                       const char *const values[], ts_err *err)
 {
     yaml_parser_t parser;
     yaml_document_t doc, extra;
@@ -1730,7 +1772,7 @@ static ts_scene *parse(const char *text, size_t len, const ts_units *units,
     if (root->type != YAML_MAPPING_NODE) {
         rc = ts_fail(err, TS_ESCENE, "top level (line %d): expected a mapping "
                      "with name, tow and cables, got %s", line_of(root),
-                     kind_name(root));
+                     tsi_scene_kind_name(root));
         goto done;
     }
     scene = calloc(1, sizeof *scene);
@@ -1738,6 +1780,11 @@ static ts_scene *parse(const char *text, size_t len, const ts_units *units,
         rc = ts_fail(err, TS_ENOMEM, "out of memory");
         goto done;
     }
+    rc = tsi_scene_apply(&doc, n, keys, values, err);
+    if (rc != TS_OK)
+        goto done;
+    /* A setting may have replaced the root's contents; the root stays. */
+    root = yaml_document_get_root_node(&doc);
     ctx c = {&doc, units, err};
     rc = parse_root(&c, root, scene);
 
@@ -1763,10 +1810,57 @@ ts_scene *ts_scene_parse(const char *text, size_t len, const char *name,
     }
     if (!text)
         text = "";
-    ts_scene *scene = parse(text, len, units, err);
+    ts_scene *scene = parse(text, len, units, 0, NULL, NULL, err);
+    if (scene && keep_source(scene, text, len, NULL, 0, NULL, NULL, err)) {
+        ts_scene_free(scene);
+        scene = NULL;
+    }
     if (!scene)
         ts_err_prefix(err, "%s: ", name);
     return scene;
+}
+
+ts_scene *ts_scene_set(const ts_scene *scene, int n, const char *const keys[],
+                       const char *const values[], const ts_units *units,
+                       ts_err *err)
+{
+    const char *name = scene && scene->path[0] ? scene->path : "<string>";
+    if (!scene || !units || n < 0 || (n > 0 && !keys) || !scene->text) {
+        ts_fail(err, TS_EINVAL, "ts_scene_set called with a NULL %s",
+                !scene ? "scene" : !units ? "unit system"
+                         : !scene->text ? "scene text" : "key list");
+        return NULL;
+    }
+    /* The scene's settings first, then the new ones, each key once. */
+    int total = scene->nsettings + n;
+    const char **k = malloc((size_t)(total > 0 ? total : 1) * sizeof *k);
+    const char **v = malloc((size_t)(total > 0 ? total : 1) * sizeof *v);
+    ts_scene *out = NULL;
+    if (!k || !v) {
+        ts_fail(err, TS_ENOMEM, "%s: out of memory", name);
+    } else {
+        for (int i = 0; i < scene->nsettings; i++) {
+            k[i] = scene->settings[i].key;
+            v[i] = scene->settings[i].value;
+        }
+        for (int i = 0; i < n; i++) {
+            k[scene->nsettings + i] = keys[i];
+            v[scene->nsettings + i] = values ? values[i] : NULL;
+        }
+        out = parse(scene->text, scene->text_len, units, total, k, v, err);
+        if (out && keep_source(out, scene->text, scene->text_len, scene, n,
+                               keys, values, err)) {
+            ts_scene_free(out);
+            out = NULL;
+        }
+        if (out)
+            memcpy(out->path, scene->path, sizeof out->path);
+        else
+            ts_err_prefix(err, "%s: ", name);
+    }
+    free(k);
+    free(v);
+    return out;
 }
 
 ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
@@ -1829,7 +1923,12 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
         fclose(fp);
     ts_scene *scene = NULL;
     if (rc == TS_OK) {
-        scene = parse(buf, len, units, err);
+        scene = parse(buf, len, units, 0, NULL, NULL, err);
+        if (scene &&
+            keep_source(scene, buf, len, NULL, 0, NULL, NULL, err) != TS_OK) {
+            ts_scene_free(scene);
+            scene = NULL;
+        }
         if (scene)
             snprintf(scene->path, sizeof scene->path, "%s", path);
         else
@@ -1851,6 +1950,12 @@ void ts_scene_free(ts_scene *scene)
     }
     free(scene->analyses);
     ts_system_free(scene->system);
+    for (int i = 0; i < scene->nsettings; i++) {
+        free(scene->settings[i].key);
+        free(scene->settings[i].value);
+    }
+    free(scene->settings);
+    free(scene->text);
     free(scene);
 }
 

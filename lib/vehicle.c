@@ -965,6 +965,12 @@ void tsi_vehicle_control(const ts_vehicle *v, const tsi_control_in *in,
         double x = lp->ki != 0 && m != TS_LOOP_OPEN && in->xi ? in->xi[l]
                                                               : 0.0;
         out[l] = lp->kp * e + lp->ki * x + lp->kd * in->rate[lp->measure];
+        /* A steady state of an integrating loop has e = 0 (x' = e) and no
+         * rates, so its output is ki x alone: the steady solve uses that,
+         * which has the same solutions and keeps a high kp from making
+         * the clamp below bite at every Newton iterate off the solution. */
+        if (in->steady && lp->ki != 0 && m == TS_LOOP_CLOSED)
+            out[l] = lp->ki * x;
         if (xi_dot)
             xi_dot[l] = e;
         double u = in->u_loop ? in->u_loop[l] : 0.0;

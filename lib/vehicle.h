@@ -152,8 +152,10 @@ typedef struct tsi_control_in {
     const double *setpoint; /* [nloops] set points in force */
     const int *mode;        /* [nloops] TS_LOOP_* */
     const double *frozen;   /* [nloops] outputs of open loops */
-    int steady;             /* 1: no rate limits (a steady state, where
-                               no actuator moves, is solved smoothly) */
+    int steady;             /* 1: a steady state is solved: no rate
+                               limits (no actuator moves), and an
+                               integrating closed loop's output is ki x
+                               (its e and rates vanish there) */
 } tsi_control_in;
 
 /* The controller law: the loop outputs out[nloops] (the law's value from

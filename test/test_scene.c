@@ -665,6 +665,152 @@ static void test_mutations(const ts_units *u)
           "silent", len, nok, nfail, silent);
 }
 
+/* ts_scene_set: one setting, expecting it to fail with `code` and a
+ * message containing `gist` (NULL: no check of the text). */
+static void set_fails(const ts_scene *s, const ts_units *u, const char *key,
+                      const char *value, int code, const char *gist)
+{
+    ts_err err;
+    ts_err_clear(&err);
+    const char *k[1] = {key}, *v[1] = {value};
+    ts_scene *t = ts_scene_set(s, 1, k, v, u, &err);
+    CHECK(!t && err.code == code && (!gist || strstr(err.msg, gist)),
+          "set %s = %s refused: %s", key, value ? value : "(removed)",
+          err.msg);
+    ts_scene_free(t);
+}
+
+/* Values set over the text (doc/scene-format.md, "Setting values"): each
+ * converted as in a file, selected by index or name, added when absent,
+ * removed; the scene set from is not changed; settings chain, a key set
+ * again replaces its earlier value; every bad key or value is refused
+ * naming it. */
+static void test_settings(const ts_units *u)
+{
+    const char *file = DIR "good_kamman_ex2.yaml";
+    ts_scene *s = load(u, file);
+    if (!s)
+        return;
+    FILE *f = fopen(file, "rb");
+    char want[4096];
+    size_t n = f ? fread(want, 1, sizeof want, f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(s->text && s->text_len == n && !memcmp(s->text, want, n) &&
+              s->text[n] == '\0' && s->nsettings == 0,
+          "the text read is kept, byte for byte (%zu bytes), no settings",
+          n);
+
+    ts_err err;
+    ts_err_clear(&err);
+    const char *k1[] = {"tow.speed", "cables[upper].normal_drag",
+                        "cables[2].diameter", "bodies[sphere_b].mass",
+                        "tow.point", "environment.current[1]",
+                        "cables[upper].EI", "analyses[1].tolerance"};
+    const char *v1[] = {"5 knot", "1.7", "0.5 in", "2.385 kg",
+                        "[0, 0, \"-2 m\"]", "3 cm/s", NULL, "1e-9"};
+    ts_scene *t = ts_scene_set(s, 8, k1, v1, u, &err);
+    if (CHECK(t != NULL, "eight values set (%s)", err.msg)) {
+        const ts_system *a = t->system;
+        CHECK_REL(a->tow.speed, 5 * KNOT, RTOL, "tow.speed 5 knot");
+        CHECK_REL(a->cables[2].diameter, 0.5 * INCH, RTOL,
+                  "cables[2].diameter 0.5 in");
+        CHECK(a->cables[1].cdn == 1.7 && a->bodies[2].mass == 2.385,
+              "by name: cables[upper].normal_drag, bodies[sphere_b].mass");
+        CHECK(a->tow.point[0] == 0 && a->tow.point[2] == -2 &&
+                  fabs(a->env.current[1] - 0.03) < 1e-15 &&
+                  a->env.current[0] == s->system->env.current[0],
+              "a list, and one entry of a list");
+        CHECK(a->cables[1].ei == 0 && s->system->cables[1].ei > 0,
+              "a key removed takes its default");
+        const ts_scene_option *o =
+            ts_scene_analysis_option(&t->analyses[1], "tolerance");
+        CHECK(o && !strcmp(o->value, "1e-9"), "an analysis option");
+        CHECK(s->system->tow.speed == 2.5 * FT && s->nsettings == 0,
+              "the scene set from is unchanged");
+        CHECK(t->nsettings == 8 && !strcmp(t->settings[3].key,
+                                            "bodies[sphere_b].mass") &&
+                  !strcmp(t->settings[3].value, "2.385 kg") &&
+                  !t->settings[6].value && !strcmp(t->path, s->path) &&
+                  t->text_len == s->text_len,
+              "the new scene keeps the path, the text and its settings");
+
+        /* Chained: the earlier settings stay; a key again replaces. */
+        const char *k2[] = {"tow.turn_rate", "tow.speed"};
+        const char *v2[] = {"0", "3"};
+        ts_scene *c = ts_scene_set(t, 2, k2, v2, u, &err);
+        if (CHECK(c != NULL, "chained (%s)", err.msg)) {
+            CHECK(c->system->tow.speed == 3 && c->system->tow.turn_rate == 0 &&
+                      c->system->cables[1].cdn == 1.7 &&
+                      c->nsettings == 9 &&
+                      !strcmp(c->settings[8].key, "tow.speed"),
+                  "settings chain; tow.speed set again replaces its "
+                  "earlier value (9 settings, speed %g)",
+                  c->system->tow.speed);
+            ts_scene_free(c);
+        }
+        ts_scene_free(t);
+    }
+
+    /* An absent block is added. */
+    ts_scene *m = load(u, DIR "good_minimal.yaml");
+    if (m) {
+        const char *k[] = {"environment.gravity", "cables[only].links"};
+        const char *v[] = {"9.7", "7"};
+        ts_err_clear(&err);
+        ts_scene *t2 = ts_scene_set(m, 2, k, v, u, &err);
+        CHECK(t2 && t2->system->env.gravity == 9.7 &&
+                  t2->system->nlinks == 7,
+              "a block the file lacks is added (%s)", err.msg);
+        ts_scene_free(t2);
+        ts_scene_free(m);
+    }
+
+    /* Refused, naming the key; the checks of a file apply. */
+    set_fails(s, u, "tow.sped", "3", TS_ESCENE,
+              "tow.sped (line 45): unknown key");
+    set_fails(s, u, "cables[0].length", "-3 m", TS_EINVAL,
+              "cables[0].length (line 8): must be > 0 m");
+    set_fails(s, u, "tow.speed", "3 kg", TS_EUNIT, "tow.speed (line 47)");
+    set_fails(s, u, "cables[9].length", "1", TS_EINVAL,
+              "cables[9].length: 'cables' has no entry [9] (3 entries");
+    set_fails(s, u, "cables[nope].length", "1", TS_EINVAL,
+              "has no entry [nope]");
+    set_fails(s, u, "tow.speed.x", "1", TS_EINVAL,
+              "'x' is inside a scalar, not a mapping");
+    set_fails(s, u, "tow[0]", "1", TS_EINVAL, "'tow' is a mapping, not a "
+              "list");
+    set_fails(s, u, "nothing[0]", "1", TS_EINVAL, "the scene has no list");
+    set_fails(s, u, "tow..speed", "1", TS_EINVAL, "expected a name");
+    set_fails(s, u, "cables[0", "1", TS_EINVAL, "expected [index] or [name]");
+    set_fails(s, u, "", "1", TS_EINVAL, "expected a key");
+    set_fails(s, u, "tow.speed", "[1, 2", TS_EINVAL, "is not YAML");
+    set_fails(s, u, "tow.speed", "", TS_EINVAL, "empty value");
+    set_fails(s, u, "tow.nothing", NULL, TS_EINVAL, "no such key to remove");
+    set_fails(s, u, "cables[0]", NULL, TS_EINVAL, "cannot be removed");
+    set_fails(s, u, "tow.speed", "[[[[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]]",
+              TS_EINVAL, "nested deeper");
+    set_fails(s, u, "tow.speed", NULL, TS_ESCENE, "speed");
+    ts_err_clear(&err);
+    CHECK(!ts_scene_set(NULL, 0, NULL, NULL, u, &err) &&
+              err.code == TS_EINVAL,
+          "a NULL scene is refused (%s)", err.msg);
+    ts_scene_free(s);
+
+    /* A scene read from a string keeps its text too. */
+    static const char text[] = "name: s\ntow: {speed: 1}\ncables:\n"
+                               "  - {name: c, from: tow, length: 10, "
+                               "diameter: 0.01, mass_per_length: 0.2, links: 2}\n";
+    ts_scene *p = ts_scene_parse(text, sizeof text - 1, "text", u, &err);
+    const char *k[] = {"cables[c].length"}, *v[] = {"12"};
+    ts_scene *q = p ? ts_scene_set(p, 1, k, v, u, &err) : NULL;
+    CHECK(p && q && p->text_len == sizeof text - 1 &&
+              q->system->cables[0].length == 12,
+          "a scene from a string: text kept, values set (%s)", err.msg);
+    ts_scene_free(q);
+    ts_scene_free(p);
+}
+
 int main(void)
 {
     ts_err err;
@@ -678,6 +824,7 @@ int main(void)
     test_bad_fixtures(u);
     test_buffers(u);
     test_mutations(u);
+    test_settings(u);
     ts_units_free(u);
     return tc_done();
 }

@@ -56,6 +56,11 @@ TS_API json_t *ts_report_vehicle_json(const ts_system *sys,
 TS_API int ts_report_write_json(const json_t *value, const char *path,
                                 ts_err *err);
 
+/* Write `len` bytes of `text` (a page, any document made in memory) to
+ * `path` ("-": stdout), as above. TS_OK, or TS_EIO naming the file. */
+TS_API int ts_report_write_text(const char *text, size_t len,
+                                const char *path, ts_err *err);
+
 /* Write the node table "node,x_m,y_m,z_m,tension_above_N" as CSV. */
 TS_API int ts_report_equilibrium_csv(const ts_system *sys,
                                      const ts_equilibrium *eq,
