@@ -50,6 +50,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "towstab/kernel.h"
 
@@ -1067,6 +1068,63 @@ static int sim_output(const ts_system *sys, const char *name, ts_output *out,
 }
 
 /* Everything a simulation needs that can be checked without running. */
+/* Physical memory of the machine, bytes (0: unknown). */
+static double memory_bytes(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? (double)pages * (double)size : 0.0;
+}
+
+/* An excitation faster than the run can resolve, and a history larger
+ * than memory, are refused before anything runs: a sample interval given
+ * must sample every periodic tow signal at least twice a period; without
+ * one, the 16 samples per period of the default must stay within
+ * TS_SIMULATE_AUTO_SAMPLES_MAX. */
+static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
+                            const ts_sim_opts *o, ts_err *err)
+{
+    const ts_excitation *ex = s->excitation;
+    for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
+        const ts_signal *sg = ts_excitation_signal(ex, i);
+        /* The fundamental (a crank's harmonics are small corrections). */
+        double f = sg->type == TS_SIGNAL_CRANK ||
+                           sg->type == TS_SIGNAL_SINE ||
+                           sg->type == TS_SIGNAL_SUM
+                       ? sg->frequency
+                       : 0.0;
+        if (!(f > 0))
+            continue;
+        double period = 1.0 / f;
+        if (s->sim.dt_sample > 0 && o->dt_sample > period / 2)
+            return ts_fail(err, TS_EINVAL, "sample: %g s cannot resolve the "
+                           "%g Hz excitation %s (period %g s): at most %g s, "
+                           "2 samples per period", o->dt_sample, f,
+                           ts_axis_name(sg->axis), period, period / 2);
+        double n = o->t_end * f * TS_SIMULATE_SAMPLES_PER_PERIOD;
+        if (!(s->sim.dt_sample > 0) && n > TS_SIMULATE_AUTO_SAMPLES_MAX)
+            return ts_fail(err, TS_EINVAL, "excite: the %g Hz excitation %s "
+                           "needs %.3g samples over the %g s run (%d per "
+                           "period), more than the %g a run takes without a "
+                           "sample interval given: shorten t_end, lower the "
+                           "frequency, or give the sample interval", f,
+                           ts_axis_name(sg->axis), n, o->t_end,
+                           TS_SIMULATE_SAMPLES_PER_PERIOD,
+                           TS_SIMULATE_AUTO_SAMPLES_MAX);
+    }
+    double samples = ceil(o->t_end / o->dt_sample) + 1;
+    double bytes = 8.0 * samples *
+                   (4.0 + 3.0 * sys->nnodes + sys->nlinks + TS_NINPUT);
+    double mem = memory_bytes();
+    if (mem > 0 && bytes > mem)
+        return ts_fail(err, TS_ENOMEM, "sample: out of memory for the "
+                       "history of %.3g samples of %d nodes and %d links "
+                       "(%.3g GB, the machine has %.3g GB): a coarser sample "
+                       "interval, a shorter t_end or fewer links",
+                       samples, sys->nnodes, sys->nlinks, bytes / 1e9,
+                       mem / 1e9);
+    return TS_OK;
+}
+
 static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
                           ts_sim_opts *o, double *transient, ts_output *out,
                           ts_err *err)
@@ -1095,6 +1153,8 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         return rc;
     }
     if ((rc = sim_output(sys, s->output, out, err)))
+        return rc;
+    if ((rc = check_resolution(sys, s, o, err)))
         return rc;
     /* Loads an excitation or a manoeuvre makes overflow: refused here,
      * naming the option that brought them (the simulator refuses them
@@ -2487,6 +2547,50 @@ int ts_analysis_check(const ts_system *sys, const ts_request *rq,
     ts_system_free(s);
     if (rc == TS_OK && rq->kind == TS_ANALYSIS_CONVERGE)
         rc = check_converge(sys, rq, err);
+    return rc;
+}
+
+int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
+                     ts_cost *e, ts_err *err)
+{
+    memset(e, 0, sizeof *e);
+    if (rq->kind != TS_ANALYSIS_SIMULATE && rq->kind != TS_ANALYSIS_MODES)
+        return TS_OK;
+    ts_system *s = setup_system(sys, &rq->setup, err);
+    if (!s)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int rc = TS_OK;
+    if (rq->kind == TS_ANALYSIS_SIMULATE && !rq->simulate.linear) {
+        ts_sim_opts o;
+        double transient;
+        sim_resolve(&rq->simulate, &o, &transient);
+        rc = ts_cost_simulate(s, rq->simulate.excitation, &o, e, err);
+    } else if (rq->kind == TS_ANALYSIS_MODES) {
+        ts_kernel *k = ts_kernel_alloc(s, err);
+        int n = k ? ts_kernel_nstate(k) : 0;
+        ts_kernel_free(k);
+        ts_eigen_opts o = modes_eigen_opts(&rq->modes, n);
+        rc = k ? ts_cost_modes(s, n, ts_eigen_method(n, &o), e, err)
+               : (err && err->code ? err->code : TS_ENOMEM);
+    }
+    ts_system_free(s);
+    /* The discretisation estimate runs the analysis again at a half and
+     * a quarter of the links (doc/accuracy.md): a dense eigen analysis
+     * at least 1/8 + 1/64 more, an explicit simulation 1/4 + 1/16 (its
+     * steps and its evaluations each halve with the links). */
+    int estimate = rq->setup.discretisation_error || rq->setup.refine;
+    if (rc == TS_OK && estimate && e->seconds > 0) {
+        double f = rq->kind == TS_ANALYSIS_MODES ? 1.0 / 8 + 1.0 / 64
+                                                 : 1.0 / 4 + 1.0 / 16;
+        e->seconds *= 1 + f;
+        e->evaluations *= 1 + f;
+        e->flops *= 1 + f;
+        size_t len = strlen(e->what);
+        snprintf(e->what + len, sizeof e->what - len, "%s",
+                 len + 60 < sizeof e->what
+                     ? " (with the discretisation estimate's runs)"
+                     : "");
+    }
     return rc;
 }
 

@@ -118,9 +118,9 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
         sh->lu = malloc(nn * sizeof(double));
     if (!sh->ipiv || !sh->w || !sh->wr || (!sh->zlu && !sh->lu)) {
         tsi_shift_free(sh);
-        return ts_fail(err, TS_ENOMEM,
-                       "eigen: out of memory for the %d x %d shifted matrix",
-                       nq, nq);
+        return ts_fail_nomem(err, (sh->is_complex ? 16.0 : 8.0) * (double)nn,
+                             "fewer links", "eigen: out of memory for the "
+                             "%d x %d shifted matrix", nq, nq);
     }
     /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
     const double *A = lin->A;
@@ -409,10 +409,10 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     double *scale = NULL, *rconde = NULL, *rcondv = NULL, *kap0 = NULL;
     int rc = TS_OK;
     if (!a || !vl || !vr || !wr || !wi) {
-        rc = ts_fail(err, TS_ENOMEM,
-                     "eigen: out of memory for dense %d x %d eigenvectors "
-                     "(use --method arpack with --count)",
-                     n, n);
+        rc = ts_fail_nomem(err, 3 * 8.0 * (double)nn, "fewer links, or "
+                           "method arpack with a count (the modes near a "
+                           "target)", "eigen: out of memory for dense %d x "
+                           "%d eigenvectors", n, n);
         goto out;
     }
     memcpy(a, lin->A, nn * sizeof(double));
@@ -434,7 +434,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     lwork = info == 0 ? (int)wq : n * (n + 6);
     work = malloc((size_t)lwork * sizeof(double));
     if (!work) {
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for dgeevx work");
+        rc = ts_fail_nomem(err, 8.0 * lwork, "fewer links, or method arpack "
+                           "with a count", "eigen: out of memory for LAPACK "
+                           "dgeevx's work of the %d x %d matrix", n, n);
         goto out;
     }
     dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo, &ihi,
@@ -593,8 +595,7 @@ static int batch_checks(const ts_linear *lin, cand_list *L)
     return TS_OK;
 }
 
-/* The method ts_eigen_solve uses for n states. */
-static ts_eig_method method_for(int n, const ts_eigen_opts *o)
+ts_eig_method ts_eigen_method(int n, const ts_eigen_opts *o)
 {
     if (o->method != TS_EIG_AUTO)
         return o->method;
@@ -624,7 +625,7 @@ int ts_eigen_check(int n, const ts_eigen_opts *opts, ts_err *err)
         return ts_fail(err, TS_EINVAL,
                        "eigen: arpack_tol must be >= 0 and arpack_max_iter "
                        ">= 1");
-    if (method_for(n, &o) != TS_EIG_ARPACK)
+    if (ts_eigen_method(n, &o) != TS_EIG_ARPACK)
         return TS_OK;
     if (o.count == 0)
         return ts_fail(err, TS_EINVAL,
@@ -898,7 +899,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     int rc = ts_eigen_check(n, &o, err);
     if (rc != TS_OK)
         return rc;
-    ts_eig_method m = method_for(n, &o);
+    ts_eig_method m = ts_eigen_method(n, &o);
     ts_eigen *e = calloc(1, sizeof *e);
     if (!e)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");

@@ -202,8 +202,11 @@ ts_history *ts_history_alloc(const ts_system *sys, int capacity, ts_err *err)
     return h;
 nomem:
     ts_history_free(h);
-    ts_fail(err, TS_ENOMEM, "ts_history_alloc: out of memory for %d samples",
-            capacity);
+    ts_fail_nomem(err, 8.0 * capacity * (3.0 + 3.0 * sys->nnodes +
+                                         sys->nlinks + TS_NINPUT),
+                  "a coarser sample interval, a shorter t_end or fewer links",
+                  "simulate: out of memory for a history of %d samples of "
+                  "%d nodes", capacity, sys->nnodes);
     return NULL;
 }
 
@@ -551,8 +554,13 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     return s;
 nomem:
     ts_sim_free(s);
-    ts_fail(err, TS_ENOMEM, "simulate: out of memory for %d states",
-            (int)n);
+    ts_fail_nomem(err, 8.0 * (double)n * (needs_jacobian(o->integrator)
+                                             ? (double)n + 10 : 10.0),
+                  needs_jacobian(o->integrator)
+                      ? "fewer links, or an explicit integrator (rk8pd)"
+                      : "fewer links",
+                  "simulate: out of memory for the integrator of %d states",
+                  (int)n);
     return NULL;
 }
 

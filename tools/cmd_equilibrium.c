@@ -251,6 +251,10 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
             fprintf(f, "\n");
         }
     }
+    cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet);
+    if (eq->ncontrol > 0)
+        fprintf(f, "controllers settled to %.3g (target %.3g)\n",
+                eq->control_residual, eq->tolerance);
     fprintf(f, "\ntop tension %.6f N", eq->top_tension);
     if (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->nvalues > 0) {
         char e[128];

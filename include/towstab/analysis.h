@@ -28,6 +28,7 @@
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
+#include "towstab/cost.h"
 #include "towstab/excitation.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
@@ -163,6 +164,11 @@ typedef struct ts_response_opts {
 #define TS_SIMULATE_T_END 10.0
 #define TS_SIMULATE_SAMPLE 0.05
 #define TS_SIMULATE_SAMPLES_PER_PERIOD 16
+/* A run without a sample interval takes at most this many samples: an
+ * excitation so fast that its 16 samples per period would exceed it is
+ * refused, so that a default never makes a huge run (give the sample
+ * interval to ask for one). */
+#define TS_SIMULATE_AUTO_SAMPLES_MAX 1e6
 /* Link lengths of a shape file must match the system's to this. */
 #define TS_SIMULATE_SHAPE_RTOL 1e-6
 
@@ -411,6 +417,14 @@ typedef struct ts_result {
  * the option by its scene key ("t_end: ...", "output: ..."). */
 TS_API int ts_analysis_check(const ts_system *sys, const ts_request *rq,
                              ts_err *err);
+
+/* What the analysis of rq will cost at least (towstab/cost.h):
+ * simulations (nonlinear, else the linear model's: nothing), modes (the
+ * eigen solve), with the discretisation estimate's runs when asked for;
+ * zero for the others. Meant to be said before a long run starts (the
+ * command line does above a minute). TS_OK or TS_ENOMEM. */
+TS_API int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
+                            ts_cost *e, ts_err *err);
 
 /* Run the analysis of `rq` on a copy of `sys`. *out receives the result
  * (caller frees with ts_result_free), also after a failure, with what was
