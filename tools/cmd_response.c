@@ -125,6 +125,12 @@ static void response_print(const cli_run *c, const ts_result *r)
 
 static int response_prepare(cli_run *c)
 {
+    if (c->plot.dir && c->rq.response.sea.sea) {
+        fprintf(stderr, "towstab: error: response: --plot draws a Bode plot, "
+                        "which a sea-state response has not; write its "
+                        "spectra with --csv (or --json) instead\n");
+        return EXIT_BADINPUT;
+    }
     /* The Bode plot marks the natural frequencies. */
     c->rq.response.natural = c->plot.dir != NULL;
     return 0;

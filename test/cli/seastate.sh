@@ -17,7 +17,8 @@
 #  - refusals with exit 2 and a message naming the option: --input with
 #    --sea, a bad sea, an unreadable or malformed RAO file, a heading the
 #    RAO table lacks, a turning tow, intervals not a multiple of 8, a
-#    reference point of two numbers, a sea from a released shape.
+#    reference point of two numbers, a sea from a released shape, --plot
+#    with --sea (no picture of it yet).
 # Prints one PASS/FAIL line per check and "N passed, N failed".
 set -u
 if [ $# -ne 3 ]; then
@@ -147,5 +148,7 @@ refuse "\-\-rao-reference: expected three lengths" response "$EX" \
     --output fish.z --sea Hs=4m,Tp=8s --rao-reference 1,2
 refuse "a sea state starts from the equilibrium" simulate "$EX" \
     --sea Hs=4m,Tp=8s --initial released
+refuse "which a sea-state response has not" response "$EX" --output fish.z \
+    --sea Hs=4m,Tp=8s --plot "$T/pictures"
 
 finish
