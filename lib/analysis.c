@@ -820,7 +820,7 @@ static int response_channels(const ts_system *sys, const ts_response_opts *o,
         rc = ts_fail(err, TS_EINVAL, "output: required; valid outputs: %s%s",
                      list, ts_kernel_noutput(k) > 0
                                ? " or a vehicle's (depth, pitch, roll, yaw, "
-                                 "<loop>.output)"
+                                 "<loop>.output, <surface>.deflection)"
                                : "");
     } else if (rc == TS_OK) {
         rc = ts_response_output_lookup(k, o->output, out, err);
@@ -1100,6 +1100,37 @@ static void sim_resolve(const ts_simulate_opts *s, ts_sim_opts *o,
     *transient = isnan(s->transient) ? o->t_end / 2 : s->transient;
 }
 
+/* The excitation's signals on vehicles' inputs against the system's
+ * vehicles; with the loops open, none on a loop's output or set point
+ * (they are held at the trim). */
+static int check_sim_inputs(const ts_system *sys, const ts_excitation *ex,
+                            int open_loop, ts_err *err)
+{
+    int ns = ex ? ts_excitation_nsignals(ex) : 0, any = 0;
+    for (int i = 0; i < ns; i++)
+        any |= ts_excitation_signal(ex, i)->axis == TS_AXIS_INPUT;
+    if (!any)
+        return TS_OK;
+    ts_kernel *k = ts_kernel_alloc(sys, err);
+    if (!k)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int rc = ts_sim_check_inputs(k, ex, err);
+    for (int i = 0; i < ns && rc == TS_OK && open_loop; i++) {
+        const ts_signal *sg = ts_excitation_signal(ex, i);
+        int j = sg->axis == TS_AXIS_INPUT ? ts_kernel_input_find(k, sg->input)
+                                          : -1;
+        if (j >= TS_NINPUT && ts_control_nloops(k) > 0 &&
+            !ts_kernel_input_is_surface(k, j))
+            rc = ts_fail(err, TS_EINVAL, "excite: %s does nothing with the "
+                         "loops open (open_loop): the loop's output is held "
+                         "at its trim value", sg->input);
+    }
+    ts_kernel_free(k);
+    if (rc != TS_OK && strncmp(err->msg, "excite", 6))
+        ts_err_prefix(err, "excite: ");
+    return rc;
+}
+
 /* The output of a simulation: the named one, or the last sphere's .z
  * (else the last node's). */
 static int sim_output(const ts_system *sys, const char *name, ts_output *out,
@@ -1160,7 +1191,7 @@ static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
             return ts_fail(err, TS_EINVAL, "sample: %g s cannot resolve the "
                            "%g Hz excitation %s (period %g s): at most %g s, "
                            "2 samples per period", o->dt_sample, f,
-                           ts_axis_name(sg->axis), period, period / 2);
+                           ts_signal_axis_label(sg), period, period / 2);
         double n = o->t_end * f * TS_SIMULATE_SAMPLES_PER_PERIOD;
         if (!(s->sim.dt_sample > 0) && n > TS_SIMULATE_AUTO_SAMPLES_MAX)
             return ts_fail(err, TS_EINVAL, "excite: the %g Hz excitation %s "
@@ -1168,7 +1199,7 @@ static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
                            "period), more than the %g a run takes without a "
                            "sample interval given: shorten t_end, lower the "
                            "frequency, or give the sample interval", f,
-                           ts_axis_name(sg->axis), n, o->t_end,
+                           ts_signal_axis_label(sg), n, o->t_end,
                            TS_SIMULATE_SAMPLES_PER_PERIOD,
                            TS_SIMULATE_AUTO_SAMPLES_MAX);
     }
@@ -1187,8 +1218,8 @@ static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
 }
 
 static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
-                          ts_sim_opts *o, double *transient, ts_output *out,
-                          ts_err *err)
+                          int open_loop, ts_sim_opts *o, double *transient,
+                          ts_output *out, ts_err *err)
 {
     sim_resolve(s, o, transient);
     if (!(o->t_end > 0) || !isfinite(o->t_end))
@@ -1248,6 +1279,8 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         return ts_fail(err, TS_EINVAL, "manoeuvre: the linear model has no "
                        "frame inputs; a manoeuvre can only be simulated "
                        "nonlinearly (drop %s)", lw);
+    if ((rc = check_sim_inputs(sys, ex, open_loop, err)))
+        return rc;
     /* What the comparison will need. */
     int idx;
     if (s->compare && ex && ts_excitation_periodic(ex, &idx)) {
@@ -1519,7 +1552,8 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     const ts_simulate_opts *s = &rq->simulate;
     const ts_system *sys = r->sys;
     r->excitation = s->excitation;
-    int rc = check_simulate(sys, s, &r->sim, &r->transient, &r->output, err);
+    int rc = check_simulate(sys, s, rq->setup.open_loop, &r->sim,
+                            &r->transient, &r->output, err);
     if (rc == TS_OK && s->sea.sea)
         rc = sea_realise(r, s, err);
     if (rc != TS_OK)
@@ -2371,8 +2405,8 @@ int ts_analysis_sweep(const ts_system *sys, const ts_request *rq, int series,
     else if (rc == TS_OK && kind == TS_ANALYSIS_MODES)
         rc = modes_values(r, x->rq.modes.follow, err);
     else if (rc == TS_OK) {
-        rc = check_simulate(r->sys, s, &r->sim, &r->transient, &r->output,
-                            err);
+        rc = check_simulate(r->sys, s, x->rq.setup.open_loop, &r->sim,
+                            &r->transient, &r->output, err);
         r->excitation = s->excitation;
         if (rc == TS_OK)
             rc = sim_values(r, 0, err);
@@ -2636,7 +2670,8 @@ static int check_kind(const ts_system *sys, const ts_request *rq,
         ts_sim_opts o;
         double transient;
         ts_output out;
-        return check_simulate(sys, &rq->simulate, &o, &transient, &out, err);
+        return check_simulate(sys, &rq->simulate, rq->setup.open_loop, &o,
+                              &transient, &out, err);
     }
     case TS_ANALYSIS_CONVERGE:
         return TS_OK; /* checked on the base system (check_converge) */

@@ -651,12 +651,16 @@ static int controls_start(ts_kernel *k, double *y, double *sp0, double *sp1,
                 sp1[i] = m + dh;
             }
         }
+        int nsurf = 0;
         for (int c = 0; c < d->ncomponents; c++) {
             const ts_component *cp = &d->component[c];
             act[c] = fmax(-cp->limit, fmin(cp->limit, cp->deflection));
+            nsurf += cp->control != 0;
         }
         ts_kernel_set_controls(k, v, xi, act, y);
-        j += 4 + d->nloops;
+        /* Its outputs: 4 measures, the loops, the surfaces' deflections
+         * (ts_kernel_outputs). */
+        j += 4 + d->nloops + nsurf;
     }
     free(out);
     return i;

@@ -418,11 +418,20 @@ void ts_kernel_set_controls(const ts_kernel *k, int v, const double xi[],
 }
 
 
+/* Control surfaces of vehicle V. */
+static int nsurfaces(const veh *V)
+{
+    int n = 0;
+    for (int c = 0; c < V->d->ncomponents; c++)
+        n += V->in_surf[c] >= 0;
+    return n;
+}
+
 int ts_kernel_noutput(const ts_kernel *k)
 {
     int n = 0;
     for (int v = 0; v < k->nv; v++)
-        n += OUT_MEASURES + k->veh[v].d->nloops;
+        n += OUT_MEASURES + k->veh[v].d->nloops + nsurfaces(&k->veh[v]);
     return n;
 }
 
@@ -444,6 +453,12 @@ const char *ts_kernel_output_name(const ts_kernel *k, int j, char *buf,
             return buf;
         }
         j -= V->d->nloops;
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] >= 0 && j-- == 0) {
+                snprintf(buf, size, "%s.%s.deflection", body,
+                         V->d->component[c].name);
+                return buf;
+            }
     }
     return NULL;
 }
@@ -470,6 +485,9 @@ void ts_kernel_outputs(const ts_kernel *k, double out[])
             out[j++] = V->meas[m];
         for (int l = 0; l < V->d->nloops; l++)
             out[j++] = V->out[l];
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] >= 0)
+                out[j++] = V->delta[c];
     }
 }
 
@@ -559,11 +577,20 @@ const char *ts_kernel_output_unit(const ts_kernel *k, int j)
     for (int v = 0; v < k->nv && j >= 0; v++) {
         if (j < OUT_MEASURES)
             return j == 0 ? "m" : "rad";
-        j -= OUT_MEASURES + k->veh[v].d->nloops;
+        j -= OUT_MEASURES + k->veh[v].d->nloops + nsurfaces(&k->veh[v]);
         if (j < 0)
             return "rad";
     }
     return NULL;
+}
+
+int ts_kernel_input_is_surface(const ts_kernel *k, int j)
+{
+    for (int v = 0; v < k->nv && j >= TS_NINPUT; v++)
+        for (int c = 0; c < k->veh[v].d->ncomponents; c++)
+            if (k->veh[v].in_surf[c] == j)
+                return 1;
+    return 0;
 }
 
 int ts_kernel_input_find(const ts_kernel *k, const char *name)

@@ -369,8 +369,9 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
     {.name = "excite", .type = TS_OPT_SPECS, .section = TS_SEC_SIMULATE,      \
      NOLIM, .flags = TS_OPT_REPEAT, .offset = OFF(simulate.excitation),       \
      .only = o, .arg = "SPEC",                                                \
-     .help = "tow-point excitation, e.g. "                                    \
-             "tow.heave:amplitude=0.1ft,frequency=1Hz",                       \
+     .help = "tow-point or vehicle-input excitation, e.g. "                   \
+             "tow.heave:amplitude=0.1ft,frequency=1Hz or "                    \
+             "fish.depth.setpoint:step,amplitude=5m",                         \
      .deftext = "none"},                                                      \
     {.name = "manoeuvre", .type = TS_OPT_SPECS, .section = TS_SEC_SIMULATE,   \
      NOLIM, .flags = TS_OPT_REPEAT, .offset = OFF(simulate.excitation),       \
@@ -446,7 +447,7 @@ static const ts_option response_rows[] = {
      .arg = "NAME",
      .help = "<node>.x, .y or .z (sphere.z, cable.3.x), "
              "<cable>.<k>.tension, or a vehicle's <vehicle>.depth, .pitch, "
-             ".roll, .yaw or .<loop>.output",
+             ".roll, .yaw, .<loop>.output or .<surface>.deflection",
      .deftext = "required"},
     {.name = "from", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
      .unit = "Hz", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
@@ -689,9 +690,10 @@ static int add_specs(const ts_option *o, ts_request *rq, const char *text,
                          sg->axis == TS_AXIS_TURN_RATE;
             if (is_man != manoeuvre)
                 rc = ts_fail(err, TS_EINVAL, "%s: '%s' is %s; give it as %s",
-                             w, ts_axis_name(sg->axis),
+                             w, ts_signal_axis_label(sg),
                              is_man ? "a manoeuvre of the ship"
-                                    : "a tow-point excitation",
+                                    : "a tow-point or vehicle-input "
+                                      "excitation",
                              is_man ? "manoeuvre (--manoeuvre)"
                                     : "excite (--excite)");
             else if (sg->axis == TS_AXIS_SPEED && sg->absolute &&

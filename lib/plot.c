@@ -1131,7 +1131,75 @@ static int check_shape(const char *fn, const char *what, int i,
         return ts_fail(err, TS_EINVAL, "%s: %s[%d].style: expected solid or "
                                        "dashed, got %d",
                        fn, what, i, s->style);
+    if (s->noutlines < 0 || (s->noutlines > 0 && !s->outlines))
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].outlines: expected %d",
+                       fn, what, i, s->noutlines);
+    for (int b = 0; b < s->noutlines; b++) {
+        const ts_plot_outline *o = &s->outlines[b];
+        if (o->npoints < 0 || (o->npoints > 0 && !o->pts) ||
+            !isfinite(o->anchor[0]) || !isfinite(o->anchor[1]) ||
+            !isfinite(o->anchor[2]))
+            return ts_fail(err, TS_EINVAL, "%s: %s[%d].outlines[%d]: "
+                           "expected points and a finite anchor", fn, what,
+                           i, b);
+    }
     return TS_OK;
+}
+
+/* The magnification of the outlines of shapes[nshapes]: the smallest
+ * drawn at least TS_PLOT_OUTLINE_MIN of `extent` (m), at least 1. */
+static double outline_scale(int nshapes, const ts_plot_shape *shapes,
+                            double extent)
+{
+    double smallest = INFINITY;
+    for (int i = 0; i < nshapes; i++)
+        for (int b = 0; b < shapes[i].noutlines; b++) {
+            const ts_plot_outline *o = &shapes[i].outlines[b];
+            double lo[3] = {INFINITY, INFINITY, INFINITY};
+            double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (int k = 0; k < o->npoints; k++)
+                for (int j = 0; j < 3; j++)
+                    if (isfinite(o->pts[3 * k + j])) {
+                        lo[j] = fmin(lo[j], o->pts[3 * k + j]);
+                        hi[j] = fmax(hi[j], o->pts[3 * k + j]);
+                    }
+            double size = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1],
+                                                   hi[2] - lo[2]));
+            if (size > 0)
+                smallest = fmin(smallest, size);
+        }
+    if (!isfinite(smallest) || !(extent > 0))
+        return 1.0;
+    return fmax(1.0, TS_PLOT_OUTLINE_MIN * extent / smallest);
+}
+
+/* Draw the outlines of s in the side view (top 0) or the top view,
+ * magnified by `scale` about their anchors. */
+static void draw_outlines(frame *f, const ts_plot_shape *s, int top,
+                          double scale, ts_plot_units u)
+{
+    for (int b = 0; b < s->noutlines; b++) {
+        const ts_plot_outline *o = &s->outlines[b];
+        double ph[2], pv[2];
+        int have = 0;
+        for (int k = 0; k < o->npoints; k++) {
+            const double *p = o->pts + 3 * (size_t)k;
+            if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+                have = 0;
+                continue;
+            }
+            double q[3];
+            for (int j = 0; j < 3; j++)
+                q[j] = o->anchor[j] + scale * (p[j] - o->anchor[j]);
+            ph[1] = ts_plot_convert(TS_PLOT_LENGTH, u, q[0]);
+            pv[1] = ts_plot_convert(TS_PLOT_LENGTH, u, top ? q[1] : q[2]);
+            if (have)
+                draw_line(f, 2, ph, pv);
+            ph[0] = ph[1];
+            pv[0] = pv[1];
+            have = 1;
+        }
+    }
 }
 
 /* Fill xy from pos (+ scale * disp when disp is not NULL). */
@@ -1335,6 +1403,22 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
     if (circles)
         legend_add(&L, "the ship's turning circle", COL_FG, TS_PLOT_DOTTED,
                    NULL);
+    /* extent is in the axes' unit, the outlines in m. */
+    double oscale = outline_scale(
+        c->nshapes, c->shapes,
+        extent / ts_plot_convert(TS_PLOT_LENGTH, u, 1.0));
+    char olab[TEXT_MAX];
+    int outlines = 0;
+    for (int i = 0; i < c->nshapes; i++)
+        outlines |= c->shapes[i].noutlines > 0;
+    if (outlines) {
+        if (oscale > 1.0)
+            snprintf(olab, sizeof olab, "vehicles at their attitude, drawn "
+                     "%.3g times their size", oscale);
+        else
+            snprintf(olab, sizeof olab, "vehicles at their attitude");
+        legend_add(&L, olab, COL_FG, TS_PLOT_SOLID, NULL);
+    }
     PLFLT sx0, sx1, sy0, sy1;
     plgspa(&sx0, &sx1, &sy0, &sy1);
     legend_layout lay = legend_plan(&L, 0.87 * (sx1 - sx0));
@@ -1391,6 +1475,8 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
         plwidth(CURVE_WIDTH);
         draw_shape_links(&f, s, &xy[i], water, work);
         draw_marks(&f, s, &xy[i], 1.1);
+        plwidth(1.4);
+        draw_outlines(&f, s, top, oscale, u);
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
     axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, u);
@@ -1503,6 +1589,8 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
         pad_range(&lo[view][0], &hi[view][0], 0.05, extent);
         pad_range(&lo[view][1], &hi[view][1], 0.10, extent);
     }
+    double oscale = outline_scale(1, c->eq, extent / ts_plot_convert(
+                                                TS_PLOT_LENGTH, u, 1.0));
     /* Rows from the top; normalised page coordinates. */
     double top_frac = (double)MODE_TOP_PX / height;
     double bottom_frac = (double)MODE_BOTTOM_PX / height;
@@ -1545,6 +1633,8 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
             plwidth(1.6);
             draw_shape_links(&f, c->eq, &s[0], water, work);
             draw_marks(&f, c->eq, &s[0], 0.8);
+            plwidth(1.2);
+            draw_outlines(&f, c->eq, view == 1, oscale, u);
             int col = color_index(0, m);
             for (int j = 1; j <= 2; j++) {
                 ts_plot_shape style = *c->eq;
@@ -1569,10 +1659,14 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
     plwind(0, 1, 0, 1);
     plcol0(COL_FG);
     plschr(0, 0.8);
-    snprintf(lab, sizeof lab,
-             "grey: equilibrium; solid, dashed: the mode at opposite phases, "
-             "largest displacement %.0f %% of the cable's extent",
-             100 * MODE_AMPLITUDE);
+    int nl = snprintf(lab, sizeof lab,
+                      "grey: equilibrium; solid, dashed: the mode at "
+                      "opposite phases, largest displacement %.0f %% of the "
+                      "cable's extent",
+                      100 * MODE_AMPLITUDE);
+    if (oscale > 1.0 && nl > 0 && (size_t)nl < sizeof lab)
+        snprintf(lab + nl, sizeof lab - (size_t)nl, "; vehicles at their "
+                 "trim attitude, drawn %.3g times their size", oscale);
     plschr(0, 1.0);
     {
         double w, h;

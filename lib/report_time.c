@@ -78,6 +78,16 @@ json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
                                       series(h->energy, n, 2), "potential",
                                       series(h->energy + 1, n, 2)));
     }
+    if (h->noutput > 0 && h->outputs) {
+        /* The vehicles' depth, attitude, loop outputs and deflections. */
+        json_t *vo = json_array();
+        for (int j = 0; vo && j < h->noutput; j++)
+            json_array_append_new(
+                vo, json_pack("{s:s,s:s,s:o}", "name", h->output_name[j],
+                              "unit", h->output_unit[j], "value",
+                              series(h->outputs + j, n, (size_t)h->noutput)));
+        json_object_set_new(o, "vehicle_outputs", vo);
+    }
     return o;
 }
 
@@ -122,6 +132,8 @@ json_t *ts_report_excitation_json(const ts_excitation *ex)
         const ts_signal *s = ts_excitation_signal(ex, i);
         json_t *o = json_pack("{s:s,s:s}", "axis", ts_axis_name(s->axis),
                               "type", ts_signal_type_name(s->type));
+        if (o && s->axis == TS_AXIS_INPUT)
+            json_object_set_new(o, "input", json_string(s->input));
         switch (s->type) {
         case TS_SIGNAL_CRANK:
             json_object_set_new(o, "rod", num(s->rod));
@@ -171,6 +183,8 @@ static void csv_header(FILE *f, const ts_system *sys, const ts_history *h,
             fprintf(f, ",%s%s.%d.tension_N", prefix,
                     sys->cables[sys->links[l].cable].name,
                     sys->links[l].index);
+    for (int j = 0; h->outputs && j < h->noutput; j++)
+        fprintf(f, ",%s%s_%s", prefix, h->output_name[j], h->output_unit[j]);
 }
 
 static void csv_row(FILE *f, const ts_history *h, int i)
@@ -183,6 +197,9 @@ static void csv_row(FILE *f, const ts_history *h, int i)
         for (int l = 0; l < h->nlinks; l++)
             fprintf(f, ",%.17g", t[l]);
     }
+    const double *o = h->outputs ? h->outputs + (size_t)h->noutput * i : NULL;
+    for (int j = 0; o && j < h->noutput; j++)
+        fprintf(f, ",%.17g", o[j]);
 }
 
 int ts_report_history_csv(const ts_system *sys, const ts_history *nl,

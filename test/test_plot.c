@@ -300,7 +300,8 @@ static void test_shapes(void)
     ts_err err = {0};
     /* Side view of a submerged chain without labels: no legend, so the
      * plot box is known. */
-    ts_plot_shape one = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
+                         0, NULL};
     int rc = ts_plot_shapes(dir, "side_si", "chain: side view", TS_PLOT_SIDE,
                             TS_PLOT_WATER, 1, &one, &o, &err);
     CHECK(rc == TS_OK, "side view drawn (%s)", err.msg);
@@ -349,9 +350,9 @@ static void test_shapes(void)
     /* Overlay: straight and turning, side and top, with labels. */
     ts_plot_shape two[2] = {
         {N, chain, NULL, 1, end_mark, 0, "5 knot, straight", TS_PLOT_SOLID,
-         0},
+         0, 0, NULL},
         {N, chain_turn, NULL, 1, end_mark, 38.5, "5 knot, turn",
-         TS_PLOT_DASHED, 0}};
+         TS_PLOT_DASHED, 0, 0, NULL}};
     rc = ts_plot_shapes(dir, "side", "overlay: side view", TS_PLOT_SIDE,
                         TS_PLOT_WATER | TS_PLOT_EQUAL, 2, two, &o, &err);
     CHECK(rc == TS_OK, "side view of two shapes drawn (%s)", err.msg);
@@ -382,7 +383,8 @@ static void test_shapes(void)
     free(svg);
 
     /* A branched tree in both views. */
-    ts_plot_shape t = {NT, tree, tree_upper, 2, tree_marks, -20, "tree", 0, 3};
+    ts_plot_shape t = {NT,   tree, tree_upper, 2, tree_marks, -20,
+                       "tree", 0,    3,          0, NULL};
     rc = ts_plot_shapes(dir, "tree_side", "tree", TS_PLOT_SIDE,
                         TS_PLOT_WATER | TS_PLOT_EQUAL, 1, &t, &o, &err);
     CHECK(rc == TS_OK, "branched tree, side view (%s)", err.msg);
@@ -390,6 +392,27 @@ static void test_shapes(void)
                         &err);
     CHECK(rc == TS_OK, "branched tree, top view, port turn (%s)", err.msg);
     check_png("tree_top", 1000, 700);
+
+    /* A body outline (a square of 0.2 m at the end of the chain) drawn
+     * with its attitude; a bad one refused. */
+    const double *e = chain + 3 * (N - 1);
+    double sq[15] = {e[0], e[1], e[2], e[0] - 0.2, e[1], e[2],
+                     e[0] - 0.2, e[1], e[2] + 0.2, e[0], e[1], e[2] + 0.2,
+                     e[0], e[1], e[2]};
+    ts_plot_outline ol = {5, sq, {e[0], e[1], e[2]}};
+    ts_plot_shape b = {N, chain, NULL, 1, end_mark, 0, "with a body", 0, 0,
+                       1, &ol};
+    rc = ts_plot_shapes(dir, "outline", "outline", TS_PLOT_SIDE,
+                        TS_PLOT_WATER, 1, &b, &o, &err);
+    CHECK(rc == TS_OK && file_exists("outline", "png"),
+          "a body's outline drawn (%s)", err.msg);
+    ts_plot_outline bad = {5, NULL, {0, 0, 0}};
+    b.outlines = &bad;
+    ts_err e2 = {0};
+    rc = ts_plot_shapes(dir, "outline_bad", "outline", TS_PLOT_SIDE, 0, 1,
+                        &b, &o, &e2);
+    CHECK(rc == TS_EINVAL && strstr(e2.msg, "outlines[0]"),
+          "an outline without points refused (%s)", e2.msg);
 }
 
 static void test_modes(void)
@@ -414,7 +437,7 @@ static void test_modes(void)
         modes[m].disp = disp[m];
         modes[m].label = label[m];
     }
-    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     int rc = ts_plot_mode_shapes(dir, "modes", "chain: lowest modes",
                                  TS_PLOT_WATER, &eq, NM, modes, &o, &err);
     CHECK(rc == TS_OK, "mode shapes drawn (%s)", err.msg);
@@ -657,7 +680,7 @@ static void test_bad_places(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     ts_err err = {0};
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     static const char *const names[] = {"", ".hidden", "a/b", "x y", NULL};
     for (int i = 0; names[i]; i++) {
         ts_err_clear(&err);
@@ -764,7 +787,7 @@ static void test_streams(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     o.formats = TS_PLOT_PNG;
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     ts_err err = {0};
     int rc = ts_plot_shapes(dir, "stream", "t", TS_PLOT_TOP, 0, 1, &one, &o,
                             &err);
@@ -792,7 +815,7 @@ static void test_without_plplot(void)
               strstr(err.msg, "libplplot-dev") &&
               strstr(err.msg, "plplot-driver-cairo"),
           "ts_plot_check names the missing packages: %s", err.msg);
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     ts_plot_mode mode = {chain, "m"};
     double x[2] = {1, 2}, y[2] = {1, 2}, ph[2] = {0, 0}, nat[1] = {1};
     ts_plot_series s = {2, x, y, "s", 0, 0, 0};

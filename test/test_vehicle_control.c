@@ -24,6 +24,20 @@
  *     crossover (0.9 and 1.1 times it: stable and unstable); at the gain
  *     crossover the loop transfer, evaluated densely with the loop broken,
  *     has magnitude 1 and phase -180 deg + the phase margin.
+ *  6. Closed-loop eigenvalues against the time domain: the nonlinear
+ *     simulation started from the trim displaced along one mode's shape
+ *     (its real part, scaled to 1e-6) stays on that mode; fitting the
+ *     state's deviation onto the shape's real and imaginary parts at each
+ *     sample gives its decay rate and frequency, which equal the
+ *     eigenvalue's, for the slowest mode and for the mode the depth
+ *     integrator moves most.
+ *  7. A depth change in the time domain (a step of the depth set point,
+ *     a vehicle input of the excitation): linear and nonlinear runs
+ *     differ by the nonlinearity, which falls like the square of the
+ *     step (halving the step divides the largest difference of depth by
+ *     about 4); at a 20 m step the wing saturates in the nonlinear run
+ *     and never exceeds its limit or its rate limit, while the linear
+ *     model, which has neither, commands beyond the limit.
  * Tolerances are stated at each check with their reason. */
 #include "towstab/control.h"
 #include "towstab/eigen.h"
@@ -32,6 +46,7 @@
 #include "towstab/linearize.h"
 #include "towstab/response.h"
 #include "towstab/scene.h"
+#include "towstab/simulate.h"
 
 #include <complex.h>
 #include <gsl/gsl_errno.h>
@@ -432,17 +447,27 @@ static ts_system *scaled(const ts_system *sys, double f)
     return q;
 }
 
+/* The closed-loop trim of sys, its linear model and every mode with its
+ * shape (LAPACK's defaults). */
+static int solve_modes(const ts_system *sys, solved *s, ts_linear **lin,
+                       ts_eigen **e)
+{
+    int rc = solve(sys, s);
+    *lin = rc == TS_OK ? linearize(s->k, s->eq) : NULL;
+    *e = NULL;
+    ts_eigen_opts o;
+    ts_eigen_opts_default(&o);
+    return *lin ? ts_eigen_solve(*lin, &o, e, NULL) : -1;
+}
+
 /* Max Re and the eigenvalue nearest i w of sys's closed loop. */
 static int closed_modes(const ts_system *sys, double w, double *max_re,
                         double complex *nearest)
 {
     solved s;
-    int rc = solve(sys, &s);
-    ts_linear *lin = rc == TS_OK ? linearize(s.k, s.eq) : NULL;
-    ts_eigen *e = NULL;
-    ts_eigen_opts o;
-    ts_eigen_opts_default(&o);
-    rc = lin ? ts_eigen_solve(lin, &o, &e, NULL) : -1;
+    ts_linear *lin;
+    ts_eigen *e;
+    int rc = solve_modes(sys, &s, &lin, &e);
     if (rc == TS_OK) {
         *max_re = e->max_real;
         double best = INFINITY;
@@ -556,6 +581,294 @@ static void test_margins(void)
     ts_system_free(sys);
 }
 
+/* 6. Closed-loop eigenvalues against the decay of a disturbance. */
+
+/* Least-squares coefficients of z[n] on a and b (b NULL: a alone). */
+static void fit_shape(const double *z, const double *a, const double *b,
+                      int n, double *al, double *be)
+{
+    double aa = 0, ab = 0, bb = 0, za = 0, zb = 0;
+    for (int i = 0; i < n; i++) {
+        aa += a[i] * a[i];
+        za += z[i] * a[i];
+        if (b) {
+            ab += a[i] * b[i];
+            bb += b[i] * b[i];
+            zb += z[i] * b[i];
+        }
+    }
+    if (!b) {
+        *al = za / aa;
+        *be = 0.0;
+        return;
+    }
+    double det = aa * bb - ab * ab;
+    *al = (za * bb - zb * ab) / det;
+    *be = (zb * aa - za * ab) / det;
+}
+
+/* Simulate from y0 + eps Re(v) of mode m and fit lambda: the slope of
+ * log|c(t)| and of the unwrapped angle of c(t) = alpha - i beta over
+ * NS samples in [0, T]. */
+#define DECAY_SAMPLES 20
+static int decay_fit(const solved *s, const ts_linear *lin,
+                     const ts_eigen *e, int m, double complex *fit)
+{
+    int n = lin->nstate;
+    const double *a = e->vec_re + (size_t)n * m;
+    const double *b = e->modes[m].im > 0 ? e->vec_im + (size_t)n * m : NULL;
+    double amax = 0;
+    for (int i = 0; i < n; i++)
+        amax = fmax(amax, fabs(a[i]));
+    double eps = 1e-6 / amax;
+    const ts_mode *md = &e->modes[m];
+    /* Two time constants or two periods, whichever is shorter, at most
+     * 20 s. */
+    double T = fmin(20.0, -2.0 / md->re);
+    if (md->im > 0)
+        T = fmin(T, 2.0 * 2.0 * M_PI / md->im);
+    double *y = malloc(2 * (size_t)n * sizeof(double));
+    double *z = y + n;
+    ts_err err = {0};
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    o.t_end = T;
+    o.rel_tol = 1e-11;
+    o.abs_tol = 1e-16;
+    for (int i = 0; i < n; i++)
+        y[i] = lin->y0[i] + eps * a[i];
+    ts_sim *sim = y ? ts_sim_alloc(s->k, NULL, &o, &err) : NULL;
+    int rc = sim ? ts_sim_set_state(sim, 0.0, y, &err) : -1;
+    double st = 0, stt = 0, sl = 0, stl = 0, sp = 0, stp = 0, prev = 0,
+           unwrap = 0;
+    for (int k = 1; k <= DECAY_SAMPLES && rc == TS_OK; k++) {
+        double t = T * k / DECAY_SAMPLES;
+        rc = ts_sim_advance(sim, t, &err);
+        if (rc != TS_OK)
+            break;
+        const double *yt = ts_sim_state(sim);
+        for (int i = 0; i < n; i++)
+            z[i] = (yt[i] - lin->y0[i]) / eps;
+        double al, be;
+        fit_shape(z, a, b, n, &al, &be);
+        double l = log(hypot(al, be)), p = atan2(-be, al);
+        while (p + unwrap - prev > M_PI)
+            unwrap -= 2 * M_PI;
+        while (p + unwrap - prev < -M_PI)
+            unwrap += 2 * M_PI;
+        p += unwrap;
+        prev = p;
+        /* Lines through the origin: c(0) = 1. */
+        st += t;
+        stt += t * t;
+        sl += l;
+        stl += t * l;
+        sp += p;
+        stp += t * p;
+    }
+    (void)st;
+    (void)sl;
+    (void)sp;
+    if (rc != TS_OK)
+        printf("  simulate: %s\n", err.msg);
+    *fit = stl / stt + I * (stp / stt);
+    ts_sim_free(sim);
+    free(y);
+    return rc;
+}
+
+static void test_decay(void)
+{
+    solved s;
+    ts_linear *lin;
+    ts_eigen *e;
+    int rc = solve_modes(base, &s, &lin, &e);
+    CHECK(rc == TS_OK && e->vec_re, "closed-loop modes with their shapes");
+    if (rc != TS_OK)
+        goto done;
+    /* The slowest mode, and the mode the depth integrator moves most
+     * (relative to its shape's largest entry). */
+    int slow = 0, integ = -1, n = lin->nstate;
+    double best = 0;
+    int xi = -1;
+    for (int i = 0; i < ts_kernel_ncontrol(s.k); i++) {
+        ts_control_state cs;
+        ts_kernel_control_state(s.k, i, &cs);
+        if (cs.actuator == 0)
+            xi = 2 * ts_kernel_nq(s.k) + i;
+    }
+    for (int m = 0; m < e->nmodes; m++) {
+        if (e->modes[m].re > e->modes[slow].re)
+            slow = m;
+        if (xi >= 0) {
+            double w = hypot(e->vec_re[(size_t)n * m + xi],
+                             e->vec_im[(size_t)n * m + xi]);
+            if (w > best) {
+                best = w;
+                integ = m;
+            }
+        }
+    }
+    CHECK(xi >= 0 && integ >= 0, "the depth loop's integrator is a state "
+          "(%d) moved most by mode %d", xi, integ + 1);
+    int which[2] = {slow, integ};
+    const char *what[2] = {"the slowest mode", "the depth integrator's mode"};
+    for (int c = 0; c < 2 && which[c] >= 0; c++) {
+        const ts_mode *md = &e->modes[which[c]];
+        double complex lam = md->re + I * md->im, fit = 0;
+        rc = decay_fit(&s, lin, e, which[c], &fit);
+        /* 1e-5 of |lambda|: the disturbance's own nonlinearity (1e-6),
+         * the integrator's tolerance (1e-11) and the linearization's
+         * truncation error (the modes' error bound) are all far below
+         * it; a wrong closed-loop model (a controller state missing or
+         * mis-signed) moves the eigenvalues by far more. */
+        double d = cabs(fit - lam) / cabs(lam);
+        CHECK(rc == TS_OK && d < 1e-5, "%s: simulated decay %.6g 1/s, "
+              "frequency %.6g rad/s against the eigenvalue %.6g%+.6gi "
+              "(relative difference %.2g, <= 1e-5; error bound %.2g 1/s)",
+              what[c], creal(fit), cimag(fit), md->re, md->im, d,
+              md->error_bound);
+    }
+done:
+    ts_eigen_free(e);
+    ts_linear_free(lin);
+    solved_free(&s);
+}
+
+/* 7. A depth change with the controllers active. */
+
+/* Linear and nonlinear runs of a depth set point step of `step` m at 10
+ * links: the histories (free with ts_history_free). */
+static int depth_change(const solved *s, const ts_linear *lin, double step,
+                        double t_end, ts_history **hn, ts_history **hl)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_signal sg = {0};
+    sg.type = TS_SIGNAL_STEP;
+    sg.axis = TS_AXIS_INPUT;
+    snprintf(sg.input, sizeof sg.input, "aurora.depth.setpoint");
+    snprintf(sg.input_unit, sizeof sg.input_unit, "m");
+    sg.amplitude = step;
+    sg.start = 1.0;
+    sg.rise = 2.0;
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    o.t_end = t_end;
+    o.dt_sample = 0.05;
+    o.rel_tol = 1e-9;
+    o.abs_tol = 1e-12;
+    int N = ts_sim_nsamples(&o);
+    const ts_system *sys = ts_kernel_system(s->k);
+    *hn = ts_history_alloc(sys, N, &err);
+    *hl = ts_history_alloc(sys, N, &err);
+    int rc = ex && *hn && *hl ? ts_excitation_add(ex, &sg, &err) : -1;
+    if (rc == TS_OK)
+        rc = ts_simulate(s->k, ex, s->eq->y, &o, *hn, NULL, NULL, &err);
+    if (rc == TS_OK)
+        rc = ts_simulate_linear(s->k, lin, ex, NULL, &o, *hl, NULL, &err);
+    if (rc != TS_OK)
+        printf("  simulate: %s\n", err.msg);
+    ts_excitation_free(ex);
+    return rc;
+}
+
+/* Column of output `name` in h, -1 if none. */
+static int out_col(const ts_history *h, const char *name)
+{
+    for (int j = 0; j < h->noutput; j++)
+        if (!strcmp(h->output_name[j], name))
+            return j;
+    return -1;
+}
+
+static double out_at(const ts_history *h, int j, int i)
+{
+    return h->outputs[(size_t)h->noutput * i + j];
+}
+
+/* Largest |linear - nonlinear| of output j over the runs. */
+static double largest_difference(const ts_history *a, const ts_history *b,
+                                 int j)
+{
+    double d = 0;
+    for (int i = 0; i < a->nsamples && i < b->nsamples; i++)
+        d = fmax(d, fabs(out_at(a, j, i) - out_at(b, j, i)));
+    return d;
+}
+
+static void test_depth_change(void)
+{
+    solved s;
+    int rc = solve(base, &s);
+    ts_linear *lin = rc == TS_OK ? linearize(s.k, s.eq) : NULL;
+    CHECK(lin != NULL, "closed-loop trim and linear model");
+    if (!lin) {
+        solved_free(&s);
+        return;
+    }
+    /* Small steps: the difference is the nonlinearity. */
+    double dmax[2] = {NAN, NAN}, final[2] = {NAN, NAN};
+    const double steps[2] = {0.5, 0.25};
+    for (int c = 0; c < 2; c++) {
+        ts_history *hn = NULL, *hl = NULL;
+        rc = depth_change(&s, lin, steps[c], 15.0, &hn, &hl);
+        int jd = rc == TS_OK ? out_col(hn, "aurora.depth") : -1;
+        if (jd >= 0 && out_col(hl, "aurora.depth") == jd) {
+            dmax[c] = largest_difference(hn, hl, jd);
+            final[c] = out_at(hn, jd, hn->nsamples - 1) -
+                       out_at(hn, jd, 0);
+        }
+        ts_history_free(hn);
+        ts_history_free(hl);
+    }
+    /* Second order: the ratio 4 within [3, 5] (the next order and the
+     * integrators' 1e-9 tolerances shift it by far less); the step moves
+     * the fish (more than a fifth of it by 15 s). */
+    double ratio = dmax[0] / dmax[1];
+    CHECK(ratio > 3 && ratio < 5 && dmax[0] < 0.05 * steps[0] &&
+          final[0] > 0.2 * steps[0],
+          "depth set point steps 0.5 m and 0.25 m: the fish moved %.3g m; "
+          "largest linear-nonlinear difference of depth %.3g m and %.3g m, "
+          "ratio %.3f (second order: in [3, 5]; < 5 %% of the step)",
+          final[0], dmax[0], dmax[1], ratio);
+
+    /* A large step: saturation and rate limit in the nonlinear run. */
+    ts_history *hn = NULL, *hl = NULL;
+    rc = depth_change(&s, lin, 20.0, 8.0, &hn, &hl);
+    int jw = rc == TS_OK ? out_col(hn, "aurora.wing.deflection") : -1;
+    CHECK(jw >= 0, "the wing's deflection is recorded");
+    if (jw >= 0) {
+        const ts_vehicle *v = vehicle_of(base);
+        const ts_component *w = &v->component[component(v, "wing")];
+        double dmx = 0, rate = 0, lmx = 0;
+        for (int i = 0; i < hn->nsamples; i++) {
+            dmx = fmax(dmx, fabs(out_at(hn, jw, i)));
+            lmx = fmax(lmx, fabs(out_at(hl, jw, i)));
+            if (i > 0)
+                rate = fmax(rate, fabs(out_at(hn, jw, i) -
+                                       out_at(hn, jw, i - 1)) /
+                                      (hn->t[i] - hn->t[i - 1]));
+        }
+        /* The limits hold to rounding (1e-9 relative); the sampled rate
+         * is a mean over 0.05 s, at most the largest rate. Reaching 99 %
+         * of the limit shows the limit acts. */
+        CHECK(dmx <= w->limit * (1 + 1e-9) && dmx > 0.99 * w->limit,
+              "20 m step: the wing reaches %.4f deg, its limit %.4f deg",
+              dmx * 180 / M_PI, w->limit * 180 / M_PI);
+        CHECK(rate <= w->rate_limit * (1 + 1e-9) &&
+              rate > 0.9 * w->rate_limit,
+              "its sampled rate reaches %.4f deg/s, the rate limit %.4f "
+              "deg/s", rate * 180 / M_PI, w->rate_limit * 180 / M_PI);
+        CHECK(lmx > 1.5 * w->limit, "the linear model commands %.2f deg "
+              "(no limit)", lmx * 180 / M_PI);
+    }
+    ts_history_free(hn);
+    ts_history_free(hl);
+    ts_linear_free(lin);
+    solved_free(&s);
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
@@ -571,6 +884,8 @@ int main(void)
     test_open_loop();
     test_closed_static();
     test_margins();
+    test_decay();
+    test_depth_change();
     ts_system_free(base);
     ts_scene_free(sc);
     ts_units_free(u);

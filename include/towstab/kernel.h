@@ -99,6 +99,8 @@ TS_API const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
 TS_API int ts_kernel_input_find(const ts_kernel *k, const char *name);
 /* Unit of input j ("m", "m/s", "m/s^2", "rad"), NULL out of range. */
 TS_API const char *ts_kernel_input_unit(const ts_kernel *k, int j);
+/* 1 when input j is a control surface's deflection. */
+TS_API int ts_kernel_input_is_surface(const ts_kernel *k, int j);
 /* Offset of link `link`'s coordinates in q (2 for rigid, 3 for elastic). */
 TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 
@@ -196,9 +198,11 @@ TS_API void ts_kernel_set_controls(const ts_kernel *k, int v,
 /* Outputs of the vehicles, for the linear model's output rows: per
  * vehicle (in order) its depth (m), pitch, roll and yaw (rad, towstab/
  * vehicle.h ts_vehicle_result), then each loop's output (rad, the law's
- * value whatever the loop's mode). Their number, names
- * ("<vehicle>.depth", "<vehicle>.pitch", "<vehicle>.roll",
- * "<vehicle>.yaw", "<vehicle>.<loop>.output"; NULL out of range), the
+ * value whatever the loop's mode), then each control surface's deflection
+ * (rad, what the hydrodynamics sees: limited, through its actuator).
+ * Their number, names ("<vehicle>.depth", "<vehicle>.pitch",
+ * "<vehicle>.roll", "<vehicle>.yaw", "<vehicle>.<loop>.output",
+ * "<vehicle>.<surface>.deflection"; NULL out of range), the
  * index of a name (-1: none), and their values after an evaluation into
  * out[noutput]. */
 TS_API int ts_kernel_noutput(const ts_kernel *k);

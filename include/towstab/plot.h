@@ -109,6 +109,21 @@ typedef struct ts_plot_series {
                            the palette, modulo its size */
 } ts_plot_series;
 
+/* A body drawn with its attitude (a vehicle, towstab/vehicle.h
+ * ts_vehicle_outline): polylines of points in M (m), a point of NaNs
+ * between two. The pictures magnify every outline about its anchor by one
+ * common factor, so that the smallest is at least TS_PLOT_OUTLINE_MIN of
+ * the picture's extent (a towfish is small beside its cable), and say so
+ * in a note. */
+typedef struct ts_plot_outline {
+    int npoints;
+    const double *pts;     /* [3 npoints] */
+    double anchor[3];      /* fixed point of the magnification (the cable's
+                              attach point), m */
+} ts_plot_outline;
+
+#define TS_PLOT_OUTLINE_MIN 0.06
+
 /* A cable shape: nodes and the links between them, in the mean ship
  * frame M (x forward, y starboard, z down = depth; the water surface is
  * z = 0), as the equilibrium and the simulation report them. */
@@ -128,6 +143,9 @@ typedef struct ts_plot_shape {
     int style;               /* TS_PLOT_SOLID or TS_PLOT_DASHED (under
                                 water; parts in air are always dashed) */
     int color;               /* as ts_plot_series */
+    int noutlines;           /* bodies drawn with their attitude */
+    const ts_plot_outline *outlines; /* [noutlines]; in ts_plot_mode_shapes
+                                the equilibrium's */
 } ts_plot_shape;
 
 /* Views of ts_plot_shapes. */

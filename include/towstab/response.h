@@ -78,7 +78,7 @@ TS_API int ts_response_input_lookup(const ts_kernel *k, const char *name,
 
 /* The same for outputs: ts_response_output_find's names, or a vehicle's
  * outputs ("<vehicle>.depth", ".pitch", ".roll", ".yaw",
- * "<vehicle>.<loop>.output"). */
+ * "<vehicle>.<loop>.output", "<vehicle>.<surface>.deflection"). */
 TS_API int ts_response_output_lookup(const ts_kernel *k, const char *name,
                                      ts_output *out, ts_err *err);
 

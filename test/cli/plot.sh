@@ -93,7 +93,15 @@ if [ "$HAVE" = no ]; then
     ts equilibrium "$EX1" --quiet
     check "without PLplot: the analysis still runs (exit $status)" \
         bash -c "[ $status -eq 0 ] && grep -q '^converged' '$T/out'"
-    echo "$npass passed, $nfail failed"
+    # Vehicles with their attitude: the legend says how much they are
+# magnified (the SVG keeps the text).
+ts equilibrium examples/aurora_towfish.yaml --links 10 --quiet --plot "$T/veh"
+check "vehicle: equilibrium side and top views (exit $status)" \
+    [ $status -eq 0 -a -s "$T/veh/side.png" -a -s "$T/veh/top.png" ]
+check "vehicle: the legend names the vehicles at their attitude" \
+    grep -q 'vehicles at their attitude' "$T/veh/side.svg"
+
+echo "$npass passed, $nfail failed"
     [ $nfail -eq 0 ]
     exit
 fi
