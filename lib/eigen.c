@@ -14,9 +14,10 @@
  * whose largest eigenvalues mu = 1 / (lambda - sigma) belong to the
  * eigenvalues lambda nearest sigma. Real sigma: dnaupd/dneupd, mode 3;
  * complex sigma: znaupd/zneupd, mode 3 in complex arithmetic. OP is applied
- * with the structured solver of eigen_impl.h (one nq x nq LU of
- * P(sigma) = K + sigma C - sigma^2 I). ARPACK's Ritz vectors are checked
- * by their residual ||A v - lambda v||.
+ * with the sparse model (lib/shift.h: one KLU factorisation of the shifted
+ * node equations, O(nlinks) per application). ARPACK's Ritz vectors are
+ * checked by their residual ||A v - lambda v||, A applied through the
+ * same model.
  *
  * Modes: one eigenvalue of each conjugate pair (Im >= 0) and every real
  * eigenvalue; the `count` nearest sigma are kept and sorted by frequency.
@@ -33,8 +34,8 @@
 #include <string.h>
 
 #include "arpack.h"
-#include "eigen_impl.h"
 #include "lapack.h"
+#include "shift.h"
 #include "towstab/report.h"
 
 /* |Im lambda| below this fraction of |lambda| makes an eigenvalue from the
@@ -90,129 +91,6 @@ void ts_eigen_free(ts_eigen *e)
     free(e->vec_re);
     free(e->vec_im);
     free(e);
-}
-
-/* ---- Structured shift solver (eigen_impl.h) ---------------------------- */
-
-int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
-                     ts_err *err)
-{
-    memset(sh, 0, sizeof *sh);
-    int nq = lin->nq, n = lin->nstate, info = 0;
-    size_t nn = (size_t)nq * (size_t)nq;
-    sh->lin = lin;
-    sh->nq = nq;
-    sh->n = n;
-    sh->s = s;
-    sh->is_complex = cimag(s) != 0.0;
-    sh->ipiv = malloc((size_t)nq * sizeof(int));
-    sh->w = malloc((size_t)nq * sizeof(double complex));
-    sh->wr = malloc(2 * (size_t)nq * sizeof(double));
-    if (sh->is_complex)
-        sh->zlu = malloc(nn * sizeof(double complex));
-    else
-        sh->lu = malloc(nn * sizeof(double));
-    if (!sh->ipiv || !sh->w || !sh->wr || (!sh->zlu && !sh->lu)) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ENOMEM,
-                       "eigen: out of memory for the %d x %d shifted matrix",
-                       nq, nq);
-    }
-    /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
-    const double *A = lin->A;
-    double complex s2 = s * s;
-    for (int j = 0; j < nq; j++) {
-        const double *Kj = A + (size_t)j * n + nq;
-        const double *Cj = A + (size_t)(j + nq) * n + nq;
-        if (sh->is_complex) {
-            double complex *Pj = sh->zlu + (size_t)j * nq;
-            for (int i = 0; i < nq; i++)
-                Pj[i] = Kj[i] + s * Cj[i];
-            Pj[j] -= s2;
-        } else {
-            double *Pj = sh->lu + (size_t)j * nq;
-            double sr = creal(s);
-            for (int i = 0; i < nq; i++)
-                Pj[i] = Kj[i] + sr * Cj[i];
-            Pj[j] -= sr * sr;
-        }
-    }
-    if (sh->is_complex)
-        zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
-    else
-        dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
-    if (info < 0) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d",
-                       sh->is_complex ? "zgetrf" : "dgetrf", info);
-    }
-    if (info > 0) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ESINGULAR,
-                       "eigen: A - s I is singular at s = %g%+gi 1/s (an "
-                       "eigenvalue sits on the shift; move the target "
-                       "slightly)",
-                       creal(s), cimag(s));
-    }
-    return TS_OK;
-}
-
-void tsi_shift_free(tsi_shift *sh)
-{
-    free(sh->lu);
-    free(sh->zlu);
-    free(sh->ipiv);
-    free(sh->w);
-    free(sh->wr);
-    memset(sh, 0, sizeof *sh);
-}
-
-void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
-{
-    int nq = sh->nq, n = sh->n, one = 1, info = 0;
-    double sr = creal(sh->s), mone = -1.0, pone = 1.0;
-    const double *b1 = b, *b2 = b + nq;
-    double *x1 = x, *x2 = x + nq;
-    /* x1 = b2 + s b1 - C b1 */
-    for (int i = 0; i < nq; i++)
-        x1[i] = b2[i] + sr * b1[i];
-    dgemv_("N", &nq, &nq, &mone, sh->lin->A + (size_t)nq * n + nq, &n, b1,
-           &one, &pone, x1, &one, 1);
-    dgetrs_("N", &nq, &one, sh->lu, &nq, sh->ipiv, x1, &nq, &info, 1);
-    for (int i = 0; i < nq; i++)
-        x2[i] = b1[i] + sr * x1[i];
-}
-
-void tsi_shift_solve(tsi_shift *sh, const double complex *b,
-                     double complex *x)
-{
-    int nq = sh->nq, n = sh->n, one = 1, two = 2, info = 0;
-    double complex s = sh->s;
-    const double complex *b1 = b, *b2 = b + nq;
-    double complex *x1 = x, *x2 = x + nq;
-    /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
-     * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
-    double pone = 1.0, zero = 0.0;
-    dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
-           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->w, &two,
-           1, 1);
-    for (int i = 0; i < nq; i++)
-        x1[i] = b2[i] + s * b1[i] - sh->w[i];
-    if (sh->is_complex) {
-        zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
-    } else {
-        /* Real factors: solve the real and imaginary parts together. */
-        double *r = sh->wr;
-        for (int i = 0; i < nq; i++) {
-            r[i] = creal(x1[i]);
-            r[nq + i] = cimag(x1[i]);
-        }
-        dgetrs_("N", &nq, &two, sh->lu, &nq, sh->ipiv, r, &nq, &info, 1);
-        for (int i = 0; i < nq; i++)
-            x1[i] = r[i] + I * r[nq + i];
-    }
-    for (int i = 0; i < nq; i++)
-        x2[i] = b1[i] + s * x1[i];
 }
 
 /* ---- Candidate modes ----------------------------------------------------- */
@@ -531,61 +409,59 @@ out:
 
 /* ---- ARPACK -------------------------------------------------------------- */
 
-/* Residuals ||A v - lam v|| / (||A||_F |v|) and error estimates
- * ||E v|| / |v| (E the linearization's error estimate; kappa = 1 without a
- * left vector, exact for a normal matrix) of every candidate, with one
- * pass over A and one over E (BLAS dgemm on the real and imaginary parts
- * of all vectors at once): the matrices are the largest objects here, and
- * streaming them once per vector would dominate ARPACK's own cost. */
-static int batch_checks(const ts_linear *lin, cand_list *L)
+/* Checks of every ARPACK candidate through the sparse model (lib/shift.h:
+ * A and the linearization's error estimate dA applied with one
+ * factorisation of S_inf, O(nlinks) per vector): the residual
+ * r = ||A v - lam v|| / |v|, reported relative to |lam|, and the
+ * eigenvalue's first-order change by the error estimate, ||dA v|| / |v|
+ * (kappa = 1 without a left vector, exact for a normal matrix). The
+ * residual itself is the rounding allowance (Bauer-Fike with kappa = 1):
+ * an exact eigenpair of a matrix within ||r|| of A. */
+static int batch_checks(const ts_linear *lin, cand_list *L, ts_err *err)
 {
-    int n = lin->nstate, nq = lin->nq, m = 2 * L->n;
+    int n = lin->nstate, nq = lin->nq;
     if (L->n == 0)
         return TS_OK;
-    double *W = calloc((size_t)n * (size_t)m, sizeof(double));
-    double *AW = malloc((size_t)n * (size_t)m * sizeof(double));
-    double *EW = lin->Aerr ? malloc((size_t)nq * (size_t)m * sizeof(double))
-                           : NULL;
-    if (!W || !AW || (lin->Aerr && !EW)) {
-        free(W);
-        free(AW);
-        free(EW);
-        return TS_ENOMEM;
+    tsi_shift acc;
+    int rc = tsi_shift_factor_inf(&acc, lin, err);
+    if (rc != TS_OK)
+        return rc;
+    double *w = malloc(6 * (size_t)n * sizeof(double));
+    if (!w) {
+        tsi_shift_free(&acc);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
-    for (int c = 0; c < L->n; c++) {
-        const double complex *v = L->v + (size_t)L->c[c].vec * n;
-        for (int i = 0; i < n; i++) {
-            W[(size_t)(2 * c) * n + i] = creal(v[i]);
-            W[(size_t)(2 * c + 1) * n + i] = cimag(v[i]);
-        }
-    }
-    double pone = 1.0, zero = 0.0;
-    dgemm_("N", "N", &n, &m, &n, &pone, lin->A, &n, W, &n, &zero, AW, &n, 1,
-           1);
-    if (EW)
-        dgemm_("N", "N", &nq, &m, &n, &pone, lin->Aerr, &nq, W, &n, &zero, EW,
-               &nq, 1, 1);
+    double *vr = w, *vi = w + n, *ar = w + 2 * n, *ai = w + 3 * n;
+    double *er = w + 4 * n, *ei = w + 5 * n;
+    int with_err = lin->desc_err == lin->desc_err; /* not NaN */
     for (int c = 0; c < L->n; c++) {
         double complex lam = L->c[c].lam;
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
-        const double *ar = AW + (size_t)(2 * c) * n, *ai = ar + n;
+        for (int i = 0; i < n; i++) {
+            vr[i] = creal(v[i]);
+            vi[i] = cimag(v[i]);
+        }
+        tsi_shift_apply(&acc, vr, ar, 0);
+        tsi_shift_apply(&acc, vi, ai, 0);
         double r2 = 0, v2 = 0, e2 = 0;
         for (int i = 0; i < n; i++) {
-            double complex d = ar[i] + I * ai[i] - lam * v[i];
-            r2 += creal(d) * creal(d) + cimag(d) * cimag(d);
+            double complex dd = ar[i] + I * ai[i] - lam * v[i];
+            r2 += creal(dd) * creal(dd) + cimag(dd) * cimag(dd);
             v2 += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
         }
-        L->c[c].resid = sqrt(r2 / v2) / lin->a_norm;
-        if (EW) {
-            const double *er = EW + (size_t)(2 * c) * nq, *ei = er + nq;
-            for (int i = 0; i < nq; i++)
+        double res = sqrt(r2 / v2);
+        L->c[c].round = res;
+        L->c[c].resid = cabs(lam) > 0 ? res / cabs(lam) : res;
+        if (with_err) {
+            tsi_shift_apply(&acc, vr, er, 1);
+            tsi_shift_apply(&acc, vi, ei, 1);
+            for (int i = nq; i < n; i++)
                 e2 += er[i] * er[i] + ei[i] * ei[i];
             L->c[c].dlam = sqrt(e2 / v2);
         }
     }
-    free(W);
-    free(AW);
-    free(EW);
+    free(w);
+    tsi_shift_free(&acc);
     return TS_OK;
 }
 
@@ -703,8 +579,8 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
             j++;
         }
     }
-    if (batch_checks(lin, L) != TS_OK)
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    if (rc == TS_OK)
+        rc = batch_checks(lin, L, err);
 out:
     tsi_shift_free(&sh);
     free(resid);
@@ -819,8 +695,8 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
         }
         cand_add(L, d[j], re, im, NAN, NAN, NAN);
     }
-    if (batch_checks(lin, L) != TS_OK)
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    if (rc == TS_OK)
+        rc = batch_checks(lin, L, err);
 out:
     tsi_shift_free(&sh);
     free(resid);
@@ -865,8 +741,20 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                        ">= 1");
     ts_eig_method m = o.method;
     if (m == TS_EIG_AUTO)
-        m = o.count > 0 && n >= o.arpack_min_states ? TS_EIG_ARPACK
-                                                     : TS_EIG_LAPACK;
+        m = o.count > 0 && (n >= o.arpack_min_states || !lin->A)
+                ? TS_EIG_ARPACK
+                : TS_EIG_LAPACK;
+    if (m == TS_EIG_LAPACK && !lin->A)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method lapack needs the dense A of %d states "
+                       "(%.3g MB; linearize with model TS_LIN_DENSE or "
+                       "BOTH), or ask for a number of modes for the sparse "
+                       "method",
+                       n, 8e-6 * (double)n * (double)n);
+    if (m == TS_EIG_ARPACK && !lin->desc)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method arpack needs the sparse linear model "
+                       "(linearize with model TS_LIN_AUTO, SPARSE or BOTH)");
     if (m == TS_EIG_ARPACK && o.count == 0)
         return ts_fail(err, TS_EINVAL,
                        "eigen: method arpack needs a number of modes (count "
@@ -898,7 +786,6 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
      * the edge of the computed subset an uncomputed neighbour may be
      * nearer). */
     if (m != TS_EIG_LAPACK) {
-        double rnd = DBL_EPSILON * lin->a_norm;
         for (int i = 0; i < L.n; i++) {
             double complex li = L.c[i].lam;
             double gap = cimag(li) > 0 ? 2.0 * cimag(li) : INFINITY;
@@ -909,7 +796,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                 gap = fmin(gap, fmin(cabs(li - lk), cabs(li - conj(lk))));
             }
             double dl = isfinite(L.c[i].dlam) ? L.c[i].dlam : 0.0;
-            L.c[i].verr = gap > 0 ? (dl + rnd) / gap : INFINITY;
+            L.c[i].verr = gap > 0 ? (dl + L.c[i].round) / gap : INFINITY;
         }
     }
 
@@ -945,7 +832,6 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         ts_eigen_free(e);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
-    double round_err = DBL_EPSILON * lin->a_norm;
     e->neig = 0;
     e->max_real = -INFINITY;
     e->max_real_error = 0.0;
@@ -964,7 +850,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         md->residual = c->resid;
         md->vector_condition = c->vcond;
         md->vector_error = c->verr;
-        double rnd = m == TS_EIG_LAPACK ? c->round : round_err;
+        double rnd = c->round;
         md->error_bound =
             ERROR_SAFETY * ((isfinite(c->dlam) ? c->dlam : 0.0) + rnd);
         e->neig += im > 0 ? 2 : 1;

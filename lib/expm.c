@@ -25,12 +25,6 @@
 
 #include "lapack.h"
 
-void dgemm_(const char *transa, const char *transb, const int *m,
-            const int *n, const int *k, const double *alpha, const double *a,
-            const int *lda, const double *b, const int *ldb,
-            const double *beta, double *c, const int *ldc, size_t transa_len,
-            size_t transb_len);
-
 /* Higham 2005, table 2.3 (double precision). */
 static const double theta[5] = {1.495585217958292e-2, 2.539398330063230e-1,
                                  9.504178996162932e-1, 2.097847961257068e0,

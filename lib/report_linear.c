@@ -55,7 +55,14 @@ json_t *ts_report_linear_json(const ts_linear *lin, int matrices)
     json_object_set_new(o, "kink_tow", json_boolean(lin->kink_tow));
     json_object_set_new(o, "evaluations", json_integer(lin->evaluations));
     json_object_set_new(o, "threads", json_integer(lin->threads));
-    if (matrices) {
+    json_object_set_new(o, "model", json_string(lin->A ? (lin->desc ? "dense "
+                                                      "and sparse" : "dense")
+                                                : "sparse"));
+    json_object_set_new(o, "groups", json_integer(lin->groups));
+    json_object_set_new(o, "residual_evaluations",
+                        json_integer(lin->residual_evaluations));
+    json_object_set_new(o, "sparse_error", num(lin->desc_err));
+    if (matrices && lin->A && lin->B) {
         json_t *A = matrix_rows(lin->A, lin->nstate, lin->nstate,
                                 lin->nstate);
         json_t *B = matrix_rows(lin->B, lin->nstate, lin->ninput,

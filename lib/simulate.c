@@ -57,11 +57,8 @@
 
 #include "esdirk.h"
 #include "expm.h"
+#include "lapack.h"
 
-void dgemv_(const char *trans, const int *m, const int *n,
-            const double *alpha, const double *a, const int *lda,
-            const double *x, const int *incx, const double *beta, double *y,
-            const int *incy, size_t trans_len);
 
 /* Interpolation error constant of the cubic input hold (see above). */
 #define CUBIC_HOLD_ERR 5.1e-4
@@ -513,6 +510,7 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         ts_linearize_opts_default(&s->lopts);
         s->lopts.estimate_error = 0;
         s->lopts.threads = o->jacobian_threads;
+        s->lopts.model = TS_LIN_DENSE;
     }
     if (o->integrator == TS_INT_ESDIRK) {
         s->sd = tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk, s,
@@ -1101,6 +1099,10 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EINVAL, "simulate (linear): the model has %d "
                        "states, the kernel %d and the history %d links", n,
                        ts_kernel_nstate(k), h->nlinks);
+    if (!lin->A || !lin->B)
+        return ts_fail(err, TS_EINVAL, "simulate (linear): the linear "
+                       "simulation needs the dense A and B (linearize with "
+                       "model TS_LIN_DENSE or BOTH)");
     if (ex && ts_excitation_has_manoeuvre(ex))
         return ts_fail(err, TS_EDOMAIN, "simulate (linear): the linear model "
                        "has no frame inputs: a speed or turn-rate manoeuvre "

@@ -22,16 +22,17 @@
 #define DEFAULT_NEAR_COUNT 10
 
 int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
-                     int tensions, ts_equilibrium **eq, json_t **eqjson,
-                     ts_linear **lin, ts_err *err);
+                     ts_lin_model model, ts_equilibrium **eq,
+                     json_t **eqjson, ts_linear **lin, ts_err *err);
 
 /* Solve the equilibrium (printing its summary), then linearize about it
- * with a fresh kernel re-charted from the equilibrium's directions. On
- * failure returns the library code with the message in err; an
- * equilibrium that did not converge is never linearized. */
+ * with a fresh kernel re-charted from the equilibrium's directions,
+ * forming the models `model` asks for. On failure returns the library
+ * code with the message in err; an equilibrium that did not converge is
+ * never linearized. */
 int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
-                     int tensions, ts_equilibrium **eq, json_t **eqjson,
-                     ts_linear **lin, ts_err *err)
+                     ts_lin_model model, ts_equilibrium **eq,
+                     json_t **eqjson, ts_linear **lin, ts_err *err)
 {
     *lin = NULL;
     int rc = cli_equilibrium(sys, eo, 1, eq, eqjson, err);
@@ -51,7 +52,7 @@ int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
     }
     ts_linearize_opts lo;
     ts_linearize_opts_default(&lo);
-    lo.tensions = tensions;
+    lo.model = model;
     double t0 = cli_wall_now();
     rc = ts_linearize_equilibrium(k, *eq, &lo, l, err);
     double wall = cli_wall_now() - t0;
@@ -60,12 +61,19 @@ int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
         ts_linear_free(l);
         return rc;
     }
-    printf("linearized: %d states, %d inputs, %ld kernel evaluations on %d "
-           "thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
-           "||dA||_F %.3g)\n",
-           l->nstate, l->ninput, l->evaluations, l->threads,
-           l->threads == 1 ? "" : "s", wall * 1e3, l->trunc_err, l->a_scale,
-           l->trunc_norm);
+    if (l->A)
+        printf("linearized: %d states, %d inputs, %ld kernel evaluations on "
+               "%d thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
+               "||dA||_F %.3g)\n",
+               l->nstate, l->ninput, l->evaluations, l->threads,
+               l->threads == 1 ? "" : "s", wall * 1e3, l->trunc_err,
+               l->a_scale, l->trunc_norm);
+    else
+        printf("linearized: %d states, sparse model (%d perturbation groups, "
+               "%ld residual evaluations on %d thread%s), %.3f ms; relative "
+               "truncation error %.3g\n",
+               l->nstate, l->groups, l->residual_evaluations, l->threads,
+               l->threads == 1 ? "" : "s", wall * 1e3, l->desc_err);
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
         ts_report_node_name(sys, l->kink_node, name, sizeof name);
@@ -219,7 +227,8 @@ static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
     *json = NULL;
     *lin_out = NULL;
     *eig_out = NULL;
-    int rc = cli_linear_setup(sys, eqo, 0, &eq, &eqjson, &lin, err);
+    int rc = cli_linear_setup(sys, eqo, matrices ? TS_LIN_BOTH : TS_LIN_AUTO,
+                              &eq, &eqjson, &lin, err);
     if (rc != TS_OK) {
         json_decref(eqjson);
         ts_equilibrium_free(eq);

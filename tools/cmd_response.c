@@ -18,8 +18,8 @@
 
 /* Defined in cmd_modes.c: equilibrium (printed) and linearization. */
 int cli_linear_setup(const ts_system *sys, const ts_equilibrium_opts *eo,
-                     int tensions, ts_equilibrium **eq, json_t **eqjson,
-                     ts_linear **lin, ts_err *err);
+                     ts_lin_model model, ts_equilibrium **eq,
+                     json_t **eqjson, ts_linear **lin, ts_err *err);
 
 #define DEFAULT_FROM_HZ 0.01
 #define DEFAULT_TO_HZ 10.0
@@ -108,8 +108,7 @@ static int response_analysis(const ts_system *sys,
     ts_equilibrium *eq = NULL;
     json_t *eqjson = NULL;
     ts_linear *lin = NULL;
-    rc = cli_linear_setup(sys, eqo, out.kind == TS_OUT_TENSION, &eq, &eqjson,
-                          &lin, err);
+    rc = cli_linear_setup(sys, eqo, TS_LIN_SPARSE, &eq, &eqjson, &lin, err);
     if (rc == TS_OK)
         rc = ts_response_compute(sys, lin, input, &out, freq, rq->points, res,
                                  err);

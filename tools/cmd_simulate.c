@@ -473,6 +473,9 @@ static int simulate(const cli_ctx *ctx, const cli_sim_args *a,
         lin = ts_linear_alloc(k, &err);
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
+        /* The linear simulation uses the dense A and B, the response
+         * prediction of --compare the sparse model. */
+        lo.model = TS_LIN_BOTH;
         rc = lin ? ts_linearize_equilibrium(k, eq, &lo, lin, &err)
                  : TS_ENOMEM;
         if (rc) {

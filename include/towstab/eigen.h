@@ -10,12 +10,12 @@
  *    in Hz; 0 gives the lowest modes, smallest |lambda|) by implicitly
  *    restarted Arnoldi (ARPACK) in shift-invert mode, OP = (A - sigma I)^-1:
  *    dnaupd/dneupd for a real shift, znaupd/zneupd for a complex one. The
- *    operator uses the structure A = [[0, I], [K, C]]: (A - s I) x = b
- *    reduces to one nq x nq solve with P(s) = K + s C - s^2 I, factored
- *    once by LAPACK (dgetrf or zgetrf): O(nq^3) once, O(nq^2) per
- *    application.
+ *    operator is a solve with the sparse linear model (ts_linear.desc,
+ *    doc/linear.md section 2b): one KLU factorisation of the shifted node
+ *    equations, O(nlinks), then O(nlinks) per application.
  *  - auto: arpack when a number of modes is asked for and nstate >=
- *    arpack_min_states, else lapack.
+ *    arpack_min_states or the dense A was not formed, else lapack.
+ * lapack needs the dense A, arpack the sparse model.
  *
  * A mode is one eigenvalue with Im >= 0: one of each complex-conjugate
  * pair, or a real (non-oscillatory) eigenvalue. Units: lambda in 1/s,
@@ -67,12 +67,15 @@ typedef struct ts_mode {
                                linearization's error estimate E
                                (ts_linear.Aerr), |u^H E v| / |u^H v|
                                (lapack; ||E v|| / |v| with arpack, which
-                               has no left vector u), plus rounding
+                               has no left vector u, E the sparse model's
+                               error estimate), plus rounding
                                kappa eps ||A_bal|| (lapack: the balanced
                                matrix's 1-norm and condition number from
-                               dgeevx) or eps ||A||_F (arpack) */
-    double residual;        /* ||A v - lambda v|| / (||A||_F |v|); NaN when
-                               not computed (lapack: backward stable) */
+                               dgeevx) or the residual ||A v - lambda v||
+                               / |v| (arpack) */
+    double residual;        /* ||A v - lambda v|| / (|lambda| |v|); NaN
+                               when not computed (lapack: backward
+                               stable) */
     double vector_condition;/* conditioning of the right eigenvector: the
                                largest kappa_k ||A_bal||_1 / |lambda -
                                lambda_k| over the other eigenvalues k

@@ -1,0 +1,36 @@
+/* kernel_impl.h (internal): the kernel's node residual, for the sparse
+ * descriptor model of lib/descriptor.c (doc/linear.md, section 2).
+ *
+ * f(y, u) = the kernel's kinematics (angles to node positions, velocities
+ * and link directions), the link-local assembly of loads, nodal mass
+ * matrices and frame accelerations, then the O(nlinks) articulated
+ * elimination of the tensions. The residual below is the same assembly
+ * before any elimination: every node's equation of motion written with
+ * node positions, velocities and accelerations and the link tensions as
+ * unknowns, so that each equation involves only a node and its
+ * neighbours. */
+#ifndef TOWSTAB_KERNEL_IMPL_H
+#define TOWSTAB_KERNEL_IMPL_H
+
+#include "towstab/kernel.h"
+
+/* R[3 nnodes] (N) of node positions r[3 nnodes], velocities v[3 nnodes]
+ * relative to M (m, m/s; node 0 is the tow point, r_0 = point + tow
+ * displacement), accelerations a[3 nnodes] relative to M (m/s^2; a_0 is
+ * not used) and link tensions t[nlinks] (N, rigid and elastic links alike):
+ *   R_k = M_k (a_k + afr_k) - Q_k + t_l n_l - sum_c t_c n_c
+ * for every node k >= 1 (l the link ending at k, c the links leaving it,
+ * n = d / |d| from the positions); R_0 = 0. The loads Q, masses M and frame
+ * accelerations afr are those of ts_kernel_eval (the same code). At the
+ * state, tensions and accelerations of an evaluation of f, R = 0 to
+ * rounding. Uses the kernel's frame and bending scale; overwrites its
+ * last-evaluation results. Returns TS_OK, or TS_ESINGULAR when two ends
+ * of a link coincide. O(nlinks). */
+int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
+                        const double a[], const double t[], double R[]);
+
+/* Nodal 3x3 mass matrices [6 nnodes] (kg, symmetric packed xx, yy, zz, xy,
+ * xz, yz) of the last evaluation or residual: dR_k / da_k. */
+const double *tsi_kernel_mass(const ts_kernel *k);
+
+#endif
