@@ -156,6 +156,14 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
         printf(", %d restarts, %d operator applications", e->arpack_iterations,
                e->arpack_ops);
     printf("\n");
+    if (e->sweep_shifts > 0)
+        printf("rightmost search: %d shifts up to %.4g Hz found %d more "
+               "eigenvalues%s; the rightmost: Re %.6g 1/s at %.6g Hz\n",
+               e->sweep_shifts, e->top_hz, e->sweep_found,
+               e->sweep_failed || e->sweep_rejected ? " (some runs stopped "
+                                                      "short)"
+                                                    : "",
+               e->rightmost.re, e->rightmost.freq_hz);
     if (!quiet) {
         char desc[256];
         printf("\n%4s %14s %14s %12s %12s %10s  %s\n", "mode", "Re [1/s]",
@@ -181,7 +189,9 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
         }
         printf("\n");
     }
-    const char *scope = e->complete ? "" : " among the modes computed";
+    const char *scope = e->complete         ? ""
+                        : e->sweep_shifts > 0 ? " among the eigenvalues found"
+                                              : " among the modes computed";
     switch (e->verdict) {
     case TS_STABLE:
         printf("verdict: stable%s: max Re(lambda) = %.6g 1/s, error bound "
@@ -201,7 +211,7 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
                "stability (undamped or nearly so)\n",
                scope, e->max_real, e->max_real_error);
     }
-    if (!e->complete)
+    if (!e->complete && e->sweep_shifts == 0)
         printf("note: only %d of %d eigenvalues were computed (those nearest "
                "%.6g Hz); modes elsewhere are not covered by the verdict\n",
                e->neig, e->nstate, e->target_hz);
@@ -227,7 +237,9 @@ static int modes_analysis(const ts_system *sys, const ts_equilibrium_opts *eqo,
     *json = NULL;
     *lin_out = NULL;
     *eig_out = NULL;
-    int rc = cli_linear_setup(sys, eqo, matrices ? TS_LIN_BOTH : TS_LIN_AUTO,
+    /* LAPACK and --matrices need the dense model at any size. */
+    int dense = matrices || rq->eo.method == TS_EIG_LAPACK;
+    int rc = cli_linear_setup(sys, eqo, dense ? TS_LIN_BOTH : TS_LIN_AUTO,
                               &eq, &eqjson, &lin, err);
     if (rc != TS_OK) {
         json_decref(eqjson);
