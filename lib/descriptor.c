@@ -29,8 +29,13 @@
  * position step (6e-6 of the link length, a strain step of the same size)
  * never meets the slack kink of max(0, EA e): at EA = 1e9 N that step is a
  * tension step of 6000 N, far beyond a cable's tension. Its linear law is
- * exact instead: dt = (EA/l) n.dd + Cv (n.dd' + dd'.(I - n n^T) dd / |d|),
- * or dt = 0 when slack.
+ * written out instead: dt = (EA/l) n.dd + Cv n.dd', or dt = 0 when slack.
+ * In the kernel's coordinates that is EA de + Cv l de', exactly its
+ * tension's: n.dd = l de and n.dd' = l de' for any change of the link's
+ * angles and their rates. (The node-form term Cv dd'0.(I - n n^T) dd / |d|
+ * of a link that turns while stretching is left out: with the velocity map
+ * J dq' it would make the tension depend on the link's angles, which it
+ * does not, by Cv l |n'| per rad, a large error on a stiff link.)
  */
 #include "descriptor.h"
 
@@ -648,14 +653,9 @@ void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
 void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,
                        double complex g[3])
 {
-    const ts_link *L = &d->sys->links[l];
     const double *n = d->n + 3 * l;
-    const double *vk = d->v0 + 3 * L->lower, *vp = d->v0 + 3 * L->upper;
-    double dd[3] = {vk[0] - vp[0], vk[1] - vp[1], vk[2] - vp[2]};
-    double nd = n[0] * dd[0] + n[1] * dd[1] + n[2] * dd[2];
     for (int c = 0; c < 3; c++)
-        g[c] = (d->ka[l] + s * d->ca[l]) * n[c] +
-               d->ca[l] * (dd[c] - nd * n[c]) / d->len[l];
+        g[c] = (d->ka[l] + s * d->ca[l]) * n[c];
 }
 
 /* The symmetric 3x3 mass matrix entry (a, b) of node k. */

@@ -8,7 +8,7 @@
  *
  *     M dr'' + C dr' + K dr + N dt = -(K_0 + s C_0) u     (3 per free node)
  *     rigid link l:    n_l . (dr_k - dr_p) = 0             (1 per link)
- *     elastic link l:  dt_l = (EA/l) n.dd + Cv (n.dd' + dd'.(I - n n^T) dd / |d|)
+ *     elastic link l:  dt_l = (EA/l) n.dd + Cv n.dd'     (EA de + Cv l de')
  *
  * (k, p the link's lower and upper node, dd = dr_k - dr_p), i.e. the
  * descriptor system E x' = F x + G u with x = (dr, dv, dt),
@@ -132,8 +132,7 @@ void tsi_desc_fill_complex(const ts_descriptor *d, double complex s,
                            double Sz[]);
 
 /* The row of a taut elastic link l at shift s: its coefficients g[3] on
- * dr_lower (and -g on dr_upper), (EA/l + s Cv) n + Cv (I - n n^T) dd' /
- * |d| with dd' the base rate of the link vector. */
+ * dr_lower (and -g on dr_upper), (EA/l + s Cv) n. */
 void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,
                        double complex g[3]);
 

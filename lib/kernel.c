@@ -663,25 +663,29 @@ int ts_kernel_set_shape(ts_kernel *k, const double n[], const double strain[],
     return moved;
 }
 
+int tsi_kernel_set_link(ts_kernel *k, int l, const double d[3],
+                        const double ddot[3], double threshold, double y[])
+{
+    const ts_link *L = &k->sys->links[l];
+    double len = v3_norm(d), n[3], nd[3], along = 0.0;
+    for (int j = 0; j < 3; j++)
+        n[j] = d[j] / len;
+    if (ddot) {
+        along = v3_dot(n, ddot);
+        for (int j = 0; j < 3; j++)
+            nd[j] = (ddot[j] - along * n[j]) / len;
+    }
+    return set_one_link(k, l, n, ddot ? nd : NULL, len / L->length - 1.0,
+                        along / L->length, threshold, y);
+}
+
 int ts_kernel_set_links(ts_kernel *k, const double d[], const double ddot[],
                         double threshold, double y[])
 {
     int moved = 0;
-    for (int l = 0; l < k->nl; l++) {
-        const ts_link *L = &k->sys->links[l];
-        const double *dl = d + 3 * l, *ddl = ddot ? ddot + 3 * l : NULL;
-        double len = v3_norm(dl), n[3], nd[3], along = 0.0;
-        for (int j = 0; j < 3; j++)
-            n[j] = dl[j] / len;
-        if (ddl) {
-            along = v3_dot(n, ddl);
-            for (int j = 0; j < 3; j++)
-                nd[j] = (ddl[j] - along * n[j]) / len;
-        }
-        moved += set_one_link(k, l, n, ddl ? nd : NULL,
-                              len / L->length - 1.0, along / L->length,
-                              threshold, y);
-    }
+    for (int l = 0; l < k->nl; l++)
+        moved += tsi_kernel_set_link(k, l, d + 3 * l,
+                                     ddot ? ddot + 3 * l : NULL, threshold, y);
     return moved;
 }
 

@@ -33,4 +33,10 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
  * xz, yz) of the last evaluation or residual: dR_k / da_k. */
 const double *tsi_kernel_mass(const ts_kernel *k);
 
+/* Link l's coordinates in y[2 nq] (the others untouched) from its link
+ * vector d[3] (m) and rate ddot[3] (m/s; NULL: zero), as
+ * ts_kernel_set_links does for every link. Returns 1 when re-charted. */
+int tsi_kernel_set_link(ts_kernel *k, int l, const double d[3],
+                        const double ddot[3], double threshold, double y[]);
+
 #endif

@@ -287,8 +287,7 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
             sh->rhs[XR(k, c)] = -f[3 * k + c];
     /* Link rows: rigid n.(a_k - a_p) = 0; elastic -dt = -(the tension
      * change), EA de + Cv l de' from the coordinates themselves (exact,
-     * so zero for the error estimate; the displacement's terms
-     * dd'.(I - n n^T) dd / |d| vanish at rest and are left out). */
+     * so zero for the error estimate). */
     for (int l = 0; l < d->nl; l++) {
         double v = 0.0;
         if (d->kind[l] == TSI_LINK_TAUT && !err) {
