@@ -61,8 +61,7 @@ int ts_compare_fit_sinusoid(const double t[], const double x[], int n,
     return TS_OK;
 }
 
-/* Wrap degrees into (-180, 180]. */
-static double wrap_deg(double d)
+double ts_compare_wrap_deg(double d)
 {
     d = fmod(d, 360.0);
     if (d > 180.0)
@@ -95,7 +94,7 @@ static void run_stats(const double *t, const double *x, int n, double eq,
     r->mean_offset = c - eq;
     r->amplitude = a;
     r->amplitude_ratio = a / exc_amp;
-    r->phase_deg = wrap_deg((ph - exc_phase) * 180.0 / M_PI);
+    r->phase_deg = ts_compare_wrap_deg((ph - exc_phase) * 180.0 / M_PI);
 }
 
 int ts_compare_histories(const ts_system *sys, const ts_linear *lin,

@@ -29,14 +29,13 @@
  * cancellation at a coarse setting from being recommended. Across series
  * the recommendation with the least wall time wins.
  *
- * The built-in analyses rebuild the system with N links per cable
- * (ts_conv_system_with_links) or change a tolerance or step, and report
- * values that keep their meaning across resolutions: bodies and free ends
- * (not node indices), the top tension, the k-th lowest oscillatory mode,
- * and for a simulation the amplitude ratio, mean offset and phase of a
- * named output under a periodic excitation, fitted by least squares at
- * the excitation frequency over the window after the transient
- * (ts_compare_fit_sinusoid; Kamman & Nguyen 1990, example 4).
+ * The analyses swept are the pipelines of towstab/analysis.h
+ * (ts_analysis_sweep): they rerun an equilibrium, a mode analysis or a
+ * simulation at each setting and report values that keep their meaning
+ * across resolutions: bodies and free ends (not node indices), the top
+ * tension, the k-th lowest oscillatory mode, and for a simulation the
+ * amplitude ratio, mean offset and phase of a named output under a
+ * periodic excitation (Kamman & Nguyen 1990, example 4).
  */
 #include "towstab/converge.h"
 
@@ -49,8 +48,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "towstab/compare.h"
-#include "towstab/response.h"
 
 /* The finest two observed orders agree (asymptotic range) when they
  * differ by at most this fraction of the finer one. */
@@ -58,12 +55,6 @@
 /* Differences below the two rows' noise plus this many ulps of the values
  * are not resolved. */
 #define ROUND_ULPS 8.0
-/* Noise of an equilibrium value: this many times its relative residual
- * (at least 16 eps) times the length or force scale. */
-#define EQ_NOISE_FACTOR 10.0
-#define EQ_NOISE_MIN_REL (16.0 * DBL_EPSILON)
-/* Noise of a mode value in a step sweep, relative. */
-#define STEP_NOISE_REL (64.0 * DBL_EPSILON)
 /* Brent iterations for the observed order. */
 #define ORDER_MAXIT 200
 
@@ -100,11 +91,11 @@ static int check_setting(ts_conv_param p, double v, const char *what,
 {
     switch (p) {
     case TS_CONV_LINKS:
-        if (!(v >= 1 && v <= TS_CONV_MAX_LINKS) || v != floor(v))
+        if (!(v >= 1 && v <= TS_MAX_LINKS) || v != floor(v))
             return ts_fail(err, TS_EINVAL,
                            "%s: links must be whole numbers in [1, %d], "
                            "got %g",
-                           what, TS_CONV_MAX_LINKS, v);
+                           what, TS_MAX_LINKS, v);
         break;
     case TS_CONV_TOLERANCE:
         if (!(v > 0 && v < 1))
@@ -361,6 +352,10 @@ int ts_convergence_add_row(ts_convergence *c, int series, double setting,
         r->trust = *trust;
     else
         ts_trust_init(&r->trust);
+    /* A failed run is not trustworthy, whatever its statistics say. */
+    if (status != TS_OK)
+        ts_trust_fail(&r->trust, "the run failed: %s",
+                      message && message[0] ? message : ts_strerror(status));
     for (size_t i = 0; i < nv; i++) {
         r->values[i] = status == TS_OK && values ? values[i] : NAN;
         r->noise[i] = noise && noise[i] >= 0 ? noise[i] : 0.0;
@@ -704,6 +699,12 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
     }
     for (int i = 0; i < n && rc == TS_OK; i++) {
+        ts_progress p = {"sweep", i, n, "runs"};
+        if (c->progress && c->progress(&p, c->progress_data)) {
+            rc = ts_fail(err, TS_ECANCEL, "convergence: stopped on request "
+                         "after %d of %d runs", i, n);
+            break;
+        }
         for (int v = 0; v < c->nvalues; v++) {
             val[v] = NAN;
             noise[v] = 0.0;
@@ -727,6 +728,11 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         rc = ts_convergence_add_row(c, series, settings[i], st,
                                     st == TS_OK ? NULL : rerr.msg, wall,
                                     evals, &trust, val, noise, err);
+        if (rc == TS_OK && st == TS_ECANCEL) {
+            if (err)
+                *err = rerr;
+            rc = st;
+        }
     }
     free(val);
     free(noise);
@@ -738,604 +744,10 @@ int ts_convergence_sweep(ts_convergence *c, int series,
 ts_system *ts_conv_system_with_links(const ts_system *sys, int links,
                                      ts_err *err)
 {
-    if (links < 1 || links > TS_CONV_MAX_LINKS) {
-        ts_fail(err, TS_EINVAL, "links: expected 1 to %d per cable, got %d",
-                TS_CONV_MAX_LINKS, links);
-        return NULL;
-    }
-    for (int c = 0; c < sys->ncables; c++)
-        if (sys->cables[c].link_fraction) {
-            ts_fail(err, TS_EINVAL,
-                    "links: cables[%d] '%s' has link_lengths; a link sweep "
-                    "needs equal links (remove link_lengths)",
-                    c, sys->cables[c].name);
-            return NULL;
-        }
     ts_system *s = ts_system_copy(sys, err);
-    if (!s)
-        return NULL;
-    for (int c = 0; c < s->ncables; c++)
-        s->cables[c].nlinks = links;
-    if (ts_system_build(s, err) != TS_OK) {
+    if (s && ts_system_set_links(s, links, err) != TS_OK) {
         ts_system_free(s);
         return NULL;
     }
     return s;
-}
-
-static double total_length(const ts_system *sys)
-{
-    double L = 0;
-    for (int c = 0; c < sys->ncables; c++)
-        L += sys->cables[c].length;
-    return L;
-}
-
-/* Node of reported point i: body i, or the free end of the i-th cable
- * without a body at its end. */
-static int point_node(const ts_system *sys, int use_bodies, int i)
-{
-    if (use_bodies)
-        return ts_system_body_node(sys, i);
-    int k = 0;
-    for (int c = 0; c < sys->ncables; c++) {
-        if (sys->cables[c].to_body >= 0)
-            continue;
-        if (k++ != i)
-            continue;
-        for (int l = 0; l < sys->nlinks; l++)
-            if (sys->links[l].cable == c && sys->links[l].next < 0)
-                return sys->links[l].lower;
-    }
-    return -1;
-}
-
-/* The system of one run: a copy with N links, or the analysis' own. */
-static ts_system *run_system(const ts_system *base, ts_conv_param p,
-                             double setting, ts_err *err)
-{
-    if (p == TS_CONV_LINKS)
-        return ts_conv_system_with_links(base, (int)setting, err);
-    return (ts_system *)base;
-}
-
-/* ---- equilibrium ----------------------------------------------------- */
-
-typedef struct eq_ctx {
-    ts_system *sys;
-    ts_equilibrium_opts eo;
-    int use_bodies, npoints;
-    double length;
-} eq_ctx;
-
-static void eq_ctx_free(void *p)
-{
-    eq_ctx *x = p;
-    ts_system_free(x->sys);
-    free(x);
-}
-
-static int eq_run(void *ctx, ts_conv_param p, double setting,
-                  double values[], double noise[], long *evaluations,
-                  ts_trust *trust, ts_err *err)
-{
-    eq_ctx *x = ctx;
-    if (p == TS_CONV_STEP)
-        return ts_fail(err, TS_EINVAL,
-                       "equilibrium: there is no linearization step to "
-                       "sweep; sweep links or tolerance");
-    ts_equilibrium_opts o = x->eo;
-    if (p == TS_CONV_TOLERANCE)
-        o.tol = setting;
-    ts_system *sys = run_system(x->sys, p, setting, err);
-    if (!sys)
-        return err && err->code ? err->code : TS_EINVAL;
-    ts_kernel *k = ts_kernel_alloc(sys, err);
-    ts_equilibrium *eq = k ? ts_equilibrium_alloc(sys, err) : NULL;
-    int rc = eq ? ts_equilibrium_solve(k, &o, eq, err) : TS_ENOMEM;
-    if (eq) {
-        *evaluations += eq->evaluations;
-        ts_health_equilibrium(sys, eq, trust);
-    }
-    if (rc == TS_OK) {
-        double rel = fmax(eq->residual, EQ_NOISE_MIN_REL);
-        for (int i = 0; i < x->npoints; i++) {
-            int node = point_node(sys, x->use_bodies, i);
-            for (int j = 0; j < 3; j++) {
-                values[3 * i + j] = eq->positions[3 * node + j];
-                noise[3 * i + j] = EQ_NOISE_FACTOR * rel * x->length;
-            }
-        }
-        values[3 * x->npoints] = eq->top_tension;
-        noise[3 * x->npoints] = EQ_NOISE_FACTOR * rel * eq->force_scale;
-    }
-    ts_equilibrium_free(eq);
-    ts_kernel_free(k);
-    if (sys != x->sys)
-        ts_system_free(sys);
-    return rc;
-}
-
-/* Names of the reported points (bodies, or free ends) into an's values.
- * Returns the number of points, or -1 out of memory. */
-static int point_values(const ts_system *sys, ts_conv_analysis *an,
-                        int extra, int *use_bodies)
-{
-    *use_bodies = sys->nbodies > 0;
-    int np = 0;
-    if (*use_bodies)
-        np = sys->nbodies;
-    else
-        for (int c = 0; c < sys->ncables; c++)
-            np += sys->cables[c].to_body < 0;
-    an->nvalues = 3 * np + extra;
-    an->values = calloc((size_t)an->nvalues, sizeof *an->values);
-    if (!an->values)
-        return -1;
-    double L = total_length(sys);
-    static const char axis[3] = {'x', 'y', 'z'};
-    int i = 0;
-    for (int c = 0; !*use_bodies && c < sys->ncables; c++) {
-        if (sys->cables[c].to_body >= 0)
-            continue;
-        for (int j = 0; j < 3; j++) {
-            ts_conv_value *v = &an->values[3 * i + j];
-            snprintf(v->name, sizeof v->name, "%.60s.end.%c",
-                     sys->cables[c].name, axis[j]);
-            snprintf(v->unit, sizeof v->unit, "m");
-            v->scale = L;
-        }
-        i++;
-    }
-    for (int b = 0; *use_bodies && b < sys->nbodies; b++)
-        for (int j = 0; j < 3; j++) {
-            ts_conv_value *v = &an->values[3 * b + j];
-            snprintf(v->name, sizeof v->name, "%.63s.%c", sys->bodies[b].name,
-                     axis[j]);
-            snprintf(v->unit, sizeof v->unit, "m");
-            v->scale = L;
-        }
-    return np;
-}
-
-int ts_conv_equilibrium_analysis(const ts_system *sys,
-                                 const ts_equilibrium_opts *eo,
-                                 ts_conv_analysis *an, ts_err *err)
-{
-    memset(an, 0, sizeof *an);
-    eq_ctx *x = calloc(1, sizeof *x);
-    if (!x)
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    x->sys = ts_system_copy(sys, err);
-    if (!x->sys) {
-        free(x);
-        return err && err->code ? err->code : TS_ENOMEM;
-    }
-    if (eo)
-        x->eo = *eo;
-    else
-        ts_equilibrium_opts_default(&x->eo);
-    x->length = total_length(sys);
-    snprintf(an->name, sizeof an->name, "equilibrium");
-    an->ctx = x;
-    an->free_ctx = eq_ctx_free;
-    an->run = eq_run;
-    x->npoints = point_values(sys, an, 1, &x->use_bodies);
-    if (x->npoints < 0) {
-        ts_conv_analysis_free(an);
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    }
-    ts_conv_value *t = &an->values[3 * x->npoints];
-    snprintf(t->name, sizeof t->name, "top_tension");
-    snprintf(t->unit, sizeof t->unit, "N");
-    t->scale = 0.0;
-    return TS_OK;
-}
-
-/* ---- modes ----------------------------------------------------------- */
-
-typedef struct modes_ctx {
-    ts_system *sys;
-    ts_equilibrium_opts eo;
-    ts_linearize_opts lo;
-    ts_eigen_opts eig;
-    int have_eig;
-    int nmodes;
-} modes_ctx;
-
-static void modes_ctx_free(void *p)
-{
-    modes_ctx *x = p;
-    ts_system_free(x->sys);
-    free(x);
-}
-
-/* States from which the default uses ARPACK (ts_eigen_opts default). */
-#define MODES_ARPACK_STATES 1200
-
-static int modes_run(void *ctx, ts_conv_param p, double setting,
-                     double values[], double noise[], long *evaluations,
-                     ts_trust *trust, ts_err *err)
-{
-    modes_ctx *x = ctx;
-    ts_equilibrium_opts o = x->eo;
-    ts_linearize_opts lo = x->lo;
-    if (p == TS_CONV_TOLERANCE)
-        o.tol = setting;
-    if (p == TS_CONV_STEP)
-        lo.rel_step = setting;
-    ts_system *sys = run_system(x->sys, p, setting, err);
-    if (!sys)
-        return err && err->code ? err->code : TS_EINVAL;
-    ts_kernel *k = ts_kernel_alloc(sys, err);
-    ts_equilibrium *eq = k ? ts_equilibrium_alloc(sys, err) : NULL;
-    ts_linear *lin = NULL;
-    ts_eigen *e = NULL;
-    ts_mode_health *mh = NULL;
-    int rc = eq ? ts_equilibrium_solve(k, &o, eq, err) : TS_ENOMEM;
-    if (eq) {
-        *evaluations += eq->evaluations;
-        ts_health_equilibrium(sys, eq, trust);
-    }
-    if (rc == TS_OK) {
-        lin = ts_linear_alloc(k, err);
-        rc = lin ? ts_linearize_equilibrium(k, eq, &lo, lin, err) : TS_ENOMEM;
-    }
-    if (rc == TS_OK) {
-        *evaluations += lin->evaluations;
-        ts_eigen_opts eg;
-        if (x->have_eig) {
-            eg = x->eig;
-        } else {
-            ts_eigen_opts_default(&eg);
-            eg.count = lin->nstate >= MODES_ARPACK_STATES ? 2 * x->nmodes + 10
-                                                          : 0;
-            eg.vectors = 1;
-        }
-        rc = ts_eigen_solve(lin, &eg, &e, err);
-    }
-    if (rc == TS_OK) {
-        mh = malloc((size_t)(e->nmodes > 0 ? e->nmodes : 1) * sizeof *mh);
-        ts_trust all;
-        ts_trust_init(&all);
-        rc = mh ? ts_health_modes(sys, lin, e, mh, &all, err)
-                : ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-        if (rc == TS_OK) {
-            /* The row's health: the surface kink and the reported modes
-             * (a stiff axial mode far above them does not make their
-             * frequencies untrustworthy); the notes of the whole
-             * analysis. */
-            if (lin->kinks > lin->kink_tow)
-                ts_trust_fail(trust, "%s", all.reasons[0]);
-            for (int i = 0; i < all.nnotes; i++)
-                ts_trust_note(trust, "%s", all.notes[i]);
-            int k2 = 0;
-            for (int m = 0; m < e->nmodes && k2 < x->nmodes; m++) {
-                const ts_mode *md = &e->modes[m];
-                if (!(md->im > 0) ||
-                    !(md->damping_ratio < TS_CONV_MODE_DAMPING_MAX))
-                    continue;
-                double mag = hypot(md->re, md->im);
-                values[2 * k2] = md->freq_hz;
-                values[2 * k2 + 1] = md->damping_ratio;
-                if (p == TS_CONV_STEP) {
-                    noise[2 * k2] = STEP_NOISE_REL * fabs(md->freq_hz);
-                    noise[2 * k2 + 1] =
-                        STEP_NOISE_REL * fmax(fabs(md->damping_ratio), 1.0);
-                } else {
-                    noise[2 * k2] = md->error_bound / (2.0 * M_PI);
-                    noise[2 * k2 + 1] = md->error_bound / mag;
-                }
-                if (!mh[m].trustworthy)
-                    ts_trust_fail(trust, "mode%d (%.6g Hz): damping ratio "
-                                         "%.3g +- %.2g is not resolved",
-                                  k2 + 1, md->freq_hz, md->damping_ratio,
-                                  mh[m].damping_error);
-                k2++;
-            }
-        }
-    }
-    free(mh);
-    ts_eigen_free(e);
-    ts_linear_free(lin);
-    ts_equilibrium_free(eq);
-    ts_kernel_free(k);
-    if (sys != x->sys)
-        ts_system_free(sys);
-    return rc;
-}
-
-int ts_conv_modes_analysis(const ts_system *sys,
-                           const ts_equilibrium_opts *eo,
-                           const ts_linearize_opts *lo,
-                           const ts_eigen_opts *eig, int nmodes,
-                           ts_conv_analysis *an, ts_err *err)
-{
-    memset(an, 0, sizeof *an);
-    if (nmodes < 1 || nmodes > 1000)
-        return ts_fail(err, TS_EINVAL,
-                       "modes: expected 1 to 1000 modes to follow, got %d",
-                       nmodes);
-    modes_ctx *x = calloc(1, sizeof *x);
-    if (!x)
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    x->sys = ts_system_copy(sys, err);
-    if (!x->sys) {
-        free(x);
-        return err && err->code ? err->code : TS_ENOMEM;
-    }
-    if (eo)
-        x->eo = *eo;
-    else
-        ts_equilibrium_opts_default(&x->eo);
-    if (lo)
-        x->lo = *lo;
-    else
-        ts_linearize_opts_default(&x->lo);
-    x->lo.estimate_error = 1; /* the error bounds are the modes' noise */
-    if (eig) {
-        x->eig = *eig;
-        x->eig.vectors = 1;
-        x->have_eig = 1;
-    }
-    x->nmodes = nmodes;
-    snprintf(an->name, sizeof an->name, "modes");
-    an->ctx = x;
-    an->free_ctx = modes_ctx_free;
-    an->run = modes_run;
-    an->nvalues = 2 * nmodes;
-    an->values = calloc((size_t)an->nvalues, sizeof *an->values);
-    if (!an->values) {
-        ts_conv_analysis_free(an);
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    }
-    for (int m = 0; m < nmodes; m++) {
-        ts_conv_value *f = &an->values[2 * m], *z = f + 1;
-        snprintf(f->name, sizeof f->name, "mode%d.freq_hz", m + 1);
-        snprintf(f->unit, sizeof f->unit, "Hz");
-        f->scale = 0.0;
-        snprintf(z->name, sizeof z->name, "mode%d.damping_ratio", m + 1);
-        snprintf(z->unit, sizeof z->unit, "1");
-        z->scale = 1.0;
-    }
-    return TS_OK;
-}
-
-/* ---- simulate ---------------------------------------------------------- */
-
-/* Rounding noise of a simulated value: this many eps per sqrt(step). */
-#define SIM_ROUND_EPS 16.0
-/* Integrator noise of a simulated value in a links sweep: this many
- * times rel_tol of the value's scale. */
-#define SIM_TOL_NOISE 10.0
-
-typedef struct sim_ctx {
-    ts_system *sys;
-    ts_equilibrium_opts eo;
-    ts_sim_opts so;
-    const ts_excitation *ex;
-    char output[2 * TS_NAME_MAX + 16];
-    double transient;
-    int exc_index;
-    double length;
-} sim_ctx;
-
-static void sim_ctx_free(void *p)
-{
-    sim_ctx *x = p;
-    ts_system_free(x->sys);
-    free(x);
-}
-
-static double wrap_deg(double d)
-{
-    d = fmod(d, 360.0);
-    if (d > 180.0)
-        d -= 360.0;
-    if (d <= -180.0)
-        d += 360.0;
-    return d;
-}
-
-/* Fit the output and the excitation over the window of history h. */
-static int sim_fit(const sim_ctx *x, const ts_history *h,
-                   const ts_output *out, double eq_value, double values[],
-                   ts_err *err)
-{
-    const ts_signal *sg = ts_excitation_signal(x->ex, x->exc_index);
-    int first = 0;
-    while (first < h->nsamples && h->t[first] < x->transient - 1e-12)
-        first++;
-    int n = h->nsamples - first;
-    if (n < 3)
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: %d samples after the transient (%g s)", n,
-                       x->transient);
-    double *buf = malloc(3 * (size_t)n * sizeof(double));
-    if (!buf)
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    double *t = buf, *xo = buf + n, *xe = buf + 2 * n;
-    size_t stride = 3 * (size_t)h->nnodes;
-    for (int i = 0; i < n; i++) {
-        size_t s = (size_t)(first + i);
-        t[i] = h->t[s];
-        xo[i] = h->positions[stride * s + 3 * (size_t)out->node + out->comp];
-        xe[i] = h->input[TS_NINPUT * s + sg->axis];
-    }
-    double c, a, ph, ce, ae, phe;
-    int rc = ts_compare_fit_sinusoid(t, xe, n, sg->frequency, &ce, &ae, &phe,
-                                     err);
-    if (rc == TS_OK)
-        rc = ts_compare_fit_sinusoid(t, xo, n, sg->frequency, &c, &a, &ph,
-                                     err);
-    if (rc == TS_OK) {
-        values[0] = a / ae;
-        values[1] = c - eq_value;
-        values[2] = wrap_deg((ph - phe) * 180.0 / M_PI);
-    }
-    free(buf);
-    return rc;
-}
-
-static int sim_run(void *ctx, ts_conv_param p, double setting,
-                   double values[], double noise[], long *evaluations,
-                   ts_trust *trust, ts_err *err)
-{
-    sim_ctx *x = ctx;
-    if (p == TS_CONV_STEP)
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: there is no linearization step to sweep; "
-                       "sweep tolerances or links");
-    ts_sim_opts o = x->so;
-    if (p == TS_CONV_TOLERANCE) {
-        o.abs_tol = x->so.abs_tol * (setting / x->so.rel_tol);
-        o.rel_tol = setting;
-    }
-    ts_system *sys = run_system(x->sys, p, setting, err);
-    if (!sys)
-        return err && err->code ? err->code : TS_EINVAL;
-    ts_output out;
-    ts_kernel *k = NULL;
-    ts_equilibrium *eq = NULL;
-    ts_history *h = NULL;
-    ts_sim_stats st;
-    memset(&st, 0, sizeof st);
-    int rc = ts_response_output_find(sys, x->output, &out, err);
-    if (rc == TS_OK) {
-        k = ts_kernel_alloc(sys, err);
-        eq = k ? ts_equilibrium_alloc(sys, err) : NULL;
-        rc = eq ? ts_equilibrium_solve(k, &x->eo, eq, err) : TS_ENOMEM;
-        if (eq) {
-            *evaluations += eq->evaluations;
-            ts_trust eqt;
-            ts_trust_init(&eqt);
-            ts_health_equilibrium(sys, eq, &eqt);
-            ts_trust_merge(trust, "equilibrium: ", &eqt);
-        }
-        if (rc != TS_OK)
-            ts_err_prefix(err, "simulate: the initial equilibrium: ");
-    }
-    if (rc == TS_OK) {
-        h = ts_history_alloc(sys, ts_sim_nsamples(&o), err);
-        rc = h ? ts_simulate(k, x->ex, eq->y, &o, h, &st, NULL, err)
-               : TS_ENOMEM;
-        *evaluations += st.evaluations;
-        ts_health_simulation(&o, &st, trust);
-    }
-    if (rc == TS_OK)
-        rc = sim_fit(x, h, &out, eq->positions[3 * out.node + out.comp],
-                     values, err);
-    if (rc == TS_OK) {
-        double eq_noise = EQ_NOISE_FACTOR *
-                          fmax(eq->residual, EQ_NOISE_MIN_REL) * x->length;
-        double scale[3] = {fabs(values[0]), x->length, 360.0};
-        double round = SIM_ROUND_EPS * DBL_EPSILON *
-                       sqrt((double)(st.steps + st.rejected + 1));
-        for (int v = 0; v < 3; v++) {
-            noise[v] = round * scale[v];
-            if (p == TS_CONV_LINKS)
-                noise[v] += SIM_TOL_NOISE * o.rel_tol * scale[v];
-        }
-        noise[1] += eq_noise;
-    }
-    ts_history_free(h);
-    ts_equilibrium_free(eq);
-    ts_kernel_free(k);
-    if (sys != x->sys)
-        ts_system_free(sys);
-    return rc;
-}
-
-int ts_conv_simulate_analysis(const ts_system *sys,
-                              const ts_equilibrium_opts *eo,
-                              const ts_sim_opts *so, const ts_excitation *ex,
-                              const char *output, double transient,
-                              ts_conv_analysis *an, ts_err *err)
-{
-    memset(an, 0, sizeof *an);
-    int idx;
-    if (!ex || !ts_excitation_periodic(ex, &idx))
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: the convergence of an amplitude ratio "
-                       "needs a single periodic tow-point excitation (one "
-                       "sine or crank on tow.surge, tow.sway or tow.heave)");
-    ts_sim_opts o;
-    if (so)
-        o = *so;
-    else
-        ts_sim_opts_default(&o);
-    int rc = ts_sim_opts_check(&o, err);
-    if (rc)
-        return rc;
-    ts_output out;
-    if (!output ||
-        (rc = ts_response_output_find(sys, output, &out, err)) != TS_OK)
-        return rc ? rc
-                  : ts_fail(err, TS_EINVAL, "simulate: no output named");
-    if (out.kind != TS_OUT_POSITION)
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: output '%s' is a tension; the amplitude "
-                       "ratio is of a position <node>.x|y|z",
-                       output);
-    const ts_signal *sg = ts_excitation_signal(ex, idx);
-    double period = 1.0 / sg->frequency;
-    if (!(transient >= 0) || !(transient < o.t_end))
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: the transient must be in [0, %g) s (the "
-                       "run), got %g s",
-                       o.t_end, transient);
-    if (o.t_end - transient < period * (1.0 - 1e-9))
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: %g s are left after the transient, less "
-                       "than one period (%g s) of the %g Hz excitation",
-                       o.t_end - transient, period, sg->frequency);
-    if (o.dt_sample >
-        period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD * (1.0 + 1e-9))
-        return ts_fail(err, TS_EINVAL,
-                       "simulate: the sample interval %g s is too coarse "
-                       "for %g Hz; at most %g s (%d samples per period)",
-                       o.dt_sample, sg->frequency,
-                       period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
-                       TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
-    if ((rc = ts_excitation_check_span(ex, o.t_end, err)))
-        return rc;
-    sim_ctx *x = calloc(1, sizeof *x);
-    if (!x)
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    x->sys = ts_system_copy(sys, err);
-    if (!x->sys) {
-        free(x);
-        return err && err->code ? err->code : TS_ENOMEM;
-    }
-    if (eo)
-        x->eo = *eo;
-    else
-        ts_equilibrium_opts_default(&x->eo);
-    x->so = o;
-    x->ex = ex;
-    snprintf(x->output, sizeof x->output, "%s", out.name);
-    x->transient = transient;
-    x->exc_index = idx;
-    x->length = total_length(sys);
-    snprintf(an->name, sizeof an->name, "simulate");
-    an->ctx = x;
-    an->free_ctx = sim_ctx_free;
-    an->run = sim_run;
-    an->nvalues = 3;
-    an->values = calloc(3, sizeof *an->values);
-    if (!an->values) {
-        ts_conv_analysis_free(an);
-        return ts_fail(err, TS_ENOMEM, "convergence: out of memory");
-    }
-    static const char *const suffix[3] = {"amplitude_ratio", "mean_offset",
-                                          "phase_deg"};
-    static const char *const unit[3] = {"1", "m", "deg"};
-    double scale[3] = {0.0, sg->amplitude, 360.0};
-    for (int v = 0; v < 3; v++) {
-        ts_conv_value *V = &an->values[v];
-        snprintf(V->name, sizeof V->name, "%.70s.%s", out.name, suffix[v]);
-        snprintf(V->unit, sizeof V->unit, "%s", unit[v]);
-        V->scale = scale[v];
-    }
-    return TS_OK;
 }

@@ -1,5 +1,5 @@
 /* descriptor.h (internal): the sparse linear model of the node residual
- * (doc/linear.md, section 2; MODEL.md section 6).
+ * (doc/linear.md, section 2; doc/model.md section 6).
  *
  * The kernel's equations before elimination (lib/kernel_impl.h) couple a
  * node only with its neighbours: with the node displacements dr, their

@@ -1,5 +1,5 @@
 /* eigen.c: modes of the linear model z' = A z (towstab/eigen.h;
- * MODEL.md section 6; doc/linear.md).
+ * doc/model.md section 6; doc/linear.md).
  *
  * lapack: dgeevx on a copy of A (balancing, Hessenberg QR; ~25 n^3 flops
  * with both eigenvector sets) gives every eigenvalue with its right
@@ -24,6 +24,10 @@
  * Conjugate pairs found by the complex solver are matched one to one, so a
  * double eigenvalue (the in-plane and out-of-plane modes of a hanging
  * chain) stays two modes.
+ *
+ * One module, though long: LAPACK and ARPACK answer the same request with
+ * the same mode table, error bounds, verdict and descriptions, which are
+ * most of the file.
  */
 #include "towstab/eigen.h"
 
@@ -36,7 +40,7 @@
 #include "arpack.h"
 #include "lapack.h"
 #include "shift.h"
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 /* |Im lambda| below this fraction of |lambda| makes an eigenvalue from the
  * complex solver real (its imaginary part is rounding). */
@@ -308,10 +312,10 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     double *scale = NULL, *rconde = NULL, *rcondv = NULL, *kap0 = NULL;
     int rc = TS_OK;
     if (!a || !vl || !vr || !wr || !wi) {
-        rc = ts_fail(err, TS_ENOMEM,
-                     "eigen: out of memory for dense %d x %d eigenvectors "
-                     "(use --method arpack with --count)",
-                     n, n);
+        rc = ts_fail_nomem(err, 3 * 8.0 * (double)nn, "fewer links, or "
+                           "method arpack with a count (the modes near a "
+                           "target)", "eigen: out of memory for dense %d x "
+                           "%d eigenvectors", n, n);
         goto out;
     }
     memcpy(a, lin->A, nn * sizeof(double));
@@ -333,7 +337,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     lwork = info == 0 ? (int)wq : n * (n + 6);
     work = malloc((size_t)lwork * sizeof(double));
     if (!work) {
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for dgeevx work");
+        rc = ts_fail_nomem(err, 8.0 * lwork, "fewer links, or method arpack "
+                           "with a count", "eigen: out of memory for LAPACK "
+                           "dgeevx's work of the %d x %d matrix", n, n);
         goto out;
     }
     dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo, &ihi,
@@ -442,6 +448,81 @@ out:
  * (kappa = 1 without a left vector, exact for a normal matrix). The
  * residual itself is the rounding allowance (Bauer-Fike with kappa = 1):
  * an exact eigenpair of a matrix within ||r|| of A. */
+/* The same checks with the dense A and its error estimate (a system the
+ * sparse model does not cover: vehicles), with one pass over A and one
+ * over E (BLAS dgemm on the real and imaginary parts of all the unchecked
+ * vectors at once). */
+/* A candidate's residual ||A v - lam v|| / |v| (round) and relative to
+ * |lam| (resid) from A v = ar + i ai; returns |v|^2. */
+static double set_residual(cand *c, const double complex *v,
+                           const double *ar, const double *ai, int n)
+{
+    double r2 = 0, v2 = 0;
+    for (int i = 0; i < n; i++) {
+        double complex d = ar[i] + I * ai[i] - c->lam * v[i];
+        r2 += creal(d) * creal(d) + cimag(d) * cimag(d);
+        v2 += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
+    }
+    double res = sqrt(r2 / v2);
+    c->round = res;
+    c->resid = cabs(c->lam) > 0 ? res / cabs(c->lam) : res;
+    return v2;
+}
+
+static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
+{
+    int n = lin->nstate, nlow = n - lin->nq, m = 0;
+    for (int c = 0; c < L->n; c++)
+        m += L->c[c].checked ? 0 : 2;
+    if (m == 0)
+        return TS_OK;
+    double *W = calloc((size_t)n * (size_t)m, sizeof(double));
+    double *AW = malloc((size_t)n * (size_t)m * sizeof(double));
+    double *EW = lin->Aerr ? malloc((size_t)nlow * (size_t)m * sizeof(double))
+                           : NULL;
+    if (!W || !AW || (lin->Aerr && !EW)) {
+        free(W);
+        free(AW);
+        free(EW);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
+    for (int c = 0, j = 0; c < L->n; c++) {
+        if (L->c[c].checked)
+            continue;
+        const double complex *v = L->v + (size_t)L->c[c].vec * n;
+        for (int i = 0; i < n; i++) {
+            W[(size_t)j * n + i] = creal(v[i]);
+            W[(size_t)(j + 1) * n + i] = cimag(v[i]);
+        }
+        j += 2;
+    }
+    double pone = 1.0, zero = 0.0;
+    dgemm_("N", "N", &n, &m, &n, &pone, lin->A, &n, W, &n, &zero, AW, &n, 1,
+           1);
+    if (EW)
+        dgemm_("N", "N", &nlow, &m, &n, &pone, lin->Aerr, &nlow, W, &n, &zero,
+               EW, &nlow, 1, 1);
+    for (int c = 0, j = 0; c < L->n; c++) {
+        if (L->c[c].checked)
+            continue;
+        L->c[c].checked = 1;
+        const double complex *v = L->v + (size_t)L->c[c].vec * n;
+        const double *ar = AW + (size_t)j * n, *ai = ar + n;
+        double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
+        if (EW) {
+            const double *er = EW + (size_t)j * nlow, *ei = er + nlow;
+            for (int i = 0; i < nlow; i++)
+                e2 += er[i] * er[i] + ei[i] * ei[i];
+            L->c[c].dlam = sqrt(e2 / v2);
+        }
+        j += 2;
+    }
+    free(W);
+    free(AW);
+    free(EW);
+    return TS_OK;
+}
+
 static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
                         ts_err *err)
 {
@@ -456,7 +537,6 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
         if (L->c[c].checked)
             continue;
         L->c[c].checked = 1;
-        double complex lam = L->c[c].lam;
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
         for (int i = 0; i < n; i++) {
             vr[i] = creal(v[i]);
@@ -464,15 +544,7 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
         }
         tsi_shift_apply(acc, vr, ar, 0);
         tsi_shift_apply(acc, vi, ai, 0);
-        double r2 = 0, v2 = 0, e2 = 0;
-        for (int i = 0; i < n; i++) {
-            double complex dd = ar[i] + I * ai[i] - lam * v[i];
-            r2 += creal(dd) * creal(dd) + cimag(dd) * cimag(dd);
-            v2 += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
-        }
-        double res = sqrt(r2 / v2);
-        L->c[c].round = res;
-        L->c[c].resid = cabs(lam) > 0 ? res / cabs(lam) : res;
+        double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
         if (with_err) {
             tsi_shift_apply(acc, vr, er, 1);
             tsi_shift_apply(acc, vi, ei, 1);
@@ -483,6 +555,46 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
     }
     free(w);
     return TS_OK;
+}
+
+ts_eig_method ts_eigen_method(int n, const ts_eigen_opts *o)
+{
+    if (o->method != TS_EIG_AUTO)
+        return o->method;
+    return o->count > 0 && n >= o->arpack_min_states ? TS_EIG_ARPACK
+                                                      : TS_EIG_LAPACK;
+}
+
+static int arpack_sizes(int n, int count, int *nev, int *ncv, ts_err *err);
+
+int ts_eigen_check(int n, const ts_eigen_opts *opts, ts_err *err)
+{
+    ts_eigen_opts o;
+    if (opts)
+        o = *opts;
+    else
+        ts_eigen_opts_default(&o);
+    if (o.count < 0 || o.count > n)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: count must be in [0, %d] (0: all modes; the "
+                       "system has %d states), got %d",
+                       n, n, o.count);
+    if (!(o.target_hz >= 0) || !isfinite(o.target_hz))
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: target must be a frequency >= 0 Hz, got %g",
+                       o.target_hz);
+    if (!(o.arpack_tol >= 0) || o.arpack_max_iter < 1)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: arpack_tol must be >= 0 and arpack_max_iter "
+                       ">= 1");
+    if (ts_eigen_method(n, &o) != TS_EIG_ARPACK)
+        return TS_OK;
+    if (o.count == 0)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method arpack needs a number of modes (count "
+                       "> 0); it finds the modes nearest a target, not all");
+    int nev, ncv;
+    return arpack_sizes(n, o.count, &nev, &ncv, err);
 }
 
 static int arpack_sizes(int n, int count, int *nev, int *ncv, ts_err *err)
@@ -883,7 +995,8 @@ static int sweep_new(cand_list *L, int from, double complex sigma,
             if (cabs(dot) > SWEEP_SAME_VECTOR * sqrt(ni * nj))
                 c->sweep = 2;
         }
-        if (c->sweep == 1 && (best < 0 || creal(c->lam) > creal(L->c[best].lam)))
+        if (c->sweep == 1 &&
+            (best < 0 || creal(c->lam) > creal(L->c[best].lam)))
             best = i;
     }
     return best;
@@ -1056,24 +1169,15 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         ts_eigen_opts_default(&o);
     *out = NULL;
     int n = lin->nstate;
-    if (o.count < 0 || o.count > n)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: count must be in [0, %d] (0: all modes), got "
-                       "%d",
-                       n, o.count);
-    if (!(o.target_hz >= 0) || !isfinite(o.target_hz))
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: target must be a frequency >= 0 Hz, got %g",
-                       o.target_hz);
-    if (!(o.arpack_tol >= 0) || o.arpack_max_iter < 1)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: arpack_tol must be >= 0 and arpack_max_iter "
-                       ">= 1");
-    ts_eig_method m = o.method;
-    if (m == TS_EIG_AUTO)
-        m = o.count > 0 && (n >= o.arpack_min_states || !lin->A)
-                ? TS_EIG_ARPACK
-                : TS_EIG_LAPACK;
+    int rc = ts_eigen_check(n, &o, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_eig_method m = ts_eigen_method(n, &o);
+    /* Without the dense A (a large system) the modes come from ARPACK on
+     * the sparse model. */
+    if (o.method == TS_EIG_AUTO && m == TS_EIG_LAPACK && !lin->A &&
+        o.count > 0)
+        m = TS_EIG_ARPACK;
     if (m == TS_EIG_LAPACK && !lin->A)
         return ts_fail(err, TS_EINVAL,
                        "eigen: method lapack needs the dense A of %d states "
@@ -1081,14 +1185,10 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                        "BOTH), or ask for a number of modes for the sparse "
                        "method",
                        n, 8e-6 * (double)n * (double)n);
-    if (m == TS_EIG_ARPACK && !lin->desc)
+    if (m == TS_EIG_ARPACK && !lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
-                       "eigen: method arpack needs the sparse linear model "
-                       "(linearize with model TS_LIN_AUTO, SPARSE or BOTH)");
-    if (m == TS_EIG_ARPACK && o.count == 0)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: method arpack needs a number of modes (count "
-                       "> 0); it finds the modes nearest a target, not all");
+                       "eigen: method arpack needs a linear model (sparse "
+                       "or dense)");
     ts_eigen *e = calloc(1, sizeof *e);
     if (!e)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
@@ -1096,7 +1196,6 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     e->method = m;
     e->target_hz = o.target_hz;
     cand_list L = {0};
-    int rc;
     if (m == TS_EIG_LAPACK)
         rc = solve_lapack(lin, &L, err);
     else if (o.target_hz == 0.0)
@@ -1110,7 +1209,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     }
 
     e->top_hz = NAN;
-    if (m == TS_EIG_ARPACK && o.rightmost)
+    if (m == TS_EIG_ARPACK && o.rightmost && lin->desc)
         rc = rightmost_search(lin, &o, e, &L, err);
     if (rc != TS_OK) {
         cand_free(&L);
@@ -1155,10 +1254,14 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     } else {
         for (int i = 0; i < L.n; i++)
             L.c[i].checked = i < keep ? 0 : -1;
-        tsi_shift acc;
-        rc = tsi_shift_factor_inf(&acc, lin, err);
-        if (rc == TS_OK)
-            rc = batch_checks(lin, &acc, &L, err);
+        tsi_shift acc = {0};
+        if (lin->desc) {
+            rc = tsi_shift_factor_inf(&acc, lin, err);
+            if (rc == TS_OK)
+                rc = batch_checks(lin, &acc, &L, err);
+        } else {
+            rc = dense_checks(lin, &L, err);
+        }
         /* The rightmost of the search, checked one by one: a Ritz pair
          * whose residual shows it has not converged (a run stopped at its
          * restart limit in a cluster) is no eigenvalue and is dropped. */
@@ -1179,7 +1282,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                 t++;
             }
         }
-        if (acc.numeric)
+        if (acc.numeric || acc.lu || acc.zlu)
             tsi_shift_free(&acc);
         for (int i = 0; i < L.n; i++)
             if (L.c[i].checked == 1 && L.c[i].sweep != 3)
@@ -1471,7 +1574,7 @@ void ts_eigen_describe(const ts_system *sys, const ts_linear *lin,
     else
         snprintf(plane, sizeof plane, "mixed (%.0f%% out-of-plane)",
                  100 * share);
-    ts_report_node_name(sys, inode, node, sizeof node);
+    ts_system_node_name(sys, inode, node, sizeof node);
     snprintf(buf, size, "%s%s, cable '%s' order %d (%d node%s), largest at %s",
              e->modes[m].im > 0 ? "" : "real: ", plane, sys->cables[cb].name,
              crossings + 1, crossings, crossings == 1 ? "" : "s", node);

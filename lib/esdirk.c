@@ -322,7 +322,9 @@ static tsi_esdirk *alloc_common(int n, tsi_ode_fn f, tsi_ode_jac jac,
         !(s->A = lsys ? sm_new(s->ctx) : SUNDenseMatrix(n, n, s->ctx)) ||
         !(s->ls = lsys ? ss_new(s, s->ctx) : lu_new(n, s->ctx))) {
         tsi_esdirk_free(s);
-        ts_fail(err, TS_ENOMEM, "esdirk: out of memory for %d states", n);
+        ts_fail_nomem(err, 2 * 8.0 * n * (double)n, "fewer links, or an "
+                      "explicit integrator (rk8pd)", "esdirk: out of memory "
+                      "for the %d x %d Jacobian and its LU", n, n);
         return NULL;
     }
     N_VConst(0.0, s->y);

@@ -5,7 +5,7 @@
  * closed form, so the kernel's input u = (x, x', x'') is exactly consistent
  * (a finite-difference velocity would break the rigid links' kinematics).
  *  - sine: x = A sin th, th = w t + phase.
- *  - slider crank (MODEL.md section 8): with S = sqrt(l^2 - A^2 sin^2 th),
+ *  - slider crank (doc/model.md section 8): with S = sqrt(l^2 - A^2 sin^2 th),
  *      x   = A cos th + l - S,
  *      x'  = w (-A sin th + A^2 sin th cos th / S),
  *      x'' = w^2 (-A cos th + A^2 cos 2th / S + (A^2 sin th cos th)^2 / S^3).
@@ -21,11 +21,20 @@
  *    and x'' are continuous; evaluated without an accelerator (binary
  *    search) so that evaluation does not write and the excitation can be
  *    shared read-only.
+ *  - sum: x_j = r s_j with s_j = sum_k (a_jk cos w_k t - b_jk sin w_k t),
+ *    s_j' = -sum_k w_k (a_jk sin + b_jk cos), s_j'' = -sum_k w_k^2 (a_jk cos
+ *    - b_jk sin), and the fade-in r = S5(t / rise): x' = r' s + r s',
+ *    x'' = r'' s + 2 r' s' + r s''. The axes of one sum share a group: one
+ *    sin/cos pair per component and time serves all of them.
  * Manoeuvres: V(t) = V0 + sum dV(t), Omega(t) = Omega0 + sum dOmega(t), with
  * their rates from the same derivatives; the heading psi(t) = Omega0 t +
  * sum int dOmega uses J(xi) = int_0^xi I = xi^5/2 - xi^6/2 + xi^7/7 on [0,1]
  * and 1/7 + xi (xi - 1)/2 beyond. A current c fixed in inertial space has,
  * in M rotated by psi about +z, the components R_z(psi)^T c.
+ *
+ * One module, though long: the signal types share one evaluation of
+ * displacement, velocity and acceleration, one spec parser and one
+ * description; a signal is a few dozen lines of each.
  */
 #include "towstab/excitation.h"
 
@@ -45,12 +54,33 @@
 /* A series may end this little before t_end (relative) and still cover. */
 #define SPAN_RTOL 1e-12
 
+/* The components of a sum, shared by the signals of its axes. */
+typedef struct sum_group {
+    int n;                 /* components */
+    double *omega;         /* [n] rad/s */
+    double *c;             /* [6 n]: re, im of axes 0, 1, 2 per component */
+    double rise;           /* fade-in, s (0: none) */
+    int axes[3];           /* 1: the group drives tow axis j */
+} sum_group;
+
 struct ts_excitation {
     int n, cap;
     ts_signal *sig;        /* [cap] */
     gsl_spline **spline;   /* [cap], non-NULL for series */
     double *series_dt;     /* [cap] smallest sample spacing of a series */
+    sum_group **sum;       /* [cap], the group of a sum signal */
+    char *sum_lead;        /* [cap] 1: the first signal of its group (which
+                              owns and evaluates it) */
 };
+
+static void sum_group_free(sum_group *g)
+{
+    if (!g)
+        return;
+    free(g->omega);
+    free(g->c);
+    free(g);
+}
 
 ts_excitation *ts_excitation_alloc(ts_err *err)
 {
@@ -64,13 +94,60 @@ void ts_excitation_free(ts_excitation *ex)
 {
     if (!ex)
         return;
-    for (int i = 0; i < ex->n; i++)
+    for (int i = 0; i < ex->n; i++) {
         if (ex->spline[i])
             gsl_spline_free(ex->spline[i]);
+        if (ex->sum_lead[i])
+            sum_group_free(ex->sum[i]);
+    }
     free(ex->sig);
     free(ex->spline);
     free(ex->series_dt);
+    free(ex->sum);
+    free(ex->sum_lead);
     free(ex);
+}
+
+ts_excitation *ts_excitation_copy(const ts_excitation *ex, ts_err *err)
+{
+    ts_excitation *c = ts_excitation_alloc(err);
+    if (!c || !ex)
+        return c;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    int rc = TS_OK;
+    for (int i = 0; i < ex->n && rc == TS_OK; i++) {
+        if (ex->sum[i] && !ex->sum_lead[i])
+            continue; /* added with its group's lead */
+        if (ex->sum[i]) {
+            const sum_group *g = ex->sum[i];
+            double *re = malloc(3 * (size_t)g->n * sizeof *re);
+            double *im = malloc(3 * (size_t)g->n * sizeof *im);
+            if (!re || !im)
+                rc = ts_fail(err, TS_ENOMEM, "excitation: out of memory");
+            for (int k = 0; rc == TS_OK && k < g->n; k++)
+                for (int j = 0; j < 3; j++) {
+                    re[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j] : 0.0;
+                    im[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j + 1] : 0.0;
+                }
+            if (rc == TS_OK)
+                rc = ts_excitation_add_sum(c, g->n, g->omega, re, im, g->rise,
+                                           err);
+            free(re);
+            free(im);
+        } else if (ex->spline[i]) {
+            const gsl_spline *sp = ex->spline[i];
+            rc = ts_excitation_add_series(c, ex->sig[i].axis, (int)sp->size,
+                                          sp->x, sp->y, err);
+        } else {
+            rc = ts_excitation_add(c, &ex->sig[i], err);
+        }
+    }
+    gsl_set_error_handler(old);
+    if (rc != TS_OK) {
+        ts_excitation_free(c);
+        return NULL;
+    }
+    return c;
 }
 
 const char *ts_axis_name(ts_axis a)
@@ -93,6 +170,7 @@ const char *ts_signal_type_name(ts_signal_type t)
     case TS_SIGNAL_STEP: return "step";
     case TS_SIGNAL_RAMP: return "ramp";
     case TS_SIGNAL_SERIES: return "csv";
+    case TS_SIGNAL_SUM: return "sum";
     }
     return "?";
 }
@@ -113,7 +191,13 @@ static int grow(ts_excitation *ex, ts_err *err)
     double *dt = realloc(ex->series_dt, (size_t)cap * sizeof *dt);
     if (dt)
         ex->series_dt = dt;
-    if (!s || !sp || !dt)
+    sum_group **sg = realloc(ex->sum, (size_t)cap * sizeof *sg);
+    if (sg)
+        ex->sum = sg;
+    char *sl = realloc(ex->sum_lead, (size_t)cap);
+    if (sl)
+        ex->sum_lead = sl;
+    if (!s || !sp || !dt || !sg || !sl)
         return ts_fail(err, TS_ENOMEM, "excitation: out of memory");
     ex->cap = cap;
     return TS_OK;
@@ -186,6 +270,8 @@ int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
     ex->sig[ex->n] = *s;
     ex->spline[ex->n] = NULL;
     ex->series_dt[ex->n] = INFINITY;
+    ex->sum[ex->n] = NULL;
+    ex->sum_lead[ex->n] = 0;
     ex->n++;
     return TS_OK;
 }
@@ -241,8 +327,99 @@ int ts_excitation_add_series(ts_excitation *ex, ts_axis axis, int n,
     ex->sig[ex->n] = s;
     ex->spline[ex->n] = sp;
     ex->series_dt[ex->n] = dtmin;
+    ex->sum[ex->n] = NULL;
+    ex->sum_lead[ex->n] = 0;
     ex->n++;
     return TS_OK;
+}
+
+int ts_excitation_add_sum(ts_excitation *ex, int n, const double omega[],
+                          const double re[], const double im[], double rise,
+                          ts_err *err)
+{
+    if (n < 1)
+        return ts_fail(err, TS_EINVAL, "excitation sum: at least one "
+                       "component is needed, got %d", n);
+    if (!(rise >= 0) || !isfinite(rise))
+        return ts_fail(err, TS_EINVAL, "excitation sum: the fade-in time "
+                       "must be >= 0 s, got %g s", rise);
+    double ms[3] = {0, 0, 0}, wmax = 0;
+    for (int k = 0; k < n; k++) {
+        if (!isfinite(omega[k]))
+            return ts_fail(err, TS_EINVAL, "excitation sum: component %d: "
+                           "frequency must be finite, got %g rad/s", k,
+                           omega[k]);
+        wmax = fmax(wmax, fabs(omega[k]));
+        for (int j = 0; j < 3; j++) {
+            double a = re[3 * k + j], b = im[3 * k + j];
+            if (!isfinite(a) || !isfinite(b))
+                return ts_fail(err, TS_EINVAL, "excitation sum: component "
+                               "%d, %s: the amplitude overflows (is not a "
+                               "finite number): the wave heights or the "
+                               "motions per metre of wave are too large",
+                               k, ts_axis_name((ts_axis)j));
+            ms[j] += 0.5 * (a * a + b * b);
+        }
+    }
+    int naxes = (ms[0] > 0) + (ms[1] > 0) + (ms[2] > 0);
+    if (naxes == 0)
+        return ts_fail(err, TS_EINVAL, "excitation sum: every coefficient "
+                       "is zero: no axis is driven");
+    sum_group *g = calloc(1, sizeof *g);
+    if (g) {
+        g->omega = malloc((size_t)n * sizeof(double));
+        g->c = malloc(6 * (size_t)n * sizeof(double));
+    }
+    if (!g || !g->omega || !g->c) {
+        sum_group_free(g);
+        return ts_fail(err, TS_ENOMEM, "excitation: out of memory");
+    }
+    g->n = n;
+    g->rise = rise;
+    memcpy(g->omega, omega, (size_t)n * sizeof(double));
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < 3; j++) {
+            g->c[6 * k + 2 * j] = re[3 * k + j];
+            g->c[6 * k + 2 * j + 1] = im[3 * k + j];
+        }
+    for (int j = 0; j < 3; j++)
+        g->axes[j] = ms[j] > 0;
+    /* Room for every axis first, so that a failure adds nothing (grow()
+     * enlarges a full table). */
+    while (ex->cap < ex->n + naxes) {
+        int keep = ex->n;
+        ex->n = ex->cap;
+        int rc = grow(ex, err);
+        ex->n = keep;
+        if (rc) {
+            sum_group_free(g);
+            return rc;
+        }
+    }
+    int lead = 1;
+    for (int j = 0; j < 3; j++) {
+        if (!g->axes[j])
+            continue;
+        ts_signal sg = {0};
+        sg.type = TS_SIGNAL_SUM;
+        sg.axis = (ts_axis)j;
+        sg.amplitude = sqrt(ms[j]);
+        sg.frequency = wmax / (2.0 * M_PI);
+        sg.rise = rise;
+        ex->sig[ex->n] = sg;
+        ex->spline[ex->n] = NULL;
+        ex->series_dt[ex->n] = INFINITY;
+        ex->sum[ex->n] = g;
+        ex->sum_lead[ex->n] = (char)lead;
+        lead = 0;
+        ex->n++;
+    }
+    return TS_OK;
+}
+
+int ts_excitation_sum_components(const ts_excitation *ex, int i)
+{
+    return i >= 0 && i < ex->n && ex->sum[i] ? ex->sum[i]->n : 0;
 }
 
 /* Skip blanks. */
@@ -365,6 +542,8 @@ static unsigned keys_for(ts_signal_type t, int tow)
                B(K_DURATION) | B(K_RISE);
     case TS_SIGNAL_SERIES:
         return B(K_FILE);
+    case TS_SIGNAL_SUM: /* built by ts_excitation_add_sum, not parsed */
+        return 0;
     }
     return 0;
 #undef B
@@ -670,6 +849,8 @@ static void signal_raw(const ts_excitation *ex, int i, double amp, double t,
         *a = amp / (T * tau) * (s5d(x1) - s5d(x2));
         return;
     }
+    case TS_SIGNAL_SUM: /* evaluated by group (sum_eval) */
+        break;
     case TS_SIGNAL_SERIES: {
         const gsl_spline *sp = ex->spline[i];
         double lo = s->start, hi = s->start + s->duration;
@@ -730,6 +911,37 @@ static double signal_integral(const ts_signal *s, double amp, double t)
     return amp * tau * tau / T * (s5ii(x1) - s5ii(x2));
 }
 
+/* Add the displacement, velocity and acceleration of sum group g at t to
+ * u (each driven axis). */
+static void sum_eval(const sum_group *g, double t, double u[TS_NINPUT])
+{
+    double x[3] = {0, 0, 0}, v[3] = {0, 0, 0}, a[3] = {0, 0, 0};
+    for (int k = 0; k < g->n; k++) {
+        double w = g->omega[k], sn = sin(w * t), cs = cos(w * t);
+        const double *c = g->c + 6 * k;
+        for (int j = 0; j < 3; j++) {
+            double re = c[2 * j], im = c[2 * j + 1];
+            double p = re * cs - im * sn, q = re * sn + im * cs;
+            x[j] += p;
+            v[j] -= w * q;
+            a[j] -= w * w * p;
+        }
+    }
+    double r = 1.0, r1 = 0.0, r2 = 0.0;
+    if (g->rise > 0) {
+        double xi = t / g->rise;
+        r = s5(xi);
+        r1 = s5d(xi) / g->rise;
+        r2 = s5dd(xi) / (g->rise * g->rise);
+    }
+    for (int j = 0; j < 3; j++)
+        if (g->axes[j]) {
+            u[j] += r * x[j];
+            u[3 + j] += r1 * x[j] + r * v[j];
+            u[6 + j] += r2 * x[j] + 2.0 * r1 * v[j] + r * a[j];
+        }
+}
+
 int ts_excitation_nsignals(const ts_excitation *ex) { return ex->n; }
 
 const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i)
@@ -754,6 +966,11 @@ void ts_excitation_input(const ts_excitation *ex, double t,
         int ax = ex->sig[i].axis;
         if (!is_tow_axis(ax))
             continue;
+        if (ex->sig[i].type == TS_SIGNAL_SUM) {
+            if (ex->sum_lead[i])
+                sum_eval(ex->sum[i], t, u);
+            continue;
+        }
         double x, v, a;
         signal_eval(ex, i, ex->sig[i].amplitude, t, &x, &v, &a);
         u[ax] += x;
@@ -831,6 +1048,8 @@ int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
         if (s->type == TS_SIGNAL_STEP) {
             all[m++] = s->start;
             all[m++] = s->start + s->rise;
+        } else if (s->type == TS_SIGNAL_SUM && s->rise > 0) {
+            all[m++] = s->rise;
         } else if (s->type == TS_SIGNAL_RAMP) {
             all[m++] = s->start;
             all[m++] = s->start + s->rise;
@@ -870,11 +1089,96 @@ double ts_excitation_time_scale(const ts_excitation *ex)
         case TS_SIGNAL_STEP:
         case TS_SIGNAL_RAMP: v = s->rise; break;
         case TS_SIGNAL_SERIES: v = ex->series_dt[i]; break;
+        case TS_SIGNAL_SUM:
+            v = s->frequency > 0 ? 1.0 / (2.0 * M_PI * s->frequency)
+                                 : INFINITY;
+            if (s->rise > 0 && s->rise < v)
+                v = s->rise;
+            break;
         }
         if (v < ts)
             ts = v;
     }
     return ts;
+}
+
+/* Largest slopes of the quintic S(xi) = 10 xi^3 - 15 xi^4 + 6 xi^5:
+ * S' at xi = 1/2, S'' at xi = (3 - sqrt 3) / 6. */
+#define QUINTIC_SLOPE 1.875
+#define QUINTIC_CURVE 5.7735
+
+void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
+                         ts_motion_bound *m)
+{
+    m->speed = fabs(base->speed);
+    m->turn_rate = fabs(base->turn_rate);
+    m->tow_speed = m->tow_accel = 0.0;
+    for (int i = 0; ex && i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        double A = fabs(s->amplitude), w = 2.0 * M_PI * s->frequency;
+        double v = 0.0, a = 0.0;
+        switch (s->type) {
+        case TS_SIGNAL_SINE:
+            v = A * w;
+            a = A * w * w;
+            break;
+        case TS_SIGNAL_CRANK: {
+            double f = 1.0 + A / sqrt(s->rod * s->rod - A * A);
+            v = A * w * f;
+            a = A * w * w * f * f;
+            break;
+        }
+        case TS_SIGNAL_STEP:
+            v = QUINTIC_SLOPE * A / s->rise;
+            a = QUINTIC_CURVE * A / (s->rise * s->rise);
+            break;
+        case TS_SIGNAL_RAMP:
+            v = A / s->duration;
+            a = QUINTIC_SLOPE * v / s->rise;
+            break;
+        case TS_SIGNAL_SUM: {
+            /* Sum of |c_k| w_k (and w_k^2) on this axis, plus the fade-in's
+             * slopes times the sum of |c_k|. */
+            const sum_group *g = ex->sum[i];
+            int j = (int)s->axis;
+            double c = 0.0;
+            for (int k = 0; k < g->n; k++) {
+                double ck = hypot(g->c[6 * k + 2 * j], g->c[6 * k + 2 * j + 1]);
+                double wk = fabs(g->omega[k]);
+                c += ck;
+                v += ck * wk;
+                a += ck * wk * wk;
+            }
+            if (g->rise > 0) {
+                a += 2.0 * QUINTIC_SLOPE / g->rise * v +
+                     QUINTIC_CURVE / (g->rise * g->rise) * c;
+                v += QUINTIC_SLOPE / g->rise * c;
+            }
+            break;
+        }
+        case TS_SIGNAL_SERIES: {
+            const gsl_spline *sp = ex->spline[i];
+            double vprev = 0.0;
+            for (size_t k = 1; k < sp->size; k++) {
+                double dt = sp->x[k] - sp->x[k - 1];
+                double vk = (sp->y[k] - sp->y[k - 1]) / dt;
+                v = fmax(v, fabs(vk));
+                if (k > 1)
+                    a = fmax(a, fabs(vk - vprev) / dt);
+                vprev = vk;
+            }
+            break;
+        }
+        }
+        if (s->axis == TS_AXIS_SPEED)
+            m->speed += A;
+        else if (s->axis == TS_AXIS_TURN_RATE)
+            m->turn_rate += A;
+        else {
+            m->tow_speed += v;
+            m->tow_accel += a;
+        }
+    }
 }
 
 int ts_excitation_check_span(const ts_excitation *ex, double t_end,
@@ -953,6 +1257,11 @@ void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
         snprintf(buf, size, "%s series (cubic spline) on [%.6g, %.6g] s, "
                  "spacing >= %.6g s", an, s->start, s->start + s->duration,
                  ex->series_dt[i]);
+        return;
+    case TS_SIGNAL_SUM:
+        snprintf(buf, size, "%s sum of %d sinusoids up to %.6g Hz, rms %.6g "
+                 "m, fade-in %.6g s", an, ex->sum[i]->n, s->frequency,
+                 s->amplitude, s->rise);
         return;
     }
     snprintf(buf, size, "%s ?", an);

@@ -1,4 +1,4 @@
-/* forces.h: the external loads of MODEL.md section 3, shared by the kernel
+/* forces.h: the external loads of doc/model.md section 3, shared by the kernel
  * and the equilibrium solver so that the physics is written once (internal).
  *
  * Conventions: M frame (x forward, y starboard, z down), SI. The fluid is at
@@ -15,7 +15,7 @@
 #include "vec3.h"
 
 /* Velocity relative to the water of a point at r moving at rd relative to
- * M: w = V e_x + Omega e_z x r + rd - v_c (MODEL.md section 1). */
+ * M: w = V e_x + Omega e_z x r + rd - v_c (doc/model.md section 1). */
 static inline void tsi_rel_velocity(const ts_frame *f, const double r[3],
                                     const double rd[3], double w[3])
 {
@@ -38,7 +38,7 @@ static inline void tsi_frame_accel(const ts_frame *f, const double r[3],
 }
 
 /* Fraction of a straight link below the surface z = 0, linear in the end
- * depths (MODEL.md section 3). Kinked where an end crosses z = 0. */
+ * depths (doc/model.md section 3). Kinked where an end crosses z = 0. */
 static inline double tsi_link_submerged(double z_upper, double z_lower)
 {
     if (z_upper >= 0 && z_lower >= 0)
@@ -65,7 +65,7 @@ static inline double tsi_sphere_submerged(double z, double D)
     return h * h * (3 * R - h) / (4 * R * R * R);
 }
 
-/* Loading functions of Driscoll & Nahon as used by Buckham et al. (seed 001),
+/* Loading functions of Driscoll & Nahon as used by Buckham et al. 2003,
  * h the angle between link and flow in [0, pi/2]. */
 static inline double tsi_loading_fp(double h)
 {
@@ -80,8 +80,9 @@ static inline double tsi_loading_fq(double h)
 }
 
 /* Total external load on a link of direction n (weight, buoyancy, drag;
- * MODEL.md section 3): to be split half to each end. `w` is the velocity of
- * the link midpoint relative to the water, z_upper/z_lower the end depths.
+ * doc/model.md section 3): to be split half to each end. `w` is the
+ * velocity of the link midpoint relative to the water, z_upper/z_lower the
+ * end depths.
  * Writes the submerged fraction to *s. */
 static inline void tsi_link_load(const ts_link *L, double rho, double g,
                                  const double n[3], double z_upper,
@@ -212,7 +213,7 @@ static inline void tsi_body_added_mass(const ts_body *b, double rho,
 
 /* Bending at a joint between link a (above, direction na) and link b
  * (below, nb) with U = 1/2 (EI / lbar) alpha^2, alpha the angle between
- * them (MODEL.md section 3). Forces -dU/dr on the upper node of a (Fi),
+ * them (doc/model.md section 3). Forces -dU/dr on the upper node of a (Fi),
  * the joint (Fj) and the lower node of b (Fk), with lengths la, lb. */
 static inline void tsi_bending(double ei, double la, double lb,
                                const double na[3], const double nb[3],

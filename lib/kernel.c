@@ -1,4 +1,4 @@
-/* kernel.c: f(y, u) of the rigid-link tree (MODEL.md sections 1-4).
+/* kernel.c: f(y, u) of the rigid-link tree (doc/model.md sections 1-4, 8).
  *
  * Algorithm, O(nlinks) per call:
  *  1. Kinematics, tow point to free ends: link directions n, e1, e2 and
@@ -21,21 +21,90 @@
  *     first, without fill-in.
  *  4. Angles: r''_k = a_k - afr_k, n'' = (r''_k - r''_p) / l and
  *     t1'' = (e1.n'' + 2 s2 t1' t2') / c2, t2'' = e2.n'' - c2 s2 t1'^2.
+ *
+ * Vehicles (doc/kernel.md, "Vehicles"; lib/vehicle.h for their physics):
+ * a vehicle hangs on a spherical joint at its node i, the lower end of the
+ * link `in` above it, and adds its three 1-2-3 angles to q. Its body
+ * equations about the attach point A in body axes are M6 (a_A, alpha) =
+ * G + (F_j, 0) + the child cables that start at its points P (each a
+ * rank-one update J_P^T n n^T J_P / D like a child link of a node, J_P =
+ * [I, -S(rho_P)]). Eliminating the six body accelerations leaves a_A =
+ * W F_j + a_free with W = J M6^-1 J^T (J = [I 0]), so the node sees
+ * the articulated mass M_i + W^-1 and the load Q_i + W^-1 a_free: the
+ * tree recursion is unchanged and each vehicle costs O(1). Going down,
+ * F_j = W^-1 (a_A - a_free) gives the body's accelerations and the
+ * accelerations of the points its child cables start from. Controller
+ * states (integrators, actuators) follow q' in y.
+ *
+ * One module, though long: f(y, u) is one recursion over the tree (down
+ * for the kinematics, up for the articulated masses, down again for the
+ * accelerations) whose rigid, elastic, bending and vehicle parts share
+ * every per-node and per-link array of one pass.
  */
 #include "towstab/kernel.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "forces.h"
 #include "kernel_impl.h"
 #include "vec3.h"
+#include "vehicle.h"
+
+/* One vehicle's coupling data. */
+typedef struct veh {
+    int body, node, qoff;     /* body index, its node, offset in q */
+    const ts_vehicle *d;
+    double mass;
+    double chart[9];          /* body chart to M: R = chart R123(theta) */
+    int charted;
+    tsi_vehicle_ws *ws;
+    tsi_vehicle_state st;
+    double M6[36];            /* spatial inertia about A, body axes, with
+                                 the point masses of child cables' ends */
+    double M6h[36], L6[36];   /* with the child cables eliminated; its
+                                 Cholesky factor */
+    double G[6];              /* known generalised force about A */
+    double Winv[6];           /* W^-1 in M (sym3) */
+    double afree[3];          /* a_free in M */
+    double a6[6];             /* (a_A, alpha), body axes */
+    double alpha_m[3];        /* alpha in M */
+    double Fj[3];             /* joint force on the body, M */
+    /* Controller layout: -1 where there is none. */
+    int xi_off[TS_VEHICLE_MAX_LOOPS];      /* integrator, offset in c */
+    int act_off[TS_VEHICLE_MAX_COMPONENTS];/* actuator, offset in c */
+    int in_surf[TS_VEHICLE_MAX_COMPONENTS];/* input index */
+    int in_loop[TS_VEHICLE_MAX_LOOPS];     /* input index */
+    int mode[TS_VEHICLE_MAX_LOOPS];        /* TSI_LOOP_* */
+    double frozen[TS_VEHICLE_MAX_LOOPS];   /* frozen outputs */
+    double meas[4], rate[4];
+    double out[TS_VEHICLE_MAX_LOOPS];
+    double delta[TS_VEHICLE_MAX_COMPONENTS];
+    double xi_dot[TS_VEHICLE_MAX_LOOPS];
+    double act_dot[TS_VEHICLE_MAX_COMPONENTS];
+    double lever;             /* tsi_vehicle_lever, at least 1 m */
+} veh;
 
 struct ts_kernel {
     const ts_system *sys;
     int nl, nn;
     int nq;            /* generalised coordinates: 2 per rigid link, 3 per
-                          elastic link */
+                          elastic link, then 3 per vehicle */
+    int nql;           /* the links' share of nq */
+    int nc;            /* controller states, after q' in y */
+    int nin;           /* inputs: TS_NINPUT, the vehicles' control
+                          surfaces, their loops */
+    double *uzero;     /* [nin] zero input */
+    int nv;            /* vehicles */
+    veh *veh;          /* [nv] */
+    int *node_veh;     /* [nn] vehicle at the node, -1 */
+    /* Links that start at a point P of a vehicle (up_body >= 0): */
+    double *ur, *urd;  /* [3 nl] P's position and velocity rel. to M */
+    double *uafr, *ua; /* [3 nl] P's frame and inertial acceleration */
+    double *uQ;        /* [3 nl] loads at P (half the link's, bending) */
+    double *uM;        /* [6 nl] mass at P (half the link's, its normal
+                          added mass), sym3 in M */
     int *off;          /* [nl] offset of link l's coordinates in q */
     ts_frame frame;
     double bend_scale; /* multiplies every EI (continuation), default 1 */
@@ -69,6 +138,41 @@ static void *zalloc(size_t n, size_t size, int *fail)
     if (!p)
         *fail = 1;
     return p;
+}
+
+/* Offsets of the controller states (integrators of loops that are not
+ * frozen, actuators of surfaces with a time constant) and of the inputs
+ * (every control surface, every loop), from the loops' modes. */
+static int layout_controls(ts_kernel *k, ts_err *err)
+{
+    k->nc = 0;
+    k->nin = TS_NINPUT;
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const ts_vehicle *d = V->d;
+        for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++) {
+            V->xi_off[l] = V->in_loop[l] = -1;
+            if (l >= d->nloops)
+                continue;
+            if (d->loop[l].ki != 0 && V->mode[l] != TSI_LOOP_FROZEN)
+                V->xi_off[l] = k->nc++;
+        }
+        for (int c = 0; c < TS_VEHICLE_MAX_COMPONENTS; c++) {
+            V->act_off[c] = V->in_surf[c] = -1;
+            if (c >= d->ncomponents || !d->component[c].control)
+                continue;
+            V->in_surf[c] = k->nin++;
+            if (d->component[c].time_constant > 0)
+                V->act_off[c] = k->nc++;
+        }
+        for (int l = 0; l < d->nloops; l++)
+            V->in_loop[l] = k->nin++;
+    }
+    free(k->uzero);
+    k->uzero = calloc((size_t)k->nin, sizeof(double));
+    if (!k->uzero)
+        return ts_fail(err, TS_ENOMEM, "kernel: out of memory");
+    return TS_OK;
 }
 
 ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
@@ -112,10 +216,21 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     k->w = zalloc(3 * snn, sizeof(double), &fail);
     k->a = zalloc(3 * snn, sizeof(double), &fail);
     k->rdd = zalloc(3 * snn, sizeof(double), &fail);
+    k->node_veh = zalloc(snn, sizeof(int), &fail);
+    k->nv = sys->nvehicles;
+    k->veh = zalloc((size_t)k->nv, sizeof(veh), &fail);
+    if (k->nv > 0) {
+        k->ur = zalloc(3 * snl, sizeof(double), &fail);
+        k->urd = zalloc(3 * snl, sizeof(double), &fail);
+        k->uafr = zalloc(3 * snl, sizeof(double), &fail);
+        k->ua = zalloc(3 * snl, sizeof(double), &fail);
+        k->uQ = zalloc(3 * snl, sizeof(double), &fail);
+        k->uM = zalloc(6 * snl, sizeof(double), &fail);
+    }
     if (fail) {
         ts_kernel_free(k);
-        ts_fail(err, TS_ENOMEM, "ts_kernel_alloc: out of memory for %d links",
-                nl);
+        ts_fail_nomem(err, 8.0 * 60.0 * nl, "fewer links", "kernel: out of "
+                      "memory for %d links", nl);
         return NULL;
     }
     for (int l = 0; l < nl; l++) {
@@ -123,6 +238,37 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
         R[0] = R[4] = R[8] = 1.0;
         k->off[l] = k->nq;
         k->nq += sys->links[l].elastic ? 3 : 2;
+    }
+    k->nql = k->nq;
+    for (int i = 0; i < nn; i++)
+        k->node_veh[i] = -1;
+    for (int b = 0, v = 0; b < sys->nbodies; b++) {
+        if (sys->bodies[b].type != TS_BODY_VEHICLE)
+            continue;
+        veh *V = &k->veh[v];
+        V->body = b;
+        V->node = ts_system_body_node(sys, b);
+        V->d = sys->bodies[b].vehicle;
+        V->mass = sys->bodies[b].mass;
+        V->chart[0] = V->chart[4] = V->chart[8] = 1.0;
+        V->qoff = k->nq;
+        k->nq += 3;
+        /* A body whose points all sit at A has no lever: its unbalanced
+         * moment is compared per metre. */
+        V->lever = fmax(tsi_vehicle_lever(V->d), 1.0);
+        for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++)
+            V->mode[l] = TSI_LOOP_CLOSED;
+        k->node_veh[V->node] = v;
+        V->ws = tsi_vehicle_ws_alloc(V->d, err);
+        if (!V->ws) {
+            ts_kernel_free(k);
+            return NULL;
+        }
+        v++;
+    }
+    if (layout_controls(k, err) != TS_OK) {
+        ts_kernel_free(k);
+        return NULL;
     }
     k->bend_scale = 1.0;
     k->frame.speed = sys->tow.speed;
@@ -160,6 +306,17 @@ void ts_kernel_free(ts_kernel *k)
     free(k->w);
     free(k->a);
     free(k->rdd);
+    for (int v = 0; k->veh && v < k->nv; v++)
+        tsi_vehicle_ws_free(k->veh[v].ws);
+    free(k->veh);
+    free(k->node_veh);
+    free(k->ur);
+    free(k->urd);
+    free(k->uafr);
+    free(k->ua);
+    free(k->uQ);
+    free(k->uM);
+    free(k->uzero);
     free(k);
 }
 
@@ -172,17 +329,101 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
     c->bend_scale = k->bend_scale;
     memcpy(c->chart, k->chart, 9 * (size_t)k->nl * sizeof(double));
     memcpy(c->charted, k->charted, (size_t)k->nl);
+    for (int v = 0; v < k->nv; v++) {
+        memcpy(c->veh[v].chart, k->veh[v].chart, sizeof k->veh[v].chart);
+        c->veh[v].charted = k->veh[v].charted;
+        memcpy(c->veh[v].mode, k->veh[v].mode, sizeof k->veh[v].mode);
+        memcpy(c->veh[v].frozen, k->veh[v].frozen, sizeof k->veh[v].frozen);
+    }
+    if (layout_controls(c, err) != TS_OK) {
+        ts_kernel_free(c);
+        return NULL;
+    }
     return c;
 }
 
 const ts_system *ts_kernel_system(const ts_kernel *k) { return k->sys; }
 int ts_kernel_nq(const ts_kernel *k) { return k->nq; }
-int ts_kernel_nstate(const ts_kernel *k) { return 2 * k->nq; }
+int ts_kernel_nstate(const ts_kernel *k) { return 2 * k->nq + k->nc; }
+int ts_kernel_ncontrol(const ts_kernel *k) { return k->nc; }
 int ts_kernel_link_offset(const ts_kernel *k, int link) { return k->off[link]; }
-int ts_kernel_ninput(const ts_kernel *k)
+int ts_kernel_ninput(const ts_kernel *k) { return k->nin; }
+int ts_kernel_nvehicles(const ts_kernel *k) { return k->nv; }
+
+void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
 {
-    (void)k;
-    return TS_NINPUT;
+    cs->vehicle = cs->actuator = cs->index = -1;
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        for (int l = 0; l < V->d->nloops; l++)
+            if (V->xi_off[l] == i) {
+                cs->vehicle = v;
+                cs->actuator = 0;
+                cs->index = l;
+                return;
+            }
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->act_off[c] == i) {
+                cs->vehicle = v;
+                cs->actuator = 1;
+                cs->index = c;
+                return;
+            }
+    }
+}
+
+const char *tsi_tow_input_name(int j)
+{
+    static const char *const names[TS_NINPUT] = {
+        "tow.surge",
+        "tow.sway",
+        "tow.heave",
+        "tow.surge_velocity",
+        "tow.sway_velocity",
+        "tow.heave_velocity",
+        "tow.surge_acceleration",
+        "tow.sway_acceleration",
+        "tow.heave_acceleration"};
+    return j >= 0 && j < TS_NINPUT ? names[j] : NULL;
+}
+
+const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
+                                 size_t size)
+{
+    if (j >= 0 && j < TS_NINPUT) {
+        snprintf(buf, size, "%s", tsi_tow_input_name(j));
+        return buf;
+    }
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        const char *body = k->sys->bodies[V->body].name;
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] == j) {
+                snprintf(buf, size, "%s.%s", body, V->d->component[c].name);
+                return buf;
+            }
+        for (int l = 0; l < V->d->nloops; l++)
+            if (V->in_loop[l] == j) {
+                snprintf(buf, size, "%s.%s", body, V->d->loop[l].name);
+                return buf;
+            }
+    }
+    return NULL;
+}
+
+int ts_kernel_input_find(const ts_kernel *k, const char *name)
+{
+    char buf[2 * TS_NAME_MAX + 8];
+    for (int j = 0; j < k->nin; j++)
+        if (ts_kernel_input_name(k, j, buf, sizeof buf) &&
+            !strcmp(buf, name))
+            return j;
+    return -1;
+}
+int ts_kernel_vehicle_body(const ts_kernel *k, int v) { return k->veh[v].body; }
+int ts_kernel_vehicle_offset(const ts_kernel *k, int v)
+{
+    return k->veh[v].qoff;
 }
 
 void ts_kernel_set_frame(ts_kernel *k, const ts_frame *f) { k->frame = *f; }
@@ -224,12 +465,230 @@ void ts_kernel_direction(const ts_kernel *k, int link, double t1, double t2,
     link_axes(k, link, t1, t2, n, e1, e2, &c2, &s2);
 }
 
+void tsi_vehicle_flow(const ts_frame *f, const ts_vehicle *d,
+                      tsi_vehicle_state *st)
+{
+    double w[3], rB[3], rdB[3];
+    tsi_rel_velocity(f, st->rO, st->rdO, w);
+    mat3_tmul(st->R, w, st->wO_b);
+    tsi_vehicle_point(d, st, d->buoyancy_centre, rB, rdB);
+    st->frac = d->surface_diameter > 0
+                   ? tsi_cylinder_submerged(rB[2], d->surface_diameter)
+                   : (rB[2] > 0 ? 1.0 : 0.0);
+}
+
+/* Fill dydt[n] with NaN and return code: the kernel never returns numbers
+ * computed outside the model. */
+static int refuse(const ts_kernel *k, double dydt[], int code)
+{
+    int n = 2 * k->nq + k->nc;
+    for (int i = 0; i < n; i++)
+        dydt[i] = NAN;
+    return code;
+}
+
+/* Body axes: rho_P = P - A of the point link l starts from. */
+static void link_lever(const veh *V, const ts_link *L, double rho[3])
+{
+    for (int j = 0; j < 3; j++)
+        rho[j] = L->up_point[j] - V->d->attach[j];
+}
+
+/* A vehicle's kinematics once its node's position and velocity are known,
+ * and the points its child cables start from. Returns 1 when its chart is
+ * singular. */
+static int vehicle_kinematics(ts_kernel *k, veh *V, const double y[])
+{
+    const double *th = y + V->qoff, *thd = y + k->nq + V->qoff;
+    tsi_vehicle_kinematics(V->d, V->chart, th, thd, k->frame.turn_rate,
+                           k->r + 3 * V->node, k->rd + 3 * V->node, &V->st);
+    tsi_vehicle_flow(&k->frame, V->d, &V->st);
+    const ts_node *nd = &k->sys->nodes[V->node];
+    for (int c = nd->child_begin; c < nd->child_end; c++) {
+        int l = k->sys->child_links[c];
+        tsi_vehicle_point(V->d, &V->st, k->sys->links[l].up_point,
+                          k->ur + 3 * l, k->urd + 3 * l);
+    }
+    return !(fabs(V->st.c2) >= TS_CHART_MIN);
+}
+
+/* sym3 S (M axes) to body axes: R^T S R, as a full 3x3. */
+static void sym3_to_body(const double R[9], const double S[6], double B[9])
+{
+    double F[9] = {S[0], S[3], S[4], S[3], S[1], S[5], S[4], S[5], S[2]};
+    double T[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            T[3 * i + j] = F[3 * i] * R[j] + F[3 * i + 1] * R[3 + j] +
+                           F[3 * i + 2] * R[6 + j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            B[3 * i + j] = R[i] * T[j] + R[3 + i] * T[3 + j] +
+                           R[6 + i] * T[6 + j];
+}
+
+/* A mass M3 (3x3, body axes) at lever rho (body axes, from A) whose point
+ * accelerates as J (a_A, alpha) + b, J = [I, -S(rho)], under the force f
+ * (body axes): M6 += J^T M3 J, G += J^T (f - M3 b). */
+static void add_point(double M6[36], double G[6], const double M3[9],
+                      const double rho[3], const double f[3],
+                      const double b[3])
+{
+    double MS[9], S[9] = {0, -rho[2], rho[1], rho[2], 0, -rho[0],
+                          -rho[1], rho[0], 0};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            MS[3 * i + j] = M3[3 * i] * S[j] + M3[3 * i + 1] * S[3 + j] +
+                            M3[3 * i + 2] * S[6 + j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double SMS = S[3 * i] * MS[j] + S[3 * i + 1] * MS[3 + j] +
+                         S[3 * i + 2] * MS[6 + j];
+            M6[6 * i + j] += M3[3 * i + j];
+            M6[6 * i + 3 + j] -= MS[3 * i + j];
+            M6[6 * (3 + i) + j] -= MS[3 * j + i];
+            M6[6 * (3 + i) + 3 + j] -= SMS;
+        }
+    double h[3], x[3];
+    for (int i = 0; i < 3; i++)
+        h[i] = f[i] - (M3[3 * i] * b[0] + M3[3 * i + 1] * b[1] +
+                       M3[3 * i + 2] * b[2]);
+    v3_cross(rho, h, x);
+    for (int i = 0; i < 3; i++) {
+        G[i] += h[i];
+        G[3 + i] += x[i];
+    }
+}
+
+/* om x (om x rho). */
+static void centripetal(const double om[3], const double rho[3], double b[3])
+{
+    double t[3];
+    v3_cross(om, rho, t);
+    v3_cross(om, t, b);
+}
+
+/* A vehicle's controller, inertia and loads, with the masses and loads
+ * its child cables put at their starting points. */
+static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
+                          const double u[], double rho, double g)
+{
+    const ts_vehicle *d = V->d;
+    const double *c = y + 2 * k->nq;
+    double xi[TS_VEHICLE_MAX_LOOPS], ul[TS_VEHICLE_MAX_LOOPS];
+    double act[TS_VEHICLE_MAX_COMPONENTS], us[TS_VEHICLE_MAX_COMPONENTS];
+    for (int l = 0; l < d->nloops; l++) {
+        xi[l] = V->xi_off[l] >= 0 ? c[V->xi_off[l]] : 0.0;
+        ul[l] = V->in_loop[l] >= 0 ? u[V->in_loop[l]] : 0.0;
+    }
+    for (int j = 0; j < d->ncomponents; j++) {
+        act[j] = V->act_off[j] >= 0 ? c[V->act_off[j]] : 0.0;
+        us[j] = V->in_surf[j] >= 0 ? u[V->in_surf[j]] : 0.0;
+    }
+    tsi_vehicle_measure(&V->st, V->meas, V->rate);
+    tsi_vehicle_control(d, V->meas, V->rate, xi, act, us, ul, V->mode,
+                        V->frozen, V->out, V->delta, V->xi_dot, V->act_dot);
+    tsi_vehicle_mass6(d, V->mass, &V->st, V->M6);
+    tsi_vehicle_loads(d, V->ws, V->mass, rho, g, &V->st, V->delta, V->G,
+                      NULL);
+    const ts_node *nd = &k->sys->nodes[V->node];
+    for (int j = nd->child_begin; j < nd->child_end; j++) {
+        int l = k->sys->child_links[j];
+        double lever[3], M3[9], f[3], b[3];
+        link_lever(V, &k->sys->links[l], lever);
+        sym3_to_body(V->st.R, k->uM + 6 * l, M3);
+        mat3_tmul(V->st.R, k->uQ + 3 * l, f);
+        centripetal(V->st.om_b, lever, b);
+        add_point(V->M6, V->G, M3, lever, f, b);
+    }
+    memcpy(V->M6h, V->M6, sizeof V->M6);
+}
+
+/* Eliminate the body: W = J M6h^-1 J^T and a_free = J M6h^-1 G, both to
+ * M. Returns -1 when M6h is not positive definite. */
+static int vehicle_articulate(veh *V)
+{
+    if (tsi_chol6(V->M6h, V->L6) != 0)
+        return -1;
+    double W[6], e[6], Lw[6], Wi[9];
+    for (int j = 0; j < 3; j++) {
+        memset(e, 0, sizeof e);
+        e[j] = 1.0;
+        tsi_chol6_solve(V->L6, e);
+        W[j] = e[j];
+        if (j == 0) {
+            W[3] = e[1];
+            W[4] = e[2];
+        } else if (j == 1) {
+            W[5] = e[2];
+        }
+    }
+    if (sym3_chol(W, Lw) != 0)
+        return -1;
+    for (int j = 0; j < 3; j++) {
+        double x[3] = {j == 0, j == 1, j == 2};
+        sym3_chol_solve(Lw, x);
+        for (int i = 0; i < 3; i++)
+            Wi[3 * i + j] = x[i];
+    }
+    /* R W^-1 R^T, symmetric: keep the sym3 entries. */
+    const double *R = V->st.R;
+    double T[9], F[9];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            T[3 * i + j] = R[3 * i] * Wi[j] + R[3 * i + 1] * Wi[3 + j] +
+                           R[3 * i + 2] * Wi[6 + j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            F[3 * i + j] = T[3 * i] * R[3 * j] + T[3 * i + 1] * R[3 * j + 1] +
+                           T[3 * i + 2] * R[3 * j + 2];
+    V->Winv[0] = F[0];
+    V->Winv[1] = F[4];
+    V->Winv[2] = F[8];
+    V->Winv[3] = 0.5 * (F[1] + F[3]);
+    V->Winv[4] = 0.5 * (F[2] + F[6]);
+    V->Winv[5] = 0.5 * (F[5] + F[7]);
+    memcpy(e, V->G, sizeof e);
+    tsi_chol6_solve(V->L6, e);
+    mat3_mul(R, e, V->afree);
+    return 0;
+}
+
+/* The body's accelerations once its attach point's acceleration a_A (M)
+ * is known: F_j = W^-1 (a_A - a_free), (a_A, alpha) = M6h^-1 (G + (F_j,
+ * 0)). */
+static void vehicle_accelerate(veh *V, const double aA[3])
+{
+    double d[3] = {aA[0] - V->afree[0], aA[1] - V->afree[1],
+                   aA[2] - V->afree[2]};
+    double Fb[3];
+    sym3_mul(V->Winv, d, V->Fj);
+    mat3_tmul(V->st.R, V->Fj, Fb);
+    for (int j = 0; j < 6; j++)
+        V->a6[j] = V->G[j] + (j < 3 ? Fb[j] : 0.0);
+    tsi_chol6_solve(V->L6, V->a6);
+    mat3_mul(V->st.R, V->a6 + 3, V->alpha_m);
+}
+
+/* Inertial acceleration (M) of the point link l starts from on V. */
+static void vehicle_point_accel(const veh *V, const ts_link *L, double a[3])
+{
+    double lever[3], x[3], b[3], ab[3];
+    link_lever(V, L, lever);
+    v3_cross(V->a6 + 3, lever, x);
+    centripetal(V->st.om_b, lever, b);
+    for (int j = 0; j < 3; j++)
+        ab[j] = V->a6[j] + x[j] + b[j];
+    mat3_mul(V->st.R, ab, a);
+}
+
 /* 2. The link-local assembly shared by f(y, u) and the node residual:
  * from node positions k->r and velocities k->rd (relative to M), link
  * directions k->n and strains k->strain, the external load Q, the 3x3
  * mass matrix M and the frame part afr of the acceleration of every node,
  * and each link's submerged fraction. Each link adds to its two end nodes
- * (and a bending joint to three), each body to its node: O(nlinks). */
+ * (and a bending joint to three), each body to its node: O(nlinks). A
+ * vehicle's own loads follow (vehicle_loads, in ts_kernel_eval). */
 static void assemble(ts_kernel *k)
 {
     const ts_system *sys = k->sys;
@@ -246,7 +705,7 @@ static void assemble(ts_kernel *k)
         tsi_frame_accel(&k->frame, k->r + 3 * i, k->rd + 3 * i,
                         k->afr + 3 * i);
         int b = nodes[i].body;
-        if (b >= 0) {
+        if (b >= 0 && sys->bodies[b].type != TS_BODY_VEHICLE) {
             /* A cylinder's axis lies along the link that ends at it. */
             const double *axis = k->n + 3 * nodes[i].link;
             double w[3], F[3], frac;
@@ -261,20 +720,34 @@ static void assemble(ts_kernel *k)
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         const double *n = k->n + 3 * l;
-        const double *rp = k->r + 3 * L->upper, *rk = k->r + 3 * L->lower;
+        const double *rp = k->r + 3 * L->upper, *rdp = k->rd + 3 * L->upper;
+        double *Qp = k->Q + 3 * L->upper, *Mp = k->M + 6 * L->upper;
+        if (L->up_body >= 0) {
+            /* The upper end is a point of a vehicle: what lands there is
+             * the vehicle's (vehicle_loads). */
+            rp = k->ur + 3 * l;
+            rdp = k->urd + 3 * l;
+            Qp = k->uQ + 3 * l;
+            Mp = k->uM + 6 * l;
+            v3_set(Qp, 0, 0, 0);
+            Mp[0] = Mp[1] = Mp[2] = 0.5 * L->mass;
+            Mp[3] = Mp[4] = Mp[5] = 0.0;
+            tsi_frame_accel(&k->frame, rp, rdp, k->uafr + 3 * l);
+        }
+        const double *rk = k->r + 3 * L->lower;
         double rm[3], vm[3], w[3], F[3];
         for (int j = 0; j < 3; j++) {
             rm[j] = 0.5 * (rp[j] + rk[j]);
-            vm[j] = 0.5 * (k->rd[3 * L->upper + j] + k->rd[3 * L->lower + j]);
+            vm[j] = 0.5 * (rdp[j] + k->rd[3 * L->lower + j]);
         }
         tsi_rel_velocity(&k->frame, rm, vm, w);
         tsi_link_load(L, rho, g, n, rp[2], rk[2], w, F, &k->sub[l]);
-        v3_axpy(0.5, F, k->Q + 3 * L->upper);
+        v3_axpy(0.5, F, Qp);
         v3_axpy(0.5, F, k->Q + 3 * L->lower);
         if (added && L->can > 0 && k->sub[l] > 0) {
             double A = L->can * rho * M_PI * 0.25 * L->diameter *
                        L->diameter * L->length * k->sub[l];
-            sym3_add_normal(k->M + 6 * L->upper, 0.5 * A, n);
+            sym3_add_normal(Mp, 0.5 * A, n);
             sym3_add_normal(k->M + 6 * L->lower, 0.5 * A, n);
         }
         if (L->ei > 0) {
@@ -289,7 +762,7 @@ static void assemble(ts_kernel *k)
                         (L->length + B->length);
             double Fi[3], Fj[3], Fk[3];
             tsi_bending(ei, la, lb, n, k->n + 3 * L->next, Fi, Fj, Fk);
-            v3_axpy(1.0, Fi, k->Q + 3 * L->upper);
+            v3_axpy(1.0, Fi, Qp);
             v3_axpy(1.0, Fj, k->Q + 3 * L->lower);
             v3_axpy(1.0, Fk, k->Q + 3 * B->lower);
         }
@@ -303,9 +776,9 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     const ts_link *links = sys->links;
     const int nl = k->nl, nn = k->nn, nq = k->nq;
     const double *qd = y + nq;
-    static const double zero[TS_NINPUT] = {0};
+    const double rho = sys->env.water_density, g = sys->env.gravity;
     if (!u)
-        u = zero;
+        u = k->uzero;
 
     /* 1. Kinematics. */
     for (int j = 0; j < 3; j++) {
@@ -318,6 +791,10 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         const int o = k->off[l];
         double *n = k->n + 3 * l, *nd = k->nd + 3 * l;
         const double *rp = k->r + 3 * L->upper, *rdp = k->rd + 3 * L->upper;
+        if (L->up_body >= 0) {
+            rp = k->ur + 3 * l;
+            rdp = k->urd + 3 * l;
+        }
         double *rk = k->r + 3 * L->lower, *rdk = k->rd + 3 * L->lower;
         double *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
         double c2, s2;
@@ -346,20 +823,19 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
             rk[j] = rp[j] + len * n[j];
             rdk[j] = rdp[j] + len * nd[j] + lrate * n[j];
         }
+        int v = k->node_veh[L->lower];
+        if (v >= 0 && vehicle_kinematics(k, &k->veh[v], y))
+            chart_bad = 1;
     }
-    if (slack_bad) {
-        for (int i = 0; i < 2 * nq; i++)
-            dydt[i] = NAN;
-        return TS_ESINGULAR;
-    }
-    if (chart_bad) {
-        for (int i = 0; i < 2 * nq; i++)
-            dydt[i] = NAN;
-        return TS_CHART;
-    }
+    if (slack_bad)
+        return refuse(k, dydt, TS_ESINGULAR);
+    if (chart_bad)
+        return refuse(k, dydt, TS_CHART);
 
     /* 2. Loads, mass matrices and frame accelerations. */
     assemble(k);
+    for (int v = 0; v < k->nv; v++)
+        vehicle_loads(k, &k->veh[v], y, u, rho, g);
 
     /* 3a. Free ends to tow point: articulated mass and load. An elastic
      * link passes no inertia up: its known tension pulls both ends. */
@@ -370,9 +846,20 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     if (sys->has_elastic)
         for (int l = 0; l < nl; l++)
             if (links[l].elastic) {
-                if (links[l].upper > 0)
-                    v3_axpy(k->t[l], k->n + 3 * l, k->Fh + 3 * links[l].upper);
-                v3_axpy(-k->t[l], k->n + 3 * l, k->Fh + 3 * links[l].lower);
+                const ts_link *L = &links[l];
+                if (L->up_body >= 0) {
+                    veh *V = &k->veh[k->node_veh[L->upper]];
+                    double lever[3], f[3], T[3], zero3[3] = {0, 0, 0};
+                    static const double none[9] = {0};
+                    for (int j = 0; j < 3; j++)
+                        T[j] = k->t[l] * k->n[3 * l + j];
+                    link_lever(V, L, lever);
+                    mat3_tmul(V->st.R, T, f);
+                    add_point(V->M6h, V->G, none, lever, f, zero3);
+                } else if (L->upper > 0) {
+                    v3_axpy(k->t[l], k->n + 3 * l, k->Fh + 3 * L->upper);
+                }
+                v3_axpy(-k->t[l], k->n + 3 * l, k->Fh + 3 * L->lower);
             }
     for (int l = nl - 1; l >= 0; l--) {
         const ts_link *L = &links[l];
@@ -380,11 +867,21 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         const double *n = k->n + 3 * l, *nd = k->nd + 3 * l;
         double *Mh = k->Mh + 6 * i, *gi = k->g + 3 * i, *wi = k->w + 3 * i;
         double Lc[6];
-        if (sym3_chol(Mh, Lc) != 0) {
-            for (int j = 0; j < 2 * nq; j++)
-                dydt[j] = NAN;
-            return TS_ESINGULAR;
+        int v = k->node_veh[i];
+        if (v >= 0) {
+            /* The body and its child cables are done: they hang on node
+             * i as W^-1. */
+            veh *V = &k->veh[v];
+            if (vehicle_articulate(V) != 0)
+                return refuse(k, dydt, TS_ESINGULAR);
+            for (int j = 0; j < 6; j++)
+                Mh[j] += V->Winv[j];
+            double f[3];
+            sym3_mul(V->Winv, V->afree, f);
+            v3_axpy(1.0, f, k->Fh + 3 * i);
         }
+        if (sym3_chol(Mh, Lc) != 0)
+            return refuse(k, dydt, TS_ESINGULAR);
         v3_copy(k->Fh + 3 * i, gi);
         sym3_chol_solve(Lc, gi);
         if (L->elastic)
@@ -392,14 +889,30 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         v3_copy(n, wi);
         sym3_chol_solve(Lc, wi);
         double D = v3_dot(n, wi);
-        double da[3] = {k->afr[3 * i] - k->afr[3 * p],
-                        k->afr[3 * i + 1] - k->afr[3 * p + 1],
-                        k->afr[3 * i + 2] - k->afr[3 * p + 2]};
+        const double *afr_p = L->up_body >= 0 ? k->uafr + 3 * l
+                                              : k->afr + 3 * p;
+        double da[3] = {k->afr[3 * i] - afr_p[0],
+                        k->afr[3 * i + 1] - afr_p[1],
+                        k->afr[3 * i + 2] - afr_p[2]};
         double rhs = v3_dot(n, da) - L->length * v3_dot(nd, nd);
         double beta = (v3_dot(n, gi) - rhs) / D;
         k->D[l] = D;
         k->beta[l] = beta;
-        if (p > 0) {
+        if (L->up_body >= 0) {
+            /* t = beta - n.a_P / D with a_P = J (a_A, alpha) + b: a
+             * rank-one update of the body's inertia. */
+            veh *V = &k->veh[k->node_veh[p]];
+            double lever[3], nb[3], M3[9], f[3], b[3];
+            link_lever(V, L, lever);
+            mat3_tmul(V->st.R, n, nb);
+            for (int a = 0; a < 3; a++) {
+                f[a] = beta * nb[a];
+                for (int c = 0; c < 3; c++)
+                    M3[3 * a + c] = nb[a] * nb[c] / D;
+            }
+            centripetal(V->st.om_b, lever, b);
+            add_point(V->M6h, V->G, M3, lever, f, b);
+        } else if (p > 0) {
             sym3_add_outer(k->Mh + 6 * p, 1.0 / D, n);
             v3_axpy(beta, n, k->Fh + 3 * p);
         }
@@ -411,16 +924,22 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         int i = L->lower, p = L->upper;
-        const double *n = k->n + 3 * l;
+        const double *n = k->n + 3 * l, *ap = k->a + 3 * p;
+        if (L->up_body >= 0) {
+            vehicle_point_accel(&k->veh[k->node_veh[p]], L, k->ua + 3 * l);
+            ap = k->ua + 3 * l;
+        }
         if (L->elastic) {
             v3_copy(k->g + 3 * i, k->a + 3 * i);
-            continue;
+        } else {
+            double t = k->beta[l] - v3_dot(n, ap) / k->D[l];
+            k->t[l] = t;
+            double *ai = k->a + 3 * i;
+            for (int j = 0; j < 3; j++)
+                ai[j] = k->g[3 * i + j] - t * k->w[3 * i + j];
         }
-        double t = k->beta[l] - v3_dot(n, k->a + 3 * p) / k->D[l];
-        k->t[l] = t;
-        double *ai = k->a + 3 * i;
-        for (int j = 0; j < 3; j++)
-            ai[j] = k->g[3 * i + j] - t * k->w[3 * i + j];
+        if (k->node_veh[i] >= 0)
+            vehicle_accelerate(&k->veh[k->node_veh[i]], k->a + 3 * i);
     }
 
     /* 4. Relative accelerations and angle accelerations. */
@@ -432,6 +951,12 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         const double *ri = k->rdd + 3 * L->lower, *rp = k->rdd + 3 * L->upper;
+        double rP[3];
+        if (L->up_body >= 0) {
+            for (int j = 0; j < 3; j++)
+                rP[j] = k->ua[3 * l + j] - k->uafr[3 * l + j];
+            rp = rP;
+        }
         const int o = k->off[l];
         const double *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
         double dd2[3] = {ri[0] - rp[0], ri[1] - rp[1], ri[2] - rp[2]};
@@ -457,6 +982,22 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         dydt[o + 1] = t2d;
         dydt[nq + o] = (a1 + 2.0 * s2 * t1d * t2d) / c2;
         dydt[nq + o + 1] = a2 - c2 * s2 * t1d * t1d;
+    }
+    double *cdot = dydt + 2 * nq;
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const double *th = y + V->qoff, *thd = qd + V->qoff;
+        for (int j = 0; j < 3; j++)
+            dydt[V->qoff + j] = thd[j];
+        tsi_vehicle_angle_accel(&V->st, th, thd, k->frame.turn_rate,
+                                k->frame.turn_accel, V->alpha_m,
+                                dydt + nq + V->qoff);
+        for (int l = 0; l < V->d->nloops; l++)
+            if (V->xi_off[l] >= 0)
+                cdot[V->xi_off[l]] = V->xi_dot[l];
+        for (int j = 0; j < V->d->ncomponents; j++)
+            if (V->act_off[j] >= 0)
+                cdot[V->act_off[j]] = V->act_dot[j];
     }
     return TS_OK;
 }
@@ -551,9 +1092,42 @@ double ts_kernel_unbalanced(const ts_kernel *k, double *scale)
     for (int l = 0; l < k->nl; l++)
         if (fabs(k->t[l]) > big)
             big = fabs(k->t[l]);
+    /* A vehicle: M6 times its acceleration relative to the steady motion
+     * in M, the force part and the moment part over the body's lever. */
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        double ar[3], af[3], r6[6], x6[6];
+        const double *rdd = k->rdd + 3 * V->node;
+        tsi_vehicle_frame_alpha(&V->st, k->frame.turn_rate,
+                                k->frame.turn_accel, af);
+        for (int j = 0; j < 3; j++)
+            af[j] = V->alpha_m[j] - af[j];
+        mat3_tmul(V->st.R, rdd, ar);
+        mat3_tmul(V->st.R, af, x6 + 3);
+        v3_copy(ar, x6);
+        for (int i = 0; i < 6; i++) {
+            r6[i] = 0;
+            for (int j = 0; j < 6; j++)
+                r6[i] += V->M6[6 * i + j] * x6[j];
+        }
+        double m = fmax(v3_norm(r6), v3_norm(r6 + 3) / V->lever);
+        if (!(m <= worst))
+            worst = m;
+        big = fmax(big, fmax(V->mass * k->sys->env.gravity,
+                             v3_norm(V->Fj)));
+    }
     if (scale)
         *scale = big;
     return worst;
+}
+
+/* Inertial velocity of a point at r moving at rd relative to M. */
+static void inertial_velocity(const ts_frame *f, const double r[3],
+                              const double rd[3], double v[3])
+{
+    v[0] = f->speed - f->turn_rate * r[1] + rd[0];
+    v[1] = f->turn_rate * r[0] + rd[1];
+    v[2] = rd[2];
 }
 
 double ts_kernel_kinetic_energy(const ts_kernel *k)
@@ -563,11 +1137,23 @@ double ts_kernel_kinetic_energy(const ts_kernel *k)
     double T = 0.0;
     for (int i = 1; i < k->nn; i++) {
         const double *r = k->r + 3 * i, *rd = k->rd + 3 * i;
-        double v[3] = {k->frame.speed - k->frame.turn_rate * r[1] + rd[0],
-                       k->frame.turn_rate * r[0] + rd[1], rd[2]};
-        double Mv[3];
+        double v[3], Mv[3];
+        inertial_velocity(&k->frame, r, rd, v);
         sym3_mul(k->M + 6 * i, v, Mv);
         T += 0.5 * v3_dot(v, Mv);
+    }
+    /* A vehicle: 1/2 nu^T M6 nu about A (rigid body, added mass and the
+     * masses at its child cables' starting points), nu = (v_A, omega) in
+     * body axes. */
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        double va[3], nu[6];
+        inertial_velocity(&k->frame, V->st.rA, V->st.rdA, va);
+        mat3_tmul(V->st.R, va, nu);
+        v3_copy(V->st.om_b, nu + 3);
+        for (int i = 0; i < 6; i++)
+            for (int j = 0; j < 6; j++)
+                T += 0.5 * nu[i] * V->M6[6 * i + j] * nu[j];
     }
     return T;
 }
@@ -578,8 +1164,16 @@ double ts_kernel_potential_energy(const ts_kernel *k)
     double U = 0.0, g = sys->env.gravity;
     for (int i = 1; i < k->nn; i++)
         U -= sys->nodes[i].mass * g * k->r[3 * i + 2];
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        double rG[3], rdG[3];
+        tsi_vehicle_point(V->d, &V->st, V->d->mass_centre, rG, rdG);
+        U -= V->mass * g * rG[2];
+    }
     for (int l = 0; l < k->nl; l++) {
         const ts_link *L = &sys->links[l];
+        if (L->up_body >= 0)
+            U -= 0.5 * L->mass * g * k->ur[3 * l + 2];
         /* Strain energy 1/2 EA l e^2 while taut (e > 0): the potential
          * of the elastic part EA e of the tension, whatever the damping. */
         if (L->elastic && k->strain[l] > 0) {
@@ -707,6 +1301,77 @@ static void link_dir_rate(const ts_kernel *k, int l, const double y[],
         nd[j] = c2 * y[nq + o] * e1[j] + y[nq + o + 1] * e2[j];
 }
 
+/* 1-2-3 angles of a rotation R = R1 R2 R3 (regular where cos theta2 is
+ * not 0). */
+static void angles123(const double R[9], double th[3])
+{
+    double s2 = R[2] > 1 ? 1 : (R[2] < -1 ? -1 : R[2]);
+    th[0] = atan2(-R[5], R[8]);
+    th[1] = asin(s2);
+    th[2] = atan2(-R[1], R[0]);
+}
+
+/* Vehicle v's angles and rates in its chart for attitude R (body to M)
+ * and angular velocity om (relative to M, body axes; NULL: zero); a chart
+ * whose cos theta2 would fall below threshold is first centred on R (the
+ * angles then are 0). Returns 1 when re-charted. */
+static int vehicle_set(ts_kernel *k, int v, const double R[9],
+                       const double om[3], double threshold, double y[])
+{
+    veh *V = &k->veh[v];
+    double Rc[9], th[3], thd[3] = {0, 0, 0};
+    static const double zero[3] = {0, 0, 0};
+    int moved = 0;
+    for (int i = 0; i < 3; i++) /* Rc = chart^T R */
+        for (int j = 0; j < 3; j++)
+            Rc[3 * i + j] = V->chart[i] * R[j] + V->chart[3 + i] * R[3 + j] +
+                            V->chart[6 + i] * R[6 + j];
+    angles123(Rc, th);
+    if (!(fabs(cos(th[1])) >= threshold)) {
+        memcpy(V->chart, R, sizeof V->chart);
+        V->charted = 1;
+        th[0] = th[1] = th[2] = 0.0;
+        moved = 1;
+    }
+    tsi_rates_from_omega(th, om ? om : zero, thd);
+    for (int j = 0; j < 3; j++) {
+        y[V->qoff + j] = th[j];
+        y[k->nq + V->qoff + j] = thd[j];
+    }
+    return moved;
+}
+
+/* Attitude (body to M) and angular velocity relative to M (body axes) of
+ * vehicle v in state y. */
+static void vehicle_get(const ts_kernel *k, int v, const double y[],
+                        double R[9], double om[3])
+{
+    const veh *V = &k->veh[v];
+    double R123[9], E[9];
+    tsi_rot123(y + V->qoff, R123);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            R[3 * i + j] = V->chart[3 * i] * R123[j] +
+                           V->chart[3 * i + 1] * R123[3 + j] +
+                           V->chart[3 * i + 2] * R123[6 + j];
+    if (om) {
+        tsi_rate_matrix(y + V->qoff, E);
+        mat3_mul(E, y + k->nq + V->qoff, om);
+    }
+}
+
+int ts_kernel_set_vehicle(ts_kernel *k, int v, const double R[9],
+                          const double omega[3], double threshold, double y[])
+{
+    return vehicle_set(k, v, R, omega, threshold, y);
+}
+
+void ts_kernel_get_vehicle(const ts_kernel *k, int v, const double y[],
+                           double R[9], double omega[3])
+{
+    vehicle_get(k, v, y, R, omega);
+}
+
 int ts_kernel_rechart(ts_kernel *k, double y[], double threshold)
 {
     int nq = k->nq, moved = 0;
@@ -720,6 +1385,13 @@ int ts_kernel_rechart(ts_kernel *k, double y[], double threshold)
         k->charted[l] = 1;
         link_set(k, l, n, nd, &y[o], &y[o + 1], &y[nq + o], &y[nq + o + 1]);
         moved++;
+    }
+    for (int v = 0; v < k->nv; v++) {
+        if (fabs(cos(y[k->veh[v].qoff + 1])) >= threshold)
+            continue;
+        double R[9], om[3];
+        vehicle_get(k, v, y, R, om);
+        moved += vehicle_set(k, v, R, om, INFINITY, y);
     }
     return moved;
 }
@@ -741,5 +1413,59 @@ int ts_kernel_reset_charts(ts_kernel *k, double y[], double threshold)
         k->charted[l] = 0;
         link_set(k, l, n, nd, &y[o], &y[o + 1], &y[nq + o], &y[nq + o + 1]);
     }
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        if (!V->charted)
+            continue;
+        double R[9], om[3], th[3];
+        vehicle_get(k, v, y, R, om);
+        angles123(R, th);
+        if (fabs(cos(th[1])) < threshold) {
+            left++;
+            continue;
+        }
+        memset(V->chart, 0, sizeof V->chart);
+        V->chart[0] = V->chart[4] = V->chart[8] = 1.0;
+        V->charted = 0;
+        vehicle_set(k, v, R, om, 0.0, y);
+    }
     return left;
+}
+
+void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
+{
+    const veh *V = &k->veh[v];
+    const ts_vehicle *d = V->d;
+    double ypr[3], rd[3];
+    memset(r, 0, sizeof *r);
+    r->body = V->body;
+    memcpy(r->R, V->st.R, sizeof r->R);
+    tsi_ypr_from_rot(V->st.R, ypr);
+    r->yaw = ypr[0];
+    r->pitch = ypr[1];
+    r->roll = ypr[2];
+    const double *w = V->st.wO_b;
+    r->speed = v3_norm(w);
+    r->alpha = atan2(w[2], w[0]) + 0.0;
+    r->beta = r->speed > 0 ? asin(w[1] / r->speed) + 0.0 : 0.0;
+    v3_copy(V->st.rO, r->origin);
+    tsi_vehicle_point(d, &V->st, d->mass_centre, r->mass_centre, rd);
+    v3_copy(V->st.om_rel_b, r->omega);
+    r->submerged = V->st.frac;
+    v3_copy(V->Fj, r->joint_force);
+    r->ncomponents = d->ncomponents;
+    memcpy(r->delta, V->delta, sizeof r->delta);
+    const ts_system *sys = k->sys;
+    tsi_vehicle_hydro(d, V->ws, sys->env.water_density, V->st.frac, w,
+                      V->st.om_b, V->delta, r->hydro_force, r->hydro_moment,
+                      r->load);
+    /* The Munk moment: the -v x p part of the loads, with gravity off. */
+    double G[6];
+    tsi_vehicle_loads(d, V->ws, V->mass, sys->env.water_density, 0.0, &V->st,
+                      V->delta, G, r->munk);
+    r->nloops = d->nloops;
+    for (int l = 0; l < d->nloops; l++) {
+        r->loop_error[l] = tsi_loop_error(&d->loop[l], V->meas);
+        r->loop_output[l] = V->out[l];
+    }
 }

@@ -1,5 +1,7 @@
-/* kernel_impl.h (internal): the kernel's node residual, for the sparse
- * descriptor model of lib/descriptor.c (doc/linear.md, section 2).
+/* kernel_impl.h: what lib/kernel.c shares with the modules above it
+ * (internal): names of inputs, the flow past a vehicle, and the node
+ * residual of the sparse descriptor model (lib/descriptor.c; doc/linear.md,
+ * section 2b).
  *
  * f(y, u) = the kernel's kinematics (angles to node positions, velocities
  * and link directions), the link-local assembly of loads, nodal mass
@@ -13,6 +15,19 @@
 #define TOWSTAB_KERNEL_IMPL_H
 
 #include "towstab/kernel.h"
+#include "vehicle.h"
+
+/* Name of tow input j < TS_NINPUT ("tow.surge", ...), NULL outside. */
+const char *tsi_tow_input_name(int j);
+
+/* The flow past a vehicle whose kinematics st holds (tsi_vehicle_kinematics):
+ * st->wO_b, the velocity of its origin relative to the water (frame f and
+ * its current), and st->frac, its submerged fraction: the circular
+ * segment of a horizontal cylinder of the vehicle's surface_diameter
+ * centred at its buoyancy centre (1 below one radius; a step at z = 0
+ * without a diameter). */
+void tsi_vehicle_flow(const ts_frame *f, const ts_vehicle *d,
+                      tsi_vehicle_state *st);
 
 /* R[3 nnodes] (N) of node positions r[3 nnodes], velocities v[3 nnodes]
  * relative to M (m, m/s; node 0 is the tow point, r_0 = point + tow
@@ -23,9 +38,10 @@
  * n = d / |d| from the positions); R_0 = 0. The loads Q, masses M and frame
  * accelerations afr are those of ts_kernel_eval (the same code). At the
  * state, tensions and accelerations of an evaluation of f, R = 0 to
- * rounding. Uses the kernel's frame and bending scale; overwrites its
- * last-evaluation results. Returns TS_OK, or TS_ESINGULAR when two ends
- * of a link coincide. O(nlinks). */
+ * rounding. Systems without vehicles (a vehicle's own unknowns, its
+ * attitude and rates, are not in it). Uses the kernel's frame and bending
+ * scale; overwrites its last-evaluation results. Returns TS_OK, or
+ * TS_ESINGULAR when two ends of a link coincide. O(nlinks). */
 int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
                         const double a[], const double t[], double R[]);
 

@@ -1,6 +1,7 @@
-/* lapack.h: prototypes of the LAPACK (Fortran) routines towstab calls
- * (internal). Integers are Fortran INTEGER (int with Debian's LP64 build);
- * a CHARACTER argument carries gfortran's hidden length, passed last. */
+/* lapack.h: prototypes of every LAPACK and BLAS (Fortran) routine towstab
+ * calls (internal; ARPACK's are in arpack.h). Integers are Fortran INTEGER
+ * (int with Debian's LP64 build); a CHARACTER argument carries gfortran's
+ * hidden length, passed last; COMPLEX*16 is double complex. */
 #ifndef TOWSTAB_LAPACK_H
 #define TOWSTAB_LAPACK_H
 
@@ -19,7 +20,6 @@ void dgetrf_(const int *m, const int *n, double *a, const int *lda, int *ipiv,
 void dgetrs_(const char *trans, const int *n, const int *nrhs, const double *a,
              const int *lda, const int *ipiv, double *b, const int *ldb,
              int *info, size_t trans_len);
-
 void dgeev_(const char *jobvl, const char *jobvr, const int *n, double *a,
             const int *lda, double *wr, double *wi, double *vl,
             const int *ldvl, double *vr, const int *ldvr, double *work,
@@ -36,6 +36,8 @@ void zgetrf_(const int *m, const int *n, double complex *a, const int *lda,
 void zgetrs_(const char *trans, const int *n, const int *nrhs,
              const double complex *a, const int *lda, const int *ipiv,
              double complex *b, const int *ldb, int *info, size_t trans_len);
+
+/* BLAS. */
 void dgemv_(const char *trans, const int *m, const int *n,
             const double *alpha, const double *a, const int *lda,
             const double *x, const int *incx, const double *beta, double *y,

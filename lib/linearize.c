@@ -1,5 +1,5 @@
 /* linearize.c: A = df/dy, B = df/du about a state (towstab/linearize.h;
- * MODEL.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
  *
  * Algorithm. For every column j (n state columns, then TS_NINPUT input
  * columns) the coordinate x_j is perturbed by +-h_j and the kernel is
@@ -40,6 +40,8 @@
 #endif
 
 #include "descriptor.h"
+#include "kernel_impl.h"
+#include "vehicle.h"
 
 #ifdef _OPENMP
 /* Below this many links a column costs a few microseconds and starting a
@@ -66,7 +68,7 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
         ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory");
         return NULL;
     }
-    int n = ts_kernel_nstate(k), ni = TS_NINPUT;
+    int n = ts_kernel_nstate(k), ni = ts_kernel_ninput(k);
     size_t sn = (size_t)n;
     lin->nstate = n;
     lin->nq = ts_kernel_nq(k);
@@ -87,10 +89,18 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
         lin->elastic[l] = (char)(sys->links[l].elastic != 0);
     }
     lin->h = calloc(sn + (size_t)ni, sizeof(double));
+    lin->u0 = calloc((size_t)ni, sizeof(double));
     lin->kink_node = -1;
     lin->desc_err = NAN;
+    lin->nvehicles = ts_kernel_nvehicles(k);
+    if (lin->nvehicles > 0) {
+        lin->up_qoff = malloc((size_t)sys->nlinks * sizeof(int));
+        lin->up_map = calloc(12 * (size_t)sys->nlinks, sizeof(double));
+    }
     if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
-        !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h) {
+        !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
+        !lin->u0 ||
+        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map))) {
         ts_linear_free(lin);
         ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory for %d "
                 "states", n);
@@ -119,23 +129,13 @@ void ts_linear_free(ts_linear *lin)
     free(lin->Aerr);
     free(lin->h);
     tsi_desc_free(lin->desc);
+    free(lin->u0);
+    free(lin->up_qoff);
+    free(lin->up_map);
     free(lin);
 }
 
-const char *ts_input_name(int j)
-{
-    static const char *const names[TS_NINPUT] = {
-        "tow.surge",
-        "tow.sway",
-        "tow.heave",
-        "tow.surge_velocity",
-        "tow.sway_velocity",
-        "tow.heave_velocity",
-        "tow.surge_acceleration",
-        "tow.sway_acceleration",
-        "tow.heave_acceleration"};
-    return j >= 0 && j < TS_NINPUT ? names[j] : NULL;
-}
+const char *ts_input_name(int j) { return tsi_tow_input_name(j); }
 
 /* The step of one column: rel * max(|x|, scale), rounded so that x + h is
  * a machine number (then (x + h) - x == h exactly). */
@@ -167,12 +167,12 @@ static void col_ws_free(col_ws *w, const ts_kernel *owner)
 }
 
 static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
-                        const double *u0, int n, int nl, ts_err *err)
+                        const double *u0, int n, int ni, int nl, ts_err *err)
 {
     memset(w, 0, sizeof *w);
     w->k = use_k ? k : ts_kernel_clone(k, err);
     w->y = malloc((size_t)n * sizeof(double));
-    w->u = malloc(TS_NINPUT * sizeof(double));
+    w->u = malloc((size_t)ni * sizeof(double));
     int ok = w->k && w->y && w->u;
     for (int i = 0; i < 4; i++) {
         w->f[i] = malloc((size_t)n * sizeof(double));
@@ -182,7 +182,7 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
     if (!ok)
         return TS_ENOMEM;
     memcpy(w->y, y0, (size_t)n * sizeof(double));
-    memcpy(w->u, u0, TS_NINPUT * sizeof(double));
+    memcpy(w->u, u0, (size_t)ni * sizeof(double));
     return TS_OK;
 }
 
@@ -202,8 +202,8 @@ typedef struct col_err {
 } col_err;
 
 /* Differentiate column j (j < n: state, else input j - n). Writes the lower
- * block of the column into `col` (nq entries, stride 1) and, when `tcol`
- * is not NULL, the tension derivatives (nl entries). */
+ * block of the column, rows nq..n-1, into `col` (n - nq entries, stride 1)
+ * and, when `tcol` is not NULL, the tension derivatives (nl entries). */
 static int column(col_ws *w, int j, int n, int nq, int nl, double h,
                   int estimate, double *col, double *ecol, double *tcol,
                   col_err *ce)
@@ -222,7 +222,7 @@ static int column(col_ws *w, int j, int n, int nq, int nl, double h,
     const double *fp = w->f[0] + nq, *fm = w->f[1] + nq;
     double inv = 1.0 / (2.0 * h), inv2 = 1.0 / (4.0 * h);
     ce->max_a = ce->sum2_a = ce->max_t = 0.0;
-    for (int i = 0; i < nq; i++) {
+    for (int i = 0; i < n - nq; i++) {
         col[i] = (fp[i] - fm[i]) * inv;
         if (estimate) {
             double d2 = (w->f[2][nq + i] - w->f[3][nq + i]) * inv2;
@@ -257,26 +257,63 @@ static int column(col_ws *w, int j, int n, int nq, int nl, double h,
  * relative step loses nothing to rounding. */
 #define STRAIN_FLOOR 1e-14
 
-/* Scale of column j (see linearize.h); link[] maps a coordinate to its
- * link, kind[] to 0 angle, 1 strain. */
+/* Scale of column j (see linearize.h): scale[] holds the coordinates'
+ * and rates' own (state columns), then the inputs follow. */
 static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
-                           int nq, int n, const int *link, const char *kind)
+                           int n, const double *scale)
 {
+    if (j < n)
+        return scale[j];
     double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
     double V = fabs(fr->speed);
-    if (j < n) {
-        int c = j < nq ? j : j - nq;
-        double l = sys->links[link[c]].length;
-        double s = kind[c] ? (j < nq ? STRAIN_FLOOR : STRAIN_SCALE) : 1.0;
-        return j < nq ? s : s * (sqrt(g * l) + V) / l;
-    }
     double l0 = sys->links[0].length;
     int c = j - n;
     if (c < TS_IN_VEL)
         return l0;
     if (c < TS_IN_ACC)
         return sqrt(g * l0) + V;
-    return g;
+    if (c < TS_NINPUT)
+        return g;
+    return 1.0; /* a deflection or a loop input, rad */
+}
+
+/* The state columns' scales (see linearize.h): a link's angle 1 rad, its
+ * strain STRAIN_FLOOR, their rates (sqrt(g l) + |V|) / l (times
+ * STRAIN_SCALE for a strain); a vehicle's angle 1 rad and its rates
+ * (sqrt(g l) + |V|) / l with l its hull's length (or 1 m); a controller
+ * state 1 (rad, or m s / rad s for an integrator). */
+static void state_scales(const ts_kernel *k, const ts_frame *fr,
+                         double *scale)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k), n = ts_kernel_nstate(k);
+    double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
+    double V = fabs(fr->speed);
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        int o = ts_kernel_link_offset(k, l);
+        double rate = (sqrt(g * L->length) + V) / L->length;
+        scale[o] = scale[o + 1] = 1.0;
+        scale[nq + o] = scale[nq + o + 1] = rate;
+        if (L->elastic) {
+            scale[o + 2] = STRAIN_FLOOR;
+            scale[nq + o + 2] = STRAIN_SCALE * rate;
+        }
+    }
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        double l = 1.0;
+        for (int c = 0; c < d->ncomponents; c++)
+            if (d->component[c].type == TS_COMP_HULL)
+                l = d->component[c].length;
+        int o = ts_kernel_vehicle_offset(k, v);
+        for (int j = 0; j < 3; j++) {
+            scale[o + j] = 1.0;
+            scale[nq + o + j] = (sqrt(g * l) + V) / l;
+        }
+    }
+    for (int j = 2 * nq; j < n; j++)
+        scale[j] = 1.0;
 }
 
 /* Count nodes within twice the largest step that moves them of z = 0. */
@@ -341,12 +378,14 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         o = *opts;
     else
         ts_linearize_opts_default(&o);
-    int n = ts_kernel_nstate(k), nq = n / 2, nl = sys->nlinks;
-    int ni = TS_NINPUT, ncol = n + ni;
-    if (lin->nstate != n || lin->nlinks != nl)
+    int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k), nl = sys->nlinks;
+    int ni = ts_kernel_ninput(k), ncol = n + ni, nlow = n - nq;
+    if (lin->nstate != n || lin->nlinks != nl || lin->ninput != ni ||
+        lin->nq != nq)
         return ts_fail(err, TS_EINVAL,
-                       "linearize: result sized for %d states, kernel has %d",
-                       lin->nstate, n);
+                       "linearize: result sized for %d states and %d "
+                       "inputs, kernel has %d and %d",
+                       lin->nstate, lin->ninput, n, ni);
     if (!(o.rel_step > 0 && o.rel_step < 0.1))
         return ts_fail(err, TS_EINVAL,
                        "linearize: rel_step must be in (0, 0.1), got %g",
@@ -354,14 +393,23 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     if (o.model < TS_LIN_AUTO || o.model > TS_LIN_BOTH)
         return ts_fail(err, TS_EINVAL, "linearize: unknown model %d",
                        (int)o.model);
+    /* The sparse model covers cables, links and lumped bodies; a vehicle
+     * (its attitude and controller states) only the dense one. */
+    int vehicles = lin->nvehicles > 0 || n != 2 * nq;
+    if (vehicles && o.model == TS_LIN_SPARSE)
+        return ts_fail(err, TS_EINVAL, "linearize: the sparse model does not "
+                       "cover vehicles (their attitude and controller "
+                       "states); use model TS_LIN_DENSE or TS_LIN_AUTO");
     int dense = o.model == TS_LIN_DENSE || o.model == TS_LIN_BOTH ||
-                (o.model == TS_LIN_AUTO && n < o.dense_max_states);
-    int sparse = o.model != TS_LIN_DENSE;
-    static const double zero_u[TS_NINPUT] = {0};
-    if (!u0)
-        u0 = zero_u;
+                (o.model == TS_LIN_AUTO &&
+                 (n < o.dense_max_states || vehicles));
+    int sparse = o.model != TS_LIN_DENSE && !vehicles;
+    if (u0)
+        memcpy(lin->u0, u0, (size_t)ni * sizeof(double));
+    else
+        memset(lin->u0, 0, (size_t)ni * sizeof(double));
+    u0 = lin->u0;
     memcpy(lin->y0, y0, (size_t)n * sizeof(double));
-    memcpy(lin->u0, u0, sizeof lin->u0);
     lin->evaluations = 0;
     lin->residual_evaluations = 0;
     /* Dense arrays only for the dense model: a result reused with another
@@ -401,18 +449,18 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         lin->Ty = malloc((size_t)nl * (size_t)n * sizeof(double));
         lin->Tu = malloc((size_t)nl * (size_t)ni * sizeof(double));
         if (!lin->Ty || !lin->Tu)
-            return ts_fail(err, TS_ENOMEM,
-                           "linearize: out of memory for the %d x %d tension "
-                           "Jacobian",
-                           nl, n);
+            return ts_fail_nomem(err, 8.0 * nl * (double)(n + ni),
+                                 "fewer links", "linearize: out of memory "
+                                 "for the %d x %d tension Jacobian", nl, n);
     }
+
     if (dense && o.estimate_error && !lin->Aerr) {
-        lin->Aerr = malloc((size_t)nq * (size_t)n * sizeof(double));
+        lin->Aerr = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (!lin->Aerr)
-            return ts_fail(err, TS_ENOMEM,
-                           "linearize: out of memory for the %d x %d error "
-                           "estimate (set estimate_error = 0)",
-                           nq, n);
+            return ts_fail_nomem(err, 8.0 * nlow * (double)n, "fewer links, "
+                                 "or estimate_error = 0", "linearize: out "
+                                 "of memory for the %d x %d error estimate",
+                                 nlow, n);
     }
     if (!o.estimate_error) {
         free(lin->Aerr);
@@ -450,29 +498,46 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         }
     }
 
+    /* A cable starting at a point P of a vehicle moves with the body:
+     * dr_P = dr_A + (R E dtheta) x rho_P (rho_P = R (P - A)). */
+    for (int l = 0; lin->nvehicles > 0 && l < nl; l++) {
+        const ts_link *L = &sys->links[l];
+        lin->up_qoff[l] = -1;
+        if (L->up_body < 0)
+            continue;
+        int v = 0;
+        while (ts_kernel_vehicle_body(k, v) != L->up_body)
+            v++;
+        const ts_vehicle *d = sys->bodies[L->up_body].vehicle;
+        double R[9], om[3], E[9], lev[3];
+        int qo = ts_kernel_vehicle_offset(k, v);
+        ts_kernel_get_vehicle(k, v, y0, R, om);
+        tsi_rate_matrix(y0 + qo, E);
+        double *map = lin->up_map + 12 * l;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                map[3 * i + j] = R[3 * i] * E[j] + R[3 * i + 1] * E[3 + j] +
+                                 R[3 * i + 2] * E[6 + j];
+        for (int j = 0; j < 3; j++)
+            lev[j] = L->up_point[j] - d->attach[j];
+        for (int j = 0; j < 3; j++)
+            map[9 + j] = R[3 * j] * lev[0] + R[3 * j + 1] * lev[1] +
+                         R[3 * j + 2] * lev[2];
+        lin->up_qoff[l] = qo;
+    }
+
     ts_frame fr;
     ts_kernel_get_frame(k, &fr);
-    int *clink = malloc((size_t)nq * sizeof(int));
-    char *ckind = malloc((size_t)nq);
-    if (!clink || !ckind) {
-        free(clink);
-        free(ckind);
+    double *scale = malloc((size_t)n * sizeof(double));
+    if (!scale)
         return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
-    }
-    for (int l = 0; l < nl; l++) {
-        int qo = lin->qoff[l], nc = lin->elastic[l] ? 3 : 2;
-        for (int c = 0; c < nc && qo + c < nq; c++) {
-            clink[qo + c] = l;
-            ckind[qo + c] = (char)(c == 2);
-        }
-    }
+    state_scales(k, &fr, scale);
     for (int j = 0; j < ncol; j++) {
         double x = j < n ? y0[j] : u0[j - n];
-        lin->h[j] = step_for(x, column_scale(sys, &fr, j, nq, n, clink, ckind),
+        lin->h[j] = step_for(x, column_scale(sys, &fr, j, n, scale),
                              o.rel_step);
     }
-    free(clink);
-    free(ckind);
+    free(scale);
     find_kinks(sys, lin, n);
 
     int nthreads = 1;
@@ -519,11 +584,11 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         return TS_OK;
     }
 
-    /* Upper blocks: [0 I] and 0, exactly. */
+    /* Upper blocks: [0 I 0] and 0, exactly. */
     for (int j = 0; j < n; j++) {
         double *colj = lin->A + (size_t)j * n;
         memset(colj, 0, (size_t)nq * sizeof(double));
-        if (j >= nq)
+        if (j >= nq && j < 2 * nq)
             colj[j - nq] = 1.0;
     }
     for (int j = 0; j < ni; j++)
@@ -536,7 +601,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     if (!ws)
         return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
     for (int t = 0; t < nthreads && rc == TS_OK; t++)
-        rc = col_ws_alloc(&ws[t], k, t == 0, y0, u0, n, nl, err);
+        rc = col_ws_alloc(&ws[t], k, t == 0, y0, u0, n, ni, nl, err);
     if (rc != TS_OK) {
         for (int t = 0; t < nthreads; t++)
             col_ws_free(&ws[t], k);
@@ -570,7 +635,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
             if (with_t)
                 tcol = j < n ? lin->Ty + (size_t)j * nl
                              : lin->Tu + (size_t)(j - n) * nl;
-            double *ecol = estimate && j < n ? lin->Aerr + (size_t)j * nq
+            double *ecol = estimate && j < n ? lin->Aerr + (size_t)j * nlow
                                              : NULL;
             col_err ce;
             int crc = column(w, j, n, nq, nl, lin->h[j], estimate, col, ecol,
@@ -607,18 +672,25 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         free(ftmp);
     }
     if (bad_col >= 0) {
-        if (bad_col < n)
+        if (bad_col < 2 * nq)
             return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
                            "linearize: state column %d (%s of q[%d]) "
                            "perturbed by %.3g left the model (%s)",
                            bad_col, bad_col < nq ? "coordinate" : "rate",
                            bad_col % nq, lin->h[bad_col],
                            ts_strerror(bad_rc));
+        if (bad_col < n)
+            return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
+                           "linearize: controller state %d perturbed by "
+                           "%.3g left the model (%s)",
+                           bad_col - 2 * nq, lin->h[bad_col],
+                           ts_strerror(bad_rc));
+        char name[2 * TS_NAME_MAX + 8];
         return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
                        "linearize: input %s perturbed by %.3g left the model "
                        "(%s)",
-                       ts_input_name(bad_col - n), lin->h[bad_col],
-                       ts_strerror(bad_rc));
+                       ts_kernel_input_name(k, bad_col - n, name, sizeof name),
+                       lin->h[bad_col], ts_strerror(bad_rc));
     }
     lin->trunc_err = estimate ? max_a : NAN;
     lin->trunc_norm = estimate ? sqrt(sum2_a) : NAN;
@@ -664,7 +736,9 @@ int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
             strain[l] = eq->y[ts_kernel_link_offset(k, l) + 2];
     ts_kernel_set_shape(k, eq->directions, strain, NULL, NULL,
                         TS_CHART_RECHART, y);
-    int rc = ts_linearize(k, y, NULL, opts, lin, err);
+    int rc = ts_equilibrium_set_bodies(k, eq, y, err);
+    if (rc == TS_OK)
+        rc = ts_linearize(k, y, NULL, opts, lin, err);
     free(y);
     free(strain);
     return rc;
@@ -680,7 +754,20 @@ void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,
         const double *rp = dr + 3 * L->upper;
         double *rk = dr + 3 * L->lower;
         int o = lin->qoff[l];
-        double de = lin->elastic[l] ? dq[o + 2] : 0.0;
+        double de = lin->elastic[l] ? dq[o + 2] : 0.0, rP[3];
+        if (L->up_body >= 0) {
+            /* dr_P = dr_A + (R E dtheta) x rho_P */
+            const double *map = lin->up_map + 12 * l;
+            const double *dth = dq + lin->up_qoff[l];
+            double phi[3];
+            for (int c = 0; c < 3; c++)
+                phi[c] = map[3 * c] * dth[0] + map[3 * c + 1] * dth[1] +
+                         map[3 * c + 2] * dth[2];
+            rP[0] = rp[0] + phi[1] * map[11] - phi[2] * map[10];
+            rP[1] = rp[1] + phi[2] * map[9] - phi[0] * map[11];
+            rP[2] = rp[2] + phi[0] * map[10] - phi[1] * map[9];
+            rp = rP;
+        }
         for (int c = 0; c < 3; c++)
             rk[c] = rp[c] +
                     lin->len0[l] * (d1[c] * dq[o] + d2[c] * dq[o + 1]) +

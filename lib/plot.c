@@ -13,8 +13,8 @@
  *     a white background, draw, and end the stream with plend1, which
  *     closes the FILE (cairo's tidy calls plCloseFile). The previously
  *     current stream is made current again.
- *  3. Write the bytes under a temporary name and rename (ts_report_open /
- *     ts_report_commit), so no half-written picture is left behind. The
+ *  3. Write the bytes under a temporary name and rename (tsi_outfile,
+ *     lib/outfile.h), so no half-written picture is left behind. The
  *     SVG gets a <title> element right after its root tag.
  *
  * Drawing: every number is converted to the requested unit system first
@@ -39,6 +39,11 @@
  * plwind, plbox, pllegend); src/plctrl.c (plOpenFile, plCloseFile) and
  * drivers/cairo.c (plD_init_pngcairo, plD_tidy_cairo) of PLplot 5.15;
  * memo Figs. 7-12 (Kamman & Nguyen 1990) for what is drawn.
+ *
+ * One module, though long: every picture goes through the same stream
+ * handling, page set-up, unit conversion, axes and legend code, and only
+ * its draw callback differs (a few dozen lines each); split by picture,
+ * each file would repeat or export that machinery.
  */
 #include "towstab/plot.h"
 
@@ -50,7 +55,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "towstab/report.h"
+#include "outfile.h"
 
 #ifdef TS_HAVE_PLPLOT
 #include <plplot.h>
@@ -936,8 +941,9 @@ static int render(const char *fn, const char *dir, const char *name,
         return rc;
     }
     /* Both temporary files first, then both renames. */
-    char path[2][1200], tmp[2][1300];
-    FILE *f[2] = {NULL, NULL};
+    char path[2][1200];
+    tsi_outfile f[2];
+    memset(f, 0, sizeof f);
     for (int k = 0; k < 2 && rc == TS_OK; k++) {
         if (!buf[k])
             continue;
@@ -948,20 +954,18 @@ static int render(const char *fn, const char *dir, const char *name,
                          fn, dir, name, ext[k]);
             break;
         }
-        f[k] = ts_report_open(path[k], tmp[k], sizeof tmp[k], err);
-        if (!f[k])
-            rc = TS_EIO;
-        else
-            rc = write_bytes(f[k], path[k], buf[k], size[k], k == 1, title,
+        rc = tsi_outfile_open(&f[k], path[k], err);
+        if (rc == TS_OK)
+            rc = write_bytes(f[k].f, path[k], buf[k], size[k], k == 1, title,
                              err);
     }
     for (int k = 0; k < 2; k++) {
-        if (!f[k])
+        if (!f[k].f)
             continue;
         if (rc == TS_OK)
-            rc = ts_report_commit(f[k], path[k], tmp[k], err);
+            rc = tsi_outfile_commit(&f[k], err);
         else
-            ts_report_abandon(f[k], path[k], tmp[k]);
+            tsi_outfile_abandon(&f[k]);
     }
     free(buf[0]);
     free(buf[1]);

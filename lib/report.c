@@ -1,40 +1,100 @@
 /* report.c: JSON (jansson) and CSV output of results (towstab/report.h).
- * Files are written under a temporary name and renamed into place only when
- * complete, so no half-written file survives a failure. */
+ * Files are written through tsi_outfile (lib/outfile.h): a regular file
+ * under a temporary name renamed into place only when complete, so no
+ * half-written file survives a failure, and a device or FIFO in place. */
 #include "towstab/report.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "towstab/health.h"
+#include "outfile.h"
 #include "towstab/kernel.h"
-#include "towstab/report_converge.h"
-
-void ts_report_node_name(const ts_system *sys, int node, char *buf,
-                         size_t size)
-{
-    if (node == 0) {
-        snprintf(buf, size, "tow");
-        return;
-    }
-    const ts_node *nd = &sys->nodes[node];
-    if (nd->body >= 0) {
-        snprintf(buf, size, "%s", sys->bodies[nd->body].name);
-        return;
-    }
-    const ts_link *L = &sys->links[nd->link];
-    snprintf(buf, size, "%s.%d", sys->cables[L->cable].name, L->index);
-}
 
 /* A JSON number, or null for a value that is not finite. */
 static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
 
+json_t *ts_report_trust_json(const ts_trust *t)
+{
+    json_t *o = json_object(), *r = json_array(), *n = json_array();
+    if (!o || !r || !n) {
+        json_decref(o);
+        json_decref(r);
+        json_decref(n);
+        return NULL;
+    }
+    for (int i = 0; i < t->nreasons; i++)
+        json_array_append_new(r, json_string(t->reasons[i]));
+    for (int i = 0; i < t->nnotes; i++)
+        json_array_append_new(n, json_string(t->notes[i]));
+    json_object_set_new(o, "trustworthy", json_boolean(t->trustworthy));
+    json_object_set_new(o, "reasons", r);
+    json_object_set_new(o, "notes", n);
+    if (t->dropped)
+        json_object_set_new(o, "dropped", json_integer(t->dropped));
+    return o;
+}
+
+/* [x, y, z] of a 3-vector. */
+static json_t *vec3(const double v[3])
+{
+    return json_pack("[o,o,o]", num(v[0]), num(v[1]), num(v[2]));
+}
+
+#define DEG (180.0 / M_PI)
+
+json_t *ts_report_vehicle_json(const ts_system *sys,
+                               const ts_vehicle_result *r)
+{
+    const ts_body *bd = &sys->bodies[r->body];
+    const ts_vehicle *d = bd->vehicle;
+    json_t *comps = json_array(), *defl = json_object(), *loops = json_array();
+    json_t *o = json_pack(
+        "{s:s,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}",
+        "name", bd->name, "x", num(r->origin[0]), "y", num(r->origin[1]),
+        "depth", num(r->origin[2]), "pitch_deg", num(r->pitch * DEG),
+        "roll_deg", num(r->roll * DEG), "yaw_deg", num(r->yaw * DEG),
+        "alpha_deg", num(r->alpha * DEG), "beta_deg", num(r->beta * DEG),
+        "speed", num(r->speed), "submerged", num(r->submerged),
+        "joint_force", vec3(r->joint_force), "hydro_force",
+        vec3(r->hydro_force), "hydro_moment", vec3(r->hydro_moment),
+        "munk_moment", vec3(r->munk), "mass_centre", vec3(r->mass_centre));
+    if (!o || !comps || !defl || !loops) {
+        json_decref(o);
+        json_decref(comps);
+        json_decref(defl);
+        json_decref(loops);
+        return NULL;
+    }
+    for (int c = 0; c < r->ncomponents; c++) {
+        const ts_component *cp = &d->component[c];
+        const ts_component_load *ld = &r->load[c];
+        json_array_append_new(
+            comps, json_pack("{s:s,s:s,s:o,s:o,s:o,s:o}", "name", cp->name,
+                             "type",
+                             cp->type == TS_COMP_HULL    ? "hull"
+                             : cp->type == TS_COMP_BLUFF ? "bluff"
+                                                         : "surface",
+                             "force", vec3(ld->force), "moment",
+                             vec3(ld->moment), "alpha_deg",
+                             num(ld->alpha * DEG), "speed", num(ld->speed)));
+        if (cp->control)
+            json_object_set_new(defl, cp->name, num(r->delta[c] * DEG));
+    }
+    for (int l = 0; l < r->nloops; l++)
+        json_array_append_new(
+            loops, json_pack("{s:s,s:o,s:o}", "name", d->loop[l].name,
+                             "error", num(r->loop_error[l]), "output_deg",
+                             num(r->loop_output[l] * DEG)));
+    json_object_set_new(o, "deflections_deg", defl);
+    json_object_set_new(o, "components", comps);
+    json_object_set_new(o, "controllers", loops);
+    return o;
+}
+
 json_t *ts_report_equilibrium_json(const ts_system *sys,
-                                   const ts_equilibrium *eq, double wall_s)
+                                   const ts_equilibrium *eq, double wall_s,
+                                   const ts_trust *trust)
 {
     json_t *o = json_object();
     json_t *nodes = json_array(), *links = json_array(), *bodies = json_array();
@@ -63,7 +123,7 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     char name[2 * TS_NAME_MAX];
     for (int i = 0; i < sys->nnodes; i++) {
         const double *r = eq->positions + 3 * i;
-        ts_report_node_name(sys, i, name, sizeof name);
+        ts_system_node_name(sys, i, name, sizeof name);
         json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name", name,
                                                "x", num(r[0]), "y", num(r[1]),
                                                "z", num(r[2])));
@@ -90,10 +150,7 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     json_object_set_new(o, "condition", num(eq->condition));
     json_object_set_new(o, "shape_error", num(eq->shape_error));
     /* What an engineer must not overlook: trustworthy, reasons, notes. */
-    ts_trust t;
-    ts_trust_init(&t);
-    ts_health_equilibrium(sys, eq, &t);
-    json_t *tj = ts_report_trust_json(&t);
+    json_t *tj = trust ? ts_report_trust_json(trust) : NULL;
     if (tj) {
         json_object_update(o, tj);
         json_decref(tj);
@@ -101,99 +158,89 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     json_object_set_new(o, "nodes", nodes);
     json_object_set_new(o, "links", links);
     json_object_set_new(o, "bodies", bodies);
+    if (eq->nvehicles > 0) {
+        json_t *veh = json_array();
+        for (int v = 0; veh && v < eq->nvehicles; v++)
+            json_array_append_new(veh,
+                                  ts_report_vehicle_json(sys, &eq->vehicles[v]));
+        json_object_set_new(o, "vehicles", veh);
+        json_object_set_new(o, "control_residual", num(eq->control_residual));
+    }
     return o;
-}
-
-FILE *ts_report_open(const char *path, char *tmp, size_t tmpsize, ts_err *err)
-{
-    if (strcmp(path, "-") == 0) {
-        tmp[0] = '\0';
-        return stdout;
-    }
-    /* A fresh name beside the target, created exclusively with mode 0666 so
-     * that the user's umask applies as to any file (mkstemp would make it
-     * 0600). The process id and an attempt count make the name unique;
-     * O_EXCL makes sure. */
-    int fd = -1, e = 0;
-    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
-        int n = snprintf(tmp, tmpsize, "%s.partial-%ld-%d", path,
-                         (long)getpid(), attempt);
-        if (n < 0 || (size_t)n >= tmpsize) {
-            ts_fail(err, TS_EIO, "%s: path too long", path);
-            return NULL;
-        }
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        e = errno;
-        if (fd < 0 && e != EEXIST)
-            break;
-    }
-    if (fd < 0) {
-        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(e));
-        return NULL;
-    }
-    FILE *f = fdopen(fd, "w");
-    if (!f) {
-        e = errno;
-        close(fd);
-        unlink(tmp);
-        ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(e));
-    }
-    return f;
-}
-
-int ts_report_commit(FILE *f, const char *path, const char *tmp, ts_err *err)
-{
-    if (f == stdout)
-        return fflush(stdout) == 0
-                   ? TS_OK
-                   : ts_fail(err, TS_EIO, "standard output: write failed");
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad) {
-        unlink(tmp);
-        return ts_fail(err, TS_EIO, "%s: write failed", path);
-    }
-    if (rename(tmp, path) != 0) {
-        int e = errno;
-        unlink(tmp);
-        return ts_fail(err, TS_EIO, "%s: cannot write (%s)", path, strerror(e));
-    }
-    return TS_OK;
-}
-
-void ts_report_abandon(FILE *f, const char *path, const char *tmp)
-{
-    (void)path;
-    if (!f || f == stdout)
-        return;
-    fclose(f);
-    unlink(tmp);
 }
 
 int ts_report_write_json(const json_t *value, const char *path, ts_err *err)
 {
-    char tmp[1024];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f)
-        return TS_EIO;
-    if (json_dumpf(value, f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0 ||
-        fputc('\n', f) == EOF) {
-        ts_report_abandon(f, path, tmp);
+    tsi_outfile out;
+    int rc = tsi_outfile_open(&out, path, err);
+    if (rc != TS_OK)
+        return rc;
+    if (json_dumpf(value, out.f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) !=
+            0 ||
+        fputc('\n', out.f) == EOF) {
+        tsi_outfile_abandon(&out);
         return ts_fail(err, TS_EIO, "%s: write failed", path);
     }
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
+}
+
+int ts_report_write_text(const char *text, size_t len, const char *path,
+                         ts_err *err)
+{
+    tsi_outfile out;
+    int rc = tsi_outfile_open(&out, path, err);
+    if (rc != TS_OK)
+        return rc;
+    if (len > 0 && fwrite(text, 1, len, out.f) != len) {
+        tsi_outfile_abandon(&out);
+        return ts_fail(err, TS_EIO, "%s: write failed", path);
+    }
+    return tsi_outfile_commit(&out, err);
+}
+
+int ts_report_check_targets(int n, const char *const what[],
+                            const char *const paths[], ts_err *err)
+{
+    for (int i = 0; i < n; i++) {
+        if (!paths[i])
+            continue;
+        tsi_outfile_id a;
+        if (tsi_outfile_identify(paths[i], &a, NULL) != TS_OK || a.kind == 1)
+            continue; /* the write reports it; devices may be shared */
+        for (int j = i + 1; j < n; j++) {
+            tsi_outfile_id b;
+            if (!paths[j] ||
+                tsi_outfile_identify(paths[j], &b, NULL) != TS_OK ||
+                a.kind != b.kind || a.dev != b.dev || a.ino != b.ino ||
+                strcmp(a.last, b.last) != 0)
+                continue;
+            if (a.kind == 2)
+                return ts_fail(err, TS_EINVAL,
+                               "%s and %s: both write to standard output; "
+                               "give one of them another file",
+                               what[i], what[j]);
+            return ts_fail(err, TS_EINVAL,
+                           "%s '%s' and %s '%s' name the same file; give "
+                           "each output its own",
+                           what[i], paths[i], what[j], paths[j]);
+        }
+    }
+    return TS_OK;
 }
 
 int ts_report_equilibrium_csv(const ts_system *sys, const ts_equilibrium *eq,
                               const char *path, ts_err *err)
 {
-    char tmp[1024], name[2 * TS_NAME_MAX];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f)
-        return TS_EIO;
+    char name[2 * TS_NAME_MAX];
+    tsi_outfile out;
+    int rc = tsi_outfile_open(&out, path, err);
+    if (rc != TS_OK)
+        return rc;
+    FILE *f = out.f;
     fprintf(f, "node,x_m,y_m,z_m,tension_above_N\n");
     for (int i = 0; i < sys->nnodes; i++) {
         const double *r = eq->positions + 3 * i;
-        ts_report_node_name(sys, i, name, sizeof name);
+        ts_system_node_name(sys, i, name, sizeof name);
         if (i == 0)
             fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
                     eq->top_tension);
@@ -201,5 +248,5 @@ int ts_report_equilibrium_csv(const ts_system *sys, const ts_equilibrium *eq,
             fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
                     eq->tensions[i - 1]);
     }
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }

@@ -1,6 +1,6 @@
 /* report_converge.c: JSON (jansson) and CSV of convergence studies and of
  * health verdicts (towstab/report_converge.h). Files go through
- * ts_report_open/commit/abandon, so a failed run leaves no file that
+ * tsi_outfile (lib/outfile.h), so a failed run leaves no file that
  * looks finished. */
 #include "towstab/report_converge.h"
 
@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "towstab/report.h"
 
 /* A JSON number, or null for a value that is not finite. */
@@ -23,27 +24,6 @@ static json_t *setting_json(const ts_convergence *c, double s)
         return json_null();
     return c->param == TS_CONV_LINKS ? json_integer((json_int_t)s)
                                      : json_real(s);
-}
-
-json_t *ts_report_trust_json(const ts_trust *t)
-{
-    json_t *o = json_object(), *r = json_array(), *n = json_array();
-    if (!o || !r || !n) {
-        json_decref(o);
-        json_decref(r);
-        json_decref(n);
-        return NULL;
-    }
-    for (int i = 0; i < t->nreasons; i++)
-        json_array_append_new(r, json_string(t->reasons[i]));
-    for (int i = 0; i < t->nnotes; i++)
-        json_array_append_new(n, json_string(t->notes[i]));
-    json_object_set_new(o, "trustworthy", json_boolean(t->trustworthy));
-    json_object_set_new(o, "reasons", r);
-    json_object_set_new(o, "notes", n);
-    if (t->dropped)
-        json_object_set_new(o, "dropped", json_integer(t->dropped));
-    return o;
 }
 
 int ts_report_modes_health_json(json_t *modes, const ts_eigen *e,
@@ -218,12 +198,13 @@ int ts_report_convergence_csv(const ts_convergence *c, const char *path,
     int *idx = malloc((size_t)(c->nrows > 0 ? c->nrows : 1) * sizeof(int));
     if (!idx)
         return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
-    char tmp[4096];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f) {
+    tsi_outfile out;
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK) {
         free(idx);
-        return err && err->code ? err->code : TS_EIO;
+        return orc;
     }
+    FILE *f = out.f;
     fprintf(f, "series,setting,h,status,wall_s,evaluations,trustworthy,"
                "max_relative_error");
     for (int v = 0; v < c->nvalues; v++)
@@ -246,5 +227,5 @@ int ts_report_convergence_csv(const ts_convergence *c, const char *path,
         fprintf(f, "\n");
     }
     free(idx);
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }

@@ -1,6 +1,6 @@
 /* report_linear.c: JSON (jansson) and CSV output of linearizations, modes
  * and frequency responses (towstab/report_linear.h). Every file goes
- * through ts_report_open/commit/abandon, so a failed run leaves no file
+ * through tsi_outfile (lib/outfile.h), so a failed run leaves no file
  * that looks finished. */
 #include "towstab/report_linear.h"
 
@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "towstab/report.h"
 
 /* A JSON number, or null for a value that is not finite. */
@@ -89,7 +90,7 @@ static json_t *shape_json(const ts_system *sys, const ts_linear *lin,
     char name[2 * TS_NAME_MAX];
     for (int i = 0; arr && i < sys->nnodes; i++) {
         const double *a = amp + 3 * i, *p = phase + 3 * i;
-        ts_report_node_name(sys, i, name, sizeof name);
+        ts_system_node_name(sys, i, name, sizeof name);
         json_array_append_new(
             arr, json_pack("{s:s,s:o,s:o,s:o,s:o,s:o,s:o}", "node", name,
                            "x_amp", num(a[0]), "x_phase_deg",
@@ -165,10 +166,12 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
 int ts_report_modes_csv(const ts_system *sys, const ts_linear *lin,
                         const ts_eigen *e, const char *path, ts_err *err)
 {
-    char tmp[1024], desc[256];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f)
-        return TS_EIO;
+    tsi_outfile out;
+    char desc[256];
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK)
+        return orc;
+    FILE *f = out.f;
     fprintf(f, "mode,re_per_s,im_rad_per_s,freq_hz,period_s,damping_ratio,"
                "time_constant_s,condition,error_bound,description\n");
     for (int m = 0; m < e->nmodes; m++) {
@@ -179,7 +182,7 @@ int ts_report_modes_csv(const ts_system *sys, const ts_linear *lin,
                 md->damping_ratio, md->time_constant_s, md->condition,
                 md->error_bound, desc);
     }
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }
 
 int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
@@ -196,13 +199,15 @@ int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
         free(phase);
         return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
     }
-    char tmp[1024], name[2 * TS_NAME_MAX];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f) {
+    tsi_outfile out;
+    char name[2 * TS_NAME_MAX];
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK) {
         free(amp);
         free(phase);
-        return TS_EIO;
+        return orc;
     }
+    FILE *f = out.f;
     fprintf(f, "mode,freq_hz,node,x_amp,x_phase_deg,y_amp,y_phase_deg,z_amp,"
                "z_phase_deg\n");
     int rc = TS_OK;
@@ -210,7 +215,7 @@ int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
         rc = ts_eigen_mode_shape(sys, lin, e, m, amp, phase, err);
         for (int i = 0; rc == TS_OK && i < sys->nnodes; i++) {
             const double *a = amp + 3 * i, *p = phase + 3 * i;
-            ts_report_node_name(sys, i, name, sizeof name);
+            ts_system_node_name(sys, i, name, sizeof name);
             fprintf(f, "%d,%.17g,%s,%.10g,%.6f,%.10g,%.6f,%.10g,%.6f\n", m + 1,
                     e->modes[m].freq_hz, name, a[0], p[0] * 180 / M_PI, a[1],
                     p[1] * 180 / M_PI, a[2], p[2] * 180 / M_PI);
@@ -219,10 +224,10 @@ int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
     free(amp);
     free(phase);
     if (rc != TS_OK) {
-        ts_report_abandon(f, path, tmp);
+        tsi_outfile_abandon(&out);
         return rc;
     }
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }
 
 json_t *ts_report_response_json(const ts_response *r)
@@ -251,13 +256,14 @@ json_t *ts_report_response_json(const ts_response *r)
 int ts_report_response_csv(const ts_response *r, const char *path,
                            ts_err *err)
 {
-    char tmp[1024];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f)
-        return TS_EIO;
+    tsi_outfile out;
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK)
+        return orc;
+    FILE *f = out.f;
     fprintf(f, "freq_hz,magnitude,phase_deg,re,im\n");
     for (int i = 0; i < r->npoints; i++)
         fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", r->freq_hz[i],
                 r->magnitude[i], r->phase_deg[i], r->re[i], r->im[i]);
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "towstab/report.h"
 
 static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
@@ -52,7 +53,7 @@ json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
     for (int k = 0; k < h->nnodes; k++) {
         if (node >= 0 && k != node)
             continue;
-        ts_report_node_name(sys, k, name, sizeof name);
+        ts_system_node_name(sys, k, name, sizeof name);
         const double *p = h->positions + 3 * (size_t)k;
         json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name",
                                                name, "x", series(p, n, ps),
@@ -143,6 +144,13 @@ json_t *ts_report_excitation_json(const ts_excitation *ex)
             json_object_set_new(o, "from_s", num(s->start));
             json_object_set_new(o, "to_s", num(s->start + s->duration));
             break;
+        case TS_SIGNAL_SUM:
+            json_object_set_new(o, "rms", num(s->amplitude));
+            json_object_set_new(o, "components",
+                                json_integer(ts_excitation_sum_components(ex, i)));
+            json_object_set_new(o, "max_frequency_hz", num(s->frequency));
+            json_object_set_new(o, "fade_in_s", num(s->rise));
+            break;
         }
         json_array_append_new(a, o);
     }
@@ -154,7 +162,7 @@ static void csv_header(FILE *f, const ts_system *sys, const ts_history *h,
 {
     char name[2 * TS_NAME_MAX];
     for (int k = 0; k < h->nnodes; k++) {
-        ts_report_node_name(sys, k, name, sizeof name);
+        ts_system_node_name(sys, k, name, sizeof name);
         fprintf(f, ",%s%s.x_m,%s%s.y_m,%s%s.z_m", prefix, name, prefix, name,
                 prefix, name);
     }
@@ -183,10 +191,11 @@ int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
 {
     if (!nl && !li)
         return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
-    char tmp[1024];
-    FILE *f = ts_report_open(path, tmp, sizeof tmp, err);
-    if (!f)
-        return TS_EIO;
+    tsi_outfile out;
+    int orc = tsi_outfile_open(&out, path, err);
+    if (orc != TS_OK)
+        return orc;
+    FILE *f = out.f;
     int both = nl && li;
     const ts_history *first = nl ? nl : li;
     int rows = first->nsamples;
@@ -206,5 +215,5 @@ int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
             csv_row(f, li, i);
         fputc('\n', f);
     }
-    return ts_report_commit(f, path, tmp, err);
+    return tsi_outfile_commit(&out, err);
 }

@@ -1,5 +1,5 @@
 /* response.c: frequency response to tow-point motion (towstab/response.h;
- * MODEL.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md,
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md,
  * section 4).
  *
  * Algorithm, per frequency w: one solve with the sparse linear model at
@@ -9,6 +9,12 @@
  * factorisation of S(s) and one solve give every node's absolute
  * displacement and every link's tension: O(nlinks) per frequency. At
  * w = 0 the solve is real and gives the static gain.
+ *
+ * A system the sparse model does not cover (vehicles) takes the dense
+ * way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1 b by the dense shifted
+ * solve of lib/shift.h (one LU of P(s), O(nq^3)), then positions through
+ * the link geometry plus the tow displacement, tensions through dT/dy and
+ * dT/du.
  */
 #include "towstab/response.h"
 
@@ -19,7 +25,7 @@
 #include <string.h>
 
 #include "shift.h"
-#include "towstab/report.h"
+#include "towstab/system.h"
 
 static const char *const input_names[3] = {"tow.surge", "tow.sway",
                                            "tow.heave"};
@@ -159,7 +165,7 @@ int ts_response_output_find(const ts_system *sys, const char *name,
         out->comp = comp;
         out->unit = "m/m";
         char nm[2 * TS_NAME_MAX];
-        ts_report_node_name(sys, out->node, nm, sizeof nm);
+        ts_system_node_name(sys, out->node, nm, sizeof nm);
         snprintf(out->name, sizeof out->name, "%s.%c", nm, "xyz"[comp]);
     }
     return TS_OK;
@@ -207,13 +213,53 @@ void ts_response_free(ts_response *r)
     free(r);
 }
 
-/* Work for one evaluation: node displacements and link tensions. */
+/* Work for one evaluation: node displacements and link tensions (the
+ * sparse way), state and input vectors (the dense way). */
 typedef struct resp_ws {
     double complex *dr, *dt;
+    double complex *b, *x;
+    double *dq, *drr;
 } resp_ws;
 
-static int gain_at(const ts_linear *lin, int input, const ts_output *out,
-                   double omega, resp_ws *w, double complex *g, ts_err *err)
+/* The dense way (see the head of the file); lin holds A, B, Ty, Tu. */
+static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
+                       const ts_output *out, tsi_shift *sh, resp_ws *w,
+                       double complex *g)
+{
+    int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
+    double complex s = sh->s;
+    const double *Bx = lin->B + (size_t)(TS_IN_DISP + input) * n;
+    const double *Bv = lin->B + (size_t)(TS_IN_VEL + input) * n;
+    const double *Ba = lin->B + (size_t)(TS_IN_ACC + input) * n;
+    for (int i = 0; i < n; i++)
+        w->b[i] = -(Bx[i] + s * Bv[i] + s * s * Ba[i]);
+    tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
+    if (out->kind == TS_OUT_POSITION) {
+        int idx = 3 * out->node + out->comp;
+        for (int i = 0; i < nq; i++)
+            w->dq[i] = creal(w->x[i]);
+        ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+        double gr = w->drr[idx];
+        for (int i = 0; i < nq; i++)
+            w->dq[i] = cimag(w->x[i]);
+        ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+        double gi = w->drr[idx];
+        *g = gr + I * gi + (out->comp == input ? 1.0 : 0.0);
+    } else {
+        int l = out->link;
+        double complex acc = 0;
+        for (int j = 0; j < n; j++)
+            acc += lin->Ty[l + (size_t)j * nl] * w->x[j];
+        acc += lin->Tu[l + (size_t)(TS_IN_DISP + input) * nl] +
+               s * lin->Tu[l + (size_t)(TS_IN_VEL + input) * nl] +
+               s * s * lin->Tu[l + (size_t)(TS_IN_ACC + input) * nl];
+        *g = acc;
+    }
+}
+
+static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
+                   const ts_output *out, double omega, resp_ws *w,
+                   double complex *g, ts_err *err)
 {
     tsi_shift sh;
     int rc = tsi_shift_factor(&sh, lin, I * omega, err);
@@ -225,10 +271,14 @@ static int gain_at(const ts_linear *lin, int input, const ts_output *out,
                     omega / (2 * M_PI));
         return rc;
     }
-    tsi_shift_input(&sh, input, w->dr, w->dt);
+    if (lin->desc) {
+        tsi_shift_input(&sh, input, w->dr, w->dt);
+        *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
+                                          : w->dt[out->link];
+    } else {
+        dense_gain(sys, lin, input, out, &sh, w, g);
+    }
     tsi_shift_free(&sh);
-    *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
-                                      : w->dt[out->link];
     return TS_OK;
 }
 
@@ -245,10 +295,16 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
                        "response: input channel must be 0, 1 or 2 "
                        "(tow.surge, tow.sway, tow.heave), got %d",
                        input);
-    if (!lin->desc)
+    if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
-                       "response: output %s needs the sparse linear model; "
-                       "linearize with model TS_LIN_AUTO, SPARSE or BOTH",
+                       "response: output %s needs a linear model (sparse, "
+                       "or dense)",
+                       out->name);
+    if (!lin->desc && out->kind == TS_OUT_TENSION && (!lin->Ty || !lin->Tu))
+        return ts_fail(err, TS_EINVAL,
+                       "response: output %s needs the tension Jacobians "
+                       "of the dense model; linearize with opts.tensions = "
+                       "1",
                        out->name);
     if (out->kind == TS_OUT_POSITION &&
         (out->node < 1 || out->node >= lin->nnodes || out->comp < 0 ||
@@ -266,9 +322,18 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
 
 static int ws_alloc(resp_ws *w, const ts_linear *lin)
 {
+    memset(w, 0, sizeof *w);
     w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double complex));
     w->dt = malloc((size_t)(lin->nlinks > 0 ? lin->nlinks : 1) *
                    sizeof(double complex));
+    if (!lin->desc) {
+        w->b = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->x = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->dq = malloc((size_t)lin->nq * sizeof(double));
+        w->drr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
+        if (!w->b || !w->x || !w->dq || !w->drr)
+            return 0;
+    }
     return w->dr && w->dt;
 }
 
@@ -276,6 +341,10 @@ static void ws_free(resp_ws *w)
 {
     free(w->dr);
     free(w->dt);
+    free(w->b);
+    free(w->x);
+    free(w->dq);
+    free(w->drr);
 }
 
 int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
@@ -296,7 +365,7 @@ int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
         return ts_fail(err, TS_ENOMEM, "response: out of memory");
     }
     double complex g = 0;
-    rc = gain_at(lin, input, out, omega, &w, &g, err);
+    rc = gain_at(sys, lin, input, out, omega, &w, &g, err);
     ws_free(&w);
     *re = creal(g);
     *im = cimag(g);
@@ -342,10 +411,10 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
     r->output = *out;
     r->npoints = npoints;
     double complex g = 0;
-    rc = gain_at(lin, input, out, 0.0, &w, &g, err);
+    rc = gain_at(sys, lin, input, out, 0.0, &w, &g, err);
     r->static_gain = creal(g);
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
-        rc = gain_at(lin, input, out, 2 * M_PI * freq_hz[i], &w, &g, err);
+        rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &g, err);
         r->freq_hz[i] = freq_hz[i];
         r->re[i] = creal(g);
         r->im[i] = cimag(g);

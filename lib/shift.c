@@ -13,11 +13,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lapack.h"
+
 #define XR(k, c) (4 * ((k)-1) + (c))
 #define XT(l) (4 * (l) + 3)
 
 void tsi_shift_free(tsi_shift *sh)
 {
+    free(sh->lu);
+    free(sh->zlu);
+    free(sh->ipiv);
+    free(sh->zw);
+    free(sh->wr);
     if (sh->numeric) {
         klu_numeric *num = sh->numeric;
         if (sh->is_complex)
@@ -34,6 +41,120 @@ void tsi_shift_free(tsi_shift *sh)
     free(sh->w);
     memset(sh, 0, sizeof *sh);
 }
+
+/* ---- Dense backend (lib/shift.h: systems with vehicles) -------------- */
+
+static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                        ts_err *err)
+{
+    memset(sh, 0, sizeof *sh);
+    int nq = lin->nq, n = lin->nstate, info = 0;
+    size_t nn = (size_t)nq * (size_t)nq;
+    sh->lin = lin;
+    sh->nq = nq;
+    sh->n = n;
+    sh->s = s;
+    sh->is_complex = cimag(s) != 0.0;
+    sh->ipiv = malloc((size_t)nq * sizeof(int));
+    sh->zw = malloc((size_t)nq * sizeof(double complex));
+    sh->wr = malloc(2 * (size_t)nq * sizeof(double));
+    if (sh->is_complex)
+        sh->zlu = malloc(nn * sizeof(double complex));
+    else
+        sh->lu = malloc(nn * sizeof(double));
+    if (!sh->ipiv || !sh->zw || !sh->wr || (!sh->zlu && !sh->lu)) {
+        tsi_shift_free(sh);
+        return ts_fail_nomem(err, (sh->is_complex ? 16.0 : 8.0) * (double)nn,
+                             "fewer links", "eigen: out of memory for the "
+                             "%d x %d shifted matrix", nq, nq);
+    }
+    /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
+    const double *A = lin->A;
+    double complex s2 = s * s;
+    for (int j = 0; j < nq; j++) {
+        const double *Kj = A + (size_t)j * n + nq;
+        const double *Cj = A + (size_t)(j + nq) * n + nq;
+        if (sh->is_complex) {
+            double complex *Pj = sh->zlu + (size_t)j * nq;
+            for (int i = 0; i < nq; i++)
+                Pj[i] = Kj[i] + s * Cj[i];
+            Pj[j] -= s2;
+        } else {
+            double *Pj = sh->lu + (size_t)j * nq;
+            double sr = creal(s);
+            for (int i = 0; i < nq; i++)
+                Pj[i] = Kj[i] + sr * Cj[i];
+            Pj[j] -= sr * sr;
+        }
+    }
+    if (sh->is_complex)
+        zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
+    else
+        dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
+    if (info < 0) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d",
+                       sh->is_complex ? "zgetrf" : "dgetrf", info);
+    }
+    if (info > 0) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ESINGULAR,
+                       "the shifted system is singular at s = %g%+gi 1/s "
+                       "(an eigenvalue sits on the shift)",
+                       creal(s), cimag(s));
+    }
+    return TS_OK;
+}
+
+static void dense_solve_real(tsi_shift *sh, const double *b, double *x)
+{
+    int nq = sh->nq, n = sh->n, one = 1, info = 0;
+    double sr = creal(sh->s), mone = -1.0, pone = 1.0;
+    const double *b1 = b, *b2 = b + nq;
+    double *x1 = x, *x2 = x + nq;
+    /* x1 = b2 + s b1 - C b1 */
+    for (int i = 0; i < nq; i++)
+        x1[i] = b2[i] + sr * b1[i];
+    dgemv_("N", &nq, &nq, &mone, sh->lin->A + (size_t)nq * n + nq, &n, b1,
+           &one, &pone, x1, &one, 1);
+    dgetrs_("N", &nq, &one, sh->lu, &nq, sh->ipiv, x1, &nq, &info, 1);
+    for (int i = 0; i < nq; i++)
+        x2[i] = b1[i] + sr * x1[i];
+}
+
+static void dense_solve(tsi_shift *sh, const double complex *b,
+                        double complex *x)
+{
+    int nq = sh->nq, n = sh->n, one = 1, two = 2, info = 0;
+    double complex s = sh->s;
+    const double complex *b1 = b, *b2 = b + nq;
+    double complex *x1 = x, *x2 = x + nq;
+    /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
+     * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
+    double pone = 1.0, zero = 0.0;
+    dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
+           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->zw,
+           &two, 1, 1);
+    for (int i = 0; i < nq; i++)
+        x1[i] = b2[i] + s * b1[i] - sh->zw[i];
+    if (sh->is_complex) {
+        zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
+    } else {
+        /* Real factors: solve the real and imaginary parts together. */
+        double *r = sh->wr;
+        for (int i = 0; i < nq; i++) {
+            r[i] = creal(x1[i]);
+            r[nq + i] = cimag(x1[i]);
+        }
+        dgetrs_("N", &nq, &two, sh->lu, &nq, sh->ipiv, r, &nq, &info, 1);
+        for (int i = 0; i < nq; i++)
+            x1[i] = r[i] + I * r[nq + i];
+    }
+    for (int i = 0; i < nq; i++)
+        x2[i] = b1[i] + s * x1[i];
+}
+
+/* ---- Sparse backend ------------------------------------------------------ */
 
 static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
 {
@@ -54,7 +175,8 @@ static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
     sh->u1 = malloc(2 * n3 * sizeof(double));
     sh->u2 = malloc(4 * n3 * sizeof(double));
     sh->w = malloc(2 * ((size_t)lin->nq + 1) * sizeof(double));
-    if (!sh->common || !sh->Sx || !sh->rhs || !sh->cols || !sh->u1 || !sh->u2 || !sh->w) {
+    if (!sh->common || !sh->Sx || !sh->rhs || !sh->cols || !sh->u1 ||
+        !sh->u2 || !sh->w) {
         tsi_shift_free(sh);
         return ts_fail(err, TS_ENOMEM, "shift: out of memory for %d "
                        "unknowns", d->nx);
@@ -90,6 +212,8 @@ static int factor(tsi_shift *sh, ts_err *err)
 int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                      ts_err *err)
 {
+    if (!lin->desc && lin->A)
+        return dense_factor(sh, lin, s, err);
     int rc = setup(sh, lin, err);
     if (rc != TS_OK)
         return rc;
@@ -171,6 +295,10 @@ static void rhs_parts(const tsi_shift *sh, const double *wq, const double *wqd,
 
 void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
 {
+    if (!sh->d) {
+        dense_solve_real(sh, b, x);
+        return;
+    }
     const ts_descriptor *d = sh->d;
     int nq = sh->lin->nq;
     size_t n3 = 3 * (size_t)d->nn;
@@ -216,6 +344,10 @@ static void two_columns(tsi_shift *sh)
 void tsi_shift_solve(tsi_shift *sh, const double complex *b,
                      double complex *x)
 {
+    if (!sh->d) {
+        dense_solve(sh, b, x);
+        return;
+    }
     const ts_descriptor *d = sh->d;
     int nq = sh->lin->nq;
     size_t n3 = 3 * (size_t)d->nn;

@@ -20,7 +20,13 @@
  *
  * The maps are exact about a state at rest relative to M (an equilibrium);
  * about a moving state they omit the terms of J' (first order in the link
- * rates), which the stiff integrator's Newton iteration absorbs. */
+ * rates), which the stiff integrator's Newton iteration absorbs.
+ *
+ * Without the sparse model (a system with vehicles: ts_linear.desc NULL)
+ * the same solves use the dense A = [[0, I], [K, C]]: (A - s I) x = b is
+ * P(s) x1 = b2 - C b1 + s b1, x2 = b1 + s x1 with P(s) = K + s C - s^2 I,
+ * one LAPACK LU (dgetrf or zgetrf) of P, O(nq^3), then O(nq^2) per solve.
+ * Only tsi_shift_solve_real and tsi_shift_solve work then. */
 #ifndef TOWSTAB_SHIFT_H
 #define TOWSTAB_SHIFT_H
 
@@ -37,6 +43,14 @@ typedef struct tsi_shift {
     double complex s;
     int is_complex;        /* s has a nonzero imaginary part */
     int inf;               /* S_inf: A's action, not a shift */
+    /* Dense backend (no sparse model). */
+    int nq, n;
+    double *lu;            /* [nq * nq] real LU (dgetrf), when real */
+    double complex *zlu;   /* [nq * nq] complex LU (zgetrf), when complex */
+    int *ipiv;             /* [nq] */
+    double complex *zw;    /* [nq] work */
+    double *wr;            /* [2 nq] work */
+    /* Sparse backend. */
     void *common;          /* KLU parameters and status (own copy) */
     void *numeric;         /* KLU factors */
     double *Sx;            /* [nnz] real or [2 nnz] complex values */
@@ -46,10 +60,10 @@ typedef struct tsi_shift {
     double *w;             /* [2 nq] */
 } tsi_shift;
 
-/* Factor S(s) (real arithmetic when Im s == 0) of lin's sparse model.
- * Returns TS_OK, TS_EINVAL (no sparse model), TS_ESINGULAR (s is an
- * eigenvalue to working precision) or TS_ENOMEM. Free with
- * tsi_shift_free. */
+/* Factor S(s) (real arithmetic when Im s == 0) of lin's sparse model, or
+ * P(s) of its dense A without one. Returns TS_OK, TS_EINVAL (no model),
+ * TS_ESINGULAR (s is an eigenvalue to working precision) or TS_ENOMEM.
+ * Free with tsi_shift_free. */
 int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                      ts_err *err);
 

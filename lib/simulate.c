@@ -44,6 +44,10 @@
  * shortest time scale, and at most the output interval. Each distinct h
  * costs one exponential (two at most per run: the regular interval and a
  * shorter last one).
+ *
+ * One module, though long: the nonlinear and the linear runs share the
+ * options, the sampling into a history, the step checks, the re-charting
+ * and the statistics.
  */
 #include "towstab/simulate.h"
 
@@ -55,13 +59,12 @@
 #include <string.h>
 #include <time.h>
 
-#include "esdirk.h"
 #include "descriptor.h"
+#include "esdirk.h"
 #include "expm.h"
 #include "kernel_impl.h"
 #include "lapack.h"
 #include "shift.h"
-
 
 /* Interpolation error constant of the cubic input hold (see above). */
 #define CUBIC_HOLD_ERR 5.1e-4
@@ -92,6 +95,8 @@ void ts_sim_opts_default(ts_sim_opts *o)
     o->linear_method = TS_LINSIM_EXPM;
     o->kinematics = TS_KIN_LINEAR;
     o->jacobian_threads = 1;
+    o->progress = NULL;
+    o->progress_data = NULL;
 }
 
 static const char *const integrator_names[] = {"rk8pd", "rkf45", "rk4imp",
@@ -200,8 +205,11 @@ ts_history *ts_history_alloc(const ts_system *sys, int capacity, ts_err *err)
     return h;
 nomem:
     ts_history_free(h);
-    ts_fail(err, TS_ENOMEM, "ts_history_alloc: out of memory for %d samples",
-            capacity);
+    ts_fail_nomem(err, 8.0 * capacity * (3.0 + 3.0 * sys->nnodes +
+                                         sys->nlinks + TS_NINPUT),
+                  "a coarser sample interval, a shorter t_end or fewer links",
+                  "simulate: out of memory for a history of %d samples of "
+                  "%d nodes", capacity, sys->nnodes);
     return NULL;
 }
 
@@ -416,6 +424,18 @@ static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
     return esdirk_code(rhs(t, y, dydt, params));
 }
 
+/* esdirk's dense Jacobian: a system the sparse model does not cover (a
+ * vehicle). */
+static int jacobian_esdirk(double t, const double y[], double J[],
+                           void *params)
+{
+    ts_sim *s = params;
+    int rc = linearize_at(s, t, y);
+    if (rc == GSL_SUCCESS)
+        memcpy(J, s->lin->A, (size_t)s->n * (size_t)s->n * sizeof(double));
+    return esdirk_code(rc);
+}
+
 /* esdirk's Newton matrix I - gamma J from the sparse model (lib/shift.h):
  * J re-evaluated unless ARKODE says the last one will do, then S(1 /
  * gamma) factored, O(nlinks) each. */
@@ -491,6 +511,17 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
 {
     if (ts_sim_opts_check(o, err))
         return NULL;
+    /* Loads that overflow under the excitation's motion are the input's
+     * fault: refuse them before a single step, naming the input (a step
+     * size would otherwise shrink towards zero chasing them). */
+    ts_frame f0;
+    ts_motion_bound mb;
+    ts_kernel_get_frame(k, &f0);
+    ts_excitation_bound(ex, &f0, &mb);
+    if (ts_system_check_loads(ts_kernel_system(k), &mb, err) != TS_OK) {
+        ts_err_prefix(err, "simulate: ");
+        return NULL;
+    }
     ts_sim *s = calloc(1, sizeof *s);
     if (!s) {
         ts_fail(err, TS_ENOMEM, "simulate: out of memory");
@@ -531,6 +562,7 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     if (!s->y || !s->work || !s->breaks)
         goto nomem;
     s->nbreaks = ts_excitation_breakpoints(ex, o->t_end, s->breaks, nb);
+    int sparse = 0;
     if (needs_jacobian(o->integrator)) {
         s->lin = ts_linear_alloc(k, err);
         if (!s->lin) {
@@ -541,14 +573,20 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         s->lopts.estimate_error = 0;
         s->lopts.threads = o->jacobian_threads;
         /* GSL's implicit steppers take a dense Jacobian; esdirk solves
-         * with the sparse model. */
-        s->lopts.model = o->integrator == TS_INT_ESDIRK ? TS_LIN_SPARSE
-                                                        : TS_LIN_DENSE;
+         * with the sparse model where it covers the system (not with a
+         * vehicle). */
+        sparse = o->integrator == TS_INT_ESDIRK &&
+                 ts_kernel_nvehicles(k) == 0 && s->n == 2 * s->nq;
+        s->lopts.model = sparse ? TS_LIN_SPARSE : TS_LIN_DENSE;
     }
     if (o->integrator == TS_INT_ESDIRK) {
         const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk};
-        s->sd = tsi_esdirk_alloc_lsys(s->n, rhs_esdirk, &lsys, s, o->rel_tol,
-                                      o->abs_tol, s->h, err);
+        s->sd = sparse ? tsi_esdirk_alloc_lsys(s->n, rhs_esdirk, &lsys, s,
+                                               o->rel_tol, o->abs_tol, s->h,
+                                               err)
+                       : tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk,
+                                          s, o->rel_tol, o->abs_tol, s->h,
+                                          err);
         if (!s->sd) {
             ts_sim_free(s);
             return NULL;
@@ -570,8 +608,13 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     return s;
 nomem:
     ts_sim_free(s);
-    ts_fail(err, TS_ENOMEM, "simulate: out of memory for %d states",
-            (int)n);
+    ts_fail_nomem(err, 8.0 * (double)n * (needs_jacobian(o->integrator)
+                                             ? (double)n + 10 : 10.0),
+                  needs_jacobian(o->integrator)
+                      ? "fewer links, or an explicit integrator (rk8pd)"
+                      : "fewer links",
+                  "simulate: out of memory for the integrator of %d states",
+                  (int)n);
     return NULL;
 }
 
@@ -661,6 +704,20 @@ static int finite_state(const double y[], int n)
     return 1;
 }
 
+/* Report progress at simulated time t (run `what`) to the caller's
+ * callback: TS_ECANCEL when it asks to stop, else TS_OK. */
+static int report_progress(const ts_sim_opts *o, const char *what, double t,
+                           ts_err *err)
+{
+    if (!o->progress)
+        return TS_OK;
+    ts_progress p = {what, t, o->t_end, "s"};
+    if (!o->progress(&p, o->progress_data))
+        return TS_OK;
+    return ts_fail(err, TS_ECANCEL, "simulate (%s): stopped on request at "
+                   "t = %.6g s of %.6g s", what, t, o->t_end);
+}
+
 /* A step that failed inside the kernel (fatal) or on the angle chart. */
 static int fail_kernel(const ts_sim *s, ts_err *err)
 {
@@ -700,7 +757,10 @@ static int check_step(const ts_sim *s, double t_before, double t,
         return ts_fail(err, TS_EINTEGRATOR, "simulate: %s failed at t = "
                        "%.9g s: the step size %.3g s fell below h_min %.3g s",
                        name, t, h, s->o.h_min);
-    if (s->o.max_steps > 0 && steps >= s->o.max_steps && t < t1)
+    /* The limit counts over the run: reached anywhere before its end (or
+     * the caller's target beyond it) it fails, also at an output time. */
+    if (s->o.max_steps > 0 && steps >= s->o.max_steps &&
+        t < fmax(t1, s->o.t_end))
         return ts_fail(err, TS_EINTEGRATOR, "simulate: %s reached the step "
                        "limit %ld at t = %.9g s", name, s->o.max_steps, t);
     return TS_OK;
@@ -754,6 +814,9 @@ static int advance_esdirk(ts_sim *s, double t1, ts_err *err)
             return rc;
         s->t_int = t;
         s->ahead = 1;
+        /* Stopping here keeps s->t, the last state handed out. */
+        if ((rc = report_progress(&s->o, "nonlinear", t, err)))
+            return rc;
     }
     return TS_OK;
 }
@@ -807,6 +870,8 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
                 break;
             s->nrestart++;
         }
+        if ((rc = report_progress(&s->o, "nonlinear", s->t, err)))
+            break;
     }
     if (step_failed)
         stiffness_note(s, err);
@@ -1269,7 +1334,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                                                 n[2] * jp[2];
                 for (int c = 0; c < 3; c++) {
                     jump[3 * L->lower + c] = along * n[c];
-                    dr[3 * L->lower + c] = jump[3 * L->lower + c] - du[3 * part + c];
+                    dr[3 * L->lower + c] =
+                        jump[3 * L->lower + c] - du[3 * part + c];
                 }
             }
             tsi_desc_from_nodes(sys, lin, dr, tmp);
@@ -1359,6 +1425,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
             break;
         }
         rc = lin_record(k, lin, &L, o, t1, z, h, ywork, dr, err);
+        if (!rc)
+            rc = report_progress(o, "linear", t1, err);
     }
 done:
     if (drv) {

@@ -1,5 +1,5 @@
 /* system.c: validation of a towed system and its discretisation into a tree
- * of rigid links and lumped nodes (MODEL.md section 2).
+ * of rigid links and lumped nodes (doc/model.md section 2).
  *
  * Cables are ordered breadth-first from the tow point, so every link comes
  * after the link above it: a forward loop over links runs from the tow
@@ -63,9 +63,29 @@ void ts_system_free(ts_system *s)
     if (s->cables)
         for (int i = 0; i < s->ncables; i++)
             free(s->cables[i].link_fraction);
+    if (s->bodies)
+        for (int b = 0; b < s->nbodies; b++)
+            free(s->bodies[b].vehicle);
     free(s->cables);
     free(s->bodies);
     free(s);
+}
+
+ts_vehicle *ts_body_set_vehicle(ts_system *s, int b, ts_err *err)
+{
+    if (b < 0 || b >= s->nbodies) {
+        ts_fail(err, TS_EINVAL, "ts_body_set_vehicle: no body %d", b);
+        return NULL;
+    }
+    ts_vehicle *v = calloc(1, sizeof *v);
+    if (!v) {
+        ts_fail(err, TS_ENOMEM, "ts_body_set_vehicle: out of memory");
+        return NULL;
+    }
+    free(s->bodies[b].vehicle);
+    s->bodies[b].vehicle = v;
+    s->bodies[b].type = TS_BODY_VEHICLE;
+    return v;
 }
 
 ts_system *ts_system_copy(const ts_system *src, ts_err *err)
@@ -77,6 +97,19 @@ ts_system *ts_system_copy(const ts_system *src, ts_err *err)
     s->env = src->env;
     s->tow = src->tow;
     memcpy(s->bodies, src->bodies, (size_t)src->nbodies * sizeof *s->bodies);
+    for (int b = 0; b < src->nbodies; b++) {
+        s->bodies[b].vehicle = NULL;
+        if (!src->bodies[b].vehicle)
+            continue;
+        s->bodies[b].vehicle = malloc(sizeof(ts_vehicle));
+        if (!s->bodies[b].vehicle) {
+            ts_system_free(s);
+            ts_fail(err, TS_ENOMEM, "ts_system_copy: " "out of memory");
+            return NULL;
+        }
+        memcpy(s->bodies[b].vehicle, src->bodies[b].vehicle,
+               sizeof(ts_vehicle));
+    }
     for (int i = 0; i < src->ncables; i++) {
         s->cables[i] = src->cables[i];
         s->cables[i].link_fraction = NULL;
@@ -115,6 +148,39 @@ int ts_system_find_body(const ts_system *s, const char *name)
     return -1;
 }
 
+int ts_system_set_links(ts_system *sys, int links, ts_err *err)
+{
+    if (links < 1 || links > TS_MAX_LINKS)
+        return ts_fail(err, TS_EINVAL,
+                       "links: expected 1 to %d per cable, got %d",
+                       TS_MAX_LINKS, links);
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].link_fraction)
+            return ts_fail(err, TS_EINVAL,
+                           "links: cables[%d] '%s' has link_lengths; remove "
+                           "them to set the number of links",
+                           c, sys->cables[c].name);
+    for (int c = 0; c < sys->ncables; c++)
+        sys->cables[c].nlinks = links;
+    return ts_system_build(sys, err);
+}
+
+void ts_system_node_name(const ts_system *sys, int node, char *buf,
+                         size_t size)
+{
+    if (node == 0) {
+        snprintf(buf, size, "tow");
+        return;
+    }
+    const ts_node *nd = &sys->nodes[node];
+    if (nd->body >= 0) {
+        snprintf(buf, size, "%s", sys->bodies[nd->body].name);
+        return;
+    }
+    const ts_link *L = &sys->links[nd->link];
+    snprintf(buf, size, "%s.%d", sys->cables[L->cable].name, L->index);
+}
+
 int ts_system_body_node(const ts_system *s, int b)
 {
     if (!s->nodes || b < 0 || b >= s->nbodies)
@@ -131,6 +197,7 @@ double ts_body_volume(const ts_body *b)
     switch (b->type) {
     case TS_BODY_SPHERE: return M_PI * D * D * D / 6.0;
     case TS_BODY_CYLINDER: return M_PI * 0.25 * D * D * b->length;
+    case TS_BODY_VEHICLE: return b->vehicle ? b->vehicle->volume : 0.0;
     default: return 0.0;
     }
 }
@@ -140,6 +207,172 @@ double ts_cable_wet_weight(const ts_system *s, int c)
     const ts_cable *cb = &s->cables[c];
     double area = M_PI * cb->diameter * cb->diameter / 4.0;
     return (cb->mass_per_length - s->env.water_density * area) * s->env.gravity;
+}
+
+void ts_motion_bound_steady(const ts_system *sys, ts_motion_bound *m)
+{
+    m->speed = fabs(sys->tow.speed);
+    m->turn_rate = fabs(sys->tow.turn_rate);
+    m->tow_speed = 0.0;
+    m->tow_accel = 0.0;
+}
+
+/* The load sizes of one part (a link or a body) under the bounds: mass in
+ * air and displaced mass (kg), drag area times coefficient (m^2) and added
+ * mass (kg). */
+typedef struct part_load {
+    double mass, displaced, drag_area, added;
+} part_load;
+
+/* Which load of which part is the largest, and what it is. */
+typedef struct load_worst {
+    double size;      /* N; NaN sorts first */
+    int kind;         /* 0 weight, 1 buoyancy, 2 drag, 3 inertia */
+    int link, body;   /* the part: a link index or a body index, -1 */
+} load_worst;
+
+static void consider(load_worst *w, double size, int kind, int link,
+                     int body)
+{
+    if (!(size <= w->size) && !(isnan(w->size))) {
+        w->size = size;
+        w->kind = kind;
+        w->link = link;
+        w->body = body;
+    }
+}
+
+/* Consider the loads of part p; returns their sum. */
+static double part_loads(load_worst *w, const part_load *p, double g,
+                         double rho, double flow, double acc, int link,
+                         int body)
+{
+    double f[4] = {p->mass * g, rho * p->displaced * g,
+                   0.5 * rho * flow * flow * p->drag_area,
+                   (p->mass + p->added) * acc};
+    for (int i = 0; i < 4; i++)
+        consider(w, f[i], i, link, body);
+    return f[0] + f[1] + f[2] + f[3];
+}
+
+int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
+                          ts_err *err)
+{
+    const double rho = sys->env.water_density, g = fabs(sys->env.gravity);
+    const double *c = sys->env.current, *p = sys->tow.point;
+    double R = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int k = 0; k < sys->ncables; k++)
+        R += sys->cables[k].length;
+    double current = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    /* The flow speed bound and what makes it up, largest named. */
+    const double flow_part[4] = {m->speed, m->turn_rate * R, current,
+                                 m->tow_speed};
+    double flow = flow_part[0] + flow_part[1] + flow_part[2] + flow_part[3];
+    double acc = m->turn_rate * m->turn_rate * R + m->turn_rate * m->speed +
+                 m->tow_accel;
+    load_worst w = {0.0, 0, -1, -1};
+    double total = 0.0; /* bounds every tension */
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        double vol = M_PI * 0.25 * L->diameter * L->diameter * L->length;
+        part_load pl = {L->mass, vol,
+                        L->diameter * L->length *
+                            (L->cdn + M_PI * L->cdt),
+                        rho * L->can * vol};
+        total += part_loads(&w, &pl, g, rho, flow, acc, l, -1);
+    }
+    for (int b = 0; b < sys->nbodies; b++) {
+        const ts_body *B = &sys->bodies[b];
+        double vol = ts_body_volume(B), D = B->diameter;
+        part_load pl = {B->mass, vol,
+                        B->cd * M_PI * 0.25 * D * D +
+                            (B->type == TS_BODY_CYLINDER
+                                 ? B->cd_cross * D * B->length
+                                 : 0.0),
+                        rho * fmax(B->ca, B->ca_cross) * vol};
+        total += part_loads(&w, &pl, g, rho, flow, acc, -1, b);
+    }
+    if (w.size <= TS_LOAD_MAX) {
+        /* Strains T / EA of elastic links under the largest tension: a
+         * stiffness near zero makes them overflow. */
+        for (int c = 0; c < sys->ncables; c++) {
+            const ts_cable *C = &sys->cables[c];
+            double strain = total / C->ea;
+            if (C->ea > 0 && !(strain <= TS_LOAD_MAX))
+                return ts_fail(err, TS_EDOMAIN, "forces overflow at EA "
+                               "%.3g N of cables[%d] '%s': a tension of up "
+                               "to %.3g N would stretch its links without "
+                               "bound (strains beyond %.3g)", C->ea, c,
+                               C->name, total, TS_LOAD_MAX);
+        }
+        return TS_OK;
+    }
+    /* The input to blame: the largest factor of the worst load. A drag or
+     * an inertia whose motion factor is moderate is the part's own
+     * (a drag coefficient, a size, a mass). */
+    char cause[2 * TS_NAME_MAX + 96];
+    double q = 0.5 * rho * flow * flow;
+    if ((w.kind == 2 && q <= 1e100) || (w.kind == 3 && acc <= 1e100)) {
+        if (w.link >= 0) {
+            const ts_link *L = &sys->links[w.link];
+            snprintf(cause, sizeof cause, w.kind == 2 ? "drag coefficients "
+                     "%.3g (normal) and %.3g (tangential) on a %.3g m by "
+                     "%.3g m link" : "a link mass of %.3g kg",
+                     w.kind == 2 ? L->cdn : L->mass, L->cdt, L->diameter,
+                     L->length);
+        } else {
+            const ts_body *B = &sys->bodies[w.body];
+            snprintf(cause, sizeof cause, w.kind == 2 ? "drag coefficients "
+                     "%.3g and %.3g on a body %.3g m across" : "a body mass "
+                     "of %.3g kg", w.kind == 2 ? B->cd : B->mass,
+                     B->cd_cross, B->diameter);
+        }
+    } else if (w.kind == 2 || w.kind == 3) {
+        static const char *const what[4] = {"speed %.3g m/s",
+                                            "turn rate %.3g rad/s",
+                                            "current %.3g m/s",
+                                            "tow-point velocity %.3g m/s"};
+        int big = 0;
+        double val[4] = {m->speed, m->turn_rate, current, m->tow_speed};
+        for (int i = 1; i < 4; i++)
+            if (!(flow_part[i] <= flow_part[big]))
+                big = i;
+        if (w.kind == 3 && !(m->tow_accel <= acc - m->tow_accel))
+            snprintf(cause, sizeof cause, "tow-point acceleration %.3g "
+                     "m/s^2", m->tow_accel);
+        else
+            snprintf(cause, sizeof cause, what[big], val[big]);
+    } else {
+        double mass = w.link >= 0 ? sys->links[w.link].mass
+                                  : sys->bodies[w.body].mass;
+        if (w.kind == 1 && !(rho <= 1e100))
+            snprintf(cause, sizeof cause, "water density %.3g kg/m^3", rho);
+        else if (!(g <= 1e100))
+            snprintf(cause, sizeof cause, "gravity %.3g m/s^2", g);
+        else if (w.kind == 0)
+            snprintf(cause, sizeof cause, "a mass of %.3g kg", mass);
+        else
+            snprintf(cause, sizeof cause, "a displaced volume that large");
+    }
+    static const char *const load[4] = {"weight", "buoyancy", "drag",
+                                        "inertia"};
+    char part[2 * TS_NAME_MAX + 64];
+    if (w.link >= 0)
+        snprintf(part, sizeof part, "cables[%d] '%s' link %d",
+                 sys->links[w.link].cable,
+                 sys->cables[sys->links[w.link].cable].name,
+                 sys->links[w.link].index);
+    else
+        snprintf(part, sizeof part, "bodies[%d] '%s'", w.body,
+                 sys->bodies[w.body].name);
+    char size[48];
+    if (isfinite(w.size))
+        snprintf(size, sizeof size, "is about %.3g N", w.size);
+    else
+        snprintf(size, sizeof size, "is not a finite number");
+    return ts_fail(err, TS_EDOMAIN, "forces overflow at %s: the %s on %s "
+                   "%s, beyond the %.3g N the solvers can take", cause,
+                   load[w.kind], part, size, TS_LOAD_MAX);
 }
 
 /* " (line N)" for messages about a scene entry, "" when built in code;
@@ -237,6 +470,18 @@ static int validate(const ts_system *s, ts_err *err)
                                "must add up to the cable length", i,
                                at_line(c->line));
         }
+        if (c->has_from_point) {
+            if (c->from_body < 0 ||
+                s->bodies[c->from_body].type != TS_BODY_VEHICLE)
+                return ts_fail(err, TS_EINVAL, "cables[%d].at%s: "
+                               "a starting point on a body needs a vehicle "
+                               "as 'from'", i, at_line(c->line));
+            for (int j = 0; j < 3; j++)
+                if (!isfinite(c->from_point[j]))
+                    return ts_fail(err, TS_EINVAL, "cables[%d].at%s: "
+                                   "component %d must be finite", i,
+                                   at_line(c->line), j);
+        }
         if (c->damping > 0 && !(c->ea > 0))
             return ts_fail(err, TS_EINVAL, "cables[%d].damping%s: "
                            "internal damping needs an elastic cable (EA > 0)",
@@ -263,6 +508,19 @@ static int validate(const ts_system *s, ts_err *err)
                            "volume: diameter and length > 0 m, got %g m and "
                            "%g m",
                            b, at_line(bd->line), bd->diameter, bd->length);
+        if (bd->type == TS_BODY_VEHICLE) {
+            char where[64];
+            snprintf(where, sizeof where, "bodies[%d]", b);
+            if (!bd->vehicle)
+                return ts_fail(err, TS_EINVAL, "%s%s: a vehicle without a "
+                               "description", where, at_line(bd->line));
+            if ((rc = ts_vehicle_check(bd->vehicle, bd->mass, where,
+                                       bd->line, err)))
+                return rc;
+        } else if (bd->vehicle) {
+            return ts_fail(err, TS_EINVAL, "bodies[%d]%s: only a vehicle "
+                           "has a vehicle description", b, at_line(bd->line));
+        }
         if (bd->type == TS_BODY_SPHERE && !(bd->diameter > 0))
             return ts_fail(err, TS_EINVAL, "bodies[%d].diameter%s: "
                            "a sphere needs a diameter > 0 m, got %g", b,
@@ -361,6 +619,9 @@ int ts_system_build(ts_system *s, ts_err *err)
     s->has_bending = 0;
     s->has_added_mass = 0;
     s->has_elastic = 0;
+    s->nvehicles = 0;
+    for (int b = 0; b < s->nbodies; b++)
+        s->nvehicles += s->bodies[b].type == TS_BODY_VEHICLE;
     int k = 0;
     for (int o = 0; o < nc; o++) {
         int ci = order[o];
@@ -388,22 +649,35 @@ int ts_system_build(ts_system *s, ts_err *err)
             L->elastic = c->ea > 0;
             L->ea = c->ea;
             L->damping = c->damping;
+            /* The first link of a cable from a vehicle starts at a point of
+             * the vehicle, which carries half the link's mass. */
+            L->up_body = -1;
+            if (j == 0 && c->from_body >= 0 &&
+                s->bodies[c->from_body].type == TS_BODY_VEHICLE) {
+                const ts_vehicle *v = s->bodies[c->from_body].vehicle;
+                L->up_body = c->from_body;
+                for (int q = 0; q < 3; q++)
+                    L->up_point[q] = c->has_from_point ? c->from_point[q]
+                                                       : v->attach[q];
+            }
             if (L->elastic)
                 s->has_elastic = 1;
             if (L->ei > 0)
                 s->has_bending = 1;
             if (L->can > 0 && rho > 0 && L->diameter > 0)
                 s->has_added_mass = 1;
-            s->nodes[L->upper].mass += 0.5 * L->mass;
+            if (L->up_body < 0)
+                s->nodes[L->upper].mass += 0.5 * L->mass;
             s->nodes[L->lower].mass += 0.5 * L->mass;
         }
         if (c->to_body >= 0) {
             body_node[c->to_body] = k;
             s->nodes[k].body = c->to_body;
-            s->nodes[k].mass += s->bodies[c->to_body].mass;
             const ts_body *bd = &s->bodies[c->to_body];
+            if (bd->type != TS_BODY_VEHICLE)
+                s->nodes[k].mass += bd->mass;
             if ((bd->ca > 0 || bd->ca_cross > 0) && rho > 0 &&
-                bd->type != TS_BODY_JUNCTION)
+                bd->type != TS_BODY_JUNCTION && bd->type != TS_BODY_VEHICLE)
                 s->has_added_mass = 1;
         }
     }
@@ -434,9 +708,12 @@ int ts_system_build(ts_system *s, ts_err *err)
 
     /* A node without mass cannot be accelerated by finite tensions: every
      * free node needs structural mass (a junction between massless
-     * cables would make the tension system singular). */
+     * cables would make the tension system singular). A vehicle lends its
+     * node the inertia of its body. */
     for (int n = 1; n < s->nnodes; n++)
-        if (!(s->nodes[n].mass > 0)) {
+        if (!(s->nodes[n].mass > 0) &&
+            !(s->nodes[n].body >= 0 &&
+              s->bodies[s->nodes[n].body].type == TS_BODY_VEHICLE)) {
             const ts_link *L = &s->links[n - 1];
             ts_fail(err, TS_EINVAL, "cables[%d]%s: "
                     "'%s' link %d ends at a node with zero mass: give the "

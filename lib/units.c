@@ -703,7 +703,7 @@ done:
     return rc;
 }
 
-int ts_units_from_si(const ts_units *u, double si_value, const char *si_unit,
+int ts_units_from_si(const ts_units *u, double value_si, const char *si_unit,
                      const char *unit, double *out, ts_err *err)
 {
     if (!u || !si_unit || !unit || !out)
@@ -751,7 +751,7 @@ int ts_units_from_si(const ts_units *u, double si_value, const char *si_unit,
                      "%s", si_unit, quote(unit, q, sizeof q));
         goto done;
     }
-    *out = cv_convert_double(conv, si_value);
+    *out = cv_convert_double(conv, value_si);
 
 done:
     cv_free(conv);

@@ -1,6 +1,6 @@
-/* test_bending.c: bending stiffness (MODEL.md section 3; doc/elastic.md) in
- * the rigid and the elastic model, against references that do not come
- * from the code under test.
+/* test_bending.c: bending stiffness (doc/model.md section 3;
+ * doc/elastic.md) in the rigid and the elastic model, against references
+ * that do not come from the code under test.
  *
  *  1. Joint forces: tsi_bending (lib/forces.h) against -dU/dr of
  *     tsi_bending_energy by central differences, at awkward angles from

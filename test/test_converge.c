@@ -46,6 +46,8 @@
  *     run and no link count is predicted: 10 links is not yet
  *     asymptotic for it.
  *  9. JSON and CSV of a study: the required keys, one CSV line per run.
+ * 11. A sweep stopped by its progress callback before the third run keeps
+ *     the two rows so far (TS_ECANCEL), which still estimate.
  * 10. The simulate analysis on Kamman ex. 4 (tow point heaved 0.1 ft at
  *     1 Hz, 8 s, fitted over 4..8 s), rk8pd at tolerances 1e-3 .. 1e-6:
  *     the true error of the amplitude ratio and of the phase (against an
@@ -72,6 +74,7 @@
 #include <unistd.h>
 
 #include "tcheck.h"
+#include "towstab/analysis.h"
 #include "towstab/compare.h"
 #include "towstab/report_converge.h"
 #include "towstab/scene.h"
@@ -393,6 +396,33 @@ static ts_scene *load(const char *path, ts_units **u)
     return s;
 }
 
+/* A sweep of the pipeline of `analysis` (towstab/analysis.h) with the
+ * request's defaults; extra settings from *rq when given. */
+static int pipeline_sweep(const ts_system *sys, ts_analysis_kind analysis,
+                          ts_request *rq, ts_conv_analysis *an, ts_err *err)
+{
+    ts_request own;
+    if (!rq) {
+        ts_request_init(&own, TS_ANALYSIS_CONVERGE);
+        rq = &own;
+    }
+    rq->converge.analysis = analysis;
+    return ts_analysis_sweep(sys, rq, 0, an, err);
+}
+
+/* The equilibrium analysis of sys (into *an) and a links table of 8 rows
+ * for it; NULL on failure (an is then safe to free). */
+static ts_convergence *equilibrium_links_table(const ts_system *sys,
+                                               ts_conv_analysis *an,
+                                               ts_err *err)
+{
+    memset(an, 0, sizeof *an);
+    if (pipeline_sweep(sys, TS_ANALYSIS_EQUILIBRIUM, NULL, an, err) != TS_OK)
+        return NULL;
+    return ts_convergence_alloc(an->name, TS_CONV_LINKS, an->nvalues,
+                                an->values, 8, err);
+}
+
 /* Sphere x, z and top tension of a system with N links per cable. */
 static int solve_ex(const ts_system *base, int links, double out[3])
 {
@@ -423,6 +453,7 @@ static int value_index(const ts_convergence *c, const char *name)
     return -1;
 }
 
+
 static void test_equilibrium_sweep(void)
 {
     ts_units *u;
@@ -433,13 +464,9 @@ static void test_equilibrium_sweep(void)
     }
     ts_err err = {0};
     ts_conv_analysis an;
-    int rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
-    ts_convergence *c =
-        rc ? NULL
-           : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
-                                  an.values, 8, &err);
+    ts_convergence *c = equilibrium_links_table(sc->system, &an, &err);
     static const double N[4] = {40, 80, 160, 320};
-    rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
+    int rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
     if (rc == 0)
         rc = ts_convergence_sweep(c, 0, &an, N, 4, &err);
     if (rc == TS_OK)
@@ -547,7 +574,7 @@ static void test_equilibrium_sweep(void)
 
     /* A tolerance sweep: positions stop changing once the residual is
      * below what moves them. */
-    rc = ts_conv_equilibrium_analysis(sc->system, NULL, &an, &err);
+    rc = pipeline_sweep(sc->system, TS_ANALYSIS_EQUILIBRIUM, NULL, &an, &err);
     c = ts_convergence_alloc(an.name, TS_CONV_TOLERANCE, an.nvalues,
                              an.values, 4, &err);
     static const double T[3] = {1e-6, 1e-9, 1e-12};
@@ -578,8 +605,7 @@ static void test_modes_sweep(void)
     }
     ts_err err = {0};
     ts_conv_analysis an;
-    int rc = ts_conv_modes_analysis(sc->system, NULL, NULL, NULL, 3, &an,
-                                    &err);
+    int rc = pipeline_sweep(sc->system, TS_ANALYSIS_MODES, NULL, &an, &err);
     ts_convergence *c =
         rc ? NULL
            : ts_convergence_alloc(an.name, TS_CONV_LINKS, an.nvalues,
@@ -683,9 +709,15 @@ static void test_simulate_sweep(void)
     o.dt_sample = 0.05;
     ts_conv_analysis an;
     memset(&an, 0, sizeof an);
+    /* The request borrows ex: it is not cleared. */
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_CONVERGE);
+    rq.simulate.sim = o;
+    rq.simulate.excitation = ex;
+    rq.simulate.transient = 4.0;
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
     if (rc == TS_OK)
-        rc = ts_conv_simulate_analysis(sc->system, NULL, &o, ex, "sphere.z",
-                                       4.0, &an, &err);
+        rc = pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an, &err);
     static const double tol[4] = {1e-3, 1e-4, 1e-5, 1e-6};
     ts_convergence *c =
         rc ? NULL
@@ -768,20 +800,68 @@ static void test_simulate_sweep(void)
     ts_conv_analysis_free(&an);
     /* Refusals. */
     ts_excitation *none = ts_excitation_alloc(&err);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, none, "sphere.z",
-                                    4.0, &an, &err) == TS_EINVAL &&
+    rq.simulate.excitation = none;
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL &&
               strstr(err.msg, "periodic"),
           "no periodic excitation refused: %s", err.msg);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, ex,
-                                    "sphere.tension", 4.0, &an,
-                                    &err) == TS_EINVAL,
+    rq.simulate.excitation = ex;
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.tension");
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL,
           "a tension output refused: %s", err.msg);
-    CHECK(ts_conv_simulate_analysis(sc->system, NULL, &o, ex, "sphere.z",
-                                    7.5, &an, &err) == TS_EINVAL &&
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
+    rq.simulate.transient = 7.5;
+    CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
+                         &err) == TS_EINVAL &&
               strstr(err.msg, "period"),
           "a window shorter than a period refused: %s", err.msg);
     ts_excitation_free(none);
     ts_excitation_free(ex);
+    ts_scene_free(sc);
+    ts_units_free(u);
+}
+
+/* A progress callback that stops the sweep before run `stop_before`. */
+static int stop_sweep(const ts_progress *p, void *data)
+{
+    int *calls = data;
+    (*calls)++;
+    return p->done >= 2 && !strcmp(p->unit, "runs");
+}
+
+/* 10. Stopping a sweep: the callback is called before each run with the
+ * runs done; its nonzero return stops the sweep with TS_ECANCEL and the
+ * rows so far, which still estimate. */
+static void test_stop(void)
+{
+    ts_units *u;
+    ts_scene *sc = load("examples/kamman_ex1_submerged.yaml", &u);
+    if (!CHECK(sc, "load Kamman ex. 1")) {
+        ts_units_free(u);
+        return;
+    }
+    ts_err err = {0};
+    ts_conv_analysis an;
+    ts_convergence *c = equilibrium_links_table(sc->system, &an, &err);
+    static const double N[5] = {5, 10, 20, 40, 80};
+    int calls = 0;
+    if (c) {
+        c->progress = stop_sweep;
+        c->progress_data = &calls;
+    }
+    int rc = c ? ts_convergence_add_series(c, "", &err) : TS_ENOMEM;
+    if (rc == 0)
+        rc = ts_convergence_sweep(c, 0, &an, N, 5, &err);
+    CHECK(rc == TS_ECANCEL && c->nrows == 2 && calls == 3 &&
+              strstr(err.msg, "after 2 of 5 runs"),
+          "a sweep stopped before its third run keeps 2 rows (%d calls): %s",
+          calls, err.msg);
+    CHECK(c && c->nrows == 2 &&
+              ts_convergence_estimate(c, 1e-3, &err) == TS_OK,
+          "the rows so far still estimate");
+    ts_conv_analysis_free(&an);
+    ts_convergence_free(c);
     ts_scene_free(sc);
     ts_units_free(u);
 }
@@ -797,5 +877,6 @@ int main(void)
     test_equilibrium_sweep();
     test_modes_sweep();
     test_simulate_sweep();
+    test_stop();
     return tc_done();
 }

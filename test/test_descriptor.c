@@ -17,7 +17,8 @@
  *     own uncertainty, as for eigenvalue bounds) plus 1e-8 of the column's
  *     size (rounding, see ROUNDING); the same for the nine columns of B
  *     (the heave columns excepted when the tow point is at the waterline,
- *     a kink both report).
+ *     a kink both report). A scene with a vehicle has the dense model
+ *     only; the sparse one alone is refused, naming the vehicles.
  *  3. The shifted solve: (A - s I)^-1 b by the sparse model equals the
  *     dense solve (LAPACK) at real and complex s, to 1e-7 relative (the
  *     two A differ by ~1e-9 relative; (A - s I)^-1 amplifies by the
@@ -37,6 +38,7 @@
 #include "kernel_impl.h"
 #include "shift.h"
 #include "tcheck.h"
+#include "tscene.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
 
@@ -47,11 +49,7 @@ static ts_units *units;
 
 static ts_scene *scene_from(const char *yaml)
 {
-    ts_err err = {0};
-    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", units, &err);
-    if (!s)
-        printf("scene: %s\n", err.msg);
-    return s;
+    return tscene_parse(units, yaml);
 }
 
 /* Every kind of link and body, in a turn with a current. */
@@ -200,6 +198,29 @@ static void compare_dense(const char *name, const ts_system *sys)
     }
     if (!lin) {
         CHECK(0, "%s: linearized with both models", name);
+        ts_kernel_free(k);
+        return;
+    }
+    if (ts_kernel_nvehicles(k) > 0) {
+        /* The sparse model does not cover a vehicle's attitude and
+         * controller states: the dense model only, and the sparse model
+         * alone refused, naming the vehicles. */
+        CHECK(!lin->desc && lin->A, "%s (%d links): a vehicle: the dense "
+              "model only", name, sys->nlinks);
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = TS_LIN_SPARSE;
+        ts_err e = {0};
+        double *y = malloc((size_t)lin->nstate * sizeof(double));
+        int rc = TS_ENOMEM;
+        if (y) {
+            memcpy(y, lin->y0, (size_t)lin->nstate * sizeof(double));
+            rc = ts_linearize(k, y, lin->u0, &o, lin, &e);
+        }
+        CHECK(rc == TS_EINVAL && strstr(e.msg, "vehicle"),
+              "%s: the sparse model alone refused: %s", name, e.msg);
+        free(y);
+        ts_linear_free(lin);
         ts_kernel_free(k);
         return;
     }

@@ -1,4 +1,4 @@
-/* test_elastic.c: elastic cables (MODEL.md section 7; doc/elastic.md)
+/* test_elastic.c: elastic cables (doc/model.md section 7; doc/elastic.md)
  * against the rigid model, invariants and limits that do not come from the
  * elastic code itself.
  *
@@ -52,6 +52,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tscene.h"
 
 #define FT 0.3048
 
@@ -68,14 +69,6 @@ static int all_finite(const double *v, int n)
         if (!isfinite(v[i]))
             return 0;
     return 1;
-}
-
-static ts_scene *load(const ts_units *u, const char *path)
-{
-    ts_err err = {0};
-    ts_scene *s = ts_scene_load(path, u, &err);
-    CHECK(s != NULL, "%s loads (%s)", path, s ? "ok" : err.msg);
-    return s;
 }
 
 /* Equilibrium of a built system by method m (guess: link directions for
@@ -152,8 +145,8 @@ static void hooke(const ts_system *s, const ts_equilibrium *eq,
 
 static void test_same_physics(const ts_units *u)
 {
-    ts_scene *sr = load(u, "examples/kamman_ex1_submerged.yaml");
-    ts_scene *se = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *sr = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
+    ts_scene *se = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (!sr || !se) {
         ts_scene_free(sr);
         ts_scene_free(se);
@@ -296,8 +289,8 @@ static void set_case(ts_system *s, const eq_case *c, double ea)
 
 static void test_rigid_limit(const ts_units *u)
 {
-    ts_scene *sr = load(u, "examples/kamman_ex1_submerged.yaml");
-    ts_scene *se = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *sr = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
+    ts_scene *se = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (!sr || !se) {
         ts_scene_free(sr);
         ts_scene_free(se);
@@ -475,8 +468,8 @@ static int oscillatory(const ts_eigen *e)
 
 static void test_modes(const ts_units *u)
 {
-    ts_scene *sr = load(u, "examples/kamman_ex1_submerged.yaml");
-    ts_scene *se = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *sr = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
+    ts_scene *se = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (!sr || !se) {
         ts_scene_free(sr);
         ts_scene_free(se);
@@ -690,7 +683,7 @@ static void test_slack(const ts_units *u)
     /* (e) Towed in water: the equilibrium of the elastic example with
      * every link vector 0.7 of its rest length (the tow point moved 30 %
      * of the way toward the sphere). */
-    ts_scene *se = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *se = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (se) {
         ts_system *e = se->system;
         ts_kernel *ke = ts_kernel_alloc(e, NULL);
@@ -743,7 +736,7 @@ static void test_slack(const ts_units *u)
      * the turn in one step makes an elastic link go slack on the way (the
      * local root's other branch), which must not end the solve: a steady
      * state exists (Newton finds it directly) and auto must find it too. */
-    ts_scene *sr = load(u, "examples/kamman_ex1_submerged.yaml");
+    ts_scene *sr = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
     if (sr) {
         ts_system *r = sr->system;
         r->cables[0].nlinks = 10;
@@ -945,7 +938,7 @@ static void test_mixed(void)
 
 static void test_two_part(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/two_part_tow.yaml");
+    ts_scene *sc = tscene_load(u, "examples/two_part_tow.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;

@@ -1,4 +1,4 @@
-/* test_elastic_sim.c: time-domain simulation of elastic cables (MODEL.md
+/* test_elastic_sim.c: time-domain simulation of elastic cables (doc/model.md
  * section 7; doc/elastic.md section 7; doc/two-part-tow.md), against the
  * rigid model and the linear frequency response, which do not come from
  * the elastic simulation itself.
@@ -51,16 +51,9 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tscene.h"
 
 #define FT 0.3048
-
-static ts_scene *load(const ts_units *u, const char *path)
-{
-    ts_err err = {0};
-    ts_scene *s = ts_scene_load(path, u, &err);
-    CHECK(s != NULL, "%s loads (%s)", path, s ? "ok" : err.msg);
-    return s;
-}
 
 /* A run from the equilibrium of sys: the history (caller frees), the
  * code, the statistics and the error. */
@@ -119,7 +112,7 @@ static void set_ea(ts_system *s, double ea, double cv)
 
 static void test_rigid_limit(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/kamman_ex1_submerged.yaml");
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;
@@ -252,7 +245,7 @@ static void test_rigid_limit(const ts_units *u)
 
 static void test_slack(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;
@@ -396,7 +389,7 @@ static int two_part_ratio(ts_system *s, const char *what, double r,
 
 static void test_two_part(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/two_part_tow.yaml");
+    ts_scene *sc = tscene_load(u, "examples/two_part_tow.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;
@@ -410,7 +403,7 @@ static void test_two_part(const ts_units *u)
     two_part_ratio(s, "neutral", 0.1, &rl, &ppl, &Hl);
     /* Small crank (5 mm): the heave velocity (0.02 m/s) is 1 % of the tow
      * speed, so the drag is linear in it to ~1 %; the tow point at the
-     * waterline (a kink, MODEL.md section 6) shifts the mean, not the
+     * waterline (a kink, doc/model.md section 6) shifts the mean, not the
      * fundamental; the start's transient is down to 0.5 % (above). 2 %
      * allows for these (observed 3e-5). */
     CHECK(fabs(rs - Hs) < 0.02 * Hs, "5 mm crank: heave ratio %.5f within "
@@ -465,7 +458,7 @@ static void test_two_part(const ts_units *u)
 /* Section 5. */
 static void test_impulsive_start(const ts_units *u)
 {
-    ts_scene *sc = load(u, "examples/kamman_ex1_elastic.yaml");
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex1_elastic.yaml");
     if (!sc)
         return;
     ts_system *s = sc->system;

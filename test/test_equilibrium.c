@@ -99,7 +99,7 @@ static ts_system *build(int nc, const cable_def *cd, int nb,
     return s;
 }
 
-/* Kamman example 1 (MODEL.md section 9) in SI, our coefficients. */
+/* Kamman example 1 (doc/model.md section 9) in SI, our coefficients. */
 static ts_system *ex1(double tow_z, double speed)
 {
     cable_def c = {"cable", -1, 0, 100 * FT, INCH, LB / FT, 20,
@@ -534,7 +534,7 @@ static void check_junction(double W)
     const double *r = eq->positions + 3 * J;
     double rho = s->env.water_density, V = s->tow.speed;
     /* A node at rest in the turning frame accelerates at
-     * (-W^2 x, W V - W^2 y, 0) (MODEL.md section 1). */
+     * (-W^2 x, W V - W^2 y, 0) (doc/model.md section 1). */
     double a[3] = {-W * W * r[0], W * V - W * W * r[1], 0};
     double lhs[3], rhs[3];
     for (int j = 0; j < 3; j++) {

@@ -4,7 +4,7 @@
  *  1. Every shape's velocity and acceleration against central differences
  *     of its displacement and velocity (they must be exact derivatives, or
  *     the rigid-link kinematics would be inconsistent).
- *  2. Closed-form values: sine, the slider crank of MODEL.md section 8,
+ *  2. Closed-form values: sine, the slider crank of doc/model.md section 8,
  *     the end values and midpoint of steps and ramps, the ramp's plateau
  *     rate and its linear part x = A/T (t - start - rise/2).
  *  3. Series: a sampled sinusoid through the cubic spline, its
@@ -17,7 +17,11 @@
  *     to port, along -y).
  *  5. Breakpoints, time scales, the periodic signal.
  *  6. The spec parser: units, defaults, and every refusal with its message.
- *  7. The smooth start of a sine or crank: the signal times S(t / ramp),
+ *  7. Sums (an irregular sea's tow-point motion): the closed-form value
+ *     at full amplitude, the derivatives by differences during and after
+ *     the fade-in (whose end is a breakpoint), one signal per driven axis
+ *     sharing the components, the rms and the time scale, refusals.
+ *  8. The smooth start of a sine or crank: the signal times S(t / ramp),
  *     written out here, exact derivatives across the ramp's end (a
  *     breakpoint), no jump at t = 0 (ts_excitation_start_jump), the
  *     parser's default of two periods, ramp=0 for an impulsive start.
@@ -90,7 +94,7 @@ static void test_shapes(void)
           "%.2g, %.2g m/s, m/s^2 < 1e-8)", ev, ea);
     ts_excitation_free(ex);
 
-    /* Slider crank, MODEL.md section 8: z = r cos th + l (1 - sqrt(1 -
+    /* Slider crank, doc/model.md section 8: z = r cos th + l (1 - sqrt(1 -
      * (r/l)^2 sin^2 th)), with awkward r/l so that the rod term matters. */
     s.type = TS_SIGNAL_CRANK;
     s.axis = TS_AXIS_SURGE;
@@ -107,7 +111,7 @@ static void test_shapes(void)
         ts_excitation_input(ex, tt, u);
         maxd = fmax(maxd, fabs(u[0] - z));
     }
-    CHECK(maxd < 1e-15, "crank displacement is MODEL.md's formula (max err "
+    CHECK(maxd < 1e-15, "crank displacement is doc/model.md section 8's (max err "
           "%.2g m < 1e-15)", maxd);
     fd_check(ex, 0, 0.0, 3.2, 60, h, &ev, &ea);
     CHECK(ev < 1e-8 && ea < 1e-7, "crank v, a are the derivatives (max err "
@@ -503,7 +507,132 @@ static void test_parse(void)
     ts_units_free(units);
 }
 
-/* Section 7: the smooth start. */
+static void test_sum(void)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    /* Three components; sway is not driven. */
+    const double w[3] = {0.43, -0.91, 1.7};
+    const double re[9] = {0.3, 0, -0.2, 0.1, 0, 0.05, -0.02, 0, 0.07};
+    const double im[9] = {0.1, 0, 0.4, -0.2, 0, 0.01, 0.03, 0, -0.06};
+    int rc = ts_excitation_add_sum(ex, 3, w, re, im, 5.0, &err);
+    CHECK(rc == TS_OK && ts_excitation_nsignals(ex) == 2,
+          "sum: one signal per driven axis (%d): %s",
+          ts_excitation_nsignals(ex), err.msg);
+    const ts_signal *s0 = ts_excitation_signal(ex, 0);
+    const ts_signal *s1 = ts_excitation_signal(ex, 1);
+    CHECK(s0->type == TS_SIGNAL_SUM && s0->axis == TS_AXIS_SURGE &&
+              s1->axis == TS_AXIS_HEAVE &&
+              ts_excitation_sum_components(ex, 1) == 3,
+          "sum signals on surge and heave, 3 components");
+    CHECK_NEAR(s1->amplitude,
+               sqrt(0.5 * (0.2 * 0.2 + 0.4 * 0.4 + 0.05 * 0.05 +
+                           0.01 * 0.01 + 0.07 * 0.07 + 0.06 * 0.06)),
+               1e-15, "sum: heave rms sqrt(sum |c|^2 / 2)");
+    /* Full amplitude after the fade-in: x = sum Re(c e^(i w t)). */
+    double t = 11.3, u[9];
+    ts_excitation_input(ex, t, u);
+    double x0 = 0, x2 = 0;
+    for (int k = 0; k < 3; k++) {
+        x0 += re[3 * k] * cos(w[k] * t) - im[3 * k] * sin(w[k] * t);
+        x2 += re[3 * k + 2] * cos(w[k] * t) - im[3 * k + 2] * sin(w[k] * t);
+    }
+    CHECK(fabs(u[0] - x0) < 1e-15 && fabs(u[2] - x2) < 1e-15 &&
+              u[1] == 0 && u[4] == 0 && u[7] == 0,
+          "sum after the fade-in: the closed form; sway untouched");
+    ts_excitation_input(ex, 0.0, u);
+    CHECK(u[0] == 0 && u[3] == 0 && u[6] == 0 && u[2] == 0,
+          "sum at t = 0: faded in from rest");
+    /* Derivatives by central differences (step 1e-5 s: |x'''| < 1, so
+     * truncation below 1e-10), in and after the fade-in. */
+    double ev, ea, worst = 0;
+    for (int ax = 0; ax < 3; ax += 2) {
+        fd_check(ex, ax, 0.01, 4.99, 40, 1e-5, &ev, &ea);
+        worst = fmax(worst, fmax(ev, ea));
+        fd_check(ex, ax, 5.01, 30, 40, 1e-5, &ev, &ea);
+        worst = fmax(worst, fmax(ev, ea));
+    }
+    CHECK(worst < 1e-8, "sum: velocity and acceleration are the "
+          "derivatives (max diff %.2g)", worst);
+    double bp[4];
+    CHECK(ts_excitation_breakpoints(ex, 20, bp, 4) == 1 && bp[0] == 5.0,
+          "sum: the end of the fade-in is a breakpoint");
+    CHECK_NEAR(ts_excitation_time_scale(ex), 1 / 1.7, 1e-15,
+               "sum: time scale 1 / max |w|");
+    int idx;
+    CHECK(!ts_excitation_periodic(ex, &idx), "a sum is not periodic");
+    char d[256];
+    ts_excitation_describe(ex, 1, d, sizeof d);
+    CHECK(strstr(d, "tow.heave sum of 3 sinusoids") != NULL, "describe: %s",
+          d);
+    ts_excitation_free(ex);
+    /* Refusals add nothing. */
+    ex = ts_excitation_alloc(&err);
+    const double zero[9] = {0};
+    const double bad_w[1] = {NAN};
+    ts_err e = {0};
+    CHECK(ts_excitation_add_sum(ex, 3, w, zero, zero, 0, &e) == TS_EINVAL,
+          "sum of zeros refused: %s", e.msg);
+    CHECK(ts_excitation_add_sum(ex, 1, bad_w, re, im, 0, &e) == TS_EINVAL,
+          "non-finite frequency refused: %s", e.msg);
+    CHECK(ts_excitation_add_sum(ex, 3, w, re, im, -1, &e) == TS_EINVAL,
+          "negative fade-in refused: %s", e.msg);
+    CHECK(ts_excitation_add_sum(ex, 0, w, re, im, 0, &e) == TS_EINVAL,
+          "no component refused");
+    CHECK(ts_excitation_nsignals(ex) == 0, "refused sums added nothing");
+    /* Many signals before: the sum's signals still fit. */
+    ts_signal sg = {0};
+    sg.type = TS_SIGNAL_SINE;
+    sg.axis = TS_AXIS_SWAY;
+    sg.amplitude = 0.1;
+    sg.frequency = 0.2;
+    for (int i = 0; i < 4; i++)
+        ts_excitation_add(ex, &sg, &e);
+    CHECK(ts_excitation_add_sum(ex, 3, w, re, im, 0, &e) == TS_OK &&
+              ts_excitation_nsignals(ex) == 6,
+          "a sum after four signals (table full): %s", e.msg);
+    ts_excitation_input(ex, 2.0, u);
+    CHECK(fabs(u[1] - 4 * 0.1 * sin(2 * M_PI * 0.2 * 2.0)) < 1e-15,
+          "the sines still add up beside the sum");
+    /* A copy: the same inputs and frames, and independent of the
+     * original. Add a series and a manoeuvre first. */
+    const double ts[4] = {-1, 0.7, 1.9, 3.4}, xs[4] = {0, 0.02, -0.01, 0.03};
+    ts_signal man = {0};
+    man.type = TS_SIGNAL_RAMP;
+    man.axis = TS_AXIS_TURN_RATE;
+    man.amplitude = 0.1;
+    man.duration = 1.0;
+    man.rise = 0.1;
+    man.absolute = 1;
+    int rc2 = ts_excitation_add_series(ex, TS_AXIS_HEAVE, 4, ts, xs, &e);
+    if (rc2 == TS_OK)
+        rc2 = ts_excitation_add(ex, &man, &e);
+    CHECK(rc2 == TS_OK && ts_excitation_nsignals(ex) == 8,
+          "a series and a manoeuvre beside the sum: %s", e.msg);
+    ts_excitation *cp = ts_excitation_copy(ex, &e);
+    int same = cp && ts_excitation_nsignals(cp) == ts_excitation_nsignals(ex);
+    ts_frame base = {0}, fa, fb;
+    base.speed = 2;
+    for (int i = 0; same && i < 30; i++) {
+        double ua[9], ub[9], t = 0.11 * i;
+        ts_excitation_input(ex, t, ua);
+        ts_excitation_input(cp, t, ub);
+        ts_excitation_frame(ex, &base, t, &fa);
+        ts_excitation_frame(cp, &base, t, &fb);
+        same = !memcmp(ua, ub, sizeof ua) && fa.turn_rate == fb.turn_rate &&
+               fa.turn_accel == fb.turn_accel;
+    }
+    ts_excitation_free(ex);
+    double uc[9];
+    if (cp)
+        ts_excitation_input(cp, 1.3, uc);
+    CHECK(same && cp && isfinite(uc[2]), "a copy gives the same inputs and "
+          "frames, and outlives the original (%d signals)",
+          cp ? ts_excitation_nsignals(cp) : 0);
+    ts_excitation_free(cp);
+}
+
+/* Section 8: the smooth start. */
 static void test_smooth_start(void)
 {
     ts_signal s = {0};
@@ -589,6 +718,7 @@ static void test_smooth_start(void)
 
 int main(void)
 {
+    test_sum();
     test_shapes();
     test_smooth_start();
     test_series();

@@ -1,8 +1,8 @@
 /* test_kernel.c: the dynamics kernel f(y, u) (towstab/kernel.h) against
  * references written out here, independently of lib/kernel.c.
  *
- *  1. Loads (MODEL.md section 3): the nodal loads of one link and a sphere,
- *     partly submerged, moving in a turning, accelerating frame with a
+ *  1. Loads (doc/model.md section 3): the nodal loads of one link and a
+ *     sphere, partly submerged, moving in a turning, accelerating frame with a
  *     current, for both drag laws, recomputed from the formulas.
  *  2. Hanging at rest (V = 0): q'' = 0 and every link's tension is the wet
  *     weight below its midpoint in the lumped model.
@@ -141,7 +141,7 @@ static void chart_of(const ts_kernel *k, int l, double R[3][3])
 }
 
 /* Direction, its rate and its second rate for link angles a = t1, b = t2
- * with rates and accelerations, in the chart R (MODEL.md section 2:
+ * with rates and accelerations, in the chart R (doc/model.md section 2:
  * n = (-c1 c2, -s2, s1 c2) before rotation), differentiated here. */
 static void dir_derivs(const double R[3][3], double a, double b, double ad,
                        double bd, double add, double bdd, double n[3],
@@ -172,7 +172,7 @@ static void dir_derivs(const double R[3][3], double a, double b, double ad,
 
 /* Node positions, velocities and accelerations relative to M from the
  * state y and its derivative dydt, by the chart formulas above: the
- * kinematics of MODEL.md section 4 run forward. r, rd, rdd [3 nnodes]. */
+ * kinematics of doc/model.md section 4 run forward. r, rd, rdd [3 nnodes]. */
 static void nodes_from_state(const ts_kernel *k, const double y[],
                              const double dydt[], const double u[],
                              double r[], double rd[], double rdd[])
@@ -542,7 +542,7 @@ static void test_newton_nodes(gsl_rng *rng)
         const double *Q = ts_kernel_loads(k), *t = ts_kernel_tensions(k);
         const double *kr = ts_kernel_positions(k);
         const double *krdd = ts_kernel_rel_accelerations(k);
-        /* Frame part of each node's acceleration (MODEL.md section 1). */
+        /* Frame part of each node's acceleration (doc/model.md section 1). */
         double worst = 0, scale = 0, rig = 0, rscale = 0;
         for (int l = 0; l < nl; l++)
             scale = fmax(scale, fabs(t[l]));
@@ -559,7 +559,7 @@ static void test_newton_nodes(gsl_rng *rng)
             double a[3], Mm[3][3] = {{0}};
             for (int j = 0; j < 3; j++)
                 a[j] = rdd[3 * i + j] + afr[j];
-            /* Node mass matrix (MODEL.md section 4). */
+            /* Node mass matrix (doc/model.md section 4). */
             double m = s->nodes[i].mass;
             int bi = s->nodes[i].body;
             if (bi >= 0 && s->bodies[bi].type == TS_BODY_SPHERE) {

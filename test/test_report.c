@@ -4,14 +4,12 @@
  * system: tow point, cable nodes, a junction and two spheres) goes to JSON
  * and CSV; every value must come back bit for bit (17 significant digits),
  * names follow the documented rule, angles are the directions' angles in
- * degrees, a non-finite number becomes null. Atomicity: a write that fails
- * (folder missing, target is a folder, the stream fails before commit, an
- * abandoned write) leaves no file and no temporary file behind, and a
- * failed replacement leaves the old file as it was. "-" writes to standard
- * output. Files go to a fresh folder under $TMPDIR (default /tmp). */
+ * degrees, a non-finite number becomes null. Writing: a failed write
+ * reports and leaves nothing (the rest of safe writing is
+ * test_outfile.c). Files go to a fresh folder under $TMPDIR (default
+ * /tmp). */
 #include "towstab/report.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -21,40 +19,7 @@
 #include <unistd.h>
 
 #include "tcheck.h"
-
-static char dir[512];
-
-static int exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
-}
-
-/* Number of entries in the test folder whose name contains `part`. */
-static int count_in_dir(const char *part)
-{
-    DIR *d = opendir(dir);
-    int n = 0;
-    if (!d)
-        return -1;
-    for (struct dirent *e; (e = readdir(d));)
-        if (strstr(e->d_name, part))
-            n++;
-    closedir(d);
-    return n;
-}
-
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return NULL;
-    static char buf[1 << 16];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-    return buf;
-}
+#include "tfiles.h"
 
 /* Lead cable (2 links) to a junction, branches "up" (2 links) to sphere
  * "s1" and "lo" (1 link) to sphere "s2". */
@@ -130,7 +95,7 @@ static double num(const json_t *o, const char *key)
 
 static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
 {
-    json_t *o = ts_report_equilibrium_json(s, eq, 0.0625);
+    json_t *o = ts_report_equilibrium_json(s, eq, 0.0625, NULL);
     if (!CHECK(o != NULL, "json: object built"))
         return;
     CHECK(json_is_true(json_object_get(o, "converged")), "json: converged");
@@ -177,9 +142,9 @@ static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
                                       "junction, up.1, s1, s2");
     CHECK(pos_ok, "json: node positions exact");
     char buf[64];
-    ts_report_node_name(s, 3, buf, sizeof buf);
+    ts_system_node_name(s, 3, buf, sizeof buf);
     CHECK(!strcmp(buf, "up.1"), "node_name: cable node 'up.1' (%s)", buf);
-    ts_report_node_name(s, 0, buf, 3);
+    ts_system_node_name(s, 0, buf, 3);
     CHECK(!strcmp(buf, "to"), "node_name: truncated to the buffer ('%s')",
           buf);
 
@@ -220,7 +185,7 @@ static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
 
     /* Written and read back: the same document, every number exact. */
     char path[600];
-    snprintf(path, sizeof path, "%s/eq.json", dir);
+    snprintf(path, sizeof path, "%s/eq.json", tf_dir);
     ts_err err = {0};
     int rc = ts_report_write_json(o, path, &err);
     json_error_t je;
@@ -228,8 +193,8 @@ static void test_json_content(const ts_system *s, const ts_equilibrium *eq)
     CHECK(rc == TS_OK && back && json_equal(o, back),
           "json: written file reads back equal, bit for bit (%s)",
           back ? "parsed" : je.text);
-    CHECK(count_in_dir("partial") == 0, "json: no temporary file left");
-    const char *text = slurp(path);
+    CHECK(tf_count("partial") == 0, "json: no temporary file left");
+    const char *text = tf_slurp(path);
     CHECK(text && text[strlen(text) - 1] == '\n' && strstr(text, "\n  \""),
           "json: indented, ends with a newline");
     json_decref(back);
@@ -242,14 +207,14 @@ static void test_json_nonfinite(const ts_system *s, ts_equilibrium *eq)
     double keep = eq->residual, kx = eq->positions[4];
     eq->residual = NAN;
     eq->positions[4] = INFINITY;
-    json_t *o = ts_report_equilibrium_json(s, eq, NAN);
+    json_t *o = ts_report_equilibrium_json(s, eq, NAN, NULL);
     const json_t *n1 = json_array_get(json_object_get(o, "nodes"), 1);
     CHECK(o && json_is_null(json_object_get(o, "residual")) &&
               json_is_null(json_object_get(o, "wall_s")) &&
               json_is_null(json_object_get(n1, "y")),
           "json: NaN and Inf become null (JSON has no such numbers)");
     char path[600];
-    snprintf(path, sizeof path, "%s/nan.json", dir);
+    snprintf(path, sizeof path, "%s/nan.json", tf_dir);
     int rc = ts_report_write_json(o, path, NULL);
     json_t *back = json_load_file(path, 0, NULL);
     CHECK(rc == TS_OK && back != NULL, "json: such a document is valid JSON");
@@ -263,7 +228,7 @@ static void test_json_nonfinite(const ts_system *s, ts_equilibrium *eq)
 static void test_csv(const ts_system *s, const ts_equilibrium *eq)
 {
     char path[600];
-    snprintf(path, sizeof path, "%s/eq.csv", dir);
+    snprintf(path, sizeof path, "%s/eq.csv", tf_dir);
     ts_err err = {0};
     int rc = ts_report_equilibrium_csv(s, eq, path, &err);
     CHECK(rc == TS_OK, "csv: written (%s)", err.msg);
@@ -294,7 +259,7 @@ static void test_csv(const ts_system *s, const ts_equilibrium *eq)
             p = end;
         }
         char want[128];
-        ts_report_node_name(s, row, want, sizeof want);
+        ts_system_node_name(s, row, want, sizeof want);
         double t = row == 0 ? eq->top_tension : eq->tensions[row - 1];
         ok &= !strcmp(name, want) && v[0] == eq->positions[3 * row] &&
               v[1] == eq->positions[3 * row + 1] &&
@@ -308,102 +273,62 @@ static void test_csv(const ts_system *s, const ts_equilibrium *eq)
     unlink(path);
 }
 
-static void test_atomic(const ts_system *s, const ts_equilibrium *eq)
+/* The writers go through lib/outfile.h (test_outfile.c tests it); here
+ * only that a failed write reports and leaves nothing, and a good one
+ * writes the document. */
+static void test_write(const ts_system *s, const ts_equilibrium *eq)
 {
-    json_t *o = ts_report_equilibrium_json(s, eq, 0);
-    char path[600], tmp[1024];
+    json_t *o = ts_report_equilibrium_json(s, eq, 0, NULL);
+    char path[600];
     ts_err err = {0};
 
-    /* A folder that does not exist. */
-    snprintf(path, sizeof path, "%s/no/such/folder/eq.json", dir);
+    snprintf(path, sizeof path, "%s/no/such/folder/eq.json", tf_dir);
     int rc = ts_report_write_json(o, path, &err);
-    CHECK(rc == TS_EIO && strstr(err.msg, path) && !exists(path),
-          "atomic: missing folder: TS_EIO naming the path, nothing written "
+    CHECK(rc == TS_EIO && strstr(err.msg, path) && !tf_exists(path),
+          "write: missing folder: TS_EIO naming the path, nothing written "
           "(%s)", err.msg);
     ts_err_clear(&err);
     rc = ts_report_equilibrium_csv(s, eq, path, &err);
-    CHECK(rc == TS_EIO && !exists(path), "atomic: csv to a missing folder: "
-                                         "TS_EIO (%s)", err.msg);
+    CHECK(rc == TS_EIO && !tf_exists(path),
+          "write: csv to a missing folder: TS_EIO (%s)", err.msg);
 
-    /* The target is a folder: the rename fails, the temporary goes. */
-    snprintf(path, sizeof path, "%s/a_folder", dir);
-    mkdir(path, 0700);
-    ts_err_clear(&err);
-    rc = ts_report_write_json(o, path, &err);
-    CHECK(rc == TS_EIO && count_in_dir("partial") == 0,
-          "atomic: target is a folder: TS_EIO, no temporary left (%s)",
-          err.msg);
-    rmdir(path);
-
-    /* An existing file survives an abandoned replacement untouched. */
-    snprintf(path, sizeof path, "%s/old.json", dir);
-    FILE *f = fopen(path, "w");
-    fputs("{\"old\": true}\n", f);
-    fclose(f);
-    f = ts_report_open(path, tmp, sizeof tmp, &err);
-    CHECK(f != NULL && strstr(tmp, "old.json") && exists(tmp),
-          "atomic: open writes to a temporary beside the target (%s)", tmp);
-    if (f) {
-        fputs("{\"new\": ", f);
-        ts_report_abandon(f, path, tmp);
-    }
-    const char *text = slurp(path);
-    CHECK(text && !strcmp(text, "{\"old\": true}\n") &&
-              count_in_dir("partial") == 0,
-          "atomic: abandon keeps the old file and removes the temporary");
-
-    /* A stream that fails before commit (its descriptor is closed under
-     * it, so the final flush fails): error, old file intact, no
-     * temporary. */
-    f = ts_report_open(path, tmp, sizeof tmp, &err);
-    if (f) {
-        for (int i = 0; i < 2000; i++)
-            fputs("{\"half written\": 1234567890}\n", f);
-        close(fileno(f));
-        ts_err_clear(&err);
-        rc = ts_report_commit(f, path, tmp, &err);
-    }
-    text = slurp(path);
-    CHECK(f && rc == TS_EIO && text && !strcmp(text, "{\"old\": true}\n") &&
-              count_in_dir("partial") == 0,
-          "atomic: a failed write reports TS_EIO (%s), keeps the old file, "
-          "leaves no temporary", err.msg);
-
-    /* A successful replacement. */
+    snprintf(path, sizeof path, "%s/eq.json", tf_dir);
     rc = ts_report_write_json(o, path, &err);
     json_t *back = json_load_file(path, 0, NULL);
     CHECK(rc == TS_OK && back && json_equal(back, o) &&
-              count_in_dir("partial") == 0,
-          "atomic: replacement by a complete file");
-    json_decref(back);
-    unlink(path);
-
-    /* "-": standard output, no file. Capture fd 1 in a file. */
-    snprintf(path, sizeof path, "%s/stdout.txt", dir);
-    fflush(stdout);
-    int saved = dup(1);
-    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    dup2(fd, 1);
-    close(fd);
-    rc = ts_report_write_json(o, "-", &err);
-    fflush(stdout);
-    dup2(saved, 1);
-    close(saved);
-    back = json_load_file(path, 0, NULL);
-    CHECK(rc == TS_OK && back && json_equal(back, o) && !exists("-"),
-          "stdout: '-' writes the document to standard output only");
+              tf_count("partial") == 0,
+          "write: the complete document, no temporary left");
     json_decref(back);
     unlink(path);
     json_decref(o);
+
+    /* Text (a page): every byte, a NUL inside included; a failed write
+     * leaves nothing. */
+    static const char page[] = "<p>2.385 \xc2\xb1 0.01 m</p>\0tail\n";
+    snprintf(path, sizeof path, "%s/page.html", tf_dir);
+    rc = ts_report_write_text(page, sizeof page - 1, path, &err);
+    FILE *f = fopen(path, "rb");
+    char back_text[64] = {0};
+    size_t got = f ? fread(back_text, 1, sizeof back_text, f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(rc == TS_OK && got == sizeof page - 1 &&
+              !memcmp(back_text, page, got) && tf_count("partial") == 0,
+          "write text: every byte (%zu of %zu), no temporary left", got,
+          sizeof page - 1);
+    unlink(path);
+    snprintf(path, sizeof path, "%s/no/such/folder/page.html", tf_dir);
+    ts_err_clear(&err);
+    rc = ts_report_write_text(page, sizeof page - 1, path, &err);
+    CHECK(rc == TS_EIO && strstr(err.msg, path) && !tf_exists(path),
+          "write text: missing folder: TS_EIO naming the path, nothing "
+          "written (%s)", err.msg);
 }
 
 int main(void)
 {
-    const char *t = getenv("TMPDIR");
-    snprintf(dir, sizeof dir, "%s/towstab-test-report-XXXXXX",
-             t && *t ? t : "/tmp");
-    if (!mkdtemp(dir)) {
-        printf("FAIL cannot make a folder under %s: %s\n", dir,
+    if (tf_begin("report") != 0) {
+        printf("FAIL cannot make a folder under %s: %s\n", tf_dir,
                strerror(errno));
         return 1;
     }
@@ -414,11 +339,10 @@ int main(void)
         test_json_content(s, eq);
         test_json_nonfinite(s, eq);
         test_csv(s, eq);
-        test_atomic(s, eq);
+        test_write(s, eq);
     }
     ts_equilibrium_free(eq);
     ts_system_free(s);
-    CHECK(count_in_dir("") == 2, "nothing left in the test folder");
-    rmdir(dir);
+    CHECK(tf_end(), "nothing left in the test folder");
     return tc_done();
 }

@@ -22,7 +22,12 @@
  *     linearizer) agree with rk8pd.
  *  8. Initial shapes, sample times, the sinusoid fit, reports, and every
  *     refusal: options, a history too small, step-size underflow (history
- *     kept), h_min, the step limit, a manoeuvre in a linear run.
+ *     kept), h_min, the step limit (also when every step ends on an output
+ *     time), a manoeuvre in a linear run.
+ *  9. The progress callback: called after every accepted step with the
+ *     simulated time (rk8pd, esdirk) or every sample (linear, expm); a
+ *     nonzero return stops the run with TS_ECANCEL, keeping the history
+ *     so far.
  * Tolerances are stated at each check with their reason. */
 #include "towstab/simulate.h"
 
@@ -765,6 +770,39 @@ static void test_misc(void)
               h->nsamples >= 1 && h->nsamples < ts_sim_nsamples(&o),
           "step limit enforced after %d samples: %s", h->nsamples, err.msg);
     ts_history_free(h);
+    /* A chain at rest in equilibrium takes one step per output interval:
+     * every step ends on an output time, and the limit still counts. */
+    {
+        ts_scene *s3 = scene(ex1_small);
+        ts_kernel *k3 = ts_kernel_alloc(s3->system, &err);
+        ts_equilibrium *eq = ts_equilibrium_alloc(s3->system, &err);
+        ts_equilibrium_solve(k3, NULL, eq, &err);
+        ts_sim_opts_default(&o);
+        o.t_end = 10.0;
+        o.dt_sample = 0.5;
+        o.max_steps = 7;
+        ts_history *h3 = ts_history_alloc(s3->system, ts_sim_nsamples(&o),
+                                          &err);
+        rc = ts_simulate(k3, NULL, eq->y, &o, h3, &st, NULL, &err);
+        CHECK(rc == TS_EINTEGRATOR && strstr(err.msg, "step limit 7") &&
+                  st.steps == 7 && st.t_reached < o.t_end,
+              "the step limit counts steps that end on output times: %ld "
+              "steps to t = %g s: %s", st.steps, st.t_reached, err.msg);
+        o.max_steps = 0;
+        h3->nsamples = 0;
+        rc = ts_simulate(k3, NULL, eq->y, &o, h3, &st, NULL, &err);
+        long need = st.steps;
+        o.max_steps = need;
+        h3->nsamples = 0;
+        rc |= ts_simulate(k3, NULL, eq->y, &o, h3, &st, NULL, &err);
+        CHECK(rc == TS_OK && st.steps == need,
+              "a limit of the %ld steps the run needs is enough (%s)", need,
+              rc ? err.msg : "ok");
+        ts_history_free(h3);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k3);
+        ts_scene_free(s3);
+    }
     free(y);
     free(y2);
     free(dy);
@@ -886,6 +924,106 @@ static void test_misc(void)
     lin_case_close(&lc);
 }
 
+/* ---- 9. progress and stopping ---------------------------------------- */
+
+/* Counts calls, checks that time only grows and stops once it passes
+ * `stop_at` (s). */
+typedef struct progress_log {
+    long calls;
+    double last, stop_at, total;
+    int backwards;
+    const char *what;
+} progress_log;
+
+static int log_progress(const ts_progress *p, void *data)
+{
+    progress_log *l = data;
+    l->calls++;
+    l->backwards |= p->done < l->last;
+    l->last = p->done;
+    l->total = p->total;
+    l->what = p->what;
+    return p->done >= l->stop_at;
+}
+
+static void test_progress(void)
+{
+    ts_err err = {0};
+    ts_scene *sc = scene(vacuum_chain);
+    ts_system *sys = sc->system;
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    int n = ts_kernel_nstate(k);
+    double *y = calloc(n, sizeof *y);
+    ts_sim_released_state(k, 0.6, 0.2, y, &err);
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    o.t_end = 4.0;
+    o.dt_sample = 0.25;
+    int N = ts_sim_nsamples(&o);
+    ts_history *h = ts_history_alloc(sys, N, &err);
+    ts_sim_stats st;
+    /* To the end: one call per accepted step, time growing to t_end. */
+    progress_log l = {0, 0, INFINITY, 0, 0, NULL};
+    o.progress = log_progress;
+    o.progress_data = &l;
+    int rc = ts_simulate(k, NULL, y, &o, h, &st, NULL, &err);
+    /* GSL's step count includes the rejected trials. */
+    CHECK(rc == TS_OK && l.calls == st.steps - st.rejected && !l.backwards &&
+              l.last == o.t_end && l.total == o.t_end &&
+              !strcmp(l.what, "nonlinear"),
+          "rk8pd: the callback sees every accepted step (%ld calls, %ld "
+          "steps, %ld rejected, %ld restarts), time growing to t_end",
+          l.calls, st.steps, st.rejected, st.restarts);
+    /* Stopped after 1.3 s: TS_ECANCEL, samples up to there kept, and the
+     * last one is the state the run stopped at. */
+    progress_log s = {0, 0, 1.3, 0, 0, NULL};
+    o.progress_data = &s;
+    h->nsamples = 0;
+    rc = ts_simulate(k, NULL, y, &o, h, &st, NULL, &err);
+    double tl = h->nsamples ? h->t[h->nsamples - 1] : -1;
+    CHECK(rc == TS_ECANCEL && strstr(err.msg, "stopped on request") &&
+              st.t_reached >= 1.3 && st.t_reached < 2.0 &&
+              tl == st.t_reached && h->nsamples >= 6 && h->nsamples < N,
+          "rk8pd: stopped at t = %g s, %d samples kept, the last at %g s: "
+          "%s", st.t_reached, h->nsamples, tl, err.msg);
+    /* esdirk stops the same way. */
+    o.integrator = TS_INT_ESDIRK;
+    progress_log e = {0, 0, 1.3, 0, 0, NULL};
+    o.progress_data = &e;
+    h->nsamples = 0;
+    rc = ts_simulate(k, NULL, y, &o, h, &st, NULL, &err);
+    CHECK(rc == TS_ECANCEL && e.calls == st.steps && st.t_reached < 2.5 &&
+              h->nsamples >= 5 && h->nsamples < N,
+          "esdirk: stopped at t = %g s after %ld calls, %d samples: %s",
+          st.t_reached, e.calls, h->nsamples, err.msg);
+    ts_history_free(h);
+    free(y);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+
+    /* Linear (expm): a call per sample; stopped after 1 s. */
+    lin_case lc;
+    lin_case_open(&lc, ex1_small, "sphere.z");
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_excitation_parse(ex, "tow.heave:amplitude=0.01m,frequency=0.5Hz",
+                        units, "test", &err);
+    ts_sim_opts_default(&o);
+    o.t_end = 4.0;
+    o.dt_sample = 0.25;
+    progress_log li = {0, 0, 1.0, 0, 0, NULL};
+    o.progress = log_progress;
+    o.progress_data = &li;
+    ts_history *hl = ts_history_alloc(lc.sys, ts_sim_nsamples(&o), &err);
+    rc = ts_simulate_linear(lc.k, lc.lin, ex, NULL, &o, hl, &st, &err);
+    CHECK(rc == TS_ECANCEL && !strcmp(li.what, "linear") &&
+              hl->nsamples == 5 && hl->t[4] == 1.0 && li.calls == 4,
+          "linear: stopped at the sample t = 1 s (%d samples, %ld calls): "
+          "%s", hl->nsamples, li.calls, err.msg);
+    ts_history_free(hl);
+    ts_excitation_free(ex);
+    lin_case_close(&lc);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -898,6 +1036,7 @@ int main(void)
     test_turn();
     test_implicit();
     test_misc();
+    test_progress();
     ts_units_free(units);
     return tc_done();
 }

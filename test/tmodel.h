@@ -1,5 +1,5 @@
 /* tmodel.h: model pieces the tests write out independently of lib/, shared
- * by several test programs: the submerged fractions of MODEL.md section 3
+ * by several test programs: the submerged fractions of doc/model.md section 3
  * and doc/kernel.md, and one classical RK4 step of the kernel. The tests
  * check the library against these, so they must not call into it (except
  * the kernel evaluation the RK4 step integrates). */

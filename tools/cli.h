@@ -1,14 +1,22 @@
 /* cli.h: what the towstab subcommands share (tools only; the library never
- * prints). Each subcommand lives in tools/cmd_<name>.c and exports one
- * cli_command; tools/towstab.c lists them. */
+ * prints). A command is parse -> run -> print: its options come from the
+ * analysis' option table (towstab/options.h) on the command line and in
+ * the scene's entry, the library runs the pipeline (towstab/analysis.h),
+ * and the command prints the result, writes its JSON and CSV
+ * (towstab/report_result.h) and draws it. Each subcommand lives in
+ * tools/cmd_<name>.c and exports one cli_command; tools/towstab.c lists
+ * them. */
 #ifndef TOWSTAB_CLI_H
 #define TOWSTAB_CLI_H
 
 #include <jansson.h>
 #include <stdio.h>
 
-#include "towstab/equilibrium.h"
+#include "cli_plot.h"
+#include "towstab/analysis.h"
 #include "towstab/error.h"
+#include "towstab/options.h"
+#include "towstab/progress.h"
 #include "towstab/scene.h"
 #include "towstab/system.h"
 #include "towstab/units.h"
@@ -16,28 +24,55 @@
 #define EXIT_FAILED 1   /* the analysis failed: no convergence, I/O */
 #define EXIT_BADINPUT 2 /* usage, scene, units, impossible configuration */
 
-/* What a scene analysis entry runs with. */
-typedef struct cli_ctx {
+/* An option of a command beyond its analysis' table: what to write or
+ * draw (command line only). */
+typedef struct cli_extra {
+    const char *name;   /* "shapes" (--shapes) */
+    int has_arg;        /* 1: takes a value; 0: a flag */
+    int repeat;         /* 1: may be given several times */
+    const char *arg;    /* metavariable */
+    const char *help;
+} cli_extra;
+
+#define CLI_EXTRA_MAX 8
+#define CLI_EXTRA_VALUES 8
+
+/* One run of an analysis command (or of one entry of `towstab run`). */
+typedef struct cli_run {
+    const struct cli_command *cmd;
     const ts_scene *scene;
     const ts_units *units;
+    ts_request rq;
+    ts_optset *opts;
     int quiet;
-} cli_ctx;
+    int entry;              /* -1: the command line; else analyses[entry] */
+    const char *json, *csv; /* output paths, NULL when not asked for */
+    cli_plot plot;          /* --plot DIR and --units */
+    int json_flags;         /* TS_REPORT_* */
+    /* The extras given: values[k][0..nvalues[k]) for cmd->extras[k]. */
+    const char *extra[CLI_EXTRA_MAX][CLI_EXTRA_VALUES];
+    int nextra[CLI_EXTRA_MAX];
+    void *state;            /* the command's own (released by release) */
+} cli_run;
 
 typedef struct cli_command {
     const char *name;
     const char *summary;
-    /* `towstab NAME ...`: argv[0] is NAME. Returns the exit status. */
+    int kind;               /* ts_analysis_kind; -1 for run */
+    /* `towstab run`: its own main. NULL for analyses (cli_main runs
+     * them). */
     int (*main)(int argc, char **argv);
-    /* One `analyses:` entry of type NAME. With result == NULL it only
-     * checks the entry's option values (units, ranges, names), so that
-     * `run` refuses a bad entry before the first runs; otherwise it runs
-     * the entry and sets *result to its JSON (NULL when there is none).
-     * Prints its messages; returns the exit status. NULL when the command
-     * is not an analysis. */
-    int (*entry)(const cli_ctx *ctx, const ts_scene_analysis *a, int index,
-                 json_t **result);
-    /* Option keys the scene entry accepts (NULL-terminated). */
-    const char *const *keys;
+    /* Check the extras and prepare what the pictures need before anything
+     * runs; prints and returns the exit status. May be NULL. */
+    int (*prepare)(cli_run *c);
+    /* Print the result (tables, verdict): everything but the header. */
+    void (*print)(const cli_run *c, const ts_result *r);
+    /* Pictures and extra files; prints and returns the exit status. May
+     * be NULL. */
+    int (*draw)(cli_run *c, const ts_result *r);
+    void (*release)(cli_run *c);
+    const char *const *pictures;  /* what --plot writes (NAME.png/.svg) */
+    const cli_extra *extras;      /* NULL-name-terminated, may be NULL */
 } cli_command;
 
 double cli_wall_now(void);
@@ -45,74 +80,95 @@ double cli_wall_now(void);
 /* Exit status for a library code. */
 int cli_exit_code(int rc);
 
-/* Print "towstab: error: <message>" and return the exit status. */
-int cli_report(const ts_err *err, int rc);
+/* Print "towstab: error: <message>" and return the exit status. A message
+ * about the scene's analysis (a failed analysis, an option of an
+ * `analyses` entry) gets the scene file in front, in err too, so that a
+ * JSON written afterwards gives the same reason. */
+int cli_report(ts_err *err, int rc);
 
-/* Load units and a scene; on failure prints and returns NULL with *status
- * set. Free with cli_close(). */
+/* Load units and a scene; on failure prints and returns the status. Free
+ * with cli_close(). */
 int cli_open(const char *path, ts_units **units, ts_scene **scene);
 void cli_close(ts_units *units, ts_scene *scene);
 
-/* Settings that override a scene's tow or solver, as text with units.
- * `where` names the origin of each for messages. */
-typedef struct cli_settings {
-    const char *speed, *turn_rate, *method, *tol;
-    int links;                  /* 0: keep the scene's */
-    char where[5][128];         /* speed, turn_rate, method, tol, links */
-} cli_settings;
+/* The command line of an analysis command: options of the table, the
+ * outputs, the command's extras, one scene; then the run (cli_execute).
+ * Returns the exit status. */
+int cli_main(const struct cli_command *cmd, int argc, char **argv);
 
-/* Settings named as command-line options (--speed, ...). */
-void cli_settings_from_options(cli_settings *s);
+/* Prepare c (c->cmd, scene, units, entry and c->opts filled) into
+ * c->rq: apply the options, check the request against the system (a scene
+ * value the command line contradicts yields to its default, with a
+ * note), then the command's prepare. Prints; returns the exit status. */
+int cli_prepare(cli_run *c);
 
-/* Settings from a scene analysis entry (keys speed, turn_rate, method,
- * tolerance, links). */
-int cli_settings_from_analysis(cli_settings *s, const ts_scene_analysis *a,
-                               int index, ts_err *err);
+/* Run a prepared c, print, write and draw. Sets *result (may be NULL) to
+ * its JSON when asked (caller frees). Returns the exit status. */
+int cli_execute(cli_run *c, json_t **result);
 
-/* A copy of the scene's system with the settings applied and rebuilt, and
- * the solver options. NULL on failure (message in err). */
-ts_system *cli_system(const ts_scene *scene, const ts_units *units,
-                      const cli_settings *s, ts_equilibrium_opts *eo,
-                      ts_err *err);
+/* Release what cli_prepare and cli_execute took. */
+void cli_run_free(cli_run *c);
 
-/* Refuse analysis options outside `keys`. */
-int cli_check_keys(const ts_scene_analysis *a, const char *const keys[],
-                   int index, ts_err *err);
+/* The option set of an analysis entry of `scene` (analyses[index], of
+ * type kind) with its related entry (a study's first simulate entry);
+ * with command-line texts added by the caller. NULL after printing. */
+ts_optset *cli_entry_options(const ts_scene *scene, int kind, int index,
+                             int *status);
 
-/* Text of option `key` of a scene analysis, or NULL. */
-const char *cli_option(const ts_scene_analysis *a, const char *key);
+/* The analyses a scene lists (`towstab run`, `towstab report`). */
+typedef struct cli_scene_runs {
+    int n;                  /* the scene's analyses */
+    cli_run *runs;          /* [n], prepared */
+    char (*csv)[1200];      /* [n] DIR/<k>_<type>.csv when asked for */
+    char (*dirs)[1200];     /* [n] DIR/<k>_<type> of the pictures */
+} cli_scene_runs;
 
-/* Solve and print an equilibrium (summary always, tables unless quiet).
- * *out receives the result (caller frees, may be partial on failure);
- * *json, when not NULL, its JSON. Returns the library code. */
-int cli_equilibrium(const ts_system *sys, const ts_equilibrium_opts *eo,
-                    int quiet, ts_equilibrium **out, json_t **json,
-                    ts_err *err);
+/* Read every entry of the scene's analyses list through its option table
+ * and check it against the system (cli_prepare) before anything runs;
+ * with csv_dir each writes csv_dir/<k>_<type>.csv, with plot_dir its
+ * pictures into plot_dir/<k>_<type>/ (k from 1) in plot_units. `cmd`
+ * names the command in messages. Prints and returns the exit status (a
+ * scene without analyses is bad input); on success release s with
+ * cli_scene_free. */
+int cli_scene_prepare(const char *cmd, const ts_scene *scene,
+                      const ts_units *units, int quiet, const char *csv_dir,
+                      const char *plot_dir, const char *plot_units,
+                      cli_scene_runs *s);
 
-/* The getopt entries of the shared settings: --speed, --turn-rate,
- * --links, the equilibrium method's option (named `method`) and --tol,
- * with the codes cli_settings_option() takes. */
-#define CLI_SETTINGS_LONGOPTS(method)                                        \
-    {"speed", required_argument, NULL, 's'},                                 \
-        {"turn-rate", required_argument, NULL, 'w'},                         \
-        {"links", required_argument, NULL, 'n'},                             \
-        {method, required_argument, NULL, 'm'},                              \
-        {"tol", required_argument, NULL, 't'}
+/* Run the prepared analyses in order, each after a line "== analysis k of
+ * n: TYPE (SCENE) ==", until one fails. *all receives the JSON document
+ * {"scene", "analyses": [result, ...], "completed"} (with "error" and
+ * "trustworthy": false after a failure; "interrupted" after a signal),
+ * NULL only when out of memory. Returns the exit status. */
+int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
+                      json_t **all);
 
-/* Take a shared setting (getopt code ch, value arg) into s: 1 when ch was
- * one, 0 when not, -1 (message printed) when its value is bad. */
-int cli_settings_option(cli_settings *s, int ch, const char *arg);
+void cli_scene_free(cli_scene_runs *s);
 
-/* Report a getopt failure of command `cmd` (ch ':' for a missing value,
- * anything else an unknown option; `arg` the offending argument) and
- * return EXIT_BADINPUT. */
-int cli_option_error(const char *cmd, int ch, const char *arg);
+/* Make directory `dir` (one level) unless it is one; 0, or the status
+ * after printing a message naming `cmd` and the option `opt`. */
+int cli_make_dir(const char *cmd, const char *opt, const char *dir);
+
+/* The option help of an analysis command (towstab CMD --help). */
+void cli_usage(const struct cli_command *cmd, FILE *f);
+
+/* The vehicles' attitudes, flow angles and depths, their control
+ * deflections and (unless quiet) their components' loads. */
+void cli_print_vehicles(FILE *f, const ts_system *sys,
+                        const ts_vehicle_result *vr, int nv, int quiet);
+
+/* Markdown of every option of the analyses: the reference of
+ * doc/manual.md (towstab options --markdown). */
+void cli_options_markdown(FILE *f);
 
 /* Parse a whole number option value in [lo, hi]. */
 int cli_parse_int(const char *opt, const char *text, long lo, long hi,
                   long *value);
 
-
+/* Report a getopt failure of command `cmd` (ch ':' for a missing value,
+ * anything else an unknown option; `arg` the offending argument) and
+ * return EXIT_BADINPUT. */
+int cli_option_error(const char *cmd, int ch, const char *arg);
 
 /* Standard output for JSON. When a command is given `--json -`, main()
  * moves standard output to standard error for the text report and keeps
@@ -120,9 +176,61 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
  * cli_stdout_for_json() does that once, before anything is printed. */
 void cli_stdout_for_json(void);
 
-/* Write JSON to `path` ("-": the JSON standard output), atomically. */
+/* Write JSON to `path` ("-": the JSON standard output), as
+ * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
+
+/* ---- Interruption and progress (doc/manual.md, "Long runs") ----------
+ * main() installs handlers for SIGINT and SIGTERM. A run that takes
+ * cli_progress as its progress callback (simulations, convergence sweeps)
+ * polls them: the first signal makes it stop at its next step, write what
+ * it has marked incomplete, and exit with 128 + the signal (130 for
+ * SIGINT, 143 for SIGTERM). A second signal, or one that comes while
+ * nothing polls (reading the scene, an equilibrium, an eigensolver), ends
+ * the process at once with the same status. */
+void cli_signals_install(void);
+
+/* The signal that asked to stop, 0 if none came, and its name ("SIGINT",
+ * "SIGTERM"; NULL if none). */
+int cli_stop_signal(void);
+const char *cli_stop_signal_name(void);
+
+/* A ts_progress_fn: nonzero once SIGINT or SIGTERM came. When standard
+ * error is a terminal and the run has lasted a second, it also shows one
+ * line there, rewritten at most four times a second: what is done of how
+ * much, the rate and the time left. Quiet when standard error is not a
+ * terminal. `data` is unused. */
+int cli_progress(const ts_progress *p, void *data);
+
+/* Clear the progress line, if one is shown; a run that polled is over. */
+void cli_progress_done(void);
+
+/* Refuse, before anything runs, an empty output name and outputs that
+ * name the same file
+ * (ts_report_check_targets): the n options what[i] with paths[i] (NULL
+ * when not given), and the pictures `plot_names` (NULL-terminated, each
+ * written as NAME.png and NAME.svg) that --plot writes into plot_dir (may
+ * be NULL). Prints and returns EXIT_BADINPUT, or 0. */
+int cli_check_outputs(const char *cmd, int n, const char *const what[],
+                      const char *const paths[], const char *plot_dir,
+                      const char *const plot_names[]);
+
+/* The verdict lines: "trustworthy: yes|NO", reasons, notes. */
+void cli_print_trust(const ts_trust *t);
+
+/* At the end of main: flush and close standard output and standard error,
+ * checking both; a failed write turns status 0 into EXIT_FAILED (with a
+ * message naming standard output). Returns the status. */
+int cli_finish(int status);
 
 /* All subcommands, NULL-terminated (tools/towstab.c). */
 extern const cli_command *const cli_commands[];
+/* The command of analysis `kind`. */
+const cli_command *cli_command_of(int kind);
+
+/* Printing shared by the commands (cmd_equilibrium.c, cmd_modes.c). */
+void cli_print_equilibrium(const ts_result *r, int quiet);
+void cli_print_linearization(const ts_result *r);
+/* The sea state and its statistics (cmd_response.c; simulate too). */
+void cli_print_seastate(const ts_result *r, int quiet);
 #endif

@@ -67,7 +67,7 @@ int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out)
     s->link_upper = out->link_upper;
     s->nmarks = nmarks;
     s->marks = out->marks;
-    /* MODEL.md section 1: the turn centre is at (0, V / Omega, 0). */
+    /* doc/model.md section 1: the turn centre is at (0, V / Omega, 0). */
     s->turn_radius = sys->tow.turn_rate != 0
                          ? sys->tow.speed / sys->tow.turn_rate
                          : 0;

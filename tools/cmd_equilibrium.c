@@ -1,30 +1,37 @@
 /* cmd_equilibrium.c: `towstab equilibrium SCENE` and the `equilibrium`
- * analysis of a scene.
+ * analysis of a scene: the steady shape (doc/equilibrium.md), printed as
+ * node, link and body tables with the verdict.
  *
  * Pictures (--plot DIR): side and top views of the cable (side.png/svg,
  * top.png/svg), with overlays of other speeds, turn rates or scenes
  * solved with the same settings (doc/plots.md). */
-#include <getopt.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
 #include "cli_plot.h"
 #include "towstab/kernel.h"
-#include "towstab/report.h"
 
 /* At most this many overlay curves (speeds, turn rates and scenes). */
 #define MAX_OVERLAYS 8
 #define ITEM_MAX 128
 
-/* One curve of the pictures: a system and its equilibrium (owned). */
+/* One curve of the pictures: a system and its equilibrium. */
 typedef struct eq_curve {
-    ts_system *sys;
-    ts_equilibrium *eq;
+    const ts_system *sys;
+    const ts_equilibrium *eq;
+    ts_result *res;    /* an overlay's result (owned), else NULL */
     ts_scene *scene;   /* an --overlay scene (owned), else NULL */
-    ts_equilibrium_opts eo;
+    ts_request rq;     /* an overlay's request (a shallow copy) */
     char what[ITEM_MAX + 64];
 } eq_curve;
+
+/* What the pictures need: the overlays, checked before the first solve. */
+typedef struct eq_state {
+    eq_curve curves[MAX_OVERLAYS + 1];
+    int ncurves;
+} eq_state;
 
 /* Split "2,4,6 knot" into items; items without a unit take the unit of
  * the last item ("2 knot", "4 knot", "6 knot"). Returns the number of
@@ -80,39 +87,6 @@ static int split_list(const char *opt, const char *text,
         }
     }
     return n;
-}
-
-/* Build the system of an overlay (settings validated now, before any
- * analysis runs). Returns 0 or the exit status after printing. */
-static int overlay_system(eq_curve *c, const ts_scene *scene,
-                          const ts_units *units, const cli_settings *s)
-{
-    ts_err err = {0};
-    c->sys = cli_system(scene, units, s, &c->eo, &err);
-    if (!c->sys) {
-        ts_err_prefix(&err, "%s: ", c->what);
-        return cli_report(&err, err.code);
-    }
-    return 0;
-}
-
-/* Solve an overlay's equilibrium and print one line. Returns the exit
- * status (0 when converged). */
-static int overlay_solve(eq_curve *c)
-{
-    ts_err err = {0};
-    ts_kernel *k = ts_kernel_alloc(c->sys, &err);
-    c->eq = k ? ts_equilibrium_alloc(c->sys, &err) : NULL;
-    int rc = c->eq ? ts_equilibrium_solve(k, &c->eo, c->eq, &err)
-                   : (err.code ? err.code : TS_ENOMEM);
-    ts_kernel_free(k);
-    if (rc != TS_OK) {
-        ts_err_prefix(&err, "%s: ", c->what);
-        return cli_report(&err, rc);
-    }
-    printf("overlay %s: converged (%s), top tension %.6f N\n", c->what,
-           ts_eq_method_name(c->eq->method), c->eq->top_tension);
-    return 0;
 }
 
 /* "a", "a and b", "a, b and c" of the distinct scene names. */
@@ -203,222 +177,222 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
     return status;
 }
 
-static void usage(FILE *f)
+void cli_print_equilibrium(const ts_result *r, int quiet)
 {
-    fprintf(f,
-            "usage: towstab equilibrium SCENE [options]\n"
-            "  steady shape at the scene's speed and turn rate\n"
-            "  --json FILE      write the result as JSON ('-' for stdout)\n"
-            "  --csv FILE       write the node table as CSV\n"
-            "  --speed Q        override tow.speed (e.g. '5 knot', 2.5)\n"
-            "  --turn-rate Q    override tow.turn_rate (e.g. '0.5 rad/s')\n"
-            "  --links N        use N links on every cable\n"
-            "  --method M       auto (default), shooting or newton\n"
-            "  --tol X          relative force residual (default 1e-10)\n"
-            "  --quiet          print the summary only, not the tables\n"
-            "  --plot DIR       draw side and top views into DIR (side.png,\n"
-            "                   side.svg, top.png, top.svg); DIR is created\n"
-            "  --units U        units of the pictures: si (default) or\n"
-            "                   imperial (ft, lbf, knot)\n"
-            "  --overlay-speeds LIST      also draw these speeds ('2,4,6 "
-            "knot')\n"
-            "  --overlay-turn-rates LIST  also draw these turn rates "
-            "('0.2,0.5 rad/s')\n"
-            "  --overlay SCENE  also draw this scene (repeatable); the\n"
-            "                   options above apply to every curve\n");
+    if (!r->eq || !r->eq_attempted)
+        return;
+    FILE *f = stdout;
+    const ts_system *sys = r->sys;
+    const ts_equilibrium *eq = r->eq;
+    double wall_s = r->eq_wall_s;
+    /* The equilibrium's own verdict; an equilibrium analysis' is the
+     * result's (which also says why a failed run failed). */
+    const ts_trust *t = r->kind == TS_ANALYSIS_EQUILIBRIUM ? &r->trust
+                                                           : &r->eq_trust;
+    fprintf(f, "speed %.6g m/s, turn rate %.6g rad/s, %d cable%s, %d links, "
+               "%d bod%s\n",
+            sys->tow.speed, sys->tow.turn_rate, sys->ncables,
+            sys->ncables == 1 ? "" : "s", sys->nlinks, sys->nbodies,
+            sys->nbodies == 1 ? "y" : "ies");
+    /* A failed solve may end on forces that overflowed: no "nan". */
+    char res[64];
+    if (isfinite(eq->residual) && isfinite(eq->force_scale))
+        snprintf(res, sizeof res, "%.3g of %.6g N", eq->residual,
+                 eq->force_scale);
+    else
+        snprintf(res, sizeof res, "not finite");
+    fprintf(f, "%s: %s, %d iterations, %ld evaluations, residual %s "
+               "(target %.3g), %.3f ms\n",
+            eq->converged ? "converged" : "NOT CONVERGED",
+            ts_eq_method_name(eq->method), eq->iterations, eq->evaluations,
+            res, eq->tolerance, wall_s * 1e3);
+    if (!eq->converged) {
+        if (r->kind == TS_ANALYSIS_EQUILIBRIUM)
+            cli_print_trust(t);
+        return;
+    }
+    char name[2 * TS_NAME_MAX];
+    if (!quiet) {
+        fprintf(f, "\n%-20s %14s %14s %14s\n", "node", "x [m]", "y [m]",
+                "z [m]");
+        for (int i = 0; i < sys->nnodes; i++) {
+            const double *p = eq->positions + 3 * i;
+            ts_system_node_name(sys, i, name, sizeof name);
+            fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", name, p[0], p[1], p[2]);
+        }
+        fprintf(f, "\n%-20s %6s %14s %14s %14s\n", "cable", "link",
+                "tension [N]", "theta1 [deg]", "theta2 [deg]");
+        for (int l = 0; l < sys->nlinks; l++) {
+            const ts_link *L = &sys->links[l];
+            double t1, t2;
+            ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
+            fprintf(f, "%-20s %6d %14.6f %14.6f %14.6f\n",
+                    sys->cables[L->cable].name, L->index, eq->tensions[l],
+                    t1 * 180 / M_PI, t2 * 180 / M_PI);
+        }
+    }
+    if (sys->nbodies > 0) {
+        fprintf(f, "\n%-20s %14s %14s %14s\n", "body", "x [m]", "y [m]",
+                "z [m] (depth)");
+        for (int b = 0; b < sys->nbodies; b++) {
+            const double *p = eq->positions + 3 * ts_system_body_node(sys, b);
+            fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", sys->bodies[b].name,
+                    p[0], p[1], p[2]);
+        }
+    }
+    cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet);
+    if (eq->ncontrol > 0)
+        fprintf(f, "controllers settled to %.3g (target %.3g)\n",
+                eq->control_residual, eq->tolerance);
+    fprintf(f, "\ntop tension %.6f N (force on the tow point %.6f, %.6f, "
+               "%.6f N)\n",
+            eq->top_tension, eq->tow_force[0], eq->tow_force[1],
+            eq->tow_force[2]);
+    fprintf(f, "solver Jacobian condition %.3g, shape error estimate %.3g "
+               "m\n",
+            eq->condition, eq->shape_error);
+    cli_print_trust(t);
 }
 
-static int eq_main(int argc, char **argv)
+
+/* The extras: --overlay-speeds, --overlay-turn-rates, --overlay. */
+enum { X_SPEEDS, X_TURNS, X_SCENES };
+
+/* Check the overlays and build their requests (before anything runs). */
+static int eq_prepare(cli_run *c)
 {
-    cli_settings s = {0};
-    cli_settings_from_options(&s);
-    const char *json_path = NULL, *csv_path = NULL;
-    const char *overlay_speeds = NULL, *overlay_turns = NULL;
-    const char *overlay_scenes[MAX_OVERLAYS];
-    int noverlay_scenes = 0;
-    cli_plot plot = {0};
-    int quiet = 0;
-    static const struct option longopts[] = {
-        {"json", required_argument, NULL, 'j'},
-        {"csv", required_argument, NULL, 'c'},
-        CLI_SETTINGS_LONGOPTS("method"),
-        {"quiet", no_argument, NULL, 'q'},
-        {"plot", required_argument, NULL, 'p'},
-        {"units", required_argument, NULL, 'u'},
-        {"overlay-speeds", required_argument, NULL, 'V'},
-        {"overlay-turn-rates", required_argument, NULL, 'W'},
-        {"overlay", required_argument, NULL, 'O'},
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
-    optind = 1;
-    opterr = 0;
-    int ch;
-    while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
-        switch (ch) {
-        case 'j': json_path = optarg; break;
-        case 'c': csv_path = optarg; break;
-        case 'q': quiet = 1; break;
-        case 'p': plot.dir = optarg; break;
-        case 'u': plot.units = optarg; break;
-        case 'V': overlay_speeds = optarg; break;
-        case 'W': overlay_turns = optarg; break;
-        case 'O':
-            if (noverlay_scenes == MAX_OVERLAYS) {
-                fprintf(stderr, "towstab: error: equilibrium: --overlay: at most %d "
-                                "scenes\n",
-                        MAX_OVERLAYS);
-                return EXIT_BADINPUT;
-            }
-            overlay_scenes[noverlay_scenes++] = optarg;
-            break;
-        case 'h': usage(stdout); return 0;
-        default: {
-            int r = cli_settings_option(&s, ch, optarg);
-            if (r < 0)
-                return EXIT_BADINPUT;
-            if (r == 0)
-                return cli_option_error("equilibrium", ch, argv[optind - 1]);
-        }
-        }
-    }
-    if (optind != argc - 1) {
-        fprintf(stderr, "towstab: error: equilibrium: expected one scene file\n");
-        usage(stderr);
-        return EXIT_BADINPUT;
-    }
-    char speed_items[MAX_OVERLAYS][ITEM_MAX];
-    char turn_items[MAX_OVERLAYS][ITEM_MAX];
-    int nspeeds = 0, nturns = 0;
-    if ((overlay_speeds || overlay_turns || noverlay_scenes) && !plot.dir) {
+    int given = c->nextra[X_SPEEDS] + c->nextra[X_TURNS] +
+                c->nextra[X_SCENES];
+    if (given && !c->plot.dir) {
         fprintf(stderr, "towstab: error: equilibrium: --overlay-speeds, "
                         "--overlay-turn-rates and --overlay add curves to the "
                         "--plot pictures; add --plot DIR\n");
         return EXIT_BADINPUT;
     }
-    if (overlay_speeds && (nspeeds = split_list("--overlay-speeds",
-                                                overlay_speeds, speed_items,
-                                                MAX_OVERLAYS)) < 0)
-        return EXIT_BADINPUT;
-    if (overlay_turns && (nturns = split_list("--overlay-turn-rates",
-                                              overlay_turns, turn_items,
-                                              MAX_OVERLAYS)) < 0)
-        return EXIT_BADINPUT;
-    if (nspeeds + nturns + noverlay_scenes > MAX_OVERLAYS) {
-        fprintf(stderr, "towstab: error: equilibrium: at most %d overlay curves in "
-                        "all, got %d\n",
-                MAX_OVERLAYS, nspeeds + nturns + noverlay_scenes);
+    if (!c->plot.dir)
+        return 0;
+    eq_state *st = calloc(1, sizeof *st);
+    if (!st) {
+        fprintf(stderr, "towstab: error: equilibrium: out of memory\n");
+        return EXIT_FAILED;
+    }
+    c->state = st;
+    st->ncurves = 1;
+    char items[2][MAX_OVERLAYS][ITEM_MAX];
+    int nitems[2] = {0, 0};
+    static const char *const opt[2] = {"--overlay-speeds",
+                                       "--overlay-turn-rates"};
+    for (int k = 0; k < 2; k++)
+        if (c->nextra[k] &&
+            (nitems[k] = split_list(opt[k], c->extra[k][0], items[k],
+                                    MAX_OVERLAYS)) < 0)
+            return EXIT_BADINPUT;
+    int total = nitems[0] + nitems[1] + c->nextra[X_SCENES];
+    if (total > MAX_OVERLAYS) {
+        fprintf(stderr, "towstab: error: equilibrium: at most %d overlay "
+                        "curves in all, got %d\n",
+                MAX_OVERLAYS, total);
         return EXIT_BADINPUT;
     }
-    int status = cli_plot_begin(&plot, "equilibrium");
-    if (status)
-        return status;
-    ts_units *units;
-    ts_scene *scene;
-    status = cli_open(argv[optind], &units, &scene);
-    if (status)
-        return status;
     ts_err err = {0};
-    ts_equilibrium_opts eo;
-    ts_system *sys = cli_system(scene, units, &s, &eo, &err);
-    if (!sys) {
-        status = cli_report(&err, err.code);
-        cli_close(units, scene);
-        return status;
-    }
-    /* Overlays: every setting is checked before the first solve. */
-    eq_curve curves[MAX_OVERLAYS + 1];
-    memset(curves, 0, sizeof curves);
-    int ncurves = 1;
-    for (int i = 0; i < nspeeds + nturns + noverlay_scenes && !status; i++) {
-        eq_curve *c = &curves[ncurves++];
-        cli_settings o = s;
-        const ts_scene *from = scene;
-        if (i < nspeeds) {
-            o.speed = speed_items[i];
-            snprintf(c->what, sizeof c->what, "--overlay-speeds '%.120s'",
-                     speed_items[i]);
-        } else if (i < nspeeds + nturns) {
-            o.turn_rate = turn_items[i - nspeeds];
-            snprintf(c->what, sizeof c->what, "--overlay-turn-rates '%.120s'",
-                     turn_items[i - nspeeds]);
+    for (int i = 0; i < total; i++) {
+        eq_curve *cv = &st->curves[st->ncurves++];
+        cv->rq = c->rq;
+        cv->rq.simulate.excitation = NULL;
+        const ts_scene *from = c->scene;
+        int rc = TS_OK;
+        if (i < nitems[0] + nitems[1]) {
+            int k = i < nitems[0] ? 0 : 1;
+            const char *item = items[k][k ? i - nitems[0] : i];
+            snprintf(cv->what, sizeof cv->what, "%s '%.120s'", opt[k], item);
+            rc = ts_option_set(ts_option_find(TS_ANALYSIS_EQUILIBRIUM,
+                                              k ? "turn_rate" : "speed"),
+                               &cv->rq, item, cv->what, c->units, &err);
         } else {
-            const char *path = overlay_scenes[i - nspeeds - nturns];
-            snprintf(c->what, sizeof c->what, "--overlay '%.120s'", path);
-            c->scene = ts_scene_load(path, units, &err);
-            if (!c->scene) {
-                ts_err_prefix(&err, "%s: ", c->what);
-                status = cli_report(&err, err.code == TS_EIO ? TS_ESCENE
-                                                             : err.code);
-                break;
+            const char *path = c->extra[X_SCENES][i - nitems[0] - nitems[1]];
+            snprintf(cv->what, sizeof cv->what, "--overlay '%.120s'", path);
+            cv->scene = ts_scene_load(path, c->units, &err);
+            if (!cv->scene) {
+                ts_err_prefix(&err, "%s: ", cv->what);
+                return cli_report(&err, err.code == TS_EIO ? TS_ESCENE
+                                                           : err.code);
             }
-            from = c->scene;
+            from = cv->scene;
         }
-        status = overlay_system(c, from, units, &o);
-    }
-    if (!status) {
-        printf("towstab equilibrium: %s (%s)\n", sys->name, scene->path);
-        ts_equilibrium *eq = NULL;
-        json_t *json = NULL;
-        int rc = cli_equilibrium(sys, &eo, quiet, &eq,
-                                 json_path ? &json : NULL, &err);
-        if (rc)
-            status = cli_report(&err, rc);
-        ts_err werr = {0};
-        if (json && cli_write_json(json, json_path, &werr) != TS_OK)
-            status = cli_report(&werr, werr.code);
-        if (csv_path && eq && eq->converged &&
-            ts_report_equilibrium_csv(sys, eq, csv_path, &werr) != TS_OK)
-            status = cli_report(&werr, werr.code);
-        json_decref(json);
-        curves[0].sys = sys;
-        curves[0].eq = eq;
-        if (plot.dir) {
-            for (int i = 1; i < ncurves; i++) {
-                int st = overlay_solve(&curves[i]);
-                if (st && !status)
-                    status = st;
-            }
-            int st = eq_plot(&plot, curves, ncurves);
-            if (st && !status)
-                status = st;
+        if (rc == TS_OK)
+            rc = ts_analysis_check(from->system, &cv->rq, &err);
+        if (rc != TS_OK) {
+            if (strncmp(err.msg, cv->what, strlen(cv->what)) != 0)
+                ts_err_prefix(&err, "%s: ", cv->what);
+            return cli_report(&err, rc);
         }
-    } else {
-        ts_system_free(sys);
     }
-    for (int i = 0; i < ncurves; i++) {
-        ts_equilibrium_free(curves[i].eq);
-        ts_system_free(curves[i].sys);
-        ts_scene_free(curves[i].scene);
-    }
-    cli_close(units, scene);
-    return status;
+    return 0;
 }
 
-static const char *const eq_keys[] = {"speed", "turn_rate", "method",
-                                      "tolerance", "links", NULL};
-
-static int eq_entry(const cli_ctx *ctx, const ts_scene_analysis *a,
-                    int index, json_t **result)
+/* Solve an overlay's equilibrium and print one line. Returns the exit
+ * status (0 when converged). */
+static int overlay_solve(const cli_run *c, eq_curve *cv)
 {
     ts_err err = {0};
-    cli_settings s = {0};
-    if (cli_settings_from_analysis(&s, a, index, &err))
-        return cli_report(&err, err.code);
-    ts_equilibrium_opts eo;
-    ts_system *sys = cli_system(ctx->scene, ctx->units, &s, &eo, &err);
-    if (!sys)
-        return cli_report(&err, err.code);
-    int status = 0;
-    if (result) {
-        ts_equilibrium *eq = NULL;
-        int rc = cli_equilibrium(sys, &eo, ctx->quiet, &eq, result, &err);
-        status = rc ? cli_report(&err, rc) : 0;
-        ts_equilibrium_free(eq);
+    const ts_system *sys = (cv->scene ? cv->scene : c->scene)->system;
+    int rc = ts_analysis_run(sys, &cv->rq, &cv->res, &err);
+    if (rc != TS_OK) {
+        ts_err_prefix(&err, "%s: ", cv->what);
+        return cli_report(&err, rc);
     }
-    ts_system_free(sys);
-    return status;
+    cv->sys = cv->res->sys;
+    cv->eq = cv->res->eq;
+    printf("overlay %s: converged (%s), top tension %.6f N\n", cv->what,
+           ts_eq_method_name(cv->eq->method), cv->eq->top_tension);
+    return 0;
 }
+
+static void eq_print(const cli_run *c, const ts_result *r)
+{
+    cli_print_equilibrium(r, c->quiet);
+}
+
+static int eq_draw(cli_run *c, const ts_result *r)
+{
+    eq_state *st = c->state;
+    if (!st)
+        return 0;
+    int status = 0;
+    st->curves[0].sys = r->sys;
+    st->curves[0].eq = r->eq && r->eq->converged ? r->eq : NULL;
+    for (int i = 1; i < st->ncurves; i++) {
+        int s = overlay_solve(c, &st->curves[i]);
+        status = status ? status : s;
+    }
+    int s = eq_plot(&c->plot, st->curves, st->ncurves);
+    return status ? status : s;
+}
+
+static void eq_release(cli_run *c)
+{
+    eq_state *st = c->state;
+    for (int i = 1; st && i < st->ncurves; i++) {
+        ts_result_free(st->curves[i].res);
+        ts_scene_free(st->curves[i].scene);
+    }
+    free(st);
+    c->state = NULL;
+}
+
+static const cli_extra eq_extras[] = {
+    {"overlay-speeds", 1, 0, "LIST",
+     "also draw these speeds ('2,4,6 knot'; needs --plot)"},
+    {"overlay-turn-rates", 1, 0, "LIST",
+     "also draw these turn rates ('0.2,0.5 rad/s'; needs --plot)"},
+    {"overlay", 1, 1, "SCENE",
+     "also draw this scene (repeatable); the options above apply to every "
+     "curve"},
+    {NULL, 0, 0, NULL, NULL}};
+
+static const char *const eq_pictures[] = {"side", "top", NULL};
 
 const cli_command cli_cmd_equilibrium = {
     "equilibrium", "steady shape at the scene's speed and turn rate",
-    eq_main, eq_entry, eq_keys};
+    TS_ANALYSIS_EQUILIBRIUM, NULL, eq_prepare, eq_print, eq_draw,
+    eq_release, eq_pictures, eq_extras};

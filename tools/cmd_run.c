@@ -1,25 +1,38 @@
 /* cmd_run.c: `towstab run SCENE`: the scene's analyses, in order. Every
- * entry is checked before the first one runs; only what is listed runs. */
+ * entry is read through its analysis' option table and checked against
+ * the system before the first one runs; only what is listed runs. With
+ * --csv DIR and --plot DIR every analysis writes its own file set,
+ * DIR/<k>_<type>.csv and DIR/<k>_<type>/ (k from 1). */
 #include <getopt.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
-#include "towstab/report.h"
 
-static const cli_command *find(const char *type)
+static void usage(FILE *f)
 {
-    for (int i = 0; cli_commands[i]; i++)
-        if (cli_commands[i]->entry && strcmp(cli_commands[i]->name, type) == 0)
-            return cli_commands[i];
-    return NULL;
+    fprintf(f, "usage: towstab run SCENE [--json FILE] [--csv DIR] "
+               "[--plot DIR] [--units U] [--quiet]\n"
+               "  runs the scene's 'analyses' list in order, each with its "
+               "own settings\n"
+               "  --json FILE   every result as one JSON document ('-' for "
+               "standard output)\n"
+               "  --csv DIR     each analysis' table as DIR/<k>_<type>.csv\n"
+               "  --plot DIR    each analysis' pictures in DIR/<k>_<type>/\n"
+               "  --units U     units of the pictures: si or imperial\n"
+               "  --quiet       print the summaries only\n");
 }
 
 static int run_main(int argc, char **argv)
 {
-    const char *json_path = NULL;
+    const char *json_path = NULL, *csv_dir = NULL, *plot_dir = NULL;
+    const char *plot_units = NULL;
     int quiet = 0;
     static const struct option longopts[] = {
         {"json", required_argument, NULL, 'j'},
+        {"csv", required_argument, NULL, 'c'},
+        {"plot", required_argument, NULL, 'p'},
+        {"units", required_argument, NULL, 'u'},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
@@ -29,17 +42,16 @@ static int run_main(int argc, char **argv)
     while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
         switch (ch) {
         case 'j': json_path = optarg; break;
+        case 'c': csv_dir = optarg; break;
+        case 'p': plot_dir = optarg; break;
+        case 'u': plot_units = optarg; break;
         case 'q': quiet = 1; break;
-        case 'h':
-            printf("usage: towstab run SCENE [--json FILE] [--quiet]\n"
-                   "  runs the scene's 'analyses' list in order\n");
-            return 0;
-        case ':':
-            return cli_option_error("run", ch, argv[optind - 1]);
+        case 'h': usage(stdout); return 0;
+        case ':': return cli_option_error("run", ch, argv[optind - 1]);
         default:
-            fprintf(stderr, "towstab: error: run: unknown option '%s'; only "
-                            "--json and --quiet apply (the scene's analyses "
-                            "carry their own settings)\n",
+            fprintf(stderr, "towstab: error: run: unknown option '%s'; the "
+                            "scene's analyses carry their own settings "
+                            "(towstab run --help)\n",
                     argv[optind - 1]);
             return EXIT_BADINPUT;
         }
@@ -48,68 +60,76 @@ static int run_main(int argc, char **argv)
         fprintf(stderr, "towstab: error: run: expected one scene file\n");
         return EXIT_BADINPUT;
     }
+    const char *given[3] = {json_path, csv_dir, plot_dir};
+    static const char *const opt[3] = {"--json", "--csv", "--plot"};
+    for (int k = 0; k < 3; k++)
+        if (given[k] && !given[k][0]) {
+            fprintf(stderr, "towstab: error: run: %s: expected a %s name, "
+                            "got an empty one\n",
+                    opt[k], k ? "directory" : "file");
+            return EXIT_BADINPUT;
+        }
+    if (plot_units && !plot_dir) {
+        fprintf(stderr, "towstab: error: run: --units sets the units of the "
+                        "--plot pictures; add --plot DIR\n");
+        return EXIT_BADINPUT;
+    }
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);
     if (status)
         return status;
-    ts_err err = {0};
-    if (scene->nanalyses == 0) {
-        fprintf(stderr, "towstab: error: run: %s lists no analyses: nothing "
-                        "to run (add an 'analyses' list)\n",
-                scene->path);
+    cli_scene_runs s;
+    status = cli_scene_prepare("run", scene, units, quiet, csv_dir,
+                               plot_dir, plot_units, &s);
+    if (status) {
         cli_close(units, scene);
-        return EXIT_BADINPUT;
+        return status;
     }
-    char types[256] = "";
-    for (int i = 0; cli_commands[i]; i++)
-        if (cli_commands[i]->entry) {
-            if (types[0])
-                strncat(types, ", ", sizeof types - strlen(types) - 1);
-            strncat(types, cli_commands[i]->name,
-                    sizeof types - strlen(types) - 1);
-        }
-    for (int i = 0; i < scene->nanalyses && !status; i++) {
-        const ts_scene_analysis *a = &scene->analyses[i];
-        const cli_command *c = find(a->type);
-        if (!c) {
-            ts_fail(&err, TS_ESCENE,
-                    "analyses[%d] (line %d): unknown analysis type '%s'; "
-                    "expected one of %s",
-                    i, a->line, a->type, types);
-            status = cli_report(&err, TS_ESCENE);
-        } else if (cli_check_keys(a, c->keys, i, &err)) {
-            status = cli_report(&err, err.code);
-        } else {
-            cli_ctx cctx = {scene, units, quiet};
-            status = c->entry(&cctx, a, i, NULL);
-        }
+    int n = s.n;
+    const char **what = calloc((size_t)n + 1, sizeof *what);
+    const char **paths = calloc((size_t)n + 1, sizeof *paths);
+    if (!what || !paths) {
+        fprintf(stderr, "towstab: error: run: out of memory for %d "
+                        "analyses\n", n);
+        status = EXIT_FAILED;
     }
-    json_t *all = json_object(), *list = json_array();
-    json_object_set_new(all, "scene", json_string(scene->system->name));
-    json_object_set_new(all, "analyses", list);
-    cli_ctx ctx = {scene, units, quiet};
-    for (int i = 0; i < scene->nanalyses && !status; i++) {
-        const ts_scene_analysis *a = &scene->analyses[i];
-        printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
-               scene->nanalyses, a->type, scene->system->name);
-        json_t *j = NULL;
-        status = find(a->type)->entry(&ctx, a, i, &j);
-        if (j) {
-            json_object_set_new(j, "type", json_string(a->type));
-            json_array_append_new(list, j);
-        }
+    for (int i = 0; i < n && !status; i++) {
+        what[i] = "--csv";
+        paths[i] = s.runs[i].csv;
     }
-    /* Results only when every analysis succeeded: a file holding some of
-     * them would look complete. */
-    ts_err werr = {0};
-    if (json_path && status == 0 &&
-        cli_write_json(all, json_path, &werr) != TS_OK)
-        status = cli_report(&werr, werr.code);
-    json_decref(all);
+    if (!status) {
+        what[n] = "--json";
+        paths[n] = json_path;
+        status = cli_check_outputs("run", n + 1, what, paths, NULL, NULL);
+    }
+    if (!status && csv_dir)
+        status = cli_make_dir("run", "--csv", csv_dir);
+    if (!status && plot_dir)
+        status = cli_make_dir("run", "--plot", plot_dir);
+    for (int i = 0; i < n && !status && plot_dir; i++)
+        status = cli_plot_begin(&s.runs[i].plot, "run");
+    if (!status) {
+        json_t *all = NULL;
+        status = cli_scene_execute(scene, &s, &all);
+        /* After a failure the results so far, marked as incomplete with
+         * the failed analysis' message; nothing after bad input. */
+        if (json_path && all && status != EXIT_BADINPUT) {
+            ts_err werr = {0};
+            if (cli_write_json(all, json_path, &werr) != TS_OK) {
+                int st = cli_report(&werr, werr.code);
+                status = status ? status : st;
+            }
+        }
+        json_decref(all);
+    }
+    free(what);
+    free(paths);
+    cli_scene_free(&s);
     cli_close(units, scene);
     return status;
 }
 
 const cli_command cli_cmd_run = {"run", "the analyses the scene lists, in order",
-                                 run_main, NULL, NULL};
+                                 -1, run_main, NULL, NULL, NULL, NULL, NULL,
+                                 NULL};

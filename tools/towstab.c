@@ -2,7 +2,9 @@
  * each prints a table and optionally writes JSON or CSV (SI units).
  * Exit status: 0 success, 1 the analysis failed (no convergence, singular
  * system, output not written), 2 bad input (usage, scene, units, an
- * impossible configuration). The manual is doc/manual.md. */
+ * impossible configuration). Standard output and standard error are
+ * checked when the command ends: a table that could not be written is a
+ * failure too. The manual is doc/manual.md. */
 #include <stdio.h>
 #include <string.h>
 
@@ -13,11 +15,28 @@ extern const cli_command cli_cmd_modes, cli_cmd_response;
 extern const cli_command cli_cmd_simulate;
 extern const cli_command cli_cmd_converge;
 
+/* `towstab options`: every analysis' option table as markdown, the
+ * reference of doc/manual.md. */
+static int options_main(int argc, char **argv)
+{
+    (void)argv;
+    if (argc != 1) {
+        fprintf(stderr, "towstab: error: options: takes no arguments\n");
+        return EXIT_BADINPUT;
+    }
+    cli_options_markdown(stdout);
+    return 0;
+}
+
+static const cli_command cli_cmd_options = {
+    "options", "every option of the analyses, as a markdown reference", -1,
+    options_main, NULL, NULL, NULL, NULL, NULL, NULL};
+
 const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
                                            &cli_cmd_simulate,
                                            &cli_cmd_converge,
-                                           NULL};
+                                           &cli_cmd_options, NULL};
 
 static void usage(FILE *f)
 {
@@ -27,24 +46,28 @@ static void usage(FILE *f)
                 cli_commands[i]->summary);
     fprintf(f, "\n'towstab COMMAND --help' lists a command's options.\n"
                "Plain numbers are SI; strings may carry units ('100 ft').\n"
-               "Exit status: 0 ok, 1 analysis failed, 2 bad input.\n");
+               "Exit status: 0 ok, 1 analysis failed, 2 bad input,\n"
+               "130 or 143 stopped by SIGINT or SIGTERM.\n");
 }
 
 int main(int argc, char **argv)
 {
     if (argc < 2) {
+        fprintf(stderr, "towstab: error: no command given (a COMMAND and a "
+                        "SCENE file)\n");
         usage(stderr);
-        return EXIT_BADINPUT;
+        return cli_finish(EXIT_BADINPUT);
     }
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
         strcmp(argv[1], "help") == 0) {
         usage(stdout);
-        return 0;
+        return cli_finish(0);
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("towstab 0.1.0\n");
-        return 0;
+        return cli_finish(0);
     }
+    cli_signals_install();
     /* `--json -`: keep standard output for the JSON alone. */
     for (int i = 2; i < argc; i++)
         if ((strcmp(argv[i], "--json") == 0 && i + 1 < argc &&
@@ -53,8 +76,11 @@ int main(int argc, char **argv)
             cli_stdout_for_json();
     for (int i = 0; cli_commands[i]; i++)
         if (strcmp(argv[1], cli_commands[i]->name) == 0)
-            return cli_commands[i]->main(argc - 1, argv + 1);
+            return cli_finish(
+                cli_commands[i]->main
+                    ? cli_commands[i]->main(argc - 1, argv + 1)
+                    : cli_main(cli_commands[i], argc - 1, argv + 1));
     fprintf(stderr, "towstab: error: unknown command '%s' (towstab --help)\n",
             argv[1]);
-    return EXIT_BADINPUT;
+    return cli_finish(EXIT_BADINPUT);
 }

@@ -74,6 +74,9 @@ TS_API int ts_compare_fit_sinusoid(const double t[], const double x[],
                                    double *amplitude, double *phase,
                                    ts_err *err);
 
+/* A phase difference in degrees wrapped into (-180, 180]. */
+TS_API double ts_compare_wrap_deg(double deg);
+
 /* Compare the position output `out` of the nonlinear history nl and the
  * linear history li (same sample times) over t >= t_discard. lin is the
  * linear model (its r0 gives the equilibrium value and it yields the

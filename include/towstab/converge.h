@@ -28,21 +28,16 @@
  * accurate. Nothing here prints; report_converge.h writes JSON and CSV.
  *
  * Analyses plug in through ts_conv_analysis (a run callback with its value
- * names). Built in: the equilibrium (ts_conv_equilibrium_analysis), the
- * modes (ts_conv_modes_analysis) and a time-domain simulation under a
- * periodic excitation (ts_conv_simulate_analysis); others provide the same
- * callback.
+ * names). The pipelines of towstab/analysis.h provide it for the
+ * equilibrium, the modes and a time-domain simulation under a periodic
+ * excitation (ts_analysis_sweep); others provide the same callback.
  */
 #ifndef TOWSTAB_CONVERGE_H
 #define TOWSTAB_CONVERGE_H
 
-#include "towstab/eigen.h"
-#include "towstab/equilibrium.h"
 #include "towstab/error.h"
-#include "towstab/excitation.h"
 #include "towstab/health.h"
-#include "towstab/linearize.h"
-#include "towstab/simulate.h"
+#include "towstab/progress.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
@@ -54,8 +49,6 @@ extern "C" {
 #define TS_CONV_MSG_MAX 512
 /* Settings in one sweep. */
 #define TS_CONV_MAX_SETTINGS 64
-/* Links per cable a sweep may ask for (as the scene format). */
-#define TS_CONV_MAX_LINKS 100000
 
 /* The parameter swept. */
 typedef enum {
@@ -146,6 +139,12 @@ typedef struct ts_convergence {
                                 finest rows (wall ~ h^-q); NaN */
     int limiting_value;      /* value with the largest finest-row error of
                                 the reference series, -1 */
+    /* Set by the caller (ts_convergence_alloc leaves them NULL): called by
+     * ts_convergence_sweep before each run with the runs done of the
+     * sweep's ("sweep", unit "runs"); nonzero stops the sweep
+     * (towstab/progress.h). */
+    ts_progress_fn progress;
+    void *progress_data;
 } ts_convergence;
 
 /* A table for `nvalues` values (names, units and scales copied from
@@ -165,7 +164,8 @@ TS_API int ts_convergence_add_series(ts_convergence *c, const char *name,
 /* Add a row to series `series`: the run at `setting` ended with `status`
  * (message: its error text or NULL) after wall_s seconds and
  * `evaluations` evaluations; values[nvalues] and noise[nvalues] (NULL:
- * zero) as the run gave them, trust its health (NULL: trustworthy).
+ * zero) as the run gave them, trust its health (NULL: trustworthy; a
+ * failed run is made untrustworthy with its message as the reason).
  * TS_EINVAL for a setting outside the parameter's range or already in the
  * series, TS_ENOMEM when the table is full or memory runs out. */
 TS_API int ts_convergence_add_row(ts_convergence *c, int series,
@@ -201,7 +201,10 @@ TS_API void ts_conv_analysis_free(ts_conv_analysis *an);
  * ts_conv_check_settings) into series `series` of c, timing each run
  * (CLOCK_MONOTONIC). c must have been allocated with an's values. Returns
  * TS_OK when every run was recorded (failed runs included), TS_EINVAL
- * (bad settings, mismatched values) or TS_ENOMEM. */
+ * (bad settings, mismatched values) or TS_ENOMEM; TS_ECANCEL when
+ * c->progress asked to stop before a run, or a run returned TS_ECANCEL
+ * (its own progress callback asked: that run is recorded with the
+ * status), the rows so far kept. */
 TS_API int ts_convergence_sweep(ts_convergence *c, int series,
                                 const ts_conv_analysis *an,
                                 const double settings[], int n, ts_err *err);
@@ -217,7 +220,7 @@ TS_API int ts_convergence_estimate(ts_convergence *c, double target,
 TS_API void ts_convergence_sorted_rows(const ts_convergence *c, int idx[]);
 
 /* Check settings[n] for parameter p: 1 <= n <= TS_CONV_MAX_SETTINGS,
- * finite, distinct; links whole numbers in [1, TS_CONV_MAX_LINKS];
+ * finite, distinct; links whole numbers in [1, TS_MAX_LINKS];
  * tolerances in (0, 1); steps in (0, 0.1]. `what` names the option in
  * the message ("--links"). */
 TS_API int ts_conv_check_settings(ts_conv_param p, const double settings[],
@@ -246,99 +249,15 @@ TS_API double ts_conv_extrapolate(double h1, double f1, double h2, double f2,
 TS_API const char *ts_conv_param_name(ts_conv_param p);
 TS_API const char *ts_conv_ref_name(ts_conv_ref k);
 
-/* --- Built-in analyses ------------------------------------------------ */
-
-/* The equilibrium of `sys` (copied: the analysis keeps its own) solved
- * with options eo (NULL: defaults). Values: x, y, z of every body
- * ("<body>.x", m, scale the total cable length) or, without bodies, of
- * every free cable end ("<cable>.end.x"), and "top_tension" (N, relative
- * to itself). Noise: 10 max(residual, 16 eps) times the length or the
- * largest force. Parameters: links (every cable gets N equal links;
- * refused for cables with link_lengths) and tolerance (the equilibrium's
- * residual target). Health: ts_health_equilibrium. Returns TS_OK,
- * TS_EINVAL or TS_ENOMEM. */
-TS_API int ts_conv_equilibrium_analysis(const ts_system *sys,
-                                        const ts_equilibrium_opts *eo,
-                                        ts_conv_analysis *an, ts_err *err);
-
 /* Modes a modes sweep follows are oscillatory with a damping ratio below
  * this: a pair near critical damping is two real modes about to meet, and
  * its frequency (the square root of a small discriminant) is not a value
  * that converges; such pairs come and go as the resolution changes. */
 #define TS_CONV_MODE_DAMPING_MAX 0.95
 
-/* The `nmodes` lowest oscillatory modes (Im lambda > 0 and damping ratio
- * below TS_CONV_MODE_DAMPING_MAX, by frequency) of the linearization
- * about the equilibrium: "mode<k>.freq_hz" (Hz,
- * relative to itself) and "mode<k>.damping_ratio" (scale 1: absolute).
- * Options: eo for the equilibrium, lo for the linearization (its
- * rel_step is what a step sweep sets), eig for the eigen solver (NULL:
- * all modes by LAPACK below 1200 states, else the 2 nmodes + 10 lowest by
- * ARPACK). Noise: each mode's error_bound (as a frequency and as a
- * damping ratio) for links and tolerance sweeps, 64 eps |value| for step
- * sweeps (where that bound is what is swept). Parameters: links,
- * tolerance (the equilibrium's), step. Health: the equilibrium's, kinks,
- * and the damping of the reported modes (ts_health_modes; its notes are
- * kept). A run with fewer oscillatory modes than nmodes has NaN values
- * for the missing ones. Returns TS_OK, TS_EINVAL (nmodes < 1) or
- * TS_ENOMEM. */
-TS_API int ts_conv_modes_analysis(const ts_system *sys,
-                                  const ts_equilibrium_opts *eo,
-                                  const ts_linearize_opts *lo,
-                                  const ts_eigen_opts *eig, int nmodes,
-                                  ts_conv_analysis *an, ts_err *err);
-
-/* Run statistics a simulate run judges (ts_conv_simulate_analysis):
- * more than TS_CONV_SIM_REJECT_NOTE rejected trial steps per accepted step
- * is a note (the tolerance is near what the method can deliver, or the
- * scene is stiff for it); any re-chart is a note (each restarts the
- * integrator); a mean accepted step below TS_CONV_SIM_STEP_FAIL t_end
- * makes the run untrustworthy (the steps approach the resolution of time
- * itself: rounding of t + h, not the tolerance, sets the error). */
-#define TS_CONV_SIM_REJECT_NOTE TS_HEALTH_SIM_REJECT_NOTE
-#define TS_CONV_SIM_STEP_FAIL TS_HEALTH_SIM_STEP_FAIL
-
-/* A nonlinear simulation (ts_simulate) under a single periodic tow-point
- * excitation ex (a sine or a slider crank; used, not owned: it must
- * outlive the analysis), from the equilibrium of sys (solved with eo,
- * NULL: defaults) with the integrator options so (its integrator, t_end,
- * dt_sample, tolerances; NULL: defaults). Over the window t >= transient
- * (s, in [0, t_end)) the output `output` (a position name as
- * ts_response_output_find takes it, "sphere.z"; resolved again for every
- * link count) and the tow-point motion along the excitation axis are fitted
- * by c + a sin(w t) + b cos(w t) (ts_compare_fit_sinusoid). Values:
- *   "<output>.amplitude_ratio"  (1, relative to itself): output amplitude
- *       over the fitted excitation amplitude;
- *   "<output>.mean_offset"  (m, scale the excitation amplitude): c less
- *       the output's equilibrium value;
- *   "<output>.phase_deg"  (deg, scale 360): output phase less the
- *       excitation's, wrapped to (-180, 180].
- * Parameters: tolerance (the integrator's rel_tol = setting, abs_tol
- * scaled with it: abs_tol = setting so->abs_tol / so->rel_tol) and links
- * (N per cable). Noise: in a tolerance sweep the equilibrium's residual
- * (10 max(residual, 16 eps) times the cable length for the mean offset)
- * plus rounding 16 eps sqrt(steps) times each value's scale; in a links
- * sweep, in addition, the integrator's error 10 rel_tol times each value's
- * scale (|ratio|, the cable length, 360 deg). Evaluations: the
- * equilibrium's plus the integrator's (Jacobians included). Health: the
- * equilibrium's (ts_health_equilibrium, prefixed "equilibrium: "), and the
- * run statistics against TS_CONV_SIM_REJECT_NOTE and TS_CONV_SIM_STEP_FAIL.
- * TS_EINVAL (before any run) when ex has no single periodic tow excitation,
- * the output is not a position of sys, the window [transient, t_end] is
- * shorter than one period or has fewer than
- * TS_COMPARE_MIN_SAMPLES_PER_PERIOD samples per period, or the options are
- * bad; else TS_OK or TS_ENOMEM. A run whose simulation fails becomes a
- * failed row (its status and message). */
-TS_API int ts_conv_simulate_analysis(const ts_system *sys,
-                                     const ts_equilibrium_opts *eo,
-                                     const ts_sim_opts *so,
-                                     const ts_excitation *ex,
-                                     const char *output, double transient,
-                                     ts_conv_analysis *an, ts_err *err);
-
 /* A copy of sys with every cable cut into `links` equal links, built.
  * TS_EINVAL for a cable with link_lengths or links outside
- * [1, TS_CONV_MAX_LINKS]. NULL on failure. */
+ * [1, TS_MAX_LINKS]. NULL on failure. */
 TS_API ts_system *ts_conv_system_with_links(const ts_system *sys, int links,
                                             ts_err *err);
 

@@ -1,5 +1,5 @@
 /* towstab/equilibrium.h: steady configurations, straight tow and steady turn
- * (MODEL.md section 5; Kamman & Nguyen eq. 55).
+ * (doc/model.md section 5; Kamman & Nguyen eq. 55).
  *
  * An equilibrium is a state with q' = 0 and q''(q) = 0 for the kernel's
  * frame (speed V, turn rate Omega). Convergence is judged on forces: the
@@ -69,6 +69,19 @@ typedef struct ts_equilibrium {
     double shape_error;   /* node position error it implies, m: Newton
                              |J^-1 q''| times the cable length, shooting
                              |J^-1| |mismatch|; NaN if none */
+    int nvehicles;
+    double *attitudes;    /* [9 nvehicles] each vehicle's attitude, body to
+                             M, row-major (ts_kernel_vehicle_body order) */
+    int ncontrol;         /* controller states of the kernel solved with */
+    double *controls;     /* [ncontrol] their values */
+    double control_residual; /* the controllers' settling: the largest
+                             |integrator rate| (a loop's error) over its
+                             scale (the cable length for depth, 1 rad for
+                             angles) and |actuator rate| times its time
+                             constant (rad); converged needs it <= tol
+                             too; 0 without controllers */
+    ts_vehicle_result *vehicles; /* [nvehicles] attitude, flow angles,
+                             loads and deflections of each vehicle */
 } ts_equilibrium;
 
 TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);
@@ -86,6 +99,13 @@ TS_API void ts_equilibrium_free(ts_equilibrium *eq);
  * eq->converged = 0; eq then holds the best iterate, for diagnosis only. */
 TS_API int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                                 ts_equilibrium *eq, ts_err *err);
+
+/* Set the vehicles' attitudes (at rest in M) and the controller states of
+ * equilibrium eq in state y[nstate] of kernel k (any kernel of eq's system
+ * whose controller layout matches). TS_OK, or TS_EINVAL when the layouts
+ * differ. */
+TS_API int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
+                                     double y[], ts_err *err);
 
 /* Name of a method ("auto", "shooting", "newton"). */
 TS_API const char *ts_eq_method_name(ts_eq_method m);

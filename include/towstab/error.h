@@ -33,7 +33,8 @@ enum {
     TS_ELAPACK = -7,     /* LAPACK or ARPACK reported a failure */
     TS_ESINGULAR = -8,   /* a singular system (zero mass, zero tension, ...) */
     TS_EDOMAIN = -9,     /* a request the model cannot represent */
-    TS_EINTEGRATOR = -10 /* the time integrator failed */
+    TS_EINTEGRATOR = -10, /* the time integrator failed */
+    TS_ECANCEL = -11     /* stopped on request (towstab/progress.h) */
 };
 
 #define TS_ERR_MSG_MAX 1024
@@ -54,6 +55,17 @@ TS_API void ts_err_clear(ts_err *err);
 TS_API int ts_fail(ts_err *err, int code, const char *fmt, ...)
 #ifdef __GNUC__
     __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Record TS_ENOMEM for an allocation of `bytes` bytes: the message is the
+ * printf text (where, and what was being allocated), then the size
+ * ("(2.9 GB)") and, when `hint` is not NULL, "; " and the hint (the
+ * option or setting that reduces it). Returns TS_ENOMEM. */
+TS_API int ts_fail_nomem(ts_err *err, double bytes, const char *hint,
+                         const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 4, 5)))
 #endif
     ;
 

@@ -1,5 +1,5 @@
 /* towstab/excitation.h: prescribed motions as functions of time, for the
- * simulator (doc/simulate.md; MODEL.md sections 1 and 8).
+ * simulator (doc/simulate.md; doc/model.md sections 1 and 8).
  *
  * An excitation is a list of signals. A signal drives one axis:
  *  - a tow-point axis (surge x, sway y, heave z of the mean ship frame M):
@@ -10,12 +10,12 @@
  *  - a manoeuvre axis (the speed V of M, or its turn rate Omega): the
  *    signal is the change of V (m/s) or Omega (rad/s) from the base frame,
  *    and the frame of time t carries the matching speed_rate / turn_accel
- *    (MODEL.md section 1). The current, fixed in inertial space, rotates in
- *    M by the heading change psi(t) = integral of Omega.
+ *    (doc/model.md sections 1 and 10). The current, fixed in inertial
+ *    space, rotates in M by the heading change psi(t) = integral of Omega.
  *
  * Signal shapes (t in s; A the amplitude; w = 2 pi f):
  *  - sine:   A sin(w t + phase), for all t >= 0;
- *  - crank:  slider crank of radius A and rod l (MODEL.md section 8),
+ *  - crank:  slider crank of radius A and rod l (doc/model.md section 8),
  *            A cos(th) + l (1 - sqrt(1 - (A/l)^2 sin^2 th)), th = w t + phase;
  *            a sine or crank starts smoothly: times S(t / ramp) (S below),
  *            full from t = ramp on (default two periods; ramp = 0 starts
@@ -28,7 +28,12 @@
  *            over `rise` (the rate itself follows S), so that the velocity
  *            and acceleration are continuous and the final value is exactly A;
  *  - series: a natural cubic spline through samples (t_i, x_i) (tow axes
- *            only), defined on [t_0, t_last] with t_0 <= 0.
+ *            only), defined on [t_0, t_last] with t_0 <= 0;
+ *  - sum:    a sum of sinusoids shared by the tow axes, the tow point's
+ *            motion in an irregular sea (towstab/seastate.h):
+ *            x_j = r(t) sum_k Re(c_jk e^(i w_k t)), faded in by
+ *            r = S(t / rise) (r = 1 without a rise); one signal per axis
+ *            driven, the components evaluated once for all of them.
  * A rigid-link cable cannot follow a tow point whose velocity jumps (it
  * would need an impulsive tension), hence the rounded steps and ramps:
  * `rise` must be > 0 (default TS_SIGNAL_RISE).
@@ -60,7 +65,8 @@ typedef enum {
     TS_SIGNAL_CRANK = 1,
     TS_SIGNAL_STEP = 2,
     TS_SIGNAL_RAMP = 3,
-    TS_SIGNAL_SERIES = 4
+    TS_SIGNAL_SERIES = 4,
+    TS_SIGNAL_SUM = 5
 } ts_signal_type;
 
 typedef enum {
@@ -76,13 +82,15 @@ typedef struct ts_signal {
     ts_signal_type type;
     ts_axis axis;
     double amplitude;  /* m on tow axes, m/s on speed, rad/s on turn rate;
-                          the crank radius for a crank */
-    double frequency;  /* Hz, > 0 (sine, crank) */
+                          the crank radius for a crank; a sum's rms
+                          (sqrt(sum_k |c_jk|^2 / 2), before the fade-in) */
+    double frequency;  /* Hz, > 0 (sine, crank); a sum's highest |w_k| /
+                          2 pi */
     double phase;      /* rad (sine, crank) */
     double rod;        /* m, > amplitude (crank) */
     double start;      /* s, >= 0 (step, ramp) */
     double duration;   /* s, > 0 (ramp) */
-    double rise;       /* s, > 0 (step, ramp) */
+    double rise;       /* s, > 0 (step, ramp); >= 0 fade-in (sum) */
     double ramp;       /* s, >= 0 (sine, crank): the signal starts
                           smoothly, times S(t / ramp) (the quintic of the
                           steps), reaching full amplitude at t = ramp; 0
@@ -99,6 +107,11 @@ typedef struct ts_excitation ts_excitation;
 TS_API ts_excitation *ts_excitation_alloc(ts_err *err);
 TS_API void ts_excitation_free(ts_excitation *ex);
 
+/* A deep copy of ex (NULL: an empty excitation), to add signals to
+ * without changing ex. NULL on failure (TS_ENOMEM). */
+TS_API ts_excitation *ts_excitation_copy(const ts_excitation *ex,
+                                         ts_err *err);
+
 /* Add a copy of signal s after checking it (TS_EINVAL naming the field:
  * frequency <= 0, negative start, rise <= 0, a crank rod not longer than
  * its radius, a series or sine on a manoeuvre axis, a second absolute
@@ -111,6 +124,20 @@ TS_API int ts_excitation_add(ts_excitation *ex, const ts_signal *s,
 TS_API int ts_excitation_add_series(ts_excitation *ex, ts_axis axis, int n,
                                     const double t[], const double x[],
                                     ts_err *err);
+
+/* Add a sum of n >= 1 sinusoids driving the tow axes, with shared
+ * components: axis j (0 surge, 1 sway, 2 heave) moves by
+ *   x_j(t) = r(t) sum_k (re[3 k + j] cos(w_k t) - im[3 k + j] sin(w_k t)),
+ * w_k = omega[k] (rad/s, finite, any sign), r the quintic fade-in over
+ * [0, rise] (rise >= 0 s; 0: none, the motion starts at full amplitude).
+ * Adds one TS_SIGNAL_SUM signal for each axis with a nonzero coefficient
+ * (TS_EINVAL when there is none, or for a non-finite value); the
+ * components are copied and evaluated once per time for all the axes
+ * (n sines and cosines). */
+TS_API int ts_excitation_add_sum(ts_excitation *ex, int n,
+                                 const double omega[], const double re[],
+                                 const double im[], double rise,
+                                 ts_err *err);
 
 /* Read a series from a CSV file: two columns, time (s) and displacement
  * (m); lines starting with '#' and a first line that is not numeric (a
@@ -164,16 +191,29 @@ TS_API double ts_excitation_heading(const ts_excitation *ex,
                                     const ts_frame *base, double t);
 
 /* Times in (0, t_end) where a signal is not smooth (ends of steps, ramp
- * corners, the end of a smooth start), sorted, without duplicates; writes
- * at most `max` of them to out and returns how many there are. */
+ * corners, the end of a smooth start or of a sum's fade-in), sorted,
+ * without duplicates; writes at most `max` of them to out and returns how
+ * many there are. */
 TS_API int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
                                      double out[], int max);
 
 /* The shortest time scale of the tow-point signals (s): 1/(2 pi f) for a
  * sine, 1/(4 pi f) for a crank (its second harmonic), the rise of steps and
- * ramps, the smallest sample spacing of a series; INFINITY without tow
- * signals. The linear simulator sizes its steps on it. */
+ * ramps, the smallest sample spacing of a series, 1/max |w_k| for a sum
+ * (and its fade-in time, if shorter); INFINITY without tow signals. The linear simulator sizes its steps on it. */
 TS_API double ts_excitation_time_scale(const ts_excitation *ex);
+
+/* Bounds of the motion under ex from the frame `base` (ex may be NULL:
+ * none): |speed| and |turn rate| at most their base values plus every
+ * manoeuvre's change; the tow point's velocity and acceleration at most
+ * the sum over its signals of each one's largest (a sine: A w and A w^2; a
+ * crank: those times 1 + A / sqrt(l^2 - A^2) and its square; a step:
+ * 1.875 A / rise and 5.78 A / rise^2, the quintic's largest slopes; a
+ * ramp: A / duration and 1.875 A / (duration rise); a series: its largest
+ * sample differences; a sum of sinusoids: the sums of |c_k| w_k and
+ * |c_k| w_k^2, with its fade-in's slopes). For ts_system_check_loads. */
+TS_API void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
+                                ts_motion_bound *m);
 
 /* Check that every series covers [0, t_end] (TS_EINVAL otherwise). */
 TS_API int ts_excitation_check_span(const ts_excitation *ex, double t_end,
@@ -184,8 +224,11 @@ TS_API int ts_excitation_check_span(const ts_excitation *ex, double t_end,
  * else 0. */
 TS_API int ts_excitation_periodic(const ts_excitation *ex, int *index);
 
+/* Number of components of sum signal i (0 for other signals). */
+TS_API int ts_excitation_sum_components(const ts_excitation *ex, int i);
+
 /* Names: "tow.surge", "tow.sway", "tow.heave", "speed", "turn_rate";
- * "sine", "crank", "step", "ramp", "csv". */
+ * "sine", "crank", "step", "ramp", "csv", "sum". */
 TS_API const char *ts_axis_name(ts_axis a);
 TS_API const char *ts_signal_type_name(ts_signal_type t);
 

@@ -1,16 +1,28 @@
 /* towstab/kernel.h: the one dynamics kernel, y' = f(y, u), of the rigid-link
- * tree (MODEL.md sections 1-4; Kamman & Nguyen 1990, eqs. 4-11, 20-22, 43-44).
+ * tree (doc/model.md sections 1-4, 7 and 8; Kamman & Nguyen 1990, eqs. 4-11,
+ * 12-22, 43-44).
  *
- * State y[2 nq]: y[0..nq) the generalised coordinates, y[nq..2nq) their
- * rates. A rigid link has two, its angles theta1, theta2 in its chart
- * (rad); an elastic link (EA > 0, MODEL.md section 7) three, its angles
- * and its strain e (length l (1 + e)). Link l's coordinates start at
- * ts_kernel_link_offset(k, l); with rigid links only, nq = 2 nlinks and link
- * l is at 2l. An elastic link's tension is EA e + Cv l e', never
- * compressive (slack: 0); keeping the strain itself as a coordinate keeps
- * that tension exact however stiff the link. Input u[TS_NINPUT]: the tow-point displacement (m),
+ * State y[2 nq + nc]: y[0..nq) the generalised coordinates, y[nq..2nq)
+ * their rates, y[2nq..2nq+nc) the controllers' states. A rigid link has
+ * two coordinates, its angles theta1, theta2 in its chart (rad); an
+ * elastic link (EA > 0, doc/model.md section 7) three, its angles and its
+ * strain e (length l (1 + e)); a vehicle (towstab/vehicle.h) three, its
+ * 1-2-3 attitude angles in its chart, after all the links. Link l's
+ * coordinates start at ts_kernel_link_offset(k, l), vehicle v's at
+ * ts_kernel_vehicle_offset(k, v); with rigid links only and no vehicle,
+ * nq = 2 nlinks, link l is at 2l and nc = 0. An elastic link's tension is
+ * EA e + Cv l e', never compressive (slack: 0); keeping the strain itself
+ * as a coordinate keeps that tension exact however stiff the link. The
+ * controller states are the integrals of the loops' errors (loops with an
+ * integral gain) and the deflections of control surfaces with an actuator
+ * (time constant > 0), vehicle by vehicle.
+ *
+ * Input u[ninput]: u[0..TS_NINPUT) the tow-point displacement (m),
  * velocity (m/s) and acceleration (m/s^2) relative to its nominal position
- * in the mean ship frame M, each as x, y, z. The motion of M (speed V, turn
+ * in the mean ship frame M, each as x, y, z; then, vehicle by vehicle, a
+ * deflection command (rad) per control surface, added to its open-loop
+ * deflection, and an input per controller loop (rad), added to the loop's
+ * output (ts_kernel_input_name). The motion of M (speed V, turn
  * rate Omega and their rates) and the current are set with
  * ts_kernel_set_frame() (default: the system's steady tow, no current
  * rotation).
@@ -29,6 +41,8 @@
  */
 #ifndef TOWSTAB_KERNEL_H
 #define TOWSTAB_KERNEL_H
+
+#include <stddef.h>
 
 #include "towstab/error.h"
 #include "towstab/system.h"
@@ -71,8 +85,17 @@ TS_API ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err);
 
 TS_API const ts_system *ts_kernel_system(const ts_kernel *k);
 TS_API int ts_kernel_nq(const ts_kernel *k);      /* coordinates */
-TS_API int ts_kernel_nstate(const ts_kernel *k);  /* 2 nq */
-TS_API int ts_kernel_ninput(const ts_kernel *k);  /* TS_NINPUT */
+TS_API int ts_kernel_nstate(const ts_kernel *k);  /* 2 nq + nc */
+TS_API int ts_kernel_ncontrol(const ts_kernel *k);/* nc */
+TS_API int ts_kernel_ninput(const ts_kernel *k);  /* TS_NINPUT + the
+                                                     vehicles' inputs */
+/* Name of input j into buf: "tow.surge" ... (ts_input_name order), then
+ * "<vehicle>.<surface>" and "<vehicle>.<loop>". Returns buf, or NULL
+ * when j is out of range. */
+TS_API const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
+                                        size_t size);
+/* Index of the input called `name`, -1 if none. */
+TS_API int ts_kernel_input_find(const ts_kernel *k, const char *name);
 /* Offset of link `link`'s coordinates in q (2 for rigid, 3 for elastic). */
 TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 
@@ -126,6 +149,40 @@ TS_API double ts_kernel_unbalanced(const ts_kernel *k, double *scale);
 TS_API double ts_kernel_kinetic_energy(const ts_kernel *k);
 TS_API double ts_kernel_potential_energy(const ts_kernel *k);
 
+/* What controller state i (0 <= i < nc, at y[2 nq + i]) is: the
+ * integral of loop `index`'s error (rad s or m s) or the deflection of
+ * control surface `index` (its actuator, rad), of vehicle `vehicle`. */
+typedef struct ts_control_state {
+    int vehicle;      /* vehicle index (ts_kernel_vehicle_body) */
+    int actuator;     /* 1: an actuator, 0: an integrator */
+    int index;        /* component (actuator) or loop (integrator) */
+} ts_control_state;
+TS_API void ts_kernel_control_state(const ts_kernel *k, int i,
+                                    ts_control_state *cs);
+
+/* Vehicles, in body order: their number, body index and the offset of
+ * their three angles in q. */
+TS_API int ts_kernel_nvehicles(const ts_kernel *k);
+TS_API int ts_kernel_vehicle_body(const ts_kernel *k, int v);
+TS_API int ts_kernel_vehicle_offset(const ts_kernel *k, int v);
+
+/* Set vehicle v's angles and rates in y for attitude R[9] (body to M,
+ * row-major) and angular velocity omega[3] relative to M in body axes
+ * (NULL: zero). A vehicle whose |cos theta2| would fall below threshold
+ * is first moved to a chart centred on R. Returns 1 when re-charted. */
+TS_API int ts_kernel_set_vehicle(ts_kernel *k, int v, const double R[9],
+                                 const double omega[3], double threshold,
+                                 double y[]);
+/* Read them back from y (omega may be NULL). */
+TS_API void ts_kernel_get_vehicle(const ts_kernel *k, int v, const double y[],
+                                  double R[9], double omega[3]);
+
+/* After an evaluation: vehicle v's attitude, flow angles, position, loads
+ * (per component, the Munk moment, the joint force), deflections and
+ * loop errors and outputs (towstab/vehicle.h). */
+TS_API void ts_kernel_vehicle_result(const ts_kernel *k, int v,
+                                     ts_vehicle_result *r);
+
 /* Unit direction of link `link` for angles (t1, t2) in its chart. */
 TS_API void ts_kernel_direction(const ts_kernel *k, int link, double t1,
                                 double t2, double n[3]);
@@ -155,8 +212,10 @@ TS_API int ts_kernel_set_directions(ts_kernel *k, const double n[],
                                     const double ndot[], double threshold,
                                     double y[]);
 
-/* Re-chart every rigid link of state y with |cos theta2| < threshold and
- * rewrite its angles and rates in place. Returns the number re-charted. */
+/* Re-chart every link and vehicle of state y with |cos theta2| <
+ * threshold and rewrite its angles and rates in place (a vehicle's chart
+ * is centred on its attitude: its angles become 0). Returns the number
+ * re-charted. */
 TS_API int ts_kernel_rechart(ts_kernel *k, double y[], double threshold);
 
 /* Restore the standard chart (R = I) on every link whose direction allows

@@ -1,5 +1,5 @@
 /* towstab/linearize.h: the linear model z' = A z + B v about a state
- * (MODEL.md section 6; Kamman & Nguyen eqs. 56-65; doc/linear.md).
+ * (doc/model.md section 6; Kamman & Nguyen eqs. 56-65; doc/linear.md).
  *
  * Two forms of the same model (ts_linearize_opts.model):
  *  - the sparse model (desc): the kernel's node equations before
@@ -60,27 +60,31 @@ typedef struct ts_descriptor ts_descriptor;
 /* Which linear models ts_linearize forms. */
 typedef enum {
     TS_LIN_AUTO = 0,   /* the sparse model always; the dense A and B too
-                          when nstate < dense_max_states */
+                          when nstate < dense_max_states. A system with a
+                          vehicle: the dense model only */
     TS_LIN_DENSE = 1,  /* the dense A and B only */
-    TS_LIN_SPARSE = 2, /* the sparse model only */
-    TS_LIN_BOTH = 3    /* both, at any size */
+    TS_LIN_SPARSE = 2, /* the sparse model only (refused with a vehicle) */
+    TS_LIN_BOTH = 3    /* the dense model at any size, and the sparse one
+                          (except with a vehicle) */
 } ts_lin_model;
 
 typedef struct ts_linear {
-    int nstate;        /* n = 2 nq */
-    int nq;            /* generalised coordinates, 2 nlinks */
-    int ninput;        /* TS_NINPUT */
+    int nstate;        /* n = 2 nq + nc (nc controller states) */
+    int nq;            /* generalised coordinates (ts_kernel_nq) */
+    int ninput;        /* ts_kernel_ninput: TS_NINPUT tow inputs, then the
+                          vehicles' surfaces and loops */
     int nlinks, nnodes;
-    double *A;         /* [n * n] column-major; rows 0..nq-1 are [0 I];
+    double *A;         /* [n * n] column-major; rows 0..nq-1 are [0 I 0];
                           NULL unless the dense model was formed */
     double *B;         /* [n * ninput] column-major; rows 0..nq-1 zero;
                           NULL with A */
     ts_descriptor *desc; /* the sparse model E x' = F x + G u of the node
                           equations (O(nlinks) memory), NULL unless
-                          formed; the eigen, response and stiff
-                          simulation solvers use it at any size */
+                          formed (never with vehicles); the eigen,
+                          response and stiff simulation solvers use it at
+                          any size */
     double *y0;        /* [n] state linearized about (kernel's charts) */
-    double u0[TS_NINPUT]; /* input linearized about */
+    double *u0;        /* [ninput] input linearized about */
     double *f0;        /* [n] f(y0, u0): zero at an exact equilibrium */
     double *r0;        /* [3 nnodes] node positions at y0, m */
     double *t0;        /* [nlinks] link tensions at y0, N */
@@ -92,14 +96,23 @@ typedef struct ts_linear {
                           (ts_kernel_link_offset) */
     char *elastic;     /* [nlinks] 1: the link's third coordinate is its
                           strain e */
+    int nvehicles;
+    int *up_qoff;      /* [nlinks] for a link starting at a point P of a
+                          vehicle, the offset of that vehicle's angles in
+                          q; -1 otherwise; NULL without vehicles */
+    double *up_map;    /* [12 nlinks] for such a link, R E of its vehicle
+                          at y0 (M frame, 9 row-major: the small rotation
+                          of the body per angle change) and rho_P = R (P -
+                          A) (3, m); NULL without vehicles */
     double *Ty;        /* [nlinks * n] dT/dy (N/rad, N s/rad) column-major,
                           or NULL unless opts.tensions */
     double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
                           or NULL unless opts.tensions */
-    double *Aerr;      /* [nq * n] estimated error of the lower block of A,
-                          (A(2h) - A(h)) / 3, column-major with leading
-                          dimension nq (A(h) - Aerr is the Richardson
-                          value); NULL unless estimate_error */
+    double *Aerr;      /* [(n - nq) * n] estimated error of the lower block
+                          of A (rows nq..n-1), (A(2h) - A(h)) / 3,
+                          column-major with leading dimension n - nq
+                          (A(h) - Aerr is the Richardson value); NULL
+                          unless estimate_error */
     double *h;         /* [n + ninput] the step used for each column */
     double trunc_err;  /* max |A(h) - A(2h)| / 3 over the lower block */
     double trunc_norm; /* ||A(h) - A(2h)||_F / 3 over the lower block: the
@@ -112,7 +125,7 @@ typedef struct ts_linear {
     int kinks;         /* nodes (tow point included) within 2 steps of the
                           water surface z = 0 while the fluid has density:
                           f is not smooth there and the central difference
-                          is the mean of one-sided derivatives (MODEL.md
+                          is the mean of one-sided derivatives (doc/model.md
                           section 6) */
     int kink_tow;      /* 1 when the tow point is one of them: only B (and
                           Tu) are affected, not A */
@@ -166,8 +179,9 @@ TS_API int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
 /* Linearize about a solved equilibrium: refuses one that did not converge
  * (TS_ECONV, naming its residual and target); otherwise re-charts k from
  * eq->directions (ts_kernel_set_directions with TS_CHART_RECHART, so any
- * kernel of the system will do) and calls ts_linearize with zero rates
- * and zero input. */
+ * kernel of the system will do), sets the vehicles' attitudes and the
+ * controller states (ts_equilibrium_set_bodies) and calls ts_linearize
+ * with zero rates and zero input. */
 TS_API int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
                                     const ts_linearize_opts *opts,
                                     ts_linear *lin, ts_err *err);
@@ -175,8 +189,9 @@ TS_API int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
 /* Node displacements dr[3 nnodes] (m, M frame; node 0, the tow point, is 0)
  * produced by coordinate perturbations dq[nq] (angles, rad; strains) about
  * lin->y0, to first order: dr_k = dr_p + l_k (dn/dt1 dq1 + dn/dt2 dq2)
- * (+ l n de for an elastic link; l_k its length at y0) down the tree.
- * Exact geometry, O(nlinks). */
+ * (+ l n de for an elastic link; l_k its length at y0) down the tree; a
+ * cable starting at a point P of a vehicle starts from dr_A + (R E
+ * dtheta) x rho_P. Exact geometry, O(nlinks). */
 TS_API void ts_linear_node_displacements(const ts_system *sys,
                                          const ts_linear *lin,
                                          const double dq[], double dr[]);

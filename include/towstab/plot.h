@@ -182,10 +182,10 @@ TS_API int ts_plot_check(ts_err *err);
  * Works without PLplot. */
 TS_API int ts_plot_prepare_dir(const char *dir, ts_err *err);
 
-/* `si_value` of quantity q in the unit system u, and that unit's name
+/* `value_si` of quantity q in the unit system u, and that unit's name
  * ("m", "ft", "deg", "-"). Work without PLplot. */
 TS_API double ts_plot_convert(ts_plot_quantity q, ts_plot_units u,
-                              double si_value);
+                              double value_si);
 TS_API const char *ts_plot_unit(ts_plot_quantity q, ts_plot_units u);
 
 /* Cable shapes, overlaid: nshapes >= 1 shapes in one view (memo Figs. 7-8;

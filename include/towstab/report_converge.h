@@ -1,8 +1,8 @@
-/* towstab/report_converge.h: convergence tables and health verdicts as JSON
+/* towstab/report_converge.h: convergence tables and the health of modes as JSON
  * (jansson) and CSV (doc/converge.md). SI units (the unit of each value is
  * named with it); numbers that are not finite are JSON null and "nan" in
- * CSV. Files are written atomically (ts_report_open / commit,
- * towstab/report.h).
+ * CSV. Files are written as towstab/report.h describes
+ * (atomically, devices in place).
  */
 #ifndef TOWSTAB_REPORT_CONVERGE_H
 #define TOWSTAB_REPORT_CONVERGE_H
@@ -13,15 +13,11 @@
 #include "towstab/eigen.h"
 #include "towstab/error.h"
 #include "towstab/health.h"
+#include "towstab/report.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* {"trustworthy": bool, "reasons": [text], "notes": [text]} plus
- * "dropped": n when reasons or notes were dropped. NULL on allocation
- * failure. */
-TS_API json_t *ts_report_trust_json(const ts_trust *t);
 
 /* Add the health of a mode analysis to its JSON (ts_report_modes_json):
  * top level "trustworthy", "reasons", "notes", "margin_ratio" (|max Re| /

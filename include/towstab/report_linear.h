@@ -1,7 +1,7 @@
 /* towstab/report_linear.h: the linear-stability results as JSON (jansson)
  * and CSV (doc/linear.md). SI units throughout (1/s, Hz, s, m, N); phases
- * in degrees with the unit in the key. Files are written atomically
- * (ts_report_open/commit, towstab/report.h). Numbers that are not finite
+ * in degrees with the unit in the key. Files are written as
+ * towstab/report.h describes (atomically, devices in place). Numbers that are not finite
  * are written as JSON null and as "nan"/"inf" in CSV.
  */
 #ifndef TOWSTAB_REPORT_LINEAR_H

@@ -1,8 +1,8 @@
 /* towstab/report_time.h: time histories, run statistics and the
  * linear-against-nonlinear comparison as JSON (jansson) and CSV
  * (doc/simulate.md, "Output"). SI throughout (m, N, s, J); phases in
- * degrees with the unit in the key. Files are written atomically
- * (ts_report_open / ts_report_commit, towstab/report.h).
+ * degrees with the unit in the key. Files are written as
+ * towstab/report.h describes (atomically, devices in place).
  */
 #ifndef TOWSTAB_REPORT_TIME_H
 #define TOWSTAB_REPORT_TIME_H

@@ -1,5 +1,5 @@
 /* towstab/response.h: frequency response of the linear model to tow-point
- * motion (MODEL.md section 6; doc/linear.md).
+ * motion (doc/model.md section 6; doc/linear.md).
  *
  * For a tow-point displacement X(i w) along x, y or z (input tow.surge,
  * tow.sway, tow.heave) the tow point also moves with velocity i w X and
@@ -47,7 +47,7 @@ typedef struct ts_output {
 TS_API int ts_response_input_find(const char *name, int *channel,
                                   ts_err *err);
 
-/* Parse an output name: "<node>.x|y|z" (node as ts_report_node_name
+/* Parse an output name: "<node>.x|y|z" (node as ts_system_node_name
  * writes it: a body's name or "<cable>.<k>", k = 1..links of that cable)
  * or "<cable>.<k>.tension" (link k of the cable; "<body>.tension" is the
  * link ending at the body). Returns TS_OK or TS_EINVAL with a message that

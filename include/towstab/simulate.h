@@ -3,7 +3,7 @@
  * (doc/simulate.md; Kamman & Nguyen 1990, examples 3 to 5).
  *
  * Nonlinear: GSL odeiv2 (evolve/control/step under a driver) on the
- * kernel's state y[2 nq] (link angles and rates, MODEL.md section 2), with
+ * kernel's state y[2 nq] (link angles and rates, doc/model.md section 2), with
  * the tow-point input u(t) and the frame motion of an excitation
  * (towstab/excitation.h). Explicit adaptive Runge-Kutta (rk8pd, rkf45) or
  * implicit methods for stiff scenes (GSL's rk4imp, bsimp, msbdf, and
@@ -38,6 +38,7 @@
 #include "towstab/excitation.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
+#include "towstab/progress.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
@@ -86,6 +87,12 @@ typedef struct ts_sim_opts {
     ts_kinematics kinematics;        /* default TS_KIN_LINEAR */
     int jacobian_threads; /* threads of the Jacobian (ts_linearize_opts);
                            default 1 */
+    ts_progress_fn progress; /* called after every accepted step (linear
+                           expm: every output sample) with the simulated
+                           time of t_end, "nonlinear" or "linear"; nonzero
+                           stops the run with TS_ECANCEL at that state
+                           (towstab/progress.h). Default NULL: none */
+    void *progress_data;  /* passed to progress */
 } ts_sim_opts;
 
 TS_API void ts_sim_opts_default(ts_sim_opts *o);
@@ -158,8 +165,9 @@ TS_API int ts_sim_set_state(ts_sim *s, double t, const double y[],
 /* Integrate to t1 (> current time). Returns TS_OK; TS_EINTEGRATOR when
  * the step size underflows (below h_min or machine precision), the step
  * limit is reached or the state stops being finite; TS_ESINGULAR when the
- * kernel fails fatally. On failure the simulator holds the last accepted
- * state and time (ts_sim_time). */
+ * kernel fails fatally; TS_ECANCEL when the progress callback asked to
+ * stop. On failure the simulator holds the last accepted state and time
+ * (ts_sim_time). */
 TS_API int ts_sim_advance(ts_sim *s, double t1, ts_err *err);
 
 TS_API double ts_sim_time(const ts_sim *s);

@@ -39,7 +39,7 @@ TS_API int ts_units_parse(const ts_units *u, const char *text,
 
 /* Convert an SI value to `unit` (for reports: "ft", "lbf", "knot").
  * Returns TS_OK or TS_EUNIT when the dimensions differ. */
-TS_API int ts_units_from_si(const ts_units *u, double si_value,
+TS_API int ts_units_from_si(const ts_units *u, double value_si,
                             const char *si_unit, const char *unit,
                             double *out, ts_err *err);
 

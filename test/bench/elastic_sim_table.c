@@ -4,7 +4,7 @@
  *
  * Scene: Kamman example 1 (examples/kamman_ex1_submerged.yaml), 20 links,
  * the tow point 1 ft below the surface (so that no link crosses it: the
- * kink of MODEL.md section 6 would make the linearization's one-sided
+ * kink of doc/model.md section 6 would make the linearization's one-sided
  * derivatives differ), Cv = 0 as in the equilibrium columns.
  *  - frequency response: the largest relative difference of the sphere's
  *    heave response H(i w) = sphere.z / tow.heave (complex) from the rigid

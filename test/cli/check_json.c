@@ -16,6 +16,14 @@
  *       z}] with the tow point first, links [{cable, index, tension,
  *       theta1_deg, theta2_deg}] (one fewer than nodes), bodies [{name, x,
  *       y, z}] and top_tension. Prints the number of nodes of each.
+ *   check_json keys COMMAND FILE
+ *       Prints "SECTION KEY" for every object key in FILE, the result of
+ *       `towstab COMMAND --json`, once per pair, for test/cli/manual_keys.sh:
+ *       SECTION is the command whose part of doc/manual.md defines the key.
+ *       It is COMMAND, except inside an "equilibrium" object (the
+ *       equilibrium's keys) and, for `run`, inside each entry of
+ *       "analyses" (its "type"). Keys with a dot are names of quantities
+ *       (sphere.z, mode1.freq_hz), not keys of the format: skipped.
  *
  * Every mismatch is printed with its path in the document (e.g.
  * analyses[1].bodies[0].x). Exit status: 0 all good, 1 a check failed,
@@ -59,6 +67,55 @@ static const char *type_name(const json_t *v)
     case JSON_TRUE:
     case JSON_FALSE: return "a boolean";
     default: return "null";
+    }
+}
+
+/* ---- keys --------------------------------------------------------------- */
+
+/* Distinct "section key" pairs, printed once each. */
+#define KEYS_MAX 4096
+static char *seen[KEYS_MAX];
+static int nseen;
+
+static void key_out(const char *section, const char *key)
+{
+    char pair[512];
+    snprintf(pair, sizeof pair, "%s %s", section, key);
+    for (int i = 0; i < nseen; i++)
+        if (strcmp(seen[i], pair) == 0)
+            return;
+    if (nseen < KEYS_MAX && (seen[nseen] = strdup(pair)))
+        nseen++;
+    printf("%s\n", pair);
+}
+
+/* run: 0 anywhere but in a run's result; 1 its top level and "analyses";
+ * 2 an entry of "analyses", whose "type" key the run adds. */
+static void keys(const json_t *v, const char *section, int run)
+{
+    if (json_is_array(v)) {
+        size_t i;
+        const json_t *x;
+        json_array_foreach(v, i, x) {
+            /* An entry of a run's "analyses" belongs to its type. */
+            const json_t *ty = run ? json_object_get(x, "type") : NULL;
+            keys(x, json_is_string(ty) ? json_string_value(ty) : section,
+                 run ? 2 : 0);
+        }
+        return;
+    }
+    if (!json_is_object(v))
+        return;
+    const char *k;
+    const json_t *x;
+    json_object_foreach((json_t *)v, k, x) {
+        if (strchr(k, '.'))
+            continue;
+        key_out(run == 2 && strcmp(k, "type") == 0 ? "run" : section, k);
+        if (strcmp(k, "equilibrium") == 0 && json_is_object(x))
+            keys(x, "equilibrium", 0);
+        else
+            keys(x, section, run == 1 && strcmp(k, "analyses") == 0);
     }
 }
 
@@ -273,7 +330,17 @@ int main(int argc, char **argv)
         json_decref(got);
         return nbad ? 1 : 0;
     }
+    if (argc == 4 && strcmp(argv[1], "keys") == 0) {
+        json_t *got = load(argv[3]);
+        if (!got)
+            return 2;
+        keys(got, argv[2], strcmp(argv[2], "run") == 0);
+        json_decref(got);
+        for (int i = 0; i < nseen; i++)
+            free(seen[i]);
+        return 0;
+    }
     fprintf(stderr, "usage: check_json parse FILE | compare RESULT EXPECTED "
-                    "| equilibrium RESULT\n");
+                    "| equilibrium RESULT | keys COMMAND FILE\n");
     return 2;
 }

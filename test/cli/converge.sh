@@ -109,7 +109,7 @@ for bad in "--links 5,5" "--links 5,x" "--links 0" "--links 7.5" \
            "--target 0" "--target 2" "--analysis foo" "--tolerances 2" \
            "--steps 1e-3" "--links 5,10 --tolerances 1e-3" "--modes 3" \
            "--analysis modes --modes 0" "--analysis modes --steps 0.5" \
-           "--eq-method foo"; do
+           "--equilibrium-method foo"; do
     fresh
     eval ts converge "$EX1" $bad --json "$T/o/c.json" --csv "$T/o/c.csv"
     opt=${bad%% *}
@@ -187,7 +187,7 @@ else
 fi
 
 fresh
-ts converge "$EX1" --links 5,10 --tol 1e-300 --json "$T/o/c.json"
+ts converge "$EX1" --links 5,10 --tolerance 1e-300 --json "$T/o/c.json"
 if [ "$status" -eq 1 ] && grep -q 'every run failed' "$T/err" &&
    [ -z "$(ls -A "$T/o")" ]; then
     pass "converge: every run failing exits 1 with no file"

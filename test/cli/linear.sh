@@ -89,8 +89,8 @@ else
     fail "modes --shapes: status $status"
 fi
 
-for bad in "--count 0" "--count x" "--near -1" "--near '5 m'" "--method foo" \
-           "--eq-method foo"; do
+for bad in "--count 0" "--count x" "--near -1" "--near '5 m'" "--eigen-method foo" \
+           "--equilibrium-method foo"; do
     rm -rf "$T/o"
     mkdir "$T/o"
     eval ts modes examples/kamman_ex3_turn.yaml $bad --json "$T/o/m.json"
@@ -134,12 +134,12 @@ fi
 
 rm -rf "$T/o"
 mkdir "$T/o"
-ts modes examples/kamman_ex3_turn.yaml --tol 1e-300 --json "$T/o/m.json"
+ts modes examples/kamman_ex3_turn.yaml --tolerance 1e-300 --json "$T/o/m.json"
 if [ "$status" -eq 1 ] && grep -q -i "converge" "$T/err" &&
    [ -z "$(ls -A "$T/o")" ]; then
     pass "modes: an unconverged equilibrium is not linearized (exit 1, no file)"
 else
-    fail "modes --tol 1e-300: status $status; $(cat "$T/err")"
+    fail "modes --tolerance 1e-300: status $status; $(cat "$T/err")"
 fi
 
 echo "$npass passed, $nfail failed"

@@ -189,8 +189,8 @@ run_cli() {
     bad_option "unknown option" "--frobnicate" equilibrium "$good" --frobnicate --json "$T/o/r.json"
     bad_option "--links 0" "--links" equilibrium "$good" --links 0 --json "$T/o/r.json"
     bad_option "--links abc" "--links" equilibrium "$good" --links abc --json "$T/o/r.json"
-    bad_option "--tol -1" "--tol" equilibrium "$good" --tol -1 --json "$T/o/r.json"
-    bad_option "--method foo" "--method" equilibrium "$good" --method foo --json "$T/o/r.json"
+    bad_option "--tolerance -1" "--tolerance" equilibrium "$good" --tolerance -1 --json "$T/o/r.json"
+    bad_option "--equilibrium-method foo" "--equilibrium-method" equilibrium "$good" --equilibrium-method foo --json "$T/o/r.json"
     bad_option "--speed '50 lb'" "--speed" equilibrium "$good" --speed "50 lb" --json "$T/o/r.json"
     bad_option "--turn-rate '1 Hz'" "--turn-rate" equilibrium "$good" --turn-rate "1 Hz" --json "$T/o/r.json"
     bad_option "--json without a value" "--json" equilibrium "$good" --json
@@ -262,7 +262,7 @@ run_cli() {
     # An analysis that cannot reach its tolerance: exit 1, a message with
     # the residual, no CSV; a JSON, if any, says it did not converge.
     fresh_outputs
-    ts equilibrium examples/kamman_ex1_submerged.yaml --quiet --tol 1e-300 \
+    ts equilibrium examples/kamman_ex1_submerged.yaml --quiet --tolerance 1e-300 \
         --json "$T/o/f.json" --csv "$T/o/f.csv"
     local why=""
     [ "$status" -eq 1 ] || why="$why exit status $status, not 1;"
@@ -273,9 +273,9 @@ run_cli() {
     fi
     ls "$T/o" | grep -q partial && why="$why a temporary file left;"
     if [ -z "$why" ]; then
-        pass "--tol 1e-300: exit 1, $(head -1 "$T/err")"
+        pass "--tolerance 1e-300: exit 1, $(head -1 "$T/err")"
     else
-        fail "--tol 1e-300:$why"
+        fail "--tolerance 1e-300:$why"
     fi
 }
 

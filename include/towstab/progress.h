@@ -1,0 +1,36 @@
+/* towstab/progress.h: progress reports from long runs, and stopping them.
+ *
+ * A long analysis (a simulation, a convergence sweep) takes an optional
+ * callback in its options (ts_sim_opts.progress, ts_convergence.progress)
+ * and calls it as it goes: after every accepted integrator step, after
+ * every run of a sweep. The callback is given what is done and of how
+ * much; a nonzero return asks the run to stop. It then stops at once, at
+ * a state it can report (the last accepted step, the last finished run),
+ * keeps what it has computed and returns TS_ECANCEL with a message saying
+ * how far it got. The callback must be cheap (it may be called millions of
+ * times) and must not call back into the run. Nothing is global: whatever
+ * the callback needs is in its `data`; a command line, for example, lets
+ * its signal handler set a flag that its callback returns.
+ */
+#ifndef TOWSTAB_PROGRESS_H
+#define TOWSTAB_PROGRESS_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* How far a run is. */
+typedef struct ts_progress {
+    const char *what;   /* the run: "nonlinear", "linear", "sweep" */
+    double done;        /* what is done, in `unit` */
+    double total;       /* of this much (> 0) */
+    const char *unit;   /* "s" (simulated time), "runs" */
+} ts_progress;
+
+/* Called with the progress so far; returns 0 to go on, nonzero to stop. */
+typedef int (*ts_progress_fn)(const ts_progress *p, void *data);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

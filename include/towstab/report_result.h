@@ -1,0 +1,42 @@
+/* towstab/report_result.h: a result of towstab/analysis.h as one JSON
+ * document and one CSV table (doc/manual.md, "JSON and CSV").
+ *
+ * Every kind writes what its command always wrote (towstab/report.h,
+ * report_linear.h, report_time.h, report_converge.h), plus the keys every
+ * result shares: "type" (the analysis), "completed", the verdict
+ * "trustworthy", "reasons", "notes" (towstab/health.h), "error" when it
+ * failed, and "key_values": [{"name", "unit", "value", "error":
+ * {"discretisation", "solver"}}] (null where not estimated). SI units.
+ * Files are written as towstab/report.h describes.
+ */
+#ifndef TOWSTAB_REPORT_RESULT_H
+#define TOWSTAB_REPORT_RESULT_H
+
+#include <jansson.h>
+
+#include "towstab/analysis.h"
+#include "towstab/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Flags of ts_report_result_json. */
+#define TS_REPORT_MATRICES 1  /* modes: A and B */
+#define TS_REPORT_OUTPUT_ONLY 2 /* simulate: histories of the output's
+                                   node only (else of every node) */
+
+/* The result as a new JSON object; NULL on allocation failure. */
+TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
+
+/* The result's table as CSV: an equilibrium's nodes (converged only),
+ * the modes, the response, the histories (also of a failed run: the
+ * samples reached) or the runs of a study. TS_EINVAL when the result has
+ * no such table (nothing is written). */
+TS_API int ts_report_result_csv(const ts_result *r, const char *path,
+                                ts_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

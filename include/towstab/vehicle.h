@@ -1,0 +1,215 @@
+/* towstab/vehicle.h: a towed vehicle as a rigid body built up from
+ * components, with control surfaces and PID controllers (doc/vehicle.md;
+ * doc/model.md section 8; Kamman & Nguyen 1990, eqs. 12-19, 27-42;
+ * Buckham et al. 2003, sections 3-4).
+ *
+ * Body axes b: origin O (a reference point the scene chooses, usually the
+ * hull centre), x forward (the nose), y starboard, z down: at zero attitude
+ * they are parallel to the mean ship frame M. Every position of the
+ * description (mass centre, buoyancy centre, cable attach point,
+ * components) is in body axes relative to O, in m. The attitude is a
+ * dextral 1-2-3 rotation sequence relative to M (Kamman's angles theta1,
+ * theta2, theta3 about the body x, y, z axes); reports give the usual
+ * yaw-pitch-roll (Z-Y-X) angles of the same rotation (towstab/kernel.h).
+ *
+ * The description is a flat struct with fixed-size arrays (no pointers),
+ * so a ts_system copies it with memcpy. SI units, angles in rad.
+ */
+#ifndef TOWSTAB_VEHICLE_H
+#define TOWSTAB_VEHICLE_H
+
+#include "towstab/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TS_VEHICLE_NAME_MAX 64
+#define TS_VEHICLE_MAX_COMPONENTS 16  /* hull and lifting surfaces */
+#define TS_VEHICLE_MAX_LOOPS 8        /* controller loops */
+#define TS_CURVE_MAX_POINTS 64        /* rows of a lift/drag table */
+
+typedef enum {
+    TS_COMP_HULL = 0,     /* slender hull: axial and cross-flow drag */
+    TS_COMP_SURFACE = 1,  /* lifting surface: lift and drag curves */
+    TS_COMP_BLUFF = 2     /* bluff part (a ballast weight, a bulb): drag
+                             -1/2 rho Cd A |w| w whatever the direction */
+} ts_component_type;
+
+typedef enum {
+    TS_CURVE_LIFTING_LINE = 0, /* Helmbold lift slope from the aspect ratio,
+                                  induced drag, flat plate past the stall */
+    TS_CURVE_TABLE = 1         /* C_L(alpha), C_D(alpha) tabulated */
+} ts_curve_type;
+
+/* One component. Fields of the other type are ignored. */
+typedef struct ts_component {
+    char name[TS_VEHICLE_NAME_MAX];
+    ts_component_type type;
+    double position[3];   /* hull, bluff part: its centre; surface: its
+                             centre of pressure; body axes from O, m */
+    /* Bluff part (and a surface's planform area below). */
+    double drag;          /* drag coefficient on `area` */
+    /* Hull (axis along body x). */
+    double length;        /* m, > 0 */
+    double diameter;      /* m, > 0 */
+    double cd_axial;      /* axial drag coefficient on pi D^2 / 4 */
+    double cd_cross;      /* cross-flow drag coefficient on D dx */
+    /* Lifting surface: chord along body x, normal (0, -sin roll, cos
+     * roll): roll 0 is a horizontal surface with its normal down, +-pi/2
+     * a vertical fin, +-pi/4 and +-3pi/4 an X tail. */
+    double area;          /* planform area S (a bluff part: frontal
+                             area), m^2, > 0 */
+    double span;          /* m, > 0; aspect ratio span^2 / area */
+    double roll;          /* rad */
+    double incidence;     /* rad, fixed setting added to the angle of attack */
+    ts_curve_type curve;
+    double lift_slope;    /* dC_L/dalpha, 1/rad; 0: Helmbold from the
+                             aspect ratio (ts_lift_slope_helmbold) */
+    double stall;         /* stall angle of attack, rad, > 0 */
+    double stall_width;   /* half-width of the blend into the flat plate,
+                             rad, in (0, stall) */
+    double cd0;           /* zero-lift drag coefficient */
+    double efficiency;    /* Oswald span efficiency of the induced drag */
+    double cn90;          /* flat-plate normal-force coefficient at 90 deg */
+    int npoints;          /* table rows (curve table), 3..TS_CURVE_MAX_POINTS */
+    double alpha[TS_CURVE_MAX_POINTS]; /* rad, strictly increasing */
+    double cl[TS_CURVE_MAX_POINTS];
+    double cd[TS_CURVE_MAX_POINTS];
+    /* Control surface (all-moving): the deflection adds to the angle of
+     * attack; a positive deflection gives force along -normal (up for a
+     * horizontal surface). */
+    int control;          /* 1: a control surface, with a named input */
+    double deflection;    /* open-loop (bias) deflection delta0, rad */
+    double limit;         /* largest |deflection|, rad (INFINITY: none) */
+    double rate_limit;    /* largest |d deflection / dt|, rad/s
+                             (INFINITY: none; needs time_constant > 0) */
+    double time_constant; /* s: actuator lag tau, delta' =
+                             sat((delta_cmd - delta) / tau); 0: ideal */
+    int line;             /* scene line, 0 if none */
+} ts_component;
+
+/* What a loop measures (relative to M; yaw-pitch-roll angles). */
+typedef enum {
+    TS_MEASURE_DEPTH = 0,   /* z of the body origin O, m */
+    TS_MEASURE_PITCH = 1,   /* rad, nose up > 0 */
+    TS_MEASURE_ROLL = 2,    /* rad, starboard down > 0 */
+    TS_MEASURE_HEADING = 3  /* rad, yaw relative to M, to starboard > 0 */
+} ts_measure;
+
+/* One PID loop: e = measured - setpoint (a heading error wrapped into
+ * (-pi, pi]), e' its rate, x the integral of e (a state when ki != 0):
+ *   v = kp e + ki x + kd e',
+ * and each surface it drives is commanded delta0 + input + sum of
+ * gain[i] v over the loops driving it. */
+typedef struct ts_loop {
+    char name[TS_VEHICLE_NAME_MAX];
+    ts_measure measure;
+    double setpoint;      /* m or rad */
+    double kp, ki, kd;    /* rad per m (rad), per m s (rad s), per m/s
+                             (rad/s) */
+    int nsurfaces;
+    int surface[TS_VEHICLE_MAX_COMPONENTS]; /* component indices */
+    double gain[TS_VEHICLE_MAX_COMPONENTS]; /* mixing weights */
+    int line;
+} ts_loop;
+
+typedef struct ts_vehicle {
+    double inertia[6];    /* about the mass centre, body axes, kg m^2:
+                             Ixx, Iyy, Izz, Ixy, Ixz, Iyz (products as
+                             tensor entries, I_xy = -sum m x y) */
+    double mass_centre[3];
+    double buoyancy_centre[3];
+    double attach[3];     /* cable attach point (spherical joint) */
+    double volume;        /* displaced volume, m^3 */
+    double added_mass[36];/* 6x6 about O, body axes, row-major, symmetric:
+                             rows/columns surge, sway, heave, roll, pitch,
+                             yaw (kg, kg m, kg m^2) */
+    int added_mass_estimated; /* 1: added_mass is the Newman ellipsoid
+                             estimate of estimate_length/diameter */
+    double estimate_length, estimate_diameter; /* m */
+    double estimate_centre[3]; /* ellipsoid centre, body axes, m */
+    double surface_diameter;  /* m: height of the hull used for the
+                             submerged fraction near z = 0 */
+    int ncomponents;
+    ts_component component[TS_VEHICLE_MAX_COMPONENTS];
+    int nloops;
+    ts_loop loop[TS_VEHICLE_MAX_LOOPS];
+} ts_vehicle;
+
+/* Loads of one component (body axes): force (N), moment about the body
+ * origin O (N m), its angle of attack (a surface: with incidence and
+ * deflection; the hull: of the flow at its centre, atan2(w_z, w_x)) and
+ * the speed of the flow past it (m/s; a surface: in its chord-normal
+ * plane). */
+typedef struct ts_component_load {
+    double force[3], moment[3];
+    double alpha, speed;
+} ts_component_load;
+
+/* A vehicle at one state (ts_kernel_vehicle_result). Angles in rad. */
+typedef struct ts_vehicle_result {
+    int body;             /* body index */
+    double R[9];          /* attitude: body to M, row-major */
+    double yaw, pitch, roll; /* Z-Y-X angles relative to M: yaw > 0 to
+                             starboard, pitch > 0 nose up, roll > 0
+                             starboard down */
+    double alpha, beta;   /* angle of attack atan2(w_z, w_x) and sideslip
+                             asin(w_y / |w|) of the flow at O, w the
+                             velocity of O relative to the water (body
+                             axes) */
+    double speed;         /* |w|, m/s */
+    double origin[3];     /* O in M, m (origin[2] is the depth) */
+    double mass_centre[3];/* G in M, m */
+    double omega[3];      /* angular velocity relative to M, body axes */
+    double submerged;     /* fraction under water */
+    double joint_force[3];/* force of the cable's end node on the vehicle
+                             through the joint, M frame, N */
+    double hydro_force[3], hydro_moment[3]; /* all components, body axes,
+                             moment about O */
+    double munk[3];       /* the added mass's -v x p moment, body axes */
+    int ncomponents;
+    double delta[TS_VEHICLE_MAX_COMPONENTS];      /* deflections, rad */
+    ts_component_load load[TS_VEHICLE_MAX_COMPONENTS];
+    int nloops;
+    double loop_error[TS_VEHICLE_MAX_LOOPS];  /* measured - setpoint */
+    double loop_output[TS_VEHICLE_MAX_LOOPS]; /* the law's value, rad */
+} ts_vehicle_result;
+
+/* Defaults of a component of `type` (doc/vehicle.md): hull Cd axial 0.2,
+ * cross 1.2; surface lifting line, Helmbold slope, stall 15 deg, width 3
+ * deg, cd0 0.01, efficiency 0.9, cn90 1.2, no limits, ideal actuator. */
+TS_API void ts_component_defaults(ts_component *c, ts_component_type type);
+
+/* Validate a vehicle description (finite values, ranges, tables, loops
+ * referring to control surfaces, symmetric added mass with a
+ * non-negative diagonal). `where` and `line` name it in messages
+ * ("bodies[2].inertia (line 14): ..."; line 0: none; components and loops
+ * give their own lines). TS_OK or TS_EINVAL. */
+TS_API int ts_vehicle_check(const ts_vehicle *v, double mass,
+                            const char *where, int line, ts_err *err);
+
+/* Added mass of a prolate spheroid of length L and diameter D (L >= D > 0)
+ * in fluid of density rho, about its centre, in its axes (x along the
+ * length), Newman (1977) section 4.13 with Lamb's coefficients:
+ * A11 = k1 m_f, A22 = A33 = k2 m_f, A55 = A66 = k' I_f, A44 = 0, with
+ * m_f = rho pi L D^2 / 6 and I_f = m_f (L^2 + D^2) / 20. A[36] row-major;
+ * k[3] (may be NULL) receives k1, k2, k'. TS_EINVAL when L < D. */
+TS_API int ts_added_mass_spheroid(double rho, double length, double diameter,
+                                  double A[36], double k[3], ts_err *err);
+
+/* Move a 6x6 added-mass matrix about point P to one about point O, both
+ * in the same axes: r is P relative to O. A_O = H^T A_P H with
+ * H = [[I, -S(r)], [0, I]] (S(r) x = r x x). In place allowed. */
+TS_API void ts_added_mass_shift(const double A_P[36], const double r[3],
+                                 double A_O[36]);
+
+/* Helmbold's lift slope of a wing of aspect ratio ar (> 0):
+ * 2 pi ar / (2 + sqrt(ar^2 + 4)), 1/rad: 2 pi for ar -> infinity and
+ * pi ar / 2 (slender wing) for ar -> 0. */
+TS_API double ts_lift_slope_helmbold(double ar);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,1797 @@
+/* analysis.c: one pipeline per analysis (towstab/analysis.h;
+ * doc/architecture.md, "Pipelines").
+ *
+ * Every pipeline starts from a copy of the system with the request's
+ * settings applied (ts_setup), checks what can be checked before anything
+ * runs, and fills one ts_result: the parts it computed (equilibrium,
+ * linearization, modes, response, histories, comparison, sweep), the
+ * verdict on them (towstab/health.h, judged here and nowhere else), the
+ * key values with their solver error estimates, the run time and the
+ * kernel evaluations. A failure ends the pipeline with its code and
+ * message in the result, which keeps what was computed before it and is
+ * never trustworthy.
+ *
+ * The chains (doc/linear.md, doc/simulate.md, doc/converge.md):
+ *   equilibrium  solve (doc/equilibrium.md);
+ *   modes        equilibrium -> linearize about it with a fresh kernel
+ *                re-charted from its directions -> eigen (LAPACK, or
+ *                ARPACK for a subset) -> health of the modes;
+ *   response     the same linearization (with tension Jacobians for a
+ *                tension output) -> frequency response at log-spaced
+ *                frequencies (and optionally the lowest natural ones);
+ *                with a sea, the spectral response to it instead
+ *                (towstab/seastate.h) and its discretisation error;
+ *   simulate     initial state (equilibrium, released or a shape file)
+ *                -> the linear model about the equilibrium (linearized
+ *                with the equilibrium's own kernel, whose charts both runs
+ *                then start from) and/or the nonlinear integration ->
+ *                comparison and the fit of the output's amplitude ratio,
+ *                mean offset and phase against a periodic excitation;
+ *                with a sea, a realisation of it added to the
+ *                excitation, the records' statistics and the spectral
+ *                prediction over the realisation's band;
+ *   converge     one of the above rerun at every setting of a resolution
+ *                sweep (towstab/converge.h estimates errors and orders),
+ *                one series per integrator for a simulation.
+ * The convergence study calls the same pipelines through
+ * ts_analysis_sweep, so a sweep's runs are exactly what the commands run.
+ *
+ * One module: the pipelines share the system set-up, the equilibrium and
+ * linearization stages, the result and its key values, and converge runs
+ * the others; split, each file would need the others' internals.
+ */
+#include "towstab/analysis.h"
+
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "towstab/kernel.h"
+
+/* Noise of an equilibrium value: this many times its relative residual
+ * (at least EQ_NOISE_MIN_REL) times the length or force scale. */
+#define EQ_NOISE_FACTOR 10.0
+#define EQ_NOISE_MIN_REL (16.0 * DBL_EPSILON)
+/* Noise of a mode value in a step sweep, relative. */
+#define STEP_NOISE_REL (64.0 * DBL_EPSILON)
+/* Rounding noise of a simulated value: this many eps per sqrt(step). */
+#define SIM_ROUND_EPS 16.0
+/* Integrator noise of a simulated value in a links sweep: this many times
+ * rel_tol of the value's scale. */
+#define SIM_TOL_NOISE 10.0
+/* Times compared within this (s) are the same sample. */
+#define TIME_EPS 1e-12
+
+static const char *const kind_names[TS_ANALYSIS_COUNT] = {
+    "equilibrium", "modes", "response", "simulate", "converge"};
+
+const char *ts_analysis_name(ts_analysis_kind kind)
+{
+    return (int)kind >= 0 && kind < TS_ANALYSIS_COUNT ? kind_names[kind]
+                                                      : "?";
+}
+
+int ts_analysis_find(const char *name)
+{
+    for (int k = 0; name && k < TS_ANALYSIS_COUNT; k++)
+        if (strcmp(name, kind_names[k]) == 0)
+            return k;
+    return -1;
+}
+
+static double wall_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* ---- requests ---------------------------------------------------------- */
+
+void ts_request_init(ts_request *rq, ts_analysis_kind kind)
+{
+    memset(rq, 0, sizeof *rq);
+    rq->kind = kind;
+    rq->setup.speed = NAN;
+    rq->setup.turn_rate = NAN;
+    ts_equilibrium_opts_default(&rq->setup.equilibrium);
+    ts_eigen_opts_default(&rq->modes.eigen);
+    rq->modes.follow = TS_MODES_FOLLOW;
+    ts_linearize_opts_default(&rq->modes.linearize);
+    snprintf(rq->response.input, sizeof rq->response.input, "tow.heave");
+    rq->response.from_hz = TS_RESPONSE_FROM_HZ;
+    rq->response.to_hz = TS_RESPONSE_TO_HZ;
+    rq->response.points = TS_RESPONSE_POINTS;
+    rq->response.intervals = TS_SEASTATE_INTERVALS;
+    rq->response.duration = TS_SEASTATE_DURATION;
+    rq->response.discretisation = 1;
+    rq->simulate.seed = 1;
+    rq->simulate.components = TS_SEA_COMPONENTS;
+    rq->simulate.fade_in = NAN;
+    ts_sim_opts_default(&rq->simulate.sim);
+    rq->simulate.sim.t_end = TS_SIMULATE_T_END;
+    rq->simulate.sim.dt_sample = 0;
+    rq->simulate.transient = NAN;
+    rq->converge.analysis = TS_ANALYSIS_EQUILIBRIUM;
+    rq->converge.param = TS_CONV_LINKS;
+    rq->converge.target = TS_CONVERGE_TARGET;
+}
+
+void ts_request_clear(ts_request *rq)
+{
+    ts_excitation_free(rq->simulate.excitation);
+    ts_sea_free(rq->response.sea.sea);
+    ts_rao_free(rq->response.sea.rao);
+    ts_sea_free(rq->simulate.sea.sea);
+    ts_rao_free(rq->simulate.sea.rao);
+    ts_request_init(rq, rq->kind);
+}
+
+const char *ts_converge_default_sweep(ts_analysis_kind analysis,
+                                      ts_conv_param *param)
+{
+    *param = analysis == TS_ANALYSIS_SIMULATE ? TS_CONV_TOLERANCE
+                                              : TS_CONV_LINKS;
+    switch (analysis) {
+    case TS_ANALYSIS_MODES: return "10,20,40,80";
+    case TS_ANALYSIS_SIMULATE: return "1e-3,1e-5,1e-7,1e-9";
+    default: return "5,10,20,40,80,160,320";
+    }
+}
+
+/* The default sweep as numbers. */
+static int default_settings(ts_analysis_kind analysis, ts_conv_param *param,
+                            double *settings)
+{
+    const char *text = ts_converge_default_sweep(analysis, param);
+    int n = 0;
+    for (const char *p = text; *p && n < TS_CONV_MAX_SETTINGS;) {
+        char *end;
+        settings[n++] = strtod(p, &end);
+        p = *end == ',' ? end + 1 : end;
+    }
+    return n;
+}
+
+/* ---- the system -------------------------------------------------------- */
+
+/* The setup's own checks (those a scene makes of tow.speed and
+ * tow.turn_rate, and the link limit). */
+static int check_setup(const ts_setup *s, ts_err *err)
+{
+    if (!isnan(s->speed) && !(s->speed >= 0 && isfinite(s->speed)))
+        return ts_fail(err, TS_EINVAL, "speed: must be >= 0 m/s, got %g m/s",
+                       s->speed);
+    if (!isnan(s->turn_rate) && !isfinite(s->turn_rate))
+        return ts_fail(err, TS_EINVAL,
+                       "turn_rate: must be finite, got %g rad/s",
+                       s->turn_rate);
+    if (s->links != 0 && (s->links < 1 || s->links > TS_MAX_LINKS))
+        return ts_fail(err, TS_EINVAL,
+                       "links: expected 1 to %d per cable, got %d",
+                       TS_MAX_LINKS, s->links);
+    const ts_equilibrium_opts *e = &s->equilibrium;
+    if (!(e->tol > 0 && e->tol < 1))
+        return ts_fail(err, TS_EINVAL,
+                       "tolerance: expected a number in (0, 1), got %g",
+                       e->tol);
+    return TS_OK;
+}
+
+/* A copy of sys with the setup applied, built; NULL on failure. */
+static ts_system *setup_system(const ts_system *sys, const ts_setup *s,
+                               ts_err *err)
+{
+    if (check_setup(s, err) != TS_OK)
+        return NULL;
+    ts_system *c = ts_system_copy(sys, err);
+    if (!c)
+        return NULL;
+    if (!isnan(s->speed))
+        c->tow.speed = s->speed;
+    if (!isnan(s->turn_rate))
+        c->tow.turn_rate = s->turn_rate;
+    int rc = s->links > 0 ? ts_system_set_links(c, s->links, err)
+                          : ts_system_build(c, err);
+    if (rc != TS_OK) {
+        ts_system_free(c);
+        return NULL;
+    }
+    return c;
+}
+
+static double total_length(const ts_system *sys)
+{
+    double L = 0;
+    for (int c = 0; c < sys->ncables; c++)
+        L += sys->cables[c].length;
+    return L;
+}
+
+/* ---- results ----------------------------------------------------------- */
+
+static ts_result *result_alloc(ts_analysis_kind kind, ts_err *err)
+{
+    ts_result *r = calloc(1, sizeof *r);
+    if (!r) {
+        ts_fail(err, TS_ENOMEM, "%s: out of memory", ts_analysis_name(kind));
+        return NULL;
+    }
+    r->kind = kind;
+    ts_trust_init(&r->trust);
+    ts_trust_init(&r->eq_trust);
+    ts_trust_init(&r->modes_trust);
+    r->transient = NAN;
+    return r;
+}
+
+void ts_result_free(ts_result *r)
+{
+    if (!r)
+        return;
+    free(r->values);
+    ts_system_free(r->sys);
+    ts_equilibrium_free(r->eq);
+    ts_linear_free(r->lin);
+    ts_eigen_free(r->eigen);
+    free(r->mode_health);
+    ts_response_free(r->response);
+    ts_seastate_free(r->seastate);
+    ts_excitation_free(r->sea_excitation);
+    ts_history_free(r->nonlinear);
+    ts_history_free(r->linear);
+    ts_convergence_free(r->convergence);
+    free(r);
+}
+
+const ts_value *ts_result_value(const ts_result *r, const char *name)
+{
+    for (int i = 0; r && name && i < r->nvalues; i++)
+        if (strcmp(r->values[i].name, name) == 0)
+            return &r->values[i];
+    return NULL;
+}
+
+/* Room for n key values, named later; NAN values and estimates. */
+static int values_alloc(ts_result *r, int n, ts_err *err)
+{
+    r->values = calloc((size_t)(n > 0 ? n : 1), sizeof *r->values);
+    if (!r->values)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory",
+                       ts_analysis_name(r->kind));
+    r->nvalues = n;
+    for (int i = 0; i < n; i++) {
+        r->values[i].value = NAN;
+        r->values[i].error.discretisation = NAN;
+        r->values[i].error.solver = NAN;
+    }
+    return TS_OK;
+}
+
+static void value_name(ts_value *v, const char *unit, double scale,
+                       const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static void value_name(ts_value *v, const char *unit, double scale,
+                       const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(v->name, sizeof v->name, fmt, ap);
+    va_end(ap);
+    snprintf(v->unit, sizeof v->unit, "%s", unit);
+    v->scale = scale;
+}
+
+/* End a pipeline: record the outcome; a failure is never trustworthy. */
+static int finish(ts_result *r, int rc, const ts_err *e, ts_err *err,
+                  double t0)
+{
+    r->wall_s = wall_now() - t0;
+    r->status = rc;
+    r->completed = rc == TS_OK;
+    if (rc != TS_OK) {
+        const char *msg = e && e->msg[0] ? e->msg : ts_strerror(rc);
+        snprintf(r->error, sizeof r->error, "%s", msg);
+        ts_trust_fail(&r->trust, "the run failed: %s", msg);
+        if (err && err != e)
+            ts_fail(err, rc, "%s", msg);
+    }
+    return rc;
+}
+
+/* ---- equilibrium ------------------------------------------------------- */
+
+/* Reported points: the bodies, or without bodies the free cable ends. */
+static int npoints(const ts_system *sys)
+{
+    if (sys->nbodies > 0)
+        return sys->nbodies;
+    int n = 0;
+    for (int c = 0; c < sys->ncables; c++)
+        n += sys->cables[c].to_body < 0;
+    return n;
+}
+
+/* Node of reported point i. */
+static int point_node(const ts_system *sys, int i)
+{
+    if (sys->nbodies > 0)
+        return ts_system_body_node(sys, i);
+    int k = 0;
+    for (int c = 0; c < sys->ncables; c++) {
+        if (sys->cables[c].to_body >= 0 || k++ != i)
+            continue;
+        for (int l = 0; l < sys->nlinks; l++)
+            if (sys->links[l].cable == c && sys->links[l].next < 0)
+                return sys->links[l].lower;
+    }
+    return -1;
+}
+
+/* Key values of an equilibrium: x, y, z of the points ("<body>.x", or
+ * "<cable>.end.x"; scale the cable length) and the top tension (relative
+ * to itself). Solver error: EQ_NOISE_FACTOR times the relative residual
+ * (at least EQ_NOISE_MIN_REL) of the length or the largest force. */
+static int eq_values(ts_result *r, ts_err *err)
+{
+    const ts_system *sys = r->sys;
+    int np = npoints(sys);
+    int rc = values_alloc(r, 3 * np + 1, err);
+    if (rc)
+        return rc;
+    double L = total_length(sys);
+    static const char axis[3] = {'x', 'y', 'z'};
+    for (int i = 0, c = 0; i < np; i++) {
+        for (int j = 0; j < 3; j++) {
+            ts_value *v = &r->values[3 * i + j];
+            if (sys->nbodies > 0) {
+                value_name(v, "m", L, "%.63s.%c", sys->bodies[i].name,
+                           axis[j]);
+            } else {
+                while (sys->cables[c].to_body >= 0)
+                    c++;
+                value_name(v, "m", L, "%.60s.end.%c", sys->cables[c].name,
+                           axis[j]);
+            }
+        }
+        if (sys->nbodies == 0)
+            c++;
+    }
+    value_name(&r->values[3 * np], "N", 0.0, "top_tension");
+    const ts_equilibrium *eq = r->eq;
+    if (!eq || !eq->converged)
+        return TS_OK;
+    double rel = fmax(eq->residual, EQ_NOISE_MIN_REL);
+    for (int i = 0; i < np; i++) {
+        int node = point_node(sys, i);
+        for (int j = 0; j < 3; j++) {
+            r->values[3 * i + j].value = eq->positions[3 * node + j];
+            r->values[3 * i + j].error.solver = EQ_NOISE_FACTOR * rel * L;
+        }
+    }
+    r->values[3 * np].value = eq->top_tension;
+    r->values[3 * np].error.solver = EQ_NOISE_FACTOR * rel * eq->force_scale;
+    return TS_OK;
+}
+
+/* Solve the equilibrium of r->sys with kernel k (re-charted by the
+ * solver). Its own verdict goes to r->eq_trust. */
+static int run_equilibrium(ts_result *r, ts_kernel *k,
+                           const ts_equilibrium_opts *eo, ts_err *err)
+{
+    r->eq = ts_equilibrium_alloc(r->sys, err);
+    if (!r->eq)
+        return err && err->code ? err->code : TS_ENOMEM;
+    double t0 = wall_now();
+    int rc = ts_equilibrium_solve(k, eo, r->eq, err);
+    r->eq_wall_s = wall_now() - t0;
+    r->eq_attempted = rc != TS_EINVAL && rc != TS_EDOMAIN;
+    r->evaluations += r->eq->evaluations;
+    if (rc == TS_OK)
+        ts_health_equilibrium(r->sys, r->eq, &r->eq_trust);
+    return rc;
+}
+
+/* Linearize about r->eq with a fresh kernel re-charted from its
+ * directions. An equilibrium that did not converge is not linearized. */
+static int run_linearize(ts_result *r, const ts_linearize_opts *lo,
+                         ts_err *err)
+{
+    ts_kernel *k = ts_kernel_alloc(r->sys, err);
+    if (!k)
+        return err && err->code ? err->code : TS_ENOMEM;
+    r->lin = ts_linear_alloc(k, err);
+    int rc = r->lin ? TS_OK : (err && err->code ? err->code : TS_ENOMEM);
+    if (rc == TS_OK) {
+        double t0 = wall_now();
+        rc = ts_linearize_equilibrium(k, r->eq, lo, r->lin, err);
+        r->lin_wall_s = wall_now() - t0;
+        r->evaluations += r->lin->evaluations;
+    }
+    ts_kernel_free(k);
+    if (rc != TS_OK) {
+        ts_linear_free(r->lin);
+        r->lin = NULL;
+    }
+    return rc;
+}
+
+/* The equilibrium stage of modes and response: solve, then linearize. */
+static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
+                                   const ts_linearize_opts *lo, ts_err *err)
+{
+    ts_kernel *k = ts_kernel_alloc(r->sys, err);
+    int rc = k ? run_equilibrium(r, k, &rq->setup.equilibrium, err)
+               : (err && err->code ? err->code : TS_ENOMEM);
+    ts_kernel_free(k);
+    if (rc != TS_OK) {
+        if (r->eq && !r->eq->converged)
+            ts_err_prefix(err, "the equilibrium did not converge, so it is "
+                               "not linearized: ");
+        return rc;
+    }
+    ts_trust_merge(&r->trust, "equilibrium: ", &r->eq_trust);
+    return run_linearize(r, lo, err);
+}
+
+static int pipeline_equilibrium(ts_result *r, const ts_request *rq,
+                                ts_err *err)
+{
+    ts_kernel *k = ts_kernel_alloc(r->sys, err);
+    int rc = k ? run_equilibrium(r, k, &rq->setup.equilibrium, err)
+               : (err && err->code ? err->code : TS_ENOMEM);
+    ts_kernel_free(k);
+    if (rc == TS_OK)
+        ts_trust_merge(&r->trust, NULL, &r->eq_trust);
+    int vrc = r->eq ? eq_values(r, err) : TS_OK;
+    return rc ? rc : vrc;
+}
+
+/* ---- modes ------------------------------------------------------------- */
+
+/* The eigen options of a request for a linear model of n states. */
+static ts_eigen_opts modes_eigen_opts(const ts_modes_opts *m, int n)
+{
+    ts_eigen_opts o = m->eigen;
+    o.count = m->count;
+    if (o.count == 0) {
+        int large = 2 * m->follow + 10;
+        if (large < TS_MODES_LARGE_COUNT)
+            large = TS_MODES_LARGE_COUNT;
+        if (m->near)
+            o.count = TS_MODES_NEAR_COUNT;
+        else if (o.method == TS_EIG_ARPACK ||
+                 (o.method == TS_EIG_AUTO && n >= o.arpack_min_states))
+            o.count = large;
+    }
+    /* More than exist: all of them. ARPACK finds a few near a target and
+     * says how many it can (ts_eigen_check). */
+    if (o.count > n / 2 + 1 && o.method != TS_EIG_ARPACK)
+        o.count = 0;
+    return o;
+}
+
+/* Key values: frequency (Hz, relative to itself) and damping ratio (scale
+ * 1) of the `follow` lowest oscillatory modes with damping below
+ * TS_CONV_MODE_DAMPING_MAX; solver error: each mode's error bound as a
+ * frequency and as a damping ratio. */
+static int modes_values(ts_result *r, int follow, ts_err *err)
+{
+    int rc = values_alloc(r, 2 * follow, err);
+    if (rc)
+        return rc;
+    for (int m = 0; m < follow; m++) {
+        value_name(&r->values[2 * m], "Hz", 0.0, "mode%d.freq_hz", m + 1);
+        value_name(&r->values[2 * m + 1], "1", 1.0, "mode%d.damping_ratio",
+                   m + 1);
+    }
+    const ts_eigen *e = r->eigen;
+    for (int m = 0, k = 0; e && m < e->nmodes && k < follow; m++) {
+        const ts_mode *md = &e->modes[m];
+        if (!(md->im > 0) || !(md->damping_ratio < TS_CONV_MODE_DAMPING_MAX))
+            continue;
+        double mag = hypot(md->re, md->im);
+        r->values[2 * k].value = md->freq_hz;
+        r->values[2 * k].error.solver = md->error_bound / (2.0 * M_PI);
+        r->values[2 * k + 1].value = md->damping_ratio;
+        r->values[2 * k + 1].error.solver = md->error_bound / mag;
+        k++;
+    }
+    return TS_OK;
+}
+
+static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
+{
+    const ts_modes_opts *m = &rq->modes;
+    /* LAPACK needs the dense A at any size. */
+    ts_linearize_opts lo = m->linearize;
+    if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
+        lo.model = TS_LIN_BOTH;
+    int rc = equilibrium_then_linear(r, rq, &lo, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_eigen_opts o = modes_eigen_opts(m, r->lin->nstate);
+    double t0 = wall_now();
+    rc = ts_eigen_solve(r->lin, &o, &r->eigen, err);
+    r->eigen_wall_s = wall_now() - t0;
+    if (rc != TS_OK)
+        return rc;
+    int nm = r->eigen->nmodes;
+    r->mode_health = malloc((size_t)(nm > 0 ? nm : 1) *
+                            sizeof *r->mode_health);
+    if (!r->mode_health)
+        return ts_fail(err, TS_ENOMEM, "modes: out of memory for the health "
+                                       "of %d modes", nm);
+    rc = ts_health_modes(r->sys, r->lin, r->eigen, r->mode_health,
+                         &r->modes_trust, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_trust_merge(&r->trust, NULL, &r->modes_trust);
+    return modes_values(r, m->follow, err);
+}
+
+/* ---- response ---------------------------------------------------------- */
+
+/* A sea's seaway on sys: the message names the option at fault. */
+static int sea_seaway(const ts_system *sys, const ts_sea_opts *so,
+                      ts_seaway *w, ts_err *err)
+{
+    int rc = ts_seaway_init(w, sys, so->sea, so->rao, so->reference, err);
+    if (rc)
+        ts_err_prefix(err, "sea: ");
+    return rc;
+}
+
+static int check_response_sea(const ts_system *sys, const ts_response_opts *o,
+                              ts_output *out, ts_err *err)
+{
+    if (o->frequency_given)
+        return ts_fail(err, TS_EINVAL, "sea: the sea drives every tow-point "
+                       "axis over its own frequencies: input, from, to and "
+                       "points do not apply (leave them out)");
+    if (!o->output[0]) {
+        char list[768];
+        ts_response_output_names(sys, list, sizeof list);
+        return ts_fail(err, TS_EINVAL, "output: required; valid outputs: %s",
+                       list);
+    }
+    int rc = ts_response_output_find(sys, o->output, out, err);
+    if (rc != TS_OK) {
+        ts_err_prefix(err, "output: ");
+        return rc;
+    }
+    if (o->intervals < 16 || o->intervals % 8)
+        return ts_fail(err, TS_EINVAL, "intervals: expected a multiple of 8 "
+                       "from 16 on (the grid is halved twice for its error "
+                       "estimate), got %d", o->intervals);
+    ts_seaway w;
+    return sea_seaway(sys, &o->sea, &w, err);
+}
+
+static int check_response(const ts_system *sys, const ts_response_opts *o,
+                          int *input, ts_output *out, ts_err *err)
+{
+    if (o->sea.sea)
+        return check_response_sea(sys, o, out, err);
+    int rc = ts_response_input_find(o->input, input, err);
+    if (rc != TS_OK) {
+        ts_err_prefix(err, "input: ");
+        return rc;
+    }
+    if (!o->output[0]) {
+        char list[768];
+        ts_response_output_names(sys, list, sizeof list);
+        return ts_fail(err, TS_EINVAL, "output: required; valid outputs: %s",
+                       list);
+    }
+    rc = ts_response_output_find(sys, o->output, out, err);
+    if (rc != TS_OK) {
+        ts_err_prefix(err, "output: ");
+        return rc;
+    }
+    if (!(o->points >= 2 && o->points <= TS_RESPONSE_MAX_POINTS))
+        return ts_fail(err, TS_EINVAL,
+                       "points: expected a whole number in [2, %d], got %d",
+                       TS_RESPONSE_MAX_POINTS, o->points);
+    double f[2];
+    rc = ts_response_logspace(o->from_hz, o->to_hz, 2, f, err);
+    if (rc != TS_OK)
+        ts_err_prefix(err, "to: ");
+    return rc;
+}
+
+/* Key values of a spectral result: <output>.sigma, .tz, .mpm with the
+ * discretisation error (NAN when not estimated) and the grid and band
+ * errors as the solver's. */
+static int sea_values(ts_result *r, const ts_seastate *s, ts_err *err)
+{
+    int rc = values_alloc(r, 3, err);
+    if (rc)
+        return rc;
+    static const char *const suffix[3] = {"sigma", "tz", "mpm"};
+    const ts_stat *st[3] = {&s->sigma, &s->tz, &s->mpm};
+    for (int v = 0; v < 3; v++) {
+        value_name(&r->values[v], v == 1 ? "s" : s->unit, 0.0, "%.70s.%s",
+                   s->output.name, suffix[v]);
+        r->values[v].value = st[v]->value;
+        r->values[v].error.solver = st[v]->grid + st[v]->band;
+        r->values[v].error.discretisation =
+            s->disc_estimated ? st[v]->discretisation : NAN;
+    }
+    return TS_OK;
+}
+
+static int pipeline_response_sea(ts_result *r, const ts_request *rq,
+                                 ts_err *err)
+{
+    const ts_response_opts *o = &rq->response;
+    ts_output out;
+    int rc = check_response_sea(r->sys, o, &out, err);
+    if (rc == TS_OK)
+        rc = sea_seaway(r->sys, &o->sea, &r->seaway, err);
+    if (rc != TS_OK)
+        return rc;
+    r->has_sea = 1;
+    snprintf(r->rao_file, sizeof r->rao_file, "%s", o->sea.rao_file);
+    ts_linearize_opts lo = rq->modes.linearize;
+    lo.tensions = out.kind == TS_OUT_TENSION;
+    rc = equilibrium_then_linear(r, rq, &lo, err);
+    ts_seastate_opts so;
+    ts_seastate_opts_default(&so);
+    so.intervals = o->intervals;
+    so.duration = o->duration;
+    if (rc == TS_OK)
+        rc = ts_seastate_compute(r->sys, r->lin, &r->seaway, &out, &so,
+                                 &r->seastate, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_seastate *s = r->seastate;
+    if (o->discretisation) {
+        ts_err de = {0};
+        int drc = ts_seastate_discretisation(r->sys, &rq->setup.equilibrium,
+                                             &r->seaway, &so, s, &de);
+        if (drc == TS_EDOMAIN)
+            ts_trust_note(&s->trust, "the discretisation error was not "
+                          "estimated (%s); towstab converge can sweep "
+                          "the links", de.msg);
+        else if (drc != TS_OK)
+            return ts_fail(err, drc, "sea: the discretisation estimate: %s",
+                           de.msg);
+    }
+    ts_trust_merge(&r->trust, NULL, &s->trust);
+    const ts_linear *lin = r->lin;
+    if (lin->kink_tow && s->sigma.value > 0)
+        ts_trust_note(&r->trust, "the tow point is at the water surface: a "
+                                 "real heave also shifts the mean depth at "
+                                 "first order, which the linear model "
+                                 "cannot show");
+    return sea_values(r, s, err);
+}
+
+static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
+{
+    const ts_response_opts *o = &rq->response;
+    if (o->sea.sea)
+        return pipeline_response_sea(r, rq, err);
+    int input;
+    ts_output out;
+    int rc = check_response(r->sys, o, &input, &out, err);
+    double *freq = rc ? NULL : malloc((size_t)o->points * sizeof(double));
+    if (rc == TS_OK && !freq)
+        rc = ts_fail(err, TS_ENOMEM, "response: out of memory for %d "
+                                     "frequencies", o->points);
+    if (rc == TS_OK)
+        rc = ts_response_logspace(o->from_hz, o->to_hz, o->points, freq, err);
+    if (rc != TS_OK) {
+        free(freq);
+        return rc;
+    }
+    ts_linearize_opts lo = rq->modes.linearize;
+    lo.tensions = out.kind == TS_OUT_TENSION;
+    rc = equilibrium_then_linear(r, rq, &lo, err);
+    if (rc == TS_OK)
+        rc = ts_response_compute(r->sys, r->lin, input, &out, freq,
+                                 o->points, &r->response, err);
+    free(freq);
+    if (rc != TS_OK)
+        return rc;
+    if (o->natural) {
+        /* The lowest natural frequencies; a failure leaves none. */
+        ts_eigen_opts eo;
+        ts_eigen_opts_default(&eo);
+        eo.count = TS_RESPONSE_NATURAL;
+        eo.rightmost = 0; /* the lowest modes only, no verdict */
+        if (eo.count > r->lin->nstate / 2)
+            eo.count = 0;
+        ts_eigen *e = NULL;
+        if (ts_eigen_solve(r->lin, &eo, &e, NULL) == TS_OK)
+            for (int m = 0; m < e->nmodes && r->nnatural < TS_RESPONSE_NATURAL;
+                 m++)
+                if (e->modes[m].im > 0)
+                    r->natural_hz[r->nnatural++] = e->modes[m].freq_hz;
+        ts_eigen_free(e);
+    }
+    /* The waterline kink for a heave input (towstab/health.h). */
+    const ts_linear *lin = r->lin;
+    if (lin->kink_tow && input == 2)
+        ts_trust_note(&r->trust, "the tow point is at the water surface: a "
+                                 "real heave also shifts the mean depth at "
+                                 "first order, which a frequency response "
+                                 "cannot show");
+    if (lin->kinks && !(lin->kink_tow && lin->kinks == 1))
+        ts_trust_note(&r->trust, "%d node%s within a linearization step of "
+                                 "the water surface: f is not smooth there",
+                      lin->kinks, lin->kinks == 1 ? "" : "s");
+    return TS_OK;
+}
+
+/* ---- simulate ---------------------------------------------------------- */
+
+/* Read "node,x_m,y_m,z_m[,...]" rows (a header first) into pos[3 nnodes],
+ * matching node names; the tow point's row may be left out. */
+static int read_shape(const ts_system *sys, const char *path, double *pos,
+                      ts_err *err)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return ts_fail(err, TS_EINVAL, "initial: cannot read '%s': %s", path,
+                       strerror(errno));
+    char *seen = calloc((size_t)sys->nnodes, 1);
+    if (!seen) {
+        fclose(f);
+        return ts_fail(err, TS_ENOMEM, "initial: out of memory");
+    }
+    char line[1024], name[2 * TS_NAME_MAX];
+    int lineno = 0, rc = TS_OK;
+    while (!rc && fgets(line, sizeof line, f)) {
+        lineno++;
+        line[strcspn(line, "\r\n")] = '\0';
+        if (line[0] == '#' || line[0] == '\0')
+            continue;
+        if (lineno == 1 && !strncmp(line, "node,", 5))
+            continue;
+        char *c1 = strchr(line, ',');
+        if (!c1) {
+            rc = ts_fail(err, TS_EINVAL, "initial: %s line %d: expected "
+                         "node,x_m,y_m,z_m", path, lineno);
+            break;
+        }
+        *c1 = '\0';
+        double v[3];
+        char *p = c1 + 1, *end;
+        for (int j = 0; j < 3 && !rc; j++) {
+            v[j] = strtod(p, &end);
+            if (end == p || !isfinite(v[j]) || (*end != ',' && *end != '\0'))
+                rc = ts_fail(err, TS_EINVAL, "initial: %s line %d: "
+                             "coordinate %d is not a number", path, lineno,
+                             j + 1);
+            p = *end ? end + 1 : end;
+        }
+        int k = 0;
+        for (; !rc && k < sys->nnodes; k++) {
+            ts_system_node_name(sys, k, name, sizeof name);
+            if (!strcmp(name, line))
+                break;
+        }
+        if (!rc && k == sys->nnodes)
+            rc = ts_fail(err, TS_EINVAL, "initial: %s line %d: '%.60s' is "
+                         "not a node of the scene", path, lineno, line);
+        if (!rc) {
+            memcpy(pos + 3 * k, v, sizeof v);
+            seen[k] = 1;
+        }
+    }
+    fclose(f);
+    for (int k = 1; !rc && k < sys->nnodes; k++)
+        if (!seen[k]) {
+            ts_system_node_name(sys, k, name, sizeof name);
+            rc = ts_fail(err, TS_EINVAL, "initial: %s has no row for node "
+                         "'%s'", path, name);
+        }
+    if (!rc && !seen[0])
+        memcpy(pos, sys->tow.point, 3 * sizeof(double));
+    free(seen);
+    return rc;
+}
+
+/* The resolved options of a simulation: the sample interval and the
+ * transient of their defaults. */
+static void sim_resolve(const ts_simulate_opts *s, ts_sim_opts *o,
+                        double *transient)
+{
+    *o = s->sim;
+    if (!(o->dt_sample > 0)) {
+        double dt = TS_SIMULATE_SAMPLE;
+        int idx;
+        if (s->excitation && ts_excitation_periodic(s->excitation, &idx)) {
+            double f = ts_excitation_signal(s->excitation, idx)->frequency;
+            dt = fmin(dt, 1.0 / (TS_SIMULATE_SAMPLES_PER_PERIOD * f));
+        }
+        o->dt_sample = fmin(dt, o->t_end);
+    }
+    *transient = isnan(s->transient) ? o->t_end / 2 : s->transient;
+}
+
+/* The output of a simulation: the named one, or the last sphere's .z
+ * (else the last node's). */
+static int sim_output(const ts_system *sys, const char *name, ts_output *out,
+                      ts_err *err)
+{
+    char def[2 * TS_NAME_MAX + 4];
+    if (!name || !name[0]) {
+        int node = sys->nnodes - 1;
+        for (int b = sys->nbodies - 1; b >= 0; b--)
+            if (sys->bodies[b].type == TS_BODY_SPHERE) {
+                node = ts_system_body_node(sys, b);
+                break;
+            }
+        ts_system_node_name(sys, node, def, sizeof def - 2);
+        strcat(def, ".z");
+        name = def;
+    }
+    int rc = ts_response_output_find(sys, name, out, err);
+    if (rc) {
+        ts_err_prefix(err, "output: ");
+        return rc;
+    }
+    if (out->kind != TS_OUT_POSITION)
+        return ts_fail(err, TS_EINVAL, "output: '%s' is a tension; the "
+                       "simulation reports positions <node>.x|y|z", name);
+    return TS_OK;
+}
+
+/* Everything a simulation needs that can be checked without running. */
+/* Physical memory of the machine, bytes (0: unknown). */
+static double memory_bytes(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? (double)pages * (double)size : 0.0;
+}
+
+/* An excitation faster than the run can resolve, and a history larger
+ * than memory, are refused before anything runs: a sample interval given
+ * must sample every periodic tow signal at least twice a period; without
+ * one, the 16 samples per period of the default must stay within
+ * TS_SIMULATE_AUTO_SAMPLES_MAX. */
+static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
+                            const ts_sim_opts *o, ts_err *err)
+{
+    const ts_excitation *ex = s->excitation;
+    for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
+        const ts_signal *sg = ts_excitation_signal(ex, i);
+        /* The fundamental (a crank's harmonics are small corrections). */
+        double f = sg->type == TS_SIGNAL_CRANK ||
+                           sg->type == TS_SIGNAL_SINE ||
+                           sg->type == TS_SIGNAL_SUM
+                       ? sg->frequency
+                       : 0.0;
+        if (!(f > 0))
+            continue;
+        double period = 1.0 / f;
+        if (s->sim.dt_sample > 0 && o->dt_sample > period / 2)
+            return ts_fail(err, TS_EINVAL, "sample: %g s cannot resolve the "
+                           "%g Hz excitation %s (period %g s): at most %g s, "
+                           "2 samples per period", o->dt_sample, f,
+                           ts_axis_name(sg->axis), period, period / 2);
+        double n = o->t_end * f * TS_SIMULATE_SAMPLES_PER_PERIOD;
+        if (!(s->sim.dt_sample > 0) && n > TS_SIMULATE_AUTO_SAMPLES_MAX)
+            return ts_fail(err, TS_EINVAL, "excite: the %g Hz excitation %s "
+                           "needs %.3g samples over the %g s run (%d per "
+                           "period), more than the %g a run takes without a "
+                           "sample interval given: shorten t_end, lower the "
+                           "frequency, or give the sample interval", f,
+                           ts_axis_name(sg->axis), n, o->t_end,
+                           TS_SIMULATE_SAMPLES_PER_PERIOD,
+                           TS_SIMULATE_AUTO_SAMPLES_MAX);
+    }
+    double samples = ceil(o->t_end / o->dt_sample) + 1;
+    double bytes = 8.0 * samples *
+                   (4.0 + 3.0 * sys->nnodes + sys->nlinks + TS_NINPUT);
+    double mem = memory_bytes();
+    if (mem > 0 && bytes > mem)
+        return ts_fail(err, TS_ENOMEM, "sample: out of memory for the "
+                       "history of %.3g samples of %d nodes and %d links "
+                       "(%.3g GB, the machine has %.3g GB): a coarser sample "
+                       "interval, a shorter t_end or fewer links",
+                       samples, sys->nnodes, sys->nlinks, bytes / 1e9,
+                       mem / 1e9);
+    return TS_OK;
+}
+
+static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
+                          ts_sim_opts *o, double *transient, ts_output *out,
+                          ts_err *err)
+{
+    sim_resolve(s, o, transient);
+    if (!(o->t_end > 0) || !isfinite(o->t_end))
+        return ts_fail(err, TS_EINVAL, "t_end: the run length must be > 0 "
+                       "s, got %g s", o->t_end);
+    if (o->dt_sample > o->t_end)
+        return ts_fail(err, TS_EINVAL, "sample: the sample interval %g s is "
+                       "longer than the run (%g s)", o->dt_sample, o->t_end);
+    if (s->compare && s->linear)
+        return ts_fail(err, TS_EINVAL, "linear: linear runs the linear model "
+                       "alone; compare runs both: give one");
+    if (!(*transient >= 0) || !(*transient < o->t_end))
+        return ts_fail(err, TS_EINVAL, "transient: must be in [0, %g) s (the "
+                       "run length), got %g s", o->t_end, *transient);
+    int rc = ts_sim_opts_check(o, err);
+    if (rc)
+        return rc;
+    if (s->initial == TS_INITIAL_SHAPE && !s->shape_file[0])
+        return ts_fail(err, TS_EINVAL, "initial: shape: needs a file name");
+    const ts_excitation *ex = s->excitation;
+    if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err))) {
+        ts_err_prefix(err, "excite: ");
+        return rc;
+    }
+    if ((rc = sim_output(sys, s->output, out, err)))
+        return rc;
+    if ((rc = check_resolution(sys, s, o, err)))
+        return rc;
+    /* Loads an excitation or a manoeuvre makes overflow: refused here,
+     * naming the option that brought them (the simulator refuses them
+     * too, naming only the input). */
+    {
+        ts_frame f0 = {sys->tow.speed, sys->tow.turn_rate, 0, 0,
+                       {sys->env.current[0], sys->env.current[1],
+                        sys->env.current[2]}};
+        ts_motion_bound mb, st;
+        ts_excitation_bound(ex, &f0, &mb);
+        if ((rc = ts_system_check_loads(sys, &mb, err))) {
+            ts_motion_bound_steady(sys, &st);
+            mb.tow_speed = mb.tow_accel = 0.0;
+            if (ts_system_check_loads(sys, &st, NULL))
+                ts_err_prefix(err, "simulate: ");
+            else if (ts_system_check_loads(sys, &mb, NULL))
+                ts_err_prefix(err, "manoeuvre: ");
+            else
+                ts_err_prefix(err, "excite: ");
+            return rc;
+        }
+    }
+    int use_linear = s->compare || s->linear;
+    const char *lw = s->compare ? "compare" : "linear";
+    if (use_linear && s->initial != TS_INITIAL_EQUILIBRIUM)
+        return ts_fail(err, TS_EINVAL, "initial: the linear model starts at "
+                       "the equilibrium, so %s needs the initial state "
+                       "'equilibrium'", lw);
+    if (use_linear && ex && ts_excitation_has_manoeuvre(ex))
+        return ts_fail(err, TS_EINVAL, "manoeuvre: the linear model has no "
+                       "frame inputs; a manoeuvre can only be simulated "
+                       "nonlinearly (drop %s)", lw);
+    /* What the comparison will need. */
+    int idx;
+    if (s->compare && ex && ts_excitation_periodic(ex, &idx)) {
+        double f = ts_excitation_signal(ex, idx)->frequency;
+        double period = 1.0 / f;
+        if (o->dt_sample > period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD)
+            return ts_fail(err, TS_EINVAL, "sample: the sample interval %g s "
+                           "is too coarse to compare at %g Hz; at most %g s "
+                           "(%d samples per period)", o->dt_sample, f,
+                           period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
+                           TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
+        if (o->t_end - *transient < period)
+            return ts_fail(err, TS_EINVAL, "transient: %g s are left after "
+                           "the transient, less than one period (%g s) of "
+                           "the %g Hz excitation", o->t_end - *transient,
+                           period, f);
+    }
+    if (s->sea.sea) {
+        ts_seaway w;
+        if ((rc = sea_seaway(sys, &s->sea, &w, err)))
+            return rc;
+        if (s->initial != TS_INITIAL_EQUILIBRIUM)
+            return ts_fail(err, TS_EINVAL, "initial: a sea state starts from "
+                           "the equilibrium (its statistics and spectral "
+                           "prediction are about it)");
+        if (s->components < 1)
+            return ts_fail(err, TS_EINVAL, "components: expected a whole "
+                           "number >= 1, got %d", s->components);
+        if (!isnan(s->fade_in) && !(s->fade_in >= 0 && isfinite(s->fade_in)))
+            return ts_fail(err, TS_EINVAL, "fade_in: expected a time >= 0 "
+                           "s, got %g s", s->fade_in);
+    }
+    if (s->need_values && !s->sea.sea) {
+        if (!ex || !ts_excitation_periodic(ex, &idx))
+            return ts_fail(err, TS_EINVAL, "excite: the amplitude ratio, "
+                           "mean offset and phase need a single periodic "
+                           "tow-point excitation (one sine or crank on "
+                           "tow.surge, tow.sway or tow.heave)");
+        double f = ts_excitation_signal(ex, idx)->frequency;
+        double period = 1.0 / f;
+        if (o->t_end - *transient < period * (1.0 - 1e-9))
+            return ts_fail(err, TS_EINVAL, "transient: %g s are left after "
+                           "the transient, less than one period (%g s) of "
+                           "the %g Hz excitation", o->t_end - *transient,
+                           period, f);
+        if (o->dt_sample >
+            period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD * (1.0 + 1e-9))
+            return ts_fail(err, TS_EINVAL, "sample: the sample interval %g s "
+                           "is too coarse for %g Hz; at most %g s (%d samples "
+                           "per period)", o->dt_sample, f,
+                           period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
+                           TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
+    }
+    if (s->initial == TS_INITIAL_SHAPE) {
+        double *pos = malloc(3 * (size_t)sys->nnodes * sizeof *pos);
+        if (!pos)
+            return ts_fail(err, TS_ENOMEM, "initial: out of memory");
+        rc = read_shape(sys, s->shape_file, pos, err);
+        free(pos);
+    }
+    return rc;
+}
+
+/* Key values of a simulation under a single periodic excitation: the
+ * output's amplitude ratio (relative to itself), mean offset from the
+ * equilibrium (m, scale the excitation amplitude) and phase (deg, scale
+ * 360), fitted with the tow motion over t >= transient of the nonlinear
+ * run. Solver error: rounding, SIM_ROUND_EPS eps sqrt(steps) of each
+ * value's scale, and the equilibrium's residual for the mean offset. A
+ * fit that cannot be made leaves NAN values (an error only when
+ * required). */
+static int sim_values(ts_result *r, int required, ts_err *err)
+{
+    const ts_excitation *ex = r->excitation;
+    int idx;
+    if (!ex || !ts_excitation_periodic(ex, &idx))
+        return TS_OK;
+    const ts_signal *sg = ts_excitation_signal(ex, idx);
+    int rc = values_alloc(r, 3, err);
+    if (rc)
+        return rc;
+    static const char *const suffix[3] = {"amplitude_ratio", "mean_offset",
+                                          "phase_deg"};
+    static const char *const unit[3] = {"1", "m", "deg"};
+    double scale[3] = {0.0, sg->amplitude, 360.0};
+    for (int v = 0; v < 3; v++)
+        value_name(&r->values[v], unit[v], scale[v], "%.70s.%s",
+                   r->output.name, suffix[v]);
+    const ts_history *h = r->nonlinear;
+    if (!h || !r->eq || r->status != TS_OK)
+        return TS_OK;
+    int first = 0;
+    while (first < h->nsamples && h->t[first] < r->transient - TIME_EPS)
+        first++;
+    int n = h->nsamples - first;
+    ts_err fe = {0};
+    if (n < 3) {
+        ts_fail(&fe, TS_EINVAL, "simulate: %d samples after the transient "
+                                "(%g s)", n, r->transient);
+        return required ? ts_fail(err, fe.code, "%s", fe.msg) : TS_OK;
+    }
+    double *buf = malloc(3 * (size_t)n * sizeof(double));
+    if (!buf)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    double *t = buf, *xo = buf + n, *xe = buf + 2 * n;
+    size_t stride = 3 * (size_t)h->nnodes;
+    const ts_output *out = &r->output;
+    for (int i = 0; i < n; i++) {
+        size_t s = (size_t)(first + i);
+        t[i] = h->t[s];
+        xo[i] = h->positions[stride * s + 3 * (size_t)out->node + out->comp];
+        xe[i] = h->input[TS_NINPUT * s + sg->axis];
+    }
+    double c, a, ph, ce, ae, phe;
+    rc = ts_compare_fit_sinusoid(t, xe, n, sg->frequency, &ce, &ae, &phe,
+                                 &fe);
+    if (rc == TS_OK)
+        rc = ts_compare_fit_sinusoid(t, xo, n, sg->frequency, &c, &a, &ph,
+                                     &fe);
+    free(buf);
+    if (rc != TS_OK)
+        return required ? ts_fail(err, rc, "%s", fe.msg) : TS_OK;
+    double eqv = r->eq->positions[3 * out->node + out->comp];
+    double vals[3] = {a / ae, c - eqv,
+                      ts_compare_wrap_deg((ph - phe) * 180.0 / M_PI)};
+    double L = total_length(r->sys);
+    double noise_scale[3] = {fabs(vals[0]), L, 360.0};
+    const ts_sim_stats *st = &r->nonlinear_stats;
+    double round = SIM_ROUND_EPS * DBL_EPSILON *
+                   sqrt((double)(st->steps + st->rejected + 1));
+    for (int v = 0; v < 3; v++) {
+        r->values[v].value = vals[v];
+        r->values[v].error.solver = round * noise_scale[v];
+    }
+    r->values[1].error.solver += EQ_NOISE_FACTOR *
+                                 fmax(r->eq->residual, EQ_NOISE_MIN_REL) * L;
+    return TS_OK;
+}
+
+/* The realisation of a simulation's sea, added to a copy of the request's
+ * excitation (r->sea_excitation, which r->excitation then points to). */
+/* The excitation of s with its sea's realisation added, into *out (a new
+ * excitation, NULL on failure), with the seaway and the realisation's
+ * settings. */
+static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
+                          ts_seaway *w, ts_sea_realisation *real,
+                          ts_excitation **out, ts_err *err)
+{
+    *out = NULL;
+    int rc = sea_seaway(sys, &s->sea, w, err);
+    if (rc)
+        return rc;
+    *out = ts_excitation_copy(s->excitation, err);
+    if (!*out)
+        return err && err->code ? err->code : TS_ENOMEM;
+    ts_sea_realisation_default(w, real);
+    real->seed = s->seed;
+    real->components = s->components;
+    if (!isnan(s->fade_in))
+        real->rise = s->fade_in;
+    rc = ts_seaway_excitation(w, real, *out, NULL, err);
+    if (rc)
+        ts_err_prefix(err, "sea: ");
+    return rc;
+}
+
+static int sea_realise(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+{
+    int rc = sea_excitation(r->sys, s, &r->seaway, &r->realisation,
+                            &r->sea_excitation, err);
+    if (!r->sea_excitation)
+        return rc;
+    r->has_sea = 1;
+    snprintf(r->rao_file, sizeof r->rao_file, "%s", s->sea.rao_file);
+    r->excitation = r->sea_excitation;
+    return rc;
+}
+
+/* After a simulation with a sea: the records' statistics over t >=
+ * transient, their key values (<output>.sigma and .mean_offset, with the
+ * statistical error as the solver's), and the spectral prediction over
+ * the realisation's band. */
+static int sea_records(ts_result *r, ts_err *err)
+{
+    const ts_history *h[2] = {r->nonlinear, r->linear};
+    ts_record_stats *st[2] = {&r->record_nonlinear, &r->record_linear};
+    int n = r->nonlinear ? r->nonlinear->nsamples : r->linear->nsamples;
+    double *x = malloc((size_t)(n > 0 ? n : 1) * sizeof *x);
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    int rc = TS_OK;
+    for (int i = 0; i < 2 && rc == TS_OK; i++) {
+        if (!h[i])
+            continue;
+        int m;
+        double dt;
+        rc = ts_record_from_history(h[i], &r->output, r->transient, x, &m,
+                                    &dt, err);
+        if (rc == TS_OK)
+            rc = ts_record_stats_compute(x, m, dt, st[i], err);
+        if (rc == TS_OK)
+            r->has_records |= 1 << i;
+        else
+            ts_err_prefix(err, "transient: the record after %g s: ",
+                          r->transient);
+    }
+    free(x);
+    if (rc == TS_OK && r->lin) {
+        double lo, hi;
+        ts_seastate_opts so;
+        ts_seastate_opts_default(&so);
+        rc = ts_seaway_band(&r->seaway, TS_SEA_REALISATION_TAIL, &lo, &hi,
+                            err);
+        so.omega_lo = lo;
+        so.omega_hi = hi;
+        so.duration = r->sim.t_end - r->transient;
+        if (rc == TS_OK)
+            rc = ts_seastate_compute(r->sys, r->lin, &r->seaway, &r->output,
+                                     &so, &r->seastate, err);
+        if (rc == TS_OK)
+            ts_trust_merge(&r->trust, "spectral prediction: ",
+                           &r->seastate->trust);
+    }
+    if (rc != TS_OK)
+        return rc;
+    const ts_record_stats *use =
+        r->has_records & 1 ? &r->record_nonlinear : &r->record_linear;
+    rc = values_alloc(r, 2, err);
+    if (rc)
+        return rc;
+    value_name(&r->values[0], "m", 0.0, "%.70s.sigma", r->output.name);
+    value_name(&r->values[1], "m", total_length(r->sys), "%.70s.mean_offset",
+               r->output.name);
+    r->values[0].value = use->sigma.value;
+    r->values[0].error.solver = use->sigma.error;
+    double eqv = r->eq ? r->eq->positions[3 * r->output.node +
+                                          r->output.comp]
+                       : NAN;
+    r->values[1].value = use->mean - eqv;
+    r->values[1].error.solver = use->mean_error;
+    double window = r->sim.t_end - r->transient;
+    if (use->corr_time > 0 && window < 20 * use->corr_time)
+        ts_trust_note(&r->trust, "the record after the transient is %g s, "
+                      "%.3g correlation times: sigma's statistical error is "
+                      "%.2g %%", window, window / use->corr_time,
+                      100 * use->sigma.error / use->sigma.value);
+    return TS_OK;
+}
+
+static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
+{
+    const ts_simulate_opts *s = &rq->simulate;
+    const ts_system *sys = r->sys;
+    r->excitation = s->excitation;
+    int rc = check_simulate(sys, s, &r->sim, &r->transient, &r->output, err);
+    if (rc == TS_OK && s->sea.sea)
+        rc = sea_realise(r, s, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_sim_opts *o = &r->sim;
+    if (!o->progress) {
+        o->progress = rq->progress;
+        o->progress_data = rq->progress_data;
+    }
+    ts_excitation *none = NULL;
+    const ts_excitation *ex = r->excitation;
+    if (!ex) {
+        ex = none = ts_excitation_alloc(err);
+        if (!ex)
+            return err && err->code ? err->code : TS_ENOMEM;
+    }
+    ts_kernel *k = ts_kernel_alloc(sys, err), *knl = NULL;
+    int n = k ? ts_kernel_nstate(k) : 0;
+    double *y0 = k ? calloc((size_t)n, sizeof *y0) : NULL;
+    double *pos = k ? calloc(3 * (size_t)sys->nnodes, sizeof *pos) : NULL;
+    if (!k)
+        rc = err && err->code ? err->code : TS_ENOMEM;
+    else if (!y0 || !pos)
+        rc = ts_fail(err, TS_ENOMEM, "simulate: out of memory for %d states",
+                     n);
+    /* Initial state. */
+    if (rc == TS_OK && s->initial == TS_INITIAL_EQUILIBRIUM) {
+        snprintf(r->initial, sizeof r->initial, "equilibrium");
+        rc = run_equilibrium(r, k, &rq->setup.equilibrium, err);
+        if (rc) {
+            ts_err_prefix(err, "simulate: the initial equilibrium: ");
+        } else {
+            memcpy(y0, r->eq->y, (size_t)n * sizeof *y0);
+            ts_trust_merge(&r->trust, "initial equilibrium: ", &r->eq_trust);
+        }
+    } else if (rc == TS_OK && s->initial == TS_INITIAL_RELEASED) {
+        snprintf(r->initial, sizeof r->initial,
+                 "released straight at rest, theta1 %.6g deg, theta2 %.6g "
+                 "deg",
+                 s->theta1 * 180 / M_PI, s->theta2 * 180 / M_PI);
+        rc = ts_sim_released_state(k, s->theta1, s->theta2, y0, err);
+    } else if (rc == TS_OK) {
+        snprintf(r->initial, sizeof r->initial, "shape from %.200s",
+                 s->shape_file);
+        rc = read_shape(sys, s->shape_file, pos, err);
+        if (!rc) {
+            rc = ts_sim_shape_state(k, pos, TS_SIMULATE_SHAPE_RTOL, y0, err);
+            if (rc)
+                ts_err_prefix(err, "initial: %s: ", s->shape_file);
+        }
+    }
+    int N = ts_sim_nsamples(o);
+    if (rc == TS_OK && (s->compare || s->linear || r->has_sea)) {
+        /* The linear model about the equilibrium, with its kernel: both
+         * runs then start from the linearization's charts (a sea's
+         * spectral prediction needs it too). */
+        r->lin = ts_linear_alloc(k, err);
+        ts_linearize_opts lo;
+        ts_linearize_opts_default(&lo);
+        /* The linear run needs the dense A and B at any size. */
+        if (s->compare || s->linear)
+            lo.model = TS_LIN_BOTH;
+        double t0 = wall_now();
+        rc = r->lin ? ts_linearize_equilibrium(k, r->eq, &lo, r->lin, err)
+                    : (err && err->code ? err->code : TS_ENOMEM);
+        r->lin_wall_s = wall_now() - t0;
+        if (r->lin)
+            r->evaluations += r->lin->evaluations;
+        if (rc == TS_OK && (s->compare || s->linear)) {
+            r->linear = ts_history_alloc(sys, N, err);
+            rc = r->linear ? ts_simulate_linear(k, r->lin, ex, NULL, o,
+                                                r->linear, &r->linear_stats,
+                                                err)
+                           : (err && err->code ? err->code : TS_ENOMEM);
+            r->evaluations += r->linear_stats.evaluations;
+        }
+        if (rc == TS_OK)
+            memcpy(y0, r->lin->y0, (size_t)n * sizeof *y0);
+    }
+    if (rc == TS_OK && !s->linear) {
+        knl = ts_kernel_clone(k, err);
+        r->nonlinear = knl ? ts_history_alloc(sys, N, err) : NULL;
+        rc = r->nonlinear ? ts_simulate(knl, ex, y0, o, r->nonlinear,
+                                        &r->nonlinear_stats, NULL, err)
+                          : (err && err->code ? err->code : TS_ENOMEM);
+        r->evaluations += r->nonlinear_stats.evaluations;
+    }
+    /* Health: the start, the linear model's kinks and the integrations'
+     * statistics (towstab/health.h). */
+    if (r->lin && r->lin->kink_tow && s->compare)
+        ts_trust_note(&r->trust, "the tow point is at the water surface: a "
+                                 "heave shifts the mean depth at first "
+                                 "order, which the linear model cannot "
+                                 "show");
+    if (r->nonlinear)
+        ts_health_simulation(o, &r->nonlinear_stats, &r->trust);
+    if (r->linear && o->linear_method != TS_LINSIM_EXPM)
+        ts_health_simulation(o, &r->linear_stats, &r->trust);
+    if (rc == TS_OK && s->compare) {
+        rc = ts_compare_histories(sys, r->lin, ex, r->nonlinear, r->linear,
+                                  &r->output, r->transient, &r->compare, err);
+        if (rc)
+            ts_err_prefix(err, "compare: ");
+        else
+            r->compared = 1;
+    }
+    if (rc == TS_OK && r->has_sea)
+        rc = sea_records(r, err);
+    else if (rc == TS_OK)
+        rc = sim_values(r, s->need_values, err);
+    else if (s->need_values)
+        sim_values(r, 0, NULL); /* names, NAN values */
+    free(y0);
+    free(pos);
+    ts_kernel_free(knl);
+    ts_kernel_free(k);
+    ts_excitation_free(none);
+    if (none)
+        r->excitation = NULL;
+    return rc;
+}
+
+/* ---- converge ---------------------------------------------------------- */
+
+/* A sweep's run: the pipeline of the study's analysis at one setting. */
+typedef struct sweep_ctx {
+    const ts_system *sys;
+    ts_request rq;      /* a shallow copy: the excitation is borrowed */
+    ts_conv_param param;
+} sweep_ctx;
+
+static void sweep_ctx_free(void *p) { free(p); }
+
+/* The row verdict of a modes run: the equilibrium's, the surface kink,
+ * the notes of the mode analysis, and the damping of the modes followed
+ * (a stiff axial mode far above them does not make their frequencies
+ * untrustworthy). */
+static void modes_row_trust(const ts_result *r, int follow, ts_trust *t)
+{
+    ts_trust_merge(t, NULL, &r->eq_trust);
+    if (!r->eigen)
+        return;
+    const ts_linear *lin = r->lin;
+    if (lin->kinks > lin->kink_tow && r->modes_trust.nreasons > 0)
+        ts_trust_fail(t, "%s", r->modes_trust.reasons[0]);
+    for (int i = 0; i < r->modes_trust.nnotes; i++)
+        ts_trust_note(t, "%s", r->modes_trust.notes[i]);
+    const ts_eigen *e = r->eigen;
+    for (int m = 0, k = 0; m < e->nmodes && k < follow; m++) {
+        const ts_mode *md = &e->modes[m];
+        if (!(md->im > 0) || !(md->damping_ratio < TS_CONV_MODE_DAMPING_MAX))
+            continue;
+        if (!r->mode_health[m].trustworthy)
+            ts_trust_fail(t, "mode%d (%.6g Hz): damping ratio %.3g +- %.2g "
+                             "is not resolved",
+                          k + 1, md->freq_hz, md->damping_ratio,
+                          r->mode_health[m].damping_error);
+        k++;
+    }
+}
+
+static int sweep_run(void *ctx, ts_conv_param p, double setting,
+                     double values[], double noise[], long *evaluations,
+                     ts_trust *trust, ts_err *err)
+{
+    sweep_ctx *x = ctx;
+    ts_request rq = x->rq;
+    ts_analysis_kind kind = rq.kind;
+    if (p == TS_CONV_STEP && kind != TS_ANALYSIS_MODES)
+        return ts_fail(err, TS_EINVAL, "%s: there is no linearization step "
+                       "to sweep; sweep links or tolerances",
+                       ts_analysis_name(kind));
+    if (p == TS_CONV_LINKS)
+        rq.setup.links = (int)setting;
+    else if (p == TS_CONV_STEP)
+        rq.modes.linearize.rel_step = setting;
+    else if (kind == TS_ANALYSIS_SIMULATE) {
+        ts_sim_opts *o = &rq.simulate.sim;
+        o->abs_tol = o->abs_tol * (setting / o->rel_tol);
+        o->rel_tol = setting;
+    } else
+        rq.setup.equilibrium.tol = setting;
+    ts_result *r = NULL;
+    int rc = ts_analysis_run(x->sys, &rq, &r, err);
+    if (!r)
+        return rc;
+    *evaluations += r->evaluations;
+    if (kind == TS_ANALYSIS_MODES)
+        modes_row_trust(r, rq.modes.follow, trust);
+    else {
+        /* Its verdict without the failure, which the row records. */
+        for (int i = 0; i < r->trust.nreasons; i++)
+            if (strncmp(r->trust.reasons[i], "the run failed: ", 16) != 0)
+                ts_trust_fail(trust, "%s", r->trust.reasons[i]);
+        for (int i = 0; i < r->trust.nnotes; i++)
+            ts_trust_note(trust, "%s", r->trust.notes[i]);
+    }
+    for (int v = 0; rc == TS_OK && v < r->nvalues; v++) {
+        const ts_value *V = &r->values[v];
+        values[v] = V->value;
+        noise[v] = isfinite(V->error.solver) ? V->error.solver : 0.0;
+        if (p == TS_CONV_STEP)
+            noise[v] = STEP_NOISE_REL *
+                       (V->scale > 0 ? fmax(fabs(V->value), V->scale)
+                                     : fabs(V->value));
+        if (p == TS_CONV_LINKS && kind == TS_ANALYSIS_SIMULATE) {
+            double sc = V->scale > 0 ? V->scale : fabs(V->value);
+            if (v == 1)
+                sc = total_length(r->sys); /* the mean offset, m */
+            noise[v] += SIM_TOL_NOISE * rq.simulate.sim.rel_tol * sc;
+        }
+    }
+    ts_result_free(r);
+    return rc;
+}
+
+int ts_analysis_sweep(const ts_system *sys, const ts_request *rq, int series,
+                      ts_conv_analysis *an, ts_err *err)
+{
+    memset(an, 0, sizeof *an);
+    ts_analysis_kind kind = rq->converge.analysis;
+    if (kind != TS_ANALYSIS_EQUILIBRIUM && kind != TS_ANALYSIS_MODES &&
+        kind != TS_ANALYSIS_SIMULATE)
+        return ts_fail(err, TS_EINVAL, "analysis: '%s' is not an analysis to "
+                       "converge; expected equilibrium, modes or simulate",
+                       ts_analysis_name(kind));
+    sweep_ctx *x = calloc(1, sizeof *x);
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "converge: out of memory");
+    x->sys = sys;
+    x->rq = *rq;
+    x->rq.kind = kind;
+    x->param = rq->converge.param;
+    ts_simulate_opts *s = &x->rq.simulate;
+    if (kind == TS_ANALYSIS_SIMULATE) {
+        s->need_values = 1;
+        s->compare = 0;
+        if (series < rq->converge.nintegrators)
+            s->sim.integrator = rq->converge.integrators[series];
+    }
+    if (kind == TS_ANALYSIS_MODES && !(rq->modes.follow >= 1 &&
+                                       rq->modes.follow <= 100)) {
+        free(x);
+        return ts_fail(err, TS_EINVAL, "modes: expected 1 to 100 modes to "
+                       "follow, got %d", rq->modes.follow);
+    }
+    /* The value names: those of a result, without running. */
+    ts_result *r = result_alloc(kind, err);
+    int rc = r ? TS_OK : TS_ENOMEM;
+    if (rc == TS_OK) {
+        r->sys = setup_system(sys, &x->rq.setup, err);
+        rc = r->sys ? TS_OK : (err && err->code ? err->code : TS_ENOMEM);
+    }
+    if (rc == TS_OK && kind == TS_ANALYSIS_EQUILIBRIUM)
+        rc = eq_values(r, err);
+    else if (rc == TS_OK && kind == TS_ANALYSIS_MODES)
+        rc = modes_values(r, x->rq.modes.follow, err);
+    else if (rc == TS_OK) {
+        rc = check_simulate(r->sys, s, &r->sim, &r->transient, &r->output,
+                            err);
+        r->excitation = s->excitation;
+        if (rc == TS_OK)
+            rc = sim_values(r, 0, err);
+    }
+    if (rc == TS_OK) {
+        an->values = calloc((size_t)r->nvalues, sizeof *an->values);
+        if (!an->values)
+            rc = ts_fail(err, TS_ENOMEM, "converge: out of memory");
+    }
+    if (rc != TS_OK) {
+        ts_result_free(r);
+        free(x);
+        return rc;
+    }
+    an->nvalues = r->nvalues;
+    for (int v = 0; v < r->nvalues; v++) {
+        snprintf(an->values[v].name, sizeof an->values[v].name, "%s",
+                 r->values[v].name);
+        snprintf(an->values[v].unit, sizeof an->values[v].unit, "%s",
+                 r->values[v].unit);
+        an->values[v].scale = r->values[v].scale;
+    }
+    ts_result_free(r);
+    snprintf(an->name, sizeof an->name, "%s", ts_analysis_name(kind));
+    an->ctx = x;
+    an->free_ctx = sweep_ctx_free;
+    an->run = sweep_run;
+    return TS_OK;
+}
+
+/* The sweep of a study: the request's, or the default one. */
+static void converge_sweep(const ts_converge_opts *c, ts_conv_param *param,
+                           double *settings, int *n)
+{
+    if (c->nsettings > 0) {
+        *param = c->param;
+        *n = c->nsettings;
+        memcpy(settings, c->settings, (size_t)*n * sizeof *settings);
+    } else {
+        *n = default_settings(c->analysis, param, settings);
+    }
+}
+
+static int check_converge(const ts_system *sys, const ts_request *rq,
+                          ts_err *err)
+{
+    const ts_converge_opts *c = &rq->converge;
+    ts_conv_param param;
+    double settings[TS_CONV_MAX_SETTINGS];
+    int n;
+    converge_sweep(c, &param, settings, &n);
+    static const char *const key[3] = {"links", "tolerances", "steps"};
+    int rc = ts_conv_check_settings(param, settings, n, key[param], err);
+    if (rc)
+        return rc;
+    if (param == TS_CONV_STEP && c->analysis != TS_ANALYSIS_MODES)
+        return ts_fail(err, TS_EINVAL, "steps: the linearization step "
+                       "applies to the modes analysis, not to %s",
+                       ts_analysis_name(c->analysis));
+    if (!(c->target > 0 && c->target < 1))
+        return ts_fail(err, TS_EINVAL, "target: expected a relative error in "
+                       "(0, 1), got %g", c->target);
+    if (c->nintegrators > 0 && c->analysis != TS_ANALYSIS_SIMULATE)
+        return ts_fail(err, TS_EINVAL, "integrators: applies to the simulate "
+                       "analysis, not to %s", ts_analysis_name(c->analysis));
+    for (int c1 = 0; param == TS_CONV_LINKS && c1 < sys->ncables; c1++)
+        if (sys->cables[c1].link_fraction)
+            return ts_fail(err, TS_EINVAL,
+                           "links: cables[%d] '%s' has link_lengths; a link "
+                           "sweep needs equal links (remove link_lengths, or "
+                           "sweep tolerances)",
+                           c1, sys->cables[c1].name);
+    if (c->analysis == TS_ANALYSIS_SIMULATE) {
+        const ts_simulate_opts *s = &rq->simulate;
+        if (s->initial != TS_INITIAL_EQUILIBRIUM)
+            return ts_fail(err, TS_EINVAL, "initial: the simulate study "
+                           "starts from the equilibrium (its values are the "
+                           "steady response to a periodic excitation)");
+        if (s->linear)
+            return ts_fail(err, TS_EINVAL, "linear: the simulate study sweeps "
+                           "the nonlinear integrator; drop linear");
+        int idx;
+        if (!s->excitation || !ts_excitation_periodic(s->excitation, &idx))
+            return ts_fail(err, TS_EINVAL, "excite: the simulate study needs "
+                           "a single periodic tow-point excitation (one sine "
+                           "or crank), e.g. --excite "
+                           "tow.heave:amplitude=0.1ft,frequency=1Hz");
+    }
+    ts_conv_analysis an;
+    rc = ts_analysis_sweep(sys, rq, 0, &an, err);
+    ts_conv_analysis_free(&an);
+    return rc;
+}
+
+static int pipeline_converge(ts_result *r, const ts_request *rq,
+                             const ts_system *base, ts_err *err)
+{
+    const ts_converge_opts *c = &rq->converge;
+    ts_conv_param param;
+    double settings[TS_CONV_MAX_SETTINGS];
+    int n;
+    converge_sweep(c, &param, settings, &n);
+    ts_request sub = *rq;
+    sub.converge.param = param;
+    int simulate = c->analysis == TS_ANALYSIS_SIMULATE;
+    int nseries = simulate && c->nintegrators > 0 ? c->nintegrators : 1;
+    if (simulate) {
+        r->excitation = rq->simulate.excitation;
+        sim_resolve(&rq->simulate, &r->sim, &r->transient);
+        int rc = sim_output(r->sys, rq->simulate.output, &r->output, err);
+        if (rc)
+            return rc;
+    }
+    int rc = TS_OK;
+    for (int k = 0; k < nseries && rc == TS_OK; k++) {
+        ts_conv_analysis an;
+        rc = ts_analysis_sweep(base, &sub, k, &an, err);
+        if (rc)
+            break;
+        if (!r->convergence) {
+            r->convergence = ts_convergence_alloc(an.name, param, an.nvalues,
+                                                  an.values, n * nseries,
+                                                  err);
+            if (r->convergence) {
+                r->convergence->progress = rq->progress;
+                r->convergence->progress_data = rq->progress_data;
+            }
+        }
+        if (!r->convergence) {
+            ts_conv_analysis_free(&an);
+            return err && err->code ? err->code : TS_ENOMEM;
+        }
+        char series[TS_CONV_NAME_MAX] = "";
+        if (simulate)
+            snprintf(series, sizeof series, "%s",
+                     ts_integrator_name(k < c->nintegrators
+                                            ? c->integrators[k]
+                                            : rq->simulate.sim.integrator));
+        int s = ts_convergence_add_series(r->convergence, series, err);
+        rc = s < 0 ? s
+                   : ts_convergence_sweep(r->convergence, s, &an, settings, n,
+                                          err);
+        ts_conv_analysis_free(&an);
+    }
+    /* Stopped on request: the runs so far, estimated as far as they go,
+     * are the result, marked incomplete by the status. */
+    ts_err stop = {0};
+    if (rc == TS_ECANCEL && r->convergence && r->convergence->nrows > 0) {
+        stop = *err;
+        rc = TS_OK;
+    }
+    if (rc == TS_OK)
+        rc = ts_convergence_estimate(r->convergence, c->target, err);
+    if (rc != TS_OK)
+        return rc;
+    if (stop.code) {
+        *err = stop;
+        return stop.code;
+    }
+    const ts_convergence *cv = r->convergence;
+    int nok = 0;
+    for (int i = 0; i < cv->nrows; i++) {
+        nok += cv->rows[i].status == TS_OK;
+        r->evaluations += cv->rows[i].evaluations;
+    }
+    /* Every run failed: nothing was learnt. */
+    if (nok == 0)
+        return ts_fail(err, TS_ECONV, "converge: every run failed (first: "
+                       "%s)", cv->rows[0].message);
+    /* The verdict of the finest runs: their notes. */
+    int *idx = malloc((size_t)cv->nrows * sizeof *idx);
+    if (!idx)
+        return ts_fail(err, TS_ENOMEM, "converge: out of memory");
+    ts_convergence_sorted_rows(cv, idx);
+    const ts_conv_row *fin = &cv->rows[idx[cv->nrows - 1]];
+    for (int i = 0; i < fin->trust.nnotes; i++)
+        ts_trust_note(&r->trust, "finest run: %s", fin->trust.notes[i]);
+    free(idx);
+    if (cv->recommended < 0)
+        ts_trust_note(&r->trust, "no trustworthy setting meets the target "
+                                 "%.3g", cv->target);
+    return TS_OK;
+}
+
+/* ---- the entry points -------------------------------------------------- */
+
+static int check_kind(const ts_system *sys, const ts_request *rq,
+                      ts_err *err)
+{
+    switch (rq->kind) {
+    case TS_ANALYSIS_EQUILIBRIUM:
+        return TS_OK;
+    case TS_ANALYSIS_MODES:
+        if (rq->modes.count < 0)
+            return ts_fail(err, TS_EINVAL, "count: expected a whole number "
+                           ">= 1, got %d", rq->modes.count);
+        if (!(rq->modes.eigen.target_hz >= 0) ||
+            !isfinite(rq->modes.eigen.target_hz))
+            return ts_fail(err, TS_EINVAL, "near: expected a frequency >= 0 "
+                           "Hz, got %g Hz", rq->modes.eigen.target_hz);
+        {
+            /* The count and method against the number of states, before
+             * the equilibrium runs. */
+            ts_kernel *k = ts_kernel_alloc(sys, err);
+            if (!k)
+                return err && err->code ? err->code : TS_ENOMEM;
+            int n = ts_kernel_nstate(k);
+            ts_kernel_free(k);
+            ts_eigen_opts o = modes_eigen_opts(&rq->modes, n);
+            int rc = ts_eigen_check(n, &o, err);
+            if (rc != TS_OK)
+                ts_err_prefix(err, "count: ");
+            return rc;
+        }
+    case TS_ANALYSIS_RESPONSE: {
+        int input;
+        ts_output out;
+        return check_response(sys, &rq->response, &input, &out, err);
+    }
+    case TS_ANALYSIS_SIMULATE: {
+        ts_sim_opts o;
+        double transient;
+        ts_output out;
+        return check_simulate(sys, &rq->simulate, &o, &transient, &out, err);
+    }
+    case TS_ANALYSIS_CONVERGE:
+        return TS_OK; /* checked on the base system (check_converge) */
+    }
+    return ts_fail(err, TS_EINVAL, "analysis: unknown kind %d",
+                   (int)rq->kind);
+}
+
+int ts_analysis_check(const ts_system *sys, const ts_request *rq,
+                      ts_err *err)
+{
+    ts_system *s = setup_system(sys, &rq->setup, err);
+    if (!s)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int rc = check_kind(s, rq, err);
+    ts_system_free(s);
+    if (rc == TS_OK && rq->kind == TS_ANALYSIS_CONVERGE)
+        rc = check_converge(sys, rq, err);
+    return rc;
+}
+
+int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
+                     ts_cost *e, ts_err *err)
+{
+    memset(e, 0, sizeof *e);
+    if (rq->kind != TS_ANALYSIS_SIMULATE && rq->kind != TS_ANALYSIS_MODES)
+        return TS_OK;
+    ts_system *s = setup_system(sys, &rq->setup, err);
+    if (!s)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int rc = TS_OK;
+    if (rq->kind == TS_ANALYSIS_SIMULATE && !rq->simulate.linear) {
+        ts_sim_opts o;
+        double transient;
+        sim_resolve(&rq->simulate, &o, &transient);
+        /* With a sea, its realisation is part of the excitation. */
+        ts_excitation *ex = NULL;
+        if (rq->simulate.sea.sea) {
+            ts_seaway w;
+            ts_sea_realisation real;
+            rc = sea_excitation(s, &rq->simulate, &w, &real, &ex, err);
+        }
+        if (rc == TS_OK)
+            rc = ts_cost_simulate(s, ex ? ex : rq->simulate.excitation, &o,
+                                  e, err);
+        ts_excitation_free(ex);
+    } else if (rq->kind == TS_ANALYSIS_MODES) {
+        ts_kernel *k = ts_kernel_alloc(s, err);
+        int n = k ? ts_kernel_nstate(k) : 0;
+        ts_kernel_free(k);
+        ts_eigen_opts o = modes_eigen_opts(&rq->modes, n);
+        rc = k ? ts_cost_modes(s, n, ts_eigen_method(n, &o), e, err)
+               : (err && err->code ? err->code : TS_ENOMEM);
+    }
+    ts_system_free(s);
+    return rc;
+}
+
+int ts_analysis_run(const ts_system *sys, const ts_request *rq,
+                    ts_result **out, ts_err *err)
+{
+    double t0 = wall_now();
+    ts_err e = {0};
+    *out = result_alloc(rq->kind, err);
+    if (!*out)
+        return TS_ENOMEM;
+    ts_result *r = *out;
+    r->sys = setup_system(sys, &rq->setup, &e);
+    int rc = r->sys ? check_kind(r->sys, rq, &e) : (e.code ? e.code
+                                                           : TS_ENOMEM);
+    if (rc == TS_OK && rq->kind == TS_ANALYSIS_CONVERGE)
+        rc = check_converge(sys, rq, &e);
+    if (rc == TS_OK) {
+        switch (rq->kind) {
+        case TS_ANALYSIS_EQUILIBRIUM:
+            rc = pipeline_equilibrium(r, rq, &e);
+            break;
+        case TS_ANALYSIS_MODES: rc = pipeline_modes(r, rq, &e); break;
+        case TS_ANALYSIS_RESPONSE: rc = pipeline_response(r, rq, &e); break;
+        case TS_ANALYSIS_SIMULATE: rc = pipeline_simulate(r, rq, &e); break;
+        case TS_ANALYSIS_CONVERGE:
+            rc = pipeline_converge(r, rq, sys, &e);
+            break;
+        }
+    }
+    return finish(r, rc, &e, err, t0);
+}

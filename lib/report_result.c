@@ -1,0 +1,269 @@
+/* report_result.c: a result of any analysis as JSON and CSV
+ * (towstab/report_result.h). Each kind is serialised by the writers of
+ * its parts (report.c, report_linear.c, report_time.c,
+ * report_converge.c); the keys every result shares are added here, once. */
+#include "towstab/report_result.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "towstab/report.h"
+#include "towstab/report_converge.h"
+#include "towstab/report_linear.h"
+#include "towstab/report_seastate.h"
+#include "towstab/report_time.h"
+
+/* A JSON number, or null for a value that is not finite. */
+static json_t *num(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+/* Set key of o to the trust of t (replacing what is there). */
+static void set_trust(json_t *o, const ts_trust *t)
+{
+    json_t *tj = ts_report_trust_json(t);
+    if (tj) {
+        json_object_update(o, tj);
+        json_decref(tj);
+    }
+}
+
+/* The equilibrium part, with its own verdict. */
+static json_t *eq_json(const ts_result *r, const ts_trust *t)
+{
+    return r->eq && r->eq_attempted
+               ? ts_report_equilibrium_json(r->sys, r->eq, r->eq_wall_s, t)
+               : NULL;
+}
+
+static json_t *modes_json(const ts_result *r, int flags)
+{
+    if (!r->eigen || !r->mode_health)
+        return json_object();
+    json_t *j = ts_report_modes_json(r->sys, r->lin, r->eigen, 0);
+    if (j && ts_report_modes_health_json(j, r->eigen, r->mode_health,
+                                         &r->trust) != TS_OK) {
+        json_decref(j);
+        return NULL;
+    }
+    if (j)
+        json_object_set_new(j, "linearization",
+                            ts_report_linear_json(r->lin,
+                                                  flags & TS_REPORT_MATRICES));
+    return j;
+}
+
+/* The sea state of a response or a simulation: the spectral result with
+ * the RAO file (and, with `points`, the spectra). */
+static json_t *sea_json(const ts_result *r, int points)
+{
+    json_t *j = r->seastate
+                    ? ts_report_seastate_json(r->seastate, &r->seaway, points)
+                    : json_object();
+    if (j) {
+        json_object_set_new(j, "rao_file", json_string(r->rao_file));
+        if (!json_object_get(j, "sea"))
+            json_object_set_new(j, "sea", ts_report_sea_json(r->seaway.sea));
+    }
+    return j;
+}
+
+/* A simulation's sea: the realisation, the records' statistics and the
+ * spectral prediction over the realisation's band. */
+static json_t *sim_sea_json(const ts_result *r)
+{
+    json_t *j = json_object(), *rec = json_object();
+    if (!j || !rec) {
+        json_decref(j);
+        json_decref(rec);
+        return NULL;
+    }
+    if (r->has_records & 1)
+        json_object_set_new(rec, "nonlinear",
+                            ts_report_record_json(&r->record_nonlinear));
+    if (r->has_records & 2)
+        json_object_set_new(rec, "linear",
+                            ts_report_record_json(&r->record_linear));
+    json_object_set_new(j, "seed", json_integer((json_int_t)r->realisation.seed));
+    json_object_set_new(j, "components",
+                        json_integer(r->realisation.components));
+    json_object_set_new(j, "fade_in_s", num(r->realisation.rise));
+    json_object_set_new(j, "transient_s", num(r->transient));
+    json_object_set_new(j, "records", rec);
+    json_object_set_new(j, "spectral", sea_json(r, 0));
+    return j;
+}
+
+static json_t *simulate_json(const ts_result *r, int flags)
+{
+    const ts_system *sys = r->sys;
+    json_t *j = json_object();
+    if (!j || !sys)
+        return j;
+    int node = flags & TS_REPORT_OUTPUT_ONLY ? r->output.node : -1;
+    json_object_set_new(j, "scene", json_string(sys->name));
+    json_object_set_new(j, "nlinks", json_integer(sys->nlinks));
+    json_object_set_new(j, "output", json_string(r->output.name));
+    json_object_set_new(j, "t_end", json_real(r->sim.t_end));
+    json_object_set_new(j, "sample", json_real(r->sim.dt_sample));
+    json_object_set_new(j, "initial", json_string(r->initial));
+    json_object_set_new(j, "excitation",
+                        r->excitation ? ts_report_excitation_json(r->excitation)
+                                      : json_array());
+    if (r->nonlinear) {
+        json_t *o = json_object();
+        json_object_set_new(o, "stats",
+                            ts_report_sim_stats_json(
+                                &r->nonlinear_stats,
+                                ts_integrator_name(r->sim.integrator)));
+        json_object_set_new(o, "rel_tol", json_real(r->sim.rel_tol));
+        json_object_set_new(o, "abs_tol", json_real(r->sim.abs_tol));
+        json_object_set_new(o, "history",
+                            ts_report_history_json(sys, r->nonlinear, node));
+        json_object_set_new(j, "nonlinear", o);
+    }
+    if (r->linear) {
+        json_t *o = json_object();
+        json_object_set_new(
+            o, "stats",
+            ts_report_sim_stats_json(&r->linear_stats,
+                                     r->sim.linear_method == TS_LINSIM_EXPM
+                                         ? "expm"
+                                         : ts_integrator_name(
+                                               r->sim.integrator)));
+        json_object_set_new(o, "kinematics",
+                            json_string(r->sim.kinematics == TS_KIN_LINEAR
+                                            ? "linear"
+                                            : "nonlinear"));
+        json_object_set_new(o, "history",
+                            ts_report_history_json(sys, r->linear, node));
+        json_object_set_new(j, "linear", o);
+    }
+    if (r->compared)
+        json_object_set_new(j, "compare", ts_report_compare_json(&r->compare));
+    if (r->has_sea)
+        json_object_set_new(j, "sea", sim_sea_json(r));
+    /* Final positions of the bodies (the nonlinear run when there is
+     * one). */
+    const ts_history *hf = r->nonlinear ? r->nonlinear : r->linear;
+    if (hf && hf->nsamples > 0) {
+        json_t *bodies = json_array();
+        const double *p = hf->positions +
+                          3 * (size_t)hf->nnodes * (size_t)(hf->nsamples - 1);
+        for (int b = 0; b < sys->nbodies; b++) {
+            const double *q = p + 3 * ts_system_body_node(sys, b);
+            json_array_append_new(bodies,
+                                  json_pack("{s:s,s:f,s:f,s:f}", "name",
+                                            sys->bodies[b].name, "x", q[0],
+                                            "y", q[1], "z", q[2]));
+        }
+        json_object_set_new(j, "final_t",
+                            json_real(hf->t[hf->nsamples - 1]));
+        json_object_set_new(j, "final_bodies", bodies);
+    }
+    return j;
+}
+
+static json_t *converge_json(const ts_result *r)
+{
+    if (!r->convergence)
+        return json_object();
+    json_t *j = ts_report_convergence_json(r->convergence);
+    if (j && r->excitation) {
+        json_t *o = json_pack("{s:s,s:f,s:f,s:f,s:f,s:f}", "output",
+                              r->output.name, "t_end", r->sim.t_end,
+                              "sample", r->sim.dt_sample, "transient",
+                              r->transient, "rel_tol", r->sim.rel_tol,
+                              "abs_tol", r->sim.abs_tol);
+        json_t *ej = ts_report_excitation_json(r->excitation);
+        if (o && ej)
+            json_object_set_new(o, "excitation", ej);
+        else
+            json_decref(ej);
+        if (!o || json_object_set_new(j, "simulation", o) != 0) {
+            json_decref(j);
+            return NULL;
+        }
+    }
+    return j;
+}
+
+static json_t *key_values_json(const ts_result *r)
+{
+    json_t *a = json_array();
+    for (int i = 0; a && i < r->nvalues; i++) {
+        const ts_value *v = &r->values[i];
+        json_array_append_new(
+            a, json_pack("{s:s,s:s,s:o,s:{s:o,s:o}}", "name", v->name, "unit",
+                         v->unit, "value", num(v->value), "error",
+                         "discretisation", num(v->error.discretisation),
+                         "solver", num(v->error.solver)));
+    }
+    return a;
+}
+
+json_t *ts_report_result_json(const ts_result *r, int flags)
+{
+    json_t *j = NULL;
+    switch (r->kind) {
+    case TS_ANALYSIS_EQUILIBRIUM:
+        j = eq_json(r, &r->trust);
+        if (!j)
+            j = json_object();
+        break;
+    case TS_ANALYSIS_MODES: j = modes_json(r, flags); break;
+    case TS_ANALYSIS_RESPONSE:
+        j = r->has_sea    ? sea_json(r, 1)
+            : r->response ? ts_report_response_json(r->response)
+                          : json_object();
+        break;
+    case TS_ANALYSIS_SIMULATE: j = simulate_json(r, flags); break;
+    case TS_ANALYSIS_CONVERGE: j = converge_json(r); break;
+    }
+    if (!j)
+        return NULL;
+    if (r->kind == TS_ANALYSIS_MODES || r->kind == TS_ANALYSIS_RESPONSE) {
+        json_t *e = eq_json(r, &r->eq_trust);
+        if (e)
+            json_object_set_new(j, "equilibrium", e);
+    }
+    json_object_set_new(j, "type", json_string(ts_analysis_name(r->kind)));
+    json_object_set_new(j, "completed", json_boolean(r->completed));
+    if (r->status != TS_OK)
+        json_object_set_new(j, "error", json_string(r->error));
+    set_trust(j, &r->trust);
+    json_object_set_new(j, "key_values", key_values_json(r));
+    return j;
+}
+
+int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
+{
+    switch (r->kind) {
+    case TS_ANALYSIS_EQUILIBRIUM:
+        if (r->eq && r->eq->converged)
+            return ts_report_equilibrium_csv(r->sys, r->eq, path, err);
+        break;
+    case TS_ANALYSIS_MODES:
+        if (r->eigen)
+            return ts_report_modes_csv(r->sys, r->lin, r->eigen, path, err);
+        break;
+    case TS_ANALYSIS_RESPONSE:
+        if (r->seastate)
+            return ts_report_seastate_csv(r->seastate, path, err);
+        if (r->response)
+            return ts_report_response_csv(r->response, path, err);
+        break;
+    case TS_ANALYSIS_SIMULATE:
+        if (r->nonlinear || r->linear)
+            return ts_report_history_csv(r->sys, r->nonlinear, r->linear,
+                                         path, err);
+        break;
+    case TS_ANALYSIS_CONVERGE:
+        if (r->convergence)
+            return ts_report_convergence_csv(r->convergence, path, err);
+        break;
+    }
+    return ts_fail(err, TS_EINVAL, "%s: the %s result has no table to write",
+                   path, ts_analysis_name(r->kind));
+}

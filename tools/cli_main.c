@@ -1,0 +1,442 @@
+/* cli_main.c: parse -> run -> print for every analysis command (cli.h).
+ *
+ * The command line of `towstab KIND` is made from the analysis' option
+ * table (towstab/options.h): every row is --name (with '-' for '_'), a
+ * boolean also --no-name; then the outputs (--json, --csv, --plot,
+ * --units, --quiet) and the command's extras. Options not given on the
+ * command line come from the scene's first entry of the command's type,
+ * else their defaults (one precedence rule; a convergence study of a
+ * simulation also takes the scene's first simulate entry, below its own).
+ * The library checks the request against the system before anything
+ * runs, runs the pipeline, and the command prints the result and writes
+ * its files. */
+#include "cli.h"
+
+#include <getopt.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "towstab/report_result.h"
+
+/* getopt codes: table rows, their --no- forms, the extras. */
+enum { CODE_ROW = 1000, CODE_NO = 2000, CODE_EXTRA = 3000 };
+/* Checks of a request a scene value may yield in, at most. */
+#define MAX_YIELDS 16
+
+static int nextras(const cli_command *cmd)
+{
+    int n = 0;
+    while (cmd->extras && cmd->extras[n].name && n < CLI_EXTRA_MAX)
+        n++;
+    return n;
+}
+
+void cli_usage(const cli_command *cmd, FILE *f)
+{
+    int n;
+    const ts_option *t = ts_options(cmd->kind, &n);
+    fprintf(f, "usage: towstab %s SCENE [options]\n  %s\n", cmd->name,
+            cmd->summary);
+    fprintf(f, "options (also keys of the scene's '%s' entries; a plain "
+               "number is SI):\n", cmd->name);
+    for (int i = 0; i < n; i++) {
+        char name[TS_NAME_MAX], def[128], lim[256], left[2 * TS_NAME_MAX + 16];
+        ts_option_cli_name(&t[i], name, sizeof name);
+        ts_option_default_text(&t[i], cmd->kind, def, sizeof def);
+        ts_option_limits_text(&t[i], lim, sizeof lim);
+        if (t[i].type == TS_OPT_BOOL)
+            snprintf(left, sizeof left, "--%s, --no-%s", name, name);
+        else
+            snprintf(left, sizeof left, "--%s %s", name, t[i].arg);
+        fprintf(f, "  %-26s %s", left, t[i].help);
+        if (def[0] && t[i].type != TS_OPT_BOOL)
+            fprintf(f, " [default %s]", def);
+        if (lim[0] && !t[i].choices)
+            fprintf(f, " (%s)", lim);
+        if (t[i].flags & TS_OPT_REPEAT)
+            fprintf(f, " (repeatable)");
+        fprintf(f, "\n");
+    }
+    fprintf(f, "outputs:\n"
+               "  %-26s %s\n  %-26s %s\n  %-26s %s\n  %-26s %s\n  %-26s %s\n",
+            "--json FILE", "the result as JSON ('-' for standard output)",
+            "--csv FILE", "the result's table as CSV", "--plot DIR",
+            "draw the pictures into DIR (created)", "--units U",
+            "units of the pictures: si (default) or imperial", "--quiet",
+            "print the summary only");
+    for (int k = 0; k < nextras(cmd); k++) {
+        char left[96];
+        snprintf(left, sizeof left, "--%s%s%s", cmd->extras[k].name,
+                 cmd->extras[k].has_arg ? " " : "",
+                 cmd->extras[k].has_arg ? cmd->extras[k].arg : "");
+        fprintf(f, "  %-26s %s\n", left, cmd->extras[k].help);
+    }
+}
+
+void cli_options_markdown(FILE *f)
+{
+    for (int k = 0; k < TS_ANALYSIS_COUNT; k++) {
+        int n;
+        const ts_option *t = ts_options(k, &n);
+        fprintf(f, "### Options of %s\n\n", ts_analysis_name(k));
+        fprintf(f, "| option | scene key | unit | default | range | "
+                   "meaning |\n|---|---|---|---|---|---|\n");
+        for (int i = 0; i < n; i++) {
+            char name[TS_NAME_MAX], def[128], lim[256];
+            ts_option_cli_name(&t[i], name, sizeof name);
+            ts_option_default_text(&t[i], k, def, sizeof def);
+            ts_option_limits_text(&t[i], lim, sizeof lim);
+            fprintf(f, "| `--%s`%s | `%s` | %s | %s | %s | %s%s%s |\n", name,
+                    t[i].type == TS_OPT_BOOL ? ", `--no-` form" : "",
+                    t[i].name,
+                    t[i].type == TS_OPT_QUANTITY ? t[i].unit : "",
+                    def[0] ? def : "see meaning", lim[0] ? lim : "",
+                    t[i].help,
+                    t[i].flags & TS_OPT_REPEAT ? "; repeatable" : "",
+                    t[i].only ? (t[i].only - 1 == TS_ANALYSIS_MODES
+                                     ? " (a study of modes)"
+                                     : " (a study of simulate)")
+                              : "");
+        }
+        fprintf(f, "\n");
+    }
+}
+
+/* The related entry of a study: the scene's first simulate entry, when the
+ * study's analysis is simulate. */
+static int add_related(ts_optset *o, const ts_scene *scene, ts_err *err)
+{
+    const char *an = ts_optset_text(o, "analysis");
+    if (!an || strcmp(an, "simulate") != 0)
+        return TS_OK;
+    for (int i = 0; i < scene->nanalyses; i++)
+        if (!strcmp(scene->analyses[i].type, "simulate"))
+            return ts_optset_give_entry(o, &scene->analyses[i], i,
+                                        scene->path, TS_OPTSET_RELATED,
+                                        TS_SEC_SIMULATE, err);
+    return TS_OK;
+}
+
+ts_optset *cli_entry_options(const ts_scene *scene, int kind, int index,
+                             int *status)
+{
+    ts_err err = {0};
+    ts_optset *o = ts_optset_alloc(kind, &err);
+    int rc = o ? TS_OK : TS_ENOMEM;
+    if (!rc && index >= 0)
+        rc = ts_optset_give_entry(o, &scene->analyses[index], index,
+                                  scene->path, TS_OPTSET_SCENE, -1, &err);
+    if (!rc && kind == TS_ANALYSIS_CONVERGE)
+        rc = add_related(o, scene, &err);
+    if (rc) {
+        *status = cli_report(&err, rc);
+        ts_optset_free(o);
+        return NULL;
+    }
+    *status = 0;
+    return o;
+}
+
+/* Apply the set up to `max` and check against the system. */
+static int request_check(cli_run *c, int max, ts_request *rq, ts_err *err)
+{
+    ts_request_init(rq, c->cmd->kind);
+    int rc = ts_optset_apply(c->opts, max, c->units, rq, err);
+    if (rc == TS_OK)
+        rc = ts_analysis_check(c->scene->system, rq, err);
+    return rc;
+}
+
+int cli_prepare(cli_run *c)
+{
+    ts_err err = {0};
+    ts_request_init(&c->rq, c->cmd->kind);
+    int rc = ts_optset_apply(c->opts, TS_OPTSET_COMMAND, c->units, &c->rq,
+                             &err);
+    if (rc)
+        return cli_report(&err, rc);
+    for (int k = 0; k < MAX_YIELDS; k++) {
+        ts_err_clear(&err);
+        rc = ts_analysis_check(c->scene->system, &c->rq, &err);
+        if (rc == TS_OK)
+            break;
+        /* A scene value that the command line's values contradict (and
+         * that is fine without them) yields to its default. */
+        const char *key = ts_optset_yields(c->opts, &err);
+        int top = ts_optset_top(c->opts);
+        ts_request alone;
+        ts_err aerr = {0};
+        int ok_alone = key && request_check(c, top - 1, &alone, &aerr) ==
+                                  TS_OK;
+        if (key)
+            ts_request_clear(&alone);
+        if (!ok_alone) {
+            ts_optset_locate(c->opts, &err);
+            return cli_report(&err, rc);
+        }
+        ts_optset_locate(c->opts, &err);
+        printf("note: %s; with the command line's options this scene value "
+               "does not hold, so its default is used\n",
+               err.msg);
+        char name[TS_NAME_MAX];
+        snprintf(name, sizeof name, "%s", key);
+        ts_optset_drop(c->opts, name);
+        ts_request_clear(&c->rq);
+        rc = ts_optset_apply(c->opts, TS_OPTSET_COMMAND, c->units, &c->rq,
+                             &err);
+        if (rc)
+            return cli_report(&err, rc);
+    }
+    if (rc)
+        return cli_report(&err, rc);
+    /* Long runs poll SIGINT and SIGTERM and show their progress. */
+    c->rq.progress = cli_progress;
+    return c->cmd->prepare ? c->cmd->prepare(c) : 0;
+}
+
+/* A failed run writes its JSON and CSV when it has a result of its own
+ * kind to show (an equilibrium that did not converge, the history so far,
+ * the runs of a study stopped on request). */
+static int has_partial(const ts_result *r)
+{
+    return (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->eq_attempted) ||
+           (r->kind == TS_ANALYSIS_SIMULATE && (r->nonlinear || r->linear)) ||
+           (r->kind == TS_ANALYSIS_CONVERGE && r->status == TS_ECANCEL &&
+            r->convergence && r->convergence->estimated);
+}
+
+/* A run estimated to take longer than this (s) is announced first, with
+ * what would shorten it (towstab/cost.h). */
+#define ANNOUNCE_S 60.0
+
+int cli_execute(cli_run *c, json_t **result)
+{
+    ts_err err = {0};
+    ts_result *r = NULL;
+    ts_cost cost;
+    if (ts_analysis_cost(c->scene->system, &c->rq, &cost, NULL) == TS_OK &&
+        cost.seconds > ANNOUNCE_S) {
+        fprintf(stderr, "towstab: warning: %s is estimated to take %s; to "
+                        "shorten it: %s (Ctrl-C stops it, keeping what it "
+                        "has)\n",
+                ts_analysis_name(c->rq.kind), cost.what, cost.reduce);
+        fflush(stderr);
+    }
+    int rc = ts_analysis_run(c->scene->system, &c->rq, &r, &err);
+    cli_progress_done();
+    if (!r)
+        return cli_report(&err, rc);
+    c->cmd->print(c, r);
+    int status = 0;
+    if (rc != TS_OK) {
+        ts_optset_locate(c->opts, &err);
+        status = cli_report(&err, rc);
+        /* The JSON gives the reason standard error gave (the option and
+         * the scene file located in it). */
+        snprintf(r->error, sizeof r->error, "%s", err.msg);
+    }
+    ts_err werr = {0};
+    int write = status == 0 || has_partial(r);
+    if ((c->json && write) || result) {
+        json_t *j = ts_report_result_json(r, c->json_flags);
+        if (j && cli_stop_signal_name())
+            json_object_set_new(j, "interrupted",
+                                json_string(cli_stop_signal_name()));
+        if (!j) {
+            ts_fail(&werr, TS_ENOMEM, "%s: out of memory for the JSON",
+                    c->json ? c->json : ts_analysis_name(r->kind));
+            status = status ? status : cli_report(&werr, werr.code);
+        } else if (c->json && write &&
+                   cli_write_json(j, c->json, &werr) != TS_OK) {
+            int st = cli_report(&werr, werr.code);
+            status = status ? status : st;
+        }
+        if (result)
+            *result = j;
+        else
+            json_decref(j);
+    }
+    if (c->csv && write && (status == 0 || has_partial(r)) &&
+        ts_report_result_csv(r, c->csv, &werr) != TS_OK) {
+        int st = cli_report(&werr, werr.code);
+        status = status ? status : st;
+    }
+    if (c->cmd->draw) {
+        int st = c->cmd->draw(c, r);
+        status = status ? status : st;
+    }
+    ts_result_free(r);
+    return status;
+}
+
+void cli_run_free(cli_run *c)
+{
+    if (c->cmd && c->cmd->release)
+        c->cmd->release(c);
+    ts_request_clear(&c->rq);
+    ts_optset_free(c->opts);
+    c->opts = NULL;
+}
+
+/* The first entry of type `name`, or -1. */
+static int first_entry(const ts_scene *scene, const char *name)
+{
+    for (int i = 0; i < scene->nanalyses; i++)
+        if (!strcmp(scene->analyses[i].type, name))
+            return i;
+    return -1;
+}
+
+int cli_main(const cli_command *cmd, int argc, char **argv)
+{
+    int n;
+    const ts_option *t = ts_options(cmd->kind, &n);
+    int ne = nextras(cmd);
+    struct option *lo = calloc((size_t)(2 * n + ne + 8), sizeof *lo);
+    char (*names)[TS_NAME_MAX + 3] = calloc((size_t)(2 * n),
+                                            sizeof *names);
+    ts_err err = {0};
+    ts_optset *opts = ts_optset_alloc(cmd->kind, &err);
+    if (!lo || !names || !opts) {
+        free(lo);
+        free(names);
+        ts_optset_free(opts);
+        return cli_report(&err, ts_fail(&err, TS_ENOMEM, "out of memory"));
+    }
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        ts_option_cli_name(&t[i], names[2 * i], TS_NAME_MAX);
+        int flag = t[i].type == TS_OPT_BOOL;
+        lo[m++] = (struct option){names[2 * i],
+                                  flag ? no_argument : required_argument,
+                                  NULL, CODE_ROW + i};
+        if (flag) {
+            snprintf(names[2 * i + 1], TS_NAME_MAX + 3, "no-%s",
+                     names[2 * i]);
+            lo[m++] = (struct option){names[2 * i + 1], no_argument, NULL,
+                                      CODE_NO + i};
+        }
+    }
+    for (int k = 0; k < ne; k++)
+        lo[m++] = (struct option){cmd->extras[k].name,
+                                  cmd->extras[k].has_arg ? required_argument
+                                                         : no_argument,
+                                  NULL, CODE_EXTRA + k};
+    static const struct option common[] = {
+        {"json", required_argument, NULL, 'j'},
+        {"csv", required_argument, NULL, 'c'},
+        {"plot", required_argument, NULL, 'p'},
+        {"units", required_argument, NULL, 'u'},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'}};
+    for (size_t k = 0; k < sizeof common / sizeof common[0]; k++)
+        lo[m++] = common[k];
+    cli_run c;
+    memset(&c, 0, sizeof c);
+    c.cmd = cmd;
+    c.opts = opts;
+    c.entry = -1;
+    int status = 0;
+    optind = 1;
+    opterr = 0;
+    int ch;
+    while (!status && (ch = getopt_long(argc, argv, ":", lo, NULL)) != -1) {
+        char where[TS_NAME_MAX + 8];
+        if (ch >= CODE_ROW && ch < CODE_ROW + n) {
+            int i = ch - CODE_ROW;
+            snprintf(where, sizeof where, "--%s", names[2 * i]);
+            if (ts_optset_give(opts, t[i].name, optarg ? optarg : "true",
+                               TS_OPTSET_COMMAND, where, &err))
+                status = cli_report(&err, err.code);
+        } else if (ch >= CODE_NO && ch < CODE_NO + n) {
+            int i = ch - CODE_NO;
+            snprintf(where, sizeof where, "--no-%s", names[2 * i]);
+            if (ts_optset_give(opts, t[i].name, "false", TS_OPTSET_COMMAND,
+                               where, &err))
+                status = cli_report(&err, err.code);
+        } else if (ch >= CODE_EXTRA && ch < CODE_EXTRA + ne) {
+            int k = ch - CODE_EXTRA;
+            if (c.nextra[k] > 0 && !cmd->extras[k].repeat)
+                c.nextra[k] = 0; /* the last one counts */
+            if (c.nextra[k] == CLI_EXTRA_VALUES) {
+                fprintf(stderr, "towstab: error: %s: --%s: at most %d\n",
+                        cmd->name, cmd->extras[k].name, CLI_EXTRA_VALUES);
+                status = EXIT_BADINPUT;
+            } else {
+                c.extra[k][c.nextra[k]++] = optarg ? optarg : "";
+            }
+        } else {
+            switch (ch) {
+            case 'j': c.json = optarg; break;
+            case 'c': c.csv = optarg; break;
+            case 'p': c.plot.dir = optarg; break;
+            case 'u': c.plot.units = optarg; break;
+            case 'q': c.quiet = 1; break;
+            case 'h':
+                cli_usage(cmd, stdout);
+                status = -1;
+                break;
+            default:
+                status = cli_option_error(cmd->name, ch, argv[optind - 1]);
+            }
+        }
+    }
+    free(lo);
+    free(names);
+    if (status) {
+        ts_optset_free(opts);
+        return status < 0 ? 0 : status;
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "towstab: error: %s: expected one scene file\n",
+                cmd->name);
+        cli_usage(cmd, stderr);
+        ts_optset_free(opts);
+        return EXIT_BADINPUT;
+    }
+    /* Outputs naming one file are refused before anything runs. */
+    const char *what[2 + CLI_EXTRA_MAX] = {"--json", "--csv"};
+    const char *paths[2 + CLI_EXTRA_MAX] = {c.json, c.csv};
+    char ewhat[CLI_EXTRA_MAX][TS_NAME_MAX + 3];
+    int nw = 2;
+    for (int k = 0; k < ne; k++)
+        if (cmd->extras[k].has_arg && c.nextra[k] > 0 &&
+            !strcmp(cmd->extras[k].arg, "FILE")) {
+            snprintf(ewhat[k], sizeof ewhat[k], "--%s", cmd->extras[k].name);
+            what[nw] = ewhat[k];
+            paths[nw++] = c.extra[k][0];
+        }
+    status = cli_check_outputs(cmd->name, nw, what, paths, c.plot.dir,
+                               cmd->pictures);
+    if (!status)
+        status = cli_plot_begin(&c.plot, cmd->name);
+    ts_units *units = NULL;
+    ts_scene *scene = NULL;
+    if (!status)
+        status = cli_open(argv[optind], &units, &scene);
+    if (status) {
+        ts_optset_free(opts);
+        return status;
+    }
+    c.scene = scene;
+    c.units = units;
+    /* Below the command line: the scene's first entry of this type. */
+    int e = first_entry(scene, cmd->name);
+    int rc = e >= 0 ? ts_optset_give_entry(opts, &scene->analyses[e], e,
+                                           scene->path, TS_OPTSET_SCENE, -1,
+                                           &err)
+                    : TS_OK;
+    if (!rc && cmd->kind == TS_ANALYSIS_CONVERGE)
+        rc = add_related(opts, scene, &err);
+    status = rc ? cli_report(&err, rc) : cli_prepare(&c);
+    if (!status) {
+        /* A simulation names itself with its settings (its print). */
+        if (cmd->kind != TS_ANALYSIS_SIMULATE)
+            printf("towstab %s: %s (%s)\n", cmd->name, scene->system->name,
+                   scene->path);
+        status = cli_execute(&c, NULL);
+    }
+    cli_run_free(&c);
+    cli_close(units, scene);
+    return status;
+}
