@@ -1,9 +1,9 @@
-/* tscene.h: loading a scene in a test program, from a file or from YAML
- * text: one checked line, PASS or FAIL with the reader's message. Needs
- * tcheck.h. */
+/* tscene.h: loading a scene in a test program: one checked line, PASS or
+ * FAIL with the reader's message. Needs tcheck.h. */
 #ifndef TOWSTAB_TSCENE_H
 #define TOWSTAB_TSCENE_H
 
+#include <stdio.h>
 #include <string.h>
 
 #include "towstab/scene.h"
@@ -16,14 +16,14 @@ static inline ts_scene *tscene_load(const ts_units *u, const char *path)
     return s;
 }
 
-/* A scene from YAML text; its name in the messages is its first line. */
+/* A scene from YAML text (named "test"); NULL after printing the
+ * reader's message. */
 static inline ts_scene *tscene_parse(const ts_units *u, const char *yaml)
 {
     ts_err err = {0};
-    ts_scene *s = u ? ts_scene_parse(yaml, strlen(yaml), "test", u, &err)
-                    : NULL;
-    CHECK(s != NULL, "scene '%.*s' parses (%s)", (int)strcspn(yaml, "\n"),
-          yaml, s ? "ok" : err.msg);
+    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", u, &err);
+    if (!s)
+        printf("scene: %s\n", err.msg);
     return s;
 }
 
