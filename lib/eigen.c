@@ -160,6 +160,33 @@ static void cand_free(cand_list *L)
 
 /* Add an eigenvalue with its vector given as re/im parts (im may be NULL);
  * lam in the lower half plane is conjugated with its vector. */
+/* The root mean square of u^H N v for the rounding noise N of the
+ * linearization's differences (independent entries of size fnoise_i /
+ * (sqrt(2) h_j) in the lower rows, ts_linear.fnoise): sqrt(sum_i |u_(nq+i)|^2
+ * fnoise_i^2) sqrt(sum_j |v_j|^2 / h_j^2) / sqrt(2). u = ur + i ui, v =
+ * vr + i vi (ui, vi NULL for real vectors); without u (ARPACK) the
+ * rounding's share of |N v|, with every |u_i| 1. 0 without fnoise. */
+static double rounding_change(const ts_linear *lin, const double *ur,
+                              const double *ui, const double *vr,
+                              const double *vi)
+{
+    if (!lin->fnoise)
+        return 0.0;
+    int n = lin->nstate, nq = lin->nq;
+    double su = 0, sv = 0;
+    for (int i = 0; i < n - nq; i++) {
+        double a = ur ? ur[nq + i] * ur[nq + i] +
+                            (ui ? ui[nq + i] * ui[nq + i] : 0.0)
+                      : 1.0;
+        su += a * lin->fnoise[i] * lin->fnoise[i];
+    }
+    for (int j = 0; j < n; j++) {
+        double b = vr[j] * vr[j] + (vi ? vi[j] * vi[j] : 0.0);
+        sv += b / (lin->h[j] * lin->h[j]);
+    }
+    return sqrt(0.5 * su * sv);
+}
+
 static void cand_add(cand_list *L, double complex lam, const double *vr,
                      const double *vi, double cond, double resid,
                      double dlam)
@@ -395,7 +422,10 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
             (void)uu;
             (void)vv;
             cand_add(L, wr[j], vrj, NULL, 1.0 / rconde[j], NAN,
-                     evj ? fabs(uev / uv) : NAN);
+                     evj ? fabs(uev / uv) +
+                               rounding_change(lin, vlj, NULL, vrj, NULL) /
+                                   fabs(uv)
+                         : NAN);
             L->c[L->n - 1].round = DBL_EPSILON * abnrm / rconde[j];
             vector_health(lin, vl, wr, wi, rconde, kap0, ev, abnrm, j,
                           &L->c[L->n - 1]);
@@ -416,7 +446,10 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
             (void)uu;
             (void)vv;
             cand_add(L, wr[j] + I * wi[j], vrj, vrk, 1.0 / rconde[j], NAN,
-                     evj ? cabs(uev / uv) : NAN);
+                     evj ? cabs(uev / uv) +
+                               rounding_change(lin, vlj, vlk, vrj, vrk) /
+                                   cabs(uv)
+                         : NAN);
             L->c[L->n - 1].round = DBL_EPSILON * abnrm / rconde[j];
             vector_health(lin, vl, wr, wi, rconde, kap0, ev, abnrm, j,
                           &L->c[L->n - 1]);
@@ -513,7 +546,11 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
             const double *er = EW + (size_t)j * nlow, *ei = er + nlow;
             for (int i = 0; i < nlow; i++)
                 e2 += er[i] * er[i] + ei[i] * ei[i];
-            L->c[c].dlam = sqrt(e2 / v2);
+            L->c[c].dlam = sqrt(e2 / v2) +
+                           rounding_change(lin, NULL, NULL,
+                                           W + (size_t)(2 * c) * n,
+                                           W + (size_t)(2 * c + 1) * n) /
+                               sqrt(v2);
         }
         j += 2;
     }

@@ -41,6 +41,7 @@
 
 #include "descriptor.h"
 #include "kernel_impl.h"
+#include "lapack.h"
 #include "vehicle.h"
 
 #ifdef _OPENMP
@@ -127,6 +128,7 @@ void ts_linear_free(ts_linear *lin)
     free(lin->Ty);
     free(lin->Tu);
     free(lin->Aerr);
+    free(lin->fnoise);
     free(lin->h);
     tsi_desc_free(lin->desc);
     free(lin->u0);
@@ -193,6 +195,64 @@ static int eval_into(col_ws *w, int slot, int nl)
     if (rc == TS_OK)
         memcpy(w->t[slot], ts_kernel_tensions(w->k),
                (size_t)nl * sizeof(double));
+    return rc;
+}
+
+/* Rounding noise of the kernel, lin->fnoise[n - nq]: at NOISE_SAMPLES
+ * states y0 + d, d_j = +-NOISE_REL h_j (signs from a fixed sequence),
+ * f(y0 + d) - f(y0) - A d is the rounding of the two evaluations (A's
+ * own error times d, and the second-order term NOISE_REL^2 h^2 f'', are
+ * far below it); its root mean square over the samples, over sqrt(2), is
+ * the noise of one evaluation of each lower row. A central difference
+ * with step h_j then carries noise fnoise_i / (sqrt(2) h_j) in entry (i,
+ * j), which the truncation estimate (A(h) - A(2h)) / 3 samples only by
+ * chance. Cost: NOISE_SAMPLES evaluations and matrix-vector products. */
+#define NOISE_SAMPLES 8
+#define NOISE_REL 1e-4
+
+static int kernel_noise(ts_kernel *k, const double *y0, const double *u0,
+                        ts_linear *lin)
+{
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    double *y = malloc((size_t)n * sizeof *y);
+    double *d = malloc((size_t)n * sizeof *d);
+    double *f = malloc((size_t)n * sizeof *f);
+    double *ad = malloc((size_t)(nlow > 0 ? nlow : 1) * sizeof *ad);
+    double *acc = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof *acc);
+    int rc = y && d && f && ad && acc ? TS_OK : TS_ENOMEM;
+    unsigned long long seq = 0x9E3779B97F4A7C15ULL;
+    int used = 0;
+    for (int s = 0; rc == TS_OK && s < NOISE_SAMPLES; s++) {
+        for (int j = 0; j < n; j++) {
+            seq = seq * 6364136223846793005ULL + 1442695040888963407ULL;
+            double dj = (seq >> 63 ? 1.0 : -1.0) * NOISE_REL * lin->h[j];
+            y[j] = y0[j] + dj;
+            d[j] = y[j] - y0[j]; /* exactly what was added */
+        }
+        lin->evaluations++;
+        if (ts_kernel_eval(k, y, u0, f) != TS_OK)
+            continue; /* a state off the chart: another sample */
+        double one = 1.0, zero = 0.0;
+        int inc = 1;
+        dgemv_("N", &nlow, &n, &one, lin->A + nq, &n, d, &inc, &zero, ad,
+               &inc, 1);
+        for (int i = 0; i < nlow; i++) {
+            double r = f[nq + i] - lin->f0[nq + i] - ad[i];
+            acc[i] += r * r;
+        }
+        used++;
+    }
+    if (rc == TS_OK && used > 0) {
+        for (int i = 0; i < nlow; i++)
+            lin->fnoise[i] = sqrt(acc[i] / (2.0 * used));
+    } else if (rc == TS_OK) {
+        rc = TS_ECONV;
+    }
+    free(y);
+    free(d);
+    free(f);
+    free(ad);
+    free(acc);
     return rc;
 }
 
@@ -462,10 +522,18 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                                  "of memory for the %d x %d error estimate",
                                  nlow, n);
     }
+    if (o.estimate_error && !lin->fnoise) {
+        lin->fnoise = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof(double));
+        if (!lin->fnoise)
+            return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+    }
     if (!o.estimate_error) {
         free(lin->Aerr);
         lin->Aerr = NULL;
+        free(lin->fnoise);
+        lin->fnoise = NULL;
     }
+    lin->round_norm = NAN;
 
     /* Base point: f0, positions, tensions, direction derivatives. */
     int rc = ts_kernel_eval(k, y0, u0, lin->f0);
@@ -663,6 +731,16 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         col_ws_free(&ws[t], k);
     free(ws);
     lin->evaluations += (long)ncol * (estimate ? 4 : 2);
+
+    /* The kernel's rounding noise (beside the truncation error). */
+    if (estimate && bad_col < 0 && kernel_noise(k, y0, u0, lin) == TS_OK) {
+        double sr = 0, sh = 0;
+        for (int i = 0; i < nlow; i++)
+            sr += lin->fnoise[i] * lin->fnoise[i];
+        for (int j = 0; j < n; j++)
+            sh += 1.0 / (2.0 * lin->h[j] * lin->h[j]);
+        lin->round_norm = sqrt(sr * sh);
+    }
 
     /* Leave the kernel's results at the base point. */
     double *ftmp = malloc((size_t)n * sizeof(double));

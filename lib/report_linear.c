@@ -50,6 +50,7 @@ json_t *ts_report_linear_json(const ts_linear *lin, int matrices)
     json_object_set_new(o, "inputs", inputs);
     json_object_set_new(o, "trunc_err", num(lin->trunc_err));
     json_object_set_new(o, "trunc_norm", num(lin->trunc_norm));
+    json_object_set_new(o, "round_norm", num(lin->round_norm));
     json_object_set_new(o, "b_trunc_err", num(lin->b_trunc_err));
     json_object_set_new(o, "a_scale", num(lin->a_scale));
     json_object_set_new(o, "kinks", json_integer(lin->kinks));

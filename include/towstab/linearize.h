@@ -24,7 +24,8 @@
  * link's length for a tow displacement, sqrt(g l) + |V| for a tow velocity
  * and g for a tow acceleration. The truncation error is estimated by
  * differentiating again with steps 2 h_j: for a smooth f the error of the
- * h result is (A(2h) - A(h)) / 3 to leading order.
+ * h result is (A(2h) - A(h)) / 3 to leading order; the rounding noise of
+ * the differences from the kernel's own scatter (fnoise).
  *
  * Inputs v (TS_NINPUT = 9): tow-point displacement x, y, z (m), velocity
  * (m/s), acceleration (m/s^2) in the mean ship frame, named tow.surge,
@@ -118,6 +119,15 @@ typedef struct ts_linear {
     double trunc_norm; /* ||A(h) - A(2h)||_F / 3 over the lower block: the
                           size of the error matrix dA used for eigenvalue
                           error bounds (1/s, 1/s^2 mixed, as A) */
+    double *fnoise;    /* [n - nq] rounding noise of one kernel evaluation
+                          of each lower row of f (its scatter at 8 states a
+                          ten-thousandth of a step from y0, less A's part):
+                          entry (i, j) of A carries rounding noise
+                          fnoise[i] / (sqrt(2) h[j]), which the truncation
+                          estimate samples only by chance; NULL unless
+                          estimate_error */
+    double round_norm; /* the Frobenius norm of that noise over the state
+                          columns (units of A); NaN unless estimate_error */
     double b_trunc_err;/* max |B(h) - B(2h)| / 3 */
     double t_trunc_err;/* max |T(h) - T(2h)| / 3 of the tension rows */
     double a_scale;    /* max |A_ij| of the lower block, for relative use */
