@@ -548,8 +548,8 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
                 e2 += er[i] * er[i] + ei[i] * ei[i];
             L->c[c].dlam = sqrt(e2 / v2) +
                            rounding_change(lin, NULL, NULL,
-                                           W + (size_t)(2 * c) * n,
-                                           W + (size_t)(2 * c + 1) * n) /
+                                           W + (size_t)j * n,
+                                           W + (size_t)(j + 1) * n) /
                                sqrt(v2);
         }
         j += 2;
