@@ -53,13 +53,71 @@ static json_t *modes_json(const ts_result *r, int flags)
     return j;
 }
 
+/* A run's history: the channels reported, and the full state when it
+ * was asked for. */
+static json_t *history_json(const ts_result *r, const ts_history *h)
+{
+    json_t *o = ts_report_channels_json(r->sys, h, r->noutputs, r->outputs);
+    if (o && r->all_outputs && ts_report_history_full(o, r->sys, h)) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* The forces of the nonlinear run: the tow force, every link, the peak
+ * and lowest links, the output's extremes, the links out of range. */
+static json_t *forces_json(const ts_result *r)
+{
+    const ts_system *sys = r->sys;
+    json_t *f = json_object(), *links = json_array(), *slack = json_array();
+    if (!f || !links || !slack) {
+        json_decref(f);
+        json_decref(links);
+        json_decref(slack);
+        return NULL;
+    }
+    json_object_set_new(f, "tow", ts_report_extremes_json(&r->tow_force));
+    for (int l = 0; l < sys->nlinks; l++) {
+        json_t *e = ts_report_extremes_json(&r->tensions[l]);
+        json_object_set_new(e, "cable", json_string(
+                                sys->cables[sys->links[l].cable].name));
+        json_object_set_new(e, "index", json_integer(sys->links[l].index));
+        json_array_append_new(links, e);
+    }
+    json_object_set_new(f, "links", links);
+    int pick[2] = {r->peak_link, r->low_link};
+    static const char *const key[2] = {"peak_link", "low_link"};
+    for (int k = 0; k < 2; k++) {
+        const ts_link *L = pick[k] >= 0 ? &sys->links[pick[k]] : NULL;
+        json_object_set_new(f, key[k],
+                            L ? json_pack("{s:s,s:i}", "cable",
+                                          sys->cables[L->cable].name,
+                                          "index", L->index)
+                              : json_null());
+    }
+    for (int k = 0; k < r->nslack; k++) {
+        const ts_slack *e = &r->slack[k];
+        const ts_link *L = &sys->links[e->link];
+        json_array_append_new(
+            slack, json_pack("{s:s,s:i,s:s,s:o,s:o,s:i,s:o}", "cable",
+                             sys->cables[L->cable].name, "index", L->index,
+                             "kind", e->elastic ? "slack" : "compression",
+                             "t_first", num(e->t_first), "t_last",
+                             num(e->t_last), "samples", e->samples, "min",
+                             num(e->min)));
+    }
+    json_object_set_new(f, "slack", slack);
+    return f;
+}
+
 static json_t *simulate_json(const ts_result *r, int flags)
 {
+    (void)flags;
     const ts_system *sys = r->sys;
     json_t *j = json_object();
     if (!j || !sys)
         return j;
-    int node = flags & TS_REPORT_OUTPUT_ONLY ? r->output.node : -1;
     json_object_set_new(j, "scene", json_string(sys->name));
     json_object_set_new(j, "nlinks", json_integer(sys->nlinks));
     json_object_set_new(j, "output", json_string(r->output.name));
@@ -77,8 +135,7 @@ static json_t *simulate_json(const ts_result *r, int flags)
                                 ts_integrator_name(r->sim.integrator)));
         json_object_set_new(o, "rel_tol", json_real(r->sim.rel_tol));
         json_object_set_new(o, "abs_tol", json_real(r->sim.abs_tol));
-        json_object_set_new(o, "history",
-                            ts_report_history_json(sys, r->nonlinear, node));
+        json_object_set_new(o, "history", history_json(r, r->nonlinear));
         json_object_set_new(j, "nonlinear", o);
     }
     if (r->linear) {
@@ -94,10 +151,24 @@ static json_t *simulate_json(const ts_result *r, int flags)
                             json_string(r->sim.kinematics == TS_KIN_LINEAR
                                             ? "linear"
                                             : "nonlinear"));
-        json_object_set_new(o, "history",
-                            ts_report_history_json(sys, r->linear, node));
+        json_object_set_new(o, "history", history_json(r, r->linear));
         json_object_set_new(j, "linear", o);
     }
+    json_t *outs = json_array();
+    for (int k = 0; outs && k < r->noutputs; k++)
+        json_array_append_new(outs, json_string(r->outputs[k].name));
+    json_object_set_new(j, "outputs", outs);
+    json_object_set_new(j, "full_state", json_boolean(r->all_outputs));
+    const ts_history *ho = r->nonlinear ? r->nonlinear : r->linear;
+    if (ho) {
+        json_t *oe = ts_report_extremes_json(&r->output_extremes);
+        if (oe)
+            json_object_set_new(oe, "unit",
+                                json_string(r->output.si_unit));
+        json_object_set_new(j, "output_extremes", oe);
+    }
+    if (r->tensions)
+        json_object_set_new(j, "forces", forces_json(r));
     if (r->compared)
         json_object_set_new(j, "compare", ts_report_compare_json(&r->compare));
     /* Final positions of the bodies (the nonlinear run when there is
@@ -208,9 +279,13 @@ int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
             return ts_report_response_csv(r->response, path, err);
         break;
     case TS_ANALYSIS_SIMULATE:
-        if (r->nonlinear || r->linear)
+        if ((r->nonlinear || r->linear) && r->all_outputs)
             return ts_report_history_csv(r->sys, r->nonlinear, r->linear,
                                          path, err);
+        if (r->nonlinear || r->linear)
+            return ts_report_channels_csv(r->sys, r->nonlinear, r->linear,
+                                          r->noutputs, r->outputs, path,
+                                          err);
         break;
     case TS_ANALYSIS_CONVERGE:
         if (r->convergence)

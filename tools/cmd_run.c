@@ -150,7 +150,6 @@ static int run_main(int argc, char **argv)
         c->units = units;
         c->entry = i;
         c->quiet = quiet;
-        c->json_flags = kind == TS_ANALYSIS_SIMULATE ? TS_REPORT_OUTPUT_ONLY : 0;
         if (csv_dir) {
             snprintf(csv[i], sizeof csv[i], "%s/%d_%s.csv", csv_dir, i + 1,
                      a->type);

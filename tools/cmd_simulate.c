@@ -28,28 +28,61 @@ static void print_stats(const char *what, const ts_sim_stats *st,
            st->wall_s > 0 ? st->t_reached / st->wall_s : INFINITY);
 }
 
-static void print_table(const ts_system *sys, const ts_output *out,
-                        const ts_history *nl, const ts_history *li)
+/* Channels printed at most (more go to --json and --csv). */
+#define TABLE_COLS 8
+
+/* Column width of channel `name` with unit `unit`. */
+static int col_width(const char *name, const char *unit)
 {
+    int w = (int)(strlen(name) + strlen(unit)) + 4;
+    return w < 16 ? 16 : w;
+}
+
+/* The channels of the result, one row per sample (strided): those the
+ * main run gives, and with both runs the compared output of the linear
+ * run. */
+static void print_table(const ts_result *r)
+{
+    const ts_system *sys = r->sys;
+    const ts_history *nl = r->nonlinear, *li = r->linear;
     const ts_history *h = nl ? nl : li;
     if (!h || h->nsamples == 0)
         return;
-    char name[2 * TS_NAME_MAX];
-    ts_system_node_name(sys, out->node, name, sizeof name);
+    int cols[TABLE_COLS], nc = 0, more = 0;
+    for (int k = 0; k < r->noutputs; k++) {
+        if (!isfinite(ts_history_value(sys, h, &r->outputs[k], 0)))
+            continue;
+        if (nc < TABLE_COLS)
+            cols[nc++] = k;
+        else
+            more++;
+    }
+    int both = nl && li;
     int stride = (h->nsamples + TABLE_ROWS - 1) / TABLE_ROWS;
-    printf("\n%10s %16s %16s %16s", "t [s]", "x [m]", "y [m]", "z [m]");
-    if (nl && li)
-        printf(" %16s", "linear");
-    printf("    (%s%s%s)\n", name, nl ? "" : ", linear model",
-           nl && li ? "; 'linear': the same coordinate of the linear run"
-                    : "");
-    size_t st = 3 * (size_t)h->nnodes;
+    char head[TS_OUTPUT_NAME_MAX + 16];
+    printf("\n%10s", "t [s]");
+    for (int c = 0; c < nc; c++) {
+        const ts_output *o = &r->outputs[cols[c]];
+        snprintf(head, sizeof head, "%s [%s]", o->name, o->si_unit);
+        printf(" %*s", col_width(o->name, o->si_unit), head);
+    }
+    if (both) {
+        snprintf(head, sizeof head, "linear %s", r->output.name);
+        printf(" %*s", col_width(head, r->output.si_unit), head);
+    }
+    printf("%s\n", nl ? "" : "    (linear model)");
     for (int i = 0; i < h->nsamples; i += stride) {
-        const double *p = h->positions + st * i + 3 * (size_t)out->node;
-        printf("%10.4f %16.9f %16.9f %16.9f", h->t[i], p[0], p[1], p[2]);
-        if (nl && li && i < li->nsamples)
-            printf(" %16.9f", li->positions[st * i + 3 * (size_t)out->node +
-                                            out->comp]);
+        printf("%10.4f", h->t[i]);
+        for (int c = 0; c < nc; c++) {
+            const ts_output *o = &r->outputs[cols[c]];
+            printf(" %*.9f", col_width(o->name, o->si_unit),
+                   ts_history_value(sys, h, o, i));
+        }
+        if (both && i < li->nsamples) {
+            snprintf(head, sizeof head, "linear %s", r->output.name);
+            printf(" %*.9f", col_width(head, r->output.si_unit),
+                   ts_history_value(sys, li, &r->output, i));
+        }
         printf("\n");
         if (i + stride >= h->nsamples && i != h->nsamples - 1)
             i = h->nsamples - 1 - stride; /* always show the last sample */
@@ -57,10 +90,94 @@ static void print_table(const ts_system *sys, const ts_output *out,
     if (stride > 1)
         printf("(one sample in %d of %d shown; --csv for all)\n", stride,
                h->nsamples);
+    if (more)
+        printf("(%d more channel%s in --json and --csv)\n", more,
+               more == 1 ? "" : "s");
+}
+
+/* A number in a field of width w, "-" when it is not finite. */
+static void field(double v, int w)
+{
+    if (isfinite(v))
+        printf(" %*.6g", w, v);
+    else
+        printf(" %*s", w, "-");
+}
+
+/* One row of the forces table. */
+static void print_extremes(const char *name, const ts_extremes *e)
+{
+    printf("%-32s", name);
+    double v[7] = {e->max, e->t_max, e->min, e->t_min, e->mean,
+                   e->reference, e->amplification};
+    static const int w[7] = {14, 9, 14, 9, 14, 14, 13};
+    for (int k = 0; k < 7; k++)
+        field(v[k], w[k]);
+    printf("\n");
+}
+
+/* Events of links out of range printed at most (all are in the JSON). */
+#define SLACK_LINES 10
+
+/* The forces of the nonlinear run: extremes of the tow force, of the
+ * links with the largest and the smallest tension and of a tension
+ * output; then the links that went into compression or slack. */
+static void print_forces(const ts_result *r)
+{
+    const ts_system *sys = r->sys;
+    if (!r->tensions || r->tow_force.samples == 0)
+        return;
+    printf("\nforces of the nonlinear run (static: the initial "
+           "equilibrium's; amplification: max / static)\n");
+    printf("%-32s %14s %9s %14s %9s %14s %14s %13s\n", "channel", "max [N]",
+           "t [s]", "min [N]", "t [s]", "mean [N]", "static [N]",
+           "amplification");
+    print_extremes("tow.force (top tension)", &r->tow_force);
+    double err = r->tow_force.max_error;
+    int pick[2] = {r->peak_link, r->low_link};
+    static const char *const what[2] = {"largest", "smallest"};
+    char name[TS_OUTPUT_NAME_MAX + 16];
+    for (int k = 0; k < 2; k++) {
+        if (pick[k] < 0 || (k == 1 && pick[1] == pick[0]))
+            continue;
+        const ts_link *L = &sys->links[pick[k]];
+        snprintf(name, sizeof name, "%s.%d.tension (%s)",
+                 sys->cables[L->cable].name, L->index,
+                 pick[1] == pick[0] ? "largest, smallest" : what[k]);
+        print_extremes(name, &r->tensions[pick[k]]);
+        err = fmax(err, fmax(r->tensions[pick[k]].max_error,
+                             r->tensions[pick[k]].min_error));
+    }
+    if (r->output.kind == TS_OUT_TENSION && r->output.link != pick[0] &&
+        r->output.link != pick[1]) {
+        print_extremes(r->output.name, &r->output_extremes);
+        err = fmax(err, r->output_extremes.max_error);
+    }
+    if (err > 0)
+        printf("between samples the extremes may reach up to %.3g N "
+               "further (sampling every %g s; --sample shortens it)\n",
+               err, r->sim.dt_sample);
+    for (int k = 0; k < r->nslack && k < SLACK_LINES; k++) {
+        const ts_slack *e = &r->slack[k];
+        const ts_link *L = &sys->links[e->link];
+        printf("warning: %s link %s.%d %s at t = %.6g s", e->elastic
+               ? "elastic" : "rigid", sys->cables[L->cable].name, L->index,
+               e->elastic ? "goes slack" : "is in compression", e->t_first);
+        if (e->samples > 1)
+            printf(" (%d samples to t = %.6g s)", e->samples, e->t_last);
+        if (!e->elastic)
+            printf(", lowest tension %.6g N", e->min);
+        printf("\n");
+    }
+    if (r->nslack > SLACK_LINES)
+        printf("warning: %d more links (forces.slack of --json)\n",
+               r->nslack - SLACK_LINES);
 }
 
 static void print_compare(const ts_compare *c)
 {
+    const char *u = c->output.si_unit;
+    char label[64];
     printf("\ncomparison of %s over t = %.6g .. %.6g s (%d samples; the "
            "transient before is discarded)\n",
            c->output.name, c->t_from, c->t_to, c->nsamples);
@@ -68,22 +185,30 @@ static void print_compare(const ts_compare *c)
         printf("excitation %s %s, amplitude %.6g m, %.6g Hz\n",
                ts_axis_name(c->exc_axis), ts_signal_type_name(c->exc_type),
                c->exc_amplitude, c->exc_frequency_hz);
-    printf("%-26s %16s %16s %16s\n", "", "linear", "nonlinear",
+    printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
            "freq. response");
-    printf("%-26s %16.6g %16.6g %16.6g\n", "amplitude ratio",
+    snprintf(label, sizeof label, "amplitude ratio [%s/m]", u);
+    printf("%-30s %16.6g %16.6g %16.6g\n", label,
            c->linear.amplitude_ratio, c->nonlinear.amplitude_ratio,
            c->pred_ratio);
-    printf("%-26s %16.4f %16.4f %16.4f\n", "phase [deg]", c->linear.phase_deg,
+    printf("%-30s %16.4f %16.4f %16.4f\n", "phase [deg]", c->linear.phase_deg,
            c->nonlinear.phase_deg, c->pred_phase_deg);
-    printf("%-26s %16.6g %16.6g\n", "mean offset [m]", c->linear.mean_offset,
+    snprintf(label, sizeof label, "mean offset [%s]", u);
+    printf("%-30s %16.6g %16.6g\n", label, c->linear.mean_offset,
            c->nonlinear.mean_offset);
-    printf("%-26s %16.6g %16.6g\n", "half range [m]", c->linear.half_range,
+    snprintf(label, sizeof label, "half range [%s]", u);
+    printf("%-30s %16.6g %16.6g\n", label, c->linear.half_range,
            c->nonlinear.half_range);
     printf("amplitude difference %.4g %%, mean difference %.4g %% (linear "
            "less nonlinear, relative to nonlinear)\n",
            c->amplitude_difference_pct, c->mean_difference_pct);
-    printf("rms difference %.6g m (%.4g %% of the excitation amplitude)\n",
-           c->rms_difference, 100 * c->rms_difference_ratio);
+    if (!strcmp(u, "m"))
+        printf("rms difference %.6g m (%.4g %% of the excitation "
+               "amplitude)\n", c->rms_difference,
+               100 * c->rms_difference_ratio);
+    else
+        printf("rms difference %.6g %s (%.6g %s per m of excitation)\n",
+               c->rms_difference, u, c->rms_difference_ratio, u);
 }
 
 /* ---- pictures (--plot) ------------------------------------------------- */
@@ -102,8 +227,8 @@ static int nearest_sample(const ts_history *h, double t)
 }
 
 /* Time histories: the output (nonlinear solid, linear dashed), the
- * tow-point displacement on every excited tow axis, and the top link's
- * tension (nonlinear run). */
+ * tow-point displacement on every excited tow axis, and the force on the
+ * tow point (the top tension; nonlinear run). */
 static int plot_histories(const ts_system *sys, const ts_output *out,
                           const ts_excitation *ex, const ts_history *hn,
                           const ts_history *hl, const cli_plot *plot)
@@ -122,19 +247,19 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
     char outlabel[160], towlabel[3][64];
     snprintf(outlabel, sizeof outlabel, "%s", out->name);
     panels[np].label = outlabel;
-    panels[np].quantity = TS_PLOT_LENGTH;
-    size_t st = 3 * (size_t)hf->nnodes;
-    size_t off = 3 * (size_t)out->node + (size_t)out->comp;
+    panels[np].quantity = out->kind == TS_OUT_STRAIN ? TS_PLOT_NONE
+                          : ts_output_is_force(out)  ? TS_PLOT_FORCE
+                                                     : TS_PLOT_LENGTH;
     if (hn) {
         for (int i = 0; i < hn->nsamples; i++)
-            xn[i] = hn->positions[st * (size_t)i + off];
+            xn[i] = ts_history_value(sys, hn, out, i);
         ts_plot_series a = {hn->nsamples, hn->t, xn, "nonlinear", np,
                             TS_PLOT_SOLID, 1};
         ser[ns++] = a;
     }
     if (hl) {
         for (int i = 0; i < hl->nsamples; i++)
-            xl[i] = hl->positions[st * (size_t)i + off];
+            xl[i] = ts_history_value(sys, hl, out, i);
         ts_plot_series a = {hl->nsamples, hl->t, xl, "linear", np,
                             TS_PLOT_DASHED, 2};
         ser[ns++] = a;
@@ -167,10 +292,13 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
         }
         np++;
     }
-    if (hn && hn->nlinks > 0) {
+    ts_output tow_force;
+    if (hn && hn->nsamples > 0 && isfinite(hn->tow_force[0]) &&
+        ts_output_find(sys, "tow.force", TS_OUT_ALL, &tow_force, NULL) ==
+            TS_OK) {
         for (int i = 0; i < hn->nsamples; i++)
-            tens[i] = hn->tensions[(size_t)hn->nlinks * (size_t)i];
-        panels[np].label = "top tension";
+            tens[i] = ts_history_value(sys, hn, &tow_force, i);
+        panels[np].label = "tow.force (top tension)";
         panels[np].quantity = TS_PLOT_FORCE;
         ts_plot_series a = {hn->nsamples, hn->t, tens, "nonlinear", np,
                             TS_PLOT_SOLID, 1};
@@ -348,7 +476,8 @@ static void sim_print(const cli_run *c, const ts_result *r)
         print_stats("nonlinear", &r->nonlinear_stats, method);
     }
     if (!c->quiet)
-        print_table(sys, &r->output, r->nonlinear, r->linear);
+        print_table(r);
+    print_forces(r);
     if (r->nonlinear || r->linear)
         cli_print_trust(&r->trust);
     if (r->compared)

@@ -23,8 +23,6 @@ extern "C" {
 
 /* Flags of ts_report_result_json. */
 #define TS_REPORT_MATRICES 1  /* modes: A and B */
-#define TS_REPORT_OUTPUT_ONLY 2 /* simulate: histories of the output's
-                                   node only (else of every node) */
 
 /* The result as a new JSON object; NULL on allocation failure. */
 TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
