@@ -118,9 +118,9 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
         sh->lu = malloc(nn * sizeof(double));
     if (!sh->ipiv || !sh->w || !sh->wr || (!sh->zlu && !sh->lu)) {
         tsi_shift_free(sh);
-        return ts_fail(err, TS_ENOMEM,
-                       "eigen: out of memory for the %d x %d shifted matrix",
-                       nq, nq);
+        return ts_fail_nomem(err, (sh->is_complex ? 16.0 : 8.0) * (double)nn,
+                             "fewer links", "eigen: out of memory for the "
+                             "%d x %d shifted matrix", nq, nq);
     }
     /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
     const double *A = lin->A;
@@ -409,10 +409,10 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     double *scale = NULL, *rconde = NULL, *rcondv = NULL, *kap0 = NULL;
     int rc = TS_OK;
     if (!a || !vl || !vr || !wr || !wi) {
-        rc = ts_fail(err, TS_ENOMEM,
-                     "eigen: out of memory for dense %d x %d eigenvectors "
-                     "(use --method arpack with --count)",
-                     n, n);
+        rc = ts_fail_nomem(err, 3 * 8.0 * (double)nn, "fewer links, or "
+                           "method arpack with a count (the modes near a "
+                           "target)", "eigen: out of memory for dense %d x "
+                           "%d eigenvectors", n, n);
         goto out;
     }
     memcpy(a, lin->A, nn * sizeof(double));
@@ -434,7 +434,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     lwork = info == 0 ? (int)wq : n * (n + 6);
     work = malloc((size_t)lwork * sizeof(double));
     if (!work) {
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for dgeevx work");
+        rc = ts_fail_nomem(err, 8.0 * lwork, "fewer links, or method arpack "
+                           "with a count", "eigen: out of memory for LAPACK "
+                           "dgeevx's work of the %d x %d matrix", n, n);
         goto out;
     }
     dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo, &ihi,
@@ -591,6 +593,46 @@ static int batch_checks(const ts_linear *lin, cand_list *L)
     free(AW);
     free(EW);
     return TS_OK;
+}
+
+ts_eig_method ts_eigen_method(int n, const ts_eigen_opts *o)
+{
+    if (o->method != TS_EIG_AUTO)
+        return o->method;
+    return o->count > 0 && n >= o->arpack_min_states ? TS_EIG_ARPACK
+                                                      : TS_EIG_LAPACK;
+}
+
+static int arpack_sizes(int n, int count, int *nev, int *ncv, ts_err *err);
+
+int ts_eigen_check(int n, const ts_eigen_opts *opts, ts_err *err)
+{
+    ts_eigen_opts o;
+    if (opts)
+        o = *opts;
+    else
+        ts_eigen_opts_default(&o);
+    if (o.count < 0 || o.count > n)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: count must be in [0, %d] (0: all modes; the "
+                       "system has %d states), got %d",
+                       n, n, o.count);
+    if (!(o.target_hz >= 0) || !isfinite(o.target_hz))
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: target must be a frequency >= 0 Hz, got %g",
+                       o.target_hz);
+    if (!(o.arpack_tol >= 0) || o.arpack_max_iter < 1)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: arpack_tol must be >= 0 and arpack_max_iter "
+                       ">= 1");
+    if (ts_eigen_method(n, &o) != TS_EIG_ARPACK)
+        return TS_OK;
+    if (o.count == 0)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method arpack needs a number of modes (count "
+                       "> 0); it finds the modes nearest a target, not all");
+    int nev, ncv;
+    return arpack_sizes(n, o.count, &nev, &ncv, err);
 }
 
 static int arpack_sizes(int n, int count, int *nev, int *ncv, ts_err *err)
@@ -854,27 +896,10 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         ts_eigen_opts_default(&o);
     *out = NULL;
     int n = lin->nstate;
-    if (o.count < 0 || o.count > n)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: count must be in [0, %d] (0: all modes), got "
-                       "%d",
-                       n, o.count);
-    if (!(o.target_hz >= 0) || !isfinite(o.target_hz))
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: target must be a frequency >= 0 Hz, got %g",
-                       o.target_hz);
-    if (!(o.arpack_tol >= 0) || o.arpack_max_iter < 1)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: arpack_tol must be >= 0 and arpack_max_iter "
-                       ">= 1");
-    ts_eig_method m = o.method;
-    if (m == TS_EIG_AUTO)
-        m = o.count > 0 && n >= o.arpack_min_states ? TS_EIG_ARPACK
-                                                     : TS_EIG_LAPACK;
-    if (m == TS_EIG_ARPACK && o.count == 0)
-        return ts_fail(err, TS_EINVAL,
-                       "eigen: method arpack needs a number of modes (count "
-                       "> 0); it finds the modes nearest a target, not all");
+    int rc = ts_eigen_check(n, &o, err);
+    if (rc != TS_OK)
+        return rc;
+    ts_eig_method m = ts_eigen_method(n, &o);
     ts_eigen *e = calloc(1, sizeof *e);
     if (!e)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
@@ -882,7 +907,6 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     e->method = m;
     e->target_hz = o.target_hz;
     cand_list L = {0};
-    int rc;
     if (m == TS_EIG_LAPACK)
         rc = solve_lapack(lin, &L, err);
     else if (o.target_hz == 0.0)

@@ -25,6 +25,30 @@ int ts_fail(ts_err *err, int code, const char *fmt, ...)
     return code;
 }
 
+int ts_fail_nomem(ts_err *err, double bytes, const char *hint,
+                  const char *fmt, ...)
+{
+    if (!err)
+        return TS_ENOMEM;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+    va_end(ap);
+    static const char *const unit[] = {"bytes", "kB", "MB", "GB", "TB",
+                                       "PB"};
+    int u = 0;
+    double v = bytes;
+    while (v >= 1000 && u < 5) {
+        v /= 1000;
+        u++;
+    }
+    size_t len = strlen(err->msg);
+    snprintf(err->msg + len, sizeof err->msg - len, " (%.3g %s)%s%s", v,
+             unit[u], hint ? "; " : "", hint ? hint : "");
+    err->code = TS_ENOMEM;
+    return TS_ENOMEM;
+}
+
 void ts_err_prefix(ts_err *err, const char *fmt, ...)
 {
     if (!err)

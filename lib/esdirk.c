@@ -217,7 +217,9 @@ tsi_esdirk *tsi_esdirk_alloc(int n, tsi_ode_fn f, tsi_ode_jac jac,
         !(s->A = SUNDenseMatrix(n, n, s->ctx)) ||
         !(s->ls = lu_new(n, s->ctx))) {
         tsi_esdirk_free(s);
-        ts_fail(err, TS_ENOMEM, "esdirk: out of memory for %d states", n);
+        ts_fail_nomem(err, 2 * 8.0 * n * (double)n, "fewer links, or an "
+                      "explicit integrator (rk8pd)", "esdirk: out of memory "
+                      "for the %d x %d Jacobian and its LU", n, n);
         return NULL;
     }
     N_VConst(0.0, s->y);

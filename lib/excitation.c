@@ -108,6 +108,48 @@ void ts_excitation_free(ts_excitation *ex)
     free(ex);
 }
 
+ts_excitation *ts_excitation_copy(const ts_excitation *ex, ts_err *err)
+{
+    ts_excitation *c = ts_excitation_alloc(err);
+    if (!c || !ex)
+        return c;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    int rc = TS_OK;
+    for (int i = 0; i < ex->n && rc == TS_OK; i++) {
+        if (ex->sum[i] && !ex->sum_lead[i])
+            continue; /* added with its group's lead */
+        if (ex->sum[i]) {
+            const sum_group *g = ex->sum[i];
+            double *re = malloc(3 * (size_t)g->n * sizeof *re);
+            double *im = malloc(3 * (size_t)g->n * sizeof *im);
+            if (!re || !im)
+                rc = ts_fail(err, TS_ENOMEM, "excitation: out of memory");
+            for (int k = 0; rc == TS_OK && k < g->n; k++)
+                for (int j = 0; j < 3; j++) {
+                    re[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j] : 0.0;
+                    im[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j + 1] : 0.0;
+                }
+            if (rc == TS_OK)
+                rc = ts_excitation_add_sum(c, g->n, g->omega, re, im, g->rise,
+                                           err);
+            free(re);
+            free(im);
+        } else if (ex->spline[i]) {
+            const gsl_spline *sp = ex->spline[i];
+            rc = ts_excitation_add_series(c, ex->sig[i].axis, (int)sp->size,
+                                          sp->x, sp->y, err);
+        } else {
+            rc = ts_excitation_add(c, &ex->sig[i], err);
+        }
+    }
+    gsl_set_error_handler(old);
+    if (rc != TS_OK) {
+        ts_excitation_free(c);
+        return NULL;
+    }
+    return c;
+}
+
 const char *ts_axis_name(ts_axis a)
 {
     switch (a) {
@@ -308,8 +350,10 @@ int ts_excitation_add_sum(ts_excitation *ex, int n, const double omega[],
             double a = re[3 * k + j], b = im[3 * k + j];
             if (!isfinite(a) || !isfinite(b))
                 return ts_fail(err, TS_EINVAL, "excitation sum: component "
-                               "%d, %s: coefficient not finite (%g, %g m)",
-                               k, ts_axis_name((ts_axis)j), a, b);
+                               "%d, %s: the amplitude overflows (is not a "
+                               "finite number): the wave heights or the "
+                               "motions per metre of wave are too large",
+                               k, ts_axis_name((ts_axis)j));
             ms[j] += 0.5 * (a * a + b * b);
         }
     }
@@ -1007,6 +1051,85 @@ double ts_excitation_time_scale(const ts_excitation *ex)
             ts = v;
     }
     return ts;
+}
+
+/* Largest slopes of the quintic S(xi) = 10 xi^3 - 15 xi^4 + 6 xi^5:
+ * S' at xi = 1/2, S'' at xi = (3 - sqrt 3) / 6. */
+#define QUINTIC_SLOPE 1.875
+#define QUINTIC_CURVE 5.7735
+
+void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
+                         ts_motion_bound *m)
+{
+    m->speed = fabs(base->speed);
+    m->turn_rate = fabs(base->turn_rate);
+    m->tow_speed = m->tow_accel = 0.0;
+    for (int i = 0; ex && i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        double A = fabs(s->amplitude), w = 2.0 * M_PI * s->frequency;
+        double v = 0.0, a = 0.0;
+        switch (s->type) {
+        case TS_SIGNAL_SINE:
+            v = A * w;
+            a = A * w * w;
+            break;
+        case TS_SIGNAL_CRANK: {
+            double f = 1.0 + A / sqrt(s->rod * s->rod - A * A);
+            v = A * w * f;
+            a = A * w * w * f * f;
+            break;
+        }
+        case TS_SIGNAL_STEP:
+            v = QUINTIC_SLOPE * A / s->rise;
+            a = QUINTIC_CURVE * A / (s->rise * s->rise);
+            break;
+        case TS_SIGNAL_RAMP:
+            v = A / s->duration;
+            a = QUINTIC_SLOPE * v / s->rise;
+            break;
+        case TS_SIGNAL_SUM: {
+            /* Sum of |c_k| w_k (and w_k^2) on this axis, plus the fade-in's
+             * slopes times the sum of |c_k|. */
+            const sum_group *g = ex->sum[i];
+            int j = (int)s->axis;
+            double c = 0.0;
+            for (int k = 0; k < g->n; k++) {
+                double ck = hypot(g->c[6 * k + 2 * j], g->c[6 * k + 2 * j + 1]);
+                double wk = fabs(g->omega[k]);
+                c += ck;
+                v += ck * wk;
+                a += ck * wk * wk;
+            }
+            if (g->rise > 0) {
+                a += 2.0 * QUINTIC_SLOPE / g->rise * v +
+                     QUINTIC_CURVE / (g->rise * g->rise) * c;
+                v += QUINTIC_SLOPE / g->rise * c;
+            }
+            break;
+        }
+        case TS_SIGNAL_SERIES: {
+            const gsl_spline *sp = ex->spline[i];
+            double vprev = 0.0;
+            for (size_t k = 1; k < sp->size; k++) {
+                double dt = sp->x[k] - sp->x[k - 1];
+                double vk = (sp->y[k] - sp->y[k - 1]) / dt;
+                v = fmax(v, fabs(vk));
+                if (k > 1)
+                    a = fmax(a, fabs(vk - vprev) / dt);
+                vprev = vk;
+            }
+            break;
+        }
+        }
+        if (s->axis == TS_AXIS_SPEED)
+            m->speed += A;
+        else if (s->axis == TS_AXIS_TURN_RATE)
+            m->turn_rate += A;
+        else {
+            m->tow_speed += v;
+            m->tow_accel += a;
+        }
+    }
 }
 
 int ts_excitation_check_span(const ts_excitation *ex, double t_end,

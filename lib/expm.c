@@ -84,7 +84,9 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
     if (!work || !ipiv) {
         free(work);
         free(ipiv);
-        return ts_fail(err, TS_ENOMEM, "expm: out of memory for order %d", n);
+        return ts_fail_nomem(err, 6 * 8.0 * (double)nn, "fewer links, or "
+                             "linear_method ode", "expm: out of memory for "
+                             "the exponential of order %d", n);
     }
     double *As = work, *A2 = work + nn, *A4 = work + 2 * nn,
            *A6 = work + 3 * nn, *U = work + 4 * nn, *V = work + 5 * nn;

@@ -99,13 +99,66 @@ void ts_trust_merge(ts_trust *dst, const char *prefix, const ts_trust *src)
         dst->trustworthy = 0;
 }
 
+/* Notes on what crosses the water surface (z = 0) at an equilibrium: the
+ * model takes it in its stride (doc/model.md section 3: buoyancy, drag
+ * and added mass by the submerged fraction), but a body awash or a cable
+ * leaving the water is worth saying. A sphere crosses when its centre is
+ * nearer the surface than its radius; a cylinder when its vertical half
+ * extent (L/2 |a_z| + D/2 sqrt(1 - a_z^2), a its axis, along the link
+ * ending at it) exceeds that distance; a link when its ends lie on both
+ * sides (the first such link of each cable is named). */
+static void surface_notes(const ts_system *sys, const ts_equilibrium *eq,
+                          ts_trust *t)
+{
+    for (int b = 0; b < sys->nbodies; b++) {
+        const ts_body *B = &sys->bodies[b];
+        int node = ts_system_body_node(sys, b);
+        double z = eq->positions[3 * node + 2], half;
+        if (B->type == TS_BODY_SPHERE) {
+            half = 0.5 * B->diameter;
+        } else if (B->type == TS_BODY_CYLINDER && node > 0) {
+            double az = fabs(eq->directions[3 * (node - 1) + 2]);
+            half = 0.5 * B->length * az +
+                   0.5 * B->diameter * sqrt(fmax(0.0, 1.0 - az * az));
+        } else {
+            continue;
+        }
+        if (fabs(z) < half)
+            ts_trust_note(t, "bodies[%d] '%s' breaks the water surface: its "
+                             "centre is %.3g m %s the water, its half-height "
+                             "%.3g m; its buoyancy, drag and added mass are "
+                             "those of the submerged part (doc/model.md "
+                             "section 3)",
+                          b, B->name, fabs(z), z >= 0 ? "below" : "above",
+                          half);
+    }
+    int noted = -1;
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        double zu = eq->positions[3 * L->upper + 2];
+        double zl = eq->positions[3 * L->lower + 2];
+        if (L->cable == noted || !((zu < 0 && zl > 0) || (zu > 0 && zl < 0)))
+            continue;
+        noted = L->cable;
+        ts_trust_note(t, "cables[%d] '%s' crosses the water surface at link "
+                         "%d (its ends %.3g m and %.3g m deep); the "
+                         "submerged fraction of that link carries its "
+                         "buoyancy and drag (doc/model.md section 3)",
+                      L->cable, sys->cables[L->cable].name, L->index, zu, zl);
+    }
+}
+
 void ts_health_equilibrium(const ts_system *sys, const ts_equilibrium *eq,
                            ts_trust *t)
 {
     if (!eq->converged) {
-        ts_trust_fail(t, "the equilibrium did not converge: residual %.3g "
-                         "of the largest force %.6g N (target %.3g)",
-                      eq->residual, eq->force_scale, eq->tolerance);
+        if (isfinite(eq->residual) && isfinite(eq->force_scale))
+            ts_trust_fail(t, "the equilibrium did not converge: residual "
+                             "%.3g of the largest force %.6g N (target %.3g)",
+                          eq->residual, eq->force_scale, eq->tolerance);
+        else
+            ts_trust_fail(t, "the equilibrium did not converge: its forces "
+                             "are not finite");
         return;
     }
     if (eq->min_tension < 0) {
@@ -141,6 +194,7 @@ void ts_health_equilibrium(const ts_system *sys, const ts_equilibrium *eq,
         ts_trust_fail(t, "node positions are uncertain by %.3g m, more than "
                          "%.3g of the cable length %.6g m",
                       eq->shape_error, TS_HEALTH_SHAPE_RTOL, L);
+    surface_notes(sys, eq, t);
 }
 
 void ts_health_simulation(const ts_sim_opts *o, const ts_sim_stats *st,

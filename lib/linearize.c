@@ -100,10 +100,9 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
         !lin->h || !lin->u0 ||
         (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map))) {
         ts_linear_free(lin);
-        ts_fail(err, TS_ENOMEM,
-                "ts_linear_alloc: out of memory for a %d x %d matrix A "
-                "(%.3g MB)",
-                n, n, 8e-6 * (double)sn * (double)sn);
+        ts_fail_nomem(err, 8.0 * (double)sn * (double)sn, "fewer links",
+                      "linearize: out of memory for the %d x %d matrix A",
+                      n, n);
         return NULL;
     }
     return lin;
@@ -382,19 +381,18 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         lin->Ty = malloc((size_t)nl * (size_t)n * sizeof(double));
         lin->Tu = malloc((size_t)nl * (size_t)ni * sizeof(double));
         if (!lin->Ty || !lin->Tu)
-            return ts_fail(err, TS_ENOMEM,
-                           "linearize: out of memory for the %d x %d tension "
-                           "Jacobian",
-                           nl, n);
+            return ts_fail_nomem(err, 8.0 * nl * (double)(n + ni),
+                                 "fewer links", "linearize: out of memory "
+                                 "for the %d x %d tension Jacobian", nl, n);
     }
 
     if (o.estimate_error && !lin->Aerr) {
         lin->Aerr = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (!lin->Aerr)
-            return ts_fail(err, TS_ENOMEM,
-                           "linearize: out of memory for the %d x %d error "
-                           "estimate (set estimate_error = 0)",
-                           nlow, n);
+            return ts_fail_nomem(err, 8.0 * nlow * (double)n, "fewer links, "
+                                 "or estimate_error = 0", "linearize: out "
+                                 "of memory for the %d x %d error estimate",
+                                 nlow, n);
     }
     if (!o.estimate_error) {
         free(lin->Aerr);

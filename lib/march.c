@@ -67,6 +67,7 @@ struct tsi_march {
     char *rset;         /* [nn] position known */
     double *K;          /* [3 nn] known loads accumulated from children */
     double *Ma;         /* [6 nn] added mass from child links */
+    double *extra;      /* [3 nn] extra nodal loads, or NULL */
     double mismatch;
 
     gsl_multiroot_fsolver *local;
@@ -157,8 +158,19 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     (void)nres;
     return m;
 nomem:
-    tsi_march_free(m);
-    ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    {
+        /* What the march holds: two dense 3f x 3f Jacobians of the f free
+         * ends (the shooting problem) dominate. */
+        double f = m ? m->nleaf : 0, n = sys->nnodes;
+        double bytes = 8 * (18 * f * f + 6 * f) + f * f +
+                       8 * (13 * n + 5 * n);
+        tsi_march_free(m);
+        ts_fail_nomem(err, bytes, "fewer cables with free ends (bodies "
+                      "or junctions joining them)",
+                      "equilibrium: out of memory for the shooting problem "
+                      "of %.0f free ends and %.0f nodes, two %.0f x %.0f "
+                      "Jacobians", f, n, 3 * f, 3 * f);
+    }
     return NULL;
 }
 
@@ -181,6 +193,7 @@ void tsi_march_free(tsi_march *m)
     free(m->rset);
     free(m->K);
     free(m->Ma);
+    free(m->extra);
     if (m->local)
         gsl_multiroot_fsolver_free(m->local);
     if (m->lx)
@@ -189,6 +202,8 @@ void tsi_march_free(tsi_march *m)
 }
 
 int tsi_march_nunknown(const tsi_march *m) { return 3 * m->nleaf; }
+const double *tsi_march_positions(const tsi_march *m) { return m->r; }
+
 const double *tsi_march_directions(const tsi_march *m) { return m->n; }
 const double *tsi_march_tensions(const tsi_march *m) { return m->t; }
 
@@ -457,7 +472,15 @@ static int solve_link(tsi_march *m, link_problem *P, const double guess[3],
      * buoyancy) down at rounding level of the forces that cancel. */
     const ts_link *L = P->L;
     double gross = v3_norm(P->K) + L->mass * m->sys->env.gravity;
-    if (!(hn > NO_LOAD_RTOL * gross) || !isfinite(hn))
+    /* Forces that overflowed: say so where it happens (the loads were
+     * checked against TS_LOAD_MAX before, so an iterate far off the
+     * solution made them). */
+    if (!isfinite(hn) || !isfinite(gross))
+        return ts_fail(err, TS_ECONV,
+                       "equilibrium: the forces on cables[%d] '%s' link %d "
+                       "overflowed (are not finite) in the march",
+                       L->cable, m->sys->cables[L->cable].name, L->index);
+    if (!(hn > NO_LOAD_RTOL * gross))
         return ts_fail(err, TS_ESINGULAR,
                        "equilibrium: cables[%d] '%s' link %d carries no load "
                        "(|force| = %.3g N against a weight of %.3g N), so its "
@@ -567,6 +590,21 @@ static int march_link(tsi_march *m, link_problem *P, int l,
     return TS_OK;
 }
 
+int tsi_march_set_loads(tsi_march *m, const double *F)
+{
+    if (!F) {
+        free(m->extra);
+        m->extra = NULL;
+        return TS_OK;
+    }
+    if (!m->extra)
+        m->extra = malloc(3 * (size_t)m->nn * sizeof(double));
+    if (!m->extra)
+        return TS_ENOMEM;
+    memcpy(m->extra, F, 3 * (size_t)m->nn * sizeof(double));
+    return TS_OK;
+}
+
 int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
                    double e[], ts_err *err)
 {
@@ -603,7 +641,7 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
             const ts_body *bd = &sys->bodies[nd->body];
             if (bd->type == TS_BODY_CYLINDER) {
                 P.body = bd;
-            } else {
+            } else if (bd->type != TS_BODY_VEHICLE) {
                 double w[3], frac;
                 tsi_rel_velocity(f, ri, zero, w);
                 /* A sphere's load has no axis: the link's last direction
@@ -616,6 +654,8 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
         }
         double Maf[3];
         sym3_mul(Mi, P.afr, Maf);
+        if (m->extra)
+            v3_axpy(1.0, m->extra + 3 * i, Fb);
         for (int j = 0; j < 3; j++)
             P.K[j] = m->K[3 * i + j] + Fb[j] - Maf[j];
         /* First guess: this link's last direction, else its first child's,

@@ -100,6 +100,91 @@ static int parse_initial(const ts_option *o, ts_request *rq, const char *v,
     return TS_OK;
 }
 
+/* The sea state of a response or a simulation: the row's offset is its
+ * ts_sea_opts. A file that cannot be read is bad input, like a missing
+ * scene (TS_EINVAL, not TS_EIO). */
+static ts_sea_opts *sea_opts(const ts_option *o, ts_request *rq)
+{
+    return (ts_sea_opts *)((char *)rq + o->offset);
+}
+
+static int unreadable_is_bad_input(int rc, ts_err *err)
+{
+    if (rc == TS_EIO) {
+        if (err)
+            err->code = TS_EINVAL;
+        return TS_EINVAL;
+    }
+    return rc;
+}
+
+static int parse_sea(const ts_option *o, ts_request *rq, const char *text,
+                     const char *w, const ts_units *u, ts_err *err)
+{
+    ts_sea *sea = ts_sea_parse(text, u, w, err);
+    if (!sea)
+        return unreadable_is_bad_input(err && err->code ? err->code
+                                                        : TS_EINVAL,
+                                       err);
+    ts_sea_opts *so = sea_opts(o, rq);
+    ts_sea_free(so->sea);
+    so->sea = sea;
+    return TS_OK;
+}
+
+static int parse_rao(const ts_option *o, ts_request *rq, const char *text,
+                     const char *w, const ts_units *u, ts_err *err)
+{
+    ts_sea_opts *so = sea_opts(o, rq);
+    if (strlen(text) >= sizeof so->rao_file)
+        return ts_fail(err, TS_EINVAL, "%s: the file name is longer than %zu "
+                       "characters", w, sizeof so->rao_file - 1);
+    ts_rao *rao = ts_rao_read_csv(text, u, err);
+    if (!rao) {
+        ts_err_prefix(err, "%s: ", w);
+        return unreadable_is_bad_input(err && err->code ? err->code
+                                                        : TS_EINVAL,
+                                       err);
+    }
+    ts_rao_free(so->rao);
+    so->rao = rao;
+    snprintf(so->rao_file, sizeof so->rao_file, "%s", text);
+    return TS_OK;
+}
+
+/* "x,y,z": three lengths. */
+static int parse_reference(const ts_option *o, ts_request *rq,
+                           const char *text, const char *w,
+                           const ts_units *u, ts_err *err)
+{
+    char buf[256];
+    if (strlen(text) >= sizeof buf)
+        return ts_fail(err, TS_EINVAL, "%s: too long", w);
+    strcpy(buf, text);
+    double v[3];
+    int n = 0;
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, ",", &save); tok;
+         tok = strtok_r(NULL, ",", &save)) {
+        if (n == 3)
+            return ts_fail(err, TS_EINVAL, "%s: expected three lengths "
+                           "x,y,z (m, in M: x forward, y starboard, z "
+                           "down), got '%s'", w, text);
+        char where[WHERE_MAX + 8];
+        snprintf(where, sizeof where, "%s: %c", w, "xyz"[n]);
+        int rc = ts_units_parse(u, tok, "m", where, &v[n], err);
+        if (rc)
+            return rc;
+        n++;
+    }
+    if (n != 3)
+        return ts_fail(err, TS_EINVAL, "%s: expected three lengths x,y,z "
+                       "(m, in M: x forward, y starboard, z down), got '%s'",
+                       w, text);
+    memcpy(sea_opts(o, rq)->reference, v, sizeof v);
+    return TS_OK;
+}
+
 /* A sweep: links, tolerances or steps of a convergence study. */
 static int parse_sweep(const ts_option *o, ts_request *rq, const char *text,
                        const char *w, const ts_units *u, ts_err *err)
@@ -204,6 +289,23 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
      .max = TS_MAX_LINKS, .offset = OFF(setup.links), .arg = "N",             \
      .help = "equal links on every cable", .deftext = "the scene's links"}
 
+/* How accurate a result must be, and whether it is checked. */
+#define ACCURACY_ROWS                                                         \
+    {.name = "accuracy", .type = TS_OPT_NUMBER, .section = TS_SEC_SETUP,      \
+     .min = 0, .max = 1, .flags = TS_OPT_MIN_OPEN | TS_OPT_MAX_OPEN,          \
+     .offset = OFF(setup.accuracy), .arg = "X",                               \
+     .help = "relative discretisation error allowed of the key values; "      \
+             "missed: not trustworthy"},                                      \
+    {.name = "discretisation_error", .type = TS_OPT_BOOL,                     \
+     .section = TS_SEC_SETUP, NOLIM,                                          \
+     .offset = OFF(setup.discretisation_error),                               \
+     .help = "estimate it from the same analysis at about half (and a "       \
+             "quarter of) the links"},                                        \
+    {.name = "refine", .type = TS_OPT_BOOL, .section = TS_SEC_SETUP, NOLIM,   \
+     .offset = OFF(setup.refine),                                             \
+     .help = "rerun with the links the error model says meet the "            \
+             "accuracy (equal links)"}
+
 /* The settings of a simulation; `only` for a convergence study. */
 #define SIM_ROWS(o)                                                           \
     {.name = "t_end", .type = TS_OPT_QUANTITY, .section = TS_SEC_SIMULATE,    \
@@ -281,11 +383,30 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
      NOLIM, .offset = OFF(simulate.linear), .group = 2, .only = o,            \
      .help = "run the linear model only"}
 
-static const ts_option eq_rows[] = {SETUP_ROWS, LINKS_ROW};
+/* The sea state of a response or a simulation (section `sec`, the
+ * ts_sea_opts at `field`). */
+#define SEA_ROWS(sec, field)                                                  \
+    {.name = "sea", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,             \
+     .offset = OFF(field), .parse = parse_sea, .arg = "SPEC",                 \
+     .help = "irregular sea: Hs=4m,Tp=10s[,gamma=3.3][,heading=150deg], "     \
+             "type=pm,Hs=..,Tp=.. or file=SPECTRUM.csv",                      \
+     .deftext = "none"},                                                      \
+    {.name = "rao", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,             \
+     .offset = OFF(field), .parse = parse_rao, .arg = "FILE",                 \
+     .help = "the ship's RAOs (CSV, doc/seastate.md)",                        \
+     .deftext = "none: the tow point follows the water surface"},             \
+    {.name = "rao_reference", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,   \
+     .offset = OFF(field), .parse = parse_reference, .arg = "X,Y,Z",          \
+     .help = "the RAOs' reference point in M (the lever arm is the tow "      \
+             "point less it)",                                                \
+     .deftext = "0,0,0 m (M's origin)"}
+
+static const ts_option eq_rows[] = {SETUP_ROWS, LINKS_ROW, ACCURACY_ROWS};
 
 static const ts_option modes_rows[] = {
     SETUP_ROWS,
     LINKS_ROW,
+    ACCURACY_ROWS,
     {.name = "count", .type = TS_OPT_INT, .section = TS_SEC_MODES, .min = 1,
      .max = 100000000, .offset = OFF(modes.count), .arg = "N",
      .help = "modes to report",
@@ -299,14 +420,19 @@ static const ts_option modes_rows[] = {
      NOLIM, .choices = eig_methods, .values = eig_method_values,
      .offset = OFF(modes.eigen.method), .arg = "M",
      .help = "lapack: every eigenvalue; arpack: shift-invert, a subset"},
+    {.name = "oscillatory", .type = TS_OPT_BOOL, .section = TS_SEC_MODES,
+     NOLIM, .offset = OFF(modes.oscillatory),
+     .help = "list the oscillatory modes only (they come first anyway)"},
 };
 
 static const ts_option response_rows[] = {
     SETUP_ROWS,
     LINKS_ROW,
+    ACCURACY_ROWS,
     {.name = "input", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .choices = inputs, .offset = OFF(response.input),
-     .size = SZ(response.input), .arg = "NAME",
+     .size = SZ(response.input),
+     .flag_offset = OFF(response.frequency_given), .arg = "NAME",
      .help = "the tow point's motion"},
     {.name = "output", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.output), .size = SZ(response.output),
@@ -315,24 +441,52 @@ static const ts_option response_rows[] = {
      .deftext = "required"},
     {.name = "from", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
      .unit = "Hz", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
-     .offset = OFF(response.from_hz), .arg = "F",
+     .offset = OFF(response.from_hz),
+     .flag_offset = OFF(response.frequency_given), .arg = "F",
      .help = "lowest frequency"},
     {.name = "to", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
      .unit = "Hz", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
-     .offset = OFF(response.to_hz), .arg = "F", .help = "highest frequency"},
+     .offset = OFF(response.to_hz),
+     .flag_offset = OFF(response.frequency_given), .arg = "F",
+     .help = "highest frequency"},
     {.name = "points", .type = TS_OPT_INT, .section = TS_SEC_RESPONSE,
      .min = 2, .max = TS_RESPONSE_MAX_POINTS, .offset = OFF(response.points),
-     .arg = "N", .help = "log-spaced frequencies"},
+     .flag_offset = OFF(response.frequency_given), .arg = "N",
+     .help = "log-spaced frequencies"},
+    SEA_ROWS(TS_SEC_RESPONSE, response.sea),
+    {.name = "intervals", .type = TS_OPT_INT, .section = TS_SEC_RESPONSE,
+     .min = 16, .max = 1 << 20, .offset = OFF(response.intervals),
+     .arg = "N", .help = "with sea: intervals of the spectral grid, a "
+                         "multiple of 8"},
+    {.name = "duration", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
+     .unit = "s", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
+     .offset = OFF(response.duration), .arg = "T",
+     .help = "with sea: the duration of the most probable maximum"},
 };
 
 static const ts_option simulate_rows[] = {
-    SETUP_ROWS, LINKS_ROW, SIM_ROWS(0),
+    SETUP_ROWS,
+    LINKS_ROW,
+    ACCURACY_ROWS,
+    SIM_ROWS(0),
+    SEA_ROWS(TS_SEC_SIMULATE, simulate.sea),
+    {.name = "seed", .type = TS_OPT_LONG, .section = TS_SEC_SIMULATE,
+     .min = 0, .max = 4294967295.0, .offset = OFF(simulate.seed), .arg = "N",
+     .help = "the sea realisation's random seed"},
+    {.name = "components", .type = TS_OPT_INT, .section = TS_SEC_SIMULATE,
+     .min = 1, .max = 1000000, .offset = OFF(simulate.components),
+     .arg = "N", .help = "sinusoids of the sea realisation"},
+    {.name = "fade_in", .type = TS_OPT_QUANTITY, .section = TS_SEC_SIMULATE,
+     .unit = "s", .min = 0, .max = INFINITY,
+     .offset = OFF(simulate.fade_in), .arg = "T",
+     .help = "the sea's fade-in from rest", .deftext = "2 Tp"},
     {.name = "outputs", .type = TS_OPT_TEXT, .section = TS_SEC_SIMULATE,
      NOLIM, .offset = OFF(simulate.outputs), .size = SZ(simulate.outputs),
      .arg = "LIST",
      .help = "the channels written and printed, e.g. "
              "fish.z,armour.1.tension,tow.force; all: the full state",
-     .deftext = "the output (a node's x, y, z) and tow.force"}};
+     .deftext = "the output (a node's x, y, z) and tow.force"},
+};
 
 static const ts_option converge_rows[] = {
     {.name = "analysis", .type = TS_OPT_ENUM, .section = TS_SEC_CONVERGE,

@@ -140,9 +140,10 @@ int ts_report_seastate_csv(const ts_seastate *r, const char *path,
 
 json_t *ts_report_record_json(const ts_record_stats *st)
 {
-    return json_pack("{s:i,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:i}", "samples",
-                     st->nsamples, "duration_s", num(st->duration), "mean",
-                     num(st->mean), "sigma",
+    return json_pack("{s:i,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:i}",
+                     "samples", st->nsamples, "duration_s",
+                     num(st->duration), "mean", num(st->mean), "mean_error",
+                     num(st->mean_error), "sigma",
                      json_pack("{s:o,s:o}", "value", num(st->sigma.value),
                                "error", num(st->sigma.error)),
                      "corr_time_s",

@@ -417,7 +417,11 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
                       "the band %.4g to %.4g rad/s (its estimated share of "
                       "the output variance is in the band error)",
                       100 * s->wave_m0_out / si.m0, lo, hi);
-    if (!(s->cycles >= CYCLES_NOTE))
+    if (!(s->m0.value > 0))
+        ts_trust_note(&s->trust, "%s does not respond to this sea (sigma "
+                      "= 0): Tz and the most probable maximum are not "
+                      "defined", s->output.name);
+    else if (s->cycles < CYCLES_NOTE)
         ts_trust_note(&s->trust, "only %.3g response cycles in %g s: the "
                       "most probable maximum sigma sqrt(2 ln N) assumes many",
                       s->cycles, s->duration);
@@ -574,11 +578,12 @@ int ts_record_stats_compute(const double x[], int n, double dt,
         return TS_OK;
     }
     /* Sokal's window on tau2(M) = dt (1 + 2 sum_1^M rho_k^2). */
-    double sum = 1.0;
+    double sum = 1.0, sum1 = 1.0;
     int M = n / 2, k;
     for (k = 1; k < n / 2; k++) {
         double rho = a[k] / n / r0;
         sum += 2.0 * rho * rho;
+        sum1 += 2.0 * rho;
         if (k >= TS_SEA_SOKAL * sum) {
             M = k;
             break;
@@ -587,6 +592,8 @@ int ts_record_stats_compute(const double x[], int n, double dt,
     free(a);
     st->window_lags = M;
     st->corr_time = dt * sum;
+    st->mean_error = st->sigma.value * sqrt(dt * fmax(sum1, 1.0) /
+                                            st->duration);
     st->independent = st->duration / st->corr_time;
     st->sigma.error = st->sigma.value * sqrt(st->corr_time /
                                              (2.0 * st->duration));

@@ -204,8 +204,11 @@ ts_history *ts_history_alloc(const ts_system *sys, int capacity, ts_err *err)
     return h;
 nomem:
     ts_history_free(h);
-    ts_fail(err, TS_ENOMEM, "ts_history_alloc: out of memory for %d samples",
-            capacity);
+    ts_fail_nomem(err, 8.0 * capacity * (3.0 + 3.0 * sys->nnodes +
+                                         sys->nlinks + TS_NINPUT),
+                  "a coarser sample interval, a shorter t_end or fewer links",
+                  "simulate: out of memory for a history of %d samples of "
+                  "%d nodes", capacity, sys->nnodes);
     return NULL;
 }
 
@@ -480,6 +483,17 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
 {
     if (ts_sim_opts_check(o, err))
         return NULL;
+    /* Loads that overflow under the excitation's motion are the input's
+     * fault: refuse them before a single step, naming the input (a step
+     * size would otherwise shrink towards zero chasing them). */
+    ts_frame f0;
+    ts_motion_bound mb;
+    ts_kernel_get_frame(k, &f0);
+    ts_excitation_bound(ex, &f0, &mb);
+    if (ts_system_check_loads(ts_kernel_system(k), &mb, err) != TS_OK) {
+        ts_err_prefix(err, "simulate: ");
+        return NULL;
+    }
     ts_sim *s = calloc(1, sizeof *s);
     if (!s) {
         ts_fail(err, TS_ENOMEM, "simulate: out of memory");
@@ -554,8 +568,13 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     return s;
 nomem:
     ts_sim_free(s);
-    ts_fail(err, TS_ENOMEM, "simulate: out of memory for %d states",
-            (int)n);
+    ts_fail_nomem(err, 8.0 * (double)n * (needs_jacobian(o->integrator)
+                                             ? (double)n + 10 : 10.0),
+                  needs_jacobian(o->integrator)
+                      ? "fewer links, or an explicit integrator (rk8pd)"
+                      : "fewer links",
+                  "simulate: out of memory for the integrator of %d states",
+                  (int)n);
     return NULL;
 }
 

@@ -209,6 +209,172 @@ double ts_cable_wet_weight(const ts_system *s, int c)
     return (cb->mass_per_length - s->env.water_density * area) * s->env.gravity;
 }
 
+void ts_motion_bound_steady(const ts_system *sys, ts_motion_bound *m)
+{
+    m->speed = fabs(sys->tow.speed);
+    m->turn_rate = fabs(sys->tow.turn_rate);
+    m->tow_speed = 0.0;
+    m->tow_accel = 0.0;
+}
+
+/* The load sizes of one part (a link or a body) under the bounds: mass in
+ * air and displaced mass (kg), drag area times coefficient (m^2) and added
+ * mass (kg). */
+typedef struct part_load {
+    double mass, displaced, drag_area, added;
+} part_load;
+
+/* Which load of which part is the largest, and what it is. */
+typedef struct load_worst {
+    double size;      /* N; NaN sorts first */
+    int kind;         /* 0 weight, 1 buoyancy, 2 drag, 3 inertia */
+    int link, body;   /* the part: a link index or a body index, -1 */
+} load_worst;
+
+static void consider(load_worst *w, double size, int kind, int link,
+                     int body)
+{
+    if (!(size <= w->size) && !(isnan(w->size))) {
+        w->size = size;
+        w->kind = kind;
+        w->link = link;
+        w->body = body;
+    }
+}
+
+/* Consider the loads of part p; returns their sum. */
+static double part_loads(load_worst *w, const part_load *p, double g,
+                         double rho, double flow, double acc, int link,
+                         int body)
+{
+    double f[4] = {p->mass * g, rho * p->displaced * g,
+                   0.5 * rho * flow * flow * p->drag_area,
+                   (p->mass + p->added) * acc};
+    for (int i = 0; i < 4; i++)
+        consider(w, f[i], i, link, body);
+    return f[0] + f[1] + f[2] + f[3];
+}
+
+int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
+                          ts_err *err)
+{
+    const double rho = sys->env.water_density, g = fabs(sys->env.gravity);
+    const double *c = sys->env.current, *p = sys->tow.point;
+    double R = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int k = 0; k < sys->ncables; k++)
+        R += sys->cables[k].length;
+    double current = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    /* The flow speed bound and what makes it up, largest named. */
+    const double flow_part[4] = {m->speed, m->turn_rate * R, current,
+                                 m->tow_speed};
+    double flow = flow_part[0] + flow_part[1] + flow_part[2] + flow_part[3];
+    double acc = m->turn_rate * m->turn_rate * R + m->turn_rate * m->speed +
+                 m->tow_accel;
+    load_worst w = {0.0, 0, -1, -1};
+    double total = 0.0; /* bounds every tension */
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        double vol = M_PI * 0.25 * L->diameter * L->diameter * L->length;
+        part_load pl = {L->mass, vol,
+                        L->diameter * L->length *
+                            (L->cdn + M_PI * L->cdt),
+                        rho * L->can * vol};
+        total += part_loads(&w, &pl, g, rho, flow, acc, l, -1);
+    }
+    for (int b = 0; b < sys->nbodies; b++) {
+        const ts_body *B = &sys->bodies[b];
+        double vol = ts_body_volume(B), D = B->diameter;
+        part_load pl = {B->mass, vol,
+                        B->cd * M_PI * 0.25 * D * D +
+                            (B->type == TS_BODY_CYLINDER
+                                 ? B->cd_cross * D * B->length
+                                 : 0.0),
+                        rho * fmax(B->ca, B->ca_cross) * vol};
+        total += part_loads(&w, &pl, g, rho, flow, acc, -1, b);
+    }
+    if (w.size <= TS_LOAD_MAX) {
+        /* Strains T / EA of elastic links under the largest tension: a
+         * stiffness near zero makes them overflow. */
+        for (int c = 0; c < sys->ncables; c++) {
+            const ts_cable *C = &sys->cables[c];
+            double strain = total / C->ea;
+            if (C->ea > 0 && !(strain <= TS_LOAD_MAX))
+                return ts_fail(err, TS_EDOMAIN, "forces overflow at EA "
+                               "%.3g N of cables[%d] '%s': a tension of up "
+                               "to %.3g N would stretch its links without "
+                               "bound (strains beyond %.3g)", C->ea, c,
+                               C->name, total, TS_LOAD_MAX);
+        }
+        return TS_OK;
+    }
+    /* The input to blame: the largest factor of the worst load. A drag or
+     * an inertia whose motion factor is moderate is the part's own
+     * (a drag coefficient, a size, a mass). */
+    char cause[2 * TS_NAME_MAX + 96];
+    double q = 0.5 * rho * flow * flow;
+    if ((w.kind == 2 && q <= 1e100) || (w.kind == 3 && acc <= 1e100)) {
+        if (w.link >= 0) {
+            const ts_link *L = &sys->links[w.link];
+            snprintf(cause, sizeof cause, w.kind == 2 ? "drag coefficients "
+                     "%.3g (normal) and %.3g (tangential) on a %.3g m by "
+                     "%.3g m link" : "a link mass of %.3g kg",
+                     w.kind == 2 ? L->cdn : L->mass, L->cdt, L->diameter,
+                     L->length);
+        } else {
+            const ts_body *B = &sys->bodies[w.body];
+            snprintf(cause, sizeof cause, w.kind == 2 ? "drag coefficients "
+                     "%.3g and %.3g on a body %.3g m across" : "a body mass "
+                     "of %.3g kg", w.kind == 2 ? B->cd : B->mass,
+                     B->cd_cross, B->diameter);
+        }
+    } else if (w.kind == 2 || w.kind == 3) {
+        static const char *const what[4] = {"speed %.3g m/s",
+                                            "turn rate %.3g rad/s",
+                                            "current %.3g m/s",
+                                            "tow-point velocity %.3g m/s"};
+        int big = 0;
+        double val[4] = {m->speed, m->turn_rate, current, m->tow_speed};
+        for (int i = 1; i < 4; i++)
+            if (!(flow_part[i] <= flow_part[big]))
+                big = i;
+        if (w.kind == 3 && !(m->tow_accel <= acc - m->tow_accel))
+            snprintf(cause, sizeof cause, "tow-point acceleration %.3g "
+                     "m/s^2", m->tow_accel);
+        else
+            snprintf(cause, sizeof cause, what[big], val[big]);
+    } else {
+        double mass = w.link >= 0 ? sys->links[w.link].mass
+                                  : sys->bodies[w.body].mass;
+        if (w.kind == 1 && !(rho <= 1e100))
+            snprintf(cause, sizeof cause, "water density %.3g kg/m^3", rho);
+        else if (!(g <= 1e100))
+            snprintf(cause, sizeof cause, "gravity %.3g m/s^2", g);
+        else if (w.kind == 0)
+            snprintf(cause, sizeof cause, "a mass of %.3g kg", mass);
+        else
+            snprintf(cause, sizeof cause, "a displaced volume that large");
+    }
+    static const char *const load[4] = {"weight", "buoyancy", "drag",
+                                        "inertia"};
+    char part[2 * TS_NAME_MAX + 64];
+    if (w.link >= 0)
+        snprintf(part, sizeof part, "cables[%d] '%s' link %d",
+                 sys->links[w.link].cable,
+                 sys->cables[sys->links[w.link].cable].name,
+                 sys->links[w.link].index);
+    else
+        snprintf(part, sizeof part, "bodies[%d] '%s'", w.body,
+                 sys->bodies[w.body].name);
+    char size[48];
+    if (isfinite(w.size))
+        snprintf(size, sizeof size, "is about %.3g N", w.size);
+    else
+        snprintf(size, sizeof size, "is not a finite number");
+    return ts_fail(err, TS_EDOMAIN, "forces overflow at %s: the %s on %s "
+                   "%s, beyond the %.3g N the solvers can take", cause,
+                   load[w.kind], part, size, TS_LOAD_MAX);
+}
+
 /* " (line N)" for messages about a scene entry, "" when built in code;
  * written into a buffer that lives for the enclosing statement. */
 #define at_line(line) line_text((line), (char[32]){0})
@@ -348,7 +514,8 @@ static int validate(const ts_system *s, ts_err *err)
             if (!bd->vehicle)
                 return ts_fail(err, TS_EINVAL, "%s%s: a vehicle without a "
                                "description", where, at_line(bd->line));
-            if ((rc = ts_vehicle_check(bd->vehicle, bd->mass, where, err)))
+            if ((rc = ts_vehicle_check(bd->vehicle, bd->mass, where,
+                                       bd->line, err)))
                 return rc;
         } else if (bd->vehicle) {
             return ts_fail(err, TS_EINVAL, "bodies[%d]%s: only a vehicle "

@@ -730,12 +730,13 @@ static void test_simulate_sweep(void)
     ro.rel_tol = 1e-11;
     ro.abs_tol = 1e-14;
     double ref[2] = {NAN, NAN};
-    if (CHECK(rc == TS_OK && c->nvalues == 7 &&
+    if (CHECK(rc == TS_OK && c->nvalues == 9 &&
                   strcmp(c->values[0].name,
                          "sphere.z.amplitude_ratio") == 0 &&
                   strcmp(c->values[2].name, "sphere.z.phase_deg") == 0 &&
-                  strcmp(c->values[3].name, "tow.force.max") == 0 &&
-                  strcmp(c->values[6].name,
+                  strcmp(c->values[3].name, "tension.max") == 0 &&
+                  strcmp(c->values[5].name, "tow.force.max") == 0 &&
+                  strcmp(c->values[8].name,
                          "tow.force.amplification") == 0,
               "ex. 4 simulate tolerance sweep: the fitted values and the "
               "tow force's extremes (%s)", err.msg) &&

@@ -308,6 +308,22 @@ static void test_arpack_small(void)
     rc = ts_eigen_solve(lin, &o, &ar, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "lapack"),
           "arpack with too many modes refused: %s", err.msg);
+    /* The same checks without a linearization, naming the states. */
+    int n = lin->nstate, most = (n - 3) / 2;
+    o.count = most;
+    CHECK(ts_eigen_check(n, &o, &err) == TS_OK,
+          "ts_eigen_check: arpack with %d modes of %d states", most, n);
+    o.count = most + 1;
+    char want[64];
+    snprintf(want, sizeof want, "the %d states allow (at most %d modes)", n,
+             most);
+    CHECK(ts_eigen_check(n, &o, &err) == TS_EINVAL && strstr(err.msg, want),
+          "ts_eigen_check: %d modes refused: %s", most + 1, err.msg);
+    o.method = TS_EIG_LAPACK;
+    o.count = n + 1;
+    snprintf(want, sizeof want, "the system has %d states", n);
+    CHECK(ts_eigen_check(n, &o, &err) == TS_EINVAL && strstr(err.msg, want),
+          "ts_eigen_check: a count above the states refused: %s", err.msg);
     ts_eigen_free(all);
     ts_linear_free(lin);
     ts_scene_free(sc);

@@ -590,7 +590,42 @@ static void test_sum(void)
     ts_excitation_input(ex, 2.0, u);
     CHECK(fabs(u[1] - 4 * 0.1 * sin(2 * M_PI * 0.2 * 2.0)) < 1e-15,
           "the sines still add up beside the sum");
+    /* A copy: the same inputs and frames, and independent of the
+     * original. Add a series and a manoeuvre first. */
+    const double ts[4] = {-1, 0.7, 1.9, 3.4}, xs[4] = {0, 0.02, -0.01, 0.03};
+    ts_signal man = {0};
+    man.type = TS_SIGNAL_RAMP;
+    man.axis = TS_AXIS_TURN_RATE;
+    man.amplitude = 0.1;
+    man.duration = 1.0;
+    man.rise = 0.1;
+    man.absolute = 1;
+    int rc2 = ts_excitation_add_series(ex, TS_AXIS_HEAVE, 4, ts, xs, &e);
+    if (rc2 == TS_OK)
+        rc2 = ts_excitation_add(ex, &man, &e);
+    CHECK(rc2 == TS_OK && ts_excitation_nsignals(ex) == 8,
+          "a series and a manoeuvre beside the sum: %s", e.msg);
+    ts_excitation *cp = ts_excitation_copy(ex, &e);
+    int same = cp && ts_excitation_nsignals(cp) == ts_excitation_nsignals(ex);
+    ts_frame base = {0}, fa, fb;
+    base.speed = 2;
+    for (int i = 0; same && i < 30; i++) {
+        double ua[9], ub[9], t = 0.11 * i;
+        ts_excitation_input(ex, t, ua);
+        ts_excitation_input(cp, t, ub);
+        ts_excitation_frame(ex, &base, t, &fa);
+        ts_excitation_frame(cp, &base, t, &fb);
+        same = !memcmp(ua, ub, sizeof ua) && fa.turn_rate == fb.turn_rate &&
+               fa.turn_accel == fb.turn_accel;
+    }
     ts_excitation_free(ex);
+    double uc[9];
+    if (cp)
+        ts_excitation_input(cp, 1.3, uc);
+    CHECK(same && cp && isfinite(uc[2]), "a copy gives the same inputs and "
+          "frames, and outlives the original (%d signals)",
+          cp ? ts_excitation_nsignals(cp) : 0);
+    ts_excitation_free(cp);
 }
 
 int main(void)

@@ -67,6 +67,17 @@
  *                a horizontal cable plus the sphere's drag (1e-3); a deep
  *                tow point with Cdn 1e6 and a sphere, and Cdn 1e4 with the
  *                sphere awash at the surface: force balance (1e-9).
+ *  overflow      inputs whose loads overflow double precision are refused
+ *                before any solve (TS_EDOMAIN), each message naming the
+ *                input and the part and holding no "nan": speed and turn
+ *                rate 1e300, a drag coefficient 1e300, a cable weight of
+ *                1e300 N/m, gravity 1e300, EA 5e-324 N, a tow-point heave
+ *                of 1e300 m at 1 Hz and a turn-rate manoeuvre to 1e300
+ *                rad/s (ts_sim_alloc). The bound is the loads' size, not
+ *                the solve: 1e60 m/s (drag ~1e122 N) still converges,
+ *                1e80 m/s (~1e162 N) is refused. The motion bounds of
+ *                ts_excitation_bound: a sine's A w and A w^2 (exact), a
+ *                manoeuvre's change added to the base speed.
  *
  * With --report, one line per case, "CASE", name, what is asserted,
  * result, run time in ms and verdict separated by tabs, is printed for
@@ -83,6 +94,8 @@
 #include "towstab/analysis.h"
 #include "towstab/converge.h"
 #include "towstab/eigen.h"
+#include "towstab/excitation.h"
+#include "towstab/simulate.h"
 #include "towstab/equilibrium.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
@@ -1078,6 +1091,120 @@ static void case_drag(void)
     end();
 }
 
+/* Solve s; 1 when refused with TS_EDOMAIN and a message holding every
+ * text of want[] (NULL-terminated) and no "nan". */
+static int refused(const ts_system *s, const char *const want[],
+                   char *msg, size_t size)
+{
+    ts_err err = {0};
+    int rc;
+    ts_equilibrium *eq = solve_opts(s, NULL, &rc, &err);
+    ts_equilibrium_free(eq);
+    snprintf(msg, size, "%s", err.msg);
+    int ok = rc == TS_EDOMAIN && !strstr(err.msg, "nan");
+    for (int i = 0; want[i]; i++)
+        ok &= strstr(err.msg, want[i]) != NULL;
+    return ok;
+}
+
+static void case_overflow(void)
+{
+    begin("overflowing loads", "refused before the solve, naming the input");
+    static const struct {
+        const char *what;
+        double V, omega, cdt, mpl, g_scale, ea;
+        const char *want[4]; /* NULL-terminated */
+    } c[] = {
+        {"speed 1e300", 1e300, 0, 0.01, 1.488, 1, 0,
+         {"forces overflow at speed 1e+300 m/s", "drag", "cables[0]"}},
+        {"turn rate 1e300", 2.5, 1e300, 0.01, 1.488, 1, 0,
+         {"turn rate 1e+300 rad/s", "drag", NULL}},
+        {"Cdt 1e300", 2.5, 0, 1e300, 1.488, 1, 0,
+         {"drag coefficients 1.2 (normal) and 1e+300", "cables[0]", NULL}},
+        {"weight 1e300 N/m", 2.5, 0, 0.01, 1e300 / G, 1, 0,
+         {"the weight on cables[0] 'cable' link 1", "a mass of", NULL}},
+        {"gravity 1e300", 2.5, 0, 0.01, 1.488, 1e300 / G, 0,
+         {"gravity 1e+300 m/s^2", NULL, NULL}},
+        {"EA 5e-324", 2.5, 0, 0.01, 1.488, 1, 4.9e-324,
+         {"EA 4.94e-324 N of cables[0]", "without bound", NULL}},
+    };
+    char msg[TS_ERR_MSG_MAX];
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        spec p = ex1();
+        p.V = c[i].V;
+        p.omega = c[i].omega;
+        p.cdt = c[i].cdt;
+        p.mpl = c[i].mpl;
+        p.ea = c[i].ea;
+        ts_system *s = make(&p);
+        if (s)
+            s->env.gravity *= c[i].g_scale;
+        CHECK(s && refused(s, c[i].want, msg, sizeof msg), "%s refused: %s",
+              c[i].what, msg);
+        ts_system_free(s);
+    }
+    result("every overflowing input refused, named in its message");
+    /* The threshold is on the loads: 1e60 m/s solves, 1e80 m/s does not. */
+    spec p = ex1();
+    p.V = 1e60;
+    ts_system *s = make(&p);
+    int rc;
+    ts_equilibrium *eq = s ? solve(s, &rc) : NULL;
+    CHECK(eq && rc == TS_OK, "speed 1e60 m/s (drag ~1e122 N): solved");
+    ts_equilibrium_free(eq);
+    ts_system_free(s);
+    p.V = 1e80;
+    s = make(&p);
+    static const char *const w80[] = {"speed 1e+80 m/s", "is about", NULL};
+    CHECK(s && refused(s, w80, msg, sizeof msg),
+          "speed 1e80 m/s (drag ~1e162 N) refused: %s", msg);
+    ts_system_free(s);
+
+    /* Excitations: the bounds, and the simulator's refusal. */
+    p = ex1();
+    s = make(&p);
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_units *u = ts_units_alloc(&err);
+    ts_frame f0 = {2.5, 0, 0, 0, {0, 0, 0}};
+    ts_motion_bound mb;
+    int prc = ts_excitation_parse(ex, "tow.heave:amplitude=0.37m,frequency="
+                                  "1.3Hz", u, "test", &err);
+    prc |= ts_excitation_parse(ex, "speed:by=1.25m/s,duration=4s", u, "test",
+                               &err);
+    ts_excitation_bound(ex, &f0, &mb);
+    double w = 2 * M_PI * 1.3;
+    CHECK(prc == TS_OK && mb.speed == 2.5 + 1.25 && mb.turn_rate == 0 &&
+              fabs(mb.tow_speed - 0.37 * w) <= 1e-15 * mb.tow_speed &&
+              fabs(mb.tow_accel - 0.37 * w * w) <= 1e-15 * mb.tow_accel,
+          "bounds of a 1.3 Hz heave and a speed ramp: speed %g, tow %g m/s, "
+          "%g m/s^2", mb.speed, mb.tow_speed, mb.tow_accel);
+    ts_excitation_free(ex);
+    static const struct {
+        const char *spec, *want;
+    } e[] = {{"tow.heave:amplitude=1e300m,frequency=1Hz",
+              "tow-point velocity 6.28e+300 m/s"},
+             {"turn_rate:to=1e300rad/s,duration=1s",
+              "turn rate 1e+300 rad/s"}};
+    for (int i = 0; i < 2 && s; i++) {
+        ex = ts_excitation_alloc(&err);
+        ts_excitation_parse(ex, e[i].spec, u, "test", &err);
+        ts_kernel *k = ts_kernel_alloc(s, &err);
+        ts_sim_opts so;
+        ts_sim_opts_default(&so);
+        ts_sim *sim = ts_sim_alloc(k, ex, &so, &err);
+        CHECK(!sim && err.code == TS_EDOMAIN && strstr(err.msg, e[i].want) &&
+                  !strstr(err.msg, "nan"),
+              "simulate %s refused: %s", e[i].spec, err.msg);
+        ts_sim_free(sim);
+        ts_kernel_free(k);
+        ts_excitation_free(ex);
+    }
+    ts_units_free(u);
+    ts_system_free(s);
+    end();
+}
+
 int main(int argc, char **argv)
 {
     report = argc > 1 && strcmp(argv[1], "--report") == 0;
@@ -1094,5 +1221,6 @@ int main(int argc, char **argv)
     case_stiff();
     case_mm();
     case_drag();
+    case_overflow();
     return tc_done();
 }

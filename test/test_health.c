@@ -26,6 +26,11 @@
  *     named.
  *  6. A node at the water surface (tow point one link above it): a reason.
  *  7. JSON of the verdict and of the per-mode health.
+ *  8. The surface: a sphere whose centre is nearer the water surface than
+ *     its radius (0.0681 m deep, radius 0.127 m: Kamman's sphere at
+ *     100 m/s) is noted, one 1 m deep is not; a cylinder hanging
+ *     vertically crosses when its half-length exceeds its depth; the
+ *     first link of a cable whose ends lie on both sides is named.
  */
 #include "towstab/health.h"
 
@@ -362,11 +367,103 @@ static void test_chains(void)
     free(mh);
 }
 
+/* A built one-cable system of 3 links ending in body `type` (diameter
+ * 0.254 m, length 2 m), its equilibrium record with every node hanging
+ * straight down the z values given. */
+static ts_system *surface_system(ts_body_type type, const double z[4],
+                                 ts_equilibrium **eq)
+{
+    ts_err err = {0};
+    ts_system *sys = ts_system_alloc(1, 1, &err);
+    ts_cable *c = &sys->cables[0];
+    snprintf(c->name, sizeof c->name, "wire");
+    c->from_body = -1;
+    c->to_body = 0;
+    c->length = 3.0;
+    c->diameter = 0.01;
+    c->mass_per_length = 0.5;
+    c->nlinks = 3;
+    ts_body *b = &sys->bodies[0];
+    snprintf(b->name, sizeof b->name, "fish");
+    b->type = type;
+    b->diameter = 0.254;
+    b->length = 2.0;
+    b->mass = 10;
+    ts_system_build(sys, &err);
+    *eq = ts_equilibrium_alloc(sys, &err);
+    (*eq)->converged = 1;
+    (*eq)->tolerance = 1e-10;
+    (*eq)->force_scale = 100;
+    (*eq)->min_tension = 1;
+    for (int i = 0; i < 4; i++)
+        (*eq)->positions[3 * i + 2] = z[i];
+    for (int l = 0; l < 3; l++) {
+        (*eq)->tensions[l] = 1;
+        (*eq)->directions[3 * l + 2] = 1; /* hanging straight down */
+    }
+    return sys;
+}
+
+static int note_with(const ts_trust *t, const char *a, const char *b)
+{
+    for (int i = 0; i < t->nnotes; i++)
+        if (strstr(t->notes[i], a) && (!b || strstr(t->notes[i], b)))
+            return 1;
+    return 0;
+}
+
+static void test_surface(void)
+{
+    ts_equilibrium *eq;
+    ts_trust t;
+    static const double awash[4] = {0, 0.02, 0.04, 0.0681};
+    ts_system *sys = surface_system(TS_BODY_SPHERE, awash, &eq);
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(t.trustworthy && note_with(&t, "bodies[0] 'fish' breaks the water "
+                                         "surface", "0.0681 m below") &&
+              note_with(&t, "half-height 0.127 m", NULL) && t.nnotes == 1,
+          "a sphere 0.0681 m deep with a 0.127 m radius is awash (a note): "
+          "%s", t.nnotes ? t.notes[0] : "none");
+    ts_equilibrium_free(eq);
+    ts_system_free(sys);
+    static const double deep[4] = {0, 0.3, 0.6, 1.0};
+    sys = surface_system(TS_BODY_SPHERE, deep, &eq);
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(t.trustworthy && t.nnotes == 0, "a sphere 1 m deep: no note");
+    ts_equilibrium_free(eq);
+    ts_system_free(sys);
+    /* A vertical cylinder 2 m long, 0.9 m deep: its top is 0.1 m above. */
+    static const double fish[4] = {0, 0.3, 0.6, 0.9};
+    sys = surface_system(TS_BODY_CYLINDER, fish, &eq);
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(note_with(&t, "'fish' breaks the water surface", "half-height 1 m"),
+          "a vertical 2 m cylinder 0.9 m deep is awash: %s",
+          t.nnotes ? t.notes[0] : "none");
+    ts_equilibrium_free(eq);
+    ts_system_free(sys);
+    /* A tow point 1 m above the water: link 2 crosses. */
+    static const double above[4] = {-1.0, -0.4, 0.2, 5.0};
+    sys = surface_system(TS_BODY_SPHERE, above, &eq);
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(t.trustworthy && t.nnotes == 1 &&
+              note_with(&t, "cables[0] 'wire' crosses the water surface at "
+                            "link 2", NULL),
+          "the link whose ends lie on both sides is named: %s",
+          t.nnotes ? t.notes[0] : "none");
+    ts_equilibrium_free(eq);
+    ts_system_free(sys);
+}
+
 int main(void)
 {
     test_trust();
     test_equilibrium_health();
     test_vector_allowance();
     test_chains();
+    test_surface();
     return tc_done();
 }

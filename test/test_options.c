@@ -161,8 +161,9 @@ static int bad_texts(const ts_option *o, const char *out[], int max)
     case TS_OPT_LONG:
         ADD("x");
         ADD("1.5");
-        ADD("0");
-        if (o->max < 1e15)
+        if (o->min > 0)
+            ADD("0");
+        if (o->max < 100000001)
             ADD("100000001");
         break;
     case TS_OPT_BOOL: ADD("maybe"); break;

@@ -301,6 +301,28 @@ static void test_write(const ts_system *s, const ts_equilibrium *eq)
     json_decref(back);
     unlink(path);
     json_decref(o);
+
+    /* Text (a page): every byte, a NUL inside included; a failed write
+     * leaves nothing. */
+    static const char page[] = "<p>2.385 \xc2\xb1 0.01 m</p>\0tail\n";
+    snprintf(path, sizeof path, "%s/page.html", tf_dir);
+    rc = ts_report_write_text(page, sizeof page - 1, path, &err);
+    FILE *f = fopen(path, "rb");
+    char back_text[64] = {0};
+    size_t got = f ? fread(back_text, 1, sizeof back_text, f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(rc == TS_OK && got == sizeof page - 1 &&
+              !memcmp(back_text, page, got) && tf_count("partial") == 0,
+          "write text: every byte (%zu of %zu), no temporary left", got,
+          sizeof page - 1);
+    unlink(path);
+    snprintf(path, sizeof path, "%s/no/such/folder/page.html", tf_dir);
+    ts_err_clear(&err);
+    rc = ts_report_write_text(page, sizeof page - 1, path, &err);
+    CHECK(rc == TS_EIO && strstr(err.msg, path) && !tf_exists(path),
+          "write text: missing folder: TS_EIO naming the path, nothing "
+          "written (%s)", err.msg);
 }
 
 int main(void)

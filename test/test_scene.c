@@ -266,6 +266,73 @@ static int has_line(const char *msg, int n)
     return 0;
 }
 
+/* A vehicle with every key (good_vehicle.yaml). */
+static void test_vehicle(const ts_units *u)
+{
+    ts_scene *s = load(u, DIR "good_vehicle.yaml");
+    if (!s)
+        return;
+    const ts_system *sys = s->system;
+    const ts_body *b = &sys->bodies[0];
+    const ts_vehicle *v = b->vehicle;
+    double deg = M_PI / 180;
+    CHECK(b->type == TS_BODY_VEHICLE && v && sys->nvehicles == 1,
+          "fish is a vehicle");
+    CHECK_REL(b->mass, 500 / sys->env.gravity, RTOL, "weight -> mass");
+    CHECK_REL(v->volume, 0.030, RTOL, "volume 30 L");
+    CHECK(fabs(v->inertia[0] - 0.4) < 1e-15 && fabs(v->inertia[4] - 0.05) <
+              1e-15 && v->inertia[3] == 0,
+          "inertia with products (Ixz)");
+    CHECK(fabs(v->mass_centre[2] - 0.02) < 1e-15 &&
+              fabs(v->buoyancy_centre[0] - 0.01) < 1e-15 &&
+              fabs(v->attach[0] - 0.2) < 1e-15 &&
+              fabs(v->attach[2] + 0.12) < 1e-15,
+          "mass centre, buoyancy centre, attach point in m");
+    CHECK_REL(v->surface_diameter, 0.25, RTOL, "surface_diameter");
+    /* The spheroid's added mass, moved from its centre (5 cm forward) to
+     * O: A11 = k1 m_f unchanged; the shift couples sway and yaw. */
+    double A[36], k[3];
+    ts_added_mass_spheroid(sys->env.water_density, 1.6, 0.2, A, k, NULL);
+    CHECK(v->added_mass_estimated && fabs(v->added_mass[0] - A[0]) <
+              1e-12 * A[0] && fabs(v->added_mass[6 * 1 + 5]) > 0,
+          "added mass: spheroid of 1.6 m x 0.2 m at 5 cm, A11 %.6g kg, "
+          "A26 %.6g kg m",
+          v->added_mass[0], v->added_mass[11]);
+    CHECK(v->ncomponents == 4, "four components");
+    const ts_component *h = &v->component[0], *w = &v->component[1];
+    const ts_component *f = &v->component[2], *bl = &v->component[3];
+    CHECK(h->type == TS_COMP_HULL && fabs(h->length - 1.6) < 1e-15 &&
+              fabs(h->cd_axial - 0.25) < 1e-15,
+          "hull");
+    CHECK(w->type == TS_COMP_SURFACE && fabs(w->area - 0.12) < 1e-15 &&
+              fabs(w->incidence + 3 * deg) < 1e-15 &&
+              fabs(w->stall - 18 * deg) < 1e-15 &&
+              fabs(w->lift_slope - 3.1) < 1e-15 &&
+              fabs(w->cd0 - 0.012) < 1e-15 && !w->control,
+          "wing: area, incidence, stall, slope, zero-lift drag");
+    CHECK(f->curve == TS_CURVE_TABLE && f->npoints == 5 &&
+              fabs(f->alpha[1] + 15 * deg) < 1e-15 &&
+              fabs(f->roll - 90 * deg) < 1e-15 && f->cd[4] == 1.2,
+          "fin: a 5-row table, rolled 90 deg");
+    CHECK(bl->type == TS_COMP_BLUFF && fabs(bl->drag - 0.9) < 1e-15,
+          "ballast: a bluff part");
+    const ts_cable *t = &sys->cables[1];
+    CHECK(t->has_from_point && fabs(t->from_point[0] + 0.8) < 1e-15,
+          "the tail starts at (-0.8, 0, 0.05) m of the fish");
+    int l = 0;
+    while (l < sys->nlinks && sys->links[l].cable != 1)
+        l++;
+    CHECK(l < sys->nlinks && sys->links[l].up_body == 0 &&
+              fabs(sys->links[l].up_point[2] - 0.05) < 1e-15,
+          "its first link starts at that point of the vehicle");
+    /* The vehicle's mass and the tail's first half link are the body's,
+     * not its node's. */
+    int node = ts_system_body_node(sys, 0);
+    CHECK_REL(sys->nodes[node].mass, 0.5 * 50.0 / 8 * 0.4, RTOL,
+              "the vehicle's node carries half a main link only");
+    ts_scene_free(s);
+}
+
 static void test_bad_fixtures(const ts_units *u)
 {
     static const struct {
@@ -277,6 +344,27 @@ static void test_bad_fixtures(const ts_units *u)
     } bad[] = {
         {"bad_missing_length", TS_ESCENE, "cables[0]", 6,
          "missing key 'length'"},
+        {"bad_vehicle_no_components", TS_ESCENE, "bodies[0]", 15,
+         "missing key 'components'"},
+        {"bad_vehicle_component_type", TS_EINVAL,
+         "bodies[0].components[0].type", 23,
+         "unknown component type \"wing\"; expected hull, surface or bluff"},
+        {"bad_vehicle_inertia", TS_EINVAL, "bodies[0].inertia", 19,
+         "needs 3 to 6 entries, got 2"},
+        {"bad_vehicle_inertia_not_definite", TS_EINVAL, "bodies[0].inertia",
+         15, "must be positive definite"},
+        {"bad_vehicle_diameter", TS_ESCENE, "bodies[0].diameter", 18,
+         "does not apply to a vehicle"},
+        {"bad_vehicle_surface_hull_key", TS_ESCENE,
+         "bodies[0].components[1].axial_drag", 30,
+         "does not apply to a surface component"},
+        {"bad_vehicle_table_order", TS_EINVAL,
+         "bodies[0].components[1].table", 26,
+         "angles must increase, row 2 has 5 deg after 10 deg"},
+        {"bad_vehicle_added_mass_rows", TS_EINVAL, "bodies[0].added_mass",
+         21, "needs 6 rows of 6 numbers"},
+        {"bad_vehicle_at_sphere", TS_EINVAL, "cables[1].at", 16,
+         "a starting point on a body needs a vehicle"},
         {"bad_unknown_key_top", TS_ESCENE, "tow_speed", 5,
          "unknown key; expected one of name, environment, tow, cables, "
          "bodies, analyses"},
@@ -507,6 +595,18 @@ static void test_buffers(const ts_units *u)
           "missing file: %s", err.msg);
     s = ts_scene_load(DIR, u, &err);
     CHECK(!s && err.code == TS_EIO, "a directory: %s", err.msg);
+    /* "-" reads standard input; messages name it. */
+    if (freopen(DIR "good_minimal.yaml", "rb", stdin)) {
+        s = ts_scene_load("-", u, &err);
+        CHECK(s && !strcmp(s->path, "-"), "'-' reads a scene from standard "
+              "input (%s)", s ? "" : err.msg);
+        ts_scene_free(s);
+    }
+    if (freopen(DIR "bad_empty.yaml", "rb", stdin)) {
+        s = ts_scene_load("-", u, &err);
+        CHECK(!s && !strncmp(err.msg, "standard input: ", 16),
+              "a bad scene on standard input is named so: %s", err.msg);
+    }
     ts_scene_free(NULL);
     CHECK(1, "ts_scene_free(NULL) does nothing");
     CHECK(ts_scene_analysis_option(NULL, "x") == NULL, "option of NULL");
@@ -565,6 +665,152 @@ static void test_mutations(const ts_units *u)
           "silent", len, nok, nfail, silent);
 }
 
+/* ts_scene_set: one setting, expecting it to fail with `code` and a
+ * message containing `gist` (NULL: no check of the text). */
+static void set_fails(const ts_scene *s, const ts_units *u, const char *key,
+                      const char *value, int code, const char *gist)
+{
+    ts_err err;
+    ts_err_clear(&err);
+    const char *k[1] = {key}, *v[1] = {value};
+    ts_scene *t = ts_scene_set(s, 1, k, v, u, &err);
+    CHECK(!t && err.code == code && (!gist || strstr(err.msg, gist)),
+          "set %s = %s refused: %s", key, value ? value : "(removed)",
+          err.msg);
+    ts_scene_free(t);
+}
+
+/* Values set over the text (doc/scene-format.md, "Setting values"): each
+ * converted as in a file, selected by index or name, added when absent,
+ * removed; the scene set from is not changed; settings chain, a key set
+ * again replaces its earlier value; every bad key or value is refused
+ * naming it. */
+static void test_settings(const ts_units *u)
+{
+    const char *file = DIR "good_kamman_ex2.yaml";
+    ts_scene *s = load(u, file);
+    if (!s)
+        return;
+    FILE *f = fopen(file, "rb");
+    char want[4096];
+    size_t n = f ? fread(want, 1, sizeof want, f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(s->text && s->text_len == n && !memcmp(s->text, want, n) &&
+              s->text[n] == '\0' && s->nsettings == 0,
+          "the text read is kept, byte for byte (%zu bytes), no settings",
+          n);
+
+    ts_err err;
+    ts_err_clear(&err);
+    const char *k1[] = {"tow.speed", "cables[upper].normal_drag",
+                        "cables[2].diameter", "bodies[sphere_b].mass",
+                        "tow.point", "environment.current[1]",
+                        "cables[upper].EI", "analyses[1].tolerance"};
+    const char *v1[] = {"5 knot", "1.7", "0.5 in", "2.385 kg",
+                        "[0, 0, \"-2 m\"]", "3 cm/s", NULL, "1e-9"};
+    ts_scene *t = ts_scene_set(s, 8, k1, v1, u, &err);
+    if (CHECK(t != NULL, "eight values set (%s)", err.msg)) {
+        const ts_system *a = t->system;
+        CHECK_REL(a->tow.speed, 5 * KNOT, RTOL, "tow.speed 5 knot");
+        CHECK_REL(a->cables[2].diameter, 0.5 * INCH, RTOL,
+                  "cables[2].diameter 0.5 in");
+        CHECK(a->cables[1].cdn == 1.7 && a->bodies[2].mass == 2.385,
+              "by name: cables[upper].normal_drag, bodies[sphere_b].mass");
+        CHECK(a->tow.point[0] == 0 && a->tow.point[2] == -2 &&
+                  fabs(a->env.current[1] - 0.03) < 1e-15 &&
+                  a->env.current[0] == s->system->env.current[0],
+              "a list, and one entry of a list");
+        CHECK(a->cables[1].ei == 0 && s->system->cables[1].ei > 0,
+              "a key removed takes its default");
+        const ts_scene_option *o =
+            ts_scene_analysis_option(&t->analyses[1], "tolerance");
+        CHECK(o && !strcmp(o->value, "1e-9"), "an analysis option");
+        CHECK(s->system->tow.speed == 2.5 * FT && s->nsettings == 0,
+              "the scene set from is unchanged");
+        CHECK(t->nsettings == 8 && !strcmp(t->settings[3].key,
+                                            "bodies[sphere_b].mass") &&
+                  !strcmp(t->settings[3].value, "2.385 kg") &&
+                  !t->settings[6].value && !strcmp(t->path, s->path) &&
+                  t->text_len == s->text_len,
+              "the new scene keeps the path, the text and its settings");
+
+        /* Chained: the earlier settings stay; a key again replaces. */
+        const char *k2[] = {"tow.turn_rate", "tow.speed"};
+        const char *v2[] = {"0", "3"};
+        ts_scene *c = ts_scene_set(t, 2, k2, v2, u, &err);
+        if (CHECK(c != NULL, "chained (%s)", err.msg)) {
+            CHECK(c->system->tow.speed == 3 && c->system->tow.turn_rate == 0 &&
+                      c->system->cables[1].cdn == 1.7 &&
+                      c->nsettings == 9 &&
+                      !strcmp(c->settings[8].key, "tow.speed"),
+                  "settings chain; tow.speed set again replaces its "
+                  "earlier value (9 settings, speed %g)",
+                  c->system->tow.speed);
+            ts_scene_free(c);
+        }
+        ts_scene_free(t);
+    }
+
+    /* An absent block is added. */
+    ts_scene *m = load(u, DIR "good_minimal.yaml");
+    if (m) {
+        const char *k[] = {"environment.gravity", "cables[only].links"};
+        const char *v[] = {"9.7", "7"};
+        ts_err_clear(&err);
+        ts_scene *t2 = ts_scene_set(m, 2, k, v, u, &err);
+        CHECK(t2 && t2->system->env.gravity == 9.7 &&
+                  t2->system->nlinks == 7,
+              "a block the file lacks is added (%s)", err.msg);
+        ts_scene_free(t2);
+        ts_scene_free(m);
+    }
+
+    /* Refused, naming the key; the checks of a file apply. */
+    set_fails(s, u, "tow.sped", "3", TS_ESCENE,
+              "tow.sped (line 45): unknown key");
+    set_fails(s, u, "cables[0].length", "-3 m", TS_EINVAL,
+              "cables[0].length (line 8): must be > 0 m");
+    set_fails(s, u, "tow.speed", "3 kg", TS_EUNIT, "tow.speed (line 47)");
+    set_fails(s, u, "cables[9].length", "1", TS_EINVAL,
+              "cables[9].length: 'cables' has no entry [9] (3 entries");
+    set_fails(s, u, "cables[nope].length", "1", TS_EINVAL,
+              "has no entry [nope]");
+    set_fails(s, u, "tow.speed.x", "1", TS_EINVAL,
+              "'x' is inside a scalar, not a mapping");
+    set_fails(s, u, "tow[0]", "1", TS_EINVAL, "'tow' is a mapping, not a "
+              "list");
+    set_fails(s, u, "nothing[0]", "1", TS_EINVAL, "the scene has no list");
+    set_fails(s, u, "tow..speed", "1", TS_EINVAL, "expected a name");
+    set_fails(s, u, "cables[0", "1", TS_EINVAL, "expected [index] or [name]");
+    set_fails(s, u, "", "1", TS_EINVAL, "expected a key");
+    set_fails(s, u, "tow.speed", "[1, 2", TS_EINVAL, "is not YAML");
+    set_fails(s, u, "tow.speed", "", TS_EINVAL, "empty value");
+    set_fails(s, u, "tow.nothing", NULL, TS_EINVAL, "no such key to remove");
+    set_fails(s, u, "cables[0]", NULL, TS_EINVAL, "cannot be removed");
+    set_fails(s, u, "tow.speed", "[[[[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]]",
+              TS_EINVAL, "nested deeper");
+    set_fails(s, u, "tow.speed", NULL, TS_ESCENE, "speed");
+    ts_err_clear(&err);
+    CHECK(!ts_scene_set(NULL, 0, NULL, NULL, u, &err) &&
+              err.code == TS_EINVAL,
+          "a NULL scene is refused (%s)", err.msg);
+    ts_scene_free(s);
+
+    /* A scene read from a string keeps its text too. */
+    static const char text[] = "name: s\ntow: {speed: 1}\ncables:\n"
+                               "  - {name: c, from: tow, length: 10, "
+                               "diameter: 0.01, mass_per_length: 0.2, links: 2}\n";
+    ts_scene *p = ts_scene_parse(text, sizeof text - 1, "text", u, &err);
+    const char *k[] = {"cables[c].length"}, *v[] = {"12"};
+    ts_scene *q = p ? ts_scene_set(p, 1, k, v, u, &err) : NULL;
+    CHECK(p && q && p->text_len == sizeof text - 1 &&
+              q->system->cables[0].length == 12,
+          "a scene from a string: text kept, values set (%s)", err.msg);
+    ts_scene_free(q);
+    ts_scene_free(p);
+}
+
 int main(void)
 {
     ts_err err;
@@ -574,9 +820,11 @@ int main(void)
     test_ex1(u);
     test_ex2(u);
     test_minimal_and_wet(u);
+    test_vehicle(u);
     test_bad_fixtures(u);
     test_buffers(u);
     test_mutations(u);
+    test_settings(u);
     ts_units_free(u);
     return tc_done();
 }

@@ -230,15 +230,45 @@ int cli_exit_code(int rc)
     }
 }
 
-int cli_report(const ts_err *err, int rc)
+/* The scene file the command read (cli_open), for messages: its path, or
+ * "standard input". The tool's state, like json_fd. */
+static char scene_label[512];
+
+/* Whether a message about the scene's analysis should be prefixed with
+ * the scene file: an analysis that failed (its message names the part,
+ * not the file), or an option of an `analyses` entry; not a message about
+ * a command-line option or one that names the file already. */
+static int needs_scene(const char *msg, int rc)
+{
+    if (!scene_label[0] || !strncmp(msg, "--", 2) || strstr(msg, scene_label))
+        return 0;
+    if (!strncmp(msg, "analyses[", 9))
+        return 1;
+    switch (rc) {
+    case TS_ECONV:
+    case TS_ESINGULAR:
+    case TS_ELAPACK:
+    case TS_EINTEGRATOR:
+    case TS_ENOMEM:
+    case TS_EDOMAIN: return 1;
+    default: return 0;
+    }
+}
+
+int cli_report(ts_err *err, int rc)
 {
     cli_progress_done();
+    /* The prefix goes into the record, so that a JSON written after this
+     * gives the same reason as standard error. */
+    if (err && err->msg[0] && needs_scene(err->msg, rc))
+        ts_err_prefix(err, "%s: ", scene_label);
+    const char *msg = err && err->msg[0] ? err->msg : ts_strerror(rc);
     if (rc == TS_ECANCEL)
         fprintf(stderr, "towstab: error: interrupted (%s): ",
                 cli_stop_signal_name() ? cli_stop_signal_name() : "stop");
     else
         fprintf(stderr, "towstab: error: ");
-    fprintf(stderr, "%s\n", err && err->msg[0] ? err->msg : ts_strerror(rc));
+    fprintf(stderr, "%s\n", msg);
     return cli_exit_code(rc);
 }
 
@@ -250,6 +280,9 @@ int cli_open(const char *path, ts_units **units, ts_scene **scene)
     if (!*units)
         return cli_report(&err, err.code ? err.code : TS_EUNIT);
     *scene = ts_scene_load(path, *units, &err);
+    if (*scene)
+        snprintf(scene_label, sizeof scene_label, "%s",
+                 strcmp(path, "-") ? path : "standard input");
     if (!*scene) {
         int rc = err.code ? err.code : TS_ESCENE;
         ts_units_free(*units);
@@ -291,6 +324,121 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     }
     *value = v;
     return 0;
+}
+
+void cli_tow_text(const ts_system *sys, char *buf, size_t size)
+{
+    const ts_tow *t = &sys->tow;
+    double knots = t->speed / (1852.0 / 3600.0);
+    if (t->turn_rate == 0.0) {
+        snprintf(buf, size, "speed %.6g m/s (%.4g knots), turn rate 0 rad/s "
+                 "(straight)", t->speed, knots);
+        return;
+    }
+    double R = t->speed / fabs(t->turn_rate);
+    snprintf(buf, size, "speed %.6g m/s (%.4g knots), turn rate %.6g rad/s "
+             "(%.4g deg/s, turn radius %.4g m, to %s)", t->speed, knots,
+             t->turn_rate, t->turn_rate * 180.0 / M_PI, R,
+             t->turn_rate > 0 ? "starboard" : "port");
+}
+
+/* An error for a table: "%.2g", or "-" when not known. */
+static void err_text(double e, char *buf, size_t size)
+{
+    if (isfinite(e))
+        snprintf(buf, size, "%.2g", e);
+    else
+        snprintf(buf, size, "-");
+}
+
+void cli_value_error(const ts_value *v, char *buf, size_t size)
+{
+    char d[32], s[32];
+    err_text(v->error.discretisation, d, sizeof d);
+    err_text(v->error.solver, s, sizeof s);
+    snprintf(buf, size, "+- %s (discretisation) +- %s (solver) %s", d, s,
+             v->unit);
+}
+
+void cli_print_accuracy(const ts_result *r)
+{
+    const ts_result_accuracy *a = &r->accuracy;
+    if (!(a->accuracy > 0))
+        return;
+    if (a->refinements > 0)
+        printf("refined: %d rerun%s from %d to %d links per cable to meet "
+               "the accuracy\n",
+               a->refinements, a->refinements == 1 ? "" : "s",
+               a->refined_from, a->links[0]);
+    if (!a->estimated) {
+        printf("discretisation error: not estimated: %s\n",
+               a->not_estimated);
+        return;
+    }
+    char lev[96] = "";
+    for (int k = 0; k < a->nlevels; k++) {
+        size_t n = strlen(lev);
+        snprintf(lev + n, sizeof lev - n, "%s%d",
+                 k == 0 ? "" : k + 1 == a->nlevels ? " and " : ", ",
+                 a->links[k]);
+    }
+    printf("discretisation error: Richardson from %s links (order %.3g in "
+           "1/links), %.3f ms, %ld evaluations",
+           lev, a->order, a->wall_s * 1e3, a->evaluations);
+    if (isfinite(a->max_rel_error))
+        printf("; largest relative %.2g (%s) against the accuracy %.3g: "
+               "%s\n",
+               a->max_rel_error, a->limiting, a->accuracy,
+               a->met > 0 ? "met" : "NOT MET");
+    else
+        printf("\n");
+}
+
+void cli_print_vehicles(FILE *f, const ts_system *sys,
+                        const ts_vehicle_result *vr, int nv, int quiet)
+{
+    const double deg = 180.0 / M_PI;
+    if (nv == 0)
+        return;
+    fprintf(f, "\n%-20s %10s %10s %10s %10s %10s %12s\n", "vehicle",
+            "pitch[deg]", "roll[deg]", "yaw[deg]", "alpha[deg]",
+            "beta[deg]", "depth [m]");
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle_result *r = &vr[v];
+        fprintf(f, "%-20s %10.4f %10.4f %10.4f %10.4f %10.4f %12.6f\n",
+                sys->bodies[r->body].name, r->pitch * deg, r->roll * deg,
+                r->yaw * deg, r->alpha * deg, r->beta * deg, r->origin[2]);
+    }
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle_result *r = &vr[v];
+        const ts_vehicle *d = sys->bodies[r->body].vehicle;
+        for (int c = 0; c < r->ncomponents; c++)
+            if (d->component[c].control)
+                fprintf(f, "%s.%s deflection %.4f deg\n",
+                        sys->bodies[r->body].name, d->component[c].name,
+                        r->delta[c] * deg);
+        if (quiet)
+            continue;
+        fprintf(f, "\n%-20s %11s %11s %11s %11s %11s %11s %9s\n",
+                "component (body axes)", "Fx [N]", "Fy [N]", "Fz [N]",
+                "Mx [N m]", "My [N m]", "Mz [N m]", "alpha[deg]");
+        for (int c = 0; c < r->ncomponents; c++) {
+            const ts_component_load *ld = &r->load[c];
+            char nm[2 * TS_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s.%s", sys->bodies[r->body].name,
+                     d->component[c].name);
+            fprintf(f, "%-20s %11.4f %11.4f %11.4f %11.4f %11.4f %11.4f "
+                       "%9.3f\n",
+                    nm, ld->force[0], ld->force[1], ld->force[2],
+                    ld->moment[0], ld->moment[1], ld->moment[2],
+                    ld->alpha * deg);
+        }
+        fprintf(f, "%-20s %11s %11s %11s %11.4f %11.4f %11.4f\n",
+                "Munk moment", "", "", "", r->munk[0], r->munk[1],
+                r->munk[2]);
+        fprintf(f, "joint force (M) %.4f, %.4f, %.4f N\n", r->joint_force[0],
+                r->joint_force[1], r->joint_force[2]);
+    }
 }
 
 void cli_print_trust(const ts_trust *t)

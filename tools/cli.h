@@ -80,8 +80,11 @@ double cli_wall_now(void);
 /* Exit status for a library code. */
 int cli_exit_code(int rc);
 
-/* Print "towstab: error: <message>" and return the exit status. */
-int cli_report(const ts_err *err, int rc);
+/* Print "towstab: error: <message>" and return the exit status. A message
+ * about the scene's analysis (a failed analysis, an option of an
+ * `analyses` entry) gets the scene file in front, in err too, so that a
+ * JSON written afterwards gives the same reason. */
+int cli_report(ts_err *err, int rc);
 
 /* Load units and a scene; on failure prints and returns the status. Free
  * with cli_close(). */
@@ -112,8 +115,47 @@ void cli_run_free(cli_run *c);
 ts_optset *cli_entry_options(const ts_scene *scene, int kind, int index,
                              int *status);
 
+/* The analyses a scene lists (`towstab run`, `towstab report`). */
+typedef struct cli_scene_runs {
+    int n;                  /* the scene's analyses */
+    cli_run *runs;          /* [n], prepared */
+    char (*csv)[1200];      /* [n] DIR/<k>_<type>.csv when asked for */
+    char (*dirs)[1200];     /* [n] DIR/<k>_<type> of the pictures */
+} cli_scene_runs;
+
+/* Read every entry of the scene's analyses list through its option table
+ * and check it against the system (cli_prepare) before anything runs;
+ * with csv_dir each writes csv_dir/<k>_<type>.csv, with plot_dir its
+ * pictures into plot_dir/<k>_<type>/ (k from 1) in plot_units. `cmd`
+ * names the command in messages. Prints and returns the exit status (a
+ * scene without analyses is bad input); on success release s with
+ * cli_scene_free. */
+int cli_scene_prepare(const char *cmd, const ts_scene *scene,
+                      const ts_units *units, int quiet, const char *csv_dir,
+                      const char *plot_dir, const char *plot_units,
+                      cli_scene_runs *s);
+
+/* Run the prepared analyses in order, each after a line "== analysis k of
+ * n: TYPE (SCENE) ==", until one fails. *all receives the JSON document
+ * {"scene", "analyses": [result, ...], "completed"} (with "error" and
+ * "trustworthy": false after a failure; "interrupted" after a signal),
+ * NULL only when out of memory. Returns the exit status. */
+int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
+                      json_t **all);
+
+void cli_scene_free(cli_scene_runs *s);
+
+/* Make directory `dir` (one level) unless it is one; 0, or the status
+ * after printing a message naming `cmd` and the option `opt`. */
+int cli_make_dir(const char *cmd, const char *opt, const char *dir);
+
 /* The option help of an analysis command (towstab CMD --help). */
 void cli_usage(const struct cli_command *cmd, FILE *f);
+
+/* The vehicles' attitudes, flow angles and depths, their control
+ * deflections and (unless quiet) their components' loads. */
+void cli_print_vehicles(FILE *f, const ts_system *sys,
+                        const ts_vehicle_result *vr, int nv, int quiet);
 
 /* Markdown of every option of the analyses: the reference of
  * doc/manual.md (towstab options --markdown). */
@@ -176,6 +218,19 @@ int cli_check_outputs(const char *cmd, int n, const char *const what[],
 /* The verdict lines: "trustworthy: yes|NO", reasons, notes. */
 void cli_print_trust(const ts_trust *t);
 
+/* "speed V m/s (K knots), turn rate W rad/s (D deg/s, turn radius R m, to
+ * starboard)" or "... turn rate 0 rad/s (straight)". */
+void cli_tow_text(const ts_system *sys, char *buf, size_t size);
+
+/* "+- D (discretisation) +- S (solver) UNIT" of a key value, "-" where
+ * not estimated. */
+void cli_value_error(const ts_value *v, char *buf, size_t size);
+
+/* The discretisation-error line of a result: the levels compared, the
+ * order, the cost, the largest relative error against the accuracy (or
+ * why it was not estimated), and a --refine's reruns. */
+void cli_print_accuracy(const ts_result *r);
+
 /* At the end of main: flush and close standard output and standard error,
  * checking both; a failed write turns status 0 into EXIT_FAILED (with a
  * message naming standard output). Returns the status. */
@@ -189,4 +244,6 @@ const cli_command *cli_command_of(int kind);
 /* Printing shared by the commands (cmd_equilibrium.c, cmd_modes.c). */
 void cli_print_equilibrium(const ts_result *r, int quiet);
 void cli_print_linearization(const ts_result *r);
+/* The sea state and its statistics (cmd_response.c; simulate too). */
+void cli_print_seastate(const ts_result *r, int quiet);
 #endif

@@ -205,10 +205,23 @@ static int has_partial(const ts_result *r)
             r->convergence && r->convergence->estimated);
 }
 
+/* A run estimated to take longer than this (s) is announced first, with
+ * what would shorten it (towstab/cost.h). */
+#define ANNOUNCE_S 60.0
+
 int cli_execute(cli_run *c, json_t **result)
 {
     ts_err err = {0};
     ts_result *r = NULL;
+    ts_cost cost;
+    if (ts_analysis_cost(c->scene->system, &c->rq, &cost, NULL) == TS_OK &&
+        cost.seconds > ANNOUNCE_S) {
+        fprintf(stderr, "towstab: warning: %s is estimated to take %s; to "
+                        "shorten it: %s (Ctrl-C stops it, keeping what it "
+                        "has)\n",
+                ts_analysis_name(c->rq.kind), cost.what, cost.reduce);
+        fflush(stderr);
+    }
     int rc = ts_analysis_run(c->scene->system, &c->rq, &r, &err);
     cli_progress_done();
     if (!r)
@@ -218,6 +231,9 @@ int cli_execute(cli_run *c, json_t **result)
     if (rc != TS_OK) {
         ts_optset_locate(c->opts, &err);
         status = cli_report(&err, rc);
+        /* The JSON gives the reason standard error gave (the option and
+         * the scene file located in it). */
+        snprintf(r->error, sizeof r->error, "%s", err.msg);
     }
     ts_err werr = {0};
     int write = status == 0 || has_partial(r);

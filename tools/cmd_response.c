@@ -8,29 +8,138 @@
 #include "cli.h"
 #include "cli_plot.h"
 
-static void print_response(const ts_response *r, int quiet)
+static void print_response(const ts_result *res, int quiet)
 {
-    printf("response of %s to %s (%s): static gain %.9g\n", r->output.name,
-           ts_input_name(r->input), r->output.unit, r->static_gain);
+    const ts_response *r = res->response;
+    char e[160] = "";
+    if (res->nvalues > 0)
+        cli_value_error(&res->values[0], e, sizeof e);
+    printf("response of %s to %s (%s): static gain %.9g %s\n",
+           r->output.name, ts_input_name(r->input), r->output.unit,
+           r->static_gain, e);
     int ib = 0;
     for (int i = 1; i < r->npoints; i++)
         if (r->magnitude[i] > r->magnitude[ib])
             ib = i;
-    printf("largest magnitude %.6g at %.6g Hz (phase %.3f deg)\n",
-           r->magnitude[ib], r->freq_hz[ib], r->phase_deg[ib]);
+    if (res->nvalues > 1)
+        cli_value_error(&res->values[1], e, sizeof e);
+    printf("largest magnitude %.6g %s at %.6g Hz (phase %.3f deg)\n",
+           r->magnitude[ib], e, r->freq_hz[ib], r->phase_deg[ib]);
+    if (res->magnitude_error)
+        printf("the magnitude meets the accuracy %.3g (of the largest) up to "
+               "%s%.6g Hz%s\n",
+               res->accuracy.accuracy,
+               isfinite(res->accurate_to_hz) ? "" : "(no point) ",
+               isfinite(res->accurate_to_hz) ? res->accurate_to_hz
+                                             : r->freq_hz[0],
+               isfinite(res->accurate_to_hz) &&
+                       res->accurate_to_hz >= r->freq_hz[r->npoints - 1]
+                   ? ", the whole range"
+                   : "");
     if (quiet)
         return;
-    printf("\n%14s %16s %12s\n", "freq [Hz]", "magnitude", "phase [deg]");
-    for (int i = 0; i < r->npoints; i++)
-        printf("%14.6g %16.9g %12.4f\n", r->freq_hz[i], r->magnitude[i],
-               r->phase_deg[i]);
+    printf("\n%14s %16s %10s %12s %10s\n", "freq [Hz]", "magnitude",
+           "+- disc.", "phase [deg]", "+- disc.");
+    for (int i = 0; i < r->npoints; i++) {
+        printf("%14.6g %16.9g", r->freq_hz[i], r->magnitude[i]);
+        if (res->magnitude_error)
+            printf(" %10.2g", res->magnitude_error[i]);
+        else
+            printf(" %10s", "-");
+        printf(" %12.4f", r->phase_deg[i]);
+        if (res->phase_error_deg)
+            printf(" %10.2g\n", res->phase_error_deg[i]);
+        else
+            printf(" %10s\n", "-");
+    }
 }
 
+
+/* Rows of the spectrum table printed (every k-th grid point). */
+#define SEA_TABLE_ROWS 32
+
+static void print_stat(const char *what, const ts_stat *s, const char *unit,
+                       int disc)
+{
+    if (!isfinite(s->value)) {
+        printf("  %-36s %12s (not defined here)\n", what, "none");
+        return;
+    }
+    char dt[48] = "discretisation not estimated";
+    if (disc && isfinite(s->discretisation))
+        snprintf(dt, sizeof dt, "discretisation %.2g", s->discretisation);
+    printf("  %-36s %12.6g %s +- %.2g (grid %.2g, band %.2g, %s)\n", what,
+           s->value, unit, s->error, s->grid, s->band, dt);
+}
+
+/* The statistics of a spectral result (towstab/seastate.h), each with its
+ * error; with !quiet, the spectra on a coarse grid. */
+void cli_print_seastate(const ts_result *r, int quiet)
+{
+    const ts_seastate *s = r->seastate;
+    const ts_seaway *w = &r->seaway;
+    char d[512];
+    ts_sea_describe(w->sea, d, sizeof d);
+    printf("sea: %s\n", d);
+    if (r->rao_file[0])
+        printf("ship RAOs: %s; lever arm (tow point less reference point) "
+               "%g, %g, %g m; speed %.6g m/s\n", r->rao_file, w->lever[0],
+               w->lever[1], w->lever[2], w->speed);
+    else
+        printf("ship RAOs: none: the tow point follows the water surface; "
+               "speed %.6g m/s\n", w->speed);
+    if (!s)
+        return;
+    printf("band %.4g to %.4g rad/s (%.3g %% of the wave variance outside), "
+           "%d intervals in ln w, %ld gains\n", s->band_lo, s->band_hi,
+           100 * s->wave_m0_out / (s->wave_m0_band + s->wave_m0_out),
+           s->npoints - 1, s->responses);
+    int disc = s->disc_estimated;
+    printf("%s about its equilibrium value %.6g %s:\n", s->output.name,
+           s->mean, s->unit);
+    print_stat("standard deviation sigma", &s->sigma, s->unit, disc);
+    print_stat("significant amplitude 2 sigma", &s->significant, s->unit,
+               disc);
+    print_stat("zero up-crossing period Tz", &s->tz, "s", disc);
+    char mp[96];
+    snprintf(mp, sizeof mp, "most probable maximum in %.6g s", s->duration);
+    print_stat(mp, &s->mpm, s->unit, disc);
+    if (isfinite(s->mpm.value))
+        printf("  (%.4g cycles: most probable largest %.6g %s, smallest %.6g "
+               "%s)\n", s->cycles, s->mean + s->mpm.value, s->unit,
+               s->mean - s->mpm.value, s->unit);
+    if (disc) {
+        char order[48] = "no steady observed order";
+        if (isfinite(s->disc_order))
+            snprintf(order, sizeof order, "observed order %.3g",
+                     s->disc_order);
+        printf("discretisation error from %d, %d and %d links per cable "
+               "(%s), %.3f s\n", s->disc_links[0], s->disc_links[1],
+               s->disc_links[2], order, s->disc_wall_s);
+    }
+    if (quiet)
+        return;
+    printf("\n%12s %12s %14s %14s %16s\n", "w [rad/s]", "w_e [rad/s]",
+           "S [m^2 s/rad]", "|G|", "S_out");
+    int step = (s->npoints - 1) / SEA_TABLE_ROWS;
+    if (step < 1)
+        step = 1;
+    for (int i = 0; i < s->npoints; i += step)
+        printf("%12.5g %12.5g %14.6g %14.6g %16.6g\n", s->omega[i],
+               s->omega_e[i], s->wave[i], hypot(s->gain_re[i], s->gain_im[i]),
+               s->density[i]);
+}
 
 static void response_print(const cli_run *c, const ts_result *r)
 {
     cli_print_equilibrium(r, 1);
     cli_print_linearization(r);
+    if (r->has_sea) {
+        cli_print_seastate(r, c->quiet);
+        if (r->seastate)
+            cli_print_trust(&r->trust);
+        return;
+    }
     if (!r->response)
         return;
     if (r->lin->kink_tow && r->response->input == 2)
@@ -38,12 +147,19 @@ static void response_print(const cli_run *c, const ts_result *r)
                "heave response uses the mean of the one-sided "
                "derivatives, and a real heave also shifts the mean "
                "depth at first order (doc/model.md section 6)\n");
-    print_response(r->response, c->quiet);
+    print_response(r, c->quiet);
+    cli_print_accuracy(r);
     cli_print_trust(&r->trust);
 }
 
 static int response_prepare(cli_run *c)
 {
+    if (c->plot.dir && c->rq.response.sea.sea) {
+        fprintf(stderr, "towstab: error: response: --plot draws a Bode plot, "
+                        "which a sea-state response has not; write its "
+                        "spectra with --csv (or --json) instead\n");
+        return EXIT_BADINPUT;
+    }
     /* The Bode plot marks the natural frequencies. */
     c->rq.response.natural = c->plot.dir != NULL;
     return 0;
@@ -52,7 +168,7 @@ static int response_prepare(cli_run *c)
 /* The Bode plot with the natural frequencies marked. */
 static int response_draw(cli_run *c, const ts_result *r)
 {
-    if (!c->plot.dir || r->status != TS_OK)
+    if (!c->plot.dir || r->status != TS_OK || !r->response)
         return 0;
     const ts_response *res = r->response;
     const cli_plot *plot = &c->plot;

@@ -3,37 +3,11 @@
  * the system before the first one runs; only what is listed runs. With
  * --csv DIR and --plot DIR every analysis writes its own file set,
  * DIR/<k>_<type>.csv and DIR/<k>_<type>/ (k from 1). */
-#include <errno.h>
 #include <getopt.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "cli.h"
-#include "towstab/report_result.h"
-
-/* Room for one file name under a DIR. */
-#define RUN_PATH_MAX 1200
-
-/* Make directory `dir` (one level) unless it exists; 0 or the status
- * after printing. */
-static int make_dir(const char *opt, const char *dir)
-{
-    struct stat st;
-    if (stat(dir, &st) == 0) {
-        if (S_ISDIR(st.st_mode))
-            return 0;
-        fprintf(stderr, "towstab: error: run: %s: '%s' is not a directory\n",
-                opt, dir);
-        return EXIT_BADINPUT;
-    }
-    if (mkdir(dir, 0777) != 0) {
-        fprintf(stderr, "towstab: error: run: %s: cannot make '%s' (%s)\n",
-                opt, dir, strerror(errno));
-        return EXIT_FAILED;
-    }
-    return 0;
-}
 
 static void usage(FILE *f)
 {
@@ -105,124 +79,53 @@ static int run_main(int argc, char **argv)
     int status = cli_open(argv[optind], &units, &scene);
     if (status)
         return status;
-    int n = scene->nanalyses;
-    if (n == 0) {
-        fprintf(stderr, "towstab: error: run: %s lists no analyses: nothing "
-                        "to run (add an 'analyses' list)\n",
-                scene->path);
+    cli_scene_runs s;
+    status = cli_scene_prepare("run", scene, units, quiet, csv_dir,
+                               plot_dir, plot_units, &s);
+    if (status) {
         cli_close(units, scene);
-        return EXIT_BADINPUT;
+        return status;
     }
-    cli_run *runs = calloc((size_t)n, sizeof *runs);
-    char (*csv)[RUN_PATH_MAX] = calloc((size_t)n, sizeof *csv);
-    char (*dirs)[RUN_PATH_MAX] = calloc((size_t)n, sizeof *dirs);
+    int n = s.n;
     const char **what = calloc((size_t)n + 1, sizeof *what);
     const char **paths = calloc((size_t)n + 1, sizeof *paths);
-    if (!runs || !csv || !dirs || !what || !paths) {
+    if (!what || !paths) {
         fprintf(stderr, "towstab: error: run: out of memory for %d "
                         "analyses\n", n);
         status = EXIT_FAILED;
     }
-    char types[256] = "";
-    for (int i = 0; cli_commands[i]; i++)
-        if (cli_commands[i]->kind >= 0) {
-            if (types[0])
-                strncat(types, ", ", sizeof types - strlen(types) - 1);
-            strncat(types, cli_commands[i]->name,
-                    sizeof types - strlen(types) - 1);
-        }
-    /* Every entry is read and checked before the first runs. */
     for (int i = 0; i < n && !status; i++) {
-        const ts_scene_analysis *a = &scene->analyses[i];
-        int kind = ts_analysis_find(a->type);
-        const cli_command *cmd = kind >= 0 ? cli_command_of(kind) : NULL;
-        if (!cmd) {
-            ts_err err = {0};
-            ts_fail(&err, TS_ESCENE, "%s: analyses[%d] (line %d): unknown "
-                    "analysis type '%s'; expected one of %s",
-                    scene->path, i, a->line, a->type, types);
-            status = cli_report(&err, TS_ESCENE);
-            break;
-        }
-        cli_run *c = &runs[i];
-        c->cmd = cmd;
-        c->scene = scene;
-        c->units = units;
-        c->entry = i;
-        c->quiet = quiet;
-        if (csv_dir) {
-            snprintf(csv[i], sizeof csv[i], "%s/%d_%s.csv", csv_dir, i + 1,
-                     a->type);
-            c->csv = csv[i];
-            what[i] = "--csv";
-            paths[i] = csv[i];
-        }
-        if (plot_dir) {
-            snprintf(dirs[i], sizeof dirs[i], "%s/%d_%s", plot_dir, i + 1,
-                     a->type);
-            c->plot.dir = dirs[i];
-            c->plot.units = plot_units;
-        }
-        c->opts = cli_entry_options(scene, kind, i, &status);
-        if (!status)
-            status = cli_prepare(c);
+        what[i] = "--csv";
+        paths[i] = s.runs[i].csv;
     }
-    what[n] = "--json";
-    paths[n] = json_path;
-    if (!status)
+    if (!status) {
+        what[n] = "--json";
+        paths[n] = json_path;
         status = cli_check_outputs("run", n + 1, what, paths, NULL, NULL);
+    }
     if (!status && csv_dir)
-        status = make_dir("--csv", csv_dir);
+        status = cli_make_dir("run", "--csv", csv_dir);
     if (!status && plot_dir)
-        status = make_dir("--plot", plot_dir);
+        status = cli_make_dir("run", "--plot", plot_dir);
     for (int i = 0; i < n && !status && plot_dir; i++)
-        status = cli_plot_begin(&runs[i].plot, "run");
-    json_t *all = json_object(), *list = json_array();
-    json_object_set_new(all, "scene", json_string(scene->system->name));
-    json_object_set_new(all, "analyses", list);
-    int ran = 0;
-    for (int i = 0; i < n && !status; i++) {
-        printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
-               n, scene->analyses[i].type, scene->system->name);
-        json_t *j = NULL;
-        status = cli_execute(&runs[i], &j);
-        ran = 1;
-        if (j)
-            json_array_append_new(list, j);
-    }
-    /* After a failure the results so far, marked as incomplete with the
-     * failed analysis' message; nothing after bad input found before the
-     * first run. */
-    if (json_path &&
-        (status == 0 || (ran && status != EXIT_BADINPUT))) {
-        size_t nres = json_array_size(list);
-        const char *msg = status && nres > 0
-                              ? json_string_value(json_object_get(
-                                    json_array_get(list, nres - 1), "error"))
-                              : NULL;
-        json_object_set_new(all, "completed", json_boolean(status == 0));
-        if (status) {
-            json_object_set_new(all, "error", json_string(msg ? msg
-                                                              : "failed"));
-            json_object_set_new(all, "trustworthy", json_false());
+        status = cli_plot_begin(&s.runs[i].plot, "run");
+    if (!status) {
+        json_t *all = NULL;
+        status = cli_scene_execute(scene, &s, &all);
+        /* After a failure the results so far, marked as incomplete with
+         * the failed analysis' message; nothing after bad input. */
+        if (json_path && all && status != EXIT_BADINPUT) {
+            ts_err werr = {0};
+            if (cli_write_json(all, json_path, &werr) != TS_OK) {
+                int st = cli_report(&werr, werr.code);
+                status = status ? status : st;
+            }
         }
-        if (cli_stop_signal_name())
-            json_object_set_new(all, "interrupted",
-                                json_string(cli_stop_signal_name()));
-        ts_err werr = {0};
-        if (cli_write_json(all, json_path, &werr) != TS_OK) {
-            int st = cli_report(&werr, werr.code);
-            status = status ? status : st;
-        }
+        json_decref(all);
     }
-    json_decref(all);
-    for (int i = 0; runs && i < n; i++)
-        cli_run_free(&runs[i]);
-    free(runs);
-    free(csv);
-    free(dirs);
     free(what);
     free(paths);
+    cli_scene_free(&s);
     cli_close(units, scene);
     return status;
 }

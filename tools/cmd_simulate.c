@@ -428,13 +428,49 @@ static int sim_prepare(cli_run *c)
     return 0;
 }
 
+/* A record's statistics beside the spectral prediction. */
+static void print_record(const char *what, const ts_record_stats *st)
+{
+    char tz[32] = "none", ind[32] = "none";
+    if (isfinite(st->tz))
+        snprintf(tz, sizeof tz, "%.4g", st->tz);
+    if (isfinite(st->independent))
+        snprintf(ind, sizeof ind, "%.4g", st->independent);
+    printf("  %-10s %14.6g +- %-10.2g %14.6g +- %-10.2g %10s %8s %8.4g\n",
+           what, st->sigma.value, st->sigma.error, st->mean, st->mean_error,
+           tz, ind, st->maximum);
+}
+
+static void print_sea(const ts_result *r)
+{
+    printf("\nirregular sea, realisation: seed %lu, %d sinusoids, fade-in "
+           "%.6g s\n", r->realisation.seed, r->realisation.components,
+           r->realisation.rise);
+    cli_print_seastate(r, 1);
+    if (!r->has_records)
+        return;
+    printf("records of %s over t = %.6g .. %.6g s:\n", r->output.name,
+           r->transient, r->sim.t_end);
+    printf("  %-10s %14s    %-10s %14s    %-10s %10s %8s %8s\n", "", "sigma [m]",
+           "(stat.)", "mean [m]", "(stat.)", "Tz [s]", "indep.", "max [m]");
+    if (r->has_records & 2)
+        print_record("linear", &r->record_linear);
+    if (r->has_records & 1)
+        print_record("nonlinear", &r->record_nonlinear);
+    if (r->seastate)
+        printf("  %-10s %14.6g +- %-10.2g %14.6g\n", "spectral",
+               r->seastate->sigma.value, r->seastate->sigma.error,
+               r->seastate->mean);
+}
+
 static void sim_print(const cli_run *c, const ts_result *r)
 {
     const ts_system *sys = r->sys;
     if (!sys)
         return;
-    printf("simulate %s: %d links, speed %.6g m/s, turn rate %.6g rad/s\n",
-           sys->name, sys->nlinks, sys->tow.speed, sys->tow.turn_rate);
+    char tow[256];
+    cli_tow_text(sys, tow, sizeof tow);
+    printf("simulate %s: %d links, %s\n", sys->name, sys->nlinks, tow);
     char d[256];
     const ts_excitation *ex = r->excitation;
     for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
@@ -478,9 +514,48 @@ static void sim_print(const cli_run *c, const ts_result *r)
     if (!c->quiet)
         print_table(r);
     print_forces(r);
-    if (r->nonlinear || r->linear)
+    if (r->has_sea)
+        print_sea(r);
+    for (int v = 0, head = 0; !r->has_sea && v < r->nvalues; v++) {
+        char er[160];
+        if (!isfinite(r->values[v].value))
+            continue;
+        if (!head++)
+            printf("\nkey values (nonlinear run; fits and tension.max|min "
+                   "over t >= %.6g s, forces over the run):\n",
+                   r->transient);
+        cli_value_error(&r->values[v], er, sizeof er);
+        printf("%-34s %14.8g %s\n", r->values[v].name, r->values[v].value,
+               er);
+    }
+    const ts_window *w = &r->window;
+    if (w->checked) {
+        printf("window: t >= %.6g s of %.6g s; ", w->transient, w->t_end);
+        if (isfinite(w->slowest_tau))
+            printf("slowest time constant %.4g s (%s%.4g Hz; %.4g of them "
+                   "before the window)",
+                   w->slowest_tau,
+                   w->slowest_freq_hz > 0 ? "a mode at " : "a real mode, ",
+                   w->slowest_freq_hz, w->transient / w->slowest_tau);
+        else
+            printf("slowest time constant not known");
+        if (isfinite(w->drift))
+            printf("; the last two periods differ by %.2g of the output's "
+                   "amplitude", w->drift);
+        printf(": %s, %s\n",
+               w->settled > 0 ? "settled"
+               : w->settled == 0 ? "NOT SETTLED"
+                                 : "settling not known",
+               w->periodic > 0 ? "periodic"
+               : w->periodic == 0 ? "NOT PERIODIC"
+                                  : "periodicity not known");
+    }
+    if (r->nonlinear || r->linear) {
+        cli_print_accuracy(r);
         cli_print_trust(&r->trust);
-    if (r->compared)
+    }
+    /* Under a sea the records' table above is the comparison. */
+    if (r->compared && !r->has_sea)
         print_compare(&r->compare);
 }
 

@@ -53,6 +53,8 @@ static void usage(FILE *f)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
+        fprintf(stderr, "towstab: error: no command given (a COMMAND and a "
+                        "SCENE file)\n");
         usage(stderr);
         return cli_finish(EXIT_BADINPUT);
     }

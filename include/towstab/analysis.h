@@ -22,17 +22,20 @@
 #ifndef TOWSTAB_ANALYSIS_H
 #define TOWSTAB_ANALYSIS_H
 
+#include "towstab/accuracy.h"
 #include "towstab/compare.h"
 #include "towstab/converge.h"
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
 #include "towstab/error.h"
+#include "towstab/cost.h"
 #include "towstab/excitation.h"
 #include "towstab/extremes.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
 #include "towstab/progress.h"
 #include "towstab/response.h"
+#include "towstab/seastate.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
 
@@ -68,7 +71,25 @@ typedef struct ts_setup {
     int links;             /* equal links on every cable, 1..TS_MAX_LINKS;
                               0 (default): the system's */
     ts_equilibrium_opts equilibrium; /* method and tol (its defaults) */
+    double accuracy;       /* relative accuracy wanted of the key values,
+                              in (0, 1); default TS_ACCURACY_DEFAULT */
+    int discretisation_error; /* 1: estimate the discretisation error of
+                              the key values from the same analysis at
+                              coarser discretisations (towstab/accuracy.h;
+                              default for equilibrium, modes and response,
+                              which it costs less than the run itself);
+                              0: not (default for simulate, where it costs
+                              a second simulation) */
+    int refine;            /* 1: when the accuracy is missed, rerun with
+                              the links the error model says meet it, at
+                              most TS_REFINE_ROUNDS times (needs the
+                              estimate; equal links on every cable) */
 } ts_setup;
+
+/* --refine: reruns at most, each with at most TS_REFINE_GROWTH times the
+ * links of the run before. */
+#define TS_REFINE_ROUNDS 3
+#define TS_REFINE_GROWTH 8
 
 /* Modes reported by default when the system has at least
  * ts_eigen_opts.arpack_min_states states (ARPACK finds a subset), and
@@ -92,6 +113,10 @@ typedef struct ts_modes_opts {
                               TS_CONV_MODE_DAMPING_MAX (default
                               TS_MODES_FOLLOW, 1..100) */
     ts_linearize_opts linearize; /* its defaults */
+    int oscillatory;       /* 1: list the oscillatory modes only (the
+                              `count` lowest when count is given; the
+                              table always lists them first); the verdict
+                              still covers every mode computed */
 } ts_modes_opts;
 
 /* Frequency response defaults. */
@@ -101,6 +126,18 @@ typedef struct ts_modes_opts {
 #define TS_RESPONSE_MAX_POINTS 1000000
 /* Natural frequencies a response result carries, at most. */
 #define TS_RESPONSE_NATURAL 12
+
+/* The sea state of a response or a simulation (towstab/seastate.h,
+ * doc/seastate.md). */
+typedef struct ts_sea_opts {
+    ts_sea *sea;           /* owned by the request; NULL: no sea */
+    ts_rao *rao;           /* owned; NULL: the tow point follows the water
+                              surface (heave only) */
+    char rao_file[TS_REQUEST_PATH_MAX]; /* the RAO file read, "" without */
+    double reference[3];   /* the RAOs' reference point in M, m (default
+                              M's origin): the lever arm is the tow point
+                              less it */
+} ts_sea_opts;
 
 typedef struct ts_response_opts {
     char input[TS_REQUEST_NAME_MAX];  /* tow.surge, tow.sway, tow.heave
@@ -112,6 +149,15 @@ typedef struct ts_response_opts {
     int natural;                      /* 1: also the natural frequencies
                                          (modes nearest 0 Hz), e.g. to
                                          mark them on a Bode plot */
+    /* With a sea (sea.sea set) the response is the spectral response to
+     * the sea (ts_seastate_compute): every tow axis is an input, so
+     * input, from, to and points do not apply (giving one is refused). */
+    ts_sea_opts sea;
+    int frequency_given;              /* input, from, to or points given */
+    int intervals;                    /* the spectral grid (default
+                                         TS_SEASTATE_INTERVALS) */
+    double duration;                  /* s, for the most probable maximum
+                                         (default TS_SEASTATE_DURATION) */
 } ts_response_opts;
 
 /* Simulation defaults: run length (s), sample interval (s) and the samples
@@ -119,6 +165,11 @@ typedef struct ts_response_opts {
 #define TS_SIMULATE_T_END 10.0
 #define TS_SIMULATE_SAMPLE 0.05
 #define TS_SIMULATE_SAMPLES_PER_PERIOD 16
+/* A run without a sample interval takes at most this many samples: an
+ * excitation so fast that its 16 samples per period would exceed it is
+ * refused, so that a default never makes a huge run (give the sample
+ * interval to ask for one). */
+#define TS_SIMULATE_AUTO_SAMPLES_MAX 1e6
 /* Link lengths of a shape file must match the system's to this. */
 #define TS_SIMULATE_SHAPE_RTOL 1e-6
 
@@ -161,6 +212,18 @@ typedef struct ts_simulate_opts {
                               (owned by the request; NULL: none) */
     int need_values;       /* 1: the key values (fit over the window) are
                               required: a run whose fit fails fails */
+    /* With a sea (sea.sea set), one realisation of it
+     * (ts_seaway_excitation) drives the tow point besides `excitation`;
+     * the output's statistics over t >= transient are the key values, and
+     * the spectral prediction of the same band is computed beside them. */
+    ts_sea_opts sea;
+    long seed;             /* the realisation's seed, >= 0 (default 1) */
+    int components;        /* its sinusoids (default TS_SEA_COMPONENTS) */
+    double fade_in;        /* s, >= 0; NAN (default): 2 Tp */
+    int check_window;      /* 1 (default): check that the analysed window
+                              has settled and is periodic
+                              (ts_accuracy_window); 0: not (the runs of a
+                              convergence study) */
 } ts_simulate_opts;
 
 /* Integrators of one convergence study, at most (one series each). */
@@ -234,7 +297,42 @@ typedef struct ts_value {
     double scale;                 /* > 0: relative errors are errors /
                                      scale; 0: relative to |value| */
     ts_estimate error;
+    double order;                 /* the order in 1/links the
+                                     discretisation estimate used; NaN */
 } ts_value;
+
+/* How accurate a result is against the continuous cable (towstab/
+ * accuracy.h; doc/accuracy.md). */
+typedef struct ts_result_accuracy {
+    double accuracy;        /* the relative accuracy wanted */
+    int estimated;          /* 1: the discretisation error was estimated */
+    char not_estimated[TS_TRUST_TEXT]; /* why not, "" when estimated */
+    int nlevels;            /* discretisations compared, the run's
+                               included (2 or 3) */
+    int links[TS_ACCURACY_LEVELS]; /* links of the longest cable at each */
+    double ratio[TS_ACCURACY_LEVELS - 1]; /* resolution ratios between
+                               consecutive levels (> 1 coarser, < 1 finer) */
+    double order;           /* theoretical order in 1/links */
+    double wall_s;          /* s, the runs of the other levels: the cost
+                               of the estimate */
+    long evaluations;       /* their kernel evaluations */
+    double max_rel_error;   /* largest relative discretisation error of
+                               what the accuracy is judged on (key values,
+                               stability margin, response points); NaN */
+    char limiting[TS_VALUE_NAME_MAX]; /* the quantity it belongs to */
+    double limiting_order;  /* the order its estimate used */
+    double limiting_theory; /* its theoretical order, which predicts the
+                               links needed */
+    int met;                /* 1 met, 0 missed, -1 not known */
+    double links_factor;    /* the growth of every cable's links that the
+                               error model says meets the accuracy; NaN */
+    int links_needed;       /* --links that would meet it (the longest
+                               cable's links times links_factor, rounded
+                               up); 0 when met or not known */
+    int refined_from;       /* --refine: the longest cable's links of the
+                               first run; 0 when not refined */
+    int refinements;        /* reruns --refine made */
+} ts_result_accuracy;
 
 /* What an analysis computed. The parts it does not compute, or did not
  * reach, are NULL (counts 0). */
@@ -249,6 +347,8 @@ typedef struct ts_result {
     long evaluations;           /* kernel evaluations (and marches) */
     int nvalues;
     ts_value *values;           /* [nvalues] key values */
+    ts_result_accuracy accuracy; /* against the continuum (every kind but
+                                   converge) */
 
     ts_system *sys;             /* the system analysed: the request's
                                    settings applied (owned) */
@@ -266,12 +366,42 @@ typedef struct ts_result {
     ts_mode_health *mode_health; /* [eigen->nmodes] */
     ts_trust modes_trust;       /* the modes' own verdict (part of
                                    `trust`) */
+    ts_mode_accuracy *mode_accuracy; /* [eigen->nmodes]: discretisation
+                                   errors, shape scale, resolved */
+    ts_stability stability;     /* the verdict of the resolved modes and,
+                                   apart, of the unresolved ones, over
+                                   every mode computed (also those a
+                                   --near or --oscillatory table leaves
+                                   out) */
+    int nmodes_computed;        /* modes the eigen analysis kept, before
+                                   --near or --oscillatory chose those
+                                   listed (eigen->nmodes) */
     double eigen_wall_s;
     /* response */
     ts_response *response;
+    /* response or simulate with a sea: the seaway (its sea and RAOs are
+     * the request's) and the spectral result (of simulate: over the
+     * realisation's band) */
+    int has_sea;
+    ts_seaway seaway;
+    char rao_file[TS_REQUEST_PATH_MAX]; /* the request's, "" without */
+    ts_seastate *seastate;
+    ts_sea_realisation realisation; /* simulate: the one run */
+    /* simulate with a sea: the realisation with the request's signals
+     * (owned; `excitation` points to it) and the records' statistics */
+    ts_excitation *sea_excitation;
+    int has_records;            /* bit 0: nonlinear, bit 1: linear */
+    ts_record_stats record_nonlinear, record_linear;
     int nnatural;
     double natural_hz[TS_RESPONSE_NATURAL]; /* lowest natural frequencies,
                                                Hz */
+    double *magnitude_error;    /* [response->npoints] discretisation error
+                                   of the magnitude (output unit per m);
+                                   NULL unless estimated */
+    double *phase_error_deg;    /* [npoints] of the phase, deg */
+    double accurate_to_hz;      /* the highest frequency up to which every
+                                   point meets the accuracy (relative to
+                                   the largest magnitude); NaN */
     /* simulate */
     const ts_excitation *excitation; /* the request's (not owned: the
                                         request must outlive the result) */
@@ -303,6 +433,9 @@ typedef struct ts_result {
     ts_extremes output_extremes;
     int nslack;
     ts_slack *slack;            /* [nslack] ordered by first time */
+    ts_window window;           /* the analysed window of the nonlinear run
+                                   (the linear run's without one): settled,
+                                   periodic (checked: 0 when not) */
     /* converge */
     ts_convergence *convergence;
 } ts_result;
@@ -313,6 +446,14 @@ typedef struct ts_result {
  * the option by its scene key ("t_end: ...", "output: ..."). */
 TS_API int ts_analysis_check(const ts_system *sys, const ts_request *rq,
                              ts_err *err);
+
+/* What the analysis of rq will cost at least (towstab/cost.h):
+ * simulations (nonlinear, else the linear model's: nothing), modes (the
+ * eigen solve), with the discretisation estimate's runs when asked for;
+ * zero for the others. Meant to be said before a long run starts (the
+ * command line does above a minute). TS_OK or TS_ENOMEM. */
+TS_API int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
+                            ts_cost *e, ts_err *err);
 
 /* Run the analysis of `rq` on a copy of `sys`. *out receives the result
  * (caller frees with ts_result_free), also after a failure, with what was

@@ -122,6 +122,17 @@ enum { TS_STABLE = 0, TS_UNSTABLE = 1, TS_MARGINAL = 2 };
 
 TS_API void ts_eigen_opts_default(ts_eigen_opts *o);
 
+/* Check opts for a linearization of `nstate` states, as ts_eigen_solve
+ * does before it computes anything, so that a caller can refuse bad
+ * options before the equilibrium and the linearization: TS_OK or
+ * TS_EINVAL naming the number of states and the limit broken. */
+TS_API int ts_eigen_check(int nstate, const ts_eigen_opts *opts,
+                          ts_err *err);
+
+/* The method ts_eigen_solve uses for nstate states with opts (auto
+ * resolved: ARPACK with a count at or above arpack_min_states). */
+TS_API ts_eig_method ts_eigen_method(int nstate, const ts_eigen_opts *opts);
+
 /* Modes of lin->A. On success *out is a new result (free with
  * ts_eigen_free). Returns TS_OK, TS_EINVAL (bad options: count < 0 or
  * above the number of modes possible, target < 0, arpack asked with

@@ -58,6 +58,17 @@ TS_API int ts_fail(ts_err *err, int code, const char *fmt, ...)
 #endif
     ;
 
+/* Record TS_ENOMEM for an allocation of `bytes` bytes: the message is the
+ * printf text (where, and what was being allocated), then the size
+ * ("(2.9 GB)") and, when `hint` is not NULL, "; " and the hint (the
+ * option or setting that reduces it). Returns TS_ENOMEM. */
+TS_API int ts_fail_nomem(ts_err *err, double bytes, const char *hint,
+                         const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
 /* Prepend context to an existing message ("scene x.yaml: " + msg). */
 TS_API void ts_err_prefix(ts_err *err, const char *fmt, ...)
 #ifdef __GNUC__

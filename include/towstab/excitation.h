@@ -95,6 +95,11 @@ typedef struct ts_excitation ts_excitation;
 TS_API ts_excitation *ts_excitation_alloc(ts_err *err);
 TS_API void ts_excitation_free(ts_excitation *ex);
 
+/* A deep copy of ex (NULL: an empty excitation), to add signals to
+ * without changing ex. NULL on failure (TS_ENOMEM). */
+TS_API ts_excitation *ts_excitation_copy(const ts_excitation *ex,
+                                         ts_err *err);
+
 /* Add a copy of signal s after checking it (TS_EINVAL naming the field:
  * frequency <= 0, negative start, rise <= 0, a crank rod not longer than
  * its radius, a series or sine on a manoeuvre axis, a second absolute
@@ -177,6 +182,18 @@ TS_API int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
  * ramps, the smallest sample spacing of a series, 1/max |w_k| for a sum
  * (and its fade-in time, if shorter); INFINITY without tow signals. The linear simulator sizes its steps on it. */
 TS_API double ts_excitation_time_scale(const ts_excitation *ex);
+
+/* Bounds of the motion under ex from the frame `base` (ex may be NULL:
+ * none): |speed| and |turn rate| at most their base values plus every
+ * manoeuvre's change; the tow point's velocity and acceleration at most
+ * the sum over its signals of each one's largest (a sine: A w and A w^2; a
+ * crank: those times 1 + A / sqrt(l^2 - A^2) and its square; a step:
+ * 1.875 A / rise and 5.78 A / rise^2, the quintic's largest slopes; a
+ * ramp: A / duration and 1.875 A / (duration rise); a series: its largest
+ * sample differences; a sum of sinusoids: the sums of |c_k| w_k and
+ * |c_k| w_k^2, with its fade-in's slopes). For ts_system_check_loads. */
+TS_API void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
+                                ts_motion_bound *m);
 
 /* Check that every series covers [0, t_end] (TS_EINVAL otherwise). */
 TS_API int ts_excitation_check_span(const ts_excitation *ex, double t_end,

@@ -45,7 +45,8 @@ TS_API json_t *ts_report_seastate_json(const ts_seastate *r, const ts_seaway *w,
 TS_API int ts_report_seastate_csv(const ts_seastate *r, const char *path,
                                   ts_err *err);
 
-/* A record's statistics: {"samples", "duration_s", "mean", "sigma":
+/* A record's statistics: {"samples", "duration_s", "mean", "mean_error",
+ * "sigma":
  * {"value", "error"}, "corr_time_s", "independent_samples", "tz_s",
  * "maximum", "minimum", "window_lags"}. */
 TS_API json_t *ts_report_record_json(const ts_record_stats *st);

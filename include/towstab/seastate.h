@@ -270,6 +270,9 @@ typedef struct ts_record_stats {
     int nsamples;
     double duration;      /* s: (nsamples - 1) dt */
     double mean;          /* unit */
+    double mean_error;    /* its statistical error: sigma sqrt(tau1 / L),
+                             tau1 = int R dtau / R(0) over the same lags
+                             (at least one sample interval) */
     ts_stat sigma;        /* standard deviation, its statistical error */
     double corr_time;     /* s: int R^2 dtau / R(0)^2 over all lags */
     double independent;   /* duration / corr_time: independent samples */

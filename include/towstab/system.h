@@ -198,6 +198,37 @@ TS_API void ts_system_node_name(const ts_system *sys, int node, char *buf,
 /* Wet weight per length of a cable in N/m (weight minus buoyancy). */
 TS_API double ts_cable_wet_weight(const ts_system *sys, int c);
 
+/* Largest load (N) on one link or body the solvers take: they form
+ * squares and products of forces, which overflow double precision (about
+ * 1e308) beyond it. Real towed systems stay below 1e9 N. */
+#define TS_LOAD_MAX 1e150
+
+/* Bounds of the motion over an analysis (all >= 0; NaN or inf where an
+ * input is). */
+typedef struct ts_motion_bound {
+    double speed;      /* |V|, m/s */
+    double turn_rate;  /* |Omega|, rad/s */
+    double tow_speed;  /* tow-point velocity of an excitation, m/s */
+    double tow_accel;  /* its acceleration, m/s^2 */
+} ts_motion_bound;
+
+/* The bounds of a steady tow at the system's speed and turn rate. */
+TS_API void ts_motion_bound_steady(const ts_system *sys, ts_motion_bound *m);
+
+/* Check, before an analysis, that the loads on every link and body are
+ * finite and at most TS_LOAD_MAX under motion m: weight, buoyancy, drag at
+ * the flow speed bound |V| + |Omega| R + |current| + tow_speed and
+ * inertia (added mass included) at the acceleration bound
+ * Omega^2 R + |Omega| |V| + tow_accel, R being the tow point's distance
+ * from the origin plus the length of the cables. These are sizes, not the
+ * forces themselves (no solve): a load that fails here makes the kernel's
+ * forces overflow. O(links). Returns TS_OK, or TS_EDOMAIN naming the
+ * input that makes the loads too large, the part and the size:
+ *   "forces overflow at speed 1e+300 m/s: the drag on cables[0] 'cable'
+ *    link 1 is about inf N, beyond the 1e+150 N the solvers can take" */
+TS_API int ts_system_check_loads(const ts_system *sys,
+                                 const ts_motion_bound *m, ts_err *err);
+
 #ifdef __cplusplus
 }
 #endif

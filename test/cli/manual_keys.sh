@@ -3,7 +3,8 @@
 #   manual_keys.sh TOWSTAB CHECK_JSON
 # Runs `towstab run` on every examples/*.yaml and each command once more
 # with the options that add keys (modes with matrices and shapes, a
-# response, a simulation with a comparison, the three kinds of
+# response, a simulation with a comparison, a response and a simulation
+# in a sea, the three kinds of
 # convergence study), lists the keys of each result with
 # `check_json keys` and looks for each key, written `key`, in the part of
 # doc/manual.md of the command that wrote it ("## towstab COMMAND") or in
@@ -47,6 +48,12 @@ json modes examples/kamman_ex3_turn.yaml --matrices --shapes "$T/shapes.json"
 json response examples/kamman_ex1_above.yaml --output sphere.z --points 3
 json simulate examples/kamman_ex4.yaml --compare --t-end 34 \
     --excite tow.heave:amplitude=0.1ft,frequency=0.25Hz
+json response examples/survey_tow_sea.yaml --output fish.z \
+    --sea Hs=2m,Tp=8s --rao examples/ship_rao.csv --rao-reference 30,0,0 \
+    --intervals 64
+json simulate examples/survey_tow_sea.yaml --output fish.z --links 5 \
+    --sea Hs=2m,Tp=8s --rao examples/ship_rao.csv --rao-reference 30,0,0 \
+    --t-end 120 --transient 60 --sample 0.5 --components 32 --compare
 json simulate examples/kamman_ex3_turn.yaml --t-end 2 --sample 0.5 \
     --excite tow.heave:type=crank,amplitude=0.01,rod=0.05,period=1s \
     --excite tow.surge:type=step,amplitude=0.01,start=0.5s \

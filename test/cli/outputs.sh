@@ -133,10 +133,13 @@ why=""
 [ "$(cat "$T/t.json")" = old ] || why="$why the target was written;"
 check "a link and its target: exit 2, untouched" "$why"
 
-# 9. A failed equilibrium: the JSON says so, with the message of stderr.
-sed 's|weight: "1 lbf/ft"|weight: 1e300|' examples/kamman_ex1_submerged.yaml >"$T/heavy.yaml"
+# 9. A failed equilibrium (a neutrally buoyant line towed from the surface:
+# nothing restores its links): the JSON says so, with the message of
+# stderr. (A weight of 1e300 is refused before the solve, exit 2.)
+sed 's|weight: "1 lbf/ft"|wet_weight: 0|; s|weight: "50 lbf"|wet_weight: 0|' \
+    examples/kamman_ex1_submerged.yaml >"$T/neutral.yaml"
 fresh
-ts equilibrium "$T/heavy.yaml" --json "$T/o/f.json"
+ts equilibrium "$T/neutral.yaml" --json "$T/o/f.json"
 msg=$(sed -n 's/^towstab: error: //p' "$T/err" | head -1)
 why=""
 [ "$status" -eq 1 ] || why="$why exit $status, not 1;"
@@ -145,7 +148,7 @@ grep -q '"trustworthy": false' "$T/o/f.json" || why="$why not trustworthy false;
 grep -F -q "\"error\": \"$msg\"" "$T/o/f.json" || why="$why its error is not stderr's message;"
 grep -q 'residual 0 of' "$T/o/f.json" && why="$why it blames a residual of 0;"
 grep -q 'trustworthy: yes' "$T/out" && why="$why stdout says trustworthy: yes;"
-check "failed equilibrium (weight 1e300): JSON completed false with stderr's reason" "$why"
+check "failed equilibrium (neutral buoyancy): JSON completed false with stderr's reason" "$why"
 
 # 10. A failed simulation: its summary and JSON are not trustworthy.
 fresh
@@ -159,9 +162,9 @@ grep -q '"completed": false' "$T/o/s.json" || why="$why JSON not completed false
 check "failed simulation (--h-min 0.5): trustworthy NO, JSON incomplete" "$why"
 
 # 11. run: a failed analysis leaves the results so far, marked.
-cat "$T/heavy.yaml" >"$T/heavy_run.yaml"
+cat "$T/neutral.yaml" >"$T/neutral_run.yaml"
 fresh
-ts run "$T/heavy_run.yaml" --json "$T/o/r.json"
+ts run "$T/neutral_run.yaml" --json "$T/o/r.json"
 why=""
 [ "$status" -eq 1 ] || why="$why exit $status, not 1;"
 "$CHECK_JSON" parse "$T/o/r.json" >/dev/null 2>&1 || why="$why no JSON;"

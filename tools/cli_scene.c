@@ -1,0 +1,152 @@
+/* cli_scene.c: the analyses a scene lists, prepared and run in order, for
+ * `towstab run` and `towstab report` (cli.h). Every entry is read through
+ * its analysis' option table and checked against the system before the
+ * first one runs; the results are collected as one JSON document. */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli.h"
+#include "towstab/report_result.h"
+
+int cli_make_dir(const char *cmd, const char *opt, const char *dir)
+{
+    struct stat st;
+    if (stat(dir, &st) == 0) {
+        if (S_ISDIR(st.st_mode))
+            return 0;
+        fprintf(stderr, "towstab: error: %s: %s: '%s' is not a directory\n",
+                cmd, opt, dir);
+        return EXIT_BADINPUT;
+    }
+    if (mkdir(dir, 0777) != 0) {
+        fprintf(stderr, "towstab: error: %s: %s: cannot make '%s' (%s)\n",
+                cmd, opt, dir, strerror(errno));
+        return EXIT_FAILED;
+    }
+    return 0;
+}
+
+void cli_scene_free(cli_scene_runs *s)
+{
+    for (int i = 0; s->runs && i < s->n; i++)
+        cli_run_free(&s->runs[i]);
+    free(s->runs);
+    free(s->csv);
+    free(s->dirs);
+    memset(s, 0, sizeof *s);
+}
+
+int cli_scene_prepare(const char *cmd, const ts_scene *scene,
+                      const ts_units *units, int quiet, const char *csv_dir,
+                      const char *plot_dir, const char *plot_units,
+                      cli_scene_runs *s)
+{
+    memset(s, 0, sizeof *s);
+    int n = scene->nanalyses;
+    if (n == 0) {
+        fprintf(stderr, "towstab: error: %s: %s lists no analyses: nothing "
+                        "to run (add an 'analyses' list)\n",
+                cmd, scene->path);
+        return EXIT_BADINPUT;
+    }
+    s->n = n;
+    s->runs = calloc((size_t)n, sizeof *s->runs);
+    s->csv = calloc((size_t)n, sizeof *s->csv);
+    s->dirs = calloc((size_t)n, sizeof *s->dirs);
+    if (!s->runs || !s->csv || !s->dirs) {
+        fprintf(stderr, "towstab: error: %s: out of memory for %d "
+                        "analyses\n", cmd, n);
+        cli_scene_free(s);
+        return EXIT_FAILED;
+    }
+    char types[256] = "";
+    for (int i = 0; cli_commands[i]; i++)
+        if (cli_commands[i]->kind >= 0) {
+            if (types[0])
+                strncat(types, ", ", sizeof types - strlen(types) - 1);
+            strncat(types, cli_commands[i]->name,
+                    sizeof types - strlen(types) - 1);
+        }
+    int status = 0;
+    for (int i = 0; i < n && !status; i++) {
+        const ts_scene_analysis *a = &scene->analyses[i];
+        int kind = ts_analysis_find(a->type);
+        const cli_command *c_cmd = kind >= 0 ? cli_command_of(kind) : NULL;
+        if (!c_cmd) {
+            ts_err err = {0};
+            ts_fail(&err, TS_ESCENE, "%s: analyses[%d] (line %d): unknown "
+                    "analysis type '%s'; expected one of %s",
+                    scene->path, i, a->line, a->type, types);
+            status = cli_report(&err, TS_ESCENE);
+            break;
+        }
+        cli_run *c = &s->runs[i];
+        c->cmd = c_cmd;
+        c->scene = scene;
+        c->units = units;
+        c->entry = i;
+        c->quiet = quiet;
+        if (csv_dir) {
+            snprintf(s->csv[i], sizeof s->csv[i], "%s/%d_%s.csv", csv_dir,
+                     i + 1, a->type);
+            c->csv = s->csv[i];
+        }
+        if (plot_dir) {
+            snprintf(s->dirs[i], sizeof s->dirs[i], "%s/%d_%s", plot_dir,
+                     i + 1, a->type);
+            c->plot.dir = s->dirs[i];
+            c->plot.units = plot_units;
+        }
+        c->opts = cli_entry_options(scene, kind, i, &status);
+        if (!status)
+            status = cli_prepare(c);
+    }
+    if (status)
+        cli_scene_free(s);
+    return status;
+}
+
+int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
+                      json_t **all)
+{
+    int status = 0;
+    json_t *doc = json_object(), *list = json_array();
+    if (!doc || !list ||
+        json_object_set_new(doc, "scene",
+                            json_string(scene->system->name)) ||
+        json_object_set(doc, "analyses", list)) {
+        json_decref(doc);
+        json_decref(list);
+        fprintf(stderr, "towstab: error: out of memory for the results\n");
+        *all = NULL;
+        return EXIT_FAILED;
+    }
+    json_decref(list); /* the document holds it */
+    for (int i = 0; i < s->n && !status; i++) {
+        printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
+               s->n, scene->analyses[i].type, scene->system->name);
+        json_t *j = NULL;
+        status = cli_execute(&s->runs[i], &j);
+        if (j)
+            json_array_append_new(list, j);
+    }
+    /* After a failure the results so far, marked as incomplete with the
+     * failed analysis' message. */
+    size_t nres = json_array_size(list);
+    const char *msg = status && nres > 0
+                          ? json_string_value(json_object_get(
+                                json_array_get(list, nres - 1), "error"))
+                          : NULL;
+    json_object_set_new(doc, "completed", json_boolean(status == 0));
+    if (status) {
+        json_object_set_new(doc, "error", json_string(msg ? msg : "failed"));
+        json_object_set_new(doc, "trustworthy", json_false());
+    }
+    if (cli_stop_signal_name())
+        json_object_set_new(doc, "interrupted",
+                            json_string(cli_stop_signal_name()));
+    *all = doc;
+    return status;
+}
