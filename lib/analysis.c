@@ -999,8 +999,18 @@ static int read_shape(const ts_system *sys, const char *path, double *pos,
         line[strcspn(line, "\r\n")] = '\0';
         if (line[0] == '#' || line[0] == '\0')
             continue;
-        if (lineno == 1 && !strncmp(line, "node,", 5))
+        if (lineno == 1 && !strncmp(line, "node,", 5)) {
+            /* Positions in metres only (a CSV written with --units
+             * imperial says x_ft). */
+            if (strncmp(line, "node,x_m,y_m,z_m", 16) != 0) {
+                rc = ts_fail(err, TS_EINVAL, "initial: %s line 1: expected "
+                             "the header node,x_m,y_m,z_m (positions in m; "
+                             "write the file with --units si), got '%.60s'",
+                             path, line);
+                break;
+            }
             continue;
+        }
         char *c1 = strchr(line, ',');
         if (!c1) {
             rc = ts_fail(err, TS_EINVAL, "initial: %s line %d: expected "

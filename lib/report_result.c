@@ -434,15 +434,29 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
     json_object_set_new(j, "key_values", key_values_json(r));
     if (r->kind != TS_ANALYSIS_CONVERGE)
         json_object_set_new(j, "accuracy", accuracy_json(r));
+    /* JSON stays SI whatever the display: the units, named. */
+    const ts_display *si = ts_display_or_si(NULL);
+    json_t *units = json_object();
+    for (int q = 0; units && q < TS_QTY_COUNT; q++)
+        json_object_set_new(units, ts_quantity_name((ts_quantity)q),
+                            json_string(ts_display_unit(si, (ts_quantity)q)));
+    json_object_set_new(j, "units", units);
     return j;
 }
 
 int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
 {
+    return ts_report_result_csv_display(r, NULL, path, err);
+}
+
+int ts_report_result_csv_display(const ts_result *r, const ts_display *d,
+                                 const char *path, ts_err *err)
+{
     switch (r->kind) {
     case TS_ANALYSIS_EQUILIBRIUM:
         if (r->eq && r->eq->converged)
-            return ts_report_equilibrium_csv(r->sys, r->eq, path, err);
+            return ts_report_equilibrium_csv_display(r->sys, r->eq, d, path,
+                                                     err);
         break;
     case TS_ANALYSIS_MODES:
         if (r->eigen)
@@ -452,20 +466,21 @@ int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
         if (r->seastate)
             return ts_report_seastate_csv(r->seastate, path, err);
         if (r->response)
-            return ts_report_response_csv(r->response, path, err);
+            return ts_report_response_csv_display(r->response, d, path, err);
         break;
     case TS_ANALYSIS_SIMULATE:
         if ((r->nonlinear || r->linear) && r->all_outputs)
-            return ts_report_history_csv(r->sys, r->nonlinear, r->linear,
-                                         path, err);
+            return ts_report_history_csv_display(r->sys, r->nonlinear,
+                                                 r->linear, d, path, err);
         if (r->nonlinear || r->linear)
             return ts_report_channels_csv(r->sys, r->nonlinear, r->linear,
-                                          r->noutputs, r->outputs, path,
+                                          r->noutputs, r->outputs, d, path,
                                           err);
         break;
     case TS_ANALYSIS_CONVERGE:
         if (r->convergence)
-            return ts_report_convergence_csv(r->convergence, path, err);
+            return ts_report_convergence_csv_display(r->convergence, d, path,
+                                                     err);
         break;
     }
     return ts_fail(err, TS_EINVAL, "%s: the %s result has no table to write",

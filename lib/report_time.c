@@ -239,6 +239,8 @@ typedef struct csv_cols {
     int n;                   /* channels */
     const ts_output *outs;   /* [n] */
     char *use;               /* [2 n]: the channels each run gives */
+    const ts_display *d;     /* the units shown */
+    char t[TS_DISPLAY_UNIT_MAX * 2]; /* time's unit as a name */
 } csv_cols;
 
 /* Write "t_s" and the columns of nl and li (either may be NULL; with
@@ -256,14 +258,14 @@ static int write_runs(csv_cols *c, const ts_history *nl, const ts_history *li,
     int rows = first->nsamples;
     if (both && li->nsamples < rows)
         rows = li->nsamples;
-    fprintf(f, "t_s");
+    fprintf(f, "t_%s", c->t);
     if (nl)
         c->header(c, f, nl, both ? "nonlinear." : "", 0);
     if (li)
         c->header(c, f, li, both ? "linear." : "", 1);
     fputc('\n', f);
     for (int i = 0; i < rows; i++) {
-        fprintf(f, "%.17g", first->t[i]);
+        fprintf(f, "%.17g", ts_display_value(c->d, TS_QTY_TIME, first->t[i]));
         if (nl)
             c->row(c, f, nl, i, 0);
         if (li)
@@ -273,6 +275,14 @@ static int write_runs(csv_cols *c, const ts_history *nl, const ts_history *li,
     return tsi_outfile_commit(&out, err);
 }
 
+/* Set up the units of c: d, or SI. */
+static void cols_units(csv_cols *c, const ts_display *d)
+{
+    c->d = ts_display_or_si(d);
+    ts_display_unit_token(ts_display_unit(c->d, TS_QTY_TIME), c->t,
+                          sizeof c->t);
+}
+
 /* The full state: every node, every link's tension and the tow force
  * (nonlinear runs). */
 static void full_header(csv_cols *c, FILE *f, const ts_history *h,
@@ -280,47 +290,61 @@ static void full_header(csv_cols *c, FILE *f, const ts_history *h,
 {
     (void)slot;
     const ts_system *sys = c->sys;
-    char name[2 * TS_NAME_MAX];
+    char name[2 * TS_NAME_MAX], lu[TS_DISPLAY_UNIT_MAX * 2],
+        fu[TS_DISPLAY_UNIT_MAX * 2];
+    ts_display_unit_token(ts_display_unit(c->d, TS_QTY_LENGTH), lu,
+                          sizeof lu);
+    ts_display_unit_token(ts_display_unit(c->d, TS_QTY_FORCE), fu,
+                          sizeof fu);
     for (int k = 0; k < h->nnodes; k++) {
         ts_system_node_name(sys, k, name, sizeof name);
-        fprintf(f, ",%s%s.x_m,%s%s.y_m,%s%s.z_m", prefix, name, prefix, name,
-                prefix, name);
+        fprintf(f, ",%s%s.x_%s,%s%s.y_%s,%s%s.z_%s", prefix, name, lu, prefix,
+                name, lu, prefix, name, lu);
     }
     if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0]))
         for (int l = 0; l < h->nlinks; l++)
-            fprintf(f, ",%s%s.%d.tension_N", prefix,
+            fprintf(f, ",%s%s.%d.tension_%s", prefix,
                     sys->cables[sys->links[l].cable].name,
-                    sys->links[l].index);
+                    sys->links[l].index, fu);
     if (has_forces(h))
-        fprintf(f, ",%stow.force.x_N,%stow.force.y_N,%stow.force.z_N",
-                prefix, prefix, prefix);
+        fprintf(f, ",%stow.force.x_%s,%stow.force.y_%s,%stow.force.z_%s",
+                prefix, fu, prefix, fu, prefix, fu);
 }
 
 static void full_row(csv_cols *c, FILE *f, const ts_history *h, int i,
                      int slot)
 {
-    (void)c;
     (void)slot;
     const double *p = h->positions + 3 * (size_t)h->nnodes * (size_t)i;
     for (int k = 0; k < 3 * h->nnodes; k++)
-        fprintf(f, ",%.17g", p[k]);
+        fprintf(f, ",%.17g", ts_display_value(c->d, TS_QTY_LENGTH, p[k]));
     if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0])) {
         const double *t = h->tensions + (size_t)h->nlinks * (size_t)i;
         for (int l = 0; l < h->nlinks; l++)
-            fprintf(f, ",%.17g", t[l]);
+            fprintf(f, ",%.17g", ts_display_value(c->d, TS_QTY_FORCE, t[l]));
     }
     if (has_forces(h))
         for (int k = 0; k < 3; k++)
-            fprintf(f, ",%.17g", h->tow_force[3 * (size_t)i + (size_t)k]);
+            fprintf(f, ",%.17g",
+                    ts_display_value(c->d, TS_QTY_FORCE,
+                                     h->tow_force[3 * (size_t)i + (size_t)k]));
 }
 
 int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
                           const ts_history *li, const char *path,
                           ts_err *err)
 {
+    return ts_report_history_csv_display(sys, nl, li, NULL, path, err);
+}
+
+int ts_report_history_csv_display(const ts_system *sys, const ts_history *nl,
+                                  const ts_history *li, const ts_display *d,
+                                  const char *path, ts_err *err)
+{
     if (!nl && !li)
         return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
-    csv_cols c = {full_header, full_row, sys, 0, NULL, NULL};
+    csv_cols c = {full_header, full_row, sys, 0, NULL, NULL, NULL, ""};
+    cols_units(&c, d);
     return write_runs(&c, nl, li, path, err);
 }
 
@@ -333,10 +357,12 @@ static void channels_header(csv_cols *c, FILE *f, const ts_history *h,
         use[k] = (char)gives(c->sys, h, &c->outs[k]);
         if (!use[k])
             continue;
-        const char *u = c->outs[k].si_unit;
+        char u[64], t[64];
+        ts_display_convert(c->d, c->outs[k].si_unit, 1.0, u, sizeof u);
+        ts_display_unit_token(u, t, sizeof t);
         int bare = !strcmp(u, "1");
         fprintf(f, ",%s%s%s%s", prefix, c->outs[k].name, bare ? "" : "_",
-                bare ? "" : u);
+                bare ? "" : t);
     }
 }
 
@@ -344,19 +370,26 @@ static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
                          int slot)
 {
     const char *use = c->use + (size_t)slot * (size_t)c->n;
+    char u[64];
     for (int k = 0; k < c->n; k++)
         if (use[k])
-            fprintf(f, ",%.17g", ts_history_value(c->sys, h, &c->outs[k], i));
+            fprintf(f, ",%.17g",
+                    ts_display_convert(c->d, c->outs[k].si_unit,
+                                       ts_history_value(c->sys, h,
+                                                        &c->outs[k], i),
+                                       u, sizeof u));
 }
 
 int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,
                            const ts_history *li, int n,
-                           const ts_output outs[], const char *path,
-                           ts_err *err)
+                           const ts_output outs[], const ts_display *d,
+                           const char *path, ts_err *err)
 {
     if (!nl && !li)
         return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
-    csv_cols c = {channels_header, channels_row, sys, n, outs, NULL};
+    csv_cols c = {channels_header, channels_row, sys, n, outs, NULL, NULL,
+                  ""};
+    cols_units(&c, d);
     c.use = calloc(2 * (size_t)(n > 0 ? n : 1), 1);
     if (!c.use)
         return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);

@@ -34,6 +34,14 @@ TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
 TS_API int ts_report_result_csv(const ts_result *r, const char *path,
                                 ts_err *err);
 
+/* The same in the display units d (towstab/units.h; NULL: SI): the
+ * tables of an equilibrium, a response, a simulation and a study show
+ * their lengths, forces, times and frequencies in d's units and name
+ * their columns with them; the mode tables stay SI. */
+TS_API int ts_report_result_csv_display(const ts_result *r,
+                                        const ts_display *d,
+                                        const char *path, ts_err *err);
+
 #ifdef __cplusplus
 }
 #endif

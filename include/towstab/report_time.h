@@ -16,6 +16,7 @@
 #include "towstab/output.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -77,16 +78,25 @@ TS_API int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
                                  const ts_history *li, const char *path,
                                  ts_err *err);
 
+/* The same in the display units d (towstab/units.h; NULL: SI), columns
+ * named with them ("t_s", "sphere.x_ft", "cable.1.tension_lbf"). */
+TS_API int ts_report_history_csv_display(const ts_system *sys,
+                                         const ts_history *nl,
+                                         const ts_history *li,
+                                         const ts_display *d,
+                                         const char *path, ts_err *err);
+
 /* Write the channels outs[n] of the histories as CSV to `path` ("-":
- * stdout), atomically: a header "t_s,NAME_UNIT,..." (UNIT the channel's
- * SI unit, m or N; none for a strain), one row per sample. Either history
- * may be NULL; with both, each column carries the prefix "nonlinear." or
- * "linear." and the rows run to the shorter one. Channels a run does not
- * give (not finite at any sample) are left out of its columns. */
+ * stdout), atomically, in the display units d (NULL: SI): a header
+ * "t_s,NAME_UNIT,..." (UNIT the channel's unit shown, m or N in SI; none
+ * for a strain), one row per sample. Either history may be NULL; with
+ * both, each column carries the prefix "nonlinear." or "linear." and the
+ * rows run to the shorter one. Channels a run does not give (not finite
+ * at any sample) are left out of its columns. */
 TS_API int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,
                                   const ts_history *li, int n,
-                                  const ts_output outs[], const char *path,
-                                  ts_err *err);
+                                  const ts_output outs[], const ts_display *d,
+                                  const char *path, ts_err *err);
 
 #ifdef __cplusplus
 }
