@@ -1139,3 +1139,21 @@ out:
         ts_err_clear(err); /* a failed first attempt leaves no message */
     return rc;
 }
+
+double ts_equilibrium_strain(const ts_system *sys, const ts_equilibrium *eq,
+                             int link)
+{
+    const ts_link *L = &sys->links[link];
+    return L->elastic && L->ea > 0 ? eq->tensions[link] / L->ea : 0.0;
+}
+
+double ts_equilibrium_cable_length(const ts_system *sys,
+                                   const ts_equilibrium *eq, int c)
+{
+    double len = 0;
+    for (int l = 0; l < sys->nlinks; l++)
+        if (sys->links[l].cable == c)
+            len += sys->links[l].length *
+                   (1.0 + ts_equilibrium_strain(sys, eq, l));
+    return len;
+}
