@@ -45,8 +45,10 @@
 #define BENDING_START 1e-4
 #define CONTINUATION_MIN_STEP (1.0 / 1024)
 /* Newton iterations one solve may take along a continuation path, in
- * units of max_iter (the examples take at most 29 with max_iter 100). */
-#define CONTINUATION_MAX_ITER 10
+ * units of max_iter (the examples take at most 29 with max_iter 100: 3
+ * leaves a factor of 10, and a path that cannot be followed fails in
+ * seconds rather than a minute). */
+#define CONTINUATION_MAX_ITER 3
 /* A vehicle's attitude alone on its joint in the straight tow (the
  * Newton start): moment residual relative to its weight and flow forces
  * times its lever, and the hybrid solver's iterations. */
@@ -646,11 +648,12 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         /* A path that keeps failing can halve its step ten times, each
          * try up to max_iter Newton iterations: bound the whole. */
         if (eq->iterations > CONTINUATION_MAX_ITER * o->max_iter) {
-            rc = ts_fail(err, TS_ECONV, "equilibrium: %d Newton iterations "
-                         "without reaching the end of the path, more than "
-                         "the %d (%d times max_iter) a solve may take",
-                         eq->iterations, CONTINUATION_MAX_ITER * o->max_iter,
-                         CONTINUATION_MAX_ITER);
+            /* Keep the last try's message: it gives the residual. */
+            ts_err_prefix(err, "%d Newton iterations without reaching the "
+                               "end of the path, more than the %d (%d times "
+                               "max_iter) a solve may take; the last try: ",
+                          eq->iterations, CONTINUATION_MAX_ITER * o->max_iter,
+                          CONTINUATION_MAX_ITER);
             break;
         }
         dt *= 0.5;
