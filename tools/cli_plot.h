@@ -25,6 +25,9 @@ typedef struct cli_plot {
  * well. */
 int cli_plot_begin(cli_plot *p, const char *cmd);
 
+/* Print "wrote DIR/NAME.png and DIR/NAME.svg" (the formats drawn). */
+void cli_plot_wrote(const cli_plot *p, const char *name);
+
 /* A cable shape of `sys` at node positions pos[3 nnodes] (m, M frame),
  * for ts_plot_shapes / ts_plot_mode_shapes: links as in sys, spheres
  * marked, the ship's turning circle R = V / Omega when turning. Owns its

@@ -183,8 +183,7 @@ static int modes_plot(const ts_system *sys, const ts_linear *lin,
                             &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else
-        printf("wrote %s/eigenvalues.png and %s/eigenvalues.svg\n",
-               plot->dir, plot->dir);
+        cli_plot_wrote(plot, "eigenvalues");
     free(re);
     free(im);
 
@@ -224,8 +223,7 @@ static int modes_plot(const ts_system *sys, const ts_linear *lin,
                                 &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/modes.png and %s/modes.svg\n", plot->dir,
-                   plot->dir);
+            cli_plot_wrote(plot, "modes");
     }
     cli_plot_shape_free(&eqs);
     free(disp);
