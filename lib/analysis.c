@@ -1105,27 +1105,39 @@ static int sim_values(ts_result *r, int required, ts_err *err)
 
 /* The realisation of a simulation's sea, added to a copy of the request's
  * excitation (r->sea_excitation, which r->excitation then points to). */
-static int sea_realise(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+/* The excitation of s with its sea's realisation added, into *out (a new
+ * excitation, NULL on failure), with the seaway and the realisation's
+ * settings. */
+static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
+                          ts_seaway *w, ts_sea_realisation *real,
+                          ts_excitation **out, ts_err *err)
 {
-    int rc = sea_seaway(r->sys, &s->sea, &r->seaway, err);
+    *out = NULL;
+    int rc = sea_seaway(sys, &s->sea, w, err);
     if (rc)
         return rc;
-    r->has_sea = 1;
-    r->sea_excitation = ts_excitation_copy(s->excitation, err);
-    if (!r->sea_excitation)
+    *out = ts_excitation_copy(s->excitation, err);
+    if (!*out)
         return err && err->code ? err->code : TS_ENOMEM;
-    ts_sea_realisation real;
-    ts_sea_realisation_default(&r->seaway, &real);
-    real.seed = s->seed;
-    real.components = s->components;
+    ts_sea_realisation_default(w, real);
+    real->seed = s->seed;
+    real->components = s->components;
     if (!isnan(s->fade_in))
-        real.rise = s->fade_in;
-    r->realisation = real;
-    snprintf(r->rao_file, sizeof r->rao_file, "%s", s->sea.rao_file);
-    rc = ts_seaway_excitation(&r->seaway, &real, r->sea_excitation, NULL,
-                              err);
+        real->rise = s->fade_in;
+    rc = ts_seaway_excitation(w, real, *out, NULL, err);
     if (rc)
         ts_err_prefix(err, "sea: ");
+    return rc;
+}
+
+static int sea_realise(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+{
+    int rc = sea_excitation(r->sys, s, &r->seaway, &r->realisation,
+                            &r->sea_excitation, err);
+    if (!r->sea_excitation)
+        return rc;
+    r->has_sea = 1;
+    snprintf(r->rao_file, sizeof r->rao_file, "%s", s->sea.rao_file);
     r->excitation = r->sea_excitation;
     return rc;
 }
@@ -1723,7 +1735,17 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
         ts_sim_opts o;
         double transient;
         sim_resolve(&rq->simulate, &o, &transient);
-        rc = ts_cost_simulate(s, rq->simulate.excitation, &o, e, err);
+        /* With a sea, its realisation is part of the excitation. */
+        ts_excitation *ex = NULL;
+        if (rq->simulate.sea.sea) {
+            ts_seaway w;
+            ts_sea_realisation real;
+            rc = sea_excitation(s, &rq->simulate, &w, &real, &ex, err);
+        }
+        if (rc == TS_OK)
+            rc = ts_cost_simulate(s, ex ? ex : rq->simulate.excitation, &o,
+                                  e, err);
+        ts_excitation_free(ex);
     } else if (rq->kind == TS_ANALYSIS_MODES) {
         ts_kernel *k = ts_kernel_alloc(s, err);
         int n = k ? ts_kernel_nstate(k) : 0;

@@ -13,12 +13,15 @@
 #include "towstab/equilibrium.h"
 
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_multiroots.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "kernel_impl.h"
 #include "lapack.h"
 #include "march.h"
 #include "vec3.h"
+#include "vehicle.h"
 
 /* Shooting mismatch target, relative to the total cable length: far below
  * what moves a force by 1e-10 of the largest one. */
@@ -44,6 +47,11 @@
 /* Newton iterations one solve may take along a continuation path, in
  * units of max_iter (the examples take at most 29 with max_iter 100). */
 #define CONTINUATION_MAX_ITER 10
+/* A vehicle's attitude alone on its joint in the straight tow (the
+ * Newton start): moment residual relative to its weight and flow forces
+ * times its lever, and the hybrid solver's iterations. */
+#define TRIM_RTOL 1e-12
+#define TRIM_MAXIT 200
 /* A relative force residual this small is rounding in the sums of the
  * nodal balances (about 1000 machine epsilons): Newton stalling there has
  * converged as far as double precision goes. */
@@ -107,8 +115,10 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
     eq->tensions = calloc(nl, sizeof(double));
     eq->attitudes = calloc(9 * (size_t)sys->nvehicles + 1, sizeof(double));
     eq->controls = calloc(maxc + 1, sizeof(double));
+    eq->vehicles = calloc((size_t)sys->nvehicles + 1,
+                          sizeof(ts_vehicle_result));
     if (!eq->y || !eq->directions || !eq->positions || !eq->tensions ||
-        !eq->attitudes || !eq->controls)
+        !eq->attitudes || !eq->controls || !eq->vehicles)
         goto nomem;
     return eq;
 nomem:
@@ -129,7 +139,46 @@ void ts_equilibrium_free(ts_equilibrium *eq)
     free(eq->tensions);
     free(eq->attitudes);
     free(eq->controls);
+    free(eq->vehicles);
     free(eq);
+}
+
+static double total_length(const ts_system *sys)
+{
+    double L = 0;
+    for (int l = 0; l < sys->nlinks; l++)
+        L += sys->links[l].length;
+    return L;
+}
+
+/* Weight of controller state i's rate in the verdict: a loop's error over
+ * its scale (the cable length for depth, 1 rad for angles), an
+ * actuator's rate times its time constant. */
+static double control_weight(const ts_kernel *k, int i)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_control_state cs;
+    ts_kernel_control_state(k, i, &cs);
+    const ts_vehicle *d =
+        sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
+    if (cs.actuator)
+        return d->component[cs.index].time_constant;
+    return d->loop[cs.index].measure == TS_MEASURE_DEPTH
+               ? 1.0 / total_length(sys)
+               : 1.0;
+}
+
+/* The largest weighted |c'| of f = f(y); 0 without controllers. */
+static double control_residual_of(const ts_kernel *k, const double *f)
+{
+    int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
+    double worst = 0.0;
+    for (int i = 0; i < nc; i++) {
+        double r = fabs(f[2 * nq + i]) * control_weight(k, i);
+        if (!(r <= worst))
+            worst = r;
+    }
+    return worst;
 }
 
 /* Evaluate the kernel at y (rates zero) and record the result in eq. */
@@ -164,24 +213,38 @@ static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
     for (int l = 0; l < nl; l++)
         if (eq->tensions[l] < eq->min_tension)
             eq->min_tension = eq->tensions[l];
+    for (int v = 0; v < eq->nvehicles; v++)
+        ts_kernel_vehicle_result(k, v, &eq->vehicles[v]);
+    eq->control_residual = control_residual_of(k, dydt);
     return TS_OK;
 }
 
-/* Work arrays of the general Newton. */
+/* Work arrays of the general Newton. Its unknowns are the coordinates q
+ * and the controller states c (nu = nq + nc), its residual the rows of f
+ * that must vanish at rest, (q'', c') = f[nq..n). */
 typedef struct newton_ws {
-    int nq;
+    int nq, nc, nu, n;
     double *J, *R, *dq, *yt, *f1, *f2;
-    double *work;   /* [4 nq] and iwork [nq]: LAPACK dgecon */
+    double *work;   /* [4 nu] and iwork [nu]: LAPACK dgecon */
     int *iwork;
     int have_lu;    /* J holds the LU of the last Jacobian */
     double rcond;   /* its reciprocal 1-norm condition, anorm its norm */
     double anorm;
-    double *scale;  /* [nq] size of each coordinate: 1 rad for angles,
-                       1e-3 for an elastic link's strain */
+    double *scale;  /* [nu] size of each unknown: 1 rad for angles,
+                       1e-3 for an elastic link's strain, 1 rad for an
+                       actuator, 1 rad / |ki| for an integrator */
     double *dirs;   /* [3 nlinks] link directions of the last good state */
     double *strains;/* [nlinks] its strains */
+    double *att;    /* [9 nvehicles] its attitudes */
+    double *ctl;    /* [nc] its controller states */
     int *ipiv;
 } newton_ws;
+
+/* Index in y of unknown i. */
+static inline int unknown(const newton_ws *w, int i)
+{
+    return i < w->nq ? i : w->nq + i;
+}
 
 static void newton_ws_free(newton_ws *w)
 {
@@ -195,6 +258,8 @@ static void newton_ws_free(newton_ws *w)
     free(w->iwork);
     free(w->dirs);
     free(w->strains);
+    free(w->att);
+    free(w->ctl);
     free(w->scale);
     free(w->ipiv);
 }
@@ -202,34 +267,46 @@ static void newton_ws_free(newton_ws *w)
 static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
 {
     const ts_system *sys = ts_kernel_system(k);
-    int nq = ts_kernel_nq(k);
-    size_t n = (size_t)nq;
+    int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
     w->nq = nq;
-    w->scale = malloc(n * sizeof(double));
-    if (w->scale)
-        for (int l = 0; l < sys->nlinks; l++) {
-            int o = ts_kernel_link_offset(k, l);
-            int e = sys->links[l].elastic;
-            w->scale[o] = w->scale[o + 1] = 1.0;
+    w->nc = nc;
+    w->nu = nq + nc;
+    w->n = 2 * nq + nc;
+    size_t nu = (size_t)w->nu, n = (size_t)w->n;
+    w->scale = malloc(nu * sizeof(double));
+    if (w->scale) {
+        for (int i = 0; i < nq; i++)
+            w->scale[i] = 1.0; /* link and vehicle angles */
+        for (int l = 0; l < sys->nlinks; l++)
             /* A strain's step: small against any strain a cable carries,
              * large against rounding. */
-            if (e)
-                w->scale[o + 2] = 1e-3;
+            if (sys->links[l].elastic)
+                w->scale[ts_kernel_link_offset(k, l) + 2] = 1e-3;
+        for (int i = 0; i < nc; i++) {
+            ts_control_state cs;
+            ts_kernel_control_state(k, i, &cs);
+            const ts_vehicle *d =
+                sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
+            w->scale[nq + i] =
+                cs.actuator ? 1.0 : 1.0 / fabs(d->loop[cs.index].ki);
         }
-    w->J = malloc(n * n * sizeof(double));
-    w->R = malloc(2 * n * sizeof(double));
-    w->dq = malloc(n * sizeof(double));
-    w->yt = calloc(2 * n, sizeof(double));
-    w->f1 = malloc(2 * n * sizeof(double));
-    w->f2 = malloc(2 * n * sizeof(double));
-    w->work = malloc(4 * n * sizeof(double));
-    w->iwork = malloc(n * sizeof(int));
+    }
+    w->J = malloc(nu * nu * sizeof(double));
+    w->R = malloc(n * sizeof(double));
+    w->dq = malloc(nu * sizeof(double));
+    w->yt = calloc(n, sizeof(double));
+    w->f1 = malloc(n * sizeof(double));
+    w->f2 = malloc(n * sizeof(double));
+    w->work = malloc(4 * nu * sizeof(double));
+    w->iwork = malloc(nu * sizeof(int));
     w->dirs = malloc(3 * (size_t)sys->nlinks * sizeof(double));
     w->strains = malloc((size_t)sys->nlinks * sizeof(double));
-    w->ipiv = malloc(n * sizeof(int));
+    w->att = malloc((9 * (size_t)sys->nvehicles + 1) * sizeof(double));
+    w->ctl = malloc((nc > 0 ? (size_t)nc : 1) * sizeof(double));
+    w->ipiv = malloc(nu * sizeof(int));
     return w->J && w->R && w->dq && w->yt && w->f1 && w->f2 && w->work &&
-           w->iwork &&
-           w->dirs && w->strains && w->scale && w->ipiv;
+           w->iwork && w->dirs && w->strains && w->att && w->ctl &&
+           w->scale && w->ipiv;
 }
 
 static double norm2(const double *v, int n)
@@ -238,14 +315,6 @@ static double norm2(const double *v, int n)
     for (int i = 0; i < n; i++)
         s += v[i] * v[i];
     return sqrt(s);
-}
-
-static double total_length(const ts_system *sys)
-{
-    double L = 0;
-    for (int l = 0; l < sys->nlinks; l++)
-        L += sys->links[l].length;
-    return L;
 }
 
 /* At convergence: the condition of the last Jacobian, and the shape error
@@ -260,10 +329,10 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
     eq->shape_error = NAN;
     if (!w->have_lu)
         return;
-    int nq = w->nq, one = 1, info = 0;
-    for (int i = 0; i < nq; i++)
+    int nu = w->nu, nq = w->nq, one = 1, info = 0;
+    for (int i = 0; i < nu; i++)
         w->dq[i] = w->R[nq + i];
-    dgetrs_("N", &nq, &one, w->J, &nq, w->ipiv, w->dq, &nq, &info, 1);
+    dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
     if (info != 0)
         return;
     double big = 0.0;
@@ -273,12 +342,130 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
     eq->shape_error = big * total_length(ts_kernel_system(k));
 }
 
-/* Newton on q''(q) = 0 from y (rates must be zero; y[2 nq]). */
+/* Where the kernel's last evaluation has its largest load or tension
+ * (the first one that is not finite, if any), as a scene key path: a
+ * vehicle "bodies[b] 'name'", a body at a node, or "cables[c] 'name' link
+ * i"; and that magnitude (N) in *big. */
+static void largest_load(const ts_kernel *k, char *buf, size_t size,
+                         double *big)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    const double *Q = ts_kernel_loads(k), *t = ts_kernel_tensions(k);
+    int where = -1, veh = -1;
+    *big = 0.0;
+    /* "+ 0.0 * x" keeps a NaN, which fmax would drop. */
+    for (int i = 1; i < sys->nnodes && isfinite(*big); i++) {
+        double m = fabs(t[i - 1]);
+        for (int j = 0; j < 3; j++)
+            m = fmax(m, fabs(Q[3 * i + j])) + 0.0 * Q[3 * i + j];
+        if (!(m <= *big)) {
+            *big = m;
+            where = i;
+        }
+    }
+    for (int v = 0; v < ts_kernel_nvehicles(k) && isfinite(*big); v++) {
+        ts_vehicle_result r;
+        ts_kernel_vehicle_result(k, v, &r);
+        double m = 0;
+        for (int j = 0; j < 3; j++)
+            m = fmax(m, fabs(r.hydro_force[j])) + 0.0 * r.hydro_force[j];
+        if (!(m <= *big)) {
+            *big = m;
+            veh = r.body;
+        }
+    }
+    if (veh >= 0) {
+        snprintf(buf, size, "bodies[%d] '%s'", veh, sys->bodies[veh].name);
+    } else if (where > 0 && sys->nodes[where].body >= 0) {
+        int b = sys->nodes[where].body;
+        snprintf(buf, size, "bodies[%d] '%s'", b, sys->bodies[b].name);
+    } else if (where > 0) {
+        const ts_link *L = &sys->links[sys->nodes[where].link];
+        snprintf(buf, size, "cables[%d] '%s' link %d", L->cable,
+                 sys->cables[L->cable].name, L->index);
+    } else {
+        buf[0] = '\0';
+    }
+}
+
+/* The part of the system state y[i] (a coordinate or a controller
+ * state) belongs to, as a scene key path. */
+static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k);
+    if (i >= 2 * nq) {
+        ts_control_state cs;
+        ts_kernel_control_state(k, i - 2 * nq, &cs);
+        int b = ts_kernel_vehicle_body(k, cs.vehicle);
+        const ts_vehicle *v = sys->bodies[b].vehicle;
+        snprintf(buf, size, "bodies[%d] '%s' %s '%s'", b, sys->bodies[b].name,
+                 cs.actuator ? "control surface" : "controller",
+                 cs.actuator ? v->component[cs.index].name
+                             : v->loop[cs.index].name);
+        return;
+    }
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        int o = ts_kernel_vehicle_offset(k, v);
+        if (i >= o && i < o + 3) {
+            int b = ts_kernel_vehicle_body(k, v);
+            snprintf(buf, size, "bodies[%d] '%s' (its attitude)", b,
+                     sys->bodies[b].name);
+            return;
+        }
+    }
+    int l = 0;
+    while (l + 1 < sys->nlinks && ts_kernel_link_offset(k, l + 1) <= i)
+        l++;
+    const ts_link *L = &sys->links[l];
+    snprintf(buf, size, "cables[%d] '%s' link %d", L->cable,
+             sys->cables[L->cable].name, L->index);
+}
+
+/* The Jacobian of (q'', c') at y by central differences, column by
+ * column, and its LU and condition in w (w->R holds f(y)). */
+static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
+                    ts_err *err)
+{
+    int nq = w->nq, nu = w->nu;
+    for (int j = 0; j < nu; j++) {
+        int yj = unknown(w, j);
+        double h = NEWTON_FD_STEP * w->scale[j], y0 = y[yj];
+        y[yj] = y0 + h;
+        int r1 = ts_kernel_eval(k, y, NULL, w->f1);
+        y[yj] = y0 - h;
+        int r2 = ts_kernel_eval(k, y, NULL, w->f2);
+        y[yj] = y0;
+        eq->evaluations += 2;
+        if (r1 != TS_OK || r2 != TS_OK)
+            return ts_fail(err, TS_ECONV,
+                           "equilibrium: Newton Jacobian column %d left "
+                           "the model's chart",
+                           j);
+        double *col = w->J + (size_t)j * nu;
+        for (int i = 0; i < nu; i++)
+            col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
+    }
+    int info = 0;
+    w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
+    dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
+    w->have_lu = info == 0;
+    if (info == 0) {
+        int cinfo = 0;
+        dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
+                w->iwork, &cinfo, 1);
+        if (cinfo != 0)
+            w->rcond = NAN;
+    }
+    return info == 0 ? TS_OK : -info;
+}
+
+/* Newton on (q'', c')(q, c) = 0 from y (rates must be zero; y[n]). */
 static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                   newton_ws *w, ts_equilibrium *eq, ts_err *err)
 {
-    int nq = w->nq, rc;
-    double rel = INFINITY;
+    int nq = w->nq, nu = w->nu, n = w->n, rc;
+    double rel = INFINITY, crel = 0.0;
     for (int it = 0;; it++) {
         rc = ts_kernel_eval(k, y, NULL, w->R);
         eq->evaluations++;
@@ -287,82 +474,67 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                                     "the model (%s)", ts_strerror(rc));
         double scale, worst = ts_kernel_unbalanced(k, &scale);
         rel = scale > 0 ? worst / scale : worst;
-        if (!isfinite(rel))
-            return ts_fail(err, TS_ECONV, "equilibrium: the forces overflowed "
-                           "(are not finite) at Newton iteration %d: an "
-                           "extreme value of the scene (a stiffness, mass or "
-                           "drag coefficient) drove a tension or strain out "
-                           "of range", eq->iterations);
-        if (rel <= tol) {
+        crel = control_residual_of(k, w->R);
+        if (rel <= tol && crel <= tol) {
+            /* A start that is already the answer (a straight tow with
+             * vehicles) still gets the Jacobian its health needs. */
+            if (!w->have_lu && jacobian(k, y, w, eq, err) == TS_ECONV)
+                ts_err_clear(err);
             newton_health(k, y, w, eq);
             return TS_OK;
+        }
+        if (!isfinite(rel) || !isfinite(crel)) {
+            char place[2 * TS_NAME_MAX + 32], size[64];
+            double big;
+            largest_load(k, place, sizeof place, &big);
+            if (isfinite(big))
+                snprintf(size, sizeof size, "largest %.3g N", big);
+            else
+                snprintf(size, sizeof size, "a load is not finite");
+            return ts_fail(err, TS_EDOMAIN,
+                           "equilibrium: %s%sthe forces overflow (%s) after "
+                           "%d Newton iterations: an input beyond the "
+                           "model's range (a speed, length or coefficient "
+                           "too large?)",
+                           place, place[0] ? ": " : "", size, it);
         }
         if (it >= max_iter)
             break;
         eq->iterations++;
-        /* Jacobian of q'' by central differences, column by column. */
-        for (int j = 0; j < nq; j++) {
-            double h = NEWTON_FD_STEP * w->scale[j], y0 = y[j];
-            y[j] = y0 + h;
-            int r1 = ts_kernel_eval(k, y, NULL, w->f1);
-            y[j] = y0 - h;
-            int r2 = ts_kernel_eval(k, y, NULL, w->f2);
-            y[j] = y0;
-            eq->evaluations += 2;
-            if (r1 != TS_OK || r2 != TS_OK)
-                return ts_fail(err, TS_ECONV,
-                               "equilibrium: Newton Jacobian column %d left "
-                               "the model's chart",
-                               j);
-            double *col = w->J + (size_t)j * nq;
-            for (int i = 0; i < nq; i++)
-                col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
-        }
-        for (int i = 0; i < nq; i++)
+        rc = jacobian(k, y, w, eq, err);
+        if (rc == TS_ECONV)
+            return rc;
+        int one = 1, info = -rc;
+        for (int i = 0; i < nu; i++)
             w->dq[i] = -w->R[nq + i];
-        int one = 1, info = 0;
-        w->anorm = dlange_("1", &nq, &nq, w->J, &nq, w->work, 1);
-        dgetrf_(&nq, &nq, w->J, &nq, w->ipiv, &info);
-        w->have_lu = info == 0;
-        if (info == 0) {
-            int cinfo = 0;
-            dgecon_("1", &nq, w->J, &nq, &w->anorm, &w->rcond, w->work,
-                    w->iwork, &cinfo, 1);
-            if (cinfo != 0)
-                w->rcond = NAN;
-            dgetrs_("N", &nq, &one, w->J, &nq, w->ipiv, w->dq, &nq, &info, 1);
-        }
+        if (info == 0)
+            dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
         if (info != 0) {
-            /* Name the link of the coordinate that nothing restores. */
-            const ts_system *sys = ts_kernel_system(k);
-            int l = 0;
-            while (l + 1 < sys->nlinks &&
-                   ts_kernel_link_offset(k, l + 1) <= info - 1)
-                l++;
-            const ts_link *L = &sys->links[l];
+            char place[2 * TS_NAME_MAX + 64];
+            singular_place(k, unknown(w, info - 1), place, sizeof place);
             return ts_fail(err, TS_ESINGULAR,
                            "equilibrium: singular Newton Jacobian at "
-                           "relative residual %.3g: nothing restores "
-                           "cables[%d] '%s' link %d (LAPACK dgetrf info %d), "
-                           "as with neutral buoyancy and no flow past it",
-                           rel, L->cable, sys->cables[L->cable].name,
-                           L->index, info);
+                           "relative residual %.3g: nothing restores %s "
+                           "(LAPACK dgetrf info %d), as with neutral "
+                           "buoyancy and no flow past it",
+                           rel, place, info);
         }
         double big = 0.0;
-        for (int i = 0; i < nq; i++)
+        for (int i = 0; i < nu; i++)
             big = fmax(big, fabs(w->dq[i]) / w->scale[i]);
         if (big > NEWTON_MAX_STEP)
-            for (int i = 0; i < nq; i++)
+            for (int i = 0; i < nu; i++)
                 w->dq[i] *= NEWTON_MAX_STEP / big;
-        /* Backtracking line search on |q''|. */
-        double phi0 = norm2(w->R + nq, nq), alpha = 1.0;
+        /* Backtracking line search on |(q'', c')|. */
+        double phi0 = norm2(w->R + nq, nu), alpha = 1.0;
         int accepted = 0;
+        memcpy(w->yt, y, (size_t)n * sizeof(double));
         while (alpha >= NEWTON_ALPHA_MIN) {
-            for (int i = 0; i < nq; i++)
-                w->yt[i] = y[i] + alpha * w->dq[i];
+            for (int i = 0; i < nu; i++)
+                w->yt[unknown(w, i)] = y[unknown(w, i)] + alpha * w->dq[i];
             rc = ts_kernel_eval(k, w->yt, NULL, w->f1);
             eq->evaluations++;
-            if (rc == TS_OK && norm2(w->f1 + nq, nq) <=
+            if (rc == TS_OK && norm2(w->f1 + nq, nu) <=
                                    (1.0 - 1e-4 * alpha) * phi0) {
                 accepted = 1;
                 break;
@@ -371,9 +543,16 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         }
         if (!accepted)
             break;
-        memcpy(y, w->yt, (size_t)nq * sizeof(double));
+        memcpy(y, w->yt, (size_t)n * sizeof(double));
         ts_kernel_rechart(k, y, TS_CHART_RECHART);
     }
+    if (crel > tol && rel <= tol)
+        return ts_fail(err, TS_ECONV,
+                       "equilibrium: Newton stopped after %d iterations with "
+                       "the forces balanced but the controllers unsettled "
+                       "(controller residual %.3g, target %.3g): a set "
+                       "point out of reach of the surfaces' limits?",
+                       eq->iterations, crel, tol);
     if (rel <= ROUNDING_RESIDUAL)
         return ts_fail(err, TS_ECONV,
                        "equilibrium: Newton stopped after %d iterations at "
@@ -409,7 +588,8 @@ static void bending_path(const path_ctx *pc, double t)
     ts_kernel_set_bending_scale(pc->k, pow(pc->b0, 1.0 - t));
 }
 
-/* Remember the shape of state y (directions and strains: chart-free). */
+/* Remember the shape of state y (directions, strains, attitudes:
+ * chart-free) and its controller states. */
 static void save_shape(ts_kernel *k, const double *y, newton_ws *w)
 {
     const ts_system *sys = ts_kernel_system(k);
@@ -420,6 +600,21 @@ static void save_shape(ts_kernel *k, const double *y, newton_ws *w)
         w->strains[l] = sys->links[l].elastic
                             ? y[ts_kernel_link_offset(k, l) + 2]
                             : 0.0;
+    for (int v = 0; v < sys->nvehicles; v++)
+        ts_kernel_get_vehicle(k, v, y, w->att + 9 * v, NULL);
+    memcpy(w->ctl, y + 2 * w->nq, (size_t)w->nc * sizeof(double));
+}
+
+/* Go back to the saved shape, at rest. */
+static void restore_shape(ts_kernel *k, double *y, newton_ws *w)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    memset(y, 0, (size_t)w->n * sizeof(double));
+    ts_kernel_set_shape(k, w->dirs, w->strains, NULL, NULL, TS_CHART_RECHART,
+                        y);
+    for (int v = 0; v < sys->nvehicles; v++)
+        ts_kernel_set_vehicle(k, v, w->att + 9 * v, NULL, TS_CHART_RECHART, y);
+    memcpy(y + 2 * w->nq, w->ctl, (size_t)w->nc * sizeof(double));
 }
 
 /* Newton along a parameter path t in [0, 1] from y, a state near the
@@ -430,7 +625,6 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
                         const path_ctx *pc, const ts_equilibrium_opts *o,
                         ts_equilibrium *eq, ts_err *err)
 {
-    int nq = w->nq;
     path(pc, 0.0);
     int rc = newton(k, y, o->tol, o->max_iter, w, eq, err);
     eq->continuation_steps++;
@@ -460,9 +654,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             break;
         }
         dt *= 0.5;
-        ts_kernel_set_shape(k, w->dirs, w->strains, NULL, NULL,
-                            TS_CHART_RECHART, y);
-        memset(y + nq, 0, (size_t)nq * sizeof(double));
+        restore_shape(k, y, w);
         path(pc, t);
         rc = TS_OK;
     }
@@ -533,6 +725,171 @@ static int rigid_strains(const ts_kernel *k, const double *n, double *strain,
     return rc;
 }
 
+
+/* ------------------------------------------------------------------ */
+/* Vehicles: the Newton start                                           */
+
+/* A vehicle alone on its joint at depth zA, towed straight through the
+ * water at `flow` (its velocity relative to the water, M): in a straight
+ * steady tow its moment about the joint does not depend on the cable, so
+ * its attitude can be solved first. Actuators are taken as settled and
+ * integrators as zero (the full Newton finds them). */
+typedef struct trim_par {
+    ts_vehicle d;            /* the description, actuators made ideal */
+    tsi_vehicle_ws *ws;
+    double mass, rho, g, zA;
+    ts_frame frame;          /* straight tow */
+    int nfree;               /* angles solved: 3, or 2 (yaw held at 0) */
+    double mscale;           /* moment scale, N m */
+    double G[6];
+} trim_par;
+
+static void trim_loads(trim_par *p, const double th[3], tsi_vehicle_state *st)
+{
+    static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const double zero[3] = {0, 0, 0};
+    double rA[3] = {0, 0, p->zA}, val[4], rate[4];
+    double out[TS_VEHICLE_MAX_LOOPS], delta[TS_VEHICLE_MAX_COMPONENTS];
+    tsi_vehicle_kinematics(&p->d, I3, th, zero, 0.0, rA, zero, st);
+    tsi_vehicle_flow(&p->frame, &p->d, st);
+    tsi_vehicle_measure(st, val, rate);
+    tsi_vehicle_control(&p->d, val, rate, NULL, NULL, NULL, NULL, NULL, NULL,
+                        out, delta, NULL, NULL);
+    tsi_vehicle_loads(&p->d, p->ws, p->mass, p->rho, p->g, st, delta, p->G,
+                      NULL);
+}
+
+static int trim_f(const gsl_vector *x, void *par, gsl_vector *f)
+{
+    trim_par *p = par;
+    double th[3] = {gsl_vector_get(x, 0), gsl_vector_get(x, 1),
+                    p->nfree == 3 ? gsl_vector_get(x, 2) : 0.0};
+    tsi_vehicle_state st;
+    trim_loads(p, th, &st);
+    for (int j = 0; j < p->nfree; j++)
+        gsl_vector_set(f, (size_t)j, p->G[3 + j] / p->mscale);
+    return isfinite(p->G[3]) ? GSL_SUCCESS : GSL_EDOM;
+}
+
+/* The attitude R[9] of vehicle body b alone in the straight tow at depth
+ * zA, and the force it then pulls its node with, F[3] (M). Falls back to
+ * pitch and roll only (yaw 0: a body without yaw stiffness), then to a
+ * level attitude. */
+static void vehicle_trim(const ts_system *sys, int b, const ts_frame *fr,
+                         double zA, double R[9], double F[3])
+{
+    const ts_body *bd = &sys->bodies[b];
+    trim_par *p = calloc(1, sizeof *p);
+    double th[3] = {0, 0, 0};
+    if (!p)
+        goto level;
+    p->d = *bd->vehicle;
+    for (int c = 0; c < p->d.ncomponents; c++) {
+        p->d.component[c].time_constant = 0.0;
+        p->d.component[c].rate_limit = INFINITY;
+    }
+    p->ws = tsi_vehicle_ws_alloc(&p->d, NULL);
+    if (!p->ws)
+        goto level;
+    p->mass = bd->mass;
+    p->rho = sys->env.water_density;
+    p->g = sys->env.gravity;
+    p->zA = zA;
+    p->frame = *fr;
+    p->frame.turn_rate = 0.0;
+    tsi_vehicle_state st;
+    p->nfree = 3;
+    trim_loads(p, th, &st);
+    p->mscale = (p->mass * p->g + v3_norm(p->G)) *
+                fmax(tsi_vehicle_lever(&p->d), 1e-3);
+    for (p->nfree = 3; p->nfree >= 2; p->nfree--) {
+        gsl_multiroot_fsolver *s =
+            gsl_multiroot_fsolver_alloc(gsl_multiroot_fsolver_hybrids,
+                                        (size_t)p->nfree);
+        gsl_vector *x = gsl_vector_calloc((size_t)p->nfree);
+        gsl_multiroot_function fn = {trim_f, (size_t)p->nfree, p};
+        int ok = 0;
+        if (s && x && gsl_multiroot_fsolver_set(s, &fn, x) == GSL_SUCCESS)
+            for (int it = 0; it < TRIM_MAXIT; it++) {
+                if (gsl_multiroot_fsolver_iterate(s) != GSL_SUCCESS)
+                    break;
+                if (gsl_multiroot_test_residual(s->f, TRIM_RTOL) ==
+                    GSL_SUCCESS) {
+                    ok = 1;
+                    break;
+                }
+            }
+        if (ok)
+            for (int j = 0; j < p->nfree; j++)
+                th[j] = gsl_vector_get(s->x, (size_t)j);
+        gsl_vector_free(x);
+        if (s)
+            gsl_multiroot_fsolver_free(s);
+        if (ok)
+            break;
+        th[0] = th[1] = th[2] = 0.0;
+    }
+    trim_loads(p, th, &st);
+    memcpy(R, st.R, sizeof st.R);
+    mat3_mul(st.R, p->G, F); /* the body pulls its node with G's force */
+    tsi_vehicle_ws_free(p->ws);
+    free(p);
+    return;
+level:
+    free(p);
+    memset(R, 0, 9 * sizeof(double));
+    R[0] = R[4] = R[8] = 1.0;
+    v3_set(F, 0, 0, bd->mass * sys->env.gravity);
+}
+
+/* The straight-tow march with every vehicle trimmed alone and pulling its
+ * node (twice: the second time at the depths the first march found), into
+ * directions dvec, strains and attitudes att[9 nvehicles]. Returns the
+ * march's code. */
+static int vehicle_start(const ts_system *sys, tsi_march *m,
+                         const ts_frame *straight, double tol, int max_iter,
+                         double *dvec, double *strain, double *att,
+                         ts_equilibrium *eq)
+{
+    int nn = sys->nnodes, rc = TS_OK;
+    double *F = calloc(3 * (size_t)nn, sizeof(double));
+    double *x = malloc((size_t)tsi_march_nunknown(m) * sizeof(double) + 1);
+    if (!F || !x) {
+        free(F);
+        free(x);
+        return TS_ENOMEM;
+    }
+    double L = total_length(sys);
+    for (int pass = 0; pass < 2; pass++) {
+        for (int b = 0, v = 0; b < sys->nbodies; b++) {
+            if (sys->bodies[b].type != TS_BODY_VEHICLE)
+                continue;
+            int node = ts_system_body_node(sys, b);
+            /* First pass: deep enough to be submerged; then the march's. */
+            double zA = pass == 0 ? L : tsi_march_positions(m)[3 * node + 2];
+            vehicle_trim(sys, b, straight, zA, att + 9 * v, F + 3 * node);
+            v++;
+        }
+        tsi_march_set_loads(m, F);
+        ts_err merr = {0};
+        int it = 0;
+        long ev = 0;
+        rc = tsi_march_solve(m, straight, x, 1, tol, max_iter, &it, &ev,
+                             &merr);
+        eq->evaluations += ev;
+        if (rc != TS_OK)
+            break;
+    }
+    if (rc == TS_OK) {
+        tsi_march_strains(m, strain);
+        memcpy(dvec, tsi_march_directions(m),
+               3 * (size_t)sys->nlinks * sizeof(double));
+    }
+    tsi_march_set_loads(m, NULL);
+    free(F);
+    free(x);
+    return rc;
+}
 
 /* Shooting with continuation in turn rate: schedules of 1, 4, 16 steps. */
 static int solve_shooting(ts_kernel *k, tsi_march *m, const ts_frame *frame,
@@ -606,6 +963,11 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                        "equilibrium: method shooting does not apply to "
                        "cables with bending stiffness (EI > 0); use newton "
                        "or auto");
+    if (o.method == TS_EQ_SHOOTING && sys->nvehicles > 0)
+        return ts_fail(err, TS_EDOMAIN,
+                       "equilibrium: method shooting does not apply to "
+                       "vehicles (the march has no attitudes); use newton "
+                       "or auto");
     /* Loads that overflow are the input's fault: say which input. */
     ts_motion_bound mb = {fabs(frame.speed), fabs(frame.turn_rate), 0, 0};
     int lrc = ts_system_check_loads(sys, &mb, err);
@@ -615,17 +977,19 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     }
 
     int nl = sys->nlinks, nq = ts_kernel_nq(k), rc;
-    double *y = calloc(2 * (size_t)nq, sizeof(double));
-    double *dydt = malloc(2 * (size_t)nq * sizeof(double));
+    int n = ts_kernel_nstate(k), nv = sys->nvehicles;
+    double *y = calloc((size_t)n, sizeof(double));
+    double *dydt = malloc((size_t)n * sizeof(double));
     double *dvec = malloc(3 * (size_t)nl * sizeof(double));
     double *strain = calloc((size_t)nl, sizeof(double));
+    double *att = malloc((9 * (size_t)nv + 1) * sizeof(double));
     tsi_march *m = tsi_march_alloc(sys, err);
     newton_ws w = {0};
     if (!m) {
         rc = err ? err->code : TS_ENOMEM; /* the march named its size */
         goto out;
     }
-    if (!y || !dydt || !dvec || !strain) {
+    if (!y || !dydt || !dvec || !strain || !att) {
         rc = ts_fail_nomem(err, 8.0 * (4.0 * nq + 4.0 * nl), "fewer links",
                            "equilibrium: out of memory for the state of %d "
                            "links", nl);
@@ -634,7 +998,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
 
     /* Fast path. */
     int have_guess = 0;
-    if (!sys->has_bending && o.method != TS_EQ_NEWTON) {
+    if (!sys->has_bending && nv == 0 && o.method != TS_EQ_NEWTON) {
         ts_err serr = {0};
         rc = solve_shooting(k, m, &frame, &o, eq, &serr);
         /* The verdict is the kernel's: a shooting run that stalled just
@@ -672,10 +1036,11 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
      * shooting result, with continuation in turn rate. */
     eq->method = TS_EQ_NEWTON;
     if (!newton_ws_alloc(&w, k)) {
-        rc = ts_fail_nomem(err, 8.0 * nq * (double)nq, "fewer links "
+        int nj = nq + ts_kernel_ncontrol(k);
+        rc = ts_fail_nomem(err, 8.0 * nj * (double)nj, "fewer links "
                            "(Newton is used for bending stiffness, and "
                            "where shooting fails)", "equilibrium: out of "
-                           "memory for a %d x %d Newton Jacobian", nq, nq);
+                           "memory for a %d x %d Newton Jacobian", nj, nj);
         goto out;
     }
     rc = TS_ECONV;
@@ -700,22 +1065,37 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         int it = 0;
         long ev = 0;
         double *x = malloc((size_t)tsi_march_nunknown(m) * sizeof(double));
-        if (x && tsi_march_solve(m, &straight, x, 1,
-                                 SHOOT_POS_RTOL * total_length(sys),
-                                 o.max_iter, &it, &ev, &merr) == TS_OK) {
+        int mrc = TS_ECONV;
+        if (nv > 0)
+            mrc = vehicle_start(sys, m, &straight,
+                                SHOOT_POS_RTOL * total_length(sys),
+                                o.max_iter, dvec, strain, att, eq);
+        else if (x)
+            mrc = tsi_march_solve(m, &straight, x, 1,
+                                  SHOOT_POS_RTOL * total_length(sys),
+                                  o.max_iter, &it, &ev, &merr);
+        if (mrc == TS_OK && nv == 0) {
             tsi_march_strains(m, strain);
             memcpy(dvec, tsi_march_directions(m),
                    3 * (size_t)nl * sizeof(double));
-        } else {
+        } else if (mrc != TS_OK) {
             for (int l = 0; l < nl; l++) {
                 dvec[3 * l] = dvec[3 * l + 1] = 0.0;
                 dvec[3 * l + 2] = 1.0;
                 strain[l] = 0.0;
             }
+            for (int v = 0; v < nv; v++) {
+                double *R = att + 9 * v;
+                memset(R, 0, 9 * sizeof(double));
+                R[0] = R[4] = R[8] = 1.0;
+            }
         }
         free(x);
         eq->evaluations += ev;
         ts_kernel_set_shape(k, dvec, strain, NULL, NULL, TS_CHART_RECHART, y);
+        for (int v = 0; v < nv; v++)
+            ts_kernel_set_vehicle(k, v, att + 9 * v, NULL, TS_CHART_RECHART,
+                                  y);
         memset(y + nq, 0, (size_t)nq * sizeof(double));
         /* Turn rate from 0 with bending nearly off, then bending up. */
         double b0 = sys->has_bending ? BENDING_START : 1.0;
@@ -735,7 +1115,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                          ts_strerror(rrc));
     }
     if (rc == TS_OK)
-        eq->converged = eq->residual <= o.tol;
+        eq->converged = eq->residual <= o.tol &&
+                        eq->control_residual <= o.tol;
 
 out:
     ts_kernel_set_frame(k, &frame);
@@ -745,6 +1126,7 @@ out:
     free(dydt);
     free(dvec);
     free(strain);
+    free(att);
     if (rc == TS_OK && !eq->converged)
         rc = ts_fail(err, TS_ECONV,
                      "equilibrium: not converged, relative residual %.3g "

@@ -350,8 +350,10 @@ int ts_excitation_add_sum(ts_excitation *ex, int n, const double omega[],
             double a = re[3 * k + j], b = im[3 * k + j];
             if (!isfinite(a) || !isfinite(b))
                 return ts_fail(err, TS_EINVAL, "excitation sum: component "
-                               "%d, %s: coefficient not finite (%g, %g m)",
-                               k, ts_axis_name((ts_axis)j), a, b);
+                               "%d, %s: the amplitude overflows (is not a "
+                               "finite number): the wave heights or the "
+                               "motions per metre of wave are too large",
+                               k, ts_axis_name((ts_axis)j));
             ms[j] += 0.5 * (a * a + b * b);
         }
     }

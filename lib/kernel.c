@@ -350,6 +350,28 @@ int ts_kernel_link_offset(const ts_kernel *k, int link) { return k->off[link]; }
 int ts_kernel_ninput(const ts_kernel *k) { return k->nin; }
 int ts_kernel_nvehicles(const ts_kernel *k) { return k->nv; }
 
+void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
+{
+    cs->vehicle = cs->actuator = cs->index = -1;
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        for (int l = 0; l < V->d->nloops; l++)
+            if (V->xi_off[l] == i) {
+                cs->vehicle = v;
+                cs->actuator = 0;
+                cs->index = l;
+                return;
+            }
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->act_off[c] == i) {
+                cs->vehicle = v;
+                cs->actuator = 1;
+                cs->index = c;
+                return;
+            }
+    }
+}
+
 const char *tsi_tow_input_name(int j)
 {
     static const char *const names[TS_NINPUT] = {
@@ -443,6 +465,18 @@ void ts_kernel_direction(const ts_kernel *k, int link, double t1, double t2,
     link_axes(k, link, t1, t2, n, e1, e2, &c2, &s2);
 }
 
+void tsi_vehicle_flow(const ts_frame *f, const ts_vehicle *d,
+                      tsi_vehicle_state *st)
+{
+    double w[3], rB[3], rdB[3];
+    tsi_rel_velocity(f, st->rO, st->rdO, w);
+    mat3_tmul(st->R, w, st->wO_b);
+    tsi_vehicle_point(d, st, d->buoyancy_centre, rB, rdB);
+    st->frac = d->surface_diameter > 0
+                   ? tsi_cylinder_submerged(rB[2], d->surface_diameter)
+                   : (rB[2] > 0 ? 1.0 : 0.0);
+}
+
 /* Fill dydt[n] with NaN and return code: the kernel never returns numbers
  * computed outside the model. */
 static int refuse(const ts_kernel *k, double dydt[], int code)
@@ -468,17 +502,7 @@ static int vehicle_kinematics(ts_kernel *k, veh *V, const double y[])
     const double *th = y + V->qoff, *thd = y + k->nq + V->qoff;
     tsi_vehicle_kinematics(V->d, V->chart, th, thd, k->frame.turn_rate,
                            k->r + 3 * V->node, k->rd + 3 * V->node, &V->st);
-    /* The flow past the body origin, and how much of the body is under
-     * water: the circular segment of a horizontal cylinder of the hull's
-     * height centred at the buoyancy centre (wholly submerged below one
-     * radius). */
-    double w[3], rB[3], rdB[3];
-    tsi_rel_velocity(&k->frame, V->st.rO, V->st.rdO, w);
-    mat3_tmul(V->st.R, w, V->st.wO_b);
-    tsi_vehicle_point(V->d, &V->st, V->d->buoyancy_centre, rB, rdB);
-    V->st.frac = V->d->surface_diameter > 0
-                     ? tsi_cylinder_submerged(rB[2], V->d->surface_diameter)
-                     : (rB[2] > 0 ? 1.0 : 0.0);
+    tsi_vehicle_flow(&k->frame, V->d, &V->st);
     const ts_node *nd = &k->sys->nodes[V->node];
     for (int c = nd->child_begin; c < nd->child_end; c++) {
         int l = k->sys->child_links[c];
@@ -1268,8 +1292,10 @@ static void vehicle_get(const ts_kernel *k, int v, const double y[],
             R[3 * i + j] = V->chart[3 * i] * R123[j] +
                            V->chart[3 * i + 1] * R123[3 + j] +
                            V->chart[3 * i + 2] * R123[6 + j];
-    tsi_rate_matrix(y + V->qoff, E);
-    mat3_mul(E, y + k->nq + V->qoff, om);
+    if (om) {
+        tsi_rate_matrix(y + V->qoff, E);
+        mat3_mul(E, y + k->nq + V->qoff, om);
+    }
 }
 
 int ts_kernel_set_vehicle(ts_kernel *k, int v, const double R[9],

@@ -67,6 +67,7 @@ struct tsi_march {
     char *rset;         /* [nn] position known */
     double *K;          /* [3 nn] known loads accumulated from children */
     double *Ma;         /* [6 nn] added mass from child links */
+    double *extra;      /* [3 nn] extra nodal loads, or NULL */
     double mismatch;
 
     gsl_multiroot_fsolver *local;
@@ -192,6 +193,7 @@ void tsi_march_free(tsi_march *m)
     free(m->rset);
     free(m->K);
     free(m->Ma);
+    free(m->extra);
     if (m->local)
         gsl_multiroot_fsolver_free(m->local);
     if (m->lx)
@@ -200,6 +202,8 @@ void tsi_march_free(tsi_march *m)
 }
 
 int tsi_march_nunknown(const tsi_march *m) { return 3 * m->nleaf; }
+const double *tsi_march_positions(const tsi_march *m) { return m->r; }
+
 const double *tsi_march_directions(const tsi_march *m) { return m->n; }
 const double *tsi_march_tensions(const tsi_march *m) { return m->t; }
 
@@ -586,6 +590,21 @@ static int march_link(tsi_march *m, link_problem *P, int l,
     return TS_OK;
 }
 
+int tsi_march_set_loads(tsi_march *m, const double *F)
+{
+    if (!F) {
+        free(m->extra);
+        m->extra = NULL;
+        return TS_OK;
+    }
+    if (!m->extra)
+        m->extra = malloc(3 * (size_t)m->nn * sizeof(double));
+    if (!m->extra)
+        return TS_ENOMEM;
+    memcpy(m->extra, F, 3 * (size_t)m->nn * sizeof(double));
+    return TS_OK;
+}
+
 int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
                    double e[], ts_err *err)
 {
@@ -622,7 +641,7 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
             const ts_body *bd = &sys->bodies[nd->body];
             if (bd->type == TS_BODY_CYLINDER) {
                 P.body = bd;
-            } else {
+            } else if (bd->type != TS_BODY_VEHICLE) {
                 double w[3], frac;
                 tsi_rel_velocity(f, ri, zero, w);
                 /* A sphere's load has no axis: the link's last direction
@@ -635,6 +654,8 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
         }
         double Maf[3];
         sym3_mul(Mi, P.afr, Maf);
+        if (m->extra)
+            v3_axpy(1.0, m->extra + 3 * i, Fb);
         for (int j = 0; j < 3; j++)
             P.K[j] = m->K[3 * i + j] + Fb[j] - Maf[j];
         /* First guess: this link's last direction, else its first child's,

@@ -25,6 +25,12 @@ typedef struct tsi_march tsi_march;
 tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err);
 void tsi_march_free(tsi_march *m);
 
+/* Extra known loads at the nodes, F[3 nnodes] (N, M frame; copied), or
+ * NULL for none: a vehicle's steady pull on its node for a starting
+ * guess. Vehicles' own loads are otherwise left out of the march (it has
+ * no attitudes); their child cables start at their nodes. */
+int tsi_march_set_loads(tsi_march *m, const double *F);
+
 /* Number of shooting unknowns and residuals: 3 per free end. */
 int tsi_march_nunknown(const tsi_march *m);
 
@@ -41,8 +47,10 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
                     double pos_tol, int max_iter, int *iterations,
                     long *marches, ts_err *err);
 
-/* Results of the last march: link directions [3 nlinks], tensions. */
+/* Results of the last march: link directions [3 nlinks], tensions, node
+ * positions [3 nnodes] (m, M). */
 const double *tsi_march_directions(const tsi_march *m);
+const double *tsi_march_positions(const tsi_march *m);
 const double *tsi_march_tensions(const tsi_march *m);
 
 /* Strains e = T / EA of the last march into e[nlinks] (0 for rigid

@@ -35,6 +35,63 @@ json_t *ts_report_trust_json(const ts_trust *t)
     return o;
 }
 
+/* [x, y, z] of a 3-vector. */
+static json_t *vec3(const double v[3])
+{
+    return json_pack("[o,o,o]", num(v[0]), num(v[1]), num(v[2]));
+}
+
+#define DEG (180.0 / M_PI)
+
+json_t *ts_report_vehicle_json(const ts_system *sys,
+                               const ts_vehicle_result *r)
+{
+    const ts_body *bd = &sys->bodies[r->body];
+    const ts_vehicle *d = bd->vehicle;
+    json_t *comps = json_array(), *defl = json_object(), *loops = json_array();
+    json_t *o = json_pack(
+        "{s:s,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}",
+        "name", bd->name, "x", num(r->origin[0]), "y", num(r->origin[1]),
+        "depth", num(r->origin[2]), "pitch_deg", num(r->pitch * DEG),
+        "roll_deg", num(r->roll * DEG), "yaw_deg", num(r->yaw * DEG),
+        "alpha_deg", num(r->alpha * DEG), "beta_deg", num(r->beta * DEG),
+        "speed", num(r->speed), "submerged", num(r->submerged),
+        "joint_force", vec3(r->joint_force), "hydro_force",
+        vec3(r->hydro_force), "hydro_moment", vec3(r->hydro_moment),
+        "munk_moment", vec3(r->munk), "mass_centre", vec3(r->mass_centre));
+    if (!o || !comps || !defl || !loops) {
+        json_decref(o);
+        json_decref(comps);
+        json_decref(defl);
+        json_decref(loops);
+        return NULL;
+    }
+    for (int c = 0; c < r->ncomponents; c++) {
+        const ts_component *cp = &d->component[c];
+        const ts_component_load *ld = &r->load[c];
+        json_array_append_new(
+            comps, json_pack("{s:s,s:s,s:o,s:o,s:o,s:o}", "name", cp->name,
+                             "type",
+                             cp->type == TS_COMP_HULL    ? "hull"
+                             : cp->type == TS_COMP_BLUFF ? "bluff"
+                                                         : "surface",
+                             "force", vec3(ld->force), "moment",
+                             vec3(ld->moment), "alpha_deg",
+                             num(ld->alpha * DEG), "speed", num(ld->speed)));
+        if (cp->control)
+            json_object_set_new(defl, cp->name, num(r->delta[c] * DEG));
+    }
+    for (int l = 0; l < r->nloops; l++)
+        json_array_append_new(
+            loops, json_pack("{s:s,s:o,s:o}", "name", d->loop[l].name,
+                             "error", num(r->loop_error[l]), "output_deg",
+                             num(r->loop_output[l] * DEG)));
+    json_object_set_new(o, "deflections_deg", defl);
+    json_object_set_new(o, "components", comps);
+    json_object_set_new(o, "controllers", loops);
+    return o;
+}
+
 json_t *ts_report_equilibrium_json(const ts_system *sys,
                                    const ts_equilibrium *eq, double wall_s,
                                    const ts_trust *trust)
@@ -101,6 +158,14 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     json_object_set_new(o, "nodes", nodes);
     json_object_set_new(o, "links", links);
     json_object_set_new(o, "bodies", bodies);
+    if (eq->nvehicles > 0) {
+        json_t *veh = json_array();
+        for (int v = 0; veh && v < eq->nvehicles; v++)
+            json_array_append_new(veh,
+                                  ts_report_vehicle_json(sys, &eq->vehicles[v]));
+        json_object_set_new(o, "vehicles", veh);
+        json_object_set_new(o, "control_residual", num(eq->control_residual));
+    }
     return o;
 }
 

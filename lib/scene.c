@@ -517,15 +517,549 @@ static int parse_tow(const ctx *c, const yaml_node_t *n, ts_tow *tow)
     return rc;
 }
 
+/* ------------------------------------------------------------------ */
+/* Vehicles (doc/scene-format.md, "Vehicles"; towstab/vehicle.h)          */
+
+/* A list node of the field, refusing other kinds; its length in *n. */
+static int field_list(const ctx *c, const char *path, const field *f,
+                      const char *what, int max, int *n)
+{
+    if (f->value->type != YAML_SEQUENCE_NODE)
+        return fail_at(c, TS_ESCENE, path, f->line, "expected a list of %s, "
+                       "got %s", what, tsi_scene_kind_name(f->value));
+    *n = seq_len(f->value);
+    if (*n > max)
+        return fail_at(c, TS_EINVAL, path, f->line, "has %d entries, at "
+                       "most %d are allowed", *n, max);
+    return TS_OK;
+}
+
+/* A list of `n` quantities (lo <= n <= hi entries) in unit si. */
+static int quantity_list(const ctx *c, const char *path, const field *f,
+                         const char *si, int lo, int hi, double *v, int *n)
+{
+    char pi[PATH_LEN];
+    int rc = field_list(c, path, f, "quantities", hi, n);
+    if (rc == TS_OK && *n < lo)
+        rc = fail_at(c, TS_EINVAL, path, f->line, "needs %d to %d entries, "
+                     "got %d", lo, hi, *n);
+    for (int j = 0; rc == TS_OK && j < *n; j++) {
+        yaml_node_t *item = seq_item(c, f->value, j);
+        rc = item ? node_quantity(c, index_path(pi, path, j), line_of(item),
+                                  item, si, &v[j])
+                  : ts_fail(c->err, TS_ESCENE, "%s: broken YAML document",
+                            path);
+    }
+    return rc;
+}
+
+/* An optional quantity of any sign (finite), with a default. */
+static int optional_any(const ctx *c, const char *parent, const field *f,
+                        const char *si, double dflt, double *value)
+{
+    char p[PATH_LEN];
+    *value = dflt;
+    if (!f->value)
+        return TS_OK;
+    return field_quantity(c, join(p, parent, f->key), f, si, value);
+}
+
+/* A YAML boolean: true/false, yes/no, on/off. */
+static int field_bool(const ctx *c, const char *path, const field *f,
+                      int *value)
+{
+    const char *t = NULL;
+    int rc = field_text(c, path, f, "true or false", &t);
+    if (rc != TS_OK)
+        return rc;
+    static const char *const yes[] = {"true", "True", "TRUE", "yes", "Yes",
+                                      "on"};
+    static const char *const no[] = {"false", "False", "FALSE", "no", "No",
+                                     "off"};
+    for (int i = 0; i < 6; i++) {
+        if (!strcmp(t, yes[i])) {
+            *value = 1;
+            return TS_OK;
+        }
+        if (!strcmp(t, no[i])) {
+            *value = 0;
+            return TS_OK;
+        }
+    }
+    char s[SHOW_BUF];
+    return fail_at(c, TS_EINVAL, path, f->line, "expected true or false, got "
+                   "\"%s\"", show(t, f->value->data.scalar.length, s,
+                                  sizeof s));
+}
+
+/* A lift/drag table: rows [alpha, C_L, C_D], alpha an angle. */
+static int parse_table(const ctx *c, const char *path, const field *f,
+                       ts_component *cp)
+{
+    char pr[PATH_LEN];
+    int n = 0, rc = field_list(c, path, f, "rows [alpha, C_L, C_D]",
+                           TS_CURVE_MAX_POINTS, &n);
+    if (rc == TS_OK && n < 3)
+        rc = fail_at(c, TS_EINVAL, path, f->line, "needs 3 to %d rows, got "
+                     "%d", TS_CURVE_MAX_POINTS, n);
+    for (int j = 0; rc == TS_OK && j < n; j++) {
+        yaml_node_t *row = seq_item(c, f->value, j);
+        if (!row)
+            return ts_fail(c->err, TS_ESCENE, "%s: broken YAML document",
+                           path);
+        index_path(pr, path, j);
+        if (row->type != YAML_SEQUENCE_NODE || seq_len(row) != 3)
+            return fail_at(c, TS_ESCENE, pr, line_of(row), "expected a row "
+                           "of 3 numbers [alpha, C_L, C_D]");
+        /* The angle may carry its unit ("-10 deg"); C_L and C_D do not. */
+        static const char *const unit[3] = {"rad", "1", "1"};
+        double *out[3] = {&cp->alpha[j], &cp->cl[j], &cp->cd[j]};
+        for (int q = 0; rc == TS_OK && q < 3; q++) {
+            yaml_node_t *item = seq_item(c, row, q);
+            char pq[PATH_LEN];
+            rc = item ? node_quantity(c, index_path(pq, pr, q),
+                                      line_of(item), item, unit[q], out[q])
+                      : ts_fail(c->err, TS_ESCENE, "%s: broken YAML", pr);
+        }
+    }
+    cp->npoints = n;
+    cp->curve = TS_CURVE_TABLE;
+    return rc;
+}
+
+static int parse_component(const ctx *c, const yaml_node_t *n,
+                           const char *parent, int j, ts_component *cp)
+{
+    enum { K_NAME, K_TYPE, K_POS, K_LEN, K_DIAM, K_AXD, K_XD, K_AREA, K_DRAG,
+           K_SPAN, K_ROLL, K_INC, K_SLOPE, K_STALL, K_WIDTH, K_CD0, K_EFF,
+           K_CN90, K_TABLE, K_CONTROL, K_DEFL, K_LIMIT, K_RATE, K_TAU, K_N };
+    field f[K_N] = {{"name", 0, 0}, {"type", 0, 0}, {"position", 0, 0},
+                    {"length", 0, 0}, {"diameter", 0, 0},
+                    {"axial_drag", 0, 0}, {"cross_drag", 0, 0},
+                    {"area", 0, 0}, {"drag", 0, 0}, {"span", 0, 0},
+                    {"roll", 0, 0},
+                    {"incidence", 0, 0}, {"lift_slope", 0, 0},
+                    {"stall", 0, 0}, {"stall_width", 0, 0},
+                    {"zero_lift_drag", 0, 0}, {"efficiency", 0, 0},
+                    {"cn90", 0, 0}, {"table", 0, 0}, {"control", 0, 0},
+                    {"deflection", 0, 0}, {"limit", 0, 0},
+                    {"rate_limit", 0, 0}, {"time_constant", 0, 0}};
+    char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
+    index_path(path, parent, j);
+    int rc = read_map(c, n, path, "name, type, position, ...", f, K_N);
+    if (rc != TS_OK)
+        return rc;
+    for (int k = 0; k <= K_TYPE; k++)
+        if (!f[k].value)
+            return missing(c, path, n, f[k].key);
+    const char *type = NULL;
+    rc = field_text(c, join(p, path, "type"), &f[K_TYPE],
+                    "hull, surface or bluff", &type);
+    if (rc != TS_OK)
+        return rc;
+    int hull = !strcmp(type, "hull"), bluff = !strcmp(type, "bluff");
+    if (!hull && !bluff && strcmp(type, "surface"))
+        return fail_at(c, TS_EINVAL, p, f[K_TYPE].line, "unknown component "
+                       "type \"%s\"; expected hull, surface or bluff",
+                       show(type, f[K_TYPE].value->data.scalar.length, s,
+                            sizeof s));
+    ts_component_defaults(cp, hull    ? TS_COMP_HULL
+                              : bluff ? TS_COMP_BLUFF
+                                      : TS_COMP_SURFACE);
+    cp->line = line_of(n);
+    rc = read_name(c, join(p, path, "name"), &f[K_NAME], cp->name);
+    if (rc != TS_OK)
+        return rc;
+    /* Keys of the other types are refused: a hull's run to K_XD, a
+     * bluff part has an area and a drag, a surface an area and the rest. */
+    for (int k = K_LEN; k <= K_TAU; k++) {
+        int ok = hull ? k <= K_XD
+                      : (bluff ? (k == K_AREA || k == K_DRAG)
+                               : (k >= K_AREA && k != K_DRAG));
+        if (f[k].value && !ok)
+            return fail_at(c, TS_ESCENE, join(p, path, f[k].key), f[k].line,
+                           "does not apply to a %s component", type);
+    }
+    if (f[K_POS].value)
+        rc = vector3(c, path, &f[K_POS], "m", cp->position);
+    if (rc == TS_OK && hull) {
+        for (int k = K_LEN; k <= K_DIAM; k++)
+            if (!f[k].value)
+                return missing(c, path, n, f[k].key);
+        if ((rc = optional_min(c, path, &f[K_LEN], "m", 0, 1, 0, &cp->length)) ||
+            (rc = optional_min(c, path, &f[K_DIAM], "m", 0, 1, 0,
+                               &cp->diameter)) ||
+            (rc = optional_min(c, path, &f[K_AXD], "1", 0, 0, cp->cd_axial,
+                               &cp->cd_axial)) ||
+            (rc = optional_min(c, path, &f[K_XD], "1", 0, 0, cp->cd_cross,
+                               &cp->cd_cross)))
+            return rc;
+        return TS_OK;
+    }
+    if (rc != TS_OK)
+        return rc;
+    if (bluff) {
+        if (!f[K_AREA].value)
+            return missing(c, path, n, "area");
+        if ((rc = optional_min(c, path, &f[K_AREA], "m^2", 0, 1, 0,
+                               &cp->area)) ||
+            (rc = optional_min(c, path, &f[K_DRAG], "1", 0, 0, cp->drag,
+                               &cp->drag)))
+            return rc;
+        return TS_OK;
+    }
+    if (!f[K_AREA].value)
+        return missing(c, path, n, "area");
+    if (!f[K_SPAN].value)
+        return missing(c, path, n, "span");
+    if ((rc = optional_min(c, path, &f[K_AREA], "m^2", 0, 1, 0, &cp->area)) ||
+        (rc = optional_min(c, path, &f[K_SPAN], "m", 0, 1, 0, &cp->span)) ||
+        (rc = optional_any(c, path, &f[K_ROLL], "rad", 0, &cp->roll)) ||
+        (rc = optional_any(c, path, &f[K_INC], "rad", 0, &cp->incidence)) ||
+        (rc = optional_min(c, path, &f[K_SLOPE], "1/rad", 0, 0, 0,
+                           &cp->lift_slope)) ||
+        (rc = optional_min(c, path, &f[K_STALL], "rad", 0, 1, cp->stall,
+                           &cp->stall)) ||
+        (rc = optional_min(c, path, &f[K_WIDTH], "rad", 0, 1,
+                           cp->stall_width, &cp->stall_width)) ||
+        (rc = optional_min(c, path, &f[K_CD0], "1", 0, 0, cp->cd0,
+                           &cp->cd0)) ||
+        (rc = optional_min(c, path, &f[K_EFF], "1", 0, 1, cp->efficiency,
+                           &cp->efficiency)) ||
+        (rc = optional_min(c, path, &f[K_CN90], "1", 0, 0, cp->cn90,
+                           &cp->cn90)))
+        return rc;
+    if (f[K_TABLE].value) {
+        static const int curve_keys[] = {K_SLOPE, K_STALL, K_WIDTH, K_CD0,
+                                         K_EFF, K_CN90};
+        for (int k = 0; k < 6; k++)
+            if (f[curve_keys[k]].value)
+                return fail_at(c, TS_ESCENE,
+                               join(p, path, f[curve_keys[k]].key),
+                               f[curve_keys[k]].line, "a lifting-line "
+                               "parameter; the surface's curves come from "
+                               "its table (line %d)", f[K_TABLE].line);
+        rc = parse_table(c, join(p, path, "table"), &f[K_TABLE], cp);
+        if (rc != TS_OK)
+            return rc;
+    }
+    if (f[K_CONTROL].value &&
+        (rc = field_bool(c, join(p, path, "control"), &f[K_CONTROL],
+                         &cp->control)))
+        return rc;
+    if (!cp->control)
+        for (int k = K_DEFL; k <= K_TAU; k++)
+            if (f[k].value)
+                return fail_at(c, TS_ESCENE, join(p, path, f[k].key),
+                               f[k].line, "applies to a control surface "
+                               "(control: true)");
+    if ((rc = optional_any(c, path, &f[K_DEFL], "rad", 0, &cp->deflection)) ||
+        (rc = optional_min(c, path, &f[K_LIMIT], "rad", 0, 1, INFINITY,
+                           &cp->limit)) ||
+        (rc = optional_min(c, path, &f[K_RATE], "rad/s", 0, 1, INFINITY,
+                           &cp->rate_limit)) ||
+        (rc = optional_min(c, path, &f[K_TAU], "s", 0, 0, 0,
+                           &cp->time_constant)))
+        return rc;
+    return TS_OK;
+}
+
+/* Units of a loop's gains: per m (depth) or per rad (angles). */
+static const char *gain_unit(ts_measure m, int which)
+{
+    static const char *const depth[3] = {"rad/m", "rad/(m*s)", "rad*s/m"};
+    static const char *const angle[3] = {"1", "1/s", "s"};
+    return m == TS_MEASURE_DEPTH ? depth[which] : angle[which];
+}
+
+static int parse_loop(const ctx *c, const yaml_node_t *n, const char *parent,
+                      int j, ts_vehicle *v)
+{
+    enum { L_NAME, L_MEASURE, L_SET, L_KP, L_KI, L_KD, L_SURF, L_N };
+    field f[L_N] = {{"name", 0, 0}, {"measure", 0, 0}, {"setpoint", 0, 0},
+                    {"kp", 0, 0}, {"ki", 0, 0}, {"kd", 0, 0},
+                    {"surfaces", 0, 0}};
+    char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
+    index_path(path, parent, j);
+    ts_loop *lp = &v->loop[j];
+    memset(lp, 0, sizeof *lp);
+    lp->line = line_of(n);
+    int rc = read_map(c, n, path, "name, measure, setpoint, kp, ki, kd, "
+                      "surfaces", f, L_N);
+    if (rc != TS_OK)
+        return rc;
+    static const int required[] = {L_NAME, L_MEASURE, L_SET, L_SURF};
+    for (int k = 0; k < 4; k++)
+        if (!f[required[k]].value)
+            return missing(c, path, n, f[required[k]].key);
+    rc = read_name(c, join(p, path, "name"), &f[L_NAME], lp->name);
+    const char *m = NULL;
+    if (rc == TS_OK)
+        rc = field_text(c, join(p, path, "measure"), &f[L_MEASURE],
+                        "depth, pitch, roll or heading", &m);
+    if (rc != TS_OK)
+        return rc;
+    static const char *const names[4] = {"depth", "pitch", "roll", "heading"};
+    int mi = -1;
+    for (int k = 0; k < 4; k++)
+        if (!strcmp(m, names[k]))
+            mi = k;
+    if (mi < 0)
+        return fail_at(c, TS_EINVAL, p, f[L_MEASURE].line, "unknown "
+                       "measurement \"%s\"; expected depth, pitch, roll or "
+                       "heading",
+                       show(m, f[L_MEASURE].value->data.scalar.length, s,
+                            sizeof s));
+    lp->measure = (ts_measure)mi;
+    if ((rc = optional_any(c, path, &f[L_SET], mi ? "rad" : "m", 0,
+                           &lp->setpoint)) ||
+        (rc = optional_any(c, path, &f[L_KP], gain_unit(lp->measure, 0), 0,
+                           &lp->kp)) ||
+        (rc = optional_any(c, path, &f[L_KI], gain_unit(lp->measure, 1), 0,
+                           &lp->ki)) ||
+        (rc = optional_any(c, path, &f[L_KD], gain_unit(lp->measure, 2), 0,
+                           &lp->kd)))
+        return rc;
+    /* surfaces: a list of surface names (gain 1 each) or a mapping of
+     * surface names to gains. */
+    const yaml_node_t *sn = f[L_SURF].value;
+    join(p, path, "surfaces");
+    if (sn->type == YAML_SEQUENCE_NODE || sn->type == YAML_MAPPING_NODE) {
+        int count = sn->type == YAML_SEQUENCE_NODE
+                        ? seq_len(sn)
+                        : (int)(sn->data.mapping.pairs.top -
+                                sn->data.mapping.pairs.start);
+        if (count < 1 || count > v->ncomponents)
+            return fail_at(c, TS_EINVAL, p, f[L_SURF].line, "needs 1 to %d "
+                           "control surfaces, got %d",
+                           v->ncomponents > 0 ? v->ncomponents : 1, count);
+        for (int k = 0; k < count; k++) {
+            yaml_node_t *name_node, *gain_node = NULL;
+            if (sn->type == YAML_SEQUENCE_NODE) {
+                name_node = seq_item(c, sn, k);
+            } else {
+                yaml_node_pair_t *pr = sn->data.mapping.pairs.start + k;
+                name_node = yaml_document_get_node(c->doc, pr->key);
+                gain_node = yaml_document_get_node(c->doc, pr->value);
+            }
+            if (!name_node || name_node->type != YAML_SCALAR_NODE)
+                return fail_at(c, TS_ESCENE, p, f[L_SURF].line, "expected "
+                               "surface names");
+            const char *nm = (const char *)name_node->data.scalar.value;
+            int ci = -1;
+            for (int q = 0; q < v->ncomponents; q++)
+                if (!strcmp(v->component[q].name, nm))
+                    ci = q;
+            if (ci < 0 || !v->component[ci].control)
+                return fail_at(c, TS_EINVAL, p, line_of(name_node), "'%s' is "
+                               "not a control surface of the vehicle (a "
+                               "surface with control: true)",
+                               show(nm, name_node->data.scalar.length, s,
+                                    sizeof s));
+            for (int q = 0; q < k; q++)
+                if (lp->surface[q] == ci)
+                    return fail_at(c, TS_EINVAL, p, line_of(name_node),
+                                   "'%s' is listed twice", nm);
+            lp->surface[k] = ci;
+            lp->gain[k] = 1.0;
+            if (gain_node) {
+                char pg[PATH_LEN];
+                path_printf(pg, "%s.%s", p, v->component[ci].name);
+                rc = node_quantity(c, pg, line_of(gain_node), gain_node, "1",
+                                   &lp->gain[k]);
+                if (rc != TS_OK)
+                    return rc;
+            }
+        }
+        lp->nsurfaces = count;
+        return TS_OK;
+    }
+    return fail_at(c, TS_ESCENE, p, f[L_SURF].line, "expected a list of "
+                   "surface names or a mapping of names to gains, got %s",
+                   tsi_scene_kind_name(sn));
+}
+
+/* added_mass of a vehicle: "spheroid" (of its first hull), "none", a
+ * mapping {length, diameter, centre} or a 6x6 list of lists (SI). */
+static int parse_added_mass(const ctx *c, const char *parent, const field *f,
+                            double rho, ts_vehicle *v)
+{
+    char p[PATH_LEN], pr[PATH_LEN], s[SHOW_BUF];
+    join(p, parent, "added_mass");
+    const yaml_node_t *n = f ? f->value : NULL;
+    const ts_component *hull = NULL;
+    for (int j = 0; j < v->ncomponents && !hull; j++)
+        if (v->component[j].type == TS_COMP_HULL)
+            hull = &v->component[j];
+    ts_err local = {0};
+    if (!n || (n->type == YAML_SCALAR_NODE &&
+               !strcmp((const char *)n->data.scalar.value, "spheroid"))) {
+        if (!hull) {
+            if (n)
+                return fail_at(c, TS_EINVAL, p, f->line, "a spheroid "
+                               "estimate needs a hull component (its length "
+                               "and diameter), or give length and diameter");
+            return TS_OK; /* no hull, nothing given: no added mass */
+        }
+        v->added_mass_estimated = 1;
+        v->estimate_length = hull->length;
+        v->estimate_diameter = hull->diameter;
+        memcpy(v->estimate_centre, hull->position, sizeof v->estimate_centre);
+    } else if (n->type == YAML_SCALAR_NODE) {
+        if (!strcmp((const char *)n->data.scalar.value, "none"))
+            return TS_OK;
+        return fail_at(c, TS_EINVAL, p, f->line, "expected spheroid, none, a "
+                       "mapping {length, diameter, centre} or 6 rows of 6 "
+                       "numbers, got \"%s\"",
+                       show((const char *)n->data.scalar.value,
+                            n->data.scalar.length, s, sizeof s));
+    } else if (n->type == YAML_MAPPING_NODE) {
+        enum { A_LEN, A_DIAM, A_CENTRE, A_N };
+        field g[A_N] = {{"length", 0, 0}, {"diameter", 0, 0},
+                        {"centre", 0, 0}};
+        int rc = read_map(c, n, p, "length, diameter, centre", g, A_N);
+        for (int k = 0; rc == TS_OK && k < 2; k++)
+            if (!g[k].value)
+                rc = missing(c, p, n, g[k].key);
+        if (rc == TS_OK)
+            rc = optional_min(c, p, &g[A_LEN], "m", 0, 1, 0,
+                              &v->estimate_length);
+        if (rc == TS_OK)
+            rc = optional_min(c, p, &g[A_DIAM], "m", 0, 1, 0,
+                              &v->estimate_diameter);
+        if (rc == TS_OK && g[A_CENTRE].value)
+            rc = vector3(c, p, &g[A_CENTRE], "m", v->estimate_centre);
+        if (rc != TS_OK)
+            return rc;
+        v->added_mass_estimated = 1;
+    } else {
+        int nrow = 0;
+        int rc = field_list(c, p, f, "6 rows of 6 numbers", 6, &nrow);
+        if (rc == TS_OK && nrow != 6)
+            rc = fail_at(c, TS_EINVAL, p, f->line, "needs 6 rows of 6 "
+                         "numbers (SI: kg, kg m, kg m^2), got %d rows", nrow);
+        for (int i = 0; rc == TS_OK && i < 6; i++) {
+            yaml_node_t *row = seq_item(c, n, i);
+            field fr = {"", row, row ? line_of(row) : f->line};
+            int m = 0;
+            if (!row)
+                return ts_fail(c->err, TS_ESCENE, "%s: broken YAML", p);
+            rc = quantity_list(c, index_path(pr, p, i), &fr, "1", 6, 6,
+                               v->added_mass + 6 * i, &m);
+        }
+        return rc;
+    }
+    double A[36];
+    if (ts_added_mass_spheroid(rho, v->estimate_length, v->estimate_diameter,
+                               A, NULL, &local) != TS_OK)
+        return fail_at(c, TS_EINVAL, p, f ? f->line : 0, "%s", local.msg);
+    ts_added_mass_shift(A, v->estimate_centre, v->added_mass);
+    return TS_OK;
+}
+
+/* The keys of vehicle body b (g[]: volume, inertia, mass_centre,
+ * buoyancy_centre, attach, surface_diameter, components, controllers, as
+ * parse_body lists them; `added` its added_mass or NULL) into a new
+ * ts_vehicle; the mass keys are parse_body's. */
+static int parse_vehicle(const ctx *c, const yaml_node_t *n, const char *path,
+                         const field *g, const field *added, ts_system *sys,
+                         int b)
+{
+    enum { V_VOLUME, V_INERTIA, V_MC, V_BC, V_ATTACH, V_SURF, V_COMPONENTS,
+           V_CONTROLLERS };
+    char p[PATH_LEN], pc[PATH_LEN];
+    ts_vehicle *v = ts_body_set_vehicle(sys, b, c->err);
+    if (!v)
+        return TS_ENOMEM;
+    static const int required[] = {V_VOLUME, V_INERTIA, V_ATTACH,
+                                   V_COMPONENTS};
+    for (int k = 0; k < 4; k++)
+        if (!g[required[k]].value)
+            return missing(c, path, n, g[required[k]].key);
+    int rc = optional_min(c, path, &g[V_VOLUME], "m^3", 0, 0, 0, &v->volume);
+    double I[6] = {0};
+    int ni = 0;
+    if (rc == TS_OK)
+        rc = quantity_list(c, join(p, path, "inertia"), &g[V_INERTIA],
+                           "kg*m^2", 3, 6, I, &ni);
+    if (rc == TS_OK && ni != 3 && ni != 6)
+        rc = fail_at(c, TS_EINVAL, p, g[V_INERTIA].line, "expected [Ixx, "
+                     "Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], got %d "
+                     "entries", ni);
+    memcpy(v->inertia, I, sizeof I);
+    if (rc == TS_OK && g[V_MC].value)
+        rc = vector3(c, path, &g[V_MC], "m", v->mass_centre);
+    if (rc == TS_OK && g[V_BC].value)
+        rc = vector3(c, path, &g[V_BC], "m", v->buoyancy_centre);
+    if (rc == TS_OK)
+        rc = vector3(c, path, &g[V_ATTACH], "m", v->attach);
+    int nc = 0;
+    if (rc == TS_OK)
+        rc = field_list(c, join(p, path, "components"), &g[V_COMPONENTS],
+                        "components", TS_VEHICLE_MAX_COMPONENTS, &nc);
+    for (int j = 0; rc == TS_OK && j < nc; j++) {
+        yaml_node_t *item = seq_item(c, g[V_COMPONENTS].value, j);
+        rc = item ? parse_component(c, item, p, j, &v->component[j])
+                  : ts_fail(c->err, TS_ESCENE, "%s: broken YAML", p);
+        for (int q = 0; rc == TS_OK && q < j; q++)
+            if (!strcmp(v->component[q].name, v->component[j].name))
+                rc = fail_at(c, TS_EINVAL, index_path(pc, p, j),
+                             v->component[j].line, "duplicate component "
+                             "name '%s'", v->component[j].name);
+        v->ncomponents = j + 1;
+    }
+    if (rc == TS_OK)
+        rc = parse_added_mass(c, path, added, sys->env.water_density, v);
+    /* The height that decides the submerged fraction near the surface:
+     * given, or the first hull's diameter, or a sphere of the volume. */
+    double dflt = cbrt(6.0 * v->volume / M_PI);
+    for (int j = nc - 1; j >= 0; j--)
+        if (v->component[j].type == TS_COMP_HULL)
+            dflt = v->component[j].diameter;
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &g[V_SURF], "m", 0, 0, dflt,
+                          &v->surface_diameter);
+    int nl = 0;
+    if (rc == TS_OK && g[V_CONTROLLERS].value)
+        rc = field_list(c, join(p, path, "controllers"), &g[V_CONTROLLERS],
+                        "controllers", TS_VEHICLE_MAX_LOOPS, &nl);
+    for (int j = 0; rc == TS_OK && j < nl; j++) {
+        yaml_node_t *item = seq_item(c, g[V_CONTROLLERS].value, j);
+        rc = item ? parse_loop(c, item, p, j, v)
+                  : ts_fail(c->err, TS_ESCENE, "%s: broken YAML", p);
+        v->nloops = j + 1;
+    }
+    /* The analyses do not take control inputs and controller states yet:
+     * refuse them rather than ignore them. */
+    if (rc == TS_OK && nl > 0)
+        return fail_at(c, TS_EINVAL, join(p, path, "controllers"),
+                       g[V_CONTROLLERS].line, "controllers are not supported "
+                       "yet by the analyses");
+    for (int j = 0; rc == TS_OK && j < nc; j++)
+        if (v->component[j].control)
+            return fail_at(c, TS_EINVAL, index_path(pc, p, j),
+                           v->component[j].line, "control surfaces are not "
+                           "supported yet by the analyses (give a fixed "
+                           "surface an incidence)");
+    return rc;
+}
+
 static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                       ts_system *sys)
 {
+    /* A vehicle's own keys run from B_VOLUME to B_CONTROLLERS in the
+     * order parse_vehicle reads them; its added_mass is B_CA's node. */
     enum { B_NAME, B_TYPE, B_DIAM, B_WEIGHT, B_MASS, B_WET, B_DRAG, B_CA,
-           B_LEN, B_XDRAG, B_XCA, B_N };
+           B_LEN, B_XDRAG, B_XCA, B_VOLUME, B_INERTIA, B_MC, B_BC, B_ATTACH,
+           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_N };
     field f[B_N] = {{"name", 0, 0}, {"type", 0, 0}, {"diameter", 0, 0},
                     {"weight", 0, 0}, {"mass", 0, 0}, {"wet_weight", 0, 0},
                     {"drag", 0, 0}, {"added_mass", 0, 0}, {"length", 0, 0},
-                    {"cross_drag", 0, 0}, {"cross_added_mass", 0, 0}};
+                    {"cross_drag", 0, 0}, {"cross_added_mass", 0, 0},
+                    {"volume", 0, 0}, {"inertia", 0, 0},
+                    {"mass_centre", 0, 0}, {"buoyancy_centre", 0, 0},
+                    {"attach", 0, 0}, {"surface_diameter", 0, 0},
+                    {"components", 0, 0}, {"controllers", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     index_path(path, "bodies", b);
     ts_body *body = &sys->bodies[b];
@@ -551,7 +1085,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
 
     const char *type = NULL;
     rc = field_text(c, join(p, path, "type"), &f[B_TYPE],
-                    "sphere, cylinder or junction", &type);
+                    "sphere, cylinder, junction or vehicle", &type);
     if (rc != TS_OK)
         return rc;
     if (!strcmp(type, "sphere"))
@@ -560,13 +1094,36 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
         body->type = TS_BODY_JUNCTION;
     else if (!strcmp(type, "cylinder"))
         body->type = TS_BODY_CYLINDER;
+    else if (!strcmp(type, "vehicle"))
+        body->type = TS_BODY_VEHICLE;
     else
         return fail_at(c, TS_EINVAL, p, f[B_TYPE].line, "unknown body type "
-                       "\"%s\"; expected sphere, cylinder or junction",
+                       "\"%s\"; expected sphere, cylinder, junction or "
+                       "vehicle",
                        show(type, f[B_TYPE].value->data.scalar.length, s,
                             sizeof s));
     int sphere = body->type == TS_BODY_SPHERE;
     int cyl = body->type == TS_BODY_CYLINDER;
+    int veh = body->type == TS_BODY_VEHICLE;
+    for (int k = B_VOLUME; k <= B_CONTROLLERS; k++)
+        if (!veh && f[k].value)
+            return fail_at(c, TS_ESCENE, join(p, path, f[k].key), f[k].line,
+                           "applies to a vehicle body only, not to a %s",
+                           type);
+    static const int not_vehicle[] = {B_DIAM, B_DRAG, B_LEN, B_XDRAG, B_XCA};
+    for (int k = 0; k < 5; k++)
+        if (veh && f[not_vehicle[k]].value)
+            return fail_at(c, TS_ESCENE,
+                           join(p, path, f[not_vehicle[k]].key),
+                           f[not_vehicle[k]].line, "does not apply to a "
+                           "vehicle: give its hull and surfaces as "
+                           "components");
+    if (veh) {
+        rc = parse_vehicle(c, n, path, f + B_VOLUME,
+                           f[B_CA].value ? &f[B_CA] : NULL, sys, b);
+        if (rc != TS_OK)
+            return rc;
+    }
     /* Keys of one body type only. */
     static const int cyl_only[] = {B_LEN, B_XDRAG, B_XCA};
     for (int k = 0; k < 3; k++)
@@ -589,7 +1146,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                           sphere ? DEFAULT_SPHERE_CD
                                  : (cyl ? DEFAULT_CYL_CD_AXIAL : 0.0),
                           &body->cd);
-    if (rc == TS_OK)
+    if (rc == TS_OK && !veh)
         rc = optional_min(c, path, &f[B_CA], "1", 0, 0,
                           sphere ? DEFAULT_SPHERE_CA
                                  : (cyl ? DEFAULT_CYL_CA_AXIAL : 0.0),
@@ -607,7 +1164,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
      * one for a junction (default 0). */
     static const int mass_keys[] = {B_WEIGHT, B_MASS, B_WET};
     int which;
-    rc = one_of(c, path, n, f, mass_keys, 3, sphere || cyl, &which);
+    rc = one_of(c, path, n, f, mass_keys, 3, sphere || cyl || veh, &which);
     if (rc != TS_OK)
         return rc;
     const ts_environment *env = &sys->env;
@@ -738,14 +1295,14 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
 {
     enum { C_NAME, C_FROM, C_TO, C_LENGTH, C_DIAM, C_WEIGHT, C_MPL, C_WET,
            C_LINKS, C_LINK_LENGTHS, C_CDN, C_CDT, C_CAN, C_LAW, C_EI, C_EA,
-           C_DAMP, C_N };
+           C_DAMP, C_AT, C_N };
     field f[C_N] = {{"name", 0, 0}, {"from", 0, 0}, {"to", 0, 0},
                     {"length", 0, 0}, {"diameter", 0, 0}, {"weight", 0, 0},
                     {"mass_per_length", 0, 0}, {"wet_weight", 0, 0},
                     {"links", 0, 0}, {"link_lengths", 0, 0},
                     {"normal_drag", 0, 0}, {"tangential_drag", 0, 0},
                     {"added_mass", 0, 0}, {"drag_law", 0, 0}, {"EI", 0, 0},
-                    {"EA", 0, 0}, {"damping", 0, 0}};
+                    {"EA", 0, 0}, {"damping", 0, 0}, {"at", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     index_path(path, "cables", i);
     ts_cable *cable = &sys->cables[i];
@@ -774,6 +1331,16 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
     if (rc == TS_OK && f[C_TO].value)
         rc = resolve_body(c, join(p, path, "to"), &f[C_TO], sys, 0,
                           &cable->to_body);
+    if (rc == TS_OK && f[C_AT].value) {
+        /* A point of the vehicle the cable starts from (body axes). */
+        if (cable->from_body < 0 ||
+            sys->bodies[cable->from_body].type != TS_BODY_VEHICLE)
+            return fail_at(c, TS_EINVAL, join(p, path, "at"), f[C_AT].line,
+                           "a starting point on a body needs a vehicle as "
+                           "'from'");
+        rc = vector3(c, path, &f[C_AT], "m", cable->from_point);
+        cable->has_from_point = 1;
+    }
     if (rc == TS_OK)
         rc = optional_min(c, path, &f[C_LENGTH], "m", 0, 1, 0.0,
                           &cable->length);

@@ -514,7 +514,8 @@ static int validate(const ts_system *s, ts_err *err)
             if (!bd->vehicle)
                 return ts_fail(err, TS_EINVAL, "%s%s: a vehicle without a "
                                "description", where, at_line(bd->line));
-            if ((rc = ts_vehicle_check(bd->vehicle, bd->mass, where, err)))
+            if ((rc = ts_vehicle_check(bd->vehicle, bd->mass, where,
+                                       bd->line, err)))
                 return rc;
         } else if (bd->vehicle) {
             return ts_fail(err, TS_EINVAL, "bodies[%d]%s: only a vehicle "

@@ -24,6 +24,7 @@
 #include <gsl/gsl_integration.h>
 #include <gsl/gsl_interp.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +59,7 @@ void ts_component_defaults(ts_component *c, ts_component_type type)
     c->type = type;
     c->cd_axial = 0.2;
     c->cd_cross = 1.2;
+    c->drag = 0.5;
     c->curve = TS_CURVE_LIFTING_LINE;
     c->stall = 15.0 * M_PI / 180.0;
     c->stall_width = 3.0 * M_PI / 180.0;
@@ -164,119 +166,143 @@ int ts_added_mass_spheroid(double rho, double length, double diameter,
     return TS_OK;
 }
 
+/* Refuse with "where.key (line N): message" (key NULL: "where (line N):
+ * message"; no line when line is 0): the scene's form of an error. */
+#ifdef __GNUC__
+__attribute__((format(printf, 5, 6)))
+#endif
+static int bad(ts_err *err, const char *where, int line, const char *key,
+               const char *fmt, ...)
+{
+    char msg[TS_ERR_MSG_MAX], at[32] = "";
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (line > 0)
+        snprintf(at, sizeof at, " (line %d)", line);
+    return ts_fail(err, TS_EINVAL, "%s%s%s%s: %s", where, key ? "." : "",
+                   key ? key : "", at, msg);
+}
+
 /* A finite value >= lo (strict: > lo). */
-static int check_value(ts_err *err, const char *where, const char *key,
-                       double v, double lo, int strict)
+static int check_value(ts_err *err, const char *where, int line,
+                       const char *key, double v, double lo, int strict)
 {
     if (isfinite(v) && (strict ? v > lo : v >= lo))
         return TS_OK;
-    return ts_fail(err, TS_EINVAL, "%s.%s: must be %s %g, got %g", where, key,
-                   strict ? ">" : ">=", lo, v);
+    return bad(err, where, line, key, "must be %s %g, got %g",
+               strict ? ">" : ">=", lo, v);
 }
 
-static int check_finite3(ts_err *err, const char *where, const char *key,
-                         const double v[3])
+static int check_finite3(ts_err *err, const char *where, int line,
+                         const char *key, const double v[3])
 {
     for (int j = 0; j < 3; j++)
         if (!isfinite(v[j]))
-            return ts_fail(err, TS_EINVAL, "%s.%s: component %d must be "
-                           "finite", where, key, j);
+            return bad(err, where, line, key, "component %d must be finite",
+                       j);
     return TS_OK;
 }
 
-static int check_component(const ts_component *c, const char *where,
+static int check_component(const ts_component *c, const char *w,
                            ts_err *err)
 {
-    int rc;
-    if ((rc = check_finite3(err, where, "position", c->position)))
+    int rc, ln = c->line;
+    if ((rc = check_finite3(err, w, ln, "position", c->position)))
         return rc;
     if (c->type == TS_COMP_HULL) {
-        if ((rc = check_value(err, where, "length", c->length, 0, 1)) ||
-            (rc = check_value(err, where, "diameter", c->diameter, 0, 1)) ||
-            (rc = check_value(err, where, "axial_drag", c->cd_axial, 0, 0)) ||
-            (rc = check_value(err, where, "cross_drag", c->cd_cross, 0, 0)))
+        if ((rc = check_value(err, w, ln, "length", c->length, 0, 1)) ||
+            (rc = check_value(err, w, ln, "diameter", c->diameter, 0, 1)) ||
+            (rc = check_value(err, w, ln, "axial_drag", c->cd_axial, 0, 0)) ||
+            (rc = check_value(err, w, ln, "cross_drag", c->cd_cross, 0, 0)))
             return rc;
         if (c->control)
-            return ts_fail(err, TS_EINVAL, "%s.control: a hull is not a "
-                           "control surface", where);
+            return bad(err, w, ln, "control", "a hull is not a control "
+                       "surface");
         return TS_OK;
     }
-    if ((rc = check_value(err, where, "area", c->area, 0, 1)) ||
-        (rc = check_value(err, where, "span", c->span, 0, 1)) ||
-        (rc = check_value(err, where, "lift_slope", c->lift_slope, 0, 0)) ||
-        (rc = check_value(err, where, "cd0", c->cd0, 0, 0)) ||
-        (rc = check_value(err, where, "efficiency", c->efficiency, 0, 1)) ||
-        (rc = check_value(err, where, "cn90", c->cn90, 0, 0)) ||
-        (rc = check_value(err, where, "stall_width", c->stall_width, 0, 1)))
+    if (c->type == TS_COMP_BLUFF) {
+        if ((rc = check_value(err, w, ln, "area", c->area, 0, 1)) ||
+            (rc = check_value(err, w, ln, "drag", c->drag, 0, 0)))
+            return rc;
+        if (c->control)
+            return bad(err, w, ln, "control", "a bluff part is not a "
+                       "control surface");
+        return TS_OK;
+    }
+    if ((rc = check_value(err, w, ln, "area", c->area, 0, 1)) ||
+        (rc = check_value(err, w, ln, "span", c->span, 0, 1)) ||
+        (rc = check_value(err, w, ln, "lift_slope", c->lift_slope, 0, 0)) ||
+        (rc = check_value(err, w, ln, "zero_lift_drag", c->cd0, 0, 0)) ||
+        (rc = check_value(err, w, ln, "efficiency", c->efficiency, 0, 1)) ||
+        (rc = check_value(err, w, ln, "cn90", c->cn90, 0, 0)) ||
+        (rc = check_value(err, w, ln, "stall_width", c->stall_width, 0, 1)))
         return rc;
     if (!isfinite(c->roll) || !isfinite(c->incidence) ||
         !isfinite(c->deflection))
-        return ts_fail(err, TS_EINVAL, "%s: roll, incidence and deflection "
-                       "must be finite", where);
+        return bad(err, w, ln, NULL, "roll, incidence and deflection must "
+                   "be finite");
     if (!(c->stall > c->stall_width && c->stall + c->stall_width < M_PI_2))
-        return ts_fail(err, TS_EINVAL, "%s.stall: must lie between the stall "
-                       "width (%g deg) and 90 deg less it, got %g deg",
-                       where, c->stall_width * 180 / M_PI,
-                       c->stall * 180 / M_PI);
+        return bad(err, w, ln, "stall", "must lie between the stall width "
+                   "(%g deg) and 90 deg less it, got %g deg",
+                   c->stall_width * 180 / M_PI, c->stall * 180 / M_PI);
     if (c->curve == TS_CURVE_TABLE) {
         if (c->npoints < 3 || c->npoints > TS_CURVE_MAX_POINTS)
-            return ts_fail(err, TS_EINVAL, "%s.table: needs 3 to %d rows, "
-                           "got %d", where, TS_CURVE_MAX_POINTS, c->npoints);
+            return bad(err, w, ln, "table", "needs 3 to %d rows, got %d",
+                       TS_CURVE_MAX_POINTS, c->npoints);
         for (int i = 0; i < c->npoints; i++) {
             if (!isfinite(c->alpha[i]) || !isfinite(c->cl[i]) ||
                 !isfinite(c->cd[i]))
-                return ts_fail(err, TS_EINVAL, "%s.table: row %d is not "
-                               "finite", where, i);
+                return bad(err, w, ln, "table", "row %d is not finite", i);
             if (i > 0 && !(c->alpha[i] > c->alpha[i - 1]))
-                return ts_fail(err, TS_EINVAL, "%s.table: angles must "
-                               "increase, row %d has %g deg after %g deg",
-                               where, i, c->alpha[i] * 180 / M_PI,
-                               c->alpha[i - 1] * 180 / M_PI);
+                return bad(err, w, ln, "table", "angles must increase, row "
+                           "%d has %g deg after %g deg", i,
+                           c->alpha[i] * 180 / M_PI,
+                           c->alpha[i - 1] * 180 / M_PI);
             if (c->cd[i] < 0)
-                return ts_fail(err, TS_EINVAL, "%s.table: row %d has a "
-                               "negative drag coefficient %g", where, i,
-                               c->cd[i]);
+                return bad(err, w, ln, "table", "row %d has a negative drag "
+                           "coefficient %g", i, c->cd[i]);
         }
     }
     if (!(c->limit > 0))
-        return ts_fail(err, TS_EINVAL, "%s.limit: must be > 0 rad, got %g",
-                       where, c->limit);
+        return bad(err, w, ln, "limit", "must be > 0 rad, got %g", c->limit);
     if (!(c->rate_limit > 0))
-        return ts_fail(err, TS_EINVAL, "%s.rate_limit: must be > 0 rad/s, "
-                       "got %g", where, c->rate_limit);
-    if ((rc = check_value(err, where, "time_constant", c->time_constant, 0,
+        return bad(err, w, ln, "rate_limit", "must be > 0 rad/s, got %g",
+                   c->rate_limit);
+    if ((rc = check_value(err, w, ln, "time_constant", c->time_constant, 0,
                           0)))
         return rc;
     if (isfinite(c->rate_limit) && !(c->time_constant > 0))
-        return ts_fail(err, TS_EINVAL, "%s.rate_limit: a rate limit needs an "
-                       "actuator with time_constant > 0 s", where);
+        return bad(err, w, ln, "rate_limit", "a rate limit needs an actuator "
+                   "with time_constant > 0 s");
     if (!c->control &&
         (c->deflection != 0 || isfinite(c->limit) ||
          isfinite(c->rate_limit) || c->time_constant > 0))
-        return ts_fail(err, TS_EINVAL, "%s: deflection, limit, rate_limit "
-                       "and time_constant apply to control surfaces "
-                       "(control: true)", where);
+        return bad(err, w, ln, NULL, "deflection, limit, rate_limit and "
+                   "time_constant apply to control surfaces (control: "
+                   "true)");
     if (fabs(c->deflection) > c->limit)
-        return ts_fail(err, TS_EINVAL, "%s.deflection: %g deg is beyond the "
-                       "limit %g deg", where, c->deflection * 180 / M_PI,
-                       c->limit * 180 / M_PI);
+        return bad(err, w, ln, "deflection", "%g deg is beyond the limit %g "
+                   "deg", c->deflection * 180 / M_PI, c->limit * 180 / M_PI);
     return TS_OK;
 }
 
 int ts_vehicle_check(const ts_vehicle *v, double mass, const char *where,
-                     ts_err *err)
+                     int line, ts_err *err)
 {
     int rc;
     char w[160];
     if (!(mass > 0 && isfinite(mass)))
-        return ts_fail(err, TS_EINVAL, "%s.mass: a vehicle needs a mass > 0 "
-                       "kg, got %g", where, mass);
-    if ((rc = check_finite3(err, where, "mass_centre", v->mass_centre)) ||
-        (rc = check_finite3(err, where, "buoyancy_centre",
+        return bad(err, where, line, "mass", "a vehicle needs a mass > 0 kg, "
+                   "got %g", mass);
+    if ((rc = check_finite3(err, where, line, "mass_centre",
+                            v->mass_centre)) ||
+        (rc = check_finite3(err, where, line, "buoyancy_centre",
                             v->buoyancy_centre)) ||
-        (rc = check_finite3(err, where, "attach", v->attach)) ||
-        (rc = check_value(err, where, "volume", v->volume, 0, 0)) ||
-        (rc = check_value(err, where, "surface_diameter",
+        (rc = check_finite3(err, where, line, "attach", v->attach)) ||
+        (rc = check_value(err, where, line, "volume", v->volume, 0, 0)) ||
+        (rc = check_value(err, where, line, "surface_diameter",
                           v->surface_diameter, 0, 0)))
         return rc;
     /* Inertia about the mass centre: symmetric positive definite (a body
@@ -285,80 +311,80 @@ int ts_vehicle_check(const ts_vehicle *v, double mass, const char *where,
     const double *I = v->inertia;
     for (int j = 0; j < 6; j++)
         if (!isfinite(I[j]))
-            return ts_fail(err, TS_EINVAL, "%s.inertia: entry %d must be "
-                           "finite", where, j);
+            return bad(err, where, line, "inertia", "entry %d must be "
+                       "finite", j);
     double S[6] = {I[0], I[1], I[2], I[3], I[4], I[5]}, L[6];
     if (sym3_chol(S, L) != 0)
-        return ts_fail(err, TS_EINVAL, "%s.inertia: must be positive "
-                       "definite (Ixx, Iyy, Izz > 0 and the products of "
-                       "inertia small enough), got %g %g %g %g %g %g kg m^2",
-                       where, I[0], I[1], I[2], I[3], I[4], I[5]);
+        return bad(err, where, line, "inertia", "must be positive definite "
+                   "(Ixx, Iyy, Izz > 0 and the products of inertia small "
+                   "enough), got %g %g %g %g %g %g kg m^2",
+                   I[0], I[1], I[2], I[3], I[4], I[5]);
     const double *A = v->added_mass;
     double big = 0;
     for (int i = 0; i < 36; i++) {
         if (!isfinite(A[i]))
-            return ts_fail(err, TS_EINVAL, "%s.added_mass: entry (%d, %d) "
-                           "must be finite", where, i / 6 + 1, i % 6 + 1);
+            return bad(err, where, line, "added_mass", "entry (%d, %d) must "
+                       "be finite", i / 6 + 1, i % 6 + 1);
         big = fmax(big, fabs(A[i]));
     }
     for (int i = 0; i < 6; i++) {
         if (A[7 * i] < 0)
-            return ts_fail(err, TS_EINVAL, "%s.added_mass: diagonal entry "
-                           "(%d, %d) must be >= 0, got %g", where, i + 1,
-                           i + 1, A[7 * i]);
+            return bad(err, where, line, "added_mass", "diagonal entry (%d, "
+                       "%d) must be >= 0, got %g", i + 1, i + 1, A[7 * i]);
         for (int j = 0; j < i; j++)
             if (fabs(A[6 * i + j] - A[6 * j + i]) > 1e-9 * big)
-                return ts_fail(err, TS_EINVAL, "%s.added_mass: must be "
-                               "symmetric, entries (%d, %d) = %g and (%d, %d) "
-                               "= %g", where, i + 1, j + 1, A[6 * i + j],
-                               j + 1, i + 1, A[6 * j + i]);
+                return bad(err, where, line, "added_mass", "must be "
+                           "symmetric, entries (%d, %d) = %g and (%d, %d) = "
+                           "%g", i + 1, j + 1, A[6 * i + j], j + 1, i + 1,
+                           A[6 * j + i]);
     }
     if (v->ncomponents < 0 || v->ncomponents > TS_VEHICLE_MAX_COMPONENTS)
-        return ts_fail(err, TS_EINVAL, "%s.components: at most %d", where,
-                       TS_VEHICLE_MAX_COMPONENTS);
+        return bad(err, where, line, "components", "at most %d",
+                   TS_VEHICLE_MAX_COMPONENTS);
     for (int c = 0; c < v->ncomponents; c++) {
+        const ts_component *cp = &v->component[c];
         snprintf(w, sizeof w, "%s.components[%d]", where, c);
-        if ((rc = check_component(&v->component[c], w, err)))
+        if ((rc = check_component(cp, w, err)))
             return rc;
         for (int d = 0; d < c; d++)
-            if (!strcmp(v->component[c].name, v->component[d].name))
-                return ts_fail(err, TS_EINVAL, "%s.name: duplicate component "
-                               "name '%s'", w, v->component[c].name);
+            if (!strcmp(cp->name, v->component[d].name))
+                return bad(err, w, cp->line, "name", "duplicate component "
+                           "name '%s'", cp->name);
     }
     if (v->nloops < 0 || v->nloops > TS_VEHICLE_MAX_LOOPS)
-        return ts_fail(err, TS_EINVAL, "%s.controllers: at most %d", where,
-                       TS_VEHICLE_MAX_LOOPS);
+        return bad(err, where, line, "controllers", "at most %d",
+                   TS_VEHICLE_MAX_LOOPS);
     for (int l = 0; l < v->nloops; l++) {
         const ts_loop *lp = &v->loop[l];
+        int ln = lp->line;
         snprintf(w, sizeof w, "%s.controllers[%d]", where, l);
         if (!isfinite(lp->setpoint) || !isfinite(lp->kp) ||
             !isfinite(lp->ki) || !isfinite(lp->kd))
-            return ts_fail(err, TS_EINVAL, "%s: setpoint and gains must be "
-                           "finite", w);
+            return bad(err, w, ln, NULL, "setpoint and gains must be "
+                       "finite");
         if (lp->nsurfaces < 1)
-            return ts_fail(err, TS_EINVAL, "%s.surfaces: a loop must drive "
-                           "at least one control surface", w);
+            return bad(err, w, ln, "surfaces", "a loop must drive at least "
+                       "one control surface");
         for (int s = 0; s < lp->nsurfaces; s++) {
             int ci = lp->surface[s];
             if (ci < 0 || ci >= v->ncomponents ||
                 !v->component[ci].control)
-                return ts_fail(err, TS_EINVAL, "%s.surfaces: entry %d is not "
-                               "a control surface of the vehicle", w, s);
+                return bad(err, w, ln, "surfaces", "entry %d is not a "
+                           "control surface of the vehicle", s);
             if (!isfinite(lp->gain[s]))
-                return ts_fail(err, TS_EINVAL, "%s.surfaces: gain of entry "
-                               "%d must be finite", w, s);
+                return bad(err, w, ln, "surfaces", "gain of entry %d must be "
+                           "finite", s);
         }
         for (int d = 0; d < l; d++)
             if (!strcmp(lp->name, v->loop[d].name))
-                return ts_fail(err, TS_EINVAL, "%s.name: duplicate "
-                               "controller name '%s'", w, lp->name);
+                return bad(err, w, ln, "name", "duplicate controller name "
+                           "'%s'", lp->name);
         /* Loops and surfaces name the vehicle's inputs together. */
         for (int c = 0; c < v->ncomponents; c++)
             if (!strcmp(lp->name, v->component[c].name))
-                return ts_fail(err, TS_EINVAL, "%s.name: '%s' is also a "
-                               "component's name; inputs are named "
-                               "<vehicle>.<surface> and <vehicle>.<loop>",
-                               w, lp->name);
+                return bad(err, w, ln, "name", "'%s' is also a component's "
+                           "name; inputs are named <vehicle>.<surface> and "
+                           "<vehicle>.<loop>", lp->name);
     }
     return TS_OK;
 }
@@ -787,6 +813,13 @@ void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
             wp[j] = wO_b[j] + x[j];
         if (cp->type == TS_COMP_HULL) {
             hull_load(v, w, c, qrho, wp, om_b, &ld);
+        } else if (cp->type == TS_COMP_BLUFF) {
+            double sp = v3_norm(wp), k = -0.5 * qrho * cp->drag * cp->area * sp;
+            for (int j = 0; j < 3; j++)
+                ld.force[j] = k * wp[j];
+            v3_set(ld.moment, 0, 0, 0);
+            ld.alpha = atan2(wp[2], wp[0]);
+            ld.speed = sp;
         } else {
             surface_load(v, w, c, qrho, wp,
                          delta && cp->control ? delta[c] : 0.0, &ld);

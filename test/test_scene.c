@@ -266,6 +266,73 @@ static int has_line(const char *msg, int n)
     return 0;
 }
 
+/* A vehicle with every key (good_vehicle.yaml). */
+static void test_vehicle(const ts_units *u)
+{
+    ts_scene *s = load(u, DIR "good_vehicle.yaml");
+    if (!s)
+        return;
+    const ts_system *sys = s->system;
+    const ts_body *b = &sys->bodies[0];
+    const ts_vehicle *v = b->vehicle;
+    double deg = M_PI / 180;
+    CHECK(b->type == TS_BODY_VEHICLE && v && sys->nvehicles == 1,
+          "fish is a vehicle");
+    CHECK_REL(b->mass, 500 / sys->env.gravity, RTOL, "weight -> mass");
+    CHECK_REL(v->volume, 0.030, RTOL, "volume 30 L");
+    CHECK(fabs(v->inertia[0] - 0.4) < 1e-15 && fabs(v->inertia[4] - 0.05) <
+              1e-15 && v->inertia[3] == 0,
+          "inertia with products (Ixz)");
+    CHECK(fabs(v->mass_centre[2] - 0.02) < 1e-15 &&
+              fabs(v->buoyancy_centre[0] - 0.01) < 1e-15 &&
+              fabs(v->attach[0] - 0.2) < 1e-15 &&
+              fabs(v->attach[2] + 0.12) < 1e-15,
+          "mass centre, buoyancy centre, attach point in m");
+    CHECK_REL(v->surface_diameter, 0.25, RTOL, "surface_diameter");
+    /* The spheroid's added mass, moved from its centre (5 cm forward) to
+     * O: A11 = k1 m_f unchanged; the shift couples sway and yaw. */
+    double A[36], k[3];
+    ts_added_mass_spheroid(sys->env.water_density, 1.6, 0.2, A, k, NULL);
+    CHECK(v->added_mass_estimated && fabs(v->added_mass[0] - A[0]) <
+              1e-12 * A[0] && fabs(v->added_mass[6 * 1 + 5]) > 0,
+          "added mass: spheroid of 1.6 m x 0.2 m at 5 cm, A11 %.6g kg, "
+          "A26 %.6g kg m",
+          v->added_mass[0], v->added_mass[11]);
+    CHECK(v->ncomponents == 4, "four components");
+    const ts_component *h = &v->component[0], *w = &v->component[1];
+    const ts_component *f = &v->component[2], *bl = &v->component[3];
+    CHECK(h->type == TS_COMP_HULL && fabs(h->length - 1.6) < 1e-15 &&
+              fabs(h->cd_axial - 0.25) < 1e-15,
+          "hull");
+    CHECK(w->type == TS_COMP_SURFACE && fabs(w->area - 0.12) < 1e-15 &&
+              fabs(w->incidence + 3 * deg) < 1e-15 &&
+              fabs(w->stall - 18 * deg) < 1e-15 &&
+              fabs(w->lift_slope - 3.1) < 1e-15 &&
+              fabs(w->cd0 - 0.012) < 1e-15 && !w->control,
+          "wing: area, incidence, stall, slope, zero-lift drag");
+    CHECK(f->curve == TS_CURVE_TABLE && f->npoints == 5 &&
+              fabs(f->alpha[1] + 15 * deg) < 1e-15 &&
+              fabs(f->roll - 90 * deg) < 1e-15 && f->cd[4] == 1.2,
+          "fin: a 5-row table, rolled 90 deg");
+    CHECK(bl->type == TS_COMP_BLUFF && fabs(bl->drag - 0.9) < 1e-15,
+          "ballast: a bluff part");
+    const ts_cable *t = &sys->cables[1];
+    CHECK(t->has_from_point && fabs(t->from_point[0] + 0.8) < 1e-15,
+          "the tail starts at (-0.8, 0, 0.05) m of the fish");
+    int l = 0;
+    while (l < sys->nlinks && sys->links[l].cable != 1)
+        l++;
+    CHECK(l < sys->nlinks && sys->links[l].up_body == 0 &&
+              fabs(sys->links[l].up_point[2] - 0.05) < 1e-15,
+          "its first link starts at that point of the vehicle");
+    /* The vehicle's mass and the tail's first half link are the body's,
+     * not its node's. */
+    int node = ts_system_body_node(sys, 0);
+    CHECK_REL(sys->nodes[node].mass, 0.5 * 50.0 / 8 * 0.4, RTOL,
+              "the vehicle's node carries half a main link only");
+    ts_scene_free(s);
+}
+
 static void test_bad_fixtures(const ts_units *u)
 {
     static const struct {
@@ -277,6 +344,27 @@ static void test_bad_fixtures(const ts_units *u)
     } bad[] = {
         {"bad_missing_length", TS_ESCENE, "cables[0]", 6,
          "missing key 'length'"},
+        {"bad_vehicle_no_components", TS_ESCENE, "bodies[0]", 15,
+         "missing key 'components'"},
+        {"bad_vehicle_component_type", TS_EINVAL,
+         "bodies[0].components[0].type", 23,
+         "unknown component type \"wing\"; expected hull, surface or bluff"},
+        {"bad_vehicle_inertia", TS_EINVAL, "bodies[0].inertia", 19,
+         "needs 3 to 6 entries, got 2"},
+        {"bad_vehicle_inertia_not_definite", TS_EINVAL, "bodies[0].inertia",
+         15, "must be positive definite"},
+        {"bad_vehicle_diameter", TS_ESCENE, "bodies[0].diameter", 18,
+         "does not apply to a vehicle"},
+        {"bad_vehicle_surface_hull_key", TS_ESCENE,
+         "bodies[0].components[1].axial_drag", 30,
+         "does not apply to a surface component"},
+        {"bad_vehicle_table_order", TS_EINVAL,
+         "bodies[0].components[1].table", 26,
+         "angles must increase, row 2 has 5 deg after 10 deg"},
+        {"bad_vehicle_added_mass_rows", TS_EINVAL, "bodies[0].added_mass",
+         21, "needs 6 rows of 6 numbers"},
+        {"bad_vehicle_at_sphere", TS_EINVAL, "cables[1].at", 16,
+         "a starting point on a body needs a vehicle"},
         {"bad_unknown_key_top", TS_ESCENE, "tow_speed", 5,
          "unknown key; expected one of name, environment, tow, cables, "
          "bodies, analyses"},
@@ -732,6 +820,7 @@ int main(void)
     test_ex1(u);
     test_ex2(u);
     test_minimal_and_wet(u);
+    test_vehicle(u);
     test_bad_fixtures(u);
     test_buffers(u);
     test_mutations(u);

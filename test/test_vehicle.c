@@ -572,10 +572,10 @@ static void test_control(void)
     p->surface[1] = 1;
     p->gain[1] = 1.0;
     ts_err err = {0};
-    CHECK(ts_vehicle_check(v, 10.0, "bodies[0]", &err) == TS_EINVAL,
+    CHECK(ts_vehicle_check(v, 10.0, "bodies[0]", 0, &err) == TS_EINVAL,
           "inertia zero refused: %s", err.msg);
     v->inertia[0] = v->inertia[1] = v->inertia[2] = 1;
-    CHECK(ts_vehicle_check(v, 10.0, "bodies[0]", &err) == TS_OK,
+    CHECK(ts_vehicle_check(v, 10.0, "bodies[0]", 0, &err) == TS_OK,
           "controller description accepted");
 
     double val[4] = {10.4, 0.05, -0.02, -3.0}, rate[4] = {-0.1, 0, 0, 0};
@@ -626,46 +626,46 @@ static void test_bad(void)
     v->inertia[0] = v->inertia[1] = v->inertia[2] = 1;
     ts_component *c = &v->component[0];
     ts_err err = {0};
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_OK, "good fin");
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_OK, "good fin");
     c->area = -1;
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "bodies[1].components[0].area"),
           "negative area: %s", err.msg);
     c->area = 0.1;
     c->stall = 0.02;
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
-              strstr(err.msg, ".stall"),
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
+              strstr(err.msg, ".stall:"),
           "stall below its width: %s", err.msg);
     c->stall = 0.3;
     c->rate_limit = 1.0;
     c->control = 1;
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "time_constant"),
           "rate limit without an actuator: %s", err.msg);
     c->rate_limit = INFINITY;
     c->control = 0;
     c->limit = 0.2;
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "control surfaces"),
           "limit on a fixed surface: %s", err.msg);
     c->limit = INFINITY;
     v->added_mass[1] = 3.0;
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "symmetric"),
           "asymmetric added mass: %s", err.msg);
     v->added_mass[1] = 0;
-    CHECK(ts_vehicle_check(v, 0, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 0, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "bodies[1].mass"),
           "massless vehicle: %s", err.msg);
     v->nloops = 1;
     v->loop[0].nsurfaces = 1;
     v->loop[0].surface[0] = 0;
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "not a control surface"),
           "loop driving a fixed surface: %s", err.msg);
     c->control = 1;
     snprintf(v->loop[0].name, sizeof v->loop[0].name, "wing");
-    CHECK(ts_vehicle_check(v, 5, "bodies[1]", &err) == TS_EINVAL &&
+    CHECK(ts_vehicle_check(v, 5, "bodies[1]", 0, &err) == TS_EINVAL &&
               strstr(err.msg, "also a component's name"),
           "loop named as a surface: %s", err.msg);
     free(v);

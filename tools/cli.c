@@ -326,6 +326,53 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     return 0;
 }
 
+void cli_print_vehicles(FILE *f, const ts_system *sys,
+                        const ts_vehicle_result *vr, int nv, int quiet)
+{
+    const double deg = 180.0 / M_PI;
+    if (nv == 0)
+        return;
+    fprintf(f, "\n%-20s %10s %10s %10s %10s %10s %12s\n", "vehicle",
+            "pitch[deg]", "roll[deg]", "yaw[deg]", "alpha[deg]",
+            "beta[deg]", "depth [m]");
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle_result *r = &vr[v];
+        fprintf(f, "%-20s %10.4f %10.4f %10.4f %10.4f %10.4f %12.6f\n",
+                sys->bodies[r->body].name, r->pitch * deg, r->roll * deg,
+                r->yaw * deg, r->alpha * deg, r->beta * deg, r->origin[2]);
+    }
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle_result *r = &vr[v];
+        const ts_vehicle *d = sys->bodies[r->body].vehicle;
+        for (int c = 0; c < r->ncomponents; c++)
+            if (d->component[c].control)
+                fprintf(f, "%s.%s deflection %.4f deg\n",
+                        sys->bodies[r->body].name, d->component[c].name,
+                        r->delta[c] * deg);
+        if (quiet)
+            continue;
+        fprintf(f, "\n%-20s %11s %11s %11s %11s %11s %11s %9s\n",
+                "component (body axes)", "Fx [N]", "Fy [N]", "Fz [N]",
+                "Mx [N m]", "My [N m]", "Mz [N m]", "alpha[deg]");
+        for (int c = 0; c < r->ncomponents; c++) {
+            const ts_component_load *ld = &r->load[c];
+            char nm[2 * TS_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s.%s", sys->bodies[r->body].name,
+                     d->component[c].name);
+            fprintf(f, "%-20s %11.4f %11.4f %11.4f %11.4f %11.4f %11.4f "
+                       "%9.3f\n",
+                    nm, ld->force[0], ld->force[1], ld->force[2],
+                    ld->moment[0], ld->moment[1], ld->moment[2],
+                    ld->alpha * deg);
+        }
+        fprintf(f, "%-20s %11s %11s %11s %11.4f %11.4f %11.4f\n",
+                "Munk moment", "", "", "", r->munk[0], r->munk[1],
+                r->munk[2]);
+        fprintf(f, "joint force (M) %.4f, %.4f, %.4f N\n", r->joint_force[0],
+                r->joint_force[1], r->joint_force[2]);
+    }
+}
+
 void cli_print_trust(const ts_trust *t)
 {
     printf("trustworthy: %s\n", t->trustworthy ? "yes" : "NO");

@@ -165,6 +165,11 @@ int cli_make_dir(const char *cmd, const char *opt, const char *dir);
 /* The option help of an analysis command (towstab CMD --help). */
 void cli_usage(const struct cli_command *cmd, FILE *f);
 
+/* The vehicles' attitudes, flow angles and depths, their control
+ * deflections and (unless quiet) their components' loads. */
+void cli_print_vehicles(FILE *f, const ts_system *sys,
+                        const ts_vehicle_result *vr, int nv, int quiet);
+
 /* Markdown of every option of the analyses: the reference of
  * doc/manual.md (towstab options --markdown). */
 void cli_options_markdown(FILE *f);

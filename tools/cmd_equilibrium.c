@@ -239,6 +239,10 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
                     p[0], p[1], p[2]);
         }
     }
+    cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet);
+    if (eq->ncontrol > 0)
+        fprintf(f, "controllers settled to %.3g (target %.3g)\n",
+                eq->control_residual, eq->tolerance);
     fprintf(f, "\ntop tension %.6f N (force on the tow point %.6f, %.6f, "
                "%.6f N)\n",
             eq->top_tension, eq->tow_force[0], eq->tow_force[1],

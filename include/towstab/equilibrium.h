@@ -74,6 +74,14 @@ typedef struct ts_equilibrium {
                              M, row-major (ts_kernel_vehicle_body order) */
     int ncontrol;         /* controller states of the kernel solved with */
     double *controls;     /* [ncontrol] their values */
+    double control_residual; /* the controllers' settling: the largest
+                             |integrator rate| (a loop's error) over its
+                             scale (the cable length for depth, 1 rad for
+                             angles) and |actuator rate| times its time
+                             constant (rad); converged needs it <= tol
+                             too; 0 without controllers */
+    ts_vehicle_result *vehicles; /* [nvehicles] attitude, flow angles,
+                             loads and deflections of each vehicle */
 } ts_equilibrium;
 
 TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);

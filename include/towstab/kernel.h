@@ -149,6 +149,17 @@ TS_API double ts_kernel_unbalanced(const ts_kernel *k, double *scale);
 TS_API double ts_kernel_kinetic_energy(const ts_kernel *k);
 TS_API double ts_kernel_potential_energy(const ts_kernel *k);
 
+/* What controller state i (0 <= i < nc, at y[2 nq + i]) is: the
+ * integral of loop `index`'s error (rad s or m s) or the deflection of
+ * control surface `index` (its actuator, rad), of vehicle `vehicle`. */
+typedef struct ts_control_state {
+    int vehicle;      /* vehicle index (ts_kernel_vehicle_body) */
+    int actuator;     /* 1: an actuator, 0: an integrator */
+    int index;        /* component (actuator) or loop (integrator) */
+} ts_control_state;
+TS_API void ts_kernel_control_state(const ts_kernel *k, int i,
+                                    ts_control_state *cs);
+
 /* Vehicles, in body order: their number, body index and the offset of
  * their three angles in q. */
 TS_API int ts_kernel_nvehicles(const ts_kernel *k);
@@ -162,7 +173,7 @@ TS_API int ts_kernel_vehicle_offset(const ts_kernel *k, int v);
 TS_API int ts_kernel_set_vehicle(ts_kernel *k, int v, const double R[9],
                                  const double omega[3], double threshold,
                                  double y[]);
-/* Read them back from y. */
+/* Read them back from y (omega may be NULL). */
 TS_API void ts_kernel_get_vehicle(const ts_kernel *k, int v, const double y[],
                                   double R[9], double omega[3]);
 

@@ -34,11 +34,23 @@ TS_API json_t *ts_report_trust_json(const ts_trust *t);
  * verdict `trust` (may be NULL: left out) trustworthy, reasons [text],
  * notes [text] (towstab/health.h), nodes [{name,x,y,z}] (tow point
  * first), links [{cable,index,tension,theta1_deg,theta2_deg}], bodies
- * [{name,x,y,z}]. NULL on allocation failure. */
+ * [{name,x,y,z}], and with vehicles, vehicles [ts_report_vehicle_json]
+ * and control_residual. NULL on allocation failure. */
 TS_API json_t *ts_report_equilibrium_json(const ts_system *sys,
                                           const ts_equilibrium *eq,
                                           double wall_s,
                                           const ts_trust *trust);
+
+/* A vehicle's state as a new JSON object: name, x, y, depth (its origin,
+ * m, M frame), pitch_deg, roll_deg, yaw_deg (yaw-pitch-roll relative to
+ * M), alpha_deg, beta_deg (the flow at its origin), speed, submerged,
+ * joint_force (N, M), hydro_force, hydro_moment (all components; body
+ * axes, N and N m about the origin), munk_moment, mass_centre (m, M),
+ * deflections_deg {surface: deg}, components [{name, type, force,
+ * moment, alpha_deg, speed}] (body axes), controllers [{name, error,
+ * output_deg}]. NULL on allocation failure. */
+TS_API json_t *ts_report_vehicle_json(const ts_system *sys,
+                                      const ts_vehicle_result *r);
 
 /* Write a JSON value to `path` ("-": stdout), indented, as above. */
 TS_API int ts_report_write_json(const json_t *value, const char *path,

@@ -31,7 +31,9 @@ extern "C" {
 
 typedef enum {
     TS_COMP_HULL = 0,     /* slender hull: axial and cross-flow drag */
-    TS_COMP_SURFACE = 1   /* lifting surface: lift and drag curves */
+    TS_COMP_SURFACE = 1,  /* lifting surface: lift and drag curves */
+    TS_COMP_BLUFF = 2     /* bluff part (a ballast weight, a bulb): drag
+                             -1/2 rho Cd A |w| w whatever the direction */
 } ts_component_type;
 
 typedef enum {
@@ -44,8 +46,10 @@ typedef enum {
 typedef struct ts_component {
     char name[TS_VEHICLE_NAME_MAX];
     ts_component_type type;
-    double position[3];   /* hull: its centre; surface: its centre of
-                             pressure; body axes from O, m */
+    double position[3];   /* hull, bluff part: its centre; surface: its
+                             centre of pressure; body axes from O, m */
+    /* Bluff part (and a surface's planform area below). */
+    double drag;          /* drag coefficient on `area` */
     /* Hull (axis along body x). */
     double length;        /* m, > 0 */
     double diameter;      /* m, > 0 */
@@ -54,7 +58,8 @@ typedef struct ts_component {
     /* Lifting surface: chord along body x, normal (0, -sin roll, cos
      * roll): roll 0 is a horizontal surface with its normal down, +-pi/2
      * a vertical fin, +-pi/4 and +-3pi/4 an X tail. */
-    double area;          /* planform area S, m^2, > 0 */
+    double area;          /* planform area S (a bluff part: frontal
+                             area), m^2, > 0 */
     double span;          /* m, > 0; aspect ratio span^2 / area */
     double roll;          /* rad */
     double incidence;     /* rad, fixed setting added to the angle of attack */
@@ -177,11 +182,12 @@ typedef struct ts_vehicle_result {
 TS_API void ts_component_defaults(ts_component *c, ts_component_type type);
 
 /* Validate a vehicle description (finite values, ranges, tables, loops
- * referring to control surfaces, symmetric positive semi-definite added
- * mass). `where` names it in messages ("bodies[2]"). TS_OK or
- * TS_EINVAL. */
+ * referring to control surfaces, symmetric added mass with a
+ * non-negative diagonal). `where` and `line` name it in messages
+ * ("bodies[2].inertia (line 14): ..."; line 0: none; components and loops
+ * give their own lines). TS_OK or TS_EINVAL. */
 TS_API int ts_vehicle_check(const ts_vehicle *v, double mass,
-                            const char *where, ts_err *err);
+                            const char *where, int line, ts_err *err);
 
 /* Added mass of a prolate spheroid of length L and diameter D (L >= D > 0)
  * in fluid of density rho, about its centre, in its axes (x along the

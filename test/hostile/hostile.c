@@ -951,6 +951,11 @@ static void gen_cli_misuse(void)
         {"--initial", "shape:/nonexistent.csv", E_BADINPUT},
         {"--initial", "released:theta1=nan", E_BADINPUT},
         {"--max-steps", "0", E_BADINPUT},
+        {"--sea", "Hs=1e300m,Tp=10s", E_BADINPUT},
+        {"--sea", "bogus", E_BADINPUT},
+        {"--sea", "Hs=nan,Tp=10s", E_BADINPUT},
+        {"--sea", "Hs=4m,Tp=0s", E_BADINPUT},
+        {"--sea", "file=/nonexistent.csv", E_BADINPUT},
     };
     for (size_t i = 0; i < sizeof sim / sizeof sim[0]; i++)
         misuse(sim[i].expect, sim[i].opt, "simulate", EX1, "--quiet",
@@ -959,6 +964,18 @@ static void gen_cli_misuse(void)
            "tow.heave:amplitude=0.1m,frequency=1e6Hz", "--t-end", "1", NULL);
     misuse(R, "--sample", "simulate", EX1, "--quiet", "--t-end", "1",
            "--sample", "100", NULL);
+    misuse(R, "--rao", "simulate", EX1, "--quiet", "--rao",
+           "/nonexistent.csv", "--sea", "Hs=4m,Tp=10s", NULL);
+    /* A sea whose waves are far too fast: announced, then interrupted. */
+    c = misuse(E_ANY, NULL, "simulate", EX1, "--quiet", "--sea",
+               "Hs=4m,Tp=1e-6s", "--json", "@D/out.json", NULL);
+    c->announce_ok = 1;
+    static const char *const seas[] = {"Hs=1e300m,Tp=10s", "Hs=4m,Tp=1e-6s",
+                                       "Hs=4m,Tp=1e300s",
+                                       "Hs=4m,Tp=10s,heading=nan"};
+    for (int i = 0; i < 4; i++)
+        misuse(i == 3 ? R : E_ANY, i == 3 ? "--sea" : NULL, "response", EX1,
+               "--quiet", "--output", "sphere.z", "--sea", seas[i], NULL);
     misuse(R, "--transient", "simulate", EX1, "--quiet", "--t-end", "10",
            "--transient", "100", NULL);
     misuse(R, NULL, "simulate", EX1, "--quiet", "--compare", "--linear",
