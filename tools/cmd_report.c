@@ -309,8 +309,10 @@ static void key_values(FILE *f, const json_t *j)
         fputs("</tr>\n", f);
     }
     fputs("</table></div>\n<p>The errors are estimates in the value's unit "
-          "(doc/manual.md, \"Output conventions\"); a convergence study "
-          "(towstab converge) estimates the discretisation error.</p>\n", f);
+          "(doc/manual.md, \"Output conventions\"): the discretisation "
+          "error from the same analysis at a half and a quarter of the "
+          "links (doc/accuracy.md; \"accuracy\" under Results says how "
+          "it was made and whether it meets the accuracy asked).</p>\n", f);
 }
 
 /* The order of a picture: its place in the command's list, else after. */
