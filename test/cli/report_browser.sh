@@ -12,8 +12,8 @@
 # > 0, an SVG data URI), no cell, paragraph, heading or caption overflows
 # its box, every table fits the page, nothing but data URIs is fetched;
 # and the page has the number of pictures expected (none without PLplot).
-# Without chromium the test is skipped (exit status 77): CI installs it
-# (.ci/run); `apt-get install chromium` to run it here.
+# Without chromium the test is skipped (exit status 77): tools/setup.sh
+# installs it (and so CI, .ci/run, which runs setup.sh).
 set -u
 
 if [ $# -ne 2 ]; then
@@ -24,7 +24,7 @@ TOWSTAB=$1
 HAVE=$2
 CHROMIUM=$(command -v chromium || command -v chromium-browser || true)
 if [ -z "$CHROMIUM" ]; then
-    echo "SKIP chromium is not installed (apt-get install chromium; CI installs it)"
+    echo "SKIP chromium is not installed (apt-get install chromium, or tools/setup.sh)"
     exit 77
 fi
 . test/cli/common.sh
