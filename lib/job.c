@@ -157,6 +157,7 @@ const double *ts_job_array(const ts_job *j, const char *name, int *rows,
         {"t", h->t, 1},
         {"positions", h->positions, 3 * h->nnodes},
         {"tensions", h->tensions, h->nlinks},
+        {"tow_force", h->tow_force, 3},
         {"energy", h->energy, 2},
         {"input", h->input, TS_NINPUT},
     };

@@ -1,13 +1,20 @@
 /* response.c: frequency response to tow-point motion (towstab/response.h;
- * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md,
+ * section 4).
  *
- * Algorithm, per frequency w: s = i w; b = B_x + s B_v + s^2 B_a (lower
- * half only: the upper nq rows of B are zero); Z = (s I - A)^-1 b
- * = -(A - s I)^-1 b by the structured solver (eigen_impl.h: one complex LU
- * of P(s) = K + s C - s^2 I, nq x nq, O(nq^3)); then the output map:
- * positions through the link geometry (exact, O(nlinks)) plus the
- * feedthrough of the tow displacement, tensions through dT/dy and dT/du.
- * At w = 0 the solve is real and gives the static gain.
+ * Algorithm, per frequency w: one solve with the sparse linear model at
+ * s = i w driven by the tow point itself (lib/shift.h, tsi_shift_input):
+ * the tow point moves by e_input, its neighbours feel -(K_k0 + s C_k0)
+ * e_input, the links leaving it are constrained relative to it. One KLU
+ * factorisation of S(s) and one solve give every node's absolute
+ * displacement and every link's tension: O(nlinks) per frequency. At
+ * w = 0 the solve is real and gives the static gain.
+ *
+ * A system the sparse model does not cover (vehicles) takes the dense
+ * way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1 b by the dense shifted
+ * solve of lib/shift.h (one LU of P(s), O(nq^3)), then positions through
+ * the link geometry plus the tow displacement, tensions through dT/dy and
+ * dT/du.
  */
 #include "towstab/response.h"
 
@@ -17,7 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "eigen_impl.h"
+#include "shift.h"
 #include "towstab/system.h"
 
 static const char *const input_names[3] = {"tow.surge", "tow.sway",
@@ -36,132 +43,31 @@ int ts_response_input_find(const char *name, int *channel, ts_err *err)
                    name);
 }
 
-/* Link with index k (1-based) of cable c, or -1. */
-static int cable_link(const ts_system *sys, int c, int k)
-{
-    for (int l = 0; l < sys->nlinks; l++)
-        if (sys->links[l].cable == c && sys->links[l].index == k)
-            return l;
-    return -1;
-}
-
 void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
 {
-    size_t len = 0;
-    buf[0] = '\0';
-#define APPEND(...)                                                           \
-    do {                                                                      \
-        if (len < size) {                                                     \
-            int w_ = snprintf(buf + len, size - len, __VA_ARGS__);            \
-            if (w_ > 0)                                                       \
-                len += (size_t)w_;                                            \
-        }                                                                     \
-    } while (0)
-    APPEND("positions <node>.x|y|z with <node> one of ");
-    for (int c = 0; c < sys->ncables; c++) {
-        const ts_cable *cb = &sys->cables[c];
-        int last = cb->nlinks - (cb->to_body >= 0 ? 1 : 0);
-        if (c)
-            APPEND("; ");
-        if (last == 1)
-            APPEND("%s.1", cb->name);
-        else if (last > 1)
-            APPEND("%s.1 .. %s.%d", cb->name, cb->name, last);
-        if (cb->to_body >= 0)
-            APPEND("%s%s", last > 0 ? ", " : "",
-                   sys->bodies[cb->to_body].name);
-    }
-    APPEND("; tensions ");
-    for (int c = 0; c < sys->ncables; c++) {
-        const ts_cable *cb = &sys->cables[c];
-        if (c)
-            APPEND(", ");
-        if (cb->nlinks == 1)
-            APPEND("%s.1.tension", cb->name);
-        else
-            APPEND("%s.1.tension .. %s.%d.tension", cb->name, cb->name,
-                   cb->nlinks);
-    }
-    APPEND(" (tow is the input, not an output)");
-#undef APPEND
-}
-
-static int bad_output(const ts_system *sys, const char *name,
-                      const char *why, ts_err *err)
-{
-    char list[768];
-    ts_response_output_names(sys, list, sizeof list);
-    return ts_fail(err, TS_EINVAL, "output '%s': %s; valid outputs: %s",
-                   name, why, list);
+    ts_output_names(sys, TS_OUT_BIT(TS_OUT_POSITION) |
+                             TS_OUT_BIT(TS_OUT_TENSION),
+                    buf, size);
+    size_t len = strlen(buf);
+    if (len < size)
+        snprintf(buf + len, size - len, " (tow is the input, not an "
+                                        "output)");
 }
 
 int ts_response_output_find(const ts_system *sys, const char *name,
                             ts_output *out, ts_err *err)
 {
-    memset(out, 0, sizeof *out);
-    const char *dot = strrchr(name, '.');
-    if (!dot || dot == name || strlen(name) >= 2 * TS_NAME_MAX + 8)
-        return bad_output(sys, name, "expected <node>.<x|y|z> or "
-                                     "<cable>.<k>.tension", err);
-    char base[2 * TS_NAME_MAX + 8];
-    size_t nb = (size_t)(dot - name);
-    memcpy(base, name, nb);
-    base[nb] = '\0';
-    const char *suffix = dot + 1;
-    int comp = -1, tension = 0;
-    if (strcmp(suffix, "x") == 0)
-        comp = 0;
-    else if (strcmp(suffix, "y") == 0)
-        comp = 1;
-    else if (strcmp(suffix, "z") == 0)
-        comp = 2;
-    else if (strcmp(suffix, "tension") == 0)
-        tension = 1;
-    else
-        return bad_output(sys, name, "the part after the last '.' must be "
-                                     "x, y, z or tension", err);
-    if (strcmp(base, "tow") == 0)
-        return bad_output(sys, name, "tow is the input (tow.surge, "
-                                     "tow.sway, tow.heave), not an output",
-                          err);
-    int link = -1;
-    int b = ts_system_find_body(sys, base);
-    if (b >= 0) {
-        int node = ts_system_body_node(sys, b);
-        link = node > 0 ? sys->nodes[node].link : -1;
-    } else {
-        const char *d2 = strrchr(base, '.');
-        if (d2 && d2 != base) {
-            char cname[2 * TS_NAME_MAX + 8];
-            memcpy(cname, base, (size_t)(d2 - base));
-            cname[d2 - base] = '\0';
-            char *end;
-            long k = strtol(d2 + 1, &end, 10);
-            int c = ts_system_find_cable(sys, cname);
-            if (c >= 0 && end != d2 + 1 && *end == '\0' && k >= 1 &&
-                k <= sys->cables[c].nlinks)
-                link = cable_link(sys, c, (int)k);
-        }
-    }
-    if (link < 0)
-        return bad_output(sys, name, "no such node, body or link", err);
-    if (tension) {
-        out->kind = TS_OUT_TENSION;
-        out->link = link;
-        out->unit = "N/m";
-        const ts_link *L = &sys->links[link];
-        snprintf(out->name, sizeof out->name, "%s.%d.tension",
-                 sys->cables[L->cable].name, L->index);
-    } else {
-        out->kind = TS_OUT_POSITION;
-        out->node = sys->links[link].lower;
-        out->comp = comp;
-        out->unit = "m/m";
-        char nm[2 * TS_NAME_MAX];
-        ts_system_node_name(sys, out->node, nm, sizeof nm);
-        snprintf(out->name, sizeof out->name, "%s.%c", nm, "xyz"[comp]);
-    }
-    return TS_OK;
+    int kinds = TS_OUT_BIT(TS_OUT_POSITION) | TS_OUT_BIT(TS_OUT_TENSION);
+    int rc = ts_output_find(sys, name, kinds, out, err);
+    if (rc == TS_OK || out->kind != TS_OUT_TOW_FORCE)
+        return rc;
+    char list[768];
+    ts_response_output_names(sys, list, sizeof list);
+    return ts_fail(err, TS_EINVAL, "output '%s': the frequency response "
+                   "covers node positions and link tensions; the force on "
+                   "the tow point is an output of simulate (close to it: "
+                   "the first link's tension, <cable>.1.tension); valid "
+                   "outputs: %s", name, list);
 }
 
 int ts_response_logspace(double from, double to, int points, double freq[],
@@ -206,45 +112,37 @@ void ts_response_free(ts_response *r)
     free(r);
 }
 
-/* Work for one evaluation. */
+/* Work for one evaluation: node displacements and link tensions (the
+ * sparse way), state and input vectors (the dense way). */
 typedef struct resp_ws {
+    double complex *dr, *dt;
     double complex *b, *x;
-    double *dq, *dr;
+    double *dq, *drr;
 } resp_ws;
 
-static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
-                   const ts_output *out, double omega, resp_ws *w,
-                   double complex *g, ts_err *err)
+/* The dense way (see the head of the file); lin holds A, B, Ty, Tu. */
+static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
+                       const ts_output *out, tsi_shift *sh, resp_ws *w,
+                       double complex *g)
 {
     int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
-    double complex s = I * omega;
-    tsi_shift sh;
-    int rc = tsi_shift_factor(&sh, lin, s, err);
-    if (rc != TS_OK) {
-        if (rc == TS_ESINGULAR)
-            ts_fail(err, TS_ESINGULAR,
-                    "response: i w is an eigenvalue of A at %g Hz (an "
-                    "undamped resonance): the response is infinite there",
-                    omega / (2 * M_PI));
-        return rc;
-    }
+    double complex s = sh->s;
     const double *Bx = lin->B + (size_t)(TS_IN_DISP + input) * n;
     const double *Bv = lin->B + (size_t)(TS_IN_VEL + input) * n;
     const double *Ba = lin->B + (size_t)(TS_IN_ACC + input) * n;
     for (int i = 0; i < n; i++)
         w->b[i] = -(Bx[i] + s * Bv[i] + s * s * Ba[i]);
-    tsi_shift_solve(&sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
-    tsi_shift_free(&sh);
+    tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
     if (out->kind == TS_OUT_POSITION) {
         int idx = 3 * out->node + out->comp;
         for (int i = 0; i < nq; i++)
             w->dq[i] = creal(w->x[i]);
-        ts_linear_node_displacements(sys, lin, w->dq, w->dr);
-        double gr = w->dr[idx];
+        ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+        double gr = w->drr[idx];
         for (int i = 0; i < nq; i++)
             w->dq[i] = cimag(w->x[i]);
-        ts_linear_node_displacements(sys, lin, w->dq, w->dr);
-        double gi = w->dr[idx];
+        ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+        double gi = w->drr[idx];
         *g = gr + I * gi + (out->comp == input ? 1.0 : 0.0);
     } else {
         int l = out->link;
@@ -256,21 +154,56 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                s * s * lin->Tu[l + (size_t)(TS_IN_ACC + input) * nl];
         *g = acc;
     }
+}
+
+static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
+                   const ts_output *out, double omega, resp_ws *w,
+                   double complex *g, ts_err *err)
+{
+    tsi_shift sh;
+    int rc = tsi_shift_factor(&sh, lin, I * omega, err);
+    if (rc != TS_OK) {
+        if (rc == TS_ESINGULAR)
+            ts_fail(err, TS_ESINGULAR,
+                    "response: i w is an eigenvalue of A at %g Hz (an "
+                    "undamped resonance): the response is infinite there",
+                    omega / (2 * M_PI));
+        return rc;
+    }
+    if (lin->desc) {
+        tsi_shift_input(&sh, input, w->dr, w->dt);
+        *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
+                                          : w->dt[out->link];
+    } else {
+        dense_gain(sys, lin, input, out, &sh, w, g);
+    }
+    tsi_shift_free(&sh);
     return TS_OK;
 }
 
-static int check_args(const ts_linear *lin, int input, const ts_output *out,
-                      ts_err *err)
+static int check_args(const ts_system *sys, const ts_linear *lin, int input,
+                      const ts_output *out, ts_err *err)
 {
+    if (sys->nlinks != lin->nlinks)
+        return ts_fail(err, TS_EINVAL,
+                       "response: the linear model has %d links, the system "
+                       "%d",
+                       lin->nlinks, sys->nlinks);
     if (input < 0 || input > 2)
         return ts_fail(err, TS_EINVAL,
                        "response: input channel must be 0, 1 or 2 "
                        "(tow.surge, tow.sway, tow.heave), got %d",
                        input);
-    if (out->kind == TS_OUT_TENSION && (!lin->Ty || !lin->Tu))
+    if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
-                       "response: output %s needs the tension Jacobians; "
-                       "linearize with opts.tensions = 1",
+                       "response: output %s needs a linear model (sparse, "
+                       "or dense)",
+                       out->name);
+    if (!lin->desc && out->kind == TS_OUT_TENSION && (!lin->Ty || !lin->Tu))
+        return ts_fail(err, TS_EINVAL,
+                       "response: output %s needs the tension Jacobians "
+                       "of the dense model; linearize with opts.tensions = "
+                       "1",
                        out->name);
     if (out->kind == TS_OUT_POSITION &&
         (out->node < 1 || out->node >= lin->nnodes || out->comp < 0 ||
@@ -288,26 +221,36 @@ static int check_args(const ts_linear *lin, int input, const ts_output *out,
 
 static int ws_alloc(resp_ws *w, const ts_linear *lin)
 {
-    w->b = malloc((size_t)lin->nstate * sizeof(double complex));
-    w->x = malloc((size_t)lin->nstate * sizeof(double complex));
-    w->dq = malloc((size_t)lin->nq * sizeof(double));
-    w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
-    return w->b && w->x && w->dq && w->dr;
+    memset(w, 0, sizeof *w);
+    w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double complex));
+    w->dt = malloc((size_t)(lin->nlinks > 0 ? lin->nlinks : 1) *
+                   sizeof(double complex));
+    if (!lin->desc) {
+        w->b = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->x = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->dq = malloc((size_t)lin->nq * sizeof(double));
+        w->drr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
+        if (!w->b || !w->x || !w->dq || !w->drr)
+            return 0;
+    }
+    return w->dr && w->dt;
 }
 
 static void ws_free(resp_ws *w)
 {
+    free(w->dr);
+    free(w->dt);
     free(w->b);
     free(w->x);
     free(w->dq);
-    free(w->dr);
+    free(w->drr);
 }
 
 int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
                    const ts_output *out, double omega, double *re, double *im,
                    ts_err *err)
 {
-    int rc = check_args(lin, input, out, err);
+    int rc = check_args(sys, lin, input, out, err);
     if (rc != TS_OK)
         return rc;
     if (!(omega >= 0) || !isfinite(omega))
@@ -334,7 +277,7 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                         ts_response **res, ts_err *err)
 {
     *res = NULL;
-    int rc = check_args(lin, input, out, err);
+    int rc = check_args(sys, lin, input, out, err);
     if (rc != TS_OK)
         return rc;
     if (npoints < 1)
@@ -366,7 +309,7 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
     r->input = input;
     r->output = *out;
     r->npoints = npoints;
-    double complex g;
+    double complex g = 0;
     rc = gain_at(sys, lin, input, out, 0.0, &w, &g, err);
     r->static_gain = creal(g);
     for (int i = 0; i < npoints && rc == TS_OK; i++) {

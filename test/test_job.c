@@ -10,8 +10,10 @@
  *  3. The JSON text parses and its top tension is the result's key value
  *     to the last digit (17 significant digits, read back exactly).
  *  4. Arrays without a copy: the nonlinear run's t, positions, tensions,
- *     energy and input are the history's own memory, with its shape; the
- *     linear run's tensions are NaN; unknown names give NULL and 0 x 0.
+ *     tow force, energy and input are the history's own memory, with its
+ *     shape; the linear run's tensions are finite and start at the
+ *     nonlinear run's (both from the equilibrium), its tow force NaN;
+ *     unknown names give NULL and 0 x 0.
  *  5. A simulation that fails (h_min above the step it needs) returns its
  *     code and keeps the partial history, its error in the JSON.
  */
@@ -139,9 +141,20 @@ int main(void)
         a = ts_job_array(j, "nonlinear.input", &rows, &cols);
         CHECK(a == h->input && cols == TS_NINPUT, "nonlinear.input: %d",
               cols);
+        const double *tn = h->tensions;
         a = ts_job_array(j, "linear.tensions", &rows, &cols);
-        CHECK(a && rows == r->linear->nsamples && isnan(a[0]),
-              "linear.tensions: NaN");
+        int finite = a && rows == r->linear->nsamples && cols == 8;
+        for (int k = 0; finite && k < rows * cols; k++)
+            finite = isfinite(a[k]);
+        CHECK(finite && fabs(a[0] - tn[0]) <= 1e-9 * tn[0],
+              "linear.tensions: finite (the tension Jacobians), the first "
+              "link's at t = 0 the nonlinear run's (%.12g, %.12g N)",
+              a ? a[0] : NAN, tn[0]);
+        a = ts_job_array(j, "nonlinear.tow_force", &rows, &cols);
+        CHECK(a == h->tow_force && cols == 3 && a[0] < 0,
+              "nonlinear.tow_force: 3 columns, drag aft (%.6g N)", a[0]);
+        a = ts_job_array(j, "linear.tow_force", &rows, &cols);
+        CHECK(a && cols == 3 && isnan(a[0]), "linear.tow_force: NaN");
         const char *bad[] = {"nonlinear.speed", "lin.t", "nonlinear",
                              "nonlinear.", "t"};
         int none = 1;

@@ -1,5 +1,6 @@
-/* tscene.h: loading a scene in a test program: one checked line, PASS or
- * FAIL with the reader's message. Needs tcheck.h. */
+/* tscene.h: loading a scene in a test program (a file or YAML text): one
+ * checked line, PASS or FAIL with the reader's message. Needs tcheck.h
+ * and <string.h>. */
 #ifndef TOWSTAB_TSCENE_H
 #define TOWSTAB_TSCENE_H
 
@@ -8,7 +9,7 @@
 
 #include "towstab/scene.h"
 
-static ts_scene *tscene_load(const ts_units *u, const char *path)
+static inline ts_scene *tscene_load(const ts_units *u, const char *path)
 {
     ts_err err = {0};
     ts_scene *s = u ? ts_scene_load(path, u, &err) : NULL;

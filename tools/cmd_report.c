@@ -75,8 +75,10 @@ static void usage(FILE *f)
                "  -o, --output DIR  the directory of the page (made); also "
                "DIR/results.json\n"
                "                    and the pictures under DIR/pictures/\n"
-               "  --units U         units of the pictures: si (default) or "
-               "imperial\n"
+               "  --units U         units of the pictures and printed "
+               "tables: si (default),\n"
+               "                    imperial or items like speed=knot,"
+               "force=kN\n"
                "  --quiet           print the summaries only\n");
 }
 
@@ -547,13 +549,6 @@ static int report_run(int argc, char **argv, char **words)
         fprintf(stderr, "towstab: error: report: -o DIR: expected the "
                         "directory of the page, got %s\n",
                 dir ? "an empty name" : "none");
-        return EXIT_BADINPUT;
-    }
-    if (plot_units && strcmp(plot_units, "si") && strcmp(plot_units, "SI") &&
-        strcmp(plot_units, "imperial")) {
-        fprintf(stderr, "towstab: error: report: --units: expected si or "
-                        "imperial, got '%s'\n",
-                plot_units);
         return EXIT_BADINPUT;
     }
     char html[REPORT_PATH_MAX], json[REPORT_PATH_MAX], pics[REPORT_PATH_MAX];

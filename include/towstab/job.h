@@ -69,9 +69,11 @@ TS_API const char *ts_job_json(ts_job *j, int flags, ts_err *err);
 /* An array of the result, not copied (valid until ts_job_free), row-major
  * with *rows rows of *cols: "nonlinear.t" and "linear.t" ([samples] s,
  * one column), "<run>.positions" ([samples][3 nodes] m, node 0 the tow
- * point), "<run>.tensions" ([samples][links] N), "<run>.energy"
+ * point), "<run>.tensions" ([samples][links] N), "<run>.tow_force"
+ * ([samples][3] N, the force on the tow point), "<run>.energy"
  * ([samples][2] kinetic and potential J), "<run>.input" ([samples]
- * [TS_NINPUT] u(t)). NULL (rows and cols 0) for a name the result does
+ * [TS_NINPUT] u(t)); NaN where the run has none (towstab/simulate.h,
+ * ts_history). NULL (rows and cols 0) for a name the result does
  * not hold. */
 TS_API const double *ts_job_array(const ts_job *j, const char *name,
                                   int *rows, int *cols);

@@ -11,13 +11,11 @@
  *    the tow displacement (every node moves with the tow point) plus the
  *    node displacement of the angle response through the link geometry
  *    (ts_linear_node_displacements);
- *  - a link's tension (N per m): dT/dy Z + (dT/dx + i w dT/dv - w^2 dT/da) X
- *    from the tension Jacobians of the linearization (needs
- *    ts_linearize_opts.tensions = 1).
- * Each frequency is one complex nq x nq LU (LAPACK zgetrf) of
- * P = K + s C - s^2 I, s = i w, via the structure of A: O(nq^3) per point.
- * At w = 0 the response is the static gain -C A^-1 B_x + D, which must equal
- * the change of the equilibrium with the tow point displaced.
+ *  - a link's tension (N per m), the tension unknown of the same solve.
+ * Each frequency is one sparse solve with the linear model's node
+ * equations (ts_linear.desc; doc/linear.md, sections 2b and 4): O(nlinks)
+ * per point, at any size. At w = 0 the response is the static gain, which
+ * must equal the change of the equilibrium with the tow point displaced.
  */
 #ifndef TOWSTAB_RESPONSE_H
 #define TOWSTAB_RESPONSE_H
@@ -26,38 +24,29 @@
 
 #include "towstab/error.h"
 #include "towstab/linearize.h"
+#include "towstab/output.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-typedef enum { TS_OUT_POSITION = 0, TS_OUT_TENSION = 1 } ts_output_kind;
-
-/* An output channel. */
-typedef struct ts_output {
-    ts_output_kind kind;
-    int node;      /* position: node index (>= 1) */
-    int comp;      /* position: 0 x, 1 y, 2 z (M frame, z down) */
-    int link;      /* tension: link index */
-    char name[2 * TS_NAME_MAX + 16]; /* canonical name, e.g. "sphere.z" */
-    const char *unit; /* "m/m" or "N/m" */
-} ts_output;
-
 /* Input channel (0, 1, 2) of "tow.surge", "tow.sway" or "tow.heave".
  * Returns TS_OK or TS_EINVAL with a message listing the valid names. */
 TS_API int ts_response_input_find(const char *name, int *channel,
                                   ts_err *err);
 
-/* Parse an output name: "<node>.x|y|z" (node as ts_system_node_name
- * writes it: a body's name or "<cable>.<k>", k = 1..links of that cable)
- * or "<cable>.<k>.tension" (link k of the cable; "<body>.tension" is the
- * link ending at the body). Returns TS_OK or TS_EINVAL with a message that
- * lists the valid names (and says that tow is the input). */
+/* Parse an output of the frequency response (towstab/output.h): a
+ * position "<node>.x|y|z" (node as ts_system_node_name writes it: a
+ * body's name or "<cable>.<k>", k = 1..links of that cable) or a tension
+ * "<cable>.<k>.tension" ("<body>.tension" is the link ending at the
+ * body). Returns TS_OK or TS_EINVAL with a message that lists the valid
+ * names (and says that tow is the input); the other channels (the tow
+ * force, strains) are refused as outputs of simulate. */
 TS_API int ts_response_output_find(const ts_system *sys, const char *name,
                                    ts_output *out, ts_err *err);
 
-/* Write the valid output names, compactly ("cable.1 .. cable.19, sphere"
+/* Write the valid response output names, compactly ("cable.1 .. cable.19, sphere"
  * per cable), into buf. */
 TS_API void ts_response_output_names(const ts_system *sys, char *buf,
                                      size_t size);
@@ -80,11 +69,12 @@ typedef struct ts_response {
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at
- * freq_hz[npoints] (Hz, each >= 0). On success *res is new (free with
- * ts_response_free). Returns TS_OK, TS_EINVAL (bad channel, negative
- * frequency, tension output without tension Jacobians), TS_ESINGULAR (i w
- * is an eigenvalue: an undamped resonance exactly on a point) or
- * TS_ENOMEM. */
+ * freq_hz[npoints] (Hz, each >= 0). lin must hold the sparse model
+ * (ts_linearize with TS_LIN_AUTO, SPARSE or BOTH). On success *res is new
+ * (free with ts_response_free). Returns TS_OK, TS_EINVAL (bad channel,
+ * negative frequency, no sparse model, a system other than lin's),
+ * TS_ESINGULAR (i w is an eigenvalue: an undamped resonance exactly on a
+ * point) or TS_ENOMEM. */
 TS_API int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                                int input, const ts_output *out,
                                const double freq_hz[], int npoints,

@@ -9,7 +9,10 @@
  * implicit methods for stiff scenes (GSL's rk4imp, bsimp, msbdf, and
  * esdirk: SUNDIALS ARKODE's L-stable ESDIRK 5(4), the one for elastic
  * cables) whose Jacobian df/dy comes from the linearizer
- * (towstab/linearize.h). Steps never
+ * (towstab/linearize.h): GSL's the dense A, O(nlinks^2) per Jacobian and
+ * O(nlinks^3) per LU; esdirk's the sparse model, O(nlinks) per Jacobian,
+ * factorisation and solve. A run starts from ts_sim_start_state of its
+ * initial state (an impulsive start absorbed by the top links). Steps never
  * straddle an output time or a breakpoint of the excitation. After every
  * accepted step, links with |cos theta2| below the re-chart threshold are
  * moved to a chart centred on their direction (ts_kernel_rechart) and the
@@ -35,6 +38,7 @@
 #include "towstab/excitation.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
+#include "towstab/output.h"
 #include "towstab/progress.h"
 #include "towstab/system.h"
 
@@ -130,7 +134,10 @@ typedef struct ts_history {
     int nsamples;        /* samples filled */
     double *t;           /* [capacity] s */
     double *positions;   /* [capacity][3 nnodes] m, M frame, node 0 = tow */
-    double *tensions;    /* [capacity][nlinks] N (NaN in linear runs) */
+    double *tensions;    /* [capacity][nlinks] N (linear runs: from the
+                            tension Jacobians, NaN without them) */
+    double *tow_force;   /* [capacity][3] N, the force on the tow point
+                            (ts_kernel_tow_force; NaN in linear runs) */
     double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
                             linear runs; ts_kernel_kinetic_energy) */
     double *input;       /* [capacity][TS_NINPUT] u(t) */
@@ -140,6 +147,12 @@ typedef struct ts_history {
 TS_API ts_history *ts_history_alloc(const ts_system *sys, int capacity,
                                     ts_err *err);
 TS_API void ts_history_free(ts_history *h);
+
+/* The value of output channel `out` (towstab/output.h) at sample i of h
+ * (0 <= i < h->nsamples), NaN when the run does not give it (the tow
+ * force of a linear run). */
+TS_API double ts_history_value(const ts_system *sys, const ts_history *h,
+                               const ts_output *out, int i);
 
 /* --- Nonlinear simulation: set / advance / read, and a driver. --- */
 
@@ -177,8 +190,10 @@ TS_API void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st);
  * (TS_EINVAL when h is full). */
 TS_API int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err);
 
-/* Driver: simulate from y0 (kernel charts) over [0, o->t_end], recording
- * every output sample (h needs ts_sim_nsamples(o) samples). y_end[2 nq]
+/* Driver: simulate from y0 (kernel charts; the system before the tow
+ * point moves: the run starts from ts_sim_start_state(k, ex, y0)) over
+ * [0, o->t_end], recording every output sample (h needs ts_sim_nsamples(o)
+ * samples). y_end[2 nq]
  * (may be NULL) receives the final state in the kernel's charts, which
  * may have changed. On failure the history holds the samples reached and
  * *st the statistics so far. */
@@ -190,7 +205,10 @@ TS_API int ts_simulate(ts_kernel *k, const ts_excitation *ex,
 /* --- Linear simulation. --- */
 
 /* Simulate z' = A z + B (u(t) - u0) from z(0) = z0 (NULL: 0) over
- * [0, o->t_end], recording positions into h (tensions and energies NaN).
+ * [0, o->t_end], recording positions into h, and the link tensions
+ * T0 + dT/dy z + dT/du (u - u0) when lin has the tension Jacobians
+ * (ts_linearize_opts.tensions; else NaN); energies and the tow force are
+ * NaN.
  * `k` must be the kernel lin was computed with, in the same charts (its
  * frame too); it is used for the nonlinear kinematics only. The linear
  * model has no frame inputs: an excitation with a manoeuvre is refused
@@ -203,6 +221,23 @@ TS_API int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                               ts_sim_stats *st, ts_err *err);
 
 /* --- Initial states. --- */
+
+/* The state at t = 0+ of a run started from y0[2 nq] (the system before
+ * the tow point moves) under ex: y0 itself unless a tow signal starts
+ * impulsively (a sine or crank with ramp 0: ts_excitation_start_jump),
+ * which sets the tow point moving at once. Its coordinates being relative
+ * to the tow point, y0 would then move every node with it; instead the
+ * jump in velocity is absorbed where the cable can: a link leaving a node
+ * that jumps takes the jump whole when elastic (its lower node keeps its
+ * velocity: a rate of stretch, the start of an axial wave), and only the
+ * part normal to itself when rigid (the part along it moves its lower
+ * node, and so on down). A displacement the signal has at t = 0 (a crank
+ * at phase 0) is where the tow point rested before: the cable starts
+ * there with it. Writes y[2 nq] (may alias y0) in k's charts. ts_simulate
+ * starts from this state; doc/simulate.md. Returns TS_OK or TS_ESINGULAR
+ * (the kernel refuses y0). */
+TS_API int ts_sim_start_state(ts_kernel *k, const ts_excitation *ex,
+                              const double y0[], double y[], ts_err *err);
 
 /* A released shape: every link along the unit direction of angles
  * (theta1, theta2) (rad; n = (-c1 c2, -s2, s1 c2): 0, 0 is straight aft,

@@ -32,7 +32,6 @@ __all__ = ["Scene", "Result", "KeyValue", "Record", "Table", "History",
 ANALYSES = ("equilibrium", "modes", "response", "simulate", "converge")
 # ts_report_result_json's flags (towstab/report_result.h).
 REPORT_MATRICES = 1
-REPORT_OUTPUT_ONLY = 2
 
 
 class TowstabError(Exception):
@@ -213,16 +212,17 @@ class Scene:
             library.ts_scene_free(self._ptr)
             self._ptr = None
 
-    def run(self, analysis, entry=-1, matrices=False, output_only=False,
-            **options):
+    def run(self, analysis, entry=-1, matrices=False, **options):
         """Run ``analysis`` ("equilibrium", "modes", "response",
         "simulate", "converge") with the options of the scene's entry
         analyses[entry] (-1: its first entry of that kind, if any) below
         ``options`` (the analysis' options by scene key, ``t_end="12 s"``,
         ``count=6``, as ``towstab ANALYSIS --help`` lists them). A
         repeatable option takes a list (``excite=[...]``). ``matrices``:
-        the modes' A and B in the result; ``output_only``: a simulation's
-        histories of its output's node only. Raises TowstabError when the
+        the modes' A and B in the result (as --matrices). A simulation's
+        JSON holds the channels of ``outputs`` (``outputs="all"``: the full
+        state too); ``history()`` has every node and link whatever it is.
+        Raises TowstabError when the
         request is refused (nothing ran), AnalysisError when the analysis
         failed (its partial result attached)."""
         if analysis not in ANALYSES:
@@ -245,8 +245,7 @@ class Scene:
                     raise TowstabError(err.code, err.msg.decode())
         rc = library.ts_job_run(job.ptr, ctypes.byref(err))
         message = err.msg.decode()
-        flags = (REPORT_MATRICES if matrices else 0) | \
-            (REPORT_OUTPUT_ONLY if output_only else 0)
+        flags = REPORT_MATRICES if matrices else 0
         text = library.ts_job_json(job.ptr, flags, ctypes.byref(err))
         if text is None:
             raise TowstabError(rc or err.code, message or err.msg.decode())
@@ -431,8 +430,10 @@ class History:
     """A simulation's run as arrays that point into the library's result
     (no copy; read-only): ``t`` [samples] s, ``positions`` [samples,
     nodes, 3] m (node 0 the tow point), ``tensions`` [samples, links] N
-    (nan in a linear run), ``energy`` [samples, 2] J, ``input`` [samples,
-    9] (towstab/job.h)."""
+    (a linear run's from the tension Jacobians), ``tow_force`` [samples,
+    3] N (the force on the tow point; nan in a linear run), ``energy``
+    [samples, 2] J (nan in a linear run), ``input`` [samples, 9]
+    (towstab/job.h)."""
 
     def __init__(self, job, run):
         t = job.array(run + ".t")
@@ -440,6 +441,7 @@ class History:
         p = job.array(run + ".positions")
         self.positions = p.reshape(p.shape[0], p.shape[1] // 3, 3)
         self.tensions = job.array(run + ".tensions")
+        self.tow_force = job.array(run + ".tow_force")
         self.energy = job.array(run + ".energy")
         self.input = job.array(run + ".input")
 

@@ -60,6 +60,27 @@ else
     fail "modes --json -: status $status"
 fi
 
+# A large system: the sparse model and ARPACK, with the rightmost search.
+# Example 1 at 400 links: the rightmost eigenvalue is the top of the
+# transverse band, -0.0166107 1/s at 53.103 Hz (LAPACK on the same model,
+# test/test_eigen_search.c), not among the 20 modes nearest 0 Hz (whose
+# largest real part is -0.16).
+rm -f "$T/big.json"
+ts modes examples/kamman_ex1_submerged.yaml --links 400 --json "$T/big.json" \
+    --quiet
+cat > "$T/big.expected.json" <<'EOF'
+{"rtol": 1e-4, "atol": 0,
+ "expect": {"complete": false, "rightmost": {"re": -0.0166107, "freq_hz": 53.1029},
+            "linearization": {"model": "sparse"}}}
+EOF
+if [ "$status" -eq 0 ] && has_keys "$T/big.json" rightmost search top_hz &&
+   "$CHECK_JSON" compare "$T/big.json" "$T/big.expected.json" &&
+   grep -q 'rightmost search' "$T/out"; then
+    pass "modes at 400 links: sparse model, the rightmost search finds the band top"
+else
+    fail "modes at 400 links: status $status; $(head -c 300 "$T/err")"
+fi
+
 rm -f "$T/shapes.csv"
 ts modes examples/kamman_ex3_turn.yaml --count 2 --shapes "$T/shapes.csv" --quiet
 if [ "$status" -eq 0 ] && [ "$(wc -l < "$T/shapes.csv")" -gt 20 ]; then
@@ -109,6 +130,31 @@ if grep -q "sphere" "$T/err"; then
     pass "response: an unknown output lists the valid ones"
 else
     fail "response: unknown output message: $(cat "$T/err")"
+fi
+
+# A rigid link's tension: the note that inextensible links overstate it
+# at high frequency, in the table and in the JSON; none for a position.
+rm -rf "$T/o"
+mkdir "$T/o"
+ts response examples/kamman_ex1_submerged.yaml --output cable.1.tension \
+    --to 1 --quiet --json "$T/o/t.json"
+if [ "$status" -eq 0 ] && grep -q "note: inextensible links overstate" "$T/out" &&
+   grep -q "inextensible links overstate.*elastic cable" "$T/o/t.json"; then
+    pass "response on a rigid link's tension: $(grep -o 'note: inextensible.*(.*)' "$T/out" | cut -c1-150)"
+else
+    fail "response on a rigid link's tension: status $status, no note"
+fi
+ts response examples/kamman_ex1_submerged.yaml --output sphere.z --to 1 --quiet
+if [ "$status" -eq 0 ] && ! grep -q "inextensible" "$T/out"; then
+    pass "response on a position: no note on tensions"
+else
+    fail "response on a position: status $status or a tension note"
+fi
+ts response examples/kamman_ex1_submerged.yaml --output tow.force
+if [ "$status" -eq 2 ] && grep -q "output of simulate" "$T/err"; then
+    pass "response --output tow.force: exit 2, points to simulate"
+else
+    fail "response --output tow.force: status $status: $(cat "$T/err")"
 fi
 
 rm -rf "$T/o"

@@ -156,7 +156,7 @@ bad "no -o" "-o DIR: expected the directory" report "$ALL"
 bad "an empty -o" "got an empty name" report "$ALL" -o ""
 touch "$T/file"
 bad "-o a file" "not a directory" report "$ALL" -o "$T/file"
-bad "--units bad" "--units: expected si or imperial" report "$ALL" -o "$T/o/x" --units cubits
+bad "--units bad" "--units: 'cubits': expected si, imperial or QUANTITY=UNIT" report "$ALL" -o "$T/o/x" --units cubits
 bad "an unknown option" "unknown option '--speed'" report "$ALL" -o "$T/o/x" --speed 3
 printf 'name: none\ntow: {speed: 1}\ncables:\n  - {name: c, from: tow, length: 5, diameter: 0.01, mass_per_length: 0.1, links: 2}\n' >"$T/none.yaml"
 bad "a scene without analyses" "lists no analyses" report "$T/none.yaml" -o "$T/o/x"
