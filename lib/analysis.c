@@ -2880,12 +2880,14 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
     ts_system_free(s);
     /* The discretisation estimate runs the analysis again at a half and
      * a quarter of the links (doc/accuracy.md): a dense eigen analysis
-     * at least 1/8 + 1/64 more, an explicit simulation 1/4 + 1/16 (its
-     * steps and its evaluations each halve with the links). */
+     * at least 1/8 + 1/64 more, a sparse one (no flops counted) 1/2 +
+     * 1/4, an explicit simulation 1/4 + 1/16 (its steps and its
+     * evaluations each halve with the links). */
     int estimate = rq->setup.discretisation_error || rq->setup.refine;
     if (rc == TS_OK && estimate && e->seconds > 0) {
-        double f = rq->kind == TS_ANALYSIS_MODES ? 1.0 / 8 + 1.0 / 64
-                                                 : 1.0 / 4 + 1.0 / 16;
+        double f = rq->kind != TS_ANALYSIS_MODES ? 1.0 / 4 + 1.0 / 16
+                   : e->flops > 0                ? 1.0 / 8 + 1.0 / 64
+                                                 : 1.0 / 2 + 1.0 / 4;
         e->seconds *= 1 + f;
         e->evaluations *= 1 + f;
         e->flops *= 1 + f;

@@ -156,12 +156,14 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     }
 }
 
+/* The gain at omega; sh holds the factors of the previous frequency
+ * (zeroed before the first), which are refactored (tsi_shift_refactor);
+ * the caller frees them. */
 static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                    const ts_output *out, double omega, resp_ws *w,
-                   double complex *g, ts_err *err)
+                   tsi_shift *sh, double complex *g, ts_err *err)
 {
-    tsi_shift sh;
-    int rc = tsi_shift_factor(&sh, lin, I * omega, err);
+    int rc = tsi_shift_refactor(sh, lin, I * omega, err);
     if (rc != TS_OK) {
         if (rc == TS_ESINGULAR)
             ts_fail(err, TS_ESINGULAR,
@@ -171,13 +173,12 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
         return rc;
     }
     if (lin->desc) {
-        tsi_shift_input(&sh, input, w->dr, w->dt);
+        tsi_shift_input(sh, input, w->dr, w->dt);
         *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
                                           : w->dt[out->link];
     } else {
-        dense_gain(sys, lin, input, out, &sh, w, g);
+        dense_gain(sys, lin, input, out, sh, w, g);
     }
-    tsi_shift_free(&sh);
     return TS_OK;
 }
 
@@ -264,7 +265,9 @@ int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
         return ts_fail(err, TS_ENOMEM, "response: out of memory");
     }
     double complex g = 0;
-    rc = gain_at(sys, lin, input, out, omega, &w, &g, err);
+    tsi_shift sh = {0};
+    rc = gain_at(sys, lin, input, out, omega, &w, &sh, &g, err);
+    tsi_shift_free(&sh);
     ws_free(&w);
     *re = creal(g);
     *im = cimag(g);
@@ -310,16 +313,19 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
     r->output = *out;
     r->npoints = npoints;
     double complex g = 0;
-    rc = gain_at(sys, lin, input, out, 0.0, &w, &g, err);
+    tsi_shift sh = {0};
+    rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, err);
     r->static_gain = creal(g);
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
-        rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &g, err);
+        rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,
+                     err);
         r->freq_hz[i] = freq_hz[i];
         r->re[i] = creal(g);
         r->im[i] = cimag(g);
         r->magnitude[i] = cabs(g);
         r->phase_deg[i] = carg(g) * 180.0 / M_PI;
     }
+    tsi_shift_free(&sh);
     ws_free(&w);
     if (rc != TS_OK) {
         ts_response_free(r);

@@ -322,7 +322,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
             snprintf(label[s], sizeof label[s], "%d %s", nset[s],
                      s ? "unresolved (grid-scale, or beyond the accuracy)" : "resolved");
         ts_plot_series a = {nset[s], sre[s], sim[s], label[s], 0,
-                            TS_PLOT_MARKERS, s ? 2 : 1};
+                            TS_PLOT_MARKERS, s ? 2 : 1, NULL};
         set[nsets++] = a;
     }
     if (nsets > 0 &&

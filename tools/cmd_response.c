@@ -170,6 +170,11 @@ static int response_prepare(cli_run *c)
                         "spectra with --csv (or --json) instead\n");
         return EXIT_BADINPUT;
     }
+    if (c->nextra[0] && !c->plot.dir) {
+        fprintf(stderr, "towstab: error: response: --db sets the Bode "
+                        "plot's magnitude axis; add --plot DIR\n");
+        return EXIT_BADINPUT;
+    }
     /* The Bode plot marks the natural frequencies. */
     c->rq.response.natural = c->plot.dir != NULL;
     return 0;
@@ -213,10 +218,12 @@ static int response_draw(cli_run *c, const ts_result *r)
                                      TS_PLOT_SOLID, 0};
             int tension = res->output.kind == TS_OUT_TENSION;
             ts_err perr = {0};
+            ts_plot_opts po = plot->opts;
+            po.bode_db = c->nextra[0] > 0; /* --db */
             if (ts_plot_bode(plot->dir, "bode", title, mag_label,
                              tension ? TS_PLOT_FORCE : TS_PLOT_LENGTH,
                              TS_PLOT_LENGTH, 1, &bc, r->nnatural,
-                             r->natural_hz, &plot->opts, &perr) != TS_OK)
+                             r->natural_hz, &po, &perr) != TS_OK)
                 status = cli_report(&perr, perr.code);
             else
                 cli_plot_wrote(plot, "bode");
@@ -228,7 +235,12 @@ static int response_draw(cli_run *c, const ts_result *r)
 
 static const char *const response_pictures[] = {"bode", NULL};
 
+static const cli_extra response_extras[] = {
+    {"db", 0, 0, NULL,
+     "the Bode plot's magnitude in dB (20 log10 |H|) with --plot"},
+    {NULL, 0, 0, NULL, NULL}};
+
 const cli_command cli_cmd_response = {
     "response", "frequency response to tow-point motion",
     TS_ANALYSIS_RESPONSE, NULL, response_prepare, response_print,
-    response_draw, NULL, response_pictures, NULL};
+    response_draw, NULL, response_pictures, response_extras};
