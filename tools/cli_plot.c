@@ -31,6 +31,17 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
     return 0;
 }
 
+void cli_plot_wrote(const cli_plot *p, const char *name)
+{
+    int png = p->opts.formats & TS_PLOT_PNG, svg = p->opts.formats & TS_PLOT_SVG;
+    printf("wrote");
+    if (png)
+        printf(" %s/%s.png", p->dir, name);
+    if (svg)
+        printf("%s %s/%s.svg", png ? " and" : "", p->dir, name);
+    printf("\n");
+}
+
 int cli_display_begin(const ts_units *units, const char *spec,
                       ts_display *d)
 {

@@ -27,6 +27,8 @@ typedef struct cli_plot {
  * or all is well. */
 int cli_plot_begin(cli_plot *p, const char *cmd);
 
+/* Print "wrote DIR/NAME.png and DIR/NAME.svg" (the formats drawn). */
+void cli_plot_wrote(const cli_plot *p, const char *name);
 /* The display units of --units `spec` (NULL: SI) into d
  * (ts_display_parse: si, imperial, QUANTITY=UNIT items). Prints and
  * returns EXIT_BADINPUT for a bad spec, else 0. */

@@ -255,8 +255,7 @@ static int converge_plot(const ts_convergence *c, const char *scene,
                            &plot->opts, &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/error_time.png and %s/error_time.svg\n",
-                   plot->dir, plot->dir);
+            cli_plot_wrote(plot, "error_time");
     }
     free(idx);
     free(x);

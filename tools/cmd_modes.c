@@ -334,8 +334,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
                             NULL, &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else if (nsets > 0)
-        printf("wrote %s/eigenvalues.png and %s/eigenvalues.svg\n",
-               plot->dir, plot->dir);
+        cli_plot_wrote(plot, "eigenvalues");
     free(buf);
 
     /* The shapes: the lowest resolved oscillatory modes (the listing is
@@ -386,8 +385,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
                                 &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/modes.png and %s/modes.svg\n", plot->dir,
-                   plot->dir);
+            cli_plot_wrote(plot, "modes");
     }
     /* Each drawn mode as an animated SVG (side view), one cycle in 2 s. */
     for (int i = 0; i < np && status == 0; i++) {

@@ -162,6 +162,8 @@ static void response_print(const cli_run *c, const ts_result *r)
 
 static int response_prepare(cli_run *c)
 {
+    if (c->plot.dir && c->rq.response.sea.sea && c->plot_optional)
+        c->plot.dir = NULL; /* there is no picture of it */
     if (c->plot.dir && c->rq.response.sea.sea) {
         fprintf(stderr, "towstab: error: response: --plot draws a Bode plot, "
                         "which a sea-state response has not; write its "
@@ -224,8 +226,7 @@ static int response_draw(cli_run *c, const ts_result *r)
                              r->natural_hz, &po, &perr) != TS_OK)
                 status = cli_report(&perr, perr.code);
             else
-                printf("wrote %s/bode.png and %s/bode.svg\n", plot->dir,
-                       plot->dir);
+                cli_plot_wrote(plot, "bode");
             free(ph);
         }
     }

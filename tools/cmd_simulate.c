@@ -351,8 +351,7 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
                           &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else
-        printf("wrote %s/histories.png and %s/histories.svg\n", plot->dir,
-               plot->dir);
+        cli_plot_wrote(plot, "histories");
     free(buf);
     return status;
 }
@@ -509,8 +508,7 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
                            &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/%s.png and %s/%s.svg\n", plot->dir, names[v],
-                   plot->dir, names[v]);
+            cli_plot_wrote(plot, names[v]);
     }
     if (!status && ex && ts_excitation_has_manoeuvre(ex)) {
         char title[256];
