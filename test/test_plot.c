@@ -469,6 +469,61 @@ static void test_cylinder(void)
     CHECK(nothing_named("cyl_bad"), "refused shapes left no file");
 }
 
+/* A mode as an animated SVG: the file, its title, one <animate> with
+ * nframes + 1 path values, the first and the last the same (the loop
+ * closes), the frames apart; no PNG; bad frame counts refused. */
+static void test_animation(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    static double re[3 * N], im[3 * N];
+    for (int k = 0; k < N; k++) {
+        double s = (double)k / (N - 1);
+        re[3 * k + 2] = sin(M_PI * s);
+        im[3 * k] = 0.5 * sin(2 * M_PI * s);
+    }
+    ts_plot_shape eq = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
+                        0, NULL};
+    int rc = ts_plot_mode_animation(dir, "anim", "chain: mode 1", TS_PLOT_SIDE,
+                                    TS_PLOT_WATER, &eq, re, im,
+                                    "mode 1: 0.5 Hz", 12, 2.0, &o, &err);
+    CHECK(rc == TS_OK, "mode animation written (%s)", err.msg);
+    char *svg = check_svg("anim", "chain: mode 1");
+    CHECK(!file_exists("anim", "png"), "an animation is an SVG only");
+    const char *v = svg ? strstr(svg, "<animate ") : NULL;
+    const char *vals = v ? strstr(v, "values=\"") : NULL;
+    const char *end = vals ? strchr(vals + 8, '"') : NULL;
+    int nsep = 0;
+    for (const char *p = vals; p && p < end; p++)
+        nsep += *p == ';';
+    CHECK(v && end && nsep == 12, "one <animate> with 13 path values (%d "
+          "separators)", nsep);
+    if (v && end && nsep == 12) {
+        const char *first = vals + 8, *f_end = strchr(first, ';');
+        const char *last = end;
+        while (last > first && last[-1] != ';')
+            last--;
+        size_t lf = (size_t)(f_end - first), ll = (size_t)(end - last);
+        CHECK(lf == ll && strncmp(first, last, lf) == 0,
+              "the cycle closes: the last frame is the first");
+        const char *second = f_end + 1, *s_end = strchr(second, ';');
+        CHECK((size_t)(s_end - second) != lf ||
+                  strncmp(first, second, lf) != 0,
+              "the second frame differs from the first");
+    }
+    free(svg);
+    rc = ts_plot_mode_animation(dir, "anim_bad", "x", TS_PLOT_SIDE, 0, &eq,
+                                re, im, NULL, 2, 2.0, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "nframes"),
+          "2 frames are refused: %s", err.msg);
+    rc = ts_plot_mode_animation(dir, "anim_bad", "x", TS_PLOT_SIDE, 0, &eq,
+                                re, im, NULL, 12, 0.0, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "seconds"),
+          "a cycle of 0 s is refused: %s", err.msg);
+    CHECK(nothing_named("anim_bad"), "refused animations left no file");
+}
+
 static void test_modes(void)
 {
     ts_plot_opts o;
@@ -1063,6 +1118,7 @@ int main(int argc, char **argv)
           "PLplot with its cairo devices is available (%s)", err.msg);
     test_shapes();
     test_cylinder();
+    test_animation();
     test_modes();
     test_eigenvalues();
     test_bode();

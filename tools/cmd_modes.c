@@ -252,7 +252,7 @@ static int ends_with(const char *s, const char *suffix)
  * the eigenvector's coordinate half), Re(d e^{i phi}) = a cos phi -
  * b sin phi is largest at tan 2 phi = -2 a.b / (|a|^2 - |b|^2). */
 static int mode_disp(const ts_system *sys, const ts_linear *lin,
-                     const ts_eigen *e, int m, double *out)
+                     const ts_eigen *e, int m, double *out, double *im_out)
 {
     int nq = lin->nq, nn = sys->nnodes;
     double *dq = malloc((size_t)nq * sizeof(double));
@@ -275,8 +275,12 @@ static int mode_disp(const ts_system *sys, const ts_linear *lin,
         ab += out[i] * b[i];
     }
     double phi = 0.5 * atan2(-2 * ab, aa - bb), c = cos(phi), sn = sin(phi);
-    for (int i = 0; i < 3 * nn; i++)
+    /* d e^{i phi}: its real part, and its imaginary part when asked. */
+    for (int i = 0; i < 3 * nn; i++) {
+        if (im_out)
+            im_out[i] = out[i] * sn + b[i] * c;
         out[i] = out[i] * c - b[i] * sn;
+    }
     free(dq);
     free(b);
     return 0;
@@ -352,7 +356,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
     if (np < 1 || !e->vec_re || !e->vec_im)
         return status;
     cli_shape eqs;
-    double *disp = malloc((size_t)np * 3 * (size_t)sys->nnodes *
+    double *disp = malloc((size_t)np * 6 * (size_t)sys->nnodes *
                           sizeof(double));
     char labels[PLOT_MODES][160];
     ts_plot_mode modes[PLOT_MODES];
@@ -365,8 +369,8 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
     for (int i = 0; i < np; i++) {
         int m = pick[i];
         const ts_mode *md = &e->modes[m];
-        double *d = disp + (size_t)i * 3 * sys->nnodes;
-        if (mode_disp(sys, lin, e, m, d) != 0) {
+        double *d = disp + (size_t)i * 6 * sys->nnodes;
+        if (mode_disp(sys, lin, e, m, d, d + 3 * sys->nnodes) != 0) {
             status = EXIT_FAILED;
             break;
         }
@@ -386,6 +390,21 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
             status = cli_report(&err, err.code);
         else
             cli_plot_wrote(plot, "modes");
+    }
+    /* Each drawn mode as an animated SVG (side view), one cycle in 2 s. */
+    for (int i = 0; i < np && status == 0; i++) {
+        char name[32], at[300];
+        snprintf(name, sizeof name, "mode%d_animation", pick[i] + 1);
+        snprintf(at, sizeof at, "%s: mode %d, side view, one cycle",
+                 sys->name, pick[i] + 1);
+        const double *d = disp + (size_t)i * 6 * sys->nnodes;
+        if (ts_plot_mode_animation(plot->dir, name, at, TS_PLOT_SIDE,
+                                   TS_PLOT_WATER, &eqs.shape, d,
+                                   d + 3 * sys->nnodes, labels[i], 36, 2.0,
+                                   &plot->opts, &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            printf("wrote %s/%s.svg\n", plot->dir, name);
     }
     cli_plot_shape_free(&eqs);
     free(disp);

@@ -190,6 +190,25 @@ typedef struct ts_plot_mode {
     const char *label;   /* e.g. "mode 1: 0.412 Hz, damping 3.1 %" */
 } ts_plot_mode;
 
+/* A mode as an animation: DIR/NAME.svg only (whatever opts->formats), an
+ * SVG whose cable path runs through one cycle of the mode every `seconds`
+ * seconds and loops (SMIL <animate> of its path, nframes frames at phases
+ * 2 pi k / nframes: eq + s Re((re + i im) e^{i phi}), s making the largest
+ * node amplitude 15 % of the equilibrium's extent), over the equilibrium
+ * in grey, in one view (side, with TS_PLOT_WATER the water; or top, equal
+ * scales), titled, with `label` above the box (may be NULL). re and im:
+ * [3 nnodes] node displacements of the mode's real and imaginary parts.
+ * nframes in [4, TS_PLOT_MAX_FRAMES]. Browsers play it; a still viewer
+ * shows the first frame. */
+#define TS_PLOT_MAX_FRAMES 360
+TS_API int ts_plot_mode_animation(const char *dir, const char *name,
+                                  const char *title, ts_plot_view view,
+                                  int flags, const ts_plot_shape *eq,
+                                  const double *re, const double *im,
+                                  const char *label, int nframes,
+                                  double seconds, const ts_plot_opts *opts,
+                                  ts_err *err);
+
 /* Axis window of ts_plot_eigenvalues; a field equal to 0 is automatic. */
 typedef struct ts_plot_eig_window {
     double re_min;  /* left edge, 1/s (< 0) */

@@ -175,6 +175,14 @@ ts response "$EX1" --output sphere.z --quiet --plot "$T/bode" --units imperial
 check "response --plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
 check "response --plot: Bode plot, PNG and SVG, titled" \
     bash -c "$(declare -f is_png is_svg); is_png '$T/bode/bode.png' 1000 700 && is_svg '$T/bode/bode.svg' 'kamman_ex1_above: frequency response'"
+anim_ok=1
+nanim=0
+for f in "$T/modes"/mode*_animation.svg; do
+    nanim=$((nanim + 1))
+    { [ -f "$f" ] && grep -q '<animate ' "$f" && grep -q '<title>kamman_ex3: mode' "$f"; } || anim_ok=0
+done
+check "modes --plot: the four drawn modes as animated SVGs (got $nanim)" \
+    bash -c "[ $anim_ok -eq 1 ] && [ $nanim -eq 4 ]"
 ts modes "$EX3" --plot "$T/afile"
 check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
 
