@@ -222,4 +222,4 @@ static const char *const response_pictures[] = {"bode", NULL};
 const cli_command cli_cmd_response = {
     "response", "frequency response to tow-point motion",
     TS_ANALYSIS_RESPONSE, NULL, response_prepare, response_print,
-    response_draw, NULL, response_pictures, NULL};
+    response_draw, NULL, response_pictures, NULL, NULL};

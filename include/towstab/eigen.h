@@ -17,6 +17,10 @@
  *  - auto: arpack when a number of modes is asked for and nstate >=
  *    arpack_min_states, else lapack.
  *
+ * Threads: solves on different linear models may run at once (a sweep's
+ * threads); ARPACK's, which keeps Fortran state between calls, are taken
+ * one at a time.
+ *
  * A mode is one eigenvalue with Im >= 0: one of each complex-conjugate
  * pair, or a real (non-oscillatory) eigenvalue. Units: lambda in 1/s,
  * frequency in Hz, period and time constant in s.
