@@ -336,6 +336,31 @@ const ts_value *ts_result_value(const ts_result *r, const char *name)
     return NULL;
 }
 
+int ts_result_margin(const ts_result *r, ts_margin *m)
+{
+    const ts_stability *st = r ? &r->stability : NULL;
+    m->max_real = m->freq_hz = NAN;
+    m->error.discretisation = m->error.solver = NAN;
+    m->verdict = -1;
+    m->resolved = 0;
+    if (!r || !r->eigen)
+        return 0;
+    if (st->mode >= 0 && st->verdict >= 0) {
+        m->max_real = st->max_real;
+        m->error.solver = st->solver_error;
+        m->error.discretisation = st->discretisation_error;
+        m->freq_hz = r->eigen->modes[st->mode].freq_hz;
+        m->verdict = st->verdict;
+        m->resolved = 1;
+    } else if (st->unresolved_mode >= 0 && st->unresolved_verdict >= 0) {
+        m->max_real = st->unresolved_max_real;
+        m->error.solver = st->unresolved_error;
+        m->freq_hz = r->eigen->modes[st->unresolved_mode].freq_hz;
+        m->verdict = st->unresolved_verdict;
+    }
+    return m->verdict >= 0;
+}
+
 /* Room for n key values, named later; NAN values and estimates. */
 static int values_alloc(ts_result *r, int n, ts_err *err)
 {

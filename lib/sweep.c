@@ -381,39 +381,6 @@ static void put(ts_sweep *s, int p, const char *name, double value,
     s->errors[i].solver = solver;
 }
 
-/* The stability margin of a modes result: that of its resolved modes
- * (towstab/accuracy.h ts_stability); when none is resolved, that of the
- * modes computed (of the discrete model: the point's verdict then says
- * the accuracy is missed). Sets max Re(lambda), its solver and
- * discretisation errors, the frequency of that mode (Hz) and the verdict;
- * returns 0 (verdict -1, NaN values) without modes. */
-typedef struct margin {
-    double max_real, solver, disc, freq_hz;
-    int verdict;
-} margin;
-
-static int margin_of(const ts_result *r, margin *m)
-{
-    const ts_stability *st = &r->stability;
-    m->max_real = m->solver = m->disc = m->freq_hz = NAN;
-    m->verdict = -1;
-    if (!r->eigen)
-        return 0;
-    if (st->mode >= 0 && st->verdict >= 0) {
-        m->max_real = st->max_real;
-        m->solver = st->solver_error;
-        m->disc = st->discretisation_error;
-        m->freq_hz = r->eigen->modes[st->mode].freq_hz;
-        m->verdict = st->verdict;
-    } else if (st->unresolved_mode >= 0 && st->unresolved_verdict >= 0) {
-        m->max_real = st->unresolved_max_real;
-        m->solver = st->unresolved_error;
-        m->freq_hz = r->eigen->modes[st->unresolved_mode].freq_hz;
-        m->verdict = st->unresolved_verdict;
-    }
-    return m->verdict >= 0;
-}
-
 /* Record result r (status rc) as point p's. */
 static int record(ts_sweep *s, int p, const ts_result *r, int rc, int warm,
                   ts_err *err)
@@ -426,8 +393,8 @@ static int record(ts_sweep *s, int p, const ts_result *r, int rc, int warm,
     pt->evaluations = r->evaluations;
     pt->iterations = r->eq ? r->eq->iterations : 0;
     pt->wall_s = r->wall_s;
-    margin mg = {NAN, NAN, NAN, NAN, -1};
-    int has_margin = rc == TS_OK && margin_of(r, &mg);
+    ts_margin mg;
+    int has_margin = ts_result_margin(r, &mg) && rc == TS_OK;
     pt->verdict = has_margin ? mg.verdict : -1;
     for (size_t c = 0; c < (size_t)s->ncolumns; c++) {
         size_t i = (size_t)p * (size_t)s->ncolumns + c;
@@ -449,7 +416,8 @@ static int record(ts_sweep *s, int p, const ts_result *r, int rc, int warm,
         put(s, p, r->values[i].name, r->values[i].value,
             r->values[i].error.discretisation, r->values[i].error.solver);
     if (has_margin) {
-        put(s, p, TS_SWEEP_MAX_REAL, mg.max_real, mg.disc, mg.solver);
+        put(s, p, TS_SWEEP_MAX_REAL, mg.max_real, mg.error.discretisation,
+            mg.error.solver);
         put(s, p, TS_SWEEP_MAX_REAL_FREQ, mg.freq_hz, NAN, NAN);
     }
     if (r->response && rc == TS_OK) {
@@ -768,8 +736,8 @@ static int run_crossing(ts_sweep *s, int i, ts_err *err)
             rc = ts_fail(err, TS_ECANCEL, "sweep: stopped on request");
             break;
         }
-        margin mg;
-        if (prc != TS_OK || !margin_of(r, &mg)) {
+        ts_margin mg;
+        if (!ts_result_margin(r, &mg) || prc != TS_OK) {
             x->status = prc != TS_OK ? prc : TS_ECONV;
             snprintf(x->error, sizeof x->error, "at %.150s = %.10g: %.800s",
                      s->spec.axes[x->axis].path, mid,

@@ -238,6 +238,18 @@ void cli_progress_done(void)
     polled = 0;
 }
 
+const char *cli_analysis_arg(int argc, char **argv)
+{
+    const char *name = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--analysis") && i + 1 < argc)
+            name = argv[i + 1];
+        else if (!strncmp(argv[i], "--analysis=", 11))
+            name = argv[i] + 11;
+    }
+    return name;
+}
+
 int cli_exit_code(int rc)
 {
     switch (rc) {

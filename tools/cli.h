@@ -34,7 +34,7 @@ typedef struct cli_extra {
     const char *help;
 } cli_extra;
 
-#define CLI_EXTRA_MAX 8
+#define CLI_EXTRA_MAX 10
 #define CLI_EXTRA_VALUES 8
 
 /* One run of an analysis command (or of one entry of `towstab run`). */
@@ -85,6 +85,11 @@ typedef struct cli_command {
 } cli_command;
 
 double cli_wall_now(void);
+
+/* The value of the last `--analysis A` (or `--analysis=A`) of argv, NULL
+ * when none: commands built for another analysis (sweep, design) read it
+ * before their option table is known. */
+const char *cli_analysis_arg(int argc, char **argv);
 
 /* Exit status for a library code. */
 int cli_exit_code(int rc);

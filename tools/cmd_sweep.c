@@ -1092,14 +1092,8 @@ static int sweep_execute(cli_run *c)
 static int sweep_main(int argc, char **argv)
 {
     int kind = TS_ANALYSIS_EQUILIBRIUM;
-    for (int i = 1; i < argc; i++) {
-        const char *name = NULL;
-        if (!strcmp(argv[i], "--analysis") && i + 1 < argc)
-            name = argv[i + 1];
-        else if (!strncmp(argv[i], "--analysis=", 11))
-            name = argv[i] + 11;
-        if (!name)
-            continue;
+    const char *name = cli_analysis_arg(argc, argv);
+    if (name) {
         kind = ts_analysis_find(name);
         if (kind < 0 || kind == TS_ANALYSIS_CONVERGE) {
             fprintf(stderr, "towstab: error: sweep: --analysis: '%s' is not "

@@ -1,6 +1,7 @@
 #!/bin/bash
 # tools/make_doc_plots.sh: regenerate the pictures of doc/plots.md and
-# doc/sweep.md into doc/img/ (PNG only, each under 150 kB).
+# doc/sweep.md and doc/design.md into doc/img/ (PNG only, each under
+# 150 kB).
 #
 #   tools/make_doc_plots.sh [TOWSTAB]
 #
@@ -97,3 +98,7 @@ pic sweep_ex1_depth map_sphere_z sweep examples/kamman_ex1_above.yaml \
     --analysis modes --vary speed=2:10:17 --vary "turn_rate=0:6 deg/s:7"
 pic sweep_ex1_speed sweep sweep examples/kamman_ex1_above.yaml \
     --analysis modes --vary speed=2:10:17
+# The sphere's depth and the top tension of example 1 against the cable
+# length (doc/design.md: the design for 15 m lands on this curve).
+pic design_ex1_length sweep sweep examples/kamman_ex1_submerged.yaml \
+    --vary cables.cable.length=10:60:26 --output sphere.z,top_tension

@@ -14,7 +14,7 @@ extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
 extern const cli_command cli_cmd_modes, cli_cmd_response;
 extern const cli_command cli_cmd_simulate;
 extern const cli_command cli_cmd_converge;
-extern const cli_command cli_cmd_sweep;
+extern const cli_command cli_cmd_sweep, cli_cmd_design;
 
 /* `towstab options`: every analysis' option table as markdown, the
  * reference of doc/manual.md. */
@@ -37,7 +37,7 @@ const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
                                            &cli_cmd_simulate,
                                            &cli_cmd_converge,
-                                           &cli_cmd_sweep,
+                                           &cli_cmd_sweep, &cli_cmd_design,
                                            &cli_cmd_options, NULL};
 
 static void usage(FILE *f)

@@ -466,6 +466,23 @@ TS_API void ts_result_free(ts_result *r);
 /* The key value called `name`, or NULL. */
 TS_API const ts_value *ts_result_value(const ts_result *r, const char *name);
 
+/* The stability margin of a modes result. */
+typedef struct ts_margin {
+    double max_real;       /* max Re(lambda), 1/s */
+    ts_estimate error;     /* its estimates (discretisation NaN for
+                              unresolved modes) */
+    double freq_hz;        /* the frequency of that mode (0: real) */
+    int verdict;           /* TS_STABLE, TS_UNSTABLE, TS_MARGINAL; -1 */
+    int resolved;          /* 1: of the resolved modes */
+} ts_margin;
+
+/* The stability margin of r: that of its resolved modes (r->stability;
+ * the unresolved ones are modes of the discretisation, not of the cable)
+ * or, when none is resolved, that of the modes computed (resolved 0: the
+ * result's verdict then says the accuracy is missed). Returns 1, or 0
+ * (verdict -1, NaN values) for a result without modes. */
+TS_API int ts_result_margin(const ts_result *r, ts_margin *m);
+
 /* The key values a result of rq on sys will carry (names, units, scales;
  * values and estimates NAN), without running: *values[*n] (caller frees;
  * NULL when none, e.g. a response). rq of any kind but converge. TS_OK or
