@@ -1721,6 +1721,10 @@ static int level_request(const ts_result *r, const ts_request *rq,
                          size_t size)
 {
     *sub = *rq; /* shallow: the excitation is borrowed */
+    /* lev carries the settings (it is r->sys coarsened), and a starting
+     * guess fits the run's links only. */
+    sub->setup.nsets = 0;
+    sub->setup.equilibrium.guess = NULL;
     sub->setup.links = 0;
     sub->setup.speed = NAN;
     sub->setup.turn_rate = NAN;
@@ -2818,6 +2822,7 @@ int ts_analysis_run(const ts_system *sys, const ts_request *rq,
             break;
         ts_request rq2 = *rq;
         rq2.setup.links = next;
+        rq2.setup.equilibrium.guess = NULL; /* it fits the links before */
         ts_result *r2 = NULL;
         ts_err e2 = {0};
         int rc2 = run_once(sys, &rq2, &r2, &e2);

@@ -172,6 +172,25 @@ static void test_points(const ts_system *ex1, const ts_system *ex3)
               "the single run at its settings bit for bit", s->npoints);
     }
     ts_sweep_free(s);
+    /* Over the link count: the discretisation estimate's coarser levels
+     * are those of the point's own links, as in the single run. */
+    double nl[2] = {10, 20};
+    s = make(ex1, TS_ANALYSIS_EQUILIBRIUM, "cables.cable.links", nl, 2, NULL,
+             NULL, 0, 0, 1);
+    if (s && !run_all(s)) {
+        int ok = 1;
+        double w = 0;
+        for (int p = 0; p < s->npoints; p++)
+            ok &= against_single(s, p, 1, &w);
+        int z = ts_sweep_column_find(s, "sphere.z");
+        double e10 = z >= 0 ? s->errors[z].discretisation : NAN;
+        double e20 = z >= 0 ? s->errors[s->ncolumns + z].discretisation : NAN;
+        CHECK(ok && e20 > 0 && e20 < e10,
+              "over cables.cable.links 10, 20: each point equals its single "
+              "run bit for bit, the depth's discretisation error falls "
+              "(%.3g m, %.3g m)", e10, e20);
+    }
+    ts_sweep_free(s);
     /* Modes in a turn, continued: chain starts exact, the rest within
      * their estimates. */
     double w8[9];

@@ -728,8 +728,8 @@ static int draw_maps(const cli_run *c, const sweep_state *st)
                              (size_t)st->out[k]];
         char name[160], title[800];
         picture_name(name, sizeof name, "map_", col->name);
-        snprintf(title, sizeof title, "%s: %s over %s and %s (%s)",
-                 s->sys->name, col->name, ax->path, ay->path,
+        snprintf(title, sizeof title, "%.200s: %.95s over %.159s and %.159s "
+                 "(%s)", s->sys->name, col->name, ax->path, ay->path,
                  ts_analysis_name(s->kind));
         ts_plot_axis xa = axis_of(ax->path, ax->unit);
         ts_plot_axis ya = axis_of(ay->path, ay->unit);

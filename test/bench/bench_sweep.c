@@ -7,8 +7,10 @@
  * with its turn-rate schedule when cold); the same cable at 40 links with
  * bending stiffness EI = 50 N m^2 over the tow speed, 1.5 to 4.5 m/s in
  * 16 steps (Newton with continuation in turn rate and bending when
- * cold). Median
- * of 3 runs of each sweep; each run allocates and runs the whole sweep. */
+ * cold). Without the discretisation estimate (the equilibrium sweep
+ * itself), and once with it (chain 8, one thread: its two coarser runs
+ * per point start cold). Median of 3 runs of each sweep; each run
+ * allocates and runs the whole sweep. */
 #include "bench_common.h"
 #include "towstab/sweep.h"
 
@@ -23,7 +25,8 @@ typedef struct timing {
 } timing;
 
 static timing time_sweep(const ts_system *sys, const char *path,
-                         const double *v, int n, int chain, int threads)
+                         const double *v, int n, int chain, int threads,
+                         int estimate)
 {
     timing t = {0, 0, 1};
     double w[3];
@@ -31,6 +34,7 @@ static timing time_sweep(const ts_system *sys, const char *path,
         ts_sweep_spec sp;
         memset(&sp, 0, sizeof sp);
         ts_request_init(&sp.rq, TS_ANALYSIS_EQUILIBRIUM);
+        sp.rq.setup.discretisation_error = estimate;
         sp.naxes = 1;
         snprintf(sp.axes[0].path, sizeof sp.axes[0].path, "%s", path);
         sp.axes[0].n = n;
@@ -57,22 +61,26 @@ static timing time_sweep(const ts_system *sys, const char *path,
 static int bench_case(const char *label, const ts_system *sys,
                       const char *path, const double *v, int n)
 {
-    timing cold = time_sweep(sys, path, v, n, 1, 1);
-    timing warm1 = time_sweep(sys, path, v, n, 8, 1);
-    timing warm2 = time_sweep(sys, path, v, n, 8, 2);
-    printf("%-34s %6d %6s %7s %10s %9s %11s\n", label, n, "chain", "threads",
-           "wall [ms]", "points/s", "evaluations");
-    const timing *t[3] = {&cold, &warm1, &warm2};
-    static const int ch[3] = {1, 8, 8}, th[3] = {1, 1, 2};
-    for (int k = 0; k < 3; k++)
-        printf("%-34s %6s %6d %7d %10.2f %9.1f %11ld%s\n", "", "", ch[k],
-               th[k], t[k]->wall * 1e3, n / t[k]->wall, t[k]->evals,
+    timing cold = time_sweep(sys, path, v, n, 1, 1, 0);
+    timing warm1 = time_sweep(sys, path, v, n, 8, 1, 0);
+    timing warm2 = time_sweep(sys, path, v, n, 8, 2, 0);
+    timing est = time_sweep(sys, path, v, n, 8, 1, 1);
+    printf("%-34s %6d %6s %7s %8s %10s %9s %11s\n", label, n, "chain",
+           "threads", "estimate", "wall [ms]", "points/s", "evaluations");
+    const timing *t[4] = {&cold, &warm1, &warm2, &est};
+    static const int ch[4] = {1, 8, 8, 8}, th[4] = {1, 1, 2, 1};
+    for (int k = 0; k < 4; k++)
+        printf("%-34s %6s %6d %7d %8s %10.2f %9.1f %11ld%s\n", "", "", ch[k],
+               th[k], k == 3 ? "yes" : "no", t[k]->wall * 1e3,
+               n / t[k]->wall, t[k]->evals,
                t[k]->ok ? "" : "  (a point FAILED)");
     printf("%-34s continuation: %.2fx fewer evaluations, %.2fx faster; "
-           "2 threads: efficiency %.2f\n\n",
+           "2 threads: efficiency %.2f; the discretisation estimate "
+           "(2 coarser runs per point) costs %.2fx\n\n",
            "", (double)cold.evals / (double)warm1.evals,
-           cold.wall / warm1.wall, warm1.wall / (2.0 * warm2.wall));
-    return cold.ok && warm1.ok && warm2.ok ? 0 : 1;
+           cold.wall / warm1.wall, warm1.wall / (2.0 * warm2.wall),
+           est.wall / warm1.wall);
+    return cold.ok && warm1.ok && warm2.ok && est.ok ? 0 : 1;
 }
 
 int main(void)
