@@ -248,15 +248,24 @@ static void design_release(cli_run *c)
     c->state = NULL;
 }
 
-static void print_value(const char *label, const ts_value *v)
+static void print_value(const char *label, const ts_value *v,
+                        const ts_display *d)
 {
     char e[128];
-    cli_value_error(v, e, sizeof e);
-    printf("%-28s %.10g %s\n", label, v->value, e);
+    cli_value_error(v, d, e, sizeof e);
+    printf("%-28s %.10g %s\n", label, cli_value_shown(v, d), e);
 }
 
-static void print_study(const ts_design *d)
+/* x in `unit` as the display shows it, its unit into u. */
+static double shown(const ts_display *d, const char *unit, double x,
+                    char *u, size_t size)
 {
+    return ts_display_convert(ts_display_or_si(d), unit, x, u, size);
+}
+
+static void print_study(const ts_design *d, const ts_display *dsp)
+{
+    char u[64];
     const ts_design_spec *s = &d->spec;
     printf("design: %s, %d free value%s, %s at every evaluation\n",
            ts_design_method_name(s->method), s->nfree,
@@ -286,23 +295,26 @@ static void print_study(const ts_design *d)
     char label[TS_VALUE_NAME_MAX + 40];
     if (s->goal.kind == TS_DESIGN_TARGET) {
         snprintf(label, sizeof label, "target %s", s->goal.name);
-        print_value(label, &d->goal_value);
+        print_value(label, &d->goal_value, dsp);
         double sc = s->goal.target != 0 ? fabs(s->goal.target) : 1.0;
+        const char *gu = d->goal_value.unit;
+        double t = shown(dsp, gu, s->goal.target, u, sizeof u);
         printf("  wanted %.10g %s: %s, misfit %.3g %s (tolerance %.3g %s)\n",
-               s->goal.target, d->goal_value.unit,
-               d->reached ? "reached" : "NOT REACHED", d->goal_misfit,
-               d->goal_value.unit, s->target_rtol * sc, d->goal_value.unit);
+               t, u, d->reached ? "reached" : "NOT REACHED",
+               shown(dsp, gu, d->goal_misfit, u, sizeof u), u,
+               shown(dsp, gu, s->target_rtol * sc, u, sizeof u), u);
     } else if (s->goal.kind != TS_DESIGN_NONE) {
         snprintf(label, sizeof label, "%s %s",
                  ts_design_goal_name(s->goal.kind), s->goal.name);
-        print_value(label, &d->goal_value);
+        print_value(label, &d->goal_value, dsp);
     }
     for (int i = 0; i < s->nconstraints; i++) {
         const ts_design_constraint *k = &s->constraints[i];
         snprintf(label, sizeof label, "constraint %s", k->name);
-        print_value(label, &d->constraint_value[i]);
-        printf("  wanted %s %.10g %s: %s\n", k->upper ? "<=" : ">=",
-               k->bound, d->constraint_value[i].unit,
+        print_value(label, &d->constraint_value[i], dsp);
+        double b = shown(dsp, d->constraint_value[i].unit, k->bound, u,
+                         sizeof u);
+        printf("  wanted %s %.10g %s: %s\n", k->upper ? "<=" : ">=", b, u,
                d->constraint_met[i] ? "met" : "NOT MET");
     }
     if (!d->success)
@@ -322,7 +334,7 @@ static int design_execute(cli_run *c)
     cli_progress_done();
     if (!d)
         return cli_report(&err, rc);
-    print_study(d);
+    print_study(d, &c->display);
     if (d->result) {
         cli_run pc = *c;
         pc.cmd = d->spec.rq.kind == TS_ANALYSIS_MODES ? &cli_cmd_modes
