@@ -812,7 +812,7 @@ static int draw_lines(const cli_run *c, const sweep_state *st)
             if (m[j] > 0)
                 ser[ns++] = (ts_plot_series){m[j], x[j], y[j],
                                              k == 0 ? label[j] : NULL, k,
-                                             style[j], color[j]};
+                                             style[j], color[j], NULL};
         for (int i = 0; i < s->ncrossings && isfinite(lo); i++) {
             const ts_sweep_crossing *xc = &s->crossings[i];
             if (!xc->done || xc->status != TS_OK)
@@ -826,7 +826,7 @@ static int draw_lines(const cli_run *c, const sweep_state *st)
                                          k == 0 && i == 0
                                              ? "stability boundary"
                                              : NULL,
-                                         k, TS_PLOT_DASHED, 5};
+                                         k, TS_PLOT_DASHED, 5, NULL};
         }
     }
     char title[400];

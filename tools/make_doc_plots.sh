@@ -102,3 +102,9 @@ pic sweep_ex1_speed sweep sweep examples/kamman_ex1_above.yaml \
 # length (doc/design.md: the design for 15 m lands on this curve).
 pic design_ex1_length sweep sweep examples/kamman_ex1_submerged.yaml \
     --vary cables.cable.length=10:60:26 --output sphere.z,top_tension
+# The two-part tow: depressor sphere and cylinder towfish.
+pic equilibrium_two_part_side side equilibrium examples/two_part_tow.yaml
+# A 0.1 rad/s turn begun over 5 s, in the earth frame.
+pic simulate_manoeuvre_plan plan_earth simulate \
+    examples/kamman_ex1_submerged.yaml \
+    --manoeuvre turn_rate:to=0.1rad/s,duration=5s --t-end 40
