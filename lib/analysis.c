@@ -52,6 +52,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "clock.h"
 #include "csvtab.h"
 #include "towstab/kernel.h"
 
@@ -91,13 +92,6 @@ int ts_analysis_find(const char *name)
         if (strcmp(name, kind_names[k]) == 0)
             return k;
     return -1;
-}
-
-static double wall_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /* ---- requests ---------------------------------------------------------- */
@@ -409,7 +403,7 @@ static void value_name(ts_value *v, const char *unit, double scale,
 static int finish(ts_result *r, int rc, const ts_err *e, ts_err *err,
                   double t0)
 {
-    r->wall_s = wall_now() - t0;
+    r->wall_s = tsi_wall_now() - t0;
     r->status = rc;
     r->completed = rc == TS_OK;
     if (rc != TS_OK) {
@@ -530,9 +524,9 @@ static int run_equilibrium(ts_result *r, ts_kernel *k,
     r->eq = ts_equilibrium_alloc(r->sys, err);
     if (!r->eq)
         return err && err->code ? err->code : TS_ENOMEM;
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     int rc = ts_equilibrium_solve(k, eo, r->eq, err);
-    r->eq_wall_s = wall_now() - t0;
+    r->eq_wall_s = tsi_wall_now() - t0;
     r->eq_attempted = rc != TS_EINVAL && rc != TS_EDOMAIN;
     r->evaluations += r->eq->evaluations;
     if (rc == TS_OK)
@@ -551,7 +545,7 @@ static int run_linearize(ts_result *r, const ts_linearize_opts *lo,
     if (!k)
         return err && err->code ? err->code : TS_ENOMEM;
     int rc = TS_OK;
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     if (open_loop && ts_control_nloops(k) > 0) {
         r->open_loop = 1;
         rc = ts_linearize_open_loop(k, r->eq, lo, &r->lin, err);
@@ -560,7 +554,7 @@ static int run_linearize(ts_result *r, const ts_linearize_opts *lo,
         rc = r->lin ? ts_linearize_equilibrium(k, r->eq, lo, r->lin, err)
                     : (err && err->code ? err->code : TS_ENOMEM);
     }
-    r->lin_wall_s = wall_now() - t0;
+    r->lin_wall_s = tsi_wall_now() - t0;
     if (r->lin)
         r->evaluations += r->lin->evaluations;
     ts_kernel_free(k);
@@ -818,11 +812,11 @@ static int modes_margins(ts_result *r, ts_err *err)
             rc = ts_fail(err, TS_ENOMEM, "margins: out of memory");
         double decades = log10(TS_MARGINS_TO_HZ / TS_MARGINS_FROM_HZ);
         int points = (int)ceil(decades * TS_MARGINS_PER_DECADE) + 1;
-        double t0 = wall_now();
+        double t0 = tsi_wall_now();
         if (rc == TS_OK)
             rc = ts_loop_margins(k, r->eq, TS_MARGINS_FROM_HZ,
                                  TS_MARGINS_TO_HZ, points, r->margins, err);
-        r->margins_wall_s = wall_now() - t0;
+        r->margins_wall_s = tsi_wall_now() - t0;
         if (rc == TS_OK)
             r->nmargins = nl;
     }
@@ -841,9 +835,9 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     if (rc != TS_OK)
         return rc;
     ts_eigen_opts o = modes_eigen_opts(m, r->lin->nstate);
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     rc = ts_eigen_solve(r->lin, &o, &r->eigen, err);
-    r->eigen_wall_s = wall_now() - t0;
+    r->eigen_wall_s = tsi_wall_now() - t0;
     if (rc == TS_OK)
         rc = select_modes(r, m, err);
     if (rc != TS_OK)
@@ -1996,14 +1990,14 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         /* The linear run needs the dense A and B at any size. */
         if (s->compare || s->linear)
             lo.model = TS_LIN_BOTH;
-        double t0 = wall_now();
+        double t0 = tsi_wall_now();
         if (!r->lin)
             rc = err && err->code ? err->code : TS_ENOMEM;
         else if (rq->setup.open_loop && ts_control_nloops(k) > 0)
             rc = ts_linearize(k, y0, NULL, &lo, r->lin, err);
         else
             rc = ts_linearize_equilibrium(k, r->eq, &lo, r->lin, err);
-        r->lin_wall_s = wall_now() - t0;
+        r->lin_wall_s = tsi_wall_now() - t0;
         if (r->lin)
             r->evaluations += r->lin->evaluations;
         if (rc == TS_OK && (s->compare || s->linear)) {
@@ -2195,10 +2189,10 @@ static int run_levels(ts_result *r, const ts_request *rq, levels *L,
             a->evaluations += lr->evaluations;
         }
         if (rc == TS_ECANCEL || rc == TS_ENOMEM) {
-            ts_result_free(lr);
-            ts_system_free(lev);
             snprintf(why, size, "the run at %d links stopped: %.200s",
                      ts_accuracy_max_links(lev), e.msg);
+            ts_result_free(lr);
+            ts_system_free(lev);
             return rc;
         }
         if (rc != TS_OK) {
@@ -3171,7 +3165,7 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
 static int run_once(const ts_system *sys, const ts_request *rq,
                     ts_result **out, ts_err *err)
 {
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     ts_err e = {0};
     *out = result_alloc(rq->kind, err);
     if (!*out)
@@ -3205,7 +3199,7 @@ static int run_once(const ts_system *sys, const ts_request *rq,
 int ts_analysis_run(const ts_system *sys, const ts_request *rq,
                     ts_result **out, ts_err *err)
 {
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     int rc = run_once(sys, rq, out, err);
     ts_result *r = *out;
     /* --refine: rerun with the links the error model says meet the
@@ -3255,7 +3249,7 @@ int ts_analysis_run(const ts_system *sys, const ts_request *rq,
                                   ? r->accuracy.wall_s
                                   : 0.0) + wall;
         r->accuracy.evaluations += evals;
-        r->wall_s = wall_now() - t0;
+        r->wall_s = tsi_wall_now() - t0;
         if (r->accuracy.met == 0)
             ts_trust_note(&r->trust, "--refine: %d rerun%s from %d to %d "
                           "links did not meet the accuracy (at most %d "

@@ -48,6 +48,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "clock.h"
 
 /* The finest two observed orders agree (asymptotic range) when they
  * differ by at most this fraction of the finer one. */
@@ -654,13 +655,6 @@ int ts_convergence_estimate(ts_convergence *c, double target, ts_err *err)
 
 /* ---- the sweep ------------------------------------------------------- */
 
-static double wall_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 void ts_conv_analysis_free(ts_conv_analysis *an)
 {
     if (!an)
@@ -693,10 +687,10 @@ static double repeat_timing(const ts_conv_analysis *an, ts_conv_param p,
         ts_trust_init(&tr);
         ts_err e = {0};
         long ev = 0;
-        double t0 = wall_now();
+        double t0 = tsi_wall_now();
         int st = an->run(an->ctx, p, setting, scratch, scratch + nvalues,
                          &ev, &tr, &e);
-        double w = wall_now() - t0;
+        double w = tsi_wall_now() - t0;
         if (st != TS_OK)
             break;
         t[n++] = w;
@@ -755,10 +749,10 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         ts_trust_init(&trust);
         long evals = 0;
         ts_err rerr = {0};
-        double t0 = wall_now();
+        double t0 = tsi_wall_now();
         int st = an->run(an->ctx, c->param, settings[i], val, noise, &evals,
                          &trust, &rerr);
-        double wall = wall_now() - t0;
+        double wall = tsi_wall_now() - t0;
         int timed = 1;
         if (st == TS_OK && wall < TS_CONV_TIMING_MIN)
             wall = repeat_timing(an, c->param, settings[i], c->nvalues,

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "clock.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
 
@@ -15,13 +16,6 @@
 #define TIME_EVALS 3
 #define TIME_MIN_S 2e-3
 #define TIME_MAX_EVALS 200
-
-static double wall_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 /* Time one kernel evaluation of sys, at rest with every link straight aft
  * (y = 0: a state of every chart). */
@@ -45,11 +39,11 @@ static int time_kernel(const ts_system *sys, double *eval_s, int *nstate,
     *eval_s = INFINITY;
     for (int b = 0; b < 3; b++) {
         int m = 0;
-        double t0 = wall_now(), t = t0;
+        double t0 = tsi_wall_now(), t = t0;
         while (m < TIME_MAX_EVALS && (m < TIME_EVALS || t - t0 < TIME_MIN_S)) {
             ts_kernel_eval(k, y, NULL, y + n);
             m++;
-            t = wall_now();
+            t = tsi_wall_now();
         }
         *eval_s = fmin(*eval_s, (t - t0) / m);
     }

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clock.h"
 #include "towstab/eigen.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
@@ -23,6 +24,13 @@ struct ts_job {
     ts_result *result;
     char notes[TS_OPTSET_NOTES_MAX];
     char *json;         /* the last text of ts_job_json */
+    /* The caller's progress callback and its throttle (ts_job_progress). */
+    ts_progress_fn progress;
+    void *progress_data;
+    double interval;    /* s of wall time between reports passed on */
+    const char *what;   /* the run of the last report passed on */
+    double last;        /* its wall time */
+    double done;        /* the progress of the last report seen */
 };
 
 ts_job *ts_job_alloc(const ts_scene *scene, const ts_units *units,
@@ -81,6 +89,38 @@ int ts_job_give(ts_job *j, const char *name, const char *text, ts_err *err)
     return ts_optset_give(j->opts, name, text, TS_OPTSET_COMMAND, name, err);
 }
 
+int ts_job_progress(ts_job *j, ts_progress_fn fn, void *data,
+                    double interval, ts_err *err)
+{
+    if (j->ran)
+        return ts_fail(err, TS_EINVAL, "progress: the job has run already");
+    if (!(interval >= 0))
+        return ts_fail(err, TS_EINVAL, "progress: the interval must be "
+                       ">= 0 s, got %g s", interval);
+    j->progress = fn;
+    j->progress_data = data;
+    j->interval = interval;
+    return TS_OK;
+}
+
+/* The request's progress callback: passes the first report of a run (a
+ * new `what`, or progress going back: the next run of a sweep or of the
+ * discretisation estimate) and then one every j->interval s to the
+ * caller's; between them, goes on. */
+static int job_progress(const ts_progress *p, void *data)
+{
+    ts_job *j = data;
+    double now = tsi_wall_now();
+    int first = !j->what || strcmp(j->what, p->what) != 0 ||
+                p->done < j->done;
+    j->done = p->done;
+    if (!first && now - j->last < j->interval)
+        return 0;
+    j->what = p->what;
+    j->last = now;
+    return j->progress(p, j->progress_data);
+}
+
 int ts_job_run(ts_job *j, ts_err *err)
 {
     if (j->ran)
@@ -95,6 +135,10 @@ int ts_job_run(ts_job *j, ts_err *err)
     if (rc != TS_OK)
         return rc;
     j->have_rq = 1;
+    if (j->progress) {
+        j->rq.progress = job_progress;
+        j->rq.progress_data = j;
+    }
     rc = ts_analysis_run(j->scene->system, &j->rq, &j->result, err);
     if (!j->result)
         return rc ? rc : ts_fail(err, TS_ENOMEM, "out of memory");

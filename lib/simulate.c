@@ -59,6 +59,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "clock.h"
 #include "descriptor.h"
 #include "esdirk.h"
 #include "expm.h"
@@ -73,13 +74,6 @@
 /* Relative time step of the df/dt central difference (bsimp), times the
  * excitation's time scale (capped at 1 s). */
 #define DFDT_REL_STEP 6e-6
-
-static double wall_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 void ts_sim_opts_default(ts_sim_opts *o)
 {
@@ -963,12 +957,12 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
         return ts_fail(err, TS_EINVAL, "simulate: the target time %g s is "
                        "not after the current time %g s", t1, s->t);
     if (s->sd) {
-        double w0 = wall_now();
+        double w0 = tsi_wall_now();
         int rc = advance_esdirk(s, t1, err);
-        s->wall += wall_now() - w0;
+        s->wall += tsi_wall_now() - w0;
         return rc;
     }
-    double w0 = wall_now();
+    double w0 = tsi_wall_now();
     int rc = TS_OK, step_failed = 0;
     while (s->t < t1) {
         double target = next_stop(s, t1);
@@ -1011,7 +1005,7 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
     }
     if (step_failed)
         stiffness_note(s, err);
-    s->wall += wall_now() - w0;
+    s->wall += tsi_wall_now() - w0;
     return rc;
 }
 
@@ -1476,7 +1470,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     int *in_idx = NULL;
     if ((rc = bind_inputs(k, ex, &in_idx, err)))
         return rc;
-    double w0 = wall_now();
+    double w0 = tsi_wall_now();
     size_t sn = (size_t)n;
     /* Only the tow channels are driven unless a signal drives a vehicle's
      * input (the exponential's order is n + 4 m). */
@@ -1638,7 +1632,7 @@ done:
     }
     stats.evaluations = L.nfev;
     stats.t_reached = h->nsamples > 0 ? h->t[h->nsamples - 1] : 0.0;
-    stats.wall_s = wall_now() - w0;
+    stats.wall_s = tsi_wall_now() - w0;
     if (st)
         *st = stats;
     for (int c = 0; c < 2; c++) {

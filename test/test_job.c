@@ -16,6 +16,16 @@
  *     unknown names give NULL and 0 x 0.
  *  5. A simulation that fails (h_min above the step it needs) returns its
  *     code and keeps the partial history, its error in the JSON.
+ *  6. Progress: with interval 0 every report reaches the callback (the
+ *     simulated time rises to t_end of total t_end, unit "s"); a callback
+ *     that asks to stop at its third report stops the run there with
+ *     TS_ECANCEL, the history kept up to that time, "completed" false
+ *     and the error saying where; with a long interval only the first
+ *     report of each run (nonlinear, linear) passes; stopped at the first
+ *     report of the discretisation estimate's run, the estimate is not
+ *     made and says so; refusals after the
+ *     run and of a
+ *     negative interval.
  */
 #include "towstab/job.h"
 
@@ -25,6 +35,26 @@
 
 #include "tcheck.h"
 #include "towstab/kernel.h"
+
+/* A progress callback's record: reports seen, the last, when to stop. */
+typedef struct {
+    int calls, stop_at, ordered;
+    double done, total;
+    const char *what, *unit;
+} seen;
+
+static int on_progress(const ts_progress *p, void *data)
+{
+    seen *s = data;
+    if (s->calls > 0 && !strcmp(p->what, s->what) && p->done < s->done)
+        s->ordered = 0;
+    s->calls++;
+    s->done = p->done;
+    s->total = p->total;
+    s->what = p->what;
+    s->unit = p->unit;
+    return s->stop_at > 0 && s->calls >= s->stop_at;
+}
 
 static const char scene_text[] =
     "name: job\n"
@@ -203,6 +233,78 @@ int main(void)
           err.msg);
     ts_job_free(j);
     ts_job_free(NULL);
+
+    /* 6. Progress and stopping. */
+    seen all = {.ordered = 1};
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_err_clear(&err);
+    CHECK(ts_job_progress(j, on_progress, &all, -1, &err) == TS_EINVAL &&
+              strstr(err.msg, "interval"),
+          "a negative interval is refused: %s", err.msg);
+    ts_job_progress(j, on_progress, &all, 0, &err);
+    rc = ts_job_run(j, &err);
+    CHECK(rc == TS_OK && all.calls > 10 && all.ordered &&
+              fabs(all.done - 1.0) < 1e-12 && all.total == 1.0 &&
+              !strcmp(all.unit, "s"),
+          "every report: rc %d, %d calls, last %g of %g %s", rc, all.calls,
+          all.done, all.total, all.unit ? all.unit : "?");
+    ts_err_clear(&err);
+    CHECK(ts_job_progress(j, NULL, NULL, 0, &err) == TS_EINVAL,
+          "progress after the run is refused: %s", err.msg);
+    ts_job_free(j);
+
+    seen stop = {.stop_at = 3, .ordered = 1};
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_job_progress(j, on_progress, &stop, 0, &err);
+    ts_err_clear(&err);
+    rc = ts_job_run(j, &err);
+    r = ts_job_result(j);
+    text = ts_job_json(j, 0, NULL);
+    h = r ? r->nonlinear : NULL;
+    CHECK(rc == TS_ECANCEL && stop.calls == 3 && h && h->nsamples > 0 &&
+              h->t[h->nsamples - 1] <= stop.done && stop.done < 1.0 &&
+              !r->completed && text &&
+              strstr(text, "\"completed\": false") &&
+              strstr(text, "stopped on request"),
+          "stopped at the third report: rc %d, %d calls, t = %g, %s", rc,
+          stop.calls, stop.done, err.msg);
+    ts_job_free(j);
+
+    /* Stopped in the discretisation estimate (a run at fewer links
+     * starts again from t = 0: its first report passes): the estimate
+     * is not made, and says at how many links it stopped. */
+    seen est = {.ordered = 1};
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_job_give(j, "discretisation_error", "false", &err);
+    ts_job_progress(j, on_progress, &est, 0, &err);
+    ts_err_clear(&err);
+    rc = ts_job_run(j, &err);
+    int reports = est.calls;
+    ts_job_free(j);
+    est = (seen){.stop_at = reports + 1, .ordered = 1};
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_job_give(j, "discretisation_error", "true", &err);
+    ts_job_progress(j, on_progress, &est, 0, &err);
+    rc = ts_job_run(j, &err);
+    r = ts_job_result(j);
+    CHECK(reports > 0 && rc == TS_ECANCEL && r && !r->completed &&
+              est.done < 1e-2 && !r->accuracy.estimated &&
+              strstr(r->accuracy.not_estimated, "links stopped"),
+          "stopped in the estimate: rc %d after %d + 1 reports: %s", rc,
+          reports, r ? r->accuracy.not_estimated : "(no result)");
+    ts_job_free(j);
+
+    seen sparse = {.ordered = 1};
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_job_give(j, "compare", "true", &err);
+    ts_job_give(j, "t_end", "3 s", &err);
+    ts_job_give(j, "discretisation_error", "false", &err);
+    ts_job_progress(j, on_progress, &sparse, 3600, &err);
+    rc = ts_job_run(j, &err);
+    CHECK(rc == TS_OK && sparse.calls == 2,
+          "an hour's interval: the first report of each run only (%d; "
+          "rc %d %s)", sparse.calls, rc, err.msg);
+    ts_job_free(j);
 
     ts_scene_free(sc);
     ts_units_free(u);

@@ -48,6 +48,18 @@ TS_API void ts_job_free(ts_job *j);
 TS_API int ts_job_give(ts_job *j, const char *name, const char *text,
                        ts_err *err);
 
+/* Progress reports and stopping (towstab/progress.h): the job's run calls
+ * `fn` with `data` as the long runs go (a simulation's steps, a
+ * convergence sweep's runs): the first report of each run (a new `what`,
+ * or `done` going back) and then at most one every `interval` s of wall
+ * time (0: every report), so that a callback into an interpreter costs
+ * the run little. A nonzero return stops the run with TS_ECANCEL, keeping
+ * what it computed (the result's "completed" false, "error" how far it
+ * got). fn NULL: none. Before ts_job_run; TS_EINVAL after it or for a
+ * negative or NaN interval. The throttle's state is the job's. */
+TS_API int ts_job_progress(ts_job *j, ts_progress_fn fn, void *data,
+                           double interval, ts_err *err);
+
 /* Check the request and run the analysis, once. Returns TS_OK, a check's
  * code (nothing ran: ts_job_result is NULL; the message names the option
  * and where it was given), or the run's status (the result holds what

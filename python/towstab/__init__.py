@@ -20,18 +20,28 @@ SI units throughout, as in the JSON (doc/manual.md, "JSON and CSV").
 
 import ctypes
 import json
+import math
 import os
+import signal
+import threading
+import time
 
 import numpy as np
 
 from towstab import _config
 
 __all__ = ["Scene", "Result", "KeyValue", "Record", "Table", "History",
-           "TowstabError", "AnalysisError", "library"]
+           "Progress", "TowstabError", "AnalysisError", "Cancelled",
+           "library"]
 
 ANALYSES = ("equilibrium", "modes", "response", "simulate", "converge")
 # ts_report_result_json's flags (towstab/report_result.h).
 REPORT_MATRICES = 1
+# TS_ECANCEL (towstab/error.h): a run stopped on request.
+ECANCEL = -11
+# Wall seconds between the progress reports a long run passes to Python
+# (ts_job_progress): the latency of Ctrl-C and of a progress callable.
+PROGRESS_INTERVAL = 0.1
 
 
 class TowstabError(Exception):
@@ -55,8 +65,24 @@ class AnalysisError(TowstabError):
         self.result = result
 
 
+class Cancelled(AnalysisError):
+    """A run stopped because its progress callable returned a true value
+    (or SIGINT came and the Python handler of SIGINT in place, not the
+    default, returned): ``code`` -11 (TS_ECANCEL), the message saying how
+    far it got, ``result`` what was computed (``completed`` false)."""
+
+
 class _Err(ctypes.Structure):
     _fields_ = [("code", ctypes.c_int), ("msg", ctypes.c_char * 1024)]
+
+
+class _CProgress(ctypes.Structure):
+    _fields_ = [("what", ctypes.c_char_p), ("done", ctypes.c_double),
+                ("total", ctypes.c_double), ("unit", ctypes.c_char_p)]
+
+
+_PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(_CProgress),
+                                ctypes.c_void_p)
 
 
 def _find_library():
@@ -79,6 +105,7 @@ def _bind(lib):
         "ts_job_free": (None, [P]),
         "ts_job_give": (I, [P, S, S, E]),
         "ts_job_run": (I, [P, E]),
+        "ts_job_progress": (I, [P, _PROGRESS_FN, P, ctypes.c_double, E]),
         "ts_job_notes": (S, [P]),
         "ts_job_json": (S, [P, I, E]),
         "ts_job_array": (ctypes.POINTER(ctypes.c_double),
@@ -214,7 +241,8 @@ class Scene:
             library.ts_scene_free(self._ptr)
             self._ptr = None
 
-    def run(self, analysis, entry=-1, matrices=False, **options):
+    def run(self, analysis, entry=-1, matrices=False, progress=None,
+            **options):
         """Run ``analysis`` ("equilibrium", "modes", "response",
         "simulate", "converge") with the options of the scene's entry
         analyses[entry] (-1: its first entry of that kind, if any) below
@@ -224,6 +252,13 @@ class Scene:
         the modes' A and B in the result (as --matrices). A simulation's
         JSON holds the channels of ``outputs`` (``outputs="all"``: the full
         state too); ``history()`` has every node and link whatever it is.
+        ``progress``: a callable given a Progress as a simulation or a
+        convergence sweep goes (its first report, then every
+        PROGRESS_INTERVAL s); a true return stops the run (Cancelled), an
+        exception it raises stops the run and is raised again, with the
+        partial result as its ``result``. Ctrl-C (SIGINT) stops a long run
+        within PROGRESS_INTERVAL s and raises KeyboardInterrupt, its
+        ``result`` the partial result (``completed`` false).
         Raises TowstabError when the
         request is refused (nothing ran), AnalysisError when the analysis
         failed (its partial result attached)."""
@@ -245,13 +280,22 @@ class Scene:
                                        _text(t).encode(),
                                        ctypes.byref(err)) != 0:
                     raise TowstabError(err.code, err.msg.decode())
-        rc = library.ts_job_run(job.ptr, ctypes.byref(err))
+        watch = _Watch(progress)
+        if library.ts_job_progress(job.ptr, watch.fn, None,
+                                   PROGRESS_INTERVAL, ctypes.byref(err)):
+            raise TowstabError(err.code, err.msg.decode())
+        with watch:
+            rc = library.ts_job_run(job.ptr, ctypes.byref(err))
         message = err.msg.decode()
         flags = REPORT_MATRICES if matrices else 0
         text = library.ts_job_json(job.ptr, flags, ctypes.byref(err))
         if text is None:
+            watch.raise_pending(None)
             raise TowstabError(rc or err.code, message or err.msg.decode())
         result = Result(json.loads(text), job)
+        watch.raise_pending(result)
+        if rc == ECANCEL:
+            raise Cancelled(rc, message, result)
         if rc != 0:
             raise AnalysisError(rc, message, result)
         return result
@@ -276,6 +320,111 @@ class Scene:
     def converge(self, **options):
         """A convergence study (doc/converge.md)."""
         return self.run("converge", **options)
+
+
+class Progress:
+    """How far a long run is, given to a progress callable: ``what`` the
+    run ("nonlinear", "linear", "sweep"), ``done`` of ``total`` in
+    ``unit`` ("s" of simulated time, "runs"), ``fraction`` done/total;
+    ``elapsed`` wall s since the run's first report, ``rate`` units done
+    per wall s since then (nan before), ``left`` the wall s estimated to
+    the end at that rate (nan when unknown)."""
+
+    def __init__(self, what, done, total, unit, elapsed, rate):
+        self.what, self.done, self.total, self.unit = what, done, total, unit
+        self.fraction = done / total if total > 0 else math.nan
+        self.elapsed = elapsed
+        self.rate = rate
+        self.left = (total - done) / rate if rate > 0 else math.nan
+
+    def __repr__(self):
+        return ("Progress(%s: %.6g of %.6g %s, %.0f%%, %.3g %s per s, "
+                "%.3g s left)" % (self.what, self.done, self.total,
+                                  self.unit, 100 * self.fraction, self.rate,
+                                  self.unit, self.left))
+
+
+class _Watch:
+    """One run's progress callback (ts_job_progress) and its SIGINT
+    handler. The handler only notes the signal (it runs when the callback
+    runs Python, in the main thread); the callback then asks the run to
+    stop. An exception of the caller's callable is kept and raised after
+    the run, never through the C code."""
+
+    def __init__(self, callable_):
+        self.callable = callable_
+        self.fn = _PROGRESS_FN(self._report)
+        self.error = None       # what the caller's callable raised
+        self.signalled = False  # SIGINT came during the run
+        self.previous = None    # the SIGINT handler in place before
+        self.run = None         # (what, wall time, done) of the first report
+
+    def _on_sigint(self, signum, frame):
+        self.signalled = True
+
+    def __enter__(self):
+        # Only a Python handler (the default raises KeyboardInterrupt) is
+        # stood in for, only in the main thread (where signals arrive).
+        if threading.current_thread() is threading.main_thread():
+            h = signal.getsignal(signal.SIGINT)
+            if callable(h):
+                signal.signal(signal.SIGINT, self._on_sigint)
+                self.previous = h
+        return self
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+        return False
+
+    def _report(self, p, data):
+        try:
+            if self.signalled or self.error is not None:
+                return 1
+            if self.callable is None:
+                return 0
+            c = p.contents
+            what = c.what.decode()
+            now = time.monotonic()
+            if self.run is None or self.run[0] != what or \
+                    c.done < self.run[2]:
+                self.run = (what, now, c.done)
+            elapsed = now - self.run[1]
+            rate = ((c.done - self.run[2]) / elapsed if elapsed > 0
+                    else math.nan)
+            return 1 if self.callable(Progress(what, c.done, c.total,
+                                               c.unit.decode(), elapsed,
+                                               rate)) else 0
+        except BaseException as e:  # KeyboardInterrupt included
+            self.error = e
+            return 1
+
+    def raise_pending(self, result):
+        """After the run: raise what the callable raised, or what SIGINT
+        asks (the previous handler's KeyboardInterrupt), with the result
+        attached; nothing when neither came."""
+        e = self.error
+        if e is None and self.signalled:
+            h = self.previous
+            try:
+                if h is signal.default_int_handler:
+                    raise KeyboardInterrupt
+                h(signal.SIGINT, None)
+            except BaseException as caught:
+                e = caught
+            else:
+                if result is None or result.json.get("completed", True):
+                    return
+                e = Cancelled(ECANCEL, "interrupted (SIGINT): " +
+                              str(result.json.get("error")), result)
+        if e is None:
+            return
+        if result is not None and not hasattr(e, "result"):
+            try:
+                e.result = result
+            except AttributeError:
+                pass
+        raise e
 
 
 class _Job:

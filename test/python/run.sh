@@ -1,5 +1,6 @@
 #!/bin/bash
-# test/python/run.sh: the Python package's tests (test_towstab.py) and its
+# test/python/run.sh: the Python package's tests (test_towstab.py,
+# test_progress.py, test_install.py) and its
 # example (examples/python/), with Debian's python3-pytest and numpy.
 #   run.sh PYTHON BUILD_DIR TOWSTAB LIBRARY SANITIZE
 # Run from the project root. Skipped (77) without pytest or numpy; the
