@@ -526,7 +526,7 @@ static int field_list(const ctx *c, const char *path, const field *f,
 {
     if (f->value->type != YAML_SEQUENCE_NODE)
         return fail_at(c, TS_ESCENE, path, f->line, "expected a list of %s, "
-                       "got %s", what, kind_name(f->value));
+                       "got %s", what, tsi_scene_kind_name(f->value));
     *n = seq_len(f->value);
     if (*n > max)
         return fail_at(c, TS_EINVAL, path, f->line, "has %d entries, at "
@@ -876,7 +876,7 @@ static int parse_loop(const ctx *c, const yaml_node_t *n, const char *parent,
     }
     return fail_at(c, TS_ESCENE, p, f[L_SURF].line, "expected a list of "
                    "surface names or a mapping of names to gains, got %s",
-                   kind_name(sn));
+                   tsi_scene_kind_name(sn));
 }
 
 /* added_mass of a vehicle: "spheroid" (of its first hull), "none", a
