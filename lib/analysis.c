@@ -45,6 +45,7 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,6 +67,11 @@
 #define SIM_TOL_NOISE 10.0
 /* Times compared within this (s) are the same sample. */
 #define TIME_EPS 1e-12
+/* Key values of a simulation: amplitude ratio, mean offset, phase, then
+ * the extreme link tensions over the window. */
+#define SIM_VALUES 5
+#define SIM_TMAX 3
+#define SIM_TMIN 4
 
 static const char *const kind_names[TS_ANALYSIS_COUNT] = {
     "equilibrium", "modes", "response", "simulate", "converge"};
@@ -100,6 +106,9 @@ void ts_request_init(ts_request *rq, ts_analysis_kind kind)
     rq->setup.speed = NAN;
     rq->setup.turn_rate = NAN;
     ts_equilibrium_opts_default(&rq->setup.equilibrium);
+    rq->setup.accuracy = TS_ACCURACY_DEFAULT;
+    rq->setup.discretisation_error = kind != TS_ANALYSIS_SIMULATE &&
+                                     kind != TS_ANALYSIS_CONVERGE;
     ts_eigen_opts_default(&rq->modes.eigen);
     rq->modes.follow = TS_MODES_FOLLOW;
     ts_linearize_opts_default(&rq->modes.linearize);
@@ -109,7 +118,6 @@ void ts_request_init(ts_request *rq, ts_analysis_kind kind)
     rq->response.points = TS_RESPONSE_POINTS;
     rq->response.intervals = TS_SEASTATE_INTERVALS;
     rq->response.duration = TS_SEASTATE_DURATION;
-    rq->response.discretisation = 1;
     rq->simulate.seed = 1;
     rq->simulate.components = TS_SEA_COMPONENTS;
     rq->simulate.fade_in = NAN;
@@ -117,6 +125,7 @@ void ts_request_init(ts_request *rq, ts_analysis_kind kind)
     rq->simulate.sim.t_end = TS_SIMULATE_T_END;
     rq->simulate.sim.dt_sample = 0;
     rq->simulate.transient = NAN;
+    rq->simulate.check_window = 1;
     rq->converge.analysis = TS_ANALYSIS_EQUILIBRIUM;
     rq->converge.param = TS_CONV_LINKS;
     rq->converge.target = TS_CONVERGE_TARGET;
@@ -180,6 +189,10 @@ static int check_setup(const ts_setup *s, ts_err *err)
         return ts_fail(err, TS_EINVAL,
                        "tolerance: expected a number in (0, 1), got %g",
                        e->tol);
+    if (!(s->accuracy > 0 && s->accuracy < 1))
+        return ts_fail(err, TS_EINVAL,
+                       "accuracy: expected a relative error in (0, 1), got "
+                       "%g", s->accuracy);
     return TS_OK;
 }
 
@@ -227,6 +240,17 @@ static ts_result *result_alloc(ts_analysis_kind kind, ts_err *err)
     ts_trust_init(&r->eq_trust);
     ts_trust_init(&r->modes_trust);
     r->transient = NAN;
+    r->accurate_to_hz = NAN;
+    ts_result_accuracy *a = &r->accuracy;
+    a->accuracy = NAN;
+    a->order = a->wall_s = a->max_rel_error = NAN;
+    a->limiting_order = a->limiting_theory = a->links_factor = NAN;
+    a->met = -1;
+    r->stability.verdict = r->stability.unresolved_verdict = -1;
+    r->stability.mode = r->stability.unresolved_mode = -1;
+    r->stability.max_real = r->stability.unresolved_max_real = NAN;
+    r->stability.discretisation_error = r->stability.solver_error = NAN;
+    r->stability.unresolved_error = NAN;
     return r;
 }
 
@@ -240,9 +264,12 @@ void ts_result_free(ts_result *r)
     ts_linear_free(r->lin);
     ts_eigen_free(r->eigen);
     free(r->mode_health);
+    free(r->mode_accuracy);
     ts_response_free(r->response);
     ts_seastate_free(r->seastate);
     ts_excitation_free(r->sea_excitation);
+    free(r->magnitude_error);
+    free(r->phase_error_deg);
     ts_history_free(r->nonlinear);
     ts_history_free(r->linear);
     ts_convergence_free(r->convergence);
@@ -269,6 +296,7 @@ static int values_alloc(ts_result *r, int n, ts_err *err)
         r->values[i].value = NAN;
         r->values[i].error.discretisation = NAN;
         r->values[i].error.solver = NAN;
+        r->values[i].order = NAN;
     }
     return TS_OK;
 }
@@ -458,19 +486,25 @@ static int pipeline_equilibrium(ts_result *r, const ts_request *rq,
 
 /* ---- modes ------------------------------------------------------------- */
 
-/* The eigen options of a request for a linear model of n states. */
+/* The eigen options of a request for a linear model of n states. With
+ * `near` the modes nearest the target are chosen among the oscillatory
+ * ones (select_modes): every mode is computed below arpack_min_states,
+ * and ARPACK is asked for more than are listed (real modes near 0 Hz
+ * compete with them). */
 static ts_eigen_opts modes_eigen_opts(const ts_modes_opts *m, int n)
 {
     ts_eigen_opts o = m->eigen;
     o.count = m->count;
-    if (o.count == 0) {
+    int arpack = o.method == TS_EIG_ARPACK ||
+                 (o.method == TS_EIG_AUTO && n >= o.arpack_min_states);
+    if (m->near || (m->oscillatory && m->count > 0)) {
+        int want = m->count > 0 ? m->count : TS_MODES_NEAR_COUNT;
+        o.count = arpack ? 2 * want + 10 : 0;
+    } else if (o.count == 0) {
         int large = 2 * m->follow + 10;
         if (large < TS_MODES_LARGE_COUNT)
             large = TS_MODES_LARGE_COUNT;
-        if (m->near)
-            o.count = TS_MODES_NEAR_COUNT;
-        else if (o.method == TS_EIG_ARPACK ||
-                 (o.method == TS_EIG_AUTO && n >= o.arpack_min_states))
+        if (arpack)
             o.count = large;
     }
     /* More than exist: all of them. ARPACK finds a few near a target and
@@ -480,10 +514,154 @@ static ts_eigen_opts modes_eigen_opts(const ts_modes_opts *m, int n)
     return o;
 }
 
+/* Oscillatory modes first (by frequency), then real ones (by |lambda|);
+ * among the first `nsel` places those chosen (sel[m] = 1). */
+typedef struct mode_key {
+    int index;
+    int group;     /* 0 chosen oscillatory, 1 chosen real, 2 not chosen */
+    double freq, mag;
+} mode_key;
+
+static int cmp_mode_key(const void *a, const void *b)
+{
+    const mode_key *x = a, *y = b;
+    if (x->group != y->group)
+        return x->group < y->group ? -1 : 1;
+    double kx = x->group == 1 ? x->mag : x->freq;
+    double ky = y->group == 1 ? y->mag : y->freq;
+    if (kx != ky)
+        return kx < ky ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index;
+}
+
+/* Reorder e's modes (and vectors) as perm says: new mode i is old perm[i]. */
+static int permute_modes(ts_eigen *e, const int *perm, ts_err *err)
+{
+    int n = e->nmodes, ns = e->nstate;
+    ts_mode *md = malloc((size_t)(n > 0 ? n : 1) * sizeof *md);
+    double *vr = e->vec_re ? malloc((size_t)ns * (size_t)n * sizeof *vr)
+                           : NULL;
+    double *vi = e->vec_im ? malloc((size_t)ns * (size_t)n * sizeof *vi)
+                           : NULL;
+    if (!md || (e->vec_re && !vr) || (e->vec_im && !vi)) {
+        free(md);
+        free(vr);
+        free(vi);
+        return ts_fail(err, TS_ENOMEM, "modes: out of memory");
+    }
+    for (int i = 0; i < n; i++) {
+        md[i] = e->modes[perm[i]];
+        if (vr)
+            memcpy(vr + (size_t)i * ns, e->vec_re + (size_t)perm[i] * ns,
+                   (size_t)ns * sizeof *vr);
+        if (vi)
+            memcpy(vi + (size_t)i * ns, e->vec_im + (size_t)perm[i] * ns,
+                   (size_t)ns * sizeof *vi);
+    }
+    free(e->modes);
+    e->modes = md;
+    if (vr) {
+        free(e->vec_re);
+        e->vec_re = vr;
+    }
+    if (vi) {
+        free(e->vec_im);
+        e->vec_im = vi;
+    }
+    return TS_OK;
+}
+
+/* The modes listed: oscillatory first by frequency, then the real ones;
+ * with `near` the `count` (TS_MODES_NEAR_COUNT) oscillatory modes nearest
+ * the target frequency; with `oscillatory` the oscillatory ones only (the
+ * `count` lowest, when given). The
+ * listed modes come first in e, e->nmodes becomes their number and
+ * r->nmodes_computed keeps the number computed (the rest stay behind
+ * them, for the verdict). */
+static int select_modes(ts_result *r, const ts_modes_opts *m, ts_err *err)
+{
+    ts_eigen *e = r->eigen;
+    int n = e->nmodes;
+    r->nmodes_computed = n;
+    mode_key *key = malloc((size_t)(n > 0 ? n : 1) * sizeof *key);
+    int *perm = malloc((size_t)(n > 0 ? n : 1) * sizeof *perm);
+    if (!key || !perm) {
+        free(key);
+        free(perm);
+        return ts_fail(err, TS_ENOMEM, "modes: out of memory");
+    }
+    for (int i = 0; i < n; i++) {
+        key[i].index = i;
+        key[i].freq = e->modes[i].freq_hz;
+        key[i].mag = hypot(e->modes[i].re, e->modes[i].im);
+        key[i].group = e->modes[i].im > 0 ? 0 : 1;
+    }
+    if (m->near) {
+        /* Rank the oscillatory modes by distance to the target. */
+        int want = m->count > 0 ? m->count : TS_MODES_NEAR_COUNT;
+        for (int i = 0; i < n; i++)
+            key[i].freq = key[i].group == 0
+                              ? fabs(key[i].freq - m->eigen.target_hz)
+                              : INFINITY;
+        qsort(key, (size_t)n, sizeof *key, cmp_mode_key);
+        for (int i = 0; i < n; i++) {
+            int chosen = key[i].group == 0 && i < want;
+            key[i].freq = e->modes[key[i].index].freq_hz;
+            key[i].group = chosen ? 0 : 2;
+        }
+    } else if (m->oscillatory) {
+        /* The `count` (all) lowest oscillatory ones. */
+        qsort(key, (size_t)n, sizeof *key, cmp_mode_key);
+        for (int i = 0; i < n; i++)
+            if (key[i].group == 1 || (m->count > 0 && i >= m->count))
+                key[i].group = 2;
+    }
+    qsort(key, (size_t)n, sizeof *key, cmp_mode_key);
+    int listed = 0;
+    for (int i = 0; i < n; i++) {
+        perm[i] = key[i].index;
+        listed += key[i].group < 2;
+    }
+    int rc = permute_modes(e, perm, err);
+    free(key);
+    free(perm);
+    if (rc == TS_OK)
+        e->nmodes = listed;
+    return rc;
+}
+
+/* The mode that is the k-th key mode (0-based) of e's first n modes: the
+ * k-th lowest oscillatory one with damping below
+ * TS_CONV_MODE_DAMPING_MAX; -1. */
+static int key_mode(const ts_eigen *e, int n, int k)
+{
+    /* Lowest by frequency, whatever the listing order. */
+    int prev = -1;
+    for (int j = 0; j <= k; j++) {
+        int best = -1;
+        for (int m = 0; m < n; m++) {
+            const ts_mode *md = &e->modes[m];
+            if (!(md->im > 0) ||
+                !(md->damping_ratio < TS_CONV_MODE_DAMPING_MAX))
+                continue;
+            if (prev >= 0 &&
+                (md->freq_hz < e->modes[prev].freq_hz ||
+                 (md->freq_hz == e->modes[prev].freq_hz && m <= prev)))
+                continue;
+            if (best < 0 || md->freq_hz < e->modes[best].freq_hz)
+                best = m;
+        }
+        if (best < 0)
+            return -1;
+        prev = best;
+    }
+    return prev;
+}
+
 /* Key values: frequency (Hz, relative to itself) and damping ratio (scale
  * 1) of the `follow` lowest oscillatory modes with damping below
- * TS_CONV_MODE_DAMPING_MAX; solver error: each mode's error bound as a
- * frequency and as a damping ratio. */
+ * TS_CONV_MODE_DAMPING_MAX among every mode computed; solver error: each
+ * mode's error bound as a frequency and as a damping ratio. */
 static int modes_values(ts_result *r, int follow, ts_err *err)
 {
     int rc = values_alloc(r, 2 * follow, err);
@@ -495,16 +673,16 @@ static int modes_values(ts_result *r, int follow, ts_err *err)
                    m + 1);
     }
     const ts_eigen *e = r->eigen;
-    for (int m = 0, k = 0; e && m < e->nmodes && k < follow; m++) {
+    for (int k = 0; e && k < follow; k++) {
+        int m = key_mode(e, r->nmodes_computed, k);
+        if (m < 0)
+            break;
         const ts_mode *md = &e->modes[m];
-        if (!(md->im > 0) || !(md->damping_ratio < TS_CONV_MODE_DAMPING_MAX))
-            continue;
         double mag = hypot(md->re, md->im);
         r->values[2 * k].value = md->freq_hz;
         r->values[2 * k].error.solver = md->error_bound / (2.0 * M_PI);
         r->values[2 * k + 1].value = md->damping_ratio;
         r->values[2 * k + 1].error.solver = md->error_bound / mag;
-        k++;
     }
     return TS_OK;
 }
@@ -519,9 +697,11 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     double t0 = wall_now();
     rc = ts_eigen_solve(r->lin, &o, &r->eigen, err);
     r->eigen_wall_s = wall_now() - t0;
+    if (rc == TS_OK)
+        rc = select_modes(r, m, err);
     if (rc != TS_OK)
         return rc;
-    int nm = r->eigen->nmodes;
+    int nm = r->nmodes_computed;
     r->mode_health = malloc((size_t)(nm > 0 ? nm : 1) *
                             sizeof *r->mode_health);
     if (!r->mode_health)
@@ -531,6 +711,12 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
                          &r->modes_trust, err);
     if (rc != TS_OK)
         return rc;
+    if (m->near && r->eigen->nmodes < (m->count > 0 ? m->count
+                                                    : TS_MODES_NEAR_COUNT))
+        ts_trust_note(&r->modes_trust, "only %d oscillatory mode%s among "
+                      "the %d computed near %.4g Hz", r->eigen->nmodes,
+                      r->eigen->nmodes == 1 ? "" : "s", nm,
+                      m->eigen.target_hz);
     ts_trust_merge(&r->trust, NULL, &r->modes_trust);
     return modes_values(r, m->follow, err);
 }
@@ -651,7 +837,10 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     if (rc != TS_OK)
         return rc;
     ts_seastate *s = r->seastate;
-    if (o->discretisation) {
+    /* With a sea, the spectral analysis estimates its own discretisation
+     * error (the same levels, ts_seastate_discretisation); the accuracy
+     * stage judges it. */
+    if (rq->setup.discretisation_error || rq->setup.refine) {
         ts_err de = {0};
         int drc = ts_seastate_discretisation(r->sys, &rq->setup.equilibrium,
                                              &r->seaway, &so, s, &de);
@@ -671,6 +860,37 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
                                  "first order, which the linear model "
                                  "cannot show");
     return sea_values(r, s, err);
+}
+
+/* The frequency point of the largest magnitude. */
+static int response_peak(const ts_response *res)
+{
+    int ip = 0;
+    for (int i = 1; i < res->npoints; i++)
+        if (res->magnitude[i] > res->magnitude[ip])
+            ip = i;
+    return ip;
+}
+
+/* Key values of a response: the static gain and the largest magnitude
+ * over the frequencies (the output's unit per m), both relative to the
+ * largest magnitude. The solver's part of their error is not estimated. */
+static int response_values(ts_result *r, ts_err *err)
+{
+    const ts_response *res = r->response;
+    int rc = values_alloc(r, 2, err);
+    if (rc)
+        return rc;
+    double peak = res->magnitude[response_peak(res)];
+    value_name(&r->values[0], res->output.unit, peak, "%.80s.static_gain",
+               res->output.name);
+    value_name(&r->values[1], res->output.unit, peak,
+               "%.80s.peak_magnitude", res->output.name);
+    r->values[0].value = res->static_gain;
+    r->values[1].value = peak;
+    if (!(peak > 0))
+        r->values[0].scale = r->values[1].scale = 0.0;
+    return TS_OK;
 }
 
 static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
@@ -698,6 +918,9 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
         rc = ts_response_compute(r->sys, r->lin, input, &out, freq,
                                  o->points, &r->response, err);
     free(freq);
+    if (rc != TS_OK)
+        return rc;
+    rc = response_values(r, err);
     if (rc != TS_OK)
         return rc;
     if (o->natural) {
@@ -1031,10 +1254,11 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
  * output's amplitude ratio (relative to itself), mean offset from the
  * equilibrium (m, scale the excitation amplitude) and phase (deg, scale
  * 360), fitted with the tow motion over t >= transient of the nonlinear
- * run. Solver error: rounding, SIM_ROUND_EPS eps sqrt(steps) of each
- * value's scale, and the equilibrium's residual for the mean offset. A
- * fit that cannot be made leaves NAN values (an error only when
- * required). */
+ * run, and the largest and smallest link tension over that window (N,
+ * relative to themselves). Solver error: rounding, SIM_ROUND_EPS eps
+ * sqrt(steps) of each value's scale (of the largest tension for both
+ * tensions), and the equilibrium's residual for the mean offset. A fit
+ * that cannot be made leaves NAN values (an error only when required). */
 static int sim_values(ts_result *r, int required, ts_err *err)
 {
     const ts_excitation *ex = r->excitation;
@@ -1042,7 +1266,7 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     if (!ex || !ts_excitation_periodic(ex, &idx))
         return TS_OK;
     const ts_signal *sg = ts_excitation_signal(ex, idx);
-    int rc = values_alloc(r, 3, err);
+    int rc = values_alloc(r, SIM_VALUES, err);
     if (rc)
         return rc;
     static const char *const suffix[3] = {"amplitude_ratio", "mean_offset",
@@ -1052,6 +1276,8 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     for (int v = 0; v < 3; v++)
         value_name(&r->values[v], unit[v], scale[v], "%.70s.%s",
                    r->output.name, suffix[v]);
+    value_name(&r->values[SIM_TMAX], "N", 0.0, "tension.max");
+    value_name(&r->values[SIM_TMIN], "N", 0.0, "tension.min");
     const ts_history *h = r->nonlinear;
     if (!h || !r->eq || r->status != TS_OK)
         return TS_OK;
@@ -1059,6 +1285,14 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     while (first < h->nsamples && h->t[first] < r->transient - TIME_EPS)
         first++;
     int n = h->nsamples - first;
+    /* The extreme link tensions over the window. */
+    double tmax = -INFINITY, tmin = INFINITY;
+    for (int i = first; h->tensions && i < h->nsamples; i++)
+        for (int l = 0; l < h->nlinks; l++) {
+            double tl = h->tensions[(size_t)h->nlinks * i + l];
+            tmax = fmax(tmax, tl);
+            tmin = fmin(tmin, tl);
+        }
     ts_err fe = {0};
     if (n < 3) {
         ts_fail(&fe, TS_EINVAL, "simulate: %d samples after the transient "
@@ -1097,6 +1331,12 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     for (int v = 0; v < 3; v++) {
         r->values[v].value = vals[v];
         r->values[v].error.solver = round * noise_scale[v];
+    }
+    if (tmax >= tmin) {
+        r->values[SIM_TMAX].value = tmax;
+        r->values[SIM_TMIN].value = tmin;
+        r->values[SIM_TMAX].error.solver = round * fabs(tmax);
+        r->values[SIM_TMIN].error.solver = round * fabs(tmax);
     }
     r->values[1].error.solver += EQ_NOISE_FACTOR *
                                  fmax(r->eq->residual, EQ_NOISE_MIN_REL) * L;
@@ -1338,6 +1578,587 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     return rc;
 }
 
+/* ---- accuracy ---------------------------------------------------------- */
+
+/* A tow-point output of `sys` named again on another discretisation
+ * `lev` (the same place): into name; 0, or -1 when lev has no node
+ * there. */
+static int map_output(const ts_system *sys, const ts_system *lev,
+                      const ts_output *out, char *name, size_t size)
+{
+    int node = out->kind == TS_OUT_TENSION ? sys->links[out->link].lower
+                                           : out->node;
+    int k = ts_accuracy_node_map(sys, lev, node);
+    if (k < 1)
+        return -1;
+    char nn[2 * TS_NAME_MAX];
+    ts_system_node_name(lev, k, nn, sizeof nn);
+    static const char axis[3] = {'x', 'y', 'z'};
+    if (out->kind == TS_OUT_TENSION)
+        snprintf(name, size, "%s.tension", nn);
+    else
+        snprintf(name, size, "%s.%c", nn, axis[out->comp]);
+    return 0;
+}
+
+/* The request of another level: the same analysis on system `lev` (which
+ * carries the speed and turn rate), without estimate, refinement or
+ * window checks; its output named at the same place; modes: every mode
+ * below ARPACK's size, else more than the run kept, around the same
+ * target. Returns 0, or -1 (with why) when the output has no place. */
+static int level_request(const ts_result *r, const ts_request *rq,
+                         const ts_system *lev, ts_request *sub, char *why,
+                         size_t size)
+{
+    *sub = *rq; /* shallow: the excitation is borrowed */
+    sub->setup.links = 0;
+    sub->setup.speed = NAN;
+    sub->setup.turn_rate = NAN;
+    sub->setup.discretisation_error = 0;
+    sub->setup.refine = 0;
+    sub->simulate.check_window = 0;
+    sub->simulate.compare = 0;
+    sub->simulate.linear = 0;
+    sub->modes.near = 0;
+    sub->modes.oscillatory = 0;
+    if (rq->kind == TS_ANALYSIS_MODES) {
+        int arpack = rq->modes.eigen.method == TS_EIG_ARPACK ||
+                     (rq->modes.eigen.method == TS_EIG_AUTO &&
+                      r->lin->nstate / (double)r->sys->nlinks * lev->nlinks >=
+                          rq->modes.eigen.arpack_min_states);
+        sub->modes.count = arpack ? r->nmodes_computed + 10 : 0;
+    }
+    const ts_output *out = rq->kind == TS_ANALYSIS_RESPONSE
+                               ? &r->response->output
+                               : &r->output;
+    char *dst = rq->kind == TS_ANALYSIS_RESPONSE ? sub->response.output
+                                                 : sub->simulate.output;
+    size_t dsize = rq->kind == TS_ANALYSIS_RESPONSE
+                       ? sizeof sub->response.output
+                       : sizeof sub->simulate.output;
+    if ((rq->kind == TS_ANALYSIS_RESPONSE ||
+         rq->kind == TS_ANALYSIS_SIMULATE) &&
+        map_output(r->sys, lev, out, dst, dsize) != 0) {
+        snprintf(why, size, "the %d-link discretisation has no node at the "
+                 "place of %s (a body, a free end or a node at a fraction "
+                 "of its cable that both have)",
+                 ts_accuracy_max_links(lev), out->name);
+        return -1;
+    }
+    return 0;
+}
+
+/* The result of every level: r itself, then the runs at the other
+ * discretisations. */
+typedef struct levels {
+    int n;                                  /* r included */
+    const ts_result *res[TS_ACCURACY_LEVELS];
+    ts_result *own[TS_ACCURACY_LEVELS];     /* the other levels (owned) */
+    ts_system *sys[TS_ACCURACY_LEVELS];
+} levels;
+
+static void levels_free(levels *L)
+{
+    for (int k = 1; k < TS_ACCURACY_LEVELS; k++) {
+        ts_result_free(L->own[k]);
+        ts_system_free(L->sys[k]);
+    }
+}
+
+/* Run the other levels: two coarser ones, or one finer when some cable
+ * has a single link. A level that fails ends the series there; its
+ * message goes to why. */
+static int run_levels(ts_result *r, const ts_request *rq, levels *L,
+                      char *why, size_t size)
+{
+    ts_result_accuracy *a = &r->accuracy;
+    memset(L, 0, sizeof *L);
+    L->n = 1;
+    L->res[0] = r;
+    int coarser = ts_accuracy_can_coarsen(r->sys);
+    int want = coarser ? 3 : 2;
+    const ts_system *from = r->sys;
+    for (int k = 1; k < want; k++) {
+        if (k > 1 && !ts_accuracy_can_coarsen(from))
+            break;
+        ts_err e = {0};
+        double ratio;
+        ts_system *lev = ts_accuracy_level(from, coarser, &ratio, &e);
+        if (!lev) {
+            snprintf(why, size, "no %s discretisation: %.200s",
+                     coarser ? "coarser" : "finer", e.msg);
+            return e.code == TS_ENOMEM ? TS_ENOMEM : TS_OK;
+        }
+        ts_request sub;
+        if (level_request(r, rq, lev, &sub, why, size) != 0) {
+            ts_system_free(lev);
+            return TS_OK;
+        }
+        ts_result *lr = NULL;
+        int rc = ts_analysis_run(lev, &sub, &lr, &e);
+        if (lr) {
+            a->wall_s = (isnan(a->wall_s) ? 0.0 : a->wall_s) + lr->wall_s;
+            a->evaluations += lr->evaluations;
+        }
+        if (rc == TS_ECANCEL || rc == TS_ENOMEM) {
+            ts_result_free(lr);
+            ts_system_free(lev);
+            snprintf(why, size, "the run at %d links stopped: %.200s",
+                     ts_accuracy_max_links(lev), e.msg);
+            return rc;
+        }
+        if (rc != TS_OK) {
+            if (k == 1)
+                snprintf(why, size, "the run at %d links failed: %.200s",
+                         ts_accuracy_max_links(lev), e.msg);
+            ts_result_free(lr);
+            ts_system_free(lev);
+            break;
+        }
+        L->sys[k] = lev;
+        L->own[k] = lr;
+        L->res[k] = lr;
+        a->ratio[k - 1] = ratio;
+        a->links[k] = ts_accuracy_max_links(lev);
+        L->n = k + 1;
+        from = lev;
+    }
+    a->nlevels = L->n;
+    return TS_OK;
+}
+
+/* The Richardson estimate of key value v from the levels (values matched
+ * by index: every level names them alike). */
+static void estimate_value(ts_result *r, const levels *L, int v,
+                           double order)
+{
+    ts_accuracy_series s = {0};
+    s.order = order;
+    s.nlevels = L->n;
+    for (int k = 0; k < L->n; k++) {
+        const ts_value *x = v < L->res[k]->nvalues ? &L->res[k]->values[v]
+                                                   : NULL;
+        s.f[k] = x ? x->value : NAN;
+        if (x && isfinite(x->error.solver))
+            s.noise = fmax(s.noise, x->error.solver);
+        if (k > 0)
+            s.ratio[k - 1] = r->accuracy.ratio[k - 1];
+    }
+    ts_accuracy_estimate e = ts_accuracy_richardson(&s);
+    r->values[v].error.discretisation = e.error;
+    r->values[v].order = isfinite(e.error) ? e.order : NAN;
+}
+
+/* What the accuracy is judged on: one relative error, its order and its
+ * name. */
+static void judge(ts_result_accuracy *a, double rel, double order,
+                  double theory, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+
+/* `order` is the order the estimate used, `theory` the theoretical one,
+ * which predicts the links needed: the error falls as N^-p once N is in
+ * the asymptotic range (an estimate made at a smaller, pre-asymptotic
+ * order is already the larger). */
+static void judge(ts_result_accuracy *a, double rel, double order,
+                  double theory, const char *fmt, ...)
+{
+    if (!isfinite(rel))
+        return;
+    double f = ts_accuracy_links_factor(rel, a->accuracy, theory);
+    if (isfinite(f) && !(f <= a->links_factor))
+        a->links_factor = f;
+    if (isfinite(a->max_rel_error) && !(rel > a->max_rel_error))
+        return;
+    a->max_rel_error = rel;
+    a->limiting_order = order;
+    a->limiting_theory = theory;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(a->limiting, sizeof a->limiting, fmt, ap);
+    va_end(ap);
+}
+
+/* The relative scale of key value v. */
+static double value_scale(const ts_value *v)
+{
+    return v->scale > 0 ? v->scale : fabs(v->value);
+}
+
+/* Modes: match every mode computed to the other levels; the key values'
+ * errors from their modes; the verdicts of resolved and unresolved
+ * modes. Without levels, only the shape test. */
+static void estimate_modes(ts_result *r, const ts_request *rq,
+                           const levels *L)
+{
+    ts_result_accuracy *a = &r->accuracy;
+    ts_eigen all = *r->eigen;
+    all.nmodes = r->nmodes_computed;
+    const ts_eigen *lev[TS_ACCURACY_LEVELS - 1] = {NULL, NULL};
+    for (int k = 1; k < L->n; k++)
+        lev[k - 1] = L->res[k]->eigen;
+    ts_accuracy_modes(r->sys, r->lin, &all, L->n, lev, a->ratio, a->order,
+                      a->accuracy, r->mode_accuracy);
+    ts_accuracy_stability(&all, r->mode_accuracy, L->n > 1, &r->stability);
+    if (L->n < 2)
+        return;
+    for (int k = 0; k < rq->modes.follow && 2 * k + 1 < r->nvalues; k++) {
+        int m = key_mode(&all, all.nmodes, k);
+        if (m < 0)
+            continue;
+        const ts_mode_accuracy *ma = &r->mode_accuracy[m];
+        r->values[2 * k].error.discretisation = ma->freq_error_hz;
+        r->values[2 * k + 1].error.discretisation = ma->damping_error;
+        r->values[2 * k].order = r->values[2 * k + 1].order = ma->order;
+    }
+    const ts_stability *st = &r->stability;
+    if (st->mode >= 0) {
+        const ts_mode *md = &all.modes[st->mode];
+        double mag = hypot(md->re, md->im);
+        if (mag > 0)
+            judge(a, st->discretisation_error / mag,
+                  r->mode_accuracy[st->mode].order, a->order,
+                  "the stability margin (Re of mode %d, relative to "
+                  "|lambda|)", st->mode + 1);
+    }
+}
+
+/* Response: the errors of magnitude and phase at every frequency, of the
+ * key values, and the highest frequency up to which the magnitude meets
+ * the accuracy. */
+static int estimate_response(ts_result *r, const levels *L, ts_err *err)
+{
+    ts_result_accuracy *a = &r->accuracy;
+    const ts_response *res = r->response;
+    int np = res->npoints;
+    r->magnitude_error = malloc((size_t)np * sizeof(double));
+    r->phase_error_deg = malloc((size_t)np * sizeof(double));
+    if (!r->magnitude_error || !r->phase_error_deg)
+        return ts_fail(err, TS_ENOMEM, "response: out of memory");
+    double order = res->output.kind == TS_OUT_TENSION ? 1.0 : a->order;
+    int ip = response_peak(res);
+    double peak = res->magnitude[ip];
+    r->accurate_to_hz = NAN;
+    int all_met = 1;
+    double worst = -1;
+    int iw = -1;
+    for (int i = 0; i < np; i++) {
+        ts_accuracy_series mag = {0}, ph = {0};
+        mag.order = ph.order = order;
+        mag.nlevels = ph.nlevels = L->n;
+        for (int k = 0; k < L->n; k++) {
+            const ts_response *q = L->res[k]->response;
+            mag.f[k] = q->magnitude[i];
+            /* Phases unwrapped onto the run's. */
+            ph.f[k] = res->phase_deg[i] +
+                      ts_compare_wrap_deg(q->phase_deg[i] -
+                                          res->phase_deg[i]);
+            if (k > 0)
+                mag.ratio[k - 1] = ph.ratio[k - 1] = a->ratio[k - 1];
+        }
+        mag.noise = 16 * DBL_EPSILON * peak;
+        r->magnitude_error[i] = ts_accuracy_richardson(&mag).error;
+        r->phase_error_deg[i] = ts_accuracy_richardson(&ph).error;
+        double rel = peak > 0 ? r->magnitude_error[i] / peak : NAN;
+        if (rel > worst) {
+            worst = rel;
+            iw = i;
+        }
+        if (all_met && rel <= a->accuracy)
+            r->accurate_to_hz = res->freq_hz[i];
+        else
+            all_met = 0;
+    }
+    if (iw >= 0)
+        judge(a, worst, order, order, "the magnitude at %.4g Hz (relative to the "
+              "largest, %.4g %s)", res->freq_hz[iw], peak, res->output.unit);
+    /* Key values: the static gain at each level, the magnitude at the
+     * peak's frequency. */
+    for (int v = 0; v < r->nvalues && v < 2; v++) {
+        ts_accuracy_series s = {0};
+        s.order = order;
+        s.nlevels = L->n;
+        for (int k = 0; k < L->n; k++) {
+            const ts_response *q = L->res[k]->response;
+            s.f[k] = v == 0 ? q->static_gain : q->magnitude[ip];
+            if (k > 0)
+                s.ratio[k - 1] = a->ratio[k - 1];
+        }
+        s.noise = 16 * DBL_EPSILON * peak;
+        ts_accuracy_estimate e = ts_accuracy_richardson(&s);
+        r->values[v].error.discretisation = e.error;
+        r->values[v].order = e.order;
+    }
+    return TS_OK;
+}
+
+/* The analysed window of a simulation: settled and periodic. The slowest
+ * time constant comes from the modes of the linear model about the
+ * equilibrium (linearized here when the run did not need it). */
+static int check_window(ts_result *r, const ts_request *rq, ts_err *err)
+{
+    const ts_excitation *ex = r->excitation;
+    int idx;
+    const ts_history *h = r->nonlinear ? r->nonlinear : r->linear;
+    if (!rq->simulate.check_window || !ex ||
+        !ts_excitation_periodic(ex, &idx) || !h || h->nsamples < 3 ||
+        !r->eq || !r->eq->converged ||
+        (!r->compared && !(r->nvalues > 0 && isfinite(r->values[0].value))))
+        return TS_OK;
+    const ts_signal *sg = ts_excitation_signal(ex, idx);
+    double tau = NAN, fslow = NAN;
+    int complete = 0;
+    ts_linear *own = NULL;
+    const ts_linear *lin = r->lin;
+    if (!lin) {
+        ts_linearize_opts lo;
+        ts_linearize_opts_default(&lo);
+        lo.estimate_error = 0;
+        ts_kernel *k = ts_kernel_alloc(r->sys, err);
+        own = k ? ts_linear_alloc(k, err) : NULL;
+        int rc = own ? ts_linearize_equilibrium(k, r->eq, &lo, own, err)
+                     : (err && err->code ? err->code : TS_ENOMEM);
+        ts_kernel_free(k);
+        if (rc == TS_ENOMEM) {
+            ts_linear_free(own);
+            return rc;
+        }
+        if (rc == TS_OK) {
+            lin = own;
+            r->evaluations += own->evaluations;
+        } else {
+            ts_err_clear(err);
+        }
+    }
+    if (lin) {
+        ts_eigen_opts eo;
+        ts_eigen_opts_default(&eo);
+        if (lin->nstate >= eo.arpack_min_states)
+            eo.count = TS_MODES_LARGE_COUNT;
+        ts_eigen *e = NULL;
+        if (ts_eigen_solve(lin, &eo, &e, NULL) == TS_OK) {
+            complete = e->complete;
+            /* Grid-scale modes are left out: artefacts of the links whose
+             * time constants grow with their number (the top mode's is
+             * 9 s at 20 links and 25 s at 80 in Kamman's ex. 4), which
+             * the output hardly sees; the drift check sees them if it
+             * does. */
+            for (int m = 0; m < e->nmodes; m++)
+                if (e->modes[m].re < 0 &&
+                    !(-1.0 / e->modes[m].re <= tau) &&
+                    !(ts_accuracy_half_wave(r->sys, lin, e, m) <=
+                      TS_ACCURACY_GRID_HALF_WAVE)) {
+                    tau = -1.0 / e->modes[m].re;
+                    fslow = e->modes[m].freq_hz;
+                }
+        }
+        ts_eigen_free(e);
+    }
+    ts_linear_free(own);
+    /* The output of each run over the whole run. */
+    const ts_history *runs[2] = {r->nonlinear, r->linear};
+    size_t stride = 3 * (size_t)h->nnodes;
+    size_t off = 3 * (size_t)r->output.node + (size_t)r->output.comp;
+    double *x = malloc((size_t)h->nsamples * sizeof *x);
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    for (int j = 0; j < 2; j++) {
+        const ts_history *q = runs[j];
+        if (!q || (j == 1 && !r->compared && r->nonlinear))
+            continue;
+        for (int i = 0; i < q->nsamples; i++)
+            x[i] = q->positions[stride * i + off];
+        ts_window w;
+        ts_accuracy_window(q->t, x, q->nsamples, 1.0 / sg->frequency,
+                           sg->amplitude, r->transient, tau,
+                           rq->setup.accuracy, &w);
+        w.slowest_freq_hz = fslow;
+        w.modes_complete = complete;
+        /* The window reported is the worse of the two runs'. */
+        if (!r->window.checked || w.settled == 0 ||
+            (w.periodic == 0 && r->window.settled != 0) ||
+            (isfinite(w.drift) && w.drift > r->window.drift &&
+             r->window.settled != 0 && r->window.periodic != 0))
+            r->window = w;
+    }
+    free(x);
+    const ts_window *w = &r->window;
+    char slow[160] = "";
+    if (isfinite(tau))
+        snprintf(slow, sizeof slow, "the slowest mode%s (%s, %.4g s)",
+                 complete ? "" : " among those nearest 0 Hz",
+                 fslow > 0 ? "oscillatory" : "real", tau);
+    if (w->settled == 0)
+        ts_trust_fail(&r->trust, "not settled: the window starts at %.4g s, "
+                      "before %.4g time constants (%.4g s) of %s; "
+                      "--transient %.4g --t-end %.4g would do",
+                      w->transient, TS_ACCURACY_SETTLE_TAU,
+                      TS_ACCURACY_SETTLE_TAU * tau, slow,
+                      w->transient_needed, w->t_end_needed);
+    else if (w->settled == 1 && isfinite(tau) &&
+             w->transient < TS_ACCURACY_SETTLE_TAU * tau)
+        ts_trust_note(&r->trust, "the analysis window begins at %.4g s, "
+                      "before %.4g time constants of the slowest mode "
+                      "(%.4g s), but the last two periods agree to %.2g, so "
+                      "at most %.2g of a decaying transient remains",
+                      w->transient, TS_ACCURACY_SETTLE_TAU, tau, w->drift,
+                      w->remaining);
+    if (w->periodic == 0)
+        ts_trust_fail(&r->trust, "not periodic: the output's last two "
+                      "periods differ by %.2g of its half range, above the "
+                      "accuracy %.3g; --transient %.4g --t-end %.4g would "
+                      "do", w->drift, rq->setup.accuracy,
+                      w->transient_needed, w->t_end_needed);
+    else if (w->periodic < 0 && w->t_end < 2 * w->period)
+        ts_trust_fail(&r->trust, "the run (%.4g s) is shorter than two "
+                      "periods (%.4g s), so its periodicity cannot be "
+                      "checked; --t-end %.4g would do", w->t_end,
+                      2 * w->period, w->t_end_needed);
+    return TS_OK;
+}
+
+/* The note on a turn whose radius is short for the cable: a turn rate
+ * probably meant in other units. */
+static void tow_notes(ts_result *r)
+{
+    const ts_tow *t = &r->sys->tow;
+    if (t->turn_rate == 0.0)
+        return;
+    double R = t->speed / fabs(t->turn_rate), L = total_length(r->sys);
+    if (R < 0.1 * L)
+        ts_trust_note(&r->trust, "the turn radius V / Omega = %.4g m is "
+                      "shorter than a tenth of the cable length (%.4g m): "
+                      "the turn rate %.4g rad/s is %.4g deg/s; a rate meant "
+                      "in deg/s is given as \"%.4g deg/s\"",
+                      R, L, t->turn_rate, t->turn_rate * 180.0 / M_PI,
+                      t->turn_rate);
+}
+
+/* The theoretical order of key value v: a link tension's (the extremes
+ * of a time history, a tension output) is 1, else the result's. */
+static double value_order(const ts_result *r, const ts_request *rq, int v)
+{
+    if (rq->kind == TS_ANALYSIS_SIMULATE && !r->has_sea && v >= SIM_TMAX)
+        return 1.0;
+    if (rq->kind == TS_ANALYSIS_RESPONSE && r->response &&
+        r->response->output.kind == TS_OUT_TENSION)
+        return 1.0;
+    return r->accuracy.order;
+}
+
+/* The accuracy of a finished result: the window checks of a simulation,
+ * the discretisation error of every key value from the other levels, the
+ * modes' resolution, and the verdict against rq->setup.accuracy. */
+static int accuracy_stage(ts_result *r, const ts_request *rq, ts_err *err)
+{
+    ts_result_accuracy *a = &r->accuracy;
+    a->accuracy = rq->setup.accuracy;
+    a->order = ts_accuracy_order(r->sys);
+    /* A response through a kinked linear model converges at first order
+     * (towstab/accuracy.h). */
+    if (rq->kind == TS_ANALYSIS_RESPONSE && r->lin && r->lin->kinks > 0)
+        a->order = 1.0;
+    a->links[0] = ts_accuracy_max_links(r->sys);
+    a->nlevels = 1;
+    int rc = TS_OK;
+    if (rq->kind == TS_ANALYSIS_SIMULATE)
+        rc = check_window(r, rq, err);
+    if (rc != TS_OK)
+        return rc;
+    if (rq->kind == TS_ANALYSIS_MODES) {
+        int n = r->nmodes_computed;
+        r->mode_accuracy = calloc((size_t)(n > 0 ? n : 1),
+                                  sizeof *r->mode_accuracy);
+        if (!r->mode_accuracy)
+            return ts_fail(err, TS_ENOMEM, "modes: out of memory");
+    }
+    levels L = {1, {r}, {NULL}, {NULL}};
+    int wanted = rq->setup.discretisation_error || rq->setup.refine;
+    if (wanted && r->seastate && rq->kind == TS_ANALYSIS_RESPONSE) {
+        /* A sea response estimated its own (ts_seastate_discretisation,
+         * coarse to fine in disc_links): judge it. */
+        const ts_seastate *ss = r->seastate;
+        a->estimated = ss->disc_estimated;
+        if (a->estimated) {
+            a->nlevels = 3;
+            for (int k = 0; k < 3; k++)
+                a->links[k] = ss->disc_links[2 - k];
+            for (int k = 0; k < 2; k++)
+                a->ratio[k] = (double)a->links[k] / a->links[k + 1];
+            a->wall_s = ss->disc_wall_s;
+        } else {
+            snprintf(a->not_estimated, sizeof a->not_estimated,
+                     "the sea state's estimate needs every cable at the "
+                     "same number (at least %d) of equal links",
+                     TS_SEASTATE_DISC_LINKS_MIN);
+        }
+    } else if (!wanted)
+        snprintf(a->not_estimated, sizeof a->not_estimated,
+                 rq->kind == TS_ANALYSIS_SIMULATE
+                     ? "off: it costs the simulation again at a half and "
+                       "a quarter of the links (--discretisation-error)"
+                     : "off (--no-discretisation-error)");
+    else if (rq->kind == TS_ANALYSIS_SIMULATE && r->nvalues == 0)
+        snprintf(a->not_estimated, sizeof a->not_estimated,
+                 "the run has no key values to compare (they need a "
+                 "single periodic excitation and a nonlinear run)");
+    else
+        rc = run_levels(r, rq, &L, a->not_estimated,
+                        sizeof a->not_estimated);
+    if (rc != TS_OK) {
+        levels_free(&L);
+        return rc;
+    }
+    if (!r->seastate || rq->kind != TS_ANALYSIS_RESPONSE)
+        a->estimated = L.n > 1;
+    if (a->estimated)
+        a->not_estimated[0] = '\0';
+    if (rq->kind == TS_ANALYSIS_MODES)
+        estimate_modes(r, rq, &L);
+    else if (rq->kind == TS_ANALYSIS_RESPONSE && a->estimated &&
+             !r->seastate)
+        rc = estimate_response(r, &L, err);
+    else if (a->estimated && L.n > 1)
+        for (int v = 0; v < r->nvalues; v++)
+            estimate_value(r, &L, v, value_order(r, rq, v));
+    levels_free(&L);
+    if (rc != TS_OK)
+        return rc;
+    /* The verdict: every key value's relative error against the
+     * accuracy. */
+    for (int v = 0; a->estimated && v < r->nvalues; v++) {
+        const ts_value *x = &r->values[v];
+        double sc = value_scale(x);
+        double theory = value_order(r, rq, v);
+        if (sc > 0 && isfinite(x->error.discretisation))
+            judge(a, x->error.discretisation / sc, x->order, theory, "%s",
+                  x->name);
+    }
+    if (!a->estimated || !isfinite(a->max_rel_error))
+        return TS_OK;
+    a->met = a->max_rel_error <= a->accuracy;
+    if (a->met)
+        return TS_OK;
+    double need = ceil(a->links[0] * a->links_factor);
+    a->links_needed = need <= TS_MAX_LINKS ? (int)need : 0;
+    char links[160];
+    if (a->links_needed > 0)
+        snprintf(links, sizeof links, "about %d links per cable would meet "
+                 "it (--links %d, or --refine)", a->links_needed,
+                 a->links_needed);
+    else
+        snprintf(links, sizeof links, "more than %d links per cable would "
+                 "be needed", TS_MAX_LINKS);
+    ts_trust_fail(&r->trust, "discretisation error: %s is %.2g (relative), "
+                  "above the accuracy %.3g; the error model (Richardson "
+                  "from %d and %d links, falling as links^-%.3g) says %s",
+                  a->limiting, a->max_rel_error, a->accuracy, a->links[0],
+                  a->links[1], a->limiting_theory, links);
+    return TS_OK;
+}
+
 /* ---- converge ---------------------------------------------------------- */
 
 /* A sweep's run: the pipeline of the study's analysis at one setting. */
@@ -1384,6 +2205,10 @@ static int sweep_run(void *ctx, ts_conv_param p, double setting,
     sweep_ctx *x = ctx;
     ts_request rq = x->rq;
     ts_analysis_kind kind = rq.kind;
+    /* The study estimates the errors itself: each run is plain. */
+    rq.setup.discretisation_error = 0;
+    rq.setup.refine = 0;
+    rq.simulate.check_window = 0;
     if (p == TS_CONV_STEP && kind != TS_ANALYSIS_MODES)
         return ts_fail(err, TS_EINVAL, "%s: there is no linearization step "
                        "to sweep; sweep links or tolerances",
@@ -1519,6 +2344,18 @@ static void converge_sweep(const ts_converge_opts *c, ts_conv_param *param,
     }
 }
 
+/* Refuse a cable with link_lengths for option `key`, saying why. */
+static int equal_links_only(const ts_system *sys, const char *key,
+                            const char *why, ts_err *err)
+{
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].link_fraction)
+            return ts_fail(err, TS_EINVAL, "%s: cables[%d] '%s' has "
+                           "link_lengths; %s", key, c, sys->cables[c].name,
+                           why);
+    return TS_OK;
+}
+
 static int check_converge(const ts_system *sys, const ts_request *rq,
                           ts_err *err)
 {
@@ -1541,13 +2378,11 @@ static int check_converge(const ts_system *sys, const ts_request *rq,
     if (c->nintegrators > 0 && c->analysis != TS_ANALYSIS_SIMULATE)
         return ts_fail(err, TS_EINVAL, "integrators: applies to the simulate "
                        "analysis, not to %s", ts_analysis_name(c->analysis));
-    for (int c1 = 0; param == TS_CONV_LINKS && c1 < sys->ncables; c1++)
-        if (sys->cables[c1].link_fraction)
-            return ts_fail(err, TS_EINVAL,
-                           "links: cables[%d] '%s' has link_lengths; a link "
-                           "sweep needs equal links (remove link_lengths, or "
-                           "sweep tolerances)",
-                           c1, sys->cables[c1].name);
+    if (param == TS_CONV_LINKS &&
+        (rc = equal_links_only(sys, "links", "a link sweep needs equal links "
+                               "(remove link_lengths, or sweep tolerances)",
+                               err)))
+        return rc;
     if (c->analysis == TS_ANALYSIS_SIMULATE) {
         const ts_simulate_opts *s = &rq->simulate;
         if (s->initial != TS_INITIAL_EQUILIBRIUM)
@@ -1665,6 +2500,12 @@ static int pipeline_converge(ts_result *r, const ts_request *rq,
 static int check_kind(const ts_system *sys, const ts_request *rq,
                       ts_err *err)
 {
+    int rc;
+    if (rq->setup.refine &&
+        (rc = equal_links_only(sys, "refine", "refining sets equal links on "
+                               "every cable (remove link_lengths, or give "
+                               "--links)", err)))
+        return rc;
     switch (rq->kind) {
     case TS_ANALYSIS_EQUILIBRIUM:
         return TS_OK;
@@ -1755,10 +2596,28 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
                : (err && err->code ? err->code : TS_ENOMEM);
     }
     ts_system_free(s);
+    /* The discretisation estimate runs the analysis again at a half and
+     * a quarter of the links (doc/accuracy.md): a dense eigen analysis
+     * at least 1/8 + 1/64 more, an explicit simulation 1/4 + 1/16 (its
+     * steps and its evaluations each halve with the links). */
+    int estimate = rq->setup.discretisation_error || rq->setup.refine;
+    if (rc == TS_OK && estimate && e->seconds > 0) {
+        double f = rq->kind == TS_ANALYSIS_MODES ? 1.0 / 8 + 1.0 / 64
+                                                 : 1.0 / 4 + 1.0 / 16;
+        e->seconds *= 1 + f;
+        e->evaluations *= 1 + f;
+        e->flops *= 1 + f;
+        size_t len = strlen(e->what);
+        snprintf(e->what + len, sizeof e->what - len, "%s",
+                 len + 60 < sizeof e->what
+                     ? " (with the discretisation estimate's runs)"
+                     : "");
+    }
     return rc;
 }
 
-int ts_analysis_run(const ts_system *sys, const ts_request *rq,
+/* One run of the analysis at the request's settings, judged. */
+static int run_once(const ts_system *sys, const ts_request *rq,
                     ts_result **out, ts_err *err)
 {
     double t0 = wall_now();
@@ -1785,5 +2644,74 @@ int ts_analysis_run(const ts_system *sys, const ts_request *rq,
             break;
         }
     }
+    if (r->sys && rq->kind != TS_ANALYSIS_CONVERGE)
+        tow_notes(r);
+    if (rc == TS_OK && rq->kind != TS_ANALYSIS_CONVERGE)
+        rc = accuracy_stage(r, rq, &e);
     return finish(r, rc, &e, err, t0);
+}
+
+int ts_analysis_run(const ts_system *sys, const ts_request *rq,
+                    ts_result **out, ts_err *err)
+{
+    double t0 = wall_now();
+    int rc = run_once(sys, rq, out, err);
+    ts_result *r = *out;
+    /* --refine: rerun with the links the error model says meet the
+     * accuracy. */
+    int first = r ? r->accuracy.links[0] : 0;
+    double wall = r && isfinite(r->accuracy.wall_s) ? r->accuracy.wall_s
+                                                   : 0.0;
+    long evals = r ? r->accuracy.evaluations : 0;
+    for (int round = 0; rq->setup.refine && rc == TS_OK &&
+                        round < TS_REFINE_ROUNDS && r->accuracy.met == 0;
+         round++) {
+        int now = r->accuracy.links[0];
+        int next = r->accuracy.links_needed;
+        if (next <= now)
+            next = now + 1;
+        if (next > TS_REFINE_GROWTH * now)
+            next = TS_REFINE_GROWTH * now;
+        if (next > TS_MAX_LINKS)
+            next = TS_MAX_LINKS;
+        if (next <= now)
+            break;
+        ts_request rq2 = *rq;
+        rq2.setup.links = next;
+        ts_result *r2 = NULL;
+        ts_err e2 = {0};
+        int rc2 = run_once(sys, &rq2, &r2, &e2);
+        if (!r2)
+            break;
+        /* The coarser result is kept as its cost. */
+        wall += r->wall_s;
+        evals += r->evaluations;
+        if (rc2 != TS_OK) {
+            ts_trust_note(&r->trust, "--refine: the run at %d links failed "
+                          "(%s); the result is that at %d links", next,
+                          e2.msg, now);
+            ts_result_free(r2);
+            break;
+        }
+        ts_result_free(r);
+        *out = r = r2;
+        r->accuracy.refinements = round + 1;
+        r->accuracy.refined_from = first;
+    }
+    if (r && r->accuracy.refinements > 0) {
+        r->accuracy.wall_s = (isfinite(r->accuracy.wall_s)
+                                  ? r->accuracy.wall_s
+                                  : 0.0) + wall;
+        r->accuracy.evaluations += evals;
+        r->wall_s = wall_now() - t0;
+        if (r->accuracy.met == 0)
+            ts_trust_note(&r->trust, "--refine: %d rerun%s from %d to %d "
+                          "links did not meet the accuracy (at most %d "
+                          "reruns, each at most %d times the links)",
+                          r->accuracy.refinements,
+                          r->accuracy.refinements == 1 ? "" : "s", first,
+                          r->accuracy.links[0], TS_REFINE_ROUNDS,
+                          TS_REFINE_GROWTH);
+    }
+    return rc;
 }

@@ -289,6 +289,23 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
      .max = TS_MAX_LINKS, .offset = OFF(setup.links), .arg = "N",             \
      .help = "equal links on every cable", .deftext = "the scene's links"}
 
+/* How accurate a result must be, and whether it is checked. */
+#define ACCURACY_ROWS                                                         \
+    {.name = "accuracy", .type = TS_OPT_NUMBER, .section = TS_SEC_SETUP,      \
+     .min = 0, .max = 1, .flags = TS_OPT_MIN_OPEN | TS_OPT_MAX_OPEN,          \
+     .offset = OFF(setup.accuracy), .arg = "X",                               \
+     .help = "relative discretisation error allowed of the key values; "      \
+             "missed: not trustworthy"},                                      \
+    {.name = "discretisation_error", .type = TS_OPT_BOOL,                     \
+     .section = TS_SEC_SETUP, NOLIM,                                          \
+     .offset = OFF(setup.discretisation_error),                               \
+     .help = "estimate it from the same analysis at about half (and a "       \
+             "quarter of) the links"},                                        \
+    {.name = "refine", .type = TS_OPT_BOOL, .section = TS_SEC_SETUP, NOLIM,   \
+     .offset = OFF(setup.refine),                                             \
+     .help = "rerun with the links the error model says meet the "            \
+             "accuracy (equal links)"}
+
 /* The settings of a simulation; `only` for a convergence study. */
 #define SIM_ROWS(o)                                                           \
     {.name = "t_end", .type = TS_OPT_QUANTITY, .section = TS_SEC_SIMULATE,    \
@@ -383,11 +400,12 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
              "point less it)",                                                \
      .deftext = "0,0,0 m (M's origin)"}
 
-static const ts_option eq_rows[] = {SETUP_ROWS, LINKS_ROW};
+static const ts_option eq_rows[] = {SETUP_ROWS, LINKS_ROW, ACCURACY_ROWS};
 
 static const ts_option modes_rows[] = {
     SETUP_ROWS,
     LINKS_ROW,
+    ACCURACY_ROWS,
     {.name = "count", .type = TS_OPT_INT, .section = TS_SEC_MODES, .min = 1,
      .max = 100000000, .offset = OFF(modes.count), .arg = "N",
      .help = "modes to report",
@@ -401,11 +419,15 @@ static const ts_option modes_rows[] = {
      NOLIM, .choices = eig_methods, .values = eig_method_values,
      .offset = OFF(modes.eigen.method), .arg = "M",
      .help = "lapack: every eigenvalue; arpack: shift-invert, a subset"},
+    {.name = "oscillatory", .type = TS_OPT_BOOL, .section = TS_SEC_MODES,
+     NOLIM, .offset = OFF(modes.oscillatory),
+     .help = "list the oscillatory modes only (they come first anyway)"},
 };
 
 static const ts_option response_rows[] = {
     SETUP_ROWS,
     LINKS_ROW,
+    ACCURACY_ROWS,
     {.name = "input", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .choices = inputs, .offset = OFF(response.input),
      .size = SZ(response.input),
@@ -439,16 +461,12 @@ static const ts_option response_rows[] = {
      .unit = "s", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
      .offset = OFF(response.duration), .arg = "T",
      .help = "with sea: the duration of the most probable maximum"},
-    {.name = "discretisation", .type = TS_OPT_BOOL,
-     .section = TS_SEC_RESPONSE, NOLIM,
-     .offset = OFF(response.discretisation),
-     .help = "with sea: estimate the discretisation error from runs at a "
-             "half and a quarter of the links"},
 };
 
 static const ts_option simulate_rows[] = {
     SETUP_ROWS,
     LINKS_ROW,
+    ACCURACY_ROWS,
     SIM_ROWS(0),
     SEA_ROWS(TS_SEC_SIMULATE, simulate.sea),
     {.name = "seed", .type = TS_OPT_LONG, .section = TS_SEC_SIMULATE,

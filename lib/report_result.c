@@ -37,6 +37,64 @@ static json_t *eq_json(const ts_result *r, const ts_trust *t)
                : NULL;
 }
 
+/* {"discretisation": d, "solver": s} */
+static json_t *error_json(double disc, double solver)
+{
+    return json_pack("{s:o,s:o}", "discretisation", num(disc), "solver",
+                     num(solver));
+}
+
+static json_t *verdict_json(int v)
+{
+    return v >= 0 ? json_string(ts_verdict_name(v)) : json_null();
+}
+
+/* The stability verdict of the resolved modes and, apart, of the
+ * unresolved ones (mode numbers 1-based among the modes computed). */
+static json_t *stability_json(const ts_result *r)
+{
+    const ts_stability *st = &r->stability;
+    json_t *o = json_pack(
+        "{s:b,s:i,s:i,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "estimated",
+        st->estimated, "resolved_modes", st->nresolved, "unresolved_modes",
+        st->nunresolved, "verdict", verdict_json(st->verdict), "mode",
+        st->mode >= 0 ? json_integer(st->mode + 1) : json_null(),
+        "max_real", num(st->max_real), "max_real_error",
+        error_json(st->discretisation_error, st->solver_error),
+        "unresolved_verdict", verdict_json(st->unresolved_verdict),
+        "unresolved_mode",
+        st->unresolved_mode >= 0 ? json_integer(st->unresolved_mode + 1)
+                                 : json_null(),
+        "unresolved_max_real", num(st->unresolved_max_real),
+        "unresolved_max_real_error", num(st->unresolved_error),
+        "modes_computed", json_integer(r->nmodes_computed));
+    return o;
+}
+
+/* Every listed mode's discretisation error, shape scale and resolution. */
+static void modes_accuracy_json(json_t *j, const ts_result *r)
+{
+    json_t *modes = json_object_get(j, "modes");
+    for (int m = 0; r->mode_accuracy && m < r->eigen->nmodes; m++) {
+        json_t *o = json_array_get(modes, (size_t)m);
+        const ts_mode_accuracy *a = &r->mode_accuracy[m];
+        const ts_mode *md = &r->eigen->modes[m];
+        if (!o)
+            break;
+        json_object_set_new(o, "resolved", json_boolean(a->resolved));
+        json_object_set_new(o, "grid_scale", json_boolean(a->grid_scale));
+        json_object_set_new(o, "half_wave_links", num(a->half_wave_links));
+        json_object_set_new(o, "error",
+                            error_json(a->error, md->error_bound));
+        json_object_set_new(o, "freq_discretisation_error_hz",
+                            num(a->freq_error_hz));
+        json_object_set_new(o, "damping_discretisation_error",
+                            num(a->damping_error));
+        json_object_set_new(o, "order", num(a->order));
+    }
+    json_object_set_new(j, "stability", stability_json(r));
+}
+
 static json_t *modes_json(const ts_result *r, int flags)
 {
     if (!r->eigen || !r->mode_health)
@@ -47,6 +105,8 @@ static json_t *modes_json(const ts_result *r, int flags)
         json_decref(j);
         return NULL;
     }
+    if (j)
+        modes_accuracy_json(j, r);
     if (j)
         json_object_set_new(j, "linearization",
                             ts_report_linear_json(r->lin,
@@ -144,6 +204,28 @@ static json_t *simulate_json(const ts_result *r, int flags)
         json_object_set_new(j, "compare", ts_report_compare_json(&r->compare));
     if (r->has_sea)
         json_object_set_new(j, "sea", sim_sea_json(r));
+    if (r->window.checked) {
+        const ts_window *w = &r->window;
+        json_object_set_new(
+            j, "window",
+            json_pack("{s:o,s:o,s:o,s:o,s:o,s:b,s:o,s:o,s:o,s:o,s:o,s:o,"
+                      "s:o}",
+                      "period_s", num(w->period), "transient_s",
+                      num(w->transient), "t_end_s", num(w->t_end),
+                      "slowest_time_constant_s", num(w->slowest_tau),
+                      "slowest_freq_hz", num(w->slowest_freq_hz),
+                      "modes_complete", w->modes_complete, "drift",
+                      num(w->drift), "remaining", num(w->remaining),
+                      "settled",
+                      w->settled < 0 ? json_null()
+                                     : json_boolean(w->settled),
+                      "periodic",
+                      w->periodic < 0 ? json_null()
+                                      : json_boolean(w->periodic),
+                      "transient_needed_s", num(w->transient_needed),
+                      "t_end_needed_s", num(w->t_end_needed), "scale_m",
+                      num(w->scale)));
+    }
     /* Final positions of the bodies (the nonlinear run when there is
      * one). */
     const ts_history *hf = r->nonlinear ? r->nonlinear : r->linear;
@@ -195,12 +277,55 @@ static json_t *key_values_json(const ts_result *r)
     for (int i = 0; a && i < r->nvalues; i++) {
         const ts_value *v = &r->values[i];
         json_array_append_new(
-            a, json_pack("{s:s,s:s,s:o,s:{s:o,s:o}}", "name", v->name, "unit",
+            a, json_pack("{s:s,s:s,s:o,s:o,s:o}", "name", v->name, "unit",
                          v->unit, "value", num(v->value), "error",
-                         "discretisation", num(v->error.discretisation),
-                         "solver", num(v->error.solver)));
+                         error_json(v->error.discretisation,
+                                    v->error.solver),
+                         "order", num(v->order)));
     }
     return a;
+}
+
+/* The accuracy of a result against the continuum. */
+static json_t *accuracy_json(const ts_result *r)
+{
+    const ts_result_accuracy *a = &r->accuracy;
+    json_t *links = json_array(), *ratios = json_array();
+    for (int k = 0; links && k < a->nlevels; k++)
+        json_array_append_new(links, json_integer(a->links[k]));
+    for (int k = 0; ratios && k + 1 < a->nlevels; k++)
+        json_array_append_new(ratios, num(a->ratio[k]));
+    return json_pack(
+        "{s:o,s:b,s:o,s:o,s:o,s:o,s:o,s:I,s:o,s:o,s:o,s:o,s:o,s:o,s:i}",
+        "accuracy", num(a->accuracy), "estimated", a->estimated,
+        "not_estimated",
+        a->not_estimated[0] ? json_string(a->not_estimated) : json_null(),
+        "levels", links, "ratios", ratios, "order", num(a->order),
+        "wall_s", num(a->wall_s), "evaluations", (json_int_t)a->evaluations,
+        "max_relative_error", num(a->max_rel_error), "limiting",
+        a->limiting[0] ? json_string(a->limiting) : json_null(), "met",
+        a->met < 0 ? json_null() : json_boolean(a->met), "links_factor",
+        num(a->links_factor), "links_needed",
+        a->links_needed > 0 ? json_integer(a->links_needed) : json_null(),
+        "refined_from",
+        a->refined_from > 0 ? json_integer(a->refined_from) : json_null(),
+        "refinements", a->refinements);
+}
+
+/* Every point's discretisation error, and where the accuracy holds. */
+static void response_accuracy_json(json_t *j, const ts_result *r)
+{
+    json_t *pts = json_object_get(j, "points");
+    for (int i = 0; r->magnitude_error && i < r->response->npoints; i++) {
+        json_t *o = json_array_get(pts, (size_t)i);
+        if (!o)
+            break;
+        json_object_set_new(o, "magnitude_error",
+                            error_json(r->magnitude_error[i], NAN));
+        json_object_set_new(o, "phase_error_deg",
+                            error_json(r->phase_error_deg[i], NAN));
+    }
+    json_object_set_new(j, "accurate_to_hz", num(r->accurate_to_hz));
 }
 
 json_t *ts_report_result_json(const ts_result *r, int flags)
@@ -217,6 +342,8 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
         j = r->has_sea    ? sea_json(r, 1)
             : r->response ? ts_report_response_json(r->response)
                           : json_object();
+        if (j && r->response && !r->has_sea)
+            response_accuracy_json(j, r);
         break;
     case TS_ANALYSIS_SIMULATE: j = simulate_json(r, flags); break;
     case TS_ANALYSIS_CONVERGE: j = converge_json(r); break;
@@ -234,6 +361,8 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
         json_object_set_new(j, "error", json_string(r->error));
     set_trust(j, &r->trust);
     json_object_set_new(j, "key_values", key_values_json(r));
+    if (r->kind != TS_ANALYSIS_CONVERGE)
+        json_object_set_new(j, "accuracy", accuracy_json(r));
     return j;
 }
 

@@ -730,7 +730,7 @@ static void test_simulate_sweep(void)
     ro.rel_tol = 1e-11;
     ro.abs_tol = 1e-14;
     double ref[2] = {NAN, NAN};
-    if (CHECK(rc == TS_OK && c->nvalues == 3 &&
+    if (CHECK(rc == TS_OK && c->nvalues == 5 &&
                   strcmp(c->values[0].name,
                          "sphere.z.amplitude_ratio") == 0 &&
                   strcmp(c->values[2].name, "sphere.z.phase_deg") == 0,

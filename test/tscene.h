@@ -3,6 +3,9 @@
 #ifndef TOWSTAB_TSCENE_H
 #define TOWSTAB_TSCENE_H
 
+#include <stdio.h>
+#include <string.h>
+
 #include "towstab/scene.h"
 
 static ts_scene *tscene_load(const ts_units *u, const char *path)
@@ -10,6 +13,17 @@ static ts_scene *tscene_load(const ts_units *u, const char *path)
     ts_err err = {0};
     ts_scene *s = u ? ts_scene_load(path, u, &err) : NULL;
     CHECK(s != NULL, "%s loads (%s)", path, s ? "ok" : err.msg);
+    return s;
+}
+
+/* A scene from YAML text (named "test"); NULL after printing the
+ * reader's message. */
+static inline ts_scene *tscene_parse(const ts_units *u, const char *yaml)
+{
+    ts_err err = {0};
+    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", u, &err);
+    if (!s)
+        printf("scene: %s\n", err.msg);
     return s;
 }
 

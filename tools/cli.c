@@ -326,6 +326,74 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     return 0;
 }
 
+void cli_tow_text(const ts_system *sys, char *buf, size_t size)
+{
+    const ts_tow *t = &sys->tow;
+    double knots = t->speed / (1852.0 / 3600.0);
+    if (t->turn_rate == 0.0) {
+        snprintf(buf, size, "speed %.6g m/s (%.4g knots), turn rate 0 rad/s "
+                 "(straight)", t->speed, knots);
+        return;
+    }
+    double R = t->speed / fabs(t->turn_rate);
+    snprintf(buf, size, "speed %.6g m/s (%.4g knots), turn rate %.6g rad/s "
+             "(%.4g deg/s, turn radius %.4g m, to %s)", t->speed, knots,
+             t->turn_rate, t->turn_rate * 180.0 / M_PI, R,
+             t->turn_rate > 0 ? "starboard" : "port");
+}
+
+/* An error for a table: "%.2g", or "-" when not known. */
+static void err_text(double e, char *buf, size_t size)
+{
+    if (isfinite(e))
+        snprintf(buf, size, "%.2g", e);
+    else
+        snprintf(buf, size, "-");
+}
+
+void cli_value_error(const ts_value *v, char *buf, size_t size)
+{
+    char d[32], s[32];
+    err_text(v->error.discretisation, d, sizeof d);
+    err_text(v->error.solver, s, sizeof s);
+    snprintf(buf, size, "+- %s (discretisation) +- %s (solver) %s", d, s,
+             v->unit);
+}
+
+void cli_print_accuracy(const ts_result *r)
+{
+    const ts_result_accuracy *a = &r->accuracy;
+    if (!(a->accuracy > 0))
+        return;
+    if (a->refinements > 0)
+        printf("refined: %d rerun%s from %d to %d links per cable to meet "
+               "the accuracy\n",
+               a->refinements, a->refinements == 1 ? "" : "s",
+               a->refined_from, a->links[0]);
+    if (!a->estimated) {
+        printf("discretisation error: not estimated: %s\n",
+               a->not_estimated);
+        return;
+    }
+    char lev[96] = "";
+    for (int k = 0; k < a->nlevels; k++) {
+        size_t n = strlen(lev);
+        snprintf(lev + n, sizeof lev - n, "%s%d",
+                 k == 0 ? "" : k + 1 == a->nlevels ? " and " : ", ",
+                 a->links[k]);
+    }
+    printf("discretisation error: Richardson from %s links (order %.3g in "
+           "1/links), %.3f ms, %ld evaluations",
+           lev, a->order, a->wall_s * 1e3, a->evaluations);
+    if (isfinite(a->max_rel_error))
+        printf("; largest relative %.2g (%s) against the accuracy %.3g: "
+               "%s\n",
+               a->max_rel_error, a->limiting, a->accuracy,
+               a->met > 0 ? "met" : "NOT MET");
+    else
+        printf("\n");
+}
+
 void cli_print_vehicles(FILE *f, const ts_system *sys,
                         const ts_vehicle_result *vr, int nv, int quiet)
 {

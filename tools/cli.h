@@ -218,6 +218,19 @@ int cli_check_outputs(const char *cmd, int n, const char *const what[],
 /* The verdict lines: "trustworthy: yes|NO", reasons, notes. */
 void cli_print_trust(const ts_trust *t);
 
+/* "speed V m/s (K knots), turn rate W rad/s (D deg/s, turn radius R m, to
+ * starboard)" or "... turn rate 0 rad/s (straight)". */
+void cli_tow_text(const ts_system *sys, char *buf, size_t size);
+
+/* "+- D (discretisation) +- S (solver) UNIT" of a key value, "-" where
+ * not estimated. */
+void cli_value_error(const ts_value *v, char *buf, size_t size);
+
+/* The discretisation-error line of a result: the levels compared, the
+ * order, the cost, the largest relative error against the accuracy (or
+ * why it was not estimated), and a --refine's reruns. */
+void cli_print_accuracy(const ts_result *r);
+
 /* At the end of main: flush and close standard output and standard error,
  * checking both; a failed write turns status 0 into EXIT_FAILED (with a
  * message naming standard output). Returns the status. */

@@ -189,9 +189,9 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
      * result's (which also says why a failed run failed). */
     const ts_trust *t = r->kind == TS_ANALYSIS_EQUILIBRIUM ? &r->trust
                                                            : &r->eq_trust;
-    fprintf(f, "speed %.6g m/s, turn rate %.6g rad/s, %d cable%s, %d links, "
-               "%d bod%s\n",
-            sys->tow.speed, sys->tow.turn_rate, sys->ncables,
+    char tow[256];
+    cli_tow_text(sys, tow, sizeof tow);
+    fprintf(f, "%s, %d cable%s, %d links, %d bod%s\n", tow, sys->ncables,
             sys->ncables == 1 ? "" : "s", sys->nlinks, sys->nbodies,
             sys->nbodies == 1 ? "y" : "ies");
     /* A failed solve may end on forces that overflowed: no "nan". */
@@ -231,6 +231,10 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
                     t1 * 180 / M_PI, t2 * 180 / M_PI);
         }
     }
+    /* The key values of an equilibrium are x, y, z of each body (or free
+     * cable end), then the top tension: their errors go beside them. */
+    int own = r->kind == TS_ANALYSIS_EQUILIBRIUM &&
+              r->nvalues == 3 * (sys->nbodies > 0 ? sys->nbodies : 0) + 1;
     if (sys->nbodies > 0) {
         fprintf(f, "\n%-20s %14s %14s %14s\n", "body", "x [m]", "y [m]",
                 "z [m] (depth)");
@@ -238,19 +242,40 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
             const double *p = eq->positions + 3 * ts_system_body_node(sys, b);
             fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", sys->bodies[b].name,
                     p[0], p[1], p[2]);
+            if (!own || !r->accuracy.estimated)
+                continue;
+            fprintf(f, "%-20s", "  +- discretisation");
+            for (int j = 0; j < 3; j++)
+                fprintf(f, " %14.2g",
+                        r->values[3 * b + j].error.discretisation);
+            fprintf(f, "\n");
         }
     }
     cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet);
     if (eq->ncontrol > 0)
         fprintf(f, "controllers settled to %.3g (target %.3g)\n",
                 eq->control_residual, eq->tolerance);
-    fprintf(f, "\ntop tension %.6f N (force on the tow point %.6f, %.6f, "
-               "%.6f N)\n",
-            eq->top_tension, eq->tow_force[0], eq->tow_force[1],
-            eq->tow_force[2]);
+    fprintf(f, "\ntop tension %.6f N", eq->top_tension);
+    if (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->nvalues > 0) {
+        char e[128];
+        cli_value_error(&r->values[r->nvalues - 1], e, sizeof e);
+        fprintf(f, " %s", e);
+    }
+    fprintf(f, " (force on the tow point %.6f, %.6f, %.6f N)\n",
+            eq->tow_force[0], eq->tow_force[1], eq->tow_force[2]);
     fprintf(f, "solver Jacobian condition %.3g, shape error estimate %.3g "
                "m\n",
             eq->condition, eq->shape_error);
+    if (r->kind == TS_ANALYSIS_EQUILIBRIUM) {
+        /* Free cable ends (no bodies): their key values. */
+        for (int v = 0; sys->nbodies == 0 && v + 1 < r->nvalues; v++) {
+            char e[128];
+            cli_value_error(&r->values[v], e, sizeof e);
+            fprintf(f, "%s %.6f m %s\n", r->values[v].name,
+                    r->values[v].value, e);
+        }
+        cli_print_accuracy(r);
+    }
     cli_print_trust(t);
 }
 

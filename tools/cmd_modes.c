@@ -42,29 +42,149 @@ void cli_print_linearization(const ts_result *r)
                "derivatives; the modes (A) are not affected\n");
 }
 
-static void print_modes(const ts_system *sys, const ts_linear *lin,
-                        const ts_eigen *e, const ts_mode_health *mh,
-                        const ts_trust *trust, double wall, int quiet)
+/* The label of an unresolved mode. */
+static void unresolved_label(const ts_result *r, int m, char *buf,
+                             size_t size)
 {
+    const ts_mode_accuracy *a = &r->mode_accuracy[m];
+    const ts_result_accuracy *acc = &r->accuracy;
+    const ts_mode *md = &r->eigen->modes[m];
+    buf[0] = '\0';
+    if (a->resolved)
+        return;
+    if (a->grid_scale)
+        snprintf(buf, size, " [UNRESOLVED: %.2g links per half-wave]",
+                 a->half_wave_links);
+    else if (isfinite(a->error))
+        snprintf(buf, size, " [UNRESOLVED: error %.2g of |lambda| from %d "
+                 "and %d links]", a->error / hypot(md->re, md->im),
+                 acc->links[0], acc->links[1]);
+    else
+        snprintf(buf, size, " [UNRESOLVED: no counterpart at %d links]",
+                 acc->links[1]);
+}
+
+/* The stability verdict: the resolved modes' margin, and apart the
+ * unresolved modes'; without an estimate, every mode computed. */
+static void print_verdict(const ts_result *r)
+{
+    const ts_eigen *e = r->eigen;
+    const ts_stability *st = &r->stability;
+    const char *scope = e->complete ? "" : " among the modes computed";
+    if (!st->estimated) {
+        switch (e->verdict) {
+        case TS_STABLE:
+            printf("verdict: stable%s: max Re(lambda) = %.6g 1/s, error "
+                   "bound %.2g 1/s (the margin is %.3g times its error)\n",
+                   scope, e->max_real, e->max_real_error,
+                   e->max_real_error > 0 ? -e->max_real / e->max_real_error
+                                         : INFINITY);
+            break;
+        case TS_UNSTABLE:
+            printf("verdict: UNSTABLE%s: max Re(lambda) = %.6g 1/s > 0, "
+                   "error bound %.2g 1/s\n",
+                   scope, e->max_real, e->max_real_error);
+            break;
+        default:
+            printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s is "
+                   "within its error bound %.2g 1/s of 0; the linear model "
+                   "does not decide stability (undamped or nearly so)\n",
+                   scope, e->max_real, e->max_real_error);
+        }
+        printf("note: the verdict covers every mode, resolved or not (the "
+               "discretisation error was not estimated); %d mode%s vary on "
+               "the scale of one or two links\n",
+               st->nunresolved, st->nunresolved == 1 ? "" : "s");
+        return;
+    }
+    /* The verdict of the discrete model (every mode computed), then whose
+     * margin it is. */
+    const char *all = e->verdict == TS_STABLE     ? "stable"
+                      : e->verdict == TS_UNSTABLE ? "UNSTABLE"
+                                                  : "marginal";
+    printf("verdict: %s%s", all, scope);
+    if (st->verdict < 0) {
+        printf(" as computed, but no mode is resolved to the accuracy %.3g "
+               "at %d links: max Re(lambda) = %.6g 1/s (mode %d, "
+               "unresolved) is no margin of the cable\n",
+               r->accuracy.accuracy, r->accuracy.links[0],
+               st->unresolved_max_real, st->unresolved_mode + 1);
+        return;
+    }
+    double err = st->solver_error + (isfinite(st->discretisation_error)
+                                         ? st->discretisation_error
+                                         : 0.0);
+    printf(": the %d resolved mode%s %s: max Re(lambda) = %.6g 1/s (mode "
+           "%d) +- %.2g (discretisation) +- %.2g (solver)",
+           st->nresolved, st->nresolved == 1 ? " is" : "s are",
+           st->verdict == TS_STABLE     ? "stable"
+           : st->verdict == TS_UNSTABLE ? "UNSTABLE"
+                                        : "marginal",
+           st->max_real, st->mode + 1, st->discretisation_error,
+           st->solver_error);
+    if (st->verdict == TS_STABLE)
+        printf(", the margin %.3g times its error", -st->max_real / err);
+    printf("\n");
+    if (st->unresolved_verdict >= 0)
+        printf("unresolved modes (%d: grid-scale, or not resolved to the "
+               "accuracy at %d links): %s as computed, max Re(lambda) = "
+               "%.6g 1/s (mode %d), error bound %.2g 1/s%s\n",
+               st->nunresolved, r->accuracy.links[0],
+               st->unresolved_verdict == TS_STABLE     ? "stable"
+               : st->unresolved_verdict == TS_UNSTABLE ? "UNSTABLE"
+                                                       : "marginal",
+               st->unresolved_max_real, st->unresolved_mode + 1,
+               st->unresolved_error,
+               st->unresolved_verdict == TS_UNSTABLE
+                   ? "; an artefact of the links, or an instability they "
+                     "cannot resolve"
+                   : "");
+}
+
+static void print_modes(const ts_result *r, int quiet)
+{
+    const ts_system *sys = r->sys;
+    const ts_linear *lin = r->lin;
+    const ts_eigen *e = r->eigen;
+    const ts_mode_health *mh = r->mode_health;
     printf("eigen: %s, %d mode%s (%d of %d eigenvalues)%s, %.3f ms",
-           ts_eig_method_name(e->method), e->nmodes, e->nmodes == 1 ? "" : "s",
-           e->neig, e->nstate, e->complete ? "" : " nearest the target",
-           wall * 1e3);
+           ts_eig_method_name(e->method), r->nmodes_computed,
+           r->nmodes_computed == 1 ? "" : "s", e->neig, e->nstate,
+           e->complete ? "" : " nearest the target", r->eigen_wall_s * 1e3);
     if (e->method == TS_EIG_ARPACK)
         printf(", %d restarts, %d operator applications", e->arpack_iterations,
                e->arpack_ops);
     printf("\n");
+    if (e->nmodes < r->nmodes_computed)
+        printf("listed: %d of them (%s)\n", e->nmodes,
+               r->nmodes_computed > 0 && e->nmodes > 0 &&
+                       e->modes[0].im > 0
+                   ? "oscillatory"
+                   : "chosen");
     if (!quiet) {
-        char desc[256];
-        printf("\n%4s %14s %14s %12s %12s %10s  %s\n", "mode", "Re [1/s]",
-               "Im [rad/s]", "freq [Hz]", "period [s]", "damping",
-               "shape");
+        char desc[256], label[128];
+        printf("\n%4s %14s %14s %12s %12s %10s %8s  %s\n", "mode",
+               "Re [1/s]", "Im [rad/s]", "freq [Hz]", "period [s]",
+               "damping", "disc.err", "shape");
         for (int m = 0; m < e->nmodes; m++) {
             const ts_mode *md = &e->modes[m];
             ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
-            printf("%4d %14.6g %14.6g %12.6g %12.6g %10.6f  %s", m + 1,
+            double rel = r->mode_accuracy
+                             ? r->mode_accuracy[m].error /
+                                   hypot(md->re, md->im)
+                             : NAN;
+            char er[16];
+            if (isfinite(rel))
+                snprintf(er, sizeof er, "%.2g", rel);
+            else
+                snprintf(er, sizeof er, "-");
+            printf("%4d %14.6g %14.6g %12.6g %12.6g %10.6f %8s  %s", m + 1,
                    md->re, md->im, md->freq_hz, md->period_s,
-                   md->damping_ratio, desc);
+                   md->damping_ratio, er, desc);
+            if (r->mode_accuracy) {
+                unresolved_label(r, m, label, sizeof label);
+                printf("%s", label);
+            }
             /* Health labels (towstab/health.h). */
             if (!mh[m].trustworthy)
                 printf(" [NOT TRUSTWORTHY: damping +-%.2g]",
@@ -77,33 +197,25 @@ static void print_modes(const ts_system *sys, const ts_linear *lin,
             }
             printf("\n");
         }
-        printf("\n");
+        printf("(disc.err: the discretisation error of lambda relative to "
+               "|lambda|)\n\n");
     }
-    const char *scope = e->complete ? "" : " among the modes computed";
-    switch (e->verdict) {
-    case TS_STABLE:
-        printf("verdict: stable%s: max Re(lambda) = %.6g 1/s, error bound "
-               "%.2g 1/s (the margin is %.3g times its error: trustworthy)\n",
-               scope, e->max_real, e->max_real_error,
-               e->max_real_error > 0 ? -e->max_real / e->max_real_error
-                                     : INFINITY);
-        break;
-    case TS_UNSTABLE:
-        printf("verdict: UNSTABLE%s: max Re(lambda) = %.6g 1/s > 0, error "
-               "bound %.2g 1/s\n",
-               scope, e->max_real, e->max_real_error);
-        break;
-    default:
-        printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s is within its "
-               "error bound %.2g 1/s of 0; the linear model does not decide "
-               "stability (undamped or nearly so)\n",
-               scope, e->max_real, e->max_real_error);
+    for (int v = 0; v < r->nvalues; v++) {
+        char er[160];
+        if (!isfinite(r->values[v].value))
+            continue;
+        cli_value_error(&r->values[v], er, sizeof er);
+        printf("%-22s %14.8g %s\n", r->values[v].name, r->values[v].value,
+               er);
     }
+    if (r->mode_accuracy)
+        print_verdict(r);
     if (!e->complete)
         printf("note: only %d of %d eigenvalues were computed (those nearest "
                "%.6g Hz); modes elsewhere are not covered by the verdict\n",
                e->neig, e->nstate, e->target_hz);
-    cli_print_trust(trust);
+    cli_print_accuracy(r);
+    cli_print_trust(&r->trust);
 }
 
 static int ends_with(const char *s, const char *suffix)
@@ -150,77 +262,106 @@ static int mode_disp(const ts_system *sys, const ts_linear *lin,
     return 0;
 }
 
-/* --plot: the eigenvalue plane and the shapes of the lowest modes. */
-static int modes_plot(const ts_system *sys, const ts_linear *lin,
-                      const ts_eigen *e, const double *pos,
-                      const cli_plot *plot)
+/* --plot: the eigenvalue plane (resolved and unresolved modes apart) and
+ * the shapes of the lowest resolved oscillatory modes (the lowest
+ * oscillatory ones, labelled unresolved, when none is resolved). */
+static int modes_plot(const ts_result *r, const cli_plot *plot)
 {
+    const ts_system *sys = r->sys;
+    const ts_linear *lin = r->lin;
+    const ts_eigen *e = r->eigen;
+    const double *pos = r->eq->positions;
     ts_err err = {0};
     int n = e->nmodes, status = 0;
-    double *re = malloc(2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
-    double *im = malloc(2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
-    if (!re || !im) {
-        free(re);
-        free(im);
+    /* Set 0: resolved (or all, without the estimate), set 1: unresolved;
+     * each eigenvalue with its conjugate, so at most 2 n each. */
+    double *buf = malloc(8 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (!buf) {
         fprintf(stderr, "towstab: error: modes: --plot: out of memory\n");
         return EXIT_FAILED;
     }
-    int k = 0;
+    double *sre[2] = {buf, buf + 2 * n}, *sim[2] = {buf + 4 * n, buf + 6 * n};
+    int nset[2] = {0, 0};
     for (int m = 0; m < n; m++) {
-        re[k] = e->modes[m].re;
-        im[k++] = e->modes[m].im;
+        int s = r->mode_accuracy && !r->mode_accuracy[m].resolved;
+        sre[s][nset[s]] = e->modes[m].re;
+        sim[s][nset[s]++] = e->modes[m].im;
         if (e->modes[m].im > 0) {
-            re[k] = e->modes[m].re;
-            im[k++] = -e->modes[m].im;
+            sre[s][nset[s]] = e->modes[m].re;
+            sim[s][nset[s]++] = -e->modes[m].im;
         }
     }
-    char title[256], label[96];
+    char title[256], label[2][96];
     snprintf(title, sizeof title, "%s: eigenvalues", sys->name);
-    snprintf(label, sizeof label, "%d eigenvalues%s", k,
-             e->complete ? "" : " (nearest the target)");
-    ts_plot_series set = {k, re, im, label, 0, TS_PLOT_MARKERS, 0};
-    if (ts_plot_eigenvalues(plot->dir, "eigenvalues", title, 1, &set, NULL,
-                            &plot->opts, &err) != TS_OK)
+    ts_plot_series set[2];
+    int nsets = 0;
+    for (int s = 0; s < 2; s++) {
+        if (nset[s] == 0)
+            continue;
+        if (!r->mode_accuracy)
+            snprintf(label[s], sizeof label[s], "%d eigenvalues%s", nset[s],
+                     e->complete ? "" : " (nearest the target)");
+        else
+            snprintf(label[s], sizeof label[s], "%d %s", nset[s],
+                     s ? "unresolved (grid-scale, or beyond the accuracy)" : "resolved");
+        ts_plot_series a = {nset[s], sre[s], sim[s], label[s], 0,
+                            TS_PLOT_MARKERS, s ? 2 : 1};
+        set[nsets++] = a;
+    }
+    if (nsets > 0 &&
+        ts_plot_eigenvalues(plot->dir, "eigenvalues", title, nsets, set,
+                            NULL, &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
-    else
+    else if (nsets > 0)
         printf("wrote %s/eigenvalues.png and %s/eigenvalues.svg\n",
                plot->dir, plot->dir);
-    free(re);
-    free(im);
+    free(buf);
 
-    int nm = n < PLOT_MODES ? n : PLOT_MODES;
-    if (nm < 1 || !e->vec_re || !e->vec_im)
+    /* The shapes: the lowest resolved oscillatory modes (the listing is
+     * oscillatory first, by frequency). */
+    int pick[PLOT_MODES], np = 0, unresolved = 0;
+    for (int m = 0; m < n && np < PLOT_MODES; m++)
+        if (e->modes[m].im > 0 &&
+            (!r->mode_accuracy || r->mode_accuracy[m].resolved))
+            pick[np++] = m;
+    if (np == 0) {
+        unresolved = r->mode_accuracy != NULL;
+        for (int m = 0; m < n && np < PLOT_MODES; m++)
+            if (e->modes[m].im > 0)
+                pick[np++] = m;
+    }
+    if (np < 1 || !e->vec_re || !e->vec_im)
         return status;
     cli_shape eqs;
-    double *disp = malloc((size_t)nm * 3 * (size_t)sys->nnodes * sizeof(double));
-    char labels[PLOT_MODES][128];
+    double *disp = malloc((size_t)np * 3 * (size_t)sys->nnodes *
+                          sizeof(double));
+    char labels[PLOT_MODES][160];
     ts_plot_mode modes[PLOT_MODES];
     if (!disp || cli_plot_shape(sys, pos, &eqs) != 0) {
         free(disp);
         fprintf(stderr, "towstab: error: modes: --plot: out of memory\n");
         return EXIT_FAILED;
     }
-    for (int m = 0; m < nm; m++) {
+    for (int i = 0; i < np; i++) {
+        int m = pick[i];
         const ts_mode *md = &e->modes[m];
-        double *d = disp + (size_t)m * 3 * sys->nnodes;
+        double *d = disp + (size_t)i * 3 * sys->nnodes;
         if (mode_disp(sys, lin, e, m, d) != 0) {
             status = EXIT_FAILED;
             break;
         }
-        if (md->im > 0)
-            snprintf(labels[m], sizeof labels[m],
-                     "mode %d: %.4g Hz, damping ratio %.3g", m + 1,
-                     md->freq_hz, md->damping_ratio);
-        else
-            snprintf(labels[m], sizeof labels[m],
-                     "mode %d: real, %.4g 1/s", m + 1, md->re);
-        modes[m].disp = d;
-        modes[m].label = labels[m];
+        snprintf(labels[i], sizeof labels[i],
+                 "mode %d: %.4g Hz, damping ratio %.3g%s", m + 1,
+                 md->freq_hz, md->damping_ratio,
+                 unresolved ? " (unresolved)" : "");
+        modes[i].disp = d;
+        modes[i].label = labels[i];
     }
-    snprintf(title, sizeof title, "%s: lowest mode shapes", sys->name);
+    snprintf(title, sizeof title, "%s: lowest %soscillatory modes",
+             sys->name, unresolved || !r->mode_accuracy ? "" : "resolved ");
     if (status == 0) {
         if (ts_plot_mode_shapes(plot->dir, "modes", title, TS_PLOT_WATER,
-                                &eqs.shape, nm, modes, &plot->opts,
+                                &eqs.shape, np, modes, &plot->opts,
                                 &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
@@ -238,8 +379,7 @@ static void modes_print(const cli_run *c, const ts_result *r)
     cli_print_equilibrium(r, 1);
     cli_print_linearization(r);
     if (r->eigen && r->mode_health)
-        print_modes(r->sys, r->lin, r->eigen, r->mode_health, &r->trust,
-                    r->eigen_wall_s, c->quiet);
+        print_modes(r, c->quiet);
 }
 
 /* The extras. */
@@ -276,8 +416,7 @@ static int modes_draw_or_shapes(cli_run *c, const ts_result *r)
             status = cli_report(&werr, werr.code);
     }
     if (c->plot.dir) {
-        int s = modes_plot(r->sys, r->lin, r->eigen, r->eq->positions,
-                           &c->plot);
+        int s = modes_plot(r, &c->plot);
         status = status ? status : s;
     }
     return status;

@@ -8,22 +8,50 @@
 #include "cli.h"
 #include "cli_plot.h"
 
-static void print_response(const ts_response *r, int quiet)
+static void print_response(const ts_result *res, int quiet)
 {
-    printf("response of %s to %s (%s): static gain %.9g\n", r->output.name,
-           ts_input_name(r->input), r->output.unit, r->static_gain);
+    const ts_response *r = res->response;
+    char e[160] = "";
+    if (res->nvalues > 0)
+        cli_value_error(&res->values[0], e, sizeof e);
+    printf("response of %s to %s (%s): static gain %.9g %s\n",
+           r->output.name, ts_input_name(r->input), r->output.unit,
+           r->static_gain, e);
     int ib = 0;
     for (int i = 1; i < r->npoints; i++)
         if (r->magnitude[i] > r->magnitude[ib])
             ib = i;
-    printf("largest magnitude %.6g at %.6g Hz (phase %.3f deg)\n",
-           r->magnitude[ib], r->freq_hz[ib], r->phase_deg[ib]);
+    if (res->nvalues > 1)
+        cli_value_error(&res->values[1], e, sizeof e);
+    printf("largest magnitude %.6g %s at %.6g Hz (phase %.3f deg)\n",
+           r->magnitude[ib], e, r->freq_hz[ib], r->phase_deg[ib]);
+    if (res->magnitude_error)
+        printf("the magnitude meets the accuracy %.3g (of the largest) up to "
+               "%s%.6g Hz%s\n",
+               res->accuracy.accuracy,
+               isfinite(res->accurate_to_hz) ? "" : "(no point) ",
+               isfinite(res->accurate_to_hz) ? res->accurate_to_hz
+                                             : r->freq_hz[0],
+               isfinite(res->accurate_to_hz) &&
+                       res->accurate_to_hz >= r->freq_hz[r->npoints - 1]
+                   ? ", the whole range"
+                   : "");
     if (quiet)
         return;
-    printf("\n%14s %16s %12s\n", "freq [Hz]", "magnitude", "phase [deg]");
-    for (int i = 0; i < r->npoints; i++)
-        printf("%14.6g %16.9g %12.4f\n", r->freq_hz[i], r->magnitude[i],
-               r->phase_deg[i]);
+    printf("\n%14s %16s %10s %12s %10s\n", "freq [Hz]", "magnitude",
+           "+- disc.", "phase [deg]", "+- disc.");
+    for (int i = 0; i < r->npoints; i++) {
+        printf("%14.6g %16.9g", r->freq_hz[i], r->magnitude[i]);
+        if (res->magnitude_error)
+            printf(" %10.2g", res->magnitude_error[i]);
+        else
+            printf(" %10s", "-");
+        printf(" %12.4f", r->phase_deg[i]);
+        if (res->phase_error_deg)
+            printf(" %10.2g\n", res->phase_error_deg[i]);
+        else
+            printf(" %10s\n", "-");
+    }
 }
 
 
@@ -119,7 +147,8 @@ static void response_print(const cli_run *c, const ts_result *r)
                "heave response uses the mean of the one-sided "
                "derivatives, and a real heave also shifts the mean "
                "depth at first order (doc/model.md section 6)\n");
-    print_response(r->response, c->quiet);
+    print_response(r, c->quiet);
+    cli_print_accuracy(r);
     cli_print_trust(&r->trust);
 }
 

@@ -340,8 +340,9 @@ static void sim_print(const cli_run *c, const ts_result *r)
     const ts_system *sys = r->sys;
     if (!sys)
         return;
-    printf("simulate %s: %d links, speed %.6g m/s, turn rate %.6g rad/s\n",
-           sys->name, sys->nlinks, sys->tow.speed, sys->tow.turn_rate);
+    char tow[256];
+    cli_tow_text(sys, tow, sizeof tow);
+    printf("simulate %s: %d links, %s\n", sys->name, sys->nlinks, tow);
     char d[256];
     const ts_excitation *ex = r->excitation;
     for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
@@ -386,8 +387,43 @@ static void sim_print(const cli_run *c, const ts_result *r)
         print_table(sys, &r->output, r->nonlinear, r->linear);
     if (r->has_sea)
         print_sea(r);
-    if (r->nonlinear || r->linear)
+    for (int v = 0; !r->has_sea && v < r->nvalues; v++) {
+        char er[160];
+        if (!isfinite(r->values[v].value))
+            continue;
+        if (v == 0)
+            printf("\nkey values (nonlinear run, t >= %.6g s):\n",
+                   r->transient);
+        cli_value_error(&r->values[v], er, sizeof er);
+        printf("%-34s %14.8g %s\n", r->values[v].name, r->values[v].value,
+               er);
+    }
+    const ts_window *w = &r->window;
+    if (w->checked) {
+        printf("window: t >= %.6g s of %.6g s; ", w->transient, w->t_end);
+        if (isfinite(w->slowest_tau))
+            printf("slowest time constant %.4g s (%s%.4g Hz; %.4g of them "
+                   "before the window)",
+                   w->slowest_tau,
+                   w->slowest_freq_hz > 0 ? "a mode at " : "a real mode, ",
+                   w->slowest_freq_hz, w->transient / w->slowest_tau);
+        else
+            printf("slowest time constant not known");
+        if (isfinite(w->drift))
+            printf("; the last two periods differ by %.2g of the output's "
+                   "amplitude", w->drift);
+        printf(": %s, %s\n",
+               w->settled > 0 ? "settled"
+               : w->settled == 0 ? "NOT SETTLED"
+                                 : "settling not known",
+               w->periodic > 0 ? "periodic"
+               : w->periodic == 0 ? "NOT PERIODIC"
+                                  : "periodicity not known");
+    }
+    if (r->nonlinear || r->linear) {
+        cli_print_accuracy(r);
         cli_print_trust(&r->trust);
+    }
     /* Under a sea the records' table above is the comparison. */
     if (r->compared && !r->has_sea)
         print_compare(&r->compare);

@@ -22,6 +22,7 @@
 #ifndef TOWSTAB_ANALYSIS_H
 #define TOWSTAB_ANALYSIS_H
 
+#include "towstab/accuracy.h"
 #include "towstab/compare.h"
 #include "towstab/converge.h"
 #include "towstab/eigen.h"
@@ -69,7 +70,25 @@ typedef struct ts_setup {
     int links;             /* equal links on every cable, 1..TS_MAX_LINKS;
                               0 (default): the system's */
     ts_equilibrium_opts equilibrium; /* method and tol (its defaults) */
+    double accuracy;       /* relative accuracy wanted of the key values,
+                              in (0, 1); default TS_ACCURACY_DEFAULT */
+    int discretisation_error; /* 1: estimate the discretisation error of
+                              the key values from the same analysis at
+                              coarser discretisations (towstab/accuracy.h;
+                              default for equilibrium, modes and response,
+                              which it costs less than the run itself);
+                              0: not (default for simulate, where it costs
+                              a second simulation) */
+    int refine;            /* 1: when the accuracy is missed, rerun with
+                              the links the error model says meet it, at
+                              most TS_REFINE_ROUNDS times (needs the
+                              estimate; equal links on every cable) */
 } ts_setup;
+
+/* --refine: reruns at most, each with at most TS_REFINE_GROWTH times the
+ * links of the run before. */
+#define TS_REFINE_ROUNDS 3
+#define TS_REFINE_GROWTH 8
 
 /* Modes reported by default when the system has at least
  * ts_eigen_opts.arpack_min_states states (ARPACK finds a subset), and
@@ -93,6 +112,10 @@ typedef struct ts_modes_opts {
                               TS_CONV_MODE_DAMPING_MAX (default
                               TS_MODES_FOLLOW, 1..100) */
     ts_linearize_opts linearize; /* its defaults */
+    int oscillatory;       /* 1: list the oscillatory modes only (the
+                              `count` lowest when count is given; the
+                              table always lists them first); the verdict
+                              still covers every mode computed */
 } ts_modes_opts;
 
 /* Frequency response defaults. */
@@ -134,11 +157,6 @@ typedef struct ts_response_opts {
                                          TS_SEASTATE_INTERVALS) */
     double duration;                  /* s, for the most probable maximum
                                          (default TS_SEASTATE_DURATION) */
-    int discretisation;               /* 1 (default): estimate the
-                                         discretisation error from runs at
-                                         a half and a quarter of the links
-                                         (ts_seastate_discretisation) when
-                                         the links allow it */
 } ts_response_opts;
 
 /* Simulation defaults: run length (s), sample interval (s) and the samples
@@ -192,6 +210,10 @@ typedef struct ts_simulate_opts {
     long seed;             /* the realisation's seed, >= 0 (default 1) */
     int components;        /* its sinusoids (default TS_SEA_COMPONENTS) */
     double fade_in;        /* s, >= 0; NAN (default): 2 Tp */
+    int check_window;      /* 1 (default): check that the analysed window
+                              has settled and is periodic
+                              (ts_accuracy_window); 0: not (the runs of a
+                              convergence study) */
 } ts_simulate_opts;
 
 /* Integrators of one convergence study, at most (one series each). */
@@ -265,7 +287,42 @@ typedef struct ts_value {
     double scale;                 /* > 0: relative errors are errors /
                                      scale; 0: relative to |value| */
     ts_estimate error;
+    double order;                 /* the order in 1/links the
+                                     discretisation estimate used; NaN */
 } ts_value;
+
+/* How accurate a result is against the continuous cable (towstab/
+ * accuracy.h; doc/accuracy.md). */
+typedef struct ts_result_accuracy {
+    double accuracy;        /* the relative accuracy wanted */
+    int estimated;          /* 1: the discretisation error was estimated */
+    char not_estimated[TS_TRUST_TEXT]; /* why not, "" when estimated */
+    int nlevels;            /* discretisations compared, the run's
+                               included (2 or 3) */
+    int links[TS_ACCURACY_LEVELS]; /* links of the longest cable at each */
+    double ratio[TS_ACCURACY_LEVELS - 1]; /* resolution ratios between
+                               consecutive levels (> 1 coarser, < 1 finer) */
+    double order;           /* theoretical order in 1/links */
+    double wall_s;          /* s, the runs of the other levels: the cost
+                               of the estimate */
+    long evaluations;       /* their kernel evaluations */
+    double max_rel_error;   /* largest relative discretisation error of
+                               what the accuracy is judged on (key values,
+                               stability margin, response points); NaN */
+    char limiting[TS_VALUE_NAME_MAX]; /* the quantity it belongs to */
+    double limiting_order;  /* the order its estimate used */
+    double limiting_theory; /* its theoretical order, which predicts the
+                               links needed */
+    int met;                /* 1 met, 0 missed, -1 not known */
+    double links_factor;    /* the growth of every cable's links that the
+                               error model says meets the accuracy; NaN */
+    int links_needed;       /* --links that would meet it (the longest
+                               cable's links times links_factor, rounded
+                               up); 0 when met or not known */
+    int refined_from;       /* --refine: the longest cable's links of the
+                               first run; 0 when not refined */
+    int refinements;        /* reruns --refine made */
+} ts_result_accuracy;
 
 /* What an analysis computed. The parts it does not compute, or did not
  * reach, are NULL (counts 0). */
@@ -280,6 +337,8 @@ typedef struct ts_result {
     long evaluations;           /* kernel evaluations (and marches) */
     int nvalues;
     ts_value *values;           /* [nvalues] key values */
+    ts_result_accuracy accuracy; /* against the continuum (every kind but
+                                   converge) */
 
     ts_system *sys;             /* the system analysed: the request's
                                    settings applied (owned) */
@@ -297,6 +356,16 @@ typedef struct ts_result {
     ts_mode_health *mode_health; /* [eigen->nmodes] */
     ts_trust modes_trust;       /* the modes' own verdict (part of
                                    `trust`) */
+    ts_mode_accuracy *mode_accuracy; /* [eigen->nmodes]: discretisation
+                                   errors, shape scale, resolved */
+    ts_stability stability;     /* the verdict of the resolved modes and,
+                                   apart, of the unresolved ones, over
+                                   every mode computed (also those a
+                                   --near or --oscillatory table leaves
+                                   out) */
+    int nmodes_computed;        /* modes the eigen analysis kept, before
+                                   --near or --oscillatory chose those
+                                   listed (eigen->nmodes) */
     double eigen_wall_s;
     /* response */
     ts_response *response;
@@ -316,6 +385,13 @@ typedef struct ts_result {
     int nnatural;
     double natural_hz[TS_RESPONSE_NATURAL]; /* lowest natural frequencies,
                                                Hz */
+    double *magnitude_error;    /* [response->npoints] discretisation error
+                                   of the magnitude (output unit per m);
+                                   NULL unless estimated */
+    double *phase_error_deg;    /* [npoints] of the phase, deg */
+    double accurate_to_hz;      /* the highest frequency up to which every
+                                   point meets the accuracy (relative to
+                                   the largest magnitude); NaN */
     /* simulate */
     const ts_excitation *excitation; /* the request's (not owned: the
                                         request must outlive the result) */
@@ -328,6 +404,9 @@ typedef struct ts_result {
     ts_sim_stats nonlinear_stats, linear_stats;
     int compared;
     ts_compare compare;
+    ts_window window;           /* the analysed window of the nonlinear run
+                                   (the linear run's without one): settled,
+                                   periodic (checked: 0 when not) */
     /* converge */
     ts_convergence *convergence;
 } ts_result;
@@ -341,8 +420,9 @@ TS_API int ts_analysis_check(const ts_system *sys, const ts_request *rq,
 
 /* What the analysis of rq will cost at least (towstab/cost.h):
  * simulations (nonlinear, else the linear model's: nothing), modes (the
- * eigen solve); zero for the others. Meant to be said before a long run
- * starts (the command line does above a minute). TS_OK or TS_ENOMEM. */
+ * eigen solve), with the discretisation estimate's runs when asked for;
+ * zero for the others. Meant to be said before a long run starts (the
+ * command line does above a minute). TS_OK or TS_ENOMEM. */
 TS_API int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
                             ts_cost *e, ts_err *err);
 
