@@ -276,7 +276,10 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
         }
         cli_print_accuracy(r);
     }
-    cli_print_trust(t);
+    /* The equilibrium under an analysis that failed after it: the result
+     * asked for was not delivered, so no verdict (stderr says why). */
+    if (r->kind == TS_ANALYSIS_EQUILIBRIUM || r->status == TS_OK)
+        cli_print_trust(t);
 }
 
 
