@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "eigen_impl.h"
+#include "response_impl.h"
 #include "towstab/system.h"
 
 static const char *const input_names[3] = {"tow.surge", "tow.sway",
@@ -333,6 +334,16 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                         const double freq_hz[], int npoints,
                         ts_response **res, ts_err *err)
 {
+    return tsi_response_compute(sys, lin, input, out, freq_hz, npoints, NULL,
+                                NULL, res, err);
+}
+
+int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
+                         int input, const ts_output *out,
+                         const double freq_hz[], int npoints,
+                         ts_progress_fn progress, void *data,
+                         ts_response **res, ts_err *err)
+{
     *res = NULL;
     int rc = check_args(lin, input, out, err);
     if (rc != TS_OK)
@@ -376,6 +387,11 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
         r->im[i] = cimag(g);
         r->magnitude[i] = cabs(g);
         r->phase_deg[i] = carg(g) * 180.0 / M_PI;
+        ts_progress p = {"response", i + 1.0, npoints, "frequencies"};
+        if (rc == TS_OK && progress && progress(&p, data))
+            rc = ts_fail(err, TS_ECANCEL, "response: stopped on request "
+                         "after %d of %d frequencies (%.6g Hz)", i + 1,
+                         npoints, freq_hz[i]);
     }
     ws_free(&w);
     if (rc != TS_OK) {

@@ -379,16 +379,21 @@ int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
                      "m/s^2", m->tow_accel);
         else
             snprintf(cause, sizeof cause, what[big], val[big]);
-    } else {
-        double mass = w.link >= 0 ? sys->links[w.link].mass
-                                  : sys->bodies[w.body].mass;
-        if (w.kind == 1 && !(rho <= 1e100))
-            snprintf(cause, sizeof cause, "water density %.3g kg/m^3", rho);
-        else if (!(g <= 1e100))
-            snprintf(cause, sizeof cause, "gravity %.3g m/s^2", g);
-        else
-            snprintf(cause, sizeof cause, "a mass of %.3g kg", mass);
-    }
+    } else if (w.kind == 1 && !(rho <= 1e100))
+        snprintf(cause, sizeof cause, "water density %.3g kg/m^3", rho);
+    else if (!(g <= 1e100))
+        snprintf(cause, sizeof cause, "gravity %.3g m/s^2", g);
+    else if (w.link >= 0) {
+        /* A weight: the cable's mass per length (a weight given in the
+         * scene is converted to it). */
+        int k = sys->links[w.link].cable;
+        snprintf(cause, sizeof cause, "a mass of %.3g kg/m (a weight in air "
+                 "of %.3g N/m) of cables[%d] '%s'",
+                 sys->cables[k].mass_per_length,
+                 sys->cables[k].mass_per_length * g, k, sys->cables[k].name);
+    } else
+        snprintf(cause, sizeof cause, "a mass of %.3g kg of bodies[%d] '%s'",
+                 sys->bodies[w.body].mass, w.body, sys->bodies[w.body].name);
     static const char *const load[4] = {"weight", "buoyancy", "drag",
                                         "inertia"};
     char part[2 * TS_NAME_MAX + 64];

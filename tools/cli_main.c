@@ -216,10 +216,13 @@ int cli_execute(cli_run *c, json_t **result)
     ts_cost cost;
     if (ts_analysis_cost(c->scene->system, &c->rq, &cost, NULL) == TS_OK &&
         cost.seconds > ANNOUNCE_S) {
+        /* Simulations and studies keep what they have when stopped. */
+        int keeps = c->rq.kind == TS_ANALYSIS_SIMULATE ||
+                    c->rq.kind == TS_ANALYSIS_CONVERGE;
         fprintf(stderr, "towstab: warning: %s is estimated to take %s; to "
-                        "shorten it: %s (Ctrl-C stops it, keeping what it "
-                        "has)\n",
-                ts_analysis_name(c->rq.kind), cost.what, cost.reduce);
+                        "shorten it: %s (Ctrl-C stops it%s)\n",
+                ts_analysis_name(c->rq.kind), cost.what, cost.reduce,
+                keeps ? ", keeping what it has" : "");
         fflush(stderr);
     }
     int rc = ts_analysis_run(c->scene->system, &c->rq, &r, &err);

@@ -1237,6 +1237,31 @@ static void gen_signals(void)
     c = long_run("signal: SIGINT during a long simulation, --json -", SIGINT,
                  1.0);
     args(c, "--json", "-", NULL);
+    /* A frequency sweep stops after its current frequency; a dense
+     * eigensolve cannot poll: it ends at once, saying so (issue 15). */
+    c = add_case("signal: SIGINT during a response of 1e6 frequencies");
+    args(c, "response", EX1, "--quiet", "--output", "sphere.z", "--points",
+         "1000000", "--json", "@D/out.json", NULL);
+    c->expect = E_INTERRUPT;
+    c->sig = SIGINT;
+    c->sig_after = 1.0;
+    c->must_name = xstrdup("stopped on request after");
+    const example *ex1 = find_example("kamman_ex1_submerged");
+    const char *at = ex1 ? strstr(ex1->text, "links: 20") : NULL;
+    if (at) {
+        size_t len, a = (size_t)(at - ex1->text);
+        char *t = replaced(ex1, a, a + 9, "links: 400", 10, &len);
+        c = add_case("signal: SIGTERM during a dense eigensolve of 1600 "
+                     "states");
+        set_scene(c, ex1->file, t, len);
+        args(c, "modes", "@D/kamman_ex1_submerged.yaml", "--quiet",
+             "--eigen-method", "lapack", "--json", "@D/out.json", NULL);
+        c->expect = E_INTERRUPT;
+        c->sig = SIGTERM;
+        c->sig_after = 1.0;
+        c->must_name = xstrdup("stopped at once, writing nothing");
+        free(t);
+    }
     /* Progress: on a terminal, not on a file. */
     c = long_run("progress: shown when standard error is a terminal", SIGINT,
                  2.5);
@@ -1962,6 +1987,10 @@ static void finish_case(run *r)
             if (code != 128 + c->sig)
                 problem(&v, "exit %d, expected %d after %s", code,
                         128 + c->sig, strsignal(c->sig));
+            else if (!strstr(err, "interrupted") ||
+                     (c->must_name && !strstr(err, c->must_name)))
+                problem(&v, "stopped without saying %s",
+                        c->must_name ? c->must_name : "interrupted");
             break;
         default:
             if (code > 2 && outcome != O_STOPPED)
