@@ -418,6 +418,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
     if (!status)
         status = cli_open(argv[optind], &units, &scene);
     if (status) {
+        cli_plot_abandon(&c.plot);
         ts_optset_free(opts);
         return status;
     }
@@ -439,6 +440,8 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
                    scene->path);
         status = cli_execute(&c, NULL);
     }
+    if (status)
+        cli_plot_abandon(&c.plot);
     cli_run_free(&c);
     cli_close(units, scene);
     return status;

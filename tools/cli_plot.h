@@ -14,6 +14,7 @@ typedef struct cli_plot {
     const char *dir;   /* --plot DIR, NULL for no pictures */
     const char *units; /* --units TEXT, NULL for SI */
     ts_plot_opts opts; /* filled by cli_plot_begin */
+    int made;          /* cli_plot_begin made DIR (it did not exist) */
 } cli_plot;
 
 /* Check --plot and --units before any analysis runs: that pictures can be
@@ -24,6 +25,10 @@ typedef struct cli_plot {
  * when DIR cannot be created); 0 when there is nothing to draw or all is
  * well. */
 int cli_plot_begin(cli_plot *p, const char *cmd);
+
+/* After a refused or failed run: remove DIR again when cli_plot_begin
+ * made it and nothing was drawn into it (an empty directory). */
+void cli_plot_abandon(cli_plot *p);
 
 /* A cable shape of `sys` at node positions pos[3 nnodes] (m, M frame),
  * for ts_plot_shapes / ts_plot_mode_shapes: links as in sys, spheres

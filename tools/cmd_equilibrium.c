@@ -96,6 +96,8 @@ static void scene_names(const eq_curve *curves, int n, char *buf,
     const char *names[MAX_OVERLAYS + 1];
     int nn = 0;
     for (int i = 0; i < n; i++) {
+        if (!curves[i].sys)
+            continue;
         int seen = 0;
         for (int j = 0; j < nn; j++)
             seen |= strcmp(names[j], curves[i].sys->name) == 0;
@@ -393,8 +395,10 @@ static int eq_draw(cli_run *c, const ts_result *r)
         int s = overlay_solve(c, &st->curves[i]);
         status = status ? status : s;
     }
-    int s = eq_plot(&c->plot, st->curves, st->ncurves);
-    return status ? status : s;
+    /* A failed or refused overlay: no pictures (nothing half-drawn). */
+    if (status)
+        return status;
+    return eq_plot(&c->plot, st->curves, st->ncurves);
 }
 
 static void eq_release(cli_run *c)

@@ -944,6 +944,16 @@ static void gen_cli_misuse(void)
     misuse(R, "--csv", "equilibrium", EX1, "--csv", "", NULL);
     misuse(R, "--units", "equilibrium", EX1, "--plot", "@D/p", "--units",
            "bogus", NULL);
+    /* Overlays of the equilibrium pictures: each value checked, a failed
+     * one refused without a crash or pictures. */
+    static const char *const overlays[][2] = {
+        {"--overlay-speeds", "1,-1"}, {"--overlay-speeds", "1,nan"},
+        {"--overlay-speeds", ""}, {"--overlay-speeds", "1e300,2"},
+        {"--overlay-turn-rates", "1e300"}, {"--overlay-turn-rates", "3 m"},
+        {"--overlay", "/nonexistent.yaml"}, {"--overlay", ""}};
+    for (int i = 0; i < 8; i++)
+        misuse(R, NULL, "equilibrium", EX1, "--quiet", "--plot", "@D/p",
+               overlays[i][0], overlays[i][1], NULL);
     /* Standard input as the scene. */
     c = misuse(E_RUN, NULL, "equilibrium", "-", "--quiet", NULL);
     c->stdin_path = xstrdup(EX1);
