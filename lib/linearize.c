@@ -39,7 +39,9 @@
 #include <omp.h>
 #endif
 
+#include "descriptor.h"
 #include "kernel_impl.h"
+#include "lapack.h"
 #include "vehicle.h"
 
 #ifdef _OPENMP
@@ -55,6 +57,8 @@ void ts_linearize_opts_default(ts_linearize_opts *o)
     o->estimate_error = 1;
     o->threads = 0;
     o->tensions = 0;
+    o->model = TS_LIN_AUTO;
+    o->dense_max_states = 1200;
 }
 
 ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
@@ -72,8 +76,6 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->ninput = ni;
     lin->nlinks = sys->nlinks;
     lin->nnodes = sys->nnodes;
-    lin->A = calloc(sn * sn, sizeof(double));
-    lin->B = calloc(sn * (size_t)ni, sizeof(double));
     lin->y0 = calloc(sn, sizeof(double));
     lin->f0 = calloc(sn, sizeof(double));
     lin->r0 = calloc(3 * (size_t)sys->nnodes, sizeof(double));
@@ -90,19 +92,19 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->h = calloc(sn + (size_t)ni, sizeof(double));
     lin->u0 = calloc((size_t)ni, sizeof(double));
     lin->kink_node = -1;
+    lin->desc_err = NAN;
     lin->nvehicles = ts_kernel_nvehicles(k);
     if (lin->nvehicles > 0) {
         lin->up_qoff = malloc((size_t)sys->nlinks * sizeof(int));
         lin->up_map = calloc(12 * (size_t)sys->nlinks, sizeof(double));
     }
-    if (!lin->A || !lin->B || !lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 ||
-        !lin->dn || !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic ||
-        !lin->h || !lin->u0 ||
+    if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
+        !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
+        !lin->u0 ||
         (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map))) {
         ts_linear_free(lin);
-        ts_fail_nomem(err, 8.0 * (double)sn * (double)sn, "fewer links",
-                      "linearize: out of memory for the %d x %d matrix A",
-                      n, n);
+        ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory for %d "
+                "states", n);
         return NULL;
     }
     return lin;
@@ -126,7 +128,9 @@ void ts_linear_free(ts_linear *lin)
     free(lin->Ty);
     free(lin->Tu);
     free(lin->Aerr);
+    free(lin->fnoise);
     free(lin->h);
+    tsi_desc_free(lin->desc);
     free(lin->u0);
     free(lin->up_qoff);
     free(lin->up_map);
@@ -191,6 +195,64 @@ static int eval_into(col_ws *w, int slot, int nl)
     if (rc == TS_OK)
         memcpy(w->t[slot], ts_kernel_tensions(w->k),
                (size_t)nl * sizeof(double));
+    return rc;
+}
+
+/* Rounding noise of the kernel, lin->fnoise[n - nq]: at NOISE_SAMPLES
+ * states y0 + d, d_j = +-NOISE_REL h_j (signs from a fixed sequence),
+ * f(y0 + d) - f(y0) - A d is the rounding of the two evaluations (A's
+ * own error times d, and the second-order term NOISE_REL^2 h^2 f'', are
+ * far below it); its root mean square over the samples, over sqrt(2), is
+ * the noise of one evaluation of each lower row. A central difference
+ * with step h_j then carries noise fnoise_i / (sqrt(2) h_j) in entry (i,
+ * j), which the truncation estimate (A(h) - A(2h)) / 3 samples only by
+ * chance. Cost: NOISE_SAMPLES evaluations and matrix-vector products. */
+#define NOISE_SAMPLES 8
+#define NOISE_REL 1e-4
+
+static int kernel_noise(ts_kernel *k, const double *y0, const double *u0,
+                        ts_linear *lin)
+{
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    double *y = malloc((size_t)n * sizeof *y);
+    double *d = malloc((size_t)n * sizeof *d);
+    double *f = malloc((size_t)n * sizeof *f);
+    double *ad = malloc((size_t)(nlow > 0 ? nlow : 1) * sizeof *ad);
+    double *acc = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof *acc);
+    int rc = y && d && f && ad && acc ? TS_OK : TS_ENOMEM;
+    unsigned long long seq = 0x9E3779B97F4A7C15ULL;
+    int used = 0;
+    for (int s = 0; rc == TS_OK && s < NOISE_SAMPLES; s++) {
+        for (int j = 0; j < n; j++) {
+            seq = seq * 6364136223846793005ULL + 1442695040888963407ULL;
+            double dj = (seq >> 63 ? 1.0 : -1.0) * NOISE_REL * lin->h[j];
+            y[j] = y0[j] + dj;
+            d[j] = y[j] - y0[j]; /* exactly what was added */
+        }
+        lin->evaluations++;
+        if (ts_kernel_eval(k, y, u0, f) != TS_OK)
+            continue; /* a state off the chart: another sample */
+        double one = 1.0, zero = 0.0;
+        int inc = 1;
+        dgemv_("N", &nlow, &n, &one, lin->A + nq, &n, d, &inc, &zero, ad,
+               &inc, 1);
+        for (int i = 0; i < nlow; i++) {
+            double r = f[nq + i] - lin->f0[nq + i] - ad[i];
+            acc[i] += r * r;
+        }
+        used++;
+    }
+    if (rc == TS_OK && used > 0) {
+        for (int i = 0; i < nlow; i++)
+            lin->fnoise[i] = sqrt(acc[i] / (2.0 * used));
+    } else if (rc == TS_OK) {
+        rc = TS_ECONV;
+    }
+    free(y);
+    free(d);
+    free(f);
+    free(ad);
+    free(acc);
     return rc;
 }
 
@@ -347,6 +409,26 @@ static void find_kinks(const ts_system *sys, ts_linear *lin, int n)
     free(reach);
 }
 
+/* Kinks of the sparse model: nodes (the tow point included) within twice
+ * their own vertical position step of z = 0 while the fluid has density. */
+static void sparse_kinks(const ts_system *sys, ts_linear *lin)
+{
+    const ts_descriptor *d = lin->desc;
+    lin->kinks = 0;
+    lin->kink_tow = 0;
+    lin->kink_node = -1;
+    if (!(sys->env.water_density > 0))
+        return;
+    for (int i = 0; i < sys->nnodes; i++)
+        if (fabs(d->r0[3 * i + 2]) <= 2.0 * d->hr[3 * i + 2]) {
+            lin->kinks++;
+            if (i == 0)
+                lin->kink_tow = 1;
+            else if (lin->kink_node < 0)
+                lin->kink_node = i;
+        }
+}
+
 int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                  const ts_linearize_opts *opts, ts_linear *lin, ts_err *err)
 {
@@ -368,6 +450,20 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         return ts_fail(err, TS_EINVAL,
                        "linearize: rel_step must be in (0, 0.1), got %g",
                        o.rel_step);
+    if (o.model < TS_LIN_AUTO || o.model > TS_LIN_BOTH)
+        return ts_fail(err, TS_EINVAL, "linearize: unknown model %d",
+                       (int)o.model);
+    /* The sparse model covers cables, links and lumped bodies; a vehicle
+     * (its attitude and controller states) only the dense one. */
+    int vehicles = lin->nvehicles > 0 || n != 2 * nq;
+    if (vehicles && o.model == TS_LIN_SPARSE)
+        return ts_fail(err, TS_EINVAL, "linearize: the sparse model does not "
+                       "cover vehicles (their attitude and controller "
+                       "states); use model TS_LIN_DENSE or TS_LIN_AUTO");
+    int dense = o.model == TS_LIN_DENSE || o.model == TS_LIN_BOTH ||
+                (o.model == TS_LIN_AUTO &&
+                 (n < o.dense_max_states || vehicles));
+    int sparse = o.model != TS_LIN_DENSE && !vehicles;
     if (u0)
         memcpy(lin->u0, u0, (size_t)ni * sizeof(double));
     else
@@ -375,7 +471,39 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     u0 = lin->u0;
     memcpy(lin->y0, y0, (size_t)n * sizeof(double));
     lin->evaluations = 0;
-    if (o.tensions && (!lin->Ty || !lin->Tu)) {
+    lin->residual_evaluations = 0;
+    /* Dense arrays only for the dense model: a result reused with another
+     * model keeps nothing stale. */
+    if (!dense) {
+        free(lin->A);
+        free(lin->B);
+        free(lin->Ty);
+        free(lin->Tu);
+        free(lin->Aerr);
+        lin->A = lin->B = lin->Ty = lin->Tu = lin->Aerr = NULL;
+    }
+    if (!sparse) {
+        tsi_desc_free(lin->desc);
+        lin->desc = NULL;
+    }
+    if (dense && (!lin->A || !lin->B)) {
+        size_t sn = (size_t)n;
+        free(lin->A);
+        free(lin->B);
+        lin->A = calloc(sn * sn, sizeof(double));
+        lin->B = calloc(sn * (size_t)ni, sizeof(double));
+        if (!lin->A || !lin->B) {
+            free(lin->A);
+            free(lin->B);
+            lin->A = lin->B = NULL;
+            return ts_fail(err, TS_ENOMEM,
+                           "linearize: out of memory for a %d x %d matrix A "
+                           "(%.3g MB); the sparse model (TS_LIN_SPARSE) "
+                           "needs O(links) memory",
+                           n, n, 8e-6 * (double)sn * (double)sn);
+        }
+    }
+    if (dense && o.tensions && (!lin->Ty || !lin->Tu)) {
         free(lin->Ty);
         free(lin->Tu);
         lin->Ty = malloc((size_t)nl * (size_t)n * sizeof(double));
@@ -386,7 +514,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                                  "for the %d x %d tension Jacobian", nl, n);
     }
 
-    if (o.estimate_error && !lin->Aerr) {
+    if (dense && o.estimate_error && !lin->Aerr) {
         lin->Aerr = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (!lin->Aerr)
             return ts_fail_nomem(err, 8.0 * nlow * (double)n, "fewer links, "
@@ -394,10 +522,18 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                                  "of memory for the %d x %d error estimate",
                                  nlow, n);
     }
+    if (o.estimate_error && !lin->fnoise) {
+        lin->fnoise = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof(double));
+        if (!lin->fnoise)
+            return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+    }
     if (!o.estimate_error) {
         free(lin->Aerr);
         lin->Aerr = NULL;
+        free(lin->fnoise);
+        lin->fnoise = NULL;
     }
+    lin->round_norm = NAN;
 
     /* Base point: f0, positions, tensions, direction derivatives. */
     int rc = ts_kernel_eval(k, y0, u0, lin->f0);
@@ -472,6 +608,50 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     free(scale);
     find_kinks(sys, lin, n);
 
+    int nthreads = 1;
+#ifdef _OPENMP
+    nthreads = o.threads > 0 ? o.threads
+               : (nl >= TS_LINEARIZE_PARALLEL_LINKS ? omp_get_max_threads()
+                                                    : 1);
+    if (nthreads < 1)
+        nthreads = 1;
+#endif
+    lin->threads = nthreads;
+    lin->groups = 0;
+    lin->desc_err = NAN;
+    if (sparse) {
+        /* The kernel's last evaluation is the base point: the sparse model
+         * starts from its positions, velocities, accelerations and
+         * tensions. */
+        if (!lin->desc && !(lin->desc = tsi_desc_alloc(sys, err)))
+            return err ? err->code : TS_ENOMEM;
+        rc = tsi_desc_linearize(lin->desc, k, o.rel_step, o.estimate_error,
+                                nthreads, err);
+        if (rc != TS_OK)
+            return rc;
+        const ts_descriptor *d = lin->desc;
+        lin->residual_evaluations = d->evaluations;
+        lin->groups = d->groups;
+        if (o.estimate_error)
+            lin->desc_err = fmax(d->k_scale > 0 ? d->k_err / d->k_scale : 0,
+                                 d->c_scale > 0 ? d->c_err / d->c_scale : 0);
+    }
+    if (!dense) {
+        /* Kinks: nodes within twice their own position step of the
+         * surface. */
+        if (sparse)
+            sparse_kinks(sys, lin);
+        lin->trunc_err = lin->trunc_norm = lin->b_trunc_err = NAN;
+        lin->t_trunc_err = lin->a_scale = lin->a_norm = NAN;
+        double *ftmp = malloc((size_t)n * sizeof(double));
+        if (!ftmp)
+            return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+        ts_kernel_eval(k, y0, u0, ftmp);
+        lin->evaluations++;
+        free(ftmp);
+        return TS_OK;
+    }
+
     /* Upper blocks: [0 I 0] and 0, exactly. */
     for (int j = 0; j < n; j++) {
         double *colj = lin->A + (size_t)j * n;
@@ -482,16 +662,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     for (int j = 0; j < ni; j++)
         memset(lin->B + (size_t)j * n, 0, (size_t)nq * sizeof(double));
 
-    int nthreads = 1;
-#ifdef _OPENMP
-    nthreads = o.threads > 0 ? o.threads
-               : (nl >= TS_LINEARIZE_PARALLEL_LINKS ? omp_get_max_threads()
-                                                    : 1);
     if (nthreads > ncol)
         nthreads = ncol;
-    if (nthreads < 1)
-        nthreads = 1;
-#endif
     lin->threads = nthreads;
     col_ws *ws = calloc((size_t)nthreads, sizeof *ws);
     if (!ws)
@@ -559,6 +731,16 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         col_ws_free(&ws[t], k);
     free(ws);
     lin->evaluations += (long)ncol * (estimate ? 4 : 2);
+
+    /* The kernel's rounding noise (beside the truncation error). */
+    if (estimate && bad_col < 0 && kernel_noise(k, y0, u0, lin) == TS_OK) {
+        double sr = 0, sh = 0;
+        for (int i = 0; i < nlow; i++)
+            sr += lin->fnoise[i] * lin->fnoise[i];
+        for (int j = 0; j < n; j++)
+            sh += 1.0 / (2.0 * lin->h[j] * lin->h[j]);
+        lin->round_norm = sqrt(sr * sh);
+    }
 
     /* Leave the kernel's results at the base point. */
     double *ftmp = malloc((size_t)n * sizeof(double));

@@ -22,6 +22,9 @@
  *     any system in vacuum have none.
  *  7. Refusals: an unconverged equilibrium, a bad step, a size mismatch;
  *     input names.
+ *  8. The rounding noise (fnoise, round_norm): at a step of 1e-9 the
+ *     difference of A to a tight reference is that noise, its size
+ *     within a factor 3 of the prediction.
  */
 #include "towstab/linearize.h"
 
@@ -31,6 +34,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tscene.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
 
@@ -38,11 +42,7 @@ static ts_units *units;
 
 static ts_scene *scene_from(const char *yaml)
 {
-    ts_err err = {0};
-    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", units, &err);
-    if (!s)
-        printf("scene: %s\n", err.msg);
-    return s;
+    return tscene_parse(units, yaml);
 }
 
 /* A towed cable with a sphere, in water, straight tow, tow point 0.7 m
@@ -107,9 +107,9 @@ static void test_structure_threads_and_second_method(void)
                    0;
     CHECK(same, "A, B, dT/dy, dT/du identical with 1 and %d threads",
           l2->threads);
-    CHECK(l1->evaluations == 1 + 4L * (n + TS_NINPUT) + 1,
-          "evaluations: 4 per column plus base and restore (%ld)",
-          l1->evaluations);
+    CHECK(l1->evaluations == 1 + 4L * (n + TS_NINPUT) + 8 + 1,
+          "evaluations: 4 per column, base, 8 for the rounding noise, "
+          "restore (%ld)", l1->evaluations);
 
     /* 3. Second method: Richardson-extrapolated directional derivative.
      * Its error is O(e^4) ~ 1e-12 relative, far below A's own. */
@@ -331,6 +331,61 @@ static void test_kinks(void)
           "input names");
 }
 
+/* 8. The rounding noise: with a step of 1e-9, where rounding dominates
+ * (eps / h against h^2), the lower block of A differs from a tight
+ * reference (Richardson-extrapolated central differences at step 1e-3,
+ * fourth order, rounding a million times smaller) by noise whose root
+ * mean square over the entries is the one predicted from fnoise,
+ * sqrt(sum_ij fnoise_i^2 / (2 h_j^2)) (round_norm), within a factor 3
+ * (the rms of 2 x 80 x 80 independent draws). */
+static void test_rounding_noise(void)
+{
+    ts_scene *sc = scene_from(towed_yaml);
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sc->system, &err);
+    ts_equilibrium *eq = solve(k, sc->system);
+    ts_linear *a = ts_linear_alloc(k, &err), *b = ts_linear_alloc(k, &err);
+    ts_linearize_opts o;
+    ts_linearize_opts_default(&o);
+    o.rel_step = 1e-9;
+    int rc = ts_linearize_equilibrium(k, eq, &o, a, &err);
+    o.rel_step = 1e-3;
+    if (rc == TS_OK)
+        rc = ts_linearize_equilibrium(k, eq, &o, b, &err);
+    if (!CHECK(rc == TS_OK && a->fnoise && isfinite(a->round_norm),
+               "rounding noise estimated (%s)", err.msg)) {
+        ts_linear_free(a);
+        ts_linear_free(b);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        ts_scene_free(sc);
+        return;
+    }
+    int n = a->nstate, nq = a->nq, nlow = n - nq;
+    double d2 = 0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < nlow; i++) {
+            double ref = b->A[nq + i + (size_t)j * n] -
+                         b->Aerr[i + (size_t)j * nlow];
+            double d = a->A[nq + i + (size_t)j * n] - ref;
+            d2 += d * d;
+        }
+    double ratio = sqrt(d2) / a->round_norm;
+    int positive = 1;
+    for (int i = 0; i < nlow; i++)
+        positive &= a->fnoise[i] > 0;
+    CHECK(positive && ratio > 1.0 / 3 && ratio < 3,
+          "step 1e-9: ||A - A_tight||_F = %.3g against the predicted "
+          "rounding noise %.3g (ratio %.2f, in [1/3, 3]); the truncation "
+          "estimate says %.3g", sqrt(d2), a->round_norm, ratio,
+          a->trunc_norm);
+    ts_linear_free(a);
+    ts_linear_free(b);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -342,6 +397,7 @@ int main(void)
     test_structure_threads_and_second_method();
     test_exact_inputs();
     test_kinks();
+    test_rounding_noise();
     ts_units_free(units);
     return tc_done();
 }

@@ -14,8 +14,8 @@
  *     read-only directory (not root only), existing targets,
  *   - SIGINT and SIGTERM during long runs, and progress on a terminal
  *     (a pseudo-terminal) against a file.
- * Every case runs in its own temporary directory under a time limit, in
- * parallel. A case passes when the run is
+ * Every case runs in its own temporary directory under a time limit (of
+ * CPU time, and four times that of wall time), in parallel. A case passes when the run is
  *   refused cleanly: exit 1 or 2, a line "towstab: error: ..." naming a
  *     file, key, line or option (or what the case says it must name), no
  *     "nan" in any message (user text quoted in it excepted), no output
@@ -53,6 +53,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/types.h>
@@ -60,8 +61,11 @@
 #include <time.h>
 #include <unistd.h>
 
-/* Time limit of a case, s (times --time-scale). */
+/* Time limit of a case: CPU s (times --time-scale), so that a loaded
+ * machine does not make a slow case a hang; a case blocked without using
+ * the CPU is stopped after WALL_FACTOR times that in wall time. */
 #define CASE_TIMEOUT 60.0
+#define WALL_FACTOR 4.0
 /* After SIGINT to a run that announced its cost: time to stop, s. */
 #define INTERRUPT_GRACE 15.0
 /* Most arguments of one case. */
@@ -1679,10 +1683,13 @@ static int start_case(run *r, int idx, int serial)
     fflush(stdout);
     r->start = now();
     double limit = (c->timeout > 0 ? c->timeout : CASE_TIMEOUT) * time_scale;
-    r->deadline = r->start + limit;
+    r->deadline = r->start + WALL_FACTOR * limit;
     r->pid = fork();
     if (r->pid == 0) {
         setpgid(0, 0);
+        /* SIGXCPU at the limit, SIGKILL a little after. */
+        struct rlimit cpu = {(rlim_t)(limit + 0.999), (rlim_t)(limit + 5.999)};
+        setrlimit(RLIMIT_CPU, &cpu);
         int fi = open(in, O_RDONLY);
         int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0600);
         int fe = slave ? open(slave, O_RDWR | O_NOCTTY)
@@ -1816,14 +1823,18 @@ static void finish_case(run *r)
     int outcome;
     int st = r->status, code = -1;
     int sanitizer = strstr(err, "Sanitizer") || strstr(err, "runtime error:");
+    double limit = (c->timeout > 0 ? c->timeout : CASE_TIMEOUT) * time_scale;
     if (r->timed_out) {
         outcome = O_HUNG;
         problem(&v, r->interrupted ? "did not stop within %.0f s of SIGINT "
                                      "after announcing its cost"
-                                   : "no result within %.0f s",
+                                   : "no result within %.0f s (wall)",
                 r->interrupted ? INTERRUPT_GRACE * time_scale
-                               : (c->timeout > 0 ? c->timeout
-                                                 : CASE_TIMEOUT) * time_scale);
+                               : WALL_FACTOR * limit);
+    } else if (WIFSIGNALED(st) && (WTERMSIG(st) == SIGXCPU ||
+                                   WTERMSIG(st) == SIGKILL)) {
+        outcome = O_HUNG;
+        problem(&v, "no result within %.0f s of CPU time", limit);
     } else if (WIFSIGNALED(st) || sanitizer) {
         outcome = O_CRASHED;
         if (sanitizer)
@@ -2180,9 +2191,11 @@ int main(int argc, char **argv)
     }
     printf("hostile: %d cases (%d scene mutants of %d examples, %d sizes, "
            "%d command-line misuses, %d output faults, %d signals and "
-           "progress), %d jobs, time limit %.0f s each%s\n",
+           "progress), %d jobs, time limit %.0f s of CPU (%.0f s of wall "
+           "time) each%s\n",
            ncases, nmutants, nexamples, nsizes, ncli, nfaults, nsignals, jobs,
-           CASE_TIMEOUT * time_scale, is_root ? ", as root" : "");
+           CASE_TIMEOUT * time_scale, WALL_FACTOR * CASE_TIMEOUT * time_scale,
+           is_root ? ", as root" : "");
     double t0 = now();
     run *slots = xmalloc((size_t)jobs * sizeof *slots);
     int *busy = calloc((size_t)jobs, sizeof *busy);
