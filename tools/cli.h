@@ -48,6 +48,11 @@ typedef struct cli_run {
     int entry;              /* -1: the command line; else analyses[entry] */
     const char *json, *csv; /* output paths, NULL when not asked for */
     cli_plot plot;          /* --plot DIR and --units */
+    int plot_optional;      /* 1: an analysis that has no pictures runs
+                               without them (towstab report); 0: it
+                               refuses --plot */
+    ts_display display;     /* --units: what tables, CSV and pictures show
+                               (cli_display_begin) */
     int json_flags;         /* TS_REPORT_* */
     /* The extras given: values[k][0..nvalues[k]) for cmd->extras[k]. */
     const char *extra[CLI_EXTRA_MAX][CLI_EXTRA_VALUES];
@@ -121,19 +126,24 @@ typedef struct cli_scene_runs {
     cli_run *runs;          /* [n], prepared */
     char (*csv)[1200];      /* [n] DIR/<k>_<type>.csv when asked for */
     char (*dirs)[1200];     /* [n] DIR/<k>_<type> of the pictures */
+    double *wall_s;         /* [n] s, each analysis with its printing and
+                               pictures (cli_scene_execute); 0 when not
+                               run */
+    int ran;                /* analyses run (the last may have failed) */
 } cli_scene_runs;
 
 /* Read every entry of the scene's analyses list through its option table
  * and check it against the system (cli_prepare) before anything runs;
  * with csv_dir each writes csv_dir/<k>_<type>.csv, with plot_dir its
- * pictures into plot_dir/<k>_<type>/ (k from 1) in plot_units. `cmd`
- * names the command in messages. Prints and returns the exit status (a
+ * pictures into plot_dir/<k>_<type>/ (k from 1) in plot_units, with
+ * plot_optional (cli_run) set as given. `cmd` names the command in
+ * messages. Prints and returns the exit status (a
  * scene without analyses is bad input); on success release s with
  * cli_scene_free. */
 int cli_scene_prepare(const char *cmd, const ts_scene *scene,
                       const ts_units *units, int quiet, const char *csv_dir,
                       const char *plot_dir, const char *plot_units,
-                      cli_scene_runs *s);
+                      int plot_optional, cli_scene_runs *s);
 
 /* Run the prepared analyses in order, each after a line "== analysis k of
  * n: TYPE (SCENE) ==", until one fails. *all receives the JSON document
@@ -144,6 +154,11 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
                       json_t **all);
 
 void cli_scene_free(cli_scene_runs *s);
+
+/* Report a getopt failure of `towstab run` or `report` (ch ':' for a
+ * missing value, else an unknown option: the analyses' options belong in
+ * the scene); returns EXIT_BADINPUT. */
+int cli_scene_option_error(const char *cmd, int ch, const char *arg);
 
 /* Make directory `dir` (one level) unless it is one; 0, or the status
  * after printing a message naming `cmd` and the option `opt`. */
@@ -219,12 +234,17 @@ int cli_check_outputs(const char *cmd, int n, const char *const what[],
 void cli_print_trust(const ts_trust *t);
 
 /* "speed V m/s (K knots), turn rate W rad/s (D deg/s, turn radius R m, to
- * starboard)" or "... turn rate 0 rad/s (straight)". */
-void cli_tow_text(const ts_system *sys, char *buf, size_t size);
+ * starboard)" or "... turn rate 0 rad/s (straight)" in SI; in the display
+ * units d otherwise ("speed 5 knot, turn rate 2 deg/s (turn radius 480
+ * ft, to port)"). */
+void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
+                  size_t size);
 
-/* "+- D (discretisation) +- S (solver) UNIT" of a key value, "-" where
- * not estimated. */
-void cli_value_error(const ts_value *v, char *buf, size_t size);
+/* A key value as shown in the display units d, and "+- D
+ * (discretisation) +- S (solver) UNIT" of it, "-" where not estimated. */
+double cli_value_shown(const ts_value *v, const ts_display *d);
+void cli_value_error(const ts_value *v, const ts_display *d, char *buf,
+                     size_t size);
 
 /* The discretisation-error line of a result: the levels compared, the
  * order, the cost, the largest relative error against the accuracy (or
@@ -242,7 +262,8 @@ extern const cli_command *const cli_commands[];
 const cli_command *cli_command_of(int kind);
 
 /* Printing shared by the commands (cmd_equilibrium.c, cmd_modes.c). */
-void cli_print_equilibrium(const ts_result *r, int quiet);
+void cli_print_equilibrium(const ts_result *r, int quiet,
+                           const ts_display *d);
 void cli_print_linearization(const ts_result *r);
 /* The sea state and its statistics (cmd_response.c; simulate too). */
 void cli_print_seastate(const ts_result *r, int quiet);

@@ -10,34 +10,20 @@
 
 #include "cli.h"
 
+/* Room for a quantity as written in a legend. */
+#define ITEM_TEXT 96
+
 int cli_plot_begin(cli_plot *p, const char *cmd)
 {
+    const ts_display *d = p->opts.display; /* the caller's, kept */
     ts_plot_opts_default(&p->opts);
-    if (!p->dir) {
-        if (p->units) {
-            fprintf(stderr, "towstab: error: %s: --units sets the units of the "
-                            "--plot pictures; add --plot DIR\n",
-                    cmd);
-            return EXIT_BADINPUT;
-        }
+    p->opts.display = d;
+    if (!p->dir)
         return 0;
-    }
     ts_err err = {0};
     if (ts_plot_check(&err) != TS_OK) {
         fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
         return EXIT_BADINPUT;
-    }
-    if (p->units) {
-        if (strcmp(p->units, "si") == 0 || strcmp(p->units, "SI") == 0)
-            p->opts.units = TS_PLOT_SI;
-        else if (strcmp(p->units, "imperial") == 0)
-            p->opts.units = TS_PLOT_IMPERIAL;
-        else {
-            fprintf(stderr, "towstab: error: %s: --units: expected si or imperial, "
-                            "got '%s'\n",
-                    cmd, p->units);
-            return EXIT_BADINPUT;
-        }
     }
     struct stat st;
     int existed = stat(p->dir, &st) == 0;
@@ -57,28 +43,61 @@ void cli_plot_abandon(cli_plot *p)
         p->made = 0;
 }
 
+void cli_plot_wrote(const cli_plot *p, const char *name)
+{
+    int png = p->opts.formats & TS_PLOT_PNG, svg = p->opts.formats & TS_PLOT_SVG;
+    printf("wrote");
+    if (png)
+        printf(" %s/%s.png", p->dir, name);
+    if (svg)
+        printf("%s %s/%s.svg", png ? " and" : "", p->dir, name);
+    printf("\n");
+}
+
+int cli_display_begin(const ts_units *units, const char *spec,
+                      ts_display *d)
+{
+    ts_display_si(d);
+    if (!spec)
+        return 0;
+    ts_err err = {0};
+    int rc = ts_display_parse(units, spec, "--units", d, &err);
+    return rc ? cli_report(&err, rc) : 0;
+}
+
 int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out)
 {
     memset(out, 0, sizeof *out);
     out->link_upper = malloc(((size_t)sys->nlinks + 1) * sizeof(int));
     out->marks = malloc(((size_t)sys->nbodies + 1) * sizeof(int));
-    if (!out->link_upper || !out->marks) {
+    out->cylinders = malloc(((size_t)sys->nbodies + 1) *
+                            sizeof *out->cylinders);
+    if (!out->link_upper || !out->marks || !out->cylinders) {
         cli_plot_shape_free(out);
         return -1;
     }
     /* Link l joins its upper node to node l + 1 (ts_link.lower). */
     for (int l = 0; l < sys->nlinks; l++)
         out->link_upper[l] = sys->links[l].upper;
-    int nmarks = 0;
-    for (int b = 0; b < sys->nbodies; b++)
-        if (sys->bodies[b].type == TS_BODY_SPHERE)
-            out->marks[nmarks++] = ts_system_body_node(sys, b);
+    int nmarks = 0, ncyl = 0;
+    for (int b = 0; b < sys->nbodies; b++) {
+        const ts_body *B = &sys->bodies[b];
+        int node = ts_system_body_node(sys, b);
+        if (B->type == TS_BODY_SPHERE)
+            out->marks[nmarks++] = node;
+        else if (B->type == TS_BODY_CYLINDER && node >= 1 &&
+                 B->length > 0 && B->diameter > 0)
+            out->cylinders[ncyl++] =
+                (ts_plot_cylinder){node, B->length, B->diameter};
+    }
     ts_plot_shape *s = &out->shape;
     s->nnodes = sys->nnodes;
     s->pos = pos;
     s->link_upper = out->link_upper;
     s->nmarks = nmarks;
     s->marks = out->marks;
+    s->ncylinders = ncyl;
+    s->cylinders = out->cylinders;
     /* doc/model.md section 1: the turn centre is at (0, V / Omega, 0). */
     s->turn_radius = sys->tow.turn_rate != 0
                          ? sys->tow.speed / sys->tow.turn_rate
@@ -91,18 +110,34 @@ void cli_plot_shape_free(cli_shape *s)
 {
     free(s->link_upper);
     free(s->marks);
+    free(s->cylinders);
     s->link_upper = s->marks = NULL;
+    s->cylinders = NULL;
 }
 
-void cli_plot_tow_label(const ts_system *sys, ts_plot_units u, char *buf,
-                        size_t size)
+void cli_plot_tow_label(const ts_system *sys, const char *speed_text,
+                        const char *turn_text, const ts_display *d,
+                        char *buf, size_t size)
 {
-    double v = ts_plot_convert(TS_PLOT_SPEED, u, sys->tow.speed);
-    const char *vu = ts_plot_unit(TS_PLOT_SPEED, u);
-    if (sys->tow.turn_rate == 0)
-        snprintf(buf, size, "%.4g %s, straight", v, vu);
+    d = ts_display_or_si(d);
+    char v[ITEM_TEXT], w[ITEM_TEXT];
+    if (speed_text && speed_text[0])
+        snprintf(v, sizeof v, "%s", speed_text);
     else
-        snprintf(buf, size, "%.4g %s, turn %.4g rad/s (%s)", v, vu,
-                 fabs(sys->tow.turn_rate),
-                 sys->tow.turn_rate > 0 ? "starboard" : "port");
+        snprintf(v, sizeof v, "%.4g %s",
+                 ts_display_value(d, TS_QTY_SPEED, sys->tow.speed),
+                 ts_display_unit(d, TS_QTY_SPEED));
+    if (sys->tow.turn_rate == 0) {
+        snprintf(buf, size, "%s, straight", v);
+        return;
+    }
+    if (turn_text && turn_text[0])
+        snprintf(w, sizeof w, "%s", turn_text);
+    else
+        snprintf(w, sizeof w, "%.4g %s",
+                 ts_display_value(d, TS_QTY_ANGULAR_RATE,
+                                  fabs(sys->tow.turn_rate)),
+                 ts_display_unit(d, TS_QTY_ANGULAR_RATE));
+    snprintf(buf, size, "%s, turn %s (%s)", v, w,
+             sys->tow.turn_rate > 0 ? "starboard" : "port");
 }

@@ -221,7 +221,7 @@ static void print_modes(const ts_result *r, int quiet)
         char er[160];
         if (!isfinite(r->values[v].value))
             continue;
-        cli_value_error(&r->values[v], er, sizeof er);
+        cli_value_error(&r->values[v], NULL, er, sizeof er); /* SI */
         printf("%-22s %14.8g %s\n", r->values[v].name, r->values[v].value,
                er);
     }
@@ -322,7 +322,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
             snprintf(label[s], sizeof label[s], "%d %s", nset[s],
                      s ? "unresolved (grid-scale, or beyond the accuracy)" : "resolved");
         ts_plot_series a = {nset[s], sre[s], sim[s], label[s], 0,
-                            TS_PLOT_MARKERS, s ? 2 : 1};
+                            TS_PLOT_MARKERS, s ? 2 : 1, NULL};
         set[nsets++] = a;
     }
     if (nsets > 0 &&
@@ -330,8 +330,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
                             NULL, &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else if (nsets > 0)
-        printf("wrote %s/eigenvalues.png and %s/eigenvalues.svg\n",
-               plot->dir, plot->dir);
+        cli_plot_wrote(plot, "eigenvalues");
     free(buf);
 
     /* The shapes: the lowest resolved oscillatory modes (the listing is
@@ -382,8 +381,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
                                 &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/modes.png and %s/modes.svg\n", plot->dir,
-                   plot->dir);
+            cli_plot_wrote(plot, "modes");
     }
     cli_plot_shape_free(&eqs);
     free(disp);
@@ -393,7 +391,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
 
 static void modes_print(const cli_run *c, const ts_result *r)
 {
-    cli_print_equilibrium(r, 1);
+    cli_print_equilibrium(r, 1, &c->display);
     cli_print_linearization(r);
     if (r->eigen && r->mode_health)
         print_modes(r, c->quiet);

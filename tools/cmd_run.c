@@ -19,7 +19,9 @@ static void usage(FILE *f)
                "standard output)\n"
                "  --csv DIR     each analysis' table as DIR/<k>_<type>.csv\n"
                "  --plot DIR    each analysis' pictures in DIR/<k>_<type>/\n"
-               "  --units U     units of the pictures: si or imperial\n"
+               "  --units U     units of tables, CSV and pictures: si, "
+               "imperial or items\n"
+               "                like speed=knot,force=kN\n"
                "  --quiet       print the summaries only\n");
 }
 
@@ -47,13 +49,7 @@ static int run_main(int argc, char **argv)
         case 'u': plot_units = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
-        case ':': return cli_option_error("run", ch, argv[optind - 1]);
-        default:
-            fprintf(stderr, "towstab: error: run: unknown option '%s'; the "
-                            "scene's analyses carry their own settings "
-                            "(towstab run --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+        default: return cli_scene_option_error("run", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
@@ -69,11 +65,6 @@ static int run_main(int argc, char **argv)
                     opt[k], k ? "directory" : "file");
             return EXIT_BADINPUT;
         }
-    if (plot_units && !plot_dir) {
-        fprintf(stderr, "towstab: error: run: --units sets the units of the "
-                        "--plot pictures; add --plot DIR\n");
-        return EXIT_BADINPUT;
-    }
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);
@@ -81,7 +72,7 @@ static int run_main(int argc, char **argv)
         return status;
     cli_scene_runs s;
     status = cli_scene_prepare("run", scene, units, quiet, csv_dir,
-                               plot_dir, plot_units, &s);
+                               plot_dir, plot_units, 0, &s);
     if (status) {
         cli_close(units, scene);
         return status;

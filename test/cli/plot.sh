@@ -8,17 +8,18 @@
 # yes: --plot DIR writes side.png, side.svg, top.png, top.svg (PNG
 #   signature, 1000 x 700 px from the IHDR chunk, > 5 kB; SVG starting
 #   with <?xml and carrying the title naming the scene); a missing DIR is
-#   created; --units imperial works; overlays of speeds, turn rates and
+#   created; --units imperial works (legends show the speeds as written);
+#   overlays of speeds, turn rates and
 #   scenes add curves (one "overlay" line each); --plot into a path that
-#   is a file, a bad --units, --units or overlays without --plot, an
+#   is a file, a bad --units, overlays without --plot, an
 #   overlay with a bad unit or a missing scene are refused with exit
 #   status 2 before anything is solved, and leave no picture. modes and
 #   response write their pictures; simulate writes histories,
 #   snapshots_side and snapshots_top (PNG and SVG, titled, six files),
 #   with --snapshot-interval in the title; converge writes error_time;
 #   simulate and converge refuse --plot into a file (exit 2, nothing run),
-#   --snapshot-interval without --plot or giving too many snapshots, and
-#   --units without --plot.
+#   --snapshot-interval without --plot or giving too many snapshots;
+#   --units without --plot sets the tables (test/cli/units.sh).
 # no: --plot is refused with exit status 2 and the message naming the
 #   packages to install, while the analysis without --plot still runs.
 #
@@ -145,7 +146,6 @@ refused "--plot into a file" "$EX1" --plot "$T/afile"
 check "--plot into a file: the message says so" grep -q "not a directory" "$T/err"
 refused "--plot under a file" "$EX1" --plot "$T/afile/sub"
 refused "--units furlong" "$EX1" --plot "$T/r" --units furlong
-refused "--units without --plot" "$EX1" --units imperial
 refused "--overlay-speeds without --plot" "$EX1" --overlay-speeds "2 knot"
 refused "--overlay-speeds with a wrong unit" "$EX1" --plot "$T/r" --overlay-speeds "2,3 lbf"
 refused "--overlay-speeds with an empty item" "$EX1" --plot "$T/r" --overlay-speeds "2,,3 knot"
@@ -169,8 +169,6 @@ check "response --plot: Bode plot, PNG and SVG, titled" \
     bash -c "$(declare -f is_png is_svg); is_png '$T/bode/bode.png' 1000 700 && is_svg '$T/bode/bode.svg' 'kamman_ex1_above: frequency response'"
 ts modes "$EX3" --plot "$T/afile"
 check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
-ts response "$EX1" --output sphere.z --units imperial
-check "response --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
 
 # simulate and converge draw their pictures too.
 EX4=examples/kamman_ex4.yaml
@@ -206,8 +204,35 @@ check "simulate --snapshot-interval without --plot: exit 2 (got $status)" [ $sta
 ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz --plot "$T/r2" --snapshot-interval 0.01
 check "simulate --snapshot-interval 0.01 s on a 2 s run (too many): exit 2 (got $status)" \
     bash -c "[ $status -eq 2 ] && grep -q snapshot-interval '$T/err'"
-ts converge examples/kamman_ex1_submerged.yaml --links 5,10 --units imperial
-check "converge --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+
+# Pictures of issue 15: exaggerated snapshots, the Bode magnitude in dB,
+# a cylinder towfish drawn, error-vs-time points labelled.
+ts simulate "$EX4" --quiet --t-end 2 --transient 1 --excite tow.heave:amplitude=0.01ft,frequency=1Hz \
+    --plot "$T/ex" --exaggerate 50
+check "simulate --exaggerate 50: snapshots titled with the factor" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_svg '$T/ex/snapshots_side.svg' 'kamman_ex4: cable every 0.2 s, displacements from t = 0 s x 50, side view'"
+for k in 0.5 abc; do
+    ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz \
+        --plot "$T/exbad" --exaggerate $k
+    check "simulate --exaggerate $k: exit 2 naming it (got $status)" \
+        bash -c "[ $status -eq 2 ] && grep -q -- --exaggerate '$T/err'"
+done
+ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz --exaggerate 5
+check "simulate --exaggerate without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+ts simulate examples/kamman_ex1_submerged.yaml --quiet --t-end 20 \
+    --manoeuvre turn_rate:to=0.1rad/s,duration=5s --plot "$T/man"
+check "simulate under a manoeuvre: the earth-frame plan view with the ship's track (exit $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/man/plan_earth.png' 1000 700 && is_svg '$T/man/plan_earth.svg' \"kamman_ex1_submerged: manoeuvre in the earth frame, cable every 2 s and the ship's track\""
+check "simulate without a manoeuvre draws no plan_earth" \
+    bash -c "[ ! -e '$T/sim/plan_earth.png' ]"
+ts response "$EX1" --output sphere.z --quiet --plot "$T/db" --db
+check "response --db: the Bode plot drawn (exit $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/db/bode.png' 1000 700"
+ts response "$EX1" --output sphere.z --quiet --db
+check "response --db without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+ts equilibrium examples/two_part_tow.yaml --quiet --plot "$T/cyl"
+check "equilibrium of the two-part tow (a cylinder towfish) --plot: exit 0 (got $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/cyl/side.png' 1000 700"
 
 echo "$npass passed, $nfail failed"
 [ $nfail -eq 0 ]
