@@ -54,6 +54,7 @@
 
 #include "clock.h"
 #include "csvtab.h"
+#include "response_impl.h"
 #include "towstab/kernel.h"
 
 /* Noise of an equilibrium value: this many times its relative residual
@@ -1083,8 +1084,9 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
     lo.tensions = out.kind == TS_OUT_TENSION;
     rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc == TS_OK)
-        rc = ts_response_compute(r->sys, r->lin, input, &out, freq,
-                                 o->points, &r->response, err);
+        rc = tsi_response_compute(r->sys, r->lin, input, &out, freq,
+                                  o->points, rq->progress, rq->progress_data,
+                                  &r->response, err);
     free(freq);
     if (rc != TS_OK)
         return rc;

@@ -217,13 +217,21 @@ int ts_cost_modes(const ts_system *sys, int n, ts_eig_method m,
     e->seconds = e->evaluations * e->eval_s + e->flops / TS_COST_FLOPS;
     char d[32];
     duration(e->seconds, d, sizeof d);
-    snprintf(e->what, sizeof e->what,
-             "at least %s: %s of the %d-state %s linearization (%.3g flops, "
-             "%.3g GB) after %.3g kernel evaluations of %d links",
-             d, m == TS_EIG_ARPACK ? "ARPACK" : "a dense LAPACK eigensolve",
-             n, dense ? "dense" : "sparse", e->flops, e->bytes / 1e9,
-             e->evaluations, sys->nlinks);
-    snprintf(e->reduce, sizeof e->reduce, "fewer links, or method arpack "
-             "with a count (the modes near a target)");
+    if (e->flops > 0)
+        snprintf(e->what, sizeof e->what,
+                 "at least %s: %s of the %d-state %s linearization (%.3g "
+                 "flops, %.3g GB) after %.3g kernel evaluations of %d links",
+                 d, m == TS_EIG_ARPACK ? "ARPACK" : "a dense LAPACK eigensolve",
+                 n, dense ? "dense" : "sparse", e->flops, e->bytes / 1e9,
+                 e->evaluations, sys->nlinks);
+    else
+        snprintf(e->what, sizeof e->what,
+                 "at least %s: %.3g kernel evaluations of %d links to "
+                 "linearize, then ARPACK on the %d-state sparse system", d,
+                 e->evaluations, sys->nlinks, n);
+    snprintf(e->reduce, sizeof e->reduce, "%s", m == TS_EIG_ARPACK
+             ? "fewer links"
+             : "fewer links, or method arpack with a count (the modes near "
+               "a target)");
     return TS_OK;
 }

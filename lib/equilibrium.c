@@ -9,6 +9,10 @@
  * from the straight tow, with the step refined when a step fails. Whatever
  * the path, the answer is accepted only from the kernel's own verdict: the
  * largest unbalanced nodal force relative to the largest force.
+ *
+ * One module although long: the march, Newton, the continuations and the
+ * vehicles' trim share one workspace, one acceptance test and one report
+ * (ts_equilibrium); split, each would need the others' private state.
  */
 #include "towstab/equilibrium.h"
 

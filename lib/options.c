@@ -9,6 +9,10 @@
  * choices; then the row's limits. An option set keeps, per row and
  * source priority, the texts and where they came from; applying it takes
  * for each row the texts of its highest priority.
+ *
+ * One module although long: most of its lines are the tables themselves,
+ * one row per option, which must stay side by side so that names, limits
+ * and defaults are defined once.
  */
 #include "towstab/options.h"
 

@@ -4,6 +4,7 @@
  * half-written file survives a failure, and a device or FIFO in place. */
 #include "towstab/report.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -201,8 +202,10 @@ int ts_report_write_json(const json_t *value, const char *path, ts_err *err)
     if (json_dumpf(value, out.f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) !=
             0 ||
         fputc('\n', out.f) == EOF) {
+        int e = errno;
         tsi_outfile_abandon(&out);
-        return ts_fail(err, TS_EIO, "%s: write failed", path);
+        return ts_fail(err, TS_EIO, "%s: write failed (%s)", path,
+                       strerror(e));
     }
     return tsi_outfile_commit(&out, err);
 }
@@ -215,8 +218,10 @@ int ts_report_write_text(const char *text, size_t len, const char *path,
     if (rc != TS_OK)
         return rc;
     if (len > 0 && fwrite(text, 1, len, out.f) != len) {
+        int e = errno;
         tsi_outfile_abandon(&out);
-        return ts_fail(err, TS_EIO, "%s: write failed", path);
+        return ts_fail(err, TS_EIO, "%s: write failed (%s)", path,
+                       strerror(e));
     }
     return tsi_outfile_commit(&out, err);
 }

@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "response_impl.h"
 #include "shift.h"
 #include "towstab/system.h"
 
@@ -362,6 +363,16 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                         const double freq_hz[], int npoints,
                         ts_response **res, ts_err *err)
 {
+    return tsi_response_compute(sys, lin, input, out, freq_hz, npoints, NULL,
+                                NULL, res, err);
+}
+
+int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
+                         int input, const ts_output *out,
+                         const double freq_hz[], int npoints,
+                         ts_progress_fn progress, void *data,
+                         ts_response **res, ts_err *err)
+{
     *res = NULL;
     int rc = check_args(sys, lin, input, out, err);
     if (rc != TS_OK)
@@ -413,6 +424,11 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
         r->im[i] = cimag(g);
         r->magnitude[i] = cabs(g);
         r->phase_deg[i] = carg(g) * 180.0 / M_PI;
+        ts_progress p = {"response", i + 1.0, npoints, "frequencies"};
+        if (rc == TS_OK && progress && progress(&p, data))
+            rc = ts_fail(err, TS_ECANCEL, "response: stopped on request "
+                         "after %d of %d frequencies (%.6g Hz)", i + 1,
+                         npoints, freq_hz[i]);
     }
     tsi_shift_free(&sh);
     ws_free(&w);

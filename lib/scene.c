@@ -1884,6 +1884,11 @@ ts_scene *ts_scene_load(const char *path, const ts_units *units, ts_err *err)
                 path ? "unit system" : "path");
         return NULL;
     }
+    if (!path[0]) {
+        ts_fail(err, TS_EINVAL, "expected a scene file name, got an empty "
+                "one");
+        return NULL;
+    }
     if (strlen(path) >= sizeof ((ts_scene *)0)->path) {
         ts_fail(err, TS_EINVAL, "%s: path longer than %zu characters", path,
                 sizeof ((ts_scene *)0)->path - 1);

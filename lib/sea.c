@@ -144,14 +144,16 @@ static int check_heading(double heading, ts_err *err)
 ts_sea *ts_sea_jonswap(double hs, double tp, double gamma, double heading,
                        ts_err *err)
 {
-    if (!(hs > 0) || !isfinite(hs)) {
-        ts_fail(err, TS_EINVAL, "sea: Hs must be a finite height > 0 m, got "
-                "%g m", hs);
+    if (!(hs > 0) || !(hs <= TS_SEA_HS_MAX)) {
+        ts_fail(err, TS_EINVAL, "sea: Hs must be a height > 0 m and at most "
+                "%g m (five times the largest measured), got %g m",
+                TS_SEA_HS_MAX, hs);
         return NULL;
     }
-    if (!(tp > 0) || !isfinite(tp)) {
-        ts_fail(err, TS_EINVAL, "sea: Tp must be a finite period > 0 s, got "
-                "%g s", tp);
+    if (!(tp >= TS_SEA_TP_MIN) || !(tp <= TS_SEA_TP_MAX)) {
+        ts_fail(err, TS_EINVAL, "sea: Tp must be a period from %g s (shorter "
+                "waves are capillary ripples) to %g s, got %g s",
+                TS_SEA_TP_MIN, TS_SEA_TP_MAX, tp);
         return NULL;
     }
     if (!(gamma >= 1.0) || !(gamma <= TS_SEA_GAMMA_MAX)) {
@@ -216,6 +218,12 @@ ts_sea *ts_sea_table(int n, const double omega[], const double density[],
     }
     if (!(m0 > 0)) {
         ts_fail(err, TS_EINVAL, "sea table: the density is zero everywhere");
+        return NULL;
+    }
+    if (!(4.0 * sqrt(m0) <= TS_SEA_HS_MAX)) {
+        ts_fail(err, TS_EINVAL, "sea table: its Hs = 4 sqrt(m0) = %g m is "
+                "beyond %g m (five times the largest measured)",
+                4.0 * sqrt(m0), TS_SEA_HS_MAX);
         return NULL;
     }
     if (check_heading(heading, err))
@@ -448,8 +456,12 @@ ts_sea *ts_sea_parse(const char *spec, const ts_units *units,
     else if (!val[K_GAMMA] && hs > 0 && tp > 0)
         gamma = ts_sea_default_gamma(hs, tp);
     ts_sea *s = ts_sea_jonswap(hs, tp, gamma, heading, err);
-    if (!s)
+    if (!s) {
+        /* "WHERE: Tp must be ...", not "WHERE: sea: Tp ...". */
+        if (err && !strncmp(err->msg, "sea: ", 5))
+            memmove(err->msg, err->msg + 5, strlen(err->msg + 5) + 1);
         ts_err_prefix(err, "%s: ", where);
+    }
     return s;
 }
 

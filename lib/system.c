@@ -255,6 +255,55 @@ static double part_loads(load_worst *w, const part_load *p, double g,
     return f[0] + f[1] + f[2] + f[3];
 }
 
+/* The part's own input behind its worst load w (a drag, an inertia or a
+ * buoyancy that overflows under moderate motion): a mass, drag
+ * coefficients, or a size, named by its scene key. */
+static void part_cause(const ts_system *sys, const load_worst *w, char *buf,
+                       size_t size)
+{
+    if (w->link >= 0) {
+        const ts_link *L = &sys->links[w->link];
+        int c = L->cable;
+        const char *nm = sys->cables[c].name;
+        double added = sys->env.water_density * L->can * M_PI * 0.25 *
+                       L->diameter * L->diameter * L->length;
+        if (w->kind == 3 && L->mass >= added)
+            snprintf(buf, size, "a link mass of %.3g kg (cables[%d] '%s' "
+                     "mass_per_length %.3g kg/m)", L->mass, c, nm,
+                     sys->cables[c].mass_per_length);
+        else if (w->kind == 2 && !(L->cdn + M_PI * L->cdt <= 1e3))
+            snprintf(buf, size, "drag coefficients %.3g (normal) and %.3g "
+                     "(tangential) of cables[%d] '%s'", L->cdn, L->cdt, c,
+                     nm);
+        else if (L->length > L->diameter)
+            snprintf(buf, size, "length %.3g m of cables[%d] '%s' (links "
+                     "of %.3g m)", sys->cables[c].length, c, nm, L->length);
+        else
+            snprintf(buf, size, "diameter %.3g m of cables[%d] '%s'",
+                     L->diameter, c, nm);
+        return;
+    }
+    const ts_body *B = &sys->bodies[w->body];
+    double added = sys->env.water_density * fmax(B->ca, B->ca_cross) *
+                   ts_body_volume(B);
+    int cyl = B->type == TS_BODY_CYLINDER;
+    if (w->kind == 3 && B->mass >= added)
+        snprintf(buf, size, "a body mass of %.3g kg (bodies[%d] '%s')",
+                 B->mass, w->body, B->name);
+    else if (w->kind == 2 && !(B->cd + B->cd_cross <= 1e3))
+        snprintf(buf, size, "drag coefficients %.3g and %.3g of bodies[%d] "
+                 "'%s'", B->cd, B->cd_cross, w->body, B->name);
+    else if (B->type == TS_BODY_VEHICLE)
+        snprintf(buf, size, "the size of the vehicle bodies[%d] '%s' (its "
+                 "volume %.3g m^3)", w->body, B->name, ts_body_volume(B));
+    else if (cyl && B->length > B->diameter)
+        snprintf(buf, size, "length %.3g m of bodies[%d] '%s' (diameter "
+                 "%.3g m)", B->length, w->body, B->name, B->diameter);
+    else
+        snprintf(buf, size, "diameter %.3g m of bodies[%d] '%s'",
+                 B->diameter, w->body, B->name);
+}
+
 int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
                           ts_err *err)
 {
@@ -308,26 +357,14 @@ int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
         return TS_OK;
     }
     /* The input to blame: the largest factor of the worst load. A drag or
-     * an inertia whose motion factor is moderate is the part's own
-     * (a drag coefficient, a size, a mass). */
-    char cause[2 * TS_NAME_MAX + 96];
+     * an inertia whose motion factor is moderate is the part's own (a drag
+     * coefficient, a size, a mass); a buoyancy is the part's size. */
+    char cause[2 * TS_NAME_MAX + 160];
     double q = 0.5 * rho * flow * flow;
-    if ((w.kind == 2 && q <= 1e100) || (w.kind == 3 && acc <= 1e100)) {
-        if (w.link >= 0) {
-            const ts_link *L = &sys->links[w.link];
-            snprintf(cause, sizeof cause, w.kind == 2 ? "drag coefficients "
-                     "%.3g (normal) and %.3g (tangential) on a %.3g m by "
-                     "%.3g m link" : "a link mass of %.3g kg",
-                     w.kind == 2 ? L->cdn : L->mass, L->cdt, L->diameter,
-                     L->length);
-        } else {
-            const ts_body *B = &sys->bodies[w.body];
-            snprintf(cause, sizeof cause, w.kind == 2 ? "drag coefficients "
-                     "%.3g and %.3g on a body %.3g m across" : "a body mass "
-                     "of %.3g kg", w.kind == 2 ? B->cd : B->mass,
-                     B->cd_cross, B->diameter);
-        }
-    } else if (w.kind == 2 || w.kind == 3) {
+    if ((w.kind == 2 && q <= 1e100) || (w.kind == 3 && acc <= 1e100) ||
+        (w.kind == 1 && rho <= 1e100 && g <= 1e100))
+        part_cause(sys, &w, cause, sizeof cause);
+    else if (w.kind == 2 || w.kind == 3) {
         static const char *const what[4] = {"speed %.3g m/s",
                                             "turn rate %.3g rad/s",
                                             "current %.3g m/s",
@@ -342,18 +379,21 @@ int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
                      "m/s^2", m->tow_accel);
         else
             snprintf(cause, sizeof cause, what[big], val[big]);
-    } else {
-        double mass = w.link >= 0 ? sys->links[w.link].mass
-                                  : sys->bodies[w.body].mass;
-        if (w.kind == 1 && !(rho <= 1e100))
-            snprintf(cause, sizeof cause, "water density %.3g kg/m^3", rho);
-        else if (!(g <= 1e100))
-            snprintf(cause, sizeof cause, "gravity %.3g m/s^2", g);
-        else if (w.kind == 0)
-            snprintf(cause, sizeof cause, "a mass of %.3g kg", mass);
-        else
-            snprintf(cause, sizeof cause, "a displaced volume that large");
-    }
+    } else if (w.kind == 1 && !(rho <= 1e100))
+        snprintf(cause, sizeof cause, "water density %.3g kg/m^3", rho);
+    else if (!(g <= 1e100))
+        snprintf(cause, sizeof cause, "gravity %.3g m/s^2", g);
+    else if (w.link >= 0) {
+        /* A weight: the cable's mass per length (a weight given in the
+         * scene is converted to it). */
+        int k = sys->links[w.link].cable;
+        snprintf(cause, sizeof cause, "a mass of %.3g kg/m (a weight in air "
+                 "of %.3g N/m) of cables[%d] '%s'",
+                 sys->cables[k].mass_per_length,
+                 sys->cables[k].mass_per_length * g, k, sys->cables[k].name);
+    } else
+        snprintf(cause, sizeof cause, "a mass of %.3g kg of bodies[%d] '%s'",
+                 sys->bodies[w.body].mass, w.body, sys->bodies[w.body].name);
     static const char *const load[4] = {"weight", "buoyancy", "drag",
                                         "inertia"};
     char part[2 * TS_NAME_MAX + 64];

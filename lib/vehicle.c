@@ -17,6 +17,10 @@
  *
  * Everything here is O(1) per vehicle and allocation-free after
  * tsi_vehicle_ws_alloc.
+ *
+ * One module although long: the components' hydrodynamics, the added
+ * mass, the kinematics and the controllers all act on one body's state
+ * and workspace, and the kernel sees them through one narrow interface.
  */
 #include "vehicle.h"
 

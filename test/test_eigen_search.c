@@ -14,10 +14,13 @@
  *  2. the 20 modes nearest 0 Hz: each sparse mode matches a distinct
  *     dense eigenvalue within the sum of their error bounds;
  *  3. the verdicts never contradict each other (stable against
- *     unstable); the sparse one may be marginal where the dense one is
- *     not, since without left eigenvectors its error bound is the
- *     normal-matrix ||dA v|| / |v| (doc/linear.md, section 3), wider on
- *     stiff, nearly undamped modes.
+ *     unstable). Either may be marginal where the other is not: without
+ *     left eigenvectors the sparse bound is the normal-matrix
+ *     ||dA v|| / |v| (doc/linear.md, section 3), wider on stiff, nearly
+ *     undamped modes; the dense bound has a rounding term the sparse
+ *     model does not have yet (doc/linear.md), wider on long cables
+ *     (survey_tow_sea at 800 links: 2.2e-4 against 6.5e-8 1/s, the two
+ *     eigenvalues 3e-11 apart).
  *
  * A scene with a vehicle has no sparse model (doc/linear.md, section 2):
  * ARPACK runs on its dense A without the search; only 2 is compared, and
@@ -141,8 +144,7 @@ static void compare(const char *name, const ts_system *sys)
     /* 3. The verdicts. */
     int opposite = (ar->verdict == TS_STABLE && all->verdict == TS_UNSTABLE) ||
                    (ar->verdict == TS_UNSTABLE && all->verdict == TS_STABLE);
-    CHECK(vehicle || (!opposite && (ar->verdict == all->verdict ||
-                                    ar->verdict == TS_MARGINAL)),
+    CHECK(vehicle || !opposite,
           "%s (%d links): verdict %s, dense %s", name, sys->nlinks,
           ts_verdict_name(ar->verdict), ts_verdict_name(all->verdict));
     ts_eigen_free(all);

@@ -1112,21 +1112,29 @@ static void case_overflow(void)
     begin("overflowing loads", "refused before the solve, naming the input");
     static const struct {
         const char *what;
-        double V, omega, cdt, mpl, g_scale, ea;
+        double V, omega, cdt, mpl, g_scale, ea, d, bD;
         const char *want[4]; /* NULL-terminated */
     } c[] = {
-        {"speed 1e300", 1e300, 0, 0.01, 1.488, 1, 0,
+        {"speed 1e300", 1e300, 0, 0.01, 1.488, 1, 0, 0.0254, 0.254,
          {"forces overflow at speed 1e+300 m/s", "drag", "cables[0]"}},
-        {"turn rate 1e300", 2.5, 1e300, 0.01, 1.488, 1, 0,
+        {"turn rate 1e300", 2.5, 1e300, 0.01, 1.488, 1, 0, 0.0254, 0.254,
          {"turn rate 1e+300 rad/s", "drag", NULL}},
-        {"Cdt 1e300", 2.5, 0, 1e300, 1.488, 1, 0,
+        {"Cdt 1e300", 2.5, 0, 1e300, 1.488, 1, 0, 0.0254, 0.254,
          {"drag coefficients 1.2 (normal) and 1e+300", "cables[0]", NULL}},
-        {"weight 1e300 N/m", 2.5, 0, 0.01, 1e300 / G, 1, 0,
+        {"weight 1e300 N/m", 2.5, 0, 0.01, 1e300 / G, 1, 0, 0.0254, 0.254,
          {"the weight on cables[0] 'cable' link 1", "a mass of", NULL}},
-        {"gravity 1e300", 2.5, 0, 0.01, 1.488, 1e300 / G, 0,
+        {"gravity 1e300", 2.5, 0, 0.01, 1.488, 1e300 / G, 0, 0.0254, 0.254,
          {"gravity 1e+300 m/s^2", NULL, NULL}},
-        {"EA 5e-324", 2.5, 0, 0.01, 1.488, 1, 4.9e-324,
+        {"EA 5e-324", 2.5, 0, 0.01, 1.488, 1, 4.9e-324, 0.0254, 0.254,
          {"EA 4.94e-324 N of cables[0]", "without bound", NULL}},
+        /* A size, not the mass or the motion: the added mass (inertia)
+         * or the buoyancy of the part, its diameter named. */
+        {"cable diameter 1e300", 2.5, 0, 0.01, 1.488, 1, 0, 1e300, 0.254,
+         {"at diameter 1e+300 m of cables[0] 'cable'", NULL, NULL}},
+        {"cable diameter 1e120", 2.5, 0, 0.01, 1.488, 1, 0, 1e120, 0.254,
+         {"at diameter 1e+120 m of cables[0]", "buoyancy", NULL}},
+        {"sphere diameter 1e300", 2.5, 0, 0.01, 1.488, 1, 0, 0.0254, 1e300,
+         {"at diameter 1e+300 m of bodies[0] 'sphere'", NULL, NULL}},
     };
     char msg[TS_ERR_MSG_MAX];
     for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
@@ -1136,6 +1144,8 @@ static void case_overflow(void)
         p.cdt = c[i].cdt;
         p.mpl = c[i].mpl;
         p.ea = c[i].ea;
+        p.d = c[i].d;
+        p.bD = c[i].bD;
         ts_system *s = make(&p);
         if (s)
             s->env.gravity *= c[i].g_scale;

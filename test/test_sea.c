@@ -297,6 +297,12 @@ static void test_parse(void)
         {"Hs=4m,Tp=10s,gamma=0.5", "gamma must be in [1, 10]"},
         {"Hs=-4m,Tp=10s", "Hs must be"},
         {"Hs=4m,Tp=0s", "Tp must be"},
+        /* Beyond any sea (their integrals overflow or diverge): refused
+         * as the spec is read, before any analysis runs. */
+        {"Hs=1e300m,Tp=10s", "Hs must be a height > 0 m and at most 100 m"},
+        {"Hs=101m,Tp=10s", "Hs must be"},
+        {"Hs=4m,Tp=1e-6s", "Tp must be a period from 0.1 s"},
+        {"Hs=4m,Tp=1e300s", "to 100 s, got 1e+300 s"},
         {"type=pm,Hs=4m,Tp=10s,gamma=2", "no gamma"},
         {"type=bretschneider,Hs=4m,Tp=10s", "unknown type"},
         {"file=x.csv,Hs=4m", "leave out"},

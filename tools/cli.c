@@ -153,9 +153,21 @@ static struct {
 
 static void on_signal(int sig)
 {
-    /* A second signal, or nothing that polls the first: stop now. */
-    if (stop_signal || !polled)
+    /* A second signal, or nothing that polls the first (a dense
+     * eigensolve, reading the scene): stop now, saying so (write() is
+     * async-signal-safe; stdio is not). */
+    if (stop_signal || !polled) {
+        static const char again[] = "towstab: error: interrupted again: "
+                                    "stopped at once, writing nothing\n";
+        static const char now[] = "towstab: error: interrupted in a stage "
+                                  "that cannot stop on request: stopped at "
+                                  "once, writing nothing\n";
+        const char *m = stop_signal ? again : now;
+        size_t n = stop_signal ? sizeof again - 1 : sizeof now - 1;
+        if (write(STDERR_FILENO, m, n) < 0)
+            _exit(128 + sig);
         _exit(128 + sig);
+    }
     stop_signal = sig;
 }
 

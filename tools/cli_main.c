@@ -162,10 +162,13 @@ int cli_execute(cli_run *c, json_t **result)
     ts_cost cost;
     if (ts_analysis_cost(c->scene->system, &c->rq, &cost, NULL) == TS_OK &&
         cost.seconds > ANNOUNCE_S) {
+        /* Simulations and studies keep what they have when stopped. */
+        int keeps = c->rq.kind == TS_ANALYSIS_SIMULATE ||
+                    c->rq.kind == TS_ANALYSIS_CONVERGE;
         fprintf(stderr, "towstab: warning: %s is estimated to take %s; to "
-                        "shorten it: %s (Ctrl-C stops it, keeping what it "
-                        "has)\n",
-                ts_analysis_name(c->rq.kind), cost.what, cost.reduce);
+                        "shorten it: %s (Ctrl-C stops it%s)\n",
+                ts_analysis_name(c->rq.kind), cost.what, cost.reduce,
+                keeps ? ", keeping what it has" : "");
         fflush(stderr);
     }
     int rc = ts_analysis_run(c->scene->system, &c->rq, &r, &err);
@@ -387,6 +390,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
     if (!status)
         status = cli_plot_begin(&c.plot, cmd->name);
     if (status) {
+        cli_plot_abandon(&c.plot);
         ts_optset_free(opts);
         free_given(&c);
         cli_close(units, scene);
@@ -405,6 +409,8 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
                    scene->path);
         status = cli_execute(&c, NULL);
     }
+    if (status)
+        cli_plot_abandon(&c.plot);
     cli_run_free(&c);
     cli_close(units, scene);
     return status;

@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -23,12 +25,22 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
         fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
         return EXIT_BADINPUT;
     }
+    struct stat st;
+    int existed = stat(p->dir, &st) == 0;
     int rc = ts_plot_prepare_dir(p->dir, &err);
     if (rc != TS_OK) {
         fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
         return rc == TS_EINVAL ? EXIT_BADINPUT : EXIT_FAILED;
     }
+    p->made = !existed;
     return 0;
+}
+
+void cli_plot_abandon(cli_plot *p)
+{
+    /* rmdir removes only an empty directory: pictures drawn stay. */
+    if (p->dir && p->made && rmdir(p->dir) == 0)
+        p->made = 0;
 }
 
 void cli_plot_wrote(const cli_plot *p, const char *name)

@@ -18,6 +18,7 @@ typedef struct cli_plot {
                           pictures: cli_display_begin) */
     ts_plot_opts opts; /* filled by cli_plot_begin; opts.display is set
                           by the caller to its display */
+    int made;          /* cli_plot_begin made DIR (it did not exist) */
 } cli_plot;
 
 /* Check --plot before any analysis runs: that pictures can be drawn
@@ -27,6 +28,10 @@ typedef struct cli_plot {
  * PLplot, 1 when DIR cannot be created); 0 when there is nothing to draw
  * or all is well. */
 int cli_plot_begin(cli_plot *p, const char *cmd);
+
+/* After a refused or failed run: remove DIR again when cli_plot_begin
+ * made it and nothing was drawn into it (an empty directory). */
+void cli_plot_abandon(cli_plot *p);
 
 /* Print "wrote DIR/NAME.png and DIR/NAME.svg" (the formats drawn). */
 void cli_plot_wrote(const cli_plot *p, const char *name);

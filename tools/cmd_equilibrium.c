@@ -98,6 +98,8 @@ static void scene_names(const eq_curve *curves, int n, char *buf,
     const char *names[MAX_OVERLAYS + 1];
     int nn = 0;
     for (int i = 0; i < n; i++) {
+        if (!curves[i].sys)
+            continue;
         int seen = 0;
         for (int j = 0; j < nn; j++)
             seen |= strcmp(names[j], curves[i].sys->name) == 0;
@@ -306,7 +308,10 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
     }
 #undef L_
 #undef F_
-    cli_print_trust(t);
+    /* The equilibrium under an analysis that failed after it: the result
+     * asked for was not delivered, so no verdict (stderr says why). */
+    if (r->kind == TS_ANALYSIS_EQUILIBRIUM || r->status == TS_OK)
+        cli_print_trust(t);
 }
 
 
@@ -440,8 +445,10 @@ static int eq_draw(cli_run *c, const ts_result *r)
         int s = overlay_solve(c, &st->curves[i]);
         status = status ? status : s;
     }
-    int s = eq_plot(&c->plot, st->curves, st->ncurves);
-    return status ? status : s;
+    /* A failed or refused overlay: no pictures (nothing half-drawn). */
+    if (status)
+        return status;
+    return eq_plot(&c->plot, st->curves, st->ncurves);
 }
 
 static void eq_release(cli_run *c)

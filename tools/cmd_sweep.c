@@ -10,7 +10,11 @@
  * command restores the chains FILE holds and computes only the rest. Under
  * mpirun each process runs its share of the chains and process 0 collects
  * them (cli_mpi.h). Prints the table, writes JSON and CSV
- * (towstab/report_sweep.h) and draws maps (towstab/plot.h). */
+ * (towstab/report_sweep.h) and draws maps (towstab/plot.h).
+ *
+ * One file although long: the grid, the chains, the resume file and the
+ * three ways of running them (serial, threads, MPI) share the chain
+ * records and must produce the same table point for point. */
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>

@@ -45,6 +45,9 @@ typedef enum {
 
 /* Limits of the parameters accepted. */
 #define TS_SEA_GAMMA_MAX 10.0   /* JONSWAP peak enhancement (DNV: 1..7) */
+#define TS_SEA_HS_MAX 100.0     /* m: five times the largest Hs measured */
+#define TS_SEA_TP_MIN 0.1       /* s: shorter waves are capillary (1.6 cm) */
+#define TS_SEA_TP_MAX 100.0     /* s: four times the longest swell's Tp */
 #define TS_SEA_HEADING_DEFAULT 3.14159265358979323846 /* head seas, rad */
 
 typedef struct ts_sea ts_sea;
@@ -62,14 +65,16 @@ typedef struct ts_sea_info {
     const char *source; /* table: the file read, or "" */
 } ts_sea_info;
 
-/* A JONSWAP sea: Hs (m, > 0), Tp (s, > 0), gamma in [1,
+/* A JONSWAP sea: Hs (m, in (0, TS_SEA_HS_MAX]), Tp (s, in [TS_SEA_TP_MIN,
+ * TS_SEA_TP_MAX]), gamma in [1,
  * TS_SEA_GAMMA_MAX] (1: Pierson-Moskowitz), heading (rad, finite). NULL
  * on failure (TS_EINVAL naming the parameter, TS_ENOMEM). */
 TS_API ts_sea *ts_sea_jonswap(double hs, double tp, double gamma,
                               double heading, ts_err *err);
 
 /* A tabulated sea: n >= 2 samples, omega[n] (rad/s, >= 0, strictly
- * increasing) and density[n] (m^2 s/rad, >= 0, not all zero); copied.
+ * increasing) and density[n] (m^2 s/rad, >= 0, not all zero; its Hs at
+ * most TS_SEA_HS_MAX); copied.
  * NULL on failure (TS_EINVAL naming the sample). */
 TS_API ts_sea *ts_sea_table(int n, const double omega[],
                             const double density[], double heading,

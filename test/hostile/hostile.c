@@ -14,14 +14,15 @@
  *     read-only directory (not root only), existing targets,
  *   - SIGINT and SIGTERM during long runs, and progress on a terminal
  *     (a pseudo-terminal) against a file.
- * Every case runs in its own temporary directory under a time limit, in
- * parallel. A case passes when the run is
+ * Every case runs in its own temporary directory under a time limit (of
+ * CPU time, and four times that of wall time), in parallel. A case passes when the run is
  *   refused cleanly: exit 1 or 2, a line "towstab: error: ..." naming a
  *     file, key, line or option (or what the case says it must name), no
  *     "nan" in any message (user text quoted in it excepted), no output
  *     file left behind by a refusal (exit 2) and an existing one
  *     untouched, any JSON of a failed run valid and marked incomplete,
- *     nothing saying "trustworthy: yes";
+ *     nothing saying "trustworthy: yes" (in `run`, in the part of the
+ *     analysis that failed);
  *   or ran: exit 0 with finite output (no nan or inf in the printed
  *     report, valid JSON, CSV without non-finite numbers);
  *   or, for the signal cases, stopped: exit 130 (SIGINT) or 143 (SIGTERM)
@@ -52,6 +53,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/types.h>
@@ -59,8 +61,11 @@
 #include <time.h>
 #include <unistd.h>
 
-/* Time limit of a case, s (times --time-scale). */
+/* Time limit of a case: CPU s (times --time-scale), so that a loaded
+ * machine does not make a slow case a hang; a case blocked without using
+ * the CPU is stopped after WALL_FACTOR times that in wall time. */
 #define CASE_TIMEOUT 60.0
+#define WALL_FACTOR 4.0
 /* After SIGINT to a run that announced its cost: time to stop, s. */
 #define INTERRUPT_GRACE 15.0
 /* Most arguments of one case. */
@@ -228,7 +233,8 @@ typedef struct hcase {
     int expect;
     char *must_name;      /* the message must contain this */
     int setup;
-    int sig;              /* signal sent after sig_after s (0: none) */
+    int sig;              /* signal sent after sig_after s, times the time
+                             scale (0: none) */
     double sig_after;
     int pty;              /* standard error on a pseudo-terminal */
     int progress;         /* 1: must show progress, -1: must show none */
@@ -815,6 +821,61 @@ static hcase *misuse(int expect, const char *must, ...)
     return c;
 }
 
+/* Analyses that fail after a converged equilibrium (issue 20 part 1: no
+ * verdict for a result not delivered). `run` delivers the analyses before
+ * the failed one: they may say trustworthy, the failed one's part not. */
+static void gen_after_equilibrium(void)
+{
+    const example *ex1 = find_example("kamman_ex1_submerged");
+    const example *sea = find_example("survey_tow_sea");
+    hcase *c;
+    size_t len;
+    const char *at = strstr(ex1->text, "analyses:");
+    if (at) {
+        static const char more[] = "analyses:\n  - equilibrium\n"
+                                   "  - type: simulate\n    max_steps: 10\n";
+        size_t a = (size_t)(at - ex1->text);
+        char *t = replaced(ex1, a, ex1->len, more, sizeof more - 1, &len);
+        c = add_case("after equilibrium: run kamman_ex1_submerged, "
+                     "equilibrium then simulate to a step limit");
+        set_scene(c, ex1->file, t, len);
+        args(c, "run", "@D/kamman_ex1_submerged.yaml", "--json",
+             "@D/out.json", NULL);
+        c->expect = E_REFUSE;
+        c->must_name = xstrdup("step limit");
+        free(t);
+    }
+    /* A towfish 1e30 m across: the equilibrium converges (buoyancy 1e64 N
+     * is below the load limit); what follows may fail. */
+    at = sea ? strstr(sea->text, "diameter: \"0.5 m\"") : NULL;
+    if (!at)
+        return;
+    size_t a = (size_t)(at - sea->text);
+    char *t = replaced(sea, a, a + 17, "diameter: 1e30", 14, &len);
+    static const char *const cmd[][4] = {
+        {"run", NULL},
+        {"response", "--output", "fish.z", NULL},
+        {"response", "--output", "fish.z", NULL},
+        {"modes", NULL}};
+    for (int i = 0; i < 4; i++) {
+        char *name = fmt("after equilibrium: %s survey_tow_sea with a "
+                         "1e30 m towfish%s", cmd[i][0],
+                         i == 2 ? " in a sea" : "");
+        c = add_case(name);
+        set_scene(c, sea->file, t, len);
+        arg(c, cmd[i][0]);
+        arg(c, "@D/survey_tow_sea.yaml");
+        for (int k = 1; k < 4 && cmd[i][k]; k++)
+            arg(c, cmd[i][k]);
+        if (i == 2)
+            args(c, "--sea", "Hs=4m,Tp=8s", NULL);
+        args(c, "--quiet", "--json", "@D/out.json", NULL);
+        c->expect = E_ANY;
+        free(name);
+    }
+    free(t);
+}
+
 static void gen_cli_misuse(void)
 {
     hcase *c;
@@ -888,6 +949,16 @@ static void gen_cli_misuse(void)
     misuse(R, "--csv", "equilibrium", EX1, "--csv", "", NULL);
     misuse(R, "--units", "equilibrium", EX1, "--plot", "@D/p", "--units",
            "bogus", NULL);
+    /* Overlays of the equilibrium pictures: each value checked, a failed
+     * one refused without a crash or pictures. */
+    static const char *const overlays[][2] = {
+        {"--overlay-speeds", "1,-1"}, {"--overlay-speeds", "1,nan"},
+        {"--overlay-speeds", ""}, {"--overlay-speeds", "1e300,2"},
+        {"--overlay-turn-rates", "1e300"}, {"--overlay-turn-rates", "3 m"},
+        {"--overlay", "/nonexistent.yaml"}, {"--overlay", ""}};
+    for (int i = 0; i < 8; i++)
+        misuse(R, NULL, "equilibrium", EX1, "--quiet", "--plot", "@D/p",
+               overlays[i][0], overlays[i][1], NULL);
     /* Standard input as the scene. */
     c = misuse(E_RUN, NULL, "equilibrium", "-", "--quiet", NULL);
     c->stdin_path = xstrdup(EX1);
@@ -966,16 +1037,17 @@ static void gen_cli_misuse(void)
            "--sample", "100", NULL);
     misuse(R, "--rao", "simulate", EX1, "--quiet", "--rao",
            "/nonexistent.csv", "--sea", "Hs=4m,Tp=10s", NULL);
-    /* A sea whose waves are far too fast: announced, then interrupted. */
-    c = misuse(E_ANY, NULL, "simulate", EX1, "--quiet", "--sea",
-               "Hs=4m,Tp=1e-6s", "--json", "@D/out.json", NULL);
-    c->announce_ok = 1;
-    static const char *const seas[] = {"Hs=1e300m,Tp=10s", "Hs=4m,Tp=1e-6s",
-                                       "Hs=4m,Tp=1e300s",
-                                       "Hs=4m,Tp=10s,heading=nan"};
+    /* Seas beyond any sea: refused as the spec is read, naming the key. */
+    misuse(R, "--sea: Tp", "simulate", EX1, "--quiet", "--sea",
+           "Hs=4m,Tp=1e-6s", "--json", "@D/out.json", NULL);
+    static const char *const seas[][2] = {{"Hs=1e300m,Tp=10s", "--sea: Hs"},
+                                          {"Hs=4m,Tp=1e-6s", "--sea: Tp"},
+                                          {"Hs=4m,Tp=1e300s", "--sea: Tp"},
+                                          {"Hs=4m,Tp=10s,heading=nan",
+                                           "--sea: heading"}};
     for (int i = 0; i < 4; i++)
-        misuse(i == 3 ? R : E_ANY, i == 3 ? "--sea" : NULL, "response", EX1,
-               "--quiet", "--output", "sphere.z", "--sea", seas[i], NULL);
+        misuse(R, seas[i][1], "response", EX1, "--quiet", "--output",
+               "sphere.z", "--sea", seas[i][0], NULL);
     misuse(R, "--transient", "simulate", EX1, "--quiet", "--t-end", "10",
            "--transient", "100", NULL);
     misuse(R, NULL, "simulate", EX1, "--quiet", "--compare", "--linear",
@@ -1188,6 +1260,31 @@ static void gen_signals(void)
     c = long_run("signal: SIGINT during a long simulation, --json -", SIGINT,
                  1.0);
     args(c, "--json", "-", NULL);
+    /* A frequency sweep stops after its current frequency; a dense
+     * eigensolve cannot poll: it ends at once, saying so (issue 15). */
+    c = add_case("signal: SIGINT during a response of 1e6 frequencies");
+    args(c, "response", EX1, "--quiet", "--output", "sphere.z", "--points",
+         "1000000", "--json", "@D/out.json", NULL);
+    c->expect = E_INTERRUPT;
+    c->sig = SIGINT;
+    c->must_name = xstrdup("stopped on request after");
+    c->sig_after = 2.0; /* well into the sweep */
+    const example *ex1 = find_example("kamman_ex1_submerged");
+    const char *at = ex1 ? strstr(ex1->text, "links: 20") : NULL;
+    if (at) {
+        size_t len, a = (size_t)(at - ex1->text);
+        char *t = replaced(ex1, a, a + 9, "links: 400", 10, &len);
+        c = add_case("signal: SIGTERM during a dense eigensolve of 1600 "
+                     "states");
+        set_scene(c, ex1->file, t, len);
+        args(c, "modes", "@D/kamman_ex1_submerged.yaml", "--quiet",
+             "--eigen-method", "lapack", "--json", "@D/out.json", NULL);
+        c->expect = E_INTERRUPT;
+        c->sig = SIGTERM;
+        c->sig_after = 1.0;
+        c->must_name = xstrdup("stopped at once, writing nothing");
+        free(t);
+    }
     /* Progress: on a terminal, not on a file. */
     c = long_run("progress: shown when standard error is a terminal", SIGINT,
                  2.5);
@@ -1595,10 +1692,13 @@ static int start_case(run *r, int idx, int serial)
     fflush(stdout);
     r->start = now();
     double limit = (c->timeout > 0 ? c->timeout : CASE_TIMEOUT) * time_scale;
-    r->deadline = r->start + limit;
+    r->deadline = r->start + WALL_FACTOR * limit;
     r->pid = fork();
     if (r->pid == 0) {
         setpgid(0, 0);
+        /* SIGXCPU at the limit, SIGKILL a little after. */
+        struct rlimit cpu = {(rlim_t)(limit + 0.999), (rlim_t)(limit + 5.999)};
+        setrlimit(RLIMIT_CPU, &cpu);
         int fi = open(in, O_RDONLY);
         int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0600);
         int fe = slave ? open(slave, O_RDWR | O_NOCTTY)
@@ -1659,7 +1759,8 @@ static int poll_case(run *r)
         return 1;
     }
     double t = now();
-    if (c->sig && !r->signalled && t - r->start >= c->sig_after) {
+    /* A sanitizer build reaches the same point time_scale times later. */
+    if (c->sig && !r->signalled && t - r->start >= c->sig_after * time_scale) {
         kill(r->pid, c->sig);
         r->signalled = 1;
     }
@@ -1732,14 +1833,18 @@ static void finish_case(run *r)
     int outcome;
     int st = r->status, code = -1;
     int sanitizer = strstr(err, "Sanitizer") || strstr(err, "runtime error:");
+    double limit = (c->timeout > 0 ? c->timeout : CASE_TIMEOUT) * time_scale;
     if (r->timed_out) {
         outcome = O_HUNG;
         problem(&v, r->interrupted ? "did not stop within %.0f s of SIGINT "
                                      "after announcing its cost"
-                                   : "no result within %.0f s",
+                                   : "no result within %.0f s (wall)",
                 r->interrupted ? INTERRUPT_GRACE * time_scale
-                               : (c->timeout > 0 ? c->timeout
-                                                 : CASE_TIMEOUT) * time_scale);
+                               : WALL_FACTOR * limit);
+    } else if (WIFSIGNALED(st) && (WTERMSIG(st) == SIGXCPU ||
+                                   WTERMSIG(st) == SIGKILL)) {
+        outcome = O_HUNG;
+        problem(&v, "no result within %.0f s of CPU time", limit);
     } else if (WIFSIGNALED(st) || sanitizer) {
         outcome = O_CRASHED;
         if (sanitizer)
@@ -1812,8 +1917,16 @@ static void finish_case(run *r)
                 json_stdout = 1;
         if (json_stdout && !c->stdout_full && (code == 0 || out[0]))
             check_json_file(pout, "the JSON on standard output", failed, &v);
-        if (failed && !c->write_fault && strstr(out, "trustworthy: yes"))
-            problem(&v, "a failed run says trustworthy: yes");
+        /* `run` prints each analysis after a "== analysis k of n" line:
+         * the analyses before the failed one delivered their results, and
+         * only the failed one's part must not say trustworthy. */
+        const char *part = out;
+        for (const char *h = out; (h = strstr(h, "== analysis ")); h++)
+            if (h == out || h[-1] == '\n')
+                part = h;
+        if (failed && !c->write_fault && strstr(part, "trustworthy: yes"))
+            problem(&v, "a failed %s says trustworthy: yes",
+                    part == out ? "run" : "run's last analysis");
         if (!failed && (has_word(uqo, "inf") || has_word(uqo, "infinity")))
             problem(&v, "standard output holds a non-finite number");
     }
@@ -1905,6 +2018,10 @@ static void finish_case(run *r)
             if (code != 128 + c->sig)
                 problem(&v, "exit %d, expected %d after %s", code,
                         128 + c->sig, strsignal(c->sig));
+            else if (!strstr(err, "interrupted") ||
+                     (c->must_name && !strstr(err, c->must_name)))
+                problem(&v, "stopped without saying %s",
+                        c->must_name ? c->must_name : "interrupted");
             break;
         default:
             if (code > 2 && outcome != O_STOPPED)
@@ -2053,6 +2170,7 @@ int main(int argc, char **argv)
     int nmutants = ncases;
     gen_sizes();
     int nsizes = ncases - nmutants;
+    gen_after_equilibrium();
     gen_cli_misuse();
     int ncli = ncases - nmutants - nsizes;
     gen_output_faults();
@@ -2083,9 +2201,11 @@ int main(int argc, char **argv)
     }
     printf("hostile: %d cases (%d scene mutants of %d examples, %d sizes, "
            "%d command-line misuses, %d output faults, %d signals and "
-           "progress), %d jobs, time limit %.0f s each%s\n",
+           "progress), %d jobs, time limit %.0f s of CPU (%.0f s of wall "
+           "time) each%s\n",
            ncases, nmutants, nexamples, nsizes, ncli, nfaults, nsignals, jobs,
-           CASE_TIMEOUT * time_scale, is_root ? ", as root" : "");
+           CASE_TIMEOUT * time_scale, WALL_FACTOR * CASE_TIMEOUT * time_scale,
+           is_root ? ", as root" : "");
     double t0 = now();
     run *slots = xmalloc((size_t)jobs * sizeof *slots);
     int *busy = calloc((size_t)jobs, sizeof *busy);

@@ -1,0 +1,19 @@
+/* response_impl.h: the frequency response with a progress callback, for
+ * the analysis pipeline (lib/analysis.c). Private to the library. */
+#ifndef TOWSTAB_RESPONSE_IMPL_H
+#define TOWSTAB_RESPONSE_IMPL_H
+
+#include "towstab/progress.h"
+#include "towstab/response.h"
+
+/* ts_response_compute, calling progress(data) (when not NULL) after every
+ * frequency with what = "response", unit "frequencies"; a nonzero return
+ * stops it with TS_ECANCEL ("response: stopped on request after K of N
+ * frequencies") and no result. */
+int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
+                         int input, const ts_output *out,
+                         const double freq_hz[], int npoints,
+                         ts_progress_fn progress, void *data,
+                         ts_response **res, ts_err *err);
+
+#endif
