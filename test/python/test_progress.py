@@ -129,6 +129,23 @@ def test_stops_in_the_discretisation_estimate(ex1):
     assert a.estimated is False and "stopped" in a.not_estimated
 
 
+def test_response_stops_between_frequencies(monkeypatch):
+    monkeypatch.setattr(towstab, "PROGRESS_INTERVAL", 0.0)
+    s = towstab.Scene.load(ALL)
+    seen = []
+
+    def after_three(p):
+        seen.append(p)
+        return p.done >= 3
+
+    with pytest.raises(towstab.Cancelled) as e:
+        s.response(output="sphere.z", points=40, progress=after_three)
+    assert [p.done for p in seen] == [1.0, 2.0, 3.0]
+    assert seen[-1].what == "response" and seen[-1].total == 40.0
+    assert e.value.result.completed is False
+    assert "after 3 of 40 frequencies" in e.value.message
+
+
 def test_converge_stops_between_runs(monkeypatch):
     monkeypatch.setattr(towstab, "PROGRESS_INTERVAL", 0.0)
     s = towstab.Scene.load(ALL)
