@@ -128,6 +128,7 @@ void ts_linear_free(ts_linear *lin)
     free(lin->Tu);
     free(lin->Aerr);
     free(lin->fnoise);
+    free(lin->Berr);
     free(lin->h);
     free(lin->u0);
     free(lin->up_qoff);
@@ -456,7 +457,9 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     }
     if (o.estimate_error && !lin->fnoise) {
         lin->fnoise = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof(double));
-        if (!lin->fnoise)
+        lin->Berr = malloc((size_t)(nlow > 0 ? nlow : 1) * (size_t)ni *
+                           sizeof(double));
+        if (!lin->fnoise || !lin->Berr)
             return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
     }
     if (!o.estimate_error) {
@@ -464,6 +467,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         lin->Aerr = NULL;
         free(lin->fnoise);
         lin->fnoise = NULL;
+        free(lin->Berr);
+        lin->Berr = NULL;
     }
     lin->round_norm = NAN;
 
@@ -599,8 +604,9 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
             if (with_t)
                 tcol = j < n ? lin->Ty + (size_t)j * nl
                              : lin->Tu + (size_t)(j - n) * nl;
-            double *ecol = estimate && j < n ? lin->Aerr + (size_t)j * nlow
-                                             : NULL;
+            double *ecol = !estimate ? NULL
+                           : j < n   ? lin->Aerr + (size_t)j * nlow
+                                     : lin->Berr + (size_t)(j - n) * nlow;
             col_err ce;
             int crc = column(w, j, n, nq, nl, lin->h[j], estimate, col, ecol,
                              tcol, &ce);

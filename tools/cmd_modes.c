@@ -22,10 +22,10 @@ void cli_print_linearization(const ts_result *r)
         return;
     printf("linearized: %d states, %d inputs, %ld kernel evaluations on %d "
            "thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
-           "||dA||_F %.3g)\n",
+           "||dA||_F %.3g), rounding noise ||N||_F %.3g\n",
            l->nstate, l->ninput, l->evaluations, l->threads,
            l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->trunc_err,
-           l->a_scale, l->trunc_norm);
+           l->a_scale, l->trunc_norm, l->round_norm);
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
         ts_system_node_name(r->sys, l->kink_node, name, sizeof name);
