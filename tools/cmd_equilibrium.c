@@ -275,8 +275,13 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
                     r->values[v].value, e);
         }
         cli_print_accuracy(r);
+        cli_print_trust(t);
+    } else {
+        /* Another analysis' equilibrium: its solve is judged here, its
+         * values' discretisation error is towstab equilibrium's. */
+        cli_print_trust_as(t, "equilibrium solve (its discretisation "
+                              "error: towstab equilibrium)");
     }
-    cli_print_trust(t);
 }
 
 
