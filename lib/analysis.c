@@ -690,7 +690,11 @@ static int modes_values(ts_result *r, int follow, ts_err *err)
 static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
 {
     const ts_modes_opts *m = &rq->modes;
-    int rc = equilibrium_then_linear(r, rq, &m->linearize, err);
+    /* LAPACK needs the dense A at any size. */
+    ts_linearize_opts lo = m->linearize;
+    if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
+        lo.model = TS_LIN_BOTH;
+    int rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc != TS_OK)
         return rc;
     ts_eigen_opts o = modes_eigen_opts(m, r->lin->nstate);
@@ -932,6 +936,7 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
         ts_eigen_opts eo;
         ts_eigen_opts_default(&eo);
         eo.count = TS_RESPONSE_NATURAL;
+        eo.rightmost = 0; /* the lowest modes only, no verdict */
         if (eo.count > r->lin->nstate / 2)
             eo.count = 0;
         ts_eigen *e = NULL;
@@ -1522,6 +1527,9 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         r->lin = ts_linear_alloc(k, err);
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
+        /* The linear run needs the dense A and B at any size. */
+        if (s->compare || s->linear)
+            lo.model = TS_LIN_BOTH;
         double t0 = wall_now();
         rc = r->lin ? ts_linearize_equilibrium(k, r->eq, &lo, r->lin, err)
                     : (err && err->code ? err->code : TS_ENOMEM);

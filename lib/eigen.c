@@ -14,9 +14,10 @@
  * whose largest eigenvalues mu = 1 / (lambda - sigma) belong to the
  * eigenvalues lambda nearest sigma. Real sigma: dnaupd/dneupd, mode 3;
  * complex sigma: znaupd/zneupd, mode 3 in complex arithmetic. OP is applied
- * with the structured solver of eigen_impl.h (one nq x nq LU of
- * P(sigma) = K + sigma C - sigma^2 I). ARPACK's Ritz vectors are checked
- * by their residual ||A v - lambda v||.
+ * with the sparse model (lib/shift.h: one KLU factorisation of the shifted
+ * node equations, O(nlinks) per application). ARPACK's Ritz vectors are
+ * checked by their residual ||A v - lambda v||, A applied through the
+ * same model.
  *
  * Modes: one eigenvalue of each conjugate pair (Im >= 0) and every real
  * eigenvalue; the `count` nearest sigma are kept and sorted by frequency.
@@ -37,8 +38,8 @@
 #include <string.h>
 
 #include "arpack.h"
-#include "eigen_impl.h"
 #include "lapack.h"
+#include "shift.h"
 #include "towstab/system.h"
 
 /* |Im lambda| below this fraction of |lambda| makes an eigenvalue from the
@@ -66,6 +67,7 @@ void ts_eigen_opts_default(ts_eigen_opts *o)
     o->arpack_tol = 0.0;
     o->arpack_max_iter = 1000;
     o->vectors = 1;
+    o->rightmost = 1;
 }
 
 const char *ts_eig_method_name(ts_eig_method m)
@@ -96,129 +98,6 @@ void ts_eigen_free(ts_eigen *e)
     free(e);
 }
 
-/* ---- Structured shift solver (eigen_impl.h) ---------------------------- */
-
-int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
-                     ts_err *err)
-{
-    memset(sh, 0, sizeof *sh);
-    int nq = lin->nq, n = lin->nstate, info = 0;
-    size_t nn = (size_t)nq * (size_t)nq;
-    sh->lin = lin;
-    sh->nq = nq;
-    sh->n = n;
-    sh->s = s;
-    sh->is_complex = cimag(s) != 0.0;
-    sh->ipiv = malloc((size_t)nq * sizeof(int));
-    sh->w = malloc((size_t)nq * sizeof(double complex));
-    sh->wr = malloc(2 * (size_t)nq * sizeof(double));
-    if (sh->is_complex)
-        sh->zlu = malloc(nn * sizeof(double complex));
-    else
-        sh->lu = malloc(nn * sizeof(double));
-    if (!sh->ipiv || !sh->w || !sh->wr || (!sh->zlu && !sh->lu)) {
-        tsi_shift_free(sh);
-        return ts_fail_nomem(err, (sh->is_complex ? 16.0 : 8.0) * (double)nn,
-                             "fewer links", "eigen: out of memory for the "
-                             "%d x %d shifted matrix", nq, nq);
-    }
-    /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
-    const double *A = lin->A;
-    double complex s2 = s * s;
-    for (int j = 0; j < nq; j++) {
-        const double *Kj = A + (size_t)j * n + nq;
-        const double *Cj = A + (size_t)(j + nq) * n + nq;
-        if (sh->is_complex) {
-            double complex *Pj = sh->zlu + (size_t)j * nq;
-            for (int i = 0; i < nq; i++)
-                Pj[i] = Kj[i] + s * Cj[i];
-            Pj[j] -= s2;
-        } else {
-            double *Pj = sh->lu + (size_t)j * nq;
-            double sr = creal(s);
-            for (int i = 0; i < nq; i++)
-                Pj[i] = Kj[i] + sr * Cj[i];
-            Pj[j] -= sr * sr;
-        }
-    }
-    if (sh->is_complex)
-        zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
-    else
-        dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
-    if (info < 0) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d",
-                       sh->is_complex ? "zgetrf" : "dgetrf", info);
-    }
-    if (info > 0) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ESINGULAR,
-                       "eigen: A - s I is singular at s = %g%+gi 1/s (an "
-                       "eigenvalue sits on the shift; move the target "
-                       "slightly)",
-                       creal(s), cimag(s));
-    }
-    return TS_OK;
-}
-
-void tsi_shift_free(tsi_shift *sh)
-{
-    free(sh->lu);
-    free(sh->zlu);
-    free(sh->ipiv);
-    free(sh->w);
-    free(sh->wr);
-    memset(sh, 0, sizeof *sh);
-}
-
-void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
-{
-    int nq = sh->nq, n = sh->n, one = 1, info = 0;
-    double sr = creal(sh->s), mone = -1.0, pone = 1.0;
-    const double *b1 = b, *b2 = b + nq;
-    double *x1 = x, *x2 = x + nq;
-    /* x1 = b2 + s b1 - C b1 */
-    for (int i = 0; i < nq; i++)
-        x1[i] = b2[i] + sr * b1[i];
-    dgemv_("N", &nq, &nq, &mone, sh->lin->A + (size_t)nq * n + nq, &n, b1,
-           &one, &pone, x1, &one, 1);
-    dgetrs_("N", &nq, &one, sh->lu, &nq, sh->ipiv, x1, &nq, &info, 1);
-    for (int i = 0; i < nq; i++)
-        x2[i] = b1[i] + sr * x1[i];
-}
-
-void tsi_shift_solve(tsi_shift *sh, const double complex *b,
-                     double complex *x)
-{
-    int nq = sh->nq, n = sh->n, one = 1, two = 2, info = 0;
-    double complex s = sh->s;
-    const double complex *b1 = b, *b2 = b + nq;
-    double complex *x1 = x, *x2 = x + nq;
-    /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
-     * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
-    double pone = 1.0, zero = 0.0;
-    dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
-           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->w, &two,
-           1, 1);
-    for (int i = 0; i < nq; i++)
-        x1[i] = b2[i] + s * b1[i] - sh->w[i];
-    if (sh->is_complex) {
-        zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
-    } else {
-        /* Real factors: solve the real and imaginary parts together. */
-        double *r = sh->wr;
-        for (int i = 0; i < nq; i++) {
-            r[i] = creal(x1[i]);
-            r[nq + i] = cimag(x1[i]);
-        }
-        dgetrs_("N", &nq, &two, sh->lu, &nq, sh->ipiv, r, &nq, &info, 1);
-        for (int i = 0; i < nq; i++)
-            x1[i] = r[i] + I * r[nq + i];
-    }
-    for (int i = 0; i < nq; i++)
-        x2[i] = b1[i] + s * x1[i];
-}
-
 /* ---- Candidate modes ----------------------------------------------------- */
 
 typedef struct cand {
@@ -233,6 +112,9 @@ typedef struct cand {
     double vcond;         /* eigenvector conditioning, max kappa_k
                              ||A_bal|| / gap (lapack; vector_health) */
     double verr;          /* eigenvector error allowance, rad */
+    int sweep;            /* found by the rightmost search, not among the
+                             modes nearest the target */
+    int checked;          /* residual and error estimate computed */
 } cand;
 
 typedef struct cand_list {
@@ -249,6 +131,25 @@ static int cand_init(cand_list *L, int cap, int nstate)
     L->c = malloc((size_t)L->cap * sizeof(cand));
     L->v = malloc((size_t)L->cap * (size_t)nstate * sizeof(double complex));
     return L->c && L->v ? TS_OK : TS_ENOMEM;
+}
+
+/* Room for `extra` more candidates. */
+static int cand_grow(cand_list *L, int extra)
+{
+    if (L->n + extra <= L->cap)
+        return TS_OK;
+    int cap = 2 * L->cap > L->n + extra ? 2 * L->cap : L->n + extra;
+    cand *c = realloc(L->c, (size_t)cap * sizeof(cand));
+    if (!c)
+        return TS_ENOMEM;
+    L->c = c;
+    double complex *v = realloc(L->v, (size_t)cap * (size_t)L->nstate *
+                                          sizeof(double complex));
+    if (!v)
+        return TS_ENOMEM;
+    L->v = v;
+    L->cap = cap;
+    return TS_OK;
 }
 
 static void cand_free(cand_list *L)
@@ -301,6 +202,8 @@ static void cand_add(cand_list *L, double complex lam, const double *vr,
     c->round = DBL_EPSILON * cond; /* times ||A||: set by the caller */
     c->vcond = NAN;
     c->verr = NAN;
+    c->sweep = 0;
+    c->checked = 0;
     c->vec = L->n;
     double complex *v = L->v + (size_t)L->n * L->nstate;
     for (int i = 0; i < L->nstate; i++)
@@ -570,54 +473,78 @@ out:
 
 /* ---- ARPACK -------------------------------------------------------------- */
 
-/* Residuals ||A v - lam v|| / (||A||_F |v|) and error estimates
- * ||E v|| / |v| (E the linearization's error estimate; kappa = 1 without a
- * left vector, exact for a normal matrix) of every candidate, with one
- * pass over A and one over E (BLAS dgemm on the real and imaginary parts
- * of all vectors at once): the matrices are the largest objects here, and
- * streaming them once per vector would dominate ARPACK's own cost. */
-static int batch_checks(const ts_linear *lin, cand_list *L)
+/* Checks of every ARPACK candidate through the sparse model (lib/shift.h:
+ * A and the linearization's error estimate dA applied with one
+ * factorisation of S_inf, O(nlinks) per vector): the residual
+ * r = ||A v - lam v|| / |v|, reported relative to |lam|, and the
+ * eigenvalue's first-order change by the error estimate, ||dA v|| / |v|
+ * (kappa = 1 without a left vector, exact for a normal matrix). The
+ * residual itself is the rounding allowance (Bauer-Fike with kappa = 1):
+ * an exact eigenpair of a matrix within ||r|| of A. */
+/* The same checks with the dense A and its error estimate (a system the
+ * sparse model does not cover: vehicles), with one pass over A and one
+ * over E (BLAS dgemm on the real and imaginary parts of all the unchecked
+ * vectors at once). */
+/* A candidate's residual ||A v - lam v|| / |v| (round) and relative to
+ * |lam| (resid) from A v = ar + i ai; returns |v|^2. */
+static double set_residual(cand *c, const double complex *v,
+                           const double *ar, const double *ai, int n)
 {
-    int n = lin->nstate, nq = lin->nq, m = 2 * L->n;
-    if (L->n == 0)
+    double r2 = 0, v2 = 0;
+    for (int i = 0; i < n; i++) {
+        double complex d = ar[i] + I * ai[i] - c->lam * v[i];
+        r2 += creal(d) * creal(d) + cimag(d) * cimag(d);
+        v2 += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
+    }
+    double res = sqrt(r2 / v2);
+    c->round = res;
+    c->resid = cabs(c->lam) > 0 ? res / cabs(c->lam) : res;
+    return v2;
+}
+
+static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
+{
+    int n = lin->nstate, nlow = n - lin->nq, m = 0;
+    for (int c = 0; c < L->n; c++)
+        m += L->c[c].checked ? 0 : 2;
+    if (m == 0)
         return TS_OK;
     double *W = calloc((size_t)n * (size_t)m, sizeof(double));
     double *AW = malloc((size_t)n * (size_t)m * sizeof(double));
-    double *EW = lin->Aerr ? malloc((size_t)nq * (size_t)m * sizeof(double))
+    double *EW = lin->Aerr ? malloc((size_t)nlow * (size_t)m * sizeof(double))
                            : NULL;
     if (!W || !AW || (lin->Aerr && !EW)) {
         free(W);
         free(AW);
         free(EW);
-        return TS_ENOMEM;
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
-    for (int c = 0; c < L->n; c++) {
+    for (int c = 0, j = 0; c < L->n; c++) {
+        if (L->c[c].checked)
+            continue;
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
         for (int i = 0; i < n; i++) {
-            W[(size_t)(2 * c) * n + i] = creal(v[i]);
-            W[(size_t)(2 * c + 1) * n + i] = cimag(v[i]);
+            W[(size_t)j * n + i] = creal(v[i]);
+            W[(size_t)(j + 1) * n + i] = cimag(v[i]);
         }
+        j += 2;
     }
     double pone = 1.0, zero = 0.0;
     dgemm_("N", "N", &n, &m, &n, &pone, lin->A, &n, W, &n, &zero, AW, &n, 1,
            1);
     if (EW)
-        dgemm_("N", "N", &nq, &m, &n, &pone, lin->Aerr, &nq, W, &n, &zero, EW,
-               &nq, 1, 1);
-    for (int c = 0; c < L->n; c++) {
-        double complex lam = L->c[c].lam;
+        dgemm_("N", "N", &nlow, &m, &n, &pone, lin->Aerr, &nlow, W, &n, &zero,
+               EW, &nlow, 1, 1);
+    for (int c = 0, j = 0; c < L->n; c++) {
+        if (L->c[c].checked)
+            continue;
+        L->c[c].checked = 1;
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
-        const double *ar = AW + (size_t)(2 * c) * n, *ai = ar + n;
-        double r2 = 0, v2 = 0, e2 = 0;
-        for (int i = 0; i < n; i++) {
-            double complex d = ar[i] + I * ai[i] - lam * v[i];
-            r2 += creal(d) * creal(d) + cimag(d) * cimag(d);
-            v2 += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
-        }
-        L->c[c].resid = sqrt(r2 / v2) / lin->a_norm;
+        const double *ar = AW + (size_t)j * n, *ai = ar + n;
+        double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
         if (EW) {
-            const double *er = EW + (size_t)(2 * c) * nq, *ei = er + nq;
-            for (int i = 0; i < nq; i++)
+            const double *er = EW + (size_t)j * nlow, *ei = er + nlow;
+            for (int i = 0; i < nlow; i++)
                 e2 += er[i] * er[i] + ei[i] * ei[i];
             L->c[c].dlam = sqrt(e2 / v2) +
                            rounding_change(lin, NULL, NULL,
@@ -625,10 +552,45 @@ static int batch_checks(const ts_linear *lin, cand_list *L)
                                            W + (size_t)(2 * c + 1) * n) /
                                sqrt(v2);
         }
+        j += 2;
     }
     free(W);
     free(AW);
     free(EW);
+    return TS_OK;
+}
+
+static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
+                        ts_err *err)
+{
+    int n = lin->nstate, nq = lin->nq;
+    double *w = malloc(6 * (size_t)n * sizeof(double));
+    if (!w)
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    double *vr = w, *vi = w + n, *ar = w + 2 * n, *ai = w + 3 * n;
+    double *er = w + 4 * n, *ei = w + 5 * n;
+    int with_err = lin->desc_err == lin->desc_err; /* not NaN */
+    for (int c = 0; c < L->n; c++) {
+        if (L->c[c].checked)
+            continue;
+        L->c[c].checked = 1;
+        const double complex *v = L->v + (size_t)L->c[c].vec * n;
+        for (int i = 0; i < n; i++) {
+            vr[i] = creal(v[i]);
+            vi[i] = cimag(v[i]);
+        }
+        tsi_shift_apply(acc, vr, ar, 0);
+        tsi_shift_apply(acc, vi, ai, 0);
+        double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
+        if (with_err) {
+            tsi_shift_apply(acc, vr, er, 1);
+            tsi_shift_apply(acc, vi, ei, 1);
+            for (int i = nq; i < n; i++)
+                e2 += er[i] * er[i] + ei[i] * ei[i];
+            L->c[c].dlam = sqrt(e2 / v2);
+        }
+    }
+    free(w);
     return TS_OK;
 }
 
@@ -786,8 +748,6 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
             j++;
         }
     }
-    if (batch_checks(lin, L) != TS_OK)
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
 out:
     tsi_shift_free(&sh);
     free(resid);
@@ -802,14 +762,24 @@ out:
     return rc;
 }
 
-static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
-                                ts_eigen *e, cand_list *L, ts_err *err)
+/* ARPACK statistics of one or more runs. */
+typedef struct arpack_stats {
+    int iterations, ops, nconv, partial;
+} arpack_stats;
+
+/* The nev eigenvalues nearest the complex shift sigma with their vectors,
+ * appended to L (grown as needed): znaupd/zneupd in shift-invert mode on
+ * OP = (A - sigma I)^-1 through the sparse model, ncv Arnoldi vectors,
+ * relative tolerance tol (0: machine precision), at most maxiter restarts.
+ * Eigenvalues in the lower half plane are conjugated; a conjugate pair
+ * found whole is kept once (matched one to one, so double eigenvalues stay
+ * double). */
+static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
+                       int ncv, double tol, int maxiter, int partial,
+                       cand_list *L, arpack_stats *st, ts_err *err)
 {
-    int n = lin->nstate, nev, ncv, rc;
-    if ((rc = arpack_sizes(n, o->count, &nev, &ncv, err)) != TS_OK)
-        return rc;
+    int n = lin->nstate, rc;
     tsi_shift sh;
-    double complex sigma = I * 2.0 * M_PI * o->target_hz;
     if ((rc = tsi_shift_factor(&sh, lin, sigma, err)) != TS_OK)
         return rc;
     int lworkl = 3 * ncv * ncv + 5 * ncv;
@@ -823,35 +793,39 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
     double complex *workev = malloc(2 * (size_t)ncv * szc);
     double *rwork = malloc((size_t)ncv * sizeof(double));
     int *select = calloc((size_t)ncv, sizeof(int));
-    double *t1 = malloc(5 * (size_t)n * sizeof(double));
-    double *lam_re = malloc((size_t)(nev + 1) * sizeof(double));
+    double *t1 = malloc(2 * (size_t)n * sizeof(double));
     int *used = calloc((size_t)(nev + 1), sizeof(int));
     if (!resid || !v || !workd || !workl || !d || !z || !workev || !rwork ||
-        !select || !t1 || !lam_re || !used) {
+        !select || !t1 || !used) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
     int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
     iparam[0] = 1;
-    iparam[2] = o->arpack_max_iter;
+    iparam[2] = maxiter;
     iparam[6] = 3;
-    double tol = o->arpack_tol;
     for (;;) {
         znaupd_(&ido, "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
                 ipntr, workd, workl, &lworkl, rwork, &info, 1, 2);
         if (ido != -1 && ido != 1)
             break;
         tsi_shift_solve(&sh, workd + ipntr[0] - 1, workd + ipntr[1] - 1);
-        e->arpack_ops++;
+        st->ops++;
     }
-    e->arpack_iterations = iparam[2];
-    e->arpack_nconv = iparam[4];
-    if (info == 1) {
+    st->iterations += iparam[2];
+    st->nconv += iparam[4];
+    if (info == 1 && !(partial && iparam[4] > 0)) {
         rc = ts_fail(err, TS_ECONV,
                      "eigen: ARPACK znaupd reached %d restarts with %d of %d "
                      "Ritz values converged",
-                     o->arpack_max_iter, iparam[4], nev);
+                     maxiter, iparam[4], nev);
         goto out;
+    }
+    if (info == 1) {
+        /* The Ritz values that converged are exact to the tolerance;
+         * zneupd extracts those. */
+        st->partial++;
+        info = 0;
     }
     if (info != 0) {
         rc = ts_fail(err, TS_ELAPACK, "eigen: ARPACK znaupd info %d (%s)",
@@ -868,7 +842,7 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
         goto out;
     }
     int nconv = iparam[4];
-    if (cand_init(L, nconv, n) != TS_OK) {
+    if (cand_grow(L, nconv) != TS_OK) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
         goto out;
     }
@@ -876,8 +850,6 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
     for (int j = 0; j < nconv; j++)
         if (fabs(cimag(d[j])) <= REAL_IM_RTOL * cabs(d[j]))
             d[j] = creal(d[j]);
-    /* A lower-half eigenvalue whose conjugate was also found is dropped
-     * (matched one to one, so double eigenvalues stay double). */
     for (int j = 0; j < nconv; j++) {
         if (cimag(d[j]) >= 0.0)
             continue;
@@ -895,15 +867,13 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
         if (used[j] < 0)
             continue;
         double complex *zj = z + (size_t)j * n;
-        double *re = t1 + 3 * (size_t)n, *im = t1 + 4 * (size_t)n;
+        double *re = t1, *im = t1 + n;
         for (int i = 0; i < n; i++) {
             re[i] = creal(zj[i]);
             im[i] = cimag(zj[i]);
         }
         cand_add(L, d[j], re, im, NAN, NAN, NAN);
     }
-    if (batch_checks(lin, L) != TS_OK)
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
 out:
     tsi_shift_free(&sh);
     free(resid);
@@ -916,9 +886,312 @@ out:
     free(rwork);
     free(select);
     free(t1);
-    free(lam_re);
     free(used);
     return rc;
+}
+
+static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
+                                ts_eigen *e, cand_list *L, ts_err *err)
+{
+    int nev = 0, ncv = 0, rc;
+    if ((rc = arpack_sizes(lin->nstate, o->count, &nev, &ncv, err)) != TS_OK)
+        return rc;
+    if (cand_init(L, nev + 1, lin->nstate) != TS_OK)
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    arpack_stats st = {0, 0, 0, 0};
+    rc = arpack_near(lin, I * 2.0 * M_PI * o->target_hz, nev, ncv,
+                     o->arpack_tol, o->arpack_max_iter, 0, L, &st, err);
+    e->arpack_iterations = st.iterations;
+    e->arpack_ops = st.ops;
+    e->arpack_nconv = st.nconv;
+    return rc;
+}
+
+/* ---- The rightmost eigenvalues (sparse model) ---------------------------- */
+
+/* The search (doc/linear.md, section 3, "Rightmost eigenvalues"). */
+#define SWEEP_NEV 8        /* eigenvalues found around each shift */
+#define SWEEP_NCV 20       /* Arnoldi vectors of each shift's run */
+#define SWEEP_RATIO 4.0    /* frequency ratio of the grid of shifts */
+#define SWEEP_RESTARTS 30  /* ARPACK restarts of a run; what converged by
+                              then is kept */
+#define SWEEP_SEED_RTOL 0.05 /* seeds closer than this are one */
+#define SWEEP_CLIMBS 1     /* runs climbed towards a larger real part */
+#define SWEEP_STEPS 4      /* re-centrings of each climb */
+#define SWEEP_CHECKED 4    /* rightmost eigenvalues given error bounds */
+/* A Ritz pair of the search with a residual above this fraction of
+ * |lambda| has not converged and is dropped. */
+#define SWEEP_RESIDUAL 1e-6
+/* Two eigenvectors with |v1^H v2| above this (unit vectors) are one. */
+#define SWEEP_SAME_VECTOR 0.99
+
+/* Local band-top frequencies of node k (rad/s), the Rayleigh quotients of
+ * its zig-zag: transverse, sum_j (-1)^dist(k,j) K_kj restricted to the
+ * plane normal to the link ending at k, over the mass in that plane (the
+ * top of a uniform chain's band exactly: 2 sqrt(T / (m l)) with tension
+ * alone, with bending and drag stiffness as K has them); axial, twice the
+ * EA / l of the elastic links at k over the mass along the link. */
+static void zigzag_freq(const ts_descriptor *d, int k, double *wt,
+                        double *wa)
+{
+    const ts_system *sys = d->sys;
+    const double *n = d->n + 3 * sys->nodes[k].link;
+    double G[9] = {0};
+    for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
+        if (d->bcol[b] == 0)
+            continue;
+        double sg = d->bdist[b] % 2 ? -1.0 : 1.0;
+        for (int i = 0; i < 9; i++)
+            G[i] += sg * d->K[9 * (size_t)b + i];
+    }
+    /* An orthonormal pair normal to n. */
+    double t[3] = {fabs(n[0]) < 0.6 ? 1.0 : 0.0, fabs(n[0]) < 0.6 ? 0.0 : 1.0,
+                   0.0};
+    double a[3], c[3], tn = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+    for (int i = 0; i < 3; i++)
+        a[i] = t[i] - tn * n[i];
+    double an = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    for (int i = 0; i < 3; i++)
+        a[i] /= an;
+    c[0] = n[1] * a[2] - n[2] * a[1];
+    c[1] = n[2] * a[0] - n[0] * a[2];
+    c[2] = n[0] * a[1] - n[1] * a[0];
+    const double *e[2] = {a, c};
+    static const int mi[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    const double *M = d->M + 6 * k;
+    double g[2][2], m[2][2];
+    for (int p = 0; p < 2; p++)
+        for (int q = 0; q < 2; q++) {
+            double gs = 0, ms = 0;
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++) {
+                    gs += e[p][i] * G[3 * i + j] * e[q][j];
+                    ms += e[p][i] * M[mi[i][j]] * e[q][j];
+                }
+            g[p][q] = gs;
+            m[p][q] = ms;
+        }
+    /* Largest root of det(g_sym - w^2 m) = 0. */
+    double g01 = 0.5 * (g[0][1] + g[1][0]);
+    double A = m[0][0] * m[1][1] - m[0][1] * m[0][1];
+    double B = -(g[0][0] * m[1][1] + g[1][1] * m[0][0] - 2 * g01 * m[0][1]);
+    double C = g[0][0] * g[1][1] - g01 * g01;
+    double disc = B * B - 4 * A * C;
+    double w2 = A > 0 ? (-B + sqrt(disc > 0 ? disc : 0)) / (2 * A) : 0;
+    *wt = w2 > 0 ? sqrt(w2) : 0.0;
+    double ka = 0;
+    int l = sys->nodes[k].link;
+    if (d->kind[l] == TSI_LINK_TAUT)
+        ka += d->ka[l];
+    for (int ci = sys->nodes[k].child_begin; ci < sys->nodes[k].child_end;
+         ci++) {
+        int lc = sys->child_links[ci];
+        if (d->kind[lc] == TSI_LINK_TAUT)
+            ka += d->ka[lc];
+    }
+    double mn = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            mn += n[i] * M[mi[i][j]] * n[j];
+    *wa = ka > 0 && mn > 0 ? sqrt(2 * ka / mn) : 0.0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+/* Mark the candidates from `from` on that repeat an earlier one (the same
+ * eigenvalue within CONJ_MATCH_RTOL and the same vector); returns the
+ * index of the one with the largest real part among the new, -1 if none,
+ * and its distance to sigma's farthest new neighbour in *radius. */
+static int sweep_new(cand_list *L, int from, double complex sigma,
+                     double *radius)
+{
+    int n = L->nstate, best = -1;
+    *radius = 0;
+    for (int i = from; i < L->n; i++) {
+        cand *c = &L->c[i];
+        c->sweep = 1;
+        *radius = fmax(*radius, cabs(c->lam - sigma));
+        const double complex *vi = L->v + (size_t)c->vec * n;
+        for (int j = 0; j < i && c->sweep == 1; j++) {
+            const cand *o = &L->c[j];
+            if (o->sweep == 2 ||
+                cabs(o->lam - c->lam) > CONJ_MATCH_RTOL * cabs(c->lam))
+                continue;
+            const double complex *vj = L->v + (size_t)o->vec * n;
+            double complex dot = 0;
+            double ni = 0, nj = 0;
+            for (int r = 0; r < n; r++) {
+                dot += conj(vj[r]) * vi[r];
+                ni += creal(vi[r] * conj(vi[r]));
+                nj += creal(vj[r] * conj(vj[r]));
+            }
+            if (cabs(dot) > SWEEP_SAME_VECTOR * sqrt(ni * nj))
+                c->sweep = 2;
+        }
+        if (c->sweep == 1 &&
+            (best < 0 || creal(c->lam) > creal(L->c[best].lam)))
+            best = i;
+    }
+    return best;
+}
+
+/* One run of the search at sigma; best and radius as sweep_new. A shift
+ * exactly on an eigenvalue is moved by 1e-9 of itself once. */
+static int sweep_run(const ts_linear *lin, const ts_eigen_opts *o,
+                     double complex sigma, cand_list *L, arpack_stats *st,
+                     int *best, double *radius, ts_err *err)
+{
+    int from = L->n, ncv = SWEEP_NCV < lin->nstate ? SWEEP_NCV : lin->nstate;
+    int nev = SWEEP_NEV < ncv - 2 ? SWEEP_NEV : ncv - 2;
+    int rc = arpack_near(lin, sigma, nev, ncv, o->arpack_tol,
+                         SWEEP_RESTARTS, 1, L, st, err);
+    if (rc == TS_ESINGULAR) {
+        sigma *= 1.0 + 1e-9;
+        rc = arpack_near(lin, sigma, nev, ncv, o->arpack_tol,
+                         SWEEP_RESTARTS, 1, L, st, err);
+    }
+    if (rc != TS_OK)
+        return rc;
+    *best = sweep_new(L, from, sigma, radius);
+    return TS_OK;
+}
+
+/* The rightmost search: shifts i w at the local band tops of every cable
+ * (zigzag_freq: transverse, and axial for elastic cables) and on a grid of
+ * ratio SWEEP_RATIO from the highest frequency among the modes already
+ * found to the highest band top, the discretisation's top frequency; at
+ * each, the SWEEP_NEV eigenvalues nearest. Then the SWEEP_CLIMBS runs with
+ * the largest real parts climb: while the rightmost eigenvalue a run found
+ * lies in the outer half of its disc, the next shift is at its frequency.
+ * Adds the eigenvalues found to L (sweep = 1, repeats 2). */
+static int rightmost_search(const ts_linear *lin, const ts_eigen_opts *o,
+                            ts_eigen *e, cand_list *L, ts_err *err)
+{
+    const ts_descriptor *d = lin->desc;
+    const ts_system *sys = d->sys;
+    int nc = sys->ncables;
+    double *top = calloc(2 * (size_t)nc + 64, sizeof(double));
+    if (!top)
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    double *seed = top + 2 * nc;
+    for (int k = 1; k < d->nn; k++) {
+        double wt, wa;
+        zigzag_freq(d, k, &wt, &wa);
+        int c = sys->links[sys->nodes[k].link].cable;
+        top[2 * c] = fmax(top[2 * c], wt);
+        top[2 * c + 1] = fmax(top[2 * c + 1], wa);
+    }
+    double wtop = 0, wlo = 0;
+    for (int i = 0; i < 2 * nc; i++)
+        wtop = fmax(wtop, top[i]);
+    for (int i = 0; i < L->n; i++)
+        wlo = fmax(wlo, cimag(L->c[i].lam));
+    e->top_hz = wtop / (2 * M_PI);
+    int ns = 0;
+    for (int i = 0; i < 2 * nc; i++)
+        if (top[i] > 0)
+            seed[ns++] = top[i];
+    if (!(wlo > 0))
+        wlo = wtop / 1024;
+    for (double w = wlo * SWEEP_RATIO; w < wtop && ns < 62; w *= SWEEP_RATIO)
+        seed[ns++] = w;
+    qsort(seed, (size_t)ns, sizeof(double), cmp_double);
+    int nu = 0;
+    for (int i = 0; i < ns; i++)
+        if (nu == 0 || seed[i] > seed[nu - 1] * (1 + SWEEP_SEED_RTOL))
+            seed[nu++] = seed[i];
+    arpack_stats st = {0, 0, 0, 0};
+    int rc = TS_OK, runs = 0;
+    double run_re[64], run_w[64], run_r[64];
+    int run_best[64];
+    for (int i = 0; i < nu && rc == TS_OK; i++) {
+        int best;
+        double r;
+        rc = sweep_run(lin, o, I * seed[i], L, &st, &best, &r, err);
+        if (rc == TS_ECONV) {
+            /* A run that did not converge leaves a gap, counted; it does
+             * not make the analysis fail. */
+            e->sweep_failed++;
+            ts_err_clear(err);
+            rc = TS_OK;
+            continue;
+        }
+        if (rc == TS_OK && best >= 0) {
+            run_best[runs] = best;
+            run_re[runs] = creal(L->c[best].lam);
+            run_w[runs] = seed[i];
+            run_r[runs] = r;
+            runs++;
+        }
+    }
+    int shifts = nu;
+    for (int climb = 0; climb < SWEEP_CLIMBS && rc == TS_OK; climb++) {
+        /* The run with the largest real part not climbed yet. */
+        int pick = -1;
+        for (int i = 0; i < runs; i++)
+            if (!isnan(run_re[i]) && (pick < 0 || run_re[i] > run_re[pick]))
+                pick = i;
+        if (pick < 0)
+            break;
+        int best = run_best[pick];
+        double w = run_w[pick], r = run_r[pick];
+        run_re[pick] = NAN;
+        for (int step = 0; step < SWEEP_STEPS && rc == TS_OK; step++) {
+            double complex lb = L->c[best].lam;
+            if (cabs(lb - I * w) <= 0.5 * r)
+                break;
+            /* Towards a region another run has covered: nothing new. */
+            int seen = 0;
+            for (int j = 0; j < runs && !seen; j++)
+                seen = j != pick &&
+                       fabs(cimag(lb) - run_w[j]) <= 0.5 * run_r[j];
+            if (seen)
+                break;
+            w = cimag(lb);
+            int nb;
+            rc = sweep_run(lin, o, I * w, L, &st, &nb, &r, err);
+            shifts++;
+            if (rc == TS_ECONV) {
+                e->sweep_failed++;
+                ts_err_clear(err);
+                rc = TS_OK;
+                break;
+            }
+            if (rc == TS_OK && nb >= 0 &&
+                creal(L->c[nb].lam) >= creal(L->c[best].lam))
+                best = nb;
+            else
+                break;
+        }
+    }
+    free(top);
+    e->sweep_shifts = shifts;
+    e->arpack_iterations += st.iterations;
+    e->arpack_ops += st.ops;
+    e->arpack_nconv += st.nconv;
+    return rc;
+}
+
+/* A mode's fields from a candidate. */
+static void fill_mode(ts_mode *md, const cand *c)
+{
+    double re = creal(c->lam), im = cimag(c->lam), mag = cabs(c->lam);
+    md->re = re;
+    md->im = im;
+    md->freq_hz = im / (2.0 * M_PI);
+    md->period_s = im > 0 ? 1.0 / md->freq_hz : INFINITY;
+    md->damping_ratio = mag > 0 ? -re / mag : 0.0;
+    md->time_constant_s = re != 0 ? -1.0 / re : INFINITY;
+    md->condition = c->cond;
+    md->residual = c->resid;
+    md->vector_condition = c->vcond;
+    md->vector_error = c->verr;
+    md->error_bound =
+        ERROR_SAFETY * ((isfinite(c->dlam) ? c->dlam : 0.0) + c->round);
 }
 
 /* ---- Driver -------------------------------------------------------------- */
@@ -937,6 +1210,22 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     if (rc != TS_OK)
         return rc;
     ts_eig_method m = ts_eigen_method(n, &o);
+    /* Without the dense A (a large system) the modes come from ARPACK on
+     * the sparse model. */
+    if (o.method == TS_EIG_AUTO && m == TS_EIG_LAPACK && !lin->A &&
+        o.count > 0)
+        m = TS_EIG_ARPACK;
+    if (m == TS_EIG_LAPACK && !lin->A)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method lapack needs the dense A of %d states "
+                       "(%.3g MB; linearize with model TS_LIN_DENSE or "
+                       "BOTH), or ask for a number of modes for the sparse "
+                       "method",
+                       n, 8e-6 * (double)n * (double)n);
+    if (m == TS_EIG_ARPACK && !lin->desc && !lin->A)
+        return ts_fail(err, TS_EINVAL,
+                       "eigen: method arpack needs a linear model (sparse "
+                       "or dense)");
     ts_eigen *e = calloc(1, sizeof *e);
     if (!e)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
@@ -956,34 +1245,24 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         return rc;
     }
 
-    /* ARPACK gives no separation estimate: the eigenvector allowance is
-     * the eigenvalue's first-order change (plus rounding) over the
-     * distance to the nearest other computed eigenvalue, its own
-     * conjugate included (exact to first order for a normal matrix; at
-     * the edge of the computed subset an uncomputed neighbour may be
-     * nearer). */
-    if (m != TS_EIG_LAPACK) {
-        double rnd = DBL_EPSILON * lin->a_norm;
-        for (int i = 0; i < L.n; i++) {
-            double complex li = L.c[i].lam;
-            double gap = cimag(li) > 0 ? 2.0 * cimag(li) : INFINITY;
-            for (int k = 0; k < L.n; k++) {
-                if (k == i)
-                    continue;
-                double complex lk = L.c[k].lam;
-                gap = fmin(gap, fmin(cabs(li - lk), cabs(li - conj(lk))));
-            }
-            double dl = isfinite(L.c[i].dlam) ? L.c[i].dlam : 0.0;
-            L.c[i].verr = gap > 0 ? (dl + rnd) / gap : INFINITY;
-        }
+    e->top_hz = NAN;
+    if (m == TS_EIG_ARPACK && o.rightmost && lin->desc)
+        rc = rightmost_search(lin, &o, e, &L, err);
+    if (rc != TS_OK) {
+        cand_free(&L);
+        ts_eigen_free(e);
+        return rc;
     }
 
-    /* Keep the `count` nearest sigma, then order by frequency. */
+    /* The modes: the `count` nearest sigma among those found for them
+     * (the search's are found elsewhere). */
     double complex sigma = I * 2.0 * M_PI * o.target_hz;
     for (int i = 0; i < L.n; i++)
-        L.c[i].dist = cabs(L.c[i].lam - sigma);
+        L.c[i].dist = L.c[i].sweep ? INFINITY : cabs(L.c[i].lam - sigma);
     qsort(L.c, (size_t)L.n, sizeof(cand), cmp_dist);
-    int keep = L.n;
+    int keep = 0;
+    while (keep < L.n && !L.c[keep].sweep)
+        keep++;
     if (o.count > 0 && o.count < keep)
         keep = o.count;
     if (m == TS_EIG_ARPACK && keep < o.count) {
@@ -995,8 +1274,114 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         ts_eigen_free(e);
         return rc;
     }
-    qsort(L.c, (size_t)keep, sizeof(cand), cmp_freq);
+    /* What the verdict covers: with LAPACK every eigenvalue (all have
+     * bounds), with ARPACK the modes and the SWEEP_CHECKED rightmost of
+     * the search, whose residuals and error estimates are computed here
+     * (O(nlinks) each; the other eigenvalues it found lie further left). */
+    int *cover = malloc((size_t)(L.n > 0 ? L.n : 1) * sizeof(int));
+    if (!cover) {
+        cand_free(&L);
+        ts_eigen_free(e);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
+    int ncover = 0;
+    if (m == TS_EIG_LAPACK) {
+        for (int i = 0; i < L.n; i++)
+            cover[ncover++] = i;
+    } else {
+        for (int i = 0; i < L.n; i++)
+            L.c[i].checked = i < keep ? 0 : -1;
+        tsi_shift acc = {0};
+        if (lin->desc) {
+            rc = tsi_shift_factor_inf(&acc, lin, err);
+            if (rc == TS_OK)
+                rc = batch_checks(lin, &acc, &L, err);
+        } else {
+            rc = dense_checks(lin, &L, err);
+        }
+        /* The rightmost of the search, checked one by one: a Ritz pair
+         * whose residual shows it has not converged (a run stopped at its
+         * restart limit in a cluster) is no eigenvalue and is dropped. */
+        for (int t = 0; rc == TS_OK && t < SWEEP_CHECKED;) {
+            int best = -1;
+            for (int i = keep; i < L.n; i++)
+                if (L.c[i].sweep == 1 && L.c[i].checked == -1 &&
+                    (best < 0 || creal(L.c[i].lam) > creal(L.c[best].lam)))
+                    best = i;
+            if (best < 0)
+                break;
+            L.c[best].checked = 0;
+            rc = batch_checks(lin, &acc, &L, err);
+            if (L.c[best].resid > SWEEP_RESIDUAL) {
+                L.c[best].sweep = 3;
+                e->sweep_rejected++;
+            } else {
+                t++;
+            }
+        }
+        if (acc.numeric || acc.lu || acc.zlu)
+            tsi_shift_free(&acc);
+        for (int i = 0; i < L.n; i++)
+            if (L.c[i].checked == 1 && L.c[i].sweep != 3)
+                cover[ncover++] = i;
+        if (rc != TS_OK) {
+            free(cover);
+            cand_free(&L);
+            ts_eigen_free(e);
+            return rc;
+        }
+        /* ARPACK gives no separation estimate: the eigenvector allowance
+         * is the eigenvalue's first-order change (plus rounding) over the
+         * distance to the nearest other computed eigenvalue, its own
+         * conjugate included (exact to first order for a normal matrix;
+         * at the edge of the computed subset an uncomputed neighbour may
+         * be nearer). */
+        for (int q = 0; q < ncover; q++) {
+            int i = cover[q];
+            double complex li = L.c[i].lam;
+            double gap = cimag(li) > 0 ? 2.0 * cimag(li) : INFINITY;
+            for (int k = 0; k < L.n; k++) {
+                if (k == i || L.c[k].sweep == 2)
+                    continue;
+                double complex lk = L.c[k].lam;
+                gap = fmin(gap, fmin(cabs(li - lk), cabs(li - conj(lk))));
+            }
+            double dl = isfinite(L.c[i].dlam) ? L.c[i].dlam : 0.0;
+            L.c[i].verr = gap > 0 ? (dl + L.c[i].round) / gap : INFINITY;
+        }
+        for (int i = keep; i < L.n; i++)
+            e->sweep_found += L.c[i].sweep == 1 ? (cimag(L.c[i].lam) > 0 ? 2
+                                                                       : 1)
+                                                : 0;
+    }
 
+    /* Verdict and the rightmost eigenvalue over what is covered. */
+    e->max_real = -INFINITY;
+    e->max_real_error = 0.0;
+    int any_unstable = 0, all_stable = 1, right = -1;
+    for (int q = 0; q < ncover; q++) {
+        const cand *c = &L.c[cover[q]];
+        double re = creal(c->lam);
+        double bound = ERROR_SAFETY * ((isfinite(c->dlam) ? c->dlam : 0.0) +
+                                       c->round);
+        if (re > e->max_real) {
+            e->max_real = re;
+            e->max_real_error = bound;
+            right = cover[q];
+        }
+        if (re - bound > 0)
+            any_unstable = 1;
+        if (!(re + bound < 0))
+            all_stable = 0;
+    }
+    free(cover);
+    if (right >= 0)
+        fill_mode(&e->rightmost, &L.c[right]);
+    e->verdict = any_unstable ? TS_UNSTABLE
+                              : (all_stable && ncover > 0 ? TS_STABLE
+                                                          : TS_MARGINAL);
+
+    qsort(L.c, (size_t)keep, sizeof(cand), cmp_freq);
     e->nmodes = keep;
     e->modes = calloc((size_t)(keep > 0 ? keep : 1), sizeof(ts_mode));
     if (o.vectors) {
@@ -1010,37 +1395,11 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         ts_eigen_free(e);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
-    double round_err = DBL_EPSILON * lin->a_norm;
     e->neig = 0;
-    e->max_real = -INFINITY;
-    e->max_real_error = 0.0;
-    int any_unstable = 0, all_stable = 1;
     for (int i = 0; i < keep; i++) {
         const cand *c = &L.c[i];
-        ts_mode *md = &e->modes[i];
-        double re = creal(c->lam), im = cimag(c->lam), mag = cabs(c->lam);
-        md->re = re;
-        md->im = im;
-        md->freq_hz = im / (2.0 * M_PI);
-        md->period_s = im > 0 ? 1.0 / md->freq_hz : INFINITY;
-        md->damping_ratio = mag > 0 ? -re / mag : 0.0;
-        md->time_constant_s = re != 0 ? -1.0 / re : INFINITY;
-        md->condition = c->cond;
-        md->residual = c->resid;
-        md->vector_condition = c->vcond;
-        md->vector_error = c->verr;
-        double rnd = m == TS_EIG_LAPACK ? c->round : round_err;
-        md->error_bound =
-            ERROR_SAFETY * ((isfinite(c->dlam) ? c->dlam : 0.0) + rnd);
-        e->neig += im > 0 ? 2 : 1;
-        if (re > e->max_real) {
-            e->max_real = re;
-            e->max_real_error = md->error_bound;
-        }
-        if (re - md->error_bound > 0)
-            any_unstable = 1;
-        if (!(re + md->error_bound < 0))
-            all_stable = 0;
+        fill_mode(&e->modes[i], c);
+        e->neig += cimag(c->lam) > 0 ? 2 : 1;
         if (o.vectors) {
             const double complex *v = L.v + (size_t)c->vec * n;
             /* Unit 2-norm, largest entry real and positive. */
@@ -1062,10 +1421,8 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
             }
         }
     }
-    e->complete = e->neig == n;
-    e->verdict = any_unstable ? TS_UNSTABLE
-                              : (all_stable && keep > 0 ? TS_STABLE
-                                                        : TS_MARGINAL);
+    /* Complete: the verdict covers every eigenvalue. */
+    e->complete = m == TS_EIG_LAPACK;
     cand_free(&L);
     *out = e;
     return TS_OK;

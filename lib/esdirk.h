@@ -20,7 +20,9 @@
  * shorter) or < 0 for a fatal failure; jac writes df/dy column-major into
  * J[n * n] with the same return convention. Costs per step: 7 implicit
  * stages of a few Newton iterations, each one f and one O(n^2) LU solve;
- * an O(n^3) LU and a Jacobian now and then. */
+ * an O(n^3) LU and a Jacobian now and then. With a structured solver
+ * (tsi_ode_lsys) the solves and factorisations cost what it costs: O(n)
+ * for the sparse model of lib/shift.h. */
 #ifndef TOWSTAB_LIB_ESDIRK_H
 #define TOWSTAB_LIB_ESDIRK_H
 
@@ -30,6 +32,17 @@ typedef int (*tsi_ode_fn)(double t, const double y[], double dydt[],
                           void *params);
 typedef int (*tsi_ode_jac)(double t, const double y[], double J[],
                            void *params);
+
+/* A structured Newton solver instead of a dense Jacobian: setup prepares
+ * to solve (I - gamma J) x = b with J = df/dy at (t, y), re-evaluating J
+ * unless jok (then the last J is reused; *jcur = 1 when J was
+ * re-evaluated), and factors; solve writes x[n] for b[n]. Return codes as
+ * f. */
+typedef struct tsi_ode_lsys {
+    int (*setup)(double t, const double y[], double gamma, int jok,
+                 int *jcur, void *params);
+    int (*solve)(double x[], const double b[], void *params);
+} tsi_ode_lsys;
 
 typedef struct tsi_esdirk tsi_esdirk;
 
@@ -47,6 +60,14 @@ typedef struct tsi_esdirk_stats {
 tsi_esdirk *tsi_esdirk_alloc(int n, tsi_ode_fn f, tsi_ode_jac jac,
                              void *params, double rtol, double atol,
                              double h_init, ts_err *err);
+
+/* The same with a structured Newton solver (lsys, copied): no n x n
+ * matrix is formed; ARKODE's rules for when to re-evaluate J (lsys's jok)
+ * and when to refactor are unchanged. */
+tsi_esdirk *tsi_esdirk_alloc_lsys(int n, tsi_ode_fn f,
+                                  const tsi_ode_lsys *lsys, void *params,
+                                  double rtol, double atol, double h_init,
+                                  ts_err *err);
 void tsi_esdirk_free(tsi_esdirk *s);
 
 /* Start again from (t, y): step-size history, Jacobian and factorisation

@@ -231,6 +231,10 @@ int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
         if (!isfinite(s->phase))
             return ts_fail(err, TS_EINVAL, "excitation %s (%s): phase must "
                            "be finite, got %g rad", an, tn, s->phase);
+        if (!(s->ramp >= 0) || !isfinite(s->ramp))
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): ramp (the "
+                           "smooth start) must be >= 0 s, got %g s", an, tn,
+                           s->ramp);
     }
     if (s->type == TS_SIGNAL_CRANK &&
         (!(s->rod > s->amplitude) || !isfinite(s->rod)))
@@ -513,11 +517,11 @@ int ts_excitation_read_series(ts_excitation *ex, ts_axis axis,
 
 enum {
     K_TYPE, K_AMPLITUDE, K_FREQUENCY, K_PERIOD, K_PHASE, K_ROD, K_START,
-    K_DURATION, K_RISE, K_TO, K_BY, K_FILE, K_N
+    K_DURATION, K_RISE, K_TO, K_BY, K_FILE, K_RAMP, K_N
 };
 static const char *const key_names[K_N] = {
     "type", "amplitude", "frequency", "period", "phase", "rod", "start",
-    "duration", "rise", "to", "by", "file"};
+    "duration", "rise", "to", "by", "file", "ramp"};
 
 /* Keys each type accepts (besides `type`), as a bit set over K_*. */
 static unsigned keys_for(ts_signal_type t, int tow)
@@ -525,10 +529,11 @@ static unsigned keys_for(ts_signal_type t, int tow)
 #define B(k) (1u << (k))
     switch (t) {
     case TS_SIGNAL_SINE:
-        return B(K_AMPLITUDE) | B(K_FREQUENCY) | B(K_PERIOD) | B(K_PHASE);
+        return B(K_AMPLITUDE) | B(K_FREQUENCY) | B(K_PERIOD) | B(K_PHASE) |
+               B(K_RAMP);
     case TS_SIGNAL_CRANK:
         return B(K_AMPLITUDE) | B(K_FREQUENCY) | B(K_PERIOD) | B(K_PHASE) |
-               B(K_ROD);
+               B(K_ROD) | B(K_RAMP);
     case TS_SIGNAL_STEP:
         return (tow ? B(K_AMPLITUDE) : B(K_TO) | B(K_BY)) | B(K_START) |
                B(K_RISE);
@@ -702,7 +707,8 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
         {K_BY, amp_unit, &s.amplitude},        {K_FREQUENCY, "Hz", &s.frequency},
         {K_PERIOD, "s", &period},              {K_PHASE, "rad", &s.phase},
         {K_ROD, "m", &s.rod},                  {K_START, "s", &s.start},
-        {K_DURATION, "s", &s.duration},        {K_RISE, "s", &s.rise}};
+        {K_DURATION, "s", &s.duration},        {K_RISE, "s", &s.rise},
+        {K_RAMP, "s", &s.ramp}};
     for (size_t i = 0; i < sizeof q / sizeof q[0]; i++) {
         if (!val[q[i].key])
             continue;
@@ -734,6 +740,10 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
                                "s, got %g s", where, an, period);
             s.frequency = 1.0 / period;
         }
+        /* Smooth by default: a tow point that jumps into motion moves the
+         * whole cable at once (its coordinates are relative to it). */
+        if (!val[K_RAMP] && s.frequency > 0)
+            s.ramp = TS_SIGNAL_RAMP_PERIODS / s.frequency;
     }
     if (s.type == TS_SIGNAL_CRANK && !val[K_ROD])
         return ts_fail(err, TS_EINVAL, "%s: %s: type crank needs rod= (the "
@@ -801,8 +811,8 @@ static double s5ii(double x)
 
 /* Value and first two derivatives of signal i at t, with the amplitude
  * `amp` (the signal's own, or a manoeuvre's change). */
-static void signal_eval(const ts_excitation *ex, int i, double amp, double t,
-                        double *x, double *v, double *a)
+static void signal_raw(const ts_excitation *ex, int i, double amp, double t,
+                       double *x, double *v, double *a)
 {
     const ts_signal *s = &ex->sig[i];
     switch (s->type) {
@@ -853,6 +863,42 @@ static void signal_eval(const ts_excitation *ex, int i, double amp, double t,
     }
     }
     *x = *v = *a = 0.0;
+}
+
+/* With a sine's or crank's smooth start: x R, (x R)', (x R)'' with the
+ * envelope R = S(t / ramp). */
+static void signal_eval(const ts_excitation *ex, int i, double amp, double t,
+                        double *x, double *v, double *a)
+{
+    signal_raw(ex, i, amp, t, x, v, a);
+    const ts_signal *s = &ex->sig[i];
+    if (!(s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK) ||
+        !(s->ramp > 0) || t >= s->ramp)
+        return;
+    double xi = t / s->ramp, R = s5(xi), Rd = s5d(xi) / s->ramp,
+           Rdd = s5dd(xi) / (s->ramp * s->ramp);
+    double x0 = *x, v0 = *v, a0 = *a;
+    *x = R * x0;
+    *v = Rd * x0 + R * v0;
+    *a = Rdd * x0 + 2.0 * Rd * v0 + R * a0;
+}
+
+int ts_excitation_start_jump(const ts_excitation *ex, double du[6])
+{
+    int jump = 0;
+    for (int j = 0; j < 6; j++)
+        du[j] = 0.0;
+    for (int i = 0; i < ex->n; i++) {
+        const ts_signal *s = &ex->sig[i];
+        if (!is_tow_axis(s->axis) || s->type == TS_SIGNAL_SERIES)
+            continue;
+        double x, v, a;
+        signal_eval(ex, i, s->amplitude, 0.0, &x, &v, &a);
+        du[s->axis] += x;
+        du[3 + s->axis] += v;
+        jump |= x != 0.0 || v != 0.0;
+    }
+    return jump;
 }
 
 /* Integral over [0, t] of a step or ramp manoeuvre of amplitude amp. */
@@ -1009,6 +1055,9 @@ int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
             all[m++] = s->start + s->rise;
             all[m++] = s->start + s->duration;
             all[m++] = s->start + s->duration + s->rise;
+        } else if ((s->type == TS_SIGNAL_SINE ||
+                    s->type == TS_SIGNAL_CRANK) && s->ramp > 0) {
+            all[m++] = s->ramp;
         }
     }
     qsort(all, (size_t)m, sizeof *all, cmp_double);
@@ -1177,15 +1226,24 @@ void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
                                                 ? "amplitude" : "by";
     switch (s->type) {
     case TS_SIGNAL_SINE:
-        snprintf(buf, size, "%s sine amplitude %.6g m, frequency %.6g Hz, "
-                 "phase %.6g deg", an, s->amplitude, s->frequency,
-                 s->phase * 180.0 / M_PI);
+    case TS_SIGNAL_CRANK: {
+        char start[96];
+        if (s->ramp > 0)
+            snprintf(start, sizeof start, "smooth start over %.6g s (%.3g "
+                     "periods)", s->ramp, s->ramp * s->frequency);
+        else
+            snprintf(start, sizeof start, "impulsive start");
+        if (s->type == TS_SIGNAL_SINE)
+            snprintf(buf, size, "%s sine amplitude %.6g m, frequency %.6g "
+                     "Hz, phase %.6g deg, %s", an, s->amplitude,
+                     s->frequency, s->phase * 180.0 / M_PI, start);
+        else
+            snprintf(buf, size, "%s slider crank radius %.6g m, rod %.6g m, "
+                     "frequency %.6g Hz, phase %.6g deg, %s", an,
+                     s->amplitude, s->rod, s->frequency,
+                     s->phase * 180.0 / M_PI, start);
         return;
-    case TS_SIGNAL_CRANK:
-        snprintf(buf, size, "%s slider crank radius %.6g m, rod %.6g m, "
-                 "frequency %.6g Hz, phase %.6g deg", an, s->amplitude,
-                 s->rod, s->frequency, s->phase * 180.0 / M_PI);
-        return;
+    }
     case TS_SIGNAL_STEP:
         snprintf(buf, size, "%s step %s %.6g %s at %.6g s, rise %.6g s", an,
                  what, s->amplitude, u, s->start, s->rise);

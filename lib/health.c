@@ -32,7 +32,7 @@
 
 /* An ARPACK Ritz pair with a larger residual (relative to ||A||_F |v|)
  * is not an eigenpair to trust. */
-#define ARPACK_RESIDUAL_MAX 1e-8
+#define ARPACK_RESIDUAL_MAX 1e-6
 /* Modes listed by name in one aggregated reason. */
 #define LIST_MAX 4
 
@@ -312,7 +312,7 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
     }
     if (nres > 0)
         ts_trust_fail(t, "%d ARPACK Ritz pair%s with a residual above %.0e "
-                         "of ||A||",
+                         "of |lambda|",
                       nres, nres == 1 ? "" : "s", ARPACK_RESIDUAL_MAX);
 
     /* The stability margin: the linearization error against the smallest
@@ -382,7 +382,15 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
                          "|A| (%.3g of %.6g)",
                       lin->trunc_err / lin->a_scale, lin->trunc_err,
                       lin->a_scale);
-    if (!e->complete)
+    if (!e->complete && e->sweep_shifts > 0)
+        ts_trust_note(t, "the verdict covers the %d eigenvalues of the modes "
+                         "nearest %.6g Hz and the rightmost that a search of "
+                         "the whole spectrum found (%d shifts up to %.4g Hz, "
+                         "%d eigenvalues): not a proof that none lies "
+                         "further right",
+                      e->neig, e->target_hz, e->sweep_shifts, e->top_hz,
+                      e->sweep_found);
+    else if (!e->complete)
         ts_trust_note(t, "only %d of %d eigenvalues were computed (those "
                          "nearest %.6g Hz): the verdict covers those only",
                       e->neig, e->nstate, e->target_hz);

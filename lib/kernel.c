@@ -682,72 +682,21 @@ static void vehicle_point_accel(const veh *V, const ts_link *L, double a[3])
     mat3_mul(V->st.R, ab, a);
 }
 
-int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
-                   double dydt[])
+/* 2. The link-local assembly shared by f(y, u) and the node residual:
+ * from node positions k->r and velocities k->rd (relative to M), link
+ * directions k->n and strains k->strain, the external load Q, the 3x3
+ * mass matrix M and the frame part afr of the acceleration of every node,
+ * and each link's submerged fraction. Each link adds to its two end nodes
+ * (and a bending joint to three), each body to its node: O(nlinks). A
+ * vehicle's own loads follow (vehicle_loads, in ts_kernel_eval). */
+static void assemble(ts_kernel *k)
 {
     const ts_system *sys = k->sys;
     const ts_link *links = sys->links;
     const ts_node *nodes = sys->nodes;
-    const int nl = k->nl, nn = k->nn, nq = k->nq;
-    const double *qd = y + nq;
+    const int nl = k->nl, nn = k->nn;
     const double rho = sys->env.water_density, g = sys->env.gravity;
     const int added = sys->has_added_mass;
-    if (!u)
-        u = k->uzero;
-
-    /* 1. Kinematics. */
-    for (int j = 0; j < 3; j++) {
-        k->r[j] = sys->tow.point[j] + u[j];
-        k->rd[j] = u[3 + j];
-    }
-    int chart_bad = 0, slack_bad = 0;
-    for (int l = 0; l < nl; l++) {
-        const ts_link *L = &links[l];
-        const int o = k->off[l];
-        double *n = k->n + 3 * l, *nd = k->nd + 3 * l;
-        const double *rp = k->r + 3 * L->upper, *rdp = k->rd + 3 * L->upper;
-        if (L->up_body >= 0) {
-            rp = k->ur + 3 * l;
-            rdp = k->urd + 3 * l;
-        }
-        double *rk = k->r + 3 * L->lower, *rdk = k->rd + 3 * L->lower;
-        double *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
-        double c2, s2;
-        link_axes(k, l, y[o], y[o + 1], n, e1, e2, &c2, &s2);
-        k->c2[l] = c2;
-        k->s2[l] = s2;
-        if (!(fabs(c2) >= TS_CHART_MIN))
-            chart_bad = 1;
-        double a1 = c2 * qd[o], a2 = qd[o + 1];
-        for (int j = 0; j < 3; j++)
-            nd[j] = a1 * e1[j] + a2 * e2[j];
-        /* An elastic link's third coordinate is its strain e: length
-         * l (1 + e), tension EA e + Cv l e', never compressive. */
-        double len = L->length, lrate = 0.0;
-        if (L->elastic) {
-            double e = y[o + 2], ed = qd[o + 2];
-            k->strain[l] = e;
-            len = L->length * (1.0 + e);
-            lrate = L->length * ed;
-            if (!(len > 0))
-                slack_bad = 1;
-            double T = L->ea * e + L->damping * lrate;
-            k->t[l] = T > 0 ? T : 0.0;
-        }
-        for (int j = 0; j < 3; j++) {
-            rk[j] = rp[j] + len * n[j];
-            rdk[j] = rdp[j] + len * nd[j] + lrate * n[j];
-        }
-        int v = k->node_veh[L->lower];
-        if (v >= 0 && vehicle_kinematics(k, &k->veh[v], y))
-            chart_bad = 1;
-    }
-    if (slack_bad)
-        return refuse(k, dydt, TS_ESINGULAR);
-    if (chart_bad)
-        return refuse(k, dydt, TS_CHART);
-
-    /* 2. Loads, mass matrices and frame accelerations. */
     for (int i = 0; i < nn; i++) {
         double *Q = k->Q + 3 * i, *M = k->M + 6 * i;
         v3_set(Q, 0, 0, 0);
@@ -818,6 +767,73 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
             v3_axpy(1.0, Fk, k->Q + 3 * B->lower);
         }
     }
+}
+
+int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
+                   double dydt[])
+{
+    const ts_system *sys = k->sys;
+    const ts_link *links = sys->links;
+    const int nl = k->nl, nn = k->nn, nq = k->nq;
+    const double *qd = y + nq;
+    const double rho = sys->env.water_density, g = sys->env.gravity;
+    if (!u)
+        u = k->uzero;
+
+    /* 1. Kinematics. */
+    for (int j = 0; j < 3; j++) {
+        k->r[j] = sys->tow.point[j] + u[j];
+        k->rd[j] = u[3 + j];
+    }
+    int chart_bad = 0, slack_bad = 0;
+    for (int l = 0; l < nl; l++) {
+        const ts_link *L = &links[l];
+        const int o = k->off[l];
+        double *n = k->n + 3 * l, *nd = k->nd + 3 * l;
+        const double *rp = k->r + 3 * L->upper, *rdp = k->rd + 3 * L->upper;
+        if (L->up_body >= 0) {
+            rp = k->ur + 3 * l;
+            rdp = k->urd + 3 * l;
+        }
+        double *rk = k->r + 3 * L->lower, *rdk = k->rd + 3 * L->lower;
+        double *e1 = k->e1 + 3 * l, *e2 = k->e2 + 3 * l;
+        double c2, s2;
+        link_axes(k, l, y[o], y[o + 1], n, e1, e2, &c2, &s2);
+        k->c2[l] = c2;
+        k->s2[l] = s2;
+        if (!(fabs(c2) >= TS_CHART_MIN))
+            chart_bad = 1;
+        double a1 = c2 * qd[o], a2 = qd[o + 1];
+        for (int j = 0; j < 3; j++)
+            nd[j] = a1 * e1[j] + a2 * e2[j];
+        /* An elastic link's third coordinate is its strain e: length
+         * l (1 + e), tension EA e + Cv l e', never compressive. */
+        double len = L->length, lrate = 0.0;
+        if (L->elastic) {
+            double e = y[o + 2], ed = qd[o + 2];
+            k->strain[l] = e;
+            len = L->length * (1.0 + e);
+            lrate = L->length * ed;
+            if (!(len > 0))
+                slack_bad = 1;
+            double T = L->ea * e + L->damping * lrate;
+            k->t[l] = T > 0 ? T : 0.0;
+        }
+        for (int j = 0; j < 3; j++) {
+            rk[j] = rp[j] + len * n[j];
+            rdk[j] = rdp[j] + len * nd[j] + lrate * n[j];
+        }
+        int v = k->node_veh[L->lower];
+        if (v >= 0 && vehicle_kinematics(k, &k->veh[v], y))
+            chart_bad = 1;
+    }
+    if (slack_bad)
+        return refuse(k, dydt, TS_ESINGULAR);
+    if (chart_bad)
+        return refuse(k, dydt, TS_CHART);
+
+    /* 2. Loads, mass matrices and frame accelerations. */
+    assemble(k);
     for (int v = 0; v < k->nv; v++)
         vehicle_loads(k, &k->veh[v], y, u, rho, g);
 
@@ -992,6 +1008,48 @@ int ts_kernel_rhs(double t, const double y[], const double u[], double dydt[],
     (void)t;
     return ts_kernel_eval((ts_kernel *)params, y, u, dydt);
 }
+
+int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
+                        const double a[], const double t[], double R[])
+{
+    const ts_system *sys = k->sys;
+    const ts_link *links = sys->links;
+    const int nl = k->nl, nn = k->nn;
+    memcpy(k->r, r, 3 * (size_t)nn * sizeof(double));
+    memcpy(k->rd, v, 3 * (size_t)nn * sizeof(double));
+    /* Directions and strains from the positions: n = d / |d|, the strain
+     * of an elastic link |d| / l - 1 (it sets only the bending lengths
+     * here: the tensions are given). */
+    for (int l = 0; l < nl; l++) {
+        const ts_link *L = &links[l];
+        const double *rp = r + 3 * L->upper, *rk = r + 3 * L->lower;
+        double d[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
+        double len = v3_norm(d);
+        if (!(len > 0))
+            return TS_ESINGULAR;
+        for (int j = 0; j < 3; j++)
+            k->n[3 * l + j] = d[j] / len;
+        k->strain[l] = L->elastic ? len / L->length - 1.0 : 0.0;
+        k->t[l] = t[l];
+    }
+    assemble(k);
+    memset(R, 0, 3 * sizeof(double));
+    for (int i = 1; i < nn; i++) {
+        double ia[3] = {a[3 * i] + k->afr[3 * i], a[3 * i + 1] +
+                        k->afr[3 * i + 1], a[3 * i + 2] + k->afr[3 * i + 2]};
+        sym3_mul(k->M + 6 * i, ia, R + 3 * i);
+        v3_axpy(-1.0, k->Q + 3 * i, R + 3 * i);
+    }
+    for (int l = 0; l < nl; l++) {
+        const ts_link *L = &links[l];
+        v3_axpy(t[l], k->n + 3 * l, R + 3 * L->lower);
+        if (L->upper > 0)
+            v3_axpy(-t[l], k->n + 3 * l, R + 3 * L->upper);
+    }
+    return TS_OK;
+}
+
+const double *tsi_kernel_mass(const ts_kernel *k) { return k->M; }
 
 const double *ts_kernel_positions(const ts_kernel *k) { return k->r; }
 const double *ts_kernel_velocities(const ts_kernel *k) { return k->rd; }
@@ -1199,25 +1257,29 @@ int ts_kernel_set_shape(ts_kernel *k, const double n[], const double strain[],
     return moved;
 }
 
+int tsi_kernel_set_link(ts_kernel *k, int l, const double d[3],
+                        const double ddot[3], double threshold, double y[])
+{
+    const ts_link *L = &k->sys->links[l];
+    double len = v3_norm(d), n[3], nd[3], along = 0.0;
+    for (int j = 0; j < 3; j++)
+        n[j] = d[j] / len;
+    if (ddot) {
+        along = v3_dot(n, ddot);
+        for (int j = 0; j < 3; j++)
+            nd[j] = (ddot[j] - along * n[j]) / len;
+    }
+    return set_one_link(k, l, n, ddot ? nd : NULL, len / L->length - 1.0,
+                        along / L->length, threshold, y);
+}
+
 int ts_kernel_set_links(ts_kernel *k, const double d[], const double ddot[],
                         double threshold, double y[])
 {
     int moved = 0;
-    for (int l = 0; l < k->nl; l++) {
-        const ts_link *L = &k->sys->links[l];
-        const double *dl = d + 3 * l, *ddl = ddot ? ddot + 3 * l : NULL;
-        double len = v3_norm(dl), n[3], nd[3], along = 0.0;
-        for (int j = 0; j < 3; j++)
-            n[j] = dl[j] / len;
-        if (ddl) {
-            along = v3_dot(n, ddl);
-            for (int j = 0; j < 3; j++)
-                nd[j] = (ddl[j] - along * n[j]) / len;
-        }
-        moved += set_one_link(k, l, n, ddl ? nd : NULL,
-                              len / L->length - 1.0, along / L->length,
-                              threshold, y);
-    }
+    for (int l = 0; l < k->nl; l++)
+        moved += tsi_kernel_set_link(k, l, d + 3 * l,
+                                     ddot ? ddot + 3 * l : NULL, threshold, y);
     return moved;
 }
 

@@ -1,5 +1,16 @@
 /* kernel_impl.h: what lib/kernel.c shares with the modules above it
- * (internal). */
+ * (internal): names of inputs, the flow past a vehicle, and the node
+ * residual of the sparse descriptor model (lib/descriptor.c; doc/linear.md,
+ * section 2b).
+ *
+ * f(y, u) = the kernel's kinematics (angles to node positions, velocities
+ * and link directions), the link-local assembly of loads, nodal mass
+ * matrices and frame accelerations, then the O(nlinks) articulated
+ * elimination of the tensions. The residual below is the same assembly
+ * before any elimination: every node's equation of motion written with
+ * node positions, velocities and accelerations and the link tensions as
+ * unknowns, so that each equation involves only a node and its
+ * neighbours. */
 #ifndef TOWSTAB_KERNEL_IMPL_H
 #define TOWSTAB_KERNEL_IMPL_H
 
@@ -17,5 +28,31 @@ const char *tsi_tow_input_name(int j);
  * without a diameter). */
 void tsi_vehicle_flow(const ts_frame *f, const ts_vehicle *d,
                       tsi_vehicle_state *st);
+
+/* R[3 nnodes] (N) of node positions r[3 nnodes], velocities v[3 nnodes]
+ * relative to M (m, m/s; node 0 is the tow point, r_0 = point + tow
+ * displacement), accelerations a[3 nnodes] relative to M (m/s^2; a_0 is
+ * not used) and link tensions t[nlinks] (N, rigid and elastic links alike):
+ *   R_k = M_k (a_k + afr_k) - Q_k + t_l n_l - sum_c t_c n_c
+ * for every node k >= 1 (l the link ending at k, c the links leaving it,
+ * n = d / |d| from the positions); R_0 = 0. The loads Q, masses M and frame
+ * accelerations afr are those of ts_kernel_eval (the same code). At the
+ * state, tensions and accelerations of an evaluation of f, R = 0 to
+ * rounding. Systems without vehicles (a vehicle's own unknowns, its
+ * attitude and rates, are not in it). Uses the kernel's frame and bending
+ * scale; overwrites its last-evaluation results. Returns TS_OK, or
+ * TS_ESINGULAR when two ends of a link coincide. O(nlinks). */
+int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
+                        const double a[], const double t[], double R[]);
+
+/* Nodal 3x3 mass matrices [6 nnodes] (kg, symmetric packed xx, yy, zz, xy,
+ * xz, yz) of the last evaluation or residual: dR_k / da_k. */
+const double *tsi_kernel_mass(const ts_kernel *k);
+
+/* Link l's coordinates in y[2 nq] (the others untouched) from its link
+ * vector d[3] (m) and rate ddot[3] (m/s; NULL: zero), as
+ * ts_kernel_set_links does for every link. Returns 1 when re-charted. */
+int tsi_kernel_set_link(ts_kernel *k, int l, const double d[3],
+                        const double ddot[3], double threshold, double y[]);
 
 #endif

@@ -39,6 +39,7 @@
 #include <omp.h>
 #endif
 
+#include "descriptor.h"
 #include "kernel_impl.h"
 #include "lapack.h"
 #include "vehicle.h"
@@ -56,6 +57,8 @@ void ts_linearize_opts_default(ts_linearize_opts *o)
     o->estimate_error = 1;
     o->threads = 0;
     o->tensions = 0;
+    o->model = TS_LIN_AUTO;
+    o->dense_max_states = 1200;
 }
 
 ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
@@ -73,8 +76,6 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->ninput = ni;
     lin->nlinks = sys->nlinks;
     lin->nnodes = sys->nnodes;
-    lin->A = calloc(sn * sn, sizeof(double));
-    lin->B = calloc(sn * (size_t)ni, sizeof(double));
     lin->y0 = calloc(sn, sizeof(double));
     lin->f0 = calloc(sn, sizeof(double));
     lin->r0 = calloc(3 * (size_t)sys->nnodes, sizeof(double));
@@ -91,19 +92,19 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->h = calloc(sn + (size_t)ni, sizeof(double));
     lin->u0 = calloc((size_t)ni, sizeof(double));
     lin->kink_node = -1;
+    lin->desc_err = NAN;
     lin->nvehicles = ts_kernel_nvehicles(k);
     if (lin->nvehicles > 0) {
         lin->up_qoff = malloc((size_t)sys->nlinks * sizeof(int));
         lin->up_map = calloc(12 * (size_t)sys->nlinks, sizeof(double));
     }
-    if (!lin->A || !lin->B || !lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 ||
-        !lin->dn || !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic ||
-        !lin->h || !lin->u0 ||
+    if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
+        !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
+        !lin->u0 ||
         (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map))) {
         ts_linear_free(lin);
-        ts_fail_nomem(err, 8.0 * (double)sn * (double)sn, "fewer links",
-                      "linearize: out of memory for the %d x %d matrix A",
-                      n, n);
+        ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory for %d "
+                "states", n);
         return NULL;
     }
     return lin;
@@ -130,6 +131,7 @@ void ts_linear_free(ts_linear *lin)
     free(lin->fnoise);
     free(lin->Berr);
     free(lin->h);
+    tsi_desc_free(lin->desc);
     free(lin->u0);
     free(lin->up_qoff);
     free(lin->up_map);
@@ -408,6 +410,26 @@ static void find_kinks(const ts_system *sys, ts_linear *lin, int n)
     free(reach);
 }
 
+/* Kinks of the sparse model: nodes (the tow point included) within twice
+ * their own vertical position step of z = 0 while the fluid has density. */
+static void sparse_kinks(const ts_system *sys, ts_linear *lin)
+{
+    const ts_descriptor *d = lin->desc;
+    lin->kinks = 0;
+    lin->kink_tow = 0;
+    lin->kink_node = -1;
+    if (!(sys->env.water_density > 0))
+        return;
+    for (int i = 0; i < sys->nnodes; i++)
+        if (fabs(d->r0[3 * i + 2]) <= 2.0 * d->hr[3 * i + 2]) {
+            lin->kinks++;
+            if (i == 0)
+                lin->kink_tow = 1;
+            else if (lin->kink_node < 0)
+                lin->kink_node = i;
+        }
+}
+
 int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                  const ts_linearize_opts *opts, ts_linear *lin, ts_err *err)
 {
@@ -429,6 +451,20 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         return ts_fail(err, TS_EINVAL,
                        "linearize: rel_step must be in (0, 0.1), got %g",
                        o.rel_step);
+    if (o.model < TS_LIN_AUTO || o.model > TS_LIN_BOTH)
+        return ts_fail(err, TS_EINVAL, "linearize: unknown model %d",
+                       (int)o.model);
+    /* The sparse model covers cables, links and lumped bodies; a vehicle
+     * (its attitude and controller states) only the dense one. */
+    int vehicles = lin->nvehicles > 0 || n != 2 * nq;
+    if (vehicles && o.model == TS_LIN_SPARSE)
+        return ts_fail(err, TS_EINVAL, "linearize: the sparse model does not "
+                       "cover vehicles (their attitude and controller "
+                       "states); use model TS_LIN_DENSE or TS_LIN_AUTO");
+    int dense = o.model == TS_LIN_DENSE || o.model == TS_LIN_BOTH ||
+                (o.model == TS_LIN_AUTO &&
+                 (n < o.dense_max_states || vehicles));
+    int sparse = o.model != TS_LIN_DENSE && !vehicles;
     if (u0)
         memcpy(lin->u0, u0, (size_t)ni * sizeof(double));
     else
@@ -436,7 +472,39 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     u0 = lin->u0;
     memcpy(lin->y0, y0, (size_t)n * sizeof(double));
     lin->evaluations = 0;
-    if (o.tensions && (!lin->Ty || !lin->Tu)) {
+    lin->residual_evaluations = 0;
+    /* Dense arrays only for the dense model: a result reused with another
+     * model keeps nothing stale. */
+    if (!dense) {
+        free(lin->A);
+        free(lin->B);
+        free(lin->Ty);
+        free(lin->Tu);
+        free(lin->Aerr);
+        lin->A = lin->B = lin->Ty = lin->Tu = lin->Aerr = NULL;
+    }
+    if (!sparse) {
+        tsi_desc_free(lin->desc);
+        lin->desc = NULL;
+    }
+    if (dense && (!lin->A || !lin->B)) {
+        size_t sn = (size_t)n;
+        free(lin->A);
+        free(lin->B);
+        lin->A = calloc(sn * sn, sizeof(double));
+        lin->B = calloc(sn * (size_t)ni, sizeof(double));
+        if (!lin->A || !lin->B) {
+            free(lin->A);
+            free(lin->B);
+            lin->A = lin->B = NULL;
+            return ts_fail(err, TS_ENOMEM,
+                           "linearize: out of memory for a %d x %d matrix A "
+                           "(%.3g MB); the sparse model (TS_LIN_SPARSE) "
+                           "needs O(links) memory",
+                           n, n, 8e-6 * (double)sn * (double)sn);
+        }
+    }
+    if (dense && o.tensions && (!lin->Ty || !lin->Tu)) {
         free(lin->Ty);
         free(lin->Tu);
         lin->Ty = malloc((size_t)nl * (size_t)n * sizeof(double));
@@ -447,7 +515,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                                  "for the %d x %d tension Jacobian", nl, n);
     }
 
-    if (o.estimate_error && !lin->Aerr) {
+    if (dense && o.estimate_error && !lin->Aerr) {
         lin->Aerr = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (!lin->Aerr)
             return ts_fail_nomem(err, 8.0 * nlow * (double)n, "fewer links, "
@@ -545,6 +613,50 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     free(scale);
     find_kinks(sys, lin, n);
 
+    int nthreads = 1;
+#ifdef _OPENMP
+    nthreads = o.threads > 0 ? o.threads
+               : (nl >= TS_LINEARIZE_PARALLEL_LINKS ? omp_get_max_threads()
+                                                    : 1);
+    if (nthreads < 1)
+        nthreads = 1;
+#endif
+    lin->threads = nthreads;
+    lin->groups = 0;
+    lin->desc_err = NAN;
+    if (sparse) {
+        /* The kernel's last evaluation is the base point: the sparse model
+         * starts from its positions, velocities, accelerations and
+         * tensions. */
+        if (!lin->desc && !(lin->desc = tsi_desc_alloc(sys, err)))
+            return err ? err->code : TS_ENOMEM;
+        rc = tsi_desc_linearize(lin->desc, k, o.rel_step, o.estimate_error,
+                                nthreads, err);
+        if (rc != TS_OK)
+            return rc;
+        const ts_descriptor *d = lin->desc;
+        lin->residual_evaluations = d->evaluations;
+        lin->groups = d->groups;
+        if (o.estimate_error)
+            lin->desc_err = fmax(d->k_scale > 0 ? d->k_err / d->k_scale : 0,
+                                 d->c_scale > 0 ? d->c_err / d->c_scale : 0);
+    }
+    if (!dense) {
+        /* Kinks: nodes within twice their own position step of the
+         * surface. */
+        if (sparse)
+            sparse_kinks(sys, lin);
+        lin->trunc_err = lin->trunc_norm = lin->b_trunc_err = NAN;
+        lin->t_trunc_err = lin->a_scale = lin->a_norm = NAN;
+        double *ftmp = malloc((size_t)n * sizeof(double));
+        if (!ftmp)
+            return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
+        ts_kernel_eval(k, y0, u0, ftmp);
+        lin->evaluations++;
+        free(ftmp);
+        return TS_OK;
+    }
+
     /* Upper blocks: [0 I 0] and 0, exactly. */
     for (int j = 0; j < n; j++) {
         double *colj = lin->A + (size_t)j * n;
@@ -555,16 +667,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     for (int j = 0; j < ni; j++)
         memset(lin->B + (size_t)j * n, 0, (size_t)nq * sizeof(double));
 
-    int nthreads = 1;
-#ifdef _OPENMP
-    nthreads = o.threads > 0 ? o.threads
-               : (nl >= TS_LINEARIZE_PARALLEL_LINKS ? omp_get_max_threads()
-                                                    : 1);
     if (nthreads > ncol)
         nthreads = ncol;
-    if (nthreads < 1)
-        nthreads = 1;
-#endif
     lin->threads = nthreads;
     col_ws *ws = calloc((size_t)nthreads, sizeof *ws);
     if (!ws)

@@ -57,7 +57,14 @@ json_t *ts_report_linear_json(const ts_linear *lin, int matrices)
     json_object_set_new(o, "kink_tow", json_boolean(lin->kink_tow));
     json_object_set_new(o, "evaluations", json_integer(lin->evaluations));
     json_object_set_new(o, "threads", json_integer(lin->threads));
-    if (matrices) {
+    json_object_set_new(o, "model", json_string(lin->A ? (lin->desc ? "dense "
+                                                      "and sparse" : "dense")
+                                                : "sparse"));
+    json_object_set_new(o, "groups", json_integer(lin->groups));
+    json_object_set_new(o, "residual_evaluations",
+                        json_integer(lin->residual_evaluations));
+    json_object_set_new(o, "sparse_error", num(lin->desc_err));
+    if (matrices && lin->A && lin->B) {
         json_t *A = matrix_rows(lin->A, lin->nstate, lin->nstate,
                                 lin->nstate);
         json_t *B = matrix_rows(lin->B, lin->nstate, lin->ninput,
@@ -113,6 +120,22 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
     json_object_set_new(o, "max_real", num(e->max_real));
     json_object_set_new(o, "max_real_error", num(e->max_real_error));
     json_object_set_new(o, "complete", json_boolean(e->complete));
+    const ts_mode *r = &e->rightmost;
+    json_object_set_new(o, "rightmost",
+                        json_pack("{s:o,s:o,s:o,s:o,s:o,s:o}", "re",
+                                  num(r->re), "im", num(r->im), "freq_hz",
+                                  num(r->freq_hz), "damping_ratio",
+                                  num(r->damping_ratio), "error_bound",
+                                  num(r->error_bound), "residual",
+                                  num(r->residual)));
+    if (e->sweep_shifts > 0)
+        json_object_set_new(o, "search",
+                            json_pack("{s:i,s:i,s:i,s:i,s:o}", "shifts",
+                                      e->sweep_shifts, "failed",
+                                      e->sweep_failed, "rejected",
+                                      e->sweep_rejected, "found",
+                                      e->sweep_found, "top_hz",
+                                      num(e->top_hz)));
     json_object_set_new(o, "method", json_string(ts_eig_method_name(e->method)));
     json_object_set_new(o, "target_hz", num(e->target_hz));
     json_object_set_new(o, "nstate", json_integer(e->nstate));

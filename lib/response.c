@@ -1,13 +1,21 @@
 /* response.c: frequency response to tow-point motion (towstab/response.h;
- * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md).
+ * doc/model.md section 6; Kamman & Nguyen 1990, eqs. 56-65; doc/linear.md,
+ * section 4).
  *
- * Algorithm, per frequency w: s = i w; b = B_x + s B_v + s^2 B_a (lower
- * half only: the upper nq rows of B are zero); Z = (s I - A)^-1 b
- * = -(A - s I)^-1 b by the structured solver (eigen_impl.h: one complex LU
- * of P(s) = K + s C - s^2 I, nq x nq, O(nq^3)); then the output map:
- * positions through the link geometry (exact, O(nlinks)) plus the
- * feedthrough of the tow displacement, tensions through dT/dy and dT/du.
- * At w = 0 the solve is real and gives the static gain.
+ * Algorithm, per frequency w: one solve with the sparse linear model at
+ * s = i w driven by the tow point itself (lib/shift.h, tsi_shift_input):
+ * the tow point moves by e_input, its neighbours feel -(K_k0 + s C_k0)
+ * e_input, the links leaving it are constrained relative to it. One KLU
+ * factorisation of S(s) and one solve give every node's absolute
+ * displacement and every link's tension: O(nlinks) per frequency. At
+ * w = 0 the solve is real and gives the static gain.
+ *
+ * A system the sparse model does not cover (vehicles) takes the dense
+ * way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1 b by the dense shifted
+ * solve of lib/shift.h (one LU of P(s), O(nq^3)), then positions through
+ * the link geometry plus the tow displacement, tensions through dT/dy and
+ * dT/du; there each gain also gets the linearization's error allowance
+ * (gain_error).
  */
 #include "towstab/response.h"
 
@@ -17,7 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "eigen_impl.h"
+#include "lapack.h"
+#include "shift.h"
 #include "towstab/system.h"
 
 static const char *const input_names[3] = {"tow.surge", "tow.sway",
@@ -207,17 +216,19 @@ void ts_response_free(ts_response *r)
     free(r);
 }
 
-/* Work for one evaluation; m: the output row of the node displacement
- * map (a position's change per generalized coordinate), for the error. */
+/* Work for one evaluation: node displacements and link tensions (the
+ * sparse way), state and input vectors (the dense way). */
 typedef struct resp_ws {
+    double complex *dr, *dt;
     double complex *b, *x, *rho;
-    double *dq, *dr, *m;
+    double *dq, *drr, *m; /* m: a position output's row of the node
+                             displacement map (for the error) */
 } resp_ws;
 
-/* The linearization's error allowance of the gain g = rho^T x1 (+ a part
+/* The dense way's error allowance of the gain g = rho^T x1 (+ a part
  * without A or B), x = (sI - A)^-1 b, for errors dA, db in the lower rows:
- * dg = -w^T (dA x + db), w = P(s)^-T rho (eigen_impl.h; dx1 = -P^-1 z
- * for z in the lower rows). Two parts:
+ * dg = -w^T (dA x + db), w = P(s)^-T rho (lib/shift.h; dx1 = -P^-1 z for
+ * z in the lower rows). Two parts:
  * - truncation: w^T (Aerr x + Berr_x + s Berr_v + s^2 Berr_a);
  * - rounding: the root mean square of w^T N x over the noise N of the
  *   differences, entries fnoise_i / (sqrt(2) h_j) (doc/linear.md,
@@ -276,30 +287,20 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
     return 10.0 * (cabs(trunc) + sqrt(0.5 * wn2 * xh2));
 }
 
-/* The gain at omega into *g; with gerr, its linearization error
- * allowance (gain_error) into *gerr. */
-static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
-                   const ts_output *out, double omega, resp_ws *w,
-                   double complex *g, double *gerr, ts_err *err)
+/* The dense way (see the head of the file); lin holds A, B, Ty, Tu.
+ * With gerr, the gain's error allowance (gain_error) into *gerr. */
+static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
+                       const ts_output *out, tsi_shift *sh, resp_ws *w,
+                       double complex *g, double *gerr)
 {
     int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
-    double complex s = I * omega;
-    tsi_shift sh;
-    int rc = tsi_shift_factor(&sh, lin, s, err);
-    if (rc != TS_OK) {
-        if (rc == TS_ESINGULAR)
-            ts_fail(err, TS_ESINGULAR,
-                    "response: i w is an eigenvalue of A at %g Hz (an "
-                    "undamped resonance): the response is infinite there",
-                    omega / (2 * M_PI));
-        return rc;
-    }
+    double complex s = sh->s;
     const double *Bx = lin->B + (size_t)(TS_IN_DISP + input) * n;
     const double *Bv = lin->B + (size_t)(TS_IN_VEL + input) * n;
     const double *Ba = lin->B + (size_t)(TS_IN_ACC + input) * n;
     for (int i = 0; i < n; i++)
         w->b[i] = -(Bx[i] + s * Bv[i] + s * s * Ba[i]);
-    tsi_shift_solve(&sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
+    tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
     if (gerr) {
         /* rho: the gain's weights on x1 (x2 = s x1 for lower-row z). */
         for (int i = 0; i < nq; i++)
@@ -308,19 +309,18 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                             : lin->Ty[out->link + (size_t)i * nl] +
                                   s * lin->Ty[out->link +
                                               (size_t)(nq + i) * nl];
-        *gerr = gain_error(&sh, lin, input, w);
+        *gerr = gain_error(sh, lin, input, w);
     }
-    tsi_shift_free(&sh);
     if (out->kind == TS_OUT_POSITION) {
         int idx = 3 * out->node + out->comp;
         for (int i = 0; i < nq; i++)
             w->dq[i] = creal(w->x[i]);
-        ts_linear_node_displacements(sys, lin, w->dq, w->dr);
-        double gr = w->dr[idx];
+        ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+        double gr = w->drr[idx];
         for (int i = 0; i < nq; i++)
             w->dq[i] = cimag(w->x[i]);
-        ts_linear_node_displacements(sys, lin, w->dq, w->dr);
-        double gi = w->dr[idx];
+        ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+        double gi = w->drr[idx];
         *g = gr + I * gi + (out->comp == input ? 1.0 : 0.0);
     } else {
         int l = out->link;
@@ -332,21 +332,60 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                s * s * lin->Tu[l + (size_t)(TS_IN_ACC + input) * nl];
         *g = acc;
     }
+}
+
+/* The gain at omega into *g; with gerr, its linearization error
+ * allowance into *gerr (the dense way; NaN the sparse way). */
+static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
+                   const ts_output *out, double omega, resp_ws *w,
+                   double complex *g, double *gerr, ts_err *err)
+{
+    tsi_shift sh;
+    int rc = tsi_shift_factor(&sh, lin, I * omega, err);
+    if (rc != TS_OK) {
+        if (rc == TS_ESINGULAR)
+            ts_fail(err, TS_ESINGULAR,
+                    "response: i w is an eigenvalue of A at %g Hz (an "
+                    "undamped resonance): the response is infinite there",
+                    omega / (2 * M_PI));
+        return rc;
+    }
+    if (lin->desc) {
+        tsi_shift_input(&sh, input, w->dr, w->dt);
+        *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
+                                          : w->dt[out->link];
+        if (gerr)
+            *gerr = NAN;
+    } else {
+        dense_gain(sys, lin, input, out, &sh, w, g, gerr);
+    }
+    tsi_shift_free(&sh);
     return TS_OK;
 }
 
-static int check_args(const ts_linear *lin, int input, const ts_output *out,
-                      ts_err *err)
+static int check_args(const ts_system *sys, const ts_linear *lin, int input,
+                      const ts_output *out, ts_err *err)
 {
+    if (sys->nlinks != lin->nlinks)
+        return ts_fail(err, TS_EINVAL,
+                       "response: the linear model has %d links, the system "
+                       "%d",
+                       lin->nlinks, sys->nlinks);
     if (input < 0 || input > 2)
         return ts_fail(err, TS_EINVAL,
                        "response: input channel must be 0, 1 or 2 "
                        "(tow.surge, tow.sway, tow.heave), got %d",
                        input);
-    if (out->kind == TS_OUT_TENSION && (!lin->Ty || !lin->Tu))
+    if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
-                       "response: output %s needs the tension Jacobians; "
-                       "linearize with opts.tensions = 1",
+                       "response: output %s needs a linear model (sparse, "
+                       "or dense)",
+                       out->name);
+    if (!lin->desc && out->kind == TS_OUT_TENSION && (!lin->Ty || !lin->Tu))
+        return ts_fail(err, TS_EINVAL,
+                       "response: output %s needs the tension Jacobians "
+                       "of the dense model; linearize with opts.tensions = "
+                       "1",
                        out->name);
     if (out->kind == TS_OUT_POSITION &&
         (out->node < 1 || out->node >= lin->nnodes || out->comp < 0 ||
@@ -362,39 +401,48 @@ static int check_args(const ts_linear *lin, int input, const ts_output *out,
     return TS_OK;
 }
 
-/* Work for lin; with sys, the output row m of a position output. */
+/* Work for lin; with sys (the dense way), the output row m of a position
+ * output, for the error allowance. */
 static int ws_alloc(resp_ws *w, const ts_linear *lin, const ts_system *sys,
                     const ts_output *out)
 {
-    w->b = malloc((size_t)lin->nstate * sizeof(double complex));
-    w->x = malloc((size_t)lin->nstate * sizeof(double complex));
-    w->rho = malloc((size_t)lin->nq * sizeof(double complex));
-    w->dq = malloc((size_t)lin->nq * sizeof(double));
-    w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
-    w->m = calloc((size_t)lin->nq, sizeof(double));
-    if (!(w->b && w->x && w->rho && w->dq && w->dr && w->m))
-        return 0;
-    if (sys && out->kind == TS_OUT_POSITION) {
-        /* O(nq nlinks) once: the map is applied to each unit vector. */
-        int idx = 3 * out->node + out->comp;
-        memset(w->dq, 0, (size_t)lin->nq * sizeof(double));
-        for (int i = 0; i < lin->nq; i++) {
-            w->dq[i] = 1.0;
-            ts_linear_node_displacements(sys, lin, w->dq, w->dr);
-            w->m[i] = w->dr[idx];
-            w->dq[i] = 0.0;
+    memset(w, 0, sizeof *w);
+    w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double complex));
+    w->dt = malloc((size_t)(lin->nlinks > 0 ? lin->nlinks : 1) *
+                   sizeof(double complex));
+    if (!lin->desc) {
+        w->b = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->x = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->rho = malloc((size_t)lin->nq * sizeof(double complex));
+        w->dq = malloc((size_t)lin->nq * sizeof(double));
+        w->drr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
+        w->m = calloc((size_t)lin->nq, sizeof(double));
+        if (!w->b || !w->x || !w->rho || !w->dq || !w->drr || !w->m)
+            return 0;
+        if (sys && out->kind == TS_OUT_POSITION) {
+            /* O(nq nlinks) once: the map applied to each unit vector. */
+            int idx = 3 * out->node + out->comp;
+            memset(w->dq, 0, (size_t)lin->nq * sizeof(double));
+            for (int i = 0; i < lin->nq; i++) {
+                w->dq[i] = 1.0;
+                ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+                w->m[i] = w->drr[idx];
+                w->dq[i] = 0.0;
+            }
         }
     }
-    return 1;
+    return w->dr && w->dt;
 }
 
 static void ws_free(resp_ws *w)
 {
+    free(w->dr);
+    free(w->dt);
     free(w->b);
     free(w->x);
-    free(w->rho);
     free(w->dq);
-    free(w->dr);
+    free(w->drr);
+    free(w->rho);
     free(w->m);
 }
 
@@ -402,7 +450,7 @@ int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
                    const ts_output *out, double omega, double *re, double *im,
                    ts_err *err)
 {
-    int rc = check_args(lin, input, out, err);
+    int rc = check_args(sys, lin, input, out, err);
     if (rc != TS_OK)
         return rc;
     if (!(omega >= 0) || !isfinite(omega))
@@ -429,7 +477,7 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                         ts_response **res, ts_err *err)
 {
     *res = NULL;
-    int rc = check_args(lin, input, out, err);
+    int rc = check_args(sys, lin, input, out, err);
     if (rc != TS_OK)
         return rc;
     if (npoints < 1)
@@ -462,7 +510,7 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
     r->input = input;
     r->output = *out;
     r->npoints = npoints;
-    double complex g;
+    double complex g = 0;
     rc = gain_at(sys, lin, input, out, 0.0, &w, &g, &r->static_error, err);
     r->static_gain = creal(g);
     for (int i = 0; i < npoints && rc == TS_OK; i++) {

@@ -59,9 +59,12 @@
 #include <string.h>
 #include <time.h>
 
+#include "descriptor.h"
 #include "esdirk.h"
 #include "expm.h"
+#include "kernel_impl.h"
 #include "lapack.h"
+#include "shift.h"
 
 /* Interpolation error constant of the cubic input hold (see above). */
 #define CUBIC_HOLD_ERR 5.1e-4
@@ -247,7 +250,9 @@ struct ts_sim {
     int ahead;              /* esdirk has stepped to t_int > t */
     double t_int;
     double *y_int;          /* [n] esdirk's state at t_int */
-    ts_linear *lin;       /* Jacobian (implicit methods) */
+    ts_linear *lin;       /* Jacobian (implicit methods; sparse model for
+                             esdirk) */
+    tsi_shift sh;         /* esdirk: factored S(1 / gamma) */
     ts_linearize_opts lopts;
     /* Statistics: evolve's counters are added in at each reset. */
     long steps0, rejected0, nfev, njac, nrechart, nrestart;
@@ -369,7 +374,7 @@ static int linearize_at(ts_sim *s, double t, const double y[])
     s->njac++;
     prepare(s, t, u);
     int rc = ts_linearize(s->k, y, u, &s->lopts, s->lin, NULL);
-    s->nfev += s->lin->evaluations;
+    s->nfev += s->lin->evaluations + s->lin->residual_evaluations;
     if (rc > 0) {
         s->chart_refusals++;
         return GSL_FAILURE;
@@ -419,6 +424,8 @@ static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
     return esdirk_code(rhs(t, y, dydt, params));
 }
 
+/* esdirk's dense Jacobian: a system the sparse model does not cover (a
+ * vehicle). */
 static int jacobian_esdirk(double t, const double y[], double J[],
                            void *params)
 {
@@ -427,6 +434,39 @@ static int jacobian_esdirk(double t, const double y[], double J[],
     if (rc == GSL_SUCCESS)
         memcpy(J, s->lin->A, (size_t)s->n * (size_t)s->n * sizeof(double));
     return esdirk_code(rc);
+}
+
+/* esdirk's Newton matrix I - gamma J from the sparse model (lib/shift.h):
+ * J re-evaluated unless ARKODE says the last one will do, then S(1 /
+ * gamma) factored, O(nlinks) each. */
+static int lsys_setup_esdirk(double t, const double y[], double gamma,
+                             int jok, int *jcur, void *params)
+{
+    ts_sim *s = params;
+    if (!jok || !s->lin->desc) {
+        int rc = linearize_at(s, t, y);
+        if (rc != GSL_SUCCESS)
+            return esdirk_code(rc);
+        *jcur = 1;
+    }
+    if (s->sh.numeric)
+        tsi_shift_free(&s->sh);
+    int rc = tsi_shift_factor(&s->sh, s->lin, 1.0 / gamma, NULL);
+    if (rc == TS_ESINGULAR)
+        return 1; /* ARKODE retries with another step */
+    return rc == TS_OK ? 0 : -1;
+}
+
+/* x = (I - gamma J)^-1 b = s (s I - J)^-1 b with s = 1 / gamma, and
+ * tsi_shift_solve_real gives (J - s I)^-1. */
+static int lsys_solve_esdirk(double x[], const double b[], void *params)
+{
+    ts_sim *s = params;
+    double sh = creal(s->sh.s);
+    tsi_shift_solve_real(&s->sh, b, x);
+    for (int i = 0; i < s->n; i++)
+        x[i] *= -sh;
+    return 0;
 }
 
 static const gsl_odeiv2_step_type *step_type(ts_integrator m)
@@ -456,6 +496,8 @@ void ts_sim_free(ts_sim *s)
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);
     tsi_esdirk_free(s->sd);
+    if (s->sh.numeric)
+        tsi_shift_free(&s->sh);
     ts_linear_free(s->lin);
     free(s->y);
     free(s->y_int);
@@ -520,6 +562,7 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     if (!s->y || !s->work || !s->breaks)
         goto nomem;
     s->nbreaks = ts_excitation_breakpoints(ex, o->t_end, s->breaks, nb);
+    int sparse = 0;
     if (needs_jacobian(o->integrator)) {
         s->lin = ts_linear_alloc(k, err);
         if (!s->lin) {
@@ -529,10 +572,21 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         ts_linearize_opts_default(&s->lopts);
         s->lopts.estimate_error = 0;
         s->lopts.threads = o->jacobian_threads;
+        /* GSL's implicit steppers take a dense Jacobian; esdirk solves
+         * with the sparse model where it covers the system (not with a
+         * vehicle). */
+        sparse = o->integrator == TS_INT_ESDIRK &&
+                 ts_kernel_nvehicles(k) == 0 && s->n == 2 * s->nq;
+        s->lopts.model = sparse ? TS_LIN_SPARSE : TS_LIN_DENSE;
     }
     if (o->integrator == TS_INT_ESDIRK) {
-        s->sd = tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk, s,
-                                 o->rel_tol, o->abs_tol, s->h, err);
+        const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk};
+        s->sd = sparse ? tsi_esdirk_alloc_lsys(s->n, rhs_esdirk, &lsys, s,
+                                               o->rel_tol, o->abs_tol, s->h,
+                                               err)
+                       : tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk,
+                                          s, o->rel_tol, o->abs_tol, s->h,
+                                          err);
         if (!s->sd) {
             ts_sim_free(s);
             return NULL;
@@ -870,10 +924,17 @@ int ts_simulate(ts_kernel *k, const ts_excitation *ex, const double y0[],
                        h->capacity - h->nsamples, N);
     if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err)))
         return rc;
-    ts_sim *s = ts_sim_alloc(k, ex, o, err);
-    if (!s)
-        return err ? err->code : TS_ENOMEM;
-    rc = ts_sim_set_state(s, 0.0, y0, err);
+    double *ys = malloc((size_t)ts_kernel_nstate(k) * sizeof(double));
+    if (!ys)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    rc = ts_sim_start_state(k, ex, y0, ys, err);
+    ts_sim *s = rc ? NULL : ts_sim_alloc(k, ex, o, err);
+    if (!s) {
+        free(ys);
+        return rc ? rc : err ? err->code : TS_ENOMEM;
+    }
+    rc = ts_sim_set_state(s, 0.0, ys, err);
+    free(ys);
     if (!rc)
         rc = ts_sim_record(s, h, err);
     for (int i = 1; i < N && !rc; i++) {
@@ -892,6 +953,74 @@ int ts_simulate(ts_kernel *k, const ts_excitation *ex, const double y0[],
 
 /* ------------------------------------------------------------------ */
 /* Initial states                                                       */
+
+int ts_sim_start_state(ts_kernel *k, const ts_excitation *ex,
+                       const double y0[], double y[], ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int n = ts_kernel_nstate(k), nn = sys->nnodes;
+    if (y != y0)
+        memcpy(y, y0, (size_t)n * sizeof(double));
+    double du[6];
+    if (!ex || !ts_excitation_start_jump(ex, du) ||
+        (du[3] == 0 && du[4] == 0 && du[5] == 0))
+        return TS_OK;
+    double *f = malloc((size_t)n * sizeof(double));
+    double *r = malloc(6 * (size_t)nn * sizeof(double));
+    double *dp = calloc(6 * (size_t)nn, sizeof(double));
+    if (!f || !r || !dp) {
+        free(f);
+        free(r);
+        free(dp);
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    }
+    double *v = r + 3 * nn, *dv = dp + 3 * nn;
+    int rc = ts_kernel_eval(k, y0, NULL, f);
+    if (rc == TS_OK) {
+        memcpy(r, ts_kernel_positions(k), 3 * (size_t)nn * sizeof(double));
+        memcpy(v, ts_kernel_velocities(k), 3 * (size_t)nn * sizeof(double));
+        /* Only the velocity jumps: a displacement the signal has at t = 0
+         * is where the tow point rests before, and the cable with it. */
+        memcpy(dv, du + 3, 3 * sizeof(double));
+    }
+    /* Links in order, upper nodes first: each absorbs its upper node's
+     * jump (dp, dv) whole (elastic) or in its normal part (rigid), and
+     * passes the rest to its lower node. */
+    for (int l = 0; rc == TS_OK && l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        int p = L->upper, q = L->lower;
+        const double *pp = dp + 3 * p, *pv = dv + 3 * p;
+        if (!pp[0] && !pp[1] && !pp[2] && !pv[0] && !pv[1] && !pv[2])
+            continue;
+        double d[3], dd[3];
+        for (int j = 0; j < 3; j++) {
+            d[j] = r[3 * q + j] - r[3 * p + j] - pp[j];
+            dd[j] = v[3 * q + j] - v[3 * p + j] - pv[j];
+        }
+        if (!L->elastic) {
+            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            double along = 0.0;
+            for (int j = 0; j < 3; j++)
+                d[j] *= L->length / len;
+            for (int j = 0; j < 3; j++)
+                along += d[j] * dd[j] / (L->length * L->length);
+            for (int j = 0; j < 3; j++) {
+                dd[j] -= along * d[j];
+                /* The lower node's jump: its new place less its old. */
+                dp[3 * q + j] = r[3 * p + j] + pp[j] + d[j] - r[3 * q + j];
+                dv[3 * q + j] = v[3 * p + j] + pv[j] + dd[j] - v[3 * q + j];
+            }
+        }
+        tsi_kernel_set_link(k, l, d, dd, TS_CHART_RECHART, y);
+    }
+    free(f);
+    free(r);
+    free(dp);
+    if (rc != TS_OK)
+        return ts_fail(err, rc, "simulate: the kernel refuses the initial "
+                       "state (%s)", ts_strerror(rc));
+    return TS_OK;
+}
 
 int ts_sim_released_state(ts_kernel *k, double theta1, double theta2,
                           double y[], ts_err *err)
@@ -1144,6 +1273,10 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EINVAL, "simulate (linear): the model has %d "
                        "states, the kernel %d and the history %d links", n,
                        ts_kernel_nstate(k), h->nlinks);
+    if (!lin->A || !lin->B)
+        return ts_fail(err, TS_EINVAL, "simulate (linear): the linear "
+                       "simulation needs the dense A and B (linearize with "
+                       "model TS_LIN_DENSE or BOTH)");
     if (ex && ts_excitation_has_manoeuvre(ex))
         return ts_fail(err, TS_EDOMAIN, "simulate (linear): the linear model "
                        "has no frame inputs: a speed or turn-rate manoeuvre "
@@ -1179,6 +1312,37 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     }
     if (z0)
         memcpy(z, z0, sn * sizeof(double));
+    /* An impulsive start (ts_sim_start_state) to first order: the tow
+     * point's jump in velocity passes down the links, each elastic one
+     * absorbing it whole and each rigid one its normal part; dr holds the
+     * node velocities relative to the tow point that this makes (the jump
+     * a node takes less the tow point's), and the rates follow
+     * (tsi_desc_from_nodes). */
+    double du[6];
+    if (ex && ts_excitation_start_jump(ex, du)) {
+        const ts_system *sys = ts_kernel_system(k);
+        for (int part = 1; part < 2; part++) {
+            /* jump[] of every node in ywork (3 nnodes <= 2 n). */
+            double *jump = ywork;
+            memcpy(jump, du + 3 * part, 3 * sizeof(double));
+            dr[0] = dr[1] = dr[2] = 0.0;
+            for (int l = 0; l < sys->nlinks; l++) {
+                const ts_link *L = &sys->links[l];
+                const double *n = lin->n0 + 3 * l, *jp = jump + 3 * L->upper;
+                double along = L->elastic ? 0.0
+                                          : n[0] * jp[0] + n[1] * jp[1] +
+                                                n[2] * jp[2];
+                for (int c = 0; c < 3; c++) {
+                    jump[3 * L->lower + c] = along * n[c];
+                    dr[3 * L->lower + c] =
+                        jump[3 * L->lower + c] - du[3 * part + c];
+                }
+            }
+            tsi_desc_from_nodes(sys, lin, dr, tmp);
+            for (int i = 0; i < lin->nq; i++)
+                z[part * lin->nq + i] += tmp[i];
+        }
+    }
     if (o->linear_method == TS_LINSIM_ODE &&
         o->integrator == TS_INT_ESDIRK) {
         sd = tsi_esdirk_alloc(n, lin_rhs_esdirk, lin_jac_esdirk, &L,

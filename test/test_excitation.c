@@ -21,6 +21,10 @@
  *     at full amplitude, the derivatives by differences during and after
  *     the fade-in (whose end is a breakpoint), one signal per driven axis
  *     sharing the components, the rms and the time scale, refusals.
+ *  8. The smooth start of a sine or crank: the signal times S(t / ramp),
+ *     written out here, exact derivatives across the ramp's end (a
+ *     breakpoint), no jump at t = 0 (ts_excitation_start_jump), the
+ *     parser's default of two periods, ramp=0 for an impulsive start.
  * Tolerances are stated at each check. */
 #include "towstab/excitation.h"
 
@@ -628,10 +632,95 @@ static void test_sum(void)
     ts_excitation_free(cp);
 }
 
+/* Section 8: the smooth start. */
+static void test_smooth_start(void)
+{
+    ts_signal s = {0};
+    s.type = TS_SIGNAL_SINE;
+    s.axis = TS_AXIS_HEAVE;
+    s.amplitude = 0.03048;
+    s.frequency = 0.8375;
+    s.phase = 0.4;
+    s.ramp = 2.3;
+    ts_excitation *ex = one(&s);
+    double u[9], w = 2 * M_PI * s.frequency, maxd = 0;
+    for (int i = 0; i < 30; i++) {
+        double t = 0.1 * i + 0.013, xi = t / 2.3;
+        double R = xi >= 1 ? 1 : xi * xi * xi * (10 - 15 * xi + 6 * xi * xi);
+        ts_excitation_input(ex, t, u);
+        maxd = fmax(maxd, fabs(u[2] - R * s.amplitude * sin(w * t + 0.4)));
+    }
+    CHECK(maxd < 1e-16, "smooth sine: A sin(w t + phase) S(t / ramp) (max "
+          "err %.2g m < 1e-16)", maxd);
+    double ev, ea;
+    /* FD step 1e-5 s as in section 1; across the ramp's end S is C2. */
+    fd_check(ex, 2, 0.0, 5.0, 80, 1e-5, &ev, &ea);
+    CHECK(ev < 1e-8 && ea < 1e-7, "smooth sine: v, a are the derivatives "
+          "through the start (max err %.2g m/s, %.2g m/s^2)", ev, ea);
+    double du[6];
+    ts_excitation_input(ex, 0.0, u);
+    CHECK(!ts_excitation_start_jump(ex, du) && u[2] == 0 && u[5] == 0 &&
+              u[8] == 0,
+          "smooth sine: at rest at t = 0, no jump");
+    double bp[4];
+    int nb = ts_excitation_breakpoints(ex, 10.0, bp, 4);
+    CHECK(nb == 1 && bp[0] == 2.3, "smooth sine: the ramp's end is a "
+          "breakpoint (%d: %g s)", nb, nb ? bp[0] : NAN);
+    ts_excitation_free(ex);
+    s.ramp = 0;
+    ex = one(&s);
+    int jump = ts_excitation_start_jump(ex, du);
+    CHECK(jump && fabs(du[2] - s.amplitude * sin(0.4)) < 1e-17 &&
+              fabs(du[5] - s.amplitude * w * cos(0.4)) < 1e-16 && du[0] == 0,
+          "impulsive sine: jumps by A sin(phase), A w cos(phase) at t = 0");
+    ts_excitation_free(ex);
+    /* The crank's displacement jumps without a ramp. */
+    s = (ts_signal){0};
+    s.type = TS_SIGNAL_CRANK;
+    s.axis = TS_AXIS_SURGE;
+    s.amplitude = 0.1;
+    s.rod = 0.35;
+    s.frequency = 0.625;
+    ex = one(&s);
+    jump = ts_excitation_start_jump(ex, du);
+    CHECK(jump && fabs(du[0] - 0.1) < 1e-16 && du[3] == 0,
+          "impulsive crank: jumps by its radius at phase 0");
+    ts_excitation_free(ex);
+
+    ts_err err = {0};
+    ts_units *units = ts_units_alloc(&err);
+    ex = ts_excitation_alloc(&err);
+    int rc = ts_excitation_parse(ex, "tow.heave:amplitude=0.1ft,"
+                                 "frequency=0.25Hz", units, "--excite", &err);
+    char buf[256];
+    ts_excitation_describe(ex, 0, buf, sizeof buf);
+    CHECK(rc == TS_OK && ts_excitation_signal(ex, 0)->ramp == 8.0 &&
+              strstr(buf, "smooth start over 8 s (2 periods)"),
+          "parser: a smooth start over two periods by default: %s", buf);
+    rc = ts_excitation_parse(ex, "tow.heave:type=crank,amplitude=0.1ft,"
+                             "rod=0.35ft,period=4s,ramp=0", units, "--excite",
+                             &err);
+    ts_excitation_describe(ex, 1, buf, sizeof buf);
+    CHECK(rc == TS_OK && ts_excitation_signal(ex, 1)->ramp == 0 &&
+              strstr(buf, "impulsive start"),
+          "parser: ramp=0 starts impulsively: %s", buf);
+    rc = ts_excitation_parse(ex, "tow.heave:amplitude=1,frequency=1,ramp=-1",
+                             units, "--excite", &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "ramp"),
+          "a negative ramp refused: %s", err.msg);
+    rc = ts_excitation_parse(ex, "tow.heave:type=step,amplitude=1,ramp=2",
+                             units, "--excite", &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "ramp"),
+          "ramp does not apply to a step: %s", err.msg);
+    ts_excitation_free(ex);
+    ts_units_free(units);
+}
+
 int main(void)
 {
     test_sum();
     test_shapes();
+    test_smooth_start();
     test_series();
     test_manoeuvres();
     test_meta();

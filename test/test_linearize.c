@@ -34,6 +34,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tscene.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
 
@@ -41,11 +42,7 @@ static ts_units *units;
 
 static ts_scene *scene_from(const char *yaml)
 {
-    ts_err err = {0};
-    ts_scene *s = ts_scene_parse(yaml, strlen(yaml), "test", units, &err);
-    if (!s)
-        printf("scene: %s\n", err.msg);
-    return s;
+    return tscene_parse(units, yaml);
 }
 
 /* A towed cable with a sphere, in water, straight tow, tow point 0.7 m

@@ -8,7 +8,7 @@
 
 #include "towstab/scene.h"
 
-static ts_scene *tscene_load(const ts_units *u, const char *path)
+static inline ts_scene *tscene_load(const ts_units *u, const char *path)
 {
     ts_err err = {0};
     ts_scene *s = u ? ts_scene_load(path, u, &err) : NULL;

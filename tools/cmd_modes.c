@@ -20,12 +20,19 @@ void cli_print_linearization(const ts_result *r)
     const ts_linear *l = r->lin;
     if (!l)
         return;
-    printf("linearized: %d states, %d inputs, %ld kernel evaluations on %d "
-           "thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
-           "||dA||_F %.3g), rounding noise ||N||_F %.3g\n",
-           l->nstate, l->ninput, l->evaluations, l->threads,
-           l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->trunc_err,
-           l->a_scale, l->trunc_norm, l->round_norm);
+    if (l->A)
+        printf("linearized: %d states, %d inputs, %ld kernel evaluations on "
+               "%d thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
+               "||dA||_F %.3g), rounding noise ||N||_F %.3g\n",
+               l->nstate, l->ninput, l->evaluations, l->threads,
+               l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->trunc_err,
+               l->a_scale, l->trunc_norm, l->round_norm);
+    else
+        printf("linearized: %d states, sparse model (%d perturbation groups, "
+               "%ld residual evaluations on %d thread%s), %.3f ms; relative "
+               "truncation error %.3g\n",
+               l->nstate, l->groups, l->residual_evaluations, l->threads,
+               l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->desc_err);
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
         ts_system_node_name(r->sys, l->kink_node, name, sizeof name);
@@ -70,7 +77,9 @@ static void print_verdict(const ts_result *r)
 {
     const ts_eigen *e = r->eigen;
     const ts_stability *st = &r->stability;
-    const char *scope = e->complete ? "" : " among the modes computed";
+    const char *scope = e->complete         ? ""
+                        : e->sweep_shifts > 0 ? " among the eigenvalues found"
+                                              : " among the modes computed";
     if (!st->estimated) {
         switch (e->verdict) {
         case TS_STABLE:
@@ -155,6 +164,14 @@ static void print_modes(const ts_result *r, int quiet)
         printf(", %d restarts, %d operator applications", e->arpack_iterations,
                e->arpack_ops);
     printf("\n");
+    if (e->sweep_shifts > 0)
+        printf("rightmost search: %d shifts up to %.4g Hz found %d more "
+               "eigenvalues%s; the rightmost: Re %.6g 1/s at %.6g Hz\n",
+               e->sweep_shifts, e->top_hz, e->sweep_found,
+               e->sweep_failed || e->sweep_rejected ? " (some runs stopped "
+                                                      "short)"
+                                                    : "",
+               e->rightmost.re, e->rightmost.freq_hz);
     if (e->nmodes < r->nmodes_computed)
         printf("listed: %d of them (%s)\n", e->nmodes,
                r->nmodes_computed > 0 && e->nmodes > 0 &&
@@ -210,7 +227,7 @@ static void print_modes(const ts_result *r, int quiet)
     }
     if (r->mode_accuracy)
         print_verdict(r);
-    if (!e->complete)
+    if (!e->complete && e->sweep_shifts == 0)
         printf("note: only %d of %d eigenvalues were computed (those nearest "
                "%.6g Hz); modes elsewhere are not covered by the verdict\n",
                e->neig, e->nstate, e->target_hz);
@@ -387,8 +404,11 @@ enum { X_MATRICES, X_SHAPES };
 
 static int modes_prepare(cli_run *c)
 {
-    if (c->nextra[X_MATRICES])
+    if (c->nextra[X_MATRICES]) {
         c->json_flags |= TS_REPORT_MATRICES;
+        /* The dense A and B at any size, beside the sparse model. */
+        c->rq.modes.linearize.model = TS_LIN_BOTH;
+    }
     return 0;
 }
 

@@ -10,12 +10,12 @@
  *    in Hz; 0 gives the lowest modes, smallest |lambda|) by implicitly
  *    restarted Arnoldi (ARPACK) in shift-invert mode, OP = (A - sigma I)^-1:
  *    dnaupd/dneupd for a real shift, znaupd/zneupd for a complex one. The
- *    operator uses the structure A = [[0, I], [K, C]]: (A - s I) x = b
- *    reduces to one nq x nq solve with P(s) = K + s C - s^2 I, factored
- *    once by LAPACK (dgetrf or zgetrf): O(nq^3) once, O(nq^2) per
- *    application.
+ *    operator is a solve with the sparse linear model (ts_linear.desc,
+ *    doc/linear.md section 2b): one KLU factorisation of the shifted node
+ *    equations, O(nlinks), then O(nlinks) per application.
  *  - auto: arpack when a number of modes is asked for and nstate >=
- *    arpack_min_states, else lapack.
+ *    arpack_min_states or the dense A was not formed, else lapack.
+ * lapack needs the dense A, arpack the sparse model.
  *
  * A mode is one eigenvalue with Im >= 0: one of each complex-conjugate
  * pair, or a real (non-oscillatory) eigenvalue. Units: lambda in 1/s,
@@ -50,6 +50,10 @@ typedef struct ts_eigen_opts {
                               precision */
     int arpack_max_iter;   /* restarts; default 1000 */
     int vectors;           /* 1 (default): keep the right eigenvectors */
+    int rightmost;         /* 1 (default): with arpack, also search the
+                              whole spectrum for the eigenvalues with the
+                              largest real parts (doc/linear.md, section
+                              3); the verdict covers what it finds */
 } ts_eigen_opts;
 
 typedef struct ts_mode {
@@ -67,12 +71,15 @@ typedef struct ts_mode {
                                linearization's error estimate E
                                (ts_linear.Aerr), |u^H E v| / |u^H v|
                                (lapack; ||E v|| / |v| with arpack, which
-                               has no left vector u), plus rounding
+                               has no left vector u, E the sparse model's
+                               error estimate), plus rounding
                                kappa eps ||A_bal|| (lapack: the balanced
                                matrix's 1-norm and condition number from
-                               dgeevx) or eps ||A||_F (arpack) */
-    double residual;        /* ||A v - lambda v|| / (||A||_F |v|); NaN when
-                               not computed (lapack: backward stable) */
+                               dgeevx) or the residual ||A v - lambda v||
+                               / |v| (arpack) */
+    double residual;        /* ||A v - lambda v|| / (|lambda| |v|); NaN
+                               when not computed (lapack: backward
+                               stable) */
     double vector_condition;/* conditioning of the right eigenvector: the
                                largest kappa_k ||A_bal||_1 / |lambda -
                                lambda_k| over the other eigenvalues k
@@ -107,16 +114,31 @@ typedef struct ts_eigen {
     double *vec_re, *vec_im;/* [nstate * nmodes] right eigenvectors, column
                                m for mode m, unit 2-norm, largest entry
                                real; NULL unless opts.vectors */
-    double max_real;        /* max Re lambda over the modes, 1/s */
-    double max_real_error;  /* error_bound of that mode, 1/s */
-    int verdict;            /* TS_STABLE, TS_UNSTABLE or TS_MARGINAL */
-    int arpack_iterations;  /* restarts used (arpack) */
-    int arpack_ops;         /* applications of OP (arpack) */
-    int arpack_nconv;       /* Ritz values converged (arpack) */
+    double max_real;        /* max Re lambda over the eigenvalues the
+                               verdict covers, 1/s */
+    double max_real_error;  /* error_bound of that eigenvalue, 1/s */
+    ts_mode rightmost;      /* that eigenvalue (Im >= 0) as a mode: every
+                               field but the shape's; with lapack the
+                               rightmost of all */
+    int verdict;            /* TS_STABLE, TS_UNSTABLE or TS_MARGINAL, over
+                               every eigenvalue with lapack; with arpack
+                               over the modes and the 4 rightmost
+                               eigenvalues the search found */
+    double top_hz;          /* the highest band top of the discretisation
+                               the search estimated, Hz (NaN without it) */
+    int sweep_shifts;       /* shifts of the rightmost search (0: none) */
+    int sweep_failed;       /* of those, runs that did not converge */
+    int sweep_rejected;     /* Ritz pairs of the search dropped for their
+                               residual (not converged) */
+    int sweep_found;        /* eigenvalues it found besides the modes (2
+                               per complex pair) */
+    int arpack_iterations;  /* restarts used (arpack, all runs) */
+    int arpack_ops;         /* applications of OP (arpack, all runs) */
+    int arpack_nconv;       /* Ritz values converged (arpack, all runs) */
 } ts_eigen;
 
-/* Verdicts: stable when every mode has re + error_bound < 0; unstable
- * when some mode has re - error_bound > 0; marginal otherwise (a margin
+/* Verdicts: stable when every eigenvalue covered has re + error_bound < 0;
+ * unstable when one has re - error_bound > 0; marginal otherwise (a margin
  * smaller than its error, e.g. an undamped system). */
 enum { TS_STABLE = 0, TS_UNSTABLE = 1, TS_MARGINAL = 2 };
 

@@ -17,6 +17,9 @@
  *  - sine:   A sin(w t + phase), for all t >= 0;
  *  - crank:  slider crank of radius A and rod l (doc/model.md section 8),
  *            A cos(th) + l (1 - sqrt(1 - (A/l)^2 sin^2 th)), th = w t + phase;
+ *            a sine or crank starts smoothly: times S(t / ramp) (S below),
+ *            full from t = ramp on (default two periods; ramp = 0 starts
+ *            at full amplitude, a jump at t = 0);
  *  - step:   0 before `start`, A after `start + rise`, in between the quintic
  *            A S(xi), S(xi) = 10 xi^3 - 15 xi^4 + 6 xi^5, xi = (t-start)/rise:
  *            displacement, velocity and acceleration are continuous;
@@ -54,6 +57,8 @@ extern "C" {
 #endif
 
 #define TS_SIGNAL_RISE 0.1   /* default rise / corner time of steps, ramps, s */
+#define TS_SIGNAL_RAMP_PERIODS 2.0 /* default smooth start of a sine or crank,
+                                      periods */
 
 typedef enum {
     TS_SIGNAL_SINE = 0,
@@ -86,6 +91,13 @@ typedef struct ts_signal {
     double start;      /* s, >= 0 (step, ramp) */
     double duration;   /* s, > 0 (ramp) */
     double rise;       /* s, > 0 (step, ramp); >= 0 fade-in (sum) */
+    double ramp;       /* s, >= 0 (sine, crank): the signal starts
+                          smoothly, times S(t / ramp) (the quintic of the
+                          steps), reaching full amplitude at t = ramp; 0
+                          (a zeroed struct) starts at full amplitude, a
+                          jump in velocity (sine) or displacement (crank)
+                          at t = 0. The parser's default is two periods
+                          (TS_SIGNAL_RAMP_PERIODS) */
     int absolute;      /* manoeuvres: amplitude is the final value */
 } ts_signal;
 
@@ -140,7 +152,8 @@ TS_API int ts_excitation_read_series(ts_excitation *ex, ts_axis axis,
  * turn_rate. Keys: type (sine, crank, step, ramp, csv; default sine on tow
  * axes, ramp on manoeuvres), amplitude, frequency or period, phase, rod,
  * start, duration, rise, to (final value, manoeuvres), by (change,
- * manoeuvres), file (csv). Values may carry units ("0.1ft", "0.25 Hz",
+ * manoeuvres), file (csv), ramp (sine and crank: the smooth start, s;
+ * default two periods; 0 for an impulsive start). Values may carry units ("0.1ft", "0.25 Hz",
  * "30deg", "0.5rad/s"); plain numbers are SI. `where` names the origin in
  * messages ("--excite"). Unknown axes, types and keys, missing or
  * conflicting keys and out-of-range values give TS_EINVAL or TS_EUNIT. */
@@ -151,6 +164,12 @@ TS_API int ts_excitation_parse(ts_excitation *ex, const char *spec,
 TS_API int ts_excitation_nsignals(const ts_excitation *ex);
 /* Signal i, 0 <= i < nsignals (a series reports type TS_SIGNAL_SERIES). */
 TS_API const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i);
+
+/* The jump of the tow point's displacement and velocity at t = 0 (u(0+)
+ * less the rest state before, zero): nonzero only for a sine or crank
+ * started impulsively (ramp 0). du[0..3) displacement (m), du[3..6)
+ * velocity (m/s). Returns 1 when there is a jump. */
+TS_API int ts_excitation_start_jump(const ts_excitation *ex, double du[6]);
 
 /* 1 when any signal drives the speed or the turn rate. */
 TS_API int ts_excitation_has_manoeuvre(const ts_excitation *ex);
@@ -172,8 +191,9 @@ TS_API double ts_excitation_heading(const ts_excitation *ex,
                                     const ts_frame *base, double t);
 
 /* Times in (0, t_end) where a signal is not smooth (ends of steps, ramp
- * corners, the end of a sum's fade-in), sorted, without duplicates; writes at most `max` of them to
- * out and returns how many there are. */
+ * corners, the end of a smooth start or of a sum's fade-in), sorted,
+ * without duplicates; writes at most `max` of them to out and returns how
+ * many there are. */
 TS_API int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
                                      double out[], int max);
 

@@ -1,7 +1,18 @@
 /* towstab/linearize.h: the linear model z' = A z + B v about a state
  * (doc/model.md section 6; Kamman & Nguyen eqs. 56-65; doc/linear.md).
  *
- * A = df/dy and B = df/du by second-order central differences through the
+ * Two forms of the same model (ts_linearize_opts.model):
+ *  - the sparse model (desc): the kernel's node equations before
+ *    elimination, E x' = F x + G u with the node displacements, velocities
+ *    and link tensions as unknowns, from coloured central differences of
+ *    the node residual: a fixed number of residual evaluations (18 to 24
+ *    groups on a cable), O(nlinks) time and memory. The eigen analysis
+ *    (arpack), the frequency response and the stiff integrator solve with
+ *    it at any size (doc/linear.md, section 2b);
+ *  - the dense A and B below, O(nlinks^2): LAPACK's eigen analysis, the
+ *    linear time-domain simulation, --matrices.
+ *
+ * Dense: A = df/dy and B = df/du by second-order central differences through the
  * one kernel, column by column (columns are independent and computed in
  * parallel with OpenMP when available, one ts_kernel_clone per thread).
  * The first nq rows of A are exactly [0 I] and of B zero. The step of
@@ -44,14 +55,35 @@ enum {
     TS_IN_ACC = 6     /* tow acceleration x, y, z: columns 6, 7, 8 */
 };
 
+/* The sparse descriptor model (opaque; doc/linear.md, section 2). */
+typedef struct ts_descriptor ts_descriptor;
+
+/* Which linear models ts_linearize forms. */
+typedef enum {
+    TS_LIN_AUTO = 0,   /* the sparse model always; the dense A and B too
+                          when nstate < dense_max_states. A system with a
+                          vehicle: the dense model only */
+    TS_LIN_DENSE = 1,  /* the dense A and B only */
+    TS_LIN_SPARSE = 2, /* the sparse model only (refused with a vehicle) */
+    TS_LIN_BOTH = 3    /* the dense model at any size, and the sparse one
+                          (except with a vehicle) */
+} ts_lin_model;
+
 typedef struct ts_linear {
     int nstate;        /* n = 2 nq + nc (nc controller states) */
     int nq;            /* generalised coordinates (ts_kernel_nq) */
     int ninput;        /* ts_kernel_ninput: TS_NINPUT tow inputs, then the
                           vehicles' surfaces and loops */
     int nlinks, nnodes;
-    double *A;         /* [n * n] column-major; rows 0..nq-1 are [0 I 0] */
-    double *B;         /* [n * ninput] column-major; rows 0..nq-1 zero */
+    double *A;         /* [n * n] column-major; rows 0..nq-1 are [0 I 0];
+                          NULL unless the dense model was formed */
+    double *B;         /* [n * ninput] column-major; rows 0..nq-1 zero;
+                          NULL with A */
+    ts_descriptor *desc; /* the sparse model E x' = F x + G u of the node
+                          equations (O(nlinks) memory), NULL unless
+                          formed (never with vehicles); the eigen,
+                          response and stiff simulation solvers use it at
+                          any size */
     double *y0;        /* [n] state linearized about (kernel's charts) */
     double *u0;        /* [ninput] input linearized about */
     double *f0;        /* [n] f(y0, u0): zero at an exact equilibrium */
@@ -111,7 +143,13 @@ typedef struct ts_linear {
                           Tu) are affected, not A */
     int kink_node;     /* first such node other than the tow point, or -1 */
     int threads;       /* threads used */
-    long evaluations;  /* kernel evaluations used */
+    long evaluations;  /* kernel evaluations used (dense model) */
+    long residual_evaluations; /* node-residual evaluations (sparse) */
+    int groups;        /* perturbation groups of the sparse model's
+                          coloured differences (independent of nlinks) */
+    double desc_err;   /* largest relative error estimate of the sparse
+                          model, max(|dK|/max|K|, |dC|/max|C|); NaN
+                          without the estimate or the model */
 } ts_linear;
 
 typedef struct ts_linearize_opts {
@@ -119,20 +157,29 @@ typedef struct ts_linearize_opts {
     int estimate_error;/* 1 (default): also differentiate with 2h */
     int threads;       /* 0 (default): OpenMP's choice from 200 links on,
                           serial below; 1: serial; k: k threads */
-    int tensions;      /* 1: also fill Ty and Tu (default 0) */
+    int tensions;      /* 1: also fill Ty and Tu (dense model; default 0) */
+    ts_lin_model model;/* default TS_LIN_AUTO */
+    int dense_max_states; /* TS_LIN_AUTO forms the dense model below this
+                          many states; default 1200 (300 rigid links) */
 } ts_linearize_opts;
 
 TS_API void ts_linearize_opts_default(ts_linearize_opts *o);
 
-/* Allocate a result sized for kernel k's system: A is n x n doubles, so
- * 8 n^2 bytes (n = 4 nlinks; 2000 links: 512 MB). NULL on failure. */
+/* Allocate a result sized for kernel k's system (O(nlinks); the dense A,
+ * n x n doubles, 8 n^2 bytes, is allocated by ts_linearize only when the
+ * dense model is formed). NULL on failure. */
 TS_API ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err);
 TS_API void ts_linear_free(ts_linear *lin);
 
 /* Linearize kernel k about state y0[nstate] and input u0[ninput] (NULL:
- * zero). The kernel's charts must be those of y0; the kernel's frame is
- * used as set. Cost: (2 or 4) (n + 9) kernel evaluations, O(nlinks) each,
- * so O(nlinks^2), divided among the threads. On return the kernel's
+ * zero), forming the models opts->model asks for. The kernel's charts must
+ * be those of y0; the kernel's frame is used as set. Cost: sparse model
+ * 2 or 4 residual evaluations per group (18 to 24 groups), O(nlinks);
+ * dense model (2 or 4) (n + 9) kernel evaluations, O(nlinks) each, so
+ * O(nlinks^2); both divided among the threads. The sparse model is exact
+ * about a state at rest relative to M (an equilibrium); elsewhere its maps
+ * to the kernel's coordinates omit terms of first order in the link
+ * rates. On return the kernel's
  * last-evaluation results are those of (y0, u0). Returns TS_OK, TS_CHART
  * (a perturbed state left the chart: re-chart y0 first), TS_ESINGULAR (the
  * kernel failed at a perturbed state), TS_EINVAL (sizes differ) or

@@ -11,13 +11,11 @@
  *    the tow displacement (every node moves with the tow point) plus the
  *    node displacement of the angle response through the link geometry
  *    (ts_linear_node_displacements);
- *  - a link's tension (N per m): dT/dy Z + (dT/dx + i w dT/dv - w^2 dT/da) X
- *    from the tension Jacobians of the linearization (needs
- *    ts_linearize_opts.tensions = 1).
- * Each frequency is one complex nq x nq LU (LAPACK zgetrf) of
- * P = K + s C - s^2 I, s = i w, via the structure of A: O(nq^3) per point.
- * At w = 0 the response is the static gain -C A^-1 B_x + D, which must equal
- * the change of the equilibrium with the tow point displaced.
+ *  - a link's tension (N per m), the tension unknown of the same solve.
+ * Each frequency is one sparse solve with the linear model's node
+ * equations (ts_linear.desc; doc/linear.md, sections 2b and 4): O(nlinks)
+ * per point, at any size. At w = 0 the response is the static gain, which
+ * must equal the change of the equilibrium with the tow point displaced.
  */
 #ifndef TOWSTAB_RESPONSE_H
 #define TOWSTAB_RESPONSE_H
@@ -86,11 +84,12 @@ typedef struct ts_response {
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at
- * freq_hz[npoints] (Hz, each >= 0). On success *res is new (free with
- * ts_response_free). Returns TS_OK, TS_EINVAL (bad channel, negative
- * frequency, tension output without tension Jacobians), TS_ESINGULAR (i w
- * is an eigenvalue: an undamped resonance exactly on a point) or
- * TS_ENOMEM. */
+ * freq_hz[npoints] (Hz, each >= 0). lin must hold the sparse model
+ * (ts_linearize with TS_LIN_AUTO, SPARSE or BOTH). On success *res is new
+ * (free with ts_response_free). Returns TS_OK, TS_EINVAL (bad channel,
+ * negative frequency, no sparse model, a system other than lin's),
+ * TS_ESINGULAR (i w is an eigenvalue: an undamped resonance exactly on a
+ * point) or TS_ENOMEM. */
 TS_API int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                                int input, const ts_output *out,
                                const double freq_hz[], int npoints,

@@ -9,7 +9,10 @@
  * implicit methods for stiff scenes (GSL's rk4imp, bsimp, msbdf, and
  * esdirk: SUNDIALS ARKODE's L-stable ESDIRK 5(4), the one for elastic
  * cables) whose Jacobian df/dy comes from the linearizer
- * (towstab/linearize.h). Steps never
+ * (towstab/linearize.h): GSL's the dense A, O(nlinks^2) per Jacobian and
+ * O(nlinks^3) per LU; esdirk's the sparse model, O(nlinks) per Jacobian,
+ * factorisation and solve. A run starts from ts_sim_start_state of its
+ * initial state (an impulsive start absorbed by the top links). Steps never
  * straddle an output time or a breakpoint of the excitation. After every
  * accepted step, links with |cos theta2| below the re-chart threshold are
  * moved to a chart centred on their direction (ts_kernel_rechart) and the
@@ -177,8 +180,10 @@ TS_API void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st);
  * (TS_EINVAL when h is full). */
 TS_API int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err);
 
-/* Driver: simulate from y0 (kernel charts) over [0, o->t_end], recording
- * every output sample (h needs ts_sim_nsamples(o) samples). y_end[2 nq]
+/* Driver: simulate from y0 (kernel charts; the system before the tow
+ * point moves: the run starts from ts_sim_start_state(k, ex, y0)) over
+ * [0, o->t_end], recording every output sample (h needs ts_sim_nsamples(o)
+ * samples). y_end[2 nq]
  * (may be NULL) receives the final state in the kernel's charts, which
  * may have changed. On failure the history holds the samples reached and
  * *st the statistics so far. */
@@ -203,6 +208,23 @@ TS_API int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                               ts_sim_stats *st, ts_err *err);
 
 /* --- Initial states. --- */
+
+/* The state at t = 0+ of a run started from y0[2 nq] (the system before
+ * the tow point moves) under ex: y0 itself unless a tow signal starts
+ * impulsively (a sine or crank with ramp 0: ts_excitation_start_jump),
+ * which sets the tow point moving at once. Its coordinates being relative
+ * to the tow point, y0 would then move every node with it; instead the
+ * jump in velocity is absorbed where the cable can: a link leaving a node
+ * that jumps takes the jump whole when elastic (its lower node keeps its
+ * velocity: a rate of stretch, the start of an axial wave), and only the
+ * part normal to itself when rigid (the part along it moves its lower
+ * node, and so on down). A displacement the signal has at t = 0 (a crank
+ * at phase 0) is where the tow point rested before: the cable starts
+ * there with it. Writes y[2 nq] (may alias y0) in k's charts. ts_simulate
+ * starts from this state; doc/simulate.md. Returns TS_OK or TS_ESINGULAR
+ * (the kernel refuses y0). */
+TS_API int ts_sim_start_state(ts_kernel *k, const ts_excitation *ex,
+                              const double y0[], double y[], ts_err *err);
 
 /* A released shape: every link along the unit direction of angles
  * (theta1, theta2) (rad; n = (-c1 c2, -s2, s1 c2): 0, 0 is straight aft,

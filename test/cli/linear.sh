@@ -60,6 +60,27 @@ else
     fail "modes --json -: status $status"
 fi
 
+# A large system: the sparse model and ARPACK, with the rightmost search.
+# Example 1 at 400 links: the rightmost eigenvalue is the top of the
+# transverse band, -0.0166107 1/s at 53.103 Hz (LAPACK on the same model,
+# test/test_eigen_search.c), not among the 20 modes nearest 0 Hz (whose
+# largest real part is -0.16).
+rm -f "$T/big.json"
+ts modes examples/kamman_ex1_submerged.yaml --links 400 --json "$T/big.json" \
+    --quiet
+cat > "$T/big.expected.json" <<'EOF'
+{"rtol": 1e-4, "atol": 0,
+ "expect": {"complete": false, "rightmost": {"re": -0.0166107, "freq_hz": 53.1029},
+            "linearization": {"model": "sparse"}}}
+EOF
+if [ "$status" -eq 0 ] && has_keys "$T/big.json" rightmost search top_hz &&
+   "$CHECK_JSON" compare "$T/big.json" "$T/big.expected.json" &&
+   grep -q 'rightmost search' "$T/out"; then
+    pass "modes at 400 links: sparse model, the rightmost search finds the band top"
+else
+    fail "modes at 400 links: status $status; $(head -c 300 "$T/err")"
+fi
+
 rm -f "$T/shapes.csv"
 ts modes examples/kamman_ex3_turn.yaml --count 2 --shapes "$T/shapes.csv" --quiet
 if [ "$status" -eq 0 ] && [ "$(wc -l < "$T/shapes.csv")" -gt 20 ]; then

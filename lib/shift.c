@@ -1,0 +1,518 @@
+/* shift.c: solves with the sparse linear model (lib/shift.h; doc/linear.md,
+ * sections 2-4).
+ *
+ * Each solve maps the kernel's coordinates to node displacements (J, down
+ * the tree), builds the right-hand side node by node, runs KLU's
+ * triangular solves (klu_solve, or klu_z_solve in complex arithmetic) and
+ * maps back (J^-1, link by link): O(nlinks) throughout. The equations
+ * behind each right-hand side are in lib/shift.h and lib/descriptor.h.
+ */
+#include "shift.h"
+
+#include <klu.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lapack.h"
+
+#define XR(k, c) (4 * ((k)-1) + (c))
+#define XT(l) (4 * (l) + 3)
+
+void tsi_shift_free(tsi_shift *sh)
+{
+    free(sh->lu);
+    free(sh->zlu);
+    free(sh->ipiv);
+    free(sh->zw);
+    free(sh->wr);
+    if (sh->numeric) {
+        klu_numeric *num = sh->numeric;
+        if (sh->is_complex)
+            klu_z_free_numeric(&num, sh->common);
+        else
+            klu_free_numeric(&num, sh->common);
+    }
+    free(sh->common);
+    free(sh->Sx);
+    free(sh->rhs);
+    free(sh->cols);
+    free(sh->u1);
+    free(sh->u2);
+    free(sh->w);
+    memset(sh, 0, sizeof *sh);
+}
+
+/* ---- Dense backend (lib/shift.h: systems with vehicles) -------------- */
+
+static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                        ts_err *err)
+{
+    memset(sh, 0, sizeof *sh);
+    int nq = lin->nq, n = lin->nstate, info = 0;
+    size_t nn = (size_t)nq * (size_t)nq;
+    sh->lin = lin;
+    sh->nq = nq;
+    sh->n = n;
+    sh->s = s;
+    sh->is_complex = cimag(s) != 0.0;
+    sh->ipiv = malloc((size_t)nq * sizeof(int));
+    sh->zw = malloc((size_t)nq * sizeof(double complex));
+    sh->wr = malloc(2 * (size_t)nq * sizeof(double));
+    if (sh->is_complex)
+        sh->zlu = malloc(nn * sizeof(double complex));
+    else
+        sh->lu = malloc(nn * sizeof(double));
+    if (!sh->ipiv || !sh->zw || !sh->wr || (!sh->zlu && !sh->lu)) {
+        tsi_shift_free(sh);
+        return ts_fail_nomem(err, (sh->is_complex ? 16.0 : 8.0) * (double)nn,
+                             "fewer links", "eigen: out of memory for the "
+                             "%d x %d shifted matrix", nq, nq);
+    }
+    /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
+    const double *A = lin->A;
+    double complex s2 = s * s;
+    for (int j = 0; j < nq; j++) {
+        const double *Kj = A + (size_t)j * n + nq;
+        const double *Cj = A + (size_t)(j + nq) * n + nq;
+        if (sh->is_complex) {
+            double complex *Pj = sh->zlu + (size_t)j * nq;
+            for (int i = 0; i < nq; i++)
+                Pj[i] = Kj[i] + s * Cj[i];
+            Pj[j] -= s2;
+        } else {
+            double *Pj = sh->lu + (size_t)j * nq;
+            double sr = creal(s);
+            for (int i = 0; i < nq; i++)
+                Pj[i] = Kj[i] + sr * Cj[i];
+            Pj[j] -= sr * sr;
+        }
+    }
+    if (sh->is_complex)
+        zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
+    else
+        dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
+    if (info < 0) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d",
+                       sh->is_complex ? "zgetrf" : "dgetrf", info);
+    }
+    if (info > 0) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ESINGULAR,
+                       "the shifted system is singular at s = %g%+gi 1/s "
+                       "(an eigenvalue sits on the shift)",
+                       creal(s), cimag(s));
+    }
+    return TS_OK;
+}
+
+static void dense_solve_real(tsi_shift *sh, const double *b, double *x)
+{
+    int nq = sh->nq, n = sh->n, one = 1, info = 0;
+    double sr = creal(sh->s), mone = -1.0, pone = 1.0;
+    const double *b1 = b, *b2 = b + nq;
+    double *x1 = x, *x2 = x + nq;
+    /* x1 = b2 + s b1 - C b1 */
+    for (int i = 0; i < nq; i++)
+        x1[i] = b2[i] + sr * b1[i];
+    dgemv_("N", &nq, &nq, &mone, sh->lin->A + (size_t)nq * n + nq, &n, b1,
+           &one, &pone, x1, &one, 1);
+    dgetrs_("N", &nq, &one, sh->lu, &nq, sh->ipiv, x1, &nq, &info, 1);
+    for (int i = 0; i < nq; i++)
+        x2[i] = b1[i] + sr * x1[i];
+}
+
+static void dense_solve(tsi_shift *sh, const double complex *b,
+                        double complex *x)
+{
+    int nq = sh->nq, n = sh->n, one = 1, two = 2, info = 0;
+    double complex s = sh->s;
+    const double complex *b1 = b, *b2 = b + nq;
+    double complex *x1 = x, *x2 = x + nq;
+    /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
+     * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
+    double pone = 1.0, zero = 0.0;
+    dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
+           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->zw,
+           &two, 1, 1);
+    for (int i = 0; i < nq; i++)
+        x1[i] = b2[i] + s * b1[i] - sh->zw[i];
+    if (sh->is_complex) {
+        zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
+    } else {
+        /* Real factors: solve the real and imaginary parts together. */
+        double *r = sh->wr;
+        for (int i = 0; i < nq; i++) {
+            r[i] = creal(x1[i]);
+            r[nq + i] = cimag(x1[i]);
+        }
+        dgetrs_("N", &nq, &two, sh->lu, &nq, sh->ipiv, r, &nq, &info, 1);
+        for (int i = 0; i < nq; i++)
+            x1[i] = r[i] + I * r[nq + i];
+    }
+    for (int i = 0; i < nq; i++)
+        x2[i] = b1[i] + s * x1[i];
+}
+
+/* ---- Sparse backend ------------------------------------------------------ */
+
+static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
+{
+    memset(sh, 0, sizeof *sh);
+    if (!lin->desc)
+        return ts_fail(err, TS_EINVAL, "shift: the linear model has no sparse "
+                       "form (linearize with model TS_LIN_AUTO, SPARSE or "
+                       "BOTH)");
+    const ts_descriptor *d = lin->desc;
+    sh->lin = lin;
+    sh->d = d;
+    sh->sys = d->sys;
+    size_t n3 = 3 * (size_t)d->nn;
+    sh->common = malloc(sizeof(klu_common));
+    sh->Sx = malloc(2 * ((size_t)d->nnz + 1) * sizeof(double));
+    sh->rhs = malloc(2 * ((size_t)d->nx + 1) * sizeof(double));
+    sh->cols = malloc(2 * ((size_t)d->nx + 1) * sizeof(double));
+    sh->u1 = malloc(2 * n3 * sizeof(double));
+    sh->u2 = malloc(4 * n3 * sizeof(double));
+    sh->w = malloc(2 * ((size_t)lin->nq + 1) * sizeof(double));
+    if (!sh->common || !sh->Sx || !sh->rhs || !sh->cols || !sh->u1 ||
+        !sh->u2 || !sh->w) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ENOMEM, "shift: out of memory for %d "
+                       "unknowns", d->nx);
+    }
+    memcpy(sh->common, d->klu_common, sizeof(klu_common));
+    return TS_OK;
+}
+
+static int factor(tsi_shift *sh, ts_err *err)
+{
+    const ts_descriptor *d = sh->d;
+    klu_common *kc = sh->common;
+    klu_symbolic *sym = d->klu_symbolic;
+    if (sh->is_complex)
+        sh->numeric = klu_z_factor(d->Sp, d->Si, sh->Sx, sym, kc);
+    else
+        sh->numeric = klu_factor(d->Sp, d->Si, sh->Sx, sym, kc);
+    if (sh->numeric)
+        return TS_OK;
+    int status = kc->status;
+    double complex s = sh->s;
+    tsi_shift_free(sh);
+    if (status == KLU_OUT_OF_MEMORY)
+        return ts_fail(err, TS_ENOMEM, "shift: out of memory for the sparse "
+                       "factors");
+    if (status == KLU_SINGULAR)
+        return ts_fail(err, TS_ESINGULAR, "the shifted system is singular "
+                       "at s = %g%+gi 1/s (an eigenvalue sits on the shift)",
+                       creal(s), cimag(s));
+    return ts_fail(err, TS_ELAPACK, "shift: KLU failed (status %d)", status);
+}
+
+int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                     ts_err *err)
+{
+    if (!lin->desc && lin->A)
+        return dense_factor(sh, lin, s, err);
+    int rc = setup(sh, lin, err);
+    if (rc != TS_OK)
+        return rc;
+    sh->s = s;
+    sh->is_complex = cimag(s) != 0.0;
+    if (sh->is_complex)
+        tsi_desc_fill_complex(sh->d, s, sh->Sx);
+    else
+        tsi_desc_fill_real(sh->d, creal(s), 0, sh->Sx);
+    return factor(sh, err);
+}
+
+int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err)
+{
+    int rc = setup(sh, lin, err);
+    if (rc != TS_OK)
+        return rc;
+    sh->inf = 1;
+    tsi_desc_fill_real(sh->d, 0.0, 1, sh->Sx);
+    rc = factor(sh, err);
+    if (rc == TS_ESINGULAR)
+        ts_fail(err, TS_ESINGULAR, "the nodal mass system is singular");
+    return rc;
+}
+
+void tsi_shift_nodes_to_q(const tsi_shift *sh, const double *dr, double *dq)
+{
+    tsi_desc_from_nodes(sh->sys, sh->lin, dr, dq);
+}
+
+/* dr[3 nn] (dr_0 = 0) from the displacement part of a real solution. */
+static void solution_nodes(const ts_descriptor *d, const double *x, int stride,
+                           double *dr)
+{
+    dr[0] = dr[1] = dr[2] = 0.0;
+    for (int k = 1; k < d->nn; k++)
+        for (int c = 0; c < 3; c++)
+            dr[3 * k + c] = x[stride * XR(k, c)];
+}
+
+/* The link rows' right-hand side of taut elastic links, the damping's
+ * part of a prescribed rate: Cv n.(J w_q)_k - Cv n.(J w_q)_p = Cv l w_e
+ * (w_e the link's strain entry of w_q), taken from the coordinate itself
+ * so that no rounding of n against the direction derivatives is
+ * multiplied by a stiff link's constants. Into rhs at stride. */
+static void taut_rates(const tsi_shift *sh, const double *wq, double *rhs,
+                       int stride)
+{
+    const ts_descriptor *d = sh->d;
+    for (int l = 0; l < d->nl; l++) {
+        double v = 0.0;
+        if (d->kind[l] == TSI_LINK_TAUT)
+            v = d->ca[l] * d->sys->links[l].length * wq[sh->lin->qoff[l] + 2];
+        rhs[stride * XT(l)] = v;
+    }
+}
+
+static void mass_mul(const ts_descriptor *d, int k, const double x[3],
+                     double y[3])
+{
+    const double *S = d->M + 6 * k;
+    y[0] = S[0] * x[0] + S[3] * x[1] + S[4] * x[2];
+    y[1] = S[3] * x[0] + S[1] * x[1] + S[5] * x[2];
+    y[2] = S[4] * x[0] + S[5] * x[1] + S[2] * x[2];
+}
+
+/* The real or imaginary part (part 0, 1) of (s I - A)^-1 w's right-hand
+ * side, w given by its parts wq, wqd (nq each): node rows M (s J wq +
+ * J wqd) + C J wq, link rows of taut links Cv n.(J wq). Only for real s
+ * is this the whole right-hand side; for complex s the caller combines
+ * the parts. u1, u2, cu: [3 nn] work. */
+static void rhs_parts(const tsi_shift *sh, const double *wq, const double *wqd,
+                      double *u1, double *u2, double *cu)
+{
+    ts_linear_node_displacements(sh->sys, sh->lin, wq, u1);
+    ts_linear_node_displacements(sh->sys, sh->lin, wqd, u2);
+    tsi_desc_block_mul(sh->d, sh->d->C, u1, cu, 0);
+}
+
+void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
+{
+    if (!sh->d) {
+        dense_solve_real(sh, b, x);
+        return;
+    }
+    const ts_descriptor *d = sh->d;
+    int nq = sh->lin->nq;
+    size_t n3 = 3 * (size_t)d->nn;
+    double s = creal(sh->s);
+    double *u1 = sh->u1, *u2 = sh->u2, *cu = sh->u2 + n3, *w = sh->w;
+    /* (A - s I) x = b  <=>  (s I - A) x = -b = w. */
+    for (int i = 0; i < 2 * nq; i++)
+        w[i] = -b[i];
+    rhs_parts(sh, w, w + nq, u1, u2, cu);
+    for (int k = 1; k < d->nn; k++) {
+        double v[3], Mv[3];
+        for (int c = 0; c < 3; c++)
+            v[c] = s * u1[3 * k + c] + u2[3 * k + c];
+        mass_mul(d, k, v, Mv);
+        for (int c = 0; c < 3; c++)
+            sh->rhs[XR(k, c)] = Mv[c] + cu[3 * k + c];
+    }
+    taut_rates(sh, w, sh->rhs, 1);
+    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
+    solution_nodes(d, sh->rhs, 1, u2);
+    tsi_shift_nodes_to_q(sh, u2, x);
+    for (int i = 0; i < nq; i++)
+        x[nq + i] = s * x[i] - w[i];
+}
+
+/* Solve with real factors for the interleaved complex right-hand side in
+ * sh->rhs: its real and imaginary parts as two columns. */
+static void two_columns(tsi_shift *sh)
+{
+    int nx = sh->d->nx;
+    double *cols = sh->cols, *rhs = sh->rhs;
+    for (int i = 0; i < nx; i++) {
+        cols[i] = rhs[2 * i];
+        cols[nx + i] = rhs[2 * i + 1];
+    }
+    klu_solve(sh->d->klu_symbolic, sh->numeric, nx, 2, cols, sh->common);
+    for (int i = 0; i < nx; i++) {
+        rhs[2 * i] = cols[i];
+        rhs[2 * i + 1] = cols[nx + i];
+    }
+}
+
+void tsi_shift_solve(tsi_shift *sh, const double complex *b,
+                     double complex *x)
+{
+    if (!sh->d) {
+        dense_solve(sh, b, x);
+        return;
+    }
+    const ts_descriptor *d = sh->d;
+    int nq = sh->lin->nq;
+    size_t n3 = 3 * (size_t)d->nn;
+    double complex s = sh->s;
+    double *ur = sh->u1, *ui = sh->u1 + n3, *u2 = sh->u2, *cu = sh->u2 + n3;
+    double *w = sh->w, *rhs = sh->rhs;
+    /* Real and imaginary parts of w = -b, one map each: node rows
+     * M (s J wq + J wqd) + C J wq; parts combined below. */
+    for (int part = 0; part < 2; part++) {
+        for (int i = 0; i < 2 * nq; i++)
+            w[i] = part ? -cimag(b[i]) : -creal(b[i]);
+        double *u1 = part ? ui : ur;
+        rhs_parts(sh, w, w + nq, u1, u2, cu);
+        /* rhs += (M J wqd + C J wq) of this part, as that part. */
+        for (int k = 1; k < d->nn; k++) {
+            double Mv[3];
+            mass_mul(d, k, u2 + 3 * k, Mv);
+            for (int c = 0; c < 3; c++)
+                rhs[2 * XR(k, c) + part] = Mv[c] + cu[3 * k + c];
+        }
+        taut_rates(sh, w, rhs + part, 2);
+    }
+    /* + s M J wq, complex. */
+    for (int k = 1; k < d->nn; k++) {
+        double Mr[3], Mi[3];
+        mass_mul(d, k, ur + 3 * k, Mr);
+        mass_mul(d, k, ui + 3 * k, Mi);
+        for (int c = 0; c < 3; c++) {
+            double complex v = s * (Mr[c] + I * Mi[c]);
+            rhs[2 * XR(k, c)] += creal(v);
+            rhs[2 * XR(k, c) + 1] += cimag(v);
+        }
+    }
+    if (sh->is_complex) {
+        klu_z_solve(d->klu_symbolic, sh->numeric, d->nx, 1, rhs, sh->common);
+    } else {
+        /* Real factors: the real and imaginary parts as two right-hand
+         * sides. */
+        two_columns(sh);
+    }
+    double *xr = sh->w, *xi = sh->w + nq;
+    solution_nodes(d, rhs, 2, u2);
+    tsi_shift_nodes_to_q(sh, u2, xr);
+    solution_nodes(d, rhs + 1, 2, u2);
+    tsi_shift_nodes_to_q(sh, u2, xi);
+    for (int i = 0; i < nq; i++) {
+        x[i] = xr[i] + I * xi[i];
+        x[nq + i] = s * x[i] + b[i]; /* s x_q - w_q, w = -b */
+    }
+}
+
+void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
+{
+    const ts_descriptor *d = sh->d;
+    int nq = sh->lin->nq;
+    size_t n3 = 3 * (size_t)d->nn;
+    double *u1 = sh->u1, *u2 = sh->u1 + n3, *f = sh->u2;
+    const double *K = err ? d->Kerr : d->K, *C = err ? d->Cerr : d->C;
+    ts_linear_node_displacements(sh->sys, sh->lin, x, u1);
+    ts_linear_node_displacements(sh->sys, sh->lin, x + nq, u2);
+    if (K && C) {
+        tsi_desc_block_mul(d, K, u1, f, 0);
+        tsi_desc_block_mul(d, C, u2, f, 1);
+    } else {
+        memset(f, 0, n3 * sizeof(double));
+    }
+    for (int k = 1; k < d->nn; k++)
+        for (int c = 0; c < 3; c++)
+            sh->rhs[XR(k, c)] = -f[3 * k + c];
+    /* Link rows: rigid n.(a_k - a_p) = 0; elastic -dt = -(the tension
+     * change), EA de + Cv l de' from the coordinates themselves (exact,
+     * so zero for the error estimate). */
+    for (int l = 0; l < d->nl; l++) {
+        double v = 0.0;
+        if (d->kind[l] == TSI_LINK_TAUT && !err) {
+            const ts_link *L = &sh->sys->links[l];
+            int o = sh->lin->qoff[l];
+            v = L->ea * x[o + 2] + d->ca[l] * L->length * x[nq + o + 2];
+        }
+        sh->rhs[XT(l)] = -v;
+    }
+    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
+    solution_nodes(d, sh->rhs, 1, u1);
+    memcpy(y, x + nq, (size_t)nq * sizeof(double));
+    tsi_shift_nodes_to_q(sh, u1, y + nq);
+}
+
+void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
+                     double complex *dt)
+{
+    const ts_descriptor *d = sh->d;
+    const ts_system *sys = sh->sys;
+    double complex s = sh->s;
+    int nx = d->nx;
+    double *rhs = sh->rhs;
+    memset(rhs, 0, 2 * (size_t)nx * sizeof(double));
+    /* Node rows: -(K_k0 + s C_k0) e_input, the tow point's displacement
+     * and velocity seen by its neighbours. */
+    for (int k = 1; k < d->nn; k++)
+        for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
+            if (d->bcol[b] != 0)
+                continue;
+            const double *Kb = d->K + 9 * (size_t)b, *Cb = d->C + 9 * (size_t)b;
+            for (int a = 0; a < 3; a++) {
+                double complex v = -(Kb[3 * a + input] + s * Cb[3 * a + input]);
+                rhs[2 * XR(k, a)] = creal(v);
+                rhs[2 * XR(k, a) + 1] = cimag(v);
+            }
+        }
+    /* Rows of the links leaving the tow point: their constraint (or
+     * tension law) on dr_k - e_input. */
+    for (int l = 0; l < d->nl; l++) {
+        if (sys->links[l].upper != 0)
+            continue;
+        double complex g[3] = {d->n[3 * l], d->n[3 * l + 1], d->n[3 * l + 2]};
+        if (d->kind[l] == TSI_LINK_TAUT)
+            tsi_desc_taut_row(d, l, s, g);
+        else if (d->kind[l] == TSI_LINK_SLACK)
+            g[input] = 0.0;
+        rhs[2 * XT(l)] = creal(g[input]);
+        rhs[2 * XT(l) + 1] = cimag(g[input]);
+    }
+    if (sh->is_complex)
+        klu_z_solve(d->klu_symbolic, sh->numeric, nx, 1, rhs, sh->common);
+    else
+        two_columns(sh);
+    for (int c = 0; c < 3; c++)
+        dr[c] = c == input ? 1.0 : 0.0;
+    for (int k = 1; k < d->nn; k++)
+        for (int c = 0; c < 3; c++)
+            dr[3 * k + c] = rhs[2 * XR(k, c)] + I * rhs[2 * XR(k, c) + 1];
+    for (int l = 0; l < d->nl; l++)
+        dt[l] = rhs[2 * XT(l)] + I * rhs[2 * XT(l) + 1];
+}
+
+void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
+{
+    const ts_descriptor *d = sh->d;
+    int nq = sh->lin->nq, c = j % 3;
+    double *f = sh->u2;
+    /* Node rows: the force change of the input with the coordinates
+     * fixed; every node moves with a tow displacement or velocity. */
+    for (int k = 1; k < d->nn; k++) {
+        double acc[3] = {0, 0, 0};
+        if (j < TS_IN_ACC) {
+            const double *B = j < TS_IN_VEL ? (err ? d->Kerr : d->K)
+                                            : (err ? d->Cerr : d->C);
+            for (int b = d->bptr[k]; B && b < d->bptr[k + 1]; b++)
+                for (int a = 0; a < 3; a++)
+                    acc[a] += B[9 * (size_t)b + 3 * a + c];
+        } else if (!err) {
+            double e[3] = {0, 0, 0};
+            e[c] = 1.0;
+            mass_mul(d, k, e, acc);
+        }
+        for (int a = 0; a < 3; a++)
+            f[3 * k + a] = acc[a];
+    }
+    for (int k = 1; k < d->nn; k++)
+        for (int a = 0; a < 3; a++)
+            sh->rhs[XR(k, a)] = -f[3 * k + a];
+    for (int l = 0; l < d->nl; l++)
+        sh->rhs[XT(l)] = 0.0;
+    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
+    solution_nodes(d, sh->rhs, 1, sh->u1);
+    memset(col, 0, (size_t)nq * sizeof(double));
+    tsi_shift_nodes_to_q(sh, sh->u1, col + nq);
+}

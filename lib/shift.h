@@ -1,0 +1,107 @@
+/* shift.h (internal): solves with the sparse linear model at a shift s,
+ * shared by the eigen analysis, the frequency response and the stiff
+ * integrator (doc/linear.md, sections 2-4).
+ *
+ * The kernel's state y = (q, q') maps to node displacements dr = J q and
+ * velocities dr' = J q' (J local: one link at a time, lib/descriptor.h).
+ * With y' = A y, solving (s I - A) y = w for y is solving, for the node
+ * displacements and the link tensions,
+ *
+ *     (s^2 M + s C + K) dr + N dt = M (s J w_q + J w_q') + C J w_q
+ *     rigid link:   n . (dr_k - dr_p) = 0
+ *     elastic link: (EA/l + s Cv) n.dd + ... - dt = Cv n.(J w_q)_k - ...
+ *
+ * (the matrix S(s) of lib/descriptor.h), then q = J^-1 dr and q' = s q -
+ * w_q. The factorisation is KLU's (SuiteSparse: block triangular form,
+ * AMD ordering, left-looking LU with partial pivoting), real or complex,
+ * over KLU's ordering of the pattern computed once per system. Both the
+ * factorisation and each solve are O(nlinks). A itself is applied with
+ * S_inf = [[M, N], [acceleration constraints]], likewise O(nlinks).
+ *
+ * The maps are exact about a state at rest relative to M (an equilibrium);
+ * about a moving state they omit the terms of J' (first order in the link
+ * rates), which the stiff integrator's Newton iteration absorbs.
+ *
+ * Without the sparse model (a system with vehicles: ts_linear.desc NULL)
+ * the same solves use the dense A = [[0, I], [K, C]]: (A - s I) x = b is
+ * P(s) x1 = b2 - C b1 + s b1, x2 = b1 + s x1 with P(s) = K + s C - s^2 I,
+ * one LAPACK LU (dgetrf or zgetrf) of P, O(nq^3), then O(nq^2) per solve.
+ * Only tsi_shift_solve_real and tsi_shift_solve work then. */
+#ifndef TOWSTAB_SHIFT_H
+#define TOWSTAB_SHIFT_H
+
+#include <complex.h>
+
+#include "descriptor.h"
+#include "towstab/error.h"
+#include "towstab/linearize.h"
+
+typedef struct tsi_shift {
+    const ts_linear *lin;
+    const ts_descriptor *d;
+    const ts_system *sys;
+    double complex s;
+    int is_complex;        /* s has a nonzero imaginary part */
+    int inf;               /* S_inf: A's action, not a shift */
+    /* Dense backend (no sparse model). */
+    int nq, n;
+    double *lu;            /* [nq * nq] real LU (dgetrf), when real */
+    double complex *zlu;   /* [nq * nq] complex LU (zgetrf), when complex */
+    int *ipiv;             /* [nq] */
+    double complex *zw;    /* [nq] work */
+    double *wr;            /* [2 nq] work */
+    /* Sparse backend. */
+    void *common;          /* KLU parameters and status (own copy) */
+    void *numeric;         /* KLU factors */
+    double *Sx;            /* [nnz] real or [2 nnz] complex values */
+    double *rhs;           /* [2 nx] */
+    double *cols;          /* [2 nx] */
+    double *u1, *u2;       /* [3 nnodes] node displacement work */
+    double *w;             /* [2 nq] */
+} tsi_shift;
+
+/* Factor S(s) (real arithmetic when Im s == 0) of lin's sparse model, or
+ * P(s) of its dense A without one. Returns TS_OK, TS_EINVAL (no model),
+ * TS_ESINGULAR (s is an eigenvalue to working precision) or TS_ENOMEM.
+ * Free with tsi_shift_free. */
+int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                     ts_err *err);
+
+/* Factor S_inf, for tsi_shift_apply. Same codes. */
+int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err);
+
+void tsi_shift_free(tsi_shift *sh);
+
+/* x[n] = (A - s I)^-1 b[n], real s only. x may not alias b. */
+void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x);
+
+/* x[n] = (A - s I)^-1 b[n] in complex arithmetic (any s). x may not alias
+ * b. */
+void tsi_shift_solve(tsi_shift *sh, const double complex *b,
+                     double complex *x);
+
+/* With S_inf: y[n] = A x[n]; with err, the linearization's error estimate
+ * applied instead (dA x, from the blocks' (D(2h) - D(h)) / 3; zero without
+ * the estimate). */
+void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err);
+
+/* With S_inf: column j of B (y-space, TS_NINPUT columns: tow
+ * displacement, velocity, acceleration along x, y, z), each input alone
+ * with the coordinates fixed, into col[n]; with err, its error estimate
+ * (from the blocks' (D(2h) - D(h)) / 3). */
+void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err);
+
+/* The response to a unit harmonic tow-point displacement along input
+ * (0 x, 1 y, 2 z) at the factored s: the tow point moves by e_input,
+ * with velocity s e_input and acceleration s^2 e_input. Writes the
+ * absolute node displacements dr[3 nnodes] (dr_0 = e_input; m per m)
+ * and the link tensions dt[nlinks] (N per m), complex. */
+void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
+                     double complex *dt);
+
+/* dq[nq] of node displacements, the inverse of
+ * ts_linear_node_displacements (for displacements that keep the rigid
+ * links' lengths). */
+void tsi_shift_nodes_to_q(const tsi_shift *sh, const double *dr, double *dq);
+
+#endif

@@ -1,0 +1,470 @@
+/* test_descriptor.c: the sparse linear model (lib/descriptor.h,
+ * lib/shift.h) against the dense one of lib/linearize.c, which
+ * differentiates the eliminated kernel f(y, u) column by column: two
+ * linearizations that share only the kernel's load assembly.
+ *
+ *  1. The residual is the kernel: at a moving, non-equilibrium state of a
+ *     scene with every kind of link and body (rigid and elastic links,
+ *     bending, a junction, a sphere and a towfish, a turn with a current,
+ *     tow-point motion), the node residual at the kernel's positions,
+ *     velocities, accelerations and tensions is zero to rounding (1e-12 of
+ *     the largest force).
+ *  2. E^-1 F = A on every shipped example (about its equilibrium, at the
+ *     scene's link count and at 40 links): every column of the dense A
+ *     formed from the sparse model (S_inf solves) equals the column of
+ *     the dense linearization within ten times the sum of the two error
+ *     estimates (each (D(2h) - D(h)) / 3; the factor covers the estimate's
+ *     own uncertainty, as for eigenvalue bounds) plus 1e-8 of the column's
+ *     size (rounding, see ROUNDING); the same for the nine columns of B
+ *     (the heave columns excepted when the tow point is at the waterline,
+ *     a kink both report). A scene with a vehicle has the dense model
+ *     only; the sparse one alone is refused, naming the vehicles.
+ *  3. The shifted solve: (A - s I)^-1 b by the sparse model equals the
+ *     dense solve (LAPACK) at real and complex s, to 1e-7 relative (the
+ *     two A differ by ~1e-9 relative; (A - s I)^-1 amplifies by the
+ *     distance of s to the spectrum).
+ *  4. The maps between the kernel's coordinates and node displacements
+ *     invert each other (1e-12).
+ *  5. The number of residual evaluations does not grow with the links:
+ *     the same groups at 20 and 2000 links.
+ */
+#include <complex.h>
+#include <glob.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "descriptor.h"
+#include "kernel_impl.h"
+#include "shift.h"
+#include "tcheck.h"
+#include "tscene.h"
+#include "towstab/equilibrium.h"
+#include "towstab/scene.h"
+
+void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
+            int *ipiv, double complex *b, const int *ldb, int *info);
+
+static ts_units *units;
+
+static ts_scene *scene_from(const char *yaml)
+{
+    return tscene_parse(units, yaml);
+}
+
+/* Every kind of link and body, in a turn with a current. */
+static const char *mixed_yaml =
+    "name: mixed\n"
+    "environment: {current: [0.21, -0.13, 0]}\n"
+    "tow: {speed: 2.1, turn_rate: 0.037, point: [0, 0, -1.3]}\n"
+    "cables:\n"
+    "  - {name: main, from: tow, to: knot, length: 14.3, diameter: 0.02,\n"
+    "     mass_per_length: 0.9, links: 7, normal_drag: 1.2, added_mass: 1.0,\n"
+    "     EI: 35}\n"
+    "  - {name: a, from: knot, to: fish, length: 7.1, diameter: 0.012,\n"
+    "     mass_per_length: 0.4, links: 5, normal_drag: 1.1, EA: 3.3e6,\n"
+    "     damping: 900, EI: 6, added_mass: 0.8}\n"
+    "  - {name: b, from: knot, to: ball, length: 5.3, diameter: 0.01,\n"
+    "     mass_per_length: 0.3, links: 4, normal_drag: 1.3}\n"
+    "bodies:\n"
+    "  - {name: knot, type: junction, mass: 3.0}\n"
+    "  - {name: fish, type: cylinder, diameter: 0.2, length: 1.1, mass: 30,\n"
+    "     drag: 0.3, cross_drag: 1.0, added_mass: 0.1, cross_added_mass: "
+    "1.0}\n"
+    "  - {name: ball, type: sphere, diameter: 0.25, mass: 9.0, drag: 0.5,\n"
+    "     added_mass: 0.5}\n";
+
+static void test_residual_is_kernel(void)
+{
+    ts_scene *sc = scene_from(mixed_yaml);
+    const ts_system *sys = sc->system;
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    int n = ts_kernel_nstate(k), nq = n / 2, nn = sys->nnodes;
+    double *y = malloc((size_t)n * sizeof(double));
+    double *f = malloc((size_t)n * sizeof(double));
+    double *R = malloc(3 * (size_t)nn * sizeof(double));
+    double *r = malloc(3 * (size_t)nn * sizeof(double));
+    double *v = malloc(3 * (size_t)nn * sizeof(double));
+    double *a = malloc(3 * (size_t)nn * sizeof(double));
+    double *t = malloc((size_t)sys->nlinks * sizeof(double));
+    /* A sagging, twisted, moving shape; elastic links stretched 1e-4. */
+    for (int l = 0; l < sys->nlinks; l++) {
+        int o = ts_kernel_link_offset(k, l);
+        y[o] = 0.35 + 0.07 * l;
+        y[o + 1] = 0.2 * sin(0.9 * l);
+        y[nq + o] = 0.03 * cos(0.5 * l);
+        y[nq + o + 1] = -0.02 + 0.004 * l;
+        if (sys->links[l].elastic) {
+            y[o + 2] = 1e-4 * (1 + 0.1 * l);
+            y[nq + o + 2] = 2e-5 * sin(l);
+        }
+    }
+    double u[TS_NINPUT] = {0.03, -0.02, 0.05, 0.2, 0.1, -0.3, 0.4, -0.7, 1.1};
+    ts_frame fr;
+    ts_kernel_get_frame(k, &fr);
+    fr.speed_rate = 0.13;
+    fr.turn_accel = -0.004;
+    ts_kernel_set_frame(k, &fr);
+    int rc = ts_kernel_eval(k, y, u, f);
+    CHECK(rc == TS_OK, "mixed: kernel evaluated at a moving state");
+    memcpy(r, ts_kernel_positions(k), 3 * (size_t)nn * sizeof(double));
+    memcpy(v, ts_kernel_velocities(k), 3 * (size_t)nn * sizeof(double));
+    memcpy(a, ts_kernel_rel_accelerations(k), 3 * (size_t)nn * sizeof(double));
+    memcpy(t, ts_kernel_tensions(k), (size_t)sys->nlinks * sizeof(double));
+    double scale;
+    ts_kernel_unbalanced(k, &scale);
+    rc = tsi_kernel_residual(k, r, v, a, t, R);
+    double worst = 0;
+    for (int i = 3; i < 3 * nn; i++)
+        worst = fmax(worst, fabs(R[i]));
+    CHECK(rc == TS_OK && worst <= 1e-12 * scale,
+          "mixed: the node residual at the kernel's solution is %.3g N, "
+          "<= 1e-12 of the largest force %.4g N",
+          worst, scale);
+    /* And it is not trivially zero: a wrong tension shows. */
+    t[3] += 1.0;
+    tsi_kernel_residual(k, r, v, a, t, R);
+    worst = 0;
+    for (int i = 1; i < nn; i++)
+        worst = fmax(worst, sqrt(R[3 * i] * R[3 * i] + R[3 * i + 1] *
+                                 R[3 * i + 1] + R[3 * i + 2] * R[3 * i + 2]));
+    CHECK(fabs(worst - 1.0) < 1e-9,
+          "mixed: 1 N more tension in one link leaves 1 N unbalanced "
+          "(%.12g)",
+          worst);
+    free(y);
+    free(f);
+    free(R);
+    free(r);
+    free(v);
+    free(a);
+    free(t);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
+/* Linearize about the equilibrium with both models; NULL when there is no
+ * equilibrium. */
+static ts_linear *both(const ts_system *sys, ts_kernel **kout, int *conv)
+{
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_linear *lin = NULL;
+    *conv = ts_equilibrium_solve(k, NULL, eq, &err) == TS_OK;
+    if (*conv) {
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = TS_LIN_BOTH;
+        lin = ts_linear_alloc(k, &err);
+        if (ts_linearize_equilibrium(k, eq, &o, lin, &err) != TS_OK) {
+            printf("  linearize: %s\n", err.msg);
+            ts_linear_free(lin);
+            lin = NULL;
+        }
+    }
+    ts_equilibrium_free(eq);
+    *kout = k;
+    return lin;
+}
+
+/* Rounding allowance relative to a column's largest entry: each finite
+ * difference rounds to ~eps^(2/3) = 4e-11 of the largest term of f, which
+ * in the stiff columns (strain rates of elastic links) is about 100 times
+ * the column's entries. */
+#define ROUNDING 1e-8
+
+static double col_max(const double *x, int n)
+{
+    double m = 0;
+    for (int i = 0; i < n; i++)
+        m = fmax(m, fabs(x[i]));
+    return m;
+}
+
+/* Section 2: A and B from the sparse model against the dense ones. */
+static void compare_dense(const char *name, const ts_system *sys)
+{
+    ts_kernel *k;
+    int conv;
+    ts_linear *lin = both(sys, &k, &conv);
+    if (!conv) {
+        printf("  %s: no equilibrium (a released or dropped scene): no "
+               "linear model to compare\n",
+               name);
+        ts_kernel_free(k);
+        return;
+    }
+    if (!lin) {
+        CHECK(0, "%s: linearized with both models", name);
+        ts_kernel_free(k);
+        return;
+    }
+    if (ts_kernel_nvehicles(k) > 0) {
+        /* The sparse model does not cover a vehicle's attitude and
+         * controller states: the dense model only, and the sparse model
+         * alone refused, naming the vehicles. */
+        CHECK(!lin->desc && lin->A, "%s (%d links): a vehicle: the dense "
+              "model only", name, sys->nlinks);
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = TS_LIN_SPARSE;
+        ts_err e = {0};
+        double *y = malloc((size_t)lin->nstate * sizeof(double));
+        int rc = TS_ENOMEM;
+        if (y) {
+            memcpy(y, lin->y0, (size_t)lin->nstate * sizeof(double));
+            rc = ts_linearize(k, y, lin->u0, &o, lin, &e);
+        }
+        CHECK(rc == TS_EINVAL && strstr(e.msg, "vehicle"),
+              "%s: the sparse model alone refused: %s", name, e.msg);
+        free(y);
+        ts_linear_free(lin);
+        ts_kernel_free(k);
+        return;
+    }
+    int n = lin->nstate, nq = lin->nq;
+    ts_err err = {0};
+    tsi_shift acc;
+    int rc = tsi_shift_factor_inf(&acc, lin, &err);
+    double *x = calloc((size_t)n, sizeof(double));
+    double *col = malloc((size_t)n * sizeof(double));
+    double *ecol = malloc((size_t)n * sizeof(double));
+    double worst = 0, wb = 0;
+    int wj = -1;
+    for (int j = 0; rc == TS_OK && j < n; j++) {
+        x[j] = 1.0;
+        tsi_shift_apply(&acc, x, col, 0);
+        tsi_shift_apply(&acc, x, ecol, 1);
+        x[j] = 0.0;
+        const double *Ad = lin->A + (size_t)j * n;
+        double diff = 0;
+        for (int i = 0; i < n; i++)
+            diff = fmax(diff, fabs(col[i] - Ad[i]));
+        double allow = 10.0 * (col_max(ecol + nq, nq) +
+                               col_max(lin->Aerr + (size_t)j * nq, nq)) +
+                       ROUNDING * col_max(Ad, n);
+        if (diff / allow > worst) {
+            worst = diff / allow;
+            wj = j;
+        }
+    }
+    CHECK(rc == TS_OK && worst <= 1.0,
+          "%s (%d links): E^-1 F = A within the error estimates, every "
+          "column (largest difference %.3g of the allowance, column %d)",
+          name, sys->nlinks, worst, wj);
+    for (int j = 0; rc == TS_OK && j < TS_NINPUT; j++) {
+        if (lin->kink_tow && j % 3 == 2)
+            continue;
+        tsi_shift_apply_input(&acc, j, col, 0);
+        tsi_shift_apply_input(&acc, j, ecol, 1);
+        const double *Bd = lin->B + (size_t)j * n;
+        double diff = 0;
+        for (int i = 0; i < n; i++)
+            diff = fmax(diff, fabs(col[i] - Bd[i]));
+        double allow = 10.0 * (lin->b_trunc_err + col_max(ecol, n)) +
+                       ROUNDING * col_max(Bd, n);
+        wb = fmax(wb, diff / allow);
+    }
+    CHECK(rc == TS_OK && wb <= 1.0,
+          "%s (%d links): the columns of B agree within their error "
+          "estimates (largest difference %.3g of the allowance)",
+          name, sys->nlinks, wb);
+    if (rc == TS_OK)
+        tsi_shift_free(&acc);
+    free(x);
+    free(col);
+    free(ecol);
+    ts_linear_free(lin);
+    ts_kernel_free(k);
+}
+
+static void test_examples(void)
+{
+    glob_t g;
+    int grc = glob("examples/*.yaml", 0, NULL, &g);
+    CHECK(grc == 0 && g.gl_pathc >= 9, "examples found: %zu",
+          grc == 0 ? g.gl_pathc : 0);
+    for (size_t i = 0; grc == 0 && i < g.gl_pathc; i++) {
+        ts_err err = {0};
+        ts_scene *sc = ts_scene_load(g.gl_pathv[i], units, &err);
+        if (!sc) {
+            CHECK(0, "%s: %s", g.gl_pathv[i], err.msg);
+            continue;
+        }
+        ts_system *sys = sc->system;
+        compare_dense(g.gl_pathv[i], sys);
+        for (int c = 0; c < sys->ncables; c++) {
+            sys->cables[c].nlinks = 40 / sys->ncables + 1;
+            free(sys->cables[c].link_fraction);
+            sys->cables[c].link_fraction = NULL;
+        }
+        if (ts_system_build(sys, &err) == TS_OK)
+            compare_dense(g.gl_pathv[i], sys);
+        ts_scene_free(sc);
+    }
+    if (grc == 0)
+        globfree(&g);
+}
+
+/* Section 3: (A - s I)^-1 b, sparse against dense. */
+static void test_shifted_solve(void)
+{
+    ts_scene *sc = scene_from(mixed_yaml);
+    /* No turn and no current: an equilibrium. */
+    ts_system *sys = sc->system;
+    sys->tow.turn_rate = 0;
+    sys->env.current[0] = sys->env.current[1] = 0;
+    ts_kernel *k;
+    int conv;
+    ts_linear *lin = both(sys, &k, &conv);
+    CHECK(conv && lin, "mixed, straight: equilibrium and both models");
+    if (!lin) {
+        ts_kernel_free(k);
+        ts_scene_free(sc);
+        return;
+    }
+    int n = lin->nstate, one = 1, info;
+    double complex *M = malloc((size_t)n * n * sizeof *M);
+    double complex *b = malloc((size_t)n * sizeof *b);
+    double complex *xd = malloc((size_t)n * sizeof *xd);
+    double complex *xs = malloc((size_t)n * sizeof *xs);
+    double *br = malloc((size_t)n * sizeof *br);
+    double *xr = malloc((size_t)n * sizeof *xr);
+    int *piv = malloc((size_t)n * sizeof *piv);
+    static const double complex shifts[] = {0.0, -0.37, 2.3 * I,
+                                            -0.8 + 11.7 * I, 240.0 * I};
+    for (int si = 0; si < 5; si++) {
+        double complex s = shifts[si];
+        for (int i = 0; i < n; i++) {
+            b[i] = sin(1.7 * i + 0.3) + I * (cimag(s) != 0 ? cos(0.9 * i) : 0);
+            br[i] = creal(b[i]);
+        }
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++)
+                M[i + (size_t)j * n] = lin->A[i + (size_t)j * n] -
+                                       (i == j ? s : 0);
+        memcpy(xd, b, (size_t)n * sizeof *b);
+        zgesv_(&n, &one, M, &n, piv, xd, &n, &info);
+        tsi_shift sh;
+        ts_err err = {0};
+        int rc = tsi_shift_factor(&sh, lin, s, &err);
+        double diff = 0, big = 0, diffr = 0;
+        if (rc == TS_OK) {
+            tsi_shift_solve(&sh, b, xs);
+            if (cimag(s) == 0)
+                tsi_shift_solve_real(&sh, br, xr);
+            for (int i = 0; i < n; i++) {
+                diff = fmax(diff, cabs(xs[i] - xd[i]));
+                big = fmax(big, cabs(xd[i]));
+                if (cimag(s) == 0)
+                    diffr = fmax(diffr, fabs(xr[i] - creal(xd[i])));
+            }
+            tsi_shift_free(&sh);
+        }
+        CHECK(rc == TS_OK && info == 0 && diff <= 1e-7 * big &&
+                  diffr <= 1e-7 * big,
+              "mixed: (A - s I)^-1 b at s = %g%+gi, sparse vs dense: "
+              "%.3g (real solve %.3g) of %.3g, <= 1e-7 relative (%s)",
+              creal(s), cimag(s), diff, diffr, big, err.msg);
+    }
+    /* Section 4: the maps. */
+    double *dq = malloc((size_t)lin->nq * sizeof(double));
+    double *dq2 = malloc((size_t)lin->nq * sizeof(double));
+    double *dr = malloc(3 * (size_t)sys->nnodes * sizeof(double));
+    for (int i = 0; i < lin->nq; i++)
+        dq[i] = 1e-3 * sin(2.3 * i + 1);
+    ts_linear_node_displacements(sys, lin, dq, dr);
+    tsi_desc_from_nodes(sys, lin, dr, dq2);
+    double md = 0;
+    for (int i = 0; i < lin->nq; i++)
+        md = fmax(md, fabs(dq2[i] - dq[i]));
+    CHECK(md <= 1e-15, "mixed: node displacements map back to the "
+                       "coordinates (%.3g rad)",
+          md);
+    free(dq);
+    free(dq2);
+    free(dr);
+    free(M);
+    free(b);
+    free(xd);
+    free(xs);
+    free(br);
+    free(xr);
+    free(piv);
+    ts_linear_free(lin);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
+/* Section 5: evaluations independent of the number of links. */
+static void test_groups(void)
+{
+    int groups[4] = {0, 0, 0, 0};
+    long evals[4] = {0, 0, 0, 0};
+    /* Without bending at 20 and 2000 links, with bending at 20 and 200. */
+    static const int links[4] = {20, 2000, 20, 200};
+    for (int p = 0; p < 4; p++) {
+        char yaml[512];
+        snprintf(yaml, sizeof yaml,
+                 "name: towed\n"
+                 "tow: {speed: 2.385, point: [0, 0, 0.7]}\n"
+                 "cables:\n"
+                 "  - {name: cable, from: tow, to: sphere, length: 31.7,\n"
+                 "     diameter: 0.021, mass_per_length: 0.83, links: %d,\n"
+                 "     normal_drag: 1.2, added_mass: 1.0, EI: %g}\n"
+                 "bodies:\n"
+                 "  - {name: sphere, type: sphere, diameter: 0.3, mass: "
+                 "41.0}\n",
+                 links[p], p < 2 ? 0.0 : 2.0);
+        ts_scene *sc = scene_from(yaml);
+        ts_err err = {0};
+        ts_kernel *k = ts_kernel_alloc(sc->system, &err);
+        ts_equilibrium *eq = ts_equilibrium_alloc(sc->system, &err);
+        ts_equilibrium_solve(k, NULL, eq, &err);
+        ts_linear *lin = ts_linear_alloc(k, &err);
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = TS_LIN_SPARSE;
+        int rc = ts_linearize_equilibrium(k, eq, &o, lin, &err);
+        if (rc == TS_OK) {
+            groups[p] = lin->groups;
+            evals[p] = lin->residual_evaluations;
+        }
+        CHECK(rc == TS_OK && !lin->A,
+              "%d links: sparse model only (no dense A), %d groups, %ld "
+              "residual evaluations (%s)",
+              links[p], lin->groups, lin->residual_evaluations, err.msg);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        ts_scene_free(sc);
+    }
+    /* Positions 3 colours (rows reach 1 link), 5 with bending (2 links);
+     * velocities 3; times x, y, z. */
+    CHECK(groups[0] == 18 && groups[1] == 18 && evals[0] == evals[1],
+          "groups at 20 and 2000 links: %d and %d (18), evaluations %ld and "
+          "%ld",
+          groups[0], groups[1], evals[0], evals[1]);
+    CHECK(groups[2] == 24 && groups[3] == 24 && evals[2] == evals[3],
+          "with bending, groups at 20 and 200 links: %d and %d (24), "
+          "evaluations %ld and %ld",
+          groups[2], groups[3], evals[2], evals[3]);
+}
+
+int main(void)
+{
+    ts_err err = {0};
+    units = ts_units_alloc(&err);
+    if (!units) {
+        printf("FAIL units: %s\n", err.msg);
+        return 1;
+    }
+    test_residual_is_kernel();
+    test_examples();
+    test_shifted_solve();
+    test_groups();
+    ts_units_free(units);
+    return tc_done();
+}

@@ -1,0 +1,194 @@
+/* test_eigen_search.c: the sparse eigen analysis (ARPACK on the sparse
+ * model, with the rightmost search) against the dense one (LAPACK dgeevx
+ * on the dense A, every eigenvalue) on every shipped example with an
+ * equilibrium, at the sizes given on the command line (total links of the
+ * scene, shared equally among its cables; "scene" for the scene's own).
+ * Two linearizations and two eigensolvers:
+ *
+ *  1. the rightmost eigenvalue: the same real part within the sum of the
+ *     two error bounds, and the search's is an eigenvalue of the dense
+ *     spectrum (its nearest dense eigenvalue within the sum of the
+ *     bounds); the real part alone when the rightmost is not unique (an
+ *     undamped part of the system: many eigenvalues within rounding of
+ *     zero);
+ *  2. the 20 modes nearest 0 Hz: each sparse mode matches a distinct
+ *     dense eigenvalue within the sum of their error bounds;
+ *  3. the verdicts never contradict each other (stable against
+ *     unstable); the sparse one may be marginal where the dense one is
+ *     not, since without left eigenvectors its error bound is the
+ *     normal-matrix ||dA v|| / |v| (doc/linear.md, section 3), wider on
+ *     stiff, nearly undamped modes.
+ *
+ * A scene with a vehicle has no sparse model (doc/linear.md, section 2):
+ * ARPACK runs on its dense A without the search; only 2 is compared, and
+ * its result must say it is not complete.
+ *
+ * The default run (suite unit) uses each scene's own size and 60 links;
+ * suite slow runs 100, 200, 400 and 800 links (doc/linear.md, section 5).
+ * The drop tests have no equilibrium: they are reported and skipped. */
+#include <complex.h>
+#include <glob.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+#include "towstab/eigen.h"
+#include "towstab/equilibrium.h"
+#include "towstab/scene.h"
+
+/* Modes compared, as towstab modes shows for large systems. */
+#define COUNT 20
+
+static void compare(const char *name, const ts_system *sys)
+{
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    if (ts_equilibrium_solve(k, NULL, eq, &err) != TS_OK) {
+        printf("  %s (%d links): no equilibrium (%s): skipped\n", name,
+               sys->nlinks, err.msg);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        return;
+    }
+    ts_linear *lin = ts_linear_alloc(k, &err);
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    lo.model = TS_LIN_BOTH;
+    int rc = ts_linearize_equilibrium(k, eq, &lo, lin, &err);
+    ts_eigen *all = NULL, *ar = NULL;
+    ts_eigen_opts o;
+    ts_eigen_opts_default(&o);
+    o.method = TS_EIG_LAPACK;
+    o.vectors = 0;
+    if (rc == TS_OK)
+        rc = ts_eigen_solve(lin, &o, &all, &err);
+    o.method = TS_EIG_ARPACK;
+    o.count = COUNT < (lin->nstate - 3) / 2 ? COUNT : (lin->nstate - 3) / 2;
+    if (rc == TS_OK)
+        rc = ts_eigen_solve(lin, &o, &ar, &err);
+    if (!CHECK(rc == TS_OK && all->complete,
+               "%s (%d links, %d states): both methods (%s)", name,
+               sys->nlinks, lin ? lin->nstate : 0, err.msg)) {
+        ts_eigen_free(all);
+        ts_eigen_free(ar);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        return;
+    }
+
+    /* A vehicle: the sparse model does not cover it (its attitude and
+     * controller states), so ARPACK runs on the dense A without the
+     * search and its verdict covers its modes only. */
+    int vehicle = !lin->desc;
+    if (vehicle)
+        CHECK(ar->sweep_shifts == 0 && !ar->complete,
+              "%s (%d links): a vehicle: ARPACK on the dense A, no "
+              "rightmost search, not complete",
+              name, sys->nlinks);
+
+    /* 1. The rightmost eigenvalue. */
+    const ts_mode *ra = &ar->rightmost, *rl = &all->rightmost;
+    double allow = ra->error_bound + rl->error_bound;
+    int ties = 0;
+    for (int m = 0; m < all->nmodes; m++)
+        ties += all->modes[m].re >= rl->re - allow;
+    double near = INFINITY, near_bound = 0;
+    for (int m = 0; m < all->nmodes; m++) {
+        double dd = hypot(all->modes[m].re - ra->re, all->modes[m].im - ra->im);
+        if (dd < near) {
+            near = dd;
+            near_bound = all->modes[m].error_bound;
+        }
+    }
+    CHECK(vehicle || (fabs(ra->re - rl->re) <= allow &&
+                      near <= ra->error_bound + near_bound),
+          "%s (%d links): rightmost %.9g%+.6gi +- %.2g (%d shifts up to "
+          "%.4g Hz) = dense %.9g%+.6gi +- %.2g%s; an eigenvalue of the dense "
+          "spectrum (%.2g away)%s",
+          name, sys->nlinks, ra->re, ra->im, ra->error_bound,
+          ar->sweep_shifts, ar->top_hz, rl->re, rl->im, rl->error_bound,
+          ties > 1 ? " (not unique: real part only)" : "", near,
+          vehicle ? " (not compared: no search with a vehicle)" : "");
+
+    /* 2. The modes nearest 0 Hz, matched one to one. */
+    char *used = calloc((size_t)all->nmodes, 1);
+    double worst = 0;
+    for (int i = 0; used && i < ar->nmodes; i++) {
+        const ts_mode *a = &ar->modes[i];
+        int best = -1;
+        double bd = INFINITY;
+        for (int m = 0; m < all->nmodes; m++) {
+            double dd = hypot(all->modes[m].re - a->re, all->modes[m].im - a->im);
+            if (!used[m] && dd < bd) {
+                bd = dd;
+                best = m;
+            }
+        }
+        if (best < 0)
+            break;
+        used[best] = 1;
+        worst = fmax(worst, bd / (a->error_bound + all->modes[best].error_bound));
+    }
+    free(used);
+    CHECK(ar->nmodes == o.count && worst <= 1.0,
+          "%s (%d links): the %d modes nearest 0 Hz match dense eigenvalues "
+          "within their bounds (largest difference %.3g of the allowance)",
+          name, sys->nlinks, ar->nmodes, worst);
+
+    /* 3. The verdicts. */
+    int opposite = (ar->verdict == TS_STABLE && all->verdict == TS_UNSTABLE) ||
+                   (ar->verdict == TS_UNSTABLE && all->verdict == TS_STABLE);
+    CHECK(vehicle || (!opposite && (ar->verdict == all->verdict ||
+                                    ar->verdict == TS_MARGINAL)),
+          "%s (%d links): verdict %s, dense %s", name, sys->nlinks,
+          ts_verdict_name(ar->verdict), ts_verdict_name(all->verdict));
+    ts_eigen_free(all);
+    ts_eigen_free(ar);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+}
+
+int main(int argc, char **argv)
+{
+    ts_err err = {0};
+    ts_units *units = ts_units_alloc(&err);
+    glob_t g;
+    int grc = glob("examples/*.yaml", 0, NULL, &g);
+    if (!units || grc != 0) {
+        printf("FAIL setup: %s\n", units ? "no examples" : err.msg);
+        return 1;
+    }
+    static char *defaults[] = {"scene", "60"};
+    char **sizes = argc > 1 ? argv + 1 : defaults;
+    int nsizes = argc > 1 ? argc - 1 : 2;
+    for (int si = 0; si < nsizes; si++) {
+        int total = strcmp(sizes[si], "scene") ? atoi(sizes[si]) : 0;
+        for (size_t i = 0; i < g.gl_pathc; i++) {
+            ts_scene *sc = ts_scene_load(g.gl_pathv[i], units, &err);
+            if (!CHECK(sc != NULL, "%s: %s", g.gl_pathv[i], err.msg))
+                continue;
+            ts_system *sys = sc->system;
+            if (total > 0) {
+                for (int c = 0; c < sys->ncables; c++) {
+                    sys->cables[c].nlinks = total / sys->ncables;
+                    free(sys->cables[c].link_fraction);
+                    sys->cables[c].link_fraction = NULL;
+                }
+                if (ts_system_build(sys, &err) != TS_OK) {
+                    CHECK(0, "%s: %s", g.gl_pathv[i], err.msg);
+                    ts_scene_free(sc);
+                    continue;
+                }
+            }
+            compare(g.gl_pathv[i], sys);
+            ts_scene_free(sc);
+        }
+    }
+    globfree(&g);
+    ts_units_free(units);
+    return tc_done();
+}
