@@ -52,6 +52,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "csvtab.h"
 #include "towstab/kernel.h"
 
 /* Noise of an equilibrium value: this many times its relative residual
@@ -67,9 +68,11 @@
 #define SIM_TOL_NOISE 10.0
 /* Times compared within this (s) are the same sample. */
 #define TIME_EPS 1e-12
-/* Key values of a simulation: amplitude ratio, mean offset, phase, then
- * the extreme link tensions over the window. */
-#define SIM_VALUES 5
+/* Key values of a simulation under a periodic excitation: amplitude
+ * ratio, mean offset, phase (SIM_FIT values), then the extreme link
+ * tensions over the window; the extremes of the forces over the run
+ * follow (sim_values). */
+#define SIM_FIT 3
 #define SIM_TMAX 3
 #define SIM_TMIN 4
 
@@ -240,6 +243,7 @@ static ts_result *result_alloc(ts_analysis_kind kind, ts_err *err)
     ts_trust_init(&r->eq_trust);
     ts_trust_init(&r->modes_trust);
     r->transient = NAN;
+    r->peak_link = r->low_link = -1;
     r->accurate_to_hz = NAN;
     ts_result_accuracy *a = &r->accuracy;
     a->accuracy = NAN;
@@ -272,6 +276,9 @@ void ts_result_free(ts_result *r)
     free(r->phase_error_deg);
     ts_history_free(r->nonlinear);
     ts_history_free(r->linear);
+    free(r->outputs);
+    free(r->tensions);
+    free(r->slack);
     ts_convergence_free(r->convergence);
     free(r);
 }
@@ -947,6 +954,23 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
                     r->natural_hz[r->nnatural++] = e->modes[m].freq_hz;
         ts_eigen_free(e);
     }
+    /* A rigid cable passes the tow point's acceleration down at once: its
+     * tension grows as the frequency squared without bound. */
+    const ts_response *re = r->response;
+    if (out.kind == TS_OUT_TENSION &&
+        !r->sys->links[out.link].elastic && re->npoints > 0)
+        ts_trust_note(&r->trust, "inextensible links overstate the tension "
+                      "at high frequency: a rigid cable moves everything "
+                      "below with the tow point at once, so |H| grows as "
+                      "the frequency squared (%.4g %s at %.4g Hz, %.3g times "
+                      "the static gain); an elastic cable (cables[].ea, "
+                      "doc/elastic.md) has axial resonances and bounds it",
+                      re->magnitude[re->npoints - 1], out.unit,
+                      re->freq_hz[re->npoints - 1],
+                      re->static_gain != 0
+                          ? re->magnitude[re->npoints - 1] /
+                                fabs(re->static_gain)
+                          : INFINITY);
     /* The waterline kink for a heave input (towstab/health.h). */
     const ts_linear *lin = r->lin;
     if (lin->kink_tow && input == 2)
@@ -984,8 +1008,18 @@ static int read_shape(const ts_system *sys, const char *path, double *pos,
         line[strcspn(line, "\r\n")] = '\0';
         if (line[0] == '#' || line[0] == '\0')
             continue;
-        if (lineno == 1 && !strncmp(line, "node,", 5))
+        if (lineno == 1 && !strncmp(line, "node,", 5)) {
+            /* Positions in metres only (a CSV written with --units
+             * imperial says x_ft). */
+            if (strncmp(line, "node,x_m,y_m,z_m", 16) != 0) {
+                rc = ts_fail(err, TS_EINVAL, "initial: %s line 1: expected "
+                             "the header node,x_m,y_m,z_m (positions in m; "
+                             "write the file with --units si), got '%.60s'",
+                             path, line);
+                break;
+            }
             continue;
+        }
         char *c1 = strchr(line, ',');
         if (!c1) {
             rc = ts_fail(err, TS_EINVAL, "initial: %s line %d: expected "
@@ -1065,14 +1099,81 @@ static int sim_output(const ts_system *sys, const char *name, ts_output *out,
         strcat(def, ".z");
         name = def;
     }
-    int rc = ts_response_output_find(sys, name, out, err);
-    if (rc) {
+    int rc = ts_output_find(sys, name, TS_OUT_ALL, out, err);
+    if (rc)
         ts_err_prefix(err, "output: ");
+    return rc;
+}
+
+/* The channels a simulation reports (s->outputs): the list, each name
+ * once, or the default (the output, for a position its node's x, y, z;
+ * and tow.force). *sel (caller frees) receives them, *all 1 for "all"
+ * (with the default list). */
+static int sim_selection(const ts_system *sys, const ts_simulate_opts *s,
+                         const ts_output *out, ts_output **sel, int *n,
+                         int *all, ts_err *err)
+{
+    *sel = NULL;
+    *n = 0;
+    *all = 0;
+    char text[TS_REQUEST_PATH_MAX];
+    snprintf(text, sizeof text, "%s", s->outputs);
+    char *p = tsi_csv_trim(text);
+    if (strcmp(p, "all") == 0) {
+        *all = 1;
+        p[0] = '\0';
+    }
+    /* At most one channel per two characters of the text, plus the
+     * default's four. */
+    size_t cap = strlen(p) / 2 + 5;
+    ts_output *o = calloc(cap, sizeof *o);
+    if (!o)
+        return ts_fail(err, TS_ENOMEM, "outputs: out of memory");
+    int m = 0, rc = TS_OK;
+    if (!p[0]) {
+        char name[TS_OUTPUT_NAME_MAX + 4], node[TS_OUTPUT_NAME_MAX];
+        if (out->kind == TS_OUT_POSITION) {
+            ts_system_node_name(sys, out->node, node, sizeof node);
+            for (int c = 0; c < 3 && !rc; c++) {
+                snprintf(name, sizeof name, "%s.%c", node, "xyz"[c]);
+                rc = ts_output_find(sys, name, TS_OUT_ALL, &o[m++], err);
+            }
+        } else {
+            o[m++] = *out;
+        }
+        if (!rc && !(out->kind == TS_OUT_TOW_FORCE &&
+                     out->comp == TS_OUT_MAGNITUDE))
+            rc = ts_output_find(sys, "tow.force", TS_OUT_ALL, &o[m++], err);
+    }
+    for (char *tok = p[0] ? p : NULL; tok && !rc;) {
+        char *comma = strchr(tok, ',');
+        if (comma)
+            *comma = '\0';
+        char *b = tsi_csv_trim(tok);
+        if (!b[0])
+            rc = ts_fail(err, TS_EINVAL, "outputs: an empty name in '%s' "
+                         "(names are separated by commas)", s->outputs);
+        else if (strcmp(b, "all") == 0)
+            rc = ts_fail(err, TS_EINVAL, "outputs: 'all' (the full state) "
+                         "stands alone, not in a list");
+        else if ((size_t)m >= cap)
+            rc = ts_fail(err, TS_EINVAL, "outputs: too many names");
+        else if ((rc = ts_output_find(sys, b, TS_OUT_ALL, &o[m], err)))
+            ts_err_prefix(err, "outputs: ");
+        for (int k = 0; !rc && k < m; k++)
+            if (!strcmp(o[k].name, o[m].name))
+                rc = ts_fail(err, TS_EINVAL, "outputs: '%s' is listed twice",
+                             o[m].name);
+        if (!rc)
+            m++;
+        tok = comma ? comma + 1 : NULL;
+    }
+    if (rc) {
+        free(o);
         return rc;
     }
-    if (out->kind != TS_OUT_POSITION)
-        return ts_fail(err, TS_EINVAL, "output: '%s' is a tension; the "
-                       "simulation reports positions <node>.x|y|z", name);
+    *sel = o;
+    *n = m;
     return TS_OK;
 }
 
@@ -1188,6 +1289,12 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
     }
     int use_linear = s->compare || s->linear;
     const char *lw = s->compare ? "compare" : "linear";
+    if (use_linear && out->kind != TS_OUT_POSITION &&
+        out->kind != TS_OUT_TENSION)
+        return ts_fail(err, TS_EINVAL, "output: '%s': the linear model "
+                       "gives node positions and link tensions, so %s "
+                       "needs one of those (the nonlinear run alone gives "
+                       "the others)", out->name, lw);
     if (use_linear && s->initial != TS_INITIAL_EQUILIBRIUM)
         return ts_fail(err, TS_EINVAL, "initial: the linear model starts at "
                        "the equilibrium, so %s needs the initial state "
@@ -1249,6 +1356,11 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
                            period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
                            TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
     }
+    ts_output *sel;
+    int nsel, all;
+    if ((rc = sim_selection(sys, s, out, &sel, &nsel, &all, err)))
+        return rc;
+    free(sel);
     if (s->initial == TS_INITIAL_SHAPE) {
         double *pos = malloc(3 * (size_t)sys->nnodes * sizeof *pos);
         if (!pos)
@@ -1259,36 +1371,113 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
     return rc;
 }
 
-/* Key values of a simulation under a single periodic excitation: the
- * output's amplitude ratio (relative to itself), mean offset from the
- * equilibrium (m, scale the excitation amplitude) and phase (deg, scale
- * 360), fitted with the tow motion over t >= transient of the nonlinear
- * run, and the largest and smallest link tension over that window (N,
- * relative to themselves). Solver error: rounding, SIM_ROUND_EPS eps
- * sqrt(steps) of each value's scale (of the largest tension for both
- * tensions), and the equilibrium's residual for the mean offset. A fit
- * that cannot be made leaves NAN values (an error only when required). */
-static int sim_values(ts_result *r, int required, ts_err *err)
+/* The force key values of one channel: NAME.max, .min, .mean and
+ * .amplification (N, N, N, 1) from its extremes e. Relative errors are
+ * relative to the largest |value| (the channel's force scale). Errors:
+ * discretisation, the sampling error of an extreme; solver, rounding
+ * (`round` of each value's size) and, for the amplification, the
+ * reference's residual `res` (relative). */
+static void force_values(ts_value *v, const char *name, const ts_extremes *e,
+                         double round, double res)
+{
+    static const char *const suffix[4] = {"max", "min", "mean",
+                                          "amplification"};
+    double scale = fmax(fabs(e->max), fabs(e->min));
+    for (int k = 0; k < 4; k++)
+        value_name(&v[k], k < 3 ? "N" : "1", k < 3 && scale > 0 ? scale : 0,
+                   "%.80s.%s", name, suffix[k]);
+    if (e->samples == 0)
+        return;
+    double val[4] = {e->max, e->min, e->mean, e->amplification};
+    double disc[4] = {e->max_error, e->min_error, NAN,
+                      e->max_error / fabs(e->reference)};
+    for (int k = 0; k < 4; k++) {
+        v[k].value = val[k];
+        v[k].error.discretisation = isfinite(val[k]) ? disc[k] : NAN;
+        v[k].error.solver = round * fabs(val[k]);
+    }
+    v[3].error.solver += res * fabs(val[3]);
+}
+
+/* The number of fitted key values of a simulation (SIM_FIT under a
+ * single periodic excitation, else 0); the values from index SIM_FIT on
+ * are extremes of the time history. */
+static int sim_nfit(const ts_result *r)
+{
+    int idx;
+    return r->excitation && ts_excitation_periodic(r->excitation, &idx)
+               ? SIM_FIT
+               : 0;
+}
+
+/* Key values of a simulation:
+ *  - under a single periodic excitation, the output's amplitude ratio
+ *    (relative to itself), mean offset from the equilibrium (m, scale
+ *    the excitation amplitude; N, scale the static tension) and phase
+ *    (deg, scale 360), fitted with the tow motion over t >= transient of
+ *    the nonlinear run, and the largest and smallest link tension over
+ *    that window (tension.max, tension.min: N, relative to themselves);
+ *    solver error: rounding, SIM_ROUND_EPS eps sqrt(steps) of each
+ *    value's scale (of the largest tension for both tensions), and the
+ *    equilibrium's residual for the mean offset; a fit that cannot be
+ *    made leaves NAN values (an error only when required);
+ *  - with a nonlinear run, the extremes of the force on the tow point
+ *    (tow.force.max, ...) and of a tension output (force_values) over
+ *    the whole run.
+ * `linear_only`: the request runs the linear model alone; `ran`: the
+ * runs succeeded (else only the names, NAN values). */
+static int sim_values(ts_result *r, int linear_only, int ran, int required,
+                      ts_err *err)
 {
     const ts_excitation *ex = r->excitation;
-    int idx;
-    if (!ex || !ts_excitation_periodic(ex, &idx))
+    int idx = 0;
+    int nfit = sim_nfit(r);
+    if (nfit)
+        ts_excitation_periodic(ex, &idx);
+    int tension = r->output.kind == TS_OUT_TENSION;
+    int nforce = linear_only ? 0 : tension ? 2 : 1;
+    if (nfit + nforce == 0)
         return TS_OK;
-    const ts_signal *sg = ts_excitation_signal(ex, idx);
-    int rc = values_alloc(r, SIM_VALUES, err);
+    int ntens = nfit ? SIM_TMIN + 1 - SIM_FIT : 0; /* tension.max, .min */
+    int rc = values_alloc(r, nfit + ntens + 4 * nforce, err);
     if (rc)
         return rc;
+    const ts_history *h = r->nonlinear;
+    const ts_sim_stats *st = &r->nonlinear_stats;
+    double round = SIM_ROUND_EPS * DBL_EPSILON *
+                   sqrt((double)(st->steps + st->rejected + 1));
+    double res = r->eq ? EQ_NOISE_FACTOR *
+                             fmax(r->eq->residual, EQ_NOISE_MIN_REL)
+                       : 0;
+    ts_extremes none;
+    memset(&none, 0, sizeof none); /* samples 0: names only */
+    int have = ran && h && r->tensions;
+    if (nforce > 0) {
+        force_values(r->values + nfit + ntens, "tow.force",
+                     have ? &r->tow_force : &none, round, res);
+        if (tension)
+            force_values(r->values + nfit + ntens + 4, r->output.name,
+                         have ? &r->output_extremes : &none, round, res);
+    }
+    if (nfit == 0)
+        return TS_OK;
+    const ts_signal *sg = ts_excitation_signal(ex, idx);
     static const char *const suffix[3] = {"amplitude_ratio", "mean_offset",
                                           "phase_deg"};
-    static const char *const unit[3] = {"1", "m", "deg"};
-    double scale[3] = {0.0, sg->amplitude, 360.0};
+    /* A position's ratio is m/m ("1"), a tension's N/m. */
+    const char *ou = r->output.si_unit;
+    int position = !strcmp(ou, "m");
+    char ratio_unit[TS_VALUE_UNIT_MAX];
+    snprintf(ratio_unit, sizeof ratio_unit, "%s",
+             position ? "1" : r->output.unit);
+    const char *unit[3] = {ratio_unit, ou, "deg"};
+    double scale[3] = {0.0, position ? sg->amplitude : 0.0, 360.0};
     for (int v = 0; v < 3; v++)
         value_name(&r->values[v], unit[v], scale[v], "%.70s.%s",
                    r->output.name, suffix[v]);
     value_name(&r->values[SIM_TMAX], "N", 0.0, "tension.max");
     value_name(&r->values[SIM_TMIN], "N", 0.0, "tension.min");
-    const ts_history *h = r->nonlinear;
-    if (!h || !r->eq || r->status != TS_OK)
+    if (!h || !r->eq || !ran)
         return TS_OK;
     int first = 0;
     while (first < h->nsamples && h->t[first] < r->transient - TIME_EPS)
@@ -1312,12 +1501,11 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     if (!buf)
         return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
     double *t = buf, *xo = buf + n, *xe = buf + 2 * n;
-    size_t stride = 3 * (size_t)h->nnodes;
     const ts_output *out = &r->output;
     for (int i = 0; i < n; i++) {
         size_t s = (size_t)(first + i);
         t[i] = h->t[s];
-        xo[i] = h->positions[stride * s + 3 * (size_t)out->node + out->comp];
+        xo[i] = ts_history_value(r->sys, h, out, first + i);
         xe[i] = h->input[TS_NINPUT * s + sg->axis];
     }
     double c, a, ph, ce, ae, phe;
@@ -1329,14 +1517,16 @@ static int sim_values(ts_result *r, int required, ts_err *err)
     free(buf);
     if (rc != TS_OK)
         return required ? ts_fail(err, rc, "%s", fe.msg) : TS_OK;
-    double eqv = r->eq->positions[3 * out->node + out->comp];
+    double eqv = ts_output_value(r->sys, out, r->eq->positions,
+                                 r->eq->tensions, r->eq->tow_force);
     double vals[3] = {a / ae, c - eqv,
                       ts_compare_wrap_deg((ph - phe) * 180.0 / M_PI)};
-    double L = total_length(r->sys);
+    /* Noise is relative to the cable's length for a position, to the
+     * static value for a force or strain. */
+    double L = position ? total_length(r->sys) : fabs(eqv);
+    if (!position)
+        r->values[1].scale = fabs(eqv);
     double noise_scale[3] = {fabs(vals[0]), L, 360.0};
-    const ts_sim_stats *st = &r->nonlinear_stats;
-    double round = SIM_ROUND_EPS * DBL_EPSILON *
-                   sqrt((double)(st->steps + st->rejected + 1));
     for (int v = 0; v < 3; v++) {
         r->values[v].value = vals[v];
         r->values[v].error.solver = round * noise_scale[v];
@@ -1347,8 +1537,83 @@ static int sim_values(ts_result *r, int required, ts_err *err)
         r->values[SIM_TMAX].error.solver = round * fabs(tmax);
         r->values[SIM_TMIN].error.solver = round * fabs(tmax);
     }
-    r->values[1].error.solver += EQ_NOISE_FACTOR *
-                                 fmax(r->eq->residual, EQ_NOISE_MIN_REL) * L;
+    r->values[1].error.solver += res * L;
+    return TS_OK;
+}
+
+/* The forces of the nonlinear run (ts_result: tow_force, tensions,
+ * output_extremes, slack) and their verdict: a rigid link in compression
+ * is a reason (a cable cannot push), an elastic link going slack a note
+ * (a snap load follows). References: the initial equilibrium's values. */
+static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+{
+    const ts_system *sys = r->sys;
+    const ts_history *h = r->nonlinear;
+    const ts_equilibrium *eq =
+        s->initial == TS_INITIAL_EQUILIBRIUM && r->eq && r->eq->converged
+            ? r->eq
+            : NULL;
+    const ts_history *ho = h ? h : r->linear;
+    if (ho)
+        ts_extremes_compute(sys, ho, &r->output,
+                            eq ? ts_output_value(sys, &r->output,
+                                                 eq->positions, eq->tensions,
+                                                 eq->tow_force)
+                               : NAN,
+                            &r->output_extremes);
+    if (!h || h->nsamples == 0)
+        return TS_OK;
+    ts_output o;
+    ts_output_find(sys, "tow.force", TS_OUT_ALL, &o, NULL);
+    ts_extremes_compute(sys, h, &o, eq ? eq->top_tension : NAN,
+                        &r->tow_force);
+    r->tensions = calloc((size_t)sys->nlinks, sizeof *r->tensions);
+    if (!r->tensions)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    memset(&o, 0, sizeof o);
+    o.kind = TS_OUT_TENSION;
+    for (int l = 0; l < sys->nlinks; l++) {
+        o.link = l;
+        ts_extremes *e = &r->tensions[l];
+        ts_extremes_compute(sys, h, &o, eq ? eq->tensions[l] : NAN, e);
+        if (e->samples == 0)
+            continue;
+        if (r->peak_link < 0 || e->max > r->tensions[r->peak_link].max)
+            r->peak_link = l;
+        if (r->low_link < 0 || e->min < r->tensions[r->low_link].min)
+            r->low_link = l;
+    }
+    int rc = ts_slack_find(sys, h, &r->slack, &r->nslack, err);
+    if (rc)
+        return rc;
+    /* The first link of each kind names the event; the others are
+     * counted. */
+    for (int elastic = 0; elastic < 2; elastic++) {
+        int count = 0, first = -1;
+        for (int k = 0; k < r->nslack; k++)
+            if (r->slack[k].elastic == elastic && count++ == 0)
+                first = k;
+        if (first < 0)
+            continue;
+        const ts_slack *e = &r->slack[first];
+        const ts_link *L = &sys->links[e->link];
+        char others[64] = "";
+        if (count > 1)
+            snprintf(others, sizeof others, "; %d links in all", count);
+        if (elastic)
+            ts_trust_note(&r->trust, "elastic link %s.%d goes slack at t = "
+                          "%.6g s (%d samples to t = %.6g s%s): a snap load "
+                          "follows when it pulls again",
+                          sys->cables[L->cable].name, L->index, e->t_first,
+                          e->samples, e->t_last, others);
+        else
+            ts_trust_fail(&r->trust, "rigid link %s.%d is in compression "
+                          "at t = %.6g s (%d samples to t = %.6g s, lowest "
+                          "%.6g N%s): a cable cannot push; the elastic "
+                          "model (cables[].ea) lets it go slack",
+                          sys->cables[L->cable].name, L->index, e->t_first,
+                          e->samples, e->t_last, e->min, others);
+    }
     return TS_OK;
 }
 
@@ -1527,6 +1792,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         r->lin = ts_linear_alloc(k, err);
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
+        lo.tensions = 1; /* the linear run's tensions */
         /* The linear run needs the dense A and B at any size. */
         if (s->compare || s->linear)
             lo.model = TS_LIN_BOTH;
@@ -1574,12 +1840,20 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         else
             r->compared = 1;
     }
+    /* The selection, and the forces of what was simulated (a failed
+     * run's samples so far too). */
+    int frc = sim_selection(sys, s, &r->output, &r->outputs, &r->noutputs,
+                            &r->all_outputs, rc == TS_OK ? err : NULL);
+    if (frc == TS_OK)
+        frc = sim_forces(r, s, rc == TS_OK ? err : NULL);
+    if (rc == TS_OK)
+        rc = frc;
     if (rc == TS_OK && r->has_sea)
         rc = sea_records(r, err);
     else if (rc == TS_OK)
-        rc = sim_values(r, s->need_values, err);
+        rc = sim_values(r, s->linear, 1, s->need_values, err);
     else if (s->need_values)
-        sim_values(r, 0, NULL); /* names, NAN values */
+        sim_values(r, s->linear, 0, 0, NULL); /* names, NAN values */
     free(y0);
     free(pos);
     ts_kernel_free(knl);
@@ -2052,7 +2326,7 @@ static void tow_notes(ts_result *r)
  * of a time history, a tension output) is 1, else the result's. */
 static double value_order(const ts_result *r, const ts_request *rq, int v)
 {
-    if (rq->kind == TS_ANALYSIS_SIMULATE && !r->has_sea && v >= SIM_TMAX)
+    if (rq->kind == TS_ANALYSIS_SIMULATE && !r->has_sea && v >= sim_nfit(r))
         return 1.0;
     if (rq->kind == TS_ANALYSIS_RESPONSE && r->response &&
         r->response->output.kind == TS_OUT_TENSION)
@@ -2315,7 +2589,7 @@ int ts_analysis_sweep(const ts_system *sys, const ts_request *rq, int series,
                             err);
         r->excitation = s->excitation;
         if (rc == TS_OK)
-            rc = sim_values(r, 0, err);
+            rc = sim_values(r, s->linear, 0, 0, err);
     }
     if (rc == TS_OK) {
         an->values = calloc((size_t)r->nvalues, sizeof *an->values);
@@ -2610,12 +2884,14 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
     ts_system_free(s);
     /* The discretisation estimate runs the analysis again at a half and
      * a quarter of the links (doc/accuracy.md): a dense eigen analysis
-     * at least 1/8 + 1/64 more, an explicit simulation 1/4 + 1/16 (its
-     * steps and its evaluations each halve with the links). */
+     * at least 1/8 + 1/64 more, a sparse one (no flops counted) 1/2 +
+     * 1/4, an explicit simulation 1/4 + 1/16 (its steps and its
+     * evaluations each halve with the links). */
     int estimate = rq->setup.discretisation_error || rq->setup.refine;
     if (rc == TS_OK && estimate && e->seconds > 0) {
-        double f = rq->kind == TS_ANALYSIS_MODES ? 1.0 / 8 + 1.0 / 64
-                                                 : 1.0 / 4 + 1.0 / 16;
+        double f = rq->kind != TS_ANALYSIS_MODES ? 1.0 / 4 + 1.0 / 16
+                   : e->flops > 0                ? 1.0 / 8 + 1.0 / 64
+                                                 : 1.0 / 2 + 1.0 / 4;
         e->seconds *= 1 + f;
         e->evaluations *= 1 + f;
         e->flops *= 1 + f;

@@ -104,10 +104,12 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
 {
     memset(c, 0, sizeof *c);
     c->output = *out;
-    if (out->kind != TS_OUT_POSITION)
-        return ts_fail(err, TS_EINVAL, "compare: output '%s' is a tension; "
-                       "the linear run reconstructs positions only (choose "
-                       "<node>.x|y|z)", out->name);
+    if (out->kind != TS_OUT_POSITION &&
+        !(out->kind == TS_OUT_TENSION && lin->Ty && lin->Tu))
+        return ts_fail(err, TS_EINVAL, "compare: output '%s': the linear "
+                       "model gives node positions and, linearized with "
+                       "its tension Jacobians, link tensions (choose "
+                       "<node>.x|y|z or <cable>.<k>.tension)", out->name);
     if (nl->nsamples != li->nsamples || nl->nsamples < 1)
         return ts_fail(err, TS_EINVAL, "compare: the runs have %d and %d "
                        "samples; they must share their sample times",
@@ -133,19 +135,22 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
     c->t_from = nl->t[first];
     c->t_to = t_end;
     c->nsamples = n;
-    int node = out->node, comp = out->comp;
-    c->equilibrium = lin->r0[3 * node + comp];
+    c->equilibrium = ts_output_value(sys, out, lin->r0, lin->t0, NULL);
 
     double *buf = malloc(4 * (size_t)n * sizeof(double));
     if (!buf)
         return ts_fail(err, TS_ENOMEM, "compare: out of memory");
     double *tt = buf, *xn = buf + n, *xl = buf + 2 * n, *xe = buf + 3 * n;
-    size_t stride = 3 * (size_t)nl->nnodes;
     for (int i = 0; i < n; i++) {
-        size_t s = (size_t)(first + i);
-        tt[i] = nl->t[s];
-        xn[i] = nl->positions[stride * s + 3 * (size_t)node + comp];
-        xl[i] = li->positions[stride * s + 3 * (size_t)node + comp];
+        tt[i] = nl->t[first + i];
+        xn[i] = ts_history_value(sys, nl, out, first + i);
+        xl[i] = ts_history_value(sys, li, out, first + i);
+        if (!isfinite(xn[i]) || !isfinite(xl[i])) {
+            free(buf);
+            return ts_fail(err, TS_EINVAL, "compare: %s is not finite at t "
+                           "= %g s in the %s run", out->name, tt[i],
+                           isfinite(xn[i]) ? "linear" : "nonlinear");
+        }
     }
 
     int idx, rc = TS_OK;

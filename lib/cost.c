@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "towstab/kernel.h"
+#include "towstab/linearize.h"
 
 /* Kernel evaluations timed: at least this many, and at least this long. */
 #define TIME_EVALS 3
@@ -160,16 +161,19 @@ int ts_cost_simulate(const ts_system *sys, const ts_excitation *ex,
                           : 0.0;
     e->steps = fmax(1.0, fmax(by_samples, fmax(by_exc, by_stiff)));
     e->evaluations = e->steps * stages(o->integrator);
+    /* esdirk's Newton matrix comes from the sparse model (no vehicle):
+     * O(links); GSL's implicit steppers take a dense Jacobian and LU. */
+    int sparse = o->integrator == TS_INT_ESDIRK && sys->nvehicles == 0;
     if (!explicit_method(o->integrator)) {
-        e->evaluations += 2.0 * (n + 9);
-        e->flops = (double)n * n * n / 3.0;
+        e->evaluations += sparse ? TS_COST_SPARSE_EVALUATIONS : 2.0 * (n + 9);
+        e->flops = sparse ? 0.0 : (double)n * n * n / 3.0;
     }
     e->seconds = e->evaluations * e->eval_s + e->flops / TS_COST_FLOPS;
     /* History: time, positions, tensions, energies and inputs per sample;
      * an implicit method's Jacobian and its factors. */
     e->bytes = 8.0 * (samples + 1) *
                (1 + 3.0 * sys->nnodes + sys->nlinks + 2 + TS_NINPUT);
-    if (!explicit_method(o->integrator))
+    if (!explicit_method(o->integrator) && !sparse)
         e->bytes += 3 * 8.0 * n * n;
     char d[32];
     duration(e->seconds, d, sizeof d);
@@ -200,19 +204,31 @@ int ts_cost_modes(const ts_system *sys, int n, ts_eig_method m,
     int rc = time_kernel(sys, &e->eval_s, &nk, err);
     if (rc)
         return rc;
-    e->evaluations = 2.0 * (n + 9);
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    int dense = m != TS_EIG_ARPACK || n < lo.dense_max_states ||
+                sys->nvehicles > 0;
+    if (dense) {
+        e->evaluations = 2.0 * (n + 9);
+        e->bytes = 8.0 * n * (double)n;
+    } else {
+        e->evaluations = TS_COST_SPARSE_EVALUATIONS;
+    }
     if (m != TS_EIG_ARPACK) {
         e->flops = 30.0 * n * (double)n * n;
         e->bytes = 6 * 8.0 * n * (double)n;
+    } else if (dense) {
+        e->flops = 2.0 / 3.0 * n * (double)n * n;
     }
     e->seconds = e->evaluations * e->eval_s + e->flops / TS_COST_FLOPS;
     char d[32];
     duration(e->seconds, d, sizeof d);
     snprintf(e->what, sizeof e->what,
-             "at least %s: %s of the %d-state linearization (%.3g flops, "
+             "at least %s: %s of the %d-state %s linearization (%.3g flops, "
              "%.3g GB) after %.3g kernel evaluations of %d links",
              d, m == TS_EIG_ARPACK ? "ARPACK" : "a dense LAPACK eigensolve",
-             n, e->flops, e->bytes / 1e9, e->evaluations, sys->nlinks);
+             n, dense ? "dense" : "sparse", e->flops, e->bytes / 1e9,
+             e->evaluations, sys->nlinks);
     snprintf(e->reduce, sizeof e->reduce, "fewer links, or method arpack "
              "with a count (the modes near a target)");
     return TS_OK;

@@ -45,8 +45,10 @@
 #define BENDING_START 1e-4
 #define CONTINUATION_MIN_STEP (1.0 / 1024)
 /* Newton iterations one solve may take along a continuation path, in
- * units of max_iter (the examples take at most 29 with max_iter 100). */
-#define CONTINUATION_MAX_ITER 10
+ * units of max_iter (the examples take at most 29 with max_iter 100: 3
+ * leaves a factor of 10, and a path that cannot be followed fails in
+ * seconds rather than a minute). */
+#define CONTINUATION_MAX_ITER 3
 /* A vehicle's attitude alone on its joint in the straight tow (the
  * Newton start): moment residual relative to its weight and flow forces
  * times its lever, and the hybrid solver's iterations. */
@@ -646,11 +648,12 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         /* A path that keeps failing can halve its step ten times, each
          * try up to max_iter Newton iterations: bound the whole. */
         if (eq->iterations > CONTINUATION_MAX_ITER * o->max_iter) {
-            rc = ts_fail(err, TS_ECONV, "equilibrium: %d Newton iterations "
-                         "without reaching the end of the path, more than "
-                         "the %d (%d times max_iter) a solve may take",
-                         eq->iterations, CONTINUATION_MAX_ITER * o->max_iter,
-                         CONTINUATION_MAX_ITER);
+            /* Keep the last try's message: it gives the residual. */
+            ts_err_prefix(err, "%d Newton iterations without reaching the "
+                               "end of the path, more than the %d (%d times "
+                               "max_iter) a solve may take; the last try: ",
+                          eq->iterations, CONTINUATION_MAX_ITER * o->max_iter,
+                          CONTINUATION_MAX_ITER);
             break;
         }
         dt *= 0.5;
@@ -1135,4 +1138,22 @@ out:
     if (rc == TS_OK)
         ts_err_clear(err); /* a failed first attempt leaves no message */
     return rc;
+}
+
+double ts_equilibrium_strain(const ts_system *sys, const ts_equilibrium *eq,
+                             int link)
+{
+    const ts_link *L = &sys->links[link];
+    return L->elastic && L->ea > 0 ? eq->tensions[link] / L->ea : 0.0;
+}
+
+double ts_equilibrium_cable_length(const ts_system *sys,
+                                   const ts_equilibrium *eq, int c)
+{
+    double len = 0;
+    for (int l = 0; l < sys->nlinks; l++)
+        if (sys->links[l].cable == c)
+            len += sys->links[l].length *
+                   (1.0 + ts_equilibrium_strain(sys, eq, l));
+    return len;
 }

@@ -352,7 +352,8 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
     {.name = "output", .type = TS_OPT_TEXT, .section = TS_SEC_SIMULATE,       \
      NOLIM, .offset = OFF(simulate.output), .size = SZ(simulate.output),      \
      .only = o, .arg = "NAME",                                                \
-     .help = "the node coordinate compared and printed, e.g. sphere.z",       \
+     .help = "the channel compared and fitted, e.g. sphere.z, "               \
+             "cable.3.tension, tow.force",                                    \
      .deftext = "the last sphere's .z"},                                      \
     {.name = "linear_method", .type = TS_OPT_ENUM,                            \
      .section = TS_SEC_SIMULATE, NOLIM, .choices = linear_methods,            \
@@ -479,6 +480,12 @@ static const ts_option simulate_rows[] = {
      .unit = "s", .min = 0, .max = INFINITY,
      .offset = OFF(simulate.fade_in), .arg = "T",
      .help = "the sea's fade-in from rest", .deftext = "2 Tp"},
+    {.name = "outputs", .type = TS_OPT_TEXT, .section = TS_SEC_SIMULATE,
+     NOLIM, .offset = OFF(simulate.outputs), .size = SZ(simulate.outputs),
+     .arg = "LIST",
+     .help = "the channels written and printed, e.g. "
+             "fish.z,armour.1.tension,tow.force; all: the full state",
+     .deftext = "the output (a node's x, y, z) and tow.force"},
 };
 
 static const ts_option converge_rows[] = {

@@ -73,6 +73,7 @@
 void ts_plot_opts_default(ts_plot_opts *o)
 {
     o->units = TS_PLOT_SI;
+    o->display = NULL;
     o->width = TS_PLOT_MIN_WIDTH;
     o->height = TS_PLOT_MIN_HEIGHT;
     o->formats = TS_PLOT_PNG | TS_PLOT_SVG;
@@ -106,6 +107,40 @@ const char *ts_plot_unit(ts_plot_quantity q, ts_plot_units u)
     case TS_PLOT_ANGLE: return "deg";
     default: return "-";
     }
+}
+
+/* The display quantity of a plot quantity, -1 for those shown as they
+ * are (dimensionless, 1/s). */
+static int display_quantity(ts_plot_quantity q)
+{
+    switch (q) {
+    case TS_PLOT_LENGTH: return TS_QTY_LENGTH;
+    case TS_PLOT_FORCE: return TS_QTY_FORCE;
+    case TS_PLOT_SPEED: return TS_QTY_SPEED;
+    case TS_PLOT_TIME: return TS_QTY_TIME;
+    case TS_PLOT_FREQUENCY: return TS_QTY_FREQUENCY;
+    case TS_PLOT_ANGULAR_RATE: return TS_QTY_ANGULAR_RATE;
+    case TS_PLOT_ANGLE: return TS_QTY_ANGLE;
+    default: return -1;
+    }
+}
+
+/* An SI value as drawn, and the unit of its axis: opts->display when
+ * set, else opts->units. */
+static double pconv(ts_plot_quantity q, const ts_plot_opts *o, double v)
+{
+    int dq = display_quantity(q);
+    if (o->display && dq >= 0)
+        return ts_display_value(o->display, (ts_quantity)dq, v);
+    return ts_plot_convert(q, o->units, v);
+}
+
+static const char *punit(ts_plot_quantity q, const ts_plot_opts *o)
+{
+    int dq = display_quantity(q);
+    if (o->display && dq >= 0)
+        return ts_display_unit(o->display, (ts_quantity)dq);
+    return ts_plot_unit(q, o->units);
 }
 
 int ts_plot_prepare_dir(const char *dir, ts_err *err)
@@ -299,11 +334,11 @@ static void pl_text(char *dst, size_t size, const char *src)
 }
 
 static void axis_label(char *dst, size_t size, const char *name,
-                       ts_plot_quantity q, ts_plot_units u)
+                       ts_plot_quantity q, const ts_plot_opts *u)
 {
     char raw[TEXT_MAX];
     snprintf(raw, sizeof raw, "%s [%s]", name ? name : "",
-             ts_plot_unit(q, u));
+             punit(q, u));
     pl_text(dst, size, raw);
 }
 
@@ -1136,7 +1171,8 @@ static int check_shape(const char *fn, const char *what, int i,
 
 /* Fill xy from pos (+ scale * disp when disp is not NULL). */
 static int shape_coords(const ts_plot_shape *s, const double *disp,
-                        double scale, ts_plot_view view, ts_plot_units u,
+                        double scale, ts_plot_view view,
+                        const ts_plot_opts *u,
                         shape_xy *xy)
 {
     int n = s->nnodes;
@@ -1149,8 +1185,8 @@ static int shape_coords(const ts_plot_shape *s, const double *disp,
         double r[3];
         for (int j = 0; j < 3; j++)
             r[j] = s->pos[3 * k + j] + (disp ? scale * disp[3 * k + j] : 0);
-        xy->h[k] = ts_plot_convert(TS_PLOT_LENGTH, u, r[0]);
-        xy->v[k] = ts_plot_convert(TS_PLOT_LENGTH, u,
+        xy->h[k] = pconv(TS_PLOT_LENGTH, u, r[0]);
+        xy->v[k] = pconv(TS_PLOT_LENGTH, u,
                                    view == TS_PLOT_SIDE ? r[2] : r[1]);
         xy->z[k] = r[2];
     }
@@ -1241,7 +1277,7 @@ static void bbox_update(double *lo, double *hi, double v)
 }
 
 static void draw_water(frame *f, double x0, double x1, double zdeep,
-                       ts_plot_units u)
+                       const ts_plot_opts *u)
 {
     if (zdeep > 0) {
         double px[4] = {x0, x1, x1, x0}, pz[4] = {0, 0, zdeep, zdeep};
@@ -1255,7 +1291,7 @@ static void draw_water(frame *f, double x0, double x1, double zdeep,
     frame_segment(f, x0, 0, x1, 0);
     char t[64];
     snprintf(t, sizeof t, "water surface (z = 0 %s)",
-             ts_plot_unit(TS_PLOT_LENGTH, u));
+             punit(TS_PLOT_LENGTH, u));
     plschr(0, 0.85);
     /* Just above the line at the left end (depth axis points down). */
     double ty = -0.03 * fabs(f->top - f->bottom);
@@ -1269,7 +1305,7 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
 {
     (void)height;
     const shapes_ctx *c = vctx;
-    ts_plot_units u = o->units;
+    const ts_plot_opts *u = o;
     int top = c->view == TS_PLOT_TOP;
     int water = (c->flags & TS_PLOT_WATER) != 0;
     shape_xy *xy = calloc((size_t)c->nshapes, sizeof *xy);
@@ -1295,14 +1331,14 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
     }
     double extent = fmax(h1 - h0, v1 - v0);
     if (!(extent > 0))
-        extent = ts_plot_convert(TS_PLOT_LENGTH, u, 1.0);
+        extent = pconv(TS_PLOT_LENGTH, u, 1.0);
     if (top) {
         /* The ship at the origin, and turning circles that are not much
          * larger than the cable. */
         bbox_update(&h0, &h1, 0);
         bbox_update(&v0, &v1, 0);
         for (int i = 0; i < c->nshapes; i++) {
-            double R = ts_plot_convert(TS_PLOT_LENGTH, u,
+            double R = pconv(TS_PLOT_LENGTH, u,
                                        c->shapes[i].turn_radius);
             if (R != 0 && fabs(R) <= CIRCLE_FIT * extent) {
                 bbox_update(&h0, &h1, -fabs(R));
@@ -1362,7 +1398,7 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
         plptex(0, -1.1 * s, 1, 0, 0.5, "ship");
         plschr(0, 1.0);
         for (int i = 0; i < c->nshapes; i++) {
-            double R = ts_plot_convert(TS_PLOT_LENGTH, u,
+            double R = pconv(TS_PLOT_LENGTH, u,
                                        c->shapes[i].turn_radius);
             if (R == 0)
                 continue;
@@ -1459,7 +1495,7 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
                       ts_err *err)
 {
     const modes_ctx *c = vctx;
-    ts_plot_units u = o->units;
+    const ts_plot_opts *u = o;
     int water = (c->flags & TS_PLOT_WATER) != 0;
     int n = c->eq->nnodes;
     /* xy[view][0] equilibrium, [1 + 2m] +mode, [2 + 2m] -mode. */
@@ -1494,7 +1530,7 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
         for (int a = 0; a < 2; a++)
             extent = fmax(extent, hi[view][a] - lo[view][a]);
     if (!(extent > 0))
-        extent = ts_plot_convert(TS_PLOT_LENGTH, u, 1.0);
+        extent = pconv(TS_PLOT_LENGTH, u, 1.0);
     if (water) {
         bbox_update(&lo[0][1], &hi[0][1], 0);
         bbox_update(&lo[0][1], &hi[0][1], -0.04 * extent);
@@ -1758,9 +1794,9 @@ static int draw_eigenvalues(const void *vctx, const ts_plot_opts *o,
         legend_add(&L, S->label, col, TS_PLOT_MARKERS, marker_glyph(s));
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
-    axis_label(xl, sizeof xl, "real part σ", TS_PLOT_RATE, o->units);
+    axis_label(xl, sizeof xl, "real part σ", TS_PLOT_RATE, o);
     axis_label(yl, sizeof yl, "imaginary part ω", TS_PLOT_ANGULAR_RATE,
-               o->units);
+               o);
     label_axes(&f, xl, yl, 1.0);
     char text[160];
     if (outside)
@@ -1816,9 +1852,9 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
 {
     (void)height;
     const bode_ctx *c = vctx;
-    ts_plot_units u = o->units;
-    double gain = ts_plot_convert(c->out_q, u, 1.0) /
-                  ts_plot_convert(c->in_q, u, 1.0);
+    const ts_plot_opts *u = o;
+    double gain = pconv(c->out_q, u, 1.0) /
+                  pconv(c->in_q, u, 1.0);
     int nmax = 0;
     for (int i = 0; i < c->ncurves; i++)
         if (c->curves[i].n > nmax)
@@ -1852,7 +1888,7 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
     axis_label(xl, sizeof xl, "frequency", TS_PLOT_FREQUENCY, u);
     snprintf(raw, sizeof raw, "%s [%s/%s]",
              c->mag_label ? c->mag_label : "magnitude",
-             ts_plot_unit(c->out_q, u), ts_plot_unit(c->in_q, u));
+             punit(c->out_q, u), punit(c->in_q, u));
     pl_text(ml, sizeof ml, raw);
     int nlegend = 0, lchars = 0;
     for (int i = 0; i < c->ncurves; i++)
@@ -1997,7 +2033,7 @@ static int draw_histories(const void *vctx, const ts_plot_opts *o,
 {
     (void)height;
     const hist_ctx *c = vctx;
-    ts_plot_units u = o->units;
+    const ts_plot_opts *u = o;
     int nmax = 0;
     for (int i = 0; i < c->nseries; i++)
         if (c->series[i].n > nmax)
@@ -2024,7 +2060,7 @@ static int draw_histories(const void *vctx, const ts_plot_opts *o,
             for (int k = 0; c->series[i].panel == p && k < c->series[i].n;
                  k++)
                 bbox_update(&lo[p], &hi[p],
-                            ts_plot_convert(q, u, c->series[i].y[k]));
+                            pconv(q, u, c->series[i].y[k]));
         /* A constant series gets a window of 10 % of its value (1 when
          * it is 0). */
         pad_range(&lo[p], &hi[p], 0.08, lo[p] != 0 ? 0.1 * fabs(lo[p]) : 1.0);
@@ -2058,7 +2094,7 @@ static int draw_histories(const void *vctx, const ts_plot_opts *o,
             if (S->panel != p)
                 continue;
             for (int k = 0; k < S->n; k++)
-                yv[k] = ts_plot_convert(q, u, S->y[k]);
+                yv[k] = pconv(q, u, S->y[k]);
             int col = color_index(S->color, ord);
             draw_series(&f, S, col, ord, S->x, yv);
             legend_add(&L, S->label, col, S->style, marker_glyph(ord));
@@ -2126,7 +2162,7 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
 {
     (void)height;
     const loglog_ctx *c = vctx;
-    ts_plot_units u = o->units;
+    const ts_plot_opts *u = o;
     int nmax = 0, nlegend = 0, lchars = 0;
     for (int i = 0; i < c->nseries; i++) {
         if (c->series[i].n > nmax)
@@ -2140,9 +2176,9 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
     for (int i = 0; i < c->nseries; i++)
         for (int k = 0; k < c->series[i].n; k++) {
-            bbox_update(&x0, &x1, log10(ts_plot_convert(c->xa->quantity, u,
+            bbox_update(&x0, &x1, log10(pconv(c->xa->quantity, u,
                                                         c->series[i].x[k])));
-            bbox_update(&y0, &y1, log10(ts_plot_convert(c->ya->quantity, u,
+            bbox_update(&y0, &y1, log10(pconv(c->ya->quantity, u,
                                                         c->series[i].y[k])));
         }
     pad_range(&x0, &x1, 0.06, 1.0);
@@ -2157,8 +2193,8 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
     for (int i = 0; i < c->nseries; i++) {
         const ts_plot_series *S = &c->series[i];
         for (int k = 0; k < S->n; k++) {
-            lx[k] = log10(ts_plot_convert(c->xa->quantity, u, S->x[k]));
-            ly[k] = log10(ts_plot_convert(c->ya->quantity, u, S->y[k]));
+            lx[k] = log10(pconv(c->xa->quantity, u, S->x[k]));
+            ly[k] = log10(pconv(c->ya->quantity, u, S->y[k]));
         }
         int col = color_index(S->color, i);
         draw_series(&f, S, col, i, lx, ly);

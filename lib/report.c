@@ -132,13 +132,31 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
         const ts_link *L = &sys->links[l];
         double t1, t2;
         ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
-        json_array_append_new(
-            links, json_pack("{s:s,s:i,s:o,s:o,s:o}", "cable",
-                             sys->cables[L->cable].name, "index", L->index,
-                             "tension", num(eq->tensions[l]), "theta1_deg",
-                             num(t1 * 180 / M_PI), "theta2_deg",
-                             num(t2 * 180 / M_PI)));
+        json_t *lj = json_pack("{s:s,s:i,s:o,s:o,s:o}", "cable",
+                               sys->cables[L->cable].name, "index", L->index,
+                               "tension", num(eq->tensions[l]), "theta1_deg",
+                               num(t1 * 180 / M_PI), "theta2_deg",
+                               num(t2 * 180 / M_PI));
+        if (lj && L->elastic)
+            json_object_set_new(lj, "strain",
+                                num(ts_equilibrium_strain(sys, eq, l)));
+        json_array_append_new(links, lj);
     }
+    /* Elastic cables: their lengths at rest and stretched. */
+    json_t *cables = json_array();
+    for (int c = 0; cables && c < sys->ncables; c++)
+        if (sys->cables[c].ea > 0)
+            json_array_append_new(
+                cables, json_pack("{s:s,s:o,s:o}", "name",
+                                  sys->cables[c].name, "length",
+                                  num(sys->cables[c].length),
+                                  "stretched_length",
+                                  num(ts_equilibrium_cable_length(sys, eq,
+                                                                  c))));
+    if (cables && json_array_size(cables) > 0)
+        json_object_set_new(o, "elastic_cables", cables);
+    else
+        json_decref(cables);
     for (int b = 0; b < sys->nbodies; b++) {
         int k = ts_system_body_node(sys, b);
         const double *r = eq->positions + 3 * k;
@@ -231,22 +249,35 @@ int ts_report_check_targets(int n, const char *const what[],
 int ts_report_equilibrium_csv(const ts_system *sys, const ts_equilibrium *eq,
                               const char *path, ts_err *err)
 {
-    char name[2 * TS_NAME_MAX];
+    return ts_report_equilibrium_csv_display(sys, eq, NULL, path, err);
+}
+
+int ts_report_equilibrium_csv_display(const ts_system *sys,
+                                      const ts_equilibrium *eq,
+                                      const ts_display *d, const char *path,
+                                      ts_err *err)
+{
+    d = ts_display_or_si(d);
+    char name[2 * TS_NAME_MAX], lu[TS_DISPLAY_UNIT_MAX * 2],
+        fu[TS_DISPLAY_UNIT_MAX * 2];
+    ts_display_unit_token(ts_display_unit(d, TS_QTY_LENGTH), lu, sizeof lu);
+    ts_display_unit_token(ts_display_unit(d, TS_QTY_FORCE), fu, sizeof fu);
     tsi_outfile out;
     int rc = tsi_outfile_open(&out, path, err);
     if (rc != TS_OK)
         return rc;
     FILE *f = out.f;
-    fprintf(f, "node,x_m,y_m,z_m,tension_above_N\n");
+    fprintf(f, "node,x_%s,y_%s,z_%s,tension_above_%s\n", lu, lu, lu, fu);
     for (int i = 0; i < sys->nnodes; i++) {
         const double *r = eq->positions + 3 * i;
         ts_system_node_name(sys, i, name, sizeof name);
-        if (i == 0)
-            fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
-                    eq->top_tension);
-        else
-            fprintf(f, "%s,%.17g,%.17g,%.17g,%.17g\n", name, r[0], r[1], r[2],
-                    eq->tensions[i - 1]);
+        fprintf(f, "%s", name);
+        for (int c = 0; c < 3; c++)
+            fprintf(f, ",%.17g", ts_display_value(d, TS_QTY_LENGTH, r[c]));
+        fprintf(f, ",%.17g\n",
+                ts_display_value(d, TS_QTY_FORCE,
+                                 i == 0 ? eq->top_tension
+                                        : eq->tensions[i - 1]));
     }
     return tsi_outfile_commit(&out, err);
 }

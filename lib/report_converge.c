@@ -195,20 +195,42 @@ static void csv_num(FILE *f, double v)
 int ts_report_convergence_csv(const ts_convergence *c, const char *path,
                               ts_err *err)
 {
+    return ts_report_convergence_csv_display(c, NULL, path, err);
+}
+
+int ts_report_convergence_csv_display(const ts_convergence *c,
+                                      const ts_display *d, const char *path,
+                                      ts_err *err)
+{
+    d = ts_display_or_si(d);
+    size_t nv = (size_t)(c->nvalues > 0 ? c->nvalues : 1);
     int *idx = malloc((size_t)(c->nrows > 0 ? c->nrows : 1) * sizeof(int));
-    if (!idx)
+    double *k = malloc(nv * sizeof *k);
+    if (!idx || !k) {
+        free(idx);
+        free(k);
         return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+    }
     tsi_outfile out;
     int orc = tsi_outfile_open(&out, path, err);
     if (orc != TS_OK) {
         free(idx);
+        free(k);
         return orc;
     }
     FILE *f = out.f;
     fprintf(f, "series,setting,h,status,wall_s,evaluations,trustworthy,"
                "max_relative_error");
-    for (int v = 0; v < c->nvalues; v++)
-        fprintf(f, ",%s,%s_error", c->values[v].name, c->values[v].name);
+    for (int v = 0; v < c->nvalues; v++) {
+        char u[64], t[64] = "";
+        k[v] = ts_display_convert(d, c->values[v].unit, 1.0, u, sizeof u);
+        if (strcmp(u, c->values[v].unit)) {
+            t[0] = '_';
+            ts_display_unit_token(u, t + 1, sizeof t - 1);
+        }
+        fprintf(f, ",%s%s,%s%s_error", c->values[v].name, t,
+                c->values[v].name, t);
+    }
     fprintf(f, "\n");
     ts_convergence_sorted_rows(c, idx);
     for (int i = 0; i < c->nrows; i++) {
@@ -221,11 +243,12 @@ int ts_report_convergence_csv(const ts_convergence *c, const char *path,
         fprintf(f, ",%ld,%d", r->evaluations, r->trust.trustworthy);
         csv_num(f, r->max_rel_error);
         for (int v = 0; v < c->nvalues; v++) {
-            csv_num(f, r->values[v]);
-            csv_num(f, r->errors[v]);
+            csv_num(f, k[v] * r->values[v]);
+            csv_num(f, k[v] * r->errors[v]);
         }
         fprintf(f, "\n");
     }
     free(idx);
+    free(k);
     return tsi_outfile_commit(&out, err);
 }

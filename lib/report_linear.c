@@ -257,14 +257,31 @@ json_t *ts_report_response_json(const ts_response *r)
 int ts_report_response_csv(const ts_response *r, const char *path,
                            ts_err *err)
 {
+    return ts_report_response_csv_display(r, NULL, path, err);
+}
+
+int ts_report_response_csv_display(const ts_response *r, const ts_display *d,
+                                   const char *path, ts_err *err)
+{
+    d = ts_display_or_si(d);
+    char fu[64], gu[64], ft[64], gt[64];
+    double fk = ts_display_convert(d, "Hz", 1.0, fu, sizeof fu);
+    double gk = ts_display_convert(d, r->output.unit, 1.0, gu, sizeof gu);
+    ts_display_unit_token(fu, ft, sizeof ft);
+    ts_display_unit_token(gu, gt, sizeof gt);
+    /* The SI names, unless the unit shown is another. */
+    int gs = !strcmp(gu, r->output.unit);
     tsi_outfile out;
     int orc = tsi_outfile_open(&out, path, err);
     if (orc != TS_OK)
         return orc;
     FILE *f = out.f;
-    fprintf(f, "freq_hz,magnitude,phase_deg,re,im\n");
+    fprintf(f, "freq_%s,magnitude%s%s,phase_deg,re%s%s,im%s%s\n",
+            strcmp(fu, "Hz") ? ft : "hz", gs ? "" : "_", gs ? "" : gt,
+            gs ? "" : "_", gs ? "" : gt, gs ? "" : "_", gs ? "" : gt);
     for (int i = 0; i < r->npoints; i++)
-        fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", r->freq_hz[i],
-                r->magnitude[i], r->phase_deg[i], r->re[i], r->im[i]);
+        fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", fk * r->freq_hz[i],
+                gk * r->magnitude[i], r->phase_deg[i], gk * r->re[i],
+                gk * r->im[i]);
     return tsi_outfile_commit(&out, err);
 }

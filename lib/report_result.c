@@ -114,6 +114,64 @@ static json_t *modes_json(const ts_result *r, int flags)
     return j;
 }
 
+/* A run's history: the channels reported, and the full state when it
+ * was asked for. */
+static json_t *history_json(const ts_result *r, const ts_history *h)
+{
+    json_t *o = ts_report_channels_json(r->sys, h, r->noutputs, r->outputs);
+    if (o && r->all_outputs && ts_report_history_full(o, r->sys, h)) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* The forces of the nonlinear run: the tow force, every link, the peak
+ * and lowest links, the output's extremes, the links out of range. */
+static json_t *forces_json(const ts_result *r)
+{
+    const ts_system *sys = r->sys;
+    json_t *f = json_object(), *links = json_array(), *slack = json_array();
+    if (!f || !links || !slack) {
+        json_decref(f);
+        json_decref(links);
+        json_decref(slack);
+        return NULL;
+    }
+    json_object_set_new(f, "tow", ts_report_extremes_json(&r->tow_force));
+    for (int l = 0; l < sys->nlinks; l++) {
+        json_t *e = ts_report_extremes_json(&r->tensions[l]);
+        json_object_set_new(e, "cable", json_string(
+                                sys->cables[sys->links[l].cable].name));
+        json_object_set_new(e, "index", json_integer(sys->links[l].index));
+        json_array_append_new(links, e);
+    }
+    json_object_set_new(f, "links", links);
+    int pick[2] = {r->peak_link, r->low_link};
+    static const char *const key[2] = {"peak_link", "low_link"};
+    for (int k = 0; k < 2; k++) {
+        const ts_link *L = pick[k] >= 0 ? &sys->links[pick[k]] : NULL;
+        json_object_set_new(f, key[k],
+                            L ? json_pack("{s:s,s:i}", "cable",
+                                          sys->cables[L->cable].name,
+                                          "index", L->index)
+                              : json_null());
+    }
+    for (int k = 0; k < r->nslack; k++) {
+        const ts_slack *e = &r->slack[k];
+        const ts_link *L = &sys->links[e->link];
+        json_array_append_new(
+            slack, json_pack("{s:s,s:i,s:s,s:o,s:o,s:i,s:o}", "cable",
+                             sys->cables[L->cable].name, "index", L->index,
+                             "kind", e->elastic ? "slack" : "compression",
+                             "t_first", num(e->t_first), "t_last",
+                             num(e->t_last), "samples", e->samples, "min",
+                             num(e->min)));
+    }
+    json_object_set_new(f, "slack", slack);
+    return f;
+}
+
 /* The sea state of a response or a simulation: the spectral result with
  * the RAO file (and, with `points`, the spectra). */
 static json_t *sea_json(const ts_result *r, int points)
@@ -157,11 +215,11 @@ static json_t *sim_sea_json(const ts_result *r)
 
 static json_t *simulate_json(const ts_result *r, int flags)
 {
+    (void)flags;
     const ts_system *sys = r->sys;
     json_t *j = json_object();
     if (!j || !sys)
         return j;
-    int node = flags & TS_REPORT_OUTPUT_ONLY ? r->output.node : -1;
     json_object_set_new(j, "scene", json_string(sys->name));
     json_object_set_new(j, "nlinks", json_integer(sys->nlinks));
     json_object_set_new(j, "output", json_string(r->output.name));
@@ -179,8 +237,7 @@ static json_t *simulate_json(const ts_result *r, int flags)
                                 ts_integrator_name(r->sim.integrator)));
         json_object_set_new(o, "rel_tol", json_real(r->sim.rel_tol));
         json_object_set_new(o, "abs_tol", json_real(r->sim.abs_tol));
-        json_object_set_new(o, "history",
-                            ts_report_history_json(sys, r->nonlinear, node));
+        json_object_set_new(o, "history", history_json(r, r->nonlinear));
         json_object_set_new(j, "nonlinear", o);
     }
     if (r->linear) {
@@ -196,10 +253,24 @@ static json_t *simulate_json(const ts_result *r, int flags)
                             json_string(r->sim.kinematics == TS_KIN_LINEAR
                                             ? "linear"
                                             : "nonlinear"));
-        json_object_set_new(o, "history",
-                            ts_report_history_json(sys, r->linear, node));
+        json_object_set_new(o, "history", history_json(r, r->linear));
         json_object_set_new(j, "linear", o);
     }
+    json_t *outs = json_array();
+    for (int k = 0; outs && k < r->noutputs; k++)
+        json_array_append_new(outs, json_string(r->outputs[k].name));
+    json_object_set_new(j, "outputs", outs);
+    json_object_set_new(j, "full_state", json_boolean(r->all_outputs));
+    const ts_history *ho = r->nonlinear ? r->nonlinear : r->linear;
+    if (ho) {
+        json_t *oe = ts_report_extremes_json(&r->output_extremes);
+        if (oe)
+            json_object_set_new(oe, "unit",
+                                json_string(r->output.si_unit));
+        json_object_set_new(j, "output_extremes", oe);
+    }
+    if (r->tensions)
+        json_object_set_new(j, "forces", forces_json(r));
     if (r->compared)
         json_object_set_new(j, "compare", ts_report_compare_json(&r->compare));
     if (r->has_sea)
@@ -371,15 +442,29 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
     json_object_set_new(j, "key_values", key_values_json(r));
     if (r->kind != TS_ANALYSIS_CONVERGE)
         json_object_set_new(j, "accuracy", accuracy_json(r));
+    /* JSON stays SI whatever the display: the units, named. */
+    const ts_display *si = ts_display_or_si(NULL);
+    json_t *units = json_object();
+    for (int q = 0; units && q < TS_QTY_COUNT; q++)
+        json_object_set_new(units, ts_quantity_name((ts_quantity)q),
+                            json_string(ts_display_unit(si, (ts_quantity)q)));
+    json_object_set_new(j, "units", units);
     return j;
 }
 
 int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
 {
+    return ts_report_result_csv_display(r, NULL, path, err);
+}
+
+int ts_report_result_csv_display(const ts_result *r, const ts_display *d,
+                                 const char *path, ts_err *err)
+{
     switch (r->kind) {
     case TS_ANALYSIS_EQUILIBRIUM:
         if (r->eq && r->eq->converged)
-            return ts_report_equilibrium_csv(r->sys, r->eq, path, err);
+            return ts_report_equilibrium_csv_display(r->sys, r->eq, d, path,
+                                                     err);
         break;
     case TS_ANALYSIS_MODES:
         if (r->eigen)
@@ -389,16 +474,21 @@ int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
         if (r->seastate)
             return ts_report_seastate_csv(r->seastate, path, err);
         if (r->response)
-            return ts_report_response_csv(r->response, path, err);
+            return ts_report_response_csv_display(r->response, d, path, err);
         break;
     case TS_ANALYSIS_SIMULATE:
+        if ((r->nonlinear || r->linear) && r->all_outputs)
+            return ts_report_history_csv_display(r->sys, r->nonlinear,
+                                                 r->linear, d, path, err);
         if (r->nonlinear || r->linear)
-            return ts_report_history_csv(r->sys, r->nonlinear, r->linear,
-                                         path, err);
+            return ts_report_channels_csv(r->sys, r->nonlinear, r->linear,
+                                          r->noutputs, r->outputs, d, path,
+                                          err);
         break;
     case TS_ANALYSIS_CONVERGE:
         if (r->convergence)
-            return ts_report_convergence_csv(r->convergence, path, err);
+            return ts_report_convergence_csv_display(r->convergence, d, path,
+                                                     err);
         break;
     }
     return ts_fail(err, TS_EINVAL, "%s: the %s result has no table to write",

@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "outfile.h"
@@ -35,6 +36,75 @@ json_t *ts_report_sim_stats_json(const ts_sim_stats *st, const char *method)
                      (json_int_t)st->restarts, "t_reached",
                      num(st->t_reached), "h_last", num(st->h_last), "wall_s",
                      num(st->wall_s), "simulated_per_wall", num(ratio));
+}
+
+/* A run with tensions and a tow force (a nonlinear one). */
+static int has_forces(const ts_history *h)
+{
+    return h->nsamples > 0 && isfinite(h->tow_force[0]);
+}
+
+/* Channel `out` gives a finite value at some sample of h. */
+static int gives(const ts_system *sys, const ts_history *h,
+                 const ts_output *out)
+{
+    for (int i = 0; i < h->nsamples; i++)
+        if (isfinite(ts_history_value(sys, h, out, i)))
+            return 1;
+    return 0;
+}
+
+json_t *ts_report_channels_json(const ts_system *sys, const ts_history *h,
+                                int n, const ts_output outs[])
+{
+    json_t *o = json_object(), *ch = json_object();
+    if (!o || !ch) {
+        json_decref(o);
+        json_decref(ch);
+        return NULL;
+    }
+    json_object_set_new(o, "t", series(h->t, h->nsamples, 1));
+    for (int k = 0; k < n; k++) {
+        if (!gives(sys, h, &outs[k]))
+            continue;
+        json_t *a = json_array();
+        for (int i = 0; a && i < h->nsamples; i++)
+            json_array_append_new(a, num(ts_history_value(sys, h, &outs[k],
+                                                          i)));
+        json_object_set_new(ch, outs[k].name, a);
+    }
+    json_object_set_new(o, "outputs", ch);
+    return o;
+}
+
+int ts_report_history_full(json_t *o, const ts_system *sys,
+                           const ts_history *h)
+{
+    json_t *full = ts_report_history_json(sys, h, -1);
+    if (!full)
+        return TS_ENOMEM;
+    if (has_forces(h)) {
+        int n = h->nsamples;
+        json_object_set_new(full, "tow_force",
+                            json_pack("{s:o,s:o,s:o}", "x",
+                                      series(h->tow_force, n, 3), "y",
+                                      series(h->tow_force + 1, n, 3), "z",
+                                      series(h->tow_force + 2, n, 3)));
+    }
+    json_object_del(full, "t");
+    int rc = json_object_update(o, full) ? TS_ENOMEM : TS_OK;
+    json_decref(full);
+    return rc;
+}
+
+json_t *ts_report_extremes_json(const ts_extremes *e)
+{
+    return json_pack("{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "max",
+                     num(e->max), "t_max", num(e->t_max), "max_error",
+                     num(e->max_error), "min", num(e->min), "t_min",
+                     num(e->t_min), "min_error", num(e->min_error), "mean",
+                     num(e->mean), "static", num(e->reference),
+                     "amplification", num(e->amplification));
 }
 
 json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
@@ -157,40 +227,27 @@ json_t *ts_report_excitation_json(const ts_excitation *ex)
     return a;
 }
 
-static void csv_header(FILE *f, const ts_system *sys, const ts_history *h,
-                       const char *prefix)
-{
-    char name[2 * TS_NAME_MAX];
-    for (int k = 0; k < h->nnodes; k++) {
-        ts_system_node_name(sys, k, name, sizeof name);
-        fprintf(f, ",%s%s.x_m,%s%s.y_m,%s%s.z_m", prefix, name, prefix, name,
-                prefix, name);
-    }
-    if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0]))
-        for (int l = 0; l < h->nlinks; l++)
-            fprintf(f, ",%s%s.%d.tension_N", prefix,
-                    sys->cables[sys->links[l].cable].name,
-                    sys->links[l].index);
-}
+/* The columns of one run: its header cells (after "t_s", with a
+ * prefix) and its cells of row i. `slot` 0 is the first run, 1 the
+ * second. */
+typedef struct csv_cols {
+    void (*header)(struct csv_cols *c, FILE *f, const ts_history *h,
+                   const char *prefix, int slot);
+    void (*row)(struct csv_cols *c, FILE *f, const ts_history *h, int i,
+                int slot);
+    const ts_system *sys;
+    int n;                   /* channels */
+    const ts_output *outs;   /* [n] */
+    char *use;               /* [2 n]: the channels each run gives */
+    const ts_display *d;     /* the units shown */
+    char t[TS_DISPLAY_UNIT_MAX * 2]; /* time's unit as a name */
+} csv_cols;
 
-static void csv_row(FILE *f, const ts_history *h, int i)
+/* Write "t_s" and the columns of nl and li (either may be NULL; with
+ * both, prefixed and to the shorter run), atomically. */
+static int write_runs(csv_cols *c, const ts_history *nl, const ts_history *li,
+                      const char *path, ts_err *err)
 {
-    const double *p = h->positions + 3 * (size_t)h->nnodes * (size_t)i;
-    for (int k = 0; k < 3 * h->nnodes; k++)
-        fprintf(f, ",%.17g", p[k]);
-    if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0])) {
-        const double *t = h->tensions + (size_t)h->nlinks * (size_t)i;
-        for (int l = 0; l < h->nlinks; l++)
-            fprintf(f, ",%.17g", t[l]);
-    }
-}
-
-int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
-                          const ts_history *li, const char *path,
-                          ts_err *err)
-{
-    if (!nl && !li)
-        return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
     tsi_outfile out;
     int orc = tsi_outfile_open(&out, path, err);
     if (orc != TS_OK)
@@ -201,19 +258,142 @@ int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
     int rows = first->nsamples;
     if (both && li->nsamples < rows)
         rows = li->nsamples;
-    fprintf(f, "t_s");
+    fprintf(f, "t_%s", c->t);
     if (nl)
-        csv_header(f, sys, nl, both ? "nonlinear." : "");
+        c->header(c, f, nl, both ? "nonlinear." : "", 0);
     if (li)
-        csv_header(f, sys, li, both ? "linear." : "");
+        c->header(c, f, li, both ? "linear." : "", 1);
     fputc('\n', f);
     for (int i = 0; i < rows; i++) {
-        fprintf(f, "%.17g", first->t[i]);
+        fprintf(f, "%.17g", ts_display_value(c->d, TS_QTY_TIME, first->t[i]));
         if (nl)
-            csv_row(f, nl, i);
+            c->row(c, f, nl, i, 0);
         if (li)
-            csv_row(f, li, i);
+            c->row(c, f, li, i, 1);
         fputc('\n', f);
     }
     return tsi_outfile_commit(&out, err);
+}
+
+/* Set up the units of c: d, or SI. */
+static void cols_units(csv_cols *c, const ts_display *d)
+{
+    c->d = ts_display_or_si(d);
+    ts_display_unit_token(ts_display_unit(c->d, TS_QTY_TIME), c->t,
+                          sizeof c->t);
+}
+
+/* The full state: every node, every link's tension and the tow force
+ * (nonlinear runs). */
+static void full_header(csv_cols *c, FILE *f, const ts_history *h,
+                        const char *prefix, int slot)
+{
+    (void)slot;
+    const ts_system *sys = c->sys;
+    char name[2 * TS_NAME_MAX], lu[TS_DISPLAY_UNIT_MAX * 2],
+        fu[TS_DISPLAY_UNIT_MAX * 2];
+    ts_display_unit_token(ts_display_unit(c->d, TS_QTY_LENGTH), lu,
+                          sizeof lu);
+    ts_display_unit_token(ts_display_unit(c->d, TS_QTY_FORCE), fu,
+                          sizeof fu);
+    for (int k = 0; k < h->nnodes; k++) {
+        ts_system_node_name(sys, k, name, sizeof name);
+        fprintf(f, ",%s%s.x_%s,%s%s.y_%s,%s%s.z_%s", prefix, name, lu, prefix,
+                name, lu, prefix, name, lu);
+    }
+    if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0]))
+        for (int l = 0; l < h->nlinks; l++)
+            fprintf(f, ",%s%s.%d.tension_%s", prefix,
+                    sys->cables[sys->links[l].cable].name,
+                    sys->links[l].index, fu);
+    if (has_forces(h))
+        fprintf(f, ",%stow.force.x_%s,%stow.force.y_%s,%stow.force.z_%s",
+                prefix, fu, prefix, fu, prefix, fu);
+}
+
+static void full_row(csv_cols *c, FILE *f, const ts_history *h, int i,
+                     int slot)
+{
+    (void)slot;
+    const double *p = h->positions + 3 * (size_t)h->nnodes * (size_t)i;
+    for (int k = 0; k < 3 * h->nnodes; k++)
+        fprintf(f, ",%.17g", ts_display_value(c->d, TS_QTY_LENGTH, p[k]));
+    if (h->nsamples > 0 && h->nlinks > 0 && isfinite(h->tensions[0])) {
+        const double *t = h->tensions + (size_t)h->nlinks * (size_t)i;
+        for (int l = 0; l < h->nlinks; l++)
+            fprintf(f, ",%.17g", ts_display_value(c->d, TS_QTY_FORCE, t[l]));
+    }
+    if (has_forces(h))
+        for (int k = 0; k < 3; k++)
+            fprintf(f, ",%.17g",
+                    ts_display_value(c->d, TS_QTY_FORCE,
+                                     h->tow_force[3 * (size_t)i + (size_t)k]));
+}
+
+int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
+                          const ts_history *li, const char *path,
+                          ts_err *err)
+{
+    return ts_report_history_csv_display(sys, nl, li, NULL, path, err);
+}
+
+int ts_report_history_csv_display(const ts_system *sys, const ts_history *nl,
+                                  const ts_history *li, const ts_display *d,
+                                  const char *path, ts_err *err)
+{
+    if (!nl && !li)
+        return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
+    csv_cols c = {full_header, full_row, sys, 0, NULL, NULL, NULL, ""};
+    cols_units(&c, d);
+    return write_runs(&c, nl, li, path, err);
+}
+
+/* The channels a run gives, named with their unit (none for a strain). */
+static void channels_header(csv_cols *c, FILE *f, const ts_history *h,
+                            const char *prefix, int slot)
+{
+    char *use = c->use + (size_t)slot * (size_t)c->n;
+    for (int k = 0; k < c->n; k++) {
+        use[k] = (char)gives(c->sys, h, &c->outs[k]);
+        if (!use[k])
+            continue;
+        char u[64], t[64];
+        ts_display_convert(c->d, c->outs[k].si_unit, 1.0, u, sizeof u);
+        ts_display_unit_token(u, t, sizeof t);
+        int bare = !strcmp(u, "1");
+        fprintf(f, ",%s%s%s%s", prefix, c->outs[k].name, bare ? "" : "_",
+                bare ? "" : t);
+    }
+}
+
+static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
+                         int slot)
+{
+    const char *use = c->use + (size_t)slot * (size_t)c->n;
+    char u[64];
+    for (int k = 0; k < c->n; k++)
+        if (use[k])
+            fprintf(f, ",%.17g",
+                    ts_display_convert(c->d, c->outs[k].si_unit,
+                                       ts_history_value(c->sys, h,
+                                                        &c->outs[k], i),
+                                       u, sizeof u));
+}
+
+int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,
+                           const ts_history *li, int n,
+                           const ts_output outs[], const ts_display *d,
+                           const char *path, ts_err *err)
+{
+    if (!nl && !li)
+        return ts_fail(err, TS_EINVAL, "%s: no history to write", path);
+    csv_cols c = {channels_header, channels_row, sys, n, outs, NULL, NULL,
+                  ""};
+    cols_units(&c, d);
+    c.use = calloc(2 * (size_t)(n > 0 ? n : 1), 1);
+    if (!c.use)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory", path);
+    int rc = write_runs(&c, nl, li, path, err);
+    free(c.use);
+    return rc;
 }

@@ -45,132 +45,31 @@ int ts_response_input_find(const char *name, int *channel, ts_err *err)
                    name);
 }
 
-/* Link with index k (1-based) of cable c, or -1. */
-static int cable_link(const ts_system *sys, int c, int k)
-{
-    for (int l = 0; l < sys->nlinks; l++)
-        if (sys->links[l].cable == c && sys->links[l].index == k)
-            return l;
-    return -1;
-}
-
 void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
 {
-    size_t len = 0;
-    buf[0] = '\0';
-#define APPEND(...)                                                           \
-    do {                                                                      \
-        if (len < size) {                                                     \
-            int w_ = snprintf(buf + len, size - len, __VA_ARGS__);            \
-            if (w_ > 0)                                                       \
-                len += (size_t)w_;                                            \
-        }                                                                     \
-    } while (0)
-    APPEND("positions <node>.x|y|z with <node> one of ");
-    for (int c = 0; c < sys->ncables; c++) {
-        const ts_cable *cb = &sys->cables[c];
-        int last = cb->nlinks - (cb->to_body >= 0 ? 1 : 0);
-        if (c)
-            APPEND("; ");
-        if (last == 1)
-            APPEND("%s.1", cb->name);
-        else if (last > 1)
-            APPEND("%s.1 .. %s.%d", cb->name, cb->name, last);
-        if (cb->to_body >= 0)
-            APPEND("%s%s", last > 0 ? ", " : "",
-                   sys->bodies[cb->to_body].name);
-    }
-    APPEND("; tensions ");
-    for (int c = 0; c < sys->ncables; c++) {
-        const ts_cable *cb = &sys->cables[c];
-        if (c)
-            APPEND(", ");
-        if (cb->nlinks == 1)
-            APPEND("%s.1.tension", cb->name);
-        else
-            APPEND("%s.1.tension .. %s.%d.tension", cb->name, cb->name,
-                   cb->nlinks);
-    }
-    APPEND(" (tow is the input, not an output)");
-#undef APPEND
-}
-
-static int bad_output(const ts_system *sys, const char *name,
-                      const char *why, ts_err *err)
-{
-    char list[768];
-    ts_response_output_names(sys, list, sizeof list);
-    return ts_fail(err, TS_EINVAL, "output '%s': %s; valid outputs: %s",
-                   name, why, list);
+    ts_output_names(sys, TS_OUT_BIT(TS_OUT_POSITION) |
+                             TS_OUT_BIT(TS_OUT_TENSION),
+                    buf, size);
+    size_t len = strlen(buf);
+    if (len < size)
+        snprintf(buf + len, size - len, " (tow is the input, not an "
+                                        "output)");
 }
 
 int ts_response_output_find(const ts_system *sys, const char *name,
                             ts_output *out, ts_err *err)
 {
-    memset(out, 0, sizeof *out);
-    const char *dot = strrchr(name, '.');
-    if (!dot || dot == name || strlen(name) >= 2 * TS_NAME_MAX + 8)
-        return bad_output(sys, name, "expected <node>.<x|y|z> or "
-                                     "<cable>.<k>.tension", err);
-    char base[2 * TS_NAME_MAX + 8];
-    size_t nb = (size_t)(dot - name);
-    memcpy(base, name, nb);
-    base[nb] = '\0';
-    const char *suffix = dot + 1;
-    int comp = -1, tension = 0;
-    if (strcmp(suffix, "x") == 0)
-        comp = 0;
-    else if (strcmp(suffix, "y") == 0)
-        comp = 1;
-    else if (strcmp(suffix, "z") == 0)
-        comp = 2;
-    else if (strcmp(suffix, "tension") == 0)
-        tension = 1;
-    else
-        return bad_output(sys, name, "the part after the last '.' must be "
-                                     "x, y, z or tension", err);
-    if (strcmp(base, "tow") == 0)
-        return bad_output(sys, name, "tow is the input (tow.surge, "
-                                     "tow.sway, tow.heave), not an output",
-                          err);
-    int link = -1;
-    int b = ts_system_find_body(sys, base);
-    if (b >= 0) {
-        int node = ts_system_body_node(sys, b);
-        link = node > 0 ? sys->nodes[node].link : -1;
-    } else {
-        const char *d2 = strrchr(base, '.');
-        if (d2 && d2 != base) {
-            char cname[2 * TS_NAME_MAX + 8];
-            memcpy(cname, base, (size_t)(d2 - base));
-            cname[d2 - base] = '\0';
-            char *end;
-            long k = strtol(d2 + 1, &end, 10);
-            int c = ts_system_find_cable(sys, cname);
-            if (c >= 0 && end != d2 + 1 && *end == '\0' && k >= 1 &&
-                k <= sys->cables[c].nlinks)
-                link = cable_link(sys, c, (int)k);
-        }
-    }
-    if (link < 0)
-        return bad_output(sys, name, "no such node, body or link", err);
-    if (tension) {
-        out->kind = TS_OUT_TENSION;
-        out->link = link;
-        out->unit = "N/m";
-        const ts_link *L = &sys->links[link];
-        snprintf(out->name, sizeof out->name, "%s.%d.tension",
-                 sys->cables[L->cable].name, L->index);
-    } else {
-        out->kind = TS_OUT_POSITION;
-        out->node = sys->links[link].lower;
-        out->comp = comp;
-        out->unit = "m/m";
-        char nm[2 * TS_NAME_MAX];
-        ts_system_node_name(sys, out->node, nm, sizeof nm);
-        snprintf(out->name, sizeof out->name, "%s.%c", nm, "xyz"[comp]);
-    }
-    return TS_OK;
+    int kinds = TS_OUT_BIT(TS_OUT_POSITION) | TS_OUT_BIT(TS_OUT_TENSION);
+    int rc = ts_output_find(sys, name, kinds, out, err);
+    if (rc == TS_OK || out->kind != TS_OUT_TOW_FORCE)
+        return rc;
+    char list[768];
+    ts_response_output_names(sys, list, sizeof list);
+    return ts_fail(err, TS_EINVAL, "output '%s': the frequency response "
+                   "covers node positions and link tensions; the force on "
+                   "the tow point is an output of simulate (close to it: "
+                   "the first link's tension, <cable>.1.tension); valid "
+                   "outputs: %s", name, list);
 }
 
 int ts_response_logspace(double from, double to, int points, double freq[],
@@ -334,14 +233,16 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     }
 }
 
-/* The gain at omega into *g; with gerr, its linearization error
+/* The gain at omega; sh holds the factors of the previous frequency
+ * (zeroed before the first), which are refactored (tsi_shift_refactor);
+ * the caller frees them. With gerr, the gain's linearization error
  * allowance into *gerr (the dense way; NaN the sparse way). */
 static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                    const ts_output *out, double omega, resp_ws *w,
-                   double complex *g, double *gerr, ts_err *err)
+                   tsi_shift *sh, double complex *g, double *gerr,
+                   ts_err *err)
 {
-    tsi_shift sh;
-    int rc = tsi_shift_factor(&sh, lin, I * omega, err);
+    int rc = tsi_shift_refactor(sh, lin, I * omega, err);
     if (rc != TS_OK) {
         if (rc == TS_ESINGULAR)
             ts_fail(err, TS_ESINGULAR,
@@ -351,15 +252,14 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
         return rc;
     }
     if (lin->desc) {
-        tsi_shift_input(&sh, input, w->dr, w->dt);
+        tsi_shift_input(sh, input, w->dr, w->dt);
         *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
                                           : w->dt[out->link];
         if (gerr)
             *gerr = NAN;
     } else {
-        dense_gain(sys, lin, input, out, &sh, w, g, gerr);
+        dense_gain(sys, lin, input, out, sh, w, g, gerr);
     }
-    tsi_shift_free(&sh);
     return TS_OK;
 }
 
@@ -464,7 +364,9 @@ int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
         return ts_fail(err, TS_ENOMEM, "response: out of memory");
     }
     double complex g = 0;
-    rc = gain_at(sys, lin, input, out, omega, &w, &g, NULL, err);
+    tsi_shift sh = {0};
+    rc = gain_at(sys, lin, input, out, omega, &w, &sh, &g, NULL, err);
+    tsi_shift_free(&sh);
     ws_free(&w);
     *re = creal(g);
     *im = cimag(g);
@@ -511,10 +413,12 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
     r->output = *out;
     r->npoints = npoints;
     double complex g = 0;
-    rc = gain_at(sys, lin, input, out, 0.0, &w, &g, &r->static_error, err);
+    tsi_shift sh = {0};
+    rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,
+                 err);
     r->static_gain = creal(g);
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
-        rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &g,
+        rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,
                      &r->error[i], err);
         r->freq_hz[i] = freq_hz[i];
         r->re[i] = creal(g);
@@ -522,6 +426,7 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
         r->magnitude[i] = cabs(g);
         r->phase_deg[i] = carg(g) * 180.0 / M_PI;
     }
+    tsi_shift_free(&sh);
     ws_free(&w);
     if (rc != TS_OK) {
         ts_response_free(r);

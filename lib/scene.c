@@ -495,7 +495,19 @@ static int parse_environment(const ctx *c, const yaml_node_t *n,
     return rc;
 }
 
-static int parse_tow(const ctx *c, const yaml_node_t *n, ts_tow *tow)
+/* The scalar text of a field as written, into buf ("" when absent or
+ * not a scalar). */
+static void written(const field *f, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    if (f->value && f->value->type == YAML_SCALAR_NODE &&
+        f->value->data.scalar.length < size)
+        snprintf(buf, size, "%.*s", (int)f->value->data.scalar.length,
+                 (const char *)f->value->data.scalar.value);
+}
+
+static int parse_tow(const ctx *c, const yaml_node_t *n, ts_tow *tow,
+                     ts_scene *scene)
 {
     enum { T_SPEED, T_TURN, T_POINT, T_N };
     field f[T_N] = {{"speed", 0, 0}, {"turn_rate", 0, 0}, {"point", 0, 0}};
@@ -514,6 +526,8 @@ static int parse_tow(const ctx *c, const yaml_node_t *n, ts_tow *tow)
                             "rad/s", &tow->turn_rate);
     if (rc == TS_OK && f[T_POINT].value)
         rc = vector3(c, "tow", &f[T_POINT], "m", tow->point);
+    written(&f[T_SPEED], scene->speed_text, sizeof scene->speed_text);
+    written(&f[T_TURN], scene->turn_rate_text, sizeof scene->turn_rate_text);
     return rc;
 }
 
@@ -1584,7 +1598,7 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
     if (rc == TS_OK && f[K_ENV].value)
         rc = parse_environment(c, f[K_ENV].value, &sys->env);
     if (rc == TS_OK)
-        rc = parse_tow(c, f[K_TOW].value, &sys->tow);
+        rc = parse_tow(c, f[K_TOW].value, &sys->tow, scene);
     for (int b = 0; rc == TS_OK && b < nbodies; b++) {
         yaml_node_t *item = seq_item(c, f[K_BODIES].value, b);
         rc = item ? parse_body(c, item, b, sys)

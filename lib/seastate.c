@@ -309,10 +309,8 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
     ts_sea_info si;
     ts_sea_get_info(w->sea, &si);
     s->output = *out;
-    s->unit = out->kind == TS_OUT_TENSION ? "N" : "m";
-    s->mean = out->kind == TS_OUT_TENSION
-                  ? lin->t0[out->link]
-                  : lin->r0[3 * out->node + out->comp];
+    s->unit = out->si_unit;
+    s->mean = ts_output_value(sys, out, lin->r0, lin->t0, NULL);
     s->npoints = np;
     s->ninputs = nin;
     s->duration = o.duration;
@@ -628,14 +626,13 @@ int ts_record_from_history(const ts_history *h, const ts_output *out,
         return ts_fail(err, TS_EINVAL, "record: output link %d out of range",
                        out->link);
     for (int i = first; i <= last; i++) {
-        double v = out->kind == TS_OUT_POSITION
-                       ? h->positions[3 * (size_t)h->nnodes * i +
-                                      3 * (size_t)out->node + out->comp]
-                       : h->tensions[(size_t)h->nlinks * i + out->link];
+        double v = ts_history_value(NULL, h, out, i);
         if (!isfinite(v))
             return ts_fail(err, TS_EINVAL, "record: %s is not available at "
-                           "t = %g s (tensions come from nonlinear runs "
-                           "only)", out->name, h->t[i]);
+                           "t = %g s (a linear run has tensions when "
+                           "linearized with their Jacobians; the tow force "
+                           "comes from nonlinear runs only)", out->name,
+                           h->t[i]);
         x[(*n)++] = v;
     }
     *dt = step;

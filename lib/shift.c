@@ -194,8 +194,14 @@ static int factor(tsi_shift *sh, ts_err *err)
         sh->numeric = klu_z_factor(d->Sp, d->Si, sh->Sx, sym, kc);
     else
         sh->numeric = klu_factor(d->Sp, d->Si, sh->Sx, sym, kc);
-    if (sh->numeric)
+    if (sh->numeric) {
+        /* KLU's cheap estimate, min |u_ii| / max |u_ii|, against which a
+         * refactorisation is judged. */
+        int ok = sh->is_complex ? klu_z_rcond(sym, sh->numeric, kc)
+                                : klu_rcond(sym, sh->numeric, kc);
+        sh->rcond = ok ? kc->rcond : 0.0;
         return TS_OK;
+    }
     int status = kc->status;
     double complex s = sh->s;
     tsi_shift_free(sh);
@@ -224,6 +230,38 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
     else
         tsi_desc_fill_real(sh->d, creal(s), 0, sh->Sx);
     return factor(sh, err);
+}
+
+int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                       ts_err *err)
+{
+    int cplx = cimag(s) != 0.0;
+    if (!sh->numeric || sh->inf || cplx != sh->is_complex ||
+        sh->lin != lin) {
+        tsi_shift_free(sh);
+        return tsi_shift_factor(sh, lin, s, err);
+    }
+    const ts_descriptor *d = sh->d;
+    klu_common *kc = sh->common;
+    klu_symbolic *sym = d->klu_symbolic;
+    klu_numeric *num = sh->numeric;
+    sh->s = s;
+    int ok;
+    if (cplx) {
+        tsi_desc_fill_complex(d, s, sh->Sx);
+        ok = klu_z_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
+             klu_z_rcond(sym, num, kc);
+    } else {
+        tsi_desc_fill_real(d, creal(s), 0, sh->Sx);
+        ok = klu_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
+             klu_rcond(sym, num, kc);
+    }
+    /* The old pivots serve while the factors stay as well conditioned as
+     * a fresh factorisation's, within SHIFT_REFACTOR_RCOND. */
+    if (ok && kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond)
+        return TS_OK;
+    tsi_shift_free(sh);
+    return tsi_shift_factor(sh, lin, s, err);
 }
 
 int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err)

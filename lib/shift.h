@@ -53,6 +53,8 @@ typedef struct tsi_shift {
     /* Sparse backend. */
     void *common;          /* KLU parameters and status (own copy) */
     void *numeric;         /* KLU factors */
+    double rcond;          /* KLU's rcond estimate of the last full
+                              factorisation */
     double *Sx;            /* [nnz] real or [2 nnz] complex values */
     double *rhs;           /* [2 nx] */
     double *cols;          /* [2 nx] */
@@ -66,6 +68,17 @@ typedef struct tsi_shift {
  * Free with tsi_shift_free. */
 int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                      ts_err *err);
+
+/* Factor at a new shift s, reusing sh's factorisation (of the same lin)
+ * when it has one of the same kind (real or complex): KLU's refactor with
+ * the old pivot order, no allocation, unless the new factors' rcond
+ * estimate falls below SHIFT_REFACTOR_RCOND times the last full
+ * factorisation's, when it factors afresh (with pivoting). A sequence of
+ * nearby shifts (a frequency sweep) then pays for pivoting now and then.
+ * Otherwise as tsi_shift_factor (sh freed first). Same codes. */
+#define SHIFT_REFACTOR_RCOND 1e-2
+int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                       ts_err *err);
 
 /* Factor S_inf, for tsi_shift_apply. Same codes. */
 int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err);

@@ -198,9 +198,11 @@ ts_history *ts_history_alloc(const ts_system *sys, int capacity, ts_err *err)
     h->t = malloc(c * sizeof(double));
     h->positions = malloc(c * 3 * (size_t)sys->nnodes * sizeof(double));
     h->tensions = malloc(c * (size_t)sys->nlinks * sizeof(double));
+    h->tow_force = malloc(c * 3 * sizeof(double));
     h->energy = malloc(c * 2 * sizeof(double));
     h->input = malloc(c * TS_NINPUT * sizeof(double));
-    if (!h->t || !h->positions || !h->tensions || !h->energy || !h->input)
+    if (!h->t || !h->positions || !h->tensions || !h->tow_force ||
+        !h->energy || !h->input)
         goto nomem;
     return h;
 nomem:
@@ -220,9 +222,21 @@ void ts_history_free(ts_history *h)
     free(h->t);
     free(h->positions);
     free(h->tensions);
+    free(h->tow_force);
     free(h->energy);
     free(h->input);
     free(h);
+}
+
+double ts_history_value(const ts_system *sys, const ts_history *h,
+                        const ts_output *out, int i)
+{
+    if (i < 0 || i >= h->nsamples)
+        return NAN;
+    size_t s = (size_t)i;
+    return ts_output_value(sys, out, h->positions + 3 * (size_t)h->nnodes * s,
+                           h->tensions + (size_t)h->nlinks * s,
+                           h->tow_force + 3 * s);
 }
 
 /* ------------------------------------------------------------------ */
@@ -901,6 +915,7 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
     memcpy(h->positions + 3 * nn * i, ts_kernel_positions(s->k),
            3 * nn * sizeof(double));
     memcpy(h->tensions + nl * i, ts_kernel_tensions(s->k), nl * sizeof(double));
+    ts_kernel_tow_force(s->k, h->tow_force + 3 * i);
     h->energy[2 * i] = ts_kernel_kinetic_energy(s->k);
     h->energy[2 * i + 1] = ts_kernel_potential_energy(s->k);
     memcpy(h->input + TS_NINPUT * i, u, sizeof u);
@@ -1249,8 +1264,26 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
         memcpy(pos, ts_kernel_positions(k), 3 * nn * sizeof(double));
     }
     h->t[i] = t;
+    /* Tensions T0 + dT/dy z + dT/du v: O(nlinks n) per sample, as the
+     * dense linear model itself. */
+    double *ten = h->tensions + nl * i;
     for (size_t l = 0; l < nl; l++)
-        h->tensions[nl * i + l] = NAN;
+        ten[l] = lin->Ty && lin->Tu ? lin->t0[l] : NAN;
+    if (lin->Ty && lin->Tu) {
+        int n = lin->nstate;
+        for (int j = 0; j < n; j++)
+            if (z[j] != 0)
+                for (size_t l = 0; l < nl; l++)
+                    ten[l] += lin->Ty[l + nl * (size_t)j] * z[j];
+        for (int j = 0; j < TS_NINPUT; j++) {
+            double v = u[j] - lin->u0[j];
+            if (v != 0)
+                for (size_t l = 0; l < nl; l++)
+                    ten[l] += lin->Tu[l + nl * (size_t)j] * v;
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        h->tow_force[3 * i + (size_t)c] = NAN;
     h->energy[2 * i] = h->energy[2 * i + 1] = NAN;
     memcpy(h->input + TS_NINPUT * i, u, sizeof u);
     h->nsamples++;

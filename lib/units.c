@@ -759,3 +759,210 @@ done:
     ut_free(from);
     return rc;
 }
+
+/* ---- display units ------------------------------------------------------ */
+
+/* The quantities: name, another name, SI unit, imperial unit. */
+static const struct {
+    const char *name, *alias, *si, *imperial;
+} quantities[TS_QTY_COUNT] = {
+    {"length", NULL, "m", "ft"},
+    {"force", NULL, "N", "lbf"},
+    {"speed", NULL, "m/s", "knot"},
+    {"turn_rate", "angular_rate", "rad/s", "rad/s"},
+    {"time", NULL, "s", "s"},
+    {"frequency", NULL, "Hz", "Hz"},
+    {"angle", NULL, "rad", "deg"},
+    {"mass", NULL, "kg", "lb"},
+};
+
+/* Exact factors of the imperial units (SI value times factor), so that
+ * the presets need no unit database. */
+static const struct {
+    const char *unit;
+    double factor;
+} known[] = {
+    {"rad/s", 1.0}, {"s", 1.0}, {"Hz", 1.0}, {"deg", 180.0 / M_PI},
+    {"ft", 1.0 / 0.3048},                 /* 1 ft = 0.3048 m */
+    {"lbf", 1.0 / 4.4482216152605},       /* 1 lbf = 4.4482216152605 N */
+    {"knot", 3600.0 / 1852.0},            /* 1 knot = 1852 m / h */
+    {"lb", 1.0 / 0.45359237},             /* 1 lb = 0.45359237 kg */
+};
+
+const char *ts_quantity_name(ts_quantity q)
+{
+    return q >= 0 && q < TS_QTY_COUNT ? quantities[q].name : "?";
+}
+
+const char *ts_quantity_si(ts_quantity q)
+{
+    return q >= 0 && q < TS_QTY_COUNT ? quantities[q].si : "?";
+}
+
+static void set_known(ts_display *d, ts_quantity q, const char *unit)
+{
+    snprintf(d->unit[q], sizeof d->unit[q], "%s", unit);
+    d->factor[q] = 1.0;
+    for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
+        if (!strcmp(known[k].unit, unit))
+            d->factor[q] = known[k].factor;
+}
+
+/* SI (what ts_display_si copies), read-only. */
+static const ts_display display_si = {
+    {"m", "N", "m/s", "rad/s", "s", "Hz", "deg", "kg"},
+    {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 180.0 / M_PI, 1.0}};
+
+const ts_display *ts_display_or_si(const ts_display *d)
+{
+    return d ? d : &display_si;
+}
+
+void ts_display_si(ts_display *d) { *d = display_si; }
+
+static void display_imperial(ts_display *d)
+{
+    for (int q = 0; q < TS_QTY_COUNT; q++)
+        set_known(d, (ts_quantity)q, quantities[q].imperial);
+}
+
+int ts_display_parse(const ts_units *u, const char *spec, const char *where,
+                     ts_display *d, ts_err *err)
+{
+    ts_display_si(d);
+    char buf[256];
+    if (!spec || strlen(spec) >= sizeof buf)
+        return ts_fail(err, TS_EINVAL, "%s: expected si, imperial or "
+                       "QUANTITY=UNIT items, got %s", where,
+                       spec ? "a text too long" : "nothing");
+    snprintf(buf, sizeof buf, "%s", spec);
+    ts_display out;
+    ts_display_si(&out);
+    int n = 0;
+    for (char *tok = buf, *next; tok; tok = next) {
+        next = strchr(tok, ',');
+        if (next)
+            *next++ = '\0';
+        while (is_space(*tok))
+            tok++;
+        size_t len = strlen(tok);
+        while (len > 0 && is_space(tok[len - 1]))
+            tok[--len] = '\0';
+        n++;
+        if (!strcmp(tok, "si") || !strcmp(tok, "SI")) {
+            ts_display_si(&out);
+            continue;
+        }
+        if (!strcmp(tok, "imperial")) {
+            display_imperial(&out);
+            continue;
+        }
+        char *eq = strchr(tok, '=');
+        if (!eq)
+            return ts_fail(err, TS_EINVAL, "%s: '%s': expected si, imperial "
+                           "or QUANTITY=UNIT (e.g. speed=knot) with QUANTITY "
+                           "one of length, force, speed, turn_rate, time, "
+                           "frequency, angle, mass", where, tok);
+        *eq = '\0';
+        char *name = tok, *unit = eq + 1;
+        size_t nl = strlen(name);
+        while (nl > 0 && is_space(name[nl - 1]))
+            name[--nl] = '\0';
+        while (is_space(*unit))
+            unit++;
+        int q = -1;
+        for (int k = 0; k < TS_QTY_COUNT && q < 0; k++)
+            if (!strcmp(name, quantities[k].name) ||
+                (quantities[k].alias && !strcmp(name, quantities[k].alias)))
+                q = k;
+        if (q < 0)
+            return ts_fail(err, TS_EINVAL, "%s: unknown quantity '%s'; "
+                           "expected length, force, speed, turn_rate, time, "
+                           "frequency, angle or mass", where, name);
+        if (!unit[0] || strlen(unit) >= TS_DISPLAY_UNIT_MAX)
+            return ts_fail(err, TS_EINVAL, "%s: %s: expected a unit of "
+                           "%s, got '%s'", where, name, quantities[q].si,
+                           unit);
+        double one, zero;
+        ts_err e = {0};
+        if (ts_units_from_si(u, 1.0, quantities[q].si, unit, &one, &e) ||
+            ts_units_from_si(u, 0.0, quantities[q].si, unit, &zero, &e))
+            return ts_fail(err, TS_EUNIT, "%s: %s=%s: not a unit of %s (%s)",
+                           where, name, unit, quantities[q].si, e.msg);
+        if (zero != 0 || !(one > 0) || !isfinite(one))
+            return ts_fail(err, TS_EUNIT, "%s: %s=%s: not a positive "
+                           "multiple of %s", where, name, unit,
+                           quantities[q].si);
+        snprintf(out.unit[q], sizeof out.unit[q], "%s", unit);
+        out.factor[q] = one;
+    }
+    if (n == 0)
+        return ts_fail(err, TS_EINVAL, "%s: expected si, imperial or "
+                       "QUANTITY=UNIT items, got '%s'", where, spec);
+    *d = out;
+    return TS_OK;
+}
+
+double ts_display_value(const ts_display *d, ts_quantity q, double si)
+{
+    return q >= 0 && q < TS_QTY_COUNT ? si * d->factor[q] : si;
+}
+
+const char *ts_display_unit(const ts_display *d, ts_quantity q)
+{
+    return q >= 0 && q < TS_QTY_COUNT ? d->unit[q] : "";
+}
+
+/* The quantity whose SI unit is `si` (deg: the angle), or -1. */
+static int si_quantity(const char *si, size_t len)
+{
+    if (len == 3 && !strncmp(si, "deg", 3))
+        return TS_QTY_ANGLE;
+    for (int q = 0; q < TS_QTY_COUNT; q++)
+        if (strlen(quantities[q].si) == len &&
+            !strncmp(quantities[q].si, si, len))
+            return q;
+    return -1;
+}
+
+double ts_display_convert(const ts_display *d, const char *si_unit, double v,
+                          char *unit, size_t size)
+{
+    size_t len = strlen(si_unit);
+    int q = si_quantity(si_unit, len);
+    if (q >= 0) {
+        /* A value already in degrees is turned back into radians. */
+        double si = !strcmp(si_unit, "deg") ? v * (M_PI / 180.0) : v;
+        snprintf(unit, size, "%s", d->unit[q]);
+        return si * d->factor[q];
+    }
+    const char *slash = strchr(si_unit, '/');
+    if (slash) {
+        int a = si_quantity(si_unit, (size_t)(slash - si_unit));
+        int b = si_quantity(slash + 1, strlen(slash + 1));
+        int one = slash - si_unit == 1 && si_unit[0] == '1';
+        if (b >= 0 && a != b && (a >= 0 || one)) {
+            snprintf(unit, size, "%s/%s", a >= 0 ? d->unit[a] : "1",
+                     d->unit[b]);
+            return v * (a >= 0 ? d->factor[a] : 1.0) / d->factor[b];
+        }
+    }
+    snprintf(unit, size, "%s", si_unit);
+    return v;
+}
+
+void ts_display_unit_token(const char *unit, char *buf, size_t size)
+{
+    size_t n = 0;
+    for (const char *p = unit; *p && n + 1 < size; p++) {
+        if (*p == '/') {
+            const char *per = "_per_";
+            for (; *per && n + 1 < size; per++)
+                buf[n++] = *per;
+        } else if (*p != '^' && !is_space(*p)) {
+            buf[n++] = *p == '*' || *p == '.' ? '_' : *p;
+        }
+    }
+    if (size > 0)
+        buf[n] = '\0';
+}

@@ -733,11 +733,16 @@ static void test_simulate_sweep(void)
     ro.rel_tol = 1e-11;
     ro.abs_tol = 1e-14;
     double ref[2] = {NAN, NAN};
-    if (CHECK(rc == TS_OK && c->nvalues == 5 &&
+    if (CHECK(rc == TS_OK && c->nvalues == 9 &&
                   strcmp(c->values[0].name,
                          "sphere.z.amplitude_ratio") == 0 &&
-                  strcmp(c->values[2].name, "sphere.z.phase_deg") == 0,
-              "ex. 4 simulate tolerance sweep (%s)", err.msg) &&
+                  strcmp(c->values[2].name, "sphere.z.phase_deg") == 0 &&
+                  strcmp(c->values[3].name, "tension.max") == 0 &&
+                  strcmp(c->values[5].name, "tow.force.max") == 0 &&
+                  strcmp(c->values[8].name,
+                         "tow.force.amplification") == 0,
+              "ex. 4 simulate tolerance sweep: the fitted values and the "
+              "tow force's extremes (%s)", err.msg) &&
         CHECK(sim_reference(sc->system, ex, &ro, 4.0, ref) == TS_OK,
               "independent rkf45 run at rtol 1e-11")) {
         int vi[2] = {0, 2};
@@ -806,10 +811,10 @@ static void test_simulate_sweep(void)
               strstr(err.msg, "periodic"),
           "no periodic excitation refused: %s", err.msg);
     rq.simulate.excitation = ex;
-    snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.tension");
+    snprintf(rq.simulate.output, sizeof rq.simulate.output, "tow.z");
     CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,
-                         &err) == TS_EINVAL,
-          "a tension output refused: %s", err.msg);
+                         &err) == TS_EINVAL && strstr(err.msg, "tow.force"),
+          "the tow point's position refused, naming tow.force: %s", err.msg);
     snprintf(rq.simulate.output, sizeof rq.simulate.output, "sphere.z");
     rq.simulate.transient = 7.5;
     CHECK(pipeline_sweep(sc->system, TS_ANALYSIS_SIMULATE, &rq, &an,

@@ -121,9 +121,16 @@ static void test_bounds(const ts_units *u)
               strstr(c.what, "LAPACK"),
           "modes: LAPACK on 1000 states, 3e10 flops, 48 MB: %s", c.what);
     rc = ts_cost_modes(s, 1000, TS_EIG_ARPACK, &c, &err);
-    CHECK(rc == TS_OK && c.flops == 0 && c.evaluations == 2.0 * 1009,
-          "modes: ARPACK costs the linearization only (%g evaluations)",
-          c.evaluations);
+    CHECK(rc == TS_OK && fabs(c.flops - 2e9 / 3) <= 1e-12 * c.flops &&
+              c.evaluations == 2.0 * 1009,
+          "modes: ARPACK below 1200 states: the dense linearization and "
+          "LU (%g evaluations, %g flops)", c.evaluations, c.flops);
+    rc = ts_cost_modes(s, 40000, TS_EIG_ARPACK, &c, &err);
+    CHECK(rc == TS_OK && c.flops == 0 && c.bytes == 0 &&
+              c.evaluations == TS_COST_SPARSE_EVALUATIONS &&
+              strstr(c.what, "sparse"),
+          "modes: ARPACK on 40000 states: the sparse linearization only "
+          "(%g evaluations): %s", c.evaluations, c.what);
     ts_system_free(s);
 }
 

@@ -709,13 +709,36 @@ static void test_cross_check(setup *s)
         printf("  nonlinear mean depth %.5g m, equilibrium %.5g m\n",
                st.mean, sp->mean);
     }
+    /* The linear run's tensions (dT/dy z + dT/du v, recorded sample by
+     * sample) against the spectral statistics of the same tension (the
+     * frequency response through the same Jacobians). */
     ts_output tens;
     ts_response_output_find(sys, "cable.1.tension", &tens, &err);
+    ts_seastate *spt = NULL;
+    rc = ts_seastate_compute(sys, s->lin, &w, &tens, &o, &spt, &err);
+    if (!rc)
+        rc = ts_record_from_history(hl, &tens, transient, x, &n, &dt, &err);
+    if (!rc)
+        rc = ts_record_stats_compute(x, n, dt, &st, &err);
+    if (CHECK(rc == TS_OK, "linear run, tension: %s", err.msg)) {
+        double d = fabs(st.sigma.value - spt->sigma.value);
+        double tol = 3 * (st.sigma.error + spt->sigma.error);
+        CHECK(d <= tol, "linear time domain tension sigma %.5g +- %.2g N "
+              "against spectral %.5g +- %.2g N: |diff| %.2g <= %.2g",
+              st.sigma.value, st.sigma.error, spt->sigma.value,
+              spt->sigma.error, d, tol);
+        CHECK(fabs(st.mean - spt->mean) <= tol,
+              "linear time domain mean tension %.6g N against the "
+              "equilibrium's %.6g N within %.2g N", st.mean, spt->mean, tol);
+    }
+    ts_seastate_free(spt);
+    ts_output force;
+    ts_output_find(sys, "tow.force", TS_OUT_ALL, &force, &err);
     ts_err e = {0};
-    CHECK(ts_record_from_history(hl, &tens, transient, x, &n, &dt, &e) ==
+    CHECK(ts_record_from_history(hl, &force, transient, x, &n, &dt, &e) ==
                   TS_EINVAL &&
               strstr(e.msg, "nonlinear runs only"),
-          "tension from a linear history refused: %s", e.msg);
+          "the tow force from a linear history refused: %s", e.msg);
     free(x);
     ts_history_free(hl);
     ts_history_free(hn);

@@ -248,6 +248,96 @@ static void test_from_si(const ts_units *u)
           "unknown unit refused: %s", err.msg);
 }
 
+/* Display units: presets with the exact definitions above, items from
+ * udunits against the same definitions, a value shown and read back
+ * (a round trip to 1e-15), ratios and degrees, names for CSV columns,
+ * and every refusal. */
+static void test_display(const ts_units *u)
+{
+    ts_err err = {0};
+    ts_display d;
+    ts_display_si(&d);
+    CHECK(!strcmp(ts_display_unit(&d, TS_QTY_LENGTH), "m") &&
+              ts_display_value(&d, TS_QTY_FORCE, 2.385) == 2.385 &&
+              !strcmp(ts_display_unit(&d, TS_QTY_ANGLE), "deg"),
+          "SI shows m, N as they are and angles in deg");
+    CHECK_REL(ts_display_value(&d, TS_QTY_ANGLE, M_PI / 4), 45.0, RTOL,
+              "SI: pi/4 rad shown as 45 deg");
+    CHECK(ts_display_parse(u, "imperial", "--units", &d, &err) == TS_OK,
+          "imperial parses (%s)", err.msg);
+    CHECK_REL(ts_display_value(&d, TS_QTY_LENGTH, 30.48), 100.0, RTOL,
+              "imperial: 30.48 m is 100 ft");
+    CHECK_REL(ts_display_value(&d, TS_QTY_FORCE, 4.4482216152605), 1.0,
+              RTOL, "imperial: 4.4482216152605 N is 1 lbf");
+    CHECK_REL(ts_display_value(&d, TS_QTY_SPEED, 5 * KNOT), 5.0, RTOL,
+              "imperial: 5 knot");
+    CHECK_REL(ts_display_value(&d, TS_QTY_MASS, 50 * LB), 50.0, RTOL,
+              "imperial: 50 lb");
+    CHECK(!strcmp(ts_display_unit(&d, TS_QTY_ANGULAR_RATE), "rad/s") &&
+              !strcmp(ts_display_unit(&d, TS_QTY_TIME), "s"),
+          "imperial keeps rad/s and s");
+    /* Items from udunits against the definitions. */
+    CHECK(ts_display_parse(u, "imperial, force=kN,turn_rate=deg/s ,"
+                              "length=in", "--units", &d, &err) == TS_OK,
+          "items after a preset parse (%s)", err.msg);
+    CHECK_REL(ts_display_value(&d, TS_QTY_FORCE, 2385.0), 2.385, RTOL,
+              "force=kN: 2385 N is 2.385 kN");
+    CHECK_REL(ts_display_value(&d, TS_QTY_ANGULAR_RATE, 0.5), 0.5 / DEG,
+              RTOL, "turn_rate=deg/s: 0.5 rad/s");
+    CHECK_REL(ts_display_value(&d, TS_QTY_LENGTH, 1.0), 1.0 / INCH, RTOL,
+              "length=in: 1 m");
+    CHECK(!strcmp(ts_display_unit(&d, TS_QTY_SPEED), "knot"),
+          "the preset's speed stays knot");
+    /* A round trip: shown, then read back through the parser. */
+    double shown = ts_display_value(&d, TS_QTY_LENGTH, 12.3456789), back;
+    char text[64];
+    snprintf(text, sizeof text, "%.17g %s", shown,
+             ts_display_unit(&d, TS_QTY_LENGTH));
+    CHECK(ts_units_parse(u, text, "m", "round trip", &back, &err) == TS_OK,
+          "'%s' reads back (%s)", text, err.msg);
+    CHECK_REL(back, 12.3456789, 1e-15, "length shown in inches and read back");
+    /* Ratios, degrees and names. */
+    char unit[64], tok[64];
+    ts_display_parse(u, "imperial", "--units", &d, &err);
+    CHECK_REL(ts_display_convert(&d, "N/m", 1.0, unit, sizeof unit),
+              FT / LBF, RTOL, "N/m shown in lbf/ft");
+    CHECK(!strcmp(unit, "lbf/ft"), "its unit: %s", unit);
+    CHECK(ts_display_convert(&d, "m/m", 0.25, unit, sizeof unit) == 0.25 &&
+              !strcmp(unit, "m/m"),
+          "m/m stays as it is");
+    CHECK_REL(ts_display_convert(&d, "1/m", 1.0, unit, sizeof unit), FT, RTOL,
+              "1/m shown in 1/ft");
+    CHECK(ts_display_convert(&d, "1/s", 3.0, unit, sizeof unit) == 3.0 &&
+              !strcmp(unit, "1/s"),
+          "1/s stays");
+    ts_display_parse(u, "angle=rad", "--units", &d, &err);
+    CHECK_REL(ts_display_convert(&d, "deg", 90.0, unit, sizeof unit),
+              M_PI / 2, RTOL, "a value in deg shown in rad");
+    ts_display_unit_token("lbf/ft", tok, sizeof tok);
+    CHECK(!strcmp(tok, "lbf_per_ft"), "lbf/ft as a name: %s", tok);
+    ts_display_unit_token("m/s^2", tok, sizeof tok);
+    CHECK(!strcmp(tok, "m_per_s2"), "m/s^2 as a name: %s", tok);
+    /* Refusals, d left SI. */
+    static const struct {
+        const char *spec;
+        int code;
+        const char *part;
+    } bad[] = {{"furlong", TS_EINVAL, "expected si, imperial"},
+               {"weight=kg", TS_EINVAL, "unknown quantity 'weight'"},
+               {"force=kg", TS_EUNIT, "not a unit of N"},
+               {"length=", TS_EINVAL, "expected a unit of m"},
+               {"length=parsec^2", TS_EUNIT, "not a unit of m"},
+               {"si,", TS_EINVAL, "expected si"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        ts_err_clear(&err);
+        int rc = ts_display_parse(u, bad[k].spec, "--units", &d, &err);
+        CHECK(rc == bad[k].code && strstr(err.msg, "--units") &&
+                  strstr(err.msg, bad[k].part) &&
+                  !strcmp(ts_display_unit(&d, TS_QTY_LENGTH), "m"),
+              "'%s' refused: %s", bad[k].spec, err.msg);
+    }
+}
+
 int main(void)
 {
     ts_err err;
@@ -259,6 +349,7 @@ int main(void)
     test_wrong_dimensions(u);
     test_garbage(u);
     test_from_si(u);
+    test_display(u);
     ts_units_free(u);
     ts_units_free(NULL);
     CHECK(1, "ts_units_free(NULL) does nothing");

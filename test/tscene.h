@@ -1,5 +1,6 @@
-/* tscene.h: loading a scene in a test program: one checked line, PASS or
- * FAIL with the reader's message. Needs tcheck.h. */
+/* tscene.h: loading a scene in a test program (a file or YAML text): one
+ * checked line, PASS or FAIL with the reader's message. Needs tcheck.h
+ * and <string.h>. */
 #ifndef TOWSTAB_TSCENE_H
 #define TOWSTAB_TSCENE_H
 

@@ -326,19 +326,36 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     return 0;
 }
 
-void cli_tow_text(const ts_system *sys, char *buf, size_t size)
+void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
+                  size_t size)
 {
+    d = ts_display_or_si(d);
     const ts_tow *t = &sys->tow;
-    double knots = t->speed / (1852.0 / 3600.0);
+    const char *vu = ts_display_unit(d, TS_QTY_SPEED);
+    const char *wu = ts_display_unit(d, TS_QTY_ANGULAR_RATE);
+    char v[96], w[96];
+    /* SI speeds and turn rates also in knots and deg/s. */
+    int n = snprintf(v, sizeof v, "speed %.6g %s",
+                     ts_display_value(d, TS_QTY_SPEED, t->speed), vu);
+    if (!strcmp(vu, "m/s") && n > 0 && (size_t)n < sizeof v)
+        snprintf(v + n, sizeof v - (size_t)n, " (%.4g knots)",
+                 t->speed / (1852.0 / 3600.0));
     if (t->turn_rate == 0.0) {
-        snprintf(buf, size, "speed %.6g m/s (%.4g knots), turn rate 0 rad/s "
-                 "(straight)", t->speed, knots);
+        snprintf(buf, size, "%s, turn rate 0 %s (straight)", v, wu);
         return;
     }
+    n = snprintf(w, sizeof w, "turn rate %.6g %s",
+                 ts_display_value(d, TS_QTY_ANGULAR_RATE, t->turn_rate), wu);
+    if (!strcmp(wu, "rad/s") && n > 0 && (size_t)n < sizeof w)
+        snprintf(w + n, sizeof w - (size_t)n, " (%.4g deg/s,",
+                 t->turn_rate * 180.0 / M_PI);
+    else if (n > 0 && (size_t)n < sizeof w)
+        snprintf(w + n, sizeof w - (size_t)n, " (");
     double R = t->speed / fabs(t->turn_rate);
-    snprintf(buf, size, "speed %.6g m/s (%.4g knots), turn rate %.6g rad/s "
-             "(%.4g deg/s, turn radius %.4g m, to %s)", t->speed, knots,
-             t->turn_rate, t->turn_rate * 180.0 / M_PI, R,
+    snprintf(buf, size, "%s, %s%sturn radius %.4g %s, to %s)", v, w,
+             strcmp(wu, "rad/s") ? "" : " ",
+             ts_display_value(d, TS_QTY_LENGTH, R),
+             ts_display_unit(d, TS_QTY_LENGTH),
              t->turn_rate > 0 ? "starboard" : "port");
 }
 
@@ -351,13 +368,23 @@ static void err_text(double e, char *buf, size_t size)
         snprintf(buf, size, "-");
 }
 
-void cli_value_error(const ts_value *v, char *buf, size_t size)
+double cli_value_shown(const ts_value *v, const ts_display *d)
 {
-    char d[32], s[32];
-    err_text(v->error.discretisation, d, sizeof d);
-    err_text(v->error.solver, s, sizeof s);
-    snprintf(buf, size, "+- %s (discretisation) +- %s (solver) %s", d, s,
-             v->unit);
+    char u[64];
+    return ts_display_convert(ts_display_or_si(d), v->unit, v->value, u,
+                              sizeof u);
+}
+
+void cli_value_error(const ts_value *v, const ts_display *d, char *buf,
+                     size_t size)
+{
+    char e1[32], e2[32], u[64];
+    double k = ts_display_convert(ts_display_or_si(d), v->unit, 1.0, u,
+                                  sizeof u);
+    err_text(k * v->error.discretisation, e1, sizeof e1);
+    err_text(k * v->error.solver, e2, sizeof e2);
+    snprintf(buf, size, "+- %s (discretisation) +- %s (solver) %s", e1, e2,
+             u);
 }
 
 void cli_print_accuracy(const ts_result *r)

@@ -48,6 +48,8 @@ typedef struct cli_run {
     int entry;              /* -1: the command line; else analyses[entry] */
     const char *json, *csv; /* output paths, NULL when not asked for */
     cli_plot plot;          /* --plot DIR and --units */
+    ts_display display;     /* --units: what tables, CSV and pictures show
+                               (cli_display_begin) */
     int json_flags;         /* TS_REPORT_* */
     /* The extras given: values[k][0..nvalues[k]) for cmd->extras[k]. */
     const char *extra[CLI_EXTRA_MAX][CLI_EXTRA_VALUES];
@@ -221,12 +223,17 @@ void cli_print_trust(const ts_trust *t);
 void cli_print_trust_as(const ts_trust *t, const char *what);
 
 /* "speed V m/s (K knots), turn rate W rad/s (D deg/s, turn radius R m, to
- * starboard)" or "... turn rate 0 rad/s (straight)". */
-void cli_tow_text(const ts_system *sys, char *buf, size_t size);
+ * starboard)" or "... turn rate 0 rad/s (straight)" in SI; in the display
+ * units d otherwise ("speed 5 knot, turn rate 2 deg/s (turn radius 480
+ * ft, to port)"). */
+void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
+                  size_t size);
 
-/* "+- D (discretisation) +- S (solver) UNIT" of a key value, "-" where
- * not estimated. */
-void cli_value_error(const ts_value *v, char *buf, size_t size);
+/* A key value as shown in the display units d, and "+- D
+ * (discretisation) +- S (solver) UNIT" of it, "-" where not estimated. */
+double cli_value_shown(const ts_value *v, const ts_display *d);
+void cli_value_error(const ts_value *v, const ts_display *d, char *buf,
+                     size_t size);
 
 /* The discretisation-error line of a result: the levels compared, the
  * order, the cost, the largest relative error against the accuracy (or
@@ -244,7 +251,8 @@ extern const cli_command *const cli_commands[];
 const cli_command *cli_command_of(int kind);
 
 /* Printing shared by the commands (cmd_equilibrium.c, cmd_modes.c). */
-void cli_print_equilibrium(const ts_result *r, int quiet);
+void cli_print_equilibrium(const ts_result *r, int quiet,
+                           const ts_display *d);
 void cli_print_linearization(const ts_result *r);
 /* The sea state and its statistics (cmd_response.c; simulate too). */
 void cli_print_seastate(const ts_result *r, int quiet);

@@ -62,7 +62,8 @@ void cli_usage(const cli_command *cmd, FILE *f)
             "--json FILE", "the result as JSON ('-' for standard output)",
             "--csv FILE", "the result's table as CSV", "--plot DIR",
             "draw the pictures into DIR (created)", "--units U",
-            "units of the pictures: si (default) or imperial", "--quiet",
+            "units of tables, CSV and pictures: si (default), imperial, "
+            "or items like speed=knot,force=kN", "--quiet",
             "print the summary only");
     for (int k = 0; k < nextras(cmd); k++) {
         char left[96];
@@ -257,7 +258,8 @@ int cli_execute(cli_run *c, json_t **result)
             json_decref(j);
     }
     if (c->csv && write && (status == 0 || has_partial(r)) &&
-        ts_report_result_csv(r, c->csv, &werr) != TS_OK) {
+        ts_report_result_csv_display(r, &c->display, c->csv, &werr) !=
+            TS_OK) {
         int st = cli_report(&werr, werr.code);
         status = status ? status : st;
     }
@@ -408,18 +410,23 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
         }
     status = cli_check_outputs(cmd->name, nw, what, paths, c.plot.dir,
                                cmd->pictures);
-    if (!status)
-        status = cli_plot_begin(&c.plot, cmd->name);
     ts_units *units = NULL;
     ts_scene *scene = NULL;
     if (!status)
         status = cli_open(argv[optind], &units, &scene);
+    /* --units before --plot makes its directory. */
+    if (!status)
+        status = cli_display_begin(units, c.plot.units, &c.display);
+    if (!status)
+        status = cli_plot_begin(&c.plot, cmd->name);
     if (status) {
         ts_optset_free(opts);
+        cli_close(units, scene);
         return status;
     }
     c.scene = scene;
     c.units = units;
+    c.plot.opts.display = &c.display;
     /* Below the command line: the scene's first entry of this type. */
     int e = first_entry(scene, cmd->name);
     int rc = e >= 0 ? ts_optset_give_entry(opts, &scene->analyses[e], e,

@@ -8,34 +8,20 @@
 
 #include "cli.h"
 
+/* Room for a quantity as written in a legend. */
+#define ITEM_TEXT 96
+
 int cli_plot_begin(cli_plot *p, const char *cmd)
 {
+    const ts_display *d = p->opts.display; /* the caller's, kept */
     ts_plot_opts_default(&p->opts);
-    if (!p->dir) {
-        if (p->units) {
-            fprintf(stderr, "towstab: error: %s: --units sets the units of the "
-                            "--plot pictures; add --plot DIR\n",
-                    cmd);
-            return EXIT_BADINPUT;
-        }
+    p->opts.display = d;
+    if (!p->dir)
         return 0;
-    }
     ts_err err = {0};
     if (ts_plot_check(&err) != TS_OK) {
         fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
         return EXIT_BADINPUT;
-    }
-    if (p->units) {
-        if (strcmp(p->units, "si") == 0 || strcmp(p->units, "SI") == 0)
-            p->opts.units = TS_PLOT_SI;
-        else if (strcmp(p->units, "imperial") == 0)
-            p->opts.units = TS_PLOT_IMPERIAL;
-        else {
-            fprintf(stderr, "towstab: error: %s: --units: expected si or imperial, "
-                            "got '%s'\n",
-                    cmd, p->units);
-            return EXIT_BADINPUT;
-        }
     }
     int rc = ts_plot_prepare_dir(p->dir, &err);
     if (rc != TS_OK) {
@@ -43,6 +29,17 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
         return rc == TS_EINVAL ? EXIT_BADINPUT : EXIT_FAILED;
     }
     return 0;
+}
+
+int cli_display_begin(const ts_units *units, const char *spec,
+                      ts_display *d)
+{
+    ts_display_si(d);
+    if (!spec)
+        return 0;
+    ts_err err = {0};
+    int rc = ts_display_parse(units, spec, "--units", d, &err);
+    return rc ? cli_report(&err, rc) : 0;
 }
 
 int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out)
@@ -82,15 +79,29 @@ void cli_plot_shape_free(cli_shape *s)
     s->link_upper = s->marks = NULL;
 }
 
-void cli_plot_tow_label(const ts_system *sys, ts_plot_units u, char *buf,
-                        size_t size)
+void cli_plot_tow_label(const ts_system *sys, const char *speed_text,
+                        const char *turn_text, const ts_display *d,
+                        char *buf, size_t size)
 {
-    double v = ts_plot_convert(TS_PLOT_SPEED, u, sys->tow.speed);
-    const char *vu = ts_plot_unit(TS_PLOT_SPEED, u);
-    if (sys->tow.turn_rate == 0)
-        snprintf(buf, size, "%.4g %s, straight", v, vu);
+    d = ts_display_or_si(d);
+    char v[ITEM_TEXT], w[ITEM_TEXT];
+    if (speed_text && speed_text[0])
+        snprintf(v, sizeof v, "%s", speed_text);
     else
-        snprintf(buf, size, "%.4g %s, turn %.4g rad/s (%s)", v, vu,
-                 fabs(sys->tow.turn_rate),
-                 sys->tow.turn_rate > 0 ? "starboard" : "port");
+        snprintf(v, sizeof v, "%.4g %s",
+                 ts_display_value(d, TS_QTY_SPEED, sys->tow.speed),
+                 ts_display_unit(d, TS_QTY_SPEED));
+    if (sys->tow.turn_rate == 0) {
+        snprintf(buf, size, "%s, straight", v);
+        return;
+    }
+    if (turn_text && turn_text[0])
+        snprintf(w, sizeof w, "%s", turn_text);
+    else
+        snprintf(w, sizeof w, "%.4g %s",
+                 ts_display_value(d, TS_QTY_ANGULAR_RATE,
+                                  fabs(sys->tow.turn_rate)),
+                 ts_display_unit(d, TS_QTY_ANGULAR_RATE));
+    snprintf(buf, size, "%s, turn %s (%s)", v, w,
+             sys->tow.turn_rate > 0 ? "starboard" : "port");
 }

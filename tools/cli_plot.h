@@ -8,22 +8,30 @@
 
 #include "towstab/plot.h"
 #include "towstab/system.h"
+#include "towstab/units.h"
 
 /* What a command was asked to draw. */
 typedef struct cli_plot {
     const char *dir;   /* --plot DIR, NULL for no pictures */
-    const char *units; /* --units TEXT, NULL for SI */
-    ts_plot_opts opts; /* filled by cli_plot_begin */
+    const char *units; /* --units TEXT, NULL for SI (tables, CSV and
+                          pictures: cli_display_begin) */
+    ts_plot_opts opts; /* filled by cli_plot_begin; opts.display is set
+                          by the caller to its display */
 } cli_plot;
 
-/* Check --plot and --units before any analysis runs: that pictures can be
- * drawn (towstab built with PLplot, cairo driver present), that --units
- * is "si" or "imperial" (and comes with --plot), and that DIR is (or can
- * be made) a writable directory. Prints "towstab CMD: ..." and returns the
- * exit status on failure (2 for bad input or a build without PLplot, 1
- * when DIR cannot be created); 0 when there is nothing to draw or all is
- * well. */
+/* Check --plot before any analysis runs: that pictures can be drawn
+ * (towstab built with PLplot, cairo driver present) and that DIR is (or
+ * can be made) a writable directory. Prints "towstab CMD: ..." and
+ * returns the exit status on failure (2 for bad input or a build without
+ * PLplot, 1 when DIR cannot be created); 0 when there is nothing to draw
+ * or all is well. */
 int cli_plot_begin(cli_plot *p, const char *cmd);
+
+/* The display units of --units `spec` (NULL: SI) into d
+ * (ts_display_parse: si, imperial, QUANTITY=UNIT items). Prints and
+ * returns EXIT_BADINPUT for a bad spec, else 0. */
+int cli_display_begin(const ts_units *units, const char *spec,
+                      ts_display *d);
 
 /* A cable shape of `sys` at node positions pos[3 nnodes] (m, M frame),
  * for ts_plot_shapes / ts_plot_mode_shapes: links as in sys, spheres
@@ -40,9 +48,11 @@ typedef struct cli_shape {
 int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out);
 void cli_plot_shape_free(cli_shape *s);
 
-/* "5 knot, straight" or "1.48 knot, turn 0.5 rad/s" (imperial), the same
- * in m/s for SI: the tow of `sys` as a legend label. */
-void cli_plot_tow_label(const ts_system *sys, ts_plot_units u, char *buf,
-                        size_t size);
+/* "5 knot, straight" or "1.48 knot, turn 0.5 rad/s (starboard)": the tow
+ * of `sys` as a legend label: the speed and turn rate as the user wrote
+ * them (speed_text, turn_text; NULL or "": in the display units d). */
+void cli_plot_tow_label(const ts_system *sys, const char *speed_text,
+                        const char *turn_text, const ts_display *d,
+                        char *buf, size_t size);
 
 #endif

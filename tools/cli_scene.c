@@ -69,7 +69,8 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
             strncat(types, cli_commands[i]->name,
                     sizeof types - strlen(types) - 1);
         }
-    int status = 0;
+    ts_display display;
+    int status = cli_display_begin(units, plot_units, &display);
     for (int i = 0; i < n && !status; i++) {
         const ts_scene_analysis *a = &scene->analyses[i];
         int kind = ts_analysis_find(a->type);
@@ -88,8 +89,8 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
         c->units = units;
         c->entry = i;
         c->quiet = quiet;
-        c->json_flags = kind == TS_ANALYSIS_SIMULATE ? TS_REPORT_OUTPUT_ONLY
-                                                     : 0;
+        c->display = display;
+        c->plot.opts.display = &c->display;
         if (csv_dir) {
             snprintf(s->csv[i], sizeof s->csv[i], "%s/%d_%s.csv", csv_dir,
                      i + 1, a->type);

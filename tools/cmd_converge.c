@@ -62,29 +62,33 @@ static int constant_value(const ts_convergence *c, int v)
 }
 
 static void print_converge(const ts_convergence *c, const int *idx,
-                           int quiet)
+                           int quiet, const ts_display *d)
 {
+    char u[64];
     const char *ph = param_heading(c->param);
     printf("%s against %s: %d run%s, target relative error %.3g\n",
            c->analysis, ts_conv_param_name(c->param), c->nrows,
            c->nrows == 1 ? "" : "s", c->target);
     for (int v = 0; v < c->nvalues && !quiet; v++) {
         const ts_conv_value *V = &c->values[v];
+        /* Shown in the display units (a value's own unit when it has no
+         * other). */
+        double k = ts_display_convert(d, V->unit, 1.0, u, sizeof u);
         if (constant_value(c, v)) {
             double x = NAN;
             for (int i = 0; i < c->nrows && isnan(x); i++)
                 if (c->rows[i].status == TS_OK)
                     x = c->rows[i].values[v];
-            printf("\n%s: %.10g %s in every run\n", V->name, x, V->unit);
+            printf("\n%s: %.10g %s in every run\n", V->name, k * x, u);
             continue;
         }
-        printf("\n%s [%s]: observed order ", V->name, V->unit);
+        printf("\n%s [%s]: observed order ", V->name, u);
         if (isfinite(V->order))
             printf("%.3g", V->order);
         else
             printf("-");
-        printf(", reference %.10g +- %.2g (%s)\n", V->reference,
-               V->reference_error, ts_conv_ref_name(V->ref_kind));
+        printf(", reference %.10g +- %.2g (%s)\n", k * V->reference,
+               k * V->reference_error, ts_conv_ref_name(V->ref_kind));
         printf("%8s", ph);
         if (c->nseries > 1)
             printf(" %-10s", "series");
@@ -99,8 +103,8 @@ static void print_converge(const ts_convergence *c, const int *idx,
                 printf(" %18s\n", "failed");
                 continue;
             }
-            printf(" %18.10g", r->values[v]);
-            print_g(r->errors[v], 11);
+            printf(" %18.10g", k * r->values[v]);
+            print_g(k * r->errors[v], 11);
             print_g(r->rel_errors[v], 11);
             if (isfinite(r->order[v]))
                 printf(" %7.3f\n", r->order[v]);
@@ -277,7 +281,7 @@ static void conv_print(const cli_run *c, const ts_result *r)
         return;
     }
     ts_convergence_sorted_rows(cv, idx);
-    print_converge(cv, idx, c->quiet);
+    print_converge(cv, idx, c->quiet, &c->display);
     free(idx);
 }
 

@@ -25,6 +25,8 @@ typedef struct eq_curve {
     ts_scene *scene;   /* an --overlay scene (owned), else NULL */
     ts_request rq;     /* an overlay's request (a shallow copy) */
     char what[ITEM_MAX + 64];
+    char speed_text[ITEM_MAX], turn_text[ITEM_MAX]; /* as written, for the
+                          legend ("" when not written: display units) */
 } eq_curve;
 
 /* What the pictures need: the overlays, checked before the first solve. */
@@ -131,7 +133,8 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
             break;
         }
         char tow[128];
-        cli_plot_tow_label(c->sys, plot->opts.units, tow, sizeof tow);
+        cli_plot_tow_label(c->sys, c->speed_text, c->turn_text,
+                           plot->opts.display, tow, sizeof tow);
         if (distinct > 1)
             snprintf(shapes[n].label, sizeof shapes[n].label, "%.63s: %.120s",
                      c->sys->name, tow);
@@ -177,7 +180,8 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
     return status;
 }
 
-void cli_print_equilibrium(const ts_result *r, int quiet)
+void cli_print_equilibrium(const ts_result *r, int quiet,
+                           const ts_display *d)
 {
     if (!r->eq || !r->eq_attempted)
         return;
@@ -189,16 +193,20 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
      * result's (which also says why a failed run failed). */
     const ts_trust *t = r->kind == TS_ANALYSIS_EQUILIBRIUM ? &r->trust
                                                            : &r->eq_trust;
+    const char *lu = ts_display_unit(d, TS_QTY_LENGTH);
+    const char *fu = ts_display_unit(d, TS_QTY_FORCE);
+#define L_(v) ts_display_value(d, TS_QTY_LENGTH, (v))
+#define F_(v) ts_display_value(d, TS_QTY_FORCE, (v))
     char tow[256];
-    cli_tow_text(sys, tow, sizeof tow);
+    cli_tow_text(sys, d, tow, sizeof tow);
     fprintf(f, "%s, %d cable%s, %d links, %d bod%s\n", tow, sys->ncables,
             sys->ncables == 1 ? "" : "s", sys->nlinks, sys->nbodies,
             sys->nbodies == 1 ? "y" : "ies");
     /* A failed solve may end on forces that overflowed: no "nan". */
     char res[64];
     if (isfinite(eq->residual) && isfinite(eq->force_scale))
-        snprintf(res, sizeof res, "%.3g of %.6g N", eq->residual,
-                 eq->force_scale);
+        snprintf(res, sizeof res, "%.3g of %.6g %s", eq->residual,
+                 F_(eq->force_scale), fu);
     else
         snprintf(res, sizeof res, "not finite");
     fprintf(f, "%s: %s, %d iterations, %ld evaluations, residual %s "
@@ -211,24 +219,31 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
             cli_print_trust(t);
         return;
     }
-    char name[2 * TS_NAME_MAX];
+    char name[2 * TS_NAME_MAX], h[3][48];
     if (!quiet) {
-        fprintf(f, "\n%-20s %14s %14s %14s\n", "node", "x [m]", "y [m]",
-                "z [m]");
+        for (int c = 0; c < 3; c++)
+            snprintf(h[c], sizeof h[c], "%c [%s]", "xyz"[c], lu);
+        fprintf(f, "\n%-20s %14s %14s %14s\n", "node", h[0], h[1], h[2]);
         for (int i = 0; i < sys->nnodes; i++) {
             const double *p = eq->positions + 3 * i;
             ts_system_node_name(sys, i, name, sizeof name);
-            fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", name, p[0], p[1], p[2]);
+            fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", name, L_(p[0]),
+                    L_(p[1]), L_(p[2]));
         }
-        fprintf(f, "\n%-20s %6s %14s %14s %14s\n", "cable", "link",
-                "tension [N]", "theta1 [deg]", "theta2 [deg]");
+        snprintf(h[0], sizeof h[0], "tension [%s]", fu);
+        fprintf(f, "\n%-20s %6s %14s %14s %14s%s\n", "cable", "link", h[0],
+                "theta1 [deg]", "theta2 [deg]",
+                sys->has_elastic ? "         strain" : "");
         for (int l = 0; l < sys->nlinks; l++) {
             const ts_link *L = &sys->links[l];
             double t1, t2;
             ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
-            fprintf(f, "%-20s %6d %14.6f %14.6f %14.6f\n",
-                    sys->cables[L->cable].name, L->index, eq->tensions[l],
+            fprintf(f, "%-20s %6d %14.6f %14.6f %14.6f",
+                    sys->cables[L->cable].name, L->index, F_(eq->tensions[l]),
                     t1 * 180 / M_PI, t2 * 180 / M_PI);
+            if (L->elastic)
+                fprintf(f, " %14.6e", ts_equilibrium_strain(sys, eq, l));
+            fprintf(f, "\n");
         }
     }
     /* The key values of an equilibrium are x, y, z of each body (or free
@@ -236,18 +251,20 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
     int own = r->kind == TS_ANALYSIS_EQUILIBRIUM &&
               r->nvalues == 3 * (sys->nbodies > 0 ? sys->nbodies : 0) + 1;
     if (sys->nbodies > 0) {
-        fprintf(f, "\n%-20s %14s %14s %14s\n", "body", "x [m]", "y [m]",
-                "z [m] (depth)");
+        for (int c = 0; c < 3; c++)
+            snprintf(h[c], sizeof h[c], "%c [%s]%s", "xyz"[c], lu,
+                     c == 2 ? " (depth)" : "");
+        fprintf(f, "\n%-20s %14s %14s %14s\n", "body", h[0], h[1], h[2]);
         for (int b = 0; b < sys->nbodies; b++) {
             const double *p = eq->positions + 3 * ts_system_body_node(sys, b);
             fprintf(f, "%-20s %14.6f %14.6f %14.6f\n", sys->bodies[b].name,
-                    p[0], p[1], p[2]);
+                    L_(p[0]), L_(p[1]), L_(p[2]));
             if (!own || !r->accuracy.estimated)
                 continue;
             fprintf(f, "%-20s", "  +- discretisation");
             for (int j = 0; j < 3; j++)
                 fprintf(f, " %14.2g",
-                        r->values[3 * b + j].error.discretisation);
+                        L_(r->values[3 * b + j].error.discretisation));
             fprintf(f, "\n");
         }
     }
@@ -255,24 +272,35 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
     if (eq->ncontrol > 0)
         fprintf(f, "controllers settled to %.3g (target %.3g)\n",
                 eq->control_residual, eq->tolerance);
-    fprintf(f, "\ntop tension %.6f N", eq->top_tension);
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].ea > 0) {
+            double len = ts_equilibrium_cable_length(sys, eq, c);
+            fprintf(f, "%scable %s: stretched length %.9g %s (%.6g %s at "
+                       "rest, strain %.4g)\n",
+                    c == 0 || !(sys->cables[c - 1].ea > 0) ? "\n" : "",
+                    sys->cables[c].name, L_(len), lu,
+                    L_(sys->cables[c].length), lu,
+                    len / sys->cables[c].length - 1);
+        }
+    fprintf(f, "\ntop tension %.6f %s", F_(eq->top_tension), fu);
     if (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->nvalues > 0) {
         char e[128];
-        cli_value_error(&r->values[r->nvalues - 1], e, sizeof e);
+        cli_value_error(&r->values[r->nvalues - 1], d, e, sizeof e);
         fprintf(f, " %s", e);
     }
-    fprintf(f, " (force on the tow point %.6f, %.6f, %.6f N)\n",
-            eq->tow_force[0], eq->tow_force[1], eq->tow_force[2]);
+    fprintf(f, " (force on the tow point %.6f, %.6f, %.6f %s)\n",
+            F_(eq->tow_force[0]), F_(eq->tow_force[1]),
+            F_(eq->tow_force[2]), fu);
     fprintf(f, "solver Jacobian condition %.3g, shape error estimate %.3g "
-               "m\n",
-            eq->condition, eq->shape_error);
+               "%s\n",
+            eq->condition, L_(eq->shape_error), lu);
     if (r->kind == TS_ANALYSIS_EQUILIBRIUM) {
         /* Free cable ends (no bodies): their key values. */
         for (int v = 0; sys->nbodies == 0 && v + 1 < r->nvalues; v++) {
             char e[128];
-            cli_value_error(&r->values[v], e, sizeof e);
-            fprintf(f, "%s %.6f m %s\n", r->values[v].name,
-                    r->values[v].value, e);
+            cli_value_error(&r->values[v], d, e, sizeof e);
+            fprintf(f, "%s %.6f %s %s\n", r->values[v].name,
+                    cli_value_shown(&r->values[v], d), lu, e);
         }
         cli_print_accuracy(r);
         cli_print_trust(t);
@@ -282,6 +310,8 @@ void cli_print_equilibrium(const ts_result *r, int quiet)
         cli_print_trust_as(t, "equilibrium solve (its discretisation "
                               "error: towstab equilibrium)");
     }
+#undef L_
+#undef F_
 }
 
 
@@ -308,6 +338,16 @@ static int eq_prepare(cli_run *c)
     }
     c->state = st;
     st->ncurves = 1;
+    /* The main curve's speed and turn rate as written: on the command
+     * line or in the scene's entry (the option's text), else in the
+     * scene's tow. */
+    eq_curve *main_curve = &st->curves[0];
+    const char *sp = ts_optset_text(c->opts, "speed");
+    const char *tr = ts_optset_text(c->opts, "turn_rate");
+    snprintf(main_curve->speed_text, ITEM_MAX, "%s",
+             sp ? sp : c->scene->speed_text);
+    snprintf(main_curve->turn_text, ITEM_MAX, "%s",
+             tr ? tr : c->scene->turn_rate_text);
     char items[2][MAX_OVERLAYS][ITEM_MAX];
     int nitems[2] = {0, 0};
     static const char *const opt[2] = {"--overlay-speeds",
@@ -335,6 +375,10 @@ static int eq_prepare(cli_run *c)
             int k = i < nitems[0] ? 0 : 1;
             const char *item = items[k][k ? i - nitems[0] : i];
             snprintf(cv->what, sizeof cv->what, "%s '%.120s'", opt[k], item);
+            snprintf(cv->speed_text, ITEM_MAX, "%s",
+                     k ? main_curve->speed_text : item);
+            snprintf(cv->turn_text, ITEM_MAX, "%s",
+                     k ? item : main_curve->turn_text);
             rc = ts_option_set(ts_option_find(TS_ANALYSIS_EQUILIBRIUM,
                                               k ? "turn_rate" : "speed"),
                                &cv->rq, item, cv->what, c->units, &err);
@@ -348,6 +392,10 @@ static int eq_prepare(cli_run *c)
                                                            : err.code);
             }
             from = cv->scene;
+            snprintf(cv->speed_text, ITEM_MAX, "%s",
+                     sp ? sp : cv->scene->speed_text);
+            snprintf(cv->turn_text, ITEM_MAX, "%s",
+                     tr ? tr : cv->scene->turn_rate_text);
         }
         if (rc == TS_OK)
             rc = ts_analysis_check(from->system, &cv->rq, &err);
@@ -373,14 +421,16 @@ static int overlay_solve(const cli_run *c, eq_curve *cv)
     }
     cv->sys = cv->res->sys;
     cv->eq = cv->res->eq;
-    printf("overlay %s: converged (%s), top tension %.6f N\n", cv->what,
-           ts_eq_method_name(cv->eq->method), cv->eq->top_tension);
+    printf("overlay %s: converged (%s), top tension %.6f %s\n", cv->what,
+           ts_eq_method_name(cv->eq->method),
+           ts_display_value(&c->display, TS_QTY_FORCE, cv->eq->top_tension),
+           ts_display_unit(&c->display, TS_QTY_FORCE));
     return 0;
 }
 
 static void eq_print(const cli_run *c, const ts_result *r)
 {
-    cli_print_equilibrium(r, c->quiet);
+    cli_print_equilibrium(r, c->quiet, &c->display);
 }
 
 static int eq_draw(cli_run *c, const ts_result *r)

@@ -221,7 +221,7 @@ static void print_modes(const ts_result *r, int quiet)
         char er[160];
         if (!isfinite(r->values[v].value))
             continue;
-        cli_value_error(&r->values[v], er, sizeof er);
+        cli_value_error(&r->values[v], NULL, er, sizeof er); /* SI */
         printf("%-22s %14.8g %s\n", r->values[v].name, r->values[v].value,
                er);
     }
@@ -393,7 +393,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
 
 static void modes_print(const cli_run *c, const ts_result *r)
 {
-    cli_print_equilibrium(r, 1);
+    cli_print_equilibrium(r, 1, &c->display);
     cli_print_linearization(r);
     if (r->eigen && r->mode_health)
         print_modes(r, c->quiet);

@@ -8,42 +8,50 @@
 #include "cli.h"
 #include "cli_plot.h"
 
-static void print_response(const ts_result *res, int quiet)
+static void print_response(const ts_result *res, int quiet,
+                           const ts_display *d)
 {
     const ts_response *r = res->response;
-    char e[160] = "";
+    char e[160] = "", gu[64], fu[64];
+    double k = ts_display_convert(d, r->output.unit, 1.0, gu, sizeof gu);
+    double kf = ts_display_convert(d, "Hz", 1.0, fu, sizeof fu);
     if (res->nvalues > 0)
-        cli_value_error(&res->values[0], e, sizeof e);
+        cli_value_error(&res->values[0], d, e, sizeof e);
     printf("response of %s to %s (%s): static gain %.9g %s\n",
-           r->output.name, ts_input_name(r->input), r->output.unit,
-           r->static_gain, e);
+           r->output.name, ts_input_name(r->input), gu, k * r->static_gain,
+           e);
     int ib = 0;
     for (int i = 1; i < r->npoints; i++)
         if (r->magnitude[i] > r->magnitude[ib])
             ib = i;
     if (res->nvalues > 1)
-        cli_value_error(&res->values[1], e, sizeof e);
-    printf("largest magnitude %.6g %s at %.6g Hz (phase %.3f deg)\n",
-           r->magnitude[ib], e, r->freq_hz[ib], r->phase_deg[ib]);
+        cli_value_error(&res->values[1], d, e, sizeof e);
+    printf("largest magnitude %.6g %s at %.6g %s (phase %.3f deg)\n",
+           k * r->magnitude[ib], e, kf * r->freq_hz[ib], fu,
+           r->phase_deg[ib]);
     if (res->magnitude_error)
         printf("the magnitude meets the accuracy %.3g (of the largest) up to "
-               "%s%.6g Hz%s\n",
+               "%s%.6g %s%s\n",
                res->accuracy.accuracy,
                isfinite(res->accurate_to_hz) ? "" : "(no point) ",
-               isfinite(res->accurate_to_hz) ? res->accurate_to_hz
-                                             : r->freq_hz[0],
+               kf * (isfinite(res->accurate_to_hz) ? res->accurate_to_hz
+                                                   : r->freq_hz[0]),
+               fu,
                isfinite(res->accurate_to_hz) &&
                        res->accurate_to_hz >= r->freq_hz[r->npoints - 1]
                    ? ", the whole range"
                    : "");
     if (quiet)
         return;
-    printf("\n%14s %16s %10s %12s %10s\n", "freq [Hz]", "magnitude",
-           "+- disc.", "phase [deg]", "+- disc.");
+    char h[2][80];
+    snprintf(h[0], sizeof h[0], "freq [%s]", fu);
+    snprintf(h[1], sizeof h[1], "magnitude [%s]", gu);
+    printf("\n%14s %20s %10s %12s %10s\n", h[0], h[1], "+- disc.",
+           "phase [deg]", "+- disc.");
     for (int i = 0; i < r->npoints; i++) {
-        printf("%14.6g %16.9g", r->freq_hz[i], r->magnitude[i]);
+        printf("%14.6g %20.9g", kf * r->freq_hz[i], k * r->magnitude[i]);
         if (res->magnitude_error)
-            printf(" %10.2g", res->magnitude_error[i]);
+            printf(" %10.2g", k * res->magnitude_error[i]);
         else
             printf(" %10s", "-");
         printf(" %12.4f", r->phase_deg[i]);
@@ -132,7 +140,7 @@ void cli_print_seastate(const ts_result *r, int quiet)
 
 static void response_print(const cli_run *c, const ts_result *r)
 {
-    cli_print_equilibrium(r, 1);
+    cli_print_equilibrium(r, 1, &c->display);
     cli_print_linearization(r);
     if (r->has_sea) {
         cli_print_seastate(r, c->quiet);
@@ -147,7 +155,7 @@ static void response_print(const cli_run *c, const ts_result *r)
                "heave response uses the mean of the one-sided "
                "derivatives, and a real heave also shifts the mean "
                "depth at first order (doc/model.md section 6)\n");
-    print_response(r, c->quiet);
+    print_response(r, c->quiet, &c->display);
     cli_print_accuracy(r);
     cli_print_trust(&r->trust);
 }

@@ -19,7 +19,9 @@ static void usage(FILE *f)
                "standard output)\n"
                "  --csv DIR     each analysis' table as DIR/<k>_<type>.csv\n"
                "  --plot DIR    each analysis' pictures in DIR/<k>_<type>/\n"
-               "  --units U     units of the pictures: si or imperial\n"
+               "  --units U     units of tables, CSV and pictures: si, "
+               "imperial or items\n"
+               "                like speed=knot,force=kN\n"
                "  --quiet       print the summaries only\n");
 }
 
@@ -69,11 +71,6 @@ static int run_main(int argc, char **argv)
                     opt[k], k ? "directory" : "file");
             return EXIT_BADINPUT;
         }
-    if (plot_units && !plot_dir) {
-        fprintf(stderr, "towstab: error: run: --units sets the units of the "
-                        "--plot pictures; add --plot DIR\n");
-        return EXIT_BADINPUT;
-    }
     ts_units *units;
     ts_scene *scene;
     int status = cli_open(argv[optind], &units, &scene);

@@ -28,28 +28,73 @@ static void print_stats(const char *what, const ts_sim_stats *st,
            st->wall_s > 0 ? st->t_reached / st->wall_s : INFINITY);
 }
 
-static void print_table(const ts_system *sys, const ts_output *out,
-                        const ts_history *nl, const ts_history *li)
+/* Channels printed at most (more go to --json and --csv). */
+#define TABLE_COLS 8
+
+/* Column width of channel `name` with unit `unit`. */
+static int col_width(const char *name, const char *unit)
 {
+    int w = (int)(strlen(name) + strlen(unit)) + 4;
+    return w < 16 ? 16 : w;
+}
+
+/* One column of the table: channel o of history h, shown in d. */
+typedef struct column {
+    const ts_output *o;
+    const ts_history *h;
+    char head[TS_OUTPUT_NAME_MAX + 96];
+    int width;
+} column;
+
+static void column_set(column *c, const ts_output *o, const ts_history *h,
+                       const char *prefix, const ts_display *d)
+{
+    char u[64];
+    ts_display_convert(d, o->si_unit, 1.0, u, sizeof u);
+    c->o = o;
+    c->h = h;
+    snprintf(c->head, sizeof c->head, "%s%s [%s]", prefix, o->name, u);
+    c->width = col_width(c->head, "");
+}
+
+/* The channels of the result, one row per sample (strided): those the
+ * main run gives, and with both runs the compared output of the linear
+ * run; in the display units d. */
+static void print_table(const ts_result *r, const ts_display *d)
+{
+    const ts_system *sys = r->sys;
+    const ts_history *nl = r->nonlinear, *li = r->linear;
     const ts_history *h = nl ? nl : li;
     if (!h || h->nsamples == 0)
         return;
-    char name[2 * TS_NAME_MAX];
-    ts_system_node_name(sys, out->node, name, sizeof name);
-    int stride = (h->nsamples + TABLE_ROWS - 1) / TABLE_ROWS;
-    printf("\n%10s %16s %16s %16s", "t [s]", "x [m]", "y [m]", "z [m]");
+    column cols[TABLE_COLS + 1];
+    int nc = 0, more = 0;
+    for (int k = 0; k < r->noutputs; k++) {
+        if (!isfinite(ts_history_value(sys, h, &r->outputs[k], 0)))
+            continue;
+        if (nc < TABLE_COLS)
+            column_set(&cols[nc++], &r->outputs[k], h, "", d);
+        else
+            more++;
+    }
     if (nl && li)
-        printf(" %16s", "linear");
-    printf("    (%s%s%s)\n", name, nl ? "" : ", linear model",
-           nl && li ? "; 'linear': the same coordinate of the linear run"
-                    : "");
-    size_t st = 3 * (size_t)h->nnodes;
+        column_set(&cols[nc++], &r->output, li, "linear ", d);
+    int stride = (h->nsamples + TABLE_ROWS - 1) / TABLE_ROWS;
+    char th[40], u[64];
+    snprintf(th, sizeof th, "t [%s]", ts_display_unit(d, TS_QTY_TIME));
+    printf("\n%10s", th);
+    for (int c = 0; c < nc; c++)
+        printf(" %*s", cols[c].width, cols[c].head);
+    printf("%s\n", nl ? "" : "    (linear model)");
     for (int i = 0; i < h->nsamples; i += stride) {
-        const double *p = h->positions + st * i + 3 * (size_t)out->node;
-        printf("%10.4f %16.9f %16.9f %16.9f", h->t[i], p[0], p[1], p[2]);
-        if (nl && li && i < li->nsamples)
-            printf(" %16.9f", li->positions[st * i + 3 * (size_t)out->node +
-                                            out->comp]);
+        printf("%10.4f", ts_display_value(d, TS_QTY_TIME, h->t[i]));
+        for (int c = 0; c < nc; c++)
+            if (i < cols[c].h->nsamples)
+                printf(" %*.9f", cols[c].width,
+                       ts_display_convert(d, cols[c].o->si_unit,
+                                          ts_history_value(sys, cols[c].h,
+                                                           cols[c].o, i),
+                                          u, sizeof u));
         printf("\n");
         if (i + stride >= h->nsamples && i != h->nsamples - 1)
             i = h->nsamples - 1 - stride; /* always show the last sample */
@@ -57,33 +102,150 @@ static void print_table(const ts_system *sys, const ts_output *out,
     if (stride > 1)
         printf("(one sample in %d of %d shown; --csv for all)\n", stride,
                h->nsamples);
+    if (more)
+        printf("(%d more channel%s in --json and --csv)\n", more,
+               more == 1 ? "" : "s");
 }
 
-static void print_compare(const ts_compare *c)
+/* A number in a field of width w, "-" when it is not finite. */
+static void field(double v, int w)
 {
-    printf("\ncomparison of %s over t = %.6g .. %.6g s (%d samples; the "
+    if (isfinite(v))
+        printf(" %*.6g", w, v);
+    else
+        printf(" %*s", w, "-");
+}
+
+/* One row of the forces table, in the display units d. */
+static void print_extremes(const char *name, const ts_extremes *e,
+                           const ts_display *d)
+{
+    printf("%-32s", name);
+    double v[7] = {ts_display_value(d, TS_QTY_FORCE, e->max),
+                   ts_display_value(d, TS_QTY_TIME, e->t_max),
+                   ts_display_value(d, TS_QTY_FORCE, e->min),
+                   ts_display_value(d, TS_QTY_TIME, e->t_min),
+                   ts_display_value(d, TS_QTY_FORCE, e->mean),
+                   ts_display_value(d, TS_QTY_FORCE, e->reference),
+                   e->amplification};
+    static const int w[7] = {14, 9, 14, 9, 14, 14, 13};
+    for (int k = 0; k < 7; k++)
+        field(v[k], w[k]);
+    printf("\n");
+}
+
+/* Events of links out of range printed at most (all are in the JSON). */
+#define SLACK_LINES 10
+
+/* The forces of the nonlinear run: extremes of the tow force, of the
+ * links with the largest and the smallest tension and of a tension
+ * output; then the links that went into compression or slack. */
+static void print_forces(const ts_result *r, const ts_display *d)
+{
+    const ts_system *sys = r->sys;
+    if (!r->tensions || r->tow_force.samples == 0)
+        return;
+    const char *fu = ts_display_unit(d, TS_QTY_FORCE);
+    const char *tu = ts_display_unit(d, TS_QTY_TIME);
+    char h[5][40];
+    snprintf(h[0], sizeof h[0], "max [%s]", fu);
+    snprintf(h[1], sizeof h[1], "t [%s]", tu);
+    snprintf(h[2], sizeof h[2], "min [%s]", fu);
+    snprintf(h[3], sizeof h[3], "mean [%s]", fu);
+    snprintf(h[4], sizeof h[4], "static [%s]", fu);
+    printf("\nforces of the nonlinear run (static: the initial "
+           "equilibrium's; amplification: max / static)\n");
+    printf("%-32s %14s %9s %14s %9s %14s %14s %13s\n", "channel", h[0], h[1],
+           h[2], h[1], h[3], h[4], "amplification");
+    print_extremes("tow.force (top tension)", &r->tow_force, d);
+    double err = r->tow_force.max_error;
+    int pick[2] = {r->peak_link, r->low_link};
+    static const char *const what[2] = {"largest", "smallest"};
+    char name[TS_OUTPUT_NAME_MAX + 16];
+    for (int k = 0; k < 2; k++) {
+        if (pick[k] < 0 || (k == 1 && pick[1] == pick[0]))
+            continue;
+        const ts_link *L = &sys->links[pick[k]];
+        snprintf(name, sizeof name, "%s.%d.tension (%s)",
+                 sys->cables[L->cable].name, L->index,
+                 pick[1] == pick[0] ? "largest, smallest" : what[k]);
+        print_extremes(name, &r->tensions[pick[k]], d);
+        err = fmax(err, fmax(r->tensions[pick[k]].max_error,
+                             r->tensions[pick[k]].min_error));
+    }
+    if (r->output.kind == TS_OUT_TENSION && r->output.link != pick[0] &&
+        r->output.link != pick[1]) {
+        print_extremes(r->output.name, &r->output_extremes, d);
+        err = fmax(err, r->output_extremes.max_error);
+    }
+    if (err > 0)
+        printf("between samples the extremes may reach up to %.3g %s "
+               "further (sampling every %g %s; --sample shortens it)\n",
+               ts_display_value(d, TS_QTY_FORCE, err), fu,
+               ts_display_value(d, TS_QTY_TIME, r->sim.dt_sample), tu);
+    for (int k = 0; k < r->nslack && k < SLACK_LINES; k++) {
+        const ts_slack *e = &r->slack[k];
+        const ts_link *L = &sys->links[e->link];
+        printf("warning: %s link %s.%d %s at t = %.6g %s", e->elastic
+               ? "elastic" : "rigid", sys->cables[L->cable].name, L->index,
+               e->elastic ? "goes slack" : "is in compression",
+               ts_display_value(d, TS_QTY_TIME, e->t_first), tu);
+        if (e->samples > 1)
+            printf(" (%d samples to t = %.6g %s)", e->samples,
+                   ts_display_value(d, TS_QTY_TIME, e->t_last), tu);
+        if (!e->elastic)
+            printf(", lowest tension %.6g %s",
+                   ts_display_value(d, TS_QTY_FORCE, e->min), fu);
+        printf("\n");
+    }
+    if (r->nslack > SLACK_LINES)
+        printf("warning: %d more links (forces.slack of --json)\n",
+               r->nslack - SLACK_LINES);
+}
+
+static void print_compare(const ts_compare *c, const ts_display *d)
+{
+    char u[64], ru[80], label[128], eu[64];
+    double k = ts_display_convert(d, c->output.si_unit, 1.0, u, sizeof u);
+    char gain[16];
+    snprintf(gain, sizeof gain, "%s/m", c->output.si_unit);
+    double kr = ts_display_convert(d, !strcmp(c->output.si_unit, "m")
+                                          ? "m/m" : gain,
+                                   1.0, ru, sizeof ru);
+    double ke = ts_display_convert(d, "m", 1.0, eu, sizeof eu);
+    const char *tu = ts_display_unit(d, TS_QTY_TIME);
+    printf("\ncomparison of %s over t = %.6g .. %.6g %s (%d samples; the "
            "transient before is discarded)\n",
-           c->output.name, c->t_from, c->t_to, c->nsamples);
+           c->output.name, ts_display_value(d, TS_QTY_TIME, c->t_from),
+           ts_display_value(d, TS_QTY_TIME, c->t_to), tu, c->nsamples);
     if (c->periodic)
-        printf("excitation %s %s, amplitude %.6g m, %.6g Hz\n",
+        printf("excitation %s %s, amplitude %.6g %s, %.6g Hz\n",
                ts_axis_name(c->exc_axis), ts_signal_type_name(c->exc_type),
-               c->exc_amplitude, c->exc_frequency_hz);
-    printf("%-26s %16s %16s %16s\n", "", "linear", "nonlinear",
+               ke * c->exc_amplitude, eu, c->exc_frequency_hz);
+    printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
            "freq. response");
-    printf("%-26s %16.6g %16.6g %16.6g\n", "amplitude ratio",
-           c->linear.amplitude_ratio, c->nonlinear.amplitude_ratio,
-           c->pred_ratio);
-    printf("%-26s %16.4f %16.4f %16.4f\n", "phase [deg]", c->linear.phase_deg,
+    snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
+    printf("%-30s %16.6g %16.6g %16.6g\n", label,
+           kr * c->linear.amplitude_ratio, kr * c->nonlinear.amplitude_ratio,
+           kr * c->pred_ratio);
+    printf("%-30s %16.4f %16.4f %16.4f\n", "phase [deg]", c->linear.phase_deg,
            c->nonlinear.phase_deg, c->pred_phase_deg);
-    printf("%-26s %16.6g %16.6g\n", "mean offset [m]", c->linear.mean_offset,
-           c->nonlinear.mean_offset);
-    printf("%-26s %16.6g %16.6g\n", "half range [m]", c->linear.half_range,
-           c->nonlinear.half_range);
+    snprintf(label, sizeof label, "mean offset [%s]", u);
+    printf("%-30s %16.6g %16.6g\n", label, k * c->linear.mean_offset,
+           k * c->nonlinear.mean_offset);
+    snprintf(label, sizeof label, "half range [%s]", u);
+    printf("%-30s %16.6g %16.6g\n", label, k * c->linear.half_range,
+           k * c->nonlinear.half_range);
     printf("amplitude difference %.4g %%, mean difference %.4g %% (linear "
            "less nonlinear, relative to nonlinear)\n",
            c->amplitude_difference_pct, c->mean_difference_pct);
-    printf("rms difference %.6g m (%.4g %% of the excitation amplitude)\n",
-           c->rms_difference, 100 * c->rms_difference_ratio);
+    if (!strcmp(c->output.si_unit, "m"))
+        printf("rms difference %.6g %s (%.4g %% of the excitation "
+               "amplitude)\n", k * c->rms_difference, u,
+               100 * c->rms_difference_ratio);
+    else
+        printf("rms difference %.6g %s (%.6g %s of excitation)\n",
+               k * c->rms_difference, u, kr * c->rms_difference_ratio, ru);
 }
 
 /* ---- pictures (--plot) ------------------------------------------------- */
@@ -102,8 +264,8 @@ static int nearest_sample(const ts_history *h, double t)
 }
 
 /* Time histories: the output (nonlinear solid, linear dashed), the
- * tow-point displacement on every excited tow axis, and the top link's
- * tension (nonlinear run). */
+ * tow-point displacement on every excited tow axis, and the force on the
+ * tow point (the top tension; nonlinear run). */
 static int plot_histories(const ts_system *sys, const ts_output *out,
                           const ts_excitation *ex, const ts_history *hn,
                           const ts_history *hl, const cli_plot *plot)
@@ -122,19 +284,19 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
     char outlabel[160], towlabel[3][64];
     snprintf(outlabel, sizeof outlabel, "%s", out->name);
     panels[np].label = outlabel;
-    panels[np].quantity = TS_PLOT_LENGTH;
-    size_t st = 3 * (size_t)hf->nnodes;
-    size_t off = 3 * (size_t)out->node + (size_t)out->comp;
+    panels[np].quantity = out->kind == TS_OUT_STRAIN ? TS_PLOT_NONE
+                          : ts_output_is_force(out)  ? TS_PLOT_FORCE
+                                                     : TS_PLOT_LENGTH;
     if (hn) {
         for (int i = 0; i < hn->nsamples; i++)
-            xn[i] = hn->positions[st * (size_t)i + off];
+            xn[i] = ts_history_value(sys, hn, out, i);
         ts_plot_series a = {hn->nsamples, hn->t, xn, "nonlinear", np,
                             TS_PLOT_SOLID, 1};
         ser[ns++] = a;
     }
     if (hl) {
         for (int i = 0; i < hl->nsamples; i++)
-            xl[i] = hl->positions[st * (size_t)i + off];
+            xl[i] = ts_history_value(sys, hl, out, i);
         ts_plot_series a = {hl->nsamples, hl->t, xl, "linear", np,
                             TS_PLOT_DASHED, 2};
         ser[ns++] = a;
@@ -167,10 +329,13 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
         }
         np++;
     }
-    if (hn && hn->nlinks > 0) {
+    ts_output tow_force;
+    if (hn && hn->nsamples > 0 && isfinite(hn->tow_force[0]) &&
+        ts_output_find(sys, "tow.force", TS_OUT_ALL, &tow_force, NULL) ==
+            TS_OK) {
         for (int i = 0; i < hn->nsamples; i++)
-            tens[i] = hn->tensions[(size_t)hn->nlinks * (size_t)i];
-        panels[np].label = "top tension";
+            tens[i] = ts_history_value(sys, hn, &tow_force, i);
+        panels[np].label = "tow.force (top tension)";
         panels[np].quantity = TS_PLOT_FORCE;
         ts_plot_series a = {hn->nsamples, hn->t, tens, "nonlinear", np,
                             TS_PLOT_SOLID, 1};
@@ -340,20 +505,22 @@ static void sim_print(const cli_run *c, const ts_result *r)
     const ts_system *sys = r->sys;
     if (!sys)
         return;
+    const ts_display *d = &c->display;
     char tow[256];
-    cli_tow_text(sys, tow, sizeof tow);
+    cli_tow_text(sys, d, tow, sizeof tow);
     printf("simulate %s: %d links, %s\n", sys->name, sys->nlinks, tow);
-    char d[256];
+    char desc[256];
     const ts_excitation *ex = r->excitation;
     for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
-        ts_excitation_describe(ex, i, d, sizeof d);
-        printf("input: %s\n", d);
+        ts_excitation_describe(ex, i, desc, sizeof desc);
+        printf("input: %s\n", desc);
     }
     ts_initial init = c->rq.simulate.initial;
     if (init == TS_INITIAL_EQUILIBRIUM && r->eq && r->eq->converged)
-        printf("initial state: equilibrium (%s, residual %.3g of %.6g N)\n",
+        printf("initial state: equilibrium (%s, residual %.3g of %.6g %s)\n",
                ts_eq_method_name(r->eq->method), r->eq->residual,
-               r->eq->force_scale);
+               ts_display_value(d, TS_QTY_FORCE, r->eq->force_scale),
+               ts_display_unit(d, TS_QTY_FORCE));
     else if (init == TS_INITIAL_RELEASED && r->initial[0])
         printf("initial state: %s\n", r->initial);
     else if (init == TS_INITIAL_SHAPE && r->initial[0])
@@ -384,19 +551,22 @@ static void sim_print(const cli_run *c, const ts_result *r)
         print_stats("nonlinear", &r->nonlinear_stats, method);
     }
     if (!c->quiet)
-        print_table(sys, &r->output, r->nonlinear, r->linear);
+        print_table(r, d);
+    print_forces(r, d);
     if (r->has_sea)
         print_sea(r);
-    for (int v = 0; !r->has_sea && v < r->nvalues; v++) {
+    for (int v = 0, head = 0; !r->has_sea && v < r->nvalues; v++) {
         char er[160];
         if (!isfinite(r->values[v].value))
             continue;
-        if (v == 0)
-            printf("\nkey values (nonlinear run, t >= %.6g s):\n",
-                   r->transient);
-        cli_value_error(&r->values[v], er, sizeof er);
-        printf("%-34s %14.8g %s\n", r->values[v].name, r->values[v].value,
-               er);
+        if (!head++)
+            printf("\nkey values (nonlinear run; fits and tension.max|min "
+                   "over t >= %.6g %s, forces over the run):\n",
+                   ts_display_value(d, TS_QTY_TIME, r->transient),
+                   ts_display_unit(d, TS_QTY_TIME));
+        cli_value_error(&r->values[v], d, er, sizeof er);
+        printf("%-34s %14.8g %s\n", r->values[v].name,
+               cli_value_shown(&r->values[v], d), er);
     }
     const ts_window *w = &r->window;
     if (w->checked) {
@@ -426,7 +596,7 @@ static void sim_print(const cli_run *c, const ts_result *r)
     }
     /* Under a sea the records' table above is the comparison. */
     if (r->compared && !r->has_sea)
-        print_compare(&r->compare);
+        print_compare(&r->compare, d);
 }
 
 static int sim_draw(cli_run *c, const ts_result *r)

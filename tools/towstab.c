@@ -5,7 +5,10 @@
  * impossible configuration). Standard output and standard error are
  * checked when the command ends: a table that could not be written is a
  * failure too. The manual is doc/manual.md. */
+#define _GNU_SOURCE /* RTLD_DEFAULT */
+#include <dlfcn.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
@@ -50,8 +53,27 @@ static void usage(FILE *f)
                "130 or 143 stopped by SIGINT or SIGTERM.\n");
 }
 
+/* OpenBLAS on one thread unless OPENBLAS_NUM_THREADS (or
+ * GOTO_NUM_THREADS) asks otherwise: the BLAS work of the analyses is
+ * vector operations (ARPACK's orthogonalisation, the error estimates'
+ * products), where a second thread costs more in waking and spinning than
+ * it saves; a large dense LAPACK eigen analysis may ask for more (doc/
+ * performance.md). Looked up at run time, so that another BLAS does. */
+static void blas_threads(void)
+{
+    if (getenv("OPENBLAS_NUM_THREADS") || getenv("GOTO_NUM_THREADS"))
+        return;
+    void *sym = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
+    if (sym) {
+        void (*set)(int);
+        memcpy(&set, &sym, sizeof set);
+        set(1);
+    }
+}
+
 int main(int argc, char **argv)
 {
+    blas_threads();
     if (argc < 2) {
         fprintf(stderr, "towstab: error: no command given (a COMMAND and a "
                         "SCENE file)\n");

@@ -30,6 +30,7 @@
 #include "towstab/error.h"
 #include "towstab/cost.h"
 #include "towstab/excitation.h"
+#include "towstab/extremes.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
 #include "towstab/progress.h"
@@ -195,9 +196,18 @@ typedef struct ts_simulate_opts {
     char shape_file[TS_REQUEST_PATH_MAX]; /* TS_INITIAL_SHAPE: CSV
                               node,x_m,y_m,z_m as towstab equilibrium
                               --csv writes it */
-    char output[TS_REQUEST_NAME_MAX]; /* the node coordinate compared and
-                              fitted; "" (default): the last sphere's .z,
-                              else the last node's */
+    char output[TS_REQUEST_NAME_MAX]; /* the channel compared and fitted
+                              (towstab/output.h: a position, tension,
+                              strain, length or the tow force; the linear
+                              model gives positions and tensions); ""
+                              (default): the last sphere's .z, else the
+                              last node's */
+    char outputs[TS_REQUEST_PATH_MAX]; /* the channels reported (written
+                              and printed), comma-separated; "all": the
+                              full state (every node, link tension, the
+                              tow force, the energies); "" (default): the
+                              output (a position: its node's x, y, z) and
+                              tow.force */
     ts_excitation *excitation; /* tow-point excitations and manoeuvres
                               (owned by the request; NULL: none) */
     int need_values;       /* 1: the key values (fit over the window) are
@@ -404,6 +414,25 @@ typedef struct ts_result {
     ts_sim_stats nonlinear_stats, linear_stats;
     int compared;
     ts_compare compare;
+    /* The channels reported (rq->simulate.outputs resolved): noutputs
+     * names; all_outputs 1 when the full state was asked for. */
+    int noutputs;
+    ts_output *outputs;
+    int all_outputs;
+    /* Forces of the nonlinear run (towstab/extremes.h), also of a run
+     * that stopped early (its samples so far): the size of the force on
+     * the tow point, every link's tension, the output's extremes (NAN
+     * fields when the run gives it none), the links in compression or
+     * slack. The references are the initial equilibrium's values (NAN
+     * when the run did not start from it). */
+    ts_extremes tow_force;
+    ts_extremes *tensions;      /* [sys->nlinks], NULL without a
+                                   nonlinear run */
+    int peak_link;              /* the link of the largest tension, -1 */
+    int low_link;               /* the link of the smallest, -1 */
+    ts_extremes output_extremes;
+    int nslack;
+    ts_slack *slack;            /* [nslack] ordered by first time */
     ts_window window;           /* the analysed window of the nonlinear run
                                    (the linear run's without one): settled,
                                    periodic (checked: 0 when not) */

@@ -38,11 +38,13 @@ extern "C" {
 #define TS_COMPARE_MIN_SAMPLES_PER_PERIOD 8
 
 typedef struct ts_compare_run {
-    double amplitude;        /* fitted output amplitude, m */
-    double amplitude_ratio;  /* amplitude / excitation amplitude */
+    double amplitude;        /* fitted output amplitude, m or N */
+    double amplitude_ratio;  /* amplitude / excitation amplitude (m/m,
+                                N/m) */
     double phase_deg;        /* output phase less the excitation's, deg */
-    double mean_offset;      /* mean (fitted constant) less equilibrium, m */
-    double half_range;       /* (max - min) / 2 over the window, m */
+    double mean_offset;      /* mean (fitted constant) less equilibrium,
+                                m or N */
+    double half_range;       /* (max - min) / 2 over the window, m or N */
 } ts_compare_run;
 
 typedef struct ts_compare {
@@ -55,13 +57,13 @@ typedef struct ts_compare {
     double exc_fit_amplitude;/* fitted fundamental of the tow motion, m */
     double t_from, t_to;     /* window, s */
     int nsamples;            /* samples in the window */
-    double equilibrium;      /* output's equilibrium value, m */
+    double equilibrium;      /* output's equilibrium value, m or N */
     ts_compare_run linear, nonlinear;
     double pred_ratio;       /* |H(i w)| of the linear model */
     double pred_phase_deg;   /* arg H(i w), deg */
     double amplitude_difference_pct;
     double mean_difference_pct;
-    double rms_difference;   /* m */
+    double rms_difference;   /* m or N */
     double rms_difference_ratio; /* rms / excitation amplitude */
 } ts_compare;
 
@@ -77,14 +79,17 @@ TS_API int ts_compare_fit_sinusoid(const double t[], const double x[],
 /* A phase difference in degrees wrapped into (-180, 180]. */
 TS_API double ts_compare_wrap_deg(double deg);
 
-/* Compare the position output `out` of the nonlinear history nl and the
- * linear history li (same sample times) over t >= t_discard. lin is the
- * linear model (its r0 gives the equilibrium value and it yields the
- * frequency response), ex the excitation of both runs. Returns TS_OK or
- * TS_EINVAL (different sample times, a window with fewer than 3 samples
- * or shorter than one period, fewer than
- * TS_COMPARE_MIN_SAMPLES_PER_PERIOD samples per period, a tension output,
- * t_discard outside [0, t_end)). */
+/* Compare the output `out` of the nonlinear history nl and the linear
+ * history li (same sample times) over t >= t_discard: a node position,
+ * or a link tension when lin has the tension Jacobians (the linear run
+ * then records tensions). lin is the linear model (its r0 and t0 give the
+ * equilibrium value and it yields the frequency response), ex the
+ * excitation of both runs. Amplitudes, offsets and ranges are in the
+ * output's unit (m or N). Returns TS_OK or TS_EINVAL (different sample
+ * times, a window with fewer than 3 samples or shorter than one period,
+ * fewer than TS_COMPARE_MIN_SAMPLES_PER_PERIOD samples per period,
+ * another kind of output, a value that is not finite, t_discard outside
+ * [0, t_end)). */
 TS_API int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
                                 const ts_excitation *ex,
                                 const ts_history *nl, const ts_history *li,

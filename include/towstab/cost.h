@@ -28,7 +28,9 @@
  *    TS_COST_STABILITY = 25 keeps the count a lower bound.
  * Evaluations per step: the stages of the method (rk8pd 13, rkf45 6, the
  * implicit ones at least their stages); an implicit method forms at least
- * one Jacobian (2 (n + 9) evaluations) and factors it (n^3 / 3 flops).
+ * one Jacobian (2 (n + 9) evaluations) and factors it (n^3 / 3 flops),
+ * except esdirk without a vehicle, whose Newton matrix comes from the
+ * sparse model (TS_COST_SPARSE_EVALUATIONS, O(links) factorisations).
  * Dense linear algebra is costed at TS_COST_FLOPS flop/s, a fast
  * machine's rate, so that the bound stays a bound. Nothing is allocated
  * but the kernel whose evaluations are timed; nothing prints.
@@ -78,10 +80,20 @@ TS_API int ts_cost_simulate(const ts_system *sys, const ts_excitation *ex,
                                 const ts_sim_opts *o, ts_cost *e,
                                 ts_err *err);
 
+/* Kernel evaluations the sparse linearization costs at least: 18
+ * perturbation groups, each 2 residual evaluations (without the error
+ * estimate), a residual evaluation costing at least half a kernel
+ * evaluation (it skips the elimination). */
+#define TS_COST_SPARSE_EVALUATIONS 18.0
+
 /* The cost of the eigen analysis of an n-state linearization by method m
  * (TS_EIG_LAPACK: a dense nonsymmetric eigenproblem with vectors, about
- * 30 n^3 flops and 6 n^2 doubles; ARPACK: 0, it is built for large n),
- * plus the linearization's 2 (n + 9) evaluations of sys's kernel. */
+ * 30 n^3 flops and 6 n^2 doubles; ARPACK on the dense A, when it is
+ * formed: its LU, 2/3 n^3 flops; ARPACK on the sparse model: O(links),
+ * counted as 0), plus the linearization: the dense model's 2 (n + 9)
+ * evaluations of sys's kernel (below the linearizer's dense_max_states,
+ * with LAPACK, or with a vehicle) or the sparse model's
+ * TS_COST_SPARSE_EVALUATIONS. */
 TS_API int ts_cost_modes(const ts_system *sys, int n, ts_eig_method m,
                              ts_cost *e, ts_err *err);
 

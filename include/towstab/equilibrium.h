@@ -110,6 +110,17 @@ TS_API int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
 /* Name of a method ("auto", "shooting", "newton"). */
 TS_API const char *ts_eq_method_name(ts_eq_method m);
 
+/* An elastic link's strain at the equilibrium, e = T / EA (exact: at
+ * rest the tension is EA e; a slack link, T = 0, gives 0); 0 for a rigid
+ * link. */
+TS_API double ts_equilibrium_strain(const ts_system *sys,
+                                    const ts_equilibrium *eq, int link);
+
+/* Cable c's stretched length at the equilibrium, sum of l (1 + e) over
+ * its links (m); its length for a rigid cable. */
+TS_API double ts_equilibrium_cable_length(const ts_system *sys,
+                                          const ts_equilibrium *eq, int c);
+
 #ifdef __cplusplus
 }
 #endif

@@ -7,6 +7,7 @@
  * positions, eigenvalues or time series into the arrays below.
  *
  * Units: numbers come in SI and are converted only when drawn, to the
+ * display units of `opts->display` (any unit per quantity) or else to the
  * unit system of `opts->units` (SI: m, N, m/s; imperial: ft, lbf, knot;
  * times s, frequencies Hz, angles degrees in both). Every axis label ends
  * with its unit in brackets.
@@ -35,6 +36,7 @@
 #define TOWSTAB_PLOT_H
 
 #include "towstab/error.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -77,6 +79,9 @@ typedef enum {
 
 typedef struct ts_plot_opts {
     ts_plot_units units;  /* default TS_PLOT_SI */
+    const ts_display *display; /* when set (default NULL), the units of
+                              the axes per quantity (towstab/units.h),
+                              instead of `units`; the caller keeps it */
     int width, height;    /* default 1000 x 700; each in [MIN, MAX_SIZE] */
     int formats;          /* default TS_PLOT_PNG | TS_PLOT_SVG */
 } ts_plot_opts;

@@ -18,6 +18,7 @@
 #include "towstab/error.h"
 #include "towstab/health.h"
 #include "towstab/system.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -65,6 +66,13 @@ TS_API int ts_report_write_text(const char *text, size_t len,
 TS_API int ts_report_equilibrium_csv(const ts_system *sys,
                                      const ts_equilibrium *eq,
                                      const char *path, ts_err *err);
+
+/* The same in the display units d (towstab/units.h; NULL: SI), the
+ * columns named with them ("x_ft", "tension_above_lbf"). */
+TS_API int ts_report_equilibrium_csv_display(const ts_system *sys,
+                                             const ts_equilibrium *eq,
+                                             const ts_display *d,
+                                             const char *path, ts_err *err);
 
 /* Refuse outputs that name the same file: paths[n] (NULL entries are
  * skipped) are compared by what they resolve to (device and inode, links

@@ -14,6 +14,7 @@
 #include "towstab/error.h"
 #include "towstab/health.h"
 #include "towstab/report.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -53,6 +54,13 @@ TS_API json_t *ts_report_convergence_json(const ts_convergence *c);
  * value; same order as the JSON. */
 TS_API int ts_report_convergence_csv(const ts_convergence *c,
                                      const char *path, ts_err *err);
+
+/* The same in the display units d (towstab/units.h; NULL: SI): a value
+ * shown in another unit than its own names its columns with it
+ * ("sphere.z_ft", "sphere.z_ft_error"). */
+TS_API int ts_report_convergence_csv_display(const ts_convergence *c,
+                                             const ts_display *d,
+                                             const char *path, ts_err *err);
 
 #ifdef __cplusplus
 }

@@ -14,6 +14,7 @@
 #include "towstab/linearize.h"
 #include "towstab/response.h"
 #include "towstab/system.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -56,6 +57,13 @@ TS_API json_t *ts_report_response_json(const ts_response *r);
 /* The same as CSV: freq_hz,magnitude,phase_deg,re,im. */
 TS_API int ts_report_response_csv(const ts_response *r, const char *path,
                                   ts_err *err);
+
+/* The same in the display units d (towstab/units.h; NULL: SI): a
+ * frequency or gain shown in another unit names its columns with it
+ * ("freq_Hz", "magnitude_lbf_per_ft", "re_lbf_per_ft", ...). */
+TS_API int ts_report_response_csv_display(const ts_response *r,
+                                          const ts_display *d,
+                                          const char *path, ts_err *err);
 
 #ifdef __cplusplus
 }

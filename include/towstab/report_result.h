@@ -23,8 +23,6 @@ extern "C" {
 
 /* Flags of ts_report_result_json. */
 #define TS_REPORT_MATRICES 1  /* modes: A and B */
-#define TS_REPORT_OUTPUT_ONLY 2 /* simulate: histories of the output's
-                                   node only (else of every node) */
 
 /* The result as a new JSON object; NULL on allocation failure. */
 TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
@@ -35,6 +33,14 @@ TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
  * no such table (nothing is written). */
 TS_API int ts_report_result_csv(const ts_result *r, const char *path,
                                 ts_err *err);
+
+/* The same in the display units d (towstab/units.h; NULL: SI): the
+ * tables of an equilibrium, a response, a simulation and a study show
+ * their lengths, forces, times and frequencies in d's units and name
+ * their columns with them; the mode tables stay SI. */
+TS_API int ts_report_result_csv_display(const ts_result *r,
+                                        const ts_display *d,
+                                        const char *path, ts_err *err);
 
 #ifdef __cplusplus
 }

@@ -12,8 +12,11 @@
 #include "towstab/compare.h"
 #include "towstab/error.h"
 #include "towstab/excitation.h"
+#include "towstab/extremes.h"
+#include "towstab/output.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -35,6 +38,25 @@ TS_API json_t *ts_report_sim_stats_json(const ts_sim_stats *st,
 TS_API json_t *ts_report_history_json(const ts_system *sys,
                                        const ts_history *h, int node);
 
+/* The channels outs[n] of history h as a new JSON object {"t": [...],
+ * "outputs": {NAME: [...], ...}}: one array per channel the run gives
+ * (a channel that is not finite at any sample, e.g. the tow force of a
+ * linear run, is left out). NULL on allocation failure. */
+TS_API json_t *ts_report_channels_json(const ts_system *sys,
+                                       const ts_history *h, int n,
+                                       const ts_output outs[]);
+
+/* The full state of h added to the object o: "nodes" (every node's x, y,
+ * z), and for a nonlinear run "tensions", "tow_force" {"x", "y", "z"}
+ * and "energy" (as ts_report_history_json). TS_OK or TS_ENOMEM. */
+TS_API int ts_report_history_full(json_t *o, const ts_system *sys,
+                                  const ts_history *h);
+
+/* Extremes (towstab/extremes.h) as a new JSON object {"max", "t_max",
+ * "max_error", "min", "t_min", "min_error", "mean", "static",
+ * "amplification"}; NaN values are null. */
+TS_API json_t *ts_report_extremes_json(const ts_extremes *e);
+
 /* The comparison summary as a new JSON object:
  * {"output", "excitation": {"axis", "type", "amplitude", "frequency_hz"},
  *  "window": {"from_s", "to_s", "samples"}, "equilibrium",
@@ -55,6 +77,26 @@ TS_API json_t *ts_report_excitation_json(const ts_excitation *ex);
 TS_API int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
                                  const ts_history *li, const char *path,
                                  ts_err *err);
+
+/* The same in the display units d (towstab/units.h; NULL: SI), columns
+ * named with them ("t_s", "sphere.x_ft", "cable.1.tension_lbf"). */
+TS_API int ts_report_history_csv_display(const ts_system *sys,
+                                         const ts_history *nl,
+                                         const ts_history *li,
+                                         const ts_display *d,
+                                         const char *path, ts_err *err);
+
+/* Write the channels outs[n] of the histories as CSV to `path` ("-":
+ * stdout), atomically, in the display units d (NULL: SI): a header
+ * "t_s,NAME_UNIT,..." (UNIT the channel's unit shown, m or N in SI; none
+ * for a strain), one row per sample. Either history may be NULL; with
+ * both, each column carries the prefix "nonlinear." or "linear." and the
+ * rows run to the shorter one. Channels a run does not give (not finite
+ * at any sample) are left out of its columns. */
+TS_API int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,
+                                  const ts_history *li, int n,
+                                  const ts_output outs[], const ts_display *d,
+                                  const char *path, ts_err *err);
 
 #ifdef __cplusplus
 }

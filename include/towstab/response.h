@@ -24,38 +24,29 @@
 
 #include "towstab/error.h"
 #include "towstab/linearize.h"
+#include "towstab/output.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-typedef enum { TS_OUT_POSITION = 0, TS_OUT_TENSION = 1 } ts_output_kind;
-
-/* An output channel. */
-typedef struct ts_output {
-    ts_output_kind kind;
-    int node;      /* position: node index (>= 1) */
-    int comp;      /* position: 0 x, 1 y, 2 z (M frame, z down) */
-    int link;      /* tension: link index */
-    char name[2 * TS_NAME_MAX + 16]; /* canonical name, e.g. "sphere.z" */
-    const char *unit; /* "m/m" or "N/m" */
-} ts_output;
-
 /* Input channel (0, 1, 2) of "tow.surge", "tow.sway" or "tow.heave".
  * Returns TS_OK or TS_EINVAL with a message listing the valid names. */
 TS_API int ts_response_input_find(const char *name, int *channel,
                                   ts_err *err);
 
-/* Parse an output name: "<node>.x|y|z" (node as ts_system_node_name
- * writes it: a body's name or "<cable>.<k>", k = 1..links of that cable)
- * or "<cable>.<k>.tension" (link k of the cable; "<body>.tension" is the
- * link ending at the body). Returns TS_OK or TS_EINVAL with a message that
- * lists the valid names (and says that tow is the input). */
+/* Parse an output of the frequency response (towstab/output.h): a
+ * position "<node>.x|y|z" (node as ts_system_node_name writes it: a
+ * body's name or "<cable>.<k>", k = 1..links of that cable) or a tension
+ * "<cable>.<k>.tension" ("<body>.tension" is the link ending at the
+ * body). Returns TS_OK or TS_EINVAL with a message that lists the valid
+ * names (and says that tow is the input); the other channels (the tow
+ * force, strains) are refused as outputs of simulate. */
 TS_API int ts_response_output_find(const ts_system *sys, const char *name,
                                    ts_output *out, ts_err *err);
 
-/* Write the valid output names, compactly ("cable.1 .. cable.19, sphere"
+/* Write the valid response output names, compactly ("cable.1 .. cable.19, sphere"
  * per cable), into buf. */
 TS_API void ts_response_output_names(const ts_system *sys, char *buf,
                                      size_t size);

@@ -50,6 +50,11 @@ typedef struct ts_scene {
     int nsettings;          /* the values set over the text, in the order
                                applied (ts_scene_set); 0 for a file */
     ts_scene_setting *settings;
+    /* tow.speed and tow.turn_rate as the scene wrote them ("5 knot";
+     * "" when absent or longer than the buffer): for legends and labels,
+     * which show quantities as the user wrote them. */
+    char speed_text[TS_NAME_MAX];
+    char turn_rate_text[TS_NAME_MAX];
 } ts_scene;
 
 /* Read and build a scene from a file; path "-" reads standard input to

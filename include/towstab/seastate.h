@@ -290,8 +290,10 @@ TS_API int ts_record_stats_compute(const double x[], int n, double dt,
 /* The values of output `out` in history h at the samples with t >= t_from
  * that are spaced evenly (the last sample, at t_end, is dropped when its
  * interval is shorter): x receives them (room for h->nsamples), *n their
- * number, *dt their spacing. Tension outputs need a nonlinear history
- * (TS_EINVAL for NaN tensions). */
+ * number, *dt their spacing (outputs of towstab/output.h other than
+ * strains and lengths). A value the run does not give is refused
+ * (TS_EINVAL): tensions of a linear run made without the tension
+ * Jacobians, the tow force of any linear run. */
 TS_API int ts_record_from_history(const ts_history *h, const ts_output *out,
                                   double t_from, double x[], int *n,
                                   double *dt, ts_err *err);

@@ -38,6 +38,7 @@
 #include "towstab/excitation.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
+#include "towstab/output.h"
 #include "towstab/progress.h"
 #include "towstab/system.h"
 
@@ -133,7 +134,10 @@ typedef struct ts_history {
     int nsamples;        /* samples filled */
     double *t;           /* [capacity] s */
     double *positions;   /* [capacity][3 nnodes] m, M frame, node 0 = tow */
-    double *tensions;    /* [capacity][nlinks] N (NaN in linear runs) */
+    double *tensions;    /* [capacity][nlinks] N (linear runs: from the
+                            tension Jacobians, NaN without them) */
+    double *tow_force;   /* [capacity][3] N, the force on the tow point
+                            (ts_kernel_tow_force; NaN in linear runs) */
     double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
                             linear runs; ts_kernel_kinetic_energy) */
     double *input;       /* [capacity][TS_NINPUT] u(t) */
@@ -143,6 +147,12 @@ typedef struct ts_history {
 TS_API ts_history *ts_history_alloc(const ts_system *sys, int capacity,
                                     ts_err *err);
 TS_API void ts_history_free(ts_history *h);
+
+/* The value of output channel `out` (towstab/output.h) at sample i of h
+ * (0 <= i < h->nsamples), NaN when the run does not give it (the tow
+ * force of a linear run). */
+TS_API double ts_history_value(const ts_system *sys, const ts_history *h,
+                               const ts_output *out, int i);
 
 /* --- Nonlinear simulation: set / advance / read, and a driver. --- */
 
@@ -195,7 +205,10 @@ TS_API int ts_simulate(ts_kernel *k, const ts_excitation *ex,
 /* --- Linear simulation. --- */
 
 /* Simulate z' = A z + B (u(t) - u0) from z(0) = z0 (NULL: 0) over
- * [0, o->t_end], recording positions into h (tensions and energies NaN).
+ * [0, o->t_end], recording positions into h, and the link tensions
+ * T0 + dT/dy z + dT/du (u - u0) when lin has the tension Jacobians
+ * (ts_linearize_opts.tensions; else NaN); energies and the tow force are
+ * NaN.
  * `k` must be the kernel lin was computed with, in the same charts (its
  * frame too); it is used for the nonlinear kinematics only. The linear
  * model has no frame inputs: an excitation with a manoeuvre is refused

@@ -8,17 +8,18 @@
 # yes: --plot DIR writes side.png, side.svg, top.png, top.svg (PNG
 #   signature, 1000 x 700 px from the IHDR chunk, > 5 kB; SVG starting
 #   with <?xml and carrying the title naming the scene); a missing DIR is
-#   created; --units imperial works; overlays of speeds, turn rates and
+#   created; --units imperial works (legends show the speeds as written);
+#   overlays of speeds, turn rates and
 #   scenes add curves (one "overlay" line each); --plot into a path that
-#   is a file, a bad --units, --units or overlays without --plot, an
+#   is a file, a bad --units, overlays without --plot, an
 #   overlay with a bad unit or a missing scene are refused with exit
 #   status 2 before anything is solved, and leave no picture. modes and
 #   response write their pictures; simulate writes histories,
 #   snapshots_side and snapshots_top (PNG and SVG, titled, six files),
 #   with --snapshot-interval in the title; converge writes error_time;
 #   simulate and converge refuse --plot into a file (exit 2, nothing run),
-#   --snapshot-interval without --plot or giving too many snapshots, and
-#   --units without --plot.
+#   --snapshot-interval without --plot or giving too many snapshots;
+#   --units without --plot sets the tables (test/cli/units.sh).
 # no: --plot is refused with exit status 2 and the message naming the
 #   packages to install, while the analysis without --plot still runs.
 #
@@ -145,7 +146,6 @@ refused "--plot into a file" "$EX1" --plot "$T/afile"
 check "--plot into a file: the message says so" grep -q "not a directory" "$T/err"
 refused "--plot under a file" "$EX1" --plot "$T/afile/sub"
 refused "--units furlong" "$EX1" --plot "$T/r" --units furlong
-refused "--units without --plot" "$EX1" --units imperial
 refused "--overlay-speeds without --plot" "$EX1" --overlay-speeds "2 knot"
 refused "--overlay-speeds with a wrong unit" "$EX1" --plot "$T/r" --overlay-speeds "2,3 lbf"
 refused "--overlay-speeds with an empty item" "$EX1" --plot "$T/r" --overlay-speeds "2,,3 knot"
@@ -169,8 +169,6 @@ check "response --plot: Bode plot, PNG and SVG, titled" \
     bash -c "$(declare -f is_png is_svg); is_png '$T/bode/bode.png' 1000 700 && is_svg '$T/bode/bode.svg' 'kamman_ex1_above: frequency response'"
 ts modes "$EX3" --plot "$T/afile"
 check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
-ts response "$EX1" --output sphere.z --units imperial
-check "response --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
 
 # simulate and converge draw their pictures too.
 EX4=examples/kamman_ex4.yaml
@@ -206,8 +204,6 @@ check "simulate --snapshot-interval without --plot: exit 2 (got $status)" [ $sta
 ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz --plot "$T/r2" --snapshot-interval 0.01
 check "simulate --snapshot-interval 0.01 s on a 2 s run (too many): exit 2 (got $status)" \
     bash -c "[ $status -eq 2 ] && grep -q snapshot-interval '$T/err'"
-ts converge examples/kamman_ex1_submerged.yaml --links 5,10 --units imperial
-check "converge --units without --plot: exit 2 (got $status)" [ $status -eq 2 ]
 
 echo "$npass passed, $nfail failed"
 [ $nfail -eq 0 ]

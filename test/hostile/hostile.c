@@ -982,8 +982,16 @@ static void gen_cli_misuse(void)
            NULL);
     misuse(R, "--output", "simulate", EX1, "--quiet", "--output", "bogus.z",
            NULL);
-    misuse(R, "--output", "simulate", EX1, "--quiet", "--output",
+    misuse(E_RUN, NULL, "simulate", EX1, "--quiet", "--output",
            "cable.1.tension", NULL);
+    misuse(R, "--output", "simulate", EX1, "--quiet", "--output",
+           "tow.force", "--compare", NULL);
+    misuse(R, "--outputs", "simulate", EX1, "--quiet", "--outputs",
+           "sphere.z,,tow.force", NULL);
+    misuse(R, "--outputs", "simulate", EX1, "--quiet", "--outputs",
+           "sphere.z,sphere.z", NULL);
+    misuse(R, "--outputs", "simulate", EX1, "--quiet", "--outputs",
+           "cable.1.strain", NULL);
     misuse(R, "--snapshot-interval", "simulate", EX1, "--quiet",
            "--snapshot-interval", "1", NULL);
     misuse(R, "--h-min", "simulate", EX1, "--quiet", "--h-min", "-1", NULL);
