@@ -952,6 +952,88 @@ int ts_optset_give_entry(ts_optset *s, const ts_scene_analysis *a, int index,
     return TS_OK;
 }
 
+int ts_optset_give_scene(ts_optset *s, const ts_scene *scene, int index,
+                         ts_err *err)
+{
+    const char *kind = ts_analysis_name(s->kind);
+    if (index >= scene->nanalyses ||
+        (index >= 0 && strcmp(scene->analyses[index].type, kind) != 0))
+        return ts_fail(err, TS_EINVAL, "analyses[%d]: %s", index,
+                       index >= scene->nanalyses
+                           ? "the scene has no such entry"
+                           : "not an entry of this analysis");
+    for (int i = 0; index < 0 && i < scene->nanalyses; i++)
+        if (!strcmp(scene->analyses[i].type, kind))
+            index = i;
+    int rc = index >= 0 ? ts_optset_give_entry(s, &scene->analyses[index],
+                                               index, scene->path,
+                                               TS_OPTSET_SCENE, -1, err)
+                        : TS_OK;
+    /* A study of a simulation: below its own, the scene's first simulate
+     * entry's simulation settings. */
+    const char *an = ts_optset_text(s, "analysis");
+    if (rc || s->kind != TS_ANALYSIS_CONVERGE || !an ||
+        strcmp(an, "simulate") != 0)
+        return rc;
+    for (int i = 0; i < scene->nanalyses; i++)
+        if (!strcmp(scene->analyses[i].type, "simulate"))
+            return ts_optset_give_entry(s, &scene->analyses[i], i,
+                                        scene->path, TS_OPTSET_RELATED,
+                                        TS_SEC_SIMULATE, err);
+    return TS_OK;
+}
+
+/* Checks of a request a lower source's value may yield in, at most. */
+#define MAX_YIELDS 16
+
+/* Apply the set up to priority max into rq (initialised here) and check
+ * it against sys. */
+static int request_check(const ts_optset *s, int max, const ts_system *sys,
+                         const ts_units *u, ts_request *rq, ts_err *err)
+{
+    ts_request_init(rq, s->kind);
+    int rc = ts_optset_apply(s, max, u, rq, err);
+    return rc ? rc : ts_analysis_check(sys, rq, err);
+}
+
+int ts_optset_request(ts_optset *s, const ts_system *sys, const ts_units *u,
+                      ts_request *rq, char *notes, size_t size, ts_err *err)
+{
+    if (notes && size)
+        notes[0] = '\0';
+    int rc = TS_OK;
+    for (int k = 0; k <= MAX_YIELDS; k++) {
+        ts_err_clear(err);
+        rc = request_check(s, TS_OPTSET_COMMAND, sys, u, rq, err);
+        if (rc == TS_OK)
+            return TS_OK;
+        /* A lower source's value that the higher one contradicts, and
+         * that holds without it, yields to its default. */
+        const char *key = ts_optset_yields(s, err);
+        int ok_alone = 0;
+        if (key && k < MAX_YIELDS) {
+            ts_request alone;
+            ok_alone = request_check(s, ts_optset_top(s) - 1, sys, u, &alone,
+                                     NULL) == TS_OK;
+            ts_request_clear(&alone);
+        }
+        ts_optset_locate(s, err);
+        if (!ok_alone)
+            break;
+        if (notes && size) {
+            size_t used = strlen(notes);
+            snprintf(notes + used, size - used, "%s%s", used ? "\n" : "",
+                     err->msg);
+        }
+        char name[TS_NAME_MAX];
+        snprintf(name, sizeof name, "%s", key);
+        ts_optset_drop(s, name);
+        ts_request_clear(rq);
+    }
+    ts_request_clear(rq);
+    return rc;
+}
+
 /* The priority <= max that wins for row i, or -1 when none gave it. */
 static int winner_below(const ts_optset *s, int i, int max)
 {

@@ -56,6 +56,7 @@
 #include <unistd.h>
 
 #include "outfile.h"
+#include "plot_impl.h"
 
 #ifdef TS_HAVE_PLPLOT
 #include <plplot.h>
@@ -74,6 +75,7 @@ void ts_plot_opts_default(ts_plot_opts *o)
 {
     o->units = TS_PLOT_SI;
     o->display = NULL;
+    o->bode_db = 0;
     o->width = TS_PLOT_MIN_WIDTH;
     o->height = TS_PLOT_MIN_HEIGHT;
     o->formats = TS_PLOT_PNG | TS_PLOT_SVG;
@@ -190,6 +192,50 @@ int ts_plot_prepare_dir(const char *dir, ts_err *err)
         rc = ts_fail(err, TS_EIO, "plot directory '%s': not writable (%s)",
                      dir, strerror(errno));
     return rc;
+}
+
+/* ---- label placement (plot_impl.h) ----------------------------------- */
+
+int tsi_plot_minor_ticks(double lo, double hi, double *out, int max)
+{
+    if (!(hi - lo <= TSI_PLOT_MINOR_DECADES) || !(hi > lo))
+        return 0;
+    int n = 0;
+    static const double mult[2] = {2.0, 5.0};
+    for (long e = lround(floor(lo)); e <= lround(ceil(hi)); e++)
+        for (int k = 0; k < 2 && n < max; k++) {
+            double v = mult[k] * pow(10.0, (double)e), l = log10(v);
+            if (l > lo && l < hi)
+                out[n++] = v;
+        }
+    return n;
+}
+
+void tsi_plot_label_rows(int n, const double *x, double width, int nrows,
+                         int *row)
+{
+    enum { ROWS_MAX = 8 };
+    double last[ROWS_MAX];
+    if (nrows > ROWS_MAX)
+        nrows = ROWS_MAX;
+    for (int r = 0; r < nrows; r++)
+        last[r] = -INFINITY;
+    /* In increasing x: the next label is the smallest x not placed yet. */
+    for (int i = 0; i < n; i++)
+        row[i] = -2;
+    for (int done = 0; done < n; done++) {
+        int k = -1;
+        for (int i = 0; i < n; i++)
+            if (row[i] == -2 && (k < 0 || x[i] < x[k]))
+                k = i;
+        row[k] = -1;
+        for (int r = 0; r < nrows; r++)
+            if (x[k] - last[r] >= width) {
+                row[k] = r;
+                last[r] = x[k];
+                break;
+            }
+    }
 }
 
 #ifndef TS_HAVE_PLPLOT
@@ -1158,6 +1204,24 @@ static int check_shape(const char *fn, const char *what, int i,
                            "%s: %s[%d].marks[%d]: must be a node in [0, %d), "
                            "got %d",
                            fn, what, i, m, s->nnodes, s->marks[m]);
+    if (s->ncylinders < 0 || (s->ncylinders > 0 && !s->cylinders))
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].cylinders: expected %d "
+                                       "cylinders",
+                       fn, what, i, s->ncylinders);
+    for (int m = 0; m < s->ncylinders; m++) {
+        const ts_plot_cylinder *cy = &s->cylinders[m];
+        if (cy->node < 1 || cy->node >= s->nnodes)
+            return ts_fail(err, TS_EINVAL,
+                           "%s: %s[%d].cylinders[%d].node: must be a node "
+                           "below a link, in [1, %d), got %d",
+                           fn, what, i, m, s->nnodes, cy->node);
+        if (!(cy->length > 0) || !isfinite(cy->length) ||
+            !(cy->diameter > 0) || !isfinite(cy->diameter))
+            return ts_fail(err, TS_EINVAL,
+                           "%s: %s[%d].cylinders[%d]: length and diameter "
+                           "must be finite and > 0, got %g m and %g m",
+                           fn, what, i, m, cy->length, cy->diameter);
+    }
     if (!isfinite(s->turn_radius))
         return ts_fail(err, TS_EINVAL, "%s: %s[%d].turn_radius: must be "
                                        "finite, got %g m",
@@ -1244,6 +1308,68 @@ static void draw_shape_links(frame *f, const ts_plot_shape *s,
     if (len >= 2)
         flush_run(f, len, rh, rv, air, s->style);
     pllsty(LSTY_SOLID);
+}
+
+/* Points of a cylinder seen end on (a circle). */
+#define CYL_POINTS 33
+/* A cylinder is drawn at least this fraction of the picture's extent
+ * long. */
+#define CYL_MIN 0.03
+
+/* The cylinders of s (ts_plot_cylinder) at xy: the outline of each,
+ * centred on its node, its axis the projection of its link's direction,
+ * filled in the current colour and edged in the foreground's; at least
+ * minlen long (display units) with its proportions kept; a circle of its
+ * diameter when the axis points out of the view. Leaves colour col
+ * current. */
+static void draw_cylinders(frame *f, const ts_plot_shape *s,
+                           const shape_xy *xy, const ts_plot_opts *u,
+                           double minlen, int col)
+{
+    for (int b = 0; b < s->ncylinders; b++) {
+        const ts_plot_cylinder *cy = &s->cylinders[b];
+        int k = cy->node;
+        int up = s->link_upper ? s->link_upper[k - 1] : k - 1;
+        double d = 0;
+        for (int j = 0; j < 3; j++) {
+            double dj = s->pos[3 * k + j] - s->pos[3 * up + j];
+            d += dj * dj;
+        }
+        d = pconv(TS_PLOT_LENGTH, u, sqrt(d));
+        double L = pconv(TS_PLOT_LENGTH, u, cy->length);
+        double D = pconv(TS_PLOT_LENGTH, u, cy->diameter);
+        double g = L < minlen ? minlen / L : 1.0;
+        L *= g;
+        D *= g;
+        double eh = d > 0 ? (xy->h[k] - xy->h[up]) / d : 0;
+        double ev = d > 0 ? (xy->v[k] - xy->v[up]) / d : 0;
+        double p = hypot(eh, ev);
+        double px[CYL_POINTS + 1], py[CYL_POINTS + 1];
+        int n = 4;
+        if (p < 1e-3) {
+            n = CYL_POINTS;
+            for (int i = 0; i < n; i++) {
+                double a = 2 * M_PI * i / n;
+                px[i] = xy->h[k] + 0.5 * D * cos(a);
+                py[i] = xy->v[k] + 0.5 * D * sin(a);
+            }
+        } else {
+            double nh = -ev / p, nv = eh / p;
+            static const double sa[4] = {1, 1, -1, -1}, sb[4] = {1, -1, -1, 1};
+            for (int i = 0; i < 4; i++) {
+                px[i] = xy->h[k] + 0.5 * (sa[i] * L * eh + sb[i] * D * nh);
+                py[i] = xy->v[k] + 0.5 * (sa[i] * L * ev + sb[i] * D * nv);
+            }
+        }
+        plcol0(col);
+        plfill(n, px, py);
+        px[n] = px[0];
+        py[n] = py[0];
+        plcol0(COL_FG);
+        plwidth(1.0);
+        draw_line(f, n + 1, px, py);
+    }
+    plcol0(col);
 }
 
 static void draw_marks(frame *f, const ts_plot_shape *s, const shape_xy *xy,
@@ -1426,6 +1552,9 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
         plcol0(color_index(s->color, i));
         plwidth(CURVE_WIDTH);
         draw_shape_links(&f, s, &xy[i], water, work);
+        draw_cylinders(&f, s, &xy[i], u, CYL_MIN * extent,
+                       color_index(s->color, i));
+        plwidth(CURVE_WIDTH);
         draw_marks(&f, s, &xy[i], 1.1);
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
@@ -1847,12 +1976,25 @@ typedef struct bode_ctx {
     const double *nat;
 } bode_ctx;
 
+/* Character scale of the minor labels of a log axis. */
+#define MINOR_SCALE 0.8
+/* Rows and labels of the natural frequencies of a Bode plot. */
+#define NAT_ROWS 4
+#define NAT_LABELS_MAX 64
+
+/* A magnitude as drawn: log10 |H| on the log axis, 20 log10 |H| in dB. */
+static double mag_y(double m, int db)
+{
+    return db ? 20.0 * log10(m) : log10(m);
+}
+
 static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
                      ts_err *err)
 {
     (void)height;
     const bode_ctx *c = vctx;
     const ts_plot_opts *u = o;
+    int db = o->bode_db;
     double gain = pconv(c->out_q, u, 1.0) /
                   pconv(c->in_q, u, 1.0);
     int nmax = 0;
@@ -1870,7 +2012,7 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
         double wrap = 0;
         for (int k = 0; k < C->n; k++) {
             bbox_update(&f0, &f1, log10(C->freq[k]));
-            bbox_update(&m0, &m1, log10(gain * C->mag[k]));
+            bbox_update(&m0, &m1, mag_y(gain * C->mag[k], db));
             /* Unwrap: consecutive phases differ by at most pi. */
             if (k > 0) {
                 double d = C->phase[k] - C->phase[k - 1];
@@ -1880,22 +2022,50 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
         }
     }
     pad_range(&f0, &f1, 0.0, 1.0);
-    pad_range(&m0, &m1, 0.08, 1.0);
+    pad_range(&m0, &m1, 0.08, db ? 20.0 : 1.0);
     whole_decade(&f0, &f1);
-    whole_decade(&m0, &m1);
+    if (!db)
+        whole_decade(&m0, &m1);
     pad_range(&p0, &p1, 0.08, 90.0);
     char xl[TEXT_MAX], ml[TEXT_MAX], raw[TEXT_MAX];
     axis_label(xl, sizeof xl, "frequency", TS_PLOT_FREQUENCY, u);
-    snprintf(raw, sizeof raw, "%s [%s/%s]",
+    snprintf(raw, sizeof raw, db ? "%s [dB re 1 %s/%s]" : "%s [%s/%s]",
              c->mag_label ? c->mag_label : "magnitude",
              punit(c->out_q, u), punit(c->in_q, u));
     pl_text(ml, sizeof ml, raw);
+    /* Minor labels (2 and 5 times a power of ten) on short log axes. */
+    double fminor[16], mminor[16];
+    int nfm = tsi_plot_minor_ticks(f0, f1, fminor, 16);
+    int nmm = db ? 0 : tsi_plot_minor_ticks(m0, m1, mminor, 16);
+    double mwidth = db ? tick_width(m0, m1, 0) : tick_width(m0, m1, 1);
+    for (int k = 0; k < nmm; k++) {
+        char t[32];
+        mwidth = fmax(mwidth, MINOR_SCALE * (snprintf(t, sizeof t, "%g",
+                                                      mminor[k]) + 1) *
+                                  DIGIT_WIDTH);
+    }
     int nlegend = 0, lchars = 0;
     for (int i = 0; i < c->ncurves; i++)
         legend_count(c->curves[i].label, &nlegend, &lchars);
     legend L = {0};
-    double left = fmax(left_edge(tick_width(m0, m1, 1), 1.0),
+    double left = fmax(left_edge(mwidth, 1.0),
                        left_edge(tick_width(p0, p1, 0), 1.0));
+    /* Natural-frequency labels in rows that do not overlap (about four
+     * characters wide each, in log10 Hz). */
+    int nat_row[NAT_LABELS_MAX];
+    int nnat = c->nnat < NAT_LABELS_MAX ? c->nnat : NAT_LABELS_MAX;
+    {
+        double lx[NAT_LABELS_MAX];
+        PLFLT sx0, sx1, sy0, sy1, def, ht;
+        plgspa(&sx0, &sx1, &sy0, &sy1);
+        plgchr(&def, &ht);
+        double mm = (0.97 - left) * (sx1 - sx0) / (f1 - f0); /* per unit */
+        double w = fmax(4.0 * 0.8 * DIGIT_WIDTH * def / mm,
+                        0.035 * (f1 - f0));
+        for (int j = 0; j < nnat; j++)
+            lx[j] = log10(c->nat[j]);
+        tsi_plot_label_rows(nnat, lx, w, NAT_ROWS, nat_row);
+    }
     for (int panel = 0; panel < 2; panel++) {
         if (panel == 0)
             plvpor(left, 0.97, 0.52, 0.89);
@@ -1908,24 +2078,37 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
             frame_set(&f, f0, f1, p0, p1, 0, 0);
         /* Phase ticks at multiples of 90 or 45 degrees. */
         double ptick = p1 - p0 > 200 ? 90 : p1 - p0 > 60 ? 45 : 0;
-        frame_axes(&f, panel ? "bcnstl" : "bcstl", panel ? "bcnst" : "bcnstl",
+        frame_axes(&f, panel ? "bcnstl" : "bcstl",
+                   panel ? "bcnst" : db ? "bcnst" : "bcnstl",
                    panel ? ptick : 0);
+        plschr(0, MINOR_SCALE);
+        plcol0(COL_FG);
+        char t[32];
+        for (int k = 0; panel == 0 && k < nmm; k++) {
+            snprintf(t, sizeof t, "%g", mminor[k]);
+            plmtex("lv", 0.7, (log10(mminor[k]) - m0) / (m1 - m0), 1.0, t);
+        }
+        for (int k = 0; panel == 1 && k < nfm; k++) {
+            snprintf(t, sizeof t, "%g", fminor[k]);
+            plmtex("b", 1.6, (log10(fminor[k]) - f0) / (f1 - f0), 0.5, t);
+        }
+        plschr(0, 1.0);
         /* Natural frequencies. */
         plwidth(1.2);
         for (int j = 0; j < c->nnat; j++) {
             double x = log10(c->nat[j]);
             if (x < f0 || x > f1)
                 continue;
+            int row = j < nnat ? nat_row[j] : -1;
             plcol0(COL_GREY);
             pllsty(LSTY_DOTTED);
             pljoin(x, panel ? p0 : m0, x, panel ? p1 : m1);
             pllsty(LSTY_SOLID);
-            if (panel == 0) {
-                char t[32];
+            if (panel == 0 && row >= 0) {
                 snprintf(t, sizeof t, "f%d", j + 1);
                 plschr(0, 0.8);
                 plcol0(COL_FG);
-                double y = m1 - 0.06 * (m1 - m0);
+                double y = m1 - (0.06 + 0.07 * row) * (m1 - m0);
                 plptex(x, y, 1, 0, -0.15, t);
                 frame_segment(&f, x, y, x + 0.03 * (f1 - f0), y);
                 plschr(0, 1.0);
@@ -1936,7 +2119,7 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
             double wrap = 0;
             for (int k = 0; k < C->n; k++) {
                 lf[k] = log10(C->freq[k]);
-                lm[k] = log10(gain * C->mag[k]);
+                lm[k] = mag_y(gain * C->mag[k], db);
                 if (k > 0) {
                     double d = C->phase[k] - C->phase[k - 1];
                     wrap -= 2 * M_PI * floor((d + M_PI) / (2 * M_PI));
@@ -1944,7 +2127,7 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
                 ph[k] = (C->phase[k] + wrap) * 180 / M_PI;
             }
             ts_plot_series s = {C->n, lf, panel ? ph : lm, C->label, 0,
-                                C->style, C->color};
+                                C->style, C->color, NULL};
             int col = color_index(C->color, i);
             draw_series(&f, &s, col, i, lf, panel ? ph : lm);
             if (panel == 0)
@@ -1953,7 +2136,8 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
         if (panel == 0) {
             label_axes(&f, NULL, ml, 1.0);
             if (c->nnat > 0)
-                note("dotted: natural frequencies f1, f2, ...");
+                note("dotted: natural frequencies f1, f2, ... (labels "
+                     "that would overlap are staggered or left out)");
             legend_draw(&L, &f);
         } else {
             char pl[TEXT_MAX];
@@ -2199,6 +2383,19 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
         int col = color_index(S->color, i);
         draw_series(&f, S, col, i, lx, ly);
         legend_add(&L, S->label, col, S->style, marker_glyph(i));
+        /* Each point's text, just right of and above it. */
+        plschr(0, 0.75);
+        for (int k = 0; S->point_labels && k < S->n; k++) {
+            if (!S->point_labels[k] || !S->point_labels[k][0])
+                continue;
+            char t[TEXT_MAX];
+            pl_text(t, sizeof t, S->point_labels[k]);
+            double tx = lx[k] + 0.01 * (x1 - x0);
+            double ty = ly[k] + 0.025 * (y1 - y0);
+            plptex(tx, ty, 1, 0, 0.0, t);
+            frame_segment(&f, tx, ty, tx + 0.02 * (x1 - x0), ty);
+        }
+        plschr(0, 1.0);
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
     axis_label(xl, sizeof xl, c->xa->label, c->xa->quantity, u);

@@ -31,6 +31,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "plot_impl.h"
 #include "tcheck.h"
 #include "towstab/plot.h"
 #include "towstab/units.h"
@@ -293,6 +294,15 @@ static void make_data(void)
 
 #ifdef TS_HAVE_PLPLOT
 
+/* Occurrences of `what` in s. */
+static int count_of(const char *s, const char *what)
+{
+    int n = 0;
+    for (const char *p = strstr(s, what); p; p = strstr(p + 1, what))
+        n++;
+    return n;
+}
+
 static void test_shapes(void)
 {
     ts_plot_opts o;
@@ -300,7 +310,8 @@ static void test_shapes(void)
     ts_err err = {0};
     /* Side view of a submerged chain without labels: no legend, so the
      * plot box is known. */
-    ts_plot_shape one = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
+                         0, NULL};
     int rc = ts_plot_shapes(dir, "side_si", "chain: side view", TS_PLOT_SIDE,
                             TS_PLOT_WATER, 1, &one, &o, &err);
     CHECK(rc == TS_OK, "side view drawn (%s)", err.msg);
@@ -349,9 +360,9 @@ static void test_shapes(void)
     /* Overlay: straight and turning, side and top, with labels. */
     ts_plot_shape two[2] = {
         {N, chain, NULL, 1, end_mark, 0, "5 knot, straight", TS_PLOT_SOLID,
-         0},
+         0, 0, NULL},
         {N, chain_turn, NULL, 1, end_mark, 38.5, "5 knot, turn",
-         TS_PLOT_DASHED, 0}};
+         TS_PLOT_DASHED, 0, 0, NULL}};
     rc = ts_plot_shapes(dir, "side", "overlay: side view", TS_PLOT_SIDE,
                         TS_PLOT_WATER | TS_PLOT_EQUAL, 2, two, &o, &err);
     CHECK(rc == TS_OK, "side view of two shapes drawn (%s)", err.msg);
@@ -382,7 +393,8 @@ static void test_shapes(void)
     free(svg);
 
     /* A branched tree in both views. */
-    ts_plot_shape t = {NT, tree, tree_upper, 2, tree_marks, -20, "tree", 0, 3};
+    ts_plot_shape t = {NT,     tree, tree_upper, 2, tree_marks, -20,
+                       "tree", 0,    3,          0, NULL};
     rc = ts_plot_shapes(dir, "tree_side", "tree", TS_PLOT_SIDE,
                         TS_PLOT_WATER | TS_PLOT_EQUAL, 1, &t, &o, &err);
     CHECK(rc == TS_OK, "branched tree, side view (%s)", err.msg);
@@ -390,6 +402,50 @@ static void test_shapes(void)
                         &err);
     CHECK(rc == TS_OK, "branched tree, top view, port turn (%s)", err.msg);
     check_png("tree_top", 1000, 700);
+}
+
+/* A cylinder towfish: drawn as a filled outline (two paths more than
+ * the same picture without it), and a bad one refused. */
+static void test_cylinder(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    ts_plot_shape one = {N, chain_sub, NULL, 0, NULL, 0, NULL, 0, 0, 0, NULL};
+    int rc = ts_plot_shapes(dir, "cyl_without", "towfish", TS_PLOT_SIDE,
+                            TS_PLOT_WATER, 1, &one, &o, &err);
+    ts_plot_cylinder cy = {N - 1, 2.0, 0.4};
+    one.ncylinders = 1;
+    one.cylinders = &cy;
+    rc = rc ? rc
+            : ts_plot_shapes(dir, "cyl_with", "towfish", TS_PLOT_SIDE,
+                             TS_PLOT_WATER, 1, &one, &o, &err);
+    CHECK(rc == TS_OK, "a shape with a cylinder drawn (%s)", err.msg);
+    check_png("cyl_with", 1000, 700);
+    char *a = check_svg("cyl_without", "towfish");
+    char *b = check_svg("cyl_with", "towfish");
+    int na = a ? count_of(a, "<path ") : 0, nb = b ? count_of(b, "<path ")
+                                                  : 0;
+    CHECK(a && b && nb == na + 2, "the cylinder adds its fill and outline "
+          "(%d paths, %d without)", nb, na);
+    free(a);
+    free(b);
+    ts_plot_opts_default(&o);
+    rc = ts_plot_shapes(dir, "top_cyl", "towfish, top", TS_PLOT_TOP, 0, 1,
+                        &one, &o, &err);
+    CHECK(rc == TS_OK, "the top view with a cylinder drawn (%s)", err.msg);
+    cy.node = 0;
+    rc = ts_plot_shapes(dir, "cyl_bad", "x", TS_PLOT_SIDE, 0, 1, &one, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "cylinders[0].node"),
+          "a cylinder on the tow point is refused: %s", err.msg);
+    cy.node = N - 1;
+    cy.diameter = 0;
+    rc = ts_plot_shapes(dir, "cyl_bad", "x", TS_PLOT_SIDE, 0, 1, &one, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "diameter"),
+          "a cylinder of diameter 0 is refused: %s", err.msg);
+    CHECK(nothing_named("cyl_bad"), "refused shapes left no file");
 }
 
 static void test_modes(void)
@@ -414,7 +470,7 @@ static void test_modes(void)
         modes[m].disp = disp[m];
         modes[m].label = label[m];
     }
-    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     int rc = ts_plot_mode_shapes(dir, "modes", "chain: lowest modes",
                                  TS_PLOT_WATER, &eq, NM, modes, &o, &err);
     CHECK(rc == TS_OK, "mode shapes drawn (%s)", err.msg);
@@ -457,8 +513,8 @@ static void test_eigenvalues(void)
         im[2 * i] = wn[i] * sqrt(1 - zeta[i] * zeta[i]);
         im[2 * i + 1] = -im[2 * i];
     }
-    ts_plot_series sets[2] = {{8, re, im, "2.385 m/s", 0, 0, 0},
-                              {2, ure, uim, "4 m/s", 0, 0, 0}};
+    ts_plot_series sets[2] = {{8, re, im, "2.385 m/s", 0, 0, 0, NULL},
+                              {2, ure, uim, "4 m/s", 0, 0, 0, NULL}};
     int rc = ts_plot_eigenvalues(dir, "eig", "chain: eigenvalues", 2, sets,
                                  NULL, &o, &err);
     CHECK(rc == TS_OK, "eigenvalues drawn (%s)", err.msg);
@@ -490,7 +546,7 @@ static void test_eigenvalues(void)
     double nan_im[8];
     memcpy(nan_im, im, sizeof nan_im);
     nan_im[5] = NAN;
-    ts_plot_series nanset = {8, re, nan_im, "x", 0, 0, 0};
+    ts_plot_series nanset = {8, re, nan_im, "x", 0, 0, 0, NULL};
     rc = ts_plot_eigenvalues(dir, "eig_nan", "x", 1, &nanset, NULL, &o, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "y[5]"),
           "NaN imaginary part is refused, naming it: %s", err.msg);
@@ -527,6 +583,28 @@ static void test_bode(void)
     CHECK(rc == TS_OK, "Bode plot drawn (%s)", err.msg);
     check_png("bode", 1000, 700);
     free(check_svg("bode", "chain: heave response"));
+    /* The magnitude in dB; a short span with minor labels; crowded
+     * natural frequencies. */
+    o.bode_db = 1;
+    rc = ts_plot_bode(dir, "bode_db", "chain: heave response, dB", "heave "
+                      "/ tow-point heave", TS_PLOT_LENGTH, TS_PLOT_LENGTH, 2,
+                      c, 2, nat, &o, &err);
+    CHECK(rc == TS_OK, "Bode plot in dB drawn (%s)", err.msg);
+    check_png("bode_db", 1000, 700);
+    free(check_svg("bode_db", "chain: heave response, dB"));
+    o.bode_db = 0;
+    double fs[NF], ms[NF], crowd[6] = {0.30, 0.31, 0.32, 0.33, 0.5, 0.9};
+    for (int i = 0; i < NF; i++) {
+        fs[i] = 0.2 + 0.8 * i / (NF - 1.0);
+        ms[i] = 0.04 + 0.21 * i / (NF - 1.0);
+    }
+    ts_plot_bode_curve cs = {NF, fs, ms, ph, "short", 0, 0};
+    rc = ts_plot_bode(dir, "bode_short", "short span", "m", TS_PLOT_LENGTH,
+                      TS_PLOT_LENGTH, 1, &cs, 6, crowd, &o, &err);
+    CHECK(rc == TS_OK, "Bode plot of 0.04 .. 0.25 with six close natural "
+          "frequencies drawn (%s)", err.msg);
+    check_png("bode_short", 1000, 700);
+    free(check_svg("bode_short", "short span"));
 
     double fbad[3] = {0.1, 0.2, 0.2}, m3[3] = {1, 1, 1}, p3[3] = {0, 0, 0};
     ts_plot_bode_curve bad = {3, fbad, m3, p3, "x", 0, 0};
@@ -570,17 +648,19 @@ static void test_histories(void)
     }
     ts_plot_axis panels[2] = {{"sphere depth", TS_PLOT_LENGTH},
                               {"top tension", TS_PLOT_FORCE}};
-    ts_plot_series s[4] = {{NS, t, d1, "linear", 0, TS_PLOT_DASHED, 1},
-                           {NS2, t2, d2, "nonlinear", 0, TS_PLOT_SOLID, 2},
-                           {NS, t, f1, "linear", 1, TS_PLOT_DASHED, 1},
-                           {NS2, t2, f2, "nonlinear", 1, TS_PLOT_SOLID, 2}};
+    ts_plot_series s[4] = {{NS, t, d1, "linear", 0, TS_PLOT_DASHED, 1, NULL},
+                           {NS2, t2, d2, "nonlinear", 0, TS_PLOT_SOLID, 2,
+                            NULL},
+                           {NS, t, f1, "linear", 1, TS_PLOT_DASHED, 1, NULL},
+                           {NS2, t2, f2, "nonlinear", 1, TS_PLOT_SOLID, 2,
+                            NULL}};
     int rc = ts_plot_histories(dir, "hist", "chain: heave 0.1 ft at 0.25 Hz",
                                2, panels, 4, s, &o, &err);
     CHECK(rc == TS_OK, "time histories drawn (%s)", err.msg);
     check_png("hist", 1000, 700);
     free(check_svg("hist", "chain: heave 0.1 ft at 0.25 Hz"));
 
-    ts_plot_series orphan = {NS, t, d1, "x", 2, 0, 0};
+    ts_plot_series orphan = {NS, t, d1, "x", 2, 0, 0, NULL};
     rc = ts_plot_histories(dir, "hist_bad", "x", 2, panels, 1, &orphan, &o,
                            &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "panel"),
@@ -588,13 +668,13 @@ static void test_histories(void)
     rc = ts_plot_histories(dir, "hist_bad", "x", 2, panels, 2, s, &o, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "panels[1]"),
           "an empty panel is refused: %s", err.msg);
-    ts_plot_series empty = {0, t, d1, "x", 0, 0, 0};
+    ts_plot_series empty = {0, t, d1, "x", 0, 0, 0, NULL};
     rc = ts_plot_histories(dir, "hist_bad", "x", 1, panels, 1, &empty, &o,
                            &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "n: must be >= 1"),
           "a series of n = 0 points is refused: %s", err.msg);
     double inf[3] = {1, INFINITY, 2};
-    ts_plot_series infs = {3, t, inf, "x", 0, 0, 0};
+    ts_plot_series infs = {3, t, inf, "x", 0, 0, 0, NULL};
     rc = ts_plot_histories(dir, "hist_bad", "x", 1, panels, 1, &infs, &o,
                            &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "finite"),
@@ -616,13 +696,32 @@ static void test_loglog(void)
     }
     ts_plot_axis xa = {"run time", TS_PLOT_TIME},
                  ya = {"error in sphere depth", TS_PLOT_LENGTH};
-    ts_plot_series s[2] = {{6, rt, e1, "RK45", 0, TS_PLOT_LINE_MARKERS, 0},
-                           {6, rt2, e2, "BDF", 0, TS_PLOT_LINE_MARKERS, 0}};
+    ts_plot_series s[2] = {
+        {6, rt, e1, "RK45", 0, TS_PLOT_LINE_MARKERS, 0, NULL},
+        {6, rt2, e2, "BDF", 0, TS_PLOT_LINE_MARKERS, 0, NULL}};
     int rc = ts_plot_loglog(dir, "loglog", "chain: error against run time",
                             &xa, &ya, 2, s, &o, &err);
     CHECK(rc == TS_OK, "log-log plot drawn (%s)", err.msg);
     check_png("loglog", 1000, 700);
-    free(check_svg("loglog", "chain: error against run time"));
+    char *plain = check_svg("loglog", "chain: error against run time");
+    /* Each point labelled: the picture has more glyphs drawn. */
+    static const char *const pts[6] = {"5", "10", "20", "40", "80", "160"};
+    ts_plot_series sl[2] = {s[0], s[1]};
+    sl[0].point_labels = pts;
+    rc = ts_plot_loglog(dir, "loglog_labels", "chain: labelled", &xa, &ya,
+                        2, sl, &o, &err);
+    CHECK(rc == TS_OK, "log-log plot with point labels drawn (%s)", err.msg);
+    char *lab = check_svg("loglog_labels", "chain: labelled");
+    /* cairo writes each text as a group filled in its colour: the six
+     * labels of the first series are six more groups in its colour
+     * (palette colour 1, rgb 0 114 178). */
+    static const char g1[] = "<g style=\"fill:rgb(0%,44.705882%,69.803922%)";
+    int gp = plain ? count_of(plain, g1) : 0, gl = lab ? count_of(lab, g1)
+                                                       : 0;
+    CHECK(plain && lab && gl == gp + 6, "six point labels drawn in the "
+          "series' colour (%d text groups, %d without)", gl, gp);
+    free(plain);
+    free(lab);
     /* A title with XML specials and PLplot's escape character '#'. */
     rc = ts_plot_loglog(dir, "loglog_xml", "run #2: error & time <s>", &xa,
                         &ya, 2, s, &o, &err);
@@ -638,7 +737,7 @@ static void test_loglog(void)
     CHECK(!file_exists("loglog_big", "svg"), "no SVG when only PNG is asked");
 
     double ezero[6] = {1e-3, 1e-4, 0, 1e-6, 1e-7, 1e-8};
-    ts_plot_series z = {6, rt, ezero, "x", 0, 0, 0};
+    ts_plot_series z = {6, rt, ezero, "x", 0, 0, 0, NULL};
     ts_plot_opts_default(&o);
     rc = ts_plot_loglog(dir, "loglog_bad", "x", &xa, &ya, 1, &z, &o, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "y[2]") &&
@@ -657,7 +756,7 @@ static void test_bad_places(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     ts_err err = {0};
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     static const char *const names[] = {"", ".hidden", "a/b", "x y", NULL};
     for (int i = 0; names[i]; i++) {
         ts_err_clear(&err);
@@ -764,7 +863,7 @@ static void test_streams(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     o.formats = TS_PLOT_PNG;
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
     ts_err err = {0};
     int rc = ts_plot_shapes(dir, "stream", "t", TS_PLOT_TOP, 0, 1, &one, &o,
                             &err);
@@ -815,6 +914,35 @@ static void test_without_plplot(void)
 #endif
 
 /* Conversions and unit names (no PLplot needed), against udunits2. */
+/* The label placement: minor labels of short log axes (2 and 5 times
+ * each power of ten inside, none on a wider axis) and rows of labels
+ * that do not overlap. */
+static void test_labels(void)
+{
+    double v[16];
+    int n = tsi_plot_minor_ticks(-2, 0, v, 16);
+    CHECK(n == 4 && v[0] == 0.02 && v[1] == 0.05 && fabs(v[2] - 0.2) < 1e-15 &&
+              fabs(v[3] - 0.5) < 1e-15,
+          "10^-2 .. 10^0: minor labels 0.02, 0.05, 0.2, 0.5 (%d)", n);
+    /* The issue's span 0.04 .. 0.25 (padded: 0.035 .. 0.3). */
+    n = tsi_plot_minor_ticks(log10(0.035), log10(0.3), v, 16);
+    CHECK(n == 2 && fabs(v[0] - 0.05) < 1e-15 && fabs(v[1] - 0.2) < 1e-15,
+          "0.035 .. 0.3: 0.05 and 0.2 (%d)", n);
+    CHECK(tsi_plot_minor_ticks(-3, 0, v, 16) == 0,
+          "three decades: no minor labels");
+    CHECK(tsi_plot_minor_ticks(0, 1, v, 1) == 1, "at most max labels");
+    /* Rows: 0, 0.01, 0.02 crowd, 0.5 is free; given out of order. */
+    double x[4] = {0.5, 0.02, 0.0, 0.01};
+    int row[4];
+    tsi_plot_label_rows(4, x, 0.05, 2, row);
+    CHECK(row[2] == 0 && row[3] == 1 && row[1] == -1 && row[0] == 0,
+          "label rows: 0 -> 0, 0.01 -> 1, 0.02 left out, 0.5 -> 0 (%d %d "
+          "%d %d)", row[2], row[3], row[1], row[0]);
+    tsi_plot_label_rows(4, x, 0.009, 2, row);
+    CHECK(row[2] == 0 && row[3] == 0 && row[1] == 0 && row[0] == 0,
+          "labels 0.01 apart, 0.009 wide: one row");
+}
+
 static void test_units(void)
 {
     ts_err err = {0};
@@ -907,11 +1035,13 @@ int main(int argc, char **argv)
     }
     make_data();
     test_units();
+    test_labels();
 #ifdef TS_HAVE_PLPLOT
     ts_err err = {0};
     CHECK(ts_plot_check(&err) == TS_OK,
           "PLplot with its cairo devices is available (%s)", err.msg);
     test_shapes();
+    test_cylinder();
     test_modes();
     test_eigenvalues();
     test_bode();

@@ -48,6 +48,9 @@ typedef struct cli_run {
     int entry;              /* -1: the command line; else analyses[entry] */
     const char *json, *csv; /* output paths, NULL when not asked for */
     cli_plot plot;          /* --plot DIR and --units */
+    int plot_optional;      /* 1: an analysis that has no pictures runs
+                               without them (towstab report); 0: it
+                               refuses --plot */
     ts_display display;     /* --units: what tables, CSV and pictures show
                                (cli_display_begin) */
     int json_flags;         /* TS_REPORT_* */
@@ -123,19 +126,24 @@ typedef struct cli_scene_runs {
     cli_run *runs;          /* [n], prepared */
     char (*csv)[1200];      /* [n] DIR/<k>_<type>.csv when asked for */
     char (*dirs)[1200];     /* [n] DIR/<k>_<type> of the pictures */
+    double *wall_s;         /* [n] s, each analysis with its printing and
+                               pictures (cli_scene_execute); 0 when not
+                               run */
+    int ran;                /* analyses run (the last may have failed) */
 } cli_scene_runs;
 
 /* Read every entry of the scene's analyses list through its option table
  * and check it against the system (cli_prepare) before anything runs;
  * with csv_dir each writes csv_dir/<k>_<type>.csv, with plot_dir its
- * pictures into plot_dir/<k>_<type>/ (k from 1) in plot_units. `cmd`
- * names the command in messages. Prints and returns the exit status (a
+ * pictures into plot_dir/<k>_<type>/ (k from 1) in plot_units, with
+ * plot_optional (cli_run) set as given. `cmd` names the command in
+ * messages. Prints and returns the exit status (a
  * scene without analyses is bad input); on success release s with
  * cli_scene_free. */
 int cli_scene_prepare(const char *cmd, const ts_scene *scene,
                       const ts_units *units, int quiet, const char *csv_dir,
                       const char *plot_dir, const char *plot_units,
-                      cli_scene_runs *s);
+                      int plot_optional, cli_scene_runs *s);
 
 /* Run the prepared analyses in order, each after a line "== analysis k of
  * n: TYPE (SCENE) ==", until one fails. *all receives the JSON document
@@ -146,6 +154,11 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
                       json_t **all);
 
 void cli_scene_free(cli_scene_runs *s);
+
+/* Report a getopt failure of `towstab run` or `report` (ch ':' for a
+ * missing value, else an unknown option: the analyses' options belong in
+ * the scene); returns EXIT_BADINPUT. */
+int cli_scene_option_error(const char *cmd, int ch, const char *arg);
 
 /* Make directory `dir` (one level) unless it is one; 0, or the status
  * after printing a message naming `cmd` and the option `opt`. */

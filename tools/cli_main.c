@@ -20,8 +20,6 @@
 
 /* getopt codes: table rows, their --no- forms, the extras. */
 enum { CODE_ROW = 1000, CODE_NO = 2000, CODE_EXTRA = 3000 };
-/* Checks of a request a scene value may yield in, at most. */
-#define MAX_YIELDS 16
 
 static int nextras(const cli_command *cmd)
 {
@@ -103,32 +101,12 @@ void cli_options_markdown(FILE *f)
     }
 }
 
-/* The related entry of a study: the scene's first simulate entry, when the
- * study's analysis is simulate. */
-static int add_related(ts_optset *o, const ts_scene *scene, ts_err *err)
-{
-    const char *an = ts_optset_text(o, "analysis");
-    if (!an || strcmp(an, "simulate") != 0)
-        return TS_OK;
-    for (int i = 0; i < scene->nanalyses; i++)
-        if (!strcmp(scene->analyses[i].type, "simulate"))
-            return ts_optset_give_entry(o, &scene->analyses[i], i,
-                                        scene->path, TS_OPTSET_RELATED,
-                                        TS_SEC_SIMULATE, err);
-    return TS_OK;
-}
-
 ts_optset *cli_entry_options(const ts_scene *scene, int kind, int index,
                              int *status)
 {
     ts_err err = {0};
     ts_optset *o = ts_optset_alloc(kind, &err);
-    int rc = o ? TS_OK : TS_ENOMEM;
-    if (!rc && index >= 0)
-        rc = ts_optset_give_entry(o, &scene->analyses[index], index,
-                                  scene->path, TS_OPTSET_SCENE, -1, &err);
-    if (!rc && kind == TS_ANALYSIS_CONVERGE)
-        rc = add_related(o, scene, &err);
+    int rc = o ? ts_optset_give_scene(o, scene, index, &err) : TS_ENOMEM;
     if (rc) {
         *status = cli_report(&err, rc);
         ts_optset_free(o);
@@ -138,55 +116,20 @@ ts_optset *cli_entry_options(const ts_scene *scene, int kind, int index,
     return o;
 }
 
-/* Apply the set up to `max` and check against the system. */
-static int request_check(cli_run *c, int max, ts_request *rq, ts_err *err)
-{
-    ts_request_init(rq, c->cmd->kind);
-    int rc = ts_optset_apply(c->opts, max, c->units, rq, err);
-    if (rc == TS_OK)
-        rc = ts_analysis_check(c->scene->system, rq, err);
-    return rc;
-}
-
 int cli_prepare(cli_run *c)
 {
     ts_err err = {0};
-    ts_request_init(&c->rq, c->cmd->kind);
-    int rc = ts_optset_apply(c->opts, TS_OPTSET_COMMAND, c->units, &c->rq,
-                             &err);
-    if (rc)
-        return cli_report(&err, rc);
-    for (int k = 0; k < MAX_YIELDS; k++) {
-        ts_err_clear(&err);
-        rc = ts_analysis_check(c->scene->system, &c->rq, &err);
-        if (rc == TS_OK)
-            break;
-        /* A scene value that the command line's values contradict (and
-         * that is fine without them) yields to its default. */
-        const char *key = ts_optset_yields(c->opts, &err);
-        int top = ts_optset_top(c->opts);
-        ts_request alone;
-        ts_err aerr = {0};
-        int ok_alone = key && request_check(c, top - 1, &alone, &aerr) ==
-                                  TS_OK;
-        if (key)
-            ts_request_clear(&alone);
-        if (!ok_alone) {
-            ts_optset_locate(c->opts, &err);
-            return cli_report(&err, rc);
-        }
-        ts_optset_locate(c->opts, &err);
-        printf("note: %s; with the command line's options this scene value "
-               "does not hold, so its default is used\n",
-               err.msg);
-        char name[TS_NAME_MAX];
-        snprintf(name, sizeof name, "%s", key);
-        ts_optset_drop(c->opts, name);
-        ts_request_clear(&c->rq);
-        rc = ts_optset_apply(c->opts, TS_OPTSET_COMMAND, c->units, &c->rq,
-                             &err);
-        if (rc)
-            return cli_report(&err, rc);
+    char notes[TS_OPTSET_NOTES_MAX];
+    int rc = ts_optset_request(c->opts, c->scene->system, c->units, &c->rq,
+                               notes, sizeof notes, &err);
+    /* A scene value that the command line's values contradict (and that
+     * is fine without them) yielded to its default. */
+    for (char *line = notes; *line;) {
+        char *end = strchr(line, '\n');
+        printf("note: %.*s; with the command line's options this scene "
+               "value does not hold, so its default is used\n",
+               end ? (int)(end - line) : (int)strlen(line), line);
+        line = end ? end + 1 : line + strlen(line);
     }
     if (rc)
         return cli_report(&err, rc);
@@ -278,15 +221,6 @@ void cli_run_free(cli_run *c)
     ts_request_clear(&c->rq);
     ts_optset_free(c->opts);
     c->opts = NULL;
-}
-
-/* The first entry of type `name`, or -1. */
-static int first_entry(const ts_scene *scene, const char *name)
-{
-    for (int i = 0; i < scene->nanalyses; i++)
-        if (!strcmp(scene->analyses[i].type, name))
-            return i;
-    return -1;
 }
 
 int cli_main(const cli_command *cmd, int argc, char **argv)
@@ -428,13 +362,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
     c.units = units;
     c.plot.opts.display = &c.display;
     /* Below the command line: the scene's first entry of this type. */
-    int e = first_entry(scene, cmd->name);
-    int rc = e >= 0 ? ts_optset_give_entry(opts, &scene->analyses[e], e,
-                                           scene->path, TS_OPTSET_SCENE, -1,
-                                           &err)
-                    : TS_OK;
-    if (!rc && cmd->kind == TS_ANALYSIS_CONVERGE)
-        rc = add_related(opts, scene, &err);
+    int rc = ts_optset_give_scene(opts, scene, -1, &err);
     status = rc ? cli_report(&err, rc) : cli_prepare(&c);
     if (!status) {
         /* A simulation names itself with its settings (its print). */

@@ -31,6 +31,17 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
     return 0;
 }
 
+void cli_plot_wrote(const cli_plot *p, const char *name)
+{
+    int png = p->opts.formats & TS_PLOT_PNG, svg = p->opts.formats & TS_PLOT_SVG;
+    printf("wrote");
+    if (png)
+        printf(" %s/%s.png", p->dir, name);
+    if (svg)
+        printf("%s %s/%s.svg", png ? " and" : "", p->dir, name);
+    printf("\n");
+}
+
 int cli_display_begin(const ts_units *units, const char *spec,
                       ts_display *d)
 {
@@ -47,23 +58,34 @@ int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out)
     memset(out, 0, sizeof *out);
     out->link_upper = malloc(((size_t)sys->nlinks + 1) * sizeof(int));
     out->marks = malloc(((size_t)sys->nbodies + 1) * sizeof(int));
-    if (!out->link_upper || !out->marks) {
+    out->cylinders = malloc(((size_t)sys->nbodies + 1) *
+                            sizeof *out->cylinders);
+    if (!out->link_upper || !out->marks || !out->cylinders) {
         cli_plot_shape_free(out);
         return -1;
     }
     /* Link l joins its upper node to node l + 1 (ts_link.lower). */
     for (int l = 0; l < sys->nlinks; l++)
         out->link_upper[l] = sys->links[l].upper;
-    int nmarks = 0;
-    for (int b = 0; b < sys->nbodies; b++)
-        if (sys->bodies[b].type == TS_BODY_SPHERE)
-            out->marks[nmarks++] = ts_system_body_node(sys, b);
+    int nmarks = 0, ncyl = 0;
+    for (int b = 0; b < sys->nbodies; b++) {
+        const ts_body *B = &sys->bodies[b];
+        int node = ts_system_body_node(sys, b);
+        if (B->type == TS_BODY_SPHERE)
+            out->marks[nmarks++] = node;
+        else if (B->type == TS_BODY_CYLINDER && node >= 1 &&
+                 B->length > 0 && B->diameter > 0)
+            out->cylinders[ncyl++] =
+                (ts_plot_cylinder){node, B->length, B->diameter};
+    }
     ts_plot_shape *s = &out->shape;
     s->nnodes = sys->nnodes;
     s->pos = pos;
     s->link_upper = out->link_upper;
     s->nmarks = nmarks;
     s->marks = out->marks;
+    s->ncylinders = ncyl;
+    s->cylinders = out->cylinders;
     /* doc/model.md section 1: the turn centre is at (0, V / Omega, 0). */
     s->turn_radius = sys->tow.turn_rate != 0
                          ? sys->tow.speed / sys->tow.turn_rate
@@ -76,7 +98,9 @@ void cli_plot_shape_free(cli_shape *s)
 {
     free(s->link_upper);
     free(s->marks);
+    free(s->cylinders);
     s->link_upper = s->marks = NULL;
+    s->cylinders = NULL;
 }
 
 void cli_plot_tow_label(const ts_system *sys, const char *speed_text,

@@ -27,6 +27,8 @@ typedef struct cli_plot {
  * or all is well. */
 int cli_plot_begin(cli_plot *p, const char *cmd);
 
+/* Print "wrote DIR/NAME.png and DIR/NAME.svg" (the formats drawn). */
+void cli_plot_wrote(const cli_plot *p, const char *name);
 /* The display units of --units `spec` (NULL: SI) into d
  * (ts_display_parse: si, imperial, QUANTITY=UNIT items). Prints and
  * returns EXIT_BADINPUT for a bad spec, else 0. */
@@ -35,13 +37,15 @@ int cli_display_begin(const ts_units *units, const char *spec,
 
 /* A cable shape of `sys` at node positions pos[3 nnodes] (m, M frame),
  * for ts_plot_shapes / ts_plot_mode_shapes: links as in sys, spheres
- * marked, the ship's turning circle R = V / Omega when turning. Owns its
+ * marked, cylinder towfish drawn, the ship's turning circle R = V /
+ * Omega when turning. Owns its
  * arrays: release with cli_plot_shape_free. Returns 0, or -1 when out of
  * memory. */
 typedef struct cli_shape {
     ts_plot_shape shape;
     int *link_upper; /* [nlinks] */
     int *marks;      /* [nbodies] */
+    ts_plot_cylinder *cylinders; /* [nbodies] */
     char label[192];
 } cli_shape;
 

@@ -28,6 +28,16 @@ int cli_make_dir(const char *cmd, const char *opt, const char *dir)
     return 0;
 }
 
+int cli_scene_option_error(const char *cmd, int ch, const char *arg)
+{
+    if (ch == ':')
+        return cli_option_error(cmd, ch, arg);
+    fprintf(stderr, "towstab: error: %s: unknown option '%s'; the scene's "
+                    "analyses carry their own settings (towstab %s --help)\n",
+            cmd, arg, cmd);
+    return EXIT_BADINPUT;
+}
+
 void cli_scene_free(cli_scene_runs *s)
 {
     for (int i = 0; s->runs && i < s->n; i++)
@@ -35,13 +45,14 @@ void cli_scene_free(cli_scene_runs *s)
     free(s->runs);
     free(s->csv);
     free(s->dirs);
+    free(s->wall_s);
     memset(s, 0, sizeof *s);
 }
 
 int cli_scene_prepare(const char *cmd, const ts_scene *scene,
                       const ts_units *units, int quiet, const char *csv_dir,
                       const char *plot_dir, const char *plot_units,
-                      cli_scene_runs *s)
+                      int plot_optional, cli_scene_runs *s)
 {
     memset(s, 0, sizeof *s);
     int n = scene->nanalyses;
@@ -55,7 +66,8 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
     s->runs = calloc((size_t)n, sizeof *s->runs);
     s->csv = calloc((size_t)n, sizeof *s->csv);
     s->dirs = calloc((size_t)n, sizeof *s->dirs);
-    if (!s->runs || !s->csv || !s->dirs) {
+    s->wall_s = calloc((size_t)n, sizeof *s->wall_s);
+    if (!s->runs || !s->csv || !s->dirs || !s->wall_s) {
         fprintf(stderr, "towstab: error: %s: out of memory for %d "
                         "analyses\n", cmd, n);
         cli_scene_free(s);
@@ -101,6 +113,7 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
                      i + 1, a->type);
             c->plot.dir = s->dirs[i];
             c->plot.units = plot_units;
+            c->plot_optional = plot_optional;
         }
         c->opts = cli_entry_options(scene, kind, i, &status);
         if (!status)
@@ -131,7 +144,10 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
         printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
                s->n, scene->analyses[i].type, scene->system->name);
         json_t *j = NULL;
+        double t0 = cli_wall_now();
         status = cli_execute(&s->runs[i], &j);
+        s->wall_s[i] = cli_wall_now() - t0;
+        s->ran = i + 1;
         if (j)
             json_array_append_new(list, j);
     }

@@ -187,12 +187,17 @@ static int converge_plot(const ts_convergence *c, const char *scene,
     double *y = malloc((size_t)n * sizeof(double));
     ts_plot_series *ser = malloc((size_t)c->nseries * sizeof *ser);
     char(*labels)[160] = malloc((size_t)c->nseries * sizeof *labels);
-    if (!idx || !x || !y || !ser || !labels) {
+    /* Each point labelled with its setting. */
+    char(*ptext)[32] = malloc((size_t)(n > 0 ? n : 1) * sizeof *ptext);
+    const char **pl = malloc((size_t)(n > 0 ? n : 1) * sizeof *pl);
+    if (!idx || !x || !y || !ser || !labels || !ptext || !pl) {
         free(idx);
         free(x);
         free(y);
         free(ser);
         free(labels);
+        free(ptext);
+        free(pl);
         fprintf(stderr, "towstab: error: converge: --plot: out of memory\n");
         return EXIT_FAILED;
     }
@@ -208,7 +213,13 @@ static int converge_plot(const ts_convergence *c, const char *scene,
                 !(r->wall_s > 0))
                 continue;
             x[m] = r->wall_s;
-            y[m++] = r->max_rel_error;
+            y[m] = r->max_rel_error;
+            if (c->param == TS_CONV_LINKS)
+                snprintf(ptext[m], sizeof ptext[m], "%d", (int)r->setting);
+            else
+                snprintf(ptext[m], sizeof ptext[m], "%.2g", r->setting);
+            pl[m] = ptext[m];
+            m++;
             lo = fmin(lo, r->setting);
             hi = fmax(hi, r->setting);
         }
@@ -224,7 +235,7 @@ static int converge_plot(const ts_convergence *c, const char *scene,
                      c->series[s].name, c->series[s].name[0] ? ": " : "",
                      pn, hi, lo);
         ts_plot_series ps = {m - first, x + first, y + first, labels[ns], 0,
-                             TS_PLOT_LINE_MARKERS, 0};
+                             TS_PLOT_LINE_MARKERS, 0, pl + first};
         ser[ns++] = ps;
     }
     int status = 0;
@@ -244,14 +255,15 @@ static int converge_plot(const ts_convergence *c, const char *scene,
                            &plot->opts, &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/error_time.png and %s/error_time.svg\n",
-                   plot->dir, plot->dir);
+            cli_plot_wrote(plot, "error_time");
     }
     free(idx);
     free(x);
     free(y);
     free(ser);
     free(labels);
+    free(ptext);
+    free(pl);
     return status;
 }
 

@@ -172,8 +172,7 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
         if (rc != TS_OK)
             status = cli_report(&err, rc);
         else
-            printf("wrote %s/%s.png and %s/%s.svg\n", plot->dir,
-                   view_name[v], plot->dir, view_name[v]);
+            cli_plot_wrote(plot, view_name[v]);
     }
     for (int i = 0; i < n; i++)
         cli_plot_shape_free(&shapes[i]);

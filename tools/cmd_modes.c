@@ -322,7 +322,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
             snprintf(label[s], sizeof label[s], "%d %s", nset[s],
                      s ? "unresolved (grid-scale, or beyond the accuracy)" : "resolved");
         ts_plot_series a = {nset[s], sre[s], sim[s], label[s], 0,
-                            TS_PLOT_MARKERS, s ? 2 : 1};
+                            TS_PLOT_MARKERS, s ? 2 : 1, NULL};
         set[nsets++] = a;
     }
     if (nsets > 0 &&
@@ -330,8 +330,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
                             NULL, &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else if (nsets > 0)
-        printf("wrote %s/eigenvalues.png and %s/eigenvalues.svg\n",
-               plot->dir, plot->dir);
+        cli_plot_wrote(plot, "eigenvalues");
     free(buf);
 
     /* The shapes: the lowest resolved oscillatory modes (the listing is
@@ -382,8 +381,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
                                 &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/modes.png and %s/modes.svg\n", plot->dir,
-                   plot->dir);
+            cli_plot_wrote(plot, "modes");
     }
     cli_plot_shape_free(&eqs);
     free(disp);

@@ -162,10 +162,17 @@ static void response_print(const cli_run *c, const ts_result *r)
 
 static int response_prepare(cli_run *c)
 {
+    if (c->plot.dir && c->rq.response.sea.sea && c->plot_optional)
+        c->plot.dir = NULL; /* there is no picture of it */
     if (c->plot.dir && c->rq.response.sea.sea) {
         fprintf(stderr, "towstab: error: response: --plot draws a Bode plot, "
                         "which a sea-state response has not; write its "
                         "spectra with --csv (or --json) instead\n");
+        return EXIT_BADINPUT;
+    }
+    if (c->nextra[0] && !c->plot.dir) {
+        fprintf(stderr, "towstab: error: response: --db sets the Bode "
+                        "plot's magnitude axis; add --plot DIR\n");
         return EXIT_BADINPUT;
     }
     /* The Bode plot marks the natural frequencies. */
@@ -211,14 +218,15 @@ static int response_draw(cli_run *c, const ts_result *r)
                                      TS_PLOT_SOLID, 0};
             int tension = res->output.kind == TS_OUT_TENSION;
             ts_err perr = {0};
+            ts_plot_opts po = plot->opts;
+            po.bode_db = c->nextra[0] > 0; /* --db */
             if (ts_plot_bode(plot->dir, "bode", title, mag_label,
                              tension ? TS_PLOT_FORCE : TS_PLOT_LENGTH,
                              TS_PLOT_LENGTH, 1, &bc, r->nnatural,
-                             r->natural_hz, &plot->opts, &perr) != TS_OK)
+                             r->natural_hz, &po, &perr) != TS_OK)
                 status = cli_report(&perr, perr.code);
             else
-                printf("wrote %s/bode.png and %s/bode.svg\n", plot->dir,
-                       plot->dir);
+                cli_plot_wrote(plot, "bode");
             free(ph);
         }
     }
@@ -227,7 +235,12 @@ static int response_draw(cli_run *c, const ts_result *r)
 
 static const char *const response_pictures[] = {"bode", NULL};
 
+static const cli_extra response_extras[] = {
+    {"db", 0, 0, NULL,
+     "the Bode plot's magnitude in dB (20 log10 |H|) with --plot"},
+    {NULL, 0, 0, NULL, NULL}};
+
 const cli_command cli_cmd_response = {
     "response", "frequency response to tow-point motion",
     TS_ANALYSIS_RESPONSE, NULL, response_prepare, response_print,
-    response_draw, NULL, response_pictures, NULL};
+    response_draw, NULL, response_pictures, response_extras};

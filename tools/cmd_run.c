@@ -49,13 +49,7 @@ static int run_main(int argc, char **argv)
         case 'u': plot_units = optarg; break;
         case 'q': quiet = 1; break;
         case 'h': usage(stdout); return 0;
-        case ':': return cli_option_error("run", ch, argv[optind - 1]);
-        default:
-            fprintf(stderr, "towstab: error: run: unknown option '%s'; the "
-                            "scene's analyses carry their own settings "
-                            "(towstab run --help)\n",
-                    argv[optind - 1]);
-            return EXIT_BADINPUT;
+        default: return cli_scene_option_error("run", ch, argv[optind - 1]);
         }
     }
     if (optind != argc - 1) {
@@ -78,7 +72,7 @@ static int run_main(int argc, char **argv)
         return status;
     cli_scene_runs s;
     status = cli_scene_prepare("run", scene, units, quiet, csv_dir,
-                               plot_dir, plot_units, &s);
+                               plot_dir, plot_units, 0, &s);
     if (status) {
         cli_close(units, scene);
         return status;

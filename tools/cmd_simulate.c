@@ -291,14 +291,14 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
         for (int i = 0; i < hn->nsamples; i++)
             xn[i] = ts_history_value(sys, hn, out, i);
         ts_plot_series a = {hn->nsamples, hn->t, xn, "nonlinear", np,
-                            TS_PLOT_SOLID, 1};
+                            TS_PLOT_SOLID, 1, NULL};
         ser[ns++] = a;
     }
     if (hl) {
         for (int i = 0; i < hl->nsamples; i++)
             xl[i] = ts_history_value(sys, hl, out, i);
         ts_plot_series a = {hl->nsamples, hl->t, xl, "linear", np,
-                            TS_PLOT_DASHED, 2};
+                            TS_PLOT_DASHED, 2, NULL};
         ser[ns++] = a;
     }
     np++;
@@ -323,7 +323,7 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
             snprintf(towlabel[k], sizeof towlabel[k], "%s",
                      ts_axis_name((ts_axis)ax));
             ts_plot_series a = {n, hf->t, d, towlabel[k], np, TS_PLOT_SOLID,
-                                3 + k};
+                                3 + k, NULL};
             ser[ns++] = a;
             k++;
         }
@@ -338,7 +338,7 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
         panels[np].label = "tow.force (top tension)";
         panels[np].quantity = TS_PLOT_FORCE;
         ts_plot_series a = {hn->nsamples, hn->t, tens, "nonlinear", np,
-                            TS_PLOT_SOLID, 1};
+                            TS_PLOT_SOLID, 1, NULL};
         ser[ns++] = a;
         np++;
     }
@@ -351,16 +351,99 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
                           &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else
-        printf("wrote %s/histories.png and %s/histories.svg\n", plot->dir,
-               plot->dir);
+        cli_plot_wrote(plot, "histories");
     free(buf);
     return status;
 }
 
 /* Snapshots of the cable every `interval` s from t = 0 (side and top
  * views, memo Figs. 9 and 11). */
+/* The plan view in the earth frame under a manoeuvre (plan_earth): the
+ * snapshots ps[nsnap] at samples idx[] and the ship's track, the path of
+ * M's origin. The heading psi(t) and speed V(t) come from the
+ * excitation (ts_excitation_heading, ts_excitation_frame); the track is
+ * integrated from V (cos psi, sin psi) by trapezoids over the samples
+ * (error O(dt^2) of the sample interval, far below a pixel); a node's
+ * earth position is the track's point plus R_z(psi) times its position
+ * in M. The ship starts at the origin heading +x. */
+static int plot_earth(const ts_system *sys, const ts_history *h,
+                      const ts_excitation *ex, const int *idx, int nsnap,
+                      const ts_plot_shape *ps, const char *title,
+                      const cli_plot *plot)
+{
+    int n = h->nsamples;
+    size_t nn = 3 * (size_t)h->nnodes;
+    double *track = malloc(3 * (size_t)n * sizeof *track);
+    double *psi = malloc((size_t)n * sizeof *psi);
+    double *pos = malloc((size_t)nsnap * nn * sizeof *pos);
+    ts_plot_shape *es = malloc(((size_t)nsnap + 1) * sizeof *es);
+    if (!track || !psi || !pos || !es) {
+        free(track);
+        free(psi);
+        free(pos);
+        free(es);
+        fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    ts_frame base = {sys->tow.speed, sys->tow.turn_rate, 0, 0, {0, 0, 0}};
+    double vprev = 0;
+    for (int i = 0; i < n; i++) {
+        ts_frame f;
+        ts_excitation_frame(ex, &base, h->t[i], &f);
+        psi[i] = ts_excitation_heading(ex, &base, h->t[i]);
+        double *p = track + 3 * (size_t)i;
+        p[2] = 0;
+        if (i == 0) {
+            p[0] = p[1] = 0;
+        } else {
+            double dt = h->t[i] - h->t[i - 1];
+            p[0] = p[-3] + 0.5 * dt * (vprev * cos(psi[i - 1]) +
+                                       f.speed * cos(psi[i]));
+            p[1] = p[-2] + 0.5 * dt * (vprev * sin(psi[i - 1]) +
+                                       f.speed * sin(psi[i]));
+        }
+        vprev = f.speed;
+    }
+    for (int k = 0; k < nsnap; k++) {
+        int i = idx[k];
+        double c = cos(psi[i]), s = sin(psi[i]);
+        const double *m = ps[k].pos;
+        double *e = pos + nn * (size_t)k;
+        for (int j = 0; j < h->nnodes; j++) {
+            const double *r = m + 3 * j;
+            e[3 * j] = track[3 * i] + c * r[0] - s * r[1];
+            e[3 * j + 1] = track[3 * i + 1] + s * r[0] + c * r[1];
+            e[3 * j + 2] = r[2];
+        }
+        es[k] = ps[k];
+        es[k].pos = e;
+        es[k].turn_radius = 0;
+    }
+    ts_plot_shape tr = {0};
+    tr.nnodes = n;
+    tr.pos = track;
+    tr.label = "ship's track";
+    tr.style = TS_PLOT_DASHED;
+    tr.color = nsnap + 1;
+    es[nsnap] = tr;
+    ts_err err = {0};
+    int status = 0;
+    if (ts_plot_shapes(plot->dir, "plan_earth", title, TS_PLOT_TOP, 0,
+                       nsnap + 1, es, &plot->opts, &err) != TS_OK)
+        status = cli_report(&err, err.code);
+    else
+        printf("wrote %s/plan_earth.png and %s/plan_earth.svg\n", plot->dir,
+               plot->dir);
+    free(track);
+    free(psi);
+    free(pos);
+    free(es);
+    return status;
+}
+
 static int plot_snapshots(const ts_system *sys, const ts_history *h,
-                          double interval, const cli_plot *plot)
+                          const ts_excitation *ex, double interval,
+                          double exaggerate, const cli_plot *plot)
 {
     double t_end = h->t[h->nsamples - 1];
     int nsnap = 0;
@@ -376,10 +459,26 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
     }
     cli_shape shapes[MAX_SNAPSHOTS];
     ts_plot_shape ps[MAX_SNAPSHOTS];
+    /* Exaggerated: the first sample plus K times the displacement from
+     * it. */
+    size_t nn = 3 * (size_t)h->nnodes;
+    double *xs = exaggerate != 1.0
+                     ? malloc((size_t)nsnap * nn * sizeof *xs)
+                     : NULL;
     int status = 0, made = 0;
+    if (exaggerate != 1.0 && !xs) {
+        fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
+        status = EXIT_FAILED;
+    }
     for (int k = 0; k < nsnap && !status; k++) {
-        const double *pos = h->positions +
-                            3 * (size_t)h->nnodes * (size_t)idx[k];
+        const double *pos = h->positions + nn * (size_t)idx[k];
+        if (xs) {
+            double *e = xs + nn * (size_t)k;
+            for (size_t j = 0; j < nn; j++)
+                e[j] = h->positions[j] +
+                       exaggerate * (pos[j] - h->positions[j]);
+            pos = e;
+        }
         if (cli_plot_shape(sys, pos, &shapes[k]) != 0) {
             fprintf(stderr,
                     "towstab: error: simulate: --plot: out of memory\n");
@@ -396,9 +495,12 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
     static const char *const names[2] = {"snapshots_side", "snapshots_top"};
     static const char *const views[2] = {"side view", "top view"};
     for (int v = 0; v < 2 && !status; v++) {
-        char title[256];
-        snprintf(title, sizeof title, "%s: cable every %.4g s, %s",
-                 sys->name, interval, views[v]);
+        char title[256], ext[96] = "";
+        if (exaggerate != 1.0)
+            snprintf(ext, sizeof ext, ", displacements from t = %.4g s "
+                     "x %.4g", h->t[0], exaggerate);
+        snprintf(title, sizeof title, "%s: cable every %.4g s%s, %s",
+                 sys->name, interval, ext, views[v]);
         ts_err err = {0};
         if (ts_plot_shapes(plot->dir, names[v], title,
                            v == 0 ? TS_PLOT_SIDE : TS_PLOT_TOP,
@@ -406,29 +508,39 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
                            &err) != TS_OK)
             status = cli_report(&err, err.code);
         else
-            printf("wrote %s/%s.png and %s/%s.svg\n", plot->dir, names[v],
-                   plot->dir, names[v]);
+            cli_plot_wrote(plot, names[v]);
+    }
+    if (!status && ex && ts_excitation_has_manoeuvre(ex)) {
+        char title[256];
+        snprintf(title, sizeof title, "%s: manoeuvre in the earth frame, "
+                 "cable every %.4g s%s and the ship's track", sys->name,
+                 interval, exaggerate != 1.0 ? " (exaggerated)" : "");
+        status = plot_earth(sys, h, ex, idx, nsnap, ps, title, plot);
     }
     for (int k = 0; k < made; k++)
         cli_plot_shape_free(&shapes[k]);
+    free(xs);
     return status;
 }
 
 /* What --plot draws with: the interval of the snapshots (s). */
 typedef struct sim_state {
     double snapshot;
+    double exaggerate; /* --exaggerate: the snapshots' displacement scale */
 } sim_state;
 
-enum { X_SNAPSHOT };
+enum { X_SNAPSHOT, X_EXAGGERATE };
 
 static int sim_prepare(cli_run *c)
 {
     const char *text = c->nextra[X_SNAPSHOT] ? c->extra[X_SNAPSHOT][0]
                                              : NULL;
-    if (text && !c->plot.dir) {
-        fprintf(stderr, "towstab: error: simulate: --snapshot-interval sets "
-                        "the snapshots of the --plot pictures; add --plot "
-                        "DIR\n");
+    const char *xtext = c->nextra[X_EXAGGERATE] ? c->extra[X_EXAGGERATE][0]
+                                                : NULL;
+    if ((text || xtext) && !c->plot.dir) {
+        fprintf(stderr, "towstab: error: simulate: %s sets the snapshots of "
+                        "the --plot pictures; add --plot DIR\n",
+                text ? "--snapshot-interval" : "--exaggerate");
         return EXIT_BADINPUT;
     }
     if (!c->plot.dir)
@@ -439,6 +551,18 @@ static int sim_prepare(cli_run *c)
         return EXIT_FAILED;
     }
     c->state = st;
+    st->exaggerate = 1.0;
+    if (xtext) {
+        char *end;
+        double k = strtod(xtext, &end);
+        if (end == xtext || *end || !(k >= 1) || !(k <= 1e6)) {
+            fprintf(stderr, "towstab: error: simulate: --exaggerate: "
+                            "expected a factor from 1 to 1e6, got '%s'\n",
+                    xtext);
+            return EXIT_BADINPUT;
+        }
+        st->exaggerate = k;
+    }
     ts_err err = {0};
     if (text &&
         (ts_units_parse(c->units, text, "s", "--snapshot-interval",
@@ -608,7 +732,8 @@ static int sim_draw(cli_run *c, const ts_result *r)
     int status = plot_histories(r->sys, &r->output, r->excitation,
                                 r->nonlinear, r->linear, &c->plot);
     if (!status)
-        status = plot_snapshots(r->sys, h, st->snapshot, &c->plot);
+        status = plot_snapshots(r->sys, h, r->excitation, st->snapshot,
+                                st->exaggerate, &c->plot);
     return status;
 }
 
@@ -621,10 +746,14 @@ static void sim_release(cli_run *c)
 static const cli_extra sim_extras[] = {
     {"snapshot-interval", 1, 0, "T",
      "time between the snapshots of --plot (default t_end/10)"},
+    {"exaggerate", 1, 0, "K",
+     "the snapshots show the first sample plus K times the displacement "
+     "from it (default 1)"},
     {NULL, 0, 0, NULL, NULL}};
 
 static const char *const sim_pictures[] = {"histories", "snapshots_side",
-                                           "snapshots_top", NULL};
+                                           "snapshots_top", "plan_earth",
+                                           NULL};
 
 const cli_command cli_cmd_simulate = {
     "simulate", "nonlinear and linear time-domain simulation, comparison",

@@ -17,6 +17,7 @@ extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
 extern const cli_command cli_cmd_modes, cli_cmd_response;
 extern const cli_command cli_cmd_simulate;
 extern const cli_command cli_cmd_converge;
+extern const cli_command cli_cmd_report;
 
 /* `towstab options`: every analysis' option table as markdown, the
  * reference of doc/manual.md. */
@@ -39,6 +40,7 @@ const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
                                            &cli_cmd_simulate,
                                            &cli_cmd_converge,
+                                           &cli_cmd_report,
                                            &cli_cmd_options, NULL};
 
 static void usage(FILE *f)
@@ -86,7 +88,7 @@ int main(int argc, char **argv)
         return cli_finish(0);
     }
     if (strcmp(argv[1], "--version") == 0) {
-        printf("towstab 0.1.0\n");
+        printf("towstab " TOWSTAB_VERSION "\n");
         return cli_finish(0);
     }
     cli_signals_install();

@@ -158,6 +158,34 @@ TS_API int ts_optset_give_entry(ts_optset *s, const ts_scene_analysis *a,
                                 int index, const char *file, int priority,
                                 int section, ts_err *err);
 
+/* The scene's options for the set: its entry analyses[index] (of the
+ * set's kind), or with index -1 the scene's first entry of the set's
+ * kind when it has one, at TS_OPTSET_SCENE; and for a convergence study
+ * of a simulation (its `analysis` given as "simulate" by then) the
+ * scene's first simulate entry's simulation settings at
+ * TS_OPTSET_RELATED. So `towstab KIND SCENE` and a binding take a scene's
+ * options alike (doc/manual.md, "Options"). TS_OK, or TS_ESCENE/TS_EINVAL
+ * naming the entry's option, TS_EINVAL for an index out of range or of
+ * another kind. */
+TS_API int ts_optset_give_scene(ts_optset *s, const ts_scene *scene,
+                                int index, ts_err *err);
+
+/* Longest text of the notes of ts_optset_request. */
+#define TS_OPTSET_NOTES_MAX 2048
+
+/* The request of the set, checked against sys (ts_request_init of the
+ * set's kind, ts_optset_apply of every source, ts_analysis_check): a
+ * value of a lower source with TS_OPT_YIELD (a scene's transient or
+ * sample) that the higher source's values contradict, and that holds
+ * without them, is dropped so that its default is used; the located
+ * message that made it yield is added to `notes` (size bytes, may be
+ * NULL; one line each, cut to fit). Any other failure is returned with
+ * its message located (ts_optset_locate). On TS_OK rq holds the request
+ * (release with ts_request_clear); on failure rq is cleared. */
+TS_API int ts_optset_request(ts_optset *s, const ts_system *sys,
+                             const ts_units *u, ts_request *rq, char *notes,
+                             size_t size, ts_err *err);
+
 /* The winning text of option `name` (the first, for a repeatable one),
  * or NULL when it was not given. */
 TS_API const char *ts_optset_text(const ts_optset *s, const char *name);

@@ -84,6 +84,9 @@ typedef struct ts_plot_opts {
                               instead of `units`; the caller keeps it */
     int width, height;    /* default 1000 x 700; each in [MIN, MAX_SIZE] */
     int formats;          /* default TS_PLOT_PNG | TS_PLOT_SVG */
+    int bode_db;          /* ts_plot_bode: the magnitude in dB, 20 log10
+                             |H| on a linear axis, instead of |H| on a log
+                             axis; default 0 */
 } ts_plot_opts;
 
 /* Line styles. */
@@ -112,7 +115,19 @@ typedef struct ts_plot_series {
     int style;          /* TS_PLOT_SOLID, ... */
     int color;          /* 0: automatic (next colour); k >= 1: colour k of
                            the palette, modulo its size */
+    const char *const *point_labels; /* ts_plot_loglog: [n] a text beside
+                           each point (NULL entries: none), or NULL */
 } ts_plot_series;
+
+/* A cylinder towfish of a shape: centred on its node, its axis along the
+ * link that ends there (doc/model.md section 1). Drawn as its outline,
+ * filled in the shape's colour, at least 3 % of the picture's extent long
+ * with its proportions kept (a towfish is small beside its cable). */
+typedef struct ts_plot_cylinder {
+    int node;         /* >= 1: a node below a link */
+    double length;    /* m, > 0 */
+    double diameter;  /* m, > 0 */
+} ts_plot_cylinder;
 
 /* A cable shape: nodes and the links between them, in the mean ship
  * frame M (x forward, y starboard, z down = depth; the water surface is
@@ -133,6 +148,8 @@ typedef struct ts_plot_shape {
     int style;               /* TS_PLOT_SOLID or TS_PLOT_DASHED (under
                                 water; parts in air are always dashed) */
     int color;               /* as ts_plot_series */
+    int ncylinders;          /* cylinder towfish to draw */
+    const ts_plot_cylinder *cylinders; /* [ncylinders] */
 } ts_plot_shape;
 
 /* Views of ts_plot_shapes. */

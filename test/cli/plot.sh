@@ -205,5 +205,34 @@ ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,fr
 check "simulate --snapshot-interval 0.01 s on a 2 s run (too many): exit 2 (got $status)" \
     bash -c "[ $status -eq 2 ] && grep -q snapshot-interval '$T/err'"
 
+# Pictures of issue 15: exaggerated snapshots, the Bode magnitude in dB,
+# a cylinder towfish drawn, error-vs-time points labelled.
+ts simulate "$EX4" --quiet --t-end 2 --transient 1 --excite tow.heave:amplitude=0.01ft,frequency=1Hz \
+    --plot "$T/ex" --exaggerate 50
+check "simulate --exaggerate 50: snapshots titled with the factor" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_svg '$T/ex/snapshots_side.svg' 'kamman_ex4: cable every 0.2 s, displacements from t = 0 s x 50, side view'"
+for k in 0.5 abc; do
+    ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz \
+        --plot "$T/exbad" --exaggerate $k
+    check "simulate --exaggerate $k: exit 2 naming it (got $status)" \
+        bash -c "[ $status -eq 2 ] && grep -q -- --exaggerate '$T/err'"
+done
+ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,frequency=1Hz --exaggerate 5
+check "simulate --exaggerate without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+ts simulate examples/kamman_ex1_submerged.yaml --quiet --t-end 20 \
+    --manoeuvre turn_rate:to=0.1rad/s,duration=5s --plot "$T/man"
+check "simulate under a manoeuvre: the earth-frame plan view with the ship's track (exit $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/man/plan_earth.png' 1000 700 && is_svg '$T/man/plan_earth.svg' \"kamman_ex1_submerged: manoeuvre in the earth frame, cable every 2 s and the ship's track\""
+check "simulate without a manoeuvre draws no plan_earth" \
+    bash -c "[ ! -e '$T/sim/plan_earth.png' ]"
+ts response "$EX1" --output sphere.z --quiet --plot "$T/db" --db
+check "response --db: the Bode plot drawn (exit $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/db/bode.png' 1000 700"
+ts response "$EX1" --output sphere.z --quiet --db
+check "response --db without --plot: exit 2 (got $status)" [ $status -eq 2 ]
+ts equilibrium examples/two_part_tow.yaml --quiet --plot "$T/cyl"
+check "equilibrium of the two-part tow (a cylinder towfish) --plot: exit 0 (got $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/cyl/side.png' 1000 700"
+
 echo "$npass passed, $nfail failed"
 [ $nfail -eq 0 ]

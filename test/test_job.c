@@ -1,0 +1,187 @@
+/* test_job.c: one analysis of a scene as one handle (towstab/job.h).
+ *
+ *  1. Refusals: an unknown analysis, an entry of another kind or out of
+ *     range, an option the analysis does not have (named), a value out of
+ *     range (named, nothing runs, no result), a second run, an option
+ *     after the run; ts_job_json without a result.
+ *  2. Options by name over the scene's entry: the scene's t_end is taken,
+ *     an option given overrides it (the histories end there), and both
+ *     the scene key and the command-line spelling are accepted.
+ *  3. The JSON text parses and its top tension is the result's key value
+ *     to the last digit (17 significant digits, read back exactly).
+ *  4. Arrays without a copy: the nonlinear run's t, positions, tensions,
+ *     tow force, energy and input are the history's own memory, with its
+ *     shape; the linear run's tensions are finite and start at the
+ *     nonlinear run's (both from the equilibrium), its tow force NaN;
+ *     unknown names give NULL and 0 x 0.
+ *  5. A simulation that fails (h_min above the step it needs) returns its
+ *     code and keeps the partial history, its error in the JSON.
+ */
+#include "towstab/job.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <string.h>
+
+#include "tcheck.h"
+#include "towstab/kernel.h"
+
+static const char scene_text[] =
+    "name: job\n"
+    "tow: {speed: 2}\n"
+    "cables:\n"
+    "  - {name: c, from: tow, to: ball, length: 20, diameter: 0.01,\n"
+    "     mass_per_length: 0.2, links: 8}\n"
+    "bodies:\n"
+    "  - {name: ball, type: sphere, diameter: 0.3, mass: 30}\n"
+    "analyses:\n"
+    "  - equilibrium\n"
+    "  - {type: simulate, t_end: 1 s,\n"
+    "     excite: \"tow.heave:amplitude=0.1,frequency=1Hz\"}\n";
+
+int main(void)
+{
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    ts_scene *sc = u ? ts_scene_parse(scene_text, strlen(scene_text),
+                                      "job.yaml", u, &err)
+                     : NULL;
+    if (!CHECK(sc != NULL, "the scene reads: %s", err.msg))
+        return tc_done();
+
+    /* 1. Refusals. */
+    ts_err_clear(&err);
+    CHECK(!ts_job_alloc(sc, u, "bode", -1, &err) && err.code == TS_EINVAL &&
+              strstr(err.msg, "'bode'"),
+          "an unknown analysis is refused by name: %s", err.msg);
+    ts_err_clear(&err);
+    CHECK(!ts_job_alloc(sc, u, "modes", 1, &err) && err.code == TS_EINVAL &&
+              strstr(err.msg, "analyses[1]"),
+          "an entry of another kind is refused: %s", err.msg);
+    ts_err_clear(&err);
+    CHECK(!ts_job_alloc(sc, u, "modes", 7, &err) &&
+              strstr(err.msg, "no such entry"),
+          "an entry out of range is refused: %s", err.msg);
+    ts_job *j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_err_clear(&err);
+    CHECK(j && ts_job_give(j, "t_edn", "2", &err) == TS_EINVAL &&
+              strstr(err.msg, "t_edn"),
+          "an unknown option is refused by name: %s", err.msg);
+    ts_err_clear(&err);
+    CHECK(ts_job_json(j, 0, &err) == NULL && err.code == TS_EINVAL,
+          "no JSON before the run: %s", err.msg);
+    ts_job_give(j, "t_end", "-1", &err);
+    ts_err_clear(&err);
+    int rc = ts_job_run(j, &err);
+    CHECK(rc == TS_EINVAL && !strncmp(err.msg, "t_end: ", 7) &&
+              ts_job_result(j) == NULL,
+          "a value out of range: nothing runs, the option named: %s",
+          err.msg);
+    ts_err_clear(&err);
+    CHECK(ts_job_run(j, &err) == TS_EINVAL &&
+              ts_job_give(j, "t_end", "1", &err) == TS_EINVAL,
+          "a job runs once, and takes no option after");
+    ts_job_free(j);
+
+    /* 2.-4. Options over the scene's entry; JSON; arrays. */
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    rc = ts_job_run(j, &err);
+    const ts_result *r = ts_job_result(j);
+    CHECK(rc == TS_OK && r && r->nonlinear &&
+              fabs(r->nonlinear->t[r->nonlinear->nsamples - 1] - 1.0) < 1e-12,
+          "the scene's entry (t_end 1 s) is taken: %s", err.msg);
+    ts_job_free(j);
+    j = ts_job_alloc(sc, u, "simulate", 1, &err);
+    ts_err_clear(&err);
+    CHECK(ts_job_give(j, "t-end", "3 s", &err) == TS_OK &&
+              ts_job_give(j, "compare", "true", &err) == TS_OK,
+          "the command-line spelling and the scene key are taken");
+    rc = ts_job_run(j, &err);
+    r = ts_job_result(j);
+    const ts_history *h = r ? r->nonlinear : NULL;
+    CHECK(rc == TS_OK && h && fabs(h->t[h->nsamples - 1] - 3.0) < 1e-12 &&
+              r->linear,
+          "an option given overrides the scene's (t_end 3 s): %s",
+          err.msg);
+    CHECK(ts_job_notes(j) && ts_job_notes(j)[0] == '\0', "no notes");
+
+    const char *text = ts_job_json(j, 0, &err);
+    json_t *doc = text ? json_loads(text, 0, NULL) : NULL;
+    const ts_value *v = r ? ts_result_value(r, "tension.max") : NULL;
+    double jv = NAN;
+    size_t i;
+    json_t *kv;
+    json_array_foreach(json_object_get(doc, "key_values"), i, kv)
+    {
+        if (!strcmp(json_string_value(json_object_get(kv, "name")),
+                    "tension.max"))
+            jv = json_number_value(json_object_get(kv, "value"));
+    }
+    CHECK(doc && v && jv == v->value,
+          "the JSON's tension.max is the result's to the last digit (%.17g)",
+          jv);
+    json_decref(doc);
+
+    if (h) {
+        int rows, cols;
+        const double *a = ts_job_array(j, "nonlinear.t", &rows, &cols);
+        CHECK(a == h->t && rows == h->nsamples && cols == 1,
+              "nonlinear.t is the history's own, %d x %d", rows, cols);
+        a = ts_job_array(j, "nonlinear.positions", &rows, &cols);
+        CHECK(a == h->positions && rows == h->nsamples &&
+                  cols == 3 * h->nnodes,
+              "nonlinear.positions: %d x %d (3 x %d nodes)", rows, cols,
+              h->nnodes);
+        a = ts_job_array(j, "nonlinear.tensions", &rows, &cols);
+        CHECK(a == h->tensions && cols == h->nlinks && cols == 8 &&
+                  a[0] > 0,
+              "nonlinear.tensions: %d links, %.6g N at t = 0", cols, a[0]);
+        a = ts_job_array(j, "nonlinear.energy", &rows, &cols);
+        CHECK(a == h->energy && cols == 2, "nonlinear.energy: 2 columns");
+        a = ts_job_array(j, "nonlinear.input", &rows, &cols);
+        CHECK(a == h->input && cols == TS_NINPUT, "nonlinear.input: %d",
+              cols);
+        const double *tn = h->tensions;
+        a = ts_job_array(j, "linear.tensions", &rows, &cols);
+        int finite = a && rows == r->linear->nsamples && cols == 8;
+        for (int k = 0; finite && k < rows * cols; k++)
+            finite = isfinite(a[k]);
+        CHECK(finite && fabs(a[0] - tn[0]) <= 1e-9 * tn[0],
+              "linear.tensions: finite (the tension Jacobians), the first "
+              "link's at t = 0 the nonlinear run's (%.12g, %.12g N)",
+              a ? a[0] : NAN, tn[0]);
+        a = ts_job_array(j, "nonlinear.tow_force", &rows, &cols);
+        CHECK(a == h->tow_force && cols == 3 && a[0] < 0,
+              "nonlinear.tow_force: 3 columns, drag aft (%.6g N)", a[0]);
+        a = ts_job_array(j, "linear.tow_force", &rows, &cols);
+        CHECK(a && cols == 3 && isnan(a[0]), "linear.tow_force: NaN");
+        const char *bad[] = {"nonlinear.speed", "lin.t", "nonlinear",
+                             "nonlinear.", "t"};
+        int none = 1;
+        for (int k = 0; k < 5; k++)
+            none &= !ts_job_array(j, bad[k], &rows, &cols) && rows == 0 &&
+                    cols == 0;
+        CHECK(none, "unknown array names: NULL, 0 x 0");
+    }
+    ts_job_free(j);
+
+    /* 5. A failing run keeps what it computed. */
+    j = ts_job_alloc(sc, u, "simulate", -1, &err);
+    ts_job_give(j, "h_min", "0.5 s", &err);
+    ts_job_give(j, "initial", "released", &err);
+    ts_err_clear(&err);
+    rc = ts_job_run(j, &err);
+    r = ts_job_result(j);
+    text = ts_job_json(j, 0, NULL);
+    CHECK(rc == TS_EINTEGRATOR && r && !r->completed && r->nonlinear &&
+              r->nonlinear->nsamples > 0 && text &&
+              strstr(text, "\"completed\": false") && strstr(text, "h_min"),
+          "a failed run: code %d, its history and error kept: %s", rc,
+          err.msg);
+    ts_job_free(j);
+    ts_job_free(NULL);
+
+    ts_scene_free(sc);
+    ts_units_free(u);
+    return tc_done();
+}
