@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "towstab/eigen.h"
 #include "towstab/kernel.h"
+#include "towstab/linearize.h"
 #include "towstab/options.h"
 #include "towstab/report_result.h"
 
@@ -165,6 +167,39 @@ const double *ts_job_array(const ts_job *j, const char *name, int *rows,
         if (!strcmp(part, parts[i].name) && parts[i].data &&
             parts[i].cols > 0) {
             *rows = h->nsamples;
+            *cols = parts[i].cols;
+            return parts[i].data;
+        }
+    return NULL;
+}
+
+const double *ts_job_matrix(const ts_job *j, const char *name, int *rows,
+                            int *cols)
+{
+    *rows = *cols = 0;
+    const ts_result *r = j->result;
+    if (!r || !name)
+        return NULL;
+    const ts_linear *lin = r->lin;
+    const ts_eigen *e = r->eigen;
+    const struct {
+        const char *name;
+        const double *data;
+        int rows, cols;
+    } parts[] = {
+        {"A", lin ? lin->A : NULL, lin ? lin->nstate : 0,
+         lin ? lin->nstate : 0},
+        {"B", lin ? lin->B : NULL, lin ? lin->nstate : 0,
+         lin ? lin->ninput : 0},
+        {"vectors_re", e ? e->vec_re : NULL, e ? e->nstate : 0,
+         e ? e->nmodes : 0},
+        {"vectors_im", e ? e->vec_im : NULL, e ? e->nstate : 0,
+         e ? e->nmodes : 0},
+    };
+    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++)
+        if (!strcmp(name, parts[i].name) && parts[i].data &&
+            parts[i].rows > 0 && parts[i].cols > 0) {
+            *rows = parts[i].rows;
             *cols = parts[i].cols;
             return parts[i].data;
         }

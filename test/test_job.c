@@ -165,6 +165,29 @@ int main(void)
     }
     ts_job_free(j);
 
+    /* Matrices without a copy: A, B and the eigenvectors of modes. */
+    j = ts_job_alloc(sc, u, "modes", -1, &err);
+    rc = j ? ts_job_run(j, &err) : -1;
+    r = j ? ts_job_result(j) : NULL;
+    if (CHECK(rc == TS_OK && r && r->lin && r->eigen, "modes run: %s",
+              err.msg)) {
+        int rows, cols, n = r->lin->nstate;
+        const double *a = ts_job_matrix(j, "A", &rows, &cols);
+        CHECK(a == r->lin->A && rows == n && cols == n, "A: %d x %d", rows,
+              cols);
+        a = ts_job_matrix(j, "B", &rows, &cols);
+        CHECK(a == r->lin->B && rows == n && cols == r->lin->ninput,
+              "B: %d x %d", rows, cols);
+        a = ts_job_matrix(j, "vectors_im", &rows, &cols);
+        CHECK(a == r->eigen->vec_im && rows == n &&
+                  cols == r->eigen->nmodes,
+              "vectors_im: %d x %d", rows, cols);
+        CHECK(!ts_job_matrix(j, "C", &rows, &cols) && rows == 0 &&
+                  !ts_job_array(j, "A", &rows, &cols),
+              "unknown matrices: NULL");
+    }
+    ts_job_free(j);
+
     /* 5. A failing run keeps what it computed. */
     j = ts_job_alloc(sc, u, "simulate", -1, &err);
     ts_job_give(j, "h_min", "0.5 s", &err);

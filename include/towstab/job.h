@@ -7,7 +7,8 @@
  * pipeline (towstab/analysis.h) and keeps the request and the result
  * together (a result may point into its request). The result is read as
  * the JSON text the command line writes (towstab/report_result.h) and,
- * without a copy, as the arrays of its time histories.
+ * without a copy, as the arrays of its time histories, its linear model
+ * and its eigenvectors.
  *
  *     ts_job *j = ts_job_alloc(scene, units, "modes", -1, &err);
  *     ts_job_give(j, "count", "6", &err);
@@ -77,6 +78,16 @@ TS_API const char *ts_job_json(ts_job *j, int flags, ts_err *err);
  * not hold. */
 TS_API const double *ts_job_array(const ts_job *j, const char *name,
                                   int *rows, int *cols);
+
+/* A matrix of the result, not copied (valid until ts_job_free), stored
+ * column-major (LAPACK's order) with *rows rows of *cols: "A" ([n][n],
+ * the linear model's state matrix) and "B" ([n][ninput]) of the dense
+ * model (towstab/linearize.h; absent when only the sparse model was
+ * formed), "vectors_re" and "vectors_im" ([n][modes], column m the right
+ * eigenvector of mode m, unit 2-norm; towstab/eigen.h). NULL (rows and
+ * cols 0) for a name the result does not hold. */
+TS_API const double *ts_job_matrix(const ts_job *j, const char *name,
+                                   int *rows, int *cols);
 
 #ifdef __cplusplus
 }

@@ -83,6 +83,8 @@ def _bind(lib):
         "ts_job_json": (S, [P, I, E]),
         "ts_job_array": (ctypes.POINTER(ctypes.c_double),
                          [P, S, ctypes.POINTER(I), ctypes.POINTER(I)]),
+        "ts_job_matrix": (ctypes.POINTER(ctypes.c_double),
+                          [P, S, ctypes.POINTER(I), ctypes.POINTER(I)]),
     }
     for name, (res, args) in sig.items():
         f = getattr(lib, name)
@@ -290,17 +292,23 @@ class _Job:
             library.ts_job_free(self.ptr)
             self.ptr = None
 
-    def array(self, name):
+    def array(self, name, column_major=False):
+        """A view of the library's array `name` (ts_job_array, or with
+        column_major ts_job_matrix); None when the result has none."""
+        get = library.ts_job_matrix if column_major else library.ts_job_array
         rows, cols = ctypes.c_int(), ctypes.c_int()
-        p = library.ts_job_array(self.ptr, name.encode(), ctypes.byref(rows),
-                                 ctypes.byref(cols))
+        p = get(self.ptr, name.encode(), ctypes.byref(rows),
+                ctypes.byref(cols))
         if not p:
             return None
         n = rows.value * cols.value
         buf = (ctypes.c_double * n).from_address(ctypes.addressof(p.contents))
         buf._job = self  # the array's base holds the job, and so the data
-        a = np.frombuffer(buf, dtype=np.float64).reshape(rows.value,
-                                                         cols.value)
+        a = np.frombuffer(buf, dtype=np.float64)
+        if column_major:
+            a = a.reshape(cols.value, rows.value).T
+        else:
+            a = a.reshape(rows.value, cols.value)
         a.flags.writeable = False
         return a
 
@@ -483,6 +491,21 @@ class Result(Record):
         solver), nan when not estimated."""
         k = self._key(name)
         return k.discretisation, k.solver
+
+    def matrix(self, name):
+        """A matrix of the linear model or the modes, a view of the
+        library's (read-only, no copy, column-major): "A" [n, n] and "B"
+        [n, inputs] of the dense linear model, "vectors_re" and
+        "vectors_im" [n, modes] (column m the right eigenvector of mode m,
+        the order of ``modes``); None when the result has none."""
+        return self._job.array(name, column_major=True)
+
+    def eigenvectors(self):
+        """The right eigenvectors as one complex array [n, modes] (a copy
+        made of ``matrix("vectors_re")`` and ``"vectors_im"``); None
+        without them."""
+        re, im = self.matrix("vectors_re"), self.matrix("vectors_im")
+        return None if re is None or im is None else re + 1j * im
 
     def history(self, run="nonlinear"):
         """A simulation's ``nonlinear`` or ``linear`` run as arrays, not

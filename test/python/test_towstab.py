@@ -249,3 +249,28 @@ def test_scene_value_yields_as_on_the_command_line(scene, tmp_path):
     ref = cli(tmp_path, "simulate", ALL, "--t-end", "4 s")
     assert strip(r.json) == strip(ref)
     assert scene.simulate().request_notes == ""
+
+
+def test_matrices_without_copy(scene, tmp_path):
+    m = scene.modes(count=6, matrices=True)
+    ref = cli(tmp_path, "modes", ALL, "--count", "6", "--matrices")
+    assert strip(m.json) == strip(ref)
+    A, B = m.matrix("A"), m.matrix("B")
+    # Views of the library's column-major arrays, read-only.
+    for a in (A, B, m.matrix("vectors_re")):
+        assert a.flags.f_contiguous and not a.flags.owndata
+        assert not a.flags.writeable
+    # The JSON's A and B (rows) to the last digit.
+    assert np.array_equal(A, np.array(ref["linearization"]["A"]))
+    assert np.array_equal(B, np.array(ref["linearization"]["B"]))
+    # Each eigenvector with its eigenvalue: A v = lambda v, to 1e-9 of
+    # |lambda| (LAPACK's residuals are near rounding, ~1e-12; the error
+    # bounds, ~1e-8, are larger).
+    V = m.eigenvectors()
+    lam = m.modes.re + 1j * m.modes.im
+    assert V.shape == (A.shape[0], len(lam))
+    for k in range(len(lam)):
+        v = V[:, k]
+        assert abs(np.linalg.norm(v) - 1) < 1e-12
+        assert np.linalg.norm(A @ v - lam[k] * v) <= 1e-9 * abs(lam[k])
+    assert scene.equilibrium().matrix("A") is None
