@@ -114,6 +114,7 @@ void ts_request_init(ts_request *rq, ts_analysis_kind kind)
                                      kind != TS_ANALYSIS_CONVERGE;
     ts_eigen_opts_default(&rq->modes.eigen);
     rq->modes.follow = TS_MODES_FOLLOW;
+    rq->modes.margins = 1;
     ts_linearize_opts_default(&rq->modes.linearize);
     snprintf(rq->response.input, sizeof rq->response.input, "tow.heave");
     rq->response.from_hz = TS_RESPONSE_FROM_HZ;
@@ -268,6 +269,7 @@ void ts_result_free(ts_result *r)
     ts_linear_free(r->lin);
     ts_eigen_free(r->eigen);
     free(r->mode_health);
+    free(r->margins);
     free(r->mode_accuracy);
     ts_response_free(r->response);
     ts_seastate_free(r->seastate);
@@ -437,21 +439,28 @@ static int run_equilibrium(ts_result *r, ts_kernel *k,
 }
 
 /* Linearize about r->eq with a fresh kernel re-charted from its
- * directions. An equilibrium that did not converge is not linearized. */
+ * directions; with open_loop, the vehicles' loops open at the trim
+ * (towstab/control.h). An equilibrium that did not converge is not
+ * linearized. */
 static int run_linearize(ts_result *r, const ts_linearize_opts *lo,
-                         ts_err *err)
+                         int open_loop, ts_err *err)
 {
     ts_kernel *k = ts_kernel_alloc(r->sys, err);
     if (!k)
         return err && err->code ? err->code : TS_ENOMEM;
-    r->lin = ts_linear_alloc(k, err);
-    int rc = r->lin ? TS_OK : (err && err->code ? err->code : TS_ENOMEM);
-    if (rc == TS_OK) {
-        double t0 = wall_now();
-        rc = ts_linearize_equilibrium(k, r->eq, lo, r->lin, err);
-        r->lin_wall_s = wall_now() - t0;
-        r->evaluations += r->lin->evaluations;
+    int rc = TS_OK;
+    double t0 = wall_now();
+    if (open_loop && ts_control_nloops(k) > 0) {
+        r->open_loop = 1;
+        rc = ts_linearize_open_loop(k, r->eq, lo, &r->lin, err);
+    } else {
+        r->lin = ts_linear_alloc(k, err);
+        rc = r->lin ? ts_linearize_equilibrium(k, r->eq, lo, r->lin, err)
+                    : (err && err->code ? err->code : TS_ENOMEM);
     }
+    r->lin_wall_s = wall_now() - t0;
+    if (r->lin)
+        r->evaluations += r->lin->evaluations;
     ts_kernel_free(k);
     if (rc != TS_OK) {
         ts_linear_free(r->lin);
@@ -475,7 +484,7 @@ static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
         return rc;
     }
     ts_trust_merge(&r->trust, "equilibrium: ", &r->eq_trust);
-    return run_linearize(r, lo, err);
+    return run_linearize(r, lo, rq->setup.open_loop, err);
 }
 
 static int pipeline_equilibrium(ts_result *r, const ts_request *rq,
@@ -694,6 +703,31 @@ static int modes_values(ts_result *r, int follow, ts_err *err)
     return TS_OK;
 }
 
+/* The gain and phase margins of every loop (none without loops). */
+static int modes_margins(ts_result *r, ts_err *err)
+{
+    ts_kernel *k = ts_kernel_alloc(r->sys, err);
+    if (!k)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int nl = ts_control_nloops(k), rc = TS_OK;
+    if (nl > 0) {
+        r->margins = calloc((size_t)nl, sizeof *r->margins);
+        if (!r->margins)
+            rc = ts_fail(err, TS_ENOMEM, "margins: out of memory");
+        double decades = log10(TS_MARGINS_TO_HZ / TS_MARGINS_FROM_HZ);
+        int points = (int)ceil(decades * TS_MARGINS_PER_DECADE) + 1;
+        double t0 = wall_now();
+        if (rc == TS_OK)
+            rc = ts_loop_margins(k, r->eq, TS_MARGINS_FROM_HZ,
+                                 TS_MARGINS_TO_HZ, points, r->margins, err);
+        r->margins_wall_s = wall_now() - t0;
+        if (rc == TS_OK)
+            r->nmargins = nl;
+    }
+    ts_kernel_free(k);
+    return rc;
+}
+
 static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
 {
     const ts_modes_opts *m = &rq->modes;
@@ -729,6 +763,8 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
                       r->eigen->nmodes == 1 ? "" : "s", nm,
                       m->eigen.target_hz);
     ts_trust_merge(&r->trust, NULL, &r->modes_trust);
+    if (m->margins && !rq->setup.open_loop && (rc = modes_margins(r, err)))
+        return rc;
     return modes_values(r, m->follow, err);
 }
 
@@ -770,27 +806,51 @@ static int check_response_sea(const ts_system *sys, const ts_response_opts *o,
     return sea_seaway(sys, &o->sea, &w, err);
 }
 
+/* The input and output of a response: a tow axis or a vehicle's input
+ * (a surface, a loop, a set point: none with the loops open), a node
+ * coordinate, a tension or a vehicle's output. */
+static int response_channels(const ts_system *sys, const ts_response_opts *o,
+                             int open_loop, int *input, ts_output *out,
+                             ts_err *err)
+{
+    ts_kernel *k = ts_kernel_alloc(sys, err);
+    if (!k)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int rc = ts_response_input_lookup(k, o->input, input, err);
+    if (rc != TS_OK)
+        ts_err_prefix(err, "input: ");
+    const char *dot = strrchr(o->input, '.');
+    if (rc == TS_OK && open_loop && *input >= TS_NINPUT && dot &&
+        strcmp(dot, ".setpoint") == 0 && ts_control_nloops(k) > 0)
+        rc = ts_fail(err, TS_EINVAL, "input: %s does nothing with the loops "
+                     "open (open_loop): the loop's output is held at its "
+                     "trim value", o->input);
+    if (rc == TS_OK && !o->output[0]) {
+        char list[768];
+        ts_response_output_names(sys, list, sizeof list);
+        rc = ts_fail(err, TS_EINVAL, "output: required; valid outputs: %s%s",
+                     list, ts_kernel_noutput(k) > 0
+                               ? " or a vehicle's (depth, pitch, roll, yaw, "
+                                 "<loop>.output, <surface>.deflection)"
+                               : "");
+    } else if (rc == TS_OK) {
+        rc = ts_response_output_lookup(k, o->output, out, err);
+        if (rc != TS_OK)
+            ts_err_prefix(err, "output: ");
+    }
+    ts_kernel_free(k);
+    return rc;
+}
+
 static int check_response(const ts_system *sys, const ts_response_opts *o,
-                          int *input, ts_output *out, ts_err *err)
+                          int open_loop, int *input, ts_output *out,
+                          ts_err *err)
 {
     if (o->sea.sea)
         return check_response_sea(sys, o, out, err);
-    int rc = ts_response_input_find(o->input, input, err);
-    if (rc != TS_OK) {
-        ts_err_prefix(err, "input: ");
+    int rc = response_channels(sys, o, open_loop, input, out, err);
+    if (rc != TS_OK)
         return rc;
-    }
-    if (!o->output[0]) {
-        char list[768];
-        ts_response_output_names(sys, list, sizeof list);
-        return ts_fail(err, TS_EINVAL, "output: required; valid outputs: %s",
-                       list);
-    }
-    rc = ts_response_output_find(sys, o->output, out, err);
-    if (rc != TS_OK) {
-        ts_err_prefix(err, "output: ");
-        return rc;
-    }
     if (!(o->points >= 2 && o->points <= TS_RESPONSE_MAX_POINTS))
         return ts_fail(err, TS_EINVAL,
                        "points: expected a whole number in [2, %d], got %d",
@@ -894,9 +954,9 @@ static int response_values(ts_result *r, ts_err *err)
     if (rc)
         return rc;
     double peak = res->magnitude[response_peak(res)];
-    value_name(&r->values[0], res->output.unit, peak, "%.80s.static_gain",
+    value_name(&r->values[0], res->unit, peak, "%.80s.static_gain",
                res->output.name);
-    value_name(&r->values[1], res->output.unit, peak,
+    value_name(&r->values[1], res->unit, peak,
                "%.80s.peak_magnitude", res->output.name);
     r->values[0].value = res->static_gain;
     r->values[1].value = peak;
@@ -915,7 +975,8 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
         return pipeline_response_sea(r, rq, err);
     int input;
     ts_output out;
-    int rc = check_response(r->sys, o, &input, &out, err);
+    int rc = check_response(r->sys, o, rq->setup.open_loop, &input, &out,
+                            err);
     double *freq = rc ? NULL : malloc((size_t)o->points * sizeof(double));
     if (rc == TS_OK && !freq)
         rc = ts_fail(err, TS_ENOMEM, "response: out of memory for %d "
@@ -1082,6 +1143,37 @@ static void sim_resolve(const ts_simulate_opts *s, ts_sim_opts *o,
     *transient = isnan(s->transient) ? o->t_end / 2 : s->transient;
 }
 
+/* The excitation's signals on vehicles' inputs against the system's
+ * vehicles; with the loops open, none on a loop's output or set point
+ * (they are held at the trim). */
+static int check_sim_inputs(const ts_system *sys, const ts_excitation *ex,
+                            int open_loop, ts_err *err)
+{
+    int ns = ex ? ts_excitation_nsignals(ex) : 0, any = 0;
+    for (int i = 0; i < ns; i++)
+        any |= ts_excitation_signal(ex, i)->axis == TS_AXIS_INPUT;
+    if (!any)
+        return TS_OK;
+    ts_kernel *k = ts_kernel_alloc(sys, err);
+    if (!k)
+        return err && err->code ? err->code : TS_ENOMEM;
+    int rc = ts_sim_check_inputs(k, ex, err);
+    for (int i = 0; i < ns && rc == TS_OK && open_loop; i++) {
+        const ts_signal *sg = ts_excitation_signal(ex, i);
+        int j = sg->axis == TS_AXIS_INPUT ? ts_kernel_input_find(k, sg->input)
+                                          : -1;
+        if (j >= TS_NINPUT && ts_control_nloops(k) > 0 &&
+            !ts_kernel_input_is_surface(k, j))
+            rc = ts_fail(err, TS_EINVAL, "excite: %s does nothing with the "
+                         "loops open (open_loop): the loop's output is held "
+                         "at its trim value", sg->input);
+    }
+    ts_kernel_free(k);
+    if (rc != TS_OK && strncmp(err->msg, "excite", 6))
+        ts_err_prefix(err, "excite: ");
+    return rc;
+}
+
 /* The output of a simulation: the named one, or the last sphere's .z
  * (else the last node's). */
 static int sim_output(const ts_system *sys, const char *name, ts_output *out,
@@ -1209,7 +1301,7 @@ static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
             return ts_fail(err, TS_EINVAL, "sample: %g s cannot resolve the "
                            "%g Hz excitation %s (period %g s): at most %g s, "
                            "2 samples per period", o->dt_sample, f,
-                           ts_axis_name(sg->axis), period, period / 2);
+                           ts_signal_axis_label(sg), period, period / 2);
         double n = o->t_end * f * TS_SIMULATE_SAMPLES_PER_PERIOD;
         if (!(s->sim.dt_sample > 0) && n > TS_SIMULATE_AUTO_SAMPLES_MAX)
             return ts_fail(err, TS_EINVAL, "excite: the %g Hz excitation %s "
@@ -1217,7 +1309,7 @@ static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
                            "period), more than the %g a run takes without a "
                            "sample interval given: shorten t_end, lower the "
                            "frequency, or give the sample interval", f,
-                           ts_axis_name(sg->axis), n, o->t_end,
+                           ts_signal_axis_label(sg), n, o->t_end,
                            TS_SIMULATE_SAMPLES_PER_PERIOD,
                            TS_SIMULATE_AUTO_SAMPLES_MAX);
     }
@@ -1236,8 +1328,8 @@ static int check_resolution(const ts_system *sys, const ts_simulate_opts *s,
 }
 
 static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
-                          ts_sim_opts *o, double *transient, ts_output *out,
-                          ts_err *err)
+                          int open_loop, ts_sim_opts *o, double *transient,
+                          ts_output *out, ts_err *err)
 {
     sim_resolve(s, o, transient);
     if (!(o->t_end > 0) || !isfinite(o->t_end))
@@ -1303,6 +1395,8 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         return ts_fail(err, TS_EINVAL, "manoeuvre: the linear model has no "
                        "frame inputs; a manoeuvre can only be simulated "
                        "nonlinearly (drop %s)", lw);
+    if ((rc = check_sim_inputs(sys, ex, open_loop, err)))
+        return rc;
     /* What the comparison will need. */
     int idx;
     if (s->compare && ex && ts_excitation_periodic(ex, &idx)) {
@@ -1732,7 +1826,8 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     const ts_simulate_opts *s = &rq->simulate;
     const ts_system *sys = r->sys;
     r->excitation = s->excitation;
-    int rc = check_simulate(sys, s, &r->sim, &r->transient, &r->output, err);
+    int rc = check_simulate(sys, s, rq->setup.open_loop, &r->sim,
+                            &r->transient, &r->output, err);
     if (rc == TS_OK && s->sea.sea)
         rc = sea_realise(r, s, err);
     if (rc != TS_OK)
@@ -1767,6 +1862,13 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         } else {
             memcpy(y0, r->eq->y, (size_t)n * sizeof *y0);
             ts_trust_merge(&r->trust, "initial equilibrium: ", &r->eq_trust);
+            /* The loops open at the trim: the state loses their
+             * integrators. */
+            if (rq->setup.open_loop && ts_control_nloops(k) > 0) {
+                r->open_loop = 1;
+                rc = ts_control_open(k, r->eq, y0, err);
+                n = ts_kernel_nstate(k);
+            }
         }
     } else if (rc == TS_OK && s->initial == TS_INITIAL_RELEASED) {
         snprintf(r->initial, sizeof r->initial,
@@ -1797,8 +1899,12 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         if (s->compare || s->linear)
             lo.model = TS_LIN_BOTH;
         double t0 = wall_now();
-        rc = r->lin ? ts_linearize_equilibrium(k, r->eq, &lo, r->lin, err)
-                    : (err && err->code ? err->code : TS_ENOMEM);
+        if (!r->lin)
+            rc = err && err->code ? err->code : TS_ENOMEM;
+        else if (rq->setup.open_loop && ts_control_nloops(k) > 0)
+            rc = ts_linearize(k, y0, NULL, &lo, r->lin, err);
+        else
+            rc = ts_linearize_equilibrium(k, r->eq, &lo, r->lin, err);
         r->lin_wall_s = wall_now() - t0;
         if (r->lin)
             r->evaluations += r->lin->evaluations;
@@ -2159,7 +2265,7 @@ static int estimate_response(ts_result *r, const levels *L, ts_err *err)
     }
     if (iw >= 0)
         judge(a, worst, order, order, "the magnitude at %.4g Hz (relative to the "
-              "largest, %.4g %s)", res->freq_hz[iw], peak, res->output.unit);
+              "largest, %.4g %s)", res->freq_hz[iw], peak, res->unit);
     /* Key values: the static gain at each level, the magnitude at the
      * peak's frequency. */
     for (int v = 0; v < r->nvalues && v < 2; v++) {
@@ -2585,8 +2691,8 @@ int ts_analysis_sweep(const ts_system *sys, const ts_request *rq, int series,
     else if (rc == TS_OK && kind == TS_ANALYSIS_MODES)
         rc = modes_values(r, x->rq.modes.follow, err);
     else if (rc == TS_OK) {
-        rc = check_simulate(r->sys, s, &r->sim, &r->transient, &r->output,
-                            err);
+        rc = check_simulate(r->sys, s, x->rq.setup.open_loop, &r->sim,
+                            &r->transient, &r->output, err);
         r->excitation = s->excitation;
         if (rc == TS_OK)
             rc = sim_values(r, s->linear, 0, 0, err);
@@ -2783,10 +2889,33 @@ static int pipeline_converge(ts_result *r, const ts_request *rq,
 
 /* ---- the entry points -------------------------------------------------- */
 
+/* open_loop: loops to open, opened at the trim. */
+static int check_open_loop(const ts_system *sys, const ts_request *rq,
+                           ts_err *err)
+{
+    if (!rq->setup.open_loop)
+        return TS_OK;
+    int loops = 0;
+    for (int b = 0; b < sys->nbodies; b++)
+        if (sys->bodies[b].vehicle)
+            loops += sys->bodies[b].vehicle->nloops;
+    if (loops == 0)
+        return ts_fail(err, TS_EINVAL, "open_loop: no vehicle of the scene "
+                       "has a controller loop to open");
+    if (rq->kind == TS_ANALYSIS_SIMULATE &&
+        rq->simulate.initial != TS_INITIAL_EQUILIBRIUM)
+        return ts_fail(err, TS_EINVAL, "open_loop: the loops open at the "
+                       "trim's outputs, so it needs the initial state "
+                       "'equilibrium'");
+    return TS_OK;
+}
+
 static int check_kind(const ts_system *sys, const ts_request *rq,
                       ts_err *err)
 {
-    int rc;
+    int rc = check_open_loop(sys, rq, err);
+    if (rc != TS_OK)
+        return rc;
     if (rq->setup.refine &&
         (rc = equal_links_only(sys, "refine", "refining sets equal links on "
                                "every cable (remove link_lengths, or give "
@@ -2820,13 +2949,15 @@ static int check_kind(const ts_system *sys, const ts_request *rq,
     case TS_ANALYSIS_RESPONSE: {
         int input;
         ts_output out;
-        return check_response(sys, &rq->response, &input, &out, err);
+        return check_response(sys, &rq->response, rq->setup.open_loop,
+                              &input, &out, err);
     }
     case TS_ANALYSIS_SIMULATE: {
         ts_sim_opts o;
         double transient;
         ts_output out;
-        return check_simulate(sys, &rq->simulate, &o, &transient, &out, err);
+        return check_simulate(sys, &rq->simulate, rq->setup.open_loop, &o,
+                              &transient, &out, err);
     }
     case TS_ANALYSIS_CONVERGE:
         return TS_OK; /* checked on the base system (check_converge) */

@@ -347,6 +347,7 @@ int ts_convergence_add_row(ts_convergence *c, int series, double setting,
     r->status = status;
     snprintf(r->message, sizeof r->message, "%s", message ? message : "");
     r->wall_s = wall_s;
+    r->timed_runs = 1;
     r->evaluations = evaluations;
     if (trust)
         r->trust = *trust;
@@ -672,6 +673,47 @@ void ts_conv_analysis_free(ts_conv_analysis *an)
     an->nvalues = 0;
 }
 
+/* The median wall time of a short run: the first took `first` s; the
+ * run is repeated (its results dropped) until TS_CONV_TIMING_REPEATS runs
+ * or the repeats took TS_CONV_TIMING_MIN s; *timed is the count. A
+ * repeat that fails or cannot get memory ends the repeats. */
+static double repeat_timing(const ts_conv_analysis *an, ts_conv_param p,
+                            double setting, int nvalues, double first,
+                            int *timed)
+{
+    double t[TS_CONV_TIMING_REPEATS];
+    int n = 0;
+    t[n++] = first;
+    double *scratch = malloc(2 * (size_t)(nvalues > 0 ? nvalues : 1) *
+                             sizeof *scratch);
+    double spent = 0;
+    while (scratch && n < TS_CONV_TIMING_REPEATS &&
+           spent < TS_CONV_TIMING_MIN) {
+        ts_trust tr;
+        ts_trust_init(&tr);
+        ts_err e = {0};
+        long ev = 0;
+        double t0 = wall_now();
+        int st = an->run(an->ctx, p, setting, scratch, scratch + nvalues,
+                         &ev, &tr, &e);
+        double w = wall_now() - t0;
+        if (st != TS_OK)
+            break;
+        t[n++] = w;
+        spent += w;
+    }
+    free(scratch);
+    /* The median: insertion sort of at most TS_CONV_TIMING_REPEATS. */
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && t[j] < t[j - 1]; j--) {
+            double x = t[j];
+            t[j] = t[j - 1];
+            t[j - 1] = x;
+        }
+    *timed = n;
+    return n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
+}
+
 int ts_convergence_sweep(ts_convergence *c, int series,
                          const ts_conv_analysis *an, const double settings[],
                          int n, ts_err *err)
@@ -717,6 +759,10 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         int st = an->run(an->ctx, c->param, settings[i], val, noise, &evals,
                          &trust, &rerr);
         double wall = wall_now() - t0;
+        int timed = 1;
+        if (st == TS_OK && wall < TS_CONV_TIMING_MIN)
+            wall = repeat_timing(an, c->param, settings[i], c->nvalues,
+                                 wall, &timed);
         if (st == TS_ENOMEM) {
             if (err)
                 *err = rerr;
@@ -728,6 +774,8 @@ int ts_convergence_sweep(ts_convergence *c, int series,
         rc = ts_convergence_add_row(c, series, settings[i], st,
                                     st == TS_OK ? NULL : rerr.msg, wall,
                                     evals, &trust, val, noise, err);
+        if (rc == TS_OK)
+            c->rows[c->nrows - 1].timed_runs = timed;
         if (rc == TS_OK && st == TS_ECANCEL) {
             if (err)
                 *err = rerr;

@@ -273,7 +273,7 @@ static void vector_health(const ts_linear *lin, const double *vl,
                           const double *rconde, const double *kap0,
                           const double *ev, double abnrm, int j, cand *c)
 {
-    int n = lin->nstate, nq = lin->nq;
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
     double complex lj = eig_at(wr, wi, j);
     int near[VECTOR_NEIGHBOURS], nn = 0;
     double gaps[VECTOR_NEIGHBOURS], vcond = 0.0;
@@ -295,8 +295,8 @@ static void vector_health(const ts_linear *lin, const double *vl,
         }
     }
     double sum2 = 0.0;
-    const double *er = ev ? ev + (size_t)j * nq : NULL;
-    const double *ei = ev && wi[j] != 0.0 ? ev + (size_t)(j + 1) * nq : NULL;
+    const double *er = ev ? ev + (size_t)j * nlow : NULL;
+    const double *ei = ev && wi[j] != 0.0 ? ev + (size_t)(j + 1) * nlow : NULL;
     for (int m = 0; m < nn; m++) {
         int k = near[m];
         double gap = gaps[m];
@@ -310,7 +310,7 @@ static void vector_health(const ts_linear *lin, const double *vl,
                                         : vl + (size_t)(wi[k] < 0 ? k : k + 1) *
                                                    n + nq;
         double sg = wi[k] < 0 ? -1.0 : 1.0, sr = 0.0, si = 0.0;
-        for (int i = 0; er && i < nq; i++) {
+        for (int i = 0; er && i < nlow; i++) {
             /* conj(a + i b) (x + i y) = (a x + b y) + i (a y - b x) */
             double a = ur[i], b = ui ? sg * ui[i] : 0.0;
             double x = er[i], y = ei ? ei[i] : 0.0;
@@ -385,14 +385,14 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
         goto out;
     }
     /* EV = E VR: the estimated error of A (lower block) on every right
-     * eigenvector, one BLAS product, 2 nq n^2 flops. */
-    int nq = lin->nq;
+     * eigenvector, one BLAS product, 2 (n - nq) n^2 flops. */
+    int nq = lin->nq, nlow = n - nq;
     if (lin->Aerr) {
-        ev = malloc((size_t)nq * (size_t)n * sizeof(double));
+        ev = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (ev) {
             double pone = 1.0, zero = 0.0;
-            dgemm_("N", "N", &nq, &n, &n, &pone, lin->Aerr, &nq, vr, &n,
-                   &zero, ev, &nq, 1, 1);
+            dgemm_("N", "N", &nlow, &n, &n, &pone, lin->Aerr, &nlow, vr, &n,
+                   &zero, ev, &nlow, 1, 1);
         }
     }
     /* 1 / |u_k^H v_k| of every eigenvalue (unit vectors): O(n^2). */
@@ -409,7 +409,7 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     }
     for (int j = 0; j < n; j++) {
         const double *vrj = vr + (size_t)j * n, *vlj = vl + (size_t)j * n;
-        const double *evj = ev ? ev + (size_t)j * nq : NULL;
+        const double *evj = ev ? ev + (size_t)j * nlow : NULL;
         if (wi[j] == 0.0) {
             double uv = 0, uu = 0, vv = 0, uev = 0;
             for (int i = 0; i < n; i++) {
@@ -417,7 +417,7 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
                 uu += vlj[i] * vlj[i];
                 vv += vrj[i] * vrj[i];
             }
-            for (int i = 0; evj && i < nq; i++)
+            for (int i = 0; evj && i < nlow; i++)
                 uev += vlj[nq + i] * evj[i];
             (void)uu;
             (void)vv;
@@ -440,9 +440,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
                 uu += vlj[i] * vlj[i] + vlk[i] * vlk[i];
                 vv += vrj[i] * vrj[i] + vrk[i] * vrk[i];
             }
-            for (int i = 0; evj && i < nq; i++)
+            for (int i = 0; evj && i < nlow; i++)
                 uev += conj(vlj[nq + i] + I * vlk[nq + i]) *
-                       (evj[i] + I * evj[nq + i]);
+                       (evj[i] + I * evj[nlow + i]);
             (void)uu;
             (void)vv;
             cand_add(L, wr[j] + I * wi[j], vrj, vrk, 1.0 / rconde[j], NAN,

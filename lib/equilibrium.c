@@ -84,6 +84,25 @@ int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
     return TS_OK;
 }
 
+int ts_equilibrium_state(ts_kernel *k, const ts_equilibrium *eq, double y[],
+                         ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int n = ts_kernel_nstate(k), nl = sys->nlinks;
+    double *strain = calloc((size_t)(nl > 0 ? nl : 1), sizeof(double));
+    if (!strain)
+        return ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    /* Strains do not depend on the charts: take them from eq->y. */
+    for (int l = 0; l < nl; l++)
+        if (sys->links[l].elastic)
+            strain[l] = eq->y[ts_kernel_link_offset(k, l) + 2];
+    memset(y, 0, (size_t)n * sizeof(double));
+    ts_kernel_set_shape(k, eq->directions, strain, NULL, NULL,
+                        TS_CHART_RECHART, y);
+    free(strain);
+    return ts_equilibrium_set_bodies(k, eq, y, err);
+}
+
 const char *ts_eq_method_name(ts_eq_method m)
 {
     switch (m) {
@@ -573,6 +592,8 @@ typedef struct path_ctx {
     ts_kernel *k;
     ts_frame frame;  /* the target frame */
     double b0;       /* bending scale at the start */
+    const double *sp0, *sp1; /* set points at the start and the end,
+                                vehicle by vehicle, loop by loop */
 } path_ctx;
 typedef void (*path_fn)(const path_ctx *pc, double t);
 
@@ -582,6 +603,69 @@ static void turn_path(const path_ctx *pc, double t)
     ts_frame f = pc->frame;
     f.turn_rate *= t;
     ts_kernel_set_frame(pc->k, &f);
+}
+
+/* Every loop's set point from sp0 to sp1 (a heading by the shorter way:
+ * sp1 is within pi of sp0), the frame straight. */
+static void setpoint_path(const path_ctx *pc, double t)
+{
+    const ts_system *sys = ts_kernel_system(pc->k);
+    ts_frame f = pc->frame;
+    f.turn_rate = 0.0; /* the turn comes after, along turn_path */
+    ts_kernel_set_frame(pc->k, &f);
+    for (int v = 0, i = 0; v < ts_kernel_nvehicles(pc->k); v++) {
+        const ts_vehicle *d =
+            sys->bodies[ts_kernel_vehicle_body(pc->k, v)].vehicle;
+        for (int l = 0; l < d->nloops; l++, i++)
+            ts_kernel_set_setpoint(pc->k, v, l,
+                                   pc->sp0[i] + t * (pc->sp1[i] - pc->sp0[i]));
+    }
+}
+
+/* Controllers: start every loop at the set point the state y already
+ * has (its measurement), with integrators at zero and actuators at their
+ * open-loop deflections, so that y (a trim with the loops idle) solves the
+ * closed loop at t = 0; sp0[nloops] receives those set points and sp1
+ * the targets (the kernel's set points on entry). Returns the number of
+ * loops. */
+static int controls_start(ts_kernel *k, double *y, double *sp0, double *sp1,
+                          double *dydt)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int i = 0, nout = ts_kernel_noutput(k), j = 0;
+    double *out = malloc((size_t)(nout > 0 ? nout : 1) * sizeof(double));
+    if (!out)
+        return -1;
+    ts_kernel_eval(k, y, NULL, dydt);
+    ts_kernel_outputs(k, out);
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        double xi[TS_VEHICLE_MAX_LOOPS] = {0}, act[TS_VEHICLE_MAX_COMPONENTS];
+        static const int measure_out[4] = {0, 1, 2, 3}; /* depth pitch roll
+                                                           yaw */
+        for (int l = 0; l < d->nloops; l++, i++) {
+            double m = out[j + measure_out[d->loop[l].measure]];
+            sp1[i] = ts_kernel_setpoint(k, v, l);
+            sp0[i] = m;
+            if (d->loop[l].measure == TS_MEASURE_HEADING) {
+                /* go the shorter way round */
+                double dh = remainder(sp1[i] - m, 2 * M_PI);
+                sp1[i] = m + dh;
+            }
+        }
+        int nsurf = 0;
+        for (int c = 0; c < d->ncomponents; c++) {
+            const ts_component *cp = &d->component[c];
+            act[c] = fmax(-cp->limit, fmin(cp->limit, cp->deflection));
+            nsurf += cp->control != 0;
+        }
+        ts_kernel_set_controls(k, v, xi, act, y);
+        /* Its outputs: 4 measures, the loops, the surfaces' deflections
+         * (ts_kernel_outputs). */
+        j += 4 + d->nloops + nsurf;
+    }
+    free(out);
+    return i;
 }
 
 /* Bending stiffness from b0 times its value to its value, geometrically. */
@@ -617,6 +701,35 @@ static void restore_shape(ts_kernel *k, double *y, newton_ws *w)
     for (int v = 0; v < sys->nvehicles; v++)
         ts_kernel_set_vehicle(k, v, w->att + 9 * v, NULL, TS_CHART_RECHART, y);
     memcpy(y + 2 * w->nq, w->ctl, (size_t)w->nc * sizeof(double));
+}
+
+/* ", with <vehicle>.<surface> at its limit" for the first control
+ * surface at its deflection limit in state y, else "". */
+static void saturated(ts_kernel *k, const double *y, char *buf, size_t size)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    double *f = malloc((size_t)ts_kernel_nstate(k) * sizeof(double));
+    buf[0] = '\0';
+    if (!f || ts_kernel_eval(k, y, NULL, f) != TS_OK) {
+        free(f);
+        return;
+    }
+    free(f);
+    for (int v = 0; v < ts_kernel_nvehicles(k) && !buf[0]; v++) {
+        ts_vehicle_result r;
+        ts_kernel_vehicle_result(k, v, &r);
+        const ts_body *b = &sys->bodies[r.body];
+        for (int c = 0; c < b->vehicle->ncomponents; c++) {
+            const ts_component *cp = &b->vehicle->component[c];
+            if (cp->control && isfinite(cp->limit) &&
+                fabs(r.delta[c]) >= cp->limit * (1 - 1e-9)) {
+                snprintf(buf, size, ", with %s.%s at its limit %.4g deg: a "
+                         "set point out of the surfaces' reach?", b->name,
+                         cp->name, cp->limit * 180 / M_PI);
+                break;
+            }
+        }
+    }
 }
 
 /* Newton along a parameter path t in [0, 1] from y, a state near the
@@ -670,6 +783,14 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             ts_err_prefix(err, "continuation in bending stiffness (EI "
                                "scaled up from %g of its value) stopped "
                                "%.4g of the way: ", pc->b0, t);
+        else if (path == setpoint_path) {
+            char sat[2 * TS_NAME_MAX + 96];
+            saturated(k, y, sat, sizeof sat);
+            ts_err_prefix(err, "continuation in the controllers' set points "
+                               "(from where the loops idle to their "
+                               "targets) stopped %.4g of the way%s: ", t,
+                          sat);
+        }
         else if (pc->frame.turn_rate != 0)
             ts_err_prefix(err, "continuation in turn rate towards %.6g "
                                "rad/s stopped %.4g of the way, at %.6g "
@@ -756,8 +877,14 @@ static void trim_loads(trim_par *p, const double th[3], tsi_vehicle_state *st)
     tsi_vehicle_kinematics(&p->d, I3, th, zero, 0.0, rA, zero, st);
     tsi_vehicle_flow(&p->frame, &p->d, st);
     tsi_vehicle_measure(st, val, rate);
-    tsi_vehicle_control(&p->d, val, rate, NULL, NULL, NULL, NULL, NULL, NULL,
-                        out, delta, NULL, NULL);
+    /* The loops contribute nothing here: the set-point continuation
+     * starts from the errors this trim leaves (solve_controlled). */
+    int open[TS_VEHICLE_MAX_LOOPS];
+    for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++)
+        open[l] = TS_LOOP_OPEN;
+    tsi_control_in in = {val, rate, NULL, NULL, NULL, NULL, NULL, open, NULL,
+                         1};
+    tsi_vehicle_control(&p->d, &in, out, delta, NULL, NULL);
     tsi_vehicle_loads(&p->d, p->ws, p->mass, p->rho, p->g, st, delta, p->G,
                       NULL);
 }
@@ -980,7 +1107,20 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     }
 
     int nl = sys->nlinks, nq = ts_kernel_nq(k), rc;
-    int n = ts_kernel_nstate(k), nv = sys->nvehicles;
+    int n = ts_kernel_nstate(k), nv = sys->nvehicles, nloops = 0;
+    for (int b = 0; b < sys->nbodies; b++)
+        if (sys->bodies[b].vehicle)
+            nloops += sys->bodies[b].vehicle->nloops;
+    /* The set points in force on entry are the targets; the kernel's
+     * steady flag is restored on exit. */
+    double *sp0 = calloc((size_t)nloops + 1, sizeof(double));
+    double *sp1 = calloc((size_t)nloops + 1, sizeof(double));
+    double *sp_entry = calloc((size_t)nloops + 1, sizeof(double));
+    for (int v = 0, i = 0; sp_entry && v < nv; v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        for (int l = 0; l < d->nloops; l++, i++)
+            sp_entry[i] = ts_kernel_setpoint(k, v, l);
+    }
     double *y = calloc((size_t)n, sizeof(double));
     double *dydt = malloc((size_t)n * sizeof(double));
     double *dvec = malloc(3 * (size_t)nl * sizeof(double));
@@ -992,7 +1132,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         rc = err ? err->code : TS_ENOMEM; /* the march named its size */
         goto out;
     }
-    if (!y || !dydt || !dvec || !strain || !att) {
+    if (!y || !dydt || !dvec || !strain || !att || !sp0 || !sp1 ||
+        !sp_entry) {
         rc = ts_fail_nomem(err, 8.0 * (4.0 * nq + 4.0 * nl), "fewer links",
                            "equilibrium: out of memory for the state of %d "
                            "links", nl);
@@ -1047,6 +1188,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         goto out;
     }
     rc = TS_ECONV;
+    /* Actuators settle smoothly: no rate limit in a steady state. */
+    ts_kernel_set_steady(k, 1);
     if (o.guess || have_guess) {
         /* Straight from the guess at the full turn rate and bending. */
         if (o.guess) {
@@ -1100,11 +1243,23 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
             ts_kernel_set_vehicle(k, v, att + 9 * v, NULL, TS_CHART_RECHART,
                                   y);
         memset(y + nq, 0, (size_t)nq * sizeof(double));
-        /* Turn rate from 0 with bending nearly off, then bending up. */
+        /* Turn rate from 0 with bending nearly off, then bending up;
+         * with controllers, first their set points from where the loops
+         * are idle to their targets, straight (doc/equilibrium.md). */
         double b0 = sys->has_bending ? BENDING_START : 1.0;
-        path_ctx pc = {k, frame, b0};
+        path_ctx pc = {k, frame, b0, NULL, NULL};
         ts_kernel_set_bending_scale(k, b0);
-        rc = continuation(k, y, &w, turn_path, &pc, &o, eq, err);
+        rc = TS_OK;
+        if (ts_kernel_ncontrol(k) > 0 &&
+            controls_start(k, y, sp0, sp1, dydt) < 0)
+            rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+        if (rc == TS_OK && nloops > 0) {
+            pc.sp0 = sp0;
+            pc.sp1 = sp1;
+            rc = continuation(k, y, &w, setpoint_path, &pc, &o, eq, err);
+        }
+        if (rc == TS_OK)
+            rc = continuation(k, y, &w, turn_path, &pc, &o, eq, err);
         if (rc == TS_OK && sys->has_bending)
             rc = continuation(k, y, &w, bending_path, &pc, &o, eq, err);
         ts_kernel_set_bending_scale(k, 1.0);
@@ -1130,6 +1285,15 @@ out:
     free(dvec);
     free(strain);
     free(att);
+    ts_kernel_set_steady(k, 0);
+    for (int v = 0, i = 0; sp_entry && v < nv; v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        for (int l = 0; l < d->nloops; l++, i++)
+            ts_kernel_set_setpoint(k, v, l, sp_entry[i]);
+    }
+    free(sp0);
+    free(sp1);
+    free(sp_entry);
     if (rc == TS_OK && !eq->converged)
         rc = ts_fail(err, TS_ECONV,
                      "equilibrium: not converged, relative residual %.3g "

@@ -158,6 +158,7 @@ const char *ts_axis_name(ts_axis a)
     case TS_AXIS_HEAVE: return "tow.heave";
     case TS_AXIS_SPEED: return "speed";
     case TS_AXIS_TURN_RATE: return "turn_rate";
+    case TS_AXIS_INPUT: return "input";
     }
     return "?";
 }
@@ -176,6 +177,15 @@ const char *ts_signal_type_name(ts_signal_type t)
 }
 
 static int is_tow_axis(int a) { return a >= TS_AXIS_SURGE && a <= TS_AXIS_HEAVE; }
+static int is_manoeuvre(int a)
+{
+    return a == TS_AXIS_SPEED || a == TS_AXIS_TURN_RATE;
+}
+
+const char *ts_signal_axis_label(const ts_signal *s)
+{
+    return s->axis == TS_AXIS_INPUT ? s->input : ts_axis_name(s->axis);
+}
 
 static int grow(ts_excitation *ex, ts_err *err)
 {
@@ -205,16 +215,24 @@ static int grow(ts_excitation *ex, ts_err *err)
 
 int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
 {
-    const char *an = ts_axis_name(s->axis), *tn = ts_signal_type_name(s->type);
-    if (!(s->axis >= TS_AXIS_SURGE && s->axis <= TS_AXIS_TURN_RATE))
+    const char *an = ts_signal_axis_label(s), *tn = ts_signal_type_name(s->type);
+    if (!(s->axis >= TS_AXIS_SURGE && s->axis <= TS_AXIS_INPUT))
         return ts_fail(err, TS_EINVAL, "excitation: axis %d is not one of "
-                       "tow.surge, tow.sway, tow.heave, speed, turn_rate",
-                       (int)s->axis);
+                       "tow.surge, tow.sway, tow.heave, speed, turn_rate, "
+                       "input", (int)s->axis);
+    if (s->axis == TS_AXIS_INPUT &&
+        (!memchr(s->input, '\0', sizeof s->input) || !strchr(s->input, '.')))
+        return ts_fail(err, TS_EINVAL, "excitation: a vehicle input's name "
+                       "is <vehicle>.<surface>, <vehicle>.<loop> or "
+                       "<vehicle>.<loop>.setpoint");
+    if (s->axis == TS_AXIS_INPUT && s->type == TS_SIGNAL_CRANK)
+        return ts_fail(err, TS_EINVAL, "excitation %s: a vehicle input "
+                       "takes a sine, a step or a ramp, got crank", an);
     if (!(s->type >= TS_SIGNAL_SINE && s->type <= TS_SIGNAL_RAMP))
         return ts_fail(err, TS_EINVAL, "excitation %s: type %d is not sine, "
                        "crank, step or ramp (series: "
                        "ts_excitation_add_series)", an, (int)s->type);
-    if (!is_tow_axis(s->axis) && s->type != TS_SIGNAL_STEP &&
+    if (is_manoeuvre(s->axis) && s->type != TS_SIGNAL_STEP &&
         s->type != TS_SIGNAL_RAMP)
         return ts_fail(err, TS_EINVAL, "excitation %s: a manoeuvre is a step "
                        "or a ramp, got %s", an, tn);
@@ -224,7 +242,7 @@ int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
     if (s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK) {
         if (!(s->amplitude > 0))
             return ts_fail(err, TS_EINVAL, "excitation %s (%s): amplitude "
-                           "must be > 0 m, got %g m", an, tn, s->amplitude);
+                           "must be > 0, got %g", an, tn, s->amplitude);
         if (!(s->frequency > 0) || !isfinite(s->frequency))
             return ts_fail(err, TS_EINVAL, "excitation %s (%s): frequency "
                            "must be > 0 Hz, got %g Hz", an, tn, s->frequency);
@@ -255,7 +273,7 @@ int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
         return ts_fail(err, TS_EINVAL, "excitation %s (ramp): duration must "
                        "be > 0 s, got %g s", an, s->duration);
     if (s->absolute) {
-        if (is_tow_axis(s->axis))
+        if (!is_manoeuvre(s->axis))
             return ts_fail(err, TS_EINVAL, "excitation %s: a final value "
                            "('to') applies to manoeuvres only", an);
         for (int i = 0; i < ex->n; i++)
@@ -586,6 +604,31 @@ static char *trim(char *s)
     return s;
 }
 
+/* The amplitude of a vehicle input's signal: a length (m) or an angle
+ * (rad), its kind kept in s->input_unit ("" for a plain number). */
+static int input_amplitude(const ts_units *units, const char *text,
+                           const char *where, ts_signal *s, ts_err *err)
+{
+    char *end;
+    double v = strtod(text, &end);
+    if (end != text && !*trim(end)) {
+        s->amplitude = v;
+        return TS_OK;
+    }
+    ts_err e = {0};
+    if (ts_units_parse(units, text, "m", where, &s->amplitude, &e) == TS_OK) {
+        snprintf(s->input_unit, sizeof s->input_unit, "m");
+        return TS_OK;
+    }
+    if (ts_units_parse(units, text, "rad", where, &s->amplitude, &e) ==
+        TS_OK) {
+        snprintf(s->input_unit, sizeof s->input_unit, "rad");
+        return TS_OK;
+    }
+    return ts_fail(err, TS_EUNIT, "%s: '%.40s' is neither a length (m, for "
+                   "a depth set point) nor an angle (rad, deg)", where, text);
+}
+
 int ts_excitation_parse(ts_excitation *ex, const char *spec,
                         const ts_units *units, const char *where,
                         ts_err *err)
@@ -602,12 +645,22 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
         *colon = '\0';
     char *axis_name = trim(buf);
     ts_axis axis;
-    if (parse_axis(axis_name, &axis))
-        return ts_fail(err, TS_EINVAL, "%s: unknown axis '%.60s'; expected "
-                       "tow.surge, tow.sway, tow.heave (or tow.x, tow.y, "
-                       "tow.z), speed or turn_rate", where, axis_name);
-    int tow = is_tow_axis(axis);
-    const char *an = ts_axis_name(axis);
+    if (parse_axis(axis_name, &axis)) {
+        /* Any other dotted name is a vehicle's input, checked against the
+         * kernel by the simulator. */
+        if (!strchr(axis_name, '.') || !strncmp(axis_name, "tow.", 4) ||
+            strlen(axis_name) >= TS_SIGNAL_INPUT_MAX)
+            return ts_fail(err, TS_EINVAL, "%s: unknown axis '%.60s'; "
+                           "expected tow.surge, tow.sway, tow.heave (or "
+                           "tow.x, tow.y, tow.z), speed, turn_rate or a "
+                           "vehicle's input (<vehicle>.<surface>, "
+                           "<vehicle>.<loop>, <vehicle>.<loop>.setpoint)",
+                           where, axis_name);
+        axis = TS_AXIS_INPUT;
+    }
+    /* A vehicle input takes a tow axis' keys (amplitude, no to/by). */
+    int input = axis == TS_AXIS_INPUT, tow = is_tow_axis(axis) || input;
+    const char *an = input ? axis_name : ts_axis_name(axis);
 
     /* Collect key=value pairs. */
     char *val[K_N] = {0};
@@ -659,7 +712,9 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
 
     ts_signal s = {0};
     s.axis = axis;
-    s.type = tow ? TS_SIGNAL_SINE : TS_SIGNAL_RAMP;
+    s.type = input ? TS_SIGNAL_STEP : tow ? TS_SIGNAL_SINE : TS_SIGNAL_RAMP;
+    if (input)
+        snprintf(s.input, sizeof s.input, "%s", axis_name);
     if (val[K_TYPE]) {
         static const char *const types[] = {"sine", "crank", "step", "ramp",
                                             "csv"};
@@ -671,10 +726,15 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
         if (t == 5)
             return ts_fail(err, TS_EINVAL, "%s: %s: unknown type '%.40s'; "
                            "expected %s", where, an, val[K_TYPE],
-                           tow ? "sine, crank, step, ramp or csv"
-                               : "step or ramp");
+                           input ? "sine, step or ramp"
+                           : tow ? "sine, crank, step, ramp or csv"
+                                 : "step or ramp");
         s.type = (ts_signal_type)t;
     }
+    if (input && (s.type == TS_SIGNAL_CRANK || s.type == TS_SIGNAL_SERIES))
+        return ts_fail(err, TS_EINVAL, "%s: %s: a vehicle input takes a "
+                       "sine, a step or a ramp, got type %s", where, an,
+                       ts_signal_type_name(s.type));
     unsigned allowed = keys_for(s.type, tow);
     if (!tow && s.type != TS_SIGNAL_STEP && s.type != TS_SIGNAL_RAMP)
         return ts_fail(err, TS_EINVAL, "%s: %s: a manoeuvre is a step or a "
@@ -713,7 +773,16 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
         if (!val[q[i].key])
             continue;
         char w[160];
-        snprintf(w, sizeof w, "%s: %s: %s", where, an, key_names[q[i].key]);
+        snprintf(w, sizeof w, "%.60s: %.60s: %s", where, an,
+                 key_names[q[i].key]);
+        if (input && q[i].key == K_AMPLITUDE) {
+            /* m (a depth set point) or rad (the rest): which one the
+             * input takes is checked against the kernel. */
+            int rc = input_amplitude(units, val[K_AMPLITUDE], w, &s, err);
+            if (rc)
+                return rc;
+            continue;
+        }
         int rc = ts_units_parse(units, val[q[i].key], q[i].unit, w, q[i].dst,
                                 err);
         if (rc)
@@ -724,7 +793,7 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
     if (need_amp && !val[K_AMPLITUDE])
         return ts_fail(err, TS_EINVAL, "%s: %s: type %s needs amplitude=",
                        where, an, ts_signal_type_name(s.type));
-    if (!tow) {
+    if (is_manoeuvre(axis)) {
         if (!!val[K_TO] + !!val[K_BY] != 1)
             return ts_fail(err, TS_EINVAL, "%s: %s: give exactly one of to= "
                            "(final value) and by= (change)", where, an);
@@ -952,9 +1021,18 @@ const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i)
 int ts_excitation_has_manoeuvre(const ts_excitation *ex)
 {
     for (int i = 0; i < ex->n; i++)
-        if (!is_tow_axis(ex->sig[i].axis))
+        if (is_manoeuvre(ex->sig[i].axis))
             return 1;
     return 0;
+}
+
+double ts_excitation_value(const ts_excitation *ex, int i, double t)
+{
+    double x, v, a;
+    if (i < 0 || i >= ex->n || ex->sig[i].type == TS_SIGNAL_SUM)
+        return 0.0;
+    signal_eval(ex, i, ex->sig[i].amplitude, t, &x, &v, &a);
+    return x;
 }
 
 void ts_excitation_input(const ts_excitation *ex, double t,
@@ -1007,7 +1085,7 @@ void ts_excitation_frame(const ts_excitation *ex, const ts_frame *base,
     double psi = b.turn_rate * t;
     for (int i = 0; i < ex->n; i++) {
         const ts_signal *s = &ex->sig[i];
-        if (is_tow_axis(s->axis))
+        if (!is_manoeuvre(s->axis))
             continue;
         double b0 = s->axis == TS_AXIS_SPEED ? b.speed : b.turn_rate;
         double amp = manoeuvre_amp(s, b0), x, v, a;
@@ -1080,7 +1158,7 @@ double ts_excitation_time_scale(const ts_excitation *ex)
     double ts = INFINITY;
     for (int i = 0; i < ex->n; i++) {
         const ts_signal *s = &ex->sig[i];
-        if (!is_tow_axis(s->axis))
+        if (is_manoeuvre(s->axis))
             continue;
         double v = INFINITY;
         switch (s->type) {
@@ -1174,7 +1252,7 @@ void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
             m->speed += A;
         else if (s->axis == TS_AXIS_TURN_RATE)
             m->turn_rate += A;
-        else {
+        else if (s->axis != TS_AXIS_INPUT) {
             m->tow_speed += v;
             m->tow_accel += a;
         }
@@ -1193,7 +1271,7 @@ int ts_excitation_check_span(const ts_excitation *ex, double t_end,
             return ts_fail(err, TS_EINVAL, "excitation %s (csv): the series "
                            "ends at %g s, before the end of the run (%g s); "
                            "extend it or shorten the run",
-                           ts_axis_name(s->axis), hi, t_end);
+                           ts_signal_axis_label(s), hi, t_end);
     }
     return TS_OK;
 }
@@ -1204,7 +1282,7 @@ int ts_excitation_periodic(const ts_excitation *ex, int *index)
     for (int i = 0; i < ex->n; i++) {
         const ts_signal *s = &ex->sig[i];
         if (s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK) {
-            if (found >= 0)
+            if (found >= 0 || !is_tow_axis(s->axis))
                 return 0;
             found = i;
         }
@@ -1219,10 +1297,14 @@ void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
                             size_t size)
 {
     const ts_signal *s = &ex->sig[i];
-    const char *an = ts_axis_name(s->axis);
-    const char *u = is_tow_axis(s->axis) ? "m"
-                    : s->axis == TS_AXIS_SPEED ? "m/s" : "rad/s";
-    const char *what = s->absolute ? "to" : is_tow_axis(s->axis)
+    const char *an = ts_signal_axis_label(s);
+    const char *u = is_tow_axis(s->axis)       ? "m"
+                    : s->axis == TS_AXIS_INPUT ? (s->input_unit[0]
+                                                      ? s->input_unit
+                                                      : "(SI)")
+                    : s->axis == TS_AXIS_SPEED ? "m/s"
+                                               : "rad/s";
+    const char *what = s->absolute ? "to" : !is_manoeuvre(s->axis)
                                                 ? "amplitude" : "by";
     switch (s->type) {
     case TS_SIGNAL_SINE:
@@ -1234,8 +1316,8 @@ void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
         else
             snprintf(start, sizeof start, "impulsive start");
         if (s->type == TS_SIGNAL_SINE)
-            snprintf(buf, size, "%s sine amplitude %.6g m, frequency %.6g "
-                     "Hz, phase %.6g deg, %s", an, s->amplitude,
+            snprintf(buf, size, "%s sine amplitude %.6g %s, frequency "
+                     "%.6g Hz, phase %.6g deg, %s", an, s->amplitude, u,
                      s->frequency, s->phase * 180.0 / M_PI, start);
         else
             snprintf(buf, size, "%s slider crank radius %.6g m, rod %.6g m, "

@@ -52,6 +52,9 @@
 #include "vec3.h"
 #include "vehicle.h"
 
+/* Outputs: per vehicle its 4 measurements, then its loops' outputs. */
+#define OUT_MEASURES 4
+
 /* One vehicle's coupling data. */
 typedef struct veh {
     int body, node, qoff;     /* body index, its node, offset in q */
@@ -75,8 +78,10 @@ typedef struct veh {
     int xi_off[TS_VEHICLE_MAX_LOOPS];      /* integrator, offset in c */
     int act_off[TS_VEHICLE_MAX_COMPONENTS];/* actuator, offset in c */
     int in_surf[TS_VEHICLE_MAX_COMPONENTS];/* input index */
-    int in_loop[TS_VEHICLE_MAX_LOOPS];     /* input index */
-    int mode[TS_VEHICLE_MAX_LOOPS];        /* TSI_LOOP_* */
+    int in_loop[TS_VEHICLE_MAX_LOOPS];     /* input index (output) */
+    int in_sp[TS_VEHICLE_MAX_LOOPS];       /* input index (set point) */
+    double sp[TS_VEHICLE_MAX_LOOPS];       /* set points in force */
+    int mode[TS_VEHICLE_MAX_LOOPS];        /* TS_LOOP_* */
     double frozen[TS_VEHICLE_MAX_LOOPS];   /* frozen outputs */
     double meas[4], rate[4];
     double out[TS_VEHICLE_MAX_LOOPS];
@@ -108,6 +113,7 @@ struct ts_kernel {
     int *off;          /* [nl] offset of link l's coordinates in q */
     ts_frame frame;
     double bend_scale; /* multiplies every EI (continuation), default 1 */
+    int steady;        /* 1: actuators without rate limits (steady states) */
 
     double *chart;     /* [9 nl] row-major rotation per link */
     char *charted;     /* [nl] 1 when chart is not the identity */
@@ -151,10 +157,10 @@ static int layout_controls(ts_kernel *k, ts_err *err)
         veh *V = &k->veh[v];
         const ts_vehicle *d = V->d;
         for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++) {
-            V->xi_off[l] = V->in_loop[l] = -1;
+            V->xi_off[l] = V->in_loop[l] = V->in_sp[l] = -1;
             if (l >= d->nloops)
                 continue;
-            if (d->loop[l].ki != 0 && V->mode[l] != TSI_LOOP_FROZEN)
+            if (d->loop[l].ki != 0 && V->mode[l] != TS_LOOP_OPEN)
                 V->xi_off[l] = k->nc++;
         }
         for (int c = 0; c < TS_VEHICLE_MAX_COMPONENTS; c++) {
@@ -165,8 +171,10 @@ static int layout_controls(ts_kernel *k, ts_err *err)
             if (d->component[c].time_constant > 0)
                 V->act_off[c] = k->nc++;
         }
-        for (int l = 0; l < d->nloops; l++)
+        for (int l = 0; l < d->nloops; l++) {
             V->in_loop[l] = k->nin++;
+            V->in_sp[l] = k->nin++;
+        }
     }
     free(k->uzero);
     k->uzero = calloc((size_t)k->nin, sizeof(double));
@@ -256,8 +264,10 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
         /* A body whose points all sit at A has no lever: its unbalanced
          * moment is compared per metre. */
         V->lever = fmax(tsi_vehicle_lever(V->d), 1.0);
-        for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++)
-            V->mode[l] = TSI_LOOP_CLOSED;
+        for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++) {
+            V->mode[l] = TS_LOOP_CLOSED;
+            V->sp[l] = l < V->d->nloops ? V->d->loop[l].setpoint : 0.0;
+        }
         k->node_veh[V->node] = v;
         V->ws = tsi_vehicle_ws_alloc(V->d, err);
         if (!V->ws) {
@@ -327,6 +337,7 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
         return NULL;
     c->frame = k->frame;
     c->bend_scale = k->bend_scale;
+    c->steady = k->steady;
     memcpy(c->chart, k->chart, 9 * (size_t)k->nl * sizeof(double));
     memcpy(c->charted, k->charted, (size_t)k->nl);
     for (int v = 0; v < k->nv; v++) {
@@ -334,6 +345,7 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
         c->veh[v].charted = k->veh[v].charted;
         memcpy(c->veh[v].mode, k->veh[v].mode, sizeof k->veh[v].mode);
         memcpy(c->veh[v].frozen, k->veh[v].frozen, sizeof k->veh[v].frozen);
+        memcpy(c->veh[v].sp, k->veh[v].sp, sizeof k->veh[v].sp);
     }
     if (layout_controls(c, err) != TS_OK) {
         ts_kernel_free(c);
@@ -349,6 +361,135 @@ int ts_kernel_ncontrol(const ts_kernel *k) { return k->nc; }
 int ts_kernel_link_offset(const ts_kernel *k, int link) { return k->off[link]; }
 int ts_kernel_ninput(const ts_kernel *k) { return k->nin; }
 int ts_kernel_nvehicles(const ts_kernel *k) { return k->nv; }
+
+int ts_kernel_set_loop_mode(ts_kernel *k, int v, int loop, int mode,
+                            double frozen, ts_err *err)
+{
+    if (v < 0 || v >= k->nv || loop < 0 || loop >= k->veh[v].d->nloops)
+        return ts_fail(err, TS_EINVAL, "kernel: no loop %d of vehicle %d",
+                       loop, v);
+    if (mode != TS_LOOP_CLOSED && mode != TS_LOOP_OPEN &&
+        mode != TS_LOOP_BROKEN)
+        return ts_fail(err, TS_EINVAL, "kernel: loop mode %d", mode);
+    k->veh[v].mode[loop] = mode;
+    k->veh[v].frozen[loop] = frozen;
+    return layout_controls(k, err);
+}
+
+int ts_kernel_loop_mode(const ts_kernel *k, int v, int loop)
+{
+    return k->veh[v].mode[loop];
+}
+
+void ts_kernel_set_setpoint(ts_kernel *k, int v, int loop, double value)
+{
+    k->veh[v].sp[loop] = value;
+}
+
+double ts_kernel_setpoint(const ts_kernel *k, int v, int loop)
+{
+    return k->veh[v].sp[loop];
+}
+
+void ts_kernel_set_steady(ts_kernel *k, int steady) { k->steady = steady; }
+
+void ts_kernel_get_controls(const ts_kernel *k, int v, const double y[],
+                            double xi[], double act[])
+{
+    const veh *V = &k->veh[v];
+    const double *c = y + 2 * k->nq;
+    for (int l = 0; l < V->d->nloops; l++)
+        xi[l] = V->xi_off[l] >= 0 ? c[V->xi_off[l]] : 0.0;
+    for (int j = 0; j < V->d->ncomponents; j++)
+        act[j] = V->act_off[j] >= 0 ? c[V->act_off[j]] : 0.0;
+}
+
+void ts_kernel_set_controls(const ts_kernel *k, int v, const double xi[],
+                            const double act[], double y[])
+{
+    const veh *V = &k->veh[v];
+    double *c = y + 2 * k->nq;
+    for (int l = 0; l < V->d->nloops; l++)
+        if (V->xi_off[l] >= 0)
+            c[V->xi_off[l]] = xi[l];
+    for (int j = 0; j < V->d->ncomponents; j++)
+        if (V->act_off[j] >= 0)
+            c[V->act_off[j]] = act[j];
+}
+
+
+/* Control surfaces of vehicle V. */
+static int nsurfaces(const veh *V)
+{
+    int n = 0;
+    for (int c = 0; c < V->d->ncomponents; c++)
+        n += V->in_surf[c] >= 0;
+    return n;
+}
+
+int ts_kernel_noutput(const ts_kernel *k)
+{
+    int n = 0;
+    for (int v = 0; v < k->nv; v++)
+        n += OUT_MEASURES + k->veh[v].d->nloops + nsurfaces(&k->veh[v]);
+    return n;
+}
+
+const char *ts_kernel_output_name(const ts_kernel *k, int j, char *buf,
+                                  size_t size)
+{
+    static const char *const measure[OUT_MEASURES] = {"depth", "pitch",
+                                                      "roll", "yaw"};
+    for (int v = 0; v < k->nv && j >= 0; v++) {
+        const veh *V = &k->veh[v];
+        const char *body = k->sys->bodies[V->body].name;
+        if (j < OUT_MEASURES) {
+            snprintf(buf, size, "%s.%s", body, measure[j]);
+            return buf;
+        }
+        j -= OUT_MEASURES;
+        if (j < V->d->nloops) {
+            snprintf(buf, size, "%s.%s.output", body, V->d->loop[j].name);
+            return buf;
+        }
+        j -= V->d->nloops;
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] >= 0 && j-- == 0) {
+                snprintf(buf, size, "%s.%s.deflection", body,
+                         V->d->component[c].name);
+                return buf;
+            }
+    }
+    return NULL;
+}
+
+int ts_kernel_output_find(const ts_kernel *k, const char *name)
+{
+    char buf[2 * TS_NAME_MAX + 16];
+    int n = ts_kernel_noutput(k);
+    for (int j = 0; j < n; j++)
+        if (ts_kernel_output_name(k, j, buf, sizeof buf) &&
+            !strcmp(buf, name))
+            return j;
+    return -1;
+}
+
+void ts_kernel_outputs(const ts_kernel *k, double out[])
+{
+    int j = 0;
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        /* depth, pitch, roll, yaw: the ts_measure order is depth, pitch,
+         * roll, heading */
+        for (int m = 0; m < OUT_MEASURES; m++)
+            out[j++] = V->meas[m];
+        for (int l = 0; l < V->d->nloops; l++)
+            out[j++] = V->out[l];
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] >= 0)
+                out[j++] = V->delta[c];
+    }
+}
 
 void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
 {
@@ -402,13 +543,54 @@ const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
                 snprintf(buf, size, "%s.%s", body, V->d->component[c].name);
                 return buf;
             }
-        for (int l = 0; l < V->d->nloops; l++)
+        for (int l = 0; l < V->d->nloops; l++) {
             if (V->in_loop[l] == j) {
                 snprintf(buf, size, "%s.%s", body, V->d->loop[l].name);
                 return buf;
             }
+            if (V->in_sp[l] == j) {
+                snprintf(buf, size, "%s.%s.setpoint", body,
+                         V->d->loop[l].name);
+                return buf;
+            }
+        }
     }
     return NULL;
+}
+
+const char *ts_kernel_input_unit(const ts_kernel *k, int j)
+{
+    if (j >= 0 && j < TS_NINPUT)
+        return j < 3 ? "m" : (j < 6 ? "m/s" : "m/s^2");
+    for (int v = 0; v < k->nv; v++) {
+        const veh *V = &k->veh[v];
+        for (int l = 0; l < V->d->nloops; l++)
+            if (V->in_sp[l] == j)
+                return V->d->loop[l].measure == TS_MEASURE_DEPTH ? "m"
+                                                                 : "rad";
+    }
+    return j < k->nin ? "rad" : NULL; /* a deflection or a loop's output */
+}
+
+const char *ts_kernel_output_unit(const ts_kernel *k, int j)
+{
+    for (int v = 0; v < k->nv && j >= 0; v++) {
+        if (j < OUT_MEASURES)
+            return j == 0 ? "m" : "rad";
+        j -= OUT_MEASURES + k->veh[v].d->nloops + nsurfaces(&k->veh[v]);
+        if (j < 0)
+            return "rad";
+    }
+    return NULL;
+}
+
+int ts_kernel_input_is_surface(const ts_kernel *k, int j)
+{
+    for (int v = 0; v < k->nv && j >= TS_NINPUT; v++)
+        for (int c = 0; c < k->veh[v].d->ncomponents; c++)
+            if (k->veh[v].in_surf[c] == j)
+                return 1;
+    return 0;
 }
 
 int ts_kernel_input_find(const ts_kernel *k, const char *name)
@@ -576,18 +758,21 @@ static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
     const ts_vehicle *d = V->d;
     const double *c = y + 2 * k->nq;
     double xi[TS_VEHICLE_MAX_LOOPS], ul[TS_VEHICLE_MAX_LOOPS];
+    double sp[TS_VEHICLE_MAX_LOOPS];
     double act[TS_VEHICLE_MAX_COMPONENTS], us[TS_VEHICLE_MAX_COMPONENTS];
     for (int l = 0; l < d->nloops; l++) {
         xi[l] = V->xi_off[l] >= 0 ? c[V->xi_off[l]] : 0.0;
-        ul[l] = V->in_loop[l] >= 0 ? u[V->in_loop[l]] : 0.0;
+        ul[l] = u[V->in_loop[l]];
+        sp[l] = V->sp[l] + u[V->in_sp[l]];
     }
     for (int j = 0; j < d->ncomponents; j++) {
         act[j] = V->act_off[j] >= 0 ? c[V->act_off[j]] : 0.0;
         us[j] = V->in_surf[j] >= 0 ? u[V->in_surf[j]] : 0.0;
     }
     tsi_vehicle_measure(&V->st, V->meas, V->rate);
-    tsi_vehicle_control(d, V->meas, V->rate, xi, act, us, ul, V->mode,
-                        V->frozen, V->out, V->delta, V->xi_dot, V->act_dot);
+    tsi_control_in in = {V->meas, V->rate, xi,   act,      us,
+                         ul,      sp,      V->mode, V->frozen, k->steady};
+    tsi_vehicle_control(d, &in, V->out, V->delta, V->xi_dot, V->act_dot);
     tsi_vehicle_mass6(d, V->mass, &V->st, V->M6);
     tsi_vehicle_loads(d, V->ws, V->mass, rho, g, &V->st, V->delta, V->G,
                       NULL);
@@ -1465,7 +1650,7 @@ void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
                       V->delta, G, r->munk);
     r->nloops = d->nloops;
     for (int l = 0; l < d->nloops; l++) {
-        r->loop_error[l] = tsi_loop_error(&d->loop[l], V->meas);
+        r->loop_error[l] = tsi_loop_error(&d->loop[l], V->meas, V->sp[l]);
         r->loop_output[l] = V->out[l];
     }
 }

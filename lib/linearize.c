@@ -94,6 +94,29 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->kink_node = -1;
     lin->desc_err = NAN;
     lin->nvehicles = ts_kernel_nvehicles(k);
+    lin->noutput = ts_kernel_noutput(k);
+    if (lin->noutput > 0) {
+        size_t no = (size_t)lin->noutput;
+        lin->Vy = calloc(no * sn, sizeof(double));
+        lin->Vu = calloc(no * (size_t)ni, sizeof(double));
+        lin->v0 = calloc(no, sizeof(double));
+    }
+    lin->input_name = calloc((size_t)ni, sizeof *lin->input_name);
+    lin->input_unit = calloc((size_t)ni, sizeof *lin->input_unit);
+    lin->output_name = calloc((size_t)lin->noutput + 1,
+                              sizeof *lin->output_name);
+    lin->output_unit = calloc((size_t)lin->noutput + 1,
+                              sizeof *lin->output_unit);
+    for (int j = 0; lin->input_name && lin->input_unit && j < ni; j++) {
+        ts_kernel_input_name(k, j, lin->input_name[j], TS_IO_NAME);
+        lin->input_unit[j] = ts_kernel_input_unit(k, j);
+    }
+    for (int j = 0; lin->output_name && lin->output_unit &&
+                    j < lin->noutput;
+         j++) {
+        ts_kernel_output_name(k, j, lin->output_name[j], TS_IO_NAME);
+        lin->output_unit[j] = ts_kernel_output_unit(k, j);
+    }
     if (lin->nvehicles > 0) {
         lin->up_qoff = malloc((size_t)sys->nlinks * sizeof(int));
         lin->up_map = calloc(12 * (size_t)sys->nlinks, sizeof(double));
@@ -101,7 +124,10 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
         !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
         !lin->u0 ||
-        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map))) {
+        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map)) ||
+        (lin->noutput > 0 && (!lin->Vy || !lin->Vu || !lin->v0)) ||
+        !lin->input_name || !lin->input_unit || !lin->output_name ||
+        !lin->output_unit) {
         ts_linear_free(lin);
         ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory for %d "
                 "states", n);
@@ -135,6 +161,13 @@ void ts_linear_free(ts_linear *lin)
     free(lin->u0);
     free(lin->up_qoff);
     free(lin->up_map);
+    free(lin->Vy);
+    free(lin->Vu);
+    free(lin->v0);
+    free(lin->input_name);
+    free(lin->input_unit);
+    free(lin->output_name);
+    free(lin->output_unit);
     free(lin);
 }
 
@@ -170,7 +203,8 @@ static void col_ws_free(col_ws *w, const ts_kernel *owner)
 }
 
 static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
-                        const double *u0, int n, int ni, int nl, ts_err *err)
+                        const double *u0, int n, int ni, int nl, int nout,
+                        ts_err *err)
 {
     memset(w, 0, sizeof *w);
     w->k = use_k ? k : ts_kernel_clone(k, err);
@@ -179,7 +213,8 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
     int ok = w->k && w->y && w->u;
     for (int i = 0; i < 4; i++) {
         w->f[i] = malloc((size_t)n * sizeof(double));
-        w->t[i] = malloc((size_t)(nl > 0 ? nl : 1) * sizeof(double));
+        w->t[i] = malloc((size_t)(nl + nout > 0 ? nl + nout : 1) *
+                         sizeof(double));
         ok = ok && w->f[i] && w->t[i];
     }
     if (!ok)
@@ -189,13 +224,16 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
     return TS_OK;
 }
 
-/* Evaluate at the current (w->y, w->u) into f[slot] and t[slot]. */
+/* Evaluate at the current (w->y, w->u) into f[slot] and t[slot] (the
+ * tensions, then the vehicles' outputs). */
 static int eval_into(col_ws *w, int slot, int nl)
 {
     int rc = ts_kernel_eval(w->k, w->y, w->u, w->f[slot]);
-    if (rc == TS_OK)
+    if (rc == TS_OK) {
         memcpy(w->t[slot], ts_kernel_tensions(w->k),
                (size_t)nl * sizeof(double));
+        ts_kernel_outputs(w->k, w->t[slot] + nl);
+    }
     return rc;
 }
 
@@ -263,11 +301,12 @@ typedef struct col_err {
 } col_err;
 
 /* Differentiate column j (j < n: state, else input j - n). Writes the lower
- * block of the column, rows nq..n-1, into `col` (n - nq entries, stride 1)
- * and, when `tcol` is not NULL, the tension derivatives (nl entries). */
-static int column(col_ws *w, int j, int n, int nq, int nl, double h,
-                  int estimate, double *col, double *ecol, double *tcol,
-                  col_err *ce)
+ * block of the column, rows nq..n-1, into `col` (n - nq entries, stride 1),
+ * when `tcol` is not NULL the tension derivatives (nl entries), and when
+ * `ocol` is not NULL the vehicles' output derivatives (nout entries). */
+static int column(col_ws *w, int j, int n, int nq, int nl, int nout,
+                  double h, int estimate, double *col, double *ecol,
+                  double *tcol, double *ocol, col_err *ce)
 {
     double *x = j < n ? &w->y[j] : &w->u[j - n];
     double x0 = *x;
@@ -295,6 +334,8 @@ static int column(col_ws *w, int j, int n, int nq, int nl, double h,
             ce->sum2_a += e * e;
         }
     }
+    for (int o = 0; ocol && o < nout; o++)
+        ocol[o] = (w->t[0][nl + o] - w->t[1][nl + o]) * inv;
     if (tcol)
         for (int l = 0; l < nl; l++) {
             tcol[l] = (w->t[0][l] - w->t[1][l]) * inv;
@@ -441,6 +482,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         ts_linearize_opts_default(&o);
     int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k), nl = sys->nlinks;
     int ni = ts_kernel_ninput(k), ncol = n + ni, nlow = n - nq;
+    int nout = lin->noutput;
     if (lin->nstate != n || lin->nlinks != nl || lin->ninput != ni ||
         lin->nq != nq)
         return ts_fail(err, TS_EINVAL,
@@ -550,6 +592,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     memcpy(lin->r0, ts_kernel_positions(k),
            3 * (size_t)sys->nnodes * sizeof(double));
     memcpy(lin->t0, ts_kernel_tensions(k), (size_t)nl * sizeof(double));
+    if (nout > 0)
+        ts_kernel_outputs(k, lin->v0);
     const double *nk = ts_kernel_directions(k);
     for (int l = 0; l < nl; l++) {
         int qo = lin->qoff[l];
@@ -674,7 +718,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     if (!ws)
         return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
     for (int t = 0; t < nthreads && rc == TS_OK; t++)
-        rc = col_ws_alloc(&ws[t], k, t == 0, y0, u0, n, ni, nl, err);
+        rc = col_ws_alloc(&ws[t], k, t == 0, y0, u0, n, ni, nl, nout, err);
     if (rc != TS_OK) {
         for (int t = 0; t < nthreads; t++)
             col_ws_free(&ws[t], k);
@@ -711,9 +755,13 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
             double *ecol = !estimate ? NULL
                            : j < n   ? lin->Aerr + (size_t)j * nlow
                                      : lin->Berr + (size_t)(j - n) * nlow;
+            double *ocol = NULL;
+            if (nout > 0)
+                ocol = j < n ? lin->Vy + (size_t)j * nout
+                             : lin->Vu + (size_t)(j - n) * nout;
             col_err ce;
-            int crc = column(w, j, n, nq, nl, lin->h[j], estimate, col, ecol,
-                             tcol, &ce);
+            int crc = column(w, j, n, nq, nl, nout, lin->h[j], estimate, col,
+                             ecol, tcol, ocol, &ce);
             if (crc != TS_OK) {
 #ifdef _OPENMP
 #pragma omp critical(ts_linearize_fail)
@@ -805,26 +853,14 @@ int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
                        "about it would describe no steady state, so it is "
                        "not linearized",
                        eq->residual, eq->tolerance);
-    const ts_system *sys = ts_kernel_system(k);
-    int n = ts_kernel_nstate(k), nl = sys->nlinks;
+    int n = ts_kernel_nstate(k);
     double *y = calloc((size_t)n, sizeof(double));
-    double *strain = calloc((size_t)(nl > 0 ? nl : 1), sizeof(double));
-    if (!y || !strain) {
-        free(y);
-        free(strain);
+    if (!y)
         return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
-    }
-    /* Strains do not depend on the charts: take them from eq->y. */
-    for (int l = 0; l < nl; l++)
-        if (sys->links[l].elastic)
-            strain[l] = eq->y[ts_kernel_link_offset(k, l) + 2];
-    ts_kernel_set_shape(k, eq->directions, strain, NULL, NULL,
-                        TS_CHART_RECHART, y);
-    int rc = ts_equilibrium_set_bodies(k, eq, y, err);
+    int rc = ts_equilibrium_state(k, eq, y, err);
     if (rc == TS_OK)
         rc = ts_linearize(k, y, NULL, opts, lin, err);
     free(y);
-    free(strain);
     return rc;
 }
 

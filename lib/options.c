@@ -33,8 +33,6 @@ static const int eq_method_values[] = {TS_EQ_AUTO, TS_EQ_SHOOTING,
 static const char *const eig_methods[] = {"auto", "lapack", "arpack", NULL};
 static const int eig_method_values[] = {TS_EIG_AUTO, TS_EIG_LAPACK,
                                         TS_EIG_ARPACK};
-static const char *const inputs[] = {"tow.surge", "tow.sway", "tow.heave",
-                                     NULL};
 static const char *const integrators[] = {"rk8pd", "rkf45", "rk4imp",
                                           "bsimp", "msbdf", "esdirk", NULL};
 static const int integrator_values[] = {TS_INT_RK8PD, TS_INT_RKF45,
@@ -284,6 +282,11 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
      .min = 0, .max = 1, .flags = TS_OPT_MIN_OPEN | TS_OPT_MAX_OPEN,          \
      .offset = OFF(setup.equilibrium.tol), .arg = "X",                        \
      .help = "the equilibrium's relative force residual"}
+#define OPEN_LOOP_ROW                                                         \
+    {.name = "open_loop", .type = TS_OPT_BOOL, .section = TS_SEC_SETUP,       \
+     NOLIM, .offset = OFF(setup.open_loop),                                   \
+     .help = "the vehicles' controller loops open about the closed-loop "    \
+             "trim (the plant a controller is designed against)"}
 #define LINKS_ROW                                                             \
     {.name = "links", .type = TS_OPT_INT, .section = TS_SEC_SETUP, .min = 1,  \
      .max = TS_MAX_LINKS, .offset = OFF(setup.links), .arg = "N",             \
@@ -367,8 +370,9 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
     {.name = "excite", .type = TS_OPT_SPECS, .section = TS_SEC_SIMULATE,      \
      NOLIM, .flags = TS_OPT_REPEAT, .offset = OFF(simulate.excitation),       \
      .only = o, .arg = "SPEC",                                                \
-     .help = "tow-point excitation, e.g. "                                    \
-             "tow.heave:amplitude=0.1ft,frequency=1Hz",                       \
+     .help = "tow-point or vehicle-input excitation, e.g. "                   \
+             "tow.heave:amplitude=0.1ft,frequency=1Hz or "                    \
+             "fish.depth.setpoint:step,amplitude=5m",                         \
      .deftext = "none"},                                                      \
     {.name = "manoeuvre", .type = TS_OPT_SPECS, .section = TS_SEC_SIMULATE,   \
      NOLIM, .flags = TS_OPT_REPEAT, .offset = OFF(simulate.excitation),       \
@@ -420,6 +424,11 @@ static const ts_option modes_rows[] = {
      NOLIM, .choices = eig_methods, .values = eig_method_values,
      .offset = OFF(modes.eigen.method), .arg = "M",
      .help = "lapack: every eigenvalue; arpack: shift-invert, a subset"},
+    OPEN_LOOP_ROW,
+    {.name = "margins", .type = TS_OPT_BOOL, .section = TS_SEC_MODES, NOLIM,
+     .offset = OFF(modes.margins),
+     .help = "with controller loops: each loop's gain and phase margins, "
+             "broken one at a time"},
     {.name = "oscillatory", .type = TS_OPT_BOOL, .section = TS_SEC_MODES,
      NOLIM, .offset = OFF(modes.oscillatory),
      .help = "list the oscillatory modes only (they come first anyway)"},
@@ -430,14 +439,16 @@ static const ts_option response_rows[] = {
     LINKS_ROW,
     ACCURACY_ROWS,
     {.name = "input", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
-     .choices = inputs, .offset = OFF(response.input),
-     .size = SZ(response.input),
+     .offset = OFF(response.input), .size = SZ(response.input),
      .flag_offset = OFF(response.frequency_given), .arg = "NAME",
-     .help = "the tow point's motion"},
+     .help = "tow.surge, tow.sway or tow.heave, or a vehicle's input: "
+             "<vehicle>.<surface>, <vehicle>.<loop>, <vehicle>.<loop>.setpoint"},
     {.name = "output", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.output), .size = SZ(response.output),
      .arg = "NAME",
-     .help = "<node>.x|y|z (sphere.z, cable.3.x) or <cable>.<k>.tension",
+     .help = "<node>.x, .y or .z (sphere.z, cable.3.x), "
+             "<cable>.<k>.tension, or a vehicle's <vehicle>.depth, .pitch, "
+             ".roll, .yaw, .<loop>.output or .<surface>.deflection",
      .deftext = "required"},
     {.name = "from", .type = TS_OPT_QUANTITY, .section = TS_SEC_RESPONSE,
      .unit = "Hz", .min = 0, .max = INFINITY, .flags = TS_OPT_MIN_OPEN,
@@ -453,6 +464,7 @@ static const ts_option response_rows[] = {
      .min = 2, .max = TS_RESPONSE_MAX_POINTS, .offset = OFF(response.points),
      .flag_offset = OFF(response.frequency_given), .arg = "N",
      .help = "log-spaced frequencies"},
+    OPEN_LOOP_ROW,
     SEA_ROWS(TS_SEC_RESPONSE, response.sea),
     {.name = "intervals", .type = TS_OPT_INT, .section = TS_SEC_RESPONSE,
      .min = 16, .max = 1 << 20, .offset = OFF(response.intervals),
@@ -469,6 +481,7 @@ static const ts_option simulate_rows[] = {
     LINKS_ROW,
     ACCURACY_ROWS,
     SIM_ROWS(0),
+    OPEN_LOOP_ROW,
     SEA_ROWS(TS_SEC_SIMULATE, simulate.sea),
     {.name = "seed", .type = TS_OPT_LONG, .section = TS_SEC_SIMULATE,
      .min = 0, .max = 4294967295.0, .offset = OFF(simulate.seed), .arg = "N",
@@ -520,6 +533,7 @@ static const ts_option converge_rows[] = {
      .arg = "LIST", .help = "one series per integrator, e.g. rk8pd,msbdf",
      .deftext = "the simulation's integrator"},
     SETUP_ROWS,
+    OPEN_LOOP_ROW,
     SIM_ROWS(TS_ANALYSIS_SIMULATE + 1),
 };
 
@@ -683,9 +697,10 @@ static int add_specs(const ts_option *o, ts_request *rq, const char *text,
                          sg->axis == TS_AXIS_TURN_RATE;
             if (is_man != manoeuvre)
                 rc = ts_fail(err, TS_EINVAL, "%s: '%s' is %s; give it as %s",
-                             w, ts_axis_name(sg->axis),
+                             w, ts_signal_axis_label(sg),
                              is_man ? "a manoeuvre of the ship"
-                                    : "a tow-point excitation",
+                                    : "a tow-point or vehicle-input "
+                                      "excitation",
                              is_man ? "manoeuvre (--manoeuvre)"
                                     : "excite (--excite)");
             else if (sg->axis == TS_AXIS_SPEED && sg->absolute &&

@@ -310,6 +310,8 @@ double ts_output_value(const ts_system *sys, const ts_output *out,
                        const double tow_force[])
 {
     switch (out->kind) {
+    case TS_OUT_VEHICLE: /* needs a kernel (ts_kernel_outputs) */
+        return NAN;
     case TS_OUT_POSITION:
         return pos ? pos[3 * (size_t)out->node + (size_t)out->comp] : NAN;
     case TS_OUT_TENSION: return tens ? tens[out->link] : NAN;

@@ -275,6 +275,19 @@ int ts_plot_eigenvalues(const char *dir, const char *name, const char *title,
     return ts_plot_check(err);
 }
 
+int ts_plot_mode_animation(const char *dir, const char *name,
+                           const char *title, ts_plot_view view, int flags,
+                           const ts_plot_shape *eq, const double *re,
+                           const double *im, const char *label, int nframes,
+                           double seconds, const ts_plot_opts *opts,
+                           ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)view, (void)flags, (void)eq;
+    (void)re, (void)im, (void)label, (void)nframes, (void)seconds;
+    (void)opts;
+    return ts_plot_check(err);
+}
+
 int ts_plot_bode(const char *dir, const char *name, const char *title,
                  const char *mag_label, ts_plot_quantity out_q,
                  ts_plot_quantity in_q, int ncurves,
@@ -1230,7 +1243,75 @@ static int check_shape(const char *fn, const char *what, int i,
         return ts_fail(err, TS_EINVAL, "%s: %s[%d].style: expected solid or "
                                        "dashed, got %d",
                        fn, what, i, s->style);
+    if (s->noutlines < 0 || (s->noutlines > 0 && !s->outlines))
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].outlines: expected %d",
+                       fn, what, i, s->noutlines);
+    for (int b = 0; b < s->noutlines; b++) {
+        const ts_plot_outline *o = &s->outlines[b];
+        if (o->npoints < 0 || (o->npoints > 0 && !o->pts) ||
+            !isfinite(o->anchor[0]) || !isfinite(o->anchor[1]) ||
+            !isfinite(o->anchor[2]))
+            return ts_fail(err, TS_EINVAL, "%s: %s[%d].outlines[%d]: "
+                           "expected points and a finite anchor", fn, what,
+                           i, b);
+    }
     return TS_OK;
+}
+
+/* The magnification of the outlines of shapes[nshapes]: the smallest
+ * drawn at least TS_PLOT_OUTLINE_MIN of `extent` (m), at least 1. */
+static double outline_scale(int nshapes, const ts_plot_shape *shapes,
+                            double extent)
+{
+    double smallest = INFINITY;
+    for (int i = 0; i < nshapes; i++)
+        for (int b = 0; b < shapes[i].noutlines; b++) {
+            const ts_plot_outline *o = &shapes[i].outlines[b];
+            double lo[3] = {INFINITY, INFINITY, INFINITY};
+            double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (int k = 0; k < o->npoints; k++)
+                for (int j = 0; j < 3; j++)
+                    if (isfinite(o->pts[3 * k + j])) {
+                        lo[j] = fmin(lo[j], o->pts[3 * k + j]);
+                        hi[j] = fmax(hi[j], o->pts[3 * k + j]);
+                    }
+            double size = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1],
+                                                   hi[2] - lo[2]));
+            if (size > 0)
+                smallest = fmin(smallest, size);
+        }
+    if (!isfinite(smallest) || !(extent > 0))
+        return 1.0;
+    return fmax(1.0, TS_PLOT_OUTLINE_MIN * extent / smallest);
+}
+
+/* Draw the outlines of s in the side view (top 0) or the top view,
+ * magnified by `scale` about their anchors. */
+static void draw_outlines(frame *f, const ts_plot_shape *s, int top,
+                          double scale, const ts_plot_opts *u)
+{
+    for (int b = 0; b < s->noutlines; b++) {
+        const ts_plot_outline *o = &s->outlines[b];
+        double ph[2], pv[2];
+        int have = 0;
+        for (int k = 0; k < o->npoints; k++) {
+            const double *p = o->pts + 3 * (size_t)k;
+            if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+                have = 0;
+                continue;
+            }
+            double q[3];
+            for (int j = 0; j < 3; j++)
+                q[j] = o->anchor[j] + scale * (p[j] - o->anchor[j]);
+            ph[1] = pconv(TS_PLOT_LENGTH, u, q[0]);
+            pv[1] = pconv(TS_PLOT_LENGTH, u, top ? q[1] : q[2]);
+            if (have)
+                draw_line(f, 2, ph, pv);
+            ph[0] = ph[1];
+            pv[0] = pv[1];
+            have = 1;
+        }
+    }
 }
 
 /* Fill xy from pos (+ scale * disp when disp is not NULL). */
@@ -1497,6 +1578,22 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
     if (circles)
         legend_add(&L, "the ship's turning circle", COL_FG, TS_PLOT_DOTTED,
                    NULL);
+    /* extent is in the axes' unit, the outlines in m. */
+    double oscale = outline_scale(
+        c->nshapes, c->shapes,
+        extent / pconv(TS_PLOT_LENGTH, u, 1.0));
+    char olab[TEXT_MAX];
+    int outlines = 0;
+    for (int i = 0; i < c->nshapes; i++)
+        outlines |= c->shapes[i].noutlines > 0;
+    if (outlines) {
+        if (oscale > 1.0)
+            snprintf(olab, sizeof olab, "vehicles at their attitude, drawn "
+                     "%.3g times their size", oscale);
+        else
+            snprintf(olab, sizeof olab, "vehicles at their attitude");
+        legend_add(&L, olab, COL_FG, TS_PLOT_SOLID, NULL);
+    }
     PLFLT sx0, sx1, sy0, sy1;
     plgspa(&sx0, &sx1, &sy0, &sy1);
     legend_layout lay = legend_plan(&L, 0.87 * (sx1 - sx0));
@@ -1556,6 +1653,8 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
                        color_index(s->color, i));
         plwidth(CURVE_WIDTH);
         draw_marks(&f, s, &xy[i], 1.1);
+        plwidth(1.4);
+        draw_outlines(&f, s, top, oscale, u);
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
     axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, u);
@@ -1571,6 +1670,21 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
     return TS_OK;
 }
 
+/* begin(), and a view that is side or top. */
+static int begin_view(const char *fn, const char *dir, const char *name,
+                      const char *title, const ts_plot_opts **o,
+                      ts_plot_opts *defaults, ts_plot_view view, ts_err *err)
+{
+    int rc = begin(fn, dir, name, title, o, defaults, err);
+    if (rc)
+        return rc;
+    if (view != TS_PLOT_SIDE && view != TS_PLOT_TOP)
+        return ts_fail(err, TS_EINVAL, "%s: view: expected side or top, got "
+                                       "%d",
+                       fn, (int)view);
+    return TS_OK;
+}
+
 int ts_plot_shapes(const char *dir, const char *name, const char *title,
                    ts_plot_view view, int flags, int nshapes,
                    const ts_plot_shape shapes[], const ts_plot_opts *opts,
@@ -1578,13 +1692,9 @@ int ts_plot_shapes(const char *dir, const char *name, const char *title,
 {
     static const char fn[] = "ts_plot_shapes";
     ts_plot_opts def;
-    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
     if (rc)
         return rc;
-    if (view != TS_PLOT_SIDE && view != TS_PLOT_TOP)
-        return ts_fail(err, TS_EINVAL, "%s: view: expected side or top, got "
-                                       "%d",
-                       fn, (int)view);
     if (flags & ~(TS_PLOT_WATER | TS_PLOT_EQUAL))
         return ts_fail(err, TS_EINVAL, "%s: flags: unknown bits in %#x", fn,
                        (unsigned)flags);
@@ -1668,6 +1778,8 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
         pad_range(&lo[view][0], &hi[view][0], 0.05, extent);
         pad_range(&lo[view][1], &hi[view][1], 0.10, extent);
     }
+    double oscale = outline_scale(1, c->eq,
+                                  extent / pconv(TS_PLOT_LENGTH, u, 1.0));
     /* Rows from the top; normalised page coordinates. */
     double top_frac = (double)MODE_TOP_PX / height;
     double bottom_frac = (double)MODE_BOTTOM_PX / height;
@@ -1710,6 +1822,8 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
             plwidth(1.6);
             draw_shape_links(&f, c->eq, &s[0], water, work);
             draw_marks(&f, c->eq, &s[0], 0.8);
+            plwidth(1.2);
+            draw_outlines(&f, c->eq, view == 1, oscale, u);
             int col = color_index(0, m);
             for (int j = 1; j <= 2; j++) {
                 ts_plot_shape style = *c->eq;
@@ -1734,10 +1848,14 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
     plwind(0, 1, 0, 1);
     plcol0(COL_FG);
     plschr(0, 0.8);
-    snprintf(lab, sizeof lab,
-             "grey: equilibrium; solid, dashed: the mode at opposite phases, "
-             "largest displacement %.0f %% of the cable's extent",
-             100 * MODE_AMPLITUDE);
+    int nl = snprintf(lab, sizeof lab,
+                      "grey: equilibrium; solid, dashed: the mode at "
+                      "opposite phases, largest displacement %.0f %% of the "
+                      "cable's extent",
+                      100 * MODE_AMPLITUDE);
+    if (oscale > 1.0 && nl > 0 && (size_t)nl < sizeof lab)
+        snprintf(lab + nl, sizeof lab - (size_t)nl, "; vehicles at their "
+                 "trim attitude, drawn %.3g times their size", oscale);
     plschr(0, 1.0);
     {
         double w, h;
@@ -2198,6 +2316,238 @@ int ts_plot_bode(const char *dir, const char *name, const char *title,
                   curves,  nnat,      natural_hz};
     return render(fn, dir, name, title, opts, opts->height, draw_bode, &c,
                   err);
+}
+
+/* ---- mode animation (hand-written SVG) --------------------------------- */
+
+#define ANIM_LEFT 95.0
+#define ANIM_RIGHT 30.0
+#define ANIM_TOP 80.0
+#define ANIM_BOTTOM 70.0
+
+/* A step of about span / 5 of 1, 2 or 5 times a power of ten. */
+static double nice_step(double span)
+{
+    double p = pow(10.0, floor(log10(span / 5.0)));
+    double r = span / 5.0 / p;
+    return p * (r < 1.5 ? 1.0 : r < 3.5 ? 2.0 : r < 7.5 ? 5.0 : 10.0);
+}
+
+typedef struct anim_map {
+    double h0, h1, v0, v1;     /* window, display units */
+    double x0, x1, y0, y1;     /* plot box, px */
+} anim_map;
+
+static double anim_x(const anim_map *m, double h)
+{
+    return m->x0 + (h - m->h0) / (m->h1 - m->h0) * (m->x1 - m->x0);
+}
+
+/* Depth and starboard both grow down the page. */
+static double anim_y(const anim_map *m, double v)
+{
+    return m->y0 + (v - m->v0) / (m->v1 - m->v0) * (m->y1 - m->y0);
+}
+
+/* The links of a shape at xy as SVG path data ("M x y L x y ..."). */
+static void anim_path(FILE *f, const ts_plot_shape *s, const shape_xy *xy,
+                      const anim_map *m)
+{
+    for (int k = 0; k + 1 < s->nnodes; k++) {
+        int a = s->link_upper ? s->link_upper[k] : k, b = k + 1;
+        if (k == 0 || a != k)
+            fprintf(f, "%sM%.2f %.2f", k ? " " : "", anim_x(m, xy->h[a]),
+                    anim_y(m, xy->v[a]));
+        fprintf(f, " L%.2f %.2f", anim_x(m, xy->h[b]), anim_y(m, xy->v[b]));
+    }
+}
+
+static void anim_text(FILE *f, double x, double y, const char *anchor,
+                      double size, const char *text)
+{
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"%s\" "
+               "font-family=\"sans-serif\" font-size=\"%.0f\">",
+            x, y, anchor, size);
+    xml_escape(f, text);
+    fputs("</text>\n", f);
+}
+
+int ts_plot_mode_animation(const char *dir, const char *name,
+                           const char *title, ts_plot_view view, int flags,
+                           const ts_plot_shape *eq, const double *re,
+                           const double *im, const char *label, int nframes,
+                           double seconds, const ts_plot_opts *opts,
+                           ts_err *err)
+{
+    static const char fn[] = "ts_plot_mode_animation";
+    ts_plot_opts def;
+    int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
+    if (rc)
+        return rc;
+    if (!eq || !re || !im)
+        return ts_fail(err, TS_EINVAL, "%s: eq, re and im: expected a shape "
+                                       "and two displacement arrays",
+                       fn);
+    if ((rc = check_shape(fn, "eq", 0, eq, err)) ||
+        (rc = check_array(fn, "re", 0, re, 3 * eq->nnodes, 0, err)) ||
+        (rc = check_array(fn, "im", 0, im, 3 * eq->nnodes, 0, err)))
+        return rc;
+    if (nframes < 4 || nframes > TS_PLOT_MAX_FRAMES)
+        return ts_fail(err, TS_EINVAL, "%s: nframes: must be in [4, %d], got "
+                                       "%d",
+                       fn, TS_PLOT_MAX_FRAMES, nframes);
+    if (!(seconds > 0) || !isfinite(seconds))
+        return ts_fail(err, TS_EINVAL, "%s: seconds: must be > 0, got %g",
+                       fn, seconds);
+    int n = eq->nnodes;
+    /* Scale: the largest node displacement over the cycle (|v| per node)
+     * is 15 % of the equilibrium's extent. */
+    shape_xy base = {0};
+    if ((rc = shape_coords(eq, NULL, 0, view, opts, &base)))
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory", fn);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    double amax = 0;
+    for (int k = 0; k < n; k++) {
+        bbox_update(&lo[0], &hi[0], base.h[k]);
+        bbox_update(&lo[1], &hi[1], base.v[k]);
+        double a = 0;
+        for (int j = 0; j < 3; j++)
+            a += re[3 * k + j] * re[3 * k + j] + im[3 * k + j] * im[3 * k + j];
+        amax = fmax(amax, sqrt(a));
+    }
+    double extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    if (!(extent > 0))
+        extent = pconv(TS_PLOT_LENGTH, opts, 1.0);
+    double scale = amax > 0 ? 0.15 * extent / pconv(TS_PLOT_LENGTH, opts, 1.0) /
+                                  amax
+                            : 0;
+    /* The frames, phase 2 pi k / nframes: eq + scale Re(v e^{i phi}). */
+    shape_xy *fr = calloc((size_t)nframes, sizeof *fr);
+    double *d = malloc(3 * (size_t)n * sizeof *d);
+    for (int i = 0; fr && d && rc == TS_OK && i < nframes; i++) {
+        double ph = 2 * M_PI * i / nframes, c = cos(ph), s = sin(ph);
+        for (int j = 0; j < 3 * n; j++)
+            d[j] = re[j] * c - im[j] * s;
+        rc = shape_coords(eq, d, scale, view, opts, &fr[i]);
+        for (int k = 0; rc == TS_OK && k < n; k++) {
+            bbox_update(&lo[0], &hi[0], fr[i].h[k]);
+            bbox_update(&lo[1], &hi[1], fr[i].v[k]);
+        }
+    }
+    if (!fr || !d)
+        rc = TS_ENOMEM;
+    int water = (flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE;
+    if (water)
+        bbox_update(&lo[1], &hi[1], 0);
+    pad_range(&lo[0], &hi[0], 0.06, 1.0);
+    pad_range(&lo[1], &hi[1], 0.06, 1.0);
+    anim_map m = {lo[0], hi[0], lo[1], hi[1], ANIM_LEFT,
+                  opts->width - ANIM_RIGHT, ANIM_TOP,
+                  opts->height - ANIM_BOTTOM};
+    if (view == TS_PLOT_TOP) {
+        /* Equal scales: widen the shorter range to the box's aspect. */
+        double sx = (hi[0] - lo[0]) / (m.x1 - m.x0);
+        double sy = (hi[1] - lo[1]) / (m.y1 - m.y0);
+        double s = fmax(sx, sy), ch = 0.5 * (lo[0] + hi[0]),
+               cv = 0.5 * (lo[1] + hi[1]);
+        m.h0 = ch - 0.5 * s * (m.x1 - m.x0);
+        m.h1 = ch + 0.5 * s * (m.x1 - m.x0);
+        m.v0 = cv - 0.5 * s * (m.y1 - m.y0);
+        m.v1 = cv + 0.5 * s * (m.y1 - m.y0);
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.svg", dir, name);
+    tsi_outfile out;
+    if (rc == TS_OK)
+        rc = tsi_outfile_open(&out, path, err);
+    else
+        ts_fail(err, rc, "%s: out of memory", fn);
+    if (rc == TS_OK) {
+        FILE *f = out.f;
+        int W = opts->width, H = opts->height;
+        fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                   "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%dpt\" "
+                   "height=\"%dpt\" viewBox=\"0 0 %d %d\">\n<title>",
+                W, H, W, H);
+        xml_escape(f, title);
+        fprintf(f, "</title>\n<rect width=\"%d\" height=\"%d\" "
+                   "fill=\"white\"/>\n", W, H);
+        if (water && m.v1 > 0) {
+            double yw = anim_y(&m, fmax(0, m.v0));
+            fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" "
+                       "height=\"%.2f\" fill=\"rgb(222,236,250)\"/>\n"
+                       "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
+                       "stroke=\"rgb(50,110,190)\"/>\n",
+                    m.x0, yw, m.x1 - m.x0, m.y1 - yw, m.x0, yw, m.x1, yw);
+        }
+        /* Grid, ticks and their labels. */
+        char t[64];
+        for (int a = 0; a < 2; a++) {
+            double a0 = a ? m.v0 : m.h0, a1 = a ? m.v1 : m.h1;
+            double st = nice_step(a1 - a0);
+            for (double v = ceil(a0 / st) * st; v <= a1 + 1e-9 * st;
+                 v += st) {
+                double p = a ? anim_y(&m, v) : anim_x(&m, v);
+                snprintf(t, sizeof t, "%g", fabs(v) < 1e-9 * st ? 0.0 : v);
+                if (a)
+                    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" "
+                               "y2=\"%.2f\" stroke=\"rgb(222,222,222)\"/>\n",
+                            m.x0, p, m.x1, p);
+                else
+                    fprintf(f, "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" "
+                               "y2=\"%.2f\" stroke=\"rgb(222,222,222)\"/>\n",
+                            p, m.y0, p, m.y1);
+                if (a)
+                    anim_text(f, m.x0 - 8, p + 5, "end", 16, t);
+                else
+                    anim_text(f, p, m.y1 + 22, "middle", 16, t);
+            }
+        }
+        fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" "
+                   "height=\"%.2f\" fill=\"none\" stroke=\"black\"/>\n",
+                m.x0, m.y0, m.x1 - m.x0, m.y1 - m.y0);
+        char axis[TEXT_MAX];
+        snprintf(axis, sizeof axis, "x, forward [%s]",
+                 punit(TS_PLOT_LENGTH, opts));
+        anim_text(f, 0.5 * (m.x0 + m.x1), H - 18, "middle", 18, axis);
+        snprintf(axis, sizeof axis, "%s [%s]",
+                 view == TS_PLOT_TOP ? "y, starboard" : "z, depth",
+                 punit(TS_PLOT_LENGTH, opts));
+        fprintf(f, "<g transform=\"translate(24,%.1f) rotate(-90)\">",
+                0.5 * (m.y0 + m.y1));
+        anim_text(f, 0, 0, "middle", 18, axis);
+        fputs("</g>\n", f);
+        anim_text(f, 0.5 * W, 32, "middle", 22, title);
+        if (label)
+            anim_text(f, m.x0, ANIM_TOP - 12, "start", 17, label);
+        /* The equilibrium (grey), then the mode's cycle. */
+        fputs("<path fill=\"none\" stroke=\"rgb(140,140,140)\" "
+              "stroke-width=\"1.6\" d=\"", f);
+        anim_path(f, eq, &base, &m);
+        fputs("\"/>\n<path fill=\"none\" stroke=\"rgb(0,114,178)\" "
+              "stroke-width=\"2.2\" d=\"", f);
+        anim_path(f, eq, &fr[0], &m);
+        fprintf(f, "\">\n<animate attributeName=\"d\" dur=\"%gs\" "
+                   "repeatCount=\"indefinite\" values=\"",
+                seconds);
+        for (int i = 0; i <= nframes; i++) {
+            anim_path(f, eq, &fr[i % nframes], &m);
+            fputs(i < nframes ? ";" : "", f);
+        }
+        fputs("\"/>\n</path>\n</svg>\n", f);
+        rc = ferror(f) ? ts_fail(err, TS_EIO, "%s: write failed", path)
+                       : TS_OK;
+        if (rc == TS_OK)
+            rc = tsi_outfile_commit(&out, err);
+        else
+            tsi_outfile_abandon(&out);
+    }
+    for (int i = 0; fr && i < nframes; i++)
+        free(fr[i].h);
+    free(fr);
+    free(d);
+    free(base.h);
+    return rc;
 }
 
 /* ---- histories ------------------------------------------------------- */

@@ -48,7 +48,7 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
 {
     const ts_body *bd = &sys->bodies[r->body];
     const ts_vehicle *d = bd->vehicle;
-    json_t *comps = json_array(), *defl = json_object(), *loops = json_array();
+    json_t *comps = json_array(), *loops = json_array();
     json_t *o = json_pack(
         "{s:s,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}",
         "name", bd->name, "x", num(r->origin[0]), "y", num(r->origin[1]),
@@ -59,34 +59,31 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
         "joint_force", vec3(r->joint_force), "hydro_force",
         vec3(r->hydro_force), "hydro_moment", vec3(r->hydro_moment),
         "munk_moment", vec3(r->munk), "mass_centre", vec3(r->mass_centre));
-    if (!o || !comps || !defl || !loops) {
+    if (!o || !comps || !loops) {
         json_decref(o);
         json_decref(comps);
-        json_decref(defl);
         json_decref(loops);
         return NULL;
     }
     for (int c = 0; c < r->ncomponents; c++) {
         const ts_component *cp = &d->component[c];
         const ts_component_load *ld = &r->load[c];
-        json_array_append_new(
-            comps, json_pack("{s:s,s:s,s:o,s:o,s:o,s:o}", "name", cp->name,
-                             "type",
-                             cp->type == TS_COMP_HULL    ? "hull"
-                             : cp->type == TS_COMP_BLUFF ? "bluff"
-                                                         : "surface",
-                             "force", vec3(ld->force), "moment",
-                             vec3(ld->moment), "alpha_deg",
-                             num(ld->alpha * DEG), "speed", num(ld->speed)));
-        if (cp->control)
-            json_object_set_new(defl, cp->name, num(r->delta[c] * DEG));
+        json_t *e = json_pack(
+            "{s:s,s:s,s:o,s:o,s:o,s:o}", "name", cp->name, "type",
+            cp->type == TS_COMP_HULL    ? "hull"
+            : cp->type == TS_COMP_BLUFF ? "bluff"
+                                        : "surface",
+            "force", vec3(ld->force), "moment", vec3(ld->moment), "alpha_deg",
+            num(ld->alpha * DEG), "speed", num(ld->speed));
+        if (e && cp->control)
+            json_object_set_new(e, "deflection_deg", num(r->delta[c] * DEG));
+        json_array_append_new(comps, e);
     }
     for (int l = 0; l < r->nloops; l++)
         json_array_append_new(
             loops, json_pack("{s:s,s:o,s:o}", "name", d->loop[l].name,
                              "error", num(r->loop_error[l]), "output_deg",
                              num(r->loop_output[l] * DEG)));
-    json_object_set_new(o, "deflections_deg", defl);
     json_object_set_new(o, "components", comps);
     json_object_set_new(o, "controllers", loops);
     return o;

@@ -115,6 +115,7 @@ json_t *ts_report_convergence_json(const ts_convergence *c)
         if (r->status != TS_OK)
             json_object_set_new(row, "message", json_string(r->message));
         json_object_set_new(row, "wall_s", num(r->wall_s));
+        json_object_set_new(row, "timed_runs", json_integer(r->timed_runs));
         json_object_set_new(row, "evaluations",
                             json_integer((json_int_t)r->evaluations));
         json_object_set_new(row, "values", by_name(c, r->values));

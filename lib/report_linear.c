@@ -43,7 +43,7 @@ json_t *ts_report_linear_json(const ts_linear *lin, int matrices)
         return NULL;
     }
     for (int j = 0; j < lin->ninput; j++)
-        json_array_append_new(inputs, json_string(ts_input_name(j)));
+        json_array_append_new(inputs, json_string(lin->input_name[j]));
     json_object_set_new(o, "nstate", json_integer(lin->nstate));
     json_object_set_new(o, "nq", json_integer(lin->nq));
     json_object_set_new(o, "ninput", json_integer(lin->ninput));
@@ -239,9 +239,9 @@ json_t *ts_report_response_json(const ts_response *r)
         json_decref(pts);
         return NULL;
     }
-    json_object_set_new(o, "input", json_string(ts_input_name(r->input)));
+    json_object_set_new(o, "input", json_string(r->input_name));
     json_object_set_new(o, "output", json_string(r->output.name));
-    json_object_set_new(o, "unit", json_string(r->output.unit));
+    json_object_set_new(o, "unit", json_string(r->unit));
     json_object_set_new(o, "static_gain", num(r->static_gain));
     for (int i = 0; i < r->npoints; i++)
         json_array_append_new(

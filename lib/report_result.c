@@ -37,6 +37,40 @@ static json_t *eq_json(const ts_result *r, const ts_trust *t)
                : NULL;
 }
 
+/* The loops' margins: [{name, gain_margin, gain_margin_db,
+ * phase_crossover_hz, phase_margin_deg, gain_crossover_hz}] (null where
+ * there is no crossing in the band), with the band and run time. */
+static json_t *margins_json(const ts_result *r)
+{
+    json_t *o = json_object(), *a = json_array();
+    if (!o || !a) {
+        json_decref(o);
+        json_decref(a);
+        return NULL;
+    }
+    for (int i = 0; i < r->nmargins; i++) {
+        const ts_loop_margin *m = &r->margins[i];
+        json_t *e = json_object();
+        if (!e)
+            break;
+        json_object_set_new(e, "name", json_string(m->name));
+        json_object_set_new(e, "gain_margin", num(m->gain_margin));
+        json_object_set_new(e, "gain_margin_db",
+                            num(20.0 * log10(m->gain_margin)));
+        json_object_set_new(e, "phase_crossover_hz",
+                            num(m->phase_crossover_hz));
+        json_object_set_new(e, "phase_margin_deg", num(m->phase_margin_deg));
+        json_object_set_new(e, "gain_crossover_hz",
+                            num(m->gain_crossover_hz));
+        json_array_append_new(a, e);
+    }
+    json_object_set_new(o, "loops", a);
+    json_object_set_new(o, "from_hz", json_real(TS_MARGINS_FROM_HZ));
+    json_object_set_new(o, "to_hz", json_real(TS_MARGINS_TO_HZ));
+    json_object_set_new(o, "wall_s", json_real(r->margins_wall_s));
+    return o;
+}
+
 /* {"discretisation": d, "solver": s} */
 static json_t *error_json(double disc, double solver)
 {
@@ -111,6 +145,8 @@ static json_t *modes_json(const ts_result *r, int flags)
         json_object_set_new(j, "linearization",
                             ts_report_linear_json(r->lin,
                                                   flags & TS_REPORT_MATRICES));
+    if (j && r->nmargins > 0)
+        json_object_set_new(j, "margins", margins_json(r));
     return j;
 }
 
@@ -434,6 +470,8 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
         if (e)
             json_object_set_new(j, "equilibrium", e);
     }
+    if (r->open_loop)
+        json_object_set_new(j, "open_loop", json_true());
     json_object_set_new(j, "type", json_string(ts_analysis_name(r->kind)));
     json_object_set_new(j, "completed", json_boolean(r->completed));
     if (r->status != TS_OK)

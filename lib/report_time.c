@@ -73,6 +73,11 @@ json_t *ts_report_channels_json(const ts_system *sys, const ts_history *h,
                                                           i)));
         json_object_set_new(ch, outs[k].name, a);
     }
+    /* The vehicles' outputs (m, rad), every one. */
+    for (int j = 0; h->outputs && j < h->noutput; j++)
+        json_object_set_new(ch, h->output_name[j],
+                            series(h->outputs + j, h->nsamples,
+                                   (size_t)h->noutput));
     json_object_set_new(o, "outputs", ch);
     return o;
 }
@@ -148,6 +153,16 @@ json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
                                       series(h->energy, n, 2), "potential",
                                       series(h->energy + 1, n, 2)));
     }
+    if (h->noutput > 0 && h->outputs) {
+        /* The vehicles' depth, attitude, loop outputs and deflections. */
+        json_t *vo = json_array();
+        for (int j = 0; vo && j < h->noutput; j++)
+            json_array_append_new(
+                vo, json_pack("{s:s,s:s,s:o}", "name", h->output_name[j],
+                              "unit", h->output_unit[j], "value",
+                              series(h->outputs + j, n, (size_t)h->noutput)));
+        json_object_set_new(o, "vehicle_outputs", vo);
+    }
     return o;
 }
 
@@ -192,6 +207,8 @@ json_t *ts_report_excitation_json(const ts_excitation *ex)
         const ts_signal *s = ts_excitation_signal(ex, i);
         json_t *o = json_pack("{s:s,s:s}", "axis", ts_axis_name(s->axis),
                               "type", ts_signal_type_name(s->type));
+        if (o && s->axis == TS_AXIS_INPUT)
+            json_object_set_new(o, "input", json_string(s->input));
         switch (s->type) {
         case TS_SIGNAL_CRANK:
             json_object_set_new(o, "rod", num(s->rod));
@@ -283,6 +300,21 @@ static void cols_units(csv_cols *c, const ts_display *d)
                           sizeof c->t);
 }
 
+/* The vehicles' outputs of a run, SI (m, rad): their columns and their
+ * cells of row i. */
+static void vehicle_header(FILE *f, const ts_history *h, const char *prefix)
+{
+    for (int j = 0; h->outputs && j < h->noutput; j++)
+        fprintf(f, ",%s%s_%s", prefix, h->output_name[j], h->output_unit[j]);
+}
+
+static void vehicle_row(FILE *f, const ts_history *h, int i)
+{
+    const double *o = h->outputs ? h->outputs + (size_t)h->noutput * i : NULL;
+    for (int j = 0; o && j < h->noutput; j++)
+        fprintf(f, ",%.17g", o[j]);
+}
+
 /* The full state: every node, every link's tension and the tow force
  * (nonlinear runs). */
 static void full_header(csv_cols *c, FILE *f, const ts_history *h,
@@ -309,6 +341,7 @@ static void full_header(csv_cols *c, FILE *f, const ts_history *h,
     if (has_forces(h))
         fprintf(f, ",%stow.force.x_%s,%stow.force.y_%s,%stow.force.z_%s",
                 prefix, fu, prefix, fu, prefix, fu);
+    vehicle_header(f, h, prefix);
 }
 
 static void full_row(csv_cols *c, FILE *f, const ts_history *h, int i,
@@ -328,6 +361,7 @@ static void full_row(csv_cols *c, FILE *f, const ts_history *h, int i,
             fprintf(f, ",%.17g",
                     ts_display_value(c->d, TS_QTY_FORCE,
                                      h->tow_force[3 * (size_t)i + (size_t)k]));
+    vehicle_row(f, h, i);
 }
 
 int ts_report_history_csv(const ts_system *sys, const ts_history *nl,
@@ -364,6 +398,7 @@ static void channels_header(csv_cols *c, FILE *f, const ts_history *h,
         fprintf(f, ",%s%s%s%s", prefix, c->outs[k].name, bare ? "" : "_",
                 bare ? "" : t);
     }
+    vehicle_header(f, h, prefix);
 }
 
 static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
@@ -378,6 +413,7 @@ static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
                                        ts_history_value(c->sys, h,
                                                         &c->outs[k], i),
                                        u, sizeof u));
+    vehicle_row(f, h, i);
 }
 
 int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,

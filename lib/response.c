@@ -56,6 +56,57 @@ void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
                                         "output)");
 }
 
+int ts_response_input_lookup(const ts_kernel *k, const char *name,
+                             int *channel, ts_err *err)
+{
+    if (ts_response_input_find(name, channel, NULL) == TS_OK)
+        return TS_OK;
+    int j = ts_kernel_input_find(k, name);
+    if (j >= TS_NINPUT) {
+        *channel = j;
+        return TS_OK;
+    }
+    char list[1024], nm[TS_IO_NAME];
+    size_t len = 0;
+    list[0] = '\0';
+    for (int i = TS_NINPUT; i < ts_kernel_ninput(k) && len < sizeof list;
+         i++)
+        len += (size_t)snprintf(list + len, sizeof list - len, ", %s",
+                                ts_kernel_input_name(k, i, nm, sizeof nm));
+    return ts_fail(err, TS_EINVAL,
+                   "input '%s': not an input; expected tow.surge, tow.sway, "
+                   "tow.heave%s",
+                   name, list);
+}
+
+int ts_response_output_lookup(const ts_kernel *k, const char *name,
+                              ts_output *out, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int j = ts_kernel_output_find(k, name);
+    if (j >= 0) {
+        memset(out, 0, sizeof *out);
+        out->kind = TS_OUT_VEHICLE;
+        out->index = j;
+        out->unit = out->si_unit = ts_kernel_output_unit(k, j);
+        snprintf(out->name, sizeof out->name, "%s", name);
+        return TS_OK;
+    }
+    int rc = ts_response_output_find(sys, name, out, err);
+    if (rc != TS_OK && err && ts_kernel_noutput(k) > 0) {
+        /* Append the vehicles' outputs to the list of valid names. */
+        char nm[TS_IO_NAME];
+        size_t len = strlen(err->msg);
+        for (int i = 0; i < ts_kernel_noutput(k) && len < sizeof err->msg;
+             i++)
+            len += (size_t)snprintf(err->msg + len, sizeof err->msg - len,
+                                    "%s%s", i ? ", " : "; vehicles: ",
+                                    ts_kernel_output_name(k, i, nm,
+                                                          sizeof nm));
+    }
+    return rc;
+}
+
 int ts_response_output_find(const ts_system *sys, const char *name,
                             ts_output *out, ts_err *err)
 {
@@ -140,7 +191,10 @@ typedef struct resp_ws {
 static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
                          resp_ws *w)
 {
-    if (!lin->Aerr || !lin->Berr || !lin->fnoise)
+    /* A vehicle's controller block (the Schur complement in P) and a
+     * vehicle's input are not covered (doc/linear.md, section 4). */
+    if (!lin->Aerr || !lin->Berr || !lin->fnoise || sh->nc > 0 ||
+        sh->full || input >= TS_NINPUT)
         return NAN;
     int n = lin->nstate, nq = lin->nq, nlow = n - nq, one = 1, info = 0;
     double complex s = sh->s;
@@ -186,21 +240,48 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
     return 10.0 * (cabs(trunc) + sqrt(0.5 * wn2 * xh2));
 }
 
-/* The dense way (see the head of the file); lin holds A, B, Ty, Tu.
- * With gerr, the gain's error allowance (gain_error) into *gerr. */
+/* Row `row` of an output Jacobian pair (Jy [rows x n], Ju [rows x
+ * ninput], column-major with leading dimension `rows`) applied to the
+ * state response x and the input columns cols[3] (displacement, velocity,
+ * acceleration; cv, ca their factors): Jy x + Ju (b0 + cv b1 + ca b2). */
+static double complex row_gain(const double *Jy, const double *Ju, int row,
+                               int rows, int n, const double complex *x,
+                               const int cols[3], double complex cv,
+                               double complex ca)
+{
+    double complex acc = 0;
+    for (int j = 0; j < n; j++)
+        acc += Jy[row + (size_t)j * rows] * x[j];
+    return acc + Ju[row + (size_t)cols[0] * rows] +
+           cv * Ju[row + (size_t)cols[1] * rows] +
+           ca * Ju[row + (size_t)cols[2] * rows];
+}
+
+/* The dense way (see the head of the file); lin holds A, B, Ty, Tu and
+ * the vehicles' output Jacobians Vy, Vu. A tow displacement input brings
+ * its velocity and acceleration columns; a vehicle's input (>= TS_NINPUT)
+ * is its column alone. With gerr, the gain's error allowance (gain_error)
+ * into *gerr. */
 static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
                        const ts_output *out, tsi_shift *sh, resp_ws *w,
                        double complex *g, double *gerr)
 {
     int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
     double complex s = sh->s;
-    const double *Bx = lin->B + (size_t)(TS_IN_DISP + input) * n;
-    const double *Bv = lin->B + (size_t)(TS_IN_VEL + input) * n;
-    const double *Ba = lin->B + (size_t)(TS_IN_ACC + input) * n;
+    int tow = input < TS_NINPUT;
+    int cols[3] = {tow ? TS_IN_DISP + input : input,
+                   TS_IN_VEL + (tow ? input : 0),
+                   TS_IN_ACC + (tow ? input : 0)};
+    double complex cv = tow ? s : 0.0, ca = tow ? s * s : 0.0;
+    const double *Bx = lin->B + (size_t)cols[0] * n;
+    const double *Bv = lin->B + (size_t)cols[1] * n;
+    const double *Ba = lin->B + (size_t)cols[2] * n;
     for (int i = 0; i < n; i++)
-        w->b[i] = -(Bx[i] + s * Bv[i] + s * s * Ba[i]);
+        w->b[i] = -(Bx[i] + cv * Bv[i] + ca * Ba[i]);
     tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
-    if (gerr) {
+    if (gerr && out->kind != TS_OUT_POSITION && out->kind != TS_OUT_TENSION) {
+        *gerr = NAN; /* a vehicle's output: not covered */
+    } else if (gerr) {
         /* rho: the gain's weights on x1 (x2 = s x1 for lower-row z). */
         for (int i = 0; i < nq; i++)
             w->rho[i] = out->kind == TS_OUT_POSITION
@@ -220,16 +301,12 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
             w->dq[i] = cimag(w->x[i]);
         ts_linear_node_displacements(sys, lin, w->dq, w->drr);
         double gi = w->drr[idx];
-        *g = gr + I * gi + (out->comp == input ? 1.0 : 0.0);
+        *g = gr + I * gi + (tow && out->comp == input ? 1.0 : 0.0);
+    } else if (out->kind == TS_OUT_TENSION) {
+        *g = row_gain(lin->Ty, lin->Tu, out->link, nl, n, w->x, cols, cv, ca);
     } else {
-        int l = out->link;
-        double complex acc = 0;
-        for (int j = 0; j < n; j++)
-            acc += lin->Ty[l + (size_t)j * nl] * w->x[j];
-        acc += lin->Tu[l + (size_t)(TS_IN_DISP + input) * nl] +
-               s * lin->Tu[l + (size_t)(TS_IN_VEL + input) * nl] +
-               s * s * lin->Tu[l + (size_t)(TS_IN_ACC + input) * nl];
-        *g = acc;
+        *g = row_gain(lin->Vy, lin->Vu, out->index, lin->noutput, n, w->x,
+                      cols, cv, ca);
     }
 }
 
@@ -271,11 +348,17 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
                        "response: the linear model has %d links, the system "
                        "%d",
                        lin->nlinks, sys->nlinks);
-    if (input < 0 || input > 2)
+    if (!((input >= 0 && input <= 2) ||
+          (input >= TS_NINPUT && input < lin->ninput)))
         return ts_fail(err, TS_EINVAL,
                        "response: input channel must be 0, 1 or 2 "
-                       "(tow.surge, tow.sway, tow.heave), got %d",
-                       input);
+                       "(tow.surge, tow.sway, tow.heave) or a vehicle's "
+                       "input, %d to %d, got %d",
+                       TS_NINPUT, lin->ninput - 1, input);
+    if (lin->desc && (input >= TS_NINPUT || out->kind == TS_OUT_VEHICLE))
+        return ts_fail(err, TS_EINVAL, "response: a vehicle's input or "
+                       "output needs the dense model (the sparse one has no "
+                       "vehicles)");
     if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
                        "response: output %s needs a linear model (sparse, "
@@ -298,6 +381,11 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
         return ts_fail(err, TS_EINVAL, "response: output link %d out of "
                                        "range",
                        out->link);
+    if (out->kind == TS_OUT_VEHICLE &&
+        (out->index < 0 || out->index >= lin->noutput))
+        return ts_fail(err, TS_EINVAL, "response: vehicle output %d out of "
+                                       "range",
+                       out->index);
     return TS_OK;
 }
 
@@ -412,6 +500,12 @@ int ts_response_compute(const ts_system *sys, const ts_linear *lin,
     r->input = input;
     r->output = *out;
     r->npoints = npoints;
+    snprintf(r->input_name, sizeof r->input_name, "%s",
+             lin->input_name[input]);
+    const char *ou = out->kind == TS_OUT_POSITION  ? "m"
+                     : out->kind == TS_OUT_TENSION ? "N"
+                                                   : out->unit;
+    snprintf(r->unit, sizeof r->unit, "%s/%s", ou, lin->input_unit[input]);
     double complex g = 0;
     tsi_shift sh = {0};
     rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,

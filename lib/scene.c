@@ -1043,18 +1043,6 @@ static int parse_vehicle(const ctx *c, const yaml_node_t *n, const char *path,
                   : ts_fail(c->err, TS_ESCENE, "%s: broken YAML", p);
         v->nloops = j + 1;
     }
-    /* The analyses do not take control inputs and controller states yet:
-     * refuse them rather than ignore them. */
-    if (rc == TS_OK && nl > 0)
-        return fail_at(c, TS_EINVAL, join(p, path, "controllers"),
-                       g[V_CONTROLLERS].line, "controllers are not supported "
-                       "yet by the analyses");
-    for (int j = 0; rc == TS_OK && j < nc; j++)
-        if (v->component[j].control)
-            return fail_at(c, TS_EINVAL, index_path(pc, p, j),
-                           v->component[j].line, "control surfaces are not "
-                           "supported yet by the analyses (give a fixed "
-                           "surface an incidence)");
     return rc;
 }
 

@@ -10,6 +10,7 @@
 #include "shift.h"
 
 #include <klu.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -39,22 +40,68 @@ void tsi_shift_free(tsi_shift *sh)
     free(sh->u1);
     free(sh->u2);
     free(sh->w);
+    free(sh->hlu);
+    free(sh->hpiv);
+    free(sh->wc);
+    free(sh->full);
+    free(sh->fpiv);
     memset(sh, 0, sizeof *sh);
 }
 
 /* ---- Dense backend (lib/shift.h: systems with vehicles) -------------- */
 
+/* A failed LU of the shifted matrix (LAPACK `what`, its info). */
+static int factor_failed(int info, const char *what, double complex s,
+                         ts_err *err)
+{
+    if (info < 0)
+        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d", what,
+                       info);
+    return ts_fail(err, TS_ESINGULAR,
+                   "eigen: A - s I is singular at s = %g%+gi 1/s (an "
+                   "eigenvalue sits on the shift; move the target slightly)",
+                   creal(s), cimag(s));
+}
+
+/* The whole A - s I, factored (complex LU): the fallback when the
+ * controller block H - s I is singular. */
+static int full_factor(tsi_shift *sh, ts_err *err)
+{
+    int n = sh->n, info = 0;
+    const double *A = sh->lin->A;
+    sh->full = malloc((size_t)n * (size_t)n * sizeof(double complex));
+    sh->fpiv = malloc((size_t)n * sizeof(int));
+    if (!sh->full || !sh->fpiv) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory for the %d x "
+                       "%d shifted matrix", n, n);
+    }
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++)
+        sh->full[i] = A[i];
+    for (int i = 0; i < n; i++)
+        sh->full[(size_t)i * n + i] -= sh->s;
+    zgetrf_(&n, &n, sh->full, &n, sh->fpiv, &info);
+    if (info != 0) {
+        double complex s = sh->s;
+        tsi_shift_free(sh);
+        return factor_failed(info, "zgetrf", s, err);
+    }
+    return TS_OK;
+}
+
 static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                         ts_err *err)
 {
     memset(sh, 0, sizeof *sh);
-    int nq = lin->nq, n = lin->nstate, info = 0;
+    int nq = lin->nq, n = lin->nstate, nc = n - 2 * nq, info = 0;
     size_t nn = (size_t)nq * (size_t)nq;
     sh->lin = lin;
     sh->nq = nq;
     sh->n = n;
+    sh->nc = nc;
     sh->s = s;
-    sh->is_complex = cimag(s) != 0.0;
+    /* Controller states: the Schur complement is complex in general. */
+    sh->is_complex = cimag(s) != 0.0 || nc > 0;
     sh->ipiv = malloc((size_t)nq * sizeof(int));
     sh->zw = malloc((size_t)nq * sizeof(double complex));
     sh->wr = malloc(2 * (size_t)nq * sizeof(double));
@@ -62,13 +109,22 @@ static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
         sh->zlu = malloc(nn * sizeof(double complex));
     else
         sh->lu = malloc(nn * sizeof(double));
-    if (!sh->ipiv || !sh->zw || !sh->wr || (!sh->zlu && !sh->lu)) {
+    double complex *MF = NULL;
+    if (nc > 0) {
+        sh->hlu = malloc((size_t)nc * (size_t)nc * sizeof(double complex));
+        sh->hpiv = malloc((size_t)nc * sizeof(int));
+        sh->wc = malloc(2 * (size_t)nc * sizeof(double complex));
+        MF = malloc((size_t)nc * (size_t)nq * sizeof(double complex));
+    }
+    if (!sh->ipiv || !sh->zw || !sh->wr || (!sh->zlu && !sh->lu) ||
+        (nc > 0 && (!sh->hlu || !sh->hpiv || !sh->wc || !MF))) {
+        free(MF);
         tsi_shift_free(sh);
         return ts_fail_nomem(err, (sh->is_complex ? 16.0 : 8.0) * (double)nn,
                              "fewer links", "eigen: out of memory for the "
                              "%d x %d shifted matrix", nq, nq);
     }
-    /* P = K + s C - s^2 I; K = A[nq:, :nq], C = A[nq:, nq:]. */
+    /* P = K + s C - s^2 I; K = A[nq:2nq, :nq], C = A[nq:2nq, nq:2nq]. */
     const double *A = lin->A;
     double complex s2 = s * s;
     for (int j = 0; j < nq; j++) {
@@ -87,21 +143,51 @@ static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
             Pj[j] -= sr * sr;
         }
     }
+    if (nc > 0) {
+        /* H - s I, factored; MF = (H - sI)^-1 (F + s G), then
+         * P -= E MF with E = A[nq:2nq, 2nq:], F = A[2nq:, :nq],
+         * G = A[2nq:, nq:2nq], H = A[2nq:, 2nq:]. */
+        for (int j = 0; j < nc; j++)
+            for (int i = 0; i < nc; i++)
+                sh->hlu[(size_t)j * nc + i] =
+                    A[(size_t)(2 * nq + j) * n + 2 * nq + i] -
+                    (i == j ? s : 0.0);
+        zgetrf_(&nc, &nc, sh->hlu, &nc, sh->hpiv, &info);
+        if (info == 0) {
+            for (int j = 0; j < nq; j++)
+                for (int i = 0; i < nc; i++)
+                    MF[(size_t)j * nc + i] =
+                        A[(size_t)j * n + 2 * nq + i] +
+                        s * A[(size_t)(nq + j) * n + 2 * nq + i];
+            zgetrs_("N", &nc, &nq, sh->hlu, &nc, sh->hpiv, MF, &nc, &info,
+                    1);
+        }
+        for (int j = 0; info == 0 && j < nq; j++) {
+            double complex *Pj = sh->zlu + (size_t)j * nq;
+            for (int k = 0; k < nc; k++) {
+                double complex m = MF[(size_t)j * nc + k];
+                const double *Ek = A + (size_t)(2 * nq + k) * n + nq;
+                for (int i = 0; i < nq; i++)
+                    Pj[i] -= Ek[i] * m;
+            }
+        }
+        free(MF);
+        if (info < 0) {
+            tsi_shift_free(sh);
+            return ts_fail(err, TS_ELAPACK, "eigen: LAPACK zgetrf info %d "
+                           "on the controller block", info);
+        }
+        if (info > 0)
+            return full_factor(sh, err);
+    }
     if (sh->is_complex)
         zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
     else
         dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
-    if (info < 0) {
+    if (info != 0) {
+        const char *what = sh->is_complex ? "zgetrf" : "dgetrf";
         tsi_shift_free(sh);
-        return ts_fail(err, TS_ELAPACK, "eigen: LAPACK %s info %d",
-                       sh->is_complex ? "zgetrf" : "dgetrf", info);
-    }
-    if (info > 0) {
-        tsi_shift_free(sh);
-        return ts_fail(err, TS_ESINGULAR,
-                       "the shifted system is singular at s = %g%+gi 1/s "
-                       "(an eigenvalue sits on the shift)",
-                       creal(s), cimag(s));
+        return factor_failed(info, what, s, err);
     }
     return TS_OK;
 }
@@ -109,6 +195,24 @@ static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
 static void dense_solve_real(tsi_shift *sh, const double *b, double *x)
 {
     int nq = sh->nq, n = sh->n, one = 1, info = 0;
+    if (sh->nc > 0) {
+        /* Complex factors (the Schur complement); real s, real answer. */
+        double complex *bc = malloc((size_t)n * sizeof(double complex));
+        double complex *xc = malloc((size_t)n * sizeof(double complex));
+        if (bc && xc) {
+            for (int i = 0; i < n; i++)
+                bc[i] = b[i];
+            tsi_shift_solve(sh, bc, xc);
+            for (int i = 0; i < n; i++)
+                x[i] = creal(xc[i]);
+        } else {
+            for (int i = 0; i < n; i++)
+                x[i] = NAN;
+        }
+        free(bc);
+        free(xc);
+        return;
+    }
     double sr = creal(sh->s), mone = -1.0, pone = 1.0;
     const double *b1 = b, *b2 = b + nq;
     double *x1 = x, *x2 = x + nq;
@@ -122,21 +226,55 @@ static void dense_solve_real(tsi_shift *sh, const double *b, double *x)
         x2[i] = b1[i] + sr * x1[i];
 }
 
+/* y[nc] = M x for the real block M of A at rows 2nq.., columns c0..c0+m
+ * (y += when acc). */
+static void ctl_rows(const tsi_shift *sh, int c0, int m,
+                     const double complex *x, double complex *y, int acc)
+{
+    int n = sh->n, r0 = 2 * sh->nq;
+    const double *A = sh->lin->A;
+    for (int i = 0; i < sh->nc; i++) {
+        double complex sum = acc ? y[i] : 0.0;
+        for (int j = 0; j < m; j++)
+            sum += A[(size_t)(c0 + j) * n + r0 + i] * x[j];
+        y[i] = sum;
+    }
+}
+
 static void dense_solve(tsi_shift *sh, const double complex *b,
                         double complex *x)
 {
-    int nq = sh->nq, n = sh->n, one = 1, two = 2, info = 0;
+    int nq = sh->nq, n = sh->n, nc = sh->nc, one = 1, two = 2, info = 0;
+    if (sh->full) {
+        memcpy(x, b, (size_t)n * sizeof(double complex));
+        zgetrs_("N", &n, &one, sh->full, &n, sh->fpiv, x, &n, &info, 1);
+        return;
+    }
     double complex s = sh->s;
-    const double complex *b1 = b, *b2 = b + nq;
-    double complex *x1 = x, *x2 = x + nq;
+    const double complex *b1 = b, *b2 = b + nq, *b3 = b + 2 * nq;
+    double complex *x1 = x, *x2 = x + nq, *x3 = x + 2 * nq;
     /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
      * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
     double pone = 1.0, zero = 0.0;
     dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
-           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->zw,
-           &two, 1, 1);
+           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->zw, &two,
+           1, 1);
     for (int i = 0; i < nq; i++)
         x1[i] = b2[i] + s * b1[i] - sh->zw[i];
+    if (nc > 0) {
+        /* t3 = (H - sI)^-1 (b3 - G b1); x1 -= E t3. */
+        double complex *t3 = sh->wc;
+        ctl_rows(sh, nq, nq, b1, t3, 0);
+        for (int i = 0; i < nc; i++)
+            t3[i] = b3[i] - t3[i];
+        zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, t3, &nc, &info, 1);
+        const double *A = sh->lin->A;
+        for (int k = 0; k < nc; k++) {
+            const double *Ek = A + (size_t)(2 * nq + k) * n + nq;
+            for (int i = 0; i < nq; i++)
+                x1[i] -= Ek[i] * t3[k];
+        }
+    }
     if (sh->is_complex) {
         zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
     } else {
@@ -152,6 +290,14 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
     }
     for (int i = 0; i < nq; i++)
         x2[i] = b1[i] + s * x1[i];
+    if (nc > 0) {
+        /* x3 = (H - sI)^-1 (b3 - F x1 - G x2). */
+        ctl_rows(sh, 0, nq, x1, x3, 0);
+        ctl_rows(sh, nq, nq, x2, x3, 1);
+        for (int i = 0; i < nc; i++)
+            x3[i] = b3[i] - x3[i];
+        zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, x3, &nc, &info, 1);
+    }
 }
 
 /* ---- Sparse backend ------------------------------------------------------ */

@@ -23,9 +23,11 @@
  * rates), which the stiff integrator's Newton iteration absorbs.
  *
  * Without the sparse model (a system with vehicles: ts_linear.desc NULL)
- * the same solves use the dense A = [[0, I], [K, C]]: (A - s I) x = b is
- * P(s) x1 = b2 - C b1 + s b1, x2 = b1 + s x1 with P(s) = K + s C - s^2 I,
- * one LAPACK LU (dgetrf or zgetrf) of P, O(nq^3), then O(nq^2) per solve.
+ * the same solves use the dense A = [[0, I, 0], [K, C, E], [F, G, H]]
+ * (nc controller states last): with x = (x1, x2, x3), x2 = b1 + s x1,
+ * x3 = (H - sI)^-1 (b3 - F x1 - G x2) and P(s) x1 = b2 - (C - sI) b1 -
+ * E (H - sI)^-1 (b3 - G b1), P(s) = K + s C - s^2 I - E (H - sI)^-1 (F +
+ * s G): one LAPACK LU of P, O(nq^3 + nq^2 nc), then O(nq^2) per solve.
  * Only tsi_shift_solve_real and tsi_shift_solve work then. */
 #ifndef TOWSTAB_SHIFT_H
 #define TOWSTAB_SHIFT_H
@@ -43,8 +45,17 @@ typedef struct tsi_shift {
     double complex s;
     int is_complex;        /* s has a nonzero imaginary part */
     int inf;               /* S_inf: A's action, not a shift */
-    /* Dense backend (no sparse model). */
-    int nq, n;
+    /* Dense backend (no sparse model): A = [[0, I, 0], [K, C, E],
+     * [F, G, H]] with nc controller states; P(s) = K + s C - s^2 I -
+     * E (H - sI)^-1 (F + s G), the Schur complement of the controller
+     * block (complex whenever nc > 0); where H - s I is singular (an
+     * integrator at s = 0) the whole A - s I is factored instead. */
+    int nq, n, nc;
+    double complex *hlu;   /* [nc * nc] LU of H - s I (zgetrf), nc > 0 */
+    int *hpiv;             /* [nc] */
+    double complex *wc;    /* [2 nc] work */
+    double complex *full;  /* [n * n] LU of A - s I, the fallback */
+    int *fpiv;             /* [n] */
     double *lu;            /* [nq * nq] real LU (dgetrf), when real */
     double complex *zlu;   /* [nq * nq] complex LU (zgetrf), when complex */
     int *ipiv;             /* [nq] */

@@ -225,7 +225,110 @@ void ts_history_free(ts_history *h)
     free(h->tow_force);
     free(h->energy);
     free(h->input);
+    free(h->outputs);
+    free(h->output_name);
+    free(h->output_unit);
     free(h);
+}
+
+/* The outputs of the sample being recorded, allocated with their names
+ * and units (of kernel k) at the first sample. */
+static double *history_outputs(ts_history *h, const ts_kernel *k,
+                               ts_err *err)
+{
+    int no = ts_kernel_noutput(k);
+    if (no <= 0)
+        return NULL;
+    if (!h->outputs) {
+        size_t c = (size_t)h->capacity * (size_t)no;
+        h->outputs = malloc(c * sizeof(double));
+        h->output_name = calloc((size_t)no, sizeof *h->output_name);
+        h->output_unit = calloc((size_t)no, sizeof *h->output_unit);
+        if (!h->outputs || !h->output_name || !h->output_unit) {
+            free(h->outputs);
+            h->outputs = NULL;
+            ts_fail(err, TS_ENOMEM, "simulate: out of memory for the "
+                    "vehicles' outputs over %d samples", h->capacity);
+            return NULL;
+        }
+        h->noutput = no;
+        for (int j = 0; j < no; j++) {
+            ts_kernel_output_name(k, j, h->output_name[j],
+                                  sizeof h->output_name[j]);
+            h->output_unit[j] = ts_kernel_output_unit(k, j);
+        }
+    }
+    return h->outputs + (size_t)no * (size_t)h->nsamples;
+}
+
+/* Kernel input indices of the excitation's vehicle-input signals,
+ * idx[nsignals] (-1 for the other signals); checks each name and unit
+ * against the kernel. NULL (and *idx NULL) without such signals. */
+static int bind_inputs(const ts_kernel *k, const ts_excitation *ex,
+                       int **idx, ts_err *err)
+{
+    *idx = NULL;
+    int ns = ex ? ts_excitation_nsignals(ex) : 0, any = 0;
+    for (int i = 0; i < ns; i++)
+        any |= ts_excitation_signal(ex, i)->axis == TS_AXIS_INPUT;
+    if (!any)
+        return TS_OK;
+    int *x = malloc((size_t)ns * sizeof *x);
+    if (!x)
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    for (int i = 0; i < ns; i++) {
+        const ts_signal *sg = ts_excitation_signal(ex, i);
+        x[i] = -1;
+        if (sg->axis != TS_AXIS_INPUT)
+            continue;
+        int j = ts_kernel_input_find(k, sg->input);
+        if (j < TS_NINPUT) {
+            char list[1024] = "", buf[TS_IO_NAME];
+            for (int c = TS_NINPUT; c < ts_kernel_ninput(k); c++) {
+                size_t len = strlen(list);
+                snprintf(list + len, sizeof list - len, "%s%s",
+                         len ? ", " : "",
+                         ts_kernel_input_name(k, c, buf, sizeof buf));
+            }
+            free(x);
+            return ts_fail(err, TS_EINVAL, "excite: '%.80s' is not a "
+                           "vehicle's input; expected %s", sg->input,
+                           list[0] ? list : "(none: the scene has no "
+                           "vehicle with control surfaces or loops)");
+        }
+        const char *unit = ts_kernel_input_unit(k, j);
+        if (sg->input_unit[0] && strcmp(sg->input_unit, unit)) {
+            free(x);
+            return ts_fail(err, TS_EUNIT, "excite: %.80s: the amplitude is "
+                           "in %s, expected %s", sg->input,
+                           !strcmp(sg->input_unit, "m") ? "a length"
+                                                        : "an angle",
+                           !strcmp(unit, "m") ? "a length (m)"
+                                              : "an angle (rad, deg)");
+        }
+        x[i] = j;
+    }
+    *idx = x;
+    return TS_OK;
+}
+
+int ts_sim_check_inputs(const ts_kernel *k, const ts_excitation *ex,
+                        ts_err *err)
+{
+    int *idx;
+    int rc = bind_inputs(k, ex, &idx, err);
+    free(idx);
+    return rc;
+}
+
+/* Add the vehicle-input signals at t into u[ninput] (idx from
+ * bind_inputs; nothing when NULL). */
+static void add_inputs(const ts_excitation *ex, const int *idx, double t,
+                       double *u)
+{
+    for (int i = 0; idx && i < ts_excitation_nsignals(ex); i++)
+        if (idx[i] >= 0)
+            u[idx[i]] += ts_excitation_value(ex, i, t);
 }
 
 double ts_history_value(const ts_system *sys, const ts_history *h,
@@ -255,6 +358,11 @@ struct ts_sim {
     double t, h;
     double *y;            /* [n] */
     double *work;         /* [3 n]: kernel output and df/dt differences */
+    double *u;            /* [ninput] the kernel's input at the time of the
+                             last prepare(): the tow channels and the
+                             vehicles' inputs from the excitation */
+    int ninput;
+    int *in_idx;          /* [nsignals] bind_inputs; NULL: none */
     double *breaks;       /* [nbreaks] */
     int nbreaks;
     double dfdt_step;
@@ -346,10 +454,16 @@ static void stiffness_note(const ts_sim *s, ts_err *err)
              s->sys->links[l].index, s->sys->cables[s->sys->links[l].cable].name);
 }
 
-/* Frame and input of time t into the kernel; u[TS_NINPUT]. */
-static void prepare(ts_sim *s, double t, double u[TS_NINPUT])
+/* Frame and input of time t into the kernel; u[ninput] (s->u): the tow
+ * channels and the vehicles' inputs. */
+static void prepare(ts_sim *s, double t, double *u)
 {
     ts_excitation_input(s->ex, t, u);
+    if (s->in_idx) {
+        for (int j = TS_NINPUT; j < s->ninput; j++)
+            u[j] = 0.0;
+        add_inputs(s->ex, s->in_idx, t, u);
+    }
     if (s->frame_varies) {
         ts_frame f;
         ts_excitation_frame(s->ex, &s->base, t, &f);
@@ -360,7 +474,7 @@ static void prepare(ts_sim *s, double t, double u[TS_NINPUT])
 static int rhs(double t, const double y[], double dydt[], void *params)
 {
     ts_sim *s = params;
-    double u[TS_NINPUT];
+    double *u = s->u;
     s->nfev++;
     prepare(s, t, u);
     int rc = ts_kernel_eval(s->k, y, u, dydt);
@@ -384,7 +498,7 @@ static int rhs(double t, const double y[], double dydt[], void *params)
  * GSL_FAILURE (a refused state) or GSL_EBADFUNC (fatal). */
 static int linearize_at(ts_sim *s, double t, const double y[])
 {
-    double u[TS_NINPUT];
+    double *u = s->u;
     s->njac++;
     prepare(s, t, u);
     int rc = ts_linearize(s->k, y, u, &s->lopts, s->lin, NULL);
@@ -516,6 +630,8 @@ void ts_sim_free(ts_sim *s)
     free(s->y);
     free(s->y_int);
     free(s->work);
+    free(s->u);
+    free(s->in_idx);
     free(s->breaks);
     free(s);
 }
@@ -571,11 +687,17 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     size_t n = (size_t)s->n;
     s->y = calloc(n, sizeof(double));
     s->work = calloc(3 * n, sizeof(double));
+    s->ninput = ts_kernel_ninput(k);
+    s->u = calloc((size_t)s->ninput, sizeof(double));
     int nb = ts_excitation_breakpoints(ex, o->t_end, NULL, 0);
     s->breaks = malloc((size_t)(nb + 1) * sizeof(double));
-    if (!s->y || !s->work || !s->breaks)
+    if (!s->y || !s->work || !s->breaks || !s->u)
         goto nomem;
     s->nbreaks = ts_excitation_breakpoints(ex, o->t_end, s->breaks, nb);
+    if (bind_inputs(k, ex, &s->in_idx, err)) {
+        ts_sim_free(s);
+        return NULL;
+    }
     int sparse = 0;
     if (needs_jacobian(o->integrator)) {
         s->lin = ts_linear_alloc(k, err);
@@ -902,7 +1024,7 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
         return ts_fail(err, TS_EINVAL, "simulate: the history is sized for "
                        "%d links, the system has %d", h->nlinks,
                        s->sys->nlinks);
-    double u[TS_NINPUT];
+    double *u = s->u;
     prepare(s, s->t, u);
     int rc = ts_kernel_eval(s->k, s->y, u, s->work);
     if (rc)
@@ -918,7 +1040,13 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
     ts_kernel_tow_force(s->k, h->tow_force + 3 * i);
     h->energy[2 * i] = ts_kernel_kinetic_energy(s->k);
     h->energy[2 * i + 1] = ts_kernel_potential_energy(s->k);
-    memcpy(h->input + TS_NINPUT * i, u, sizeof u);
+    memcpy(h->input + TS_NINPUT * i, u, TS_NINPUT * sizeof(double));
+    if (ts_kernel_noutput(s->k) > 0) {
+        double *o = history_outputs(h, s->k, err);
+        if (!o)
+            return TS_ENOMEM;
+        ts_kernel_outputs(s->k, o);
+    }
     h->nsamples++;
     return TS_OK;
 }
@@ -1099,13 +1227,18 @@ typedef struct lin_hold {
 typedef struct lin_sim {
     const ts_linear *lin;
     const ts_excitation *ex;
-    int n, m;
+    int n, m;          /* states; inputs driven: TS_NINPUT, or every input
+                          when a signal drives a vehicle's input */
+    const int *in_idx; /* bind_inputs; NULL: none */
     double *tmp;       /* [n] */
+    double *v;         /* [6 m]: four input samples, two for df/dt */
+    double *p;         /* [4 m]: the cubic's coefficients */
     long nfev;
 } lin_sim;
 
-/* v = u(t) - u0. */
-static void lin_input(const lin_sim *L, double t, double v[TS_NINPUT])
+/* v[m] = u(t) - u0: the tow channels from the excitation, the vehicles'
+ * inputs (when driven) the signals on them. */
+static void lin_input(const lin_sim *L, double t, double *v)
 {
     if (L->ex)
         ts_excitation_input(L->ex, t, v);
@@ -1114,13 +1247,17 @@ static void lin_input(const lin_sim *L, double t, double v[TS_NINPUT])
             v[j] = 0.0;
     for (int j = 0; j < TS_NINPUT; j++)
         v[j] -= L->lin->u0[j];
+    for (int j = TS_NINPUT; j < L->m; j++)
+        v[j] = 0.0;
+    if (L->in_idx)
+        add_inputs(L->ex, L->in_idx, t, v);
 }
 
 /* Phi and G of step h: top blocks of exp(M h). */
-static int hold_compute(const ts_linear *lin, double h, lin_hold *H,
+static int hold_compute(const ts_linear *lin, int m, double h, lin_hold *H,
                         ts_err *err)
 {
-    int n = lin->nstate, m = TS_NINPUT, N = n + 4 * m;
+    int n = lin->nstate, N = n + 4 * m;
     size_t NN = (size_t)N * (size_t)N;
     double *M = calloc(NN, sizeof(double));
     double *E = malloc(NN * sizeof(double));
@@ -1157,18 +1294,17 @@ static int hold_compute(const ts_linear *lin, double h, lin_hold *H,
 }
 
 /* One exact step of length h: z <- Phi z + G p, the cubic through
- * v0..v3 (values at 0, h/3, 2h/3, h). */
-static void hold_step(const lin_hold *H, int n, const double v[4][TS_NINPUT],
-                      double *z, double *tmp)
+ * v0..v3 (values at 0, h/3, 2h/3, h; v[k m + j]), p[4 m] scratch. */
+static void hold_step(const lin_hold *H, int n, int m, const double *v,
+                      double *p, double *z, double *tmp)
 {
-    const int m = TS_NINPUT, m4 = 4 * m, one = 1;
-    double p[4 * TS_NINPUT];
+    const int m4 = 4 * m, one = 1;
     double h = H->h;
     for (int j = 0; j < m; j++) {
         /* Newton forward differences on x = 3 s / h. */
-        double f0 = v[0][j], d1 = v[1][j] - f0,
-               d2 = v[2][j] - 2 * v[1][j] + f0,
-               d3 = v[3][j] - 3 * v[2][j] + 3 * v[1][j] - f0;
+        const double *v0 = v, *v1 = v + m, *v2 = v + 2 * m, *v3 = v + 3 * m;
+        double f0 = v0[j], d1 = v1[j] - f0, d2 = v2[j] - 2 * v1[j] + f0,
+               d3 = v3[j] - 3 * v2[j] + 3 * v1[j] - f0;
         double c1 = d1 - d2 / 2 + d3 / 3, c2 = d2 / 2 - d3 / 2, c3 = d3 / 6;
         p[j] = f0;
         p[m + j] = 3.0 * c1 / h;
@@ -1184,9 +1320,9 @@ static void hold_step(const lin_hold *H, int n, const double v[4][TS_NINPUT],
 static int lin_rhs(double t, const double z[], double dz[], void *params)
 {
     lin_sim *L = params;
-    const int n = L->n, m = TS_NINPUT, one = 1;
+    const int n = L->n, m = L->m, one = 1;
     const double a1 = 1.0, b0 = 0.0;
-    double v[TS_NINPUT];
+    double *v = L->v + 4 * m;
     L->nfev++;
     lin_input(L, t, v);
     dgemv_("N", &n, &n, &a1, L->lin->A, &n, z, &one, &b0, dz, &one, 1);
@@ -1198,7 +1334,7 @@ static int lin_jac(double t, const double z[], double *dfdy, double dfdt[],
                    void *params)
 {
     lin_sim *L = params;
-    const int n = L->n, m = TS_NINPUT, one = 1;
+    const int n = L->n, m = L->m, one = 1;
     (void)z;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++)
@@ -1206,7 +1342,7 @@ static int lin_jac(double t, const double z[], double *dfdy, double dfdt[],
     /* df/dt = B dv/dt by a central difference of the input. */
     double tau = L->ex ? ts_excitation_time_scale(L->ex) : INFINITY;
     double dt = DFDT_REL_STEP * (tau < 1.0 ? tau : 1.0);
-    double vp[TS_NINPUT], vm[TS_NINPUT];
+    double *vp = L->v + 4 * m, *vm = L->v + 5 * m;
     lin_input(L, t + dt, vp);
     lin_input(L, t - dt, vm);
     for (int j = 0; j < m; j++)
@@ -1240,10 +1376,13 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
     const ts_system *sys = ts_kernel_system(k);
     size_t i = (size_t)h->nsamples, nn = (size_t)h->nnodes,
            nl = (size_t)h->nlinks;
+    /* The input deviation (ywork's last part), then the tow channels. */
+    int n = lin->nstate;
+    double *dv = ywork + 2 * n + lin->ninput;
+    lin_input(L, t, dv);
     double u[TS_NINPUT];
-    lin_input(L, t, u);
     for (int j = 0; j < TS_NINPUT; j++)
-        u[j] += lin->u0[j];
+        u[j] = dv[j] + lin->u0[j];
     double *pos = h->positions + 3 * nn * i;
     if (o->kinematics == TS_KIN_LINEAR) {
         ts_linear_node_displacements(sys, lin, z, dr);
@@ -1252,10 +1391,12 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
                 pos[3 * a + c] = lin->r0[3 * a + c] + dr[3 * a + c] +
                                  (u[c] - lin->u0[c]);
     } else {
-        int n = lin->nstate;
+        double *ufull = ywork + 2 * n;
         for (int j = 0; j < n; j++)
             ywork[j] = lin->y0[j] + z[j];
-        int rc = ts_kernel_eval(k, ywork, u, ywork + n);
+        for (int j = 0; j < lin->ninput; j++)
+            ufull[j] = lin->u0[j] + (j < L->m ? dv[j] : 0.0);
+        int rc = ts_kernel_eval(k, ywork, ufull, ywork + n);
         if (rc)
             return ts_fail(err, rc < 0 ? rc : TS_EDOMAIN, "simulate "
                            "(linear): the state y0 + z at t = %.9g s is "
@@ -1286,6 +1427,17 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
         h->tow_force[3 * i + (size_t)c] = NAN;
     h->energy[2 * i] = h->energy[2 * i + 1] = NAN;
     memcpy(h->input + TS_NINPUT * i, u, sizeof u);
+    if (lin->noutput > 0) {
+        /* v0 + Vy z + Vu du */
+        double *out = history_outputs(h, k, err);
+        if (!out)
+            return TS_ENOMEM;
+        const int no = lin->noutput, m = L->m, one = 1;
+        const double a1 = 1.0;
+        memcpy(out, lin->v0, (size_t)no * sizeof(double));
+        dgemv_("N", &no, &n, &a1, lin->Vy, &no, z, &one, &a1, out, &one, 1);
+        dgemv_("N", &no, &m, &a1, lin->Vu, &no, dv, &one, &a1, out, &one, 1);
+    }
     h->nsamples++;
     return TS_OK;
 }
@@ -1321,24 +1473,32 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EINVAL, "simulate (linear): the history has "
                        "room for %d samples, the run needs %d",
                        h->capacity - h->nsamples, N);
+    int *in_idx = NULL;
+    if ((rc = bind_inputs(k, ex, &in_idx, err)))
+        return rc;
     double w0 = wall_now();
     size_t sn = (size_t)n;
+    /* Only the tow channels are driven unless a signal drives a vehicle's
+     * input (the exponential's order is n + 4 m). */
+    int m = in_idx ? lin->ninput : TS_NINPUT;
     double *z = calloc(sn, sizeof(double));
     double *tmp = calloc(sn, sizeof(double));
-    double *ywork = calloc(2 * sn, sizeof(double));
+    /* y0 + z, f there, the whole input, and its deviation. */
+    double *ywork = calloc(2 * sn + 2 * (size_t)lin->ninput, sizeof(double));
     double *dr = calloc(3 * (size_t)lin->nnodes, sizeof(double));
+    double *vbuf = calloc(10 * (size_t)m, sizeof(double));
     lin_hold H[2];
     for (int c = 0; c < 2; c++) {
         H[c].h = 0.0;
         H[c].Phi = malloc(sn * sn * sizeof(double));
-        H[c].G = malloc(sn * 4 * TS_NINPUT * sizeof(double));
+        H[c].G = malloc(sn * 4 * (size_t)m * sizeof(double));
     }
-    lin_sim L = {lin, ex, n, TS_NINPUT, tmp, 0};
+    lin_sim L = {lin, ex, n, m, in_idx, tmp, vbuf, vbuf + 6 * m, 0};
     gsl_odeiv2_driver *drv = NULL;
     tsi_esdirk *sd = NULL;
     gsl_odeiv2_system gsys = {lin_rhs, lin_jac, sn, &L};
-    if (!z || !tmp || !ywork || !dr || !H[0].Phi || !H[0].G || !H[1].Phi ||
-        !H[1].G) {
+    if (!z || !tmp || !ywork || !dr || !vbuf || !H[0].Phi || !H[0].G ||
+        !H[1].Phi || !H[1].G) {
         rc = ts_fail(err, TS_ENOMEM, "simulate (linear): out of memory for "
                      "%d states", n);
         goto done;
@@ -1432,17 +1592,17 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                     Hc = &H[c];
             if (!Hc) {
                 Hc = H[0].h == 0 ? &H[0] : &H[1];
-                if ((rc = hold_compute(lin, hs, Hc, err)))
+                if ((rc = hold_compute(lin, m, hs, Hc, err)))
                     break;
             }
-            double v[4][TS_NINPUT];
-            lin_input(&L, t, v[0]);
+            double *v = L.v;
+            lin_input(&L, t, v);
             for (long s = 0; s < steps; s++) {
                 double ts = t + (double)s * hs;
                 for (int j = 1; j <= 3; j++)
-                    lin_input(&L, ts + j * hs / 3.0, v[j]);
-                hold_step(Hc, n, (const double(*)[TS_NINPUT])v, z, tmp);
-                memcpy(v[0], v[3], sizeof v[0]);
+                    lin_input(&L, ts + j * hs / 3.0, v + j * m);
+                hold_step(Hc, n, m, v, L.p, z, tmp);
+                memcpy(v, v + 3 * m, (size_t)m * sizeof(double));
                 L.nfev += 3;
                 stats.steps++;
                 stats.h_last = hs;
@@ -1489,5 +1649,7 @@ done:
     free(tmp);
     free(ywork);
     free(dr);
+    free(vbuf);
+    free(in_idx);
     return rc;
 }

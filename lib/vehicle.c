@@ -943,36 +943,42 @@ void tsi_vehicle_measure(const tsi_vehicle_state *st, double value[4],
     rate[TS_MEASURE_HEADING] = yd[0];
 }
 
-double tsi_loop_error(const ts_loop *l, const double value[4])
+double tsi_loop_error(const ts_loop *l, const double value[4], double sp)
 {
-    double e = value[l->measure] - l->setpoint;
+    double e = value[l->measure] - sp;
     return l->measure == TS_MEASURE_HEADING ? wrap_pi(e) : e;
 }
 
-void tsi_vehicle_control(const ts_vehicle *v, const double value[4],
-                         const double rate[4], const double xi[],
-                         const double act[], const double u_surf[],
-                         const double u_loop[], const int mode[],
-                         const double frozen[], double out[], double delta[],
-                         double xi_dot[], double act_dot[])
+void tsi_vehicle_control(const ts_vehicle *v, const tsi_control_in *in,
+                         double out[], double delta[], double xi_dot[],
+                         double act_dot[])
 {
     double cmd[TS_VEHICLE_MAX_COMPONENTS];
     for (int c = 0; c < v->ncomponents; c++)
-        cmd[c] = v->component[c].deflection + (u_surf ? u_surf[c] : 0.0);
+        cmd[c] = v->component[c].deflection +
+                 (in->u_surf ? in->u_surf[c] : 0.0);
     for (int l = 0; l < v->nloops; l++) {
         const ts_loop *lp = &v->loop[l];
-        int m = mode ? mode[l] : TSI_LOOP_CLOSED;
-        double e = tsi_loop_error(lp, value);
-        double x = lp->ki != 0 && m != TSI_LOOP_FROZEN && xi ? xi[l] : 0.0;
-        out[l] = lp->kp * e + lp->ki * x + lp->kd * rate[lp->measure];
+        int m = in->mode ? in->mode[l] : TS_LOOP_CLOSED;
+        double sp = in->setpoint ? in->setpoint[l] : lp->setpoint;
+        double e = tsi_loop_error(lp, in->value, sp);
+        double x = lp->ki != 0 && m != TS_LOOP_OPEN && in->xi ? in->xi[l]
+                                                              : 0.0;
+        out[l] = lp->kp * e + lp->ki * x + lp->kd * in->rate[lp->measure];
+        /* A steady state of an integrating loop has e = 0 (x' = e) and no
+         * rates, so its output is ki x alone: the steady solve uses that,
+         * which has the same solutions and keeps a high kp from making
+         * the clamp below bite at every Newton iterate off the solution. */
+        if (in->steady && lp->ki != 0 && m == TS_LOOP_CLOSED)
+            out[l] = lp->ki * x;
         if (xi_dot)
             xi_dot[l] = e;
-        double in = u_loop ? u_loop[l] : 0.0;
-        double s = m == TSI_LOOP_CLOSED   ? out[l] + in
-                   : m == TSI_LOOP_FROZEN ? (frozen ? frozen[l] : 0.0) + in
-                                          : in;
+        double u = in->u_loop ? in->u_loop[l] : 0.0;
+        double sig = m == TS_LOOP_CLOSED ? out[l] + u
+                     : m == TS_LOOP_OPEN ? (in->frozen ? in->frozen[l] : 0.0) + u
+                                         : u;
         for (int k = 0; k < lp->nsurfaces; k++)
-            cmd[lp->surface[k]] += lp->gain[k] * s;
+            cmd[lp->surface[k]] += lp->gain[k] * sig;
     }
     for (int c = 0; c < v->ncomponents; c++) {
         const ts_component *cp = &v->component[c];
@@ -986,14 +992,111 @@ void tsi_vehicle_control(const ts_vehicle *v, const double value[4],
          * rate saturates). */
         double d = fmax(-cp->limit, fmin(cp->limit, cmd[c]));
         if (cp->time_constant > 0) {
-            double r = (d - act[c]) / cp->time_constant;
+            double a = in->act ? in->act[c] : d;
+            double r = (d - a) / cp->time_constant;
             if (act_dot)
-                act_dot[c] = fmax(-cp->rate_limit, fmin(cp->rate_limit, r));
-            delta[c] = act[c];
+                act_dot[c] = in->steady ? r
+                                        : fmax(-cp->rate_limit,
+                                               fmin(cp->rate_limit, r));
+            delta[c] = a;
         } else {
             delta[c] = d;
             if (act_dot)
                 act_dot[c] = 0.0;
         }
     }
+}
+
+/* ------------------------------------------------------------------ */
+/* Drawing                                                              */
+
+void ts_vehicle_rotation(double yaw, double pitch, double roll, double R[9])
+{
+    double cy = cos(yaw), sy = sin(yaw), cp = cos(pitch), sp = sin(pitch),
+           cr = cos(roll), sr = sin(roll);
+    R[0] = cy * cp;
+    R[1] = cy * sp * sr - sy * cr;
+    R[2] = cy * sp * cr + sy * sr;
+    R[3] = sy * cp;
+    R[4] = sy * sp * sr + cy * cr;
+    R[5] = sy * sp * cr - cy * sr;
+    R[6] = -sp;
+    R[7] = cp * sr;
+    R[8] = cp * cr;
+}
+
+/* Append body point b (body axes from O) as a point in M; a NaN point
+ * when b is NULL. */
+static void outline_put(const double R[9], const double O[3],
+                        const double *b, double pts[], int max, int *n)
+{
+    if (*n < max) {
+        double *p = pts + 3 * (size_t)*n;
+        for (int i = 0; i < 3; i++)
+            p[i] = b ? O[i] + R[3 * i] * b[0] + R[3 * i + 1] * b[1] +
+                           R[3 * i + 2] * b[2]
+                     : NAN;
+    }
+    (*n)++;
+}
+
+int ts_vehicle_outline(const ts_vehicle *v, const double R[9],
+                       const double origin[3], const double *delta,
+                       double pts[], int max)
+{
+    int n = 0;
+    for (int c = 0; c < v->ncomponents; c++) {
+        const ts_component *cp = &v->component[c];
+        const double *x0 = cp->position;
+        if (n > 0)
+            outline_put(R, origin, NULL, pts, max, &n);
+        if (cp->type == TS_COMP_HULL) {
+            /* Two ellipses: in the x-z plane (axis 2), then x-y (1). */
+            for (int plane = 2; plane >= 1; plane--) {
+                if (plane == 1)
+                    outline_put(R, origin, NULL, pts, max, &n);
+                for (int k = 0; k < TS_OUTLINE_HULL_POINTS; k++) {
+                    double t = 2 * M_PI * k / (TS_OUTLINE_HULL_POINTS - 1);
+                    double b[3] = {x0[0] + 0.5 * cp->length * cos(t), x0[1],
+                                   x0[2]};
+                    b[plane] += 0.5 * cp->diameter * sin(t);
+                    outline_put(R, origin, b, pts, max, &n);
+                }
+            }
+        } else if (cp->type == TS_COMP_SURFACE) {
+            /* Span along (0, cos roll, sin roll); the chord along x,
+             * turned by the deflection about the span: a positive
+             * deflection (force along -normal) turns the leading edge
+             * toward -normal. */
+            double chord = cp->area / cp->span;
+            double d = delta ? delta[c] : cp->deflection;
+            double sa[3] = {0, cos(cp->roll), sin(cp->roll)};
+            double nr[3] = {0, -sin(cp->roll), cos(cp->roll)};
+            double ch[3];
+            for (int i = 0; i < 3; i++)
+                ch[i] = (i == 0 ? cos(d) : 0.0) - sin(d) * nr[i];
+            static const int corner[5][2] = {
+                {1, 1}, {-1, 1}, {-1, -1}, {1, -1}, {1, 1}};
+            for (int k = 0; k < 5; k++) {
+                double b[3];
+                for (int i = 0; i < 3; i++)
+                    b[i] = x0[i] + corner[k][0] * 0.5 * chord * ch[i] +
+                           corner[k][1] * 0.5 * cp->span * sa[i];
+                outline_put(R, origin, b, pts, max, &n);
+            }
+        } else {
+            /* A bluff part: a cross of its frontal area's side. */
+            double h = 0.5 * sqrt(cp->area);
+            for (int axis = 0; axis < 3; axis++) {
+                if (axis > 0)
+                    outline_put(R, origin, NULL, pts, max, &n);
+                for (int sgn = -1; sgn <= 1; sgn += 2) {
+                    double b[3] = {x0[0], x0[1], x0[2]};
+                    b[axis] += sgn * h;
+                    outline_put(R, origin, b, pts, max, &n);
+                }
+            }
+        }
+    }
+    return n;
 }

@@ -135,36 +135,40 @@ void tsi_vehicle_frame_alpha(const tsi_vehicle_state *st, double turn_rate,
 void tsi_vehicle_measure(const tsi_vehicle_state *st, double value[4],
                          double rate[4]);
 
-/* Mode of a loop in the controller law. */
-enum {
-    TSI_LOOP_CLOSED = 0, /* its output (plus the loop input) drives its
-                            surfaces */
-    TSI_LOOP_FROZEN = 1, /* its surfaces see the frozen trim output plus
-                            the loop input (open loop); no integrator */
-    TSI_LOOP_BROKEN = 2  /* its surfaces see the loop input alone (one
-                            loop broken for its margins) */
-};
+/* What the controller law of one vehicle takes (towstab/vehicle.h,
+ * ts_loop). Any pointer may be NULL: zero, or the description's set
+ * points, or every loop closed. */
+typedef struct tsi_control_in {
+    const double *value, *rate; /* [4] measurements and their rates
+                                   (tsi_vehicle_measure) */
+    const double *xi;       /* [nloops] integrators (loops without ki, or
+                               open, are ignored) */
+    const double *act;      /* [ncomponents] actuators (surfaces with a
+                               time constant); NULL: settled on their
+                               commands */
+    const double *u_surf;   /* [ncomponents] deflection commands, added to
+                               delta0 */
+    const double *u_loop;   /* [nloops] added to each loop's output */
+    const double *setpoint; /* [nloops] set points in force */
+    const int *mode;        /* [nloops] TS_LOOP_* */
+    const double *frozen;   /* [nloops] outputs of open loops */
+    int steady;             /* 1: a steady state is solved: no rate
+                               limits (no actuator moves), and an
+                               integrating closed loop's output is ki x
+                               (its e and rates vanish there) */
+} tsi_control_in;
 
-/* The controller law of one vehicle (towstab/vehicle.h, ts_loop).
- * In: measurements and rates (tsi_vehicle_measure), integrator states
- * xi[nloops] (entries of loops without ki, or frozen, are ignored),
- * actuator states act[ncomponents] (surfaces with time_constant > 0),
- * inputs u_surf[ncomponents] (deflection commands added to delta0) and
- * u_loop[nloops] (added to each loop's output), loop modes mode[nloops]
- * and frozen outputs frozen[nloops] (NULL: zero).
- * Out: loop outputs out[nloops] (the law's value from the state, whatever
- * the mode), the deflections delta[ncomponents] the hydrodynamics sees,
- * xi_dot[nloops] (= e) and act_dot[ncomponents]. */
-void tsi_vehicle_control(const ts_vehicle *v, const double value[4],
-                         const double rate[4], const double xi[],
-                         const double act[], const double u_surf[],
-                         const double u_loop[], const int mode[],
-                         const double frozen[], double out[], double delta[],
-                         double xi_dot[], double act_dot[]);
+/* The controller law: the loop outputs out[nloops] (the law's value from
+ * the state, whatever the mode), the deflections delta[ncomponents] the
+ * hydrodynamics sees, xi_dot[nloops] (= e) and act_dot[ncomponents] (the
+ * last two may be NULL). */
+void tsi_vehicle_control(const ts_vehicle *v, const tsi_control_in *in,
+                         double out[], double delta[], double xi_dot[],
+                         double act_dot[]);
 
-/* Error of loop l: measured - setpoint, a heading wrapped into
+/* Error of loop l at set point sp: measured - sp, a heading wrapped into
  * (-pi, pi]. */
-double tsi_loop_error(const ts_loop *l, const double value[4]);
+double tsi_loop_error(const ts_loop *l, const double value[4], double sp);
 
 /* Cholesky factor of a symmetric positive definite 6x6 A (row-major) into
  * the lower triangle of L; 0, or -1 when A is not positive definite. */

@@ -497,6 +497,20 @@ static void test_equilibrium_sweep(void)
           "ex. 1 target 1e-3: 40 links recommended (top tension error "
           "3.3e-4 at 40), got %g",
           c->recommended >= 0 ? c->rows[c->recommended].setting : -1.0);
+    /* Timing: a run timed once took at least TS_CONV_TIMING_MIN; a
+     * shorter one was repeated, at most TS_CONV_TIMING_REPEATS times. */
+    int timing_ok = 1, repeated = 0;
+    for (int i = 0; i < c->nrows; i++) {
+        const ts_conv_row *r = &c->rows[i];
+        if (r->timed_runs < 1 || r->timed_runs > TS_CONV_TIMING_REPEATS ||
+            !(r->wall_s > 0) ||
+            (r->timed_runs == 1 && r->wall_s < TS_CONV_TIMING_MIN))
+            timing_ok = 0;
+        repeated += r->timed_runs > 1;
+    }
+    CHECK(timing_ok, "every run's time is one run of at least %g s or the "
+          "median of repeats (%d rows repeated)", TS_CONV_TIMING_MIN,
+          repeated);
     /* Independent: the 2560-link solution. */
     double fine[3];
     if (CHECK(solve_ex(sc->system, 2560, fine) == TS_OK,

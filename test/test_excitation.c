@@ -17,6 +17,7 @@
  *     to port, along -y).
  *  5. Breakpoints, time scales, the periodic signal.
  *  6. The spec parser: units, defaults, and every refusal with its message.
+ *  7. Signals on a vehicle's inputs: by name, in m or rad, evaluated alone.
  *  7. Sums (an irregular sea's tow-point motion): the closed-form value
  *     at full amplitude, the derivatives by differences during and after
  *     the fade-in (whose end is a breakpoint), one signal per driven axis
@@ -632,6 +633,55 @@ static void test_sum(void)
     ts_excitation_free(cp);
 }
 
+/* 7. Signals on a vehicle's inputs: parsed by name, the amplitude a
+ * length or an angle, evaluated alone, neither a manoeuvre nor a periodic
+ * tow excitation; the tow input untouched. */
+static void test_vehicle_inputs(void)
+{
+    ts_err err = {0};
+    ts_units *units = ts_units_alloc(&err);
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    int rc = ts_excitation_parse(ex, "fish.wing:sine,amplitude=2deg,"
+                                 "period=10s,ramp=0", units, "--excite",
+                                 &err);
+    rc = rc ? rc : ts_excitation_parse(ex, "fish.depth.setpoint:amplitude=5m,"
+                                       "start=1s,rise=2s", units, "--excite",
+                                       &err);
+    const ts_signal *a = ts_excitation_signal(ex, 0),
+                    *b = ts_excitation_signal(ex, 1);
+    CHECK(rc == TS_OK && a->axis == TS_AXIS_INPUT &&
+              !strcmp(a->input, "fish.wing") && !strcmp(a->input_unit, "rad") &&
+              fabs(a->amplitude - 2 * M_PI / 180) < 1e-16 &&
+              b->type == TS_SIGNAL_STEP && !strcmp(b->input_unit, "m") &&
+              b->amplitude == 5.0,
+          "fish.wing sine in rad, fish.depth.setpoint a step (the default) "
+          "in m (%s)", err.msg);
+    double u[TS_NINPUT];
+    ts_excitation_input(ex, 2.0, u);
+    int zero = 1;
+    for (int j = 0; j < TS_NINPUT; j++)
+        zero &= u[j] == 0.0;
+    int idx;
+    /* At 2.5 s the sine is at 2 deg sin(pi/2); the step at mid-rise is
+     * half its amplitude (S(1/2) = 1/2). */
+    CHECK(zero && !ts_excitation_has_manoeuvre(ex) &&
+              !ts_excitation_periodic(ex, &idx) &&
+              fabs(ts_excitation_value(ex, 0, 2.5) - 2 * M_PI / 180) < 1e-16 &&
+              fabs(ts_excitation_value(ex, 1, 2.0) - 2.5) < 1e-15,
+          "values alone, tow input zero, no manoeuvre, not periodic");
+    const char *badspec[] = {"fish.wing:amplitude=1kg", "fish.wing:crank,"
+                             "amplitude=1deg,frequency=1Hz,rod=1m",
+                             "fish.wing:amplitude=1deg,to=2deg", "wing:step"};
+    for (int i = 0; i < 4; i++) {
+        ts_err e = {0};
+        rc = ts_excitation_parse(ex, badspec[i], units, "--excite", &e);
+        CHECK(rc != TS_OK && strstr(e.msg, "--excite"), "%s refused: %s",
+              badspec[i], e.msg);
+    }
+    ts_excitation_free(ex);
+    ts_units_free(units);
+}
+
 /* Section 8: the smooth start. */
 static void test_smooth_start(void)
 {
@@ -718,6 +768,7 @@ static void test_smooth_start(void)
 
 int main(void)
 {
+    test_vehicle_inputs();
     test_sum();
     test_shapes();
     test_smooth_start();

@@ -311,7 +311,7 @@ static void test_shapes(void)
     /* Side view of a submerged chain without labels: no legend, so the
      * plot box is known. */
     ts_plot_shape one = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
-                         0, NULL};
+                         0, NULL, 0, NULL};
     int rc = ts_plot_shapes(dir, "side_si", "chain: side view", TS_PLOT_SIDE,
                             TS_PLOT_WATER, 1, &one, &o, &err);
     CHECK(rc == TS_OK, "side view drawn (%s)", err.msg);
@@ -360,9 +360,9 @@ static void test_shapes(void)
     /* Overlay: straight and turning, side and top, with labels. */
     ts_plot_shape two[2] = {
         {N, chain, NULL, 1, end_mark, 0, "5 knot, straight", TS_PLOT_SOLID,
-         0, 0, NULL},
+         0, 0, NULL, 0, NULL},
         {N, chain_turn, NULL, 1, end_mark, 38.5, "5 knot, turn",
-         TS_PLOT_DASHED, 0, 0, NULL}};
+         TS_PLOT_DASHED, 0, 0, NULL, 0, NULL}};
     rc = ts_plot_shapes(dir, "side", "overlay: side view", TS_PLOT_SIDE,
                         TS_PLOT_WATER | TS_PLOT_EQUAL, 2, two, &o, &err);
     CHECK(rc == TS_OK, "side view of two shapes drawn (%s)", err.msg);
@@ -394,7 +394,7 @@ static void test_shapes(void)
 
     /* A branched tree in both views. */
     ts_plot_shape t = {NT,     tree, tree_upper, 2, tree_marks, -20,
-                       "tree", 0,    3,          0, NULL};
+                       "tree", 0,    3,          0, NULL, 0, NULL};
     rc = ts_plot_shapes(dir, "tree_side", "tree", TS_PLOT_SIDE,
                         TS_PLOT_WATER | TS_PLOT_EQUAL, 1, &t, &o, &err);
     CHECK(rc == TS_OK, "branched tree, side view (%s)", err.msg);
@@ -402,6 +402,27 @@ static void test_shapes(void)
                         &err);
     CHECK(rc == TS_OK, "branched tree, top view, port turn (%s)", err.msg);
     check_png("tree_top", 1000, 700);
+
+    /* A body outline (a square of 0.2 m at the end of the chain) drawn
+     * with its attitude; a bad one refused. */
+    const double *e = chain + 3 * (N - 1);
+    double sq[15] = {e[0], e[1], e[2], e[0] - 0.2, e[1], e[2],
+                     e[0] - 0.2, e[1], e[2] + 0.2, e[0], e[1], e[2] + 0.2,
+                     e[0], e[1], e[2]};
+    ts_plot_outline ol = {5, sq, {e[0], e[1], e[2]}};
+    ts_plot_shape b = {N, chain, NULL, 1, end_mark, 0, "with a body", 0, 0,
+                       0, NULL, 1, &ol};
+    rc = ts_plot_shapes(dir, "outline", "outline", TS_PLOT_SIDE,
+                        TS_PLOT_WATER, 1, &b, &o, &err);
+    CHECK(rc == TS_OK && file_exists("outline", "png"),
+          "a body's outline drawn (%s)", err.msg);
+    ts_plot_outline bad = {5, NULL, {0, 0, 0}};
+    b.outlines = &bad;
+    ts_err e2 = {0};
+    rc = ts_plot_shapes(dir, "outline_bad", "outline", TS_PLOT_SIDE, 0, 1,
+                        &b, &o, &e2);
+    CHECK(rc == TS_EINVAL && strstr(e2.msg, "outlines[0]"),
+          "an outline without points refused (%s)", e2.msg);
 }
 
 /* A cylinder towfish: drawn as a filled outline (two paths more than
@@ -411,7 +432,7 @@ static void test_cylinder(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     ts_err err = {0};
-    ts_plot_shape one = {N, chain_sub, NULL, 0, NULL, 0, NULL, 0, 0, 0, NULL};
+    ts_plot_shape one = {N, chain_sub, NULL, 0, NULL, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     int rc = ts_plot_shapes(dir, "cyl_without", "towfish", TS_PLOT_SIDE,
                             TS_PLOT_WATER, 1, &one, &o, &err);
     ts_plot_cylinder cy = {N - 1, 2.0, 0.4};
@@ -448,6 +469,61 @@ static void test_cylinder(void)
     CHECK(nothing_named("cyl_bad"), "refused shapes left no file");
 }
 
+/* A mode as an animated SVG: the file, its title, one <animate> with
+ * nframes + 1 path values, the first and the last the same (the loop
+ * closes), the frames apart; no PNG; bad frame counts refused. */
+static void test_animation(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    static double re[3 * N], im[3 * N];
+    for (int k = 0; k < N; k++) {
+        double s = (double)k / (N - 1);
+        re[3 * k + 2] = sin(M_PI * s);
+        im[3 * k] = 0.5 * sin(2 * M_PI * s);
+    }
+    ts_plot_shape eq = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
+                        0, NULL};
+    int rc = ts_plot_mode_animation(dir, "anim", "chain: mode 1", TS_PLOT_SIDE,
+                                    TS_PLOT_WATER, &eq, re, im,
+                                    "mode 1: 0.5 Hz", 12, 2.0, &o, &err);
+    CHECK(rc == TS_OK, "mode animation written (%s)", err.msg);
+    char *svg = check_svg("anim", "chain: mode 1");
+    CHECK(!file_exists("anim", "png"), "an animation is an SVG only");
+    const char *v = svg ? strstr(svg, "<animate ") : NULL;
+    const char *vals = v ? strstr(v, "values=\"") : NULL;
+    const char *end = vals ? strchr(vals + 8, '"') : NULL;
+    int nsep = 0;
+    for (const char *p = vals; p && p < end; p++)
+        nsep += *p == ';';
+    CHECK(v && end && nsep == 12, "one <animate> with 13 path values (%d "
+          "separators)", nsep);
+    if (v && end && nsep == 12) {
+        const char *first = vals + 8, *f_end = strchr(first, ';');
+        const char *last = end;
+        while (last > first && last[-1] != ';')
+            last--;
+        size_t lf = (size_t)(f_end - first), ll = (size_t)(end - last);
+        CHECK(lf == ll && strncmp(first, last, lf) == 0,
+              "the cycle closes: the last frame is the first");
+        const char *second = f_end + 1, *s_end = strchr(second, ';');
+        CHECK((size_t)(s_end - second) != lf ||
+                  strncmp(first, second, lf) != 0,
+              "the second frame differs from the first");
+    }
+    free(svg);
+    rc = ts_plot_mode_animation(dir, "anim_bad", "x", TS_PLOT_SIDE, 0, &eq,
+                                re, im, NULL, 2, 2.0, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "nframes"),
+          "2 frames are refused: %s", err.msg);
+    rc = ts_plot_mode_animation(dir, "anim_bad", "x", TS_PLOT_SIDE, 0, &eq,
+                                re, im, NULL, 12, 0.0, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "seconds"),
+          "a cycle of 0 s is refused: %s", err.msg);
+    CHECK(nothing_named("anim_bad"), "refused animations left no file");
+}
+
 static void test_modes(void)
 {
     ts_plot_opts o;
@@ -470,7 +546,7 @@ static void test_modes(void)
         modes[m].disp = disp[m];
         modes[m].label = label[m];
     }
-    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
+    ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     int rc = ts_plot_mode_shapes(dir, "modes", "chain: lowest modes",
                                  TS_PLOT_WATER, &eq, NM, modes, &o, &err);
     CHECK(rc == TS_OK, "mode shapes drawn (%s)", err.msg);
@@ -756,7 +832,7 @@ static void test_bad_places(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     ts_err err = {0};
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     static const char *const names[] = {"", ".hidden", "a/b", "x y", NULL};
     for (int i = 0; names[i]; i++) {
         ts_err_clear(&err);
@@ -863,7 +939,7 @@ static void test_streams(void)
     ts_plot_opts o;
     ts_plot_opts_default(&o);
     o.formats = TS_PLOT_PNG;
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     ts_err err = {0};
     int rc = ts_plot_shapes(dir, "stream", "t", TS_PLOT_TOP, 0, 1, &one, &o,
                             &err);
@@ -891,7 +967,7 @@ static void test_without_plplot(void)
               strstr(err.msg, "libplplot-dev") &&
               strstr(err.msg, "plplot-driver-cairo"),
           "ts_plot_check names the missing packages: %s", err.msg);
-    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0};
+    ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     ts_plot_mode mode = {chain, "m"};
     double x[2] = {1, 2}, y[2] = {1, 2}, ph[2] = {0, 0}, nat[1] = {1};
     ts_plot_series s = {2, x, y, "s", 0, 0, 0};
@@ -1042,6 +1118,7 @@ int main(int argc, char **argv)
           "PLplot with its cairo devices is available (%s)", err.msg);
     test_shapes();
     test_cylinder();
+    test_animation();
     test_modes();
     test_eigenvalues();
     test_bode();

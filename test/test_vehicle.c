@@ -581,8 +581,8 @@ static void test_control(void)
     double val[4] = {10.4, 0.05, -0.02, -3.0}, rate[4] = {-0.1, 0, 0, 0};
     double xi[2] = {0.7, 99.0}, act[3] = {0, 0.1, 0}, us[3] = {0.01, 0, 0};
     double ul[2] = {0, 0}, out[2], delta[3], xd[2], ad[3];
-    tsi_vehicle_control(v, val, rate, xi, act, us, ul, NULL, NULL, out, delta,
-                        xd, ad);
+    tsi_control_in in = {val, rate, xi, act, us, ul, NULL, NULL, NULL, 0};
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
     double e_d = 0.4, v_d = 0.2 * 0.4 + 0.03 * 0.7 + 0.5 * -0.1;
     /* heading error -3 - 3 = -6 rad wraps to -6 + 2 pi */
     double e_h = -6.0 + 2 * M_PI, v_h = 1.5 * e_h;
@@ -599,16 +599,27 @@ static void test_control(void)
     CHECK(delta[2] == 0 && ad[2] == 0, "a fixed surface does not deflect");
     /* Saturation of the deflection. */
     us[0] = 1.0;
-    tsi_vehicle_control(v, val, rate, xi, act, us, ul, NULL, NULL, out, delta,
-                        xd, ad);
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
     CHECK(delta[0] == 0.3, "deflection limited to 0.3 rad");
+    in.steady = 1;
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
+    CHECK_NEAR(ad[1], (v_h - 0.1) / 0.05, 1e-12,
+               "steady: the actuator's rate is not limited");
+    in.steady = 0;
+    double sp[2] = {10.25, 3.0};
+    in.setpoint = sp;
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
+    CHECK_NEAR(xd[0], 0.15, 1e-15, "a set point in force other than the "
+                                   "scene's: e = 10.4 - 10.25");
+    in.setpoint = NULL;
     us[0] = 0.0;
     /* Frozen (open) and broken loops. */
-    int mode[2] = {TSI_LOOP_FROZEN, TSI_LOOP_BROKEN};
+    int mode[2] = {TS_LOOP_OPEN, TS_LOOP_BROKEN};
     double frozen[2] = {0.011, 0.0};
     ul[1] = 0.07;
-    tsi_vehicle_control(v, val, rate, xi, act, us, ul, mode, frozen, out,
-                        delta, xd, ad);
+    in.mode = mode;
+    in.frozen = frozen;
+    tsi_vehicle_control(v, &in, out, delta, xd, ad);
     CHECK_NEAR(delta[0], 0.02 + 0.011 - 0.5 * 0.07, 1e-15,
                "frozen loop holds its trim output, a broken loop passes its "
                "input");
@@ -671,9 +682,52 @@ static void test_bad(void)
     free(v);
 }
 
+/* Drawing: ts_vehicle_rotation inverts tsi_ypr_from_rot; a hull's
+ * outline spans its length along the body axis, turned by the attitude. */
+static void test_outline(void)
+{
+    double R[9], ypr[3];
+    ts_vehicle_rotation(0.3, -0.2, 0.1, R);
+    tsi_ypr_from_rot(R, ypr);
+    CHECK(fabs(ypr[0] - 0.3) < 1e-15 && fabs(ypr[1] + 0.2) < 1e-15 &&
+              fabs(ypr[2] - 0.1) < 1e-15,
+          "yaw, pitch, roll -> R -> yaw, pitch, roll (%.17g %.17g %.17g)",
+          ypr[0], ypr[1], ypr[2]);
+    ts_vehicle v = {0};
+    v.ncomponents = 2;
+    ts_component_defaults(&v.component[0], TS_COMP_HULL);
+    v.component[0].length = 2.0;
+    v.component[0].diameter = 0.2;
+    ts_component_defaults(&v.component[1], TS_COMP_SURFACE);
+    v.component[1].position[0] = -1.0;
+    v.component[1].area = 0.1;
+    v.component[1].span = 0.5;
+    double O[3] = {1, 2, 3}, pts[3 * 100];
+    ts_vehicle_rotation(0, 0.5, 0, R); /* nose up 0.5 rad */
+    int n = ts_vehicle_outline(&v, R, O, NULL, pts, 100);
+    /* 2 hull ellipses, 2 separators, a 5-point planform. */
+    int want = 2 * TS_OUTLINE_HULL_POINTS + 2 + 5;
+    double zmin = INFINITY, zmax = -INFINITY, xmin = INFINITY;
+    for (int k = 0; k < TS_OUTLINE_HULL_POINTS; k++) {
+        zmin = fmin(zmin, pts[3 * k + 2]);
+        zmax = fmax(zmax, pts[3 * k + 2]);
+        xmin = fmin(xmin, pts[3 * k]);
+    }
+    /* The nose (body x = 1) at z = 3 - sin 0.5 (up), the tail at
+     * 3 + sin 0.5: the outline's depth range is 2 sin 0.5 plus the
+     * diameter's share; the hull outline starts at the nose. */
+    CHECK(n == want && isnan(pts[3 * TS_OUTLINE_HULL_POINTS]) &&
+              fabs(pts[0] - (1 + cos(0.5))) < 1e-15 &&
+              fabs(pts[2] - (3 - sin(0.5))) < 1e-15 && zmin < 3 - 0.47 &&
+              zmax > 3 + 0.47 && xmin > 1 - cos(0.5) - 0.1,
+          "outline: %d points (want %d), nose at x %.6f z %.6f", n, want,
+          pts[0], pts[2]);
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
+    test_outline();
     test_spheroid();
     test_shift();
     test_curves();

@@ -101,6 +101,52 @@ void cli_plot_shape_free(cli_shape *s)
     free(s->cylinders);
     s->link_upper = s->marks = NULL;
     s->cylinders = NULL;
+    for (int b = 0; s->outlines && b < s->shape.noutlines; b++)
+        free((double *)s->outlines[b].pts);
+    free(s->outlines);
+    s->outlines = NULL;
+    s->shape.outlines = NULL;
+    s->shape.noutlines = 0;
+}
+
+int cli_plot_add_vehicle(cli_shape *s, const ts_system *sys, int b,
+                         const double R[9], const double *delta)
+{
+    const ts_vehicle *v = sys->bodies[b].vehicle;
+    if (!v)
+        return 0;
+    if (!s->outlines) {
+        s->outlines = calloc((size_t)sys->nbodies, sizeof *s->outlines);
+        if (!s->outlines)
+            return -1;
+        s->shape.outlines = s->outlines;
+    }
+    /* The attach point is the body's node; the origin O = A - R a. */
+    const double *A = s->shape.pos + 3 * ts_system_body_node(sys, b);
+    double O[3];
+    for (int i = 0; i < 3; i++)
+        O[i] = A[i] - (R[3 * i] * v->attach[0] + R[3 * i + 1] * v->attach[1] +
+                       R[3 * i + 2] * v->attach[2]);
+    int n = ts_vehicle_outline(v, R, O, delta, NULL, 0);
+    double *pts = malloc(3 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (!pts)
+        return -1;
+    ts_vehicle_outline(v, R, O, delta, pts, n);
+    ts_plot_outline *o = &s->outlines[s->shape.noutlines++];
+    o->npoints = n;
+    o->pts = pts;
+    memcpy(o->anchor, A, sizeof o->anchor);
+    return 0;
+}
+
+int cli_plot_add_vehicles(cli_shape *s, const ts_system *sys,
+                          const ts_equilibrium *eq)
+{
+    for (int i = 0; i < eq->nvehicles; i++)
+        if (cli_plot_add_vehicle(s, sys, eq->vehicles[i].body,
+                                 eq->vehicles[i].R, eq->vehicles[i].delta))
+            return -1;
+    return 0;
 }
 
 void cli_plot_tow_label(const ts_system *sys, const char *speed_text,

@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 
+#include "towstab/equilibrium.h"
 #include "towstab/plot.h"
 #include "towstab/system.h"
 #include "towstab/units.h"
@@ -47,10 +48,22 @@ typedef struct cli_shape {
     int *marks;      /* [nbodies] */
     ts_plot_cylinder *cylinders; /* [nbodies] */
     char label[192];
+    ts_plot_outline *outlines; /* [nbodies]: vehicles with their attitude */
 } cli_shape;
 
 int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out);
 void cli_plot_shape_free(cli_shape *s);
+
+/* Add vehicle body `b` of sys to the shape, drawn with attitude R (body
+ * to M, row-major) about the shape's node of the body (its attach point),
+ * its surfaces at deflections delta[ncomponents] (NULL: the open-loop
+ * ones). Returns 0, or -1 when out of memory. */
+int cli_plot_add_vehicle(cli_shape *s, const ts_system *sys, int b,
+                         const double R[9], const double *delta);
+
+/* The vehicles of an equilibrium (eq->vehicles), added to s. */
+int cli_plot_add_vehicles(cli_shape *s, const ts_system *sys,
+                          const ts_equilibrium *eq);
 
 /* "5 knot, straight" or "1.48 knot, turn 0.5 rad/s (starboard)": the tow
  * of `sys` as a legend label: the speed and turn rate as the user wrote

@@ -127,7 +127,8 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
         const eq_curve *c = &curves[i];
         if (!c->eq || !c->eq->converged)
             continue;
-        if (cli_plot_shape(c->sys, c->eq->positions, &shapes[n]) != 0) {
+        if (cli_plot_shape(c->sys, c->eq->positions, &shapes[n]) != 0 ||
+            cli_plot_add_vehicles(&shapes[n], c->sys, c->eq) != 0) {
             fprintf(stderr, "towstab: error: equilibrium: --plot: out of memory\n");
             status = EXIT_FAILED;
             break;

@@ -33,6 +33,9 @@ void cli_print_linearization(const ts_result *r)
                "truncation error %.3g\n",
                l->nstate, l->groups, l->residual_evaluations, l->threads,
                l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->desc_err);
+    if (r->open_loop)
+        printf("open loop: the vehicles' controller loops are open, their "
+               "surfaces held at the trim's deflections\n");
     if (l->kinks > l->kink_tow) {
         char name[2 * TS_NAME_MAX];
         ts_system_node_name(r->sys, l->kink_node, name, sizeof name);
@@ -249,7 +252,7 @@ static int ends_with(const char *s, const char *suffix)
  * the eigenvector's coordinate half), Re(d e^{i phi}) = a cos phi -
  * b sin phi is largest at tan 2 phi = -2 a.b / (|a|^2 - |b|^2). */
 static int mode_disp(const ts_system *sys, const ts_linear *lin,
-                     const ts_eigen *e, int m, double *out)
+                     const ts_eigen *e, int m, double *out, double *im_out)
 {
     int nq = lin->nq, nn = sys->nnodes;
     double *dq = malloc((size_t)nq * sizeof(double));
@@ -272,8 +275,12 @@ static int mode_disp(const ts_system *sys, const ts_linear *lin,
         ab += out[i] * b[i];
     }
     double phi = 0.5 * atan2(-2 * ab, aa - bb), c = cos(phi), sn = sin(phi);
-    for (int i = 0; i < 3 * nn; i++)
+    /* d e^{i phi}: its real part, and its imaginary part when asked. */
+    for (int i = 0; i < 3 * nn; i++) {
+        if (im_out)
+            im_out[i] = out[i] * sn + b[i] * c;
         out[i] = out[i] * c - b[i] * sn;
+    }
     free(dq);
     free(b);
     return 0;
@@ -349,11 +356,12 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
     if (np < 1 || !e->vec_re || !e->vec_im)
         return status;
     cli_shape eqs;
-    double *disp = malloc((size_t)np * 3 * (size_t)sys->nnodes *
+    double *disp = malloc((size_t)np * 6 * (size_t)sys->nnodes *
                           sizeof(double));
     char labels[PLOT_MODES][160];
     ts_plot_mode modes[PLOT_MODES];
-    if (!disp || cli_plot_shape(sys, pos, &eqs) != 0) {
+    if (!disp || cli_plot_shape(sys, pos, &eqs) != 0 ||
+        (r->eq && cli_plot_add_vehicles(&eqs, sys, r->eq) != 0)) {
         free(disp);
         fprintf(stderr, "towstab: error: modes: --plot: out of memory\n");
         return EXIT_FAILED;
@@ -361,8 +369,8 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
     for (int i = 0; i < np; i++) {
         int m = pick[i];
         const ts_mode *md = &e->modes[m];
-        double *d = disp + (size_t)i * 3 * sys->nnodes;
-        if (mode_disp(sys, lin, e, m, d) != 0) {
+        double *d = disp + (size_t)i * 6 * sys->nnodes;
+        if (mode_disp(sys, lin, e, m, d, d + 3 * sys->nnodes) != 0) {
             status = EXIT_FAILED;
             break;
         }
@@ -383,11 +391,60 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
         else
             cli_plot_wrote(plot, "modes");
     }
+    /* Each drawn mode as an animated SVG (side view), one cycle in 2 s. */
+    for (int i = 0; i < np && status == 0; i++) {
+        char name[32], at[300];
+        snprintf(name, sizeof name, "mode%d_animation", pick[i] + 1);
+        snprintf(at, sizeof at, "%s: mode %d, side view, one cycle",
+                 sys->name, pick[i] + 1);
+        const double *d = disp + (size_t)i * 6 * sys->nnodes;
+        if (ts_plot_mode_animation(plot->dir, name, at, TS_PLOT_SIDE,
+                                   TS_PLOT_WATER, &eqs.shape, d,
+                                   d + 3 * sys->nnodes, labels[i], 36, 2.0,
+                                   &plot->opts, &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            printf("wrote %s/%s.svg\n", plot->dir, name);
+    }
     cli_plot_shape_free(&eqs);
     free(disp);
     return status;
 }
 
+
+/* The loops' gain and phase margins, one loop broken at a time. */
+static void print_margins(const ts_result *r)
+{
+    if (r->nmargins == 0)
+        return;
+    printf("\nloop margins, each loop broken at its output with the others "
+           "closed (%g to %g Hz, %.3f ms):\n", TS_MARGINS_FROM_HZ,
+           TS_MARGINS_TO_HZ, r->margins_wall_s * 1e3);
+    printf("%-28s %12s %10s %14s %14s %14s\n", "loop", "gain margin", "[dB]",
+           "at [Hz]", "phase margin", "at [Hz]");
+    for (int i = 0; i < r->nmargins; i++) {
+        const ts_loop_margin *m = &r->margins[i];
+        char gm[32], db[32], gf[32], pm[32], pf[32];
+        if (isfinite(m->gain_margin)) {
+            snprintf(gm, sizeof gm, "%.4g", m->gain_margin);
+            snprintf(db, sizeof db, "%.2f", 20 * log10(m->gain_margin));
+            snprintf(gf, sizeof gf, "%.4g", m->phase_crossover_hz);
+        } else {
+            snprintf(gm, sizeof gm, "infinite");
+            snprintf(db, sizeof db, "-");
+            snprintf(gf, sizeof gf, "-");
+        }
+        if (isfinite(m->phase_margin_deg)) {
+            snprintf(pm, sizeof pm, "%.2f deg", m->phase_margin_deg);
+            snprintf(pf, sizeof pf, "%.4g", m->gain_crossover_hz);
+        } else {
+            snprintf(pm, sizeof pm, "no crossover");
+            snprintf(pf, sizeof pf, "-");
+        }
+        printf("%-28s %12s %10s %14s %14s %14s\n", m->name, gm, db, gf, pm,
+               pf);
+    }
+}
 
 static void modes_print(const cli_run *c, const ts_result *r)
 {
@@ -395,6 +452,7 @@ static void modes_print(const cli_run *c, const ts_result *r)
     cli_print_linearization(r);
     if (r->eigen && r->mode_health)
         print_modes(r, c->quiet);
+    print_margins(r);
 }
 
 /* The extras. */

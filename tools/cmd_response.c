@@ -8,18 +8,37 @@
 #include "cli.h"
 #include "cli_plot.h"
 
+/* The plot quantities of a response's unit "OUT/IN" (m, N or rad). */
+static ts_plot_quantity unit_quantity(const char *u, size_t len)
+{
+    if (len == 1 && u[0] == 'N')
+        return TS_PLOT_FORCE;
+    if (len == 3 && strncmp(u, "rad", 3) == 0)
+        return TS_PLOT_ANGLE;
+    return TS_PLOT_LENGTH;
+}
+
+static void unit_quantities(const char *unit, ts_plot_quantity *out_q,
+                            ts_plot_quantity *in_q)
+{
+    const char *slash = strchr(unit, '/');
+    size_t lo = slash ? (size_t)(slash - unit) : strlen(unit);
+    *out_q = unit_quantity(unit, lo);
+    *in_q = slash ? unit_quantity(slash + 1, strlen(slash + 1))
+                  : TS_PLOT_LENGTH;
+}
+
 static void print_response(const ts_result *res, int quiet,
                            const ts_display *d)
 {
     const ts_response *r = res->response;
     char e[160] = "", gu[64], fu[64];
-    double k = ts_display_convert(d, r->output.unit, 1.0, gu, sizeof gu);
+    double k = ts_display_convert(d, r->unit, 1.0, gu, sizeof gu);
     double kf = ts_display_convert(d, "Hz", 1.0, fu, sizeof fu);
     if (res->nvalues > 0)
         cli_value_error(&res->values[0], d, e, sizeof e);
     printf("response of %s to %s (%s): static gain %.9g %s\n",
-           r->output.name, ts_input_name(r->input), gu, k * r->static_gain,
-           e);
+           r->output.name, r->input_name, gu, k * r->static_gain, e);
     int ib = 0;
     for (int i = 1; i < r->npoints; i++)
         if (r->magnitude[i] > r->magnitude[ib])
@@ -208,22 +227,22 @@ static int response_draw(cli_run *c, const ts_result *r)
                 }
                 ph[i] = p + shift;
             }
-            char title[256], mag_label[192];
+            char title[256], mag_label[2 * TS_IO_NAME + 8];
             snprintf(title, sizeof title, "%s: frequency response",
                      r->sys->name);
             snprintf(mag_label, sizeof mag_label, "%s / %s",
-                     res->output.name, ts_input_name(res->input));
+                     res->output.name, res->input_name);
             ts_plot_bode_curve bc = {res->npoints, res->freq_hz,
                                      res->magnitude, ph, mag_label,
                                      TS_PLOT_SOLID, 0};
-            int tension = res->output.kind == TS_OUT_TENSION;
+            ts_plot_quantity out_q, in_q;
+            unit_quantities(res->unit, &out_q, &in_q);
             ts_err perr = {0};
             ts_plot_opts po = plot->opts;
             po.bode_db = c->nextra[0] > 0; /* --db */
-            if (ts_plot_bode(plot->dir, "bode", title, mag_label,
-                             tension ? TS_PLOT_FORCE : TS_PLOT_LENGTH,
-                             TS_PLOT_LENGTH, 1, &bc, r->nnatural,
-                             r->natural_hz, &po, &perr) != TS_OK)
+            if (ts_plot_bode(plot->dir, "bode", title, mag_label, out_q,
+                             in_q, 1, &bc, r->nnatural, r->natural_hz, &po,
+                             &perr) != TS_OK)
                 status = cli_report(&perr, perr.code);
             else
                 cli_plot_wrote(plot, "bode");
@@ -241,6 +260,6 @@ static const cli_extra response_extras[] = {
     {NULL, 0, 0, NULL, NULL}};
 
 const cli_command cli_cmd_response = {
-    "response", "frequency response to tow-point motion",
+    "response", "frequency response to tow-point motion or a vehicle's input",
     TS_ANALYSIS_RESPONSE, NULL, response_prepare, response_print,
     response_draw, NULL, response_pictures, response_extras};

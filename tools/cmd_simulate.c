@@ -356,6 +356,49 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
     return status;
 }
 
+/* Value of the history's output "<body>.<what>" at sample i; NAN if
+ * none. */
+static double output_at(const ts_history *h, const char *body,
+                        const char *what, int i)
+{
+    char name[2 * TS_NAME_MAX + 16];
+    snprintf(name, sizeof name, "%s.%s", body, what);
+    for (int j = 0; h->outputs && j < h->noutput; j++)
+        if (!strcmp(h->output_name[j], name))
+            return h->outputs[(size_t)h->noutput * i + j];
+    return NAN;
+}
+
+/* The vehicles at sample i, with the attitude and deflections the history
+ * recorded. */
+static int snapshot_vehicles(const ts_system *sys, const ts_history *h,
+                             int i, cli_shape *s)
+{
+    for (int b = 0; b < sys->nbodies; b++) {
+        const ts_vehicle *v = sys->bodies[b].vehicle;
+        const char *nm = sys->bodies[b].name;
+        if (!v)
+            continue;
+        double yaw = output_at(h, nm, "yaw", i),
+               pitch = output_at(h, nm, "pitch", i),
+               roll = output_at(h, nm, "roll", i);
+        if (!isfinite(yaw) || !isfinite(pitch) || !isfinite(roll))
+            continue;
+        double R[9], delta[TS_VEHICLE_MAX_COMPONENTS];
+        ts_vehicle_rotation(yaw, pitch, roll, R);
+        for (int c = 0; c < v->ncomponents; c++) {
+            char what[TS_VEHICLE_NAME_MAX + 16];
+            snprintf(what, sizeof what, "%s.deflection",
+                     v->component[c].name);
+            double d = output_at(h, nm, what, i);
+            delta[c] = isfinite(d) ? d : v->component[c].deflection;
+        }
+        if (cli_plot_add_vehicle(s, sys, b, R, delta) != 0)
+            return -1;
+    }
+    return 0;
+}
+
 /* Snapshots of the cable every `interval` s from t = 0 (side and top
  * views, memo Figs. 9 and 11). */
 /* The plan view in the earth frame under a manoeuvre (plan_earth): the
@@ -479,7 +522,8 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
                        exaggerate * (pos[j] - h->positions[j]);
             pos = e;
         }
-        if (cli_plot_shape(sys, pos, &shapes[k]) != 0) {
+        if (cli_plot_shape(sys, pos, &shapes[k]) != 0 ||
+            snapshot_vehicles(sys, h, idx[k], &shapes[k]) != 0) {
             fprintf(stderr,
                     "towstab: error: simulate: --plot: out of memory\n");
             status = EXIT_FAILED;

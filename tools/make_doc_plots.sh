@@ -88,3 +88,9 @@ pic simulate_ex5_snapshots snapshots_side simulate \
 # (memo Fig. 12).
 pic converge_ex1_error_time error_time converge \
     examples/kamman_ex1_submerged.yaml --links 5,10,20,40,80,160,320
+# The two-part tow: depressor sphere and cylinder towfish.
+pic equilibrium_two_part_side side equilibrium examples/two_part_tow.yaml
+# A 0.1 rad/s turn begun over 5 s, in the earth frame.
+pic simulate_manoeuvre_plan plan_earth simulate \
+    examples/kamman_ex1_submerged.yaml \
+    --manoeuvre turn_rate:to=0.1rad/s,duration=5s --t-end 40

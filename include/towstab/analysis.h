@@ -24,6 +24,7 @@
 
 #include "towstab/accuracy.h"
 #include "towstab/compare.h"
+#include "towstab/control.h"
 #include "towstab/converge.h"
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
@@ -71,6 +72,13 @@ typedef struct ts_setup {
     int links;             /* equal links on every cable, 1..TS_MAX_LINKS;
                               0 (default): the system's */
     ts_equilibrium_opts equilibrium; /* method and tol (its defaults) */
+    int open_loop;         /* 1: the vehicles' controller loops open in
+                              the linear model and the simulation, about
+                              the closed-loop trim: each loop's output
+                              held at its trim value (the surfaces keep
+                              their trim deflections), its integrator out
+                              of the state (towstab/control.h); 0
+                              (default): closed */
     double accuracy;       /* relative accuracy wanted of the key values,
                               in (0, 1); default TS_ACCURACY_DEFAULT */
     int discretisation_error; /* 1: estimate the discretisation error of
@@ -113,11 +121,21 @@ typedef struct ts_modes_opts {
                               TS_CONV_MODE_DAMPING_MAX (default
                               TS_MODES_FOLLOW, 1..100) */
     ts_linearize_opts linearize; /* its defaults */
+    int margins;           /* 1 (default): with controller loops closed,
+                              each loop's gain and phase margins
+                              (ts_loop_margins over TS_MARGINS_FROM_HZ to
+                              TS_MARGINS_TO_HZ) */
     int oscillatory;       /* 1: list the oscillatory modes only (the
                               `count` lowest when count is given; the
                               table always lists them first); the verdict
                               still covers every mode computed */
 } ts_modes_opts;
+
+/* The band and scan of the loop margins of a modes result: log-spaced,
+ * TS_MARGINS_PER_DECADE points a decade, each crossing refined. */
+#define TS_MARGINS_FROM_HZ 1e-5
+#define TS_MARGINS_TO_HZ 100.0
+#define TS_MARGINS_PER_DECADE 40
 
 /* Frequency response defaults. */
 #define TS_RESPONSE_FROM_HZ 0.01
@@ -141,9 +159,12 @@ typedef struct ts_sea_opts {
 
 typedef struct ts_response_opts {
     char input[TS_REQUEST_NAME_MAX];  /* tow.surge, tow.sway, tow.heave
-                                         (default) */
-    char output[TS_REQUEST_NAME_MAX]; /* required: <node>.x|y|z or
-                                         <cable>.<k>.tension */
+                                         (default), or a vehicle's input
+                                         (ts_response_input_lookup) */
+    char output[TS_REQUEST_NAME_MAX]; /* required: <node>.x|y|z,
+                                         <cable>.<k>.tension or a
+                                         vehicle's output
+                                         (ts_response_output_lookup) */
     double from_hz, to_hz;            /* > 0, from < to; defaults above */
     int points;                       /* 2..TS_RESPONSE_MAX_POINTS */
     int natural;                      /* 1: also the natural frequencies
@@ -361,6 +382,8 @@ typedef struct ts_result {
     /* The linearization (modes, response, simulate --linear/--compare). */
     ts_linear *lin;
     double lin_wall_s;
+    int open_loop;              /* the linear model and the simulation
+                                   have the vehicles' loops open */
     /* modes */
     ts_eigen *eigen;
     ts_mode_health *mode_health; /* [eigen->nmodes] */
@@ -377,6 +400,9 @@ typedef struct ts_result {
                                    --near or --oscillatory chose those
                                    listed (eigen->nmodes) */
     double eigen_wall_s;
+    int nmargins;               /* modes with closed loops: one per loop */
+    ts_loop_margin *margins;    /* [nmargins] */
+    double margins_wall_s;
     /* response */
     ts_response *response;
     /* response or simulate with a sea: the seaway (its sea and RAOs are

@@ -87,13 +87,23 @@ typedef struct ts_conv_value {
 } ts_conv_value;
 
 /* One run. */
+/* A run shorter than this (s) is repeated, up to TS_CONV_TIMING_REPEATS
+ * runs in all or until the repeats take this long, and its wall time is
+ * the median (ts_convergence_sweep): sub-millisecond timer and scheduler
+ * noise would otherwise zig-zag the work-precision curve. */
+#define TS_CONV_TIMING_MIN 0.05
+#define TS_CONV_TIMING_REPEATS 15
+
 typedef struct ts_conv_row {
     int series;         /* index into ts_convergence.series */
     double setting;     /* links (whole), tolerance or step */
     double h;           /* resolution measure, > 0 */
     int status;         /* TS_OK, or the run's failure code */
     char message[TS_CONV_MSG_MAX]; /* the failure's message, "" if none */
-    double wall_s;      /* s */
+    double wall_s;      /* s: one run's; for a run shorter than
+                           TS_CONV_TIMING_MIN, the median of timed_runs
+                           repeats (timer noise) */
+    int timed_runs;     /* the runs timed, >= 1 */
     long evaluations;   /* kernel (or right-hand side) evaluations */
     ts_trust trust;     /* health of the run's result */
     double *values;     /* [nvalues]; NaN where the run gave none */

@@ -107,6 +107,14 @@ TS_API int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
 TS_API int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
                                      double y[], ts_err *err);
 
+/* The whole state y[nstate] of equilibrium eq in kernel k's charts (any
+ * kernel of eq's system with the same controller layout): the links'
+ * directions and strains (re-charted with TS_CHART_RECHART), the
+ * vehicles' attitudes and the controller states, at rest. TS_OK,
+ * TS_EINVAL (layouts differ) or TS_ENOMEM. */
+TS_API int ts_equilibrium_state(ts_kernel *k, const ts_equilibrium *eq,
+                                double y[], ts_err *err);
+
 /* Name of a method ("auto", "shooting", "newton"). */
 TS_API const char *ts_eq_method_name(ts_eq_method m);
 

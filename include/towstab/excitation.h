@@ -11,7 +11,13 @@
  *    signal is the change of V (m/s) or Omega (rad/s) from the base frame,
  *    and the frame of time t carries the matching speed_rate / turn_accel
  *    (doc/model.md sections 1 and 10). The current, fixed in inertial
- *    space, rotates in M by the heading change psi(t) = integral of Omega.
+ *    space, rotates in M by the heading change psi(t) = integral of Omega;
+ *  - a vehicle's input (TS_AXIS_INPUT, named by ts_signal.input: a control
+ *    surface "<vehicle>.<surface>", a loop's output "<vehicle>.<loop>" or
+ *    its set point "<vehicle>.<loop>.setpoint", ts_kernel_input_name): the
+ *    signal is added to that kernel input (rad, or m for a depth set
+ *    point); a sine, a step or a ramp (ts_excitation_value). The name is
+ *    checked against the kernel by the simulator.
  *
  * Signal shapes (t in s; A the amplitude; w = 2 pi f):
  *  - sine:   A sin(w t + phase), for all t >= 0;
@@ -74,8 +80,12 @@ typedef enum {
     TS_AXIS_SWAY = 1,      /* tow point, y of M (starboard) */
     TS_AXIS_HEAVE = 2,     /* tow point, z of M (down) */
     TS_AXIS_SPEED = 3,     /* speed V of M */
-    TS_AXIS_TURN_RATE = 4  /* turn rate Omega of M */
+    TS_AXIS_TURN_RATE = 4, /* turn rate Omega of M */
+    TS_AXIS_INPUT = 5      /* a vehicle's input, named by ts_signal.input */
 } ts_axis;
+
+/* Longest name of a vehicle input (TS_IO_NAME of towstab/linearize.h). */
+#define TS_SIGNAL_INPUT_MAX (2 * TS_NAME_MAX + 16)
 
 /* One signal. Fields a type does not use are ignored. */
 typedef struct ts_signal {
@@ -99,6 +109,10 @@ typedef struct ts_signal {
                           at t = 0. The parser's default is two periods
                           (TS_SIGNAL_RAMP_PERIODS) */
     int absolute;      /* manoeuvres: amplitude is the final value */
+    char input[TS_SIGNAL_INPUT_MAX]; /* TS_AXIS_INPUT: the input's name */
+    char input_unit[4];/* TS_AXIS_INPUT: "m" or "rad" when the amplitude
+                          was given with a unit of that kind, "" for a
+                          plain (SI) number */
 } ts_signal;
 
 typedef struct ts_excitation ts_excitation;
@@ -148,8 +162,9 @@ TS_API int ts_excitation_read_series(ts_excitation *ex, ts_axis axis,
 
 /* Parse a signal description and add it:
  *   AXIS[:key=value,key=value,...]
- * AXIS is tow.surge (tow.x), tow.sway (tow.y), tow.heave (tow.z), speed or
- * turn_rate. Keys: type (sine, crank, step, ramp, csv; default sine on tow
+ * AXIS is tow.surge (tow.x), tow.sway (tow.y), tow.heave (tow.z), speed,
+ * turn_rate, or a vehicle's input (any other name with a '.', e.g.
+ * fish.depth.setpoint: a step by default, its amplitude in m or rad). Keys: type (sine, crank, step, ramp, csv; default sine on tow
  * axes, ramp on manoeuvres), amplitude, frequency or period, phase, rod,
  * start, duration, rise, to (final value, manoeuvres), by (change,
  * manoeuvres), file (csv), ramp (sine and crank: the smooth start, s;
@@ -164,6 +179,10 @@ TS_API int ts_excitation_parse(ts_excitation *ex, const char *spec,
 TS_API int ts_excitation_nsignals(const ts_excitation *ex);
 /* Signal i, 0 <= i < nsignals (a series reports type TS_SIGNAL_SERIES). */
 TS_API const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i);
+
+/* The value at t of signal i (a step, ramp or sine; for a vehicle input,
+ * in the input's unit). */
+TS_API double ts_excitation_value(const ts_excitation *ex, int i, double t);
 
 /* The jump of the tow point's displacement and velocity at t = 0 (u(0+)
  * less the rest state before, zero): nonzero only for a sine or crank
@@ -197,10 +216,10 @@ TS_API double ts_excitation_heading(const ts_excitation *ex,
 TS_API int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
                                      double out[], int max);
 
-/* The shortest time scale of the tow-point signals (s): 1/(2 pi f) for a
+/* The shortest time scale of the tow-point and vehicle-input signals (s): 1/(2 pi f) for a
  * sine, 1/(4 pi f) for a crank (its second harmonic), the rise of steps and
  * ramps, the smallest sample spacing of a series, 1/max |w_k| for a sum
- * (and its fade-in time, if shorter); INFINITY without tow signals. The linear simulator sizes its steps on it. */
+ * (and its fade-in time, if shorter); INFINITY without such signals. The linear simulator sizes its steps on it. */
 TS_API double ts_excitation_time_scale(const ts_excitation *ex);
 
 /* Bounds of the motion under ex from the frame `base` (ex may be NULL:
@@ -221,7 +240,7 @@ TS_API int ts_excitation_check_span(const ts_excitation *ex, double t_end,
 
 /* The single periodic tow excitation, for amplitude ratios: when exactly
  * one signal is a sine or a crank, on a tow axis, returns 1 and its index;
- * else 0. */
+ * else 0 (also when a sine drives a vehicle's input). */
 TS_API int ts_excitation_periodic(const ts_excitation *ex, int *index);
 
 /* Number of components of sum signal i (0 for other signals). */
@@ -231,6 +250,9 @@ TS_API int ts_excitation_sum_components(const ts_excitation *ex, int i);
  * "sine", "crank", "step", "ramp", "csv", "sum". */
 TS_API const char *ts_axis_name(ts_axis a);
 TS_API const char *ts_signal_type_name(ts_signal_type t);
+/* A signal's axis in messages: ts_axis_name, or its input's name on
+ * TS_AXIS_INPUT. */
+TS_API const char *ts_signal_axis_label(const ts_signal *s);
 
 /* One-line description of signal i with SI values, e.g.
  * "tow.heave sine amplitude 0.03048 m, frequency 0.25 Hz, phase 0 deg". */

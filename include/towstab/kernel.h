@@ -21,8 +21,8 @@
  * velocity (m/s) and acceleration (m/s^2) relative to its nominal position
  * in the mean ship frame M, each as x, y, z; then, vehicle by vehicle, a
  * deflection command (rad) per control surface, added to its open-loop
- * deflection, and an input per controller loop (rad), added to the loop's
- * output (ts_kernel_input_name). The motion of M (speed V, turn
+ * deflection, and two inputs per controller loop: one added to the loop's
+ * output (rad), one to its set point (m or rad) (ts_kernel_input_name). The motion of M (speed V, turn
  * rate Omega and their rates) and the current are set with
  * ts_kernel_set_frame() (default: the system's steady tow, no current
  * rotation).
@@ -90,12 +90,17 @@ TS_API int ts_kernel_ncontrol(const ts_kernel *k);/* nc */
 TS_API int ts_kernel_ninput(const ts_kernel *k);  /* TS_NINPUT + the
                                                      vehicles' inputs */
 /* Name of input j into buf: "tow.surge" ... (ts_input_name order), then
- * "<vehicle>.<surface>" and "<vehicle>.<loop>". Returns buf, or NULL
- * when j is out of range. */
+ * "<vehicle>.<surface>", "<vehicle>.<loop>" and
+ * "<vehicle>.<loop>.setpoint". Returns buf, or NULL when j is out of
+ * range. */
 TS_API const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
                                         size_t size);
 /* Index of the input called `name`, -1 if none. */
 TS_API int ts_kernel_input_find(const ts_kernel *k, const char *name);
+/* Unit of input j ("m", "m/s", "m/s^2", "rad"), NULL out of range. */
+TS_API const char *ts_kernel_input_unit(const ts_kernel *k, int j);
+/* 1 when input j is a control surface's deflection. */
+TS_API int ts_kernel_input_is_surface(const ts_kernel *k, int j);
 /* Offset of link `link`'s coordinates in q (2 for rigid, 3 for elastic). */
 TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 
@@ -159,6 +164,54 @@ typedef struct ts_control_state {
 } ts_control_state;
 TS_API void ts_kernel_control_state(const ts_kernel *k, int i,
                                     ts_control_state *cs);
+
+/* Set how loop `loop` of vehicle v drives its surfaces (TS_LOOP_CLOSED,
+ * TS_LOOP_OPEN with its output frozen at `frozen` rad, TS_LOOP_BROKEN;
+ * towstab/vehicle.h). An open loop has no integrator state, so the
+ * state's layout (nc, ts_kernel_nstate) changes: move states between
+ * layouts with ts_kernel_get_controls / ts_kernel_set_controls. TS_OK or
+ * TS_EINVAL (no such loop or mode). */
+TS_API int ts_kernel_set_loop_mode(ts_kernel *k, int v, int loop, int mode,
+                                   double frozen, ts_err *err);
+TS_API int ts_kernel_loop_mode(const ts_kernel *k, int v, int loop);
+
+/* The set point in force of loop `loop` of vehicle v (m or rad; the
+ * scene's by default; the input "<vehicle>.<loop>.setpoint" adds to it). */
+TS_API void ts_kernel_set_setpoint(ts_kernel *k, int v, int loop,
+                                   double value);
+TS_API double ts_kernel_setpoint(const ts_kernel *k, int v, int loop);
+
+/* 1: actuators follow their commands without rate limits (a steady
+ * state, where no actuator moves, is then a smooth root); 0 (default):
+ * the scene's rate limits. */
+TS_API void ts_kernel_set_steady(ts_kernel *k, int steady);
+
+/* Vehicle v's controller states in y: xi[nloops] (integrators; 0 where a
+ * loop has none) and act[ncomponents] (actuators; 0 where a surface has
+ * none); and the reverse (entries without a state are ignored). */
+TS_API void ts_kernel_get_controls(const ts_kernel *k, int v, const double y[],
+                                   double xi[], double act[]);
+TS_API void ts_kernel_set_controls(const ts_kernel *k, int v,
+                                   const double xi[], const double act[],
+                                   double y[]);
+
+/* Outputs of the vehicles, for the linear model's output rows: per
+ * vehicle (in order) its depth (m), pitch, roll and yaw (rad, towstab/
+ * vehicle.h ts_vehicle_result), then each loop's output (rad, the law's
+ * value whatever the loop's mode), then each control surface's deflection
+ * (rad, what the hydrodynamics sees: limited, through its actuator).
+ * Their number, names ("<vehicle>.depth", "<vehicle>.pitch",
+ * "<vehicle>.roll", "<vehicle>.yaw", "<vehicle>.<loop>.output",
+ * "<vehicle>.<surface>.deflection"; NULL out of range), the
+ * index of a name (-1: none), and their values after an evaluation into
+ * out[noutput]. */
+TS_API int ts_kernel_noutput(const ts_kernel *k);
+TS_API const char *ts_kernel_output_name(const ts_kernel *k, int j,
+                                         char *buf, size_t size);
+TS_API int ts_kernel_output_find(const ts_kernel *k, const char *name);
+/* Unit of output j ("m" or "rad"), NULL out of range. */
+TS_API const char *ts_kernel_output_unit(const ts_kernel *k, int j);
+TS_API void ts_kernel_outputs(const ts_kernel *k, double out[]);
 
 /* Vehicles, in body order: their number, body index and the offset of
  * their three angles in q. */

@@ -55,6 +55,9 @@ enum {
     TS_IN_ACC = 6     /* tow acceleration x, y, z: columns 6, 7, 8 */
 };
 
+/* Room for an input or output name ("<vehicle>.<loop>.setpoint"). */
+#define TS_IO_NAME (2 * TS_NAME_MAX + 16)
+
 /* The sparse descriptor model (opaque; doc/linear.md, section 2). */
 typedef struct ts_descriptor ts_descriptor;
 
@@ -109,6 +112,18 @@ typedef struct ts_linear {
                           or NULL unless opts.tensions */
     double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
                           or NULL unless opts.tensions */
+    int noutput;       /* the vehicles' outputs (ts_kernel_noutput): per
+                          vehicle depth, pitch, roll, yaw and each loop's
+                          output */
+    double *v0;        /* [noutput] their values at y0 (m, rad) */
+    double *Vy;        /* [noutput * n] d output / dy, column-major; NULL
+                          without vehicles */
+    double *Vu;        /* [noutput * ninput] d output / du; NULL without
+                          vehicles */
+    char (*input_name)[TS_IO_NAME];  /* [ninput] ts_kernel_input_name */
+    const char **input_unit;         /* [ninput] ts_kernel_input_unit */
+    char (*output_name)[TS_IO_NAME]; /* [noutput] ts_kernel_output_name */
+    const char **output_unit;        /* [noutput] ts_kernel_output_unit */
     double *Aerr;      /* [(n - nq) * n] estimated error of the lower block
                           of A (rows nq..n-1), (A(2h) - A(h)) / 3,
                           column-major with leading dimension n - nq

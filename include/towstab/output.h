@@ -34,9 +34,14 @@ typedef enum {
     TS_OUT_TENSION = 1,   /* link */
     TS_OUT_TOW_FORCE = 2, /* comp 0..2, or TS_OUT_MAGNITUDE */
     TS_OUT_STRAIN = 3,    /* link (elastic) */
-    TS_OUT_LENGTH = 4     /* cable (elastic): stretched length */
+    TS_OUT_LENGTH = 4,    /* cable (elastic): stretched length */
+    TS_OUT_VEHICLE = 5    /* a vehicle's depth, pitch, roll, yaw, loop
+                             output or deflection: row `index` of the
+                             kernel's outputs (ts_kernel_output_name),
+                             found by ts_response_output_lookup with a
+                             kernel, not by ts_output_find */
 } ts_output_kind;
-#define TS_OUT_KINDS 5
+#define TS_OUT_KINDS 5 /* the kinds ts_output_find knows */
 
 /* Bits of the kinds an analysis reports (ts_output_names). */
 #define TS_OUT_BIT(kind) (1 << (kind))
@@ -55,6 +60,7 @@ typedef struct ts_output {
                       force: the same, or TS_OUT_MAGNITUDE */
     int link;      /* tension, strain: link index */
     int cable;     /* length: cable index */
+    int index;     /* vehicle: the output's row in ts_linear.Vy */
     char name[TS_OUTPUT_NAME_MAX]; /* canonical name, e.g. "sphere.z" */
     const char *unit;    /* a frequency response's gain: the quantity per
                             metre of tow-point motion ("m/m", "N/m") */

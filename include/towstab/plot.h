@@ -119,6 +119,21 @@ typedef struct ts_plot_series {
                            each point (NULL entries: none), or NULL */
 } ts_plot_series;
 
+/* A body drawn with its attitude (a vehicle, towstab/vehicle.h
+ * ts_vehicle_outline): polylines of points in M (m), a point of NaNs
+ * between two. The pictures magnify every outline about its anchor by one
+ * common factor, so that the smallest is at least TS_PLOT_OUTLINE_MIN of
+ * the picture's extent (a towfish is small beside its cable), and say so
+ * in a note. */
+typedef struct ts_plot_outline {
+    int npoints;
+    const double *pts;     /* [3 npoints] */
+    double anchor[3];      /* fixed point of the magnification (the cable's
+                              attach point), m */
+} ts_plot_outline;
+
+#define TS_PLOT_OUTLINE_MIN 0.06
+
 /* A cylinder towfish of a shape: centred on its node, its axis along the
  * link that ends there (doc/model.md section 1). Drawn as its outline,
  * filled in the shape's colour, at least 3 % of the picture's extent long
@@ -150,6 +165,9 @@ typedef struct ts_plot_shape {
     int color;               /* as ts_plot_series */
     int ncylinders;          /* cylinder towfish to draw */
     const ts_plot_cylinder *cylinders; /* [ncylinders] */
+    int noutlines;           /* bodies drawn with their attitude */
+    const ts_plot_outline *outlines; /* [noutlines]; in ts_plot_mode_shapes
+                                the equilibrium's */
 } ts_plot_shape;
 
 /* Views of ts_plot_shapes. */
@@ -171,6 +189,25 @@ typedef struct ts_plot_mode {
     const double *disp;  /* [3 nnodes] node displacements (any scale) */
     const char *label;   /* e.g. "mode 1: 0.412 Hz, damping 3.1 %" */
 } ts_plot_mode;
+
+/* A mode as an animation: DIR/NAME.svg only (whatever opts->formats), an
+ * SVG whose cable path runs through one cycle of the mode every `seconds`
+ * seconds and loops (SMIL <animate> of its path, nframes frames at phases
+ * 2 pi k / nframes: eq + s Re((re + i im) e^{i phi}), s making the largest
+ * node amplitude 15 % of the equilibrium's extent), over the equilibrium
+ * in grey, in one view (side, with TS_PLOT_WATER the water; or top, equal
+ * scales), titled, with `label` above the box (may be NULL). re and im:
+ * [3 nnodes] node displacements of the mode's real and imaginary parts.
+ * nframes in [4, TS_PLOT_MAX_FRAMES]. Browsers play it; a still viewer
+ * shows the first frame. */
+#define TS_PLOT_MAX_FRAMES 360
+TS_API int ts_plot_mode_animation(const char *dir, const char *name,
+                                  const char *title, ts_plot_view view,
+                                  int flags, const ts_plot_shape *eq,
+                                  const double *re, const double *im,
+                                  const char *label, int nframes,
+                                  double seconds, const ts_plot_opts *opts,
+                                  ts_err *err);
 
 /* Axis window of ts_plot_eigenvalues; a field equal to 0 is automatic. */
 typedef struct ts_plot_eig_window {

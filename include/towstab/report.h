@@ -47,9 +47,9 @@ TS_API json_t *ts_report_equilibrium_json(const ts_system *sys,
  * M), alpha_deg, beta_deg (the flow at its origin), speed, submerged,
  * joint_force (N, M), hydro_force, hydro_moment (all components; body
  * axes, N and N m about the origin), munk_moment, mass_centre (m, M),
- * deflections_deg {surface: deg}, components [{name, type, force,
- * moment, alpha_deg, speed}] (body axes), controllers [{name, error,
- * output_deg}]. NULL on allocation failure. */
+ * components [{name, type, force, moment, alpha_deg, speed, and for a
+ * control surface deflection_deg}] (body axes), controllers [{name,
+ * error, output_deg}]. NULL on allocation failure. */
 TS_API json_t *ts_report_vehicle_json(const ts_system *sys,
                                       const ts_vehicle_result *r);
 

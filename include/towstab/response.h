@@ -23,6 +23,7 @@
 #include <stddef.h>
 
 #include "towstab/error.h"
+#include "towstab/kernel.h"
 #include "towstab/linearize.h"
 #include "towstab/output.h"
 #include "towstab/system.h"
@@ -51,6 +52,19 @@ TS_API int ts_response_output_find(const ts_system *sys, const char *name,
 TS_API void ts_response_output_names(const ts_system *sys, char *buf,
                                      size_t size);
 
+/* The same with a vehicle's inputs: a tow displacement, or one of the
+ * kernel's vehicle inputs (ts_kernel_input_name: "<vehicle>.<surface>",
+ * "<vehicle>.<loop>", "<vehicle>.<loop>.setpoint"); k is any kernel of
+ * the system. TS_OK or TS_EINVAL listing the valid names. */
+TS_API int ts_response_input_lookup(const ts_kernel *k, const char *name,
+                                    int *channel, ts_err *err);
+
+/* The same for outputs: ts_response_output_find's names, or a vehicle's
+ * outputs ("<vehicle>.depth", ".pitch", ".roll", ".yaw",
+ * "<vehicle>.<loop>.output", "<vehicle>.<surface>.deflection"). */
+TS_API int ts_response_output_lookup(const ts_kernel *k, const char *name,
+                                     ts_output *out, ts_err *err);
+
 /* Log-spaced frequencies freq[points] from `from` to `to` Hz inclusive.
  * Refuses (TS_EINVAL) from <= 0, to <= from, non-finite values or
  * points < 2. */
@@ -58,7 +72,10 @@ TS_API int ts_response_logspace(double from, double to, int points,
                                 double freq[], ts_err *err);
 
 typedef struct ts_response {
-    int input;          /* channel 0..2 */
+    int input;          /* channel: 0..2 a tow displacement, from
+                           TS_NINPUT on a vehicle's input */
+    char input_name[TS_IO_NAME];
+    char unit[32];      /* output unit per input unit, e.g. "m/rad" */
     ts_output output;
     int npoints;
     double *freq_hz;    /* [npoints] Hz */
@@ -75,10 +92,13 @@ typedef struct ts_response {
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at
- * freq_hz[npoints] (Hz, each >= 0). lin must hold the sparse model
- * (ts_linearize with TS_LIN_AUTO, SPARSE or BOTH). On success *res is new
+ * freq_hz[npoints] (Hz, each >= 0): lin's sparse model, or its dense A
+ * and B for a system with vehicles. A tow displacement input (0..2)
+ * brings its velocity and acceleration; a vehicle input (>= TS_NINPUT)
+ * is its column of B alone, and a vehicle output (TS_OUT_VEHICLE) a row
+ * of the output Jacobians Vy, Vu (dense model). On success *res is new
  * (free with ts_response_free). Returns TS_OK, TS_EINVAL (bad channel,
- * negative frequency, no sparse model, a system other than lin's),
+ * negative frequency, no model, a system other than lin's),
  * TS_ESINGULAR (i w is an eigenvalue: an undamped resonance exactly on a
  * point) or TS_ENOMEM. */
 TS_API int ts_response_compute(const ts_system *sys, const ts_linear *lin,

@@ -141,6 +141,15 @@ typedef struct ts_history {
     double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
                             linear runs; ts_kernel_kinetic_energy) */
     double *input;       /* [capacity][TS_NINPUT] u(t) */
+    int noutput;         /* the vehicles' outputs (ts_kernel_noutput), set
+                            by the first sample recorded */
+    double *outputs;     /* [capacity][noutput] their values (depth, pitch,
+                            roll, yaw, loop outputs, deflections; the
+                            linear run's v0 + Vy z + Vu du); NULL without
+                            vehicles */
+    char (*output_name)[2 * TS_NAME_MAX + 16]; /* [noutput]
+                            ts_kernel_output_name */
+    const char **output_unit; /* [noutput] "m" or "rad" */
 } ts_history;
 
 /* A history of `capacity` samples for system sys; NULL on failure. */
@@ -201,6 +210,13 @@ TS_API int ts_simulate(ts_kernel *k, const ts_excitation *ex,
                        const double y0[], const ts_sim_opts *o,
                        ts_history *h, ts_sim_stats *st, double y_end[],
                        ts_err *err);
+
+/* Check the signals of ex on vehicles' inputs against kernel k: each
+ * names one of its inputs (ts_kernel_input_name) with an amplitude of its
+ * kind (m or rad). TS_OK, TS_EINVAL listing the valid names, TS_EUNIT.
+ * ts_sim_alloc and ts_simulate_linear check the same. */
+TS_API int ts_sim_check_inputs(const ts_kernel *k, const ts_excitation *ex,
+                               ts_err *err);
 
 /* --- Linear simulation. --- */
 

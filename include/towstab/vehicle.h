@@ -114,6 +114,18 @@ typedef struct ts_loop {
     int line;
 } ts_loop;
 
+/* How a loop drives its surfaces (ts_kernel_set_loop_mode). */
+enum {
+    TS_LOOP_CLOSED = 0, /* its output plus its input (a disturbance at the
+                           loop's output) drives its surfaces */
+    TS_LOOP_OPEN = 1,   /* its surfaces see a frozen output (the trim's)
+                           plus its input; no integrator state: the open
+                           loop plant */
+    TS_LOOP_BROKEN = 2  /* its surfaces see its input alone, the other
+                           loops staying closed: the loop broken at its
+                           output, for its gain and phase margins */
+};
+
 typedef struct ts_vehicle {
     double inertia[6];    /* about the mass centre, body axes, kg m^2:
                              Ixx, Iyy, Izz, Ixy, Ixz, Iyz (products as
@@ -208,6 +220,27 @@ TS_API void ts_added_mass_shift(const double A_P[36], const double r[3],
  * 2 pi ar / (2 + sqrt(ar^2 + 4)), 1/rad: 2 pi for ar -> infinity and
  * pi ar / 2 (slender wing) for ar -> 0. */
 TS_API double ts_lift_slope_helmbold(double ar);
+
+/* The attitude body to M of yaw, pitch and roll (Z-Y-X, as
+ * ts_vehicle_result), row-major: R = Rz(yaw) Ry(pitch) Rx(roll). */
+TS_API void ts_vehicle_rotation(double yaw, double pitch, double roll,
+                                double R[9]);
+
+/* Points per hull outline (a closed ellipse) of ts_vehicle_outline. */
+#define TS_OUTLINE_HULL_POINTS 33
+
+/* The vehicle drawn in M with attitude R and origin O (m): polylines of
+ * points pts[3 k] (x, y, z in M), one after the other, separated by a
+ * point of NaNs: each hull as its outline in the body's x-z plane and in
+ * its x-y plane (ellipses of its length and diameter: the side view shows
+ * its pitch, the top view its yaw), each lifting surface as its planform
+ * (a rectangle of its span and mean chord area / span in its own plane,
+ * turned by its deflection delta[c] about its span when delta is given),
+ * each bluff part as a cross of its frontal area's side. Writes at most
+ * max points; returns how many the outline has. */
+TS_API int ts_vehicle_outline(const ts_vehicle *v, const double R[9],
+                              const double origin[3], const double *delta,
+                              double pts[], int max);
 
 #ifdef __cplusplus
 }

@@ -167,5 +167,49 @@ else
     fail "modes --tolerance 1e-300: status $status; $(cat "$T/err")"
 fi
 
+# Vehicles: control inputs and vehicle outputs, the open loop, margins.
+A=examples/aurora_towfish.yaml
+ts response $A --input aurora.depth.setpoint --output aurora.depth \
+    --points 2 --links 10 --json "$T/v.json" --quiet
+if [ "$status" -eq 0 ] && grep -q '"unit": "m/m"' "$T/v.json" &&
+   grep -q 'response of aurora.depth to aurora.depth.setpoint (m/m): static gain 0.99999' "$T/out"; then
+    pass "response to a set point: closed-loop static gain 1 (integral action)"
+else
+    fail "response set point: status $status; $(head -c 300 "$T/err")"
+fi
+ts response $A --open-loop --input aurora.wing --output aurora.depth \
+    --points 2 --links 10 --json "$T/v.json" --quiet
+if [ "$status" -eq 0 ] && grep -q '"open_loop": true' "$T/v.json" &&
+   grep -q '"unit": "m/rad"' "$T/v.json" && grep -q '^open loop:' "$T/out"; then
+    pass "response --open-loop: fin to depth in m/rad, open_loop in the JSON"
+else
+    fail "response --open-loop: status $status; $(head -c 300 "$T/err")"
+fi
+ts modes $A --links 10 --json "$T/v.json" --quiet
+if [ "$status" -eq 0 ] && has_keys "$T/v.json" margins phase_margin_deg &&
+   grep -q '^aurora.depth .* deg' "$T/out"; then
+    pass "modes with controllers: the loops' margins"
+else
+    fail "modes margins: status $status; $(head -c 300 "$T/err")"
+fi
+ts modes $A --links 10 --no-margins --json "$T/v.json" --quiet
+if [ "$status" -eq 0 ] && ! grep -q '"margins"' "$T/v.json"; then
+    pass "modes --no-margins: none"
+else
+    fail "modes --no-margins: status $status"
+fi
+for bad in "response $A --open-loop --input aurora.depth.setpoint --output aurora.depth" \
+           "response $A --input aurora.bogus --output aurora.depth" \
+           "response $A --output aurora.bogus" \
+           "modes examples/kamman_ex1_vehicle.yaml --open-loop" \
+           "simulate $A --open-loop --initial released"; do
+    eval ts $bad --links 10
+    if [ "$status" -eq 2 ] && [ -s "$T/err" ]; then
+        pass "$bad: exit 2 ($(head -c 120 "$T/err"))"
+    else
+        fail "$bad: status $status, $(head -c 300 "$T/err")"
+    fi
+done
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

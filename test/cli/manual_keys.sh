@@ -46,6 +46,8 @@ json equilibrium examples/kamman_ex1_above.yaml
 json modes examples/kamman_ex3_turn.yaml --matrices --shapes "$T/shapes.json"
 "$CHECK_JSON" keys modes "$T/shapes.json" >>"$T/pairs" || fail=1
 json response examples/kamman_ex1_above.yaml --output sphere.z --points 3
+json response examples/aurora_towfish.yaml --open-loop --input aurora.wing \
+    --output aurora.depth --points 3 --links 10
 json simulate examples/kamman_ex4.yaml --compare --t-end 34 \
     --excite tow.heave:amplitude=0.1ft,frequency=0.25Hz
 json response examples/survey_tow_sea.yaml --output fish.z \

@@ -94,7 +94,15 @@ if [ "$HAVE" = no ]; then
     ts equilibrium "$EX1" --quiet
     check "without PLplot: the analysis still runs (exit $status)" \
         bash -c "[ $status -eq 0 ] && grep -q '^converged' '$T/out'"
-    echo "$npass passed, $nfail failed"
+    # Vehicles with their attitude: the legend says how much they are
+# magnified (the SVG keeps the text).
+ts equilibrium examples/aurora_towfish.yaml --links 10 --quiet --plot "$T/veh"
+check "vehicle: equilibrium side and top views (exit $status)" \
+    [ $status -eq 0 -a -s "$T/veh/side.png" -a -s "$T/veh/top.png" ]
+check "vehicle: the legend names the vehicles at their attitude" \
+    grep -q 'vehicles at their attitude' "$T/veh/side.svg"
+
+echo "$npass passed, $nfail failed"
     [ $nfail -eq 0 ]
     exit
 fi
@@ -167,6 +175,14 @@ ts response "$EX1" --output sphere.z --quiet --plot "$T/bode" --units imperial
 check "response --plot: exit 0 (got $status; $(head -c 300 "$T/err"))" [ $status -eq 0 ]
 check "response --plot: Bode plot, PNG and SVG, titled" \
     bash -c "$(declare -f is_png is_svg); is_png '$T/bode/bode.png' 1000 700 && is_svg '$T/bode/bode.svg' 'kamman_ex1_above: frequency response'"
+anim_ok=1
+nanim=0
+for f in "$T/modes"/mode*_animation.svg; do
+    nanim=$((nanim + 1))
+    { [ -f "$f" ] && grep -q '<animate ' "$f" && grep -q '<title>kamman_ex3: mode' "$f"; } || anim_ok=0
+done
+check "modes --plot: the four drawn modes as animated SVGs (got $nanim)" \
+    bash -c "[ $anim_ok -eq 1 ] && [ $nanim -eq 4 ]"
 ts modes "$EX3" --plot "$T/afile"
 check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
 

@@ -130,6 +130,38 @@ bad "--excite" "$EX5" --excite tow.heave:type=csv,file=$T/none.csv
 bad "--sample" "$EX4" --sample 0.5 --excite tow.heave:amplitude=0.1ft,frequency=1Hz
 bad "--frobnicate" "$EX5" --frobnicate
 
+# Vehicles: a depth change (a step of the depth set point, a vehicle's
+# input) with the controllers, linear against nonlinear; a turn with the
+# controllers (nonlinear); the vehicles' outputs in the CSV and JSON.
+A=examples/aurora_towfish.yaml
+fresh
+ts simulate $A --links 10 --excite aurora.depth.setpoint:amplitude=1m,start=1s,rise=2s \
+    --t-end 20 --sample 0.5 --output aurora.z --compare --quiet \
+    --csv "$T/o/dc.csv" --json "$T/o/dc.json"
+if [ "$status" -eq 0 ] && [ "$(wc -l <"$T/o/dc.csv")" -eq 42 ] &&
+   head -1 "$T/o/dc.csv" | grep -q 'nonlinear.aurora.depth_m' &&
+   head -1 "$T/o/dc.csv" | grep -q 'linear.aurora.wing.deflection_rad' &&
+   grep -q '"aurora.wing.deflection"' "$T/o/dc.json" &&
+   grep -q '"input": "aurora.depth.setpoint"' "$T/o/dc.json" &&
+   grep -q '^comparison of aurora.z' "$T/out"; then
+    pass "depth change with --compare: 41 samples, depth and deflections in the CSV and JSON"
+else
+    fail "depth change: status $status; $(head -c 300 "$T/err")"
+fi
+fresh
+ts simulate $A --links 10 --manoeuvre turn_rate:to=0.02rad/s,duration=5s \
+    --t-end 10 --sample 1 --quiet --csv "$T/o/turn.csv"
+if [ "$status" -eq 0 ] && head -1 "$T/o/turn.csv" | grep -q 'aurora.yaw_rad'; then
+    pass "turn with the controllers: the vehicle's yaw in the CSV"
+else
+    fail "turn: status $status; $(head -c 300 "$T/err")"
+fi
+bad "aurora.bogus" $A --links 10 --excite aurora.bogus:amplitude=1m
+bad "expected an angle" $A --links 10 --excite aurora.wing:amplitude=1m
+bad "crank" $A --links 10 --excite aurora.wing:crank,amplitude=1deg,frequency=1Hz,rod=1m
+bad "loops open" $A --links 10 --open-loop --excite aurora.depth.setpoint:amplitude=1m
+bad "no vehicle" examples/kamman_ex1_vehicle.yaml --links 10 --excite fish.depth.setpoint:amplitude=1m
+
 # 6. JSON on standard output, alone.
 ts simulate "$EX5" --t-end 3 --sample 1 --quiet --json -
 if [ "$status" -eq 0 ] && head -c 1 "$T/out" | grep -q '{' &&
