@@ -13,7 +13,7 @@
 /* Columns of a table made from a list of objects, at most, and in one
  * table on the page (more are split over several). */
 #define MAX_COLUMNS 64
-#define TABLE_COLUMNS 7
+#define TABLE_COLUMNS 6
 /* Largest picture read, bytes. */
 #define SVG_MAX (64L * 1024 * 1024)
 /* Deepest nesting of objects shown as tables of their own. */

@@ -108,13 +108,13 @@ grep -E -q '(src|href)="(https?:|//|file:)' "$P" && why="$why an external refere
 grep -E -q '<link|@import|url\(' "$P" && why="$why a stylesheet or url() to fetch;"
 nimg=$(grep -o '<img ' "$P" | wc -l)
 ndata=$(grep -o '<img alt="[^"]*" src="data:image/svg+xml,' "$P" | wc -l)
-want=9
+want=12
 [ "$HAVE" = yes ] || want=0
 [ "$nimg" -eq "$want" ] && [ "$ndata" -eq "$want" ] || why="$why $nimg images ($ndata SVG data URIs), not $want;"
 if [ "$HAVE" = yes ]; then
     nsvg=$(find "$T/o/page/pictures" -name '*.svg' | wc -l)
     npng=$(find "$T/o/page/pictures" -name '*.png' | wc -l)
-    [ "$nsvg" -eq 9 ] && [ "$npng" -eq 0 ] || why="$why $nsvg SVG and $npng PNG files, not 9 and 0;"
+    [ "$nsvg" -eq "$want" ] && [ "$npng" -eq 0 ] || why="$why $nsvg SVG and $npng PNG files, not $want and 0;"
 else
     grep -q '<p>No pictures: ' "$P" || why="$why no word on the missing pictures;"
 fi
