@@ -173,10 +173,55 @@ static int default_settings(ts_analysis_kind analysis, ts_conv_param *param,
 
 /* ---- the system -------------------------------------------------------- */
 
+int ts_setup_set(ts_setup *s, const char *path, double value, ts_err *err)
+{
+    char canon[TS_PARAM_PATH_MAX], other[TS_PARAM_PATH_MAX];
+    int rc = ts_param_canonical(path, canon, sizeof canon, err);
+    if (rc)
+        return rc;
+    int i = 0;
+    for (; i < s->nsets; i++)
+        if (ts_param_canonical(s->sets[i].path, other, sizeof other,
+                               NULL) == TS_OK &&
+            !strcmp(other, canon))
+            break;
+    if (i == TS_SETUP_MAX_SETS)
+        return ts_fail(err, TS_EINVAL, "set: at most %d scene values",
+                       TS_SETUP_MAX_SETS);
+    snprintf(s->sets[i].path, sizeof s->sets[i].path, "%s", canon);
+    s->sets[i].value = value;
+    if (i == s->nsets)
+        s->nsets++;
+    return TS_OK;
+}
+
 /* The setup's own checks (those a scene makes of tow.speed and
  * tow.turn_rate, and the link limit). */
 static int check_setup(const ts_setup *s, ts_err *err)
 {
+    if (s->nsets < 0 || s->nsets > TS_SETUP_MAX_SETS)
+        return ts_fail(err, TS_EINVAL, "set: expected 0 to %d scene values, "
+                       "got %d", TS_SETUP_MAX_SETS, s->nsets);
+    for (int i = 0; i < s->nsets; i++) {
+        char canon[TS_PARAM_PATH_MAX];
+        int rc = ts_param_canonical(s->sets[i].path, canon, sizeof canon,
+                                    err);
+        if (rc) {
+            ts_err_prefix(err, "set: ");
+            return rc;
+        }
+        static const char *const own[2] = {"speed", "turn_rate"};
+        double given[2] = {s->speed, s->turn_rate};
+        for (int k = 0; k < 2; k++)
+            if (!isnan(given[k]) && !strcmp(canon + 4, own[k]) &&
+                !strncmp(canon, "tow.", 4))
+                return ts_fail(err, TS_EINVAL, "set: %s is also given as "
+                               "%s; give it once", canon, own[k]);
+        if (s->links > 0 && strlen(canon) > 6 &&
+            !strcmp(canon + strlen(canon) - 6, ".links"))
+            return ts_fail(err, TS_EINVAL, "set: %s and links (every cable) "
+                           "both set links; give one", canon);
+    }
     if (!isnan(s->speed) && !(s->speed >= 0 && isfinite(s->speed)))
         return ts_fail(err, TS_EINVAL, "speed: must be >= 0 m/s, got %g m/s",
                        s->speed);
@@ -209,6 +254,13 @@ static ts_system *setup_system(const ts_system *sys, const ts_setup *s,
     ts_system *c = ts_system_copy(sys, err);
     if (!c)
         return NULL;
+    for (int i = 0; i < s->nsets; i++)
+        if (ts_param_set(c, s->sets[i].path, s->sets[i].value, err) !=
+            TS_OK) {
+            ts_err_prefix(err, "set: ");
+            ts_system_free(c);
+            return NULL;
+        }
     if (!isnan(s->speed))
         c->tow.speed = s->speed;
     if (!isnan(s->turn_rate))
@@ -291,6 +343,31 @@ const ts_value *ts_result_value(const ts_result *r, const char *name)
         if (strcmp(r->values[i].name, name) == 0)
             return &r->values[i];
     return NULL;
+}
+
+int ts_result_margin(const ts_result *r, ts_margin *m)
+{
+    const ts_stability *st = r ? &r->stability : NULL;
+    m->max_real = m->freq_hz = NAN;
+    m->error.discretisation = m->error.solver = NAN;
+    m->verdict = -1;
+    m->resolved = 0;
+    if (!r || !r->eigen)
+        return 0;
+    if (st->mode >= 0 && st->verdict >= 0) {
+        m->max_real = st->max_real;
+        m->error.solver = st->solver_error;
+        m->error.discretisation = st->discretisation_error;
+        m->freq_hz = r->eigen->modes[st->mode].freq_hz;
+        m->verdict = st->verdict;
+        m->resolved = 1;
+    } else if (st->unresolved_mode >= 0 && st->unresolved_verdict >= 0) {
+        m->max_real = st->unresolved_max_real;
+        m->error.solver = st->unresolved_error;
+        m->freq_hz = r->eigen->modes[st->unresolved_mode].freq_hz;
+        m->verdict = st->unresolved_verdict;
+    }
+    return m->verdict >= 0;
 }
 
 /* Room for n key values, named later; NAN values and estimates. */
@@ -376,20 +453,19 @@ static int point_node(const ts_system *sys, int i)
 
 /* Key values of an equilibrium: x, y, z of the points ("<body>.x", or
  * "<cable>.end.x"; scale the cable length) and the top tension (relative
- * to itself). Solver error: EQ_NOISE_FACTOR times the relative residual
- * (at least EQ_NOISE_MIN_REL) of the length or the largest force. */
-static int eq_values(ts_result *r, ts_err *err)
+ * to itself), into v[3 npoints + 1] (allocated by values_alloc: NAN
+ * values and estimates). Solver error: EQ_NOISE_FACTOR times the
+ * relative residual (at least EQ_NOISE_MIN_REL) of the length or the
+ * largest force. eq may be NULL or not converged: names only. */
+static void eq_values_into(const ts_system *sys, const ts_equilibrium *eq,
+                           ts_value *v0)
 {
-    const ts_system *sys = r->sys;
     int np = npoints(sys);
-    int rc = values_alloc(r, 3 * np + 1, err);
-    if (rc)
-        return rc;
     double L = total_length(sys);
     static const char axis[3] = {'x', 'y', 'z'};
     for (int i = 0, c = 0; i < np; i++) {
         for (int j = 0; j < 3; j++) {
-            ts_value *v = &r->values[3 * i + j];
+            ts_value *v = &v0[3 * i + j];
             if (sys->nbodies > 0) {
                 value_name(v, "m", L, "%.63s.%c", sys->bodies[i].name,
                            axis[j]);
@@ -403,20 +479,46 @@ static int eq_values(ts_result *r, ts_err *err)
         if (sys->nbodies == 0)
             c++;
     }
-    value_name(&r->values[3 * np], "N", 0.0, "top_tension");
-    const ts_equilibrium *eq = r->eq;
+    value_name(&v0[3 * np], "N", 0.0, "top_tension");
     if (!eq || !eq->converged)
-        return TS_OK;
+        return;
     double rel = fmax(eq->residual, EQ_NOISE_MIN_REL);
     for (int i = 0; i < np; i++) {
         int node = point_node(sys, i);
         for (int j = 0; j < 3; j++) {
-            r->values[3 * i + j].value = eq->positions[3 * node + j];
-            r->values[3 * i + j].error.solver = EQ_NOISE_FACTOR * rel * L;
+            v0[3 * i + j].value = eq->positions[3 * node + j];
+            v0[3 * i + j].error.solver = EQ_NOISE_FACTOR * rel * L;
         }
     }
-    r->values[3 * np].value = eq->top_tension;
-    r->values[3 * np].error.solver = EQ_NOISE_FACTOR * rel * eq->force_scale;
+    v0[3 * np].value = eq->top_tension;
+    v0[3 * np].error.solver = EQ_NOISE_FACTOR * rel * eq->force_scale;
+}
+
+static int eq_values(ts_result *r, ts_err *err)
+{
+    int rc = values_alloc(r, 3 * npoints(r->sys) + 1, err);
+    if (rc == TS_OK)
+        eq_values_into(r->sys, r->eq, r->values);
+    return rc;
+}
+
+int ts_result_equilibrium_values(const ts_result *r, ts_value **values,
+                                 int *n, ts_err *err)
+{
+    *values = NULL;
+    *n = 0;
+    if (!r || !r->sys)
+        return ts_fail(err, TS_EINVAL, "equilibrium values: the result has "
+                       "no system");
+    ts_result tmp;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.kind = TS_ANALYSIS_EQUILIBRIUM;
+    int rc = values_alloc(&tmp, 3 * npoints(r->sys) + 1, err);
+    if (rc)
+        return rc;
+    eq_values_into(r->sys, r->eq, tmp.values);
+    *values = tmp.values;
+    *n = tmp.nvalues;
     return TS_OK;
 }
 
@@ -2003,6 +2105,10 @@ static int level_request(const ts_result *r, const ts_request *rq,
                          size_t size)
 {
     *sub = *rq; /* shallow: the excitation is borrowed */
+    /* lev carries the settings (it is r->sys coarsened), and a starting
+     * guess fits the run's links only. */
+    sub->setup.nsets = 0;
+    sub->setup.equilibrium.guess = NULL;
     sub->setup.links = 0;
     sub->setup.speed = NAN;
     sub->setup.turn_rate = NAN;
@@ -2649,6 +2755,52 @@ static int sweep_run(void *ctx, ts_conv_param p, double setting,
     return rc;
 }
 
+/* A result of rq's kind with its key values named (values and estimates
+ * NAN), without running: *out (also after a failure, may be NULL). */
+static int named_result(const ts_system *sys, const ts_request *rq,
+                        ts_result **out, ts_err *err)
+{
+    ts_analysis_kind kind = rq->kind;
+    ts_result *r = *out = result_alloc(kind, err);
+    int rc = r ? TS_OK : TS_ENOMEM;
+    if (rc == TS_OK) {
+        r->sys = setup_system(sys, &rq->setup, err);
+        rc = r->sys ? TS_OK : (err && err->code ? err->code : TS_ENOMEM);
+    }
+    if (rc == TS_OK && kind == TS_ANALYSIS_EQUILIBRIUM)
+        rc = eq_values(r, err);
+    else if (rc == TS_OK && kind == TS_ANALYSIS_MODES)
+        rc = modes_values(r, rq->modes.follow, err);
+    else if (rc == TS_OK && kind == TS_ANALYSIS_SIMULATE) {
+        rc = check_simulate(r->sys, &rq->simulate, rq->setup.open_loop,
+                            &r->sim, &r->transient, &r->output, err);
+        r->excitation = rq->simulate.excitation;
+        if (rc == TS_OK)
+            rc = sim_values(r, rq->simulate.linear, 0, 0, err);
+    }
+    return rc;
+}
+
+int ts_analysis_value_names(const ts_system *sys, const ts_request *rq,
+                            ts_value **values, int *n, ts_err *err)
+{
+    *values = NULL;
+    *n = 0;
+    if (rq->kind == TS_ANALYSIS_CONVERGE)
+        return ts_fail(err, TS_EINVAL, "analysis: a convergence study's "
+                       "values are those of its analysis");
+    ts_result *r = NULL;
+    int rc = named_result(sys, rq, &r, err);
+    if (rc == TS_OK) {
+        *values = r->values;
+        *n = r->nvalues;
+        r->values = NULL;
+        r->nvalues = 0;
+    }
+    ts_result_free(r);
+    return rc;
+}
+
 int ts_analysis_sweep(const ts_system *sys, const ts_request *rq, int series,
                       ts_conv_analysis *an, ts_err *err)
 {
@@ -2679,24 +2831,8 @@ int ts_analysis_sweep(const ts_system *sys, const ts_request *rq, int series,
         return ts_fail(err, TS_EINVAL, "modes: expected 1 to 100 modes to "
                        "follow, got %d", rq->modes.follow);
     }
-    /* The value names: those of a result, without running. */
-    ts_result *r = result_alloc(kind, err);
-    int rc = r ? TS_OK : TS_ENOMEM;
-    if (rc == TS_OK) {
-        r->sys = setup_system(sys, &x->rq.setup, err);
-        rc = r->sys ? TS_OK : (err && err->code ? err->code : TS_ENOMEM);
-    }
-    if (rc == TS_OK && kind == TS_ANALYSIS_EQUILIBRIUM)
-        rc = eq_values(r, err);
-    else if (rc == TS_OK && kind == TS_ANALYSIS_MODES)
-        rc = modes_values(r, x->rq.modes.follow, err);
-    else if (rc == TS_OK) {
-        rc = check_simulate(r->sys, s, x->rq.setup.open_loop, &r->sim,
-                            &r->transient, &r->output, err);
-        r->excitation = s->excitation;
-        if (rc == TS_OK)
-            rc = sim_values(r, s->linear, 0, 0, err);
-    }
+    ts_result *r = NULL;
+    int rc = named_result(sys, &x->rq, &r, err);
     if (rc == TS_OK) {
         an->values = calloc((size_t)r->nvalues, sizeof *an->values);
         if (!an->values)
@@ -3097,6 +3233,7 @@ int ts_analysis_run(const ts_system *sys, const ts_request *rq,
             break;
         ts_request rq2 = *rq;
         rq2.setup.links = next;
+        rq2.setup.equilibrium.guess = NULL; /* it fits the links before */
         ts_result *r2 = NULL;
         ts_err e2 = {0};
         int rc2 = run_once(sys, &rq2, &r2, &e2);

@@ -1240,12 +1240,17 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     e->method = m;
     e->target_hz = o.target_hz;
     cand_list L = {0};
-    if (m == TS_EIG_LAPACK)
+    if (m == TS_EIG_LAPACK) {
         rc = solve_lapack(lin, &L, err);
-    else if (o.target_hz == 0.0)
-        rc = solve_arpack_real(lin, &o, e, &L, err);
-    else
-        rc = solve_arpack_complex(lin, &o, e, &L, err);
+    } else {
+        /* ARPACK keeps its state between calls in SAVE variables: one
+         * solve at a time in a process (threads of a sweep). */
+#ifdef _OPENMP
+#pragma omp critical(ts_arpack)
+#endif
+        rc = o.target_hz == 0.0 ? solve_arpack_real(lin, &o, e, &L, err)
+                                : solve_arpack_complex(lin, &o, e, &L, err);
+    }
     if (rc != TS_OK) {
         cand_free(&L);
         ts_eigen_free(e);

@@ -1021,7 +1021,9 @@ static int vehicle_start(const ts_system *sys, tsi_march *m,
     return rc;
 }
 
-/* Shooting with continuation in turn rate: schedules of 1, 4, 16 steps. */
+/* Shooting with continuation in turn rate: from the guess's shape at the
+ * full turn rate when there is one, else (or when that fails) schedules
+ * of 1, 4, 16 steps from hanging. */
 static int solve_shooting(ts_kernel *k, tsi_march *m, const ts_frame *frame,
                           const ts_equilibrium_opts *o, ts_equilibrium *eq,
                           ts_err *err)
@@ -1032,6 +1034,16 @@ static int solve_shooting(ts_kernel *k, tsi_march *m, const ts_frame *frame,
     if (!x)
         return ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
     double pos_tol = SHOOT_POS_RTOL * total_length(sys);
+    if (o->guess) {
+        tsi_march_warm(m, o->guess, x);
+        rc = tsi_march_solve(m, frame, x, 0, pos_tol, o->max_iter,
+                             &eq->iterations, &eq->evaluations, err);
+        eq->continuation_steps++;
+        if (rc == TS_OK) {
+            free(x);
+            return rc;
+        }
+    }
     static const int schedule[] = {1, 4, 16};
     int nsched = frame->turn_rate != 0 ? 3 : 1;
     for (int s = 0; s < nsched; s++) {

@@ -204,6 +204,26 @@ void tsi_march_free(tsi_march *m)
 int tsi_march_nunknown(const tsi_march *m) { return 3 * m->nleaf; }
 const double *tsi_march_positions(const tsi_march *m) { return m->r; }
 
+void tsi_march_warm(tsi_march *m, const double *directions, double x[])
+{
+    const ts_system *sys = m->sys;
+    memcpy(m->n, directions, 3 * (size_t)m->nl * sizeof(double));
+    for (int l = 0; l < m->nl; l++)
+        m->len[l] = sys->links[l].length;
+    m->have_n = 1;
+    /* Links run from the tow point down (every link after its parent):
+     * each lower node is its upper node plus the link. */
+    memcpy(m->r, sys->tow.point, 3 * sizeof(double));
+    for (int l = 0; l < m->nl; l++) {
+        const ts_link *L = &sys->links[l];
+        for (int j = 0; j < 3; j++)
+            m->r[3 * L->lower + j] =
+                m->r[3 * L->upper + j] + L->length * directions[3 * l + j];
+    }
+    for (int j = 0; j < m->nleaf; j++)
+        memcpy(x + 3 * j, m->r + 3 * m->leaf_node[j], 3 * sizeof(double));
+}
+
 const double *tsi_march_directions(const tsi_march *m) { return m->n; }
 const double *tsi_march_tensions(const tsi_march *m) { return m->t; }
 

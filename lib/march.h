@@ -47,6 +47,12 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
                     double pos_tol, int max_iter, int *iterations,
                     long *marches, ts_err *err);
 
+/* A warm start from a shape: link directions[3 nlinks] (unit vectors,
+ * e.g. a neighbouring equilibrium's) become the local roots' first
+ * guesses, and x[nunknown] the free-end positions they give from the tow
+ * point (unstretched lengths). Pass x to tsi_march_solve with fresh 0. */
+void tsi_march_warm(tsi_march *m, const double *directions, double x[]);
+
 /* Results of the last march: link directions [3 nlinks], tensions, node
  * positions [3 nnodes] (m, M). */
 const double *tsi_march_directions(const tsi_march *m);

@@ -257,6 +257,70 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
     return TS_OK;
 }
 
+/* Scene values by path: "PATH=VALUE", several separated by ';' (a
+ * repeated --set adds more). The value has the path's unit
+ * (towstab/param.h); a loop's gains and setpoint, whose unit depends on
+ * what the loop measures, are plain SI numbers here. */
+static int parse_set(const ts_option *o, ts_request *rq, const char *text,
+                     const char *w, const ts_units *u, ts_err *err)
+{
+    (void)o;
+    char *copy = strdup(text);
+    if (!copy)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory", w);
+    int rc = TS_OK;
+    char *save = NULL;
+    int n = 0;
+    for (char *p = strtok_r(copy, ";", &save); p && !rc;
+         p = strtok_r(NULL, ";", &save)) {
+        while (*p == ' ')
+            p++;
+        char *eq = strchr(p, '=');
+        if (!eq) {
+            if (!*p)
+                continue;
+            rc = ts_fail(err, TS_EINVAL, "%s: expected PATH=VALUE (e.g. "
+                         "cables.main.length=120m), got '%s'", w, p);
+            break;
+        }
+        char *end = eq;
+        while (end > p && end[-1] == ' ')
+            end--;
+        *end = '\0';
+        const char *val = eq + 1;
+        while (*val == ' ')
+            val++;
+        char unit[TS_PARAM_UNIT_MAX], where[WHERE_MAX + TS_PARAM_PATH_MAX];
+        snprintf(where, sizeof where, "%s: %s", w, p);
+        rc = ts_param_unit(NULL, p, unit, sizeof unit, err);
+        if (rc) {
+            ts_err_prefix(err, "%s: ", w);
+            break;
+        }
+        double v;
+        if (unit[0]) {
+            rc = ts_units_parse(u, val, unit, where, &v, err);
+        } else {
+            char *num_end;
+            v = strtod(val, &num_end);
+            while (*num_end == ' ')
+                num_end++;
+            if (num_end == val || *num_end || !isfinite(v))
+                rc = ts_fail(err, TS_EINVAL, "%s: expected a plain number "
+                             "(SI: a loop's gains and setpoint take the unit "
+                             "of what it measures), got '%s'", where, val);
+        }
+        if (!rc)
+            rc = ts_setup_set(&rq->setup, p, v, err);
+        n++;
+    }
+    free(copy);
+    if (!rc && n == 0)
+        rc = ts_fail(err, TS_EINVAL, "%s: expected PATH=VALUE, got '%s'", w,
+                     text);
+    return rc;
+}
+
 /* ---- the tables ---------------------------------------------------------- */
 
 /* Rows by field name; what a row leaves out is 0 or NULL. Limits NAN:
@@ -281,7 +345,13 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
     {.name = "tolerance", .type = TS_OPT_NUMBER, .section = TS_SEC_SETUP,     \
      .min = 0, .max = 1, .flags = TS_OPT_MIN_OPEN | TS_OPT_MAX_OPEN,          \
      .offset = OFF(setup.equilibrium.tol), .arg = "X",                        \
-     .help = "the equilibrium's relative force residual"}
+     .help = "the equilibrium's relative force residual"},                    \
+    {.name = "set", .type = TS_OPT_CUSTOM, .section = TS_SEC_SETUP, NOLIM,    \
+     .flags = TS_OPT_REPEAT, .offset = OFF(setup.sets), .parse = parse_set,   \
+     .arg = "PATH=Q",                                                         \
+     .help = "a scene value by its path, e.g. cables.main.length=120m "       \
+             "(';' separates several)",                                       \
+     .deftext = "none"}
 #define OPEN_LOOP_ROW                                                         \
     {.name = "open_loop", .type = TS_OPT_BOOL, .section = TS_SEC_SETUP,       \
      NOLIM, .offset = OFF(setup.open_loop),                                   \

@@ -15,6 +15,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -284,4 +285,12 @@ int tsi_outfile_identify(const char *path, tsi_outfile_id *id, ts_err *err)
     id->dev = st.st_dev;
     id->ino = st.st_ino;
     return TS_OK;
+}
+
+void tsi_csv_number(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, ",%.17g", v);
+    else
+        fprintf(f, ",%s", isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
 }

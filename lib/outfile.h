@@ -59,4 +59,8 @@ typedef struct tsi_outfile_id {
  * resolved (its directory does not exist: the write would fail too). */
 int tsi_outfile_identify(const char *path, tsi_outfile_id *id, ts_err *err);
 
+/* A CSV field ",<v>": 17 significant digits (read back to the same
+ * double), "nan", "inf" or "-inf" for what is not finite. */
+void tsi_csv_number(FILE *f, double v);
+
 #endif

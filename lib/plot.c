@@ -66,6 +66,7 @@
 #define FT_M 0.3048
 #define LBF_N 4.4482216152605
 #define KNOT_MS (1852.0 / 3600.0)
+#define LB_KG 0.45359237
 
 #define NO_PLPLOT_MSG                                                         \
     "towstab was built without PLplot; install libplplot-dev and "           \
@@ -91,6 +92,7 @@ double ts_plot_convert(ts_plot_quantity q, ts_plot_units u, double v)
     case TS_PLOT_LENGTH: return v / FT_M;
     case TS_PLOT_FORCE: return v / LBF_N;
     case TS_PLOT_SPEED: return v / KNOT_MS;
+    case TS_PLOT_MASS: return v / LB_KG;
     default: return v;
     }
 }
@@ -107,6 +109,7 @@ const char *ts_plot_unit(ts_plot_quantity q, ts_plot_units u)
     case TS_PLOT_RATE: return "1/s";
     case TS_PLOT_ANGULAR_RATE: return "rad/s";
     case TS_PLOT_ANGLE: return "deg";
+    case TS_PLOT_MASS: return imp ? "lb" : "kg";
     default: return "-";
     }
 }
@@ -321,6 +324,29 @@ int ts_plot_loglog(const char *dir, const char *name, const char *title,
     return ts_plot_check(err);
 }
 
+int ts_plot_panels(const char *dir, const char *name, const char *title,
+                   const ts_plot_axis *xaxis, int npanels,
+                   const ts_plot_axis panels[], int nseries,
+                   const ts_plot_series series[], const ts_plot_opts *opts,
+                   ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)xaxis, (void)npanels;
+    (void)panels, (void)nseries, (void)series, (void)opts;
+    return ts_plot_check(err);
+}
+
+int ts_plot_map(const char *dir, const char *name, const char *title,
+                const ts_plot_axis *xaxis, const ts_plot_axis *yaxis,
+                const ts_plot_axis *zaxis, const ts_plot_grid *grid,
+                const int *marks, int nb, const double *bx, const double *by,
+                const ts_plot_opts *opts, ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)xaxis, (void)yaxis;
+    (void)zaxis, (void)grid, (void)marks, (void)nb, (void)bx, (void)by;
+    (void)opts;
+    return ts_plot_check(err);
+}
+
 #else /* TS_HAVE_PLPLOT */
 
 /* ---- palette (cmap0) ------------------------------------------------- */
@@ -398,6 +424,19 @@ static void axis_label(char *dst, size_t size, const char *name,
     char raw[TEXT_MAX];
     snprintf(raw, sizeof raw, "%s [%s]", name ? name : "",
              punit(q, u));
+    pl_text(dst, size, raw);
+}
+
+/* The label of an axis, with its own unit when it has one. */
+static void axis_label_of(char *dst, size_t size, const ts_plot_axis *a,
+                          const ts_plot_opts *u)
+{
+    if (a->quantity != TS_PLOT_NONE || !a->unit || !a->unit[0]) {
+        axis_label(dst, size, a->label, a->quantity, u);
+        return;
+    }
+    char raw[TEXT_MAX];
+    snprintf(raw, sizeof raw, "%s [%s]", a->label ? a->label : "", a->unit);
     pl_text(dst, size, raw);
 }
 
@@ -1162,7 +1201,7 @@ static int check_series(const char *fn, int nseries,
 static int check_quantity(const char *fn, const char *what,
                           ts_plot_quantity q, ts_err *err)
 {
-    if ((int)q < TS_PLOT_NONE || (int)q > TS_PLOT_ANGLE)
+    if ((int)q < TS_PLOT_NONE || (int)q > TS_PLOT_MASS)
         return ts_fail(err, TS_EINVAL, "%s: %s: unknown quantity %d", fn,
                        what, (int)q);
     return TS_OK;
@@ -2560,6 +2599,7 @@ typedef struct hist_ctx {
     const ts_plot_axis *panels;
     int nseries;
     const ts_plot_series *series;
+    const ts_plot_axis *xaxis; /* NULL: time */
 } hist_ctx;
 
 static int draw_histories(const void *vctx, const ts_plot_opts *o,
@@ -2575,11 +2615,19 @@ static int draw_histories(const void *vctx, const ts_plot_opts *o,
     double *yv = malloc((size_t)nmax * sizeof *yv);
     if (!yv)
         return ts_fail(err, TS_ENOMEM, "out of memory");
+    ts_plot_axis time = {"time t", TS_PLOT_TIME, NULL};
+    const ts_plot_axis *xa = c->xaxis ? c->xaxis : &time;
+    double *xv = malloc((size_t)nmax * sizeof *xv);
+    if (!xv) {
+        free(yv);
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    }
     double t0 = INFINITY, t1 = -INFINITY;
     for (int i = 0; i < c->nseries; i++)
         for (int k = 0; k < c->series[i].n; k++)
-            bbox_update(&t0, &t1, c->series[i].x[k]);
-    pad_range(&t0, &t1, 0.0, 1.0);
+            bbox_update(&t0, &t1, pconv(xa->quantity, u,
+                                                  c->series[i].x[k]));
+    pad_range(&t0, &t1, c->xaxis ? 0.03 : 0.0, 1.0);
     double gap = 0.035, top = 0.89, bottom = 0.11;
     double ph = (top - bottom - gap * (c->npanels - 1)) / c->npanels;
     double cs = c->npanels > 2 ? 0.85 : 1.0;
@@ -2627,31 +2675,65 @@ static int draw_histories(const void *vctx, const ts_plot_opts *o,
             const ts_plot_series *S = &c->series[i];
             if (S->panel != p)
                 continue;
-            for (int k = 0; k < S->n; k++)
+            for (int k = 0; k < S->n; k++) {
+                xv[k] = pconv(xa->quantity, u, S->x[k]);
                 yv[k] = pconv(q, u, S->y[k]);
+            }
             int col = color_index(S->color, ord);
-            draw_series(&f, S, col, ord, S->x, yv);
+            draw_series(&f, S, col, ord, xv, yv);
             legend_add(&L, S->label, col, S->style, marker_glyph(ord));
             ord++;
         }
         char yl[TEXT_MAX], xl[TEXT_MAX];
-        axis_label(yl, sizeof yl, c->panels[p].label, q, u);
-        axis_label(xl, sizeof xl, "time t", TS_PLOT_TIME, u);
+        axis_label_of(yl, sizeof yl, &c->panels[p], u);
+        axis_label_of(xl, sizeof xl, xa, u);
         label_axes(&f, last ? xl : NULL, yl, cs);
         plschr(0, 1.0);
         legend_draw(&L, &f);
     }
     page_title(c->title);
     free(yv);
+    free(xv);
     return TS_OK;
 }
+
+static int panels_common(const char *fn, const char *dir, const char *name,
+                         const char *title, const ts_plot_axis *xaxis,
+                         int npanels, const ts_plot_axis panels[],
+                         int nseries, const ts_plot_series series[],
+                         const ts_plot_opts *opts, ts_err *err);
 
 int ts_plot_histories(const char *dir, const char *name, const char *title,
                       int npanels, const ts_plot_axis panels[], int nseries,
                       const ts_plot_series series[], const ts_plot_opts *opts,
                       ts_err *err)
 {
-    static const char fn[] = "ts_plot_histories";
+    return panels_common("ts_plot_histories", dir, name, title, NULL,
+                         npanels, panels, nseries, series, opts, err);
+}
+
+int ts_plot_panels(const char *dir, const char *name, const char *title,
+                   const ts_plot_axis *xaxis, int npanels,
+                   const ts_plot_axis panels[], int nseries,
+                   const ts_plot_series series[], const ts_plot_opts *opts,
+                   ts_err *err)
+{
+    if (!xaxis)
+        return ts_fail(err, TS_EINVAL, "ts_plot_panels: xaxis: expected an "
+                       "axis, got NULL");
+    int rc = check_quantity("ts_plot_panels", "xaxis.quantity",
+                            xaxis->quantity, err);
+    return rc ? rc : panels_common("ts_plot_panels", dir, name, title, xaxis,
+                                   npanels, panels, nseries, series, opts,
+                                   err);
+}
+
+static int panels_common(const char *fn, const char *dir, const char *name,
+                         const char *title, const ts_plot_axis *xaxis,
+                         int npanels, const ts_plot_axis panels[],
+                         int nseries, const ts_plot_series series[],
+                         const ts_plot_opts *opts, ts_err *err)
+{
     ts_plot_opts def;
     int rc = begin(fn, dir, name, title, &opts, &def, err);
     if (rc || (rc = check_series(fn, nseries, series, 0, 0, err)))
@@ -2677,7 +2759,7 @@ int ts_plot_histories(const char *dir, const char *name, const char *title,
             return ts_fail(err, TS_EINVAL, "%s: panels[%d]: no series is "
                                            "drawn in it",
                            fn, p);
-    hist_ctx c = {title, npanels, panels, nseries, series};
+    hist_ctx c = {title, npanels, panels, nseries, series, xaxis};
     return render(fn, dir, name, title, opts, opts->height, draw_histories,
                   &c, err);
 }
@@ -2748,8 +2830,8 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
         plschr(0, 1.0);
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
-    axis_label(xl, sizeof xl, c->xa->label, c->xa->quantity, u);
-    axis_label(yl, sizeof yl, c->ya->label, c->ya->quantity, u);
+    axis_label_of(xl, sizeof xl, c->xa, u);
+    axis_label_of(yl, sizeof yl, c->ya, u);
     label_axes(&f, xl, yl, 1.0);
     legend_draw(&L, &f);
     page_title(c->title);
@@ -2777,6 +2859,312 @@ int ts_plot_loglog(const char *dir, const char *name, const char *title,
         return rc;
     loglog_ctx c = {title, xaxis, yaxis, nseries, series};
     return render(fn, dir, name, title, opts, opts->height, draw_loglog, &c,
+                  err);
+}
+
+/* ---- maps ------------------------------------------------------------ */
+
+/* Filled contour levels of a map. */
+#define MAP_LEVELS 12
+
+typedef struct map_ctx {
+    const char *title;
+    const ts_plot_axis *xa, *ya, *za;
+    const ts_plot_grid *g;
+    const int *marks;
+    int nb;
+    const double *bx, *by;
+} map_ctx;
+
+/* z converted, its missing values filled with the mean of their finite
+ * neighbours, pass by pass (each pass reads the previous one's values);
+ * tmp[nx ny] is scratch. Returns the number still missing. */
+static int map_values(const map_ctx *c, const ts_plot_opts *u, double *z,
+                      double *tmp)
+{
+    int nx = c->g->nx, ny = c->g->ny, n = nx * ny, missing = 0;
+    for (int k = 0; k < n; k++) {
+        z[k] = pconv(c->za->quantity, u, c->g->z[k]);
+        missing += !isfinite(z[k]);
+    }
+    static const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
+    while (missing > 0) {
+        memcpy(tmp, z, (size_t)n * sizeof *z);
+        int filled = 0;
+        for (int k = 0; k < n; k++) {
+            if (isfinite(tmp[k]))
+                continue;
+            int i = k / ny, j = k % ny, m = 0;
+            double sum = 0;
+            for (int d = 0; d < 4; d++) {
+                int a = i + di[d], b = j + dj[d];
+                if (a >= 0 && a < nx && b >= 0 && b < ny &&
+                    isfinite(tmp[a * ny + b])) {
+                    sum += tmp[a * ny + b];
+                    m++;
+                }
+            }
+            if (m > 0) {
+                z[k] = sum / m;
+                filled++;
+            }
+        }
+        if (filled == 0)
+            break;
+        missing -= filled;
+    }
+    return missing;
+}
+
+/* Half-way points between grid values (cell edges), converted: e[n + 1]. */
+static void cell_edges(const double *v, int n, ts_plot_quantity q,
+                       const ts_plot_opts *u, double *e)
+{
+    for (int i = 1; i < n; i++)
+        e[i] = 0.5 * (pconv(q, u, v[i - 1]) +
+                      pconv(q, u, v[i]));
+    e[0] = pconv(q, u, v[0]) - (e[1] - pconv(q, u, v[0]));
+    e[n] = pconv(q, u, v[n - 1]) +
+           (pconv(q, u, v[n - 1]) - e[n - 1]);
+}
+
+/* Hatch the cell around grid point (i, j) with pattern `pattern`. */
+static void hatch_cell(const double *ex, const double *ey, int i, int j,
+                       int color, int pattern)
+{
+    double x[4] = {ex[i], ex[i + 1], ex[i + 1], ex[i]};
+    double y[4] = {ey[j], ey[j], ey[j + 1], ey[j + 1]};
+    plcol0(color);
+    plpsty(pattern);
+    plfill(4, x, y);
+    plpsty(0);
+}
+
+static int draw_map(const void *vctx, const ts_plot_opts *o, int height,
+                    ts_err *err)
+{
+    (void)height;
+    const map_ctx *c = vctx;
+    const ts_plot_grid *g = c->g;
+    const ts_plot_opts *u = o;
+    int nx = g->nx, ny = g->ny, n = nx * ny;
+    double *z = malloc((4 * (size_t)n + 2 * (size_t)(nx + ny) + 4) *
+                       sizeof *z);
+    const double **rows = malloc((size_t)nx * sizeof *rows);
+    if (!z || !rows) {
+        free(z);
+        free(rows);
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    }
+    double *tmp = z + n, *xg = tmp + n, *yg = xg + nx, *ex = yg + ny;
+    double *ey = ex + nx + 1, *mx = ey + ny + 1, *my = mx + n;
+    map_values(c, u, z, tmp);
+    double z0 = INFINITY, z1 = -INFINITY;
+    for (int k = 0; k < n; k++)
+        if (isfinite(z[k]))
+            bbox_update(&z0, &z1, z[k]);
+    if (!(z1 > z0)) {
+        double w = z0 != 0 ? 0.05 * fabs(z0) : 1.0;
+        z0 -= w;
+        z1 += w;
+    }
+    for (int i = 0; i < nx; i++) {
+        xg[i] = pconv(c->xa->quantity, u, g->x[i]);
+        rows[i] = z + (size_t)i * (size_t)ny;
+    }
+    for (int j = 0; j < ny; j++)
+        yg[j] = pconv(c->ya->quantity, u, g->y[j]);
+    cell_edges(g->x, nx, c->xa->quantity, u, ex);
+    cell_edges(g->y, ny, c->ya->quantity, u, ey);
+    /* The data's extent, a little more for the marks on its edges; the
+     * hatching of an edge cell stops there. */
+    double x0 = xg[0], x1 = xg[nx - 1], y0 = yg[0], y1 = yg[ny - 1];
+    pad_range(&x0, &x1, 0.025, 1.0);
+    pad_range(&y0, &y1, 0.025, 1.0);
+    ex[0] = fmax(ex[0], x0);
+    ex[nx] = fmin(ex[nx], x1);
+    ey[0] = fmax(ey[0], y0);
+    ey[ny] = fmin(ey[ny], y1);
+
+    /* The colour map: a perceptual blue-green-yellow ramp (viridis'
+     * end points and middle). */
+    static const PLFLT pos[5] = {0.0, 0.25, 0.5, 0.75, 1.0};
+    static const PLFLT cr[5] = {0.267, 0.231, 0.128, 0.369, 0.993};
+    static const PLFLT cg[5] = {0.005, 0.322, 0.567, 0.789, 0.906};
+    static const PLFLT cb[5] = {0.329, 0.546, 0.551, 0.383, 0.144};
+    plscmap1n(256);
+    plscmap1l(1, 5, pos, cr, cg, cb, NULL);
+    PLFLT shade[MAP_LEVELS + 1];
+    for (int k = 0; k <= MAP_LEVELS; k++)
+        shade[k] = z0 + (z1 - z0) * k / MAP_LEVELS;
+
+    /* What the marks mean, above the map. */
+    int marks_seen[3] = {0, 0, 0};
+    static const int bit[3] = {TS_PLOT_MARK_UNSTABLE, TS_PLOT_MARK_UNTRUSTED,
+                               TS_PLOT_MARK_FAILED};
+    static const char *const glyph[3] = {"◆", "○", "✖"};
+    static const int color[3] = {COL_CURVE0 + 1, COL_FG, COL_FG};
+    static const char *const what[3] = {"unstable",
+                                        "not trustworthy (hatched)",
+                                        "failed (hatched)"};
+    legend L = {0};
+    for (int k = 0; c->marks && k < 3; k++) {
+        for (int i = 0; i < n && !marks_seen[k]; i++)
+            marks_seen[k] = (c->marks[i] & bit[k]) != 0;
+        if (marks_seen[k])
+            legend_add(&L, what[k], color[k], TS_PLOT_MARKERS, glyph[k]);
+    }
+    if (c->nb > 0)
+        legend_add(&L, "stability boundary (bisection)", COL_FG,
+                   TS_PLOT_MARKERS, "★");
+    PLFLT sx0, sx1, sy0, sy1;
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    legend_layout lay = legend_plan(&L, 0.7 * (sx1 - sx0));
+    double box_top = 0.88 - (lay.height_mm > 0 ? lay.height_mm + 2.0 : 0) /
+                                (sy1 - sy0);
+    plvpor(left_edge(tick_width(y0, y1, 0), 1.0), 0.84, 0.11, box_top);
+    frame f;
+    frame_set(&f, x0, x1, y0, y1, 0, 0);
+    PLcGrid cgrid = {xg, yg, NULL, nx, ny, 0};
+    plshades(rows, nx, ny, NULL, x0, x1, y0, y1, shade, MAP_LEVELS + 1, 0, 0,
+             0, plfill, 1, pltr1, &cgrid);
+    /* Contour lines at the shade boundaries, and 0 in bold when z
+     * changes sign. */
+    plcol0(COL_FG);
+    plwidth(0.5);
+    plcont(rows, nx, ny, 1, nx, 1, ny, shade + 1, MAP_LEVELS - 1, pltr1,
+           &cgrid);
+    if (z0 < 0 && z1 > 0) {
+        PLFLT zero = 0;
+        plwidth(3.0);
+        plcont(rows, nx, ny, 1, nx, 1, ny, &zero, 1, pltr1, &cgrid);
+    }
+    plwidth(AXIS_WIDTH);
+    /* Untrustworthy and failed cells hatched. */
+    for (int i = 0; c->marks && i < nx; i++)
+        for (int j = 0; j < ny; j++) {
+            int m = c->marks[i * ny + j];
+            if (m & TS_PLOT_MARK_FAILED)
+                hatch_cell(ex, ey, i, j, COL_FG, 3);
+            else if (m & TS_PLOT_MARK_UNTRUSTED)
+                hatch_cell(ex, ey, i, j, COL_GREY, 1);
+        }
+    frame_axes(&f, "bcnst", "bcnst", 0);
+    /* Marks: unstable (red diamonds), untrustworthy (open circles),
+     * failed (crosses). */
+    for (int k = 0; c->marks && k < 3; k++) {
+        int m = 0;
+        for (int i = 0; i < nx; i++)
+            for (int j = 0; j < ny; j++)
+                if (c->marks[i * ny + j] & bit[k]) {
+                    mx[m] = xg[i];
+                    my[m++] = yg[j];
+                }
+        if (m == 0)
+            continue;
+        plcol0(color[k]);
+        plschr(0, 0.9);
+        draw_markers(&f, m, mx, my, glyph[k]);
+        plschr(0, 1.0);
+    }
+    if (c->nb > 0) {
+        double *bx = tmp, *by = tmp + c->nb;
+        if (2 * c->nb > n) {
+            bx = malloc(2 * (size_t)c->nb * sizeof *bx);
+            by = bx ? bx + c->nb : NULL;
+        }
+        if (bx) {
+            for (int k = 0; k < c->nb; k++) {
+                bx[k] = pconv(c->xa->quantity, u, c->bx[k]);
+                by[k] = pconv(c->ya->quantity, u, c->by[k]);
+            }
+            plcol0(COL_FG);
+            plschr(0, 1.2);
+            draw_markers(&f, c->nb, bx, by, "★");
+            plschr(0, 1.0);
+            if (bx != tmp)
+                free(bx);
+        }
+    }
+    char xl[TEXT_MAX], yl[TEXT_MAX], zl[TEXT_MAX];
+    axis_label_of(xl, sizeof xl, c->xa, u);
+    axis_label_of(yl, sizeof yl, c->ya, u);
+    axis_label_of(zl, sizeof zl, c->za, u);
+    label_axes(&f, xl, yl, 1.0);
+    /* The colour bar, right of the map, labelled with z. */
+    PLFLT cw, ch;
+    const char *labels[1] = {zl};
+    PLINT label_opts[1] = {PL_COLORBAR_LABEL_RIGHT};
+    const char *axis_opts[1] = {"bcvtm"};
+    PLFLT ticks[1] = {0.0};
+    PLINT sub_ticks[1] = {0};
+    PLINT n_values[1] = {MAP_LEVELS + 1};
+    const PLFLT *values[1] = {shade};
+    plcol0(COL_FG);
+    plschr(0, 0.85);
+    plcolorbar(&cw, &ch, PL_COLORBAR_SHADE | PL_COLORBAR_SHADE_LABEL,
+               PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT,
+               0.03, 0.0, 0.035, 0.9, COL_BG, COL_FG, LSTY_SOLID, 0, 0, 0, 0,
+               1, label_opts, labels, 1, axis_opts, ticks, sub_ticks,
+               n_values, values);
+    plschr(0, 1.0);
+    legend_draw_above(&L, lay);
+    page_title(c->title);
+    free(z);
+    free(rows);
+    return TS_OK;
+}
+
+static int check_increasing(const char *fn, const char *what,
+                            const double *v, int n, ts_err *err)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(v[i]) || (i > 0 && !(v[i] > v[i - 1])))
+            return ts_fail(err, TS_EINVAL, "%s: grid.%s: expected finite, "
+                           "strictly increasing values; entry %d is %g", fn,
+                           what, i, v[i]);
+    return TS_OK;
+}
+
+int ts_plot_map(const char *dir, const char *name, const char *title,
+                const ts_plot_axis *xaxis, const ts_plot_axis *yaxis,
+                const ts_plot_axis *zaxis, const ts_plot_grid *grid,
+                const int *marks, int nb, const double *bx, const double *by,
+                const ts_plot_opts *opts, ts_err *err)
+{
+    static const char fn[] = "ts_plot_map";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc)
+        return rc;
+    if (!xaxis || !yaxis || !zaxis || !grid)
+        return ts_fail(err, TS_EINVAL, "%s: expected the three axes and a "
+                       "grid", fn);
+    if ((rc = check_quantity(fn, "xaxis.quantity", xaxis->quantity, err)) ||
+        (rc = check_quantity(fn, "yaxis.quantity", yaxis->quantity, err)) ||
+        (rc = check_quantity(fn, "zaxis.quantity", zaxis->quantity, err)))
+        return rc;
+    if (grid->nx < 2 || grid->ny < 2 || !grid->x || !grid->y || !grid->z)
+        return ts_fail(err, TS_EINVAL, "%s: grid: expected at least 2 x 2 "
+                       "values, got %d x %d", fn, grid->nx, grid->ny);
+    if ((rc = check_increasing(fn, "x", grid->x, grid->nx, err)) ||
+        (rc = check_increasing(fn, "y", grid->y, grid->ny, err)))
+        return rc;
+    int finite = 0;
+    for (int k = 0; k < grid->nx * grid->ny; k++)
+        finite += isfinite(grid->z[k]);
+    if (!finite)
+        return ts_fail(err, TS_EINVAL, "%s: grid.z: no finite value to draw",
+                       fn);
+    if (nb < 0 || (nb > 0 && (!bx || !by)))
+        return ts_fail(err, TS_EINVAL, "%s: expected nb >= 0 boundary points "
+                       "with bx and by, got %d", fn, nb);
+    for (int k = 0; k < nb; k++)
+        if (!isfinite(bx[k]) || !isfinite(by[k]))
+            return ts_fail(err, TS_EINVAL, "%s: boundary point %d is not "
+                           "finite", fn, k);
+    map_ctx c = {title, xaxis, yaxis, zaxis, grid, marks, nb, bx, by};
+    return render(fn, dir, name, title, opts, opts->height, draw_map, &c,
                   err);
 }
 

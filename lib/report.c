@@ -89,6 +89,14 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
     return o;
 }
 
+int ts_report_trust_into(json_t *o, const ts_trust *t)
+{
+    json_t *j = ts_report_trust_json(t);
+    int bad = !j || json_object_update(o, j) != 0;
+    json_decref(j);
+    return bad ? TS_ENOMEM : TS_OK;
+}
+
 json_t *ts_report_equilibrium_json(const ts_system *sys,
                                    const ts_equilibrium *eq, double wall_s,
                                    const ts_trust *trust)

@@ -184,15 +184,6 @@ json_t *ts_report_convergence_json(const ts_convergence *c)
     return o;
 }
 
-/* A CSV number: "nan"/"inf" for what is not finite. */
-static void csv_num(FILE *f, double v)
-{
-    if (isfinite(v))
-        fprintf(f, ",%.17g", v);
-    else
-        fprintf(f, ",%s", isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
-}
-
 int ts_report_convergence_csv(const ts_convergence *c, const char *path,
                               ts_err *err)
 {
@@ -237,15 +228,15 @@ int ts_report_convergence_csv_display(const ts_convergence *c,
     for (int i = 0; i < c->nrows; i++) {
         const ts_conv_row *r = &c->rows[idx[i]];
         fprintf(f, "%s", c->series[r->series].name);
-        csv_num(f, r->setting);
-        csv_num(f, r->h);
+        tsi_csv_number(f, r->setting);
+        tsi_csv_number(f, r->h);
         fprintf(f, ",%s", r->status == TS_OK ? "ok" : "failed");
-        csv_num(f, r->wall_s);
+        tsi_csv_number(f, r->wall_s);
         fprintf(f, ",%ld,%d", r->evaluations, r->trust.trustworthy);
-        csv_num(f, r->max_rel_error);
+        tsi_csv_number(f, r->max_rel_error);
         for (int v = 0; v < c->nvalues; v++) {
-            csv_num(f, k[v] * r->values[v]);
-            csv_num(f, k[v] * r->errors[v]);
+            tsi_csv_number(f, k[v] * r->values[v]);
+            tsi_csv_number(f, k[v] * r->errors[v]);
         }
         fprintf(f, "\n");
     }

@@ -18,7 +18,10 @@
  *     completed 0, never trustworthy (the failure is the first reason);
  *     bad settings are refused by ts_analysis_check naming the option by
  *     its scene key (speed -1, links with link_lengths, an unknown
- *     response output, a sample interval longer than the run). */
+ *     response output, a sample interval longer than the run).
+ *  6. settings by path (ts_setup_set): the run equals the one on a system
+ *     with the fields edited, bit for bit; conflicts and bad values are
+ *     refused naming the path. */
 #include "towstab/analysis.h"
 
 #include <math.h>
@@ -327,6 +330,63 @@ static void test_failures(const ts_scene *sc)
     ts_system_free(ll);
 }
 
+/* 6. Settings by path: a request that sets cable length and sphere mass
+ * gives, bit for bit, the run on a copy of the system with those fields
+ * written in; the scene's system is untouched; tow.speed set by path and
+ * as speed both is refused. */
+static void test_sets(const ts_scene *sc)
+{
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_MODES);
+    ts_err err = {0};
+    int rc = ts_setup_set(&rq.setup, "cables.cable.length", 37.25, &err);
+    if (!rc)
+        rc = ts_setup_set(&rq.setup, "bodies.sphere.mass", 31.5, &err);
+    if (!rc)
+        rc = ts_setup_set(&rq.setup, "cables.cable.length", 35.75, &err);
+    CHECK(rc == TS_OK && rq.setup.nsets == 2,
+          "two settings, the second length replacing the first (%d)",
+          rq.setup.nsets);
+    ts_result *r = NULL, *h = NULL;
+    rc = ts_analysis_run(sc->system, &rq, &r, &err);
+    ts_system *edit = ts_system_copy(sc->system, &err);
+    edit->cables[0].length = 35.75;
+    edit->bodies[0].mass = 31.5;
+    ts_system_build(edit, &err);
+    ts_request plain;
+    ts_request_init(&plain, TS_ANALYSIS_MODES);
+    int rc2 = ts_analysis_run(edit, &plain, &h, &err);
+    int same = rc == TS_OK && rc2 == TS_OK && r->nvalues == h->nvalues &&
+               r->eigen->nmodes == h->eigen->nmodes;
+    for (int i = 0; same && i < r->nvalues; i++)
+        same = r->values[i].value == h->values[i].value;
+    for (int m = 0; same && m < r->eigen->nmodes; m++)
+        same = r->eigen->modes[m].re == h->eigen->modes[m].re &&
+               r->eigen->modes[m].im == h->eigen->modes[m].im;
+    CHECK(same && sc->system->cables[0].length != 35.75,
+          "modes with cables.cable.length and bodies.sphere.mass set by path "
+          "equal those of the edited system bit for bit (%d modes); the "
+          "scene keeps %g m", same ? r->eigen->nmodes : -1,
+          sc->system->cables[0].length);
+    ts_result_free(r);
+    ts_result_free(h);
+    ts_system_free(edit);
+    ts_request_clear(&plain);
+    rq.setup.speed = 3;
+    ts_setup_set(&rq.setup, "tow.speed", 2, NULL);
+    rc = ts_analysis_check(sc->system, &rq, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "set: tow.speed is also given "
+                                             "as speed"),
+          "tow.speed by path and speed both refused: %s", err.msg);
+    rq.setup.speed = NAN;
+    ts_setup_set(&rq.setup, "cables.cable.diameter", -1, NULL);
+    rc = ts_analysis_check(sc->system, &rq, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "set: cables.cable.diameter: "
+                                             "must be > 0 m"),
+          "a bad value by path refused naming it: %s", err.msg);
+    ts_request_clear(&rq);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -339,6 +399,7 @@ int main(void)
         test_simulate(ex4, u);
         test_converge(ex4);
         test_failures(ex1);
+        test_sets(ex1);
     }
     ts_scene_free(ex1);
     ts_scene_free(ex4);

@@ -20,6 +20,8 @@
  *     node moves and shape changes per step halve with the step.
  *  7. Failures: no convergence (TS_ECONV with the residual reached) and the
  *     requests the model refuses (TS_EDOMAIN, TS_EINVAL, TS_ESINGULAR).
+ *  8. Continuation: started from a neighbouring equilibrium (opts.guess),
+ *     the same equilibrium as from a cold start, in fewer evaluations.
  * Each check states its tolerance and the reason for it. */
 #include "towstab/equilibrium.h"
 
@@ -741,9 +743,52 @@ static void test_failures(void)
     }
 }
 
+/* 8. Continuation from a neighbour: started from the equilibrium at a
+ * nearby turn rate (opts.guess), the solver finds the same equilibrium as
+ * from a cold start (positions within 1e-9 of the cable length: both meet
+ * the force residual 1e-10, whose shape error is orders smaller), with
+ * fewer kernel evaluations where the cold start needs its continuation
+ * schedule or Newton. */
+static void warm_case(const char *what, ts_system *near, ts_system *s)
+{
+    int rc0, rc1, rc2;
+    ts_equilibrium *n = solve(near, TS_EQ_AUTO, NULL, &rc0);
+    ts_equilibrium *cold = solve(s, TS_EQ_AUTO, NULL, &rc1);
+    ts_equilibrium *warm = solve(s, TS_EQ_AUTO, n->directions, &rc2);
+    double L = total_length(s);
+    double d = rc0 == TS_OK && rc1 == TS_OK && rc2 == TS_OK
+                   ? max_pos_diff(cold, warm, 0)
+                   : INFINITY;
+    CHECK(d <= 1e-9 * L && warm->evaluations < cold->evaluations,
+          "%s: from the neighbour's shape, the cold start's equilibrium "
+          "(max |dr| %.2g m <= 1e-9 L) in %ld evaluations (%s) against "
+          "%ld (%s)",
+          what, d, warm->evaluations, ts_eq_method_name(warm->method),
+          cold->evaluations, ts_eq_method_name(cold->method));
+    ts_equilibrium_free(n);
+    ts_equilibrium_free(cold);
+    ts_equilibrium_free(warm);
+    ts_system_free(near);
+    ts_system_free(s);
+}
+
+static void test_warm_start(void)
+{
+    warm_case("ex. 3, 0.95 -> 1 rad/s (shooting)", ex3(0.95), ex3(1.0));
+    warm_case("ex. 3, 1.2 -> 1.25 rad/s", ex3(1.2), ex3(1.25));
+    /* With bending: Newton, which starts cold from the straight-tow march
+     * with continuation in turn rate and in bending. */
+    ts_system *b0 = ex3(0.45), *b1 = ex3(0.5);
+    b0->cables[0].ei = b1->cables[0].ei = 2e-4;
+    ts_system_build(b0, NULL);
+    ts_system_build(b1, NULL);
+    warm_case("ex. 3 with EI 2e-4 N m^2, 0.45 -> 0.5 rad/s (newton)", b0, b1);
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
+    test_warm_start();
     test_hanging();
     test_critical_angle();
     test_newton_vs_shooting();

@@ -196,6 +196,15 @@ static int bad_texts(const ts_option *o, const char *out[], int max)
         }
         break;
     case TS_OPT_CUSTOM:
+        if (!strcmp(o->name, "set")) {
+            ADD("cables.cable.length=-1");
+            ADD("cables.rope.length=5");
+            ADD("cables.cable.length=5 kg");
+            ADD("bodies.ball.mass=2; tow.sped=1");
+            ADD("tow.speed");
+            ADD("cables.cable.links=7.5");
+            break;
+        }
         ADD("upside_down");
         ADD("shape:");
         ADD("released:theta9=1");

@@ -484,7 +484,7 @@ static void test_animation(void)
         im[3 * k] = 0.5 * sin(2 * M_PI * s);
     }
     ts_plot_shape eq = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
-                        0, NULL};
+                        0, NULL, 0, NULL};
     int rc = ts_plot_mode_animation(dir, "anim", "chain: mode 1", TS_PLOT_SIDE,
                                     TS_PLOT_WATER, &eq, re, im,
                                     "mode 1: 0.5 Hz", 12, 2.0, &o, &err);
@@ -722,8 +722,8 @@ static void test_histories(void)
         d2[i] = 9.16 + 0.17 * sin(1.3 * t2[i]) * exp(-0.05 * t2[i]);
         f2[i] = 2010 + 120 * sin(1.3 * t2[i]);
     }
-    ts_plot_axis panels[2] = {{"sphere depth", TS_PLOT_LENGTH},
-                              {"top tension", TS_PLOT_FORCE}};
+    ts_plot_axis panels[2] = {{"sphere depth", TS_PLOT_LENGTH, NULL},
+                              {"top tension", TS_PLOT_FORCE, NULL}};
     ts_plot_series s[4] = {{NS, t, d1, "linear", 0, TS_PLOT_DASHED, 1, NULL},
                            {NS2, t2, d2, "nonlinear", 0, TS_PLOT_SOLID, 2,
                             NULL},
@@ -770,8 +770,8 @@ static void test_loglog(void)
         e1[i] = 1e-3 * pow(2, -2.0 * i);
         e2[i] = 1e-2 * pow(2, -4.0 * i);
     }
-    ts_plot_axis xa = {"run time", TS_PLOT_TIME},
-                 ya = {"error in sphere depth", TS_PLOT_LENGTH};
+    ts_plot_axis xa = {"run time", TS_PLOT_TIME, NULL},
+                 ya = {"error in sphere depth", TS_PLOT_LENGTH, NULL};
     ts_plot_series s[2] = {
         {6, rt, e1, "RK45", 0, TS_PLOT_LINE_MARKERS, 0, NULL},
         {6, rt2, e2, "BDF", 0, TS_PLOT_LINE_MARKERS, 0, NULL}};
@@ -824,6 +824,89 @@ static void test_loglog(void)
     CHECK(rc == TS_EINVAL && strstr(err.msg, "size"),
           "a 640 px wide picture is refused: %s", err.msg);
     CHECK(nothing_named("loglog_bad"), "refused log-log plots left no file");
+}
+
+/* A map over two parameters (an operating envelope) and curves against a
+ * parameter (ts_plot_panels). */
+static void test_map(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    enum { NX = 6, NY = 4 };
+    double x[NX], y[NY], z[NX * NY], bx[2] = {2.45, 2.6}, by[2] = {0, 0.3};
+    int marks[NX * NY] = {0};
+    for (int i = 0; i < NX; i++)
+        x[i] = 1.0 + 0.3 * i;
+    for (int j = 0; j < NY; j++)
+        y[j] = 0.1 * j * j;
+    for (int i = 0; i < NX; i++)
+        for (int j = 0; j < NY; j++) {
+            z[i * NY + j] = (x[i] - 2.4) * (1 + y[j]);
+            marks[i * NY + j] = z[i * NY + j] > 0 ? TS_PLOT_MARK_UNSTABLE : 0;
+        }
+    z[2 * NY + 1] = NAN;
+    marks[2 * NY + 1] = TS_PLOT_MARK_FAILED;
+    marks[0] |= TS_PLOT_MARK_UNTRUSTED;
+    ts_plot_axis xa = {"tow speed", TS_PLOT_SPEED, NULL};
+    ts_plot_axis ya = {"cable mass", TS_PLOT_NONE, "kg/m"};
+    ts_plot_axis za = {"max Re(λ)", TS_PLOT_RATE, NULL};
+    ts_plot_grid g = {NX, NY, x, y, z};
+    int rc = ts_plot_map(dir, "map", "envelope #1 & <margin>", &xa, &ya, &za,
+                         &g, marks, 2, bx, by, &o, &err);
+    CHECK(rc == TS_OK, "map with marks, a failed point and a boundary (%s)",
+          err.msg);
+    check_png("map", 1000, 700);
+    free(check_svg("map", "envelope #1 &amp; &lt;margin&gt;"));
+    o.units = TS_PLOT_IMPERIAL;
+    rc = ts_plot_map(dir, "map_imperial", "imperial", &xa, &ya, &za, &g, NULL,
+                     0, NULL, NULL, &o, &err);
+    CHECK(rc == TS_OK, "map in imperial units, no marks (%s)", err.msg);
+    ts_plot_opts_default(&o);
+    /* Refusals. */
+    double xbad[NX] = {1, 2, 2, 3, 4, 5}, znan[NX * NY];
+    for (int k = 0; k < NX * NY; k++)
+        znan[k] = NAN;
+    ts_plot_grid gx = {NX, NY, xbad, y, z}, gz = {NX, NY, x, y, znan};
+    ts_plot_grid g1 = {1, NY, x, y, z};
+    rc = ts_plot_map(dir, "map_bad", "x", &xa, &ya, &za, &gx, NULL, 0, NULL,
+                     NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "grid.x"),
+          "x not increasing refused: %s", err.msg);
+    rc = ts_plot_map(dir, "map_bad", "x", &xa, &ya, &za, &gz, NULL, 0, NULL,
+                     NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "no finite value"),
+          "no value at all refused: %s", err.msg);
+    rc = ts_plot_map(dir, "map_bad", "x", &xa, &ya, &za, &g1, NULL, 0, NULL,
+                     NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "2 x 2"),
+          "a grid of one column refused: %s", err.msg);
+    rc = ts_plot_map(dir, "map_bad", "x", &xa, &ya, &za, &g, NULL, 1, NULL,
+                     NULL, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "boundary"),
+          "boundary points without arrays refused: %s", err.msg);
+    CHECK(nothing_named("map_bad"), "refused maps left no file");
+
+    /* Curves against a parameter. */
+    double d[NX], t[NX];
+    for (int i = 0; i < NX; i++) {
+        d[i] = 10.0 / x[i];
+        t[i] = 400 + 50 * x[i] * x[i];
+    }
+    ts_plot_axis panels[2] = {{"sphere depth", TS_PLOT_LENGTH, NULL},
+                              {"top tension", TS_PLOT_FORCE, NULL}};
+    ts_plot_series s[3] = {
+        {NX, x, d, NULL, 0, TS_PLOT_LINE_MARKERS, 1, NULL},
+        {NX, x, t, NULL, 1, TS_PLOT_LINE_MARKERS, 1, NULL},
+        {2, x + 4, t + 4, "unstable", 1, TS_PLOT_MARKERS, 2, NULL}};
+    rc = ts_plot_panels(dir, "panels", "depth and tension over speed", &xa, 2,
+                        panels, 3, s, &o, &err);
+    CHECK(rc == TS_OK, "panels against the tow speed (%s)", err.msg);
+    check_png("panels", 1000, 700);
+    rc = ts_plot_panels(dir, "panels_bad", "x", NULL, 2, panels, 3, s, &o,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "xaxis"),
+          "panels without an x axis refused: %s", err.msg);
 }
 
 /* Bad names, directories and shapes. */
@@ -972,8 +1055,10 @@ static void test_without_plplot(void)
     double x[2] = {1, 2}, y[2] = {1, 2}, ph[2] = {0, 0}, nat[1] = {1};
     ts_plot_series s = {2, x, y, "s", 0, 0, 0};
     ts_plot_bode_curve b = {2, x, y, ph, "b", 0, 0};
-    ts_plot_axis a = {"a", TS_PLOT_NONE};
-    int rc[6];
+    ts_plot_axis a = {"a", TS_PLOT_NONE, NULL};
+    double gz[4] = {1, 2, 3, 4};
+    ts_plot_grid g = {2, 2, x, y, gz};
+    int rc[8];
     rc[0] = ts_plot_shapes(dir, "n0", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
     rc[1] = ts_plot_mode_shapes(dir, "n1", "t", 0, &one, 1, &mode, &o, &err);
     rc[2] = ts_plot_eigenvalues(dir, "n2", "t", 1, &s, NULL, &o, &err);
@@ -981,7 +1066,10 @@ static void test_without_plplot(void)
                          1, &b, 1, nat, &o, &err);
     rc[4] = ts_plot_histories(dir, "n4", "t", 1, &a, 1, &s, &o, &err);
     rc[5] = ts_plot_loglog(dir, "n5", "t", &a, &a, 1, &s, &o, &err);
-    for (int i = 0; i < 6; i++)
+    rc[6] = ts_plot_panels(dir, "n6", "t", &a, 1, &a, 1, &s, &o, &err);
+    rc[7] = ts_plot_map(dir, "n7", "t", &a, &a, &a, &g, NULL, 0, NULL, NULL,
+                        &o, &err);
+    for (int i = 0; i < 8; i++)
         CHECK(rc[i] == TS_EDOMAIN, "drawing function %d returns TS_EDOMAIN",
               i);
     CHECK(nothing_named("n"), "nothing was written");
@@ -1031,7 +1119,8 @@ static void test_units(void)
         const char *si, *imp;
     } cases[] = {{TS_PLOT_LENGTH, "m", "ft"},
                  {TS_PLOT_FORCE, "N", "lbf"},
-                 {TS_PLOT_SPEED, "m/s", "knot"}};
+                 {TS_PLOT_SPEED, "m/s", "knot"},
+                 {TS_PLOT_MASS, "kg", "lb"}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         double want = 0;
         int rc = ts_units_from_si(u, 2.385, cases[i].si, cases[i].imp, &want,
@@ -1124,6 +1213,7 @@ int main(int argc, char **argv)
     test_bode();
     test_histories();
     test_loglog();
+    test_map();
     test_bad_places();
     test_streams();
 #else

@@ -47,6 +47,27 @@ int cli_write_json(const json_t *value, const char *path, ts_err *err)
                : TS_OK;
 }
 
+int cli_put_json(json_t *j, const char *path, int status)
+{
+    ts_err err = {0};
+    if (j && cli_stop_signal_name())
+        json_object_set_new(j, "interrupted",
+                            json_string(cli_stop_signal_name()));
+    int rc = j ? cli_write_json(j, path, &err)
+               : ts_fail(&err, TS_ENOMEM, "%s: out of memory for the JSON",
+                         path);
+    json_decref(j);
+    return cli_put_status(rc, &err, status);
+}
+
+int cli_put_status(int rc, ts_err *err, int status)
+{
+    if (rc == TS_OK)
+        return status;
+    int e = cli_report(err, rc);
+    return status ? status : e;
+}
+
 int cli_check_outputs(const char *cmd, int n, const char *const what[],
                       const char *const paths[], const char *plot_dir,
                       const char *const plot_names[])
@@ -215,6 +236,18 @@ void cli_progress_done(void)
     line.shown = 0;
     line.what = NULL;
     polled = 0;
+}
+
+const char *cli_analysis_arg(int argc, char **argv)
+{
+    const char *name = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--analysis") && i + 1 < argc)
+            name = argv[i + 1];
+        else if (!strncmp(argv[i], "--analysis=", 11))
+            name = argv[i] + 11;
+    }
+    return name;
 }
 
 int cli_exit_code(int rc)

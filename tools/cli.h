@@ -34,7 +34,7 @@ typedef struct cli_extra {
     const char *help;
 } cli_extra;
 
-#define CLI_EXTRA_MAX 8
+#define CLI_EXTRA_MAX 10
 #define CLI_EXTRA_VALUES 8
 
 /* One run of an analysis command (or of one entry of `towstab run`). */
@@ -58,6 +58,11 @@ typedef struct cli_run {
     const char *extra[CLI_EXTRA_MAX][CLI_EXTRA_VALUES];
     int nextra[CLI_EXTRA_MAX];
     void *state;            /* the command's own (released by release) */
+    /* Every option of the table and every extra given on the command
+     * line, as "--name=value" ("--name" for a flag), in order (outputs
+     * apart): what a command that records its settings keeps. */
+    char **given;
+    int ngiven;
 } cli_run;
 
 typedef struct cli_command {
@@ -78,9 +83,18 @@ typedef struct cli_command {
     void (*release)(cli_run *c);
     const char *const *pictures;  /* what --plot writes (NAME.png/.svg) */
     const cli_extra *extras;      /* NULL-name-terminated, may be NULL */
+    /* Run a prepared c in place of cli_execute (a sweep of the analysis
+     * `kind`): prints, writes, draws; returns the exit status. May be
+     * NULL. */
+    int (*execute)(cli_run *c);
 } cli_command;
 
 double cli_wall_now(void);
+
+/* The value of the last `--analysis A` (or `--analysis=A`) of argv, NULL
+ * when none: commands built for another analysis (sweep, design) read it
+ * before their option table is known. */
+const char *cli_analysis_arg(int argc, char **argv);
 
 /* Exit status for a library code. */
 int cli_exit_code(int rc);
@@ -194,6 +208,16 @@ void cli_stdout_for_json(void);
 /* Write JSON to `path` ("-": the JSON standard output), as
  * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
+
+/* Write j (taken over; NULL: it could not be made, out of memory) to
+ * `path`, with "interrupted" when a signal stopped the run; prints a
+ * failure. Returns `status`, or the failure's exit status when `status`
+ * is 0. */
+int cli_put_json(json_t *j, const char *path, int status);
+
+/* A writer's outcome rc (err its message): prints a failure; returns
+ * `status`, or the failure's exit status when `status` is 0. */
+int cli_put_status(int rc, ts_err *err, int status);
 
 /* ---- Interruption and progress (doc/manual.md, "Long runs") ----------
  * main() installs handlers for SIGINT and SIGTERM. A run that takes

@@ -155,6 +155,8 @@ static int has_partial(const ts_result *r)
 
 int cli_execute(cli_run *c, json_t **result)
 {
+    if (c->cmd->execute)
+        return c->cmd->execute(c);
     ts_err err = {0};
     ts_result *r = NULL;
     ts_cost cost;
@@ -214,8 +216,34 @@ int cli_execute(cli_run *c, json_t **result)
     return status;
 }
 
+/* Keep "--name=value" (or "--name") of an option given. */
+static void keep_given(cli_run *c, const char *name, const char *value)
+{
+    char **g = realloc(c->given, (size_t)(c->ngiven + 1) * sizeof *g);
+    if (!g)
+        return;
+    c->given = g;
+    size_t n = strlen(name) + (value ? strlen(value) : 0) + 4;
+    g[c->ngiven] = malloc(n);
+    if (!g[c->ngiven])
+        return;
+    snprintf(g[c->ngiven], n, "--%s%s%s", name, value ? "=" : "",
+             value ? value : "");
+    c->ngiven++;
+}
+
+static void free_given(cli_run *c)
+{
+    for (int i = 0; i < c->ngiven; i++)
+        free(c->given[i]);
+    free(c->given);
+    c->given = NULL;
+    c->ngiven = 0;
+}
+
 void cli_run_free(cli_run *c)
 {
+    free_given(c);
     if (c->cmd && c->cmd->release)
         c->cmd->release(c);
     ts_request_clear(&c->rq);
@@ -281,12 +309,14 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
         if (ch >= CODE_ROW && ch < CODE_ROW + n) {
             int i = ch - CODE_ROW;
             snprintf(where, sizeof where, "--%s", names[2 * i]);
+            keep_given(&c, names[2 * i], optarg);
             if (ts_optset_give(opts, t[i].name, optarg ? optarg : "true",
                                TS_OPTSET_COMMAND, where, &err))
                 status = cli_report(&err, err.code);
         } else if (ch >= CODE_NO && ch < CODE_NO + n) {
             int i = ch - CODE_NO;
             snprintf(where, sizeof where, "--no-%s", names[2 * i]);
+            keep_given(&c, names[2 * i + 1], NULL);
             if (ts_optset_give(opts, t[i].name, "false", TS_OPTSET_COMMAND,
                                where, &err))
                 status = cli_report(&err, err.code);
@@ -300,6 +330,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
                 status = EXIT_BADINPUT;
             } else {
                 c.extra[k][c.nextra[k]++] = optarg ? optarg : "";
+                keep_given(&c, cmd->extras[k].name, optarg);
             }
         } else {
             switch (ch) {
@@ -321,6 +352,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
     free(names);
     if (status) {
         ts_optset_free(opts);
+        free_given(&c);
         return status < 0 ? 0 : status;
     }
     if (optind != argc - 1) {
@@ -328,6 +360,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
                 cmd->name);
         cli_usage(cmd, stderr);
         ts_optset_free(opts);
+        free_given(&c);
         return EXIT_BADINPUT;
     }
     /* Outputs naming one file are refused before anything runs. */
@@ -355,6 +388,7 @@ int cli_main(const cli_command *cmd, int argc, char **argv)
         status = cli_plot_begin(&c.plot, cmd->name);
     if (status) {
         ts_optset_free(opts);
+        free_given(&c);
         cli_close(units, scene);
         return status;
     }

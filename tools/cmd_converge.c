@@ -247,9 +247,9 @@ static int converge_plot(const ts_convergence *c, const char *scene,
         char title[256];
         snprintf(title, sizeof title, "%s: %s, error against run time (%s "
                  "sweep)", scene, c->analysis, ts_conv_param_name(c->param));
-        ts_plot_axis xa = {"wall time of the run", TS_PLOT_TIME};
+        ts_plot_axis xa = {"wall time of the run", TS_PLOT_TIME, NULL};
         ts_plot_axis ya = {"largest estimated relative error",
-                           TS_PLOT_NONE};
+                           TS_PLOT_NONE, NULL};
         ts_err err = {0};
         if (ts_plot_loglog(plot->dir, "error_time", title, &xa, &ya, ns, ser,
                            &plot->opts, &err) != TS_OK)
@@ -310,4 +310,4 @@ const cli_command cli_cmd_converge = {
     "converge",
     "accuracy and cost against resolution (links, tolerance, step)",
     TS_ANALYSIS_CONVERGE, NULL, NULL, conv_print, conv_draw, NULL,
-    conv_pictures, NULL};
+    conv_pictures, NULL, NULL};

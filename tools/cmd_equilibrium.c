@@ -475,4 +475,4 @@ static const char *const eq_pictures[] = {"side", "top", NULL};
 const cli_command cli_cmd_equilibrium = {
     "equilibrium", "steady shape at the scene's speed and turn rate",
     TS_ANALYSIS_EQUILIBRIUM, NULL, eq_prepare, eq_print, eq_draw,
-    eq_release, eq_pictures, eq_extras};
+    eq_release, eq_pictures, eq_extras, NULL};

@@ -509,4 +509,4 @@ static const char *const modes_pictures[] = {"eigenvalues", "modes", NULL};
 const cli_command cli_cmd_modes = {
     "modes", "stability verdict and mode table of the linearized system",
     TS_ANALYSIS_MODES, NULL, modes_prepare, modes_print, modes_draw_or_shapes,
-    NULL, modes_pictures, modes_extras};
+    NULL, modes_pictures, modes_extras, NULL};

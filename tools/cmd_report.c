@@ -640,4 +640,4 @@ static int report_main(int argc, char **argv)
 
 const cli_command cli_cmd_report = {
     "report", "the scene's analyses as one self-contained HTML page", -1,
-    report_main, NULL, NULL, NULL, NULL, NULL, NULL};
+    report_main, NULL, NULL, NULL, NULL, NULL, NULL, NULL};

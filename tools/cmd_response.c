@@ -262,4 +262,4 @@ static const cli_extra response_extras[] = {
 const cli_command cli_cmd_response = {
     "response", "frequency response to tow-point motion or a vehicle's input",
     TS_ANALYSIS_RESPONSE, NULL, response_prepare, response_print,
-    response_draw, NULL, response_pictures, response_extras};
+    response_draw, NULL, response_pictures, response_extras, NULL};

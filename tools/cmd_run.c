@@ -123,4 +123,4 @@ static int run_main(int argc, char **argv)
 
 const cli_command cli_cmd_run = {"run", "the analyses the scene lists, in order",
                                  -1, run_main, NULL, NULL, NULL, NULL, NULL,
-                                 NULL};
+                                 NULL, NULL};

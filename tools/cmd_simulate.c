@@ -802,4 +802,4 @@ static const char *const sim_pictures[] = {"histories", "snapshots_side",
 const cli_command cli_cmd_simulate = {
     "simulate", "nonlinear and linear time-domain simulation, comparison",
     TS_ANALYSIS_SIMULATE, NULL, sim_prepare, sim_print, sim_draw,
-    sim_release, sim_pictures, sim_extras};
+    sim_release, sim_pictures, sim_extras, NULL};

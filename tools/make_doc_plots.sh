@@ -1,6 +1,7 @@
 #!/bin/bash
-# tools/make_doc_plots.sh: regenerate the pictures of doc/plots.md into
-# doc/img/ (PNG only, each under 150 kB).
+# tools/make_doc_plots.sh: regenerate the pictures of doc/plots.md and
+# doc/sweep.md and doc/design.md into doc/img/ (PNG only, each under
+# 150 kB).
 #
 #   tools/make_doc_plots.sh [TOWSTAB]
 #
@@ -88,6 +89,19 @@ pic simulate_ex5_snapshots snapshots_side simulate \
 # (memo Fig. 12).
 pic converge_ex1_error_time error_time converge \
     examples/kamman_ex1_submerged.yaml --links 5,10,20,40,80,160,320
+# Operating envelope of example 1 with the tow point 35 ft above the water
+# (doc/sweep.md): modes over speed and turn rate, the sphere's depth and
+# the stability margin with the bisected boundary; and speed alone.
+pic sweep_ex1_max_real map_max_real sweep examples/kamman_ex1_above.yaml \
+    --analysis modes --vary speed=2:10:17 --vary "turn_rate=0:6 deg/s:7"
+pic sweep_ex1_depth map_sphere_z sweep examples/kamman_ex1_above.yaml \
+    --analysis modes --vary speed=2:10:17 --vary "turn_rate=0:6 deg/s:7"
+pic sweep_ex1_speed sweep sweep examples/kamman_ex1_above.yaml \
+    --analysis modes --vary speed=2:10:17
+# The sphere's depth and the top tension of example 1 against the cable
+# length (doc/design.md: the design for 15 m lands on this curve).
+pic design_ex1_length sweep sweep examples/kamman_ex1_submerged.yaml \
+    --vary cables.cable.length=10:60:26 --output sphere.z,top_tension
 # The two-part tow: depressor sphere and cylinder towfish.
 pic equilibrium_two_part_side side equilibrium examples/two_part_tow.yaml
 # A 0.1 rad/s turn begun over 5 s, in the earth frame.

@@ -18,6 +18,7 @@ extern const cli_command cli_cmd_modes, cli_cmd_response;
 extern const cli_command cli_cmd_simulate;
 extern const cli_command cli_cmd_converge;
 extern const cli_command cli_cmd_report;
+extern const cli_command cli_cmd_sweep, cli_cmd_design;
 
 /* `towstab options`: every analysis' option table as markdown, the
  * reference of doc/manual.md. */
@@ -34,13 +35,14 @@ static int options_main(int argc, char **argv)
 
 static const cli_command cli_cmd_options = {
     "options", "every option of the analyses, as a markdown reference", -1,
-    options_main, NULL, NULL, NULL, NULL, NULL, NULL};
+    options_main, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
 
 const cli_command *const cli_commands[] = {&cli_cmd_equilibrium, &cli_cmd_run,
                                            &cli_cmd_modes, &cli_cmd_response,
                                            &cli_cmd_simulate,
                                            &cli_cmd_converge,
                                            &cli_cmd_report,
+                                           &cli_cmd_sweep, &cli_cmd_design,
                                            &cli_cmd_options, NULL};
 
 static void usage(FILE *f)

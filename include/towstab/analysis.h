@@ -34,6 +34,7 @@
 #include "towstab/extremes.h"
 #include "towstab/health.h"
 #include "towstab/linearize.h"
+#include "towstab/param.h"
 #include "towstab/progress.h"
 #include "towstab/response.h"
 #include "towstab/seastate.h"
@@ -65,13 +66,24 @@ TS_API int ts_analysis_find(const char *name);
 #define TS_REQUEST_NAME_MAX 160
 #define TS_REQUEST_PATH_MAX 1024
 
+/* Scene values a request sets by path, at most. */
+#define TS_SETUP_MAX_SETS 16
+
+/* One scene value set by path (towstab/param.h). */
+typedef struct ts_setting {
+    char path[TS_PARAM_PATH_MAX]; /* "cables.main.length", "tow.speed" */
+    double value;                 /* SI, in ts_param_unit's unit */
+} ts_setting;
+
 /* What every analysis shares. */
 typedef struct ts_setup {
     double speed;          /* tow speed V, m/s, >= 0; NAN: the system's */
     double turn_rate;      /* Omega, rad/s; NAN: the system's */
     int links;             /* equal links on every cable, 1..TS_MAX_LINKS;
                               0 (default): the system's */
-    ts_equilibrium_opts equilibrium; /* method and tol (its defaults) */
+    ts_equilibrium_opts equilibrium; /* method and tol (its defaults); a
+                              guess must fit the system analysed (3
+                              directions per link) */
     int open_loop;         /* 1: the vehicles' controller loops open in
                               the linear model and the simulation, about
                               the closed-loop trim: each loop's output
@@ -92,12 +104,25 @@ typedef struct ts_setup {
                               the links the error model says meet it, at
                               most TS_REFINE_ROUNDS times (needs the
                               estimate; equal links on every cable) */
+    int nsets;             /* scene values set by path, applied in order
+                              to the copy of the system before speed,
+                              turn_rate and links (which must not name
+                              the same keys); default none */
+    ts_setting sets[TS_SETUP_MAX_SETS];
 } ts_setup;
 
 /* --refine: reruns at most, each with at most TS_REFINE_GROWTH times the
  * links of the run before. */
 #define TS_REFINE_ROUNDS 3
 #define TS_REFINE_GROWTH 8
+
+/* Set `path` to `value` (SI) in the setup: replaces an earlier setting of
+ * the same key (`speed` and `tow.speed` are one), else appends. TS_OK, or
+ * TS_EINVAL for a path of no known form or more than TS_SETUP_MAX_SETS
+ * settings. The value is checked when the request is (ts_analysis_check,
+ * against the system). */
+TS_API int ts_setup_set(ts_setup *s, const char *path, double value,
+                        ts_err *err);
 
 /* Modes reported by default when the system has at least
  * ts_eigen_opts.arpack_min_states states (ARPACK finds a subset), and
@@ -495,6 +520,38 @@ TS_API void ts_result_free(ts_result *r);
 
 /* The key value called `name`, or NULL. */
 TS_API const ts_value *ts_result_value(const ts_result *r, const char *name);
+
+/* The stability margin of a modes result. */
+typedef struct ts_margin {
+    double max_real;       /* max Re(lambda), 1/s */
+    ts_estimate error;     /* its estimates (discretisation NaN for
+                              unresolved modes) */
+    double freq_hz;        /* the frequency of that mode (0: real) */
+    int verdict;           /* TS_STABLE, TS_UNSTABLE, TS_MARGINAL; -1 */
+    int resolved;          /* 1: of the resolved modes */
+} ts_margin;
+
+/* The stability margin of r: that of its resolved modes (r->stability;
+ * the unresolved ones are modes of the discretisation, not of the cable)
+ * or, when none is resolved, that of the modes computed (resolved 0: the
+ * result's verdict then says the accuracy is missed). Returns 1, or 0
+ * (verdict -1, NaN values) for a result without modes. */
+TS_API int ts_result_margin(const ts_result *r, ts_margin *m);
+
+/* The key values a result of rq on sys will carry (names, units, scales;
+ * values and estimates NAN), without running: *values[*n] (caller frees;
+ * NULL when none, e.g. a response). rq of any kind but converge. TS_OK or
+ * a code of ts_analysis_check's (the settings, the simulation's). */
+TS_API int ts_analysis_value_names(const ts_system *sys, const ts_request *rq,
+                                   ts_value **values, int *n, ts_err *err);
+
+/* The key values of an equilibrium (the points' x, y, z and the top
+ * tension, with their estimates) for any result with a system: those of
+ * r->eq when it converged, else named with NAN values. *values[*n]
+ * (caller frees). TS_OK, TS_EINVAL (no system) or TS_ENOMEM. */
+TS_API int ts_result_equilibrium_values(const ts_result *r,
+                                        ts_value **values, int *n,
+                                        ts_err *err);
 
 /* An analysis of a convergence study (towstab/converge.h) that runs the
  * pipeline of rq->converge.analysis with rq's settings at each setting of

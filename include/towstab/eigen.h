@@ -17,6 +17,10 @@
  *    arpack_min_states or the dense A was not formed, else lapack.
  * lapack needs the dense A, arpack the sparse model.
  *
+ * Threads: solves on different linear models may run at once (a sweep's
+ * threads); ARPACK's, which keeps Fortran state between calls, are taken
+ * one at a time.
+ *
  * A mode is one eigenvalue with Im >= 0: one of each complex-conjugate
  * pair, or a real (non-oscillatory) eigenvalue. Units: lambda in 1/s,
  * frequency in Hz, period and time constant in s.

@@ -38,11 +38,16 @@ typedef struct ts_equilibrium_opts {
     double tol;           /* relative force residual, default 1e-10 */
     int max_iter;         /* per continuation step, default 100 */
     ts_eq_method method;  /* default TS_EQ_AUTO */
-    const double *guess;  /* [3 nlinks] link unit directions for Newton to
-                             start from (method newton; elastic links
-                             start at the strain of the tension a rigid
-                             copy carries there), or NULL for the
-                             straight-tow march; default NULL */
+    const double *guess;  /* [3 nlinks] link unit directions to start
+                             from, e.g. a neighbouring equilibrium's
+                             (continuation in a sweep), or NULL; default
+                             NULL. Shooting starts from the free-end
+                             positions they give (at the full turn rate,
+                             falling back to its own schedule from
+                             hanging); Newton from the shape itself
+                             (elastic links at the strain of the tension
+                             a rigid copy carries there) instead of the
+                             straight-tow march */
 } ts_equilibrium_opts;
 
 typedef struct ts_equilibrium {

@@ -55,7 +55,8 @@ typedef enum { TS_PLOT_SI = 0, TS_PLOT_IMPERIAL = 1 } ts_plot_units;
  *   FREQUENCY     Hz     | Hz
  *   RATE          1/s    | 1/s   (real part of an eigenvalue)
  *   ANGULAR_RATE  rad/s  | rad/s (imaginary part, turn rate)
- *   ANGLE         passed in rad, drawn in deg in both systems */
+ *   ANGLE         passed in rad, drawn in deg in both systems
+ *   MASS          kg     | lb    (1 lb = 0.45359237 kg) */
 typedef enum {
     TS_PLOT_NONE = 0,
     TS_PLOT_LENGTH,
@@ -65,7 +66,8 @@ typedef enum {
     TS_PLOT_FREQUENCY,
     TS_PLOT_RATE,
     TS_PLOT_ANGULAR_RATE,
-    TS_PLOT_ANGLE
+    TS_PLOT_ANGLE,
+    TS_PLOT_MASS
 } ts_plot_quantity;
 
 /* Output formats (bits of ts_plot_opts.formats). */
@@ -103,6 +105,9 @@ enum {
 typedef struct ts_plot_axis {
     const char *label;
     ts_plot_quantity quantity;
+    const char *unit;   /* TS_PLOT_NONE only: the SI unit of a quantity
+                           with none of its own ("N/m", "kg/m"), drawn as
+                           is in both systems; NULL: dimensionless */
 } ts_plot_axis;
 
 /* A curve y(x): n points (n >= 1), both arrays [n] in SI. */
@@ -310,6 +315,43 @@ TS_API int ts_plot_histories(const char *dir, const char *name,
                              const ts_plot_axis panels[], int nseries,
                              const ts_plot_series series[],
                              const ts_plot_opts *opts, ts_err *err);
+
+/* Panels of curves against a common x axis: as ts_plot_histories, with
+ * the x axis given (e.g. the tow speed of a sweep) instead of time. */
+TS_API int ts_plot_panels(const char *dir, const char *name,
+                          const char *title, const ts_plot_axis *xaxis,
+                          int npanels, const ts_plot_axis panels[],
+                          int nseries, const ts_plot_series series[],
+                          const ts_plot_opts *opts, ts_err *err);
+
+/* Values on a grid for ts_plot_map: z at (x[i], y[j]) is z[i ny + j]
+ * (x slowest); x[nx] and y[ny] strictly increasing, nx, ny >= 2; a NAN z
+ * is a point without a value (a failed run). SI units. */
+typedef struct ts_plot_grid {
+    int nx, ny;
+    const double *x, *y, *z;
+} ts_plot_grid;
+
+/* Marks of the points of a map (bits of marks[i ny + j]). */
+#define TS_PLOT_MARK_UNSTABLE 1  /* the linear model is unstable there */
+#define TS_PLOT_MARK_UNTRUSTED 2 /* the result is not trustworthy */
+#define TS_PLOT_MARK_FAILED 4    /* the run failed (no value) */
+
+/* A map of one quantity over two parameters (an operating envelope):
+ * filled contours of z with contour lines and a colour bar (the 0 level
+ * drawn bold when z changes sign, e.g. the stability margin), the points
+ * marked (marks[nx ny], may be NULL: unstable points filled red diamonds,
+ * untrustworthy ones open circles, failed ones crosses, their cells
+ * hatched), and nb >= 0 points (bx[nb], by[nb], SI) of a boundary drawn
+ * as black stars (e.g. the crossings of the stability boundary). Failed
+ * points are drawn with their neighbours' values under the hatching.
+ * TS_EINVAL when no z is finite. */
+TS_API int ts_plot_map(const char *dir, const char *name, const char *title,
+                       const ts_plot_axis *xaxis, const ts_plot_axis *yaxis,
+                       const ts_plot_axis *zaxis, const ts_plot_grid *grid,
+                       const int *marks, int nb, const double *bx,
+                       const double *by, const ts_plot_opts *opts,
+                       ts_err *err);
 
 /* Log-log lines, e.g. error against run time (memo Fig. 12): one series
  * per analysis or integrator, every x and y > 0. */

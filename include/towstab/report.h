@@ -29,6 +29,10 @@ extern "C" {
  * failure. */
 TS_API json_t *ts_report_trust_json(const ts_trust *t);
 
+/* Add the keys of ts_report_trust_json(t) to object o. TS_OK or
+ * TS_ENOMEM. */
+TS_API int ts_report_trust_into(json_t *o, const ts_trust *t);
+
 /* The equilibrium as a new JSON object: converged, iterations, evaluations,
  * residual, force_scale, tolerance, method, speed, turn_rate, wall_s,
  * top_tension, min_tension, tow_force, condition, shape_error, with a

@@ -21,8 +21,9 @@
  *       `towstab COMMAND --json`, once per pair, for test/cli/manual_keys.sh:
  *       SECTION is the command whose part of doc/manual.md defines the key.
  *       It is COMMAND, except inside an "equilibrium" object (the
- *       equilibrium's keys) and, for `run`, inside each entry of
- *       "analyses" (its "type"). Keys with a dot are names of quantities
+ *       equilibrium's keys), for `run`, inside each entry of
+ *       "analyses" (its "type"), and for `design` inside its "result"
+ *       (its "analysis"). Keys with a dot are names of quantities
  *       (sphere.z, mode1.freq_hz), not keys of the format: skipped.
  *
  * Every mismatch is printed with its path in the document (e.g.
@@ -112,8 +113,14 @@ static void keys(const json_t *v, const char *section, int run)
         if (strchr(k, '.'))
             continue;
         key_out(run == 2 && strcmp(k, "type") == 0 ? "run" : section, k);
+        const json_t *an = json_object_get(v, "analysis");
         if (strcmp(k, "equilibrium") == 0 && json_is_object(x))
             keys(x, "equilibrium", 0);
+        /* A design study's "result": the single run of its analysis. */
+        else if (strcmp(section, "design") == 0 &&
+                 strcmp(k, "result") == 0 && json_is_object(x) &&
+                 json_is_string(an))
+            keys(x, json_string_value(an), 0);
         else
             keys(x, section, run == 1 && strcmp(k, "analyses") == 0);
     }

@@ -63,6 +63,13 @@ json simulate examples/kamman_ex3_turn.yaml --t-end 2 --sample 0.5 \
 json converge examples/kamman_ex1_submerged.yaml --links 5,10,20
 json converge examples/kamman_ex3_turn.yaml --analysis modes --links 5,10,20 \
     --modes 2
+json sweep examples/kamman_ex1_above.yaml --analysis modes --vary speed=7:9:3
+json sweep examples/kamman_ex1_submerged.yaml --vary speed=0:2:2 \
+    --vary cables.cable.length=1e-3,30
+json design examples/kamman_ex1_submerged.yaml --free cables.cable.length=10:60 \
+    --target sphere.z=15m --constraint "top_tension<=600N"
+json design examples/kamman_ex1_above.yaml --analysis modes --free speed=2:8.5 \
+    --maximise speed --constraint "max_real<=0" --max-evals 60
 json converge examples/kamman_ex4.yaml --analysis simulate \
     --tolerances 1e-3,1e-5 --integrators rk8pd,rkf45 --t-end 34
 

@@ -1,0 +1,81 @@
+/* towstab/param.h: a scalar of a towed system by its scene key path
+ * (doc/scene-format.md, "Values by path").
+ *
+ * Sweeps, design studies, `--set` and bindings change one number of a
+ * scene at a time: a cable's length, a body's mass, the tow speed. A path
+ * names it as the scene file does, with cables and bodies by name:
+ *
+ *   tow.speed, tow.turn_rate, tow.point.x|y|z (also `speed`, `turn_rate`)
+ *   environment.water_density, environment.gravity,
+ *   environment.current.x|y|z
+ *   cables.<name>.length | diameter | mass_per_length | weight |
+ *       wet_weight | links | normal_drag | tangential_drag | added_mass |
+ *       EI | EA | damping
+ *   bodies.<name>.diameter | length | mass | weight | wet_weight | drag |
+ *       added_mass | cross_drag | cross_added_mass
+ *   bodies.<vehicle>.loops.<loop>.kp | ki | kd | setpoint
+ *   bodies.<vehicle>.surfaces.<surface>.area | span | deflection | limit |
+ *       incidence
+ *
+ * Values are SI in the unit ts_param_unit() names (the scene's unit of
+ * the key). The system stores masses: `weight` and `wet_weight` are
+ * converted with the environment's gravity and water density at the time
+ * of the call (as the scene reader does), and changing a diameter keeps
+ * the mass. A loop's gains take the unit of what it measures (depth: rad
+ * per m; an angle: rad per rad).
+ *
+ * ts_param_set() checks the value against the key's own limits (naming
+ * the path); the system must then be rebuilt (ts_system_build, or
+ * ts_system_set_links), which checks the whole description again.
+ * ts_analysis_run() does that for the settings of a request
+ * (towstab/analysis.h, ts_setup.sets). Nothing here allocates.
+ */
+#ifndef TOWSTAB_PARAM_H
+#define TOWSTAB_PARAM_H
+
+#include <stddef.h>
+
+#include "towstab/error.h"
+#include "towstab/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Characters of a path, with its terminating zero. */
+#define TS_PARAM_PATH_MAX 160
+/* Characters of a unit name ("N*m^2", "kg/m^3"), with the zero. */
+#define TS_PARAM_UNIT_MAX 16
+
+/* The SI unit of path's key into unit[size] ("m", "kg/m", "1" for a
+ * coefficient or a count, "rad/s"). sys may be NULL: the unit is then
+ * that of the path's form, and "" (empty) for a form whose unit depends
+ * on the system (a loop's gains and setpoint). TS_OK, or TS_EINVAL for a
+ * path of no known form (the message lists the forms; with sys, also a
+ * cable, body, loop or surface name the system does not have, listing
+ * those it has). */
+TS_API int ts_param_unit(const ts_system *sys, const char *path, char *unit,
+                         size_t size, ts_err *err);
+
+/* The value at `path`, SI. TS_OK or TS_EINVAL (as ts_param_unit). */
+TS_API int ts_param_get(const ts_system *sys, const char *path,
+                        double *value, ts_err *err);
+
+/* Set the value at `path` (SI) in the description. TS_OK, or TS_EINVAL
+ * naming the path when the value breaks the key's limits (a length > 0
+ * m, a mass >= 0 kg, links a whole number 1 to TS_MAX_LINKS on a cable
+ * without link_lengths, a weight without gravity, ...). Nothing is set on
+ * failure. The discretisation is stale until the system is rebuilt. */
+TS_API int ts_param_set(ts_system *sys, const char *path, double value,
+                        ts_err *err);
+
+/* The canonical spelling of `path` (`speed` -> `tow.speed`) into
+ * out[size]; paths of one key compare equal after it. TS_OK or TS_EINVAL
+ * for a path of no known form. */
+TS_API int ts_param_canonical(const char *path, char *out, size_t size,
+                              ts_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

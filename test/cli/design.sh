@@ -1,0 +1,90 @@
+#!/bin/bash
+# test/cli/design.sh: `towstab design` as a user runs it (suite 'cli').
+#
+#   design.sh TOWSTAB
+#
+# - A target in other units (the cable between 30 and 200 ft, the sphere
+#   at 15 m): exit 0, "reached"; the optimum the JSON gives, run again
+#   with `towstab equilibrium --set`, gives the design's sphere depth to
+#   the last digit (the final run is the single run) and 15 m within the
+#   target's tolerance.
+# - An unreachable target exits 1 with NOT REACHED, the closest point and
+#   a JSON with "success": false.
+# - Constraints in kN and m with a value to maximise: both met.
+# - Bad input exits 2 naming the option.
+set -u
+if [ $# -ne 1 ]; then
+    echo "usage: design.sh TOWSTAB" >&2
+    exit 2
+fi
+TOWSTAB=$1
+. "$(dirname "$0")/common.sh"
+# json_num FILE KEY: the first number after "KEY": in FILE.
+json_num() {
+    tr -d '\n ' <"$1" | grep -o "\"$2\":[-0-9.eE+]*" | head -1 | sed 's/.*://'
+}
+json_key_value() {
+    tr -d '\n ' <"$1" | grep -o "{\"name\":\"$2\",\"unit\":\"[^\"]*\",\"value\":[^,}]*" |
+        head -1 | sed 's/.*"value"://'
+}
+EX1=examples/kamman_ex1_submerged.yaml
+
+ts design "$EX1" --free "cables.cable.length=30ft:200ft" --target "sphere.z=15m" \
+    --json "$T/d.json" --quiet
+if [ "$status" -eq 0 ] && grep -q "wanted 15 m: reached" "$T/out"; then
+    pass "target sphere.z = 15 m reached: $(grep -o 'cables.cable.length *[0-9.]*' "$T/out")"
+    L=$(json_num "$T/d.json" optimum)
+    z=$(tr -d '\n ' <"$T/d.json" | grep -o '"goal":{.*' | grep -o '"value":[-0-9.eE+][-0-9.eE+]*' | head -1 | sed 's/.*://')
+    "$TOWSTAB" equilibrium "$EX1" --set "cables.cable.length=$L" --json "$T/s.json" --quiet >/dev/null 2>&1
+    zs=$(json_key_value "$T/s.json" sphere.z)
+    if awk -v a="$z" -v b="$zs" 'BEGIN { exit !(a != "" && a + 0 == b + 0 && (b - 15 < 1.5e-5 && 15 - b < 1.5e-5)) }'; then
+        pass "towstab equilibrium --set cables.cable.length=$L gives sphere.z $zs m, the design's $z to the last digit, 15 m within 1.5e-5 m"
+    else
+        fail "the single run at the optimum: sphere.z $zs against the design's $z"
+    fi
+else
+    fail "target 15 m: status $status $(head -c 300 "$T/err") $(grep wanted "$T/out")"
+fi
+
+ts design "$EX1" --free "cables.cable.length=10:60" --target "sphere.z=20m" \
+    --json "$T/u.json" --quiet
+if [ "$status" -eq 1 ] && grep -q "NOT REACHED" "$T/out" &&
+   grep -q "AT THE UPPER BOUND" "$T/out" && grep -q '"success": false' "$T/u.json"; then
+    pass "unreachable target: exit 1, $(grep -o 'NOT REACHED, misfit [0-9.e-]* m' "$T/out"), the cable at its upper bound"
+else
+    fail "unreachable target: status $status $(head -c 300 "$T/err")"
+fi
+
+ts design "$EX1" --free "bodies.sphere.mass=1kg:1000kg" --free "speed=1:5" \
+    --maximise speed --constraint "top_tension<=0.6kN" --constraint "layback<=25m" --quiet
+if [ "$status" -eq 0 ] && [ "$(grep -c 'wanted <= .*: met' "$T/out")" -eq 2 ]; then
+    pass "maximise speed under top_tension <= 0.6 kN and layback <= 25 m: $(grep -o 'tow.speed *[0-9.]*' "$T/out") m/s, both met"
+else
+    fail "constraints: status $status $(head -c 300 "$T/err") $(grep wanted "$T/out")"
+fi
+
+bad() { # WHAT EXPECTED-TEXT ARGS...
+    local what=$1 want=$2
+    shift 2
+    ts design "$@"
+    if [ "$status" -eq 2 ] && grep -q -- "$want" "$T/err"; then
+        pass "$what: exit 2: $(head -c 140 "$T/err")"
+    else
+        fail "$what: status $status, $(head -c 200 "$T/err")"
+    fi
+}
+F="--free cables.cable.length=10:60"
+bad "no --free" "at least one --free" "$EX1" --target sphere.z=15
+bad "malformed --free" "expected LOWER:UPPER" "$EX1" --free cables.cable.length=10 --target sphere.z=15
+bad "unknown path" "no cable of that name" "$EX1" --free cables.rope.length=10:60 --target sphere.z=15
+bad "unknown value" "no value 'fish.z'" "$EX1" $F --target fish.z=15
+bad "max_real without modes" "no value 'max_real'" "$EX1" $F --minimise max_real
+bad "two goals" "one of --target" "$EX1" $F --target sphere.z=15 --maximise top_tension
+bad "a target in the wrong unit" "--target sphere.z.*expected a length" "$EX1" $F --target sphere.z=15kg
+bad "a constraint without its operator" "NAME<=Q" "$EX1" $F --constraint top_tension=5
+bad "bobyqa with a constraint" "bobyqa takes bounds only" "$EX1" $F --target sphere.z=15 --method bobyqa --constraint "top_tension<=600"
+bad "--method" "expected cobyla or bobyqa" "$EX1" $F --target sphere.z=15 --method newton
+bad "--analysis simulate" "not an analysis to design with" "$EX1" --analysis simulate $F --target sphere.z=15
+bad "no goal" "expected a target" "$EX1" $F
+
+finish

@@ -1,0 +1,175 @@
+#!/bin/bash
+# test/cli/sweep.sh: `towstab sweep` as a user runs it (suite 'cli').
+#
+#   sweep.sh TOWSTAB PLOT(yes|no)
+#
+# - A point is the single run: every point of a cold-start sweep (--chain
+#   1) of equilibria over cable length and speed has the sphere depth and
+#   top tension of `towstab equilibrium --set cables.cable.length=L
+#   --speed V`, to the last digit (17 significant digits of the CSV
+#   against those of the JSON); the first point of a continued modes
+#   sweep has the max Re(lambda) of `towstab modes --speed V`.
+# - Threads: --jobs 1 and --jobs 3 write the same CSV, byte for byte.
+# - Resume: a sweep with --resume killed (SIGKILL) after some chains,
+#   run again, restores them, computes the rest and writes the CSV of an
+#   uninterrupted run; SIGINT stops it with status 130, a JSON marked
+#   "completed": false and "interrupted": "SIGINT"; a resume file of
+#   another sweep is refused (2).
+# - The stability boundary of examples/kamman_ex1_above.yaml is found
+#   between 8 and 9 m/s; maps are drawn (with PLplot).
+# - Bad input exits 2 naming the option: an unknown path, a malformed
+#   --vary, a column --output does not have, --no-boundary without modes,
+#   --analysis converge, no --vary.
+set -u
+if [ $# -ne 2 ]; then
+    echo "usage: sweep.sh TOWSTAB PLOT" >&2
+    exit 2
+fi
+TOWSTAB=$1
+PLOT=$2
+. "$(dirname "$0")/common.sh"
+# csv_value FILE INDEX COLUMN: the value of COLUMN in the row of point
+# INDEX.
+csv_value() {
+    awk -F, -v idx="$2" -v col="$3" '
+        NR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i; next }
+        $1 == idx { print $c }' "$1"
+}
+# json_key_value FILE NAME: the value of key value NAME.
+json_key_value() {
+    tr -d '\n ' <"$1" | grep -o "{\"name\":\"$2\",\"unit\":\"[^\"]*\",\"value\":[^,}]*" |
+        head -1 | sed 's/.*"value"://'
+}
+# same NUMBER NUMBER: the same double.
+same() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 == b + 0) }'; }
+
+EX1=examples/kamman_ex1_submerged.yaml
+ABOVE=examples/kamman_ex1_above.yaml
+
+# ---- a point is the single run ------------------------------------------
+ts sweep "$EX1" --vary "cables.cable.length=20:40:3" --vary "speed=1.5:4.5:3" \
+    --chain 1 --csv "$T/eq.csv" --quiet
+if [ "$status" -eq 0 ]; then
+    ok=1 n=0
+    for p in 0 4 8; do
+        L=$(csv_value "$T/eq.csv" $p cables.cable.length)
+        V=$(csv_value "$T/eq.csv" $p tow.speed)
+        "$TOWSTAB" equilibrium "$EX1" --set "cables.cable.length=$L" --speed "$V" \
+            --json "$T/single.json" --quiet >/dev/null 2>&1 || ok=0
+        for col in sphere.z top_tension; do
+            a=$(csv_value "$T/eq.csv" $p $col)
+            b=$(json_key_value "$T/single.json" $col)
+            same "$a" "$b" || { ok=0; echo "     point $p $col: sweep $a, single $b"; }
+            n=$((n + 1))
+        done
+    done
+    [ $ok -eq 1 ] && pass "cold-start sweep: $n values of 3 points equal the single runs (equilibrium --set cables.cable.length --speed) to the last digit" ||
+        fail "a sweep point differs from its single run"
+else
+    fail "sweep of equilibria exited $status: $(head -c 300 "$T/err")"
+fi
+ts sweep "$ABOVE" --analysis modes --vary "speed=2:10:9" --csv "$T/modes.csv" \
+    --json "$T/modes.json" --quiet
+if [ "$status" -eq 0 ]; then
+    "$TOWSTAB" modes "$ABOVE" --speed 2 --json "$T/m1.json" --quiet >/dev/null 2>&1
+    a=$(csv_value "$T/modes.csv" 0 max_real)
+    b=$(tr -d '\n ' <"$T/m1.json" | grep -o '"stability":{[^}]*' | grep -o '"max_real":[^,}]*' | head -1 | sed 's/.*://')
+    same "$a" "$b" && pass "modes sweep: its first point's max Re(lambda) of the resolved modes $a is that of towstab modes --speed 2" ||
+        fail "modes sweep point 0: max_real $a against $b"
+    if grep -q "stability boundary: tow.speed = 8\.[0-9]* m/s" "$T/out"; then
+        pass "stability boundary between 8 and 9 m/s: $(grep -o 'tow.speed = [0-9.]* m/s' "$T/out" | head -1)"
+    else
+        fail "no stability boundary between 8 and 9 m/s: $(grep boundary "$T/out")"
+    fi
+    grep -q '"boundary": \[' "$T/modes.json" && grep -q '"max_real_unstable"' "$T/modes.json" &&
+        pass "the JSON lists the boundary" || fail "the JSON has no boundary"
+else
+    fail "modes sweep exited $status: $(head -c 300 "$T/err")"
+fi
+
+# ---- threads ------------------------------------------------------------
+TURN="examples/kamman_ex3_turn.yaml --vary cables.cable.length=1.6:1.9:2 --vary turn_rate=0:1.8:7 --chain 3 --quiet"
+ts sweep $TURN --jobs 1 --csv "$T/j1.csv"
+s1=$status
+ts sweep $TURN --jobs 3 --csv "$T/j3.csv"
+if [ "$s1" -eq 0 ] && [ "$status" -eq 0 ] && cmp -s "$T/j1.csv" "$T/j3.csv"; then
+    pass "--jobs 1 and --jobs 3: the same CSV byte for byte ($(($(wc -l <"$T/j1.csv") - 1)) points)"
+else
+    fail "--jobs 1 ($s1) and --jobs 3 ($status) differ"
+fi
+
+# ---- resume ---------------------------------------------------------------
+SLOW="$ABOVE --analysis modes --vary speed=2:10:9 --vary turn_rate=0:0.1:7 --jobs 1 --chain 1 --no-boundary --quiet"
+"$TOWSTAB" sweep $SLOW --csv "$T/full.csv" >/dev/null 2>&1
+"$TOWSTAB" sweep $SLOW --resume "$T/j.txt" --csv "$T/r.csv" >/dev/null 2>&1 &
+pid=$!
+for i in $(seq 1 400); do
+    [ -f "$T/j.txt" ] && [ "$(wc -l <"$T/j.txt")" -ge 6 ] && break
+    sleep 0.02
+done
+kill -9 $pid 2>/dev/null
+wait $pid 2>/dev/null
+kept=$(($(wc -l <"$T/j.txt") - 1))
+ts sweep $SLOW --resume "$T/j.txt" --csv "$T/r.csv"
+restored=$(grep -o 'resume file [^:]*: [0-9]* of' "$T/out" | grep -o '[0-9]* of' | grep -o '[0-9]*')
+if [ "$status" -eq 0 ] && [ -n "$restored" ] && [ "$restored" -gt 0 ] &&
+   [ "$restored" -lt 63 ] && cmp -s "$T/full.csv" "$T/r.csv"; then
+    pass "killed after $kept chains, resumed ($restored of 63 restored): the CSV of one run, byte for byte"
+else
+    fail "resume after a kill: status $status, restored '$restored', $(head -c 200 "$T/err")"
+fi
+ts sweep $SLOW --resume "$T/j.txt" --chain 2
+if [ "$status" -eq 2 ] && grep -q "records another sweep" "$T/err"; then
+    pass "a resume file of another sweep refused: $(head -c 160 "$T/err")"
+else
+    fail "resume file of another sweep: status $status"
+fi
+rm -f "$T/j2.txt"
+"$TOWSTAB" sweep $SLOW --resume "$T/j2.txt" --json "$T/int.json" >/dev/null 2>"$T/interr" &
+pid=$!
+for i in $(seq 1 400); do
+    [ -f "$T/j2.txt" ] && [ "$(wc -l <"$T/j2.txt")" -ge 4 ] && break
+    sleep 0.02
+done
+kill -INT $pid 2>/dev/null
+wait $pid
+st=$?
+if [ "$st" -eq 130 ] && grep -q '"completed": false' "$T/int.json" &&
+   grep -q '"interrupted": "SIGINT"' "$T/int.json"; then
+    pass "SIGINT: exit 130, the points so far written, completed false, interrupted SIGINT"
+else
+    fail "SIGINT: exit $st, $(head -c 200 "$T/interr")"
+fi
+
+# ---- pictures -------------------------------------------------------------
+if [ "$PLOT" = yes ]; then
+    ts sweep "$ABOVE" --analysis modes --vary speed=6:10:5 --vary turn_rate=0:0.1:3 \
+        --plot "$T/pic" --quiet
+    if [ "$status" -eq 0 ] && [ -s "$T/pic/map_max_real.png" ] &&
+       [ -s "$T/pic/map_sphere_z.svg" ] && [ -s "$T/pic/map_top_tension.png" ]; then
+        pass "--plot with two --vary: maps of sphere.z, top_tension and max_real"
+    else
+        fail "--plot maps: status $status $(head -c 200 "$T/err")"
+    fi
+fi
+
+# ---- bad input --------------------------------------------------------------
+bad() { # WHAT EXPECTED-TEXT ARGS...
+    local what=$1 want=$2
+    shift 2
+    ts sweep "$@"
+    if [ "$status" -eq 2 ] && grep -q -- "$want" "$T/err"; then
+        pass "$what: exit 2: $(head -c 140 "$T/err")"
+    else
+        fail "$what: status $status, $(head -c 200 "$T/err")"
+    fi
+}
+bad "unknown path" "no cable of that name" "$EX1" --vary cables.rope.length=1:2:2
+bad "malformed --vary" "expected FROM:TO:N" "$EX1" --vary speed=1:2
+bad "unknown --output" "no column 'fish.z'" "$EX1" --vary speed=1:2:2 --output fish.z
+bad "--no-boundary without modes" "no-boundary" "$EX1" --vary speed=1:2:2 --no-boundary
+bad "--analysis converge" "not an analysis to sweep" "$EX1" --analysis converge --vary speed=1:2:2
+bad "no --vary" "at least one --vary" "$EX1"
+bad "a value out of range" "must be >= 0 m/s" "$EX1" --vary speed=-1:2:3
+
+finish

@@ -1,0 +1,360 @@
+/* test_param.c: a scalar of a system by its scene key path
+ * (towstab/param.h).
+ *
+ * The independent reference is the scene reader: a value set by path must
+ * give the system (every built link and node) that the scene file with
+ * that value written in it gives, to the last bit, including weights and
+ * wet weights converted with the scene's gravity and water density.
+ * Values read by path are the fields the reader filled. The scene
+ * format's spelling (cables[0], bodies[fish], tow.point[2]) names the same
+ * values, and ts_scene_set (which edits the text and reads it again)
+ * gives the same system. Every error names the path; unknown names list
+ * what the system has. */
+#include "towstab/param.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+#include "towstab/scene.h"
+
+/* A scene with one value left open: %s is replaced by `value` at `key`. */
+static const char *const base =
+    "name: param\n"
+    "environment: {water_density: 1025, gravity: 9.81}\n"
+    "tow: {speed: \"5 knot\", turn_rate: 0.05, point: [0, 0, -2]}\n"
+    "cables:\n"
+    "  - {name: main.a, from: tow, to: fish, length: %s, diameter: 0.02,\n"
+    "     %s, links: %s, normal_drag: 1.3}\n"
+    "bodies:\n"
+    "  - {name: fish, type: sphere, diameter: 0.5, %s, drag: %s}\n";
+
+typedef struct texts {
+    const char *length, *cable_mass, *links, *body_mass, *drag;
+} texts;
+
+static ts_scene *scene_of(const ts_units *u, const texts *t)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, base, t->length, t->cable_mass, t->links,
+             t->body_mass, t->drag);
+    ts_err err = {0};
+    ts_scene *s = ts_scene_parse(buf, strlen(buf), "param.yaml", u, &err);
+    if (!s)
+        printf("     scene: %s\n", err.msg);
+    return s;
+}
+
+/* The built systems agree bit for bit in what the kernel reads. */
+static int same_system(const ts_system *a, const ts_system *b)
+{
+    if (a->nlinks != b->nlinks || a->nnodes != b->nnodes)
+        return 0;
+    for (int l = 0; l < a->nlinks; l++)
+        if (a->links[l].length != b->links[l].length ||
+            a->links[l].mass != b->links[l].mass ||
+            a->links[l].cdn != b->links[l].cdn)
+            return 0;
+    for (int k = 0; k < a->nnodes; k++)
+        if (a->nodes[k].mass != b->nodes[k].mass)
+            return 0;
+    for (int i = 0; i < a->nbodies; i++)
+        if (a->bodies[i].mass != b->bodies[i].mass ||
+            a->bodies[i].cd != b->bodies[i].cd)
+            return 0;
+    return a->tow.speed == b->tow.speed &&
+           a->tow.turn_rate == b->tow.turn_rate;
+}
+
+/* Set `path` to `text` (parsed in the path's unit) in scene `from`, build,
+ * and compare with scene `to`. */
+static void set_like_scene(const ts_units *u, const texts *from,
+                           const texts *to, const char *path,
+                           const char *text)
+{
+    ts_scene *a = scene_of(u, from), *b = scene_of(u, to);
+    ts_err err = {0};
+    char unit[TS_PARAM_UNIT_MAX];
+    double v = NAN;
+    int rc = a && b ? ts_param_unit(a->system, path, unit, sizeof unit, &err)
+                    : TS_EINVAL;
+    if (!rc)
+        rc = ts_units_parse(u, text, unit, path, &v, &err);
+    if (!rc)
+        rc = ts_param_set(a->system, path, v, &err);
+    if (!rc)
+        rc = ts_system_build(a->system, &err);
+    CHECK(!rc && same_system(a->system, b->system),
+          "%s = %s by path gives the scene with it written in (%s)", path,
+          text, rc ? err.msg : "bit for bit");
+    ts_scene_free(a);
+    ts_scene_free(b);
+}
+
+static void test_like_scene(const ts_units *u)
+{
+    texts t0 = {"100", "mass_per_length: 1.5", "10", "mass: 80", "0.5"};
+    texts t = t0;
+    t.length = "\"250 ft\"";
+    set_like_scene(u, &t0, &t, "cables.main.a.length", "250 ft");
+    t = t0;
+    t.cable_mass = "weight: \"1.2 lbf/ft\"";
+    set_like_scene(u, &t0, &t, "cables.main.a.weight", "1.2 lbf/ft");
+    t = t0;
+    t.cable_mass = "wet_weight: \"3.7 N/m\"";
+    set_like_scene(u, &t0, &t, "cables.main.a.wet_weight", "3.7 N/m");
+    t = t0;
+    t.links = "37";
+    set_like_scene(u, &t0, &t, "cables.main.a.links", "37");
+    t = t0;
+    t.body_mass = "weight: \"612 lbf\"";
+    set_like_scene(u, &t0, &t, "bodies.fish.weight", "612 lbf");
+    t = t0;
+    t.body_mass = "wet_weight: \"1.234 kN\"";
+    set_like_scene(u, &t0, &t, "bodies.fish.wet_weight", "1.234 kN");
+    t = t0;
+    t.drag = "0.837";
+    set_like_scene(u, &t0, &t, "bodies.fish.drag", "0.837");
+}
+
+static void test_get(const ts_units *u)
+{
+    texts t0 = {"100", "wet_weight: \"3.7 N/m\"", "10", "mass: 80", "0.5"};
+    ts_scene *s = scene_of(u, &t0);
+    if (!s)
+        return;
+    const ts_system *sys = s->system;
+    ts_err err = {0};
+    double v = NAN;
+    static const struct {
+        const char *path;
+        double want;
+    } cases[] = {{"tow.speed", 5 * 1852.0 / 3600.0},
+                 {"speed", 5 * 1852.0 / 3600.0},
+                 {"turn_rate", 0.05},
+                 {"tow.point.z", -2},
+                 {"environment.gravity", 9.81},
+                 {"environment.water_density", 1025},
+                 {"environment.current.y", 0},
+                 {"cables.main.a.length", 100},
+                 {"cables.main.a.links", 10},
+                 {"cables.main.a.normal_drag", 1.3},
+                 {"cables.main.a.wet_weight", 3.7},
+                 {"bodies.fish.mass", 80},
+                 {"bodies.fish.diameter", 0.5}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int rc = ts_param_get(sys, cases[i].path, &v, &err);
+        /* The wet weight goes through mass = w / g + rho A and back:
+         * rounding of a few ulps of the mass. */
+        double tol = !strcmp(cases[i].path, "cables.main.a.wet_weight")
+                         ? 1e-13
+                         : 0.0;
+        CHECK(rc == TS_OK && fabs(v - cases[i].want) <= tol,
+              "get %s = %.17g (want %.17g)", cases[i].path, v,
+              cases[i].want);
+    }
+    char unit[TS_PARAM_UNIT_MAX], canon[TS_PARAM_PATH_MAX];
+    static const struct {
+        const char *path, *unit;
+    } units[] = {{"speed", "m/s"},
+                 {"tow.turn_rate", "rad/s"},
+                 {"environment.water_density", "kg/m^3"},
+                 {"cables.x.EI", "N*m^2"},
+                 {"cables.x.damping", "N*s/m"},
+                 {"cables.x.links", "1"},
+                 {"bodies.y.wet_weight", "N"},
+                 {"bodies.v.loops.depth.kp", ""},
+                 {"bodies.v.surfaces.elevator.limit", "rad"}};
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++) {
+        int rc = ts_param_unit(NULL, units[i].path, unit, sizeof unit, &err);
+        CHECK(rc == TS_OK && !strcmp(unit, units[i].unit),
+              "unit of %s by its form: '%s'", units[i].path, unit);
+    }
+    CHECK(ts_param_canonical("speed", canon, sizeof canon, &err) == TS_OK &&
+              !strcmp(canon, "tow.speed"),
+          "speed is short for %s", canon);
+    ts_scene_free(s);
+}
+
+/* The scene format's spelling ("cables[0].length", "bodies[fish].mass",
+ * "tow.point[2]") names the same values; ts_scene_set, which edits the
+ * scene's text and reads it again (a route of its own), gives the system
+ * ts_param_set gives, bit for bit. */
+static void test_scene_spelling(const ts_units *u)
+{
+    texts t0 = {"100", "mass_per_length: 1.5", "10", "mass: 80", "0.5"};
+    ts_scene *s = scene_of(u, &t0);
+    if (!s)
+        return;
+    ts_err err = {0};
+    static const struct {
+        const char *bracket, *dotted;
+    } same[] = {{"cables[0].length", "cables.main.a.length"},
+                {"cables[main.a].normal_drag", "cables.main.a.normal_drag"},
+                {"bodies[fish].mass", "bodies.fish.mass"},
+                {"bodies[0].drag", "bodies.fish.drag"},
+                {"tow.point[2]", "tow.point.z"}};
+    for (size_t i = 0; i < sizeof same / sizeof same[0]; i++) {
+        double a = NAN, b = NAN;
+        int rc = ts_param_get(s->system, same[i].bracket, &a, &err);
+        int rc2 = ts_param_get(s->system, same[i].dotted, &b, NULL);
+        CHECK(rc == TS_OK && rc2 == TS_OK && a == b,
+              "%s is %s (%g)", same[i].bracket, same[i].dotted, a);
+    }
+    char canon[TS_PARAM_PATH_MAX];
+    ts_param_canonical("cables[main.a].length", canon, sizeof canon, NULL);
+    CHECK(!strcmp(canon, "cables.main.a.length"), "cables[main.a].length is "
+          "spelled %s", canon);
+    int rc = ts_param_get(s->system, "cables[3].length", NULL, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "has no entry [3]"),
+          "an index past the cables refused: %s", err.msg);
+    /* Against ts_scene_set. */
+    static const struct {
+        const char *key, *value;
+    } set[] = {{"cables[0].length", "250 ft"},
+               {"bodies[fish].mass", "612 lb"},
+               {"tow.speed", "3.7 knot"},
+               {"cables[main.a].normal_drag", "1.45"}};
+    for (size_t i = 0; i < sizeof set / sizeof set[0]; i++) {
+        const char *k[1] = {set[i].key}, *v[1] = {set[i].value};
+        ts_scene *b = ts_scene_set(s, 1, k, v, u, &err);
+        ts_system *c = ts_system_copy(s->system, &err);
+        char unit[TS_PARAM_UNIT_MAX];
+        double x = NAN;
+        int ok = b && c &&
+                 ts_param_unit(c, set[i].key, unit, sizeof unit, &err) ==
+                     TS_OK &&
+                 ts_units_parse(u, set[i].value, unit, set[i].key, &x,
+                                &err) == TS_OK &&
+                 ts_param_set(c, set[i].key, x, &err) == TS_OK &&
+                 ts_system_build(c, &err) == TS_OK &&
+                 same_system(b->system, c);
+        CHECK(ok, "%s = %s: ts_param_set and ts_scene_set give one system, "
+              "bit for bit (%s)", set[i].key, set[i].value,
+              ok ? "ok" : err.msg);
+        ts_scene_free(b);
+        ts_system_free(c);
+    }
+    ts_scene_free(s);
+}
+
+/* Every refusal names the path and says what is expected. */
+static void test_errors(const ts_units *u)
+{
+    texts t0 = {"100", "mass_per_length: 1.5", "10", "mass: 80", "0.5"};
+    ts_scene *s = scene_of(u, &t0);
+    if (!s)
+        return;
+    ts_system *sys = s->system;
+    static const struct {
+        const char *path;
+        double value;
+        const char *says;
+    } bad[] = {
+        {"cables.main.a.length", -3, "cables.main.a.length: must be > 0 m"},
+        {"cables.main.a.length", NAN, "cables.main.a.length: expected a finite number in m"},
+        {"cables.main.a.links", 2.5, "whole number of links"},
+        {"cables.main.a.links", 0, "must be >= 1"},
+        {"cables.main.a.wet_weight", -100, "negative mass in air"},
+        {"cables.main.b.length", 1, "the cables: main.a"},
+        {"cables.main.a.lenght", 1, "expected one of length, diameter"},
+        {"bodies.fsh.mass", 1, "the bodies: fish"},
+        {"bodies.fish.mass", -1, "bodies.fish.mass: must be >= 0 kg"},
+        {"bodies.fish.loops.depth.kp", 1, "'fish' is not a vehicle"},
+        {"tow.point", 1, "name a component: point.x"},
+        {"tow.speed", -2, "tow.speed: must be >= 0 m/s"},
+        {"ship.speed", 1, "not a path of the scene"},
+        {"", 1, "path: empty"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ts_err err = {0};
+        double before = NAN;
+        ts_param_get(sys, bad[i].path, &before, NULL);
+        int rc = ts_param_set(sys, bad[i].path, bad[i].value, &err);
+        double after = NAN;
+        ts_param_get(sys, bad[i].path, &after, NULL);
+        CHECK(rc == TS_EINVAL && strstr(err.msg, bad[i].says) &&
+                  (isnan(before) || before == after),
+              "refused, nothing set: %s", err.msg);
+    }
+    /* A cable with link_lengths keeps them. */
+    sys->cables[0].link_fraction = calloc(10, sizeof(double));
+    ts_err err = {0};
+    int rc = ts_param_set(sys, "cables.main.a.links", 20, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "has link_lengths"),
+          "links of a cable with link_lengths refused: %s", err.msg);
+    /* Without gravity a weight gives no mass. */
+    sys->env.gravity = 0;
+    rc = ts_param_set(sys, "bodies.fish.weight", 100, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "without gravity"),
+          "weight without gravity refused: %s", err.msg);
+    ts_scene_free(s);
+}
+
+/* Loops and surfaces of a vehicle, by name; units from what the loop
+ * measures. */
+static void test_vehicle(void)
+{
+    ts_err err = {0};
+    ts_system *s = ts_system_alloc(1, 1, &err);
+    snprintf(s->bodies[0].name, TS_NAME_MAX, "fish");
+    ts_vehicle *v = ts_body_set_vehicle(s, 0, &err);
+    v->ncomponents = 2;
+    snprintf(v->component[0].name, TS_VEHICLE_NAME_MAX, "hull");
+    v->component[0].type = TS_COMP_HULL;
+    snprintf(v->component[1].name, TS_VEHICLE_NAME_MAX, "elevator");
+    v->component[1].type = TS_COMP_SURFACE;
+    v->component[1].limit = 0.3;
+    v->nloops = 2;
+    snprintf(v->loop[0].name, TS_VEHICLE_NAME_MAX, "depth");
+    v->loop[0].measure = TS_MEASURE_DEPTH;
+    v->loop[0].kp = 0.25;
+    snprintf(v->loop[1].name, TS_VEHICLE_NAME_MAX, "pitch");
+    v->loop[1].measure = TS_MEASURE_PITCH;
+    char unit[TS_PARAM_UNIT_MAX];
+    double x = NAN;
+    int rc = ts_param_get(s, "bodies.fish.loops.depth.kp", &x, &err);
+    CHECK(rc == TS_OK && x == 0.25, "depth loop kp read: %g", x);
+    rc = ts_param_unit(s, "bodies.fish.loops.depth.kd", unit, sizeof unit,
+                       &err);
+    CHECK(rc == TS_OK && !strcmp(unit, "rad*s/m"),
+          "a depth loop's kd is in %s", unit);
+    rc = ts_param_unit(s, "bodies.fish.loops.pitch.kp", unit, sizeof unit,
+                       &err);
+    CHECK(rc == TS_OK && !strcmp(unit, "1"), "a pitch loop's kp is in '%s'",
+          unit);
+    rc = ts_param_set(s, "bodies.fish.loops.pitch.kd", -1.75, &err);
+    CHECK(rc == TS_OK && v->loop[1].kd == -1.75, "pitch loop kd set: %g",
+          v->loop[1].kd);
+    rc = ts_param_set(s, "bodies[fish].components[elevator].area", 0.035,
+                      &err);
+    CHECK(rc == TS_OK && v->component[1].area == 0.035,
+          "elevator area set, the scene format's spelling: %g m^2",
+          v->component[1].area);
+    rc = ts_param_set(s, "bodies.fish.surfaces.elevator.limit", 0.2, &err);
+    CHECK(rc == TS_OK && v->component[1].limit == 0.2,
+          "elevator limit set: %g rad", v->component[1].limit);
+    rc = ts_param_set(s, "bodies.fish.surfaces.hull.limit", 0.2, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "its surfaces: elevator"),
+          "the hull is no surface: %s", err.msg);
+    rc = ts_param_set(s, "bodies.fish.loops.roll.kp", 1, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "its loops: depth, pitch"),
+          "no roll loop: %s", err.msg);
+    ts_system_free(s);
+}
+
+int main(void)
+{
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    CHECK(u != NULL, "units load (%s)", u ? "ok" : err.msg);
+    if (u) {
+        test_like_scene(u);
+        test_get(u);
+        test_errors(u);
+        test_scene_spelling(u);
+    }
+    test_vehicle();
+    ts_units_free(u);
+    return tc_done();
+}
