@@ -1042,7 +1042,8 @@ static int response_peak(const ts_response *res)
 
 /* Key values of a response: the static gain and the largest magnitude
  * over the frequencies (the output's unit per m), both relative to the
- * largest magnitude. The solver's part of their error is not estimated. */
+ * largest magnitude; the solver's part of their error is the
+ * linearization's error allowance (towstab/response.h). */
 static int response_values(ts_result *r, ts_err *err)
 {
     const ts_response *res = r->response;
@@ -1056,6 +1057,9 @@ static int response_values(ts_result *r, ts_err *err)
                "%.80s.peak_magnitude", res->output.name);
     r->values[0].value = res->static_gain;
     r->values[1].value = peak;
+    r->values[0].error.solver = res->error ? res->static_error : NAN;
+    r->values[1].error.solver = res->error ? res->error[response_peak(res)]
+                                           : NAN;
     if (!(peak > 0))
         r->values[0].scale = r->values[1].scale = 0.0;
     return TS_OK;

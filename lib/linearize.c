@@ -155,6 +155,7 @@ void ts_linear_free(ts_linear *lin)
     free(lin->Tu);
     free(lin->Aerr);
     free(lin->fnoise);
+    free(lin->Berr);
     free(lin->h);
     tsi_desc_free(lin->desc);
     free(lin->u0);
@@ -566,7 +567,9 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     }
     if (o.estimate_error && !lin->fnoise) {
         lin->fnoise = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof(double));
-        if (!lin->fnoise)
+        lin->Berr = malloc((size_t)(nlow > 0 ? nlow : 1) * (size_t)ni *
+                           sizeof(double));
+        if (!lin->fnoise || !lin->Berr)
             return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
     }
     if (!o.estimate_error) {
@@ -574,6 +577,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         lin->Aerr = NULL;
         free(lin->fnoise);
         lin->fnoise = NULL;
+        free(lin->Berr);
+        lin->Berr = NULL;
     }
     lin->round_norm = NAN;
 
@@ -747,8 +752,9 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
             if (with_t)
                 tcol = j < n ? lin->Ty + (size_t)j * nl
                              : lin->Tu + (size_t)(j - n) * nl;
-            double *ecol = estimate && j < n ? lin->Aerr + (size_t)j * nlow
-                                             : NULL;
+            double *ecol = !estimate ? NULL
+                           : j < n   ? lin->Aerr + (size_t)j * nlow
+                                     : lin->Berr + (size_t)(j - n) * nlow;
             double *ocol = NULL;
             if (nout > 0)
                 ocol = j < n ? lin->Vy + (size_t)j * nout

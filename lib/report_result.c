@@ -419,18 +419,26 @@ static json_t *accuracy_json(const ts_result *r)
         "refinements", a->refinements);
 }
 
-/* Every point's discretisation error, and where the accuracy holds. */
+/* Every point's discretisation and linearization (solver) error, and
+ * where the accuracy holds. */
 static void response_accuracy_json(json_t *j, const ts_result *r)
 {
     json_t *pts = json_object_get(j, "points");
-    for (int i = 0; r->magnitude_error && i < r->response->npoints; i++) {
+    const ts_response *res = r->response;
+    for (int i = 0; i < res->npoints; i++) {
         json_t *o = json_array_get(pts, (size_t)i);
         if (!o)
             break;
-        json_object_set_new(o, "magnitude_error",
-                            error_json(r->magnitude_error[i], NAN));
-        json_object_set_new(o, "phase_error_deg",
-                            error_json(r->phase_error_deg[i], NAN));
+        double lin = res->error ? res->error[i] : NAN;
+        json_object_set_new(
+            o, "magnitude_error",
+            error_json(r->magnitude_error ? r->magnitude_error[i] : NAN, lin));
+        json_object_set_new(
+            o, "phase_error_deg",
+            error_json(r->phase_error_deg ? r->phase_error_deg[i] : NAN,
+                       res->magnitude[i] > 0
+                           ? lin / res->magnitude[i] * 180.0 / M_PI
+                           : NAN));
     }
     json_object_set_new(j, "accurate_to_hz", num(r->accurate_to_hz));
 }

@@ -14,7 +14,8 @@
  * way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1 b by the dense shifted
  * solve of lib/shift.h (one LU of P(s), O(nq^3)), then positions through
  * the link geometry plus the tow displacement, tensions through dT/dy and
- * dT/du.
+ * dT/du; there each gain also gets the linearization's error allowance
+ * (gain_error).
  */
 #include "towstab/response.h"
 
@@ -24,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lapack.h"
 #include "response_impl.h"
 #include "shift.h"
 #include "towstab/system.h"
@@ -161,6 +163,7 @@ void ts_response_free(ts_response *r)
     free(r->im);
     free(r->magnitude);
     free(r->phase_deg);
+    free(r->error);
     free(r);
 }
 
@@ -168,9 +171,75 @@ void ts_response_free(ts_response *r)
  * sparse way), state and input vectors (the dense way). */
 typedef struct resp_ws {
     double complex *dr, *dt;
-    double complex *b, *x;
-    double *dq, *drr;
+    double complex *b, *x, *rho;
+    double *dq, *drr, *m; /* m: a position output's row of the node
+                             displacement map (for the error) */
 } resp_ws;
+
+/* The dense way's error allowance of the gain g = rho^T x1 (+ a part
+ * without A or B), x = (sI - A)^-1 b, for errors dA, db in the lower rows:
+ * dg = -w^T (dA x + db), w = P(s)^-T rho (lib/shift.h; dx1 = -P^-1 z for
+ * z in the lower rows). Two parts:
+ * - truncation: w^T (Aerr x + Berr_x + s Berr_v + s^2 Berr_a);
+ * - rounding: the root mean square of w^T N x over the noise N of the
+ *   differences, entries fnoise_i / (sqrt(2) h_j) (doc/linear.md,
+ *   section 2), and the same for b's columns,
+ *   sqrt(sum_i |w_i|^2 fnoise_i^2 / 2) sqrt(sum_j |x_j|^2 / h_j^2 +
+ *   1 / h_x^2 + |s|^2 / h_v^2 + |s|^4 / h_a^2).
+ * Returns 10 times their sum (the factor of the eigenvalues' allowance,
+ * doc/linear.md section 3), NaN without an error estimate. Cost: one
+ * transposed solve and one product with Aerr, O(nq^2). */
+static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
+                         resp_ws *w)
+{
+    /* A vehicle's controller block (the Schur complement in P) and a
+     * vehicle's input are not covered (doc/linear.md, section 4). */
+    if (!lin->Aerr || !lin->Berr || !lin->fnoise || sh->nc > 0 ||
+        sh->full || input >= TS_NINPUT)
+        return NAN;
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq, one = 1, info = 0;
+    double complex s = sh->s;
+    double complex *wv = w->rho; /* rho in, w out */
+    if (sh->is_complex) {
+        zgetrs_("T", &nq, &one, sh->zlu, &nq, sh->ipiv, wv, &nq, &info, 1);
+    } else {
+        double *re = sh->wr, *im = sh->wr + nq;
+        for (int i = 0; i < nq; i++) {
+            re[i] = creal(wv[i]);
+            im[i] = cimag(wv[i]);
+        }
+        dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, re, &nq, &info, 1);
+        dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, im, &nq, &info, 1);
+        for (int i = 0; i < nq; i++)
+            wv[i] = re[i] + I * im[i];
+    }
+    const double *bx = lin->Berr + (size_t)(TS_IN_DISP + input) * nlow;
+    const double *bv = lin->Berr + (size_t)(TS_IN_VEL + input) * nlow;
+    const double *ba = lin->Berr + (size_t)(TS_IN_ACC + input) * nlow;
+    double complex trunc = 0;
+    double wn2 = 0, xh2 = 0;
+    for (int j = 0; j < n; j++) {
+        const double *ej = lin->Aerr + (size_t)j * nlow;
+        double complex acc = 0;
+        for (int i = 0; i < nlow; i++)
+            acc += wv[i] * ej[i];
+        trunc += acc * w->x[j];
+        double a = cabs(w->x[j]) / lin->h[j];
+        xh2 += a * a;
+    }
+    for (int i = 0; i < nlow; i++) {
+        double a = cabs(wv[i]) * lin->fnoise[i];
+        trunc += wv[i] * (bx[i] + s * bv[i] + s * s * ba[i]);
+        wn2 += a * a;
+    }
+    double as = cabs(s);
+    const double *hu = lin->h + n;
+    xh2 += 1.0 / (hu[TS_IN_DISP + input] * hu[TS_IN_DISP + input]) +
+           as * as / (hu[TS_IN_VEL + input] * hu[TS_IN_VEL + input]) +
+           as * as * as * as /
+               (hu[TS_IN_ACC + input] * hu[TS_IN_ACC + input]);
+    return 10.0 * (cabs(trunc) + sqrt(0.5 * wn2 * xh2));
+}
 
 /* Row `row` of an output Jacobian pair (Jy [rows x n], Ju [rows x
  * ninput], column-major with leading dimension `rows`) applied to the
@@ -192,10 +261,11 @@ static double complex row_gain(const double *Jy, const double *Ju, int row,
 /* The dense way (see the head of the file); lin holds A, B, Ty, Tu and
  * the vehicles' output Jacobians Vy, Vu. A tow displacement input brings
  * its velocity and acceleration columns; a vehicle's input (>= TS_NINPUT)
- * is its column alone. */
+ * is its column alone. With gerr, the gain's error allowance (gain_error)
+ * into *gerr. */
 static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
                        const ts_output *out, tsi_shift *sh, resp_ws *w,
-                       double complex *g)
+                       double complex *g, double *gerr)
 {
     int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
     double complex s = sh->s;
@@ -210,6 +280,18 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     for (int i = 0; i < n; i++)
         w->b[i] = -(Bx[i] + cv * Bv[i] + ca * Ba[i]);
     tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
+    if (gerr && out->kind != TS_OUT_POSITION && out->kind != TS_OUT_TENSION) {
+        *gerr = NAN; /* a vehicle's output: not covered */
+    } else if (gerr) {
+        /* rho: the gain's weights on x1 (x2 = s x1 for lower-row z). */
+        for (int i = 0; i < nq; i++)
+            w->rho[i] = out->kind == TS_OUT_POSITION
+                            ? w->m[i]
+                            : lin->Ty[out->link + (size_t)i * nl] +
+                                  s * lin->Ty[out->link +
+                                              (size_t)(nq + i) * nl];
+        *gerr = gain_error(sh, lin, input, w);
+    }
     if (out->kind == TS_OUT_POSITION) {
         int idx = 3 * out->node + out->comp;
         for (int i = 0; i < nq; i++)
@@ -231,10 +313,12 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
 
 /* The gain at omega; sh holds the factors of the previous frequency
  * (zeroed before the first), which are refactored (tsi_shift_refactor);
- * the caller frees them. */
+ * the caller frees them. With gerr, the gain's linearization error
+ * allowance into *gerr (the dense way; NaN the sparse way). */
 static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                    const ts_output *out, double omega, resp_ws *w,
-                   tsi_shift *sh, double complex *g, ts_err *err)
+                   tsi_shift *sh, double complex *g, double *gerr,
+                   ts_err *err)
 {
     int rc = tsi_shift_refactor(sh, lin, I * omega, err);
     if (rc != TS_OK) {
@@ -249,8 +333,10 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
         tsi_shift_input(sh, input, w->dr, w->dt);
         *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
                                           : w->dt[out->link];
+        if (gerr)
+            *gerr = NAN;
     } else {
-        dense_gain(sys, lin, input, out, sh, w, g);
+        dense_gain(sys, lin, input, out, sh, w, g, gerr);
     }
     return TS_OK;
 }
@@ -304,7 +390,10 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
     return TS_OK;
 }
 
-static int ws_alloc(resp_ws *w, const ts_linear *lin)
+/* Work for lin; with sys (the dense way), the output row m of a position
+ * output, for the error allowance. */
+static int ws_alloc(resp_ws *w, const ts_linear *lin, const ts_system *sys,
+                    const ts_output *out)
 {
     memset(w, 0, sizeof *w);
     w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double complex));
@@ -313,10 +402,23 @@ static int ws_alloc(resp_ws *w, const ts_linear *lin)
     if (!lin->desc) {
         w->b = malloc((size_t)lin->nstate * sizeof(double complex));
         w->x = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->rho = malloc((size_t)lin->nq * sizeof(double complex));
         w->dq = malloc((size_t)lin->nq * sizeof(double));
         w->drr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
-        if (!w->b || !w->x || !w->dq || !w->drr)
+        w->m = calloc((size_t)lin->nq, sizeof(double));
+        if (!w->b || !w->x || !w->rho || !w->dq || !w->drr || !w->m)
             return 0;
+        if (sys && out->kind == TS_OUT_POSITION) {
+            /* O(nq nlinks) once: the map applied to each unit vector. */
+            int idx = 3 * out->node + out->comp;
+            memset(w->dq, 0, (size_t)lin->nq * sizeof(double));
+            for (int i = 0; i < lin->nq; i++) {
+                w->dq[i] = 1.0;
+                ts_linear_node_displacements(sys, lin, w->dq, w->drr);
+                w->m[i] = w->drr[idx];
+                w->dq[i] = 0.0;
+            }
+        }
     }
     return w->dr && w->dt;
 }
@@ -329,6 +431,8 @@ static void ws_free(resp_ws *w)
     free(w->x);
     free(w->dq);
     free(w->drr);
+    free(w->rho);
+    free(w->m);
 }
 
 int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
@@ -344,13 +448,13 @@ int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
                        "%g",
                        omega);
     resp_ws w;
-    if (!ws_alloc(&w, lin)) {
+    if (!ws_alloc(&w, lin, NULL, out)) {
         ws_free(&w);
         return ts_fail(err, TS_ENOMEM, "response: out of memory");
     }
     double complex g = 0;
     tsi_shift sh = {0};
-    rc = gain_at(sys, lin, input, out, omega, &w, &sh, &g, err);
+    rc = gain_at(sys, lin, input, out, omega, &w, &sh, &g, NULL, err);
     tsi_shift_free(&sh);
     ws_free(&w);
     *re = creal(g);
@@ -386,7 +490,7 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
                            i, freq_hz[i]);
     ts_response *r = calloc(1, sizeof *r);
     resp_ws w;
-    int ok = r && ws_alloc(&w, lin);
+    int ok = r && ws_alloc(&w, lin, sys, out);
     if (r) {
         size_t np = (size_t)npoints;
         r->freq_hz = malloc(np * sizeof(double));
@@ -394,8 +498,9 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
         r->im = malloc(np * sizeof(double));
         r->magnitude = malloc(np * sizeof(double));
         r->phase_deg = malloc(np * sizeof(double));
+        r->error = malloc(np * sizeof(double));
         ok = ok && r->freq_hz && r->re && r->im && r->magnitude &&
-             r->phase_deg;
+             r->phase_deg && r->error;
     }
     if (!ok) {
         if (r)
@@ -414,11 +519,12 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     snprintf(r->unit, sizeof r->unit, "%s/%s", ou, lin->input_unit[input]);
     double complex g = 0;
     tsi_shift sh = {0};
-    rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, err);
+    rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,
+                 err);
     r->static_gain = creal(g);
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
         rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,
-                     err);
+                     &r->error[i], err);
         r->freq_hz[i] = freq_hz[i];
         r->re[i] = creal(g);
         r->im[i] = cimag(g);

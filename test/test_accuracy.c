@@ -23,7 +23,7 @@
  *     (10, 20, 40 links) and 0.3 Hz (20, 40; at 10 links the coarsest
  *     level, 3 links, is past its resonances and the estimate fails, as
  *     doc/accuracy.md says) the estimate bounds the truth within a factor
- *     of 3.
+ *     of 3, and shrinks by 4 (within 1.5, at most 8) per doubling.
  *  5. Critical angle of a bare cable (Cdt = 0, no body): every lumped
  *     link lies at the continuum angle exactly, so the discretisation
  *     error is rounding: the estimate is below 1e-9 of the length and the
@@ -32,7 +32,9 @@
  *     40 links against 2560 links; a cylinder towfish (order 1) at 50,
  *     100, 200 links against the Richardson value of 1600 and 3200 links:
  *     the estimate bounds the true error within a factor of 3 for the
- *     body's x, z and the top tension.
+ *     body's x, z and the top tension, and shrinks with the links at
+ *     least at the order it states (within 1.5), at most twice as fast
+ *     as the theoretical order says.
  *  7. Under-resolved: Kamman ex. 1 at 20 links misses the accuracy 1e-3:
  *     not trustworthy, the reason names the links the error model says
  *     meet it; run there, the accuracy is met, and the true error
@@ -304,6 +306,7 @@ static void test_chain_response(void)
 {
     static const int links[3] = {10, 20, 40};
     static const double freq[2] = {0.1, 0.3};
+    double prev[2] = {NAN, NAN};
     for (int t = 0; t < 3; t++) {
         ts_scene *sc = scene_from(chain_yaml(links[t]));
         ts_request rq;
@@ -335,6 +338,13 @@ static void test_chain_response(void)
                   "|H| %.9f, continuum %.9f: error %.3g, estimated %.3g "
                   "(x %.2f)", links[t], freq[i], r->response->magnitude[i],
                   exact, truth, est, est / truth);
+            /* Order 2 (a chain in vacuum): a quarter per doubling. */
+            if (isfinite(prev[i]))
+                CHECK(prev[i] / est >= 4 / 1.5 && prev[i] / est <= 8,
+                      "chain response, %d to %d links, %.1f Hz: the "
+                      "estimate shrinks by %.3g (order 2: 4)", links[t - 1],
+                      links[t], freq[i], prev[i] / est);
+            prev[i] = est;
         }
         ts_result_free(r);
         ts_scene_free(sc);
@@ -390,11 +400,16 @@ static ts_result *eq_at(const ts_system *sys, int links, int estimate)
 }
 
 /* Check x, z of the first body and the top tension at each link count
- * against ref[]. */
+ * (each twice the one before) against ref[]; and that the estimate
+ * shrinks at the order it states: from N to 2N links by at least
+ * 2^p / 1.5 (p the order stated at N) and at most 2 * 2^theory (faster
+ * only as far as the observed order is still climbing to the theory's). */
 static void eq_bounds(const char *what, const ts_system *sys,
                       const int *links, int n, const double ref[3])
 {
     static const int idx[3] = {0, 2, 3};
+    double prev[3] = {NAN, NAN, NAN}, pord[3] = {NAN, NAN, NAN};
+    double theory = ts_accuracy_order(sys);
     for (int t = 0; t < n; t++) {
         ts_result *r = eq_at(sys, links[t], 1);
         if (!r)
@@ -406,6 +421,16 @@ static void eq_bounds(const char *what, const ts_system *sys,
             CHECK(bounds(est, truth), "%s, %d links: %s %.9g, error %.3g, "
                   "estimated %.3g (x %.2f, order %.3g)", what, links[t],
                   v->name, v->value, truth, est, est / truth, v->order);
+            if (t > 0) {
+                double q = prev[j] / est;
+                CHECK(q >= pow(2, pord[j]) / 1.5 && q <= 2 * pow(2, theory),
+                      "%s, %d to %d links: the estimate of %s shrinks by "
+                      "%.3g (stated order %.3g: %.3g; theory %g: %.3g)",
+                      what, links[t - 1], links[t], v->name, q, pord[j],
+                      pow(2, pord[j]), theory, pow(2, theory));
+            }
+            prev[j] = est;
+            pord[j] = v->order;
         }
         ts_result_free(r);
     }

@@ -19,6 +19,12 @@
  *  4. Names and ranges: inputs, outputs (aliases, tow refused, valid names
  *     listed), log spacing refused for empty or negative ranges, tension
  *     outputs need the tension Jacobians.
+ *  5. The gain's error allowance (ts_response.error, static_error)
+ *     covers the linearization's rounding: Kamman ex. 3 in the turn at 10
+ *     links, surge and sway, three outputs (one a tension), the static gain
+ *     and 5 frequencies, at the default step and at steps 1e-7 and 1e-8
+ *     where rounding dominates: every gain within its allowance of that
+ *     of a tight, fourth-order linearization (test_rounding).
  */
 #include "towstab/response.h"
 
@@ -91,8 +97,18 @@ static double displaced(ts_system *sys, int axis, double d,
     return v;
 }
 
+static ts_linear *linearize_at(const ts_system *sys, ts_lin_model model,
+                               double step, double *zmin);
+
 static ts_linear *linearize(const ts_system *sys, ts_lin_model model,
                             double *zmin)
+{
+    return linearize_at(sys, model, 0.0, zmin);
+}
+
+/* Linearized with relative step `step` (0: the default). */
+static ts_linear *linearize_at(const ts_system *sys, ts_lin_model model,
+                               double step, double *zmin)
 {
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(sys, &err);
@@ -106,6 +122,8 @@ static ts_linear *linearize(const ts_system *sys, ts_lin_model model,
         ts_linearize_opts_default(&o);
         o.tensions = 1;
         o.model = model;
+        if (step > 0)
+            o.rel_step = step;
         lin = ts_linear_alloc(k, &err);
         if (ts_linearize_equilibrium(k, eq, &o, lin, &err) != TS_OK) {
             ts_linear_free(lin);
@@ -516,6 +534,124 @@ static void test_names(void)
     ts_scene_free(sc);
 }
 
+/* ---- 5. the gain's error allowance covers rounding -------------------- */
+
+/* x = (4 x - y) / 3 over n entries: a's A, B, dT/dy, dT/du become the
+ * Richardson value of steps h (a) and 2h (b), fourth order. */
+static void richardson(ts_linear *a, const ts_linear *b)
+{
+    size_t n = (size_t)a->nstate, nl = (size_t)a->nlinks;
+    struct {
+        double *x;
+        const double *y;
+        size_t len;
+    } m[4] = {{a->A, b->A, n * n},
+              {a->B, b->B, n * TS_NINPUT},
+              {a->Ty, b->Ty, nl * n},
+              {a->Tu, b->Tu, nl * TS_NINPUT}};
+    for (int k = 0; k < 4; k++)
+        for (size_t i = 0; i < m[k].len; i++)
+            m[k].x[i] = (4 * m[k].x[i] - m[k].y[i]) / 3;
+}
+
+/* The Richardson linearization of steps h and 2h (NULL on failure). */
+static ts_linear *tight(const ts_system *sys, double h)
+{
+    ts_linear *a = linearize_at(sys, TS_LIN_DENSE, h, NULL);
+    ts_linear *b = linearize_at(sys, TS_LIN_DENSE, 2 * h, NULL);
+    if (a && b)
+        richardson(a, b);
+    ts_linear_free(b);
+    if (!b) {
+        ts_linear_free(a);
+        a = NULL;
+    }
+    return a;
+}
+
+/* Kamman ex. 3 in the turn at 10 links, tow.surge and tow.sway (heave
+ * is left out: the tow point is at the waterline, a kink) to the
+ * sphere's y and z and the top link's tension, at 0 (the static gain)
+ * and 5 frequencies from 0.05 to 5 Hz, linearized at the default step
+ * and at 1e-7 and 1e-8 (rounding, eps / h, dominating the truncation,
+ * h^2): every gain lies within its error allowance of the gain of a
+ * tight linearization (A, B, dT/dy, dT/du Richardson-extrapolated from
+ * steps 5e-4 and 1e-3, fourth order, rounding 1e4 times smaller), up to
+ * that reference's own uncertainty (its distance to the same from steps
+ * 1e-3 and 2e-3). At 1e-8 at least a third of the gains have errors 10
+ * times that uncertainty, so the check is about the allowance. */
+static void test_rounding(void)
+{
+    ts_scene *sc = scene_from(turn_yaml);
+    ts_err err = {0};
+    ts_system *sys = ts_system_copy(sc->system, &err);
+    ts_system_set_links(sys, 10, &err);
+    ts_linear *ref = tight(sys, 5e-4), *ref2 = tight(sys, 1e-3);
+    static const double steps[3] = {0.0, 1e-7, 1e-8};
+    static const char *const ins[2] = {"tow.surge", "tow.sway"};
+    static const char *const outs[3] = {"sphere.y", "sphere.z",
+                                        "cable.1.tension"};
+    double freq[5];
+    ts_response_logspace(0.05, 5, 5, freq, &err);
+    for (int k = 0; k < 3 && ref && ref2; k++) {
+        ts_linear *lin = linearize_at(sys, TS_LIN_DENSE, steps[k], NULL);
+        int n = 0, clear = 0, ok = lin != NULL;
+        double worst = 0, we = NAN, wb = NAN;
+        for (int a = 0; a < 2 && ok; a++)
+            for (int b = 0; b < 3 && ok; b++) {
+                int in;
+                ts_output out;
+                ts_response *r = NULL, *g = NULL, *g2 = NULL;
+                ok = ts_response_input_find(ins[a], &in, &err) == TS_OK &&
+                     ts_response_output_find(sys, outs[b], &out, &err) ==
+                         TS_OK &&
+                     ts_response_compute(sys, lin, in, &out, freq, 5, &r,
+                                         &err) == TS_OK &&
+                     ts_response_compute(sys, ref, in, &out, freq, 5, &g,
+                                         &err) == TS_OK &&
+                     ts_response_compute(sys, ref2, in, &out, freq, 5, &g2,
+                                         &err) == TS_OK;
+                for (int i = -1; i < 5 && ok; i++) {
+                    double e = i < 0 ? fabs(r->static_gain - g->static_gain)
+                                     : hypot(r->re[i] - g->re[i],
+                                             r->im[i] - g->im[i]);
+                    double u = i < 0 ? fabs(g2->static_gain - g->static_gain)
+                                     : hypot(g2->re[i] - g->re[i],
+                                             g2->im[i] - g->im[i]);
+                    double bd = i < 0 ? r->static_error : r->error[i];
+                    double q = e / (bd + u);
+                    n++;
+                    clear += e >= 10 * u;
+                    if (!(q <= worst)) {
+                        worst = q;
+                        we = e;
+                        wb = bd;
+                    }
+                }
+                ts_response_free(r);
+                ts_response_free(g);
+                ts_response_free(g2);
+            }
+        /* At 1e-8 the allowance is not vacuous: some gain's error is at
+         * least a hundredth of it (10 times the estimate by design; the
+         * rms estimate counts noise in every entry, while far from a
+         * perturbed coordinate the kernel rounds identically). */
+        CHECK(ok && worst <= 1 &&
+                  (k < 2 || (clear >= n / 3 && worst >= 0.01)),
+              "ex. 3 turn, 10 links, step %.3g: every gain (%d; %d with "
+              "errors 10 times the reference's uncertainty) within its "
+              "error allowance of the tight one (closest %.2f: error "
+              "%.3g, allowance %.3g) (%s)",
+              steps[k], n, clear, worst, we, wb, ok ? "" : err.msg);
+        ts_linear_free(lin);
+    }
+    CHECK(ref && ref2, "tight linearizations");
+    ts_linear_free(ref);
+    ts_linear_free(ref2);
+    ts_system_free(sys);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -528,6 +664,7 @@ int main(void)
     test_resonance();
     test_dense_reference();
     test_names();
+    test_rounding();
     ts_units_free(units);
     return tc_done();
 }

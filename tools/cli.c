@@ -515,7 +515,15 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
 
 void cli_print_trust(const ts_trust *t)
 {
-    printf("trustworthy: %s\n", t->trustworthy ? "yes" : "NO");
+    cli_print_trust_as(t, NULL);
+}
+
+void cli_print_trust_as(const ts_trust *t, const char *what)
+{
+    if (what)
+        printf("%s trustworthy: %s\n", what, t->trustworthy ? "yes" : "NO");
+    else
+        printf("trustworthy: %s\n", t->trustworthy ? "yes" : "NO");
     for (int i = 0; i < t->nreasons; i++)
         printf("  reason: %s\n", t->reasons[i]);
     for (int i = 0; i < t->nnotes; i++)

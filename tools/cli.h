@@ -256,6 +256,8 @@ int cli_check_outputs(const char *cmd, int n, const char *const what[],
 
 /* The verdict lines: "trustworthy: yes|NO", reasons, notes. */
 void cli_print_trust(const ts_trust *t);
+/* The same with the line "WHAT trustworthy: ..." (what NULL: as above). */
+void cli_print_trust_as(const ts_trust *t, const char *what);
 
 /* "speed V m/s (K knots), turn rate W rad/s (D deg/s, turn radius R m, to
  * starboard)" or "... turn rate 0 rad/s (straight)" in SI; in the display

@@ -305,13 +305,17 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
                     cli_value_shown(&r->values[v], d), lu, e);
         }
         cli_print_accuracy(r);
+        cli_print_trust(t);
+    } else if (r->status == TS_OK) {
+        /* Another analysis' equilibrium: its solve is judged here, its
+         * values' discretisation error is towstab equilibrium's. When that
+         * analysis failed after it, the result asked for was not
+         * delivered: no verdict (stderr says why). */
+        cli_print_trust_as(t, "equilibrium solve (its discretisation "
+                              "error: towstab equilibrium)");
     }
 #undef L_
 #undef F_
-    /* The equilibrium under an analysis that failed after it: the result
-     * asked for was not delivered, so no verdict (stderr says why). */
-    if (r->kind == TS_ANALYSIS_EQUILIBRIUM || r->status == TS_OK)
-        cli_print_trust(t);
 }
 
 

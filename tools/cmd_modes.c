@@ -23,10 +23,10 @@ void cli_print_linearization(const ts_result *r)
     if (l->A)
         printf("linearized: %d states, %d inputs, %ld kernel evaluations on "
                "%d thread%s, %.3f ms; truncation error %.3g (max |A| %.6g, "
-               "||dA||_F %.3g)\n",
+               "||dA||_F %.3g), rounding noise ||N||_F %.3g\n",
                l->nstate, l->ninput, l->evaluations, l->threads,
                l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->trunc_err,
-               l->a_scale, l->trunc_norm);
+               l->a_scale, l->trunc_norm, l->round_norm);
     else
         printf("linearized: %d states, sparse model (%d perturbation groups, "
                "%ld residual evaluations on %d thread%s), %.3f ms; relative "

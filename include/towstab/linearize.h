@@ -141,6 +141,8 @@ typedef struct ts_linear {
                           fnoise[i] / (sqrt(2) h[j]), which the truncation
                           estimate samples only by chance; NULL unless
                           estimate_error */
+    double *Berr;      /* [(n - nq) * TS_NINPUT] the same for B's lower
+                          block; NULL unless estimate_error */
     double round_norm; /* the Frobenius norm of that noise over the state
                           columns (units of A); NaN unless estimate_error */
     double b_trunc_err;/* max |B(h) - B(2h)| / 3 */

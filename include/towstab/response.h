@@ -83,6 +83,12 @@ typedef struct ts_response {
     double *magnitude;  /* [npoints] |gain| */
     double *phase_deg;  /* [npoints] arg(gain), degrees in (-180, 180] */
     double static_gain; /* the w = 0 limit (real) */
+    double *error;      /* [npoints] error allowance of the complex gain
+                           (so of the magnitude; of the phase over the
+                           magnitude, rad) from the linearization's
+                           truncation and rounding (doc/linear.md,
+                           section 4); NaN without its error estimate */
+    double static_error;/* the same of the static gain */
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at
