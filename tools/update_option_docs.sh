@@ -7,7 +7,7 @@
 set -eu
 TOWSTAB=${1:-build/tools/towstab}
 doc=doc/manual.md
-tmp=$(mktemp "${TMPDIR:-/tmp}/towstab-manual-XXXXXX")
+tmp=$(mktemp)
 trap 'rm -f "$tmp" "$tmp.ref"' EXIT
 "$TOWSTAB" options >"$tmp.ref"
 awk -v ref="$tmp.ref" '

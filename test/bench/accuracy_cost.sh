@@ -1,0 +1,54 @@
+#!/bin/bash
+# accuracy_cost.sh TOWSTAB [RUNS]: the whole-process CPU time of the
+# discretisation error estimate (doc/performance.md, "The cost of the
+# discretisation error"). Each command runs RUNS times (default 9) with the
+# estimate (A) and without it (B), alternating A and B; the table gives the
+# median CPU seconds (user + system) of each and their ratio. Run from the
+# project root: `meson test -C build --benchmark accuracy_cost`.
+set -eu
+TOWSTAB=$1
+RUNS=${2:-9}
+TIMEFORMAT='%U %S'
+
+# cpu CMD...: CPU seconds (user + system) of one run of CMD.
+cpu() {
+    local t
+    t=$( { time "$@" >/dev/null 2>&1; } 2>&1 ) || true
+    awk '{ printf "%.4f\n", $1 + $2 }' <<<"$t"
+}
+
+median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+
+# row LABEL "A options" "B options" COMMAND ARGS...
+row() {
+    local label=$1 a=$2 b=$3
+    shift 3
+    local ta=() tb=()
+    for ((i = 0; i < RUNS; i++)); do
+        # shellcheck disable=SC2086
+        ta+=("$(cpu "$TOWSTAB" "$@" $a)")
+        # shellcheck disable=SC2086
+        tb+=("$(cpu "$TOWSTAB" "$@" $b)")
+    done
+    local ma mb
+    ma=$(printf '%s\n' "${ta[@]}" | median)
+    mb=$(printf '%s\n' "${tb[@]}" | median)
+    awk -v l="$label" -v a="$ma" -v b="$mb" \
+        'BEGIN { printf "| %s | %.3f | %.3f | %.2f |\n", l, a, b, a / b }'
+}
+
+echo "runs $RUNS each, $(uptime | sed 's/.*load/load/')"
+echo "| command | A cpu s | B cpu s | A/B cpu |"
+echo "|---|---|---|---|"
+ex1=examples/kamman_ex1_submerged.yaml
+row "modes, ex. 1, 20 links" "" "--no-discretisation-error" \
+    modes $ex1 --quiet
+row "modes, ex. 1, 80 links" "" "--no-discretisation-error" \
+    modes $ex1 --quiet --links 80
+row "equilibrium, ex. 1, 200 links" "" "--no-discretisation-error" \
+    equilibrium $ex1 --quiet --links 200
+row "response, ex. 1, sphere.z (100 frequencies)" "" \
+    "--no-discretisation-error" response $ex1 --quiet --output sphere.z
+row "simulate, ex. 4, heave 0.1 ft at 1 Hz, 20 s" "--discretisation-error" "" \
+    simulate examples/kamman_ex4.yaml --quiet --no-compare \
+    --excite tow.heave:amplitude=0.1ft,frequency=1Hz --t-end 20 --transient 10
