@@ -17,16 +17,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "clock.h"
 #include "towstab/report_result.h"
-
-static double wall_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 const char *ts_design_goal_name(ts_design_goal_kind k)
 {
@@ -442,9 +435,9 @@ static void evaluate(study *st, const double *u)
         rq.setup.discretisation_error = 0;
         rq.setup.refine = 0;
         rq.setup.equilibrium.guess = st->dir;
-        double t0 = wall_now();
+        double t0 = tsi_wall_now();
         rc = ts_analysis_run(st->sys, &rq, &r, &e);
-        h->wall_s = wall_now() - t0;
+        h->wall_s = tsi_wall_now() - t0;
     }
     h->status = rc;
     h->evaluations = r ? r->evaluations : 0;
@@ -583,9 +576,9 @@ static int final_run(const ts_system *sys, ts_design *d, ts_err *err)
     int rc = request_at(d, d->x, &rq, err);
     if (rc)
         return rc;
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     rc = ts_analysis_run(sys, &rq, &d->result, err);
-    d->final_wall_s = wall_now() - t0;
+    d->final_wall_s = tsi_wall_now() - t0;
     d->status = rc;
     if (!d->result)
         return rc;
@@ -671,7 +664,7 @@ int ts_design_run(const ts_system *sys, const ts_design_spec *sp,
     memset(&st, 0, sizeof st);
     st.sys = sys;
     st.d = d;
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     st.opt = nlopt_create(s->method == TS_DESIGN_BOBYQA ? NLOPT_LN_BOBYQA
                                                         : NLOPT_LN_COBYLA,
                           (unsigned)n);
@@ -727,7 +720,7 @@ int ts_design_run(const ts_system *sys, const ts_design_spec *sp,
                                                            : 0;
     }
     rc = final_run(sys, d, err);
-    d->wall_s = wall_now() - t0;
+    d->wall_s = tsi_wall_now() - t0;
     *out = d;
     if (rc == TS_OK && st.rc == TS_ECANCEL) {
         ts_fail(err, TS_ECANCEL, "%s", st.err.msg);

@@ -35,20 +35,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
+#include "clock.h"
 #include "towstab/param.h"
-
-static double wall_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 void ts_sweep_free(ts_sweep *s)
 {
@@ -710,7 +703,7 @@ static int run_crossing(ts_sweep *s, int i, ts_err *err)
     double step = fabs(x->unstable - x->stable);
     int idx[TS_SWEEP_MAX_AXES];
     ts_sweep_point_index(s, x->from, idx);
-    double *dir = NULL, t0 = wall_now();
+    double *dir = NULL, t0 = tsi_wall_now();
     int ndir = 0, rc = TS_OK, cont = can_continue(s);
     x->status = TS_OK;
     x->error[0] = '\0';
@@ -757,7 +750,7 @@ static int run_crossing(ts_sweep *s, int i, ts_err *err)
     }
     free(dir);
     x->value = 0.5 * (x->stable + x->unstable);
-    x->wall_s = wall_now() - t0;
+    x->wall_s = tsi_wall_now() - t0;
     if (rc == TS_OK)
         x->done = 1;
     return rc;
@@ -777,7 +770,7 @@ static int run_tasks(ts_sweep *s, const int *todo, int n, int crossings,
     if (nt > n)
         nt = n > 0 ? n : 1;
     int rc = TS_OK;
-    double t0 = wall_now();
+    double t0 = tsi_wall_now();
     s->stop = 0;
 #ifdef _OPENMP
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
@@ -804,7 +797,7 @@ static int run_tasks(ts_sweep *s, const int *todo, int n, int crossings,
             }
         }
     }
-    s->wall_s += wall_now() - t0;
+    s->wall_s += tsi_wall_now() - t0;
     if (rc == TS_OK && get_stop(s))
         rc = ts_fail(err, TS_ECANCEL, "sweep: stopped on request");
     return rc;
