@@ -41,11 +41,6 @@
 
 static ts_units *units;
 
-static ts_scene *scene_from(const char *yaml)
-{
-    return tscene_parse(units, yaml);
-}
-
 static const char *above_yaml =
     "name: ex1_above\n"
     "environment: {water_density: \"1.9905 slug/ft^3\", gravity: \"32.174 "
@@ -180,7 +175,7 @@ static void static_case(ts_system *sys, ts_linear *lin, const char *in_name,
 
 static void test_static_gain(void)
 {
-    ts_scene *sc = scene_from(above_yaml);
+    ts_scene *sc = tscene_parse(units, above_yaml);
     double zmin;
     ts_linear *lin = linearize(sc->system, TS_LIN_BOTH, &zmin);
     CHECK(lin && zmin > 0.1, "above-water tow: every node %.3g m > 0.1 m "
@@ -193,7 +188,7 @@ static void test_static_gain(void)
     ts_linear_free(lin);
     ts_scene_free(sc);
 
-    sc = scene_from(turn_yaml);
+    sc = tscene_parse(units, turn_yaml);
     lin = linearize(sc->system, TS_LIN_BOTH, NULL);
     static_case(sc->system, lin, "tow.surge", "sphere.y", 0.01);
     ts_linear_free(lin);
@@ -202,7 +197,7 @@ static void test_static_gain(void)
 
 static void test_resonance(void)
 {
-    ts_scene *sc = scene_from(
+    ts_scene *sc = tscene_parse(units, 
         "name: chain\n"
         "environment: {water_density: 0, gravity: 9.80665}\n"
         "tow: {speed: 0}\n"
@@ -356,7 +351,7 @@ static void test_dense_reference(void)
         {"sphere.z", "cable.1.tension", "cable.7.tension"},
         {"fish.z", "a.2.tension", "b.4.y"}};
     for (int sc_i = 0; sc_i < 4; sc_i++) {
-        ts_scene *sc = scene_from(scenes[sc_i]);
+        ts_scene *sc = tscene_parse(units, scenes[sc_i]);
         if (!sc)
             continue;
         const ts_system *sys = sc->system;
@@ -445,7 +440,7 @@ static void test_dense_reference(void)
 
 static void test_names(void)
 {
-    ts_scene *sc = scene_from(above_yaml);
+    ts_scene *sc = tscene_parse(units, above_yaml);
     const ts_system *sys = sc->system;
     ts_err err = {0};
     ts_output out;
@@ -582,7 +577,7 @@ static ts_linear *tight(const ts_system *sys, double h)
  * times that uncertainty, so the check is about the allowance. */
 static void test_rounding(void)
 {
-    ts_scene *sc = scene_from(turn_yaml);
+    ts_scene *sc = tscene_parse(units, turn_yaml);
     ts_err err = {0};
     ts_system *sys = ts_system_copy(sc->system, &err);
     ts_system_set_links(sys, 10, &err);
@@ -654,12 +649,9 @@ static void test_rounding(void)
 
 int main(void)
 {
-    ts_err err = {0};
-    units = ts_units_alloc(&err);
-    if (!units) {
-        printf("FAIL units: %s\n", err.msg);
+    units = tscene_units();
+    if (!units)
         return 1;
-    }
     test_static_gain();
     test_resonance();
     test_dense_reference();
