@@ -37,13 +37,11 @@
 #include "descriptor.h"
 #include "kernel_impl.h"
 #include "shift.h"
+#include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
-
-void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
-            int *ipiv, double complex *b, const int *ldb, int *info);
 
 static ts_units *units;
 

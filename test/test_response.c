@@ -33,6 +33,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/eigen.h"
@@ -254,9 +255,6 @@ static void test_resonance(void)
     ts_linear_free(lin);
     ts_scene_free(sc);
 }
-
-void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
-            int *ipiv, double complex *b, const int *ldb, int *info);
 
 /* The response the old way, from the dense A, B and tension Jacobians of
  * the column-difference linearization (an independent reference for the
