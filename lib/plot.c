@@ -258,6 +258,15 @@ int ts_plot_shapes(const char *dir, const char *name, const char *title,
     return ts_plot_check(err);
 }
 
+int ts_plot_tracks(const char *dir, const char *name, const char *title,
+                   int ntracks, const ts_plot_track tracks[],
+                   const ts_plot_opts *opts, ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)ntracks, (void)tracks;
+    (void)opts;
+    return ts_plot_check(err);
+}
+
 int ts_plot_mode_shapes(const char *dir, const char *name, const char *title,
                         int flags, const ts_plot_shape *eq, int nmodes,
                         const ts_plot_mode modes[], const ts_plot_opts *opts,
@@ -1746,6 +1755,163 @@ int ts_plot_shapes(const char *dir, const char *name, const char *title,
             return rc;
     shapes_ctx c = {title, view, flags, nshapes, shapes};
     return render(fn, dir, name, title, opts, opts->height, draw_shapes, &c,
+                  err);
+}
+
+/* ---- tracks in the earth frame ---------------------------------------- */
+
+typedef struct tracks_ctx {
+    const char *title;
+    int ntracks;
+    const ts_plot_track *tracks;
+} tracks_ctx;
+
+/* Arrowhead length, a fraction of the window's width. */
+#define ARROW_SIZE 0.022
+
+static int draw_tracks(const void *vctx, const ts_plot_opts *o, int height,
+                       ts_err *err)
+{
+    (void)height;
+    const tracks_ctx *c = vctx;
+    int nmax = 1;
+    for (int i = 0; i < c->ntracks; i++)
+        if (c->tracks[i].n > nmax)
+            nmax = c->tracks[i].n;
+    double *px = malloc(2 * (size_t)nmax * sizeof *px);
+    if (!px)
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    double *py = px + nmax;
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    legend L = {0};
+    int markers = 0;
+    for (int i = 0; i < c->ntracks; i++) {
+        const ts_plot_track *t = &c->tracks[i];
+        for (int k = 0; k < t->n; k++) {
+            bbox_update(&x0, &x1, pconv(TS_PLOT_LENGTH, o, t->x[k]));
+            bbox_update(&y0, &y1, pconv(TS_PLOT_LENGTH, o, t->y[k]));
+        }
+        for (int k = 0; k < t->nmarkers; k++) {
+            bbox_update(&x0, &x1, pconv(TS_PLOT_LENGTH, o, t->markers[k].x));
+            bbox_update(&y0, &y1, pconv(TS_PLOT_LENGTH, o, t->markers[k].y));
+        }
+        markers |= t->nmarkers > 0;
+        legend_add(&L, t->label, color_index(t->color, i),
+                   t->n == 1 ? TS_PLOT_MARKERS : t->style, marker_glyph(i));
+    }
+    double extent = fmax(x1 - x0, y1 - y0);
+    if (!(extent > 0))
+        extent = pconv(TS_PLOT_LENGTH, o, 1.0);
+    pad_range(&x0, &x1, 0.06, extent);
+    pad_range(&y0, &y1, 0.06, extent);
+    if (markers)
+        legend_add(&L, "marked points", COL_FG, TS_PLOT_MARKERS, "◇");
+    PLFLT sx0, sx1, sy0, sy1;
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    legend_layout lay = legend_plan(&L, 0.87 * (sx1 - sx0));
+    double box_top = 0.89 - (lay.height_mm > 0 ? lay.height_mm + 2.0 : 0) /
+                                (sy1 - sy0);
+    plvpor(left_edge(tick_width(y0, y1, 0), 1.0), 0.97, 0.11, box_top);
+    equalize(&x0, &x1, &y0, &y1);
+    frame f;
+    /* y (starboard at t = 0) grows down the page, as in the top view. */
+    frame_set(&f, x0, x1, y1, y0, 0, 0);
+    frame_axes(&f, "bcnst", "bcnst", 0);
+    for (int i = 0; i < c->ntracks; i++) {
+        const ts_plot_track *t = &c->tracks[i];
+        int col = color_index(t->color, i);
+        for (int k = 0; k < t->n; k++) {
+            px[k] = pconv(TS_PLOT_LENGTH, o, t->x[k]);
+            py[k] = pconv(TS_PLOT_LENGTH, o, t->y[k]);
+        }
+        ts_plot_series s = {t->n, px, py, NULL, 0, t->style, 0, NULL};
+        draw_series(&f, &s, col, i, px, py);
+        /* The direction of travel: an arrowhead on the last segment that
+         * has a length. */
+        int k = t->n - 1;
+        while (k > 0 && px[k - 1] == px[k] && py[k - 1] == py[k])
+            k--;
+        if (k > 0 && t->style != TS_PLOT_MARKERS) {
+            double dx = px[t->n - 1] - px[k - 1], dy = py[t->n - 1] - py[k - 1];
+            double len = hypot(dx, dy), a = ARROW_SIZE * (x1 - x0);
+            double ux = dx / len, uy = dy / len;
+            double ax[3] = {px[t->n - 1], px[t->n - 1] - a * ux + 0.4 * a * uy,
+                            px[t->n - 1] - a * ux - 0.4 * a * uy};
+            double ay[3] = {py[t->n - 1], py[t->n - 1] - a * uy - 0.4 * a * ux,
+                            py[t->n - 1] - a * uy + 0.4 * a * ux};
+            plcol0(col);
+            plfill(3, ax, ay);
+            frame_point(&f, ax[0], ay[0]);
+        }
+        plschr(0, 0.85);
+        for (int m = 0; m < t->nmarkers; m++) {
+            const ts_plot_marker *mk = &t->markers[m];
+            double mx = pconv(TS_PLOT_LENGTH, o, mk->x);
+            double my = pconv(TS_PLOT_LENGTH, o, mk->y);
+            plcol0(col);
+            draw_markers(&f, 1, &mx, &my, "◇");
+            if (mk->label && mk->label[0]) {
+                char txt[TEXT_MAX];
+                pl_text(txt, sizeof txt, mk->label);
+                plcol0(COL_FG);
+                /* Just right of the marker and above it (y grows down). */
+                plptex(mx + 0.012 * (x1 - x0), my - 0.02 * (y1 - y0), 1, 0,
+                       0.0, txt);
+            }
+        }
+        plschr(0, 1.0);
+    }
+    char xl[TEXT_MAX], yl[TEXT_MAX];
+    axis_label(xl, sizeof xl, "x, earth frame (initial heading)",
+               TS_PLOT_LENGTH, o);
+    axis_label(yl, sizeof yl, "y, earth frame (initial starboard)",
+               TS_PLOT_LENGTH, o);
+    label_axes(&f, xl, yl, 1.0);
+    legend_draw_above(&L, lay);
+    page_title(c->title);
+    free(px);
+    return TS_OK;
+}
+
+int ts_plot_tracks(const char *dir, const char *name, const char *title,
+                   int ntracks, const ts_plot_track tracks[],
+                   const ts_plot_opts *opts, ts_err *err)
+{
+    static const char fn[] = "ts_plot_tracks";
+    ts_plot_opts def;
+    int rc = begin(fn, dir, name, title, &opts, &def, err);
+    if (rc)
+        return rc;
+    if (ntracks < 1 || !tracks)
+        return ts_fail(err, TS_EINVAL, "%s: expected at least one track, got "
+                                       "%d",
+                       fn, ntracks);
+    for (int i = 0; i < ntracks; i++) {
+        const ts_plot_track *t = &tracks[i];
+        if (t->n < 1)
+            return ts_fail(err, TS_EINVAL, "%s: tracks[%d].n: must be >= 1, "
+                                           "got %d",
+                           fn, i, t->n);
+        if ((rc = check_array(fn, "x", i, t->x, t->n, 0, err)) ||
+            (rc = check_array(fn, "y", i, t->y, t->n, 0, err)))
+            return rc;
+        if (t->style < TS_PLOT_SOLID || t->style > TS_PLOT_LINE_MARKERS)
+            return ts_fail(err, TS_EINVAL, "%s: tracks[%d].style: unknown "
+                                           "style %d",
+                           fn, i, t->style);
+        if (t->nmarkers < 0 || (t->nmarkers > 0 && !t->markers))
+            return ts_fail(err, TS_EINVAL, "%s: tracks[%d].markers: expected "
+                                           "%d markers, got %s",
+                           fn, i, t->nmarkers,
+                           t->nmarkers < 0 ? "a negative count" : "NULL");
+        for (int m = 0; m < t->nmarkers; m++)
+            if (!isfinite(t->markers[m].x) || !isfinite(t->markers[m].y))
+                return ts_fail(err, TS_EINVAL, "%s: tracks[%d].markers[%d]: "
+                                               "must be finite, got (%g, %g)",
+                               fn, i, m, t->markers[m].x, t->markers[m].y);
+    }
+    tracks_ctx c = {title, ntracks, tracks};
+    return render(fn, dir, name, title, opts, opts->height, draw_tracks, &c,
                   err);
 }
 

@@ -758,6 +758,105 @@ static void test_histories(void)
     CHECK(nothing_named("hist_bad"), "refused histories left no file");
 }
 
+/* Tracks in the earth frame: a full steady turn of the ship (radius
+ * 100 m about (0, 100) m, starboard) and a quarter of a body's smaller
+ * circle, with markers. Checked on the SVG: equal scales (the full
+ * circle is round on the page), starboard down the page, one arrowhead
+ * per track of several points, and refusals. */
+#define TRACK_POINTS 181
+static void test_tracks(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    double sx[TRACK_POINTS], sy[TRACK_POINTS], bx[TRACK_POINTS / 4 + 1],
+        by[TRACK_POINTS / 4 + 1];
+    for (int k = 0; k < TRACK_POINTS; k++) {
+        double a = 2 * M_PI * k / (TRACK_POINTS - 1);
+        sx[k] = 100 * sin(a);
+        sy[k] = 100 - 100 * cos(a);
+    }
+    for (int k = 0; k <= TRACK_POINTS / 4; k++) {
+        double a = 2 * M_PI * k / (TRACK_POINTS - 1);
+        bx[k] = -30 + 60 * sin(a);
+        by[k] = 100 - 60 * cos(a);
+    }
+    ts_plot_marker wp[2] = {{0, 0, "start"}, {100, 100, "WP #1"}};
+    ts_plot_track t[3] = {
+        {TRACK_POINTS, sx, sy, "ship", TS_PLOT_SOLID, 1, 2, wp},
+        {TRACK_POINTS / 4 + 1, bx, by, "towfish", TS_PLOT_DASHED, 2, 0, NULL},
+        {1, sx, sy, "one point", TS_PLOT_SOLID, 3, 0, NULL}};
+    int rc = ts_plot_tracks(dir, "tracks", "a steady turn, earth frame", 3, t,
+                            &o, &err);
+    CHECK(rc == TS_OK, "tracks drawn (%s)", err.msg);
+    check_png("tracks", 1000, 700);
+    char *svg = check_svg("tracks", "a steady turn, earth frame");
+    free(svg);
+    /* The geometry, on a picture without a legend (its line samples are
+     * strokes of the same colours) and without markers. */
+    ts_plot_track g[2] = {t[0], t[1]};
+    g[0].label = g[1].label = NULL;
+    g[0].nmarkers = 0;
+    rc = ts_plot_tracks(dir, "tracks_plain", "two tracks", 2, g, &o, &err);
+    CHECK(rc == TS_OK, "tracks without a legend drawn (%s)", err.msg);
+    svg = check_svg("tracks_plain", "two tracks");
+    /* The ship's track in palette colour 1 (0 114 178), its arrowhead a
+     * fill of that colour; the towfish's in colour 2 (213 94 0). */
+    static const char stroke1[] = "fill:none;stroke-width:2.2;stroke-linecap:"
+                                  "butt;stroke-linejoin:bevel;stroke:rgb("
+                                  "0%,44.705882%,69.803922%)";
+    static const char fill1[] = "fill-rule:nonzero;fill:rgb(0%,44.705882%,"
+                                "69.803922%)";
+    static const char fill2[] = "fill:rgb(83.529412%,36.862745%,0%)";
+    bbox circle, head1, head2;
+    int nc = svg ? svg_bbox(svg, stroke1, &circle) : 0;
+    int nh1 = svg ? svg_bbox(svg, fill1, &head1) : 0;
+    int nh2 = svg ? svg_bbox(svg, fill2, &head2) : 0;
+    CHECK(nc >= 1, "the ship's track is drawn (%d paths)", nc);
+    CHECK_NEAR((circle.y1 - circle.y0) / (circle.x1 - circle.x0), 1.0, 0.01,
+               "equal scales: the full turn is round on the page");
+    CHECK(nh1 == 1 && nh2 == 1, "one arrowhead on each track of several "
+          "points (%d, %d)", nh1, nh2);
+    /* The ship's arrowhead is at the start (the turn is closed), the
+     * circle's top point; the centre is below it: starboard is down. */
+    CHECK(fabs(0.5 * (head1.y0 + head1.y1) - circle.y0) < 10 &&
+              circle.y1 > circle.y0 + 100,
+          "starboard is down the page (arrow at %.1f pt, circle %.1f..%.1f)",
+          0.5 * (head1.y0 + head1.y1), circle.y0, circle.y1);
+    /* The towfish's quarter turn ends heading +y (down the page). */
+    CHECK(nh2 == 1 && head2.y1 - head2.y0 > head2.x1 - head2.x0,
+          "the towfish's arrowhead points along its last segment (%.1f x "
+          "%.1f pt)", head2.x1 - head2.x0, head2.y1 - head2.y0);
+    free(svg);
+    o.units = TS_PLOT_IMPERIAL;
+    rc = ts_plot_tracks(dir, "tracks_ft", "in feet", 2, t, &o, &err);
+    CHECK(rc == TS_OK, "tracks in feet drawn (%s)", err.msg);
+    free(check_svg("tracks_ft", "in feet"));
+    ts_plot_opts_default(&o);
+
+    double bad[2] = {0, NAN};
+    ts_plot_track tb = {2, sx, bad, "x", 0, 0, 0, NULL};
+    rc = ts_plot_tracks(dir, "tracks_bad", "x", 1, &tb, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "y[1]"),
+          "a NaN point is refused: %s", err.msg);
+    tb = (ts_plot_track){2, sx, sy, "x", 0, 0, 2, NULL};
+    rc = ts_plot_tracks(dir, "tracks_bad", "x", 1, &tb, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tracks[0].markers"),
+          "markers NULL with a count is refused: %s", err.msg);
+    ts_plot_marker inf = {INFINITY, 0, "far"};
+    tb = (ts_plot_track){2, sx, sy, "x", 0, 0, 1, &inf};
+    rc = ts_plot_tracks(dir, "tracks_bad", "x", 1, &tb, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "markers[0]"),
+          "an infinite marker is refused: %s", err.msg);
+    tb = (ts_plot_track){0, sx, sy, "x", 0, 0, 0, NULL};
+    rc = ts_plot_tracks(dir, "tracks_bad", "x", 1, &tb, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tracks[0].n"),
+          "an empty track is refused: %s", err.msg);
+    rc = ts_plot_tracks(dir, "tracks_bad", "x", 0, t, &o, &err);
+    CHECK(rc == TS_EINVAL, "no track is refused: %s", err.msg);
+    CHECK(nothing_named("tracks_bad"), "refused tracks left no file");
+}
+
 static void test_loglog(void)
 {
     ts_plot_opts o;
@@ -1058,7 +1157,9 @@ static void test_without_plplot(void)
     ts_plot_axis a = {"a", TS_PLOT_NONE, NULL};
     double gz[4] = {1, 2, 3, 4};
     ts_plot_grid g = {2, 2, x, y, gz};
-    int rc[8];
+    ts_plot_track tr = {2, x, y, "t", 0, 0, 0, NULL};
+    int rc[9];
+    rc[8] = ts_plot_tracks(dir, "n8", "t", 1, &tr, &o, &err);
     rc[0] = ts_plot_shapes(dir, "n0", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
     rc[1] = ts_plot_mode_shapes(dir, "n1", "t", 0, &one, 1, &mode, &o, &err);
     rc[2] = ts_plot_eigenvalues(dir, "n2", "t", 1, &s, NULL, &o, &err);
@@ -1069,7 +1170,7 @@ static void test_without_plplot(void)
     rc[6] = ts_plot_panels(dir, "n6", "t", &a, 1, &a, 1, &s, &o, &err);
     rc[7] = ts_plot_map(dir, "n7", "t", &a, &a, &a, &g, NULL, 0, NULL, NULL,
                         &o, &err);
-    for (int i = 0; i < 8; i++)
+    for (int i = 0; i < 9; i++)
         CHECK(rc[i] == TS_EDOMAIN, "drawing function %d returns TS_EDOMAIN",
               i);
     CHECK(nothing_named("n"), "nothing was written");
@@ -1213,6 +1314,7 @@ int main(int argc, char **argv)
     test_bode();
     test_histories();
     test_loglog();
+    test_tracks();
     test_map();
     test_bad_places();
     test_streams();

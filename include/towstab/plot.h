@@ -266,6 +266,39 @@ TS_API int ts_plot_shapes(const char *dir, const char *name,
                           int nshapes, const ts_plot_shape shapes[],
                           const ts_plot_opts *opts, ts_err *err);
 
+/* A marked point of a track plan (a waypoint, the start of a turn). */
+typedef struct ts_plot_marker {
+    double x, y;            /* in the earth frame R, m */
+    const char *label;      /* text beside it ("WP 1"); NULL or "": none */
+} ts_plot_marker;
+
+/* One track: the path of a point (the ship, a body) in the horizontal
+ * plane of the earth frame R (doc/model.md section 1: at t = 0 R
+ * coincides with the mean ship frame M, x forward, y starboard). */
+typedef struct ts_plot_track {
+    int n;                  /* points, >= 1 */
+    const double *x, *y;    /* [n] R's x and y, m */
+    const char *label;      /* legend text; NULL or "": no entry */
+    int style;              /* TS_PLOT_SOLID ... TS_PLOT_LINE_MARKERS */
+    int color;              /* as ts_plot_series */
+    int nmarkers;           /* >= 0 */
+    const ts_plot_marker *markers; /* [nmarkers], drawn as open diamonds
+                               in the track's colour with their text */
+} ts_plot_track;
+
+/* Tracks in plan view, the earth frame: ntracks >= 1 tracks overlaid, x
+ * to the right and y (starboard at t = 0) down the page with equal
+ * scales, the window holding every point and marker. Each track of two
+ * or more points ends in an arrowhead pointing along its last segment (the
+ * direction of travel); a track of one point is a marker. The legend sits
+ * above the plot box. E.g. a ship's track and its towfish's under a
+ * manoeuvre, with the waypoints as markers, or the circles a steady turn
+ * traces. */
+TS_API int ts_plot_tracks(const char *dir, const char *name,
+                          const char *title, int ntracks,
+                          const ts_plot_track tracks[],
+                          const ts_plot_opts *opts, ts_err *err);
+
 /* Mode shapes: one row per mode (1 <= nmodes <= 8), side view on the left
  * and top view (equal scales) on the right. Each shows the equilibrium
  * `eq` (grey) and eq +- s disp (solid and dashed), s chosen so that the
