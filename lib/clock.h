@@ -1,4 +1,5 @@
-/* clock.h (private): the wall clock of run times and progress reports. */
+/* clock.h (private): the wall clock of run times and progress reports,
+ * and the process's CPU clock (benchmarks); also used by tools/. */
 #ifndef TOWSTAB_LIB_CLOCK_H
 #define TOWSTAB_LIB_CLOCK_H
 
@@ -9,6 +10,15 @@ static inline double tsi_wall_now(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Seconds of CPU time of the whole process, every thread (differences
+ * only). */
+static inline double tsi_cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
