@@ -13,7 +13,8 @@
  *  5. A simulation of Kamman's steady turn (example 3) from its
  *     equilibrium: the sphere at rest in M runs on a circle about the turn
  *     centre (0, V/Omega) of E, its earth channels from ts_history_value;
- *     the earth channels are refused outside a simulation.
+ *     the earth channels are refused outside a simulation; the full
+ *     state's JSON carries the poses.
  *  6. Bad times refused.
  * Tolerances are stated at each check with their reason. */
 #include "towstab/track.h"
@@ -26,6 +27,7 @@
 #include "tscene.h"
 #include "towstab/analysis.h"
 #include "towstab/output.h"
+#include "towstab/report_time.h"
 
 /* The quadrature's relative tolerance TS_TRACK_RTOL times distances of
  * tens of m, summed over up to 100 stretches, with margin. */
@@ -160,6 +162,17 @@ static void test_simulated_turn(const ts_units *u)
         CHECK(tow < TOL_TRACK,
               "the tow point's earth y is V/Omega (1 - cos Omega t) to %.2g m",
               tow);
+        /* The full state's JSON carries the poses. */
+        json_t *o = json_object();
+        int jrc = ts_report_history_full(o, sys, h);
+        json_t *hd = json_object_get(json_object_get(o, "frame"), "heading");
+        int i = h->nsamples - 1;
+        CHECK(jrc == TS_OK && json_array_size(hd) == (size_t)h->nsamples &&
+                  json_real_value(json_array_get(hd, (size_t)i)) ==
+                      h->frame[3 * i + 2],
+              "the full state's JSON has the frame's heading, %g rad at "
+              "%g s", h->frame[3 * i + 2], h->t[i]);
+        json_decref(o);
     }
     ts_result_free(r);
 
