@@ -57,11 +57,6 @@
 
 static ts_units *units;
 
-static ts_scene *scene_from(const char *yaml)
-{
-    return tscene_parse(units, yaml);
-}
-
 /* Solve, linearize; NULL on failure (reported). */
 static ts_linear *linearize(const ts_system *sys)
 {
@@ -129,7 +124,7 @@ static void chain_exact(const ts_system *sys, double *w)
 
 static void test_chain(void)
 {
-    ts_scene *sc = scene_from(chain_yaml(12, 8.25));
+    ts_scene *sc = tscene_parse(units, chain_yaml(12, 8.25));
     const ts_system *sys = sc->system;
     ts_linear *lin = linearize(sys);
     ts_eigen *e = NULL;
@@ -198,7 +193,7 @@ static void test_continuum(void)
     int falling = 1;
     double last1 = 0;
     for (int t = 0; t < 3; t++) {
-        ts_scene *sc = scene_from(chain_yaml(links[t], L));
+        ts_scene *sc = tscene_parse(units, chain_yaml(links[t], L));
         ts_linear *lin = linearize(sc->system);
         ts_eigen *e = NULL;
         ts_eigen_opts o;
@@ -250,7 +245,7 @@ static double nearest(const ts_eigen *all, double re, double im)
 
 static void test_arpack_small(void)
 {
-    ts_scene *sc = scene_from(towed_yaml);
+    ts_scene *sc = tscene_parse(units, towed_yaml);
     ts_linear *lin = linearize(sc->system);
     ts_eigen *all = NULL, *ar = NULL, *lp = NULL;
     ts_err err = {0};
@@ -571,12 +566,9 @@ static void test_rounding(void)
 
 int main(void)
 {
-    ts_err err = {0};
-    units = ts_units_alloc(&err);
-    if (!units) {
-        printf("FAIL units: %s\n", err.msg);
+    units = tscene_units();
+    if (!units)
         return 1;
-    }
     test_chain();
     test_continuum();
     test_arpack_small();

@@ -36,6 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/eigen.h"
@@ -43,11 +44,6 @@
 #include "towstab/scene.h"
 
 static ts_units *units;
-
-static ts_scene *scene_from(const char *yaml)
-{
-    return tscene_parse(units, yaml);
-}
 
 static const char *above_yaml =
     "name: ex1_above\n"
@@ -183,7 +179,7 @@ static void static_case(ts_system *sys, ts_linear *lin, const char *in_name,
 
 static void test_static_gain(void)
 {
-    ts_scene *sc = scene_from(above_yaml);
+    ts_scene *sc = tscene_parse(units, above_yaml);
     double zmin;
     ts_linear *lin = linearize(sc->system, TS_LIN_BOTH, &zmin);
     CHECK(lin && zmin > 0.1, "above-water tow: every node %.3g m > 0.1 m "
@@ -196,7 +192,7 @@ static void test_static_gain(void)
     ts_linear_free(lin);
     ts_scene_free(sc);
 
-    sc = scene_from(turn_yaml);
+    sc = tscene_parse(units, turn_yaml);
     lin = linearize(sc->system, TS_LIN_BOTH, NULL);
     static_case(sc->system, lin, "tow.surge", "sphere.y", 0.01);
     ts_linear_free(lin);
@@ -205,7 +201,7 @@ static void test_static_gain(void)
 
 static void test_resonance(void)
 {
-    ts_scene *sc = scene_from(
+    ts_scene *sc = tscene_parse(units, 
         "name: chain\n"
         "environment: {water_density: 0, gravity: 9.80665}\n"
         "tow: {speed: 0}\n"
@@ -262,9 +258,6 @@ static void test_resonance(void)
     ts_linear_free(lin);
     ts_scene_free(sc);
 }
-
-void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
-            int *ipiv, double complex *b, const int *ldb, int *info);
 
 /* The response the old way, from the dense A, B and tension Jacobians of
  * the column-difference linearization (an independent reference for the
@@ -359,7 +352,7 @@ static void test_dense_reference(void)
         {"sphere.z", "cable.1.tension", "cable.7.tension"},
         {"fish.z", "a.2.tension", "b.4.y"}};
     for (int sc_i = 0; sc_i < 4; sc_i++) {
-        ts_scene *sc = scene_from(scenes[sc_i]);
+        ts_scene *sc = tscene_parse(units, scenes[sc_i]);
         if (!sc)
             continue;
         const ts_system *sys = sc->system;
@@ -448,7 +441,7 @@ static void test_dense_reference(void)
 
 static void test_names(void)
 {
-    ts_scene *sc = scene_from(above_yaml);
+    ts_scene *sc = tscene_parse(units, above_yaml);
     const ts_system *sys = sc->system;
     ts_err err = {0};
     ts_output out;
@@ -638,7 +631,7 @@ static int tally_gains(const ts_system *sys, const ts_linear *lin,
  * outputs from its own unknowns). */
 static void test_rounding(void)
 {
-    ts_scene *sc = scene_from(turn_yaml);
+    ts_scene *sc = tscene_parse(units, turn_yaml);
     ts_err err = {0};
     ts_system *sys = ts_system_copy(sc->system, &err);
     ts_system_set_links(sys, 10, &err);
@@ -753,12 +746,9 @@ static void test_vehicle_allowance(void)
 
 int main(void)
 {
-    ts_err err = {0};
-    units = ts_units_alloc(&err);
-    if (!units) {
-        printf("FAIL units: %s\n", err.msg);
+    units = tscene_units();
+    if (!units)
         return 1;
-    }
     test_static_gain();
     test_resonance();
     test_dense_reference();
