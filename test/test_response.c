@@ -24,7 +24,8 @@
  *     links, surge and sway, three outputs (one a tension), the static gain
  *     and 5 frequencies, at the default step and at steps 1e-7 and 1e-8
  *     where rounding dominates: every gain within its allowance of that
- *     of a tight, fourth-order linearization (test_rounding).
+ *     of a tight, fourth-order linearization, for the dense model and
+ *     the sparse one (test_rounding).
  */
 #include "towstab/response.h"
 
@@ -572,7 +573,10 @@ static ts_linear *tight(const ts_system *sys, double h)
  * steps 5e-4 and 1e-3, fourth order, rounding 1e4 times smaller), up to
  * that reference's own uncertainty (its distance to the same from steps
  * 1e-3 and 2e-3). At 1e-8 at least a third of the gains have errors 10
- * times that uncertainty, so the check is about the allowance. */
+ * times that uncertainty, so the check is about the allowance. The same
+ * for the dense model (A's error estimate and noise) and the sparse one
+ * (the node residual's entry-wise truncation and rounding, with tension
+ * outputs from its own unknowns). */
 static void test_rounding(void)
 {
     ts_scene *sc = tscene_parse(units, turn_yaml);
@@ -586,8 +590,11 @@ static void test_rounding(void)
                                         "cable.1.tension"};
     double freq[5];
     ts_response_logspace(0.05, 5, 5, freq, &err);
-    for (int k = 0; k < 3 && ref && ref2; k++) {
-        ts_linear *lin = linearize_at(sys, TS_LIN_DENSE, steps[k], NULL);
+    for (int kk = 0; kk < 6 && ref && ref2; kk++) {
+        int k = kk % 3, sparse = kk >= 3;
+        ts_linear *lin = linearize_at(sys, sparse ? TS_LIN_SPARSE
+                                                  : TS_LIN_DENSE,
+                                      steps[k], NULL);
         int n = 0, clear = 0, ok = lin != NULL;
         double worst = 0, we = NAN, wb = NAN;
         for (int a = 0; a < 2 && ok; a++)
@@ -631,11 +638,12 @@ static void test_rounding(void)
          * perturbed coordinate the kernel rounds identically). */
         CHECK(ok && worst <= 1 &&
                   (k < 2 || (clear >= n / 3 && worst >= 0.01)),
-              "ex. 3 turn, 10 links, step %.3g: every gain (%d; %d with "
-              "errors 10 times the reference's uncertainty) within its "
-              "error allowance of the tight one (closest %.2f: error "
+              "ex. 3 turn, 10 links, %s model, step %.3g: every gain (%d; "
+              "%d with errors 10 times the reference's uncertainty) within "
+              "its error allowance of the tight one (closest %.2f: error "
               "%.3g, allowance %.3g) (%s)",
-              steps[k], n, clear, worst, we, wb, ok ? "" : err.msg);
+              sparse ? "sparse" : "dense", steps[k], n, clear, worst, we,
+              wb, ok ? "" : err.msg);
         ts_linear_free(lin);
     }
     CHECK(ref && ref2, "tight linearizations");
