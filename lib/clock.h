@@ -1,5 +1,6 @@
 /* clock.h (private): the wall clock of run times and progress reports,
- * and the process's CPU clock (benchmarks); also used by tools/. */
+ * and the process's CPU clock (benchmarks). tools/ keeps its own: it
+ * sees the library through its public headers only (test/layers.sh). */
 #ifndef TOWSTAB_LIB_CLOCK_H
 #define TOWSTAB_LIB_CLOCK_H
 

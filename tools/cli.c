@@ -11,7 +11,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "clock.h"
 #include "towstab/report.h"
 
 /* The descriptor JSON for "-" goes to, once standard output has been moved
@@ -127,6 +126,13 @@ int cli_finish(int status)
     return status;
 }
 
+double cli_wall_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 /* ---- interruption and progress ---------------------------------------- */
 
 /* The tool's state (one process, one command), not the library's: the
@@ -206,7 +212,7 @@ int cli_progress(const ts_progress *p, void *data)
         return 1;
     if (!progress_tty)
         return 0;
-    double now = tsi_wall_now();
+    double now = cli_wall_now();
     if (line.what != p->what || p->done < line.done0) {
         line.what = p->what;
         line.start = line.last = now;

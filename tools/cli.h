@@ -89,6 +89,8 @@ typedef struct cli_command {
     int (*execute)(cli_run *c);
 } cli_command;
 
+double cli_wall_now(void);
+
 /* The value of the last `--analysis A` (or `--analysis=A`) of argv, NULL
  * when none: commands built for another analysis (sweep, design) read it
  * before their option table is known. */

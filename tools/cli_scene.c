@@ -8,7 +8,6 @@
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "clock.h"
 #include "towstab/report_result.h"
 
 int cli_make_dir(const char *cmd, const char *opt, const char *dir)
@@ -145,9 +144,9 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
         printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
                s->n, scene->analyses[i].type, scene->system->name);
         json_t *j = NULL;
-        double t0 = tsi_wall_now();
+        double t0 = cli_wall_now();
         status = cli_execute(&s->runs[i], &j);
-        s->wall_s[i] = tsi_wall_now() - t0;
+        s->wall_s[i] = cli_wall_now() - t0;
         s->ran = i + 1;
         if (j)
             json_array_append_new(list, j);
