@@ -14,6 +14,7 @@
 
 #include "towstab/error.h"
 #include "towstab/vehicle.h"
+#include "towstab/guidance.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -53,6 +54,9 @@ typedef struct ts_tow {
                                the tow point r_tow, is node 0, starting at
                                `point`; doc/towing-vehicle.md), or -1: the
                                tow point is prescribed */
+    ts_autopilot autopilot; /* the scene's waypoints (on = 0: none): a
+                               simulation steers the towing vehicle's
+                               rudder toward them (towstab/guidance.h) */
 } ts_tow;
 
 typedef struct ts_cable {
