@@ -318,6 +318,7 @@ void ts_result_free(ts_result *r)
     ts_eigen_free(r->eigen);
     free(r->mode_health);
     free(r->margins);
+    ts_free_vehicle_free(r->free_vehicle);
     free(r->mode_accuracy);
     ts_response_free(r->response);
     ts_seastate_free(r->seastate);
@@ -829,6 +830,15 @@ static int modes_margins(ts_result *r, ts_err *err)
 static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
 {
     const ts_modes_opts *m = &rq->modes;
+    if (m->free_vehicle && r->sys->tow.vehicle < 0)
+        return ts_fail(err, TS_EINVAL, "free_vehicle: the scene has no "
+                       "towing_vehicle to compare");
+    if (m->free_vehicle && rq->setup.open_loop)
+        return ts_fail(err, TS_EINVAL, "free_vehicle: compares the closed "
+                       "loops; leave out open_loop");
+    if (m->free_vehicle && m->eigen.method == TS_EIG_ARPACK)
+        return ts_fail(err, TS_EINVAL, "free_vehicle: needs every coupled "
+                       "mode with its shape: eigen_method lapack or auto");
     /* LAPACK needs the dense A at any size. */
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
@@ -862,6 +872,10 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
                       m->eigen.target_hz);
     ts_trust_merge(&r->trust, NULL, &r->modes_trust);
     if (m->margins && !rq->setup.open_loop && (rc = modes_margins(r, err)))
+        return rc;
+    if (m->free_vehicle &&
+        (rc = ts_free_vehicle_compare(r->sys, r->eq, r->lin, r->eigen,
+                                      &r->free_vehicle, err)))
         return rc;
     return modes_values(r, m->follow, err);
 }

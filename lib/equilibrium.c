@@ -144,12 +144,14 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
             maxc += (size_t)(sys->bodies[b].vehicle->nloops +
                              sys->bodies[b].vehicle->ncomponents);
     eq->nvehicles = sys->nvehicles;
-    /* up to 3 coordinates a link, 3 a vehicle, and their rates */
-    eq->y = calloc(6 * nl + 6 * (size_t)sys->nvehicles + maxc,
+    /* up to 3 coordinates a link, 3 a vehicle (6 the towing vehicle),
+     * and their rates */
+    eq->y = calloc(6 * nl + 6 * (size_t)sys->nvehicles +
+                       (sys->tow.vehicle >= 0 ? 6 : 0) + maxc,
                    sizeof(double));
-    eq->directions = calloc(3 * nl, sizeof(double));
+    eq->directions = calloc(3 * nl + 1, sizeof(double));
     eq->positions = calloc(3 * nn, sizeof(double));
-    eq->tensions = calloc(nl, sizeof(double));
+    eq->tensions = calloc(nl + 1, sizeof(double));
     eq->attitudes = calloc(9 * (size_t)sys->nvehicles + 1, sizeof(double));
     eq->controls = calloc(maxc + 1, sizeof(double));
     eq->vehicles = calloc((size_t)sys->nvehicles + 1,
@@ -180,12 +182,14 @@ void ts_equilibrium_free(ts_equilibrium *eq)
     free(eq);
 }
 
+/* The cables' length (1 m for a towing vehicle without cables: a scale
+ * of positions). */
 static double total_length(const ts_system *sys)
 {
     double L = 0;
     for (int l = 0; l < sys->nlinks; l++)
         L += sys->links[l].length;
-    return L;
+    return sys->nlinks > 0 ? L : 1.0;
 }
 
 /* Weight of controller state i's rate in the verdict: a loop's error over
@@ -1262,15 +1266,16 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     }
     double *y = calloc((size_t)n, sizeof(double));
     double *dydt = malloc((size_t)n * sizeof(double));
-    double *dvec = malloc(3 * (size_t)nl * sizeof(double));
-    double *strain = calloc((size_t)nl, sizeof(double));
+    double *dvec = malloc((3 * (size_t)nl + 1) * sizeof(double));
+    double *strain = calloc((size_t)nl + 1, sizeof(double));
     double *att = malloc((9 * (size_t)nv + 1) * sizeof(double));
-    tsi_march *m = tsi_march_alloc(sys, err);
+    /* (No march for a towing vehicle alone.) */
+    tsi_march *m = nl > 0 ? tsi_march_alloc(sys, err) : NULL;
     newton_ws w = {0};
     int ro = ts_kernel_root_offset(k);
     if (y && ro >= 0)
         memcpy(y + ro, sys->tow.point, 3 * sizeof(double));
-    if (!m) {
+    if (!m && nl > 0) {
         rc = err ? err->code : TS_ENOMEM; /* the march named its size */
         goto out;
     }
@@ -1364,9 +1369,11 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         ts_err merr = {0};
         int it = 0;
         long ev = 0;
-        double *x = malloc((size_t)tsi_march_nunknown(m) * sizeof(double));
+        double *x = m ? malloc((size_t)tsi_march_nunknown(m) *
+                               sizeof(double))
+                      : NULL;
         int mrc = TS_ECONV;
-        if (nv > 0)
+        if (nv > 0 && m)
             mrc = vehicle_start(sys, m, &straight,
                                 SHOOT_POS_RTOL * total_length(sys),
                                 o.max_iter, dvec, strain, att, eq);

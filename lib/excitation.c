@@ -604,8 +604,8 @@ static char *trim(char *s)
     return s;
 }
 
-/* The amplitude of a vehicle input's signal: a length (m) or an angle
- * (rad), its kind kept in s->input_unit ("" for a plain number). */
+/* The amplitude of a vehicle input's signal: a length (m), an angle
+ * (rad), a force (N) or a moment (N*m), its kind kept in s->input_unit ("" for a plain number). */
 static int input_amplitude(const ts_units *units, const char *text,
                            const char *where, ts_signal *s, ts_err *err)
 {
@@ -625,8 +625,18 @@ static int input_amplitude(const ts_units *units, const char *text,
         snprintf(s->input_unit, sizeof s->input_unit, "rad");
         return TS_OK;
     }
+    /* A towing vehicle's thrust or external force, or moment. */
+    static const char *const other[2] = {"N", "N*m"};
+    for (int i = 0; i < 2; i++)
+        if (ts_units_parse(units, text, other[i], where, &s->amplitude, &e) ==
+            TS_OK) {
+            snprintf(s->input_unit, sizeof s->input_unit, "%s", other[i]);
+            return TS_OK;
+        }
     return ts_fail(err, TS_EUNIT, "%s: '%.40s' is neither a length (m, for "
-                   "a depth set point) nor an angle (rad, deg)", where, text);
+                   "a depth set point), an angle (rad, deg), a force (N, a "
+                   "towing vehicle's thrust or force) nor a moment (N*m)",
+                   where, text);
 }
 
 int ts_excitation_parse(ts_excitation *ex, const char *spec,

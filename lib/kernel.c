@@ -1762,6 +1762,8 @@ void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
         ts_kernel_tow_force(k, r->joint_force);
         r->thrust = V->thrust;
         r->power = V->thrust * w[0];
+        r->track_speed = k->frame.speed;
+        r->turn_rate = k->frame.turn_rate;
     }
     r->ncomponents = d->ncomponents;
     memcpy(r->delta, V->delta, sizeof r->delta);

@@ -503,6 +503,11 @@ static const ts_option modes_rows[] = {
      .offset = OFF(modes.margins),
      .help = "with controller loops: each loop's gain and phase margins, "
              "broken one at a time"},
+    {.name = "free_vehicle", .type = TS_OPT_BOOL, .section = TS_SEC_MODES,
+     NOLIM, .offset = OFF(modes.free_vehicle),
+     .help = "with a towing vehicle: its own modes alone, without the cable, "
+             "at the same speed, each matched to the coupled mode of the "
+             "same shape"},
     {.name = "oscillatory", .type = TS_OPT_BOOL, .section = TS_SEC_MODES,
      NOLIM, .offset = OFF(modes.oscillatory),
      .help = "list the oscillatory modes only (they come first anyway)"},

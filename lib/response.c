@@ -61,8 +61,14 @@ void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
 int ts_response_input_lookup(const ts_kernel *k, const char *name,
                              int *channel, ts_err *err)
 {
-    if (ts_response_input_find(name, channel, NULL) == TS_OK)
-        return TS_OK;
+    if (ts_response_input_find(name, channel, NULL) == TS_OK) {
+        if (ts_kernel_root(k) < 0)
+            return TS_OK;
+        return ts_fail(err, TS_EINVAL, "input '%s': the tow point is the "
+                       "towing vehicle's, not prescribed; its inputs are "
+                       "<vehicle>.thrust, .force.x|y|z, .moment.x|y|z and "
+                       "its control surfaces and loops", name);
+    }
     int j = ts_kernel_input_find(k, name);
     if (j >= TS_NINPUT) {
         *channel = j;
@@ -637,6 +643,16 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,
                  err);
     r->static_gain = creal(g);
+    if (rc == TS_ESINGULAR && lin->root_qoff >= 0) {
+        /* A towing vehicle's neutral modes (its position along and across
+         * its track, its heading: doc/towing-vehicle.md) make A singular:
+         * no static gain, the frequencies above 0 are regular. */
+        ts_err_clear(err);
+        rc = TS_OK;
+        r->static_gain = r->static_error = NAN;
+        tsi_shift_free(&sh);
+        memset(&sh, 0, sizeof sh);
+    }
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
         rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,
                      &r->error[i], err);

@@ -1767,6 +1767,13 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
         rc = item ? parse_body(c, item, b, sys)
                   : ts_fail(c->err, TS_ESCENE, "bodies: broken YAML");
     }
+    if (rc == TS_OK && towing &&
+        (sys->tow.point[0] != 0 || sys->tow.point[1] != 0))
+        rc = fail_at(c, TS_EINVAL, "tow.point", line_of(f[K_TOW].value),
+                     "with a towing_vehicle the tow point starts the mean "
+                     "frame's origin: x and y must be 0 m, got %g and %g m "
+                     "(z is its starting depth)",
+                     sys->tow.point[0], sys->tow.point[1]);
     if (rc == TS_OK && towing) {
         rc = parse_body(c, f[K_TOWING].value, nbodies, sys);
         for (int b = 0; rc == TS_OK && b < nbodies; b++)

@@ -267,8 +267,16 @@ static int bind_inputs(const ts_kernel *k, const ts_excitation *ex,
 {
     *idx = NULL;
     int ns = ex ? ts_excitation_nsignals(ex) : 0, any = 0;
-    for (int i = 0; i < ns; i++)
-        any |= ts_excitation_signal(ex, i)->axis == TS_AXIS_INPUT;
+    for (int i = 0; i < ns; i++) {
+        int axis = ts_excitation_signal(ex, i)->axis;
+        any |= axis == TS_AXIS_INPUT;
+        if (ts_kernel_root(k) >= 0 && axis <= TS_AXIS_HEAVE)
+            return ts_fail(err, TS_EINVAL, "excite: the tow point is the "
+                           "towing vehicle's, not prescribed: excite its "
+                           "inputs (<vehicle>.thrust, .force.x|y|z, "
+                           ".moment.x|y|z, its control surfaces) instead of "
+                           "a tow-point motion");
+    }
     if (!any)
         return TS_OK;
     int *x = malloc((size_t)ns * sizeof *x);

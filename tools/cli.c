@@ -508,8 +508,22 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
         fprintf(f, "%-20s %11s %11s %11s %11.4f %11.4f %11.4f\n",
                 "Munk moment", "", "", "", r->munk[0], r->munk[1],
                 r->munk[2]);
-        fprintf(f, "joint force (M) %.4f, %.4f, %.4f N\n", r->joint_force[0],
-                r->joint_force[1], r->joint_force[2]);
+        fprintf(f, "%s (M) %.4f, %.4f, %.4f N\n",
+                r->towing ? "cable pull at the tow point" : "joint force",
+                r->joint_force[0], r->joint_force[1], r->joint_force[2]);
+    }
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle_result *r = &vr[v];
+        if (r->towing)
+            fprintf(f, "%s: towing at %.6g m/s (%.4g knots), turn rate %.6g "
+                       "rad/s, thrust %.6g N, power %.6g W, cable pull %.6g "
+                       "N\n",
+                    sys->bodies[r->body].name, r->track_speed,
+                    r->track_speed / (1852.0 / 3600.0), r->turn_rate,
+                    r->thrust, r->power,
+                    sqrt(r->joint_force[0] * r->joint_force[0] +
+                         r->joint_force[1] * r->joint_force[1] +
+                         r->joint_force[2] * r->joint_force[2]));
     }
 }
 

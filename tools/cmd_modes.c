@@ -447,6 +447,31 @@ static void print_margins(const ts_result *r)
     }
 }
 
+/* The towing vehicle alone against the coupled system, mode by mode. */
+static void print_free_vehicle(const ts_result *r)
+{
+    const ts_free_vehicle *f = r->free_vehicle;
+    if (!f)
+        return;
+    printf("\nthe towing vehicle alone (no cable) at %.6g m/s, turn rate "
+           "%.6g rad/s, thrust %.6g N: %d states; each of its modes beside "
+           "the coupled mode of the most similar shape over the vehicle's "
+           "coordinates (MAC 1: the same motion)\n",
+           f->speed, f->turn_rate, f->thrust, f->nstate);
+    printf("%4s %12s %12s %9s   %5s %12s %12s %9s %6s\n", "free", "Re [1/s]",
+           "Im [rad/s]", "damping", "mode", "Re [1/s]", "Im [rad/s]",
+           "damping", "MAC");
+    for (int i = 0; i < f->nmodes; i++) {
+        const ts_free_mode *m = &f->modes[i];
+        char cm[16];
+        snprintf(cm, sizeof cm, "%d", m->coupled + 1);
+        printf("%4d %12.6g %12.6g %9.4g   %5s %12.6g %12.6g %9.4g %6.3f\n",
+               i + 1, m->re, m->im, m->damping_ratio,
+               m->coupled >= 0 ? cm : "-", m->coupled_re, m->coupled_im,
+               m->coupled_damping_ratio, m->mac);
+    }
+}
+
 static void modes_print(const cli_run *c, const ts_result *r)
 {
     cli_print_equilibrium(r, 1, &c->display);
@@ -454,6 +479,7 @@ static void modes_print(const cli_run *c, const ts_result *r)
     if (r->eigen && r->mode_health)
         print_modes(r, c->quiet);
     print_margins(r);
+    print_free_vehicle(r);
 }
 
 /* The extras. */

@@ -110,7 +110,7 @@ typedef struct ts_signal {
                           (TS_SIGNAL_RAMP_PERIODS) */
     int absolute;      /* manoeuvres: amplitude is the final value */
     char input[TS_SIGNAL_INPUT_MAX]; /* TS_AXIS_INPUT: the input's name */
-    char input_unit[4];/* TS_AXIS_INPUT: "m" or "rad" when the amplitude
+    char input_unit[4];/* TS_AXIS_INPUT: "m", "rad", "N" or "N*m" when the amplitude
                           was given with a unit of that kind, "" for a
                           plain (SI) number */
 } ts_signal;
