@@ -1287,6 +1287,29 @@ static int check_sim_inputs(const ts_system *sys, const ts_excitation *ex,
     return rc;
 }
 
+/* A channel of a simulation: ts_output_find's, or a vehicle's output
+ * (ts_kernel_output_name: <vehicle>.depth|pitch|roll|yaw, its loops'
+ * outputs, <vehicle>.<surface>.deflection), whose names the message of a
+ * bad one then lists too. */
+static int sim_channel(const ts_system *sys, const char *name, int kinds,
+                       ts_output *out, ts_err *err)
+{
+    int rc = ts_output_find(sys, name, kinds, out, err);
+    if (rc == TS_OK || sys->nvehicles == 0)
+        return rc;
+    ts_kernel *k = ts_kernel_alloc(sys, NULL);
+    if (!k)
+        return rc;
+    if (ts_kernel_output_find(k, name) >= 0) {
+        ts_err_clear(err);
+        rc = ts_response_output_lookup(k, name, out, err);
+    } else {
+        tsi_response_list_vehicle_outputs(k, err);
+    }
+    ts_kernel_free(k);
+    return rc;
+}
+
 /* The output of a simulation: the named one, or the last sphere's .z
  * (else the last node's). */
 static int sim_output(const ts_system *sys, const char *name, ts_output *out,
@@ -1304,7 +1327,7 @@ static int sim_output(const ts_system *sys, const char *name, ts_output *out,
         strcat(def, ".z");
         name = def;
     }
-    int rc = ts_output_find(sys, name, TS_OUT_ALL, out, err);
+    int rc = sim_channel(sys, name, TS_OUT_ALL, out, err);
     if (rc)
         ts_err_prefix(err, "output: ");
     return rc;
@@ -1363,9 +1386,9 @@ static int sim_selection(const ts_system *sys, const ts_simulate_opts *s,
                          "stands alone, not in a list");
         else if ((size_t)m >= cap)
             rc = ts_fail(err, TS_EINVAL, "outputs: too many names");
-        else if ((rc = ts_output_find(sys, b,
-                                      TS_OUT_ALL | TS_OUT_BIT(TS_OUT_EARTH),
-                                      &o[m], err)))
+        else if ((rc = sim_channel(sys, b,
+                                   TS_OUT_ALL | TS_OUT_BIT(TS_OUT_EARTH),
+                                   &o[m], err)))
             ts_err_prefix(err, "outputs: ");
         for (int k = 0; !rc && k < m; k++)
             if (!strcmp(o[k].name, o[m].name))
@@ -1497,11 +1520,12 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
     int use_linear = s->compare || s->linear;
     const char *lw = s->compare ? "compare" : "linear";
     if (use_linear && out->kind != TS_OUT_POSITION &&
-        out->kind != TS_OUT_TENSION)
+        out->kind != TS_OUT_TENSION && out->kind != TS_OUT_VEHICLE)
         return ts_fail(err, TS_EINVAL, "output: '%s': the linear model "
-                       "gives node positions and link tensions, so %s "
-                       "needs one of those (the nonlinear run alone gives "
-                       "the others)", out->name, lw);
+                       "gives node positions, link tensions and the "
+                       "vehicles' outputs, so %s needs one of those (the "
+                       "nonlinear run alone gives the others)", out->name,
+                       lw);
     if (use_linear && s->initial != TS_INITIAL_EQUILIBRIUM)
         return ts_fail(err, TS_EINVAL, "initial: the linear model starts at "
                        "the equilibrium, so %s needs the initial state "

@@ -430,7 +430,7 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
      NOLIM, .offset = OFF(simulate.output), .size = SZ(simulate.output),      \
      .only = o, .arg = "NAME",                                                \
      .help = "the channel compared and fitted, e.g. sphere.z, "               \
-             "cable.3.tension, tow.force",                                    \
+             "cable.3.tension, tow.force, fish.depth",                        \
      .deftext = "the last sphere's .z"},                                      \
     {.name = "linear_method", .type = TS_OPT_ENUM,                            \
      .section = TS_SEC_SIMULATE, NOLIM, .choices = linear_methods,            \
@@ -576,7 +576,8 @@ static const ts_option simulate_rows[] = {
      NOLIM, .offset = OFF(simulate.outputs), .size = SZ(simulate.outputs),
      .arg = "LIST",
      .help = "the channels written and printed, e.g. "
-             "fish.z,armour.1.tension,tow.force; all: the full state",
+             "fish.z,armour.1.tension,tow.force,fish.pitch,"
+             "fish.tail1.deflection; all: the full state",
      .deftext = "the output (a node's x, y, z) and tow.force"},
 };
 

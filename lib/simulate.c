@@ -352,6 +352,10 @@ double ts_history_value(const ts_system *sys, const ts_history *h,
         return out->comp == 0 ? f[0] + c * r[0] - sn * r[1]
                               : f[1] + sn * r[0] + c * r[1];
     }
+    if (out->kind == TS_OUT_VEHICLE)
+        return h->outputs && out->index >= 0 && out->index < h->noutput
+                   ? h->outputs[(size_t)h->noutput * s + (size_t)out->index]
+                   : NAN;
     return ts_output_value(sys, out, h->positions + 3 * (size_t)h->nnodes * s,
                            h->tensions + (size_t)h->nlinks * s,
                            h->tow_force + 3 * s);
