@@ -38,10 +38,12 @@ static const char *const eig_methods[] = {"auto", "lapack", "arpack", NULL};
 static const int eig_method_values[] = {TS_EIG_AUTO, TS_EIG_LAPACK,
                                         TS_EIG_ARPACK};
 static const char *const integrators[] = {"rk8pd", "rkf45", "rk4imp",
-                                          "bsimp", "msbdf", "esdirk", NULL};
+                                          "bsimp", "msbdf", "esdirk", "bdf",
+                                          NULL};
 static const int integrator_values[] = {TS_INT_RK8PD, TS_INT_RKF45,
                                         TS_INT_RK4IMP, TS_INT_BSIMP,
-                                        TS_INT_MSBDF, TS_INT_ESDIRK};
+                                        TS_INT_MSBDF, TS_INT_ESDIRK,
+                                        TS_INT_BDF};
 static const char *const linear_methods[] = {"expm", "ode", NULL};
 static const int linear_method_values[] = {TS_LINSIM_EXPM, TS_LINSIM_ODE};
 static const char *const kinematics[] = {"linear", "nonlinear", NULL};
@@ -243,8 +245,8 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
         ts_integrator m;
         if (ts_integrator_parse(tok, &m) != 0)
             return ts_fail(err, TS_EINVAL, "%s: '%s' is not an integrator; "
-                           "expected rk8pd, rkf45, rk4imp, bsimp, msbdf or "
-                           "esdirk", w, tok);
+                           "expected rk8pd, rkf45, rk4imp, bsimp, msbdf, "
+                           "esdirk or bdf", w, tok);
         for (int i = 0; i < n; i++)
             if (c->integrators[i] == m)
                 return ts_fail(err, TS_EINVAL, "%s: %s is given twice", w,
