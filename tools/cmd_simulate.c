@@ -481,6 +481,97 @@ static int plot_earth(const ts_system *sys, const ts_history *h,
     return status;
 }
 
+/* The tracks in the earth frame (towstab/track.h) under a manoeuvre or in
+ * a turn: `tracks`, the ship's (M's origin) and every body's in plan view
+ * (ts_plot_tracks), from the run's poses of M; and `depths`, every body's
+ * depth against time (the nonlinear run solid, the linear dashed). */
+#define MAX_TRACKS 8
+static int plot_tracks(const ts_system *sys, const ts_history *hn,
+                       const ts_history *hl, const cli_plot *plot)
+{
+    const ts_history *h = hn ? hn : hl;
+    int n = h->nsamples;
+    int node[MAX_TRACKS], nb = 0;
+    for (int b = 0; b < sys->nbodies && nb < MAX_TRACKS - 1; b++) {
+        int k = ts_system_body_node(sys, b);
+        if (k > 0)
+            node[nb++] = k;
+    }
+    /* x, y of the ship and each body; z of each body in both runs. */
+    double *buf = malloc((size_t)(2 * (nb + 1) + 2 * nb) * (size_t)n *
+                         sizeof *buf);
+    if (!buf) {
+        fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    char label[MAX_TRACKS][TS_NAME_MAX + 16];
+    ts_plot_track tr[MAX_TRACKS];
+    size_t nn = 3 * (size_t)h->nnodes;
+    for (int j = 0; j <= nb; j++) {
+        double *x = buf + 2 * (size_t)j * (size_t)n, *y = x + n;
+        for (int i = 0; i < n; i++) {
+            const double *f = h->frame + 3 * (size_t)i;
+            double e[3] = {f[0], f[1], 0};
+            if (j > 0)
+                ts_track_to_earth(f, h->positions + nn * (size_t)i +
+                                         3 * (size_t)node[j - 1], e);
+            x[i] = e[0];
+            y[i] = e[1];
+        }
+        if (j == 0)
+            snprintf(label[j], sizeof label[j], "ship (M's origin)");
+        else
+            ts_system_node_name(sys, node[j - 1], label[j], TS_NAME_MAX);
+        ts_plot_track t = {n, x, y, label[j],
+                           j == 0 ? TS_PLOT_DASHED : TS_PLOT_SOLID, j + 1,
+                           0, NULL};
+        tr[j] = t;
+    }
+    char title[256];
+    snprintf(title, sizeof title, "%s: tracks in the earth frame%s",
+             sys->name, hn ? "" : ", linear model");
+    ts_err err = {0};
+    int status = 0;
+    if (ts_plot_tracks(plot->dir, "tracks", title, nb + 1, tr, &plot->opts,
+                       &err) != TS_OK)
+        status = cli_report(&err, err.code);
+    else
+        cli_plot_wrote(plot, "tracks");
+    if (!status && nb > 0) {
+        double *z = buf + 2 * (size_t)(nb + 1) * (size_t)n;
+        ts_plot_series ser[2 * MAX_TRACKS];
+        char slabel[2 * MAX_TRACKS][TS_NAME_MAX + 16];
+        int ns = 0;
+        const ts_history *runs[2] = {hn, hl};
+        for (int r = 0; r < 2; r++) {
+            if (!runs[r])
+                continue;
+            for (int j = 0; j < nb; j++, ns++) {
+                double *d = z + (size_t)ns * (size_t)n;
+                int m = runs[r]->nsamples < n ? runs[r]->nsamples : n;
+                for (int i = 0; i < m; i++)
+                    d[i] = runs[r]->positions[nn * (size_t)i +
+                                              3 * (size_t)node[j] + 2];
+                snprintf(slabel[ns], sizeof slabel[ns], "%s%s",
+                         label[j + 1], hn && hl ? (r ? " linear" : "") : "");
+                ts_plot_series a = {m, runs[r]->t, d, slabel[ns], 0,
+                                    r ? TS_PLOT_DASHED : TS_PLOT_SOLID,
+                                    j + 2, NULL};
+                ser[ns] = a;
+            }
+        }
+        ts_plot_axis panel = {"depth z (down)", TS_PLOT_LENGTH, NULL};
+        snprintf(title, sizeof title, "%s: depths against time", sys->name);
+        if (ts_plot_histories(plot->dir, "depths", title, 1, &panel, ns, ser,
+                              &plot->opts, &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            cli_plot_wrote(plot, "depths");
+    }
+    free(buf);
+    return status;
+}
+
 static int plot_snapshots(const ts_system *sys, const ts_history *h,
                           const ts_excitation *ex, double interval,
                           double exaggerate, const cli_plot *plot)
@@ -775,6 +866,10 @@ static int sim_draw(cli_run *c, const ts_result *r)
     if (!status)
         status = plot_snapshots(r->sys, h, r->excitation, st->snapshot,
                                 st->exaggerate, &c->plot);
+    if (!status && ((r->excitation &&
+                     ts_excitation_has_manoeuvre(r->excitation)) ||
+                    r->sys->tow.turn_rate != 0))
+        status = plot_tracks(r->sys, r->nonlinear, r->linear, &c->plot);
     return status;
 }
 
