@@ -56,6 +56,7 @@
 #include "csvtab.h"
 #include "response_impl.h"
 #include "towstab/kernel.h"
+#include "towstab/track.h"
 
 /* Noise of an equilibrium value: this many times its relative residual
  * (at least EQ_NOISE_MIN_REL) times the length or force scale. */
@@ -1387,7 +1388,9 @@ static int sim_selection(const ts_system *sys, const ts_simulate_opts *s,
                          "stands alone, not in a list");
         else if ((size_t)m >= cap)
             rc = ts_fail(err, TS_EINVAL, "outputs: too many names");
-        else if ((rc = ts_output_find(sys, b, TS_OUT_ALL, &o[m], err)))
+        else if ((rc = ts_output_find(sys, b,
+                                      TS_OUT_ALL | TS_OUT_BIT(TS_OUT_EARTH),
+                                      &o[m], err)))
             ts_err_prefix(err, "outputs: ");
         for (int k = 0; !rc && k < m; k++)
             if (!strcmp(o[k].name, o[m].name))
@@ -2064,6 +2067,19 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
                           : (err && err->code ? err->code : TS_ENOMEM);
         r->evaluations += r->nonlinear_stats.evaluations;
     }
+    /* The earth-frame tracks (towstab/track.h): the frame's pose at each
+     * sample, also of a run that stopped early. */
+    ts_frame base;
+    ts_kernel_get_frame(k, &base);
+    base.speed_rate = base.turn_accel = 0.0;
+    ts_history *runs[2] = {r->nonlinear, r->linear};
+    for (int i = 0; i < 2; i++)
+        if (runs[i]) {
+            int trc = ts_track_history(runs[i], ex, &base,
+                                       rc == TS_OK ? err : NULL);
+            if (rc == TS_OK)
+                rc = trc;
+        }
     /* Health: the start, the linear model's kinks and the integrations'
      * statistics (towstab/health.h). */
     if (r->lin && r->lin->kink_tow && s->compare)

@@ -1,4 +1,6 @@
-/* clock.h (private): the wall clock of run times and progress reports. */
+/* clock.h (private): the wall clock of run times and progress reports,
+ * and the process's CPU clock (benchmarks). tools/ keeps its own: it
+ * sees the library through its public headers only (test/layers.sh). */
 #ifndef TOWSTAB_LIB_CLOCK_H
 #define TOWSTAB_LIB_CLOCK_H
 
@@ -9,6 +11,15 @@ static inline double tsi_wall_now(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Seconds of CPU time of the whole process, every thread (differences
+ * only). */
+static inline double tsi_cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 

@@ -23,6 +23,16 @@
  * positions max(l, (|x| l^2)^(1/3)), l the length of the link ending at
  * the node (see tsi_desc_linearize).
  *
+ * Rounding. (D(2h) - D(h)) / 3 samples the rounding noise of the
+ * differences only by chance. The residual's own noise is measured as in
+ * lib/linearize.c: at NOISE_SAMPLES states a ten-thousandth of a step
+ * from the base (every position and velocity but the tow point's at
+ * once, signs from a fixed sequence), R(x0 + d) - R(x0) - K d_r - C d_v is the rounding of two
+ * evaluations; its root mean square over sqrt(2) is the noise rnoise_i of
+ * one evaluation of row i, and entry (i, j) of a central difference
+ * carries rnoise_i / (sqrt(2) h_j). Cost: NOISE_SAMPLES + 1 residual
+ * evaluations and block products, O(nlinks).
+ *
  * The mass matrices M (dR/da), the tension columns N (dR/dt = +-n) and the
  * link rows are exact: they are read off the base state, not differenced.
  * An elastic link's tension enters the residual as an unknown, so that a
@@ -154,6 +164,7 @@ void tsi_desc_free(ts_descriptor *d)
     free(d->C);
     free(d->Kerr);
     free(d->Cerr);
+    free(d->rnoise);
     free(d->rcolour);
     free(d->vcolour);
     free(d->hr);
@@ -472,6 +483,118 @@ static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
     return TS_OK;
 }
 
+#define NOISE_SAMPLES 8
+#define NOISE_REL 1e-4
+
+/* The residual's rounding noise d->rnoise (see the head of the file).
+ * Needs K and C. */
+static int residual_noise(ts_descriptor *d, ts_kernel *k)
+{
+    size_t n3 = 3 * (size_t)d->nn;
+    double *r = malloc(n3 * sizeof *r), *v = malloc(n3 * sizeof *v);
+    double *dr = malloc(n3 * sizeof *dr), *dv = malloc(n3 * sizeof *dv);
+    double *R0 = malloc(n3 * sizeof *R0), *R = malloc(n3 * sizeof *R);
+    double *f = malloc(n3 * sizeof *f), *acc = calloc(n3, sizeof *acc);
+    int rc = r && v && dr && dv && R0 && R && f && acc ? TS_OK : TS_ENOMEM;
+    if (rc == TS_OK)
+        rc = tsi_kernel_residual(k, d->r0, d->v0, d->a0, d->t0, R0);
+    unsigned long long seq = 0x9E3779B97F4A7C15ULL;
+    int used = 0;
+    for (int s = 0; rc == TS_OK && s < NOISE_SAMPLES; s++) {
+        for (size_t i = 0; i < 2 * n3; i++) {
+            seq = seq * 6364136223846793005ULL + 1442695040888963407ULL;
+            double sg = seq >> 63 ? 1.0 : -1.0;
+            size_t j = i < n3 ? i : i - n3;
+            double *x = i < n3 ? r : v, *dx = i < n3 ? dr : dv;
+            const double *x0 = i < n3 ? d->r0 : d->v0;
+            /* The tow point stays: at the waterline its columns are
+             * kinked (counted as kink_tow), not noisy. */
+            double h = j < 3 ? 0.0 : (i < n3 ? d->hr : d->hv)[j];
+            x[j] = x0[j] + sg * NOISE_REL * h;
+            dx[j] = x[j] - x0[j]; /* exactly what was added */
+        }
+        if (tsi_kernel_residual(k, r, v, d->a0, d->t0, R) != TS_OK)
+            continue; /* a state off the chart: another sample */
+        tsi_desc_block_mul(d, d->K, dr, f, 0);
+        tsi_desc_block_mul(d, d->C, dv, f, 1);
+        for (size_t i = 3; i < n3; i++) {
+            double e = R[i] - R0[i] - f[i];
+            acc[i] += e * e;
+        }
+        used++;
+    }
+    if (rc == TS_OK && used == 0)
+        rc = TS_ECONV;
+    if (rc == TS_OK) {
+        d->k_round = d->c_round = 0.0;
+        for (size_t i = 0; i < n3; i++)
+            d->rnoise[i] = sqrt(acc[i] / (2.0 * used));
+        for (int kk = 1; kk < d->nn; kk++)
+            for (int b = d->bptr[kk]; b < d->bptr[kk + 1]; b++) {
+                int j = d->bcol[b];
+                for (int a = 0; a < 3; a++)
+                    for (int c = 0; c < 3; c++) {
+                        double rho = d->rnoise[3 * kk + a] / sqrt(2.0);
+                        d->k_round = fmax(d->k_round, rho / d->hr[3 * j + c]);
+                        if (d->bdist[b] <= 1)
+                            d->c_round =
+                                fmax(d->c_round, rho / d->hv[3 * j + c]);
+                    }
+            }
+    }
+    free(r);
+    free(v);
+    free(dr);
+    free(dv);
+    free(R0);
+    free(R);
+    free(f);
+    free(acc);
+    return rc;
+}
+
+void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
+                          const double complex x[], double complex s,
+                          double *trunc, double *round)
+{
+    if (!d->Kerr || !d->Cerr || !d->rnoise) {
+        *trunc = *round = NAN;
+        return;
+    }
+    double complex t = 0;
+    double r2 = 0, as2 = creal(s) * creal(s) + cimag(s) * cimag(s);
+    for (int k = 1; k < d->nn; k++) {
+        double complex e[3] = {0, 0, 0};
+        double xk = 0;
+        for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
+            int j = d->bcol[b];
+            const double *Kb = d->Kerr + 9 * (size_t)b;
+            const double *Cb = d->Cerr + 9 * (size_t)b;
+            const double complex *xj = x + 3 * j;
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 3; c++)
+                    e[a] += (Kb[3 * a + c] + s * Cb[3 * a + c]) * xj[c];
+            for (int c = 0; c < 3; c++) {
+                double ax = creal(xj[c]) * creal(xj[c]) +
+                            cimag(xj[c]) * cimag(xj[c]);
+                double hr = d->hr[3 * j + c], hv = d->hv[3 * j + c];
+                xk += ax / (hr * hr) + (d->bdist[b] <= 1 ? as2 * ax / (hv * hv)
+                                                         : 0.0);
+            }
+        }
+        double wk = 0;
+        for (int a = 0; a < 3; a++) {
+            double complex wa = w[XR(k, a)];
+            t += wa * e[a];
+            double rho = d->rnoise[3 * k + a];
+            wk += (creal(wa) * creal(wa) + cimag(wa) * cimag(wa)) * rho * rho;
+        }
+        r2 += wk * xk;
+    }
+    *trunc = cabs(t);
+    *round = sqrt(0.5 * r2);
+}
+
 int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
                        int estimate, int threads, ts_err *err)
 {
@@ -509,10 +632,15 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
             return ts_fail(err, TS_ENOMEM, "descriptor: out of memory for "
                            "the error estimate");
     }
+    if (estimate && !d->rnoise &&
+        !(d->rnoise = calloc(3 * (size_t)nn, sizeof(double))))
+        return ts_fail(err, TS_ENOMEM, "descriptor: out of memory for the "
+                       "error estimate");
     if (!estimate) {
         free(d->Kerr);
         free(d->Cerr);
-        d->Kerr = d->Cerr = NULL;
+        free(d->rnoise);
+        d->Kerr = d->Cerr = d->rnoise = NULL;
     }
     /* Steps. */
     ts_frame fr;
@@ -584,6 +712,14 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
         return ts_fail(err, bad, "descriptor: the residual fails at a "
                        "perturbed state (%s)", ts_strerror(bad));
     d->evaluations = 1 + (long)ngroups * (estimate ? 4 : 2);
+    d->k_round = d->c_round = NAN;
+    if (estimate) {
+        rc = residual_noise(d, k);
+        if (rc != TS_OK)
+            return ts_fail(err, rc, "descriptor: the residual's rounding "
+                           "noise (%s)", ts_strerror(rc));
+        d->evaluations += 1 + NOISE_SAMPLES;
+    }
     d->k_scale = d->c_scale = d->k_err = d->c_err = 0.0;
     for (size_t i = 0; i < 9 * (size_t)d->nblocks; i++) {
         d->k_scale = fmax(d->k_scale, fabs(d->K[i]));

@@ -75,6 +75,12 @@ struct ts_descriptor {
     int nblocks;
     double *K, *C;       /* [9 nblocks] dR/dr (N/m), dR/dv (N s/m) */
     double *Kerr, *Cerr; /* [9 nblocks] (D(2h) - D(h)) / 3, or NULL */
+    double *rnoise;      /* [3 nn] rounding noise of one residual
+                            evaluation of each node row (N; rows of node
+                            0 unused): entry (i, j) of K carries noise
+                            rnoise[i] / (sqrt(2) hr[j]), of C
+                            rnoise[i] / (sqrt(2) hv[j]); NULL without the
+                            estimate */
     /* Colouring of the finite differences. */
     int *rcolour, *vcolour; /* [nn] */
     int nrcolour, nvcolour;
@@ -100,6 +106,8 @@ struct ts_descriptor {
     long evaluations;    /* residual evaluations */
     double k_scale, c_scale; /* max |K|, max |C| entries */
     double k_err, c_err; /* max |Kerr|, max |Cerr| */
+    double k_round, c_round; /* max rnoise_i / (sqrt(2) h_j) over the
+                            entries of K and C */
 };
 
 /* A descriptor for the built system sys: neighbours, colouring and the
@@ -116,6 +124,20 @@ void tsi_desc_free(ts_descriptor *d);
  * TS_ENOMEM. */
 int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
                        int estimate, int threads, ts_err *err);
+
+/* The linearization's error in the bilinear form w^T dS(s) x over the
+ * node rows, dS(s) = dK + s dC (the errors of K and C; M, N and the link
+ * rows are exact): w[nx] (complex; its node rows XR(k, a) are used),
+ * x[3 nn] node displacements (complex; x_0, the tow point's, is an input
+ * column). *trunc = |w^T (Kerr + s Cerr) x|; *round = the root mean
+ * square of w^T N x for the noise N of the differences, independent
+ * entries rnoise_i / (sqrt(2) hr_j) in K and |s| rnoise_i / (sqrt(2)
+ * hv_j) in C (within one link), i.e. sqrt(sum_k sum_a |w_ka|^2
+ * rnoise_ka^2 X_k / 2), X_k = sum over k's blocks j of sum_c |x_jc|^2
+ * (1 / hr_jc^2 + |s|^2 / hv_jc^2). NaN without the estimate. O(nlinks). */
+void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
+                          const double complex x[], double complex s,
+                          double *trunc, double *round);
 
 /* Node displacements dr[3 nn] (dr_0 = 0) of coordinate perturbations
  * dq[nq] (ts_linear_node_displacements), and back: dq[nq] of node

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "towstab/eigen.h"
 #include "towstab/report_result.h"
 
 const char *ts_design_goal_name(ts_design_goal_kind k)
@@ -33,7 +34,9 @@ const char *ts_design_goal_name(ts_design_goal_kind k)
 
 const char *ts_design_method_name(ts_design_method m)
 {
-    return m == TS_DESIGN_BOBYQA ? "bobyqa" : "cobyla";
+    return m == TS_DESIGN_BOBYQA  ? "bobyqa"
+           : m == TS_DESIGN_SLSQP ? "slsqp"
+                                  : "cobyla";
 }
 
 /* ---- values ------------------------------------------------------------- */
@@ -50,21 +53,51 @@ static void value_set(ts_value *out, const char *name, const char *unit,
     out->order = NAN;
 }
 
-/* The smallest damping ratio of the resolved oscillatory modes. */
-static int min_damping(const ts_result *r, ts_value *out)
+/* 1 when mode m moves a vehicle most: the largest node displacement of
+ * its shape is at a vehicle's node (the "largest at" of the mode table,
+ * ts_eigen_describe). 0 without shapes. */
+static int vehicle_mode(const ts_result *r, int m, double *amp,
+                        double *phase)
+{
+    const ts_system *sys = r->sys;
+    if (!sys || !r->lin || !r->eigen->vec_re ||
+        ts_eigen_mode_shape(sys, r->lin, r->eigen, m, amp, phase, NULL))
+        return 0;
+    int best = 0;
+    for (int k = 1; k < 3 * sys->nnodes; k++)
+        if (amp[k] > amp[best])
+            best = k;
+    int b = sys->nodes[best / 3].body;
+    return b >= 0 && sys->bodies[b].type == TS_BODY_VEHICLE;
+}
+
+/* The smallest damping ratio of the resolved oscillatory modes; with
+ * `vehicles`, of those that move a vehicle most (vehicle_mode). */
+static int min_damping(const ts_result *r, int vehicles, ts_value *out)
 {
     const ts_eigen *e = r->eigen;
     int n = r->nmodes_computed > 0 ? r->nmodes_computed : e ? e->nmodes : 0;
     int best = -1;
+    double *amp = NULL, *phase = NULL;
+    if (vehicles && r->sys) {
+        amp = malloc(3 * (size_t)r->sys->nnodes * sizeof *amp);
+        phase = malloc(3 * (size_t)r->sys->nnodes * sizeof *phase);
+        if (!amp || !phase)
+            n = 0;
+    }
     for (int m = 0; e && m < n; m++) {
         if (!(e->modes[m].im > 0))
             continue;
         if (r->mode_accuracy && !r->mode_accuracy[m].resolved)
             continue;
+        if (vehicles && !vehicle_mode(r, m, amp, phase))
+            continue;
         if (best < 0 ||
             e->modes[m].damping_ratio < e->modes[best].damping_ratio)
             best = m;
     }
+    free(amp);
+    free(phase);
     if (best < 0)
         return 0;
     double disc = r->mode_accuracy ? r->mode_accuracy[best].damping_error
@@ -72,8 +105,54 @@ static int min_damping(const ts_result *r, ts_value *out)
     /* The solver's part: the eigenvalue's error bound over |lambda|. */
     const ts_mode *md = &e->modes[best];
     double solver = md->error_bound / hypot(md->re, md->im);
-    value_set(out, "min_damping", "1", md->damping_ratio, disc, solver);
+    value_set(out, vehicles ? "control_damping" : "min_damping", "1",
+              md->damping_ratio, disc, solver);
     return 1;
+}
+
+/* The fin use: over every control surface c with a finite limit, (|delta_c|
+ * + |sum over depth loops l of kp_l g_lc step|) / limit_c, the steady
+ * deflection plus the command's jump when the depth set points step by
+ * `step` (m; the derivative term acts on the measured rate, the integral
+ * starts from its trim, so the jump is the proportional term's), at its
+ * largest. 0 when no vehicle has a limited control surface. */
+static int fin_use(const ts_result *r, double step, ts_value *out)
+{
+    const ts_equilibrium *eq = r->eq;
+    if (!r->sys || !eq || !eq->vehicles)
+        return 0;
+    double use = -1;
+    for (int i = 0; i < eq->nvehicles; i++) {
+        const ts_vehicle_result *vr = &eq->vehicles[i];
+        const ts_vehicle *v = r->sys->bodies[vr->body].vehicle;
+        for (int c = 0; v && c < v->ncomponents; c++) {
+            const ts_component *cp = &v->component[c];
+            if (!cp->control || !isfinite(cp->limit) || !(cp->limit > 0))
+                continue;
+            double kick = 0;
+            for (int l = 0; l < v->nloops; l++) {
+                const ts_loop *lp = &v->loop[l];
+                for (int k = 0; lp->measure == TS_MEASURE_DEPTH &&
+                                k < lp->nsurfaces; k++)
+                    if (lp->surface[k] == c)
+                        kick += lp->kp * lp->gain[k] * step;
+            }
+            use = fmax(use, (fabs(vr->delta[c]) + fabs(kick)) / cp->limit);
+        }
+    }
+    if (!(use >= 0))
+        return 0;
+    value_set(out, "fin_use", "1", use, NAN, 0);
+    return 1;
+}
+
+/* ts_design_value with the study's settings (the fin step). */
+static int study_value(const ts_design_spec *sp, const ts_result *r,
+                       const char *name, ts_value *out)
+{
+    if (r && !strcmp(name, "fin_use"))
+        return fin_use(r, sp->fin_step, out);
+    return ts_design_value(r, name, out);
 }
 
 int ts_design_value(const ts_result *r, const char *name, ts_value *out)
@@ -94,7 +173,11 @@ int ts_design_value(const ts_result *r, const char *name, ts_value *out)
         return isfinite(m.max_real);
     }
     if (!strcmp(name, "min_damping"))
-        return min_damping(r, out);
+        return min_damping(r, 0, out);
+    if (!strcmp(name, "control_damping"))
+        return min_damping(r, 1, out);
+    if (!strcmp(name, "fin_use"))
+        return fin_use(r, 0, out);
     ts_value *eqv = NULL;
     int neq = 0, found = 0;
     if (!r->sys || ts_result_equilibrium_values(r, &eqv, &neq, NULL))
@@ -147,11 +230,12 @@ static int name_unit(const ts_system *sys, const ts_request *rq,
             snprintf(unit, size, "%s", names[i].unit);
             return 1;
         }
-    static const char *const derived[3][2] = {
-        {"layback", "m"}, {"max_real", "1/s"}, {"min_damping", "1"}};
-    for (int k = 0; k < 3; k++)
+    static const char *const derived[5][2] = {
+        {"layback", "m"}, {"fin_use", "1"}, {"max_real", "1/s"},
+        {"min_damping", "1"}, {"control_damping", "1"}};
+    for (int k = 0; k < 5; k++)
         if (!strcmp(name, derived[k][0]) &&
-            (k == 0 || rq->kind == TS_ANALYSIS_MODES)) {
+            (k < 2 || rq->kind == TS_ANALYSIS_MODES)) {
             snprintf(unit, size, "%s", derived[k][1]);
             return 1;
         }
@@ -201,10 +285,10 @@ static int check_name(const ts_system *sys, const ts_request *rq,
         len += (size_t)snprintf(list + len, sizeof list - len, "%s%s",
                                 i ? ", " : "", names[i].name);
     return ts_fail(err, TS_EINVAL, "%s: no value '%s' in the result of %s; "
-                   "expected one of %s, layback%s or a scene path", what,
-                   name, ts_analysis_name(rq->kind), list,
+                   "expected one of %s, layback, fin_use%s or a scene path",
+                   what, name, ts_analysis_name(rq->kind), list,
                    rq->kind == TS_ANALYSIS_MODES
-                       ? ", max_real, min_damping" : "");
+                       ? ", max_real, min_damping, control_damping" : "");
 }
 
 int ts_design_unit(const ts_system *sys, const ts_request *rq,
@@ -243,8 +327,13 @@ int ts_design_check(const ts_system *sys, const ts_design_spec *sp,
     if (sp->method == TS_DESIGN_BOBYQA && sp->nconstraints > 0)
         return ts_fail(err, TS_EINVAL, "method: bobyqa takes bounds only; "
                        "use cobyla with constraints");
-    if (sp->method != TS_DESIGN_COBYLA && sp->method != TS_DESIGN_BOBYQA)
-        return ts_fail(err, TS_EINVAL, "method: expected cobyla or bobyqa");
+    if (sp->method != TS_DESIGN_COBYLA && sp->method != TS_DESIGN_BOBYQA &&
+        sp->method != TS_DESIGN_SLSQP)
+        return ts_fail(err, TS_EINVAL, "method: expected cobyla, bobyqa or "
+                       "slsqp");
+    if (!(isfinite(sp->fin_step) && sp->fin_step >= 0))
+        return ts_fail(err, TS_EINVAL, "fin_step: expected a depth step >= "
+                       "0 m, got %g m", sp->fin_step);
     if (sp->max_evals < 0 || !(sp->target_rtol >= 0 && sp->target_rtol < 1) ||
         !(sp->xtol >= 0 && sp->xtol < 1))
         return ts_fail(err, TS_EINVAL, "max_evals >= 0, target_rtol and xtol "
@@ -330,6 +419,11 @@ typedef struct study {
     int ndir;
     int cap;
     nlopt_opt opt;
+    /* SLSQP: the gradients at gu (scaled), by central differences. */
+    double gu[TS_DESIGN_MAX_FREE];
+    int have_grad;
+    double gf[TS_DESIGN_MAX_FREE];
+    double gc[TS_DESIGN_MAX_CONSTRAINTS][TS_DESIGN_MAX_FREE];
     int stop;
     int rc;                       /* TS_ENOMEM or TS_ECANCEL that stopped */
     ts_err err;
@@ -371,7 +465,7 @@ static void score(study *st, const ts_result *r, int ok)
     ts_value v;
     st->f = 0;
     if (sp->goal.kind != TS_DESIGN_NONE) {
-        if (!ok || !ts_design_value(r, sp->goal.name, &v)) {
+        if (!ok || !study_value(sp, r, sp->goal.name, &v)) {
             st->f = HUGE_VAL;
         } else {
             if (!(st->goal_scale > 0))
@@ -386,7 +480,7 @@ static void score(study *st, const ts_result *r, int ok)
     }
     for (int i = 0; i < sp->nconstraints; i++) {
         const ts_design_constraint *c = &sp->constraints[i];
-        if (!ok || !ts_design_value(r, c->name, &v)) {
+        if (!ok || !study_value(sp, r, c->name, &v)) {
             st->c[i] = 1.0;
             continue;
         }
@@ -445,7 +539,7 @@ static void evaluate(study *st, const double *u)
     h->goal = NAN;
     ts_value v;
     if (rc == TS_OK && d->spec.goal.kind != TS_DESIGN_NONE &&
-        ts_design_value(r, d->spec.goal.name, &v))
+        study_value(&d->spec, r, d->spec.goal.name, &v))
         h->goal = v.value;
     h->violation = 0;
     for (int i = 0; i < d->spec.nconstraints; i++)
@@ -478,14 +572,54 @@ static void evaluate(study *st, const double *u)
     }
 }
 
+/* The gradients of the objective and the constraints at u by central
+ * differences of step TS_DESIGN_GRAD_STEP in the scaled values (one-sided
+ * at a bound), two analysis runs per free value, each continuing from the
+ * previous equilibrium; the values at u are kept as evaluate() left them.
+ * A failed run gives the gradient of the failure's penalty, so the
+ * method steps back. */
+static void gradient(study *st, const double *u)
+{
+    ts_design *d = st->d;
+    int n = d->spec.nfree, nc = d->spec.nconstraints;
+    if (st->have_grad && !memcmp(u, st->gu, (size_t)n * sizeof *u))
+        return;
+    evaluate(st, u);
+    double f0 = st->f, c0[TS_DESIGN_MAX_CONSTRAINTS];
+    memcpy(c0, st->c, sizeof c0);
+    for (int i = 0; i < n && !st->stop; i++) {
+        double up[TS_DESIGN_MAX_FREE], dn[TS_DESIGN_MAX_FREE];
+        memcpy(up, u, (size_t)n * sizeof *u);
+        memcpy(dn, u, (size_t)n * sizeof *u);
+        up[i] = fmin(1.0, u[i] + TS_DESIGN_GRAD_STEP);
+        dn[i] = fmax(0.0, u[i] - TS_DESIGN_GRAD_STEP);
+        double h = up[i] - dn[i];
+        evaluate(st, up);
+        double fp = st->f, cp[TS_DESIGN_MAX_CONSTRAINTS];
+        memcpy(cp, st->c, sizeof cp);
+        evaluate(st, dn);
+        st->gf[i] = (fp - st->f) / h;
+        for (int k = 0; k < nc; k++)
+            st->gc[k][i] = (cp[k] - st->c[k]) / h;
+    }
+    memcpy(st->u, u, (size_t)n * sizeof *u);
+    st->f = f0;
+    memcpy(st->c, c0, sizeof c0);
+    memcpy(st->gu, u, (size_t)n * sizeof *u);
+    st->have_grad = 1;
+    d->gradients++;
+}
+
 static double objective(unsigned n, const double *u, double *grad,
                         void *data)
 {
-    (void)n;
-    (void)grad;
     study *st = data;
-    if (!st->stop)
+    if (!st->stop && grad)
+        gradient(st, u);
+    else if (!st->stop)
         evaluate(st, u);
+    if (grad)
+        memcpy(grad, st->gf, n * sizeof *grad);
     if (st->stop)
         nlopt_force_stop(st->opt);
     return st->f;
@@ -499,11 +633,13 @@ typedef struct cdata {
 static double constraint(unsigned n, const double *u, double *grad,
                          void *data)
 {
-    (void)n;
-    (void)grad;
     cdata *cd = data;
-    if (!cd->st->stop)
+    if (!cd->st->stop && grad)
+        gradient(cd->st, u);
+    else if (!cd->st->stop)
         evaluate(cd->st, u);
+    if (grad)
+        memcpy(grad, cd->st->gc[cd->i], n * sizeof *grad);
     if (cd->st->stop)
         nlopt_force_stop(cd->st->opt);
     return cd->st->c[cd->i];
@@ -587,7 +723,7 @@ static int final_run(const ts_system *sys, ts_design *d, ts_err *err)
     double tol = sp->target_rtol;
     d->reached = 1;
     if (sp->goal.kind != TS_DESIGN_NONE) {
-        if (!ts_design_value(d->result, sp->goal.name, &d->goal_value)) {
+        if (!study_value(sp, d->result, sp->goal.name, &d->goal_value)) {
             d->reached = 0;
             d->goal_value.value = NAN;
         } else if (sp->goal.kind == TS_DESIGN_TARGET) {
@@ -600,7 +736,7 @@ static int final_run(const ts_system *sys, ts_design *d, ts_err *err)
     for (int i = 0; i < sp->nconstraints; i++) {
         const ts_design_constraint *c = &sp->constraints[i];
         ts_value *v = &d->constraint_value[i];
-        if (!ts_design_value(d->result, c->name, v)) {
+        if (!study_value(sp, d->result, c->name, v)) {
             v->value = NAN;
             d->constraint_met[i] = 0;
         } else {
@@ -665,8 +801,9 @@ int ts_design_run(const ts_system *sys, const ts_design_spec *sp,
     st.sys = sys;
     st.d = d;
     double t0 = tsi_wall_now();
-    st.opt = nlopt_create(s->method == TS_DESIGN_BOBYQA ? NLOPT_LN_BOBYQA
-                                                        : NLOPT_LN_COBYLA,
+    st.opt = nlopt_create(s->method == TS_DESIGN_BOBYQA  ? NLOPT_LN_BOBYQA
+                          : s->method == TS_DESIGN_SLSQP ? NLOPT_LD_SLSQP
+                                                         : NLOPT_LN_COBYLA,
                           (unsigned)n);
     cdata cd[TS_DESIGN_MAX_CONSTRAINTS];
     int nrc = NLOPT_OUT_OF_MEMORY;
@@ -808,6 +945,10 @@ json_t *ts_design_json(const ts_design *d)
                                               d->nlopt_code, "reason",
                                               d->nlopt_reason));
     json_object_set_new(o, "iterations", json_integer(d->neval));
+    if (s->method == TS_DESIGN_SLSQP)
+        json_object_set_new(o, "gradient", json_pack("{s:i,s:f}", "count",
+                                                     d->gradients, "step",
+                                                     TS_DESIGN_GRAD_STEP));
     json_object_set_new(o, "cost", json_pack("{s:I,s:o,s:o}", "evaluations",
                                              (json_int_t)d->evaluations,
                                              "wall_s", num(d->wall_s),

@@ -562,16 +562,20 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
     return TS_OK;
 }
 
+/* A Ritz pair of the search with a residual above this fraction of
+ * |lambda| has not converged and is dropped. */
+#define SWEEP_RESIDUAL 1e-6
+
 static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
                         ts_err *err)
 {
-    int n = lin->nstate, nq = lin->nq;
-    double *w = malloc(6 * (size_t)n * sizeof(double));
+    int n = lin->nstate;
+    double *w = malloc(4 * (size_t)n * sizeof(double));
     if (!w)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     double *vr = w, *vi = w + n, *ar = w + 2 * n, *ai = w + 3 * n;
-    double *er = w + 4 * n, *ei = w + 5 * n;
     int with_err = lin->desc_err == lin->desc_err; /* not NaN */
+    tsi_shift es = {0}; /* S(lambda) of each error estimate */
     for (int c = 0; c < L->n; c++) {
         if (L->c[c].checked)
             continue;
@@ -583,15 +587,20 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
         }
         tsi_shift_apply(acc, vr, ar, 0);
         tsi_shift_apply(acc, vi, ai, 0);
-        double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
-        if (with_err) {
-            tsi_shift_apply(acc, vr, er, 1);
-            tsi_shift_apply(acc, vi, ei, 1);
-            for (int i = nq; i < n; i++)
-                e2 += er[i] * er[i] + ei[i] * ei[i];
-            L->c[c].dlam = sqrt(e2 / v2);
+        set_residual(&L->c[c], v, ar, ai, n);
+        /* A Ritz pair of the search that has not converged is dropped by
+         * the caller: no error estimate for it. */
+        if (with_err && !(L->c[c].sweep && L->c[c].resid > SWEEP_RESIDUAL)) {
+            int rc = tsi_shift_eig_error(&es, lin, L->c[c].lam, v,
+                                         &L->c[c].dlam, err);
+            if (rc != TS_OK) {
+                tsi_shift_free(&es);
+                free(w);
+                return rc;
+            }
         }
     }
+    tsi_shift_free(&es);
     free(w);
     return TS_OK;
 }
@@ -967,9 +976,6 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
                               whose error bounds are their residuals
                               (checked below); 20-30 % fewer operator
                               applications than at machine precision */
-/* A Ritz pair of the search with a residual above this fraction of
- * |lambda| has not converged and is dropped. */
-#define SWEEP_RESIDUAL 1e-6
 /* Two eigenvectors with |v1^H v2| above this (unit vectors) are one. */
 #define SWEEP_SAME_VECTOR 0.99
 

@@ -87,6 +87,18 @@ int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
         ts_kernel_set_vehicle(k, v, eq->attitudes + 9 * v, NULL,
                               TS_CHART_RECHART, y);
     memcpy(y + 2 * nq, eq->controls, (size_t)nc * sizeof(double));
+    int ro = ts_kernel_root_offset(k);
+    if (ro >= 0) {
+        /* The towing vehicle: its position, and the steady motion solved
+         * with it becomes the kernel's frame. */
+        memcpy(y + ro, eq->y + ro, 3 * sizeof(double));
+        ts_frame f;
+        ts_kernel_get_frame(k, &f);
+        f.speed = eq->speed;
+        f.turn_rate = eq->turn_rate;
+        ts_kernel_set_frame(k, &f);
+        ts_kernel_set_thrust_bias(k, eq->thrust_bias);
+    }
     return TS_OK;
 }
 
@@ -232,6 +244,11 @@ static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
            3 * (size_t)sys->nnodes * sizeof(double));
     memcpy(eq->tensions, ts_kernel_tensions(k), (size_t)nl * sizeof(double));
     eq->top_tension = ts_kernel_tow_force(k, eq->tow_force);
+    ts_frame fr;
+    ts_kernel_get_frame(k, &fr);
+    eq->speed = fr.speed;
+    eq->turn_rate = fr.turn_rate;
+    eq->thrust_bias = ts_kernel_thrust_bias(k);
     double scale;
     double worst = ts_kernel_unbalanced(k, &scale);
     eq->force_scale = scale;
@@ -265,6 +282,13 @@ typedef struct newton_ws {
     double *att;    /* [9 nvehicles] its attitudes */
     double *ctl;    /* [nc] its controller states */
     int *ipiv;
+    /* A towing vehicle: the unknowns at its x and y positions (held at the
+     * tow point) are the parameters of its steady motion instead
+     * (doc/towing-vehicle.md, section 3): the speed, or the speed
+     * controller's thrust bias, and the turn rate. -1 without one. */
+    int ux, uy;
+    int x_is_bias;  /* 1: ux is the thrust bias, 0: the speed */
+    double rootpos[3]; /* the saved shape's root position */
     ts_progress_fn progress; /* the caller's (ts_equilibrium_opts), or
                                 NULL */
     void *progress_data;
@@ -274,6 +298,42 @@ typedef struct newton_ws {
 static inline int unknown(const newton_ws *w, int i)
 {
     return i < w->nq ? i : w->nq + i;
+}
+
+static inline int is_param(const newton_ws *w, int i)
+{
+    return w->ux >= 0 && (i == w->ux || i == w->uy);
+}
+
+/* Value of unknown i: y's, or the kernel's parameter. */
+static double uget(const ts_kernel *k, const newton_ws *w, const double *y,
+                   int i)
+{
+    if (!is_param(w, i))
+        return y[unknown(w, i)];
+    ts_frame f;
+    ts_kernel_get_frame(k, &f);
+    if (i == w->uy)
+        return f.turn_rate;
+    return w->x_is_bias ? ts_kernel_thrust_bias(k) : f.speed;
+}
+
+static void uset(ts_kernel *k, const newton_ws *w, double *y, int i,
+                 double v)
+{
+    if (!is_param(w, i)) {
+        y[unknown(w, i)] = v;
+        return;
+    }
+    ts_frame f;
+    ts_kernel_get_frame(k, &f);
+    if (i == w->uy)
+        f.turn_rate = v;
+    else if (w->x_is_bias)
+        ts_kernel_set_thrust_bias(k, v);
+    else
+        f.speed = v;
+    ts_kernel_set_frame(k, &f);
 }
 
 static void newton_ws_free(newton_ws *w)
@@ -319,6 +379,21 @@ static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
                 sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
             w->scale[nq + i] =
                 cs.actuator ? 1.0 : 1.0 / fabs(d->loop[cs.index].ki);
+        }
+    }
+    w->ux = w->uy = -1;
+    int ro = ts_kernel_root_offset(k);
+    if (ro >= 0) {
+        const ts_body *bd = &sys->bodies[sys->tow.vehicle];
+        w->ux = ro;
+        w->uy = ro + 1;
+        w->x_is_bias = bd->vehicle->propulsion.type == TS_PROP_SPEED;
+        if (w->scale) {
+            /* Steps of the speed, a thrust, the turn rate. */
+            w->scale[ro] = w->x_is_bias
+                               ? fmax(bd->mass * sys->env.gravity, 1.0)
+                               : fmax(fabs(sys->tow.speed), 1.0);
+            w->scale[ro + 1] = 0.1;
         }
     }
     w->J = malloc(nu * nu * sizeof(double));
@@ -435,6 +510,13 @@ static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
                              : v->loop[cs.index].name);
         return;
     }
+    if (ts_kernel_root(k) >= 0 && i >= ts_kernel_root_offset(k) &&
+        i < ts_kernel_root_offset(k) + 3) {
+        int b = sys->tow.vehicle;
+        snprintf(buf, size, "bodies[%d] '%s' (its steady motion: speed, "
+                 "turn rate, depth)", b, sys->bodies[b].name);
+        return;
+    }
     for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
         int o = ts_kernel_vehicle_offset(k, v);
         if (i >= o && i < o + 3) {
@@ -452,8 +534,6 @@ static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
              sys->cables[L->cable].name, L->index);
 }
 
-/* The Jacobian of (q'', c') at y by central differences, column by
- * column, and its LU and condition in w (w->R holds f(y)). */
 /* Report `done` Jacobian columns of nu to the caller's progress callback:
  * TS_OK to go on, TS_ECANCEL (message set) when it asks to stop. */
 static int poll_progress(const newton_ws *w, int done, const ts_equilibrium *eq,
@@ -470,6 +550,9 @@ static int poll_progress(const newton_ws *w, int done, const ts_equilibrium *eq,
                    eq->iterations, done, w->nu);
 }
 
+/* The Jacobian of (q'', c') at y by central differences, column by
+ * column, and its LU and condition in w (w->R holds f(y)). */
+
 static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
                     ts_err *err)
 {
@@ -478,13 +561,12 @@ static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
         int prc = poll_progress(w, j, eq, err);
         if (prc != TS_OK)
             return prc;
-        int yj = unknown(w, j);
-        double h = NEWTON_FD_STEP * w->scale[j], y0 = y[yj];
-        y[yj] = y0 + h;
+        double h = NEWTON_FD_STEP * w->scale[j], y0 = uget(k, w, y, j);
+        uset(k, w, y, j, y0 + h);
         int r1 = ts_kernel_eval(k, y, NULL, w->f1);
-        y[yj] = y0 - h;
+        uset(k, w, y, j, y0 - h);
         int r2 = ts_kernel_eval(k, y, NULL, w->f2);
-        y[yj] = y0;
+        uset(k, w, y, j, y0);
         eq->evaluations += 2;
         if (r1 != TS_OK || r2 != TS_OK)
             return ts_fail(err, TS_ECONV,
@@ -589,10 +671,17 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         /* Backtracking line search on |(q'', c')|. */
         double phi0 = norm2(w->R + nq, nu), alpha = 1.0;
         int accepted = 0;
+        double p0[2] = {0, 0};
+        if (w->ux >= 0) {
+            p0[0] = uget(k, w, y, w->ux);
+            p0[1] = uget(k, w, y, w->uy);
+        }
         memcpy(w->yt, y, (size_t)n * sizeof(double));
         while (alpha >= NEWTON_ALPHA_MIN) {
             for (int i = 0; i < nu; i++)
-                w->yt[unknown(w, i)] = y[unknown(w, i)] + alpha * w->dq[i];
+                uset(k, w, w->yt, i,
+                     (is_param(w, i) ? p0[i == w->uy] : y[unknown(w, i)]) +
+                         alpha * w->dq[i]);
             rc = ts_kernel_eval(k, w->yt, NULL, w->f1);
             eq->evaluations++;
             if (rc == TS_OK && norm2(w->f1 + nq, nu) <=
@@ -602,8 +691,13 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             }
             alpha *= 0.5;
         }
-        if (!accepted)
+        if (!accepted) {
+            if (w->ux >= 0) {
+                uset(k, w, y, w->ux, p0[0]);
+                uset(k, w, y, w->uy, p0[1]);
+            }
             break;
+        }
         memcpy(y, w->yt, (size_t)n * sizeof(double));
         ts_kernel_rechart(k, y, TS_CHART_RECHART);
     }
@@ -729,6 +823,8 @@ static void save_shape(ts_kernel *k, const double *y, newton_ws *w)
     for (int v = 0; v < sys->nvehicles; v++)
         ts_kernel_get_vehicle(k, v, y, w->att + 9 * v, NULL);
     memcpy(w->ctl, y + 2 * w->nq, (size_t)w->nc * sizeof(double));
+    if (w->ux >= 0)
+        memcpy(w->rootpos, y + w->ux, sizeof w->rootpos);
 }
 
 /* Go back to the saved shape, at rest. */
@@ -741,6 +837,27 @@ static void restore_shape(ts_kernel *k, double *y, newton_ws *w)
     for (int v = 0; v < sys->nvehicles; v++)
         ts_kernel_set_vehicle(k, v, w->att + 9 * v, NULL, TS_CHART_RECHART, y);
     memcpy(y + 2 * w->nq, w->ctl, (size_t)w->nc * sizeof(double));
+    if (w->ux >= 0)
+        memcpy(y + w->ux, w->rootpos, sizeof w->rootpos);
+}
+
+/* A path step that keeps the towing vehicle's steady motion (speed, turn
+ * rate, thrust bias: unknowns, not the path's). */
+static void path_at(ts_kernel *k, const newton_ws *w, path_fn path,
+                    const path_ctx *pc, double t)
+{
+    ts_frame f;
+    double bias = ts_kernel_thrust_bias(k);
+    ts_kernel_get_frame(k, &f);
+    path(pc, t);
+    if (w->ux < 0)
+        return;
+    ts_frame g;
+    ts_kernel_get_frame(k, &g);
+    g.speed = f.speed;
+    g.turn_rate = f.turn_rate;
+    ts_kernel_set_frame(k, &g);
+    ts_kernel_set_thrust_bias(k, bias);
 }
 
 /* ", with <vehicle>.<surface> at its limit" for the first control
@@ -780,7 +897,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
                         const path_ctx *pc, const ts_equilibrium_opts *o,
                         ts_equilibrium *eq, ts_err *err)
 {
-    path(pc, 0.0);
+    path_at(k, w, path, pc, 0.0);
     int rc = newton(k, y, o->tol, o->max_iter, w, eq, err);
     eq->continuation_steps++;
     double t = 0.0, dt = 1.0;
@@ -788,7 +905,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         if (t + dt > 1.0)
             dt = 1.0 - t;
         save_shape(k, y, w);
-        path(pc, t + dt);
+        path_at(k, w, path, pc, t + dt);
         rc = newton(k, y, o->tol, o->max_iter, w, eq, err);
         eq->continuation_steps++;
         if (rc == TS_OK) {
@@ -812,7 +929,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
         }
         dt *= 0.5;
         restore_shape(k, y, w);
-        path(pc, t);
+        path_at(k, w, path, pc, t);
         rc = TS_OK;
     }
     /* Name the continuation only where there was one: a straight tow has
@@ -1035,6 +1152,13 @@ static int vehicle_start(const ts_system *sys, tsi_march *m,
         for (int b = 0, v = 0; b < sys->nbodies; b++) {
             if (sys->bodies[b].type != TS_BODY_VEHICLE)
                 continue;
+            if (b == sys->tow.vehicle) {
+                /* The towing vehicle starts level at the tow point. */
+                static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+                memcpy(att + 9 * v, I3, sizeof I3);
+                v++;
+                continue;
+            }
             int node = ts_system_body_node(sys, b);
             /* First pass: deep enough to be submerged; then the march's. */
             double zA = pass == 0 ? L : tsi_march_positions(m)[3 * node + 2];
@@ -1181,6 +1305,9 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     double *att = malloc((9 * (size_t)nv + 1) * sizeof(double));
     tsi_march *m = tsi_march_alloc(sys, err);
     newton_ws w = {0};
+    int ro = ts_kernel_root_offset(k);
+    if (y && ro >= 0)
+        memcpy(y + ro, sys->tow.point, 3 * sizeof(double));
     if (!m) {
         rc = err ? err->code : TS_ENOMEM; /* the march named its size */
         goto out;
@@ -1242,6 +1369,18 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     }
     w.progress = o.progress;
     w.progress_data = o.progress_data;
+    if (ro >= 0 && w.x_is_bias) {
+        /* A speed controller holds its set speed: the bias is solved. */
+        ts_frame f;
+        ts_kernel_get_frame(k, &f);
+        /* The tow point (M's origin) moves through the water at the set
+         * speed: V less the current (turns have no horizontal current). */
+        double sp = sys->bodies[sys->tow.vehicle].vehicle->propulsion.speed;
+        double c2 = sp * sp - f.current[1] * f.current[1] -
+                    f.current[2] * f.current[2];
+        f.speed = f.current[0] + sqrt(fmax(c2, 0.0));
+        ts_kernel_set_frame(k, &f);
+    }
     rc = TS_ECONV;
     /* Actuators settle smoothly: no rate limit in a steady state. */
     ts_kernel_set_steady(k, 1);
@@ -1313,12 +1452,15 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
             pc.sp1 = sp1;
             rc = continuation(k, y, &w, setpoint_path, &pc, &o, eq, err);
         }
+        /* (A towing vehicle's turn rate is an unknown, which the path
+         * leaves alone: path_at.) */
         if (rc == TS_OK)
             rc = continuation(k, y, &w, turn_path, &pc, &o, eq, err);
         if (rc == TS_OK && sys->has_bending)
             rc = continuation(k, y, &w, bending_path, &pc, &o, eq, err);
         ts_kernel_set_bending_scale(k, 1.0);
-        ts_kernel_set_frame(k, &frame);
+        if (ro < 0)
+            ts_kernel_set_frame(k, &frame);
     }
     {
         int rrc = record(k, y, eq, dydt);
@@ -1333,6 +1475,14 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
 
 out:
     ts_kernel_set_frame(k, &frame);
+    if (ro >= 0 && rc == TS_OK) {
+        /* The kernel is left at the towing vehicle's steady motion. */
+        ts_frame f = frame;
+        f.speed = eq->speed;
+        f.turn_rate = eq->turn_rate;
+        ts_kernel_set_frame(k, &f);
+        ts_kernel_set_thrust_bias(k, eq->thrust_bias);
+    }
     newton_ws_free(&w);
     tsi_march_free(m);
     free(y);

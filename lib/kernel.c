@@ -89,7 +89,19 @@ typedef struct veh {
     double xi_dot[TS_VEHICLE_MAX_LOOPS];
     double act_dot[TS_VEHICLE_MAX_COMPONENTS];
     double lever;             /* tsi_vehicle_lever, at least 1 m */
+    /* The towing vehicle, root of the tree (doc/towing-vehicle.md): its
+     * attach point A is node 0, whose position in M is 3 more
+     * coordinates after the angles (qoff + 3); no joint (Fj = 0). */
+    int root;
+    int in_prop;              /* its first input: thrust (N), then the
+                                 external force (N) and moment (N m) in
+                                 body axes, TSI_NPROP in all; -1 */
+    double thrust_bias;       /* the speed controller's bias, N */
+    double thrust;            /* thrust at the last evaluation, N */
 } veh;
+
+/* Inputs of a towing vehicle: thrust, force x y z, moment x y z. */
+#define TSI_NPROP 7
 
 struct ts_kernel {
     const ts_system *sys;
@@ -103,6 +115,8 @@ struct ts_kernel {
     double *uzero;     /* [nin] zero input */
     int nv;            /* vehicles */
     veh *veh;          /* [nv] */
+    int root;          /* the towing vehicle's index in veh, -1: the tow
+                          point is prescribed */
     int *node_veh;     /* [nn] vehicle at the node, -1 */
     /* Links that start at a point P of a vehicle (up_body >= 0): */
     double *ur, *urd;  /* [3 nl] P's position and velocity rel. to M */
@@ -174,6 +188,11 @@ static int layout_controls(ts_kernel *k, ts_err *err)
         for (int l = 0; l < d->nloops; l++) {
             V->in_loop[l] = k->nin++;
             V->in_sp[l] = k->nin++;
+        }
+        V->in_prop = -1;
+        if (V->root) {
+            V->in_prop = k->nin;
+            k->nin += TSI_NPROP;
         }
     }
     free(k->uzero);
@@ -250,6 +269,7 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
     k->nql = k->nq;
     for (int i = 0; i < nn; i++)
         k->node_veh[i] = -1;
+    k->root = -1;
     for (int b = 0, v = 0; b < sys->nbodies; b++) {
         if (sys->bodies[b].type != TS_BODY_VEHICLE)
             continue;
@@ -261,6 +281,12 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
         V->chart[0] = V->chart[4] = V->chart[8] = 1.0;
         V->qoff = k->nq;
         k->nq += 3;
+        if (b == sys->tow.vehicle) {
+            V->root = 1;
+            k->root = v;
+            k->nq += 3; /* the position of A (node 0) in M */
+            V->thrust_bias = V->d->propulsion.thrust;
+        }
         /* A body whose points all sit at A has no lever: its unbalanced
          * moment is compared per metre. */
         V->lever = fmax(tsi_vehicle_lever(V->d), 1.0);
@@ -346,6 +372,7 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
         memcpy(c->veh[v].mode, k->veh[v].mode, sizeof k->veh[v].mode);
         memcpy(c->veh[v].frozen, k->veh[v].frozen, sizeof k->veh[v].frozen);
         memcpy(c->veh[v].sp, k->veh[v].sp, sizeof k->veh[v].sp);
+        c->veh[v].thrust_bias = k->veh[v].thrust_bias;
     }
     if (layout_controls(c, err) != TS_OK) {
         ts_kernel_free(c);
@@ -528,6 +555,10 @@ const char *tsi_tow_input_name(int j)
     return j >= 0 && j < TS_NINPUT ? names[j] : NULL;
 }
 
+static const char *const prop_input[TSI_NPROP] = {
+    "thrust", "force.x", "force.y", "force.z", "moment.x", "moment.y",
+    "moment.z"};
+
 const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
                                  size_t size)
 {
@@ -554,6 +585,10 @@ const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
                 return buf;
             }
         }
+        if (V->in_prop >= 0 && j >= V->in_prop && j < V->in_prop + TSI_NPROP) {
+            snprintf(buf, size, "%s.%s", body, prop_input[j - V->in_prop]);
+            return buf;
+        }
     }
     return NULL;
 }
@@ -568,6 +603,8 @@ const char *ts_kernel_input_unit(const ts_kernel *k, int j)
             if (V->in_sp[l] == j)
                 return V->d->loop[l].measure == TS_MEASURE_DEPTH ? "m"
                                                                  : "rad";
+        if (V->in_prop >= 0 && j >= V->in_prop && j < V->in_prop + TSI_NPROP)
+            return j - V->in_prop < 4 ? "N" : "N*m";
     }
     return j < k->nin ? "rad" : NULL; /* a deflection or a loop's output */
 }
@@ -603,6 +640,24 @@ int ts_kernel_input_find(const ts_kernel *k, const char *name)
     return -1;
 }
 int ts_kernel_vehicle_body(const ts_kernel *k, int v) { return k->veh[v].body; }
+int ts_kernel_root(const ts_kernel *k) { return k->root; }
+int ts_kernel_root_offset(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].qoff + 3 : -1;
+}
+void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust)
+{
+    if (k->root >= 0)
+        k->veh[k->root].thrust_bias = thrust;
+}
+double ts_kernel_thrust_bias(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].thrust_bias : 0.0;
+}
+double ts_kernel_thrust(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].thrust : 0.0;
+}
 int ts_kernel_vehicle_offset(const ts_kernel *k, int v)
 {
     return k->veh[v].qoff;
@@ -776,6 +831,28 @@ static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
     tsi_vehicle_mass6(d, V->mass, &V->st, V->M6);
     tsi_vehicle_loads(d, V->ws, V->mass, rho, g, &V->st, V->delta, V->G,
                       NULL);
+    if (V->root) {
+        /* Thrust along body x at its point, and the external force and
+         * moment inputs (body axes), as a generalised force about A. */
+        const double *up = u + V->in_prop;
+        const double *pp = d->propulsion.position;
+        /* The power law sees the surge through the water, the speed
+         * controller the tow point's speed through the water. */
+        double wA[3];
+        tsi_rel_velocity(&k->frame, V->st.rA, V->st.rdA, wA);
+        double u_law = d->propulsion.type == TS_PROP_SPEED ? v3_norm(wA)
+                                                           : V->st.wO_b[0];
+        V->thrust = ts_propulsion_thrust(&d->propulsion, u_law,
+                                         V->thrust_bias, up[0]);
+        double f[3] = {V->thrust, 0, 0}, lever[3], m[3];
+        for (int j = 0; j < 3; j++)
+            lever[j] = pp[j] - d->attach[j];
+        v3_cross(lever, f, m);
+        for (int j = 0; j < 3; j++) {
+            V->G[j] += f[j] + up[1 + j];
+            V->G[3 + j] += m[j] + up[4 + j];
+        }
+    }
     const ts_node *nd = &k->sys->nodes[V->node];
     for (int j = nd->child_begin; j < nd->child_end; j++) {
         int l = k->sys->child_links[j];
@@ -965,12 +1042,23 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     if (!u)
         u = k->uzero;
 
-    /* 1. Kinematics. */
-    for (int j = 0; j < 3; j++) {
-        k->r[j] = sys->tow.point[j] + u[j];
-        k->rd[j] = u[3 + j];
-    }
+    /* 1. Kinematics. The tow point is prescribed, or the towing
+     * vehicle's attach point, whose position in M is a coordinate. */
     int chart_bad = 0, slack_bad = 0;
+    veh *Root = k->root >= 0 ? &k->veh[k->root] : NULL;
+    if (Root) {
+        for (int j = 0; j < 3; j++) {
+            k->r[j] = y[Root->qoff + 3 + j];
+            k->rd[j] = qd[Root->qoff + 3 + j];
+        }
+        if (vehicle_kinematics(k, Root, y))
+            chart_bad = 1;
+    } else {
+        for (int j = 0; j < 3; j++) {
+            k->r[j] = sys->tow.point[j] + u[j];
+            k->rd[j] = u[3 + j];
+        }
+    }
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         const int o = k->off[l];
@@ -1103,9 +1191,20 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
     }
 
-    /* 3b. Tow point to free ends: tensions and accelerations. */
-    for (int j = 0; j < 3; j++)
-        k->a[j] = k->afr[j] + u[6 + j];
+    /* 3b. Tow point to free ends: tensions and accelerations. The towing
+     * vehicle has absorbed the whole tree: M6h (a_A, alpha) = G. */
+    if (Root) {
+        if (tsi_chol6(Root->M6h, Root->L6) != 0)
+            return refuse(k, dydt, TS_ESINGULAR);
+        memcpy(Root->a6, Root->G, sizeof Root->a6);
+        tsi_chol6_solve(Root->L6, Root->a6);
+        mat3_mul(Root->st.R, Root->a6 + 3, Root->alpha_m);
+        mat3_mul(Root->st.R, Root->a6, k->a);
+        v3_set(Root->Fj, 0, 0, 0);
+    } else {
+        for (int j = 0; j < 3; j++)
+            k->a[j] = k->afr[j] + u[6 + j];
+    }
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         int i = L->lower, p = L->upper;
@@ -1129,7 +1228,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
 
     /* 4. Relative accelerations and angle accelerations. */
     for (int j = 0; j < 3; j++)
-        k->rdd[j] = u[6 + j];
+        k->rdd[j] = Root ? k->a[j] - k->afr[j] : u[6 + j];
     for (int i = 1; i < nn; i++)
         for (int j = 0; j < 3; j++)
             k->rdd[3 * i + j] = k->a[3 * i + j] - k->afr[3 * i + j];
@@ -1177,6 +1276,11 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         tsi_vehicle_angle_accel(&V->st, th, thd, k->frame.turn_rate,
                                 k->frame.turn_accel, V->alpha_m,
                                 dydt + nq + V->qoff);
+        if (V->root)
+            for (int j = 0; j < 3; j++) {
+                dydt[V->qoff + 3 + j] = thd[3 + j];
+                dydt[nq + V->qoff + 3 + j] = k->rdd[j];
+            }
         for (int l = 0; l < V->d->nloops; l++)
             if (V->xi_off[l] >= 0)
                 cdot[V->xi_off[l]] = V->xi_dot[l];
@@ -1250,6 +1354,21 @@ double ts_kernel_tow_force(const ts_kernel *k, double F[3])
 {
     const ts_system *sys = k->sys;
     double M0a[3];
+    if (k->root >= 0) {
+        /* The links leaving the towing vehicle's tow point: each its
+         * tension and the half link lumped there (its loads less its
+         * mass times its acceleration), Buckham's half of link 1. */
+        const ts_node *n0 = &sys->nodes[0];
+        v3_set(F, 0, 0, 0);
+        for (int c = n0->child_begin; c < n0->child_end; c++) {
+            int l = sys->child_links[c];
+            sym3_mul(k->uM + 6 * l, k->ua + 3 * l, M0a);
+            for (int j = 0; j < 3; j++)
+                F[j] += k->t[l] * k->n[3 * l + j] + k->uQ[3 * l + j] -
+                        M0a[j];
+        }
+        return v3_norm(F);
+    }
     sym3_mul(k->M, k->a, M0a);
     for (int j = 0; j < 3; j++)
         F[j] = k->Q[j] - M0a[j];
@@ -1638,6 +1757,12 @@ void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
     v3_copy(V->st.om_rel_b, r->omega);
     r->submerged = V->st.frac;
     v3_copy(V->Fj, r->joint_force);
+    if (V->root) {
+        r->towing = 1;
+        ts_kernel_tow_force(k, r->joint_force);
+        r->thrust = V->thrust;
+        r->power = V->thrust * w[0];
+    }
     r->ncomponents = d->ncomponents;
     memcpy(r->delta, V->delta, sizeof r->delta);
     const ts_system *sys = k->sys;

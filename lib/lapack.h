@@ -1,7 +1,8 @@
 /* lapack.h: prototypes of every LAPACK and BLAS (Fortran) routine towstab
- * calls (internal; ARPACK's are in arpack.h). Integers are Fortran INTEGER
- * (int with Debian's LP64 build); a CHARACTER argument carries gfortran's
- * hidden length, passed last; COMPLEX*16 is double complex. */
+ * and its tests call (internal; ARPACK's are in arpack.h). Integers are
+ * Fortran INTEGER (int with Debian's LP64 build); a CHARACTER argument
+ * carries gfortran's hidden length, passed last; COMPLEX*16 is double
+ * complex. */
 #ifndef TOWSTAB_LAPACK_H
 #define TOWSTAB_LAPACK_H
 
@@ -31,6 +32,8 @@ void dgeevx_(const char *balanc, const char *jobvl, const char *jobvr,
              double *abnrm, double *rconde, double *rcondv, double *work,
              const int *lwork, int *iwork, int *info, size_t balanc_len,
              size_t jobvl_len, size_t jobvr_len, size_t sense_len);
+void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
+            int *ipiv, double complex *b, const int *ldb, int *info);
 void zgetrf_(const int *m, const int *n, double complex *a, const int *lda,
              int *ipiv, int *info);
 void zgetrs_(const char *trans, const int *n, const int *nrhs,

@@ -92,7 +92,7 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->h = calloc(sn + (size_t)ni, sizeof(double));
     lin->u0 = calloc((size_t)ni, sizeof(double));
     lin->kink_node = -1;
-    lin->desc_err = NAN;
+    lin->desc_err = lin->desc_round = NAN;
     lin->nvehicles = ts_kernel_nvehicles(k);
     lin->noutput = ts_kernel_noutput(k);
     if (lin->noutput > 0) {
@@ -667,7 +667,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
 #endif
     lin->threads = nthreads;
     lin->groups = 0;
-    lin->desc_err = NAN;
+    lin->desc_err = lin->desc_round = NAN;
     if (sparse) {
         /* The kernel's last evaluation is the base point: the sparse model
          * starts from its positions, velocities, accelerations and
@@ -681,9 +681,13 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         const ts_descriptor *d = lin->desc;
         lin->residual_evaluations = d->evaluations;
         lin->groups = d->groups;
-        if (o.estimate_error)
+        if (o.estimate_error) {
             lin->desc_err = fmax(d->k_scale > 0 ? d->k_err / d->k_scale : 0,
                                  d->c_scale > 0 ? d->c_err / d->c_scale : 0);
+            lin->desc_round =
+                fmax(d->k_scale > 0 ? d->k_round / d->k_scale : 0,
+                     d->c_scale > 0 ? d->c_round / d->c_scale : 0);
+        }
     }
     if (!dense) {
         /* Kinks: nodes within twice their own position step of the

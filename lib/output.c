@@ -129,7 +129,11 @@ void ts_output_names(const ts_system *sys, int kinds, char *buf, size_t size)
                        sys->cables[c].name);
                 first = 0;
             }
+        sep = "; ";
     }
+    if (kinds & TS_OUT_BIT(TS_OUT_EARTH))
+        append(&t, "%searth-frame positions <node>.earth_x|earth_y (the "
+                   "nodes above) and tow.earth_x|earth_y", sep);
 }
 
 static int bad_output(const ts_system *sys, int kinds, const char *name,
@@ -220,7 +224,19 @@ static int find(const ts_system *sys, const char *name, int kinds,
     }
     int comp = -1;
     ts_output_kind kind = TS_OUT_POSITION;
-    if (strcmp(suffix, "x") == 0)
+    if (strcmp(suffix, "earth_x") == 0 || strcmp(suffix, "earth_y") == 0) {
+        kind = TS_OUT_EARTH;
+        comp = suffix[6] == 'x' ? 0 : 1;
+        if (strcmp(base, "tow") == 0) {
+            out->kind = kind;
+            out->node = 0;
+            out->comp = comp;
+            out->unit = "m/m";
+            out->si_unit = "m";
+            snprintf(out->name, sizeof out->name, "tow.%s", suffix);
+            return TS_OK;
+        }
+    } else if (strcmp(suffix, "x") == 0)
         comp = 0;
     else if (strcmp(suffix, "y") == 0)
         comp = 1;
@@ -232,7 +248,8 @@ static int find(const ts_system *sys, const char *name, int kinds,
         kind = TS_OUT_STRAIN;
     else
         return bad_output(sys, kinds, name, "the part after the last '.' "
-                          "must be x, y, z, tension, strain or length", err);
+                          "must be x, y, z, tension, strain, length, "
+                          "earth_x or earth_y", err);
     if (strcmp(base, "tow") == 0)
         return bad_output(sys, kinds, name, "tow is the input (tow.surge, "
                           "tow.sway, tow.heave), not an output; the force "
@@ -263,14 +280,18 @@ static int find(const ts_system *sys, const char *name, int kinds,
         break;
     }
     default: {
-        out->kind = TS_OUT_POSITION;
+        out->kind = kind;
         out->node = L->lower;
         out->comp = comp;
         out->unit = "m/m";
         out->si_unit = "m";
         char nm[2 * TS_NAME_MAX];
         ts_system_node_name(sys, out->node, nm, sizeof nm);
-        snprintf(out->name, sizeof out->name, "%s.%c", nm, "xyz"[comp]);
+        if (kind == TS_OUT_EARTH)
+            snprintf(out->name, sizeof out->name, "%s.%s", nm, suffix);
+        else
+            snprintf(out->name, sizeof out->name, "%s.%c", nm,
+                     "xyz"[comp]);
     }
     }
     return TS_OK;
@@ -282,9 +303,10 @@ int ts_output_find(const ts_system *sys, const char *name, int kinds,
     int rc = find(sys, name, kinds, out, err);
     if (rc != TS_OK || (kinds & TS_OUT_BIT(out->kind)))
         return rc;
-    static const char *const what[TS_OUT_KINDS] = {
+    static const char *const what[TS_OUT_EARTH + 1] = {
         "a position", "a tension", "the force on the tow point", "a strain",
-        "a stretched length"};
+        "a stretched length", "a vehicle's output",
+        "an earth-frame position (a simulation's)"};
     char why[160];
     snprintf(why, sizeof why, "%s is not an output of this analysis",
              what[out->kind]);
@@ -311,6 +333,7 @@ double ts_output_value(const ts_system *sys, const ts_output *out,
 {
     switch (out->kind) {
     case TS_OUT_VEHICLE: /* needs a kernel (ts_kernel_outputs) */
+    case TS_OUT_EARTH:   /* needs the frame's track (ts_history_value) */
         return NAN;
     case TS_OUT_POSITION:
         return pos ? pos[3 * (size_t)out->node + (size_t)out->comp] : NAN;

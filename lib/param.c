@@ -215,11 +215,26 @@ static void names_list(const char *names, size_t stride, int n, char *buf,
 }
 
 /* bodies.<vehicle>.loops.<loop>.<key> or .surfaces.<surface>.<key>. */
+/* The part after a vehicle's "loops." ("controllers.", the scene's
+ * word) or "surfaces." ("components."); *loops says which. NULL for
+ * neither. */
+static const char *vehicle_part(const char *key, int *loops)
+{
+    static const char *const words[4] = {"loops.", "controllers.",
+                                         "surfaces.", "components."};
+    for (int i = 0; i < 4; i++)
+        if (!strncmp(key, words[i], strlen(words[i]))) {
+            *loops = i < 2;
+            return key + strlen(words[i]);
+        }
+    return NULL;
+}
+
 static int resolve_vehicle(const char *path, const ts_system *sys, int b,
                            const char *key, target *tg, ts_err *err)
 {
-    int loops = !strncmp(key, "loops.", 6);
-    const char *rest = key + (loops ? 6 : 9);
+    int loops = 0;
+    const char *rest = vehicle_part(key, &loops);
     const ts_body *bd = sys ? &sys->bodies[b] : NULL;
     if (bd && (bd->type != TS_BODY_VEHICLE || !bd->vehicle))
         return ts_fail(err, TS_EINVAL, "%s: body '%s' is not a vehicle; "
@@ -410,9 +425,12 @@ static int resolve_spelled(const ts_system *sys, const char *path,
     if (!s) {
         /* By form: the key is what follows the last dot, or a vehicle's
          * loops/surfaces part. */
-        const char *p = strstr(rest, ".loops.");
-        if (!p)
-            p = strstr(rest, ".surfaces.");
+        const char *p = NULL;
+        int loops;
+        for (const char *q = strchr(rest, '.'); q && !p;
+             q = strchr(q + 1, '.'))
+            if (vehicle_part(q + 1, &loops))
+                p = q;
         if (!cables && p)
             return resolve_vehicle(path, NULL, -1, p + 1, tg, err);
         key = strrchr(rest, '.');
@@ -450,7 +468,8 @@ static int resolve_spelled(const ts_system *sys, const char *path,
                        "bodies: %s", path, s->nbodies > 0 ? list : "none");
     }
     tg->body = b;
-    if (!strncmp(key, "loops.", 6) || !strncmp(key, "surfaces.", 9))
+    int loops;
+    if (vehicle_part(key, &loops))
         return resolve_vehicle(path, s, b, key, tg, err);
     tg->base = (char *)&s->bodies[b];
     return resolve_key(path, key, body_rows, COUNT(body_rows), tg, err);
@@ -506,10 +525,26 @@ int ts_param_canonical(const char *path, char *out, size_t size,
         spell(NULL, path, dotted, sizeof dotted, NULL);
     else
         snprintf(dotted, sizeof dotted, "%s", path);
-    if (!strcmp(path, "speed") || !strcmp(path, "turn_rate"))
+    if (!strcmp(path, "speed") || !strcmp(path, "turn_rate")) {
         snprintf(out, size, "tow.%s", path);
-    else
-        snprintf(out, size, "%s", dotted);
+        return TS_OK;
+    }
+    /* A vehicle's controllers and components by the scene's words are its
+     * loops and surfaces. */
+    size_t o = 0;
+    int loops;
+    for (const char *p = dotted; *p && o + 1 < size;) {
+        const char *rest = p[0] == '.' ? vehicle_part(p + 1, &loops) : NULL;
+        if (rest) {
+            o += (size_t)snprintf(out + o, size - o, ".%s.",
+                                  loops ? "loops" : "surfaces");
+            p = rest;
+        } else {
+            out[o++] = *p++;
+        }
+    }
+    if (o < size)
+        out[o] = '\0';
     return TS_OK;
 }
 

@@ -64,6 +64,7 @@ json_t *ts_report_linear_json(const ts_linear *lin, int matrices)
     json_object_set_new(o, "residual_evaluations",
                         json_integer(lin->residual_evaluations));
     json_object_set_new(o, "sparse_error", num(lin->desc_err));
+    json_object_set_new(o, "sparse_rounding", num(lin->desc_round));
     if (matrices && lin->A && lin->B) {
         json_t *A = matrix_rows(lin->A, lin->nstate, lin->nstate,
                                 lin->nstate);

@@ -14,8 +14,9 @@
  * way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1 b by the dense shifted
  * solve of lib/shift.h (one LU of P(s), O(nq^3)), then positions through
  * the link geometry plus the tow displacement, tensions through dT/dy and
- * dT/du; there each gain also gets the linearization's error allowance
- * (gain_error).
+ * dT/du. Each gain gets the linearization's error allowance, the sparse
+ * way from the model's entry-wise truncation and rounding
+ * (sparse_gain_error), the dense way from A's (gain_error).
  */
 #include "towstab/response.h"
 
@@ -174,6 +175,7 @@ typedef struct resp_ws {
     double complex *b, *x, *rho;
     double *dq, *drr, *m; /* m: a position output's row of the node
                              displacement map (for the error) */
+    double complex *wt;   /* [nx] the sparse way's transposed solution */
 } resp_ws;
 
 /* The dense way's error allowance of the gain g = rho^T x1 (+ a part
@@ -311,10 +313,33 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     }
 }
 
+/* The sparse way's error allowance of the gain g = c^T x, S(s) x = b
+ * (x the node displacements and link tensions, c the output's unit
+ * vector): errors dK, dC of the model change it by dg = -w^T dS x_full
+ * with S(s)^T w = c (one transposed solve with the same factors) and
+ * x_full the node displacements with the tow point's (the input columns
+ * of K and C are the right-hand side's). tsi_desc_error_terms gives the
+ * truncation and rounding parts (doc/linear.md, section 4); the allowance
+ * is 10 times their sum, as the dense way's. A tension is an unknown of
+ * the model: its gain needs no Jacobian of its own. NaN without the
+ * estimate. Cost: one transposed solve, O(nlinks). */
+static double sparse_gain_error(tsi_shift *sh, const ts_output *out,
+                                resp_ws *w)
+{
+    const ts_descriptor *d = sh->d;
+    memset(w->wt, 0, (size_t)d->nx * sizeof(double complex));
+    w->wt[out->kind == TS_OUT_POSITION ? 4 * (out->node - 1) + out->comp
+                                       : 4 * out->link + 3] = 1.0;
+    tsi_shift_tsolve(sh, w->wt);
+    double tr, ro;
+    tsi_desc_error_terms(d, w->wt, w->dr, sh->s, &tr, &ro);
+    return 10.0 * (tr + ro);
+}
+
 /* The gain at omega; sh holds the factors of the previous frequency
  * (zeroed before the first), which are refactored (tsi_shift_refactor);
  * the caller frees them. With gerr, the gain's linearization error
- * allowance into *gerr (the dense way; NaN the sparse way). */
+ * allowance into *gerr. */
 static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
                    const ts_output *out, double omega, resp_ws *w,
                    tsi_shift *sh, double complex *g, double *gerr,
@@ -334,7 +359,7 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
         *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
                                           : w->dt[out->link];
         if (gerr)
-            *gerr = NAN;
+            *gerr = sparse_gain_error(sh, out, w);
     } else {
         dense_gain(sys, lin, input, out, sh, w, g, gerr);
     }
@@ -399,7 +424,11 @@ static int ws_alloc(resp_ws *w, const ts_linear *lin, const ts_system *sys,
     w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double complex));
     w->dt = malloc((size_t)(lin->nlinks > 0 ? lin->nlinks : 1) *
                    sizeof(double complex));
-    if (!lin->desc) {
+    if (lin->desc) {
+        w->wt = malloc(((size_t)lin->desc->nx + 1) * sizeof(double complex));
+        if (!w->wt)
+            return 0;
+    } else {
         w->b = malloc((size_t)lin->nstate * sizeof(double complex));
         w->x = malloc((size_t)lin->nstate * sizeof(double complex));
         w->rho = malloc((size_t)lin->nq * sizeof(double complex));
@@ -433,6 +462,7 @@ static void ws_free(resp_ws *w)
     free(w->drr);
     free(w->rho);
     free(w->m);
+    free(w->wt);
 }
 
 int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,

@@ -1046,6 +1046,68 @@ static int parse_vehicle(const ctx *c, const yaml_node_t *n, const char *path,
     return rc;
 }
 
+/* A towing vehicle's propulsion (towstab/vehicle.h, ts_propulsion):
+ * exactly one of thrust, power (with max_thrust) or speed (a speed
+ * controller with gain, its thrust the starting bias), and the point `at`
+ * where the thrust acts. */
+static int parse_propulsion(const ctx *c, const field *fp, const char *parent,
+                            ts_propulsion *pr)
+{
+    enum { P_THRUST, P_POWER, P_SPEED, P_MAX, P_GAIN, P_AT, P_N };
+    field f[P_N] = {{"thrust", 0, 0}, {"power", 0, 0}, {"speed", 0, 0},
+                    {"max_thrust", 0, 0}, {"gain", 0, 0}, {"at", 0, 0}};
+    char path[PATH_LEN], p[PATH_LEN];
+    join(path, parent, "propulsion");
+    pr->line = fp->line;
+    int rc = read_map(c, fp->value, path, "thrust, power or speed, ...", f,
+                      P_N);
+    if (rc != TS_OK)
+        return rc;
+    static const int laws[] = {P_THRUST, P_POWER, P_SPEED};
+    int which;
+    rc = one_of(c, path, fp->value, f, laws, 3, 1, &which);
+    if (rc != TS_OK)
+        return rc;
+    pr->max_thrust = INFINITY;
+    if (which == P_THRUST) {
+        pr->type = TS_PROP_THRUST;
+        rc = field_quantity(c, join(p, path, "thrust"), &f[P_THRUST], "N",
+                            &pr->thrust);
+    } else if (which == P_POWER) {
+        pr->type = TS_PROP_POWER;
+        if (!f[P_MAX].value)
+            return fail_at(c, TS_ESCENE, path, fp->line, "missing key "
+                           "'max_thrust': the constant-power law T = P / U "
+                           "needs its cap at low speed (the bollard "
+                           "thrust)");
+        rc = field_quantity(c, join(p, path, "power"), &f[P_POWER], "W",
+                            &pr->power);
+        if (rc == TS_OK)
+            rc = check_min(c, p, &f[P_POWER], pr->power, 0, 1, "W");
+        if (rc == TS_OK)
+            rc = optional_min(c, path, &f[P_MAX], "N", 0, 1, INFINITY,
+                              &pr->max_thrust);
+    } else {
+        pr->type = TS_PROP_SPEED;
+        rc = field_quantity(c, join(p, path, "speed"), &f[P_SPEED], "m/s",
+                            &pr->speed);
+        if (rc == TS_OK)
+            rc = check_min(c, p, &f[P_SPEED], pr->speed, 0, 1, "m/s");
+        if (rc == TS_OK)
+            rc = optional_min(c, path, &f[P_GAIN], "N*s/m", 0, 0, 0.0,
+                              &pr->gain);
+    }
+    if (rc == TS_OK && which != P_POWER && f[P_MAX].value)
+        rc = fail_at(c, TS_ESCENE, join(p, path, "max_thrust"), f[P_MAX].line,
+                     "applies to a power law only");
+    if (rc == TS_OK && which != P_SPEED && f[P_GAIN].value)
+        rc = fail_at(c, TS_ESCENE, join(p, path, "gain"), f[P_GAIN].line,
+                     "applies to a speed controller only");
+    if (rc == TS_OK && f[P_AT].value)
+        rc = vector3(c, path, &f[P_AT], "m", pr->position);
+    return rc;
+}
+
 static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                       ts_system *sys)
 {
@@ -1053,7 +1115,11 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
      * order parse_vehicle reads them; its added_mass is B_CA's node. */
     enum { B_NAME, B_TYPE, B_DIAM, B_WEIGHT, B_MASS, B_WET, B_DRAG, B_CA,
            B_LEN, B_XDRAG, B_XCA, B_VOLUME, B_INERTIA, B_MC, B_BC, B_ATTACH,
-           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_N };
+           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_PROP, B_N };
+    /* The towing vehicle (sys->tow.vehicle == b): the top-level
+     * towing_vehicle entry, a vehicle whose attach point is its tow
+     * point, with propulsion. */
+    int towing = b == sys->tow.vehicle;
     field f[B_N] = {{"name", 0, 0}, {"type", 0, 0}, {"diameter", 0, 0},
                     {"weight", 0, 0}, {"mass", 0, 0}, {"wet_weight", 0, 0},
                     {"drag", 0, 0}, {"added_mass", 0, 0}, {"length", 0, 0},
@@ -1061,17 +1127,27 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                     {"volume", 0, 0}, {"inertia", 0, 0},
                     {"mass_centre", 0, 0}, {"buoyancy_centre", 0, 0},
                     {"attach", 0, 0}, {"surface_diameter", 0, 0},
-                    {"components", 0, 0}, {"controllers", 0, 0}};
+                    {"components", 0, 0}, {"controllers", 0, 0},
+                    {"propulsion", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
-    index_path(path, "bodies", b);
+    if (towing) {
+        snprintf(path, sizeof path, "towing_vehicle");
+        f[B_ATTACH].key = "tow_point";
+    } else {
+        index_path(path, "bodies", b);
+    }
     ts_body *body = &sys->bodies[b];
     body->line = line_of(n);
-    int rc = read_map(c, n, path, "name, type, diameter, weight, ...", f, B_N);
+    int rc = read_map(c, n, path, towing ? "name, mass, inertia, ..."
+                                         : "name, type, diameter, weight, ...",
+                      f, towing ? B_N : B_N - 1);
     if (rc != TS_OK)
         return rc;
     for (int k = 0; k <= B_TYPE; k++)
-        if (!f[k].value)
+        if (!f[k].value && !(towing && k == B_TYPE))
             return missing(c, path, n, f[k].key);
+    if (towing && !f[B_PROP].value)
+        return missing(c, path, n, "propulsion");
 
     rc = read_name(c, join(p, path, "name"), &f[B_NAME], body->name);
     if (rc != TS_OK)
@@ -1085,9 +1161,13 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                            "name '%s' (bodies[%d], line %d)", body->name, j,
                            sys->bodies[j].line);
 
-    const char *type = NULL;
-    rc = field_text(c, join(p, path, "type"), &f[B_TYPE],
-                    "sphere, cylinder, junction or vehicle", &type);
+    const char *type = "vehicle";
+    if (f[B_TYPE].value)
+        rc = field_text(c, join(p, path, "type"), &f[B_TYPE],
+                        "sphere, cylinder, junction or vehicle", &type);
+    if (rc == TS_OK && towing && strcmp(type, "vehicle"))
+        rc = fail_at(c, TS_EINVAL, p, f[B_TYPE].line, "a towing vehicle is "
+                     "of type vehicle");
     if (rc != TS_OK)
         return rc;
     if (!strcmp(type, "sphere"))
@@ -1123,6 +1203,9 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
     if (veh) {
         rc = parse_vehicle(c, n, path, f + B_VOLUME,
                            f[B_CA].value ? &f[B_CA] : NULL, sys, b);
+        if (rc == TS_OK && towing)
+            rc = parse_propulsion(c, &f[B_PROP], path,
+                                  &body->vehicle->propulsion);
         if (rc != TS_OK)
             return rc;
     }
@@ -1558,9 +1641,11 @@ static int top_list(const ctx *c, const field *f, int *n)
 
 static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
 {
-    enum { K_NAME, K_ENV, K_TOW, K_CABLES, K_BODIES, K_ANALYSES, K_N };
+    enum { K_NAME, K_ENV, K_TOW, K_CABLES, K_BODIES, K_ANALYSES, K_TOWING,
+           K_N };
     field f[K_N] = {{"name", 0, 0}, {"environment", 0, 0}, {"tow", 0, 0},
-                    {"cables", 0, 0}, {"bodies", 0, 0}, {"analyses", 0, 0}};
+                    {"cables", 0, 0}, {"bodies", 0, 0}, {"analyses", 0, 0},
+                    {"towing_vehicle", 0, 0}};
     int rc = read_map(c, root, "", "name, tow, cables, ...", f, K_N);
     if (rc != TS_OK)
         return rc;
@@ -1578,10 +1663,14 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
         return fail_at(c, TS_EINVAL, "cables", f[K_CABLES].line, "at least "
                        "one cable is needed");
 
-    ts_system *sys = ts_system_alloc(ncables, nbodies, c->err);
+    /* A towing vehicle is the last body. */
+    int towing = f[K_TOWING].value != NULL;
+    ts_system *sys = ts_system_alloc(ncables, nbodies + towing, c->err);
     if (!sys)
         return c->err ? c->err->code : TS_ENOMEM;
     scene->system = sys;
+    if (towing)
+        sys->tow.vehicle = nbodies;
     rc = read_name(c, "name", &f[K_NAME], sys->name);
     if (rc == TS_OK && f[K_ENV].value)
         rc = parse_environment(c, f[K_ENV].value, &sys->env);
@@ -1591,6 +1680,14 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
         yaml_node_t *item = seq_item(c, f[K_BODIES].value, b);
         rc = item ? parse_body(c, item, b, sys)
                   : ts_fail(c->err, TS_ESCENE, "bodies: broken YAML");
+    }
+    if (rc == TS_OK && towing) {
+        rc = parse_body(c, f[K_TOWING].value, nbodies, sys);
+        for (int b = 0; rc == TS_OK && b < nbodies; b++)
+            if (!strcmp(sys->bodies[b].name, sys->bodies[nbodies].name))
+                rc = fail_at(c, TS_EINVAL, "towing_vehicle.name",
+                             sys->bodies[nbodies].line, "'%s' is also the "
+                             "name of bodies[%d]", sys->bodies[b].name, b);
     }
     long total_links = 0;
     for (int i = 0; rc == TS_OK && i < ncables; i++) {

@@ -123,6 +123,30 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err);
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
                      double complex *dt);
 
+/* The transposed solve S(s)^T w = b with the factors of sh (sparse
+ * backend; plain transpose, no conjugate): w[nx] complex, b in, w out. */
+void tsi_shift_tsolve(tsi_shift *sh, double complex *w);
+
+/* First-order error of an eigenvalue lam of lin's sparse model from the
+ * model's own error (doc/linear.md, section 3): with the right
+ * eigenvector v[n] (kernel coordinates, mapped to node displacements x)
+ * and the left null vector w of the pencil, S(lam)^T w = 0 (two steps of
+ * inverse iteration with S(lam), factored at lam; a shift that is
+ * singular to working precision is moved by 1e-10 |lam|),
+ *
+ *     dlam = (|w^T dS x| + rms of w^T N x) / |w^T S'(lam) x|,
+ *
+ * dS = dK + lam dC and N the rounding noise (tsi_desc_error_terms),
+ * S'(lam) = [[2 lam M + C, 0], [Cv n^T rows of taut elastic links, 0]].
+ * Into *dlam (1/s; NaN without the estimate). sh: the caller's (zeroed
+ * before the first call, freed with tsi_shift_free after the last), whose
+ * factors are refactored at each lam (tsi_shift_refactor). Cost: one KLU
+ * (re)factorisation and two transposed solves, O(nlinks). Returns TS_OK,
+ * TS_EINVAL (no sparse model), TS_ESINGULAR or TS_ENOMEM. */
+int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
+                        double complex lam, const double complex v[],
+                        double *dlam, ts_err *err);
+
 /* dq[nq] of node displacements, the inverse of
  * ts_linear_node_displacements (for displacements that keep the rigid
  * links' lengths). */

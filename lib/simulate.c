@@ -195,9 +195,12 @@ ts_history *ts_history_alloc(const ts_system *sys, int capacity, ts_err *err)
     h->tow_force = malloc(c * 3 * sizeof(double));
     h->energy = malloc(c * 2 * sizeof(double));
     h->input = malloc(c * TS_NINPUT * sizeof(double));
+    h->frame = malloc(c * 3 * sizeof(double));
     if (!h->t || !h->positions || !h->tensions || !h->tow_force ||
-        !h->energy || !h->input)
+        !h->energy || !h->input || !h->frame)
         goto nomem;
+    for (size_t i = 0; i < 3 * c; i++)
+        h->frame[i] = NAN;
     return h;
 nomem:
     ts_history_free(h);
@@ -219,6 +222,7 @@ void ts_history_free(ts_history *h)
     free(h->tow_force);
     free(h->energy);
     free(h->input);
+    free(h->frame);
     free(h->outputs);
     free(h->output_name);
     free(h->output_unit);
@@ -331,6 +335,15 @@ double ts_history_value(const ts_system *sys, const ts_history *h,
     if (i < 0 || i >= h->nsamples)
         return NAN;
     size_t s = (size_t)i;
+    if (out->kind == TS_OUT_EARTH) {
+        /* (x, y, 0) + Rz(psi) r of the node's position r in M. */
+        const double *r = h->positions + 3 * ((size_t)h->nnodes * s +
+                                              (size_t)out->node);
+        const double *f = h->frame + 3 * s;
+        double c = cos(f[2]), sn = sin(f[2]);
+        return out->comp == 0 ? f[0] + c * r[0] - sn * r[1]
+                              : f[1] + sn * r[0] + c * r[1];
+    }
     return ts_output_value(sys, out, h->positions + 3 * (size_t)h->nnodes * s,
                            h->tensions + (size_t)h->nlinks * s,
                            h->tow_force + 3 * s);

@@ -36,6 +36,7 @@ ts_system *ts_system_alloc(int ncables, int nbodies, ts_err *err)
     }
     s->env.water_density = 1025.0;
     s->env.gravity = 9.80665;
+    s->tow.vehicle = -1;
     return s;
 nomem:
     ts_system_free(s);
@@ -185,6 +186,8 @@ int ts_system_body_node(const ts_system *s, int b)
 {
     if (!s->nodes || b < 0 || b >= s->nbodies)
         return -1;
+    if (b == s->tow.vehicle)
+        return 0;
     for (int k = 1; k < s->nnodes; k++)
         if (s->nodes[k].body == b)
             return k;
@@ -531,6 +534,23 @@ static int validate(const ts_system *s, ts_err *err)
                            "bending needs at least 2 links, got %d", i,
                            at_line(c->line), c->nlinks);
     }
+    if (s->tow.vehicle != -1 &&
+        (s->tow.vehicle < 0 || s->tow.vehicle >= s->nbodies ||
+         s->bodies[s->tow.vehicle].type != TS_BODY_VEHICLE))
+        return ts_fail(err, TS_EINVAL, "tow.vehicle: the towing vehicle "
+                       "must be a body of type vehicle, got index %d",
+                       s->tow.vehicle);
+    if (s->tow.vehicle >= 0 && (s->tow.point[0] != 0 || s->tow.point[1] != 0))
+        return ts_fail(err, TS_EINVAL, "tow.point: with a towing vehicle the "
+                       "tow point starts the mean frame's origin: x and y "
+                       "must be 0 m, got %g and %g m (z is its starting "
+                       "depth)", s->tow.point[0], s->tow.point[1]);
+    for (int b = 0; b < s->nbodies; b++)
+        if (b != s->tow.vehicle && s->bodies[b].vehicle &&
+            s->bodies[b].vehicle->propulsion.type != TS_PROP_NONE)
+            return ts_fail(err, TS_EINVAL, "bodies[%d].propulsion%s: only "
+                           "the towing vehicle has propulsion",
+                           b, at_line(s->bodies[b].line));
     for (int b = 0; b < s->nbodies; b++) {
         const ts_body *bd = &s->bodies[b];
         if ((rc = check_min(err, "bodies", b, bd->line, "diameter", bd->diameter, 0, 0,
@@ -569,6 +589,14 @@ static int validate(const ts_system *s, ts_err *err)
         int ends = 0;
         for (int i = 0; i < s->ncables; i++)
             ends += s->cables[i].to_body == b;
+        if (b == s->tow.vehicle) {
+            if (ends != 0)
+                return ts_fail(err, TS_EINVAL, "bodies[%d]%s: the towing "
+                               "vehicle '%s' is the root of the tree: no "
+                               "cable may end at it, %d do",
+                               b, at_line(bd->line), bd->name, ends);
+            continue;
+        }
         if (ends != 1)
             return ts_fail(err, TS_EINVAL, "bodies[%d]%s: "
                            "'%s' must end exactly one cable (the cable "
@@ -596,7 +624,8 @@ int ts_system_build(ts_system *s, ts_err *err)
     }
     int norder = 0;
     for (int i = 0; i < nc; i++)
-        if (s->cables[i].from_body == -1) {
+        if (s->cables[i].from_body == -1 ||
+            (s->tow.vehicle >= 0 && s->cables[i].from_body == s->tow.vehicle)) {
             order[norder++] = i;
             done[i] = 1;
         }
@@ -654,6 +683,11 @@ int ts_system_build(ts_system *s, ts_err *err)
         s->nodes[k].body = -1;
         s->nodes[k].link = k - 1;
     }
+    /* A towing vehicle roots the tree: its attach point is node 0. */
+    if (s->tow.vehicle >= 0) {
+        body_node[s->tow.vehicle] = 0;
+        s->nodes[0].body = s->tow.vehicle;
+    }
 
     double rho = s->env.water_density;
     s->has_bending = 0;
@@ -667,7 +701,8 @@ int ts_system_build(ts_system *s, ts_err *err)
         int ci = order[o];
         const ts_cable *c = &s->cables[ci];
         /* Upper node of the first link: the tow point or the body node. */
-        int top = c->from_body < 0 ? 0 : body_node[c->from_body];
+        int from = c->from_body < 0 ? s->tow.vehicle : c->from_body;
+        int top = from < 0 ? 0 : body_node[from];
         for (int j = 0; j < c->nlinks; j++, k++) {
             ts_link *L = &s->links[k];
             double frac = c->link_fraction ? c->link_fraction[j]
@@ -692,10 +727,10 @@ int ts_system_build(ts_system *s, ts_err *err)
             /* The first link of a cable from a vehicle starts at a point of
              * the vehicle, which carries half the link's mass. */
             L->up_body = -1;
-            if (j == 0 && c->from_body >= 0 &&
-                s->bodies[c->from_body].type == TS_BODY_VEHICLE) {
-                const ts_vehicle *v = s->bodies[c->from_body].vehicle;
-                L->up_body = c->from_body;
+            if (j == 0 && from >= 0 &&
+                s->bodies[from].type == TS_BODY_VEHICLE) {
+                const ts_vehicle *v = s->bodies[from].vehicle;
+                L->up_body = from;
                 for (int q = 0; q < 3; q++)
                     L->up_point[q] = c->has_from_point ? c->from_point[q]
                                                        : v->attach[q];

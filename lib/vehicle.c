@@ -390,7 +390,60 @@ int ts_vehicle_check(const ts_vehicle *v, double mass, const char *where,
                            "name; inputs are named <vehicle>.<surface> and "
                            "<vehicle>.<loop>", lp->name);
     }
+    const ts_propulsion *pr = &v->propulsion;
+    if (pr->type != TS_PROP_NONE) {
+        snprintf(w, sizeof w, "%s.propulsion", where);
+        int pl = pr->line;
+        if ((rc = check_finite3(err, w, pl, "at", pr->position)))
+            return rc;
+        switch (pr->type) {
+        case TS_PROP_THRUST:
+            if (!isfinite(pr->thrust))
+                return bad(err, w, pl, "thrust", "must be finite, got %g",
+                           pr->thrust);
+            break;
+        case TS_PROP_POWER:
+            if ((rc = check_value(err, w, pl, "power", pr->power, 0, 1)))
+                return rc;
+            if (!(pr->max_thrust > 0))
+                return bad(err, w, pl, "max_thrust", "must be > 0 N, got %g",
+                           pr->max_thrust);
+            break;
+        case TS_PROP_SPEED:
+            if ((rc = check_value(err, w, pl, "speed", pr->speed, 0, 1)) ||
+                (rc = check_value(err, w, pl, "gain", pr->gain, 0, 0)))
+                return rc;
+            if (!isfinite(pr->thrust))
+                return bad(err, w, pl, "thrust", "must be finite, got %g",
+                           pr->thrust);
+            break;
+        default:
+            return bad(err, w, pl, NULL, "unknown propulsion type %d",
+                       (int)pr->type);
+        }
+    }
     return TS_OK;
+}
+
+double ts_propulsion_thrust(const ts_propulsion *p, double u, double bias,
+                            double input)
+{
+    double T = 0.0;
+    switch (p->type) {
+    case TS_PROP_THRUST:
+        T = p->thrust;
+        break;
+    case TS_PROP_POWER:
+        /* T U = P while P / U is below the cap (U <= 0: the cap). */
+        T = u > p->power / p->max_thrust ? p->power / u : p->max_thrust;
+        break;
+    case TS_PROP_SPEED:
+        T = bias + p->gain * (p->speed - u);
+        break;
+    default:
+        break;
+    }
+    return T + input;
 }
 
 double tsi_vehicle_lever(const ts_vehicle *v)

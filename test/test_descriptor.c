@@ -37,20 +37,13 @@
 #include "descriptor.h"
 #include "kernel_impl.h"
 #include "shift.h"
+#include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
 
-void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
-            int *ipiv, double complex *b, const int *ldb, int *info);
-
 static ts_units *units;
-
-static ts_scene *scene_from(const char *yaml)
-{
-    return tscene_parse(units, yaml);
-}
 
 /* Every kind of link and body, in a turn with a current. */
 static const char *mixed_yaml =
@@ -76,7 +69,7 @@ static const char *mixed_yaml =
 
 static void test_residual_is_kernel(void)
 {
-    ts_scene *sc = scene_from(mixed_yaml);
+    ts_scene *sc = tscene_parse(units, mixed_yaml);
     const ts_system *sys = sc->system;
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(sys, &err);
@@ -311,7 +304,7 @@ static void test_examples(void)
 /* Section 3: (A - s I)^-1 b, sparse against dense. */
 static void test_shifted_solve(void)
 {
-    ts_scene *sc = scene_from(mixed_yaml);
+    ts_scene *sc = tscene_parse(units, mixed_yaml);
     /* No turn and no current: an equilibrium. */
     ts_system *sys = sc->system;
     sys->tow.turn_rate = 0;
@@ -418,7 +411,7 @@ static void test_groups(void)
                  "  - {name: sphere, type: sphere, diameter: 0.3, mass: "
                  "41.0}\n",
                  links[p], p < 2 ? 0.0 : 2.0);
-        ts_scene *sc = scene_from(yaml);
+        ts_scene *sc = tscene_parse(units, yaml);
         ts_err err = {0};
         ts_kernel *k = ts_kernel_alloc(sc->system, &err);
         ts_equilibrium *eq = ts_equilibrium_alloc(sc->system, &err);
@@ -455,12 +448,9 @@ static void test_groups(void)
 
 int main(void)
 {
-    ts_err err = {0};
-    units = ts_units_alloc(&err);
-    if (!units) {
-        printf("FAIL units: %s\n", err.msg);
+    units = tscene_units();
+    if (!units)
         return 1;
-    }
     test_residual_is_kernel();
     test_examples();
     test_shifted_solve();

@@ -21,6 +21,19 @@
  *  5. ts_design_value: layback is the horizontal distance from the tow
  *     point to the sphere of the equilibrium; refusals name what is
  *     wrong.
+ *  6. The gradient method (SLSQP, central differences) on the problems of
+ *     1 and 3: the same optimum as COBYLA within what the tolerances
+ *     allow (the target's length as in 1; the speed of 3 within 1e-6
+ *     relative, its constraints met), with its runs counted.
+ *  7. Controller gains: the AURORA towfish's depth loop kp and kd that
+ *     maximise control_damping (the smallest damping ratio of the
+ *     resolved modes that move the vehicle most) with fin_use <= 1 for a
+ *     2 m depth step. The optimum is not beaten by any feasible point of a
+ *     5 x 5 grid of the gains around it (spacing 1% of each range) beyond
+ *     1e-6, and a separate modes run at the optimum's gains gives the
+ *     reported damping to the last digit; fin_use there is |steady wing
+ *     deflection| + kp 2 m over the 25 deg limit, recomputed here from the
+ *     equilibrium's deflection.
  */
 #include "towstab/design.h"
 
@@ -73,14 +86,20 @@ static double z_at(double L, void *data)
     return z - zd->target;
 }
 
+/* The cable length of example 1 that puts the sphere at 15 m. */
+static void target_spec(ts_design_spec *sp)
+{
+    spec_init(sp, TS_ANALYSIS_EQUILIBRIUM);
+    add_free(sp, "cables.cable.length", 10.0, 60.0);
+    sp->goal.kind = TS_DESIGN_TARGET;
+    snprintf(sp->goal.name, sizeof sp->goal.name, "sphere.z");
+    sp->goal.target = 15.0;
+}
+
 static void test_target(const ts_system *ex1)
 {
     ts_design_spec sp;
-    spec_init(&sp, TS_ANALYSIS_EQUILIBRIUM);
-    add_free(&sp, "cables.cable.length", 10.0, 60.0);
-    sp.goal.kind = TS_DESIGN_TARGET;
-    snprintf(sp.goal.name, sizeof sp.goal.name, "sphere.z");
-    sp.goal.target = 15.0;
+    target_spec(&sp);
     ts_design *d = NULL;
     ts_err err = {0};
     int rc = ts_design_run(ex1, &sp, &d, &err);
@@ -140,22 +159,29 @@ static void test_target(const ts_system *ex1)
     ts_design_free(d);
 }
 
-static void test_constraints(const ts_system *ex1)
+/* The highest speed of example 1 with top_tension <= 600 N and layback
+ * <= 25 m, the sphere's mass and the speed free. */
+static void constraints_spec(ts_design_spec *sp)
 {
-    ts_design_spec sp;
-    spec_init(&sp, TS_ANALYSIS_EQUILIBRIUM);
-    add_free(&sp, "bodies.sphere.mass", 1.0, 1000.0);
-    add_free(&sp, "tow.speed", 1.0, 5.0);
-    sp.goal.kind = TS_DESIGN_MAXIMISE;
-    snprintf(sp.goal.name, sizeof sp.goal.name, "tow.speed");
-    ts_design_constraint *c = sp.constraints;
+    spec_init(sp, TS_ANALYSIS_EQUILIBRIUM);
+    add_free(sp, "bodies.sphere.mass", 1.0, 1000.0);
+    add_free(sp, "tow.speed", 1.0, 5.0);
+    sp->goal.kind = TS_DESIGN_MAXIMISE;
+    snprintf(sp->goal.name, sizeof sp->goal.name, "tow.speed");
+    ts_design_constraint *c = sp->constraints;
     snprintf(c[0].name, sizeof c[0].name, "top_tension");
     c[0].upper = 1;
     c[0].bound = 600.0;
     snprintf(c[1].name, sizeof c[1].name, "layback");
     c[1].upper = 1;
     c[1].bound = 25.0;
-    sp.nconstraints = 2;
+    sp->nconstraints = 2;
+}
+
+static void test_constraints(const ts_system *ex1)
+{
+    ts_design_spec sp;
+    constraints_spec(&sp);
     ts_design *d = NULL;
     ts_err err = {0};
     int rc = ts_design_run(ex1, &sp, &d, &err);
@@ -294,20 +320,162 @@ static void test_values_and_refusals(const ts_system *ex1)
     }
 }
 
+/* The problems of test_target and test_constraints with SLSQP against
+ * COBYLA. */
+static void test_gradient(const ts_system *ex1)
+{
+    ts_design_spec sp;
+    target_spec(&sp);
+    ts_design *d[2] = {NULL, NULL};
+    ts_err err = {0};
+    for (int k = 0; k < 2; k++) {
+        sp.method = k ? TS_DESIGN_SLSQP : TS_DESIGN_COBYLA;
+        ts_design_run(ex1, &sp, &d[k], &err);
+    }
+    if (CHECK(d[0] && d[1] && d[0]->success && d[1]->success,
+              "target sphere.z = 15 m with cobyla and slsqp (%s)", err.msg)) {
+        /* Both within the target's tolerance 1.5e-5 m of 15 m, dz/dL
+         * about 0.3: lengths within 2 x 1.5e-5 / 0.29. */
+        double allow = 2 * 1.5e-5 / 0.29;
+        CHECK(fabs(d[0]->x[0] - d[1]->x[0]) <= allow &&
+                  d[1]->gradients > 0,
+              "slsqp: L = %.9g m in %d runs (%d gradients, step %g of the "
+              "range), %ld kernel evaluations; cobyla %.9g m in %d runs, "
+              "%ld: within %.2g m",
+              d[1]->x[0], d[1]->neval, d[1]->gradients, TS_DESIGN_GRAD_STEP,
+              d[1]->evaluations, d[0]->x[0], d[0]->neval,
+              d[0]->evaluations, allow);
+    }
+    for (int k = 0; k < 2; k++) {
+        ts_design_free(d[k]);
+        d[k] = NULL;
+    }
+
+    constraints_spec(&sp);
+    for (int k = 0; k < 2; k++) {
+        sp.method = k ? TS_DESIGN_SLSQP : TS_DESIGN_COBYLA;
+        ts_design_run(ex1, &sp, &d[k], &err);
+    }
+    if (CHECK(d[0] && d[1] && d[0]->success && d[1]->success,
+              "maximise speed under two constraints with cobyla and slsqp "
+              "(%s)", err.msg))
+        CHECK(fabs(d[0]->x[1] - d[1]->x[1]) <= 1e-6 * d[0]->x[1],
+              "slsqp: %.9g m/s (mass %.7g kg) in %d runs (%d gradients), "
+              "%ld kernel evaluations; cobyla %.9g m/s in %d runs, %ld: "
+              "within 1e-6 relative",
+              d[1]->x[1], d[1]->x[0], d[1]->neval, d[1]->gradients,
+              d[1]->evaluations, d[0]->x[1], d[0]->neval,
+              d[0]->evaluations);
+    for (int k = 0; k < 2; k++)
+        ts_design_free(d[k]);
+}
+
+/* control_damping and fin_use of one modes run at depth gains kp, kd. */
+static int aurora_at(const ts_system *sys, double kp, double kd,
+                     double *damping, double *fin, double *wing)
+{
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_MODES);
+    rq.setup.discretisation_error = 0;
+    ts_setup_set(&rq.setup, "bodies.aurora.controllers.depth.kp", kp, NULL);
+    ts_setup_set(&rq.setup, "bodies.aurora.controllers.depth.kd", kd, NULL);
+    ts_result *r = NULL;
+    ts_value v;
+    int ok = ts_analysis_run(sys, &rq, &r, NULL) == TS_OK &&
+             ts_design_value(r, "control_damping", &v);
+    *damping = ok ? v.value : NAN;
+    /* The wing is component 1; its steady deflection. */
+    *wing = ok && r->eq && r->eq->nvehicles == 1 ? r->eq->vehicles[0].delta[1]
+                                                  : NAN;
+    *fin = NAN;
+    if (ok && ts_design_value(r, "fin_use", &v))
+        *fin = v.value;
+    ts_result_free(r);
+    return ok;
+}
+
+static void test_controller(const ts_system *aurora)
+{
+    ts_design_spec sp;
+    spec_init(&sp, TS_ANALYSIS_MODES);
+    sp.rq.setup.discretisation_error = 0;
+    add_free(&sp, "bodies.aurora.controllers.depth.kp", 0.01, 0.3);
+    add_free(&sp, "bodies.aurora.controllers.depth.kd", 0.0, 0.5);
+    sp.goal.kind = TS_DESIGN_MAXIMISE;
+    snprintf(sp.goal.name, sizeof sp.goal.name, "control_damping");
+    snprintf(sp.constraints[0].name, sizeof sp.constraints[0].name,
+             "fin_use");
+    sp.constraints[0].upper = 1;
+    sp.constraints[0].bound = 1.0;
+    sp.nconstraints = 1;
+    sp.fin_step = 2.0;
+    ts_design *d = NULL;
+    ts_err err = {0};
+    int rc = ts_design_run(aurora, &sp, &d, &err);
+    if (!CHECK(rc == TS_OK && d && d->success,
+               "AURORA: maximise control_damping, depth kp and kd free, "
+               "fin_use <= 1 for a 2 m step: ran (%s)", err.msg)) {
+        ts_design_free(d);
+        return;
+    }
+    double best = d->goal_value.value, kp = d->x[0], kd = d->x[1];
+    double dmp, fin, wing;
+    int ok = aurora_at(aurora, kp, kd, &dmp, &fin, &wing);
+    CHECK(ok && dmp == best,
+          "optimum kp %.7g rad/m, kd %.7g rad s/m: control_damping %.10g in "
+          "%d runs; a separate modes run there gives %.10g",
+          kp, kd, best, d->neval, dmp);
+    double limit = 25.0 * M_PI / 180.0;
+    double fin_here = (fabs(wing) + kp * 2.0) / limit;
+    CHECK(fabs(fin_here - d->constraint_value[0].value) <= 1e-12 &&
+              fabs(fin - fabs(wing) / limit) <= 1e-12 &&
+              d->constraint_value[0].value <= 1 + d->spec.target_rtol,
+          "fin_use %.10g = (|wing %.5f deg| + kp x 2 m) / 25 deg = %.10g; "
+          "without the step (ts_design_value) %.10g",
+          d->constraint_value[0].value, wing * 180 / M_PI, fin_here, fin);
+    double hp = 0.01 * (0.3 - 0.01), hd = 0.01 * 0.5;
+    int feasible = 0, beaten = 0;
+    double worst = -INFINITY;
+    for (int i = -2; i <= 2; i++)
+        for (int j = -2; j <= 2; j++) {
+            double p = kp + i * hp, q = kd + j * hd;
+            if ((i == 0 && j == 0) || p < 0.01 || p > 0.3 || q < 0 ||
+                q > 0.5)
+                continue;
+            /* fin_use of the run is the steady part; the step's adds
+             * kp 2 m on the wing, the only surface of the depth loop. */
+            if (!aurora_at(aurora, p, q, &dmp, &fin, &wing) ||
+                (fabs(wing) + 2.0 * p) / limit > 1)
+                continue;
+            feasible++;
+            beaten += dmp > best + 1e-6;
+            worst = fmax(worst, dmp - best);
+        }
+    CHECK(feasible >= 3 && beaten == 0,
+          "a 5 x 5 grid around the optimum (kp +- %.4g, kd +- %.4g): %d "
+          "feasible points, none better by 1e-6 (largest gain %.3g)",
+          hp, hd, feasible, worst);
+    ts_design_free(d);
+}
+
 int main(void)
 {
     ts_err err = {0};
     ts_units *u = ts_units_alloc(&err);
     ts_scene *ex1 = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
     ts_scene *above = tscene_load(u, "examples/kamman_ex1_above.yaml");
-    if (ex1 && above) {
+    ts_scene *aurora = tscene_load(u, "examples/aurora_towfish.yaml");
+    if (ex1 && above && aurora) {
         test_target(ex1->system);
         test_constraints(ex1->system);
         test_stability(above->system);
         test_values_and_refusals(ex1->system);
+        test_gradient(ex1->system);
+        test_controller(aurora->system);
     }
     ts_scene_free(ex1);
     ts_scene_free(above);
+    ts_scene_free(aurora);
     ts_units_free(u);
     return tc_done();
 }

@@ -40,11 +40,6 @@
 
 static ts_units *units;
 
-static ts_scene *scene_from(const char *yaml)
-{
-    return tscene_parse(units, yaml);
-}
-
 /* A towed cable with a sphere, in water, straight tow, tow point 0.7 m
  * below the surface (so no node is near the waterline). */
 static const char *towed_yaml =
@@ -70,7 +65,7 @@ static ts_equilibrium *solve(ts_kernel *k, const ts_system *sys)
 
 static void test_structure_threads_and_second_method(void)
 {
-    ts_scene *sc = scene_from(towed_yaml);
+    ts_scene *sc = tscene_parse(units, towed_yaml);
     const ts_system *sys = sc->system;
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(sys, &err);
@@ -198,7 +193,7 @@ static void test_structure_threads_and_second_method(void)
 
 static void test_exact_inputs(void)
 {
-    ts_scene *sc = scene_from(
+    ts_scene *sc = tscene_parse(units, 
         "name: chain\n"
         "environment: {water_density: 0, gravity: 9.79}\n"
         "tow: {speed: 0}\n"
@@ -261,7 +256,7 @@ static void test_kinks(void)
 {
     ts_err err = {0};
     /* Tow point at the waterline, straight tow. */
-    ts_scene *sc = scene_from(
+    ts_scene *sc = tscene_parse(units, 
         "name: surface\n"
         "tow: {speed: 1.7}\n"
         "cables:\n"
@@ -282,7 +277,7 @@ static void test_kinks(void)
 
     /* A chain hanging at rest from 2 links' length above the water: node 2
      * sits exactly at z = 0. */
-    sc = scene_from("name: dip\n"
+    sc = tscene_parse(units, "name: dip\n"
                     "tow: {speed: 0, point: [0, 0, -2.4]}\n"
                     "cables:\n"
                     "  - {name: c, from: tow, length: 6.0, diameter: 0.02,\n"
@@ -311,7 +306,7 @@ static void test_kinks(void)
     rc = ts_linearize(k, lin->y0, NULL, &o, lin, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "rel_step"),
           "bad rel_step refused: %s", err.msg);
-    ts_scene *sc2 = scene_from(towed_yaml);
+    ts_scene *sc2 = tscene_parse(units, towed_yaml);
     ts_kernel *k2 = ts_kernel_alloc(sc2->system, &err);
     ts_err_clear(&err);
     rc = ts_linearize(k2, lin->y0, NULL, NULL, lin, &err);
@@ -340,7 +335,7 @@ static void test_kinks(void)
  * (the rms of 2 x 80 x 80 independent draws). */
 static void test_rounding_noise(void)
 {
-    ts_scene *sc = scene_from(towed_yaml);
+    ts_scene *sc = tscene_parse(units, towed_yaml);
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(sc->system, &err);
     ts_equilibrium *eq = solve(k, sc->system);
@@ -388,12 +383,9 @@ static void test_rounding_noise(void)
 
 int main(void)
 {
-    ts_err err = {0};
-    units = ts_units_alloc(&err);
-    if (!units) {
-        printf("FAIL units: %s\n", err.msg);
+    units = tscene_units();
+    if (!units)
         return 1;
-    }
     test_structure_threads_and_second_method();
     test_exact_inputs();
     test_kinks();

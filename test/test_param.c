@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "towstab/analysis.h"
 #include "towstab/scene.h"
 
 /* A scene with one value left open: %s is replaced by `value` at `key`. */
@@ -343,6 +344,88 @@ static void test_vehicle(void)
     ts_system_free(s);
 }
 
+/* A vehicle's controllers and components by the scene's own words
+ * (bodies.aurora.controllers.depth.kp, as the scene writes `controllers`):
+ * each value set by path equals the same text written in the scene
+ * (ts_scene_set) to the last digit of an equilibrium and a modes run. */
+static void test_scene_words(const ts_units *u)
+{
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load("examples/aurora_towfish.yaml", u, &err);
+    if (!CHECK(sc != NULL, "the AURORA scene loads (%s)", err.msg))
+        return;
+    static const struct {
+        const char *path, *key, *text;
+    } cases[] = {
+        {"bodies.aurora.controllers.depth.kp",
+         "bodies[aurora].controllers[depth].kp", "0.12 rad/m"},
+        {"bodies.aurora.controllers.pitch.kd",
+         "bodies[aurora].controllers[pitch].kd", "0.45 s"},
+        {"bodies.aurora.controllers.depth.setpoint",
+         "bodies[aurora].controllers[depth].setpoint", "35 m"},
+        {"bodies.aurora.components.wing.area",
+         "bodies[aurora].components[wing].area", "0.55 m^2"},
+    };
+    /* The scene as written, to see each setting change the run. */
+    ts_request r0;
+    ts_request_init(&r0, TS_ANALYSIS_MODES);
+    r0.setup.discretisation_error = 0;
+    ts_result *base_run = NULL;
+    if (ts_analysis_run(sc->system, &r0, &base_run, &err) != TS_OK) {
+        CHECK(0, "the AURORA modes run (%s)", err.msg);
+        ts_result_free(base_run);
+        ts_scene_free(sc);
+        return;
+    }
+    char canon[TS_PARAM_PATH_MAX];
+    int rc = ts_param_canonical(cases[0].path, canon, sizeof canon, &err);
+    CHECK(rc == TS_OK && !strcmp(canon, "bodies.aurora.loops.depth.kp"),
+          "controllers is the loops' word in the scene: %s", canon);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char unit[TS_PARAM_UNIT_MAX];
+        double x = NAN;
+        rc = ts_param_unit(sc->system, cases[i].path, unit, sizeof unit,
+                           &err);
+        if (!rc)
+            rc = ts_units_parse(u, cases[i].text, unit, cases[i].path, &x,
+                                &err);
+        ts_request rq;
+        ts_request_init(&rq, TS_ANALYSIS_MODES);
+        rq.setup.discretisation_error = 0;
+        if (!rc)
+            rc = ts_setup_set(&rq.setup, cases[i].path, x, &err);
+        const char *key = cases[i].key, *text = cases[i].text;
+        ts_scene *t = rc ? NULL
+                         : ts_scene_set(sc, 1, &key, &text, u, &err);
+        ts_request rt;
+        ts_request_init(&rt, TS_ANALYSIS_MODES);
+        rt.setup.discretisation_error = 0;
+        ts_result *a = NULL, *b = NULL;
+        int ok = t && ts_analysis_run(sc->system, &rq, &a, &err) == TS_OK &&
+                 ts_analysis_run(t->system, &rt, &b, &err) == TS_OK;
+        int same = ok && a->eigen && b->eigen &&
+                   a->eigen->nmodes == b->eigen->nmodes;
+        for (int k = 0; same && k < a->nvalues; k++)
+            same = a->values[k].value == b->values[k].value;
+        for (int m = 0; same && m < a->eigen->nmodes; m++)
+            same = a->eigen->modes[m].re == b->eigen->modes[m].re &&
+                   a->eigen->modes[m].im == b->eigen->modes[m].im;
+        int changed = 0;
+        for (int m = 0; same && m < a->eigen->nmodes &&
+                        m < base_run->eigen->nmodes; m++)
+            changed |= a->eigen->modes[m].re != base_run->eigen->modes[m].re;
+        CHECK(same && changed, "%s = %s (%.17g %s) by path gives the modes "
+              "run of the scene with %s: %s to the last digit, and not the "
+              "scene's as written (%s)", cases[i].path, text, x, unit, key,
+              same ? "the same" : "NOT the same", err.msg);
+        ts_result_free(a);
+        ts_result_free(b);
+        ts_scene_free(t);
+    }
+    ts_result_free(base_run);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -353,6 +436,7 @@ int main(void)
         test_get(u);
         test_errors(u);
         test_scene_spelling(u);
+        test_scene_words(u);
     }
     test_vehicle();
     ts_units_free(u);

@@ -24,7 +24,8 @@
  *     links, surge and sway, three outputs (one a tension), the static gain
  *     and 5 frequencies, at the default step and at steps 1e-7 and 1e-8
  *     where rounding dominates: every gain within its allowance of that
- *     of a tight, fourth-order linearization (test_rounding).
+ *     of a tight, fourth-order linearization, for the dense model and
+ *     the sparse one (test_rounding).
  */
 #include "towstab/response.h"
 
@@ -33,6 +34,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/eigen.h"
@@ -40,11 +42,6 @@
 #include "towstab/scene.h"
 
 static ts_units *units;
-
-static ts_scene *scene_from(const char *yaml)
-{
-    return tscene_parse(units, yaml);
-}
 
 static const char *above_yaml =
     "name: ex1_above\n"
@@ -180,7 +177,7 @@ static void static_case(ts_system *sys, ts_linear *lin, const char *in_name,
 
 static void test_static_gain(void)
 {
-    ts_scene *sc = scene_from(above_yaml);
+    ts_scene *sc = tscene_parse(units, above_yaml);
     double zmin;
     ts_linear *lin = linearize(sc->system, TS_LIN_BOTH, &zmin);
     CHECK(lin && zmin > 0.1, "above-water tow: every node %.3g m > 0.1 m "
@@ -193,7 +190,7 @@ static void test_static_gain(void)
     ts_linear_free(lin);
     ts_scene_free(sc);
 
-    sc = scene_from(turn_yaml);
+    sc = tscene_parse(units, turn_yaml);
     lin = linearize(sc->system, TS_LIN_BOTH, NULL);
     static_case(sc->system, lin, "tow.surge", "sphere.y", 0.01);
     ts_linear_free(lin);
@@ -202,7 +199,7 @@ static void test_static_gain(void)
 
 static void test_resonance(void)
 {
-    ts_scene *sc = scene_from(
+    ts_scene *sc = tscene_parse(units, 
         "name: chain\n"
         "environment: {water_density: 0, gravity: 9.80665}\n"
         "tow: {speed: 0}\n"
@@ -259,9 +256,6 @@ static void test_resonance(void)
     ts_linear_free(lin);
     ts_scene_free(sc);
 }
-
-void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
-            int *ipiv, double complex *b, const int *ldb, int *info);
 
 /* The response the old way, from the dense A, B and tension Jacobians of
  * the column-difference linearization (an independent reference for the
@@ -356,7 +350,7 @@ static void test_dense_reference(void)
         {"sphere.z", "cable.1.tension", "cable.7.tension"},
         {"fish.z", "a.2.tension", "b.4.y"}};
     for (int sc_i = 0; sc_i < 4; sc_i++) {
-        ts_scene *sc = scene_from(scenes[sc_i]);
+        ts_scene *sc = tscene_parse(units, scenes[sc_i]);
         if (!sc)
             continue;
         const ts_system *sys = sc->system;
@@ -445,7 +439,7 @@ static void test_dense_reference(void)
 
 static void test_names(void)
 {
-    ts_scene *sc = scene_from(above_yaml);
+    ts_scene *sc = tscene_parse(units, above_yaml);
     const ts_system *sys = sc->system;
     ts_err err = {0};
     ts_output out;
@@ -579,10 +573,13 @@ static ts_linear *tight(const ts_system *sys, double h)
  * steps 5e-4 and 1e-3, fourth order, rounding 1e4 times smaller), up to
  * that reference's own uncertainty (its distance to the same from steps
  * 1e-3 and 2e-3). At 1e-8 at least a third of the gains have errors 10
- * times that uncertainty, so the check is about the allowance. */
+ * times that uncertainty, so the check is about the allowance. The same
+ * for the dense model (A's error estimate and noise) and the sparse one
+ * (the node residual's entry-wise truncation and rounding, with tension
+ * outputs from its own unknowns). */
 static void test_rounding(void)
 {
-    ts_scene *sc = scene_from(turn_yaml);
+    ts_scene *sc = tscene_parse(units, turn_yaml);
     ts_err err = {0};
     ts_system *sys = ts_system_copy(sc->system, &err);
     ts_system_set_links(sys, 10, &err);
@@ -593,8 +590,11 @@ static void test_rounding(void)
                                         "cable.1.tension"};
     double freq[5];
     ts_response_logspace(0.05, 5, 5, freq, &err);
-    for (int k = 0; k < 3 && ref && ref2; k++) {
-        ts_linear *lin = linearize_at(sys, TS_LIN_DENSE, steps[k], NULL);
+    for (int kk = 0; kk < 6 && ref && ref2; kk++) {
+        int k = kk % 3, sparse = kk >= 3;
+        ts_linear *lin = linearize_at(sys, sparse ? TS_LIN_SPARSE
+                                                  : TS_LIN_DENSE,
+                                      steps[k], NULL);
         int n = 0, clear = 0, ok = lin != NULL;
         double worst = 0, we = NAN, wb = NAN;
         for (int a = 0; a < 2 && ok; a++)
@@ -638,11 +638,12 @@ static void test_rounding(void)
          * perturbed coordinate the kernel rounds identically). */
         CHECK(ok && worst <= 1 &&
                   (k < 2 || (clear >= n / 3 && worst >= 0.01)),
-              "ex. 3 turn, 10 links, step %.3g: every gain (%d; %d with "
-              "errors 10 times the reference's uncertainty) within its "
-              "error allowance of the tight one (closest %.2f: error "
+              "ex. 3 turn, 10 links, %s model, step %.3g: every gain (%d; "
+              "%d with errors 10 times the reference's uncertainty) within "
+              "its error allowance of the tight one (closest %.2f: error "
               "%.3g, allowance %.3g) (%s)",
-              steps[k], n, clear, worst, we, wb, ok ? "" : err.msg);
+              sparse ? "sparse" : "dense", steps[k], n, clear, worst, we,
+              wb, ok ? "" : err.msg);
         ts_linear_free(lin);
     }
     CHECK(ref && ref2, "tight linearizations");
@@ -654,12 +655,9 @@ static void test_rounding(void)
 
 int main(void)
 {
-    ts_err err = {0};
-    units = ts_units_alloc(&err);
-    if (!units) {
-        printf("FAIL units: %s\n", err.msg);
+    units = tscene_units();
+    if (!units)
         return 1;
-    }
     test_static_gain();
     test_resonance();
     test_dense_reference();

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "towstab/scene.h"
+#include "towstab/units.h"
 
 static inline ts_scene *tscene_load(const ts_units *u, const char *path)
 {
@@ -26,6 +27,17 @@ static inline ts_scene *tscene_parse(const ts_units *u, const char *yaml)
     if (!s)
         printf("scene: %s\n", err.msg);
     return s;
+}
+
+/* The units system of a test program; NULL after printing a FAIL line
+ * (main returns 1 then). */
+static inline ts_units *tscene_units(void)
+{
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    if (!u)
+        printf("FAIL units: %s\n", err.msg);
+    return u;
 }
 
 #endif

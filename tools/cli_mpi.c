@@ -1,219 +1,112 @@
-/* cli_mpi.c: a sweep across processes with MPI (cli_mpi.h).
+/* cli_mpi.c: a sweep across processes with MPI (cli_mpi.h): the loader.
  *
  * MPI is started only when the process was launched by mpirun (its
  * environment names a rank), so that a build with MPI runs alone exactly
- * as one without. Threads: the sweep calls back from one thread at a time
- * (its callbacks sit in one critical section), so MPI_THREAD_SERIALIZED
- * is asked for; when the library offers less, cli_mpi_threads_ok() says
- * so and the sweep runs one thread per process. Messages are small and
- * few (one per chain), sent with blocking MPI_Send and taken by process 0
- * with MPI_Iprobe between its own chains. The tool's state: one process,
- * one command.
+ * as one without. Only then is the MPI module (tools/mpi_module.c,
+ * towstab-mpi.so) opened with dlopen: first beside the executable (the
+ * build tree), then where it is installed (TS_MPI_MODULE). Every other
+ * run loads neither the module nor MPI's libraries, which would cost
+ * several of the few milliseconds a small analysis takes (doc/
+ * performance.md, "Start-up"). Without the module (a build without MPI,
+ * or before cli_mpi_init) every function says there is one process.
  */
 #include "cli_mpi.h"
 
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
-#ifdef TS_HAVE_MPI
-#include <mpi.h>
+#ifdef TS_MPI_MODULE
+#include <dlfcn.h>
+#endif
 
-enum { TAG_RECORD = 1, TAG_END = 2, TAG_STOP = 3 };
+#include "cli.h"
+#include "cli_mpi_module.h"
 
-static int started, rank, size = 1, stopped;
+/* The tool's state (one process, one command): the module's table once
+ * opened and MPI started (NULL: one process). */
+static const cli_mpi_module *mod;
+
+#ifdef TS_MPI_MODULE
+/* Open the module and check its table; prints why not and returns NULL
+ * when it cannot. */
+static const cli_mpi_module *open_module(void)
+{
+    static const char *const where[] = {"$ORIGIN/towstab-mpi.so",
+                                        TS_MPI_MODULE};
+    const char *why = "";
+    for (size_t i = 0; i < sizeof where / sizeof where[0]; i++) {
+        /* Global: MPI's own plugins look up its symbols. */
+        void *h = dlopen(where[i], RTLD_NOW | RTLD_GLOBAL);
+        if (!h) {
+            why = dlerror();
+            continue;
+        }
+        const cli_mpi_module *m = dlsym(h, CLI_MPI_MODULE_SYMBOL);
+        if (m && m->version == CLI_MPI_MODULE_VERSION)
+            return m;
+        why = m ? "a module of another version" : dlerror();
+        dlclose(h);
+    }
+    fprintf(stderr, "towstab: error: mpirun: cannot open the MPI module "
+                    "towstab-mpi.so (beside the executable or %s): %s\n",
+            TS_MPI_MODULE, why ? why : "unknown reason");
+    return NULL;
+}
+#endif
 
 int cli_mpi_init(int *argc, char ***argv)
 {
     if (!getenv("OMPI_COMM_WORLD_SIZE") && !getenv("PMIX_RANK") &&
         !getenv("PMI_RANK"))
         return 0;
-    int provided = 0;
-    if (MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided) !=
-        MPI_SUCCESS) {
-        fprintf(stderr, "towstab: error: MPI did not start\n");
-        return 1;
-    }
-    started = 1;
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-    MPI_Comm_size(MPI_COMM_WORLD, &size);
-    if (provided < MPI_THREAD_SERIALIZED) {
-        if (rank == 0)
-            fprintf(stderr, "towstab: error: this MPI library does not "
-                            "allow calls from several threads "
-                            "(MPI_THREAD_SERIALIZED)\n");
-        MPI_Finalize();
-        started = 0;
-        return 1;
-    }
+#ifdef TS_MPI_MODULE
+    const cli_mpi_module *m = open_module();
+    if (!m)
+        return EXIT_FAILED;
+    int status = m->init(argc, argv);
+    if (status == 0)
+        mod = m;
+    return status;
+#else
+    (void)argc;
+    (void)argv;
     return 0;
+#endif
 }
 
-int cli_mpi_rank(void) { return rank; }
-int cli_mpi_size(void) { return size; }
+int cli_mpi_rank(void) { return mod ? mod->rank() : 0; }
+int cli_mpi_size(void) { return mod ? mod->size() : 1; }
 
 void cli_mpi_finalize(void)
 {
-    if (started)
-        MPI_Finalize();
-    started = 0;
+    if (mod)
+        mod->finalize();
+    mod = NULL;
 }
 
 void cli_mpi_abort(int status)
 {
-    if (started)
-        MPI_Abort(MPI_COMM_WORLD, status);
+    if (mod)
+        mod->abort(status);
 }
 
 int cli_mpi_send_record(const char *text)
 {
-    if (!started || rank == 0)
-        return 0;
-    return MPI_Send(text, (int)strlen(text) + 1, MPI_CHAR, 0, TAG_RECORD,
-                    MPI_COMM_WORLD) == MPI_SUCCESS
-               ? 0
-               : -1;
+    return mod ? mod->send_record(text) : 0;
 }
 
-int cli_mpi_send_end(int status)
-{
-    if (!started || rank == 0)
-        return 0;
-    return MPI_Send(&status, 1, MPI_INT, 0, TAG_END, MPI_COMM_WORLD) ==
-                   MPI_SUCCESS
-               ? 0
-               : -1;
-}
-
-int cli_mpi_send_stop(void)
-{
-    if (!started || rank != 0)
-        return 0;
-    int one = 1;
-    for (int r = 1; r < size; r++)
-        MPI_Send(&one, 1, MPI_INT, r, TAG_STOP, MPI_COMM_WORLD);
-    return 0;
-}
+int cli_mpi_send_end(int status) { return mod ? mod->send_end(status) : 0; }
+int cli_mpi_send_stop(void) { return mod ? mod->send_stop() : 0; }
 
 int cli_mpi_poll(int wait, int (*on_record)(const char *text, void *data),
                  void *data, int *ends, int *worst)
 {
-    int status = 0;
-    while (started && rank == 0) {
-        MPI_Status st;
-        int flag = 0;
-        if (wait && *ends >= size - 1)
-            break;
-        if (wait) {
-            MPI_Probe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
-            flag = 1;
-        } else {
-            MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag,
-                       &st);
-        }
-        if (!flag)
-            break;
-        if (st.MPI_TAG == TAG_END) {
-            int s = 0;
-            MPI_Recv(&s, 1, MPI_INT, st.MPI_SOURCE, TAG_END, MPI_COMM_WORLD,
-                     MPI_STATUS_IGNORE);
-            (*ends)++;
-            if (s > *worst)
-                *worst = s;
-            continue;
-        }
-        int n = 0;
-        MPI_Get_count(&st, MPI_CHAR, &n);
-        char *text = malloc((size_t)(n > 0 ? n : 1));
-        if (!text) {
-            fprintf(stderr, "towstab: error: sweep: out of memory for a "
-                            "record\n");
-            cli_mpi_abort(1);
-            return 1;
-        }
-        MPI_Recv(text, n, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG,
-                 MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        text[n > 0 ? n - 1 : 0] = '\0';
-        if (!status && on_record)
-            status = on_record(text, data);
-        free(text);
-    }
-    return status;
+    return mod ? mod->poll(wait, on_record, data, ends, worst) : 0;
 }
 
-int cli_mpi_stopped(void)
-{
-    if (!started || rank == 0 || stopped)
-        return stopped;
-    int flag = 0;
-    MPI_Status st;
-    MPI_Iprobe(0, TAG_STOP, MPI_COMM_WORLD, &flag, &st);
-    if (flag) {
-        int one;
-        MPI_Recv(&one, 1, MPI_INT, 0, TAG_STOP, MPI_COMM_WORLD,
-                 MPI_STATUS_IGNORE);
-        stopped = 1;
-    }
-    return stopped;
-}
+int cli_mpi_stopped(void) { return mod ? mod->stopped() : 0; }
 
 int cli_mpi_broadcast(void *buf, size_t n)
 {
-    if (!started)
-        return 0;
-    /* In pieces: an int counts the bytes of one call. */
-    const size_t piece = 1u << 30;
-    for (size_t at = 0; at < n; at += piece) {
-        size_t m = n - at < piece ? n - at : piece;
-        if (MPI_Bcast((char *)buf + at, (int)m, MPI_BYTE, 0,
-                      MPI_COMM_WORLD) != MPI_SUCCESS)
-            return -1;
-    }
-    return 0;
+    return mod ? mod->broadcast(buf, n) : 0;
 }
-
-#else /* TS_HAVE_MPI */
-
-int cli_mpi_init(int *argc, char ***argv)
-{
-    (void)argc;
-    (void)argv;
-    return 0;
-}
-
-int cli_mpi_rank(void) { return 0; }
-int cli_mpi_size(void) { return 1; }
-void cli_mpi_finalize(void) {}
-void cli_mpi_abort(int status) { (void)status; }
-
-int cli_mpi_send_record(const char *text)
-{
-    (void)text;
-    return 0;
-}
-
-int cli_mpi_send_end(int status)
-{
-    (void)status;
-    return 0;
-}
-
-int cli_mpi_send_stop(void) { return 0; }
-
-int cli_mpi_poll(int wait, int (*on_record)(const char *text, void *data),
-                 void *data, int *ends, int *worst)
-{
-    (void)wait, (void)on_record, (void)data, (void)ends, (void)worst;
-    return 0;
-}
-
-int cli_mpi_stopped(void) { return 0; }
-
-int cli_mpi_broadcast(void *buf, size_t n)
-{
-    (void)buf;
-    (void)n;
-    return 0;
-}
-
-#endif /* TS_HAVE_MPI */

@@ -1,6 +1,8 @@
 /* cli_mpi.h: a sweep across processes with MPI (tools only; the library
  * knows nothing of MPI). Built with Debian's OpenMPI when found (meson
- * option mpi); otherwise every function here says there is one process.
+ * option mpi) as a module, towstab-mpi.so (tools/mpi_module.c), that
+ * cli_mpi_init opens under mpirun only; otherwise every function here
+ * says there is one process.
  *
  * `mpirun -np N towstab sweep ...` starts N processes. Each runs its share
  * of the sweep's chains (chain c on process c mod N; towstab/sweep.h) and

@@ -22,7 +22,7 @@ extern const cli_command cli_cmd_equilibrium, cli_cmd_modes;
 
 enum {
     X_ANALYSIS, X_FREE, X_TARGET, X_MINIMISE, X_MAXIMISE, X_CONSTRAINT,
-    X_METHOD, X_MAX_EVALS, X_TARGET_TOL
+    X_METHOD, X_MAX_EVALS, X_TARGET_TOL, X_FIN_STEP
 };
 
 static const cli_extra design_extras[] = {
@@ -40,11 +40,15 @@ static const cli_extra design_extras[] = {
     {"constraint", 1, 1, "NAME<=Q",
      "an inequality NAME<=Q or NAME>=Q, e.g. 'top_tension<=40kN'; up to 8"},
     {"method", 1, 0, "M",
-     "cobyla (default: bounds and constraints) or bobyqa (bounds only)"},
+     "cobyla (default: bounds and constraints), bobyqa (bounds only) or "
+     "slsqp (gradients by central differences; bounds and constraints)"},
     {"max-evals", 1, 0, "N",
      "analysis runs at most [default 200]"},
     {"target-tol", 1, 0, "X",
      "a target is reached within this fraction of it [default 1e-6]"},
+    {"fin-step", 1, 0, "Q",
+     "fin_use adds the command's jump for this step of the depth set "
+     "points, e.g. 2m [default 0: the steady deflections]"},
     {NULL, 0, 0, NULL, NULL}};
 
 typedef struct design_state {
@@ -213,9 +217,11 @@ static int design_prepare(cli_run *c)
             sp->method = TS_DESIGN_COBYLA;
         else if (!strcmp(m, "bobyqa"))
             sp->method = TS_DESIGN_BOBYQA;
+        else if (!strcmp(m, "slsqp"))
+            sp->method = TS_DESIGN_SLSQP;
         else
-            return bad("--method: expected cobyla or bobyqa, got '%s'%s", m,
-                       "");
+            return bad("--method: expected cobyla, bobyqa or slsqp, got "
+                       "'%s'%s", m, "");
     }
     long v = 0;
     if (c->nextra[X_MAX_EVALS] &&
@@ -232,6 +238,10 @@ static int design_prepare(cli_run *c)
             return bad("--target-tol: expected a fraction in (0, 1), got "
                        "'%s'%s", t, "");
     }
+    if (c->nextra[X_FIN_STEP] &&
+        quantity(c, "--fin-step", c->extra[X_FIN_STEP][0], "m",
+                 &sp->fin_step))
+        return EXIT_BADINPUT;
     sp->progress = cli_progress;
     ts_err err = {0};
     int rc = ts_design_check(c->scene->system, sp, &err);

@@ -30,9 +30,10 @@ void cli_print_linearization(const ts_result *r)
     else
         printf("linearized: %d states, sparse model (%d perturbation groups, "
                "%ld residual evaluations on %d thread%s), %.3f ms; relative "
-               "truncation error %.3g\n",
+               "truncation error %.3g, rounding noise %.3g\n",
                l->nstate, l->groups, l->residual_evaluations, l->threads,
-               l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->desc_err);
+               l->threads == 1 ? "" : "s", r->lin_wall_s * 1e3, l->desc_err,
+               l->desc_round);
     if (r->open_loop)
         printf("open loop: the vehicles' controller loops are open, their "
                "surfaces held at the trim's deflections\n");

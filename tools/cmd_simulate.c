@@ -13,6 +13,7 @@
 #include "cli_plot.h"
 #include "towstab/excitation.h"
 #include "towstab/report_result.h"
+#include "towstab/track.h"
 
 /* Largest number of table rows printed (longer runs are strided). */
 #define TABLE_ROWS 60
@@ -402,85 +403,172 @@ static int snapshot_vehicles(const ts_system *sys, const ts_history *h,
 /* Snapshots of the cable every `interval` s from t = 0 (side and top
  * views, memo Figs. 9 and 11). */
 /* The plan view in the earth frame under a manoeuvre (plan_earth): the
- * snapshots ps[nsnap] at samples idx[] and the ship's track, the path of
- * M's origin. The heading psi(t) and speed V(t) come from the
- * excitation (ts_excitation_heading, ts_excitation_frame); the track is
- * integrated from V (cos psi, sin psi) by trapezoids over the samples
- * (error O(dt^2) of the sample interval, far below a pixel); a node's
- * earth position is the track's point plus R_z(psi) times its position
- * in M. The ship starts at the origin heading +x. */
+ * snapshots ps[nsnap] at samples idx[], the ship's track (the path of M's
+ * origin) and the track of the last body (the towfish), from the run's
+ * poses of M in the earth frame (h->frame, towstab/track.h: integrated by
+ * the library from V (cos psi, sin psi)); a node's earth position is the
+ * pose's origin plus R_z(psi) times its position in M. The ship starts
+ * at the origin heading +x. */
 static int plot_earth(const ts_system *sys, const ts_history *h,
-                      const ts_excitation *ex, const int *idx, int nsnap,
-                      const ts_plot_shape *ps, const char *title,
-                      const cli_plot *plot)
+                      const int *idx, int nsnap, const ts_plot_shape *ps,
+                      const char *title, const cli_plot *plot)
 {
     int n = h->nsamples;
     size_t nn = 3 * (size_t)h->nnodes;
-    double *track = malloc(3 * (size_t)n * sizeof *track);
-    double *psi = malloc((size_t)n * sizeof *psi);
+    double *track = malloc(6 * (size_t)n * sizeof *track);
     double *pos = malloc((size_t)nsnap * nn * sizeof *pos);
-    ts_plot_shape *es = malloc(((size_t)nsnap + 1) * sizeof *es);
-    if (!track || !psi || !pos || !es) {
+    ts_plot_shape *es = malloc(((size_t)nsnap + 2) * sizeof *es);
+    if (!track || !pos || !es) {
         free(track);
-        free(psi);
         free(pos);
         free(es);
         fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
         return EXIT_FAILED;
     }
-    ts_frame base = {sys->tow.speed, sys->tow.turn_rate, 0, 0, {0, 0, 0}};
-    double vprev = 0;
-    for (int i = 0; i < n; i++) {
-        ts_frame f;
-        ts_excitation_frame(ex, &base, h->t[i], &f);
-        psi[i] = ts_excitation_heading(ex, &base, h->t[i]);
-        double *p = track + 3 * (size_t)i;
-        p[2] = 0;
-        if (i == 0) {
-            p[0] = p[1] = 0;
-        } else {
-            double dt = h->t[i] - h->t[i - 1];
-            p[0] = p[-3] + 0.5 * dt * (vprev * cos(psi[i - 1]) +
-                                       f.speed * cos(psi[i]));
-            p[1] = p[-2] + 0.5 * dt * (vprev * sin(psi[i - 1]) +
-                                       f.speed * sin(psi[i]));
+    /* The last body's node (else the last node): the towfish. */
+    int fish = h->nnodes - 1;
+    for (int b = sys->nbodies - 1; b >= 0; b--) {
+        int node = ts_system_body_node(sys, b);
+        if (node > 0) {
+            fish = node;
+            break;
         }
-        vprev = f.speed;
+    }
+    double *ship = track, *fish_track = track + 3 * (size_t)n;
+    for (int i = 0; i < n; i++) {
+        const double *f = h->frame + 3 * (size_t)i;
+        ship[3 * i] = f[0];
+        ship[3 * i + 1] = f[1];
+        ship[3 * i + 2] = 0;
+        ts_track_to_earth(f, h->positions + nn * (size_t)i + 3 * (size_t)fish,
+                          fish_track + 3 * (size_t)i);
     }
     for (int k = 0; k < nsnap; k++) {
-        int i = idx[k];
-        double c = cos(psi[i]), s = sin(psi[i]);
+        const double *f = h->frame + 3 * (size_t)idx[k];
         const double *m = ps[k].pos;
         double *e = pos + nn * (size_t)k;
-        for (int j = 0; j < h->nnodes; j++) {
-            const double *r = m + 3 * j;
-            e[3 * j] = track[3 * i] + c * r[0] - s * r[1];
-            e[3 * j + 1] = track[3 * i + 1] + s * r[0] + c * r[1];
-            e[3 * j + 2] = r[2];
-        }
+        for (int j = 0; j < h->nnodes; j++)
+            ts_track_to_earth(f, m + 3 * j, e + 3 * j);
         es[k] = ps[k];
         es[k].pos = e;
         es[k].turn_radius = 0;
     }
     ts_plot_shape tr = {0};
     tr.nnodes = n;
-    tr.pos = track;
+    tr.pos = ship;
     tr.label = "ship's track";
     tr.style = TS_PLOT_DASHED;
     tr.color = nsnap + 1;
     es[nsnap] = tr;
+    char fish_label[TS_NAME_MAX + 16];
+    ts_system_node_name(sys, fish, fish_label, TS_NAME_MAX);
+    strcat(fish_label, "'s track");
+    tr.pos = fish_track;
+    tr.label = fish_label;
+    tr.color = nsnap + 2;
+    es[nsnap + 1] = tr;
     ts_err err = {0};
     int status = 0;
     if (ts_plot_shapes(plot->dir, "plan_earth", title, TS_PLOT_TOP, 0,
-                       nsnap + 1, es, &plot->opts, &err) != TS_OK)
+                       nsnap + 2, es, &plot->opts, &err) != TS_OK)
         status = cli_report(&err, err.code);
     else
         printf("wrote %s/plan_earth.png and %s/plan_earth.svg\n", plot->dir,
                plot->dir);
     free(track);
-    free(psi);
     free(pos);
     free(es);
+    return status;
+}
+
+/* The tracks in the earth frame (towstab/track.h) under a manoeuvre or in
+ * a turn: `tracks`, the ship's (M's origin) and every body's in plan view
+ * (ts_plot_tracks), from the run's poses of M; and `depths`, every body's
+ * depth against time (the nonlinear run solid, the linear dashed). */
+#define MAX_TRACKS 8
+static int plot_tracks(const ts_system *sys, const ts_history *hn,
+                       const ts_history *hl, const cli_plot *plot)
+{
+    const ts_history *h = hn ? hn : hl;
+    int n = h->nsamples;
+    int node[MAX_TRACKS], nb = 0;
+    for (int b = 0; b < sys->nbodies && nb < MAX_TRACKS - 1; b++) {
+        int k = ts_system_body_node(sys, b);
+        if (k > 0)
+            node[nb++] = k;
+    }
+    /* x, y of the ship and each body; z of each body in both runs. */
+    double *buf = malloc((size_t)(2 * (nb + 1) + 2 * nb) * (size_t)n *
+                         sizeof *buf);
+    if (!buf) {
+        fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    char label[MAX_TRACKS][TS_NAME_MAX + 16];
+    ts_plot_track tr[MAX_TRACKS];
+    size_t nn = 3 * (size_t)h->nnodes;
+    for (int j = 0; j <= nb; j++) {
+        double *x = buf + 2 * (size_t)j * (size_t)n, *y = x + n;
+        for (int i = 0; i < n; i++) {
+            const double *f = h->frame + 3 * (size_t)i;
+            double e[3] = {f[0], f[1], 0};
+            if (j > 0)
+                ts_track_to_earth(f, h->positions + nn * (size_t)i +
+                                         3 * (size_t)node[j - 1], e);
+            x[i] = e[0];
+            y[i] = e[1];
+        }
+        if (j == 0)
+            snprintf(label[j], sizeof label[j], "ship (M's origin)");
+        else
+            ts_system_node_name(sys, node[j - 1], label[j], TS_NAME_MAX);
+        ts_plot_track t = {n, x, y, label[j],
+                           j == 0 ? TS_PLOT_DASHED : TS_PLOT_SOLID, j + 1,
+                           0, NULL};
+        tr[j] = t;
+    }
+    char title[256];
+    snprintf(title, sizeof title, "%s: tracks in the earth frame%s",
+             sys->name, hn ? "" : ", linear model");
+    ts_err err = {0};
+    int status = 0;
+    if (ts_plot_tracks(plot->dir, "tracks", title, nb + 1, tr, &plot->opts,
+                       &err) != TS_OK)
+        status = cli_report(&err, err.code);
+    else
+        cli_plot_wrote(plot, "tracks");
+    if (!status && nb > 0) {
+        double *z = buf + 2 * (size_t)(nb + 1) * (size_t)n;
+        ts_plot_series ser[2 * MAX_TRACKS];
+        char slabel[2 * MAX_TRACKS][TS_NAME_MAX + 16];
+        int ns = 0;
+        const ts_history *runs[2] = {hn, hl};
+        for (int r = 0; r < 2; r++) {
+            if (!runs[r])
+                continue;
+            for (int j = 0; j < nb; j++, ns++) {
+                double *d = z + (size_t)ns * (size_t)n;
+                int m = runs[r]->nsamples < n ? runs[r]->nsamples : n;
+                for (int i = 0; i < m; i++)
+                    d[i] = runs[r]->positions[nn * (size_t)i +
+                                              3 * (size_t)node[j] + 2];
+                snprintf(slabel[ns], sizeof slabel[ns], "%s%s",
+                         label[j + 1], hn && hl ? (r ? " linear" : "") : "");
+                ts_plot_series a = {m, runs[r]->t, d, slabel[ns], 0,
+                                    r ? TS_PLOT_DASHED : TS_PLOT_SOLID,
+                                    j + 2, NULL};
+                ser[ns] = a;
+            }
+        }
+        ts_plot_axis panel = {"depth z (down)", TS_PLOT_LENGTH, NULL};
+        snprintf(title, sizeof title, "%s: depths against time", sys->name);
+        if (ts_plot_histories(plot->dir, "depths", title, 1, &panel, ns, ser,
+                              &plot->opts, &err) != TS_OK)
+            status = cli_report(&err, err.code);
+        else
+            cli_plot_wrote(plot, "depths");
+    }
+    free(buf);
     return status;
 }
 
@@ -557,9 +645,9 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
     if (!status && ex && ts_excitation_has_manoeuvre(ex)) {
         char title[256];
         snprintf(title, sizeof title, "%s: manoeuvre in the earth frame, "
-                 "cable every %.4g s%s and the ship's track", sys->name,
+                 "cable every %.4g s%s and the tracks", sys->name,
                  interval, exaggerate != 1.0 ? " (exaggerated)" : "");
-        status = plot_earth(sys, h, ex, idx, nsnap, ps, title, plot);
+        status = plot_earth(sys, h, idx, nsnap, ps, title, plot);
     }
     for (int k = 0; k < made; k++)
         cli_plot_shape_free(&shapes[k]);
@@ -789,6 +877,10 @@ static int sim_draw(cli_run *c, const ts_result *r)
     if (!status)
         status = plot_snapshots(r->sys, h, r->excitation, st->snapshot,
                                 st->exaggerate, &c->plot);
+    if (!status && ((r->excitation &&
+                     ts_excitation_has_manoeuvre(r->excitation)) ||
+                    r->sys->tow.turn_rate != 0))
+        status = plot_tracks(r->sys, r->nonlinear, r->linear, &c->plot);
     return status;
 }
 

@@ -16,8 +16,10 @@
  * finds it.
  *
  * The optimiser is NLopt's (nlopt.h): COBYLA (derivative-free, bounds and
- * nonlinear inequality constraints; the default) or BOBYQA (derivative-
- * free, bounds only), on the free values scaled to [0, 1] over their
+ * nonlinear inequality constraints; the default), BOBYQA (derivative-
+ * free, bounds only) or SLSQP (a gradient method, bounds and inequality
+ * constraints; the gradients by central differences of the analysis,
+ * TS_DESIGN_GRAD_STEP), on the free values scaled to [0, 1] over their
  * bounds. Every evaluation is the analysis at those values (ts_setup_set),
  * without the discretisation estimate, its equilibrium started from the
  * previous evaluation's (continuation). The optimum is then run again as
@@ -62,8 +64,13 @@ typedef enum ts_design_goal_kind {
 
 typedef enum ts_design_method {
     TS_DESIGN_COBYLA = 0,
-    TS_DESIGN_BOBYQA = 1
+    TS_DESIGN_BOBYQA = 1,
+    TS_DESIGN_SLSQP = 2
 } ts_design_method;
+
+/* SLSQP's gradients: central differences of this step in the scaled free
+ * values (a fraction of each one's range; one-sided at a bound). */
+#define TS_DESIGN_GRAD_STEP 1e-4
 
 /* A free value. */
 typedef struct ts_design_var {
@@ -97,6 +104,12 @@ typedef struct ts_design_spec {
     int max_evals;                /* 0: TS_DESIGN_MAX_EVALS */
     double target_rtol;           /* 0: TS_DESIGN_TARGET_RTOL */
     double xtol;                  /* 0: TS_DESIGN_XTOL */
+    double fin_step;              /* m: fin_use adds, on every limited
+                                     control surface, |the jump of its
+                                     command| when the depth loops' set
+                                     points step by this: sum over depth
+                                     loops of kp gain fin_step; 0: the
+                                     steady deflections alone */
     ts_progress_fn progress;      /* after each evaluation ("design",
                                      evaluations of max_evals); nonzero
                                      stops the study */
@@ -120,6 +133,8 @@ typedef struct ts_design {
     char unit[TS_DESIGN_MAX_FREE][TS_PARAM_UNIT_MAX]; /* of the free */
     int neval;
     ts_design_eval *history;      /* [neval] */
+    int gradients;                /* SLSQP: gradients computed (2 nfree
+                                     runs each, in neval) */
     int nlopt_code;               /* NLopt's result */
     const char *nlopt_reason;     /* its meaning, static */
     double x[TS_DESIGN_MAX_FREE]; /* the optimum, SI */
@@ -150,6 +165,12 @@ typedef struct ts_design {
  *   min_damping    the smallest damping ratio of the oscillatory modes
  *                  computed that are resolved (not grid-scale, and within
  *                  the accuracy when the estimate ran), 1;
+ *   control_damping  the same over the modes that move a vehicle most
+ *                  (the largest node displacement of the shape is at a
+ *                  vehicle: the modes its controllers act on), 1;
+ *   fin_use        the largest |steady deflection| / limit over the
+ *                  vehicles' control surfaces with a limit, 1 (a study
+ *                  adds the jump of a depth set-point step, fin_step);
  *   a free value's path (its value in the run's system).
  * Returns 1, or 0 when r has no such value (or it is NaN). */
 TS_API int ts_design_value(const ts_result *r, const char *name,

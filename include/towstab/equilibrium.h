@@ -97,6 +97,11 @@ typedef struct ts_equilibrium {
                              too; 0 without controllers */
     ts_vehicle_result *vehicles; /* [nvehicles] attitude, flow angles,
                              loads and deflections of each vehicle */
+    /* The steady motion of the mean frame M: the kernel's speed and turn
+     * rate, or, with a towing vehicle (doc/towing-vehicle.md), the ones
+     * solved with its trim, and its speed controller's thrust bias (N;
+     * 0 without one). */
+    double speed, turn_rate, thrust_bias;
 } ts_equilibrium;
 
 TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);

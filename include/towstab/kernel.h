@@ -104,6 +104,22 @@ TS_API int ts_kernel_input_is_surface(const ts_kernel *k, int j);
 /* Offset of link `link`'s coordinates in q (2 for rigid, 3 for elastic). */
 TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 
+/* The towing vehicle (doc/towing-vehicle.md): its index among the
+ * vehicles, or -1 when the tow point is prescribed; the offset in q of
+ * the position of its attach point (the tow point, node 0) in M, three
+ * coordinates after its three angles (-1 without one). Its inputs follow
+ * its controllers': "<name>.thrust" (N), "<name>.force.x|y|z" (N) and
+ * "<name>.moment.x|y|z" (N m, about its tow point), body axes. With a
+ * towing vehicle the tow-point inputs (the first TS_NINPUT) are not used.
+ * The speed controller's thrust bias (N, towstab/vehicle.h) is a kernel
+ * parameter, trimmed by the equilibrium; ts_kernel_thrust is the thrust
+ * of the last evaluation. */
+TS_API int ts_kernel_root(const ts_kernel *k);
+TS_API int ts_kernel_root_offset(const ts_kernel *k);
+TS_API void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust);
+TS_API double ts_kernel_thrust_bias(const ts_kernel *k);
+TS_API double ts_kernel_thrust(const ts_kernel *k);
+
 /* Set / read the frame motion. The default is the system's tow (speed,
  * turn rate, zero rates) with its current. */
 TS_API void ts_kernel_set_frame(ts_kernel *k, const ts_frame *f);

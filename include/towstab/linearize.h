@@ -165,6 +165,11 @@ typedef struct ts_linear {
     double desc_err;   /* largest relative error estimate of the sparse
                           model, max(|dK|/max|K|, |dC|/max|C|); NaN
                           without the estimate or the model */
+    double desc_round; /* largest relative rounding noise of one entry of
+                          the sparse model, rnoise_i / (sqrt(2) h_j) over
+                          max|K| (max|C|): the residual's own scatter
+                          (doc/linear.md, section 2b); NaN without the
+                          estimate or the model */
 } ts_linear;
 
 typedef struct ts_linearize_opts {

@@ -12,6 +12,10 @@
  *   tow.force               the size of the force the towed system exerts
  *                           on the tow point (N): the top tension
  *   tow.force.x|y|z         its components in M (N)
+ *   <node>.earth_x|earth_y  a node's horizontal position in the earth
+ *                           frame E (m; towstab/track.h), also
+ *                           tow.earth_x|earth_y for the tow point: only
+ *                           in a simulation, which integrates M's track
  * The kinds are listed in ts_output_kind; a new kind (a vehicle's
  * attitude, say) is a new enumerator, a clause of ts_output_find and one
  * of ts_output_value. Every analysis that reports channels names them
@@ -35,11 +39,15 @@ typedef enum {
     TS_OUT_TOW_FORCE = 2, /* comp 0..2, or TS_OUT_MAGNITUDE */
     TS_OUT_STRAIN = 3,    /* link (elastic) */
     TS_OUT_LENGTH = 4,    /* cable (elastic): stretched length */
-    TS_OUT_VEHICLE = 5    /* a vehicle's depth, pitch, roll, yaw, loop
+    TS_OUT_VEHICLE = 5,   /* a vehicle's depth, pitch, roll, yaw, loop
                              output or deflection: row `index` of the
                              kernel's outputs (ts_kernel_output_name),
                              found by ts_response_output_lookup with a
                              kernel, not by ts_output_find */
+    TS_OUT_EARTH = 6      /* node (0: the tow point), comp 0 x, 1 y in the
+                             earth frame: found by ts_output_find when
+                             `kinds` has its bit (outside TS_OUT_ALL),
+                             valued by ts_history_value */
 } ts_output_kind;
 #define TS_OUT_KINDS 5 /* the kinds ts_output_find knows */
 

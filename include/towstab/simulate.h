@@ -141,6 +141,10 @@ typedef struct ts_history {
     double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
                             linear runs; ts_kernel_kinetic_energy) */
     double *input;       /* [capacity][TS_NINPUT] u(t) */
+    double *frame;       /* [capacity][3] the pose of M in the earth frame
+                            E: its origin's x, y (m) and its heading (rad)
+                            (towstab/track.h, ts_track_history); NaN until
+                            filled */
     int noutput;         /* the vehicles' outputs (ts_kernel_noutput), set
                             by the first sample recorded */
     double *outputs;     /* [capacity][noutput] their values (depth, pitch,
@@ -159,7 +163,8 @@ TS_API void ts_history_free(ts_history *h);
 
 /* The value of output channel `out` (towstab/output.h) at sample i of h
  * (0 <= i < h->nsamples), NaN when the run does not give it (the tow
- * force of a linear run). */
+ * force of a linear run; an earth-frame position before h->frame is
+ * filled). */
 TS_API double ts_history_value(const ts_system *sys, const ts_history *h,
                                const ts_output *out, int i);
 

@@ -48,6 +48,11 @@ typedef struct ts_tow {
     double speed;           /* V, m/s along +x_M */
     double turn_rate;       /* Omega, rad/s about +z_M (> 0: starboard turn) */
     double point[3];        /* nominal tow point in M, m (z < 0: above water) */
+    int vehicle;            /* body index of the towing vehicle, the
+                               dynamic root of the tree (its attach point,
+                               the tow point r_tow, is node 0, starting at
+                               `point`; doc/towing-vehicle.md), or -1: the
+                               tow point is prescribed */
 } ts_tow;
 
 typedef struct ts_cable {

@@ -126,6 +126,33 @@ enum {
                            output, for its gain and phase margins */
 };
 
+/* Propulsion of a towing vehicle (doc/towing-vehicle.md, section 2): a
+ * thrust T along the body x axis at `position`. */
+typedef enum {
+    TS_PROP_NONE = 0,   /* no thrust (a towed vehicle) */
+    TS_PROP_THRUST = 1, /* T = thrust, constant */
+    TS_PROP_POWER = 2,  /* constant power: T = min(power / U, max_thrust),
+                           U the surge speed through the water (Buckham's
+                           T = T_E U_steady / U with T_E U_steady = power) */
+    TS_PROP_SPEED = 3   /* speed controller: T = thrust + gain (speed - U)
+                           with U the tow point's speed through the water,
+                           `thrust` the bias the steady analyses trim so
+                           that U = speed */
+} ts_propulsion_type;
+
+typedef struct ts_propulsion {
+    ts_propulsion_type type;
+    double thrust;      /* N: the thrust (TS_PROP_THRUST) or the speed
+                           controller's bias (TS_PROP_SPEED) */
+    double power;       /* W, > 0 (TS_PROP_POWER) */
+    double max_thrust;  /* N, > 0: the power law's cap at low speed (its
+                           bollard thrust); INFINITY: none */
+    double speed;       /* m/s, > 0: the speed controller's set speed */
+    double gain;        /* N s/m, >= 0: the speed controller's gain */
+    double position[3]; /* where the thrust acts, body axes from O, m */
+    int line;           /* scene line, 0 if none */
+} ts_propulsion;
+
 typedef struct ts_vehicle {
     double inertia[6];    /* about the mass centre, body axes, kg m^2:
                              Ixx, Iyy, Izz, Ixy, Ixz, Iyz (products as
@@ -147,7 +174,19 @@ typedef struct ts_vehicle {
     ts_component component[TS_VEHICLE_MAX_COMPONENTS];
     int nloops;
     ts_loop loop[TS_VEHICLE_MAX_LOOPS];
+    ts_propulsion propulsion; /* a towing vehicle's (TS_PROP_NONE for a
+                             towed one) */
 } ts_vehicle;
+
+/* The thrust law of propulsion p at speed u (m/s: the power law's is
+ * the surge, the velocity of the body origin relative to the water along
+ * body x; the speed controller's the tow point's speed through the water)
+ * with `bias` the
+ * speed controller's trimmed bias (N; ignored by the other laws), plus
+ * `input` (N, the thrust input of a linear model or an excitation).
+ * The one place the law is written (the kernel and the manoeuvres). */
+TS_API double ts_propulsion_thrust(const ts_propulsion *p, double u,
+                                   double bias, double input);
 
 /* Loads of one component (body axes): force (N), moment about the body
  * origin O (N m), its angle of attack (a surface: with incidence and
@@ -176,7 +215,11 @@ typedef struct ts_vehicle_result {
     double omega[3];      /* angular velocity relative to M, body axes */
     double submerged;     /* fraction under water */
     double joint_force[3];/* force of the cable's end node on the vehicle
-                             through the joint, M frame, N */
+                             through the joint, M frame, N (the towing
+                             vehicle: the cables' pull at its tow point) */
+    int towing;           /* 1: the towing vehicle */
+    double thrust, power; /* the towing vehicle's thrust (N) and its power
+                             T U (W), U its surge speed through the water */
     double hydro_force[3], hydro_moment[3]; /* all components, body axes,
                              moment about O */
     double munk[3];       /* the added mass's -v x p moment, body axes */

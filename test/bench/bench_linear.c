@@ -13,25 +13,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "clock.h"
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double cpu(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static ts_scene *make(ts_units *u, int links)
 {
@@ -67,9 +53,9 @@ static void run(ts_units *u, int links, int arpack, int reps, double target)
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(sys, &err);
     ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
-    double t0 = now();
+    double t0 = tsi_wall_now();
     int rc = ts_equilibrium_solve(k, NULL, eq, &err);
-    double t_eq = now() - t0;
+    double t_eq = tsi_wall_now() - t0;
     ts_linear *lin = rc == TS_OK ? ts_linear_alloc(k, &err) : NULL;
     if (!lin) {
         printf("FAIL %d links: %s\n", links, err.msg);
@@ -87,16 +73,16 @@ static void run(ts_units *u, int links, int arpack, int reps, double target)
         lo.model = arpack ? TS_LIN_AUTO : TS_LIN_DENSE;
         if (links <= 400) {
             lo.threads = 1;
-            t0 = now();
+            t0 = tsi_wall_now();
             rc |= ts_linearize_equilibrium(k, eq, &lo, lin, &err);
-            best_lin1 = fmin(best_lin1, now() - t0);
+            best_lin1 = fmin(best_lin1, tsi_wall_now() - t0);
         }
         lo.threads = 0;
-        t0 = now();
-        double c0 = cpu();
+        t0 = tsi_wall_now();
+        double c0 = tsi_cpu_now();
         rc |= ts_linearize_equilibrium(k, eq, &lo, lin, &err);
-        best_lin = fmin(best_lin, now() - t0);
-        cpu_lin = fmin(cpu_lin, cpu() - c0);
+        best_lin = fmin(best_lin, tsi_wall_now() - t0);
+        cpu_lin = fmin(cpu_lin, tsi_cpu_now() - c0);
         threads = lin->threads;
         ts_eigen_opts eo;
         ts_eigen_opts_default(&eo);
@@ -105,8 +91,8 @@ static void run(ts_units *u, int links, int arpack, int reps, double target)
             eo.count = 10;
         }
         ts_eigen *e = NULL;
-        t0 = now();
-        c0 = cpu();
+        t0 = tsi_wall_now();
+        c0 = tsi_cpu_now();
         rc |= ts_eigen_solve(lin, &eo, &e, &err);
         if (e) {
             char d[256];
@@ -114,8 +100,8 @@ static void run(ts_units *u, int links, int arpack, int reps, double target)
                 ts_eigen_describe(sys, lin, e, m, d, sizeof d);
             nmodes = e->nmodes;
         }
-        best_eig = fmin(best_eig, now() - t0);
-        cpu_eig = fmin(cpu_eig, cpu() - c0);
+        best_eig = fmin(best_eig, tsi_wall_now() - t0);
+        cpu_eig = fmin(cpu_eig, tsi_cpu_now() - c0);
         ts_eigen_free(e);
     }
     double total = best_lin + best_eig;

@@ -25,8 +25,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "clock.h"
 #include "towstab/equilibrium.h"
 #include "towstab/excitation.h"
 #include "towstab/linearize.h"
@@ -36,13 +36,6 @@
 #define WALL_BUDGET 2.0
 #define IMPLICIT_STEP_CAP 400
 #define TARGET_RATIO 30.0
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 typedef struct bcase {
     const char *name, *path, *excite;
@@ -132,7 +125,7 @@ static double timed(prepared *p, ts_integrator m, double t_end,
     ts_system *sys = p->sc->system;
     ts_history *h = ts_history_alloc(sys, ts_sim_nsamples(&o), &err);
     ts_kernel *k = ts_kernel_clone(p->k, &err);
-    double t0 = now();
+    double t0 = tsi_wall_now();
     ts_sim *s = ts_sim_alloc(k, p->ex, &o, &err);
     *status = s ? ts_sim_set_state(s, 0.0, p->y0, &err) : TS_ENOMEM;
     if (!*status)
@@ -141,10 +134,10 @@ static double timed(prepared *p, ts_integrator m, double t_end,
         *status = ts_sim_advance(s, ts_sim_sample_time(&o, i), &err);
         if (!*status)
             *status = ts_sim_record(s, h, &err);
-        if (now() - t0 > budget)
+        if (tsi_wall_now() - t0 > budget)
             break;
     }
-    double wall = now() - t0;
+    double wall = tsi_wall_now() - t0;
     if (s)
         ts_sim_get_stats(s, st);
     st->wall_s = wall;
@@ -237,10 +230,10 @@ int main(void)
             ts_history *h = ts_history_alloc(p.sc->system,
                                              ts_sim_nsamples(&o), &err);
             ts_sim_stats st;
-            double t0 = now();
+            double t0 = tsi_wall_now();
             int rc = ts_simulate_linear(p.k, lin, p.ex, NULL, &o, h, &st,
                                         &err);
-            double wall = now() - t0;
+            double wall = tsi_wall_now() - t0;
             printf("%-5s %5d %-6s %9.3g %9.3f %8ld %9.4g%s\n", "ex4",
                    links[li], m ? "ode" : "expm", o.t_end, wall, st.steps,
                    o.t_end / wall, rc ? " (failed)" : "");

@@ -28,8 +28,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "clock.h"
 #include "towstab/equilibrium.h"
 #include "towstab/linearize.h"
 #include "towstab/scene.h"
@@ -42,13 +42,6 @@
 #define GAMMA 3.3
 /* Parts of the record for the ratio's error (batch means). */
 #define BATCHES 6
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static int fail(const char *what, const ts_err *err)
 {
@@ -134,7 +127,7 @@ int main(int argc, char **argv)
         ts_excitation *ex = ts_excitation_alloc(&err);
         if (!ex || ts_seaway_excitation(&w, &r, ex, NULL, &err))
             return fail("realisation", &err);
-        double t0 = now();
+        double t0 = tsi_wall_now();
         hl->nsamples = hn->nsamples = 0;
         int n, nl;
         double dt;
@@ -145,7 +138,7 @@ int main(int argc, char **argv)
             return fail("linear run", &err);
         ts_kernel *knl = ts_kernel_clone(k, &err);
         int rc = ts_simulate(knl, ex, eq->y, &so, hn, NULL, NULL, &err);
-        double wall = now() - t0;
+        double wall = tsi_wall_now() - t0;
         if (rc) {
             printf("| %g | %.4g +- %.1g | %.4g +- %.1g | failed: %s | | | "
                    "%.4g +- %.1g | | | %.0f |\n", hs, sp->sigma.value,

@@ -11,6 +11,9 @@
 # - An unreachable target exits 1 with NOT REACHED, the closest point and
 #   a JSON with "success": false.
 # - Constraints in kN and m with a value to maximise: both met.
+# - Controller gains by the scene's key path (bodies.aurora.controllers.
+#   depth.kp): the control_damping reported is a mode's damping ratio of
+#   a separate `towstab modes --set` run at the gains, to the last digit.
 # - Bad input exits 2 naming the option.
 set -u
 if [ $# -ne 1 ]; then
@@ -63,6 +66,32 @@ else
     fail "constraints: status $status $(head -c 300 "$T/err") $(grep wanted "$T/out")"
 fi
 
+# Controller gains (the AURORA towfish's depth loop, by the scene's
+# `controllers` key), a few runs: the damping the design reports is that
+# of a mode of a separate `towstab modes --set` run at its gains, to the
+# last digit.
+AUR=examples/aurora_towfish.yaml
+ts design "$AUR" --analysis modes --no-discretisation-error \
+    --free "bodies.aurora.controllers.depth.kp=0.01:0.3" \
+    --free "bodies.aurora.controllers.depth.kd=0:0.5" --maximise control_damping \
+    --constraint "fin_use<=1" --fin-step 2m --max-evals 8 --json "$T/a.json" --quiet
+if [ "$status" -eq 0 ] || [ "$status" -eq 1 ]; then
+    opt=$(tr -d '\n ' <"$T/a.json" | grep -o '"optimum":[-0-9.eE+]*' | sed 's/.*://')
+    kp=$(echo "$opt" | sed -n 1p)
+    kd=$(echo "$opt" | sed -n 2p)
+    g=$(tr -d '\n ' <"$T/a.json" | grep -o '"goal":{.*' | grep -o '"value":[-0-9.eE+][-0-9.eE+]*' | head -1 | sed 's/.*://')
+    "$TOWSTAB" modes "$AUR" --no-discretisation-error \
+        --set "bodies.aurora.controllers.depth.kp=$kp;bodies.aurora.controllers.depth.kd=$kd" \
+        --json "$T/am.json" --quiet >/dev/null 2>&1
+    if [ -n "$g" ] && tr -d '\n ' <"$T/am.json" | grep -q "\"damping_ratio\":$g[,}]"; then
+        pass "maximise control_damping over the depth gains: $g at kp $kp, kd $kd; towstab modes --set at those gains has a mode of that damping ratio"
+    else
+        fail "control_damping '$g' at kp '$kp', kd '$kd' not among the modes of the single run"
+    fi
+else
+    fail "controller gains: status $status $(head -c 300 "$T/err")"
+fi
+
 bad() { # WHAT EXPECTED-TEXT ARGS...
     local what=$1 want=$2
     shift 2
@@ -83,8 +112,10 @@ bad "two goals" "one of --target" "$EX1" $F --target sphere.z=15 --maximise top_
 bad "a target in the wrong unit" "--target sphere.z.*expected a length" "$EX1" $F --target sphere.z=15kg
 bad "a constraint without its operator" "NAME<=Q" "$EX1" $F --constraint top_tension=5
 bad "bobyqa with a constraint" "bobyqa takes bounds only" "$EX1" $F --target sphere.z=15 --method bobyqa --constraint "top_tension<=600"
-bad "--method" "expected cobyla or bobyqa" "$EX1" $F --target sphere.z=15 --method newton
+bad "--method" "expected cobyla, bobyqa or slsqp" "$EX1" $F --target sphere.z=15 --method newton
 bad "--analysis simulate" "not an analysis to design with" "$EX1" --analysis simulate $F --target sphere.z=15
 bad "no goal" "expected a target" "$EX1" $F
+bad "control_damping without modes" "no value 'control_damping'" "$EX1" $F --maximise control_damping
+bad "--fin-step in the wrong unit" "fin-step" "$EX1" $F --target sphere.z=15 --fin-step 2kg
 
 finish

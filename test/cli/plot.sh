@@ -241,10 +241,12 @@ ts simulate "$EX4" --t-end 2 --transient 1 --excite tow.heave:amplitude=0.1ft,fr
 check "simulate --exaggerate without --plot: exit 2 (got $status)" [ $status -eq 2 ]
 ts simulate examples/kamman_ex1_submerged.yaml --quiet --t-end 20 \
     --manoeuvre turn_rate:to=0.1rad/s,duration=5s --plot "$T/man"
-check "simulate under a manoeuvre: the earth-frame plan view with the ship's track (exit $status)" \
-    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/man/plan_earth.png' 1000 700 && is_svg '$T/man/plan_earth.svg' \"kamman_ex1_submerged: manoeuvre in the earth frame, cable every 2 s and the ship's track\""
-check "simulate without a manoeuvre draws no plan_earth" \
-    bash -c "[ ! -e '$T/sim/plan_earth.png' ]"
+check "simulate under a manoeuvre: the earth-frame plan view with the ship's and the sphere's tracks (exit $status)" \
+    bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/man/plan_earth.png' 1000 700 && is_svg '$T/man/plan_earth.svg' \"kamman_ex1_submerged: manoeuvre in the earth frame, cable every 2 s and the tracks\""
+check "simulate under a manoeuvre: the tracks in the earth frame and the depths against time" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/man/tracks.png' 1000 700 && is_svg '$T/man/tracks.svg' 'kamman_ex1_submerged: tracks in the earth frame' && is_png '$T/man/depths.png' 1000 700 && is_svg '$T/man/depths.svg' 'kamman_ex1_submerged: depths against time'"
+check "simulate without a manoeuvre draws no plan_earth, tracks or depths" \
+    bash -c "[ ! -e '$T/sim/plan_earth.png' ] && [ ! -e '$T/sim/tracks.png' ] && [ ! -e '$T/sim/depths.png' ]"
 ts response "$EX1" --output sphere.z --quiet --plot "$T/db" --db
 check "response --db: the Bode plot drawn (exit $status)" \
     bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/db/bode.png' 1000 700"

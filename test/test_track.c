@@ -1,0 +1,206 @@
+/* test_track.c: the earth-frame tracks (lib/track.c) against closed
+ * forms and invariants.
+ *
+ *  1. A steady turn from t = 0: M's origin on the circle
+ *     (V/Omega sin Omega t, V/Omega (1 - cos Omega t)), heading Omega t.
+ *  2. A speed step (quintic over its rise): the distance run is
+ *     V0 t + A (t - start - rise / 2) after the step (the quintic's mean
+ *     over its rise is 1/2), with no sideways motion.
+ *  3. A ramped turn rate (no closed form): after the ramp, the origin
+ *     runs on a circle of radius V / Omega_1 whose centre, found from
+ *     the pose at each later time, stays put.
+ *  4. A point of M to E: a rotation by the heading plus the origin.
+ *  5. A simulation of Kamman's steady turn (example 3) from its
+ *     equilibrium: the sphere at rest in M runs on a circle about the turn
+ *     centre (0, V/Omega) of E, its earth channels from ts_history_value;
+ *     the earth channels are refused outside a simulation.
+ *  6. Bad times refused.
+ * Tolerances are stated at each check with their reason. */
+#include "towstab/track.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcheck.h"
+#include "tscene.h"
+#include "towstab/analysis.h"
+#include "towstab/output.h"
+
+/* The quadrature's relative tolerance TS_TRACK_RTOL times distances of
+ * tens of m, summed over up to 100 stretches, with margin. */
+#define TOL_TRACK 1e-8
+
+static void test_steady_turn(void)
+{
+    ts_frame base = {0};
+    base.speed = 2.385;
+    base.turn_rate = 0.1375;
+    double t[50], pose[150];
+    for (int i = 0; i < 50; i++)
+        t[i] = 0.9 * i;
+    int rc = ts_track_poses(NULL, &base, 50, t, pose, NULL);
+    double R = base.speed / base.turn_rate, worst = 0, worst_psi = 0;
+    for (int i = 0; i < 50; i++) {
+        double w = base.turn_rate * t[i];
+        worst = fmax(worst, hypot(pose[3 * i] - R * sin(w),
+                                  pose[3 * i + 1] - R * (1 - cos(w))));
+        worst_psi = fmax(worst_psi, fabs(pose[3 * i + 2] - w));
+    }
+    CHECK(rc == TS_OK && worst < TOL_TRACK,
+          "steady turn: origin on the circle of radius V/Omega = %.4f m to "
+          "%.2g m (tolerance %.0e m)", R, worst, TOL_TRACK);
+    CHECK(worst_psi < 1e-14, "steady turn: heading Omega t to %.2g rad",
+          worst_psi);
+}
+
+static void test_speed_step(const ts_units *u)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_excitation_parse(ex, "speed:step,by=0.75,start=2.5,rise=1.5", u,
+                        "test", &err);
+    ts_frame base = {0};
+    base.speed = 1.25;
+    double t[4] = {1.0, 2.5, 5.25, 11.0}, pose[12];
+    int rc = ts_track_poses(ex, &base, 4, t, pose, &err);
+    CHECK(rc == TS_OK, "speed step: integrated (%s)", err.msg);
+    CHECK_NEAR(pose[0], 1.25, TOL_TRACK, "before the step: V0 t");
+    CHECK_NEAR(pose[3], 1.25 * 2.5, TOL_TRACK, "at its start: V0 t");
+    CHECK_NEAR(pose[6], 1.25 * 5.25 + 0.75 * (5.25 - 2.5 - 0.75), TOL_TRACK,
+               "after it: V0 t + A (t - start - rise/2)");
+    CHECK_NEAR(pose[9], 1.25 * 11.0 + 0.75 * (11.0 - 2.5 - 0.75), TOL_TRACK,
+               "long after it");
+    CHECK(pose[10] == 0 && pose[11] == 0,
+          "no sideways motion, no heading change");
+    ts_excitation_free(ex);
+}
+
+static void test_ramped_turn(const ts_units *u)
+{
+    ts_err err = {0};
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_excitation_parse(ex, "turn_rate:ramp,to=0.2rad/s,start=1,duration=4",
+                        u, "test", &err);
+    ts_frame base = {0};
+    base.speed = 3.125;
+    enum { N = 40 };
+    double t[N], pose[3 * N];
+    for (int i = 0; i < N; i++)
+        t[i] = 6.0 + 1.7 * i; /* after the ramp (ends at 5.1 s) */
+    int rc = ts_track_poses(ex, &base, N, t, pose, &err);
+    double R = base.speed / 0.2, cx[N], cy[N], spread = 0;
+    for (int i = 0; i < N; i++) {
+        /* The centre is R to starboard of the heading. */
+        double psi = pose[3 * i + 2];
+        cx[i] = pose[3 * i] - R * sin(psi);
+        cy[i] = pose[3 * i + 1] + R * cos(psi);
+        spread = fmax(spread, hypot(cx[i] - cx[0], cy[i] - cy[0]));
+    }
+    CHECK(rc == TS_OK && spread < TOL_TRACK,
+          "ramped turn: the turning circle's centre (%.6f, %.6f) m stays "
+          "put to %.2g m over %.0f s (%s)", cx[0], cy[0], spread,
+          t[N - 1] - t[0], err.msg);
+    /* Before the turn the origin runs straight along x. */
+    double t0[1] = {0.75}, p0[3];
+    ts_track_poses(ex, &base, 1, t0, p0, NULL);
+    CHECK_NEAR(p0[0], 3.125 * 0.75, TOL_TRACK, "before the ramp: straight");
+    ts_excitation_free(ex);
+}
+
+static void test_to_earth(void)
+{
+    double pose[3] = {10.5, -4.25, 2.0}, r[3] = {-1.5, 0.75, 12.0}, e[3];
+    ts_track_to_earth(pose, r, e);
+    double c = cos(2.0), s = sin(2.0);
+    CHECK_NEAR(e[0], 10.5 + c * -1.5 - s * 0.75, 1e-14, "to earth: x");
+    CHECK_NEAR(e[1], -4.25 + s * -1.5 + c * 0.75, 1e-14, "to earth: y");
+    CHECK_NEAR(e[2], 12.0, 0, "to earth: depth unchanged");
+}
+
+static void test_simulated_turn(const ts_units *u)
+{
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex3_turn.yaml");
+    if (!sc)
+        return;
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_SIMULATE);
+    rq.setup.links = 8;
+    rq.simulate.sim.t_end = 15;
+    rq.simulate.sim.dt_sample = 0.5;
+    snprintf(rq.simulate.outputs, sizeof rq.simulate.outputs,
+             "sphere.earth_x,sphere.earth_y,sphere.x,sphere.y,tow.earth_y");
+    ts_err err = {0};
+    ts_result *r = NULL;
+    int rc = ts_analysis_run(sc->system, &rq, &r, &err);
+    if (CHECK(rc == TS_OK && r && r->nonlinear && r->noutputs == 5,
+              "Kamman's steady turn simulated with earth channels (%s)",
+              err.msg)) {
+        const ts_history *h = r->nonlinear;
+        const ts_system *sys = r->sys;
+        double V = sys->tow.speed, W = sys->tow.turn_rate, R = V / W;
+        /* The sphere's distance from the turn centre (0, R) of E, and the
+         * same in M, where it is at rest. */
+        double rM = hypot(ts_history_value(sys, h, &r->outputs[2], 0),
+                          ts_history_value(sys, h, &r->outputs[3], 0) - R);
+        double worst = 0, tow = 0;
+        for (int i = 0; i < h->nsamples; i++) {
+            double x = ts_history_value(sys, h, &r->outputs[0], i);
+            double y = ts_history_value(sys, h, &r->outputs[1], i);
+            worst = fmax(worst, fabs(hypot(x, y - R) - rM));
+            /* The tow point, at M's origin, on the circle of M's origin. */
+            double ty = ts_history_value(sys, h, &r->outputs[4], i);
+            tow = fmax(tow, fabs(ty - R * (1 - cos(W * h->t[i]))));
+        }
+        /* The sphere stays at its equilibrium to the integrator's
+         * tolerance (rtol 1e-6 of a 1.8 m cable). */
+        CHECK(worst < 1e-5,
+              "the sphere runs on a circle of radius %.6f m about the turn "
+              "centre (0, %.4f) m of E to %.2g m", rM, R, worst);
+        CHECK(tow < TOL_TRACK,
+              "the tow point's earth y is V/Omega (1 - cos Omega t) to %.2g m",
+              tow);
+    }
+    ts_result_free(r);
+
+    ts_output out;
+    rc = ts_output_find(sc->system, "sphere.earth_x", TS_OUT_ALL, &out, &err);
+    CHECK(rc == TS_EINVAL &&
+              strstr(err.msg, "an earth-frame position (a simulation's) is "
+                              "not an output of this analysis"),
+          "earth channels outside a simulation refused: %.90s", err.msg);
+    rc = ts_output_find(sc->system, "sphere.earth_z",
+                        TS_OUT_ALL | TS_OUT_BIT(TS_OUT_EARTH), &out, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "earth_x or earth_y"),
+          "earth_z refused: %.90s", err.msg);
+    ts_request_clear(&rq);
+    ts_scene_free(sc);
+}
+
+static void test_bad(void)
+{
+    ts_frame base = {0};
+    base.speed = 1;
+    double t[3] = {0.0, 2.0, 1.0}, pose[9];
+    ts_err err = {0};
+    CHECK(ts_track_poses(NULL, &base, 3, t, pose, &err) == TS_EINVAL &&
+              strstr(err.msg, "non-decreasing, got t[2] = 1 s"),
+          "times out of order: %s", err.msg);
+    t[0] = -1;
+    CHECK(ts_track_poses(NULL, &base, 1, t, pose, &err) == TS_EINVAL,
+          "negative time refused: %s", err.msg);
+}
+
+int main(void)
+{
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    test_steady_turn();
+    test_speed_step(u);
+    test_ramped_turn(u);
+    test_to_earth();
+    test_simulated_turn(u);
+    test_bad();
+    ts_units_free(u);
+    return tc_done();
+}
