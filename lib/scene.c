@@ -1528,6 +1528,48 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
 
 /* An analysis: a bare type name, or a mapping with `type` and scalar
  * options kept as text. */
+/* The path of option key k of a's entry at `parent` into p[PATH_LEN];
+ * refuses a name too long or given twice. */
+static int option_key(const ctx *c, const ts_scene_analysis *a,
+                      const yaml_node_t *k, const char *parent, char *p)
+{
+    char s[SHOW_BUF];
+    const char *key = (const char *)k->data.scalar.value;
+    size_t klen = k->data.scalar.length;
+    join(p, parent, show(key, klen, s, sizeof s));
+    if (klen == 0 || klen >= TS_NAME_MAX || strlen(key) != klen)
+        return fail_at(c, TS_ESCENE, p, line_of(k), "an option name must "
+                       "have 1 to %d characters", TS_NAME_MAX - 1);
+    for (int j = 0; j < a->noptions; j++)
+        if (!strcmp(a->options[j].key, key))
+            return fail_at(c, TS_ESCENE, p, line_of(k), "duplicate key "
+                           "(first given on line %d)", a->options[j].line);
+    return TS_OK;
+}
+
+/* Keep scalar v as option `key` of a (room for it allocated); `p` names
+ * it in messages. */
+static int add_option(const ctx *c, ts_scene_analysis *a, const char *key,
+                      int line, const yaml_node_t *v, const char *p)
+{
+    if (is_null(v))
+        return fail_at(c, TS_ESCENE, p, line, "no value; give one, or "
+                       "remove the key");
+    size_t vlen = v->data.scalar.length;
+    if (strlen((const char *)v->data.scalar.value) != vlen)
+        return fail_at(c, TS_ESCENE, p, line, "the value contains a NUL "
+                       "character");
+    ts_scene_option *o = &a->options[a->noptions];
+    o->value = malloc(vlen + 1);
+    if (!o->value)
+        return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", p);
+    memcpy(o->value, v->data.scalar.value, vlen + 1);
+    snprintf(o->key, sizeof o->key, "%s", key);
+    o->line = line;
+    a->noptions++;
+    return TS_OK;
+}
+
 static int parse_analysis(const ctx *c, const yaml_node_t *n, int i,
                           ts_scene_analysis *a)
 {
@@ -1589,36 +1631,80 @@ static int parse_analysis(const ctx *c, const yaml_node_t *n, int i,
             return fail_at(c, TS_ESCENE, path, line_of(k), "keys must be "
                            "plain names, got %s as a key", tsi_scene_kind_name(k));
         const char *key = (const char *)k->data.scalar.value;
-        size_t klen = k->data.scalar.length;
         if (!strcmp(key, "type"))
             continue;
-        join(p, path, show(key, klen, s, sizeof s));
-        if (klen == 0 || klen >= TS_NAME_MAX || strlen(key) != klen)
-            return fail_at(c, TS_ESCENE, p, line_of(k), "an option name "
-                           "must have 1 to %d characters", TS_NAME_MAX - 1);
-        for (int j = 0; j < a->noptions; j++)
-            if (!strcmp(a->options[j].key, key))
-                return fail_at(c, TS_ESCENE, p, line_of(k), "duplicate key "
-                               "(first given on line %d)",
-                               a->options[j].line);
+        int rc = option_key(c, a, k, path, p);
+        if (rc)
+            return rc;
         if (v->type != YAML_SCALAR_NODE)
             return fail_at(c, TS_ESCENE, p, line_of(k), "an option value "
                            "must be a scalar, got %s", tsi_scene_kind_name(v));
-        if (is_null(v))
-            return fail_at(c, TS_ESCENE, p, line_of(k), "no value; give one, "
-                           "or remove the key");
-        size_t vlen = v->data.scalar.length;
-        if (strlen((const char *)v->data.scalar.value) != vlen)
-            return fail_at(c, TS_ESCENE, p, line_of(k), "the value contains "
-                           "a NUL character");
-        ts_scene_option *o = &a->options[a->noptions];
-        o->value = malloc(vlen + 1);
-        if (!o->value)
-            return ts_fail(c->err, TS_ENOMEM, "%s: out of memory", p);
-        memcpy(o->value, v->data.scalar.value, vlen + 1);
-        memcpy(o->key, key, klen + 1);
-        o->line = line_of(k);
-        a->noptions++;
+        rc = add_option(c, a, key, line_of(k), v, p);
+        if (rc)
+            return rc;
+    }
+    return TS_OK;
+}
+
+/* The design section (doc/design.md, "Settings in the scene"): a mapping
+ * of the study's settings, each a scalar or a list of scalars (one
+ * option per item, in order), kept as text for `towstab design`. */
+static int parse_design(const ctx *c, const yaml_node_t *n,
+                        ts_scene_analysis *a)
+{
+    char p[PATH_LEN];
+    snprintf(a->type, sizeof a->type, "design");
+    a->line = line_of(n);
+    if (n->type != YAML_MAPPING_NODE)
+        return fail_at(c, TS_ESCENE, "design", line_of(n), "expected a "
+                       "mapping of the study's settings, got %s",
+                       tsi_scene_kind_name(n));
+    /* Options: one per scalar or list item, at most MAX_ENTRIES. */
+    size_t count = 0;
+    for (yaml_node_pair_t *pr = n->data.mapping.pairs.start;
+         pr < n->data.mapping.pairs.top; pr++) {
+        yaml_node_t *v = yaml_document_get_node(c->doc, pr->value);
+        count += v && v->type == YAML_SEQUENCE_NODE ? (size_t)seq_len(v) : 1;
+        if (count > MAX_ENTRIES)
+            return fail_at(c, TS_EINVAL, "design", line_of(n), "too many "
+                           "settings (at most %d)", MAX_ENTRIES);
+    }
+    a->options = calloc(count ? count : 1, sizeof *a->options);
+    if (!a->options)
+        return ts_fail(c->err, TS_ENOMEM, "design: out of memory");
+    for (yaml_node_pair_t *pr = n->data.mapping.pairs.start;
+         pr < n->data.mapping.pairs.top; pr++) {
+        yaml_node_t *k = yaml_document_get_node(c->doc, pr->key);
+        yaml_node_t *v = yaml_document_get_node(c->doc, pr->value);
+        if (!k || !v)
+            return ts_fail(c->err, TS_ESCENE, "design: broken YAML document");
+        if (k->type != YAML_SCALAR_NODE)
+            return fail_at(c, TS_ESCENE, "design", line_of(k), "keys must be "
+                           "plain names, got %s as a key",
+                           tsi_scene_kind_name(k));
+        const char *key = (const char *)k->data.scalar.value;
+        int rc = option_key(c, a, k, "design", p);
+        if (rc)
+            return rc;
+        if (v->type == YAML_MAPPING_NODE)
+            return fail_at(c, TS_ESCENE, p, line_of(k), "expected a value "
+                           "or a list of values, got a mapping");
+        int items = v->type == YAML_SEQUENCE_NODE ? seq_len(v) : 1;
+        if (items == 0)
+            return fail_at(c, TS_ESCENE, p, line_of(k), "an empty list; "
+                           "give values, or remove the key");
+        for (int j = 0; j < items; j++) {
+            yaml_node_t *item = v->type == YAML_SEQUENCE_NODE
+                                    ? seq_item(c, v, j) : v;
+            if (!item || item->type != YAML_SCALAR_NODE)
+                return fail_at(c, TS_ESCENE, p, item ? line_of(item)
+                                                     : line_of(k),
+                               "expected a value, got %s",
+                               item ? tsi_scene_kind_name(item) : "nothing");
+            rc = add_option(c, a, key, line_of(item), item, p);
+            if (rc)
+                return rc;
+        }
     }
     return TS_OK;
 }
@@ -1642,10 +1728,10 @@ static int top_list(const ctx *c, const field *f, int *n)
 static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
 {
     enum { K_NAME, K_ENV, K_TOW, K_CABLES, K_BODIES, K_ANALYSES, K_TOWING,
-           K_N };
+           K_DESIGN, K_N };
     field f[K_N] = {{"name", 0, 0}, {"environment", 0, 0}, {"tow", 0, 0},
                     {"cables", 0, 0}, {"bodies", 0, 0}, {"analyses", 0, 0},
-                    {"towing_vehicle", 0, 0}};
+                    {"towing_vehicle", 0, 0}, {"design", 0, 0}};
     int rc = read_map(c, root, "", "name, tow, cables, ...", f, K_N);
     if (rc != TS_OK)
         return rc;
@@ -1714,6 +1800,12 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
         yaml_node_t *item = seq_item(c, f[K_ANALYSES].value, i);
         rc = item ? parse_analysis(c, item, i, &scene->analyses[i])
                   : ts_fail(c->err, TS_ESCENE, "analyses: broken YAML");
+    }
+    if (rc == TS_OK && f[K_DESIGN].value) {
+        scene->design = calloc(1, sizeof *scene->design);
+        rc = scene->design ? parse_design(c, f[K_DESIGN].value, scene->design)
+                           : ts_fail(c->err, TS_ENOMEM, "design: out of "
+                                     "memory");
     }
     if (rc == TS_OK)
         rc = ts_system_build(sys, c->err);
@@ -2058,13 +2150,16 @@ void ts_scene_free(ts_scene *scene)
 {
     if (!scene)
         return;
-    for (int i = 0; i < scene->nanalyses; i++) {
-        ts_scene_analysis *a = &scene->analyses[i];
-        for (int j = 0; j < a->noptions; j++)
+    for (int i = 0; i <= scene->nanalyses; i++) {
+        ts_scene_analysis *a = i < scene->nanalyses ? &scene->analyses[i]
+                                                    : scene->design;
+        for (int j = 0; a && j < a->noptions; j++)
             free(a->options[j].value);
-        free(a->options);
+        if (a)
+            free(a->options);
     }
     free(scene->analyses);
+    free(scene->design);
     ts_system_free(scene->system);
     for (int i = 0; i < scene->nsettings; i++) {
         free(scene->settings[i].key);

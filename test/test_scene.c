@@ -811,6 +811,56 @@ static void test_settings(const ts_units *u)
     ts_scene_free(p);
 }
 
+/* The design section: kept as text, a list's items as options of one key
+ * in order; a mapping, an empty list and a missing value refused by
+ * line; absent: NULL. */
+static void test_design_section(const ts_units *u)
+{
+    static const char head[] =
+        "name: d\n"
+        "tow: {speed: 2}\n"
+        "cables: [{name: c, from: tow, length: 10, diameter: 0.01,\n"
+        "          mass_per_length: 0.1, links: 4}]\n";
+    char text[1024];
+    ts_err err;
+    snprintf(text, sizeof text, "%s%s", head,
+             "design:\n"
+             "  free: [\"cables.c.length=5:20\", \"speed=1:3\"]\n"
+             "  target: \"c.z=4 m\"\n");
+    ts_scene *s = ts_scene_parse(text, strlen(text), "d.yaml", u, &err);
+    const ts_scene_analysis *d = s ? s->design : NULL;
+    CHECK(d && d->noptions == 3 && !strcmp(d->options[0].key, "free") &&
+              !strcmp(d->options[0].value, "cables.c.length=5:20") &&
+              !strcmp(d->options[1].key, "free") &&
+              !strcmp(d->options[1].value, "speed=1:3") &&
+              d->options[1].line == 6 && !strcmp(d->options[2].value,
+                                                 "c.z=4 m"),
+          "design: a list's items in order, then target (%s)",
+          s ? "" : err.msg);
+    ts_scene_free(s);
+    s = ts_scene_parse(head, strlen(head), "d.yaml", u, &err);
+    CHECK(s && !s->design, "no design section: NULL");
+    ts_scene_free(s);
+    static const struct {
+        const char *section, *want;
+    } bad[] = {
+        {"design: 3\n", "design (line 5): expected a mapping"},
+        {"design:\n  free: {a: 1}\n", "design.free (line 6): expected a "
+                                      "value or a list of values"},
+        {"design:\n  free: []\n", "design.free (line 6): an empty list"},
+        {"design:\n  target:\n", "design.target (line 6): no value"},
+        {"design:\n  free: [[1]]\n", "design.free (line 6): expected a "
+                                     "value, got a list"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(text, sizeof text, "%s%s", head, bad[i].section);
+        s = ts_scene_parse(text, strlen(text), "d.yaml", u, &err);
+        CHECK(!s && err.code == TS_ESCENE && strstr(err.msg, bad[i].want),
+              "refused: %s", s ? "(parsed)" : err.msg);
+        ts_scene_free(s);
+    }
+}
+
 int main(void)
 {
     ts_err err;
@@ -825,6 +875,7 @@ int main(void)
     test_buffers(u);
     test_mutations(u);
     test_settings(u);
+    test_design_section(u);
     ts_units_free(u);
     return tc_done();
 }

@@ -51,9 +51,6 @@ static const cli_extra design_extras[] = {
      "points, e.g. 2m [default 0: the steady deflections]"},
     {NULL, 0, 0, NULL, NULL}};
 
-typedef struct design_state {
-    ts_design_spec spec;
-} design_state;
 
 static int bad(const char *fmt, const char *a, const char *b)
 {
@@ -86,18 +83,26 @@ static int quantity(const cli_run *c, const char *where, const char *text,
     return rc ? EXIT_BADINPUT : 0;
 }
 
+/* A setting's value: `text`, given where `src` says ("--free", or
+ * "scene.yaml: design.free (line 12)"). */
+typedef struct given {
+    const char *text;
+    char src[600];
+} given;
+
 /* --free PATH=LOWER:UPPER[:START]. */
-static int parse_free(const cli_run *c, const char *text, ts_design_var *f)
+static int parse_free(const cli_run *c, const given *g, ts_design_var *f)
 {
+    const char *text = g->text;
     const char *eq = strchr(text, '=');
     if (!eq || eq == text)
-        return bad("--free: expected PATH=LOWER:UPPER[:START] (e.g. "
-                   "cables.main.length=100m:800m), got '%s'%s", text, "");
+        return bad("%s: expected PATH=LOWER:UPPER[:START] (e.g. "
+                   "cables.main.length=100m:800m), got '%s'", g->src, text);
     snprintf(f->path, sizeof f->path, "%.*s", (int)(eq - text), text);
     char unit[TS_PARAM_UNIT_MAX];
     ts_err err = {0};
     if (ts_param_unit(c->scene->system, f->path, unit, sizeof unit, &err)) {
-        fprintf(stderr, "towstab: error: design: --free: %s\n", err.msg);
+        fprintf(stderr, "towstab: error: design: %s: %s\n", g->src, err.msg);
         return EXIT_BADINPUT;
     }
     char buf[512];
@@ -108,11 +113,11 @@ static int parse_free(const cli_run *c, const char *text, ts_design_var *f)
     for (char *p = strtok_r(buf, ":", &save); p && nf < 4;
          p = strtok_r(NULL, ":", &save))
         field[nf++] = p;
+    char where[TS_PARAM_PATH_MAX + 620];
+    snprintf(where, sizeof where, "%s %s", g->src, f->path);
     if (nf < 2 || nf > 3)
-        return bad("--free %s: expected LOWER:UPPER or LOWER:UPPER:START, "
-                   "got '%s'", f->path, eq + 1);
-    char where[TS_PARAM_PATH_MAX + 16];
-    snprintf(where, sizeof where, "--free %s", f->path);
+        return bad("%s: expected LOWER:UPPER or LOWER:UPPER:START, got '%s'",
+                   where, eq + 1);
     double *dst[3] = {&f->lower, &f->upper, &f->start};
     f->start = NAN;
     for (int i = 0; i < nf; i++)
@@ -135,9 +140,10 @@ static int value_unit(const cli_run *c, const char *what, const char *name,
 }
 
 /* --constraint NAME<=Q or NAME>=Q. */
-static int parse_constraint(const cli_run *c, const char *text,
+static int parse_constraint(const cli_run *c, const given *g,
                             ts_design_constraint *k)
 {
+    const char *text = g->text;
     const char *op = strstr(text, "<=");
     k->upper = 1;
     if (!op) {
@@ -145,16 +151,82 @@ static int parse_constraint(const cli_run *c, const char *text,
         k->upper = 0;
     }
     if (!op || op == text)
-        return bad("--constraint: expected NAME<=Q or NAME>=Q (e.g. "
-                   "'top_tension<=40kN'), got '%s'%s", text, "");
+        return bad("%s: expected NAME<=Q or NAME>=Q (e.g. "
+                   "'top_tension<=40kN'), got '%s'", g->src, text);
     snprintf(k->name, sizeof k->name, "%.*s", (int)(op - text), text);
     char unit[TS_VALUE_UNIT_MAX];
-    if (value_unit(c, "--constraint", k->name, unit, sizeof unit))
+    if (value_unit(c, g->src, k->name, unit, sizeof unit))
         return EXIT_BADINPUT;
-    char where[TS_VALUE_NAME_MAX + 16];
-    snprintf(where, sizeof where, "--constraint %s", k->name);
+    char where[TS_VALUE_NAME_MAX + 620];
+    snprintf(where, sizeof where, "%s %s", g->src, k->name);
     return quantity(c, where, op + 2, unit, &k->bound);
 }
+
+/* The settings of the study, extra by extra: the command line's values
+ * of an extra when it gives any, else the scene's `design` section's
+ * (the option table's rule: the higher source's texts of an option
+ * replace the lower's; the goals --target, --minimise and --maximise are
+ * one group). Refuses a section key that is no setting. */
+typedef struct settings {
+    int n[X_FIN_STEP + 1];
+    given g[X_FIN_STEP + 1][CLI_EXTRA_VALUES];
+} settings;
+
+static int gather(const cli_run *c, settings *s)
+{
+    memset(s, 0, sizeof *s);
+    const ts_scene_analysis *d = c->scene->design;
+    int cmd_goal = c->nextra[X_TARGET] + c->nextra[X_MINIMISE] +
+                   c->nextra[X_MAXIMISE];
+    for (int i = 0; d && i < d->noptions; i++) {
+        const ts_scene_option *o = &d->options[i];
+        int k = -1;
+        for (int j = 0; j <= X_FIN_STEP && k < 0; j++) {
+            char name[TS_NAME_MAX];
+            snprintf(name, sizeof name, "%s", design_extras[j].name);
+            for (char *q = name; *q; q++)
+                *q = *q == '-' ? '_' : *q;
+            if (!strcmp(name, o->key))
+                k = j;
+        }
+        if (k < 0) {
+            fprintf(stderr, "towstab: error: design: %s: design.%s (line "
+                            "%d): unknown setting; expected one of analysis, "
+                            "free, target, minimise, maximise, constraint, "
+                            "method, max_evals, target_tol, fin_step (the "
+                            "analysis' own options go in its entry of "
+                            "'analyses')\n",
+                    c->scene->path, o->key, o->line);
+            return EXIT_BADINPUT;
+        }
+        int goal = k == X_TARGET || k == X_MINIMISE || k == X_MAXIMISE;
+        if (c->nextra[k] > 0 || (goal && cmd_goal) || k == X_ANALYSIS)
+            continue;
+        if (s->n[k] == CLI_EXTRA_VALUES || (s->n[k] && !design_extras[k].repeat))
+            return bad("%s: design.%s: given more than once", c->scene->path,
+                       o->key);
+        given *g = &s->g[k][s->n[k]++];
+        g->text = o->value;
+        snprintf(g->src, sizeof g->src, "%s: design.%s (line %d)",
+                 c->scene->path, o->key, o->line);
+    }
+    for (int k = 0; k <= X_FIN_STEP; k++) {
+        if (c->nextra[k] == 0)
+            continue;
+        s->n[k] = c->nextra[k];
+        for (int i = 0; i < c->nextra[k]; i++) {
+            s->g[k][i].text = c->extra[k][i];
+            snprintf(s->g[k][i].src, sizeof s->g[k][i].src, "--%s",
+                     design_extras[k].name);
+        }
+    }
+    return 0;
+}
+
+typedef struct design_state {
+    ts_design_spec spec;
+    settings settings;
+} design_state;
 
 static int design_prepare(cli_run *c)
 {
@@ -167,52 +239,57 @@ static int design_prepare(cli_run *c)
     ts_design_spec *sp = &st->spec;
     sp->rq = c->rq;
     sp->rq.progress = NULL;
-    sp->nfree = c->nextra[X_FREE];
+    settings *se = &st->settings;
+    if (gather(c, se))
+        return EXIT_BADINPUT;
+    sp->nfree = se->n[X_FREE];
     if (sp->nfree == 0)
         return bad("expected at least one --free PATH=LOWER:UPPER (e.g. "
-                   "--free cables.main.length=100m:800m)%s%s", "", "");
+                   "--free cables.main.length=100m:800m), or free: in the "
+                   "scene's design section%s%s", "", "");
     if (sp->nfree > TS_DESIGN_MAX_FREE)
-        return bad("at most 8 --free%s%s", "", "");
+        return bad("at most 8 free values (%s)%s", se->g[X_FREE][0].src, "");
     for (int i = 0; i < sp->nfree; i++)
-        if (parse_free(c, c->extra[X_FREE][i], &sp->free[i]))
+        if (parse_free(c, &se->g[X_FREE][i], &sp->free[i]))
             return EXIT_BADINPUT;
-    int ngoals = c->nextra[X_TARGET] + c->nextra[X_MINIMISE] +
-                 c->nextra[X_MAXIMISE];
+    int ngoals = se->n[X_TARGET] + se->n[X_MINIMISE] + se->n[X_MAXIMISE];
     if (ngoals > 1)
-        return bad("give one of --target, --minimise and --maximise%s%s", "",
-                   "");
+        return bad("give one of --target, --minimise and --maximise (in the "
+                   "scene: target, minimise, maximise)%s%s", "", "");
     char unit[TS_VALUE_UNIT_MAX];
-    if (c->nextra[X_TARGET]) {
-        const char *t = c->extra[X_TARGET][0], *eq = strchr(t, '=');
+    if (se->n[X_TARGET]) {
+        const given *g = &se->g[X_TARGET][0];
+        const char *t = g->text, *eq = strchr(t, '=');
         if (!eq || eq == t)
-            return bad("--target: expected NAME=Q (e.g. fish.z=300m), got "
-                       "'%s'%s", t, "");
+            return bad("%s: expected NAME=Q (e.g. fish.z=300m), got '%s'",
+                       g->src, t);
         sp->goal.kind = TS_DESIGN_TARGET;
         snprintf(sp->goal.name, sizeof sp->goal.name, "%.*s", (int)(eq - t),
                  t);
-        char where[TS_VALUE_NAME_MAX + 16];
-        snprintf(where, sizeof where, "--target %s", sp->goal.name);
-        if (value_unit(c, "--target", sp->goal.name, unit, sizeof unit) ||
+        char where[TS_VALUE_NAME_MAX + 620];
+        snprintf(where, sizeof where, "%s %s", g->src, sp->goal.name);
+        if (value_unit(c, g->src, sp->goal.name, unit, sizeof unit) ||
             quantity(c, where, eq + 1, unit, &sp->goal.target))
             return EXIT_BADINPUT;
     } else if (ngoals == 1) {
-        int k = c->nextra[X_MINIMISE] ? X_MINIMISE : X_MAXIMISE;
+        int k = se->n[X_MINIMISE] ? X_MINIMISE : X_MAXIMISE;
         sp->goal.kind = k == X_MINIMISE ? TS_DESIGN_MINIMISE
                                         : TS_DESIGN_MAXIMISE;
-        snprintf(sp->goal.name, sizeof sp->goal.name, "%s", c->extra[k][0]);
-        if (value_unit(c, k == X_MINIMISE ? "--minimise" : "--maximise",
-                       sp->goal.name, unit, sizeof unit))
+        snprintf(sp->goal.name, sizeof sp->goal.name, "%s",
+                 se->g[k][0].text);
+        if (value_unit(c, se->g[k][0].src, sp->goal.name, unit, sizeof unit))
             return EXIT_BADINPUT;
     }
-    sp->nconstraints = c->nextra[X_CONSTRAINT];
+    sp->nconstraints = se->n[X_CONSTRAINT];
     if (sp->nconstraints > TS_DESIGN_MAX_CONSTRAINTS)
-        return bad("at most 8 --constraint%s%s", "", "");
+        return bad("at most 8 constraints (%s)%s",
+                   se->g[X_CONSTRAINT][0].src, "");
     for (int i = 0; i < sp->nconstraints; i++)
-        if (parse_constraint(c, c->extra[X_CONSTRAINT][i],
+        if (parse_constraint(c, &se->g[X_CONSTRAINT][i],
                              &sp->constraints[i]))
             return EXIT_BADINPUT;
-    if (c->nextra[X_METHOD]) {
-        const char *m = c->extra[X_METHOD][0];
+    if (se->n[X_METHOD]) {
+        const char *m = se->g[X_METHOD][0].text;
         if (!strcmp(m, "cobyla"))
             sp->method = TS_DESIGN_COBYLA;
         else if (!strcmp(m, "bobyqa"))
@@ -220,26 +297,27 @@ static int design_prepare(cli_run *c)
         else if (!strcmp(m, "slsqp"))
             sp->method = TS_DESIGN_SLSQP;
         else
-            return bad("--method: expected cobyla, bobyqa or slsqp, got "
-                       "'%s'%s", m, "");
+            return bad("%s: expected cobyla, bobyqa or slsqp, got '%s'",
+                       se->g[X_METHOD][0].src, m);
     }
     long v = 0;
-    if (c->nextra[X_MAX_EVALS] &&
-        cli_parse_int("design: --max-evals", c->extra[X_MAX_EVALS][0], 1,
-                      100000, &v))
+    char what[700];
+    snprintf(what, sizeof what, "design: %s", se->g[X_MAX_EVALS][0].src);
+    if (se->n[X_MAX_EVALS] &&
+        cli_parse_int(what, se->g[X_MAX_EVALS][0].text, 1, 100000, &v))
         return EXIT_BADINPUT;
     sp->max_evals = (int)v;
-    if (c->nextra[X_TARGET_TOL]) {
+    if (se->n[X_TARGET_TOL]) {
         char *end;
-        const char *t = c->extra[X_TARGET_TOL][0];
+        const char *t = se->g[X_TARGET_TOL][0].text;
         sp->target_rtol = strtod(t, &end);
         if (end == t || *end || !(sp->target_rtol > 0 &&
                                   sp->target_rtol < 1))
-            return bad("--target-tol: expected a fraction in (0, 1), got "
-                       "'%s'%s", t, "");
+            return bad("%s: expected a fraction in (0, 1), got '%s'",
+                       se->g[X_TARGET_TOL][0].src, t);
     }
-    if (c->nextra[X_FIN_STEP] &&
-        quantity(c, "--fin-step", c->extra[X_FIN_STEP][0], "m",
+    if (se->n[X_FIN_STEP] &&
+        quantity(c, se->g[X_FIN_STEP][0].src, se->g[X_FIN_STEP][0].text, "m",
                  &sp->fin_step))
         return EXIT_BADINPUT;
     sp->progress = cli_progress;
@@ -365,16 +443,83 @@ static int design_execute(cli_run *c)
     return status;
 }
 
+/* 1 when the command-line option `arg` ("--links") takes a value as the
+ * next argument: an extra, an output, or a row of the equilibrium or
+ * modes table that is not a flag. */
+static int takes_value(const char *arg)
+{
+    const char *name = arg + 2;
+    if (strchr(name, '='))
+        return 0;
+    for (int k = 0; design_extras[k].name; k++)
+        if (!strcmp(name, design_extras[k].name))
+            return design_extras[k].has_arg;
+    static const char *const outputs[] = {"json", "csv", "plot", "units"};
+    for (int k = 0; k < 4; k++)
+        if (!strcmp(name, outputs[k]))
+            return 1;
+    static const ts_analysis_kind kinds[2] = {TS_ANALYSIS_EQUILIBRIUM,
+                                              TS_ANALYSIS_MODES};
+    for (int j = 0; j < 2; j++) {
+        int n;
+        const ts_option *t = ts_options(kinds[j], &n);
+        for (int i = 0; i < n; i++) {
+            char cli[TS_NAME_MAX];
+            ts_option_cli_name(&t[i], cli, sizeof cli);
+            if (!strcmp(name, cli))
+                return t[i].type != TS_OPT_BOOL;
+        }
+    }
+    return 0;
+}
+
+/* The analysis the scene's design section names (its `analysis`), or
+ * NULL: the scene is the argument that is neither an option nor an
+ * option's value. Its errors are left to the run proper. */
+static int scene_analysis(int argc, char **argv, char *out, size_t size)
+{
+    const char *path = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--")) {
+            path = i + 1 < argc ? argv[i + 1] : NULL;
+            break;
+        }
+        if (a[0] == '-' && a[1]) {
+            i += a[1] == '-' && takes_value(a);
+            continue;
+        }
+        path = a;
+    }
+    if (!path || !strcmp(path, "-"))
+        return 0;
+    ts_units *u = ts_units_alloc(NULL);
+    ts_scene *sc = u ? ts_scene_load(path, u, NULL) : NULL;
+    const ts_scene_option *o =
+        sc && sc->design ? ts_scene_analysis_option(sc->design, "analysis")
+                         : NULL;
+    if (o)
+        snprintf(out, size, "%s", o->value);
+    ts_scene_free(sc);
+    ts_units_free(u);
+    return o != NULL;
+}
+
 static int design_main(int argc, char **argv)
 {
     int kind = TS_ANALYSIS_EQUILIBRIUM;
     const char *name = cli_analysis_arg(argc, argv);
+    char from_scene[TS_NAME_MAX + 64];
+    if (!name && scene_analysis(argc, argv, from_scene, sizeof from_scene))
+        name = from_scene;
     if (name) {
         kind = ts_analysis_find(name);
         if (kind != TS_ANALYSIS_EQUILIBRIUM && kind != TS_ANALYSIS_MODES) {
-            fprintf(stderr, "towstab: error: design: --analysis: '%s' is not "
+            fprintf(stderr, "towstab: error: design: %s: '%s' is not "
                             "an analysis to design with; expected "
-                            "equilibrium or modes\n", name);
+                            "equilibrium or modes\n",
+                    name == from_scene ? "the scene's design.analysis"
+                                       : "--analysis", name);
             return EXIT_BADINPUT;
         }
     }

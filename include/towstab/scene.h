@@ -44,6 +44,10 @@ typedef struct ts_scene {
     ts_system *system;      /* built (ts_system_build has run) */
     int nanalyses;
     ts_scene_analysis *analyses;
+    ts_scene_analysis *design; /* the `design` section (type "design"; a
+                               list's items are options of the same key,
+                               in order), NULL when absent: the settings
+                               of `towstab design` (doc/design.md) */
     char *text;             /* the YAML text read, text_len bytes and a
                                NUL (owned): what a report shows */
     size_t text_len;

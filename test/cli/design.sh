@@ -14,6 +14,10 @@
 # - Controller gains by the scene's key path (bodies.aurora.controllers.
 #   depth.kp): the control_damping reported is a mode's damping ratio of
 #   a separate `towstab modes --set` run at the gains, to the last digit.
+# - Settings from the scene's design section: the same optimum as on the
+#   command line; the command line overrides them one by one (the goals
+#   as one group); the section's analysis; its errors name the key and
+#   line.
 # - Bad input exits 2 naming the option.
 set -u
 if [ $# -ne 1 ]; then
@@ -90,6 +94,76 @@ if [ "$status" -eq 0 ] || [ "$status" -eq 1 ]; then
     fi
 else
     fail "controller gains: status $status $(head -c 300 "$T/err")"
+fi
+
+# Settings in the scene's design section; the command line's override
+# them setting by setting (the goals as one group).
+{ cat "$EX1"; cat <<'EOF'
+design:
+  free: ["cables.cable.length=30ft:200ft"]
+  target: "sphere.z=15m"
+  method: bobyqa
+  target_tol: 1e-7
+EOF
+} >"$T/ds.yaml"
+ts design "$T/ds.yaml" --json "$T/ds.json" --quiet
+ts_status=$status
+ts_out=$(cat "$T/out")
+"$TOWSTAB" design "$EX1" --free "cables.cable.length=30ft:200ft" --target "sphere.z=15m" \
+    --method bobyqa --target-tol 1e-7 --json "$T/dc.json" --quiet >/dev/null 2>&1
+if [ "$ts_status" -eq 0 ] && echo "$ts_out" | grep -q "design: bobyqa" &&
+   echo "$ts_out" | grep -q "wanted 15 m: reached.*tolerance 1.5e-06 m" &&
+   [ "$(json_num "$T/ds.json" optimum)" = "$(json_num "$T/dc.json" optimum)" ]; then
+    pass "the scene's design section alone (free, target, method, target_tol): the optimum $(json_num "$T/ds.json" optimum) m of the same settings on the command line, to the last digit"
+else
+    fail "design section: status $ts_status $(head -c 300 "$T/err") $(echo "$ts_out" | head -3)"
+fi
+ts design "$T/ds.yaml" --target "sphere.z=12m" --quiet
+if [ "$status" -eq 0 ] && grep -q "design: bobyqa" "$T/out" &&
+   grep -q "wanted 12 m: reached.*tolerance 1.2e-06 m" "$T/out"; then
+    pass "--target sphere.z=12m overrides the scene's target; its method and target_tol stay"
+else
+    fail "override: status $status $(head -c 300 "$T/err") $(grep wanted "$T/out")"
+fi
+ts design "$T/ds.yaml" --maximise layback --constraint "top_tension<=0.5kN" --method cobyla --quiet
+if [ "$status" -eq 0 ] && grep -q "design: cobyla" "$T/out" && grep -q "maximise layback" "$T/out" &&
+   ! grep -q "target sphere.z" "$T/out"; then
+    pass "--maximise replaces the scene's target (one group of goals), --method cobyla its bobyqa"
+else
+    fail "goal group override: status $status $(head -c 300 "$T/err") $(grep -E 'maximise|target' "$T/out")"
+fi
+{ cat "$AUR"; cat <<'EOF'
+design:
+  analysis: modes
+  free:
+    - "bodies.aurora.controllers.depth.kp=0.01:0.3"
+    - "bodies.aurora.controllers.depth.kd=0:0.5"
+  maximise: control_damping
+  constraint: "fin_use<=1"
+  fin_step: 2 m
+  max_evals: 3
+EOF
+} >"$T/as.yaml"
+ts design "$T/as.yaml" --no-discretisation-error --quiet
+if { [ "$status" -eq 0 ] || [ "$status" -eq 1 ]; } && grep -q "modes at every evaluation" "$T/out" &&
+   grep -q "iterations: 3 analysis runs" "$T/out"; then
+    pass "the scene's design.analysis modes, a list of free values, max_evals 3: $(grep -o 'maximise control_damping *[0-9.]*' "$T/out")"
+else
+    fail "aurora design section: status $status $(head -c 300 "$T/err")"
+fi
+{ cat "$T/as.yaml"; printf '  steps: 4\n'; } >"$T/as_bad.yaml"
+ts design "$T/as_bad.yaml"
+if [ "$status" -eq 2 ] && grep -q "design.steps (line [0-9]*): unknown setting" "$T/err"; then
+    pass "an unknown setting in the section: exit 2: $(head -c 140 "$T/err")"
+else
+    fail "unknown design setting: status $status $(head -c 200 "$T/err")"
+fi
+sed 's/"cables.cable.length=30ft:200ft"/"cables.cable.length=30ft"/' "$T/ds.yaml" >"$T/ds_bad.yaml"
+ts design "$T/ds_bad.yaml"
+if [ "$status" -eq 2 ] && grep -q "design.free (line [0-9]*) cables.cable.length: expected LOWER:UPPER" "$T/err"; then
+    pass "a malformed free value in the section: exit 2 naming it and its line: $(head -c 160 "$T/err")"
+else
+    fail "malformed design.free: status $status $(head -c 200 "$T/err")"
 fi
 
 bad() { # WHAT EXPECTED-TEXT ARGS...
