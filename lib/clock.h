@@ -1,6 +1,7 @@
 /* clock.h (private): the wall clock of run times and progress reports,
- * and the process's CPU clock (benchmarks). tools/ keeps its own: it
- * sees the library through its public headers only (test/layers.sh). */
+ * and the process's CPU clock (benchmarks). tools/ may include public
+ * headers only (doc/architecture.md), so the command line keeps its own
+ * cli_wall_now. */
 #ifndef TOWSTAB_LIB_CLOCK_H
 #define TOWSTAB_LIB_CLOCK_H
 

@@ -163,6 +163,9 @@ void ts_linear_free(ts_linear *lin)
     free(lin->up_map);
     free(lin->Vy);
     free(lin->Vu);
+    free(lin->Terr);
+    free(lin->Verr);
+    free(lin->onoise);
     free(lin->v0);
     free(lin->input_name);
     free(lin->input_unit);
@@ -253,12 +256,16 @@ static int kernel_noise(ts_kernel *k, const double *y0, const double *u0,
                         ts_linear *lin)
 {
     int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    int nl = lin->nlinks, nout = lin->noutput, no = nl + nout;
     double *y = malloc((size_t)n * sizeof *y);
     double *d = malloc((size_t)n * sizeof *d);
     double *f = malloc((size_t)n * sizeof *f);
     double *ad = malloc((size_t)(nlow > 0 ? nlow : 1) * sizeof *ad);
     double *acc = calloc((size_t)(nlow > 0 ? nlow : 1), sizeof *acc);
-    int rc = y && d && f && ad && acc ? TS_OK : TS_ENOMEM;
+    /* The output rows: tensions (with Ty) and the vehicles' outputs. */
+    double *od = malloc((size_t)(no > 0 ? no : 1) * sizeof *od);
+    double *oacc = calloc((size_t)(no > 0 ? no : 1), sizeof *oacc);
+    int rc = y && d && f && ad && acc && od && oacc ? TS_OK : TS_ENOMEM;
     unsigned long long seq = 0x9E3779B97F4A7C15ULL;
     int used = 0;
     for (int s = 0; rc == TS_OK && s < NOISE_SAMPLES; s++) {
@@ -279,14 +286,31 @@ static int kernel_noise(ts_kernel *k, const double *y0, const double *u0,
             double r = f[nq + i] - lin->f0[nq + i] - ad[i];
             acc[i] += r * r;
         }
+        if (lin->onoise) {
+            memcpy(od, ts_kernel_tensions(k), (size_t)nl * sizeof(double));
+            ts_kernel_outputs(k, od + nl);
+            for (int i = 0; i < no; i++) {
+                const double *J = i < nl ? lin->Ty : lin->Vy;
+                int rows = i < nl ? nl : nout, r0 = i < nl ? i : i - nl;
+                double r = od[i] - (i < nl ? lin->t0[i] : lin->v0[i - nl]);
+                for (int j = 0; J && j < n; j++)
+                    r -= J[r0 + (size_t)j * rows] * d[j];
+                oacc[i] += r * r;
+            }
+        }
         used++;
     }
     if (rc == TS_OK && used > 0) {
         for (int i = 0; i < nlow; i++)
             lin->fnoise[i] = sqrt(acc[i] / (2.0 * used));
+        for (int i = 0; lin->onoise && i < no; i++)
+            lin->onoise[i] = i < nl && !lin->Ty ? NAN
+                                                : sqrt(oacc[i] / (2.0 * used));
     } else if (rc == TS_OK) {
         rc = TS_ECONV;
     }
+    free(od);
+    free(oacc);
     free(y);
     free(d);
     free(f);
@@ -306,7 +330,8 @@ typedef struct col_err {
  * `ocol` is not NULL the vehicles' output derivatives (nout entries). */
 static int column(col_ws *w, int j, int n, int nq, int nl, int nout,
                   double h, int estimate, double *col, double *ecol,
-                  double *tcol, double *ocol, col_err *ce)
+                  double *tcol, double *ocol, double *tecol,
+                  double *oecol, col_err *ce)
 {
     double *x = j < n ? &w->y[j] : &w->u[j - n];
     double x0 = *x;
@@ -334,14 +359,20 @@ static int column(col_ws *w, int j, int n, int nq, int nl, int nout,
             ce->sum2_a += e * e;
         }
     }
-    for (int o = 0; ocol && o < nout; o++)
+    for (int o = 0; ocol && o < nout; o++) {
         ocol[o] = (w->t[0][nl + o] - w->t[1][nl + o]) * inv;
+        if (estimate && oecol)
+            oecol[o] = ((w->t[2][nl + o] - w->t[3][nl + o]) * inv2 -
+                        ocol[o]) / 3.0;
+    }
     if (tcol)
         for (int l = 0; l < nl; l++) {
             tcol[l] = (w->t[0][l] - w->t[1][l]) * inv;
             if (estimate) {
                 double d2 = (w->t[2][l] - w->t[3][l]) * inv2;
                 double e = fabs(tcol[l] - d2) / 3.0;
+                if (tecol)
+                    tecol[l] = (d2 - tcol[l]) / 3.0;
                 if (!(e <= ce->max_t))
                     ce->max_t = e;
             }
@@ -572,6 +603,27 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         if (!lin->fnoise || !lin->Berr)
             return ts_fail(err, TS_ENOMEM, "linearize: out of memory");
     }
+    /* The output rows' own errors: tensions (with opts.tensions) and the
+     * vehicles' outputs, beside their Jacobians. */
+    free(lin->Terr);
+    free(lin->Verr);
+    free(lin->onoise);
+    lin->Terr = lin->Verr = lin->onoise = NULL;
+    if (dense && o.estimate_error) {
+        size_t cols = (size_t)n + (size_t)ni;
+        if (o.tensions)
+            lin->Terr = calloc((size_t)nl * cols, sizeof(double));
+        if (nout > 0)
+            lin->Verr = calloc((size_t)nout * cols, sizeof(double));
+        lin->onoise = malloc(((size_t)nl + (size_t)nout + 1) *
+                             sizeof(double));
+        if ((o.tensions && !lin->Terr) || (nout > 0 && !lin->Verr) ||
+            !lin->onoise)
+            return ts_fail(err, TS_ENOMEM, "linearize: out of memory for "
+                           "the output rows' error estimate");
+        for (int i = 0; i < nl + nout; i++)
+            lin->onoise[i] = NAN;
+    }
     if (!o.estimate_error) {
         free(lin->Aerr);
         lin->Aerr = NULL;
@@ -763,9 +815,11 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
             if (nout > 0)
                 ocol = j < n ? lin->Vy + (size_t)j * nout
                              : lin->Vu + (size_t)(j - n) * nout;
+            double *tecol = lin->Terr ? lin->Terr + (size_t)j * nl : NULL;
+            double *oecol = lin->Verr ? lin->Verr + (size_t)j * nout : NULL;
             col_err ce;
             int crc = column(w, j, n, nq, nl, nout, lin->h[j], estimate, col,
-                             ecol, tcol, ocol, &ce);
+                             ecol, tcol, ocol, tecol, oecol, &ce);
             if (crc != TS_OK) {
 #ifdef _OPENMP
 #pragma omp critical(ts_linearize_fail)

@@ -172,75 +172,164 @@ void ts_response_free(ts_response *r)
  * sparse way), state and input vectors (the dense way). */
 typedef struct resp_ws {
     double complex *dr, *dt;
-    double complex *b, *x, *rho;
+    double complex *b, *x;
+    double complex *c, *W, *t3; /* [n], [n], [nc]: the gain's weights, the
+                                   transposed solution, work */
     double *dq, *drr, *m; /* m: a position output's row of the node
                              displacement map (for the error) */
     double complex *wt;   /* [nx] the sparse way's transposed solution */
 } resp_ws;
 
-/* The dense way's error allowance of the gain g = rho^T x1 (+ a part
- * without A or B), x = (sI - A)^-1 b, for errors dA, db in the lower rows:
- * dg = -w^T (dA x + db), w = P(s)^-T rho (lib/shift.h; dx1 = -P^-1 z for
- * z in the lower rows). Two parts:
- * - truncation: w^T (Aerr x + Berr_x + s Berr_v + s^2 Berr_a);
- * - rounding: the root mean square of w^T N x over the noise N of the
+/* The dense way's error allowance of the gain g = c^T x (+ parts free of
+ * A, B and the output rows' Jacobian), x = (sI - A)^-1 b, c the output's
+ * weights on the state (c1, c2, c3 on q, q' and the controller states):
+ * errors dA, db in the lower rows change it by dg = W^T (dA x + db)
+ * (up to sign) with W the lower part of (A - sI)^-T c. Without
+ * controller states W = P(s)^-T (c1 + s c2) (x2 = s x1 for lower-row
+ * z); with them, through the Schur complement of lib/shift.h,
+ *
+ *     W2 = P^-T (c1 + s c2 - (F + s G)^T (H - sI)^-T c3),
+ *     W3 = (H - sI)^-T (c3 - E^T W2),
+ *
+ * and where H - sI is singular (the whole A - sI factored) W from one
+ * transposed solve of it. Parts:
+ * - truncation: W^T (Aerr x + db_err), db_err = Berr_x + s Berr_v +
+ *   s^2 Berr_a for a tow input, Berr_j for a vehicle's input j;
+ * - rounding: the root mean square of W^T N x over the noise N of the
  *   differences, entries fnoise_i / (sqrt(2) h_j) (doc/linear.md,
  *   section 2), and the same for b's columns,
- *   sqrt(sum_i |w_i|^2 fnoise_i^2 / 2) sqrt(sum_j |x_j|^2 / h_j^2 +
- *   1 / h_x^2 + |s|^2 / h_v^2 + |s|^4 / h_a^2).
+ *   sqrt(sum_i |W_i|^2 fnoise_i^2 / 2) sqrt(sum_j |x_j|^2 / h_j^2 + X_b),
+ *   X_b = 1 / h_x^2 + |s|^2 / h_v^2 + |s|^4 / h_a^2 (tow) or 1 / h_j^2;
+ * - the output row's own Jacobian (a tension's Ty, Tu; a vehicle
+ *   output's Vy, Vu; none for a position, whose map is exact): its
+ *   truncation |Jerr_y x + Jerr_u b| and rounding onoise /
+ *   sqrt(2) sqrt(sum_j |x_j|^2 / h_j^2 + X_b).
  * Returns 10 times their sum (the factor of the eigenvalues' allowance,
  * doc/linear.md section 3), NaN without an error estimate. Cost: one
- * transposed solve and one product with Aerr, O(nq^2). */
+ * transposed solve, products with Aerr and the controller blocks,
+ * O(nq^2 + nq nc). */
 static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
-                         resp_ws *w)
+                         const ts_output *out, resp_ws *w)
 {
-    /* A vehicle's controller block (the Schur complement in P) and a
-     * vehicle's input are not covered (doc/linear.md, section 4). */
-    if (!lin->Aerr || !lin->Berr || !lin->fnoise || sh->nc > 0 ||
-        sh->full || input >= TS_NINPUT)
+    if (!lin->Aerr || !lin->Berr || !lin->fnoise)
         return NAN;
-    int n = lin->nstate, nq = lin->nq, nlow = n - nq, one = 1, info = 0;
+    int n = lin->nstate, nq = lin->nq, nc = n - 2 * nq, nlow = n - nq;
+    int one = 1, info = 0, nl = lin->nlinks, nout = lin->noutput;
+    int tow = input < TS_NINPUT;
     double complex s = sh->s;
-    double complex *wv = w->rho; /* rho in, w out */
-    if (sh->is_complex) {
-        zgetrs_("T", &nq, &one, sh->zlu, &nq, sh->ipiv, wv, &nq, &info, 1);
-    } else {
-        double *re = sh->wr, *im = sh->wr + nq;
-        for (int i = 0; i < nq; i++) {
-            re[i] = creal(wv[i]);
-            im[i] = cimag(wv[i]);
-        }
-        dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, re, &nq, &info, 1);
-        dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, im, &nq, &info, 1);
-        for (int i = 0; i < nq; i++)
-            wv[i] = re[i] + I * im[i];
+    const double *A = lin->A;
+    /* The output's weights c on the state and its Jacobian's error. */
+    const double *J = NULL, *Jerr = NULL;
+    int rows = 0, row = 0;
+    double onoise = 0.0;
+    if (out->kind == TS_OUT_TENSION) {
+        J = lin->Ty;
+        Jerr = lin->Terr;
+        rows = nl;
+        row = out->link;
+        onoise = lin->onoise ? lin->onoise[row] : NAN;
+    } else if (out->kind == TS_OUT_VEHICLE) {
+        J = lin->Vy;
+        Jerr = lin->Verr;
+        rows = nout;
+        row = out->index;
+        onoise = lin->onoise ? lin->onoise[nl + row] : NAN;
     }
-    const double *bx = lin->Berr + (size_t)(TS_IN_DISP + input) * nlow;
-    const double *bv = lin->Berr + (size_t)(TS_IN_VEL + input) * nlow;
-    const double *ba = lin->Berr + (size_t)(TS_IN_ACC + input) * nlow;
-    double complex trunc = 0;
+    if (J && (!Jerr || !(onoise >= 0)))
+        return NAN;
+    double complex *c = w->c, *W = w->W;
+    for (int j = 0; j < n; j++)
+        c[j] = J ? J[row + (size_t)j * rows]
+                 : (j < nq ? w->m[j] : 0.0);
+    if (sh->full) {
+        /* H - sI singular: W from the whole (A - sI)^T. */
+        memcpy(W, c, (size_t)n * sizeof(double complex));
+        zgetrs_("T", &n, &one, sh->full, &n, sh->fpiv, W, &n, &info, 1);
+        memmove(W, W + nq, (size_t)nlow * sizeof(double complex));
+    } else {
+        double complex *w2 = W, *w3 = W + nq;
+        for (int i = 0; i < nq; i++)
+            w2[i] = c[i] + s * c[nq + i];
+        if (nc > 0) {
+            /* t = (H - sI)^-T c3; w2 -= (F + s G)^T t. */
+            double complex *t = w->t3;
+            memcpy(t, c + 2 * nq, (size_t)nc * sizeof(double complex));
+            zgetrs_("T", &nc, &one, sh->hlu, &nc, sh->hpiv, t, &nc, &info,
+                    1);
+            for (int i = 0; i < nq; i++) {
+                const double *Fi = A + (size_t)i * n + 2 * nq;
+                const double *Gi = A + (size_t)(nq + i) * n + 2 * nq;
+                double complex acc = 0;
+                for (int k = 0; k < nc; k++)
+                    acc += (Fi[k] + s * Gi[k]) * t[k];
+                w2[i] -= acc;
+            }
+        }
+        if (sh->is_complex) {
+            zgetrs_("T", &nq, &one, sh->zlu, &nq, sh->ipiv, w2, &nq, &info,
+                    1);
+        } else {
+            double *re = sh->wr, *im = sh->wr + nq;
+            for (int i = 0; i < nq; i++) {
+                re[i] = creal(w2[i]);
+                im[i] = cimag(w2[i]);
+            }
+            dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, re, &nq, &info,
+                    1);
+            dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, im, &nq, &info,
+                    1);
+            for (int i = 0; i < nq; i++)
+                w2[i] = re[i] + I * im[i];
+        }
+        if (nc > 0) {
+            /* w3 = (H - sI)^-T (c3 - E^T w2), E = A[nq:2nq, 2nq:]. */
+            for (int k = 0; k < nc; k++) {
+                const double *Ek = A + (size_t)(2 * nq + k) * n + nq;
+                double complex acc = 0;
+                for (int i = 0; i < nq; i++)
+                    acc += Ek[i] * w2[i];
+                w3[k] = c[2 * nq + k] - acc;
+            }
+            zgetrs_("T", &nc, &one, sh->hlu, &nc, sh->hpiv, w3, &nc, &info,
+                    1);
+        }
+    }
+    /* The input's columns of B and their factors. */
+    int cols[3] = {tow ? TS_IN_DISP + input : input, TS_IN_VEL + input,
+                   TS_IN_ACC + input};
+    double complex fac[3] = {1.0, tow ? s : 0.0, tow ? s * s : 0.0};
+    int ncols = tow ? 3 : 1;
+    const double *hu = lin->h + n;
+    double complex trunc = 0, otrunc = 0;
     double wn2 = 0, xh2 = 0;
     for (int j = 0; j < n; j++) {
         const double *ej = lin->Aerr + (size_t)j * nlow;
         double complex acc = 0;
         for (int i = 0; i < nlow; i++)
-            acc += wv[i] * ej[i];
+            acc += W[i] * ej[i];
         trunc += acc * w->x[j];
+        if (J)
+            otrunc += Jerr[row + (size_t)j * rows] * w->x[j];
         double a = cabs(w->x[j]) / lin->h[j];
         xh2 += a * a;
     }
+    for (int q = 0; q < ncols; q++) {
+        const double *be = lin->Berr + (size_t)cols[q] * nlow;
+        for (int i = 0; i < nlow; i++)
+            trunc += fac[q] * W[i] * be[i];
+        if (J)
+            otrunc += fac[q] * Jerr[row + (size_t)(n + cols[q]) * rows];
+        double a = cabs(fac[q]) / hu[cols[q]];
+        xh2 += a * a;
+    }
     for (int i = 0; i < nlow; i++) {
-        double a = cabs(wv[i]) * lin->fnoise[i];
-        trunc += wv[i] * (bx[i] + s * bv[i] + s * s * ba[i]);
+        double a = cabs(W[i]) * lin->fnoise[i];
         wn2 += a * a;
     }
-    double as = cabs(s);
-    const double *hu = lin->h + n;
-    xh2 += 1.0 / (hu[TS_IN_DISP + input] * hu[TS_IN_DISP + input]) +
-           as * as / (hu[TS_IN_VEL + input] * hu[TS_IN_VEL + input]) +
-           as * as * as * as /
-               (hu[TS_IN_ACC + input] * hu[TS_IN_ACC + input]);
-    return 10.0 * (cabs(trunc) + sqrt(0.5 * wn2 * xh2));
+    double e = cabs(trunc) + sqrt(0.5 * wn2 * xh2);
+    if (J)
+        e += cabs(otrunc) + onoise * sqrt(0.5 * xh2);
+    return 10.0 * e;
 }
 
 /* Row `row` of an output Jacobian pair (Jy [rows x n], Ju [rows x
@@ -282,18 +371,8 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     for (int i = 0; i < n; i++)
         w->b[i] = -(Bx[i] + cv * Bv[i] + ca * Ba[i]);
     tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
-    if (gerr && out->kind != TS_OUT_POSITION && out->kind != TS_OUT_TENSION) {
-        *gerr = NAN; /* a vehicle's output: not covered */
-    } else if (gerr) {
-        /* rho: the gain's weights on x1 (x2 = s x1 for lower-row z). */
-        for (int i = 0; i < nq; i++)
-            w->rho[i] = out->kind == TS_OUT_POSITION
-                            ? w->m[i]
-                            : lin->Ty[out->link + (size_t)i * nl] +
-                                  s * lin->Ty[out->link +
-                                              (size_t)(nq + i) * nl];
-        *gerr = gain_error(sh, lin, input, w);
-    }
+    if (gerr)
+        *gerr = gain_error(sh, lin, input, out, w);
     if (out->kind == TS_OUT_POSITION) {
         int idx = 3 * out->node + out->comp;
         for (int i = 0; i < nq; i++)
@@ -431,11 +510,15 @@ static int ws_alloc(resp_ws *w, const ts_linear *lin, const ts_system *sys,
     } else {
         w->b = malloc((size_t)lin->nstate * sizeof(double complex));
         w->x = malloc((size_t)lin->nstate * sizeof(double complex));
-        w->rho = malloc((size_t)lin->nq * sizeof(double complex));
+        w->c = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->W = malloc((size_t)lin->nstate * sizeof(double complex));
+        w->t3 = malloc((size_t)(lin->nstate - 2 * lin->nq + 1) *
+                       sizeof(double complex));
         w->dq = malloc((size_t)lin->nq * sizeof(double));
         w->drr = malloc(3 * (size_t)lin->nnodes * sizeof(double));
         w->m = calloc((size_t)lin->nq, sizeof(double));
-        if (!w->b || !w->x || !w->rho || !w->dq || !w->drr || !w->m)
+        if (!w->b || !w->x || !w->c || !w->W || !w->t3 || !w->dq ||
+            !w->drr || !w->m)
             return 0;
         if (sys && out->kind == TS_OUT_POSITION) {
             /* O(nq nlinks) once: the map applied to each unit vector. */
@@ -460,7 +543,9 @@ static void ws_free(resp_ws *w)
     free(w->x);
     free(w->dq);
     free(w->drr);
-    free(w->rho);
+    free(w->c);
+    free(w->W);
+    free(w->t3);
     free(w->m);
     free(w->wt);
 }

@@ -169,10 +169,23 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
 
 void cli_scene_free(cli_scene_runs *s);
 
-/* Report a getopt failure of `towstab run` or `report` (ch ':' for a
- * missing value, else an unknown option: the analyses' options belong in
- * the scene); returns EXIT_BADINPUT. */
-int cli_scene_option_error(const char *cmd, int ch, const char *arg);
+/* The command line of `towstab run` and `report`: the options `longopts`
+ * offers among --json FILE, --csv DIR, --plot DIR, --output (-o) DIR,
+ * --units U, --quiet and --help (their val 'j', 'c', 'p', 'o', 'u', 'q',
+ * 'h'; short options in `shortopts`, which starts with ':'), then one
+ * scene file. A missing value, an unknown option (the analyses' options
+ * belong in the scene) or not one scene is reported naming `cmd`, with
+ * `usage` after the last. Returns -1 to go on, 0 after --help (usage on
+ * standard output) or EXIT_BADINPUT. */
+typedef struct cli_scene_args {
+    const char *scene, *json, *csv, *plot, *output, *units;
+    int quiet;
+} cli_scene_args;
+struct option;
+int cli_scene_args_parse(const char *cmd, int argc, char **argv,
+                         const char *shortopts,
+                         const struct option *longopts, void (*usage)(FILE *),
+                         cli_scene_args *a);
 
 /* Make directory `dir` (one level) unless it is one; 0, or the status
  * after printing a message naming `cmd` and the option `opt`. */

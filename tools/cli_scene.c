@@ -3,6 +3,7 @@
  * its analysis' option table and checked against the system before the
  * first one runs; the results are collected as one JSON document. */
 #include <errno.h>
+#include <getopt.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -28,14 +29,40 @@ int cli_make_dir(const char *cmd, const char *opt, const char *dir)
     return 0;
 }
 
-int cli_scene_option_error(const char *cmd, int ch, const char *arg)
+int cli_scene_args_parse(const char *cmd, int argc, char **argv,
+                         const char *shortopts,
+                         const struct option *longopts, void (*usage)(FILE *),
+                         cli_scene_args *a)
 {
-    if (ch == ':')
-        return cli_option_error(cmd, ch, arg);
-    fprintf(stderr, "towstab: error: %s: unknown option '%s'; the scene's "
-                    "analyses carry their own settings (towstab %s --help)\n",
-            cmd, arg, cmd);
-    return EXIT_BADINPUT;
+    memset(a, 0, sizeof *a);
+    optind = 1;
+    opterr = 0;
+    int ch;
+    while ((ch = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
+        switch (ch) {
+        case 'j': a->json = optarg; break;
+        case 'c': a->csv = optarg; break;
+        case 'p': a->plot = optarg; break;
+        case 'o': a->output = optarg; break;
+        case 'u': a->units = optarg; break;
+        case 'q': a->quiet = 1; break;
+        case 'h': usage(stdout); return 0;
+        case ':': return cli_option_error(cmd, ch, argv[optind - 1]);
+        default:
+            fprintf(stderr, "towstab: error: %s: unknown option '%s'; the "
+                            "scene's analyses carry their own settings "
+                            "(towstab %s --help)\n",
+                    cmd, argv[optind - 1], cmd);
+            return EXIT_BADINPUT;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "towstab: error: %s: expected one scene file\n", cmd);
+        usage(stderr);
+        return EXIT_BADINPUT;
+    }
+    a->scene = argv[optind];
+    return -1;
 }
 
 void cli_scene_free(cli_scene_runs *s)

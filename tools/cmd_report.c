@@ -520,31 +520,18 @@ static int page(cli_page *p, const ts_scene *scene, const cli_scene_runs *s,
 /* The command: `words` are argv as given (getopt reorders argv). */
 static int report_run(int argc, char **argv, char **words)
 {
-    const char *dir = NULL, *plot_units = NULL;
-    int quiet = 0;
     static const struct option longopts[] = {
         {"output", required_argument, NULL, 'o'},
         {"units", required_argument, NULL, 'u'},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
-    optind = 1;
-    opterr = 0;
-    int ch;
-    while ((ch = getopt_long(argc, argv, ":o:", longopts, NULL)) != -1) {
-        switch (ch) {
-        case 'o': dir = optarg; break;
-        case 'u': plot_units = optarg; break;
-        case 'q': quiet = 1; break;
-        case 'h': usage(stdout); return 0;
-        default: return cli_scene_option_error("report", ch, argv[optind - 1]);
-        }
-    }
-    if (optind != argc - 1) {
-        fprintf(stderr, "towstab: error: report: expected one scene file\n");
-        usage(stderr);
-        return EXIT_BADINPUT;
-    }
+    cli_scene_args a;
+    int st = cli_scene_args_parse("report", argc, argv, ":o:", longopts,
+                                  usage, &a);
+    if (st >= 0)
+        return st;
+    const char *dir = a.output;
     if (!dir || !dir[0]) {
         fprintf(stderr, "towstab: error: report: -o DIR: expected the "
                         "directory of the page, got %s\n",
@@ -567,12 +554,12 @@ static int report_run(int argc, char **argv, char **words)
         plot_note = perr.msg;
     ts_units *units;
     ts_scene *scene;
-    int status = cli_open(argv[optind], &units, &scene);
+    int status = cli_open(a.scene, &units, &scene);
     if (status)
         return status;
     cli_scene_runs s;
-    status = cli_scene_prepare("report", scene, units, quiet, NULL,
-                               plot_note ? NULL : pics, plot_units, 1, &s);
+    status = cli_scene_prepare("report", scene, units, a.quiet, NULL,
+                               plot_note ? NULL : pics, a.units, 1, &s);
     if (status) {
         cli_close(units, scene);
         return status;

@@ -27,9 +27,6 @@ static void usage(FILE *f)
 
 static int run_main(int argc, char **argv)
 {
-    const char *json_path = NULL, *csv_dir = NULL, *plot_dir = NULL;
-    const char *plot_units = NULL;
-    int quiet = 0;
     static const struct option longopts[] = {
         {"json", required_argument, NULL, 'j'},
         {"csv", required_argument, NULL, 'c'},
@@ -38,24 +35,11 @@ static int run_main(int argc, char **argv)
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
-    optind = 1;
-    opterr = 0;
-    int ch;
-    while ((ch = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
-        switch (ch) {
-        case 'j': json_path = optarg; break;
-        case 'c': csv_dir = optarg; break;
-        case 'p': plot_dir = optarg; break;
-        case 'u': plot_units = optarg; break;
-        case 'q': quiet = 1; break;
-        case 'h': usage(stdout); return 0;
-        default: return cli_scene_option_error("run", ch, argv[optind - 1]);
-        }
-    }
-    if (optind != argc - 1) {
-        fprintf(stderr, "towstab: error: run: expected one scene file\n");
-        return EXIT_BADINPUT;
-    }
+    cli_scene_args a;
+    int st = cli_scene_args_parse("run", argc, argv, ":", longopts, usage, &a);
+    if (st >= 0)
+        return st;
+    const char *json_path = a.json, *csv_dir = a.csv, *plot_dir = a.plot;
     const char *given[3] = {json_path, csv_dir, plot_dir};
     static const char *const opt[3] = {"--json", "--csv", "--plot"};
     for (int k = 0; k < 3; k++)
@@ -67,12 +51,12 @@ static int run_main(int argc, char **argv)
         }
     ts_units *units;
     ts_scene *scene;
-    int status = cli_open(argv[optind], &units, &scene);
+    int status = cli_open(a.scene, &units, &scene);
     if (status)
         return status;
     cli_scene_runs s;
-    status = cli_scene_prepare("run", scene, units, quiet, csv_dir,
-                               plot_dir, plot_units, 0, &s);
+    status = cli_scene_prepare("run", scene, units, a.quiet, csv_dir,
+                               plot_dir, a.units, 0, &s);
     if (status) {
         cli_close(units, scene);
         return status;

@@ -120,6 +120,18 @@ typedef struct ts_linear {
                           without vehicles */
     double *Vu;        /* [noutput * ninput] d output / du; NULL without
                           vehicles */
+    double *Terr;      /* [nlinks * (n + ninput)] the error estimate of Ty
+                          (columns 0..n-1) and Tu (the rest), (T(2h) -
+                          T(h)) / 3, column-major; NULL unless tensions
+                          and estimate_error */
+    double *Verr;      /* [noutput * (n + ninput)] the same of Vy and Vu;
+                          NULL without vehicles or estimate_error */
+    double *onoise;    /* [nlinks + noutput] rounding noise of one kernel
+                          evaluation of each link tension (N) and vehicle
+                          output (m, rad), measured with fnoise: entry
+                          (i, j) of Ty or Vy carries onoise[i] / (sqrt(2)
+                          h[j]); NULL unless estimate_error (tensions
+                          NaN without opts.tensions) */
     char (*input_name)[TS_IO_NAME];  /* [ninput] ts_kernel_input_name */
     const char **input_unit;         /* [ninput] ts_kernel_input_unit */
     char (*output_name)[TS_IO_NAME]; /* [noutput] ts_kernel_output_name */
