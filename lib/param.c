@@ -83,6 +83,21 @@ static const row surface_rows[] = {
     {"limit", "rad", 0, 1, TSI_KEY_PLAIN, offsetof(ts_component, limit)},
     {"incidence", "rad", -INFINITY, 0, TSI_KEY_PLAIN,
      offsetof(ts_component, incidence)},
+    {"roll", "rad", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_component, roll)},
+    {"lift_slope", "1/rad", 0, 0, TSI_KEY_PLAIN,
+     offsetof(ts_component, lift_slope)},
+    {"stall", "rad", 0, 1, TSI_KEY_PLAIN, offsetof(ts_component, stall)},
+    {"stall_width", "rad", 0, 1, TSI_KEY_PLAIN,
+     offsetof(ts_component, stall_width)},
+    {"zero_lift_drag", "1", 0, 0, TSI_KEY_PLAIN,
+     offsetof(ts_component, cd0)},
+    {"efficiency", "1", 0, 1, TSI_KEY_PLAIN,
+     offsetof(ts_component, efficiency)},
+    {"cn90", "1", 0, 0, TSI_KEY_PLAIN, offsetof(ts_component, cn90)},
+    {"rate_limit", "rad/s", 0, 1, TSI_KEY_PLAIN,
+     offsetof(ts_component, rate_limit)},
+    {"time_constant", "s", 0, 0, TSI_KEY_PLAIN,
+     offsetof(ts_component, time_constant)},
 };
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
@@ -107,7 +122,8 @@ static const char *const forms =
     "cables.<name>.<key>, bodies.<name>.<key>, "
     "bodies.<vehicle>.loops.<loop>.kp|ki|kd|setpoint, "
     "bodies.<vehicle>.surfaces.<surface>.area|span|deflection|limit|"
-    "incidence";
+    "incidence|roll|lift_slope|stall|stall_width|zero_lift_drag|"
+    "efficiency|cn90|rate_limit|time_constant";
 
 /* A path resolved against a system (or only by its form when sys is
  * NULL). */

@@ -752,21 +752,22 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
                         &cp->area)) ||
         (rc = key_value(c, path, &f[K_SPAN], TSI_KEYS_SURFACE, 0,
                         &cp->span)) ||
-        (rc = optional_any(c, path, &f[K_ROLL], "rad", 0, &cp->roll)) ||
+        (rc = key_value(c, path, &f[K_ROLL], TSI_KEYS_SURFACE, 0,
+                        &cp->roll)) ||
         (rc = key_value(c, path, &f[K_INC], TSI_KEYS_SURFACE, 0,
                         &cp->incidence)) ||
-        (rc = optional_min(c, path, &f[K_SLOPE], "1/rad", 0, 0, 0,
-                           &cp->lift_slope)) ||
-        (rc = optional_min(c, path, &f[K_STALL], "rad", 0, 1, cp->stall,
-                           &cp->stall)) ||
-        (rc = optional_min(c, path, &f[K_WIDTH], "rad", 0, 1,
-                           cp->stall_width, &cp->stall_width)) ||
-        (rc = optional_min(c, path, &f[K_CD0], "1", 0, 0, cp->cd0,
-                           &cp->cd0)) ||
-        (rc = optional_min(c, path, &f[K_EFF], "1", 0, 1, cp->efficiency,
-                           &cp->efficiency)) ||
-        (rc = optional_min(c, path, &f[K_CN90], "1", 0, 0, cp->cn90,
-                           &cp->cn90)))
+        (rc = key_value(c, path, &f[K_SLOPE], TSI_KEYS_SURFACE, 0,
+                        &cp->lift_slope)) ||
+        (rc = key_value(c, path, &f[K_STALL], TSI_KEYS_SURFACE, cp->stall,
+                        &cp->stall)) ||
+        (rc = key_value(c, path, &f[K_WIDTH], TSI_KEYS_SURFACE,
+                        cp->stall_width, &cp->stall_width)) ||
+        (rc = key_value(c, path, &f[K_CD0], TSI_KEYS_SURFACE, cp->cd0,
+                        &cp->cd0)) ||
+        (rc = key_value(c, path, &f[K_EFF], TSI_KEYS_SURFACE,
+                        cp->efficiency, &cp->efficiency)) ||
+        (rc = key_value(c, path, &f[K_CN90], TSI_KEYS_SURFACE, cp->cn90,
+                        &cp->cn90)))
         return rc;
     if (f[K_TABLE].value) {
         static const int curve_keys[] = {K_SLOPE, K_STALL, K_WIDTH, K_CD0,
@@ -796,10 +797,10 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
                         &cp->deflection)) ||
         (rc = key_value(c, path, &f[K_LIMIT], TSI_KEYS_SURFACE, INFINITY,
                            &cp->limit)) ||
-        (rc = optional_min(c, path, &f[K_RATE], "rad/s", 0, 1, INFINITY,
-                           &cp->rate_limit)) ||
-        (rc = optional_min(c, path, &f[K_TAU], "s", 0, 0, 0,
-                           &cp->time_constant)))
+        (rc = key_value(c, path, &f[K_RATE], TSI_KEYS_SURFACE, INFINITY,
+                        &cp->rate_limit)) ||
+        (rc = key_value(c, path, &f[K_TAU], TSI_KEYS_SURFACE, 0,
+                        &cp->time_constant)))
         return rc;
     return TS_OK;
 }

@@ -368,6 +368,8 @@ static void test_scene_words(const ts_units *u)
          "bodies[aurora].controllers[depth].setpoint", "35 m"},
         {"bodies.aurora.components.wing.area",
          "bodies[aurora].components[wing].area", "0.55 m^2"},
+        {"bodies.aurora.components.tail1.time_constant",
+         "bodies[aurora].components[tail1].time_constant", "0.15 s"},
     };
     /* The scene as written, to see each setting change the run. */
     ts_request r0;
@@ -445,6 +447,9 @@ static void test_scene_words(const ts_units *u)
         {"bodies.aurora.components.wing.area",
          "bodies[aurora].components[wing].area", "0",
          "must be > 0 m^2, got 0 m^2"},
+        {"bodies.aurora.components.wing.rate_limit",
+         "bodies[aurora].components[wing].rate_limit", "0",
+         "must be > 0 rad/s, got 0 rad/s"},
     };
     for (size_t i = 0; i < sizeof lim / sizeof lim[0]; i++) {
         ts_err e1 = {0}, e2 = {0};

@@ -15,7 +15,8 @@
  *       added_mass | cross_drag | cross_added_mass
  *   bodies.<vehicle>.loops.<loop>.kp | ki | kd | setpoint
  *   bodies.<vehicle>.surfaces.<surface>.area | span | deflection | limit |
- *       incidence
+ *       incidence | roll | lift_slope | stall | stall_width |
+ *       zero_lift_drag | efficiency | cn90 | rate_limit | time_constant
  *   (the scene's words `controllers` for loops and `components` for
  *   surfaces name the same values)
  *
