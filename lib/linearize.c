@@ -94,6 +94,7 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->kink_node = -1;
     lin->desc_err = lin->desc_round = NAN;
     lin->nvehicles = ts_kernel_nvehicles(k);
+    lin->root_qoff = ts_kernel_root_offset(k);
     lin->noutput = ts_kernel_noutput(k);
     if (lin->noutput > 0) {
         size_t no = (size_t)lin->noutput;
@@ -399,7 +400,7 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
         return scale[j];
     double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
     double V = fabs(fr->speed);
-    double l0 = sys->links[0].length;
+    double l0 = sys->nlinks > 0 ? sys->links[0].length : 1.0;
     int c = j - n;
     if (c < TS_IN_VEL)
         return l0;
@@ -444,6 +445,12 @@ static void state_scales(const ts_kernel *k, const ts_frame *fr,
             scale[o + j] = 1.0;
             scale[nq + o + j] = (sqrt(g * l) + V) / l;
         }
+        if (v == ts_kernel_root(k))
+            /* The towing vehicle's position: its length, and speeds. */
+            for (int j = 3; j < 6; j++) {
+                scale[o + j] = l;
+                scale[nq + o + j] = sqrt(g * l) + V;
+            }
     }
     for (int j = 2 * nq; j < n; j++)
         scale[j] = 1.0;
@@ -926,6 +933,9 @@ void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,
                                   const double dq[], double dr[])
 {
     dr[0] = dr[1] = dr[2] = 0.0;
+    if (lin->root_qoff >= 0)
+        for (int c = 0; c < 3; c++)
+            dr[c] = dq[lin->root_qoff + c];
     for (int l = 0; l < sys->nlinks; l++) {
         const ts_link *L = &sys->links[l];
         const double *d1 = lin->dn + 6 * l, *d2 = d1 + 3;

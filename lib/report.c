@@ -87,6 +87,13 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
                              num(r->loop_output[l] * DEG)));
     json_object_set_new(o, "components", comps);
     json_object_set_new(o, "controllers", loops);
+    if (r->towing) {
+        json_object_set_new(o, "towing", json_true());
+        json_object_set_new(o, "track_speed", num(r->track_speed));
+        json_object_set_new(o, "turn_rate", num(r->turn_rate));
+        json_object_set_new(o, "thrust", num(r->thrust));
+        json_object_set_new(o, "power", num(r->power));
+    }
     return o;
 }
 
@@ -118,8 +125,11 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     json_object_set_new(o, "force_scale", num(eq->force_scale));
     json_object_set_new(o, "tolerance", num(eq->tolerance));
     json_object_set_new(o, "method", json_string(ts_eq_method_name(eq->method)));
-    json_object_set_new(o, "speed", num(sys->tow.speed));
-    json_object_set_new(o, "turn_rate", num(sys->tow.turn_rate));
+    /* With a towing vehicle the steady motion is solved. */
+    int towing = sys->tow.vehicle >= 0;
+    json_object_set_new(o, "speed", num(towing ? eq->speed : sys->tow.speed));
+    json_object_set_new(o, "turn_rate",
+                        num(towing ? eq->turn_rate : sys->tow.turn_rate));
     json_object_set_new(o, "wall_s", num(wall_s));
     json_object_set_new(o, "top_tension", num(eq->top_tension));
     json_object_set_new(o, "min_tension", num(eq->min_tension));

@@ -71,6 +71,40 @@ static json_t *margins_json(const ts_result *r)
     return o;
 }
 
+/* modes --free-vehicle: {speed, turn_rate, thrust, nstate, modes: [{re,
+ * im, freq_hz, damping_ratio, coupled (1-based mode number of the
+ * coupled table, null if none), coupled_re, coupled_im, coupled_freq_hz,
+ * coupled_damping_ratio, mac}]}. */
+static json_t *free_vehicle_json(const ts_result *r)
+{
+    const ts_free_vehicle *f = r->free_vehicle;
+    json_t *o = json_object(), *a = json_array();
+    if (!o || !a) {
+        json_decref(o);
+        json_decref(a);
+        return NULL;
+    }
+    for (int i = 0; i < f->nmodes; i++) {
+        const ts_free_mode *m = &f->modes[i];
+        json_t *e = json_pack(
+            "{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "re", num(m->re),
+            "im", num(m->im), "freq_hz", num(m->freq_hz), "damping_ratio",
+            num(m->damping_ratio), "coupled",
+            m->coupled >= 0 ? json_integer(m->coupled + 1) : json_null(),
+            "coupled_re", num(m->coupled_re), "coupled_im",
+            num(m->coupled_im), "coupled_freq_hz", num(m->coupled_freq_hz),
+            "coupled_damping_ratio", num(m->coupled_damping_ratio), "mac",
+            num(m->mac));
+        json_array_append_new(a, e);
+    }
+    json_object_set_new(o, "speed", num(f->speed));
+    json_object_set_new(o, "turn_rate", num(f->turn_rate));
+    json_object_set_new(o, "thrust", num(f->thrust));
+    json_object_set_new(o, "nstate", json_integer(f->nstate));
+    json_object_set_new(o, "modes", a);
+    return o;
+}
+
 /* {"discretisation": d, "solver": s} */
 static json_t *error_json(double disc, double solver)
 {
@@ -147,6 +181,8 @@ static json_t *modes_json(const ts_result *r, int flags)
                                                   flags & TS_REPORT_MATRICES));
     if (j && r->nmargins > 0)
         json_object_set_new(j, "margins", margins_json(r));
+    if (j && r->free_vehicle)
+        json_object_set_new(j, "free_vehicle", free_vehicle_json(r));
     return j;
 }
 
@@ -552,11 +588,13 @@ int ts_report_result_csv_display(const ts_result *r, const ts_display *d,
         break;
     case TS_ANALYSIS_MODES:
         if (r->eigen)
-            return ts_report_modes_csv(r->sys, r->lin, r->eigen, path, err);
+            return ts_report_modes_csv_display(r->sys, r->lin, r->eigen, d,
+                                               path, err);
         break;
     case TS_ANALYSIS_RESPONSE:
         if (r->seastate)
-            return ts_report_seastate_csv(r->seastate, path, err);
+            return ts_report_seastate_csv_display(r->seastate, d, path,
+                                                  err);
         if (r->response)
             return ts_report_response_csv_display(r->response, d, path, err);
         break;

@@ -73,11 +73,6 @@ json_t *ts_report_channels_json(const ts_system *sys, const ts_history *h,
                                                           i)));
         json_object_set_new(ch, outs[k].name, a);
     }
-    /* The vehicles' outputs (m, rad), every one. */
-    for (int j = 0; h->outputs && j < h->noutput; j++)
-        json_object_set_new(ch, h->output_name[j],
-                            series(h->outputs + j, h->nsamples,
-                                   (size_t)h->noutput));
     json_object_set_new(o, "outputs", ch);
     return o;
 }
@@ -409,7 +404,6 @@ static void channels_header(csv_cols *c, FILE *f, const ts_history *h,
         fprintf(f, ",%s%s%s%s", prefix, c->outs[k].name, bare ? "" : "_",
                 bare ? "" : t);
     }
-    vehicle_header(f, h, prefix);
 }
 
 static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
@@ -424,7 +418,6 @@ static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
                                        ts_history_value(c->sys, h,
                                                         &c->outs[k], i),
                                        u, sizeof u));
-    vehicle_row(f, h, i);
 }
 
 int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,

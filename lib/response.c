@@ -61,8 +61,14 @@ void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
 int ts_response_input_lookup(const ts_kernel *k, const char *name,
                              int *channel, ts_err *err)
 {
-    if (ts_response_input_find(name, channel, NULL) == TS_OK)
-        return TS_OK;
+    if (ts_response_input_find(name, channel, NULL) == TS_OK) {
+        if (ts_kernel_root(k) < 0)
+            return TS_OK;
+        return ts_fail(err, TS_EINVAL, "input '%s': the tow point is the "
+                       "towing vehicle's, not prescribed; its inputs are "
+                       "<vehicle>.thrust, .force.x|y|z, .moment.x|y|z and "
+                       "its control surfaces and loops", name);
+    }
     int j = ts_kernel_input_find(k, name);
     if (j >= TS_NINPUT) {
         *channel = j;
@@ -95,18 +101,20 @@ int ts_response_output_lookup(const ts_kernel *k, const char *name,
         return TS_OK;
     }
     int rc = ts_response_output_find(sys, name, out, err);
-    if (rc != TS_OK && err && ts_kernel_noutput(k) > 0) {
-        /* Append the vehicles' outputs to the list of valid names. */
-        char nm[TS_IO_NAME];
-        size_t len = strlen(err->msg);
-        for (int i = 0; i < ts_kernel_noutput(k) && len < sizeof err->msg;
-             i++)
-            len += (size_t)snprintf(err->msg + len, sizeof err->msg - len,
-                                    "%s%s", i ? ", " : "; vehicles: ",
-                                    ts_kernel_output_name(k, i, nm,
-                                                          sizeof nm));
-    }
+    if (rc != TS_OK)
+        tsi_response_list_vehicle_outputs(k, err);
     return rc;
+}
+
+void tsi_response_list_vehicle_outputs(const ts_kernel *k, ts_err *err)
+{
+    char nm[TS_IO_NAME];
+    size_t len = err ? strlen(err->msg) : 0;
+    for (int i = 0; err && i < ts_kernel_noutput(k) && len < sizeof err->msg;
+         i++)
+        len += (size_t)snprintf(err->msg + len, sizeof err->msg - len,
+                                "%s%s", i ? ", " : "; vehicles: ",
+                                ts_kernel_output_name(k, i, nm, sizeof nm));
 }
 
 int ts_response_output_find(const ts_system *sys, const char *name,
@@ -637,6 +645,16 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,
                  err);
     r->static_gain = creal(g);
+    if (rc == TS_ESINGULAR && lin->root_qoff >= 0) {
+        /* A towing vehicle's neutral modes (its position along and across
+         * its track, its heading: doc/towing-vehicle.md) make A singular:
+         * no static gain, the frequencies above 0 are regular. */
+        ts_err_clear(err);
+        rc = TS_OK;
+        r->static_gain = r->static_error = NAN;
+        tsi_shift_free(&sh);
+        memset(&sh, 0, sizeof sh);
+    }
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
         rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,
                      &r->error[i], err);

@@ -462,7 +462,9 @@ static int validate(const ts_system *s, ts_err *err)
         if (!isfinite(s->tow.point[j]))
             return ts_fail(err, TS_EINVAL, "tow.point: "
                            "component %d must be finite", j);
-    if (s->ncables < 1)
+    /* (A towing vehicle alone is a system: the free vehicle of
+     * towstab/towing.h.) */
+    if (s->ncables < 1 && s->tow.vehicle < 0)
         return ts_fail(err, TS_EINVAL, "cables: " "at least one cable needed");
 
     int rc;
@@ -591,10 +593,10 @@ static int validate(const ts_system *s, ts_err *err)
             ends += s->cables[i].to_body == b;
         if (b == s->tow.vehicle) {
             if (ends != 0)
-                return ts_fail(err, TS_EINVAL, "bodies[%d]%s: the towing "
-                               "vehicle '%s' is the root of the tree: no "
-                               "cable may end at it, %d do",
-                               b, at_line(bd->line), bd->name, ends);
+                return ts_fail(err, TS_EINVAL, "towing_vehicle%s: '%s' is "
+                               "the root of the tree: no cable may end at "
+                               "it, %d do",
+                               at_line(bd->line), bd->name, ends);
             continue;
         }
         if (ends != 1)
@@ -667,9 +669,10 @@ int ts_system_build(ts_system *s, ts_err *err)
     int nl = (int)total;
     s->nlinks = nl;
     s->nnodes = nl + 1;
-    s->links = calloc((size_t)nl, sizeof *s->links);
+    /* (nl is 0 for a towing vehicle alone.) */
+    s->links = calloc((size_t)nl + 1, sizeof *s->links);
     s->nodes = calloc((size_t)nl + 1, sizeof *s->nodes);
-    s->child_links = calloc((size_t)nl, sizeof *s->child_links);
+    s->child_links = calloc((size_t)nl + 1, sizeof *s->child_links);
     int *body_node = malloc((size_t)(s->nbodies + 1) * sizeof *body_node);
     if (!s->links || !s->nodes || !s->child_links || !body_node) {
         free(order);

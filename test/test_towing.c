@@ -6,36 +6,57 @@
  *     kinetic plus potential energy is conserved; RK4's drift falls like
  *     h^4.
  *  2. The cable sees only the tow point's steady motion: a towing vehicle
- *     whose speed controller holds 3 m/s and whose depth loop holds its
- *     tow point at 20 m gives the prescribed-tow equilibrium at 3 m/s from
- *     (0, 0, 20 m): the same tensions and shape, and its thrust equals
- *     the cable's pull plus its own drag.
- *  3. Thrust = drag(U), analytic: a symmetric neutral vehicle pulling a
+ *     whose speed controller holds 3 m/s (its depth loop holding it at
+ *     20 m) gives the prescribed-tow equilibrium at 3 m/s: the same
+ *     tensions, the same shape relative to the tow point, and its thrust
+ *     balances the cable's pull, its drag and its weight.
+ *  3. Modes: as the vehicle's mass, volume and inertia grow (1e4, 1e5
+ *     times), every mode of the prescribed tow has a coupled mode whose
+ *     distance falls like 1 / mass: an infinitely heavy towing vehicle
+ *     is a prescribed tow point.
+ *  4. Thrust = drag(U), analytic: a symmetric neutral vehicle pulling a
  *     neutral cable that streams straight behind it. At zero attitude the
  *     drag is 1/2 rho U^2 (Cd_axial pi D^2 / 4 + sum S Cd0 + Cdt pi d L),
  *     so at a given thrust U = sqrt(T / that), at a given power
  *     U = (P / that)^(1/3).
+ *  5. The steady state reached by simulation is Newton's: from the trim
+ *     at 1400 N, released at 1500 N, the kernel integrated (RK4) settles
+ *     on the 1500 N trim; with 3 deg of rudder, on Newton's steady
+ *     turn (its tensions, attitude, depth, speed through the water, and
+ *     its turn rate: the yaw rate relative to M vanishes).
+ *  6. Linear and nonlinear agree at small thrust steps: their difference
+ *     falls like the square of the step.
+ *  7. The free vehicle (ts_free_vehicle_compare): alone, level, its
+ *     thrust at the coupled speed is its own drag, 1/2 rho U^2 (Cd_axial
+ *     pi D^2 / 4 + sum S Cd0); on a cable of almost nothing (1 m, 0.1 mm,
+ *     1 g/m) each of its modes is a coupled mode, same eigenvalue, MAC 1.
  */
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "tcheck.h"
+#include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
+#include "towstab/linearize.h"
 #include "towstab/kernel.h"
 #include "towstab/scene.h"
+#include "towstab/towing.h"
 #include "towstab/units.h"
 #include "../lib/vec3.h"
 #include "../lib/vehicle.h"
 
-/* The towing vehicle of test/scenes/towing_sphere.yaml, with `prop` its
- * propulsion and `extra` more top-level text. */
-static const char *vehicle_text =
+/* The towing vehicle of test/scenes/towing_sphere.yaml, its mass,
+ * volume and inertia times `heavy` (neutral whatever the factor), into
+ * buf; the propulsion follows. */
+static const char *vehicle_yaml(char *buf, size_t size, double heavy)
+{
+    snprintf(buf, size,
     "towing_vehicle:\n"
     "  name: tug\n"
-    "  mass: 4126.1375 kg\n"
-    "  volume: 4.0255 m^3\n"
-    "  inertia: [330 kg*m^2, 22000 kg*m^2, 22000 kg*m^2]\n"
+    "  mass: %.17g kg\n"
+    "  volume: %.17g m^3\n"
+    "  inertia: [%.17g kg*m^2, %.17g kg*m^2, %.17g kg*m^2]\n"
     "  mass_centre: [0, 0, 0.05 m]\n"
     "  tow_point: [-4 m, 0, 0]\n"
     "  added_mass: spheroid\n"
@@ -50,7 +71,11 @@ static const char *vehicle_text =
     "area: 0.6 m^2, span: 1.2 m, roll: 90 deg, control: true}\n"
     "  controllers:\n"
     "    - {name: depth, measure: depth, setpoint: 20 m, kp: 0.05 rad/m, "
-    "ki: 0.005 rad/(m*s), kd: 0.2 rad*s/m, surfaces: {foreplane: 1}}\n";
+    "ki: 0.005 rad/(m*s), kd: 0.2 rad*s/m, surfaces: {foreplane: 1}}\n",
+    4126.1375 * heavy, 4.0255 * heavy, 330 * heavy, 22000 * heavy,
+    22000 * heavy);
+    return buf;
+}
 
 static ts_scene *scene(const char *fmt, ...)
 {
@@ -139,6 +164,8 @@ static double drift(const ts_system *s, double h, double T, double *E0)
 
 static void test_energy(void)
 {
+    char vt[2048];
+    const char *vehicle_text = vehicle_yaml(vt, sizeof vt, 1.0);
     ts_scene *sc = scene(
         "name: vacuum\n"
         "environment: {water_density: 0, gravity: 9.81}\n"
@@ -196,6 +223,8 @@ static ts_equilibrium *solve(const ts_system *s, ts_kernel **kout)
 
 static void test_prescribed(void)
 {
+    char vt[2048];
+    const char *vehicle_text = vehicle_yaml(vt, sizeof vt, 1.0);
     ts_scene *tow = scene("name: prescribed\n"
                           "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n%s",
                           cable_text);
@@ -258,7 +287,83 @@ static void test_prescribed(void)
     ts_scene_free(veh);
 }
 
-/* ---- 3. thrust = drag(U) ---------------------------------------------- */
+/* ---- 3. modes of an infinitely heavy towing vehicle ----------------- */
+
+static ts_eigen *modes(const ts_system *s, double tol)
+{
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(s, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(s, &err);
+    ts_equilibrium_opts eo;
+    ts_equilibrium_opts_default(&eo);
+    eo.tol = tol;
+    ts_linear *lin = ts_linear_alloc(k, &err);
+    ts_eigen *e = NULL;
+    ts_eigen_opts o;
+    ts_eigen_opts_default(&o);
+    if (ts_equilibrium_solve(k, &eo, eq, &err) != TS_OK ||
+        ts_linearize_equilibrium(k, eq, NULL, lin, &err) != TS_OK ||
+        ts_eigen_solve(lin, &o, &e, &err) != TS_OK)
+        printf("modes: %s\n", err.msg);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    return e;
+}
+
+/* The largest over a's modes of the relative distance to b's nearest
+ * eigenvalue (either of a conjugate pair). */
+static double nearest(const ts_eigen *a, const ts_eigen *b)
+{
+    double worst = 0;
+    for (int i = 0; i < a->nmodes; i++) {
+        double best = INFINITY, re = a->modes[i].re, im = a->modes[i].im;
+        for (int j = 0; j < b->nmodes; j++) {
+            double dr = re - b->modes[j].re;
+            double d = fmin(hypot(dr, im - b->modes[j].im),
+                            hypot(dr, im + b->modes[j].im));
+            best = fmin(best, d);
+        }
+        worst = fmax(worst, best / hypot(re, im));
+    }
+    return worst;
+}
+
+static void test_heavy_modes(void)
+{
+    ts_scene *tow = scene("name: prescribed\n"
+                          "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n%s",
+                          cable_text);
+    ts_eigen *ep = tow ? modes(tow->system, 1e-12) : NULL;
+    double d[2] = {INFINITY, INFINITY};
+    double heavy[2] = {1e4, 1e5};
+    for (int c = 0; c < 2; c++) {
+        char vt[2048];
+        ts_scene *sc = scene("name: heavy\n"
+                             "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
+                             "%s  propulsion: {speed: 3 m/s, gain: 800 "
+                             "N*s/m}\n%s",
+                             vehicle_yaml(vt, sizeof vt, heavy[c]),
+                             cable_text);
+        /* Residuals relative to the vehicle's weight (4e9 N at 1e5):
+         * 1e-13 of it is 4e-4 N on the cable's 800 N. */
+        ts_eigen *ev = sc ? modes(sc->system, 1e-13) : NULL;
+        if (ep && ev)
+            d[c] = nearest(ep, ev);
+        ts_eigen_free(ev);
+        ts_scene_free(sc);
+    }
+    /* The cable and sphere against the vehicle: 2e-3 relative at 1e3
+     * times its mass, falling tenfold per decade (1 / mass). */
+    CHECK(d[1] < 1e-4 && d[0] / d[1] > 5 && d[0] / d[1] < 20,
+          "%d prescribed-tow modes: the heavy towing vehicle's nearest "
+          "within %.3g, %.3g (relative) at 1e4, 1e5 times its mass (ratio "
+          "%.3g)", ep ? ep->nmodes : 0, d[0], d[1], d[0] / d[1]);
+    ts_eigen_free(ep);
+    ts_scene_free(tow);
+}
+
+/* ---- 4. thrust = drag(U) ---------------------------------------------- */
 
 static void test_thrust_drag(void)
 {
@@ -269,6 +374,8 @@ static void test_thrust_drag(void)
     double K = 0.5 * rho * (cda * M_PI * D * D / 4 + (S + S2 + S2) * cd0 +
                             cdt * M_PI * d * L);
     const char *laws[2] = {"thrust: 1500 N", "power: 6 kW, max_thrust: 5 kN"};
+    char vt[2048];
+    const char *vehicle_text = vehicle_yaml(vt, sizeof vt, 1.0);
     double want[2] = {sqrt(1500 / K), cbrt(6000 / K)};
     for (int c = 0; c < 2; c++) {
         ts_scene *sc = scene(
@@ -298,10 +405,290 @@ static void test_thrust_drag(void)
     }
 }
 
+/* ---- 5, 6. time domain ------------------------------------------------ */
+
+static void rk4_u(ts_kernel *k, double *y, const double *u, double h, int n,
+                  double *w)
+{
+    double *k1 = w, *k2 = w + n, *k3 = w + 2 * n, *k4 = w + 3 * n,
+           *yt = w + 4 * n;
+    ts_kernel_eval(k, y, u, k1);
+    for (int i = 0; i < n; i++)
+        yt[i] = y[i] + 0.5 * h * k1[i];
+    ts_kernel_eval(k, yt, u, k2);
+    for (int i = 0; i < n; i++)
+        yt[i] = y[i] + 0.5 * h * k2[i];
+    ts_kernel_eval(k, yt, u, k3);
+    for (int i = 0; i < n; i++)
+        yt[i] = y[i] + h * k3[i];
+    ts_kernel_eval(k, yt, u, k4);
+    for (int i = 0; i < n; i++)
+        y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+}
+
+static ts_scene *thrust_scene(double T, double rudder_deg)
+{
+    char vt[2048], *p = vt;
+    vehicle_yaml(vt, sizeof vt, 1.0);
+    /* The rudder's open-loop deflection. */
+    char *r = strstr(p, "roll: 90 deg, control: true}");
+    char buf[2200];
+    snprintf(buf, sizeof buf, "%.*sroll: 90 deg, control: true, "
+             "deflection: %g deg}%s", (int)(r - p), p, rudder_deg,
+             r + strlen("roll: 90 deg, control: true}"));
+    return scene("name: step\n"
+                 "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
+                 "%s  propulsion: {thrust: %g N}\n"
+                 "cables:\n"
+                 "  - {name: cable, from: tow, to: sphere, length: 50 m, "
+                 "diameter: 0.02 m, weight: 5 N/m, links: 4}\n"
+                 "bodies:\n"
+                 "  - {name: sphere, type: sphere, diameter: 0.5 m, "
+                 "wet_weight: 500 N}\n",
+                 buf, T);
+}
+
+static void test_settle(void)
+{
+    ts_scene *a = thrust_scene(1500, 0), *b = thrust_scene(1400, 0);
+    if (!a || !b) {
+        CHECK(0, "thrust step scenes parse");
+        return;
+    }
+    ts_kernel *ka, *kb;
+    ts_equilibrium *ea = solve(a->system, &ka), *eb = solve(b->system, &kb);
+    int n = ts_kernel_nstate(ka), nq = ts_kernel_nq(ka);
+    int ro = ts_kernel_root_offset(ka), nl = a->system->nlinks;
+    double *y = calloc((size_t)n, sizeof(double));
+    double *w = malloc(5 * (size_t)n * sizeof(double));
+    double *f = malloc((size_t)n * sizeof(double));
+    ts_frame fa;
+    ts_kernel_get_frame(ka, &fa);
+    /* The 1400 N trim in the 1500 N trim's frame: moving back at the
+     * speed difference. */
+    ts_equilibrium_state(ka, eb, y, NULL);
+    ts_kernel_set_frame(ka, &fa);
+    y[nq + ro] = eb->speed - ea->speed;
+    /* Slowest decay 0.02 1/s (a modes' run): 900 s leaves e^-18. */
+    for (int i = 0; i < 45000; i++)
+        rk4_u(ka, y, NULL, 0.02, n, w);
+    ts_kernel_eval(ka, y, NULL, f);
+    const double *t = ts_kernel_tensions(ka);
+    double dt = 0, big = 0;
+    for (int l = 0; l < nl; l++) {
+        dt = fmax(dt, fabs(t[l] - ea->tensions[l]));
+        big = fmax(big, ea->tensions[l]);
+    }
+    ts_vehicle_result r;
+    ts_kernel_vehicle_result(ka, ts_kernel_root(ka), &r);
+    const ts_vehicle_result *ra = &ea->vehicles[ts_kernel_root(ka)];
+    CHECK(dt < 1e-6 * big && fabs(y[nq + ro]) < 1e-8 &&
+              fabs(r.pitch - ra->pitch) < 1e-9 &&
+              fabs(r.origin[2] - ra->origin[2]) < 1e-7,
+          "released from the 1400 N trim at 1500 N: after 900 s the "
+          "tensions are Newton's to %.3g N of %.4g N, the speed to %.3g "
+          "m/s (%.6g m/s), pitch to %.3g rad, depth to %.3g m",
+          dt, big, fabs(y[nq + ro]), ea->speed, fabs(r.pitch - ra->pitch),
+          fabs(r.origin[2] - ra->origin[2]));
+
+    /* 5b. The steady turn at 3 deg of rudder: released from the straight
+     * trim, the simulation settles on Newton's turn. Its circle's centre
+     * need not be M's, so compare what does not depend on it: tensions,
+     * attitude, depth, the speed through the water and the yaw rate
+     * relative to M (0: turning at Newton's rate). */
+    ts_scene *c = thrust_scene(1500, 3.0);
+    ts_kernel *kc;
+    ts_equilibrium *ec = c ? solve(c->system, &kc) : NULL;
+    if (ec) {
+        ts_frame fc;
+        ts_kernel_get_frame(kc, &fc);
+        ts_equilibrium_state(kc, ea, y, NULL);
+        ts_kernel_set_frame(kc, &fc);
+        /* A roll-yaw mode of ~600 s period decays slowly: 2700 s. */
+        for (int i = 0; i < 135000; i++)
+            rk4_u(kc, y, NULL, 0.02, n, w);
+        ts_kernel_eval(kc, y, NULL, f);
+        const double *tc = ts_kernel_tensions(kc);
+        double dtc = 0;
+        for (int l = 0; l < nl; l++)
+            dtc = fmax(dtc, fabs(tc[l] - ec->tensions[l]));
+        ts_vehicle_result rc2;
+        ts_kernel_vehicle_result(kc, ts_kernel_root(kc), &rc2);
+        const ts_vehicle_result *re = &ec->vehicles[ts_kernel_root(kc)];
+        double yawrate = rc2.omega[2]; /* relative to M, body z */
+        CHECK(ec->converged && fabs(ec->turn_rate) > 5e-3 &&
+                  dtc < 1e-6 * big && fabs(rc2.speed - re->speed) < 1e-8 &&
+                  fabs(rc2.pitch - re->pitch) < 1e-8 &&
+                  fabs(rc2.roll - re->roll) < 1e-6 &&
+                  fabs(rc2.origin[2] - re->origin[2]) < 1e-7 &&
+                  fabs(yawrate) < 1e-9,
+              "rudder 3 deg: Newton's steady turn %.6g rad/s at %.6g m/s; "
+              "simulated from the straight trim for 2700 s: tensions to "
+              "%.3g N, speed through the water %.3g m/s, pitch %.3g, roll "
+              "%.3g rad, depth %.3g m, yaw rate relative to M %.3g rad/s",
+              ec->turn_rate, ec->speed, dtc, fabs(rc2.speed - re->speed),
+              fabs(rc2.pitch - re->pitch), fabs(rc2.roll - re->roll),
+              fabs(rc2.origin[2] - re->origin[2]), yawrate);
+        ts_equilibrium_free(ec);
+        ts_kernel_free(kc);
+    } else {
+        CHECK(0, "the turning scene solves");
+    }
+    ts_scene_free(c);
+
+    /* 6. Thrust steps of 20 and 10 N from the 1500 N trim, 20 s: linear
+     * (x' = A x + B u) against nonlinear. */
+    ts_err err = {0};
+    ts_linear *lin = ts_linear_alloc(ka, &err);
+    int rc = ts_linearize_equilibrium(ka, ea, NULL, lin, &err);
+    int ju = ts_kernel_input_find(ka, "tug.thrust");
+    CHECK(rc == TS_OK && ju >= 0, "linearized about the 1500 N trim, input "
+          "tug.thrust %d", ju);
+    double diff[2] = {0, 0}, resp[2] = {0, 0};
+    double *y0 = calloc((size_t)n, sizeof(double));
+    double *x = calloc((size_t)n, sizeof(double));
+    double *u = calloc((size_t)ts_kernel_ninput(ka), sizeof(double));
+    double *k4 = malloc(5 * (size_t)n * sizeof(double));
+    for (int c = 0; rc == TS_OK && c < 2; c++) {
+        double dT = c == 0 ? 20.0 : 10.0;
+        ts_equilibrium_state(ka, ea, y0, NULL);
+        memcpy(y, y0, (size_t)n * sizeof(double));
+        memset(x, 0, (size_t)n * sizeof(double));
+        u[ju] = dT;
+        const double *A = lin->A, *Bc = lin->B + (size_t)ju * n;
+        double h = 0.01;
+        for (int i = 0; i < 2000; i++) {
+            rk4_u(ka, y, u, h, n, w);
+            /* RK4 on the linear model */
+            double *s1 = k4, *s2 = k4 + n, *s3 = k4 + 2 * n,
+                   *s4 = k4 + 3 * n, *xt = k4 + 4 * n;
+            double *st[4] = {s1, s2, s3, s4};
+            for (int stage = 0; stage < 4; stage++) {
+                const double *xs = x;
+                if (stage > 0) {
+                    double a = stage == 3 ? h : 0.5 * h;
+                    for (int j = 0; j < n; j++)
+                        xt[j] = x[j] + a * st[stage - 1][j];
+                    xs = xt;
+                }
+                for (int r2 = 0; r2 < n; r2++) {
+                    double v = Bc[r2] * dT;
+                    for (int j = 0; j < n; j++)
+                        v += A[r2 + (size_t)j * n] * xs[j];
+                    st[stage][r2] = v;
+                }
+            }
+            for (int j = 0; j < n; j++)
+                x[j] += h / 6 * (s1[j] + 2 * s2[j] + 2 * s3[j] + s4[j]);
+            for (int j = 0; j < nq; j++) {
+                diff[c] = fmax(diff[c], fabs(y[j] - y0[j] - x[j]));
+                resp[c] = fmax(resp[c], fabs(x[j]));
+            }
+        }
+    }
+    CHECK(rc == TS_OK && diff[0] < 0.02 * resp[0] &&
+              diff[0] / diff[1] > 3 && diff[0] / diff[1] < 5,
+          "thrust steps 20, 10 N over 20 s: linear less nonlinear %.3g, "
+          "%.3g of responses %.3g, %.3g (coordinates; ratio %.3g, the "
+          "square of the step's)",
+          diff[0], diff[1], resp[0], resp[1], diff[0] / diff[1]);
+    free(y0);
+    free(x);
+    free(u);
+    free(k4);
+    ts_linear_free(lin);
+    free(y);
+    free(w);
+    free(f);
+    ts_equilibrium_free(ea);
+    ts_equilibrium_free(eb);
+    ts_kernel_free(ka);
+    ts_kernel_free(kb);
+    ts_scene_free(a);
+    ts_scene_free(b);
+}
+
+/* ---- 7. the free vehicle ------------------------------------------------ */
+
+static void test_free_vehicle(void)
+{
+    const double rho = 1025, D = 0.8, S = 0.4, S2 = 0.6, cd0 = 0.01,
+                 cda = 0.2;
+    char vt[2048];
+    const char *cables[2] = {
+        /* a neutral cable streaming straight behind: level trim */
+        "  - {name: cable, from: tow, length: 50 m, diameter: 0.02 m, "
+        "mass_per_length: 0.32201324699295375 kg/m, links: 10}\n",
+        /* almost nothing */
+        "  - {name: cable, from: tow, length: 1 m, diameter: 0.0001 m, "
+        "mass_per_length: 0.001 kg/m, links: 1}\n"};
+    for (int c = 0; c < 2; c++) {
+        ts_scene *sc = scene("name: free\n"
+                             "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
+                             "%s  propulsion: {thrust: 1500 N}\n"
+                             "cables:\n%s",
+                             vehicle_yaml(vt, sizeof vt, 1.0), cables[c]);
+        if (!sc) {
+            CHECK(0, "free vehicle scene %d parses", c);
+            continue;
+        }
+        ts_err err = {0};
+        ts_kernel *k;
+        ts_equilibrium *eq = solve(sc->system, &k);
+        ts_linear *lin = ts_linear_alloc(k, &err);
+        ts_eigen *e = NULL;
+        ts_eigen_opts eo;
+        ts_eigen_opts_default(&eo);
+        eo.method = TS_EIG_LAPACK;
+        ts_free_vehicle *f = NULL;
+        int rc = ts_linearize_equilibrium(k, eq, NULL, lin, &err);
+        if (rc == TS_OK)
+            rc = ts_eigen_solve(lin, &eo, &e, &err);
+        if (rc == TS_OK)
+            rc = ts_free_vehicle_compare(sc->system, eq, lin, e, &f, &err);
+        CHECK(rc == TS_OK, "free vehicle compared (%s)",
+              rc == TS_OK ? "ok" : err.msg);
+        if (rc == TS_OK && c == 0) {
+            double U = f->speed;
+            double drag = 0.5 * rho * U * U *
+                          (cda * M_PI * D * D / 4 + (S + 2 * S2) * cd0);
+            CHECK_REL(f->thrust, drag, 1e-9,
+                      "free vehicle at the coupled speed: thrust = its own "
+                      "drag");
+        }
+        if (rc == TS_OK && c == 1) {
+            double worst = 0, mac = 1;
+            for (int m = 0; m < f->nmodes; m++) {
+                const ts_free_mode *fm = &f->modes[m];
+                double mag = fmax(hypot(fm->re, fm->im), 1e-3);
+                worst = fmax(worst, hypot(fm->re - fm->coupled_re,
+                                          fm->im - fm->coupled_im) / mag);
+                if (hypot(fm->re, fm->im) > 1e-6)
+                    mac = fmin(mac, fm->mac);
+            }
+            /* The stub's 1.4 g against 4 t: eigenvalues to 1e-4
+             * relative (1e-3 1/s near zero), the shapes the same. */
+            CHECK(f->nmodes > 5 && worst < 1e-4 && mac > 0.999,
+                  "on a 1 m, 1 g/m stub: the %d free modes are coupled "
+                  "modes to %.3g (relative), smallest MAC %.6f (modes "
+                  "off zero)", f->nmodes, worst, mac);
+        }
+        ts_free_vehicle_free(f);
+        ts_eigen_free(e);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        ts_scene_free(sc);
+    }
+}
+
 int main(void)
 {
     test_energy();
     test_prescribed();
+    test_heavy_modes();
     test_thrust_drag();
+    test_settle();
+    test_free_vehicle();
     return tc_done();
 }

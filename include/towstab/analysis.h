@@ -40,6 +40,7 @@
 #include "towstab/seastate.h"
 #include "towstab/simulate.h"
 #include "towstab/system.h"
+#include "towstab/towing.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -150,6 +151,9 @@ typedef struct ts_modes_opts {
                               each loop's gain and phase margins
                               (ts_loop_margins over TS_MARGINS_FROM_HZ to
                               TS_MARGINS_TO_HZ) */
+    int free_vehicle;      /* 1: with a towing vehicle, its modes alone
+                              against the coupled ones
+                              (ts_free_vehicle_compare); default 0 */
     int oscillatory;       /* 1: list the oscillatory modes only (the
                               `count` lowest when count is given; the
                               table always lists them first); the verdict
@@ -425,6 +429,7 @@ typedef struct ts_result {
                                    --near or --oscillatory chose those
                                    listed (eigen->nmodes) */
     double eigen_wall_s;
+    ts_free_vehicle *free_vehicle; /* modes --free-vehicle, else NULL */
     int nmargins;               /* modes with closed loops: one per loop */
     ts_loop_margin *margins;    /* [nmargins] */
     double margins_wall_s;

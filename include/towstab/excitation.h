@@ -110,7 +110,7 @@ typedef struct ts_signal {
                           (TS_SIGNAL_RAMP_PERIODS) */
     int absolute;      /* manoeuvres: amplitude is the final value */
     char input[TS_SIGNAL_INPUT_MAX]; /* TS_AXIS_INPUT: the input's name */
-    char input_unit[4];/* TS_AXIS_INPUT: "m" or "rad" when the amplitude
+    char input_unit[4];/* TS_AXIS_INPUT: "m", "rad", "N" or "N*m" when the amplitude
                           was given with a unit of that kind, "" for a
                           plain (SI) number */
 } ts_signal;
@@ -258,6 +258,13 @@ TS_API const char *ts_signal_axis_label(const ts_signal *s);
  * "tow.heave sine amplitude 0.03048 m, frequency 0.25 Hz, phase 0 deg". */
 TS_API void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
                                    size_t size);
+/* The same in the display units d (towstab/units.h; NULL: SI): the
+ * amplitude in the unit of its axis' quantity (length, speed, turn rate;
+ * a vehicle input's "m" or "rad" as length or angle), times, frequencies
+ * and phases in theirs. */
+TS_API void ts_excitation_describe_display(const ts_excitation *ex, int i,
+                                           const ts_display *d, char *buf,
+                                           size_t size);
 
 #ifdef __cplusplus
 }

@@ -101,6 +101,8 @@ typedef struct ts_linear {
     char *elastic;     /* [nlinks] 1: the link's third coordinate is its
                           strain e */
     int nvehicles;
+    int root_qoff;     /* offset in q of the towing vehicle's position
+                          (its tow point, node 0), -1 without one */
     int *up_qoff;      /* [nlinks] for a link starting at a point P of a
                           vehicle, the offset of that vehicle's angles in
                           q; -1 otherwise; NULL without vehicles */

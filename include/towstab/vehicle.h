@@ -220,6 +220,9 @@ typedef struct ts_vehicle_result {
     int towing;           /* 1: the towing vehicle */
     double thrust, power; /* the towing vehicle's thrust (N) and its power
                              T U (W), U its surge speed through the water */
+    double track_speed, turn_rate; /* the towing vehicle's: the frame's
+                             speed V (m/s) and turn rate Omega (rad/s), its
+                             steady motion in an equilibrium */
     double hydro_force[3], hydro_moment[3]; /* all components, body axes,
                              moment about O */
     double munk[3];       /* the added mass's -v x p moment, body axes */

@@ -44,6 +44,7 @@ for f in examples/*.yaml; do
 done
 json equilibrium examples/kamman_ex1_above.yaml
 json modes examples/kamman_ex3_turn.yaml --matrices --shapes "$T/shapes.json"
+json modes test/scenes/towing_sphere.yaml --free-vehicle --links 4
 "$CHECK_JSON" keys modes "$T/shapes.json" >>"$T/pairs" || fail=1
 json response examples/kamman_ex1_above.yaml --output sphere.z --points 3
 json response examples/aurora_towfish.yaml --open-loop --input aurora.wing \
