@@ -527,8 +527,10 @@ static int plot_earth(const ts_system *sys, const ts_history *h,
     return status;
 }
 
-/* The tracks in the earth frame (towstab/track.h) under a manoeuvre or in
- * a turn: `tracks`, the ship's (M's origin) and every body's in plan view
+/* The tracks in the earth frame (towstab/track.h) under a manoeuvre, in
+ * a turn or with a towing vehicle: `tracks`, the ship's (M's origin; a
+ * towing vehicle's tow point, with the scene's waypoints as markers) and
+ * every body's in plan view
  * (ts_plot_tracks), from the run's poses of M; and `depths`, every body's
  * depth against time (the nonlinear run solid, the linear dashed). */
 #define MAX_TRACKS 8
@@ -552,25 +554,42 @@ static int plot_tracks(const ts_system *sys, const ts_history *hn,
     }
     char label[MAX_TRACKS][TS_NAME_MAX + 16];
     ts_plot_track tr[MAX_TRACKS];
+    int towing = sys->tow.vehicle >= 0;
+    const ts_autopilot *ap = &sys->tow.autopilot;
+    int nwp = ap->on ? ap->g.nwaypoints : 0;
+    ts_plot_marker wp[TS_GUIDANCE_MAX_WAYPOINTS];
+    char wlabel[TS_GUIDANCE_MAX_WAYPOINTS][16];
+    for (int i = 0; i < nwp; i++) {
+        snprintf(wlabel[i], sizeof wlabel[i], "WP %d", i + 1);
+        ts_plot_marker m = {ap->g.waypoint[i][0], ap->g.waypoint[i][1],
+                            wlabel[i]};
+        wp[i] = m;
+    }
     size_t nn = 3 * (size_t)h->nnodes;
     for (int j = 0; j <= nb; j++) {
         double *x = buf + 2 * (size_t)j * (size_t)n, *y = x + n;
         for (int i = 0; i < n; i++) {
             const double *f = h->frame + 3 * (size_t)i;
             double e[3] = {f[0], f[1], 0};
-            if (j > 0)
+            /* A towing vehicle's track is its tow point's (node 0). */
+            if (j > 0 || towing)
                 ts_track_to_earth(f, h->positions + nn * (size_t)i +
-                                         3 * (size_t)node[j - 1], e);
+                                         3 * (size_t)(j ? node[j - 1] : 0),
+                                  e);
             x[i] = e[0];
             y[i] = e[1];
         }
-        if (j == 0)
+        if (j == 0 && towing)
+            snprintf(label[j], sizeof label[j], "%.*s (tow point)",
+                     TS_NAME_MAX, sys->bodies[sys->tow.vehicle].name);
+        else if (j == 0)
             snprintf(label[j], sizeof label[j], "ship (M's origin)");
         else
             ts_system_node_name(sys, node[j - 1], label[j], TS_NAME_MAX);
+        /* The waypoints, as markers on the towing vehicle's track. */
         ts_plot_track t = {n, x, y, label[j],
                            j == 0 ? TS_PLOT_DASHED : TS_PLOT_SOLID, j + 1,
-                           0, NULL};
+                           j == 0 ? nwp : 0, j == 0 && nwp ? wp : NULL};
         tr[j] = t;
     }
     char title[256];
@@ -926,7 +945,7 @@ static int sim_draw(cli_run *c, const ts_result *r)
                                 st->exaggerate, &c->plot);
     if (!status && ((r->excitation &&
                      ts_excitation_has_manoeuvre(r->excitation)) ||
-                    r->sys->tow.turn_rate != 0))
+                    r->sys->tow.turn_rate != 0 || r->sys->tow.vehicle >= 0))
         status = plot_tracks(r->sys, r->nonlinear, r->linear, &c->plot);
     return status;
 }

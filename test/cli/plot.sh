@@ -247,6 +247,18 @@ check "simulate under a manoeuvre: the tracks in the earth frame and the depths 
     bash -c "$(declare -f is_png is_svg); is_png '$T/man/tracks.png' 1000 700 && is_svg '$T/man/tracks.svg' 'kamman_ex1_submerged: tracks in the earth frame' && is_png '$T/man/depths.png' 1000 700 && is_svg '$T/man/depths.svg' 'kamman_ex1_submerged: depths against time'"
 check "simulate without a manoeuvre draws no plan_earth, tracks or depths" \
     bash -c "[ ! -e '$T/sim/plan_earth.png' ] && [ ! -e '$T/sim/tracks.png' ] && [ ! -e '$T/sim/depths.png' ]"
+# A towing vehicle with waypoints: the tracks (its tow point's and the
+# fish's) and the depths are drawn; the waypoints are open diamonds labelled
+# "WP n" with a legend entry, so the picture holds more glyphs (cairo's
+# <use> elements) than the same run without the waypoints entry.
+WPS=test/scenes/dolphin_waypoints.yaml
+ts simulate "$WPS" --quiet --t-end 20 --sample 0.5 --plot "$T/wp"
+sed '/^waypoints:/,/^cables:/{/^cables:/!d}' "$WPS" >"$T/nowp.yaml"
+ts simulate "$T/nowp.yaml" --quiet --t-end 20 --sample 0.5 --plot "$T/nowp"
+nuse_wp=$(grep -c '<use' "$T/wp/tracks.svg" 2>/dev/null)
+nuse_no=$(grep -c '<use' "$T/nowp/tracks.svg" 2>/dev/null)
+check "simulate with waypoints: tracks with the waypoints marked ($nuse_wp glyphs against $nuse_no without) and depths" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/wp/tracks.png' 1000 700 && is_svg '$T/wp/tracks.svg' 'dolphin_waypoints: tracks in the earth frame' && is_png '$T/wp/depths.png' 1000 700 && [ \"${nuse_wp:-0}\" -ge \$(( ${nuse_no:-0} + 15 )) ]"
 ts response "$EX1" --output sphere.z --quiet --plot "$T/db" --db
 check "response --db: the Bode plot drawn (exit $status)" \
     bash -c "$(declare -f is_png is_svg); [ $status -eq 0 ] && is_png '$T/db/bode.png' 1000 700"
