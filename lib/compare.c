@@ -105,11 +105,13 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
     memset(c, 0, sizeof *c);
     c->output = *out;
     if (out->kind != TS_OUT_POSITION &&
-        !(out->kind == TS_OUT_TENSION && lin->Ty && lin->Tu))
+        !(out->kind == TS_OUT_TENSION && lin->Ty && lin->Tu) &&
+        !(out->kind == TS_OUT_VEHICLE && out->index < lin->noutput))
         return ts_fail(err, TS_EINVAL, "compare: output '%s': the linear "
-                       "model gives node positions and, linearized with "
-                       "its tension Jacobians, link tensions (choose "
-                       "<node>.x|y|z or <cable>.<k>.tension)", out->name);
+                       "model gives node positions, the vehicles' outputs "
+                       "and, linearized with its tension Jacobians, link "
+                       "tensions (choose <node>.x|y|z, <vehicle>.depth ... "
+                       "or <cable>.<k>.tension)", out->name);
     if (nl->nsamples != li->nsamples || nl->nsamples < 1)
         return ts_fail(err, TS_EINVAL, "compare: the runs have %d and %d "
                        "samples; they must share their sample times",
@@ -135,7 +137,9 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
     c->t_from = nl->t[first];
     c->t_to = t_end;
     c->nsamples = n;
-    c->equilibrium = ts_output_value(sys, out, lin->r0, lin->t0, NULL);
+    c->equilibrium = out->kind == TS_OUT_VEHICLE
+                         ? lin->v0[out->index]
+                         : ts_output_value(sys, out, lin->r0, lin->t0, NULL);
 
     double *buf = malloc(4 * (size_t)n * sizeof(double));
     if (!buf)

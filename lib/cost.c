@@ -101,6 +101,7 @@ static double stages(ts_integrator m)
     case TS_INT_BSIMP: return 4;
     case TS_INT_MSBDF: return 1;
     case TS_INT_ESDIRK: return 7;
+    case TS_INT_BDF: return 1;
     }
     return 1;
 }
@@ -148,7 +149,8 @@ int ts_cost_simulate(const ts_system *sys, const ts_excitation *ex,
                        : 0.0;
         fastest = fmax(fastest, f);
     }
-    double by_samples = o->integrator == TS_INT_ESDIRK ? 0.0 : samples;
+    int sundials = o->integrator == TS_INT_ESDIRK || o->integrator == TS_INT_BDF;
+    double by_samples = sundials ? 0.0 : samples;
     double by_exc = o->t_end * fastest * TS_COST_STEPS_PER_PERIOD;
     double by_stiff = explicit_method(o->integrator)
                           ? o->t_end * e->omega_max / TS_COST_STABILITY
@@ -157,7 +159,7 @@ int ts_cost_simulate(const ts_system *sys, const ts_excitation *ex,
     e->evaluations = e->steps * stages(o->integrator);
     /* esdirk's Newton matrix comes from the sparse model (no vehicle):
      * O(links); GSL's implicit steppers take a dense Jacobian and LU. */
-    int sparse = o->integrator == TS_INT_ESDIRK && sys->nvehicles == 0;
+    int sparse = sundials && sys->nvehicles == 0;
     if (!explicit_method(o->integrator)) {
         e->evaluations += sparse ? TS_COST_SPARSE_EVALUATIONS : 2.0 * (n + 9);
         e->flops = sparse ? 0.0 : (double)n * n * n / 3.0;

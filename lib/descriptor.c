@@ -801,23 +801,33 @@ static double mass_at(const ts_descriptor *d, int k, int a, int b)
     return d->M[6 * k + idx[a][b]];
 }
 
-/* Fill S(s) for complex s into z (interleaved) or real s into x; inf:
- * S_inf (real only). */
+/* S's entries as k + s c + s^2 m (S_inf: k + m, with the blocks' K and C
+ * and the elastic rows left out): each entry's three parts into kp, cp,
+ * mp when kp is given, else S(s) for complex s into z (interleaved) or
+ * real s into x. */
 static void fill(const ts_descriptor *d, double complex s, int inf,
-                 double *x, double *z)
+                 double *x, double *z, double *kp, double *cp, double *mp)
 {
     const ts_system *sys = d->sys;
-#define PUT(p, v)                                                             \
+    double complex s2 = inf ? 1.0 : s * s, s1 = inf ? 0.0 : s;
+#define PUT(p, k_, c_, m_)                                                    \
     do {                                                                      \
-        double complex v_ = (v);                                              \
-        if (z) {                                                              \
-            z[2 * (p)] = creal(v_);                                           \
-            z[2 * (p) + 1] = cimag(v_);                                       \
+        int p_ = (p);                                                         \
+        double k1 = (k_), c1 = (c_), m1 = (m_);                               \
+        if (kp) {                                                             \
+            kp[p_] = k1;                                                      \
+            cp[p_] = c1;                                                      \
+            mp[p_] = m1;                                                      \
         } else {                                                              \
-            x[p] = creal(v_);                                                 \
+            double complex v_ = k1 + s1 * c1 + s2 * m1;                       \
+            if (z) {                                                          \
+                z[2 * p_] = creal(v_);                                        \
+                z[2 * p_ + 1] = cimag(v_);                                    \
+            } else {                                                          \
+                x[p_] = creal(v_);                                            \
+            }                                                                 \
         }                                                                     \
     } while (0)
-    double complex s2 = s * s;
     for (int k = 1; k < d->nn; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             int j = d->bcol[b];
@@ -825,33 +835,30 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
                 continue;
             const double *Kb = d->K + 9 * (size_t)b, *Cb = d->C + 9 * (size_t)b;
             for (int a = 0; a < 3; a++)
-                for (int c = 0; c < 3; c++) {
-                    double complex v;
-                    double m = j == k ? mass_at(d, k, a, c) : 0.0;
-                    if (inf)
-                        v = m;
-                    else
-                        v = Kb[3 * a + c] + s * Cb[3 * a + c] + s2 * m;
-                    PUT(d->pos_blk[9 * b + 3 * a + c], v);
-                }
+                for (int c = 0; c < 3; c++)
+                    PUT(d->pos_blk[9 * b + 3 * a + c],
+                        inf ? 0.0 : Kb[3 * a + c], inf ? 0.0 : Cb[3 * a + c],
+                        j == k ? mass_at(d, k, a, c) : 0.0);
         }
     for (int l = 0; l < d->nl; l++) {
         const ts_link *L = &sys->links[l];
         const double *n = d->n + 3 * l;
-        double complex g[3] = {n[0], n[1], n[2]};
-        if (d->kind[l] == TSI_LINK_TAUT && !inf)
-            tsi_desc_taut_row(d, l, s, g);
-        else if (d->kind[l] != TSI_LINK_RIGID)
-            g[0] = g[1] = g[2] = 0.0;
+        /* The link row (tsi_desc_taut_row): (EA/l + s Cv) n when taut,
+         * n when rigid, 0 when slack (and S_inf's elastic rows). */
+        int taut = d->kind[l] == TSI_LINK_TAUT && !inf;
+        double gk = taut ? d->ka[l] : (d->kind[l] == TSI_LINK_RIGID ? 1.0
+                                                                     : 0.0);
+        double gc = taut ? d->ca[l] : 0.0;
         for (int c = 0; c < 3; c++) {
-            PUT(d->pos_n[6 * l + c], n[c]);
-            PUT(d->pos_row[6 * l + c], g[c]);
+            PUT(d->pos_n[6 * l + c], n[c], 0.0, 0.0);
+            PUT(d->pos_row[6 * l + c], gk * n[c], gc * n[c], 0.0);
             if (L->upper > 0) {
-                PUT(d->pos_n[6 * l + 3 + c], -n[c]);
-                PUT(d->pos_row[6 * l + 3 + c], -g[c]);
+                PUT(d->pos_n[6 * l + 3 + c], -n[c], 0.0, 0.0);
+                PUT(d->pos_row[6 * l + 3 + c], -gk * n[c], -gc * n[c], 0.0);
             }
         }
-        PUT(d->pos_diag[l], d->kind[l] == TSI_LINK_RIGID ? 0.0 : -1.0);
+        PUT(d->pos_diag[l], d->kind[l] == TSI_LINK_RIGID ? 0.0 : -1.0, 0.0,
+            0.0);
     }
 #undef PUT
 }
@@ -859,11 +866,17 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
 void tsi_desc_fill_real(const ts_descriptor *d, double s, int inf,
                         double Sx[])
 {
-    fill(d, s, inf, Sx, NULL);
+    fill(d, s, inf, Sx, NULL, NULL, NULL, NULL);
 }
 
 void tsi_desc_fill_complex(const ts_descriptor *d, double complex s,
                            double Sz[])
 {
-    fill(d, s, 0, NULL, Sz);
+    fill(d, s, 0, NULL, Sz, NULL, NULL, NULL);
+}
+
+void tsi_desc_fill_parts(const ts_descriptor *d, double Sk[], double Sc[],
+                         double Sm[])
+{
+    fill(d, 0.0, 0, NULL, NULL, Sk, Sc, Sm);
 }

@@ -153,6 +153,12 @@ void tsi_desc_fill_real(const ts_descriptor *d, double s, int inf,
 void tsi_desc_fill_complex(const ts_descriptor *d, double complex s,
                            double Sz[]);
 
+/* S(s)'s values as Sk + s Sc + s^2 Sm, each [nnz] (real): for a
+ * sequence of shifts (lib/shift.c, tsi_shift_refactor), each S(s) is
+ * then one pass over the three. */
+void tsi_desc_fill_parts(const ts_descriptor *d, double Sk[], double Sc[],
+                         double Sm[]);
+
 /* The row of a taut elastic link l at shift s: its coefficients g[3] on
  * dr_lower (and -g on dr_upper), (EA/l + s Cv) n. */
 void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,

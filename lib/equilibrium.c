@@ -2,7 +2,8 @@
  * doc/equilibrium.md; doc/model.md section 5).
  *
  * The fast path marches from the free ends and shoots on their positions
- * (march.c). The general path is Newton on q''(q) = 0 over all angles:
+ * (march.c); with vehicles, that march sits inside a small root problem in
+ * the vehicles' attitudes and controller states. The general path is Newton on q''(q) = 0 over all angles:
  * central-difference Jacobian through the kernel, LU solve (LAPACK dgetrf/
  * dgetrs), backtracking line search on |q''|, re-charting of links that
  * approach cos(theta2) = 0. Turns are reached by continuation in turn rate
@@ -58,6 +59,12 @@
  * times its lever, and the hybrid solver's iterations. */
 #define TRIM_RTOL 1e-12
 #define TRIM_MAXIT 200
+/* Shooting with vehicles: the outer iterations go on below the tolerance
+ * to this fraction of it while they improve (as Newton's last step lands
+ * far below it), so that the trim is not a hair's breadth from the
+ * tolerance; they stop at the march's rounding, a residual of about
+ * 1e-14. */
+#define VSHOOT_POLISH 1e-6
 /* A relative force residual this small is rounding in the sums of the
  * nodal balances (about 1000 machine epsilons): Newton stalling there has
  * converged as far as double precision goes. */
@@ -69,6 +76,8 @@ void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
     o->max_iter = 100;
     o->method = TS_EQ_AUTO;
     o->guess = NULL;
+    o->progress = NULL;
+    o->progress_data = NULL;
 }
 
 int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
@@ -295,6 +304,9 @@ typedef struct newton_ws {
     int y_is_turn;  /* 1: uy is the turn surface's deflection (the turn
                        rate given), 0: the turn rate */
     double rootpos[3]; /* the saved shape's root position */
+    ts_progress_fn progress; /* the caller's (ts_equilibrium_opts), or
+                                NULL */
+    void *progress_data;
 } newton_ws;
 
 /* Index in y of unknown i. */
@@ -540,13 +552,33 @@ static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
              sys->cables[L->cable].name, L->index);
 }
 
+/* Report `done` Jacobian columns of nu to the caller's progress callback:
+ * TS_OK to go on, TS_ECANCEL (message set) when it asks to stop. */
+static int poll_progress(const newton_ws *w, int done, const ts_equilibrium *eq,
+                         ts_err *err)
+{
+    if (!w->progress)
+        return TS_OK;
+    ts_progress p = {"equilibrium", done, w->nu, "Jacobian columns"};
+    if (!w->progress(&p, w->progress_data))
+        return TS_OK;
+    return ts_fail(err, TS_ECANCEL, "equilibrium: stopped on request in "
+                                    "Newton iteration %d (%d of %d Jacobian "
+                                    "columns formed)",
+                   eq->iterations, done, w->nu);
+}
+
 /* The Jacobian of (q'', c') at y by central differences, column by
  * column, and its LU and condition in w (w->R holds f(y)). */
+
 static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
                     ts_err *err)
 {
     int nq = w->nq, nu = w->nu;
     for (int j = 0; j < nu; j++) {
+        int prc = poll_progress(w, j, eq, err);
+        if (prc != TS_OK)
+            return prc;
         double h = NEWTON_FD_STEP * w->scale[j], y0 = uget(k, w, y, j);
         uset(k, w, y, j, y0 + h);
         int r1 = ts_kernel_eval(k, y, NULL, w->f1);
@@ -563,6 +595,9 @@ static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
         for (int i = 0; i < nu; i++)
             col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
     }
+    int prc = poll_progress(w, nu, eq, err);
+    if (prc != TS_OK)
+        return prc;
     int info = 0;
     w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
     dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
@@ -595,7 +630,10 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         if (rel <= tol && crel <= tol) {
             /* A start that is already the answer (a straight tow with
              * vehicles) still gets the Jacobian its health needs. */
-            if (!w->have_lu && jacobian(k, y, w, eq, err) == TS_ECONV)
+            int jrc = w->have_lu ? TS_OK : jacobian(k, y, w, eq, err);
+            if (jrc == TS_ECANCEL)
+                return jrc;
+            if (jrc == TS_ECONV)
                 ts_err_clear(err);
             newton_health(k, y, w, eq);
             return TS_OK;
@@ -619,6 +657,12 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             break;
         eq->iterations++;
         rc = jacobian(k, y, w, eq, err);
+        if (rc == TS_ECANCEL)
+            return ts_fail(err, TS_ECANCEL, "equilibrium: stopped on "
+                                            "request in Newton iteration %d "
+                                            "at relative residual %.3g "
+                                            "(tolerance %.3g)",
+                           eq->iterations, rel, tol);
         if (rc == TS_ECONV)
             return rc;
         int one = 1, info = -rc;
@@ -889,7 +933,8 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             dt *= 2.0;
             continue;
         }
-        if (rc == TS_ENOMEM || dt <= CONTINUATION_MIN_STEP)
+        if (rc == TS_ENOMEM || rc == TS_ECANCEL ||
+            dt <= CONTINUATION_MIN_STEP)
             break;
         /* A path that keeps failing can halve its step ten times, each
          * try up to max_iter Newton iterations: bound the whole. */
@@ -909,7 +954,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
     }
     /* Name the continuation only where there was one: a straight tow has
      * no turn-rate path (its first Newton solve is the whole of it). */
-    if (rc != TS_OK && rc != TS_ENOMEM) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
         ts_frame f;
         ts_kernel_get_frame(k, &f);
         if (path == bending_path)
@@ -1204,6 +1249,347 @@ static int solve_shooting(ts_kernel *k, tsi_march *m, const ts_frame *frame,
     return rc;
 }
 
+/* ------------------------------------------------------------------ */
+/* Vehicles: shooting                                                    */
+
+/* Shooting with vehicles. A small outer root problem has for unknowns
+ * every vehicle's three attitude angles and every controller state; for
+ * each value of them, the march (whose unknowns are the free ends'
+ * positions, as without vehicles) balances every cable with each vehicle
+ * pulling its node as tsi_kernel_vehicle_pull gives at the node's marched
+ * position, and its child cables starting at their points on it. The
+ * outer residual is what the kernel then finds unbalanced: the vehicles'
+ * angular accelerations (the moments about their joints) and the
+ * controllers' rates. Each residual is one march solve, O(links); the
+ * outer Jacobian has 3 per vehicle plus one per controller state
+ * columns. */
+typedef struct vshoot {
+    ts_kernel *k;
+    tsi_march *m;
+    ts_frame frame;       /* the frame of the current solve */
+    double *y, *f;        /* [n] the state and its f(y) */
+    double *x;            /* [march nunknown] free-end positions */
+    double *off;          /* [3 nlinks] starts of links on vehicles */
+    double *strain;       /* [nlinks] */
+    int *node_veh;        /* [nnodes] vehicle at the node, or -1 */
+    int nz, *zy;          /* outer unknown i is y[zy[i]] / zscale[i] */
+    double *zscale, *zw;  /* and its residual's weight */
+    double pos_tol;
+    int max_iter;
+    ts_equilibrium *eq;
+    ts_err merr;          /* the last march failure */
+} vshoot;
+
+static int vshoot_pull(void *ctx, int node, const double r[3], double F[3])
+{
+    vshoot *s = ctx;
+    return tsi_kernel_vehicle_pull(s->k, s->node_veh[node], s->y, r, F);
+}
+
+/* The outer residual res[nz] at the unknowns z[nz]; the state in s->y,
+ * its f(y) in s->f. */
+static int vshoot_eval(vshoot *s, const double *z, double *res)
+{
+    ts_kernel *k = s->k;
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k);
+    for (int i = 0; i < s->nz; i++)
+        s->y[s->zy[i]] = z[i] * s->zscale[i];
+    for (int l = 0; l < sys->nlinks; l++)
+        if (sys->links[l].up_body >= 0)
+            tsi_kernel_vehicle_lever(k, s->node_veh[sys->links[l].upper],
+                                     s->y, l, s->off + 3 * l);
+    int it = 0;
+    long ev = 0;
+    ts_err_clear(&s->merr);
+    int rc = tsi_march_solve(s->m, &s->frame, s->x, 0, s->pos_tol,
+                             s->max_iter, &it, &ev, &s->merr);
+    s->eq->evaluations += ev;
+    if (rc != TS_OK)
+        return rc;
+    tsi_march_strains(s->m, s->strain);
+    ts_kernel_set_shape(k, tsi_march_directions(s->m), s->strain, NULL, NULL,
+                        TS_CHART_RECHART, s->y);
+    rc = ts_kernel_eval(k, s->y, NULL, s->f);
+    s->eq->evaluations++;
+    if (rc != TS_OK)
+        return rc;
+    for (int i = 0; i < s->nz; i++) {
+        int j = s->zy[i] < nq ? nq + s->zy[i] : s->zy[i];
+        res[i] = s->f[j] * s->zw[i];
+    }
+    return TS_OK;
+}
+
+static int vshoot_f(const gsl_vector *z, void *par, gsl_vector *r)
+{
+    return vshoot_eval(par, z->data, r->data) == TS_OK ? GSL_SUCCESS
+                                                        : GSL_EDOM;
+}
+
+/* Forward differences, step NEWTON_FD_STEP of each unknown's size. */
+static int vshoot_fdf(const gsl_vector *z, void *par, gsl_vector *r,
+                      gsl_matrix *J)
+{
+    vshoot *s = par;
+    int nz = s->nz;
+    double *zt = malloc(2 * (size_t)nz * sizeof(double)), *rt = zt + nz;
+    if (!zt)
+        return GSL_ENOMEM;
+    int status = GSL_SUCCESS;
+    memcpy(zt, z->data, (size_t)nz * sizeof(double));
+    for (int j = 0; j < nz && status == GSL_SUCCESS; j++) {
+        zt[j] = z->data[j] + NEWTON_FD_STEP;
+        if (vshoot_eval(s, zt, rt) != TS_OK)
+            status = GSL_EDOM;
+        zt[j] = z->data[j];
+        for (int i = 0; i < nz && status == GSL_SUCCESS; i++)
+            gsl_matrix_set(J, (size_t)i, (size_t)j, rt[i]);
+    }
+    /* Last, so that s->y and s->f are those of z. */
+    if (status == GSL_SUCCESS && vshoot_eval(s, z->data, r->data) != TS_OK)
+        status = GSL_EDOM;
+    for (int j = 0; j < nz && status == GSL_SUCCESS; j++)
+        for (int i = 0; i < nz; i++)
+            gsl_matrix_set(J, (size_t)i, (size_t)j,
+                           (gsl_matrix_get(J, (size_t)i, (size_t)j) -
+                            r->data[i]) / NEWTON_FD_STEP);
+    free(zt);
+    return status;
+}
+
+static int vshoot_df(const gsl_vector *z, void *par, gsl_matrix *J)
+{
+    vshoot *s = par;
+    double *r = malloc((size_t)s->nz * sizeof(double));
+    if (!r)
+        return GSL_ENOMEM;
+    gsl_vector_view rv = gsl_vector_view_array(r, (size_t)s->nz);
+    int status = vshoot_fdf(z, par, &rv.vector, J);
+    free(r);
+    return status;
+}
+
+/* The outer solve from z[nz] at the kernel's frame and set points, until
+ * the kernel's verdict (force and controller residuals) is at most
+ * VSHOOT_POLISH tol, or at most tol where the iterations stop improving
+ * it. On success s->y is the equilibrium and z its unknowns. */
+static int vshoot_solve(vshoot *s, double *z, double tol, int max_iter)
+{
+    ts_kernel *k = s->k;
+    gsl_multiroot_function_fdf fn = {vshoot_f, vshoot_df, vshoot_fdf,
+                                     (size_t)s->nz, s};
+    gsl_multiroot_fdfsolver *solver = gsl_multiroot_fdfsolver_alloc(
+        gsl_multiroot_fdfsolver_hybridsj, (size_t)s->nz);
+    double *r = malloc(2 * (size_t)s->nz * sizeof(double)), *best = r + s->nz;
+    double best_merit = INFINITY;
+    int rc = TS_ECONV;
+    if (!solver || !r) {
+        rc = TS_ENOMEM;
+        goto out;
+    }
+    gsl_vector_view zv = gsl_vector_view_array(z, (size_t)s->nz);
+    for (int it = 0;; it++) {
+        rc = vshoot_eval(s, z, r);
+        if (rc != TS_OK)
+            break;
+        double scale, worst = ts_kernel_unbalanced(k, &scale);
+        double merit = fmax(scale > 0 ? worst / scale : worst,
+                            control_residual_of(k, s->f));
+        rc = TS_ECONV;
+        if (!isfinite(merit))
+            break;
+        if (merit < best_merit) {
+            best_merit = merit;
+            memcpy(best, z, (size_t)s->nz * sizeof(double));
+        } else if (best_merit <= tol) {
+            break; /* no better than the best, which will do */
+        }
+        if (merit <= VSHOOT_POLISH * tol || it >= max_iter)
+            break;
+        if (it == 0 &&
+            gsl_multiroot_fdfsolver_set(solver, &fn, &zv.vector) !=
+                GSL_SUCCESS)
+            break;
+        s->eq->iterations++;
+        if (gsl_multiroot_fdfsolver_iterate(solver) != GSL_SUCCESS)
+            break;
+        memcpy(z, solver->x->data, (size_t)s->nz * sizeof(double));
+    }
+    if (rc != TS_ENOMEM && best_merit <= tol) {
+        memcpy(z, best, (size_t)s->nz * sizeof(double));
+        rc = vshoot_eval(s, z, r);
+    }
+out:
+    free(r);
+    if (solver)
+        gsl_multiroot_fdfsolver_free(solver);
+    return rc;
+}
+
+/* The equilibrium of a system with vehicles by shooting (no bending):
+ * from the straight-tow march with each vehicle trimmed alone, with the
+ * controllers idle at the set points that start gives (controls_start),
+ * the outer solve at the frame and set points of the kernel; where that
+ * fails, continuation from that start to them (turn rate and set points
+ * together) in 4, then 16 steps. On TS_OK, y[n] is the equilibrium; the
+ * kernel's frame and set points are then the targets again. */
+static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
+                                  const ts_frame *frame,
+                                  const ts_equilibrium_opts *o,
+                                  ts_equilibrium *eq, double *y, double *dydt,
+                                  double *dvec, double *att, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
+    int n = ts_kernel_nstate(k), nv = sys->nvehicles, nl = sys->nlinks;
+    int nx = tsi_march_nunknown(m), nloops = 0;
+    for (int v = 0; v < nv; v++)
+        nloops += sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle->nloops;
+    vshoot s = {0};
+    s.k = k;
+    s.m = m;
+    s.eq = eq;
+    s.nz = 3 * nv + nc;
+    s.pos_tol = SHOOT_POS_RTOL * total_length(sys);
+    s.max_iter = o->max_iter;
+    s.y = y;
+    s.f = dydt;
+    s.x = malloc(2 * ((size_t)nx + 1) * sizeof(double));
+    s.off = calloc(3 * (size_t)nl, sizeof(double));
+    s.strain = calloc((size_t)nl, sizeof(double));
+    s.node_veh = malloc((size_t)sys->nnodes * sizeof(int));
+    s.zy = malloc((size_t)s.nz * sizeof(int));
+    s.zscale = malloc(3 * (size_t)s.nz * sizeof(double));
+    double *y0 = malloc((size_t)n * sizeof(double));
+    double *sp = calloc(2 * (size_t)nloops + 1, sizeof(double));
+    int rc = TS_ENOMEM;
+    if (!s.x || !s.off || !s.strain || !s.node_veh || !s.zy || !s.zscale ||
+        !y0 || !sp)
+        goto out;
+    s.zw = s.zscale + s.nz;
+    double *z = s.zscale + 2 * s.nz, *x0 = s.x + nx + 1;
+    for (int i = 0; i < sys->nnodes; i++)
+        s.node_veh[i] = -1;
+    for (int v = 0; v < nv; v++) {
+        s.node_veh[ts_system_body_node(sys, ts_kernel_vehicle_body(k, v))] =
+            v;
+        for (int j = 0; j < 3; j++) {
+            s.zy[3 * v + j] = ts_kernel_vehicle_offset(k, v) + j;
+            s.zscale[3 * v + j] = 1.0;
+            s.zw[3 * v + j] = 1.0;
+        }
+    }
+    for (int i = 0; i < nc; i++) {
+        ts_control_state cs;
+        ts_kernel_control_state(k, i, &cs);
+        const ts_vehicle *d =
+            sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
+        s.zy[3 * nv + i] = 2 * nq + i;
+        s.zscale[3 * nv + i] =
+            cs.actuator ? 1.0 : 1.0 / fabs(d->loop[cs.index].ki);
+        s.zw[3 * nv + i] = control_weight(k, i);
+    }
+
+    /* The start, straight, the loops idle where it leaves them. */
+    ts_frame f = *frame;
+    f.turn_rate = 0.0;
+    ts_kernel_set_frame(k, &f);
+    rc = vehicle_start(sys, m, &f, s.pos_tol, o->max_iter, dvec, s.strain,
+                       att, eq);
+    if (rc != TS_OK)
+        goto out;
+    memset(y, 0, (size_t)n * sizeof(double));
+    ts_kernel_set_shape(k, dvec, s.strain, NULL, NULL, TS_CHART_RECHART, y);
+    for (int v = 0; v < nv; v++)
+        ts_kernel_set_vehicle(k, v, att + 9 * v, NULL, TS_CHART_RECHART, y);
+    if (nc > 0 && controls_start(k, y, sp, sp + nloops, dydt) < 0) {
+        rc = TS_ENOMEM;
+        goto out;
+    }
+    tsi_march_warm(m, dvec, x0);
+    memcpy(y0, y, (size_t)n * sizeof(double));
+    tsi_march_set_vehicles(m, vshoot_pull, &s, s.off);
+
+    static const int schedule[] = {1, 4, 16};
+    int nsched = frame->turn_rate != 0 || nloops > 0 ? 3 : 1;
+    rc = TS_ECONV;
+    for (int sc = 0; sc < nsched && rc != TS_OK; sc++) {
+        int steps = schedule[sc];
+        memcpy(y, y0, (size_t)n * sizeof(double));
+        memcpy(s.x, x0, (size_t)nx * sizeof(double));
+        rc = TS_OK;
+        for (int j = 1; j <= steps && rc == TS_OK; j++) {
+            double t = (double)j / steps;
+            s.frame = *frame;
+            s.frame.turn_rate = frame->turn_rate * t;
+            ts_kernel_set_frame(k, &s.frame);
+            for (int v = 0, i = 0; v < nv; v++) {
+                const ts_vehicle *d =
+                    sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+                for (int l = 0; l < d->nloops; l++, i++)
+                    ts_kernel_set_setpoint(
+                        k, v, l, sp[i] + t * (sp[nloops + i] - sp[i]));
+            }
+            for (int i = 0; i < s.nz; i++)
+                z[i] = y[s.zy[i]] / s.zscale[i];
+            rc = vshoot_solve(&s, z, o->tol, o->max_iter);
+            eq->continuation_steps++;
+        }
+    }
+    if (rc != TS_OK && rc != TS_ENOMEM)
+        rc = ts_fail(err, TS_ECONV, "equilibrium: shooting with vehicles "
+                     "did not converge (%d outer iterations)%s%s",
+                     eq->iterations, s.merr.msg[0] ? ": " : "", s.merr.msg);
+out:
+    if (rc == TS_ENOMEM)
+        ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
+    tsi_march_set_vehicles(m, NULL, NULL, NULL);
+    ts_kernel_set_frame(k, frame);
+    free(s.x);
+    free(s.off);
+    free(s.strain);
+    free(s.node_veh);
+    free(s.zy);
+    free(s.zscale);
+    free(y0);
+    free(sp);
+    return rc;
+}
+
+/* Record the shooting result in y (*rc: record's code) and accept it
+ * when the kernel's force and controller residuals meet tol: then eq is
+ * shooting's, with the march's condition, and the return 1. */
+static int shooting_accept(ts_kernel *k, tsi_march *m, const double *y,
+                           ts_equilibrium *eq, double *dydt, double tol,
+                           int *rc)
+{
+    if ((*rc = record(k, y, eq, dydt)) != TS_OK || eq->residual > tol ||
+        eq->control_residual > tol)
+        return 0;
+    eq->method = TS_EQ_SHOOTING;
+    eq->converged = 1;
+    tsi_march_condition(m, &eq->condition, &eq->shape_error,
+                        &eq->evaluations);
+    return 1;
+}
+
+/* The error of a shooting run that is the answer (method shooting, or a
+ * failure Newton cannot mend): its own message serr, or, when it
+ * converged, the kernel's residual against tol. */
+static int shooting_refuse(int rc, const ts_err *serr,
+                           const ts_equilibrium *eq, double tol, ts_err *err)
+{
+    if (err)
+        *err = *serr;
+    if (rc == TS_OK)
+        rc = ts_fail(err, TS_ECONV,
+                     "equilibrium: shooting converged but the kernel "
+                     "residual is %.3g (target %.3g)",
+                     eq->residual, tol);
+    return rc;
+}
+
 int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                          ts_equilibrium *eq, ts_err *err)
 {
@@ -1244,11 +1630,6 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         return ts_fail(err, TS_EDOMAIN,
                        "equilibrium: method shooting does not apply to "
                        "cables with bending stiffness (EI > 0); use newton "
-                       "or auto");
-    if (o.method == TS_EQ_SHOOTING && sys->nvehicles > 0)
-        return ts_fail(err, TS_EDOMAIN,
-                       "equilibrium: method shooting does not apply to "
-                       "vehicles (the march has no attitudes); use newton "
                        "or auto");
     /* Loads that overflow are the input's fault: say which input. */
     ts_motion_bound mb = {fabs(frame.speed), fabs(frame.turn_rate), 0, 0};
@@ -1312,24 +1693,40 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
             ts_kernel_set_shape(k, tsi_march_directions(m), strain, NULL,
                                 NULL, TS_CHART_RECHART, y);
             have_guess = 1;
-            if ((rc = record(k, y, eq, dydt)) == TS_OK && eq->residual <= o.tol) {
-                eq->method = TS_EQ_SHOOTING;
-                eq->converged = 1;
-                tsi_march_condition(m, &eq->condition, &eq->shape_error,
-                                    &eq->evaluations);
+            if (shooting_accept(k, m, y, eq, dydt, o.tol, &rc))
                 goto out;
-            }
         }
         if (o.method == TS_EQ_SHOOTING || rc == TS_ESINGULAR) {
-            if (err)
-                *err = serr;
-            if (rc == TS_OK)
-                rc = ts_fail(err, TS_ECONV,
-                             "equilibrium: shooting converged but the kernel "
-                             "residual is %.3g (target %.3g)",
-                             eq->residual, o.tol);
+            rc = shooting_refuse(rc, &serr, eq, o.tol, err);
             goto out;
         }
+    }
+
+    /* Vehicles without bending: shooting, the vehicles' attitudes and the
+     * controllers as outer unknowns; else (or when it fails, or with a
+     * towing vehicle at the root, whose position the march cannot move)
+     * Newton. */
+    if (!sys->has_bending && nv > 0 && ts_kernel_root(k) < 0 &&
+        o.method != TS_EQ_NEWTON) {
+        ts_err serr = {0};
+        ts_kernel_set_steady(k, 1);
+        rc = solve_vehicle_shooting(k, m, &frame, &o, eq, y, dydt, dvec, att,
+                                    &serr);
+        if (rc == TS_OK && shooting_accept(k, m, y, eq, dydt, o.tol, &rc))
+            goto out;
+        if (o.method == TS_EQ_SHOOTING || rc == TS_ENOMEM) {
+            rc = shooting_refuse(rc, &serr, eq, o.tol, err);
+            goto out;
+        }
+        /* Newton starts afresh, at the targets. */
+        ts_kernel_set_frame(k, &frame);
+        for (int v = 0, i = 0; v < nv; v++) {
+            const ts_vehicle *d =
+                sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+            for (int l = 0; l < d->nloops; l++, i++)
+                ts_kernel_set_setpoint(k, v, l, sp_entry[i]);
+        }
+        memset(y, 0, (size_t)n * sizeof(double));
     }
 
     /* General Newton, from the straight-tow march (no bending) or from the
@@ -1343,6 +1740,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                            "memory for a %d x %d Newton Jacobian", nj, nj);
         goto out;
     }
+    w.progress = o.progress;
+    w.progress_data = o.progress_data;
     if (ro >= 0 && w.x_is_bias) {
         /* A speed controller holds its set speed: the bias is solved. */
         ts_frame f;
@@ -1371,7 +1770,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
         eq->continuation_steps++;
     }
-    if (rc != TS_OK && rc != TS_ENOMEM) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
         /* From the straight-tow march (bending ignored), or hanging. */
         ts_frame straight = frame;
         straight.turn_rate = 0;

@@ -34,6 +34,17 @@
  *    answer to 2e-8 m; the benchmark's errors against its reference did
  *    not grow).
  *
+ * The same stepper can be SUNDIALS CVODE's variable-step BDF instead
+ * (tsi_esdirk_alloc_method, bdf = 1: `--integrator bdf`), with the same
+ * Newton matrix I - gamma J (CVODE's gamma is h times its BDF
+ * coefficient), the same structured solver and the same retries. Its
+ * order is capped at BDF_MAX_ORDER = 2: BDF2 is A- and L-stable, while
+ * BDF3 to BDF5 are unstable in a bounded region next to the imaginary
+ * axis, where an elastic cable's lightly damped axial modes sit at
+ * moderate steps. One Newton solve per step instead of seven stages:
+ * cheaper per step, more steps (order 2 against 5); measured in
+ * doc/performance.md ("Simulating a stiff elastic cable").
+ *
  * ARKODE reports failures through an error handler: the last message is
  * kept in the stepper (nothing is printed) and handed on in ts_err.
  * Written against SUNDIALS 6 (Debian 12); every object hangs off a
@@ -43,6 +54,8 @@
 #include <string.h>
 
 #include <arkode/arkode_arkstep.h>
+#include <cvode/cvode.h>
+#include <cvode/cvode_ls.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_linearsolver.h>
 #include <sunmatrix/sunmatrix_dense.h>
@@ -54,6 +67,9 @@
 #define RETRIES 4
 /* Newton iterations allowed per stage (ARKODE's default: 3; see above). */
 #define NEWTON_ITERS 10
+/* The BDF's highest order: 2, A- and L-stable (see the head of the
+ * file). */
+#define BDF_MAX_ORDER 2
 
 struct tsi_esdirk {
     int n;
@@ -66,6 +82,7 @@ struct tsi_esdirk {
     SUNMatrix A;
     SUNLinearSolver ls;
     void *mem;
+    int bdf;                /* CVODE's BDF instead of ARKODE */
     double h_init;
     char msg[400];          /* ARKODE's last error message */
     /* Counters of earlier runs (ARKStepReInit zeroes ARKODE's own). */
@@ -247,6 +264,14 @@ static int linsys(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix A,
     return rc;
 }
 
+static int cv_linsys(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix A,
+                     sunbooleantype jok, sunbooleantype *jcur,
+                     sunrealtype gamma, void *ud, N_Vector t1, N_Vector t2,
+                     N_Vector t3)
+{
+    return linsys(t, y, fy, A, NULL, jok, jcur, gamma, ud, t1, t2, t3);
+}
+
 /* --- ARKODE callbacks ------------------------------------------------- */
 
 static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *ud)
@@ -284,7 +309,9 @@ void tsi_esdirk_free(tsi_esdirk *s)
 {
     if (!s)
         return;
-    if (s->mem)
+    if (s->mem && s->bdf)
+        CVodeFree(&s->mem);
+    else if (s->mem)
         ARKStepFree(&s->mem);
     if (s->ls)
         SUNLinSolFree(s->ls);
@@ -299,10 +326,10 @@ void tsi_esdirk_free(tsi_esdirk *s)
     free(s);
 }
 
-static tsi_esdirk *alloc_common(int n, tsi_ode_fn f, tsi_ode_jac jac,
-                                const tsi_ode_lsys *lsys, void *params,
-                                double rtol, double atol, double h_init,
-                                ts_err *err)
+tsi_esdirk *tsi_esdirk_alloc_method(int n, tsi_ode_fn f, tsi_ode_jac jac,
+                                    const tsi_ode_lsys *lsys, void *params,
+                                    double rtol, double atol, double h_init,
+                                    int bdf, ts_err *err)
 {
     tsi_esdirk *s = calloc(1, sizeof *s);
     if (!s) {
@@ -328,6 +355,37 @@ static tsi_esdirk *alloc_common(int n, tsi_ode_fn f, tsi_ode_jac jac,
         return NULL;
     }
     N_VConst(0.0, s->y);
+    s->bdf = bdf;
+    if (bdf) {
+        int bad = 0;
+        s->mem = CVodeCreate(CV_BDF, s->ctx);
+        if (!s->mem) {
+            tsi_esdirk_free(s);
+            ts_fail(err, TS_ENOMEM, "bdf: CVODE could not be set up for %d "
+                    "states", n);
+            return NULL;
+        }
+        bad |= CVodeInit(s->mem, rhs, 0.0, s->y);
+        bad |= CVodeSetErrHandlerFn(s->mem, on_error, s);
+        bad |= CVodeSetUserData(s->mem, s);
+        bad |= CVodeSStolerances(s->mem, rtol, atol);
+        bad |= CVodeSetLinearSolver(s->mem, s->ls, s->A);
+        if (lsys)
+            bad |= CVodeSetLinSysFn(s->mem, cv_linsys);
+        else
+            bad |= CVodeSetJacFn(s->mem, jacobian);
+        bad |= CVodeSetInitStep(s->mem, h_init);
+        bad |= CVodeSetMaxOrd(s->mem, BDF_MAX_ORDER);
+        bad |= CVodeSetMaxNonlinIters(s->mem, NEWTON_ITERS);
+        if (bad) {
+            ts_fail(err, TS_EINVAL, "bdf: CVODE refused the options (rtol "
+                    "%g, atol %g, first step %g s): %s", rtol, atol, h_init,
+                    s->msg);
+            tsi_esdirk_free(s);
+            return NULL;
+        }
+        return s;
+    }
     s->mem = ARKStepCreate(NULL, rhs, 0.0, s->y, s->ctx);
     if (!s->mem) {
         tsi_esdirk_free(s);
@@ -363,7 +421,8 @@ tsi_esdirk *tsi_esdirk_alloc(int n, tsi_ode_fn f, tsi_ode_jac jac,
                              void *params, double rtol, double atol,
                              double h_init, ts_err *err)
 {
-    return alloc_common(n, f, jac, NULL, params, rtol, atol, h_init, err);
+    return tsi_esdirk_alloc_method(n, f, jac, NULL, params, rtol, atol,
+                                   h_init, 0, err);
 }
 
 tsi_esdirk *tsi_esdirk_alloc_lsys(int n, tsi_ode_fn f,
@@ -371,12 +430,25 @@ tsi_esdirk *tsi_esdirk_alloc_lsys(int n, tsi_ode_fn f,
                                   double rtol, double atol, double h_init,
                                   ts_err *err)
 {
-    return alloc_common(n, f, NULL, lsys, params, rtol, atol, h_init, err);
+    return tsi_esdirk_alloc_method(n, f, NULL, lsys, params, rtol, atol,
+                                   h_init, 0, err);
 }
 
 int tsi_esdirk_reset(tsi_esdirk *s, double t, const double y[], ts_err *err)
 {
     long v = 0;
+    if (s->bdf) {
+        tsi_esdirk_stats st;
+        tsi_esdirk_get_stats(s, &st);
+        s->steps0 = st.steps;
+        s->rejected0 = st.rejected;
+        s->setups0 = st.setups;
+        memcpy(N_VGetArrayPointer(s->y), y, (size_t)s->n * sizeof(double));
+        if (CVodeReInit(s->mem, t, s->y) != 0)
+            return ts_fail(err, TS_EINTEGRATOR, "bdf: restart at t = %.9g s "
+                           "failed: %s", t, s->msg);
+        return TS_OK;
+    }
     if (ARKStepGetNumSteps(s->mem, &v) == 0)
         s->steps0 += v;
     long etf = 0, ncf = 0;
@@ -392,11 +464,51 @@ int tsi_esdirk_reset(tsi_esdirk *s, double t, const double y[], ts_err *err)
     return TS_OK;
 }
 
+/* CVODE's step, with the same retries as ARKODE's (see the head of the
+ * file): a refused right-hand side restarts from the last accepted state
+ * with a quarter of the last step. */
+static int bdf_step(tsi_esdirk *s, double tstop, double *t, double y[],
+                    ts_err *err)
+{
+    sunrealtype tret = *t, h = 0;
+    int flag = CVodeSetStopTime(s->mem, tstop);
+    if (flag == 0)
+        flag = CVode(s->mem, tstop, s->y, &tret, CV_ONE_STEP);
+    CVodeGetLastStep(s->mem, &h);
+    for (int r = 0; r < RETRIES && (flag == CV_UNREC_RHSFUNC_ERR ||
+                                    flag == CV_REPTD_RHSFUNC_ERR);
+         r++) {
+        h = (h > 0 ? h : s->h_init) / 4.0;
+        memcpy(N_VGetArrayPointer(s->y), y, (size_t)s->n * sizeof(double));
+        s->msg[0] = '\0';
+        flag = CVodeReInit(s->mem, *t, s->y);
+        if (flag == 0)
+            flag = CVodeSetInitStep(s->mem, h);
+        if (flag == 0)
+            flag = CVodeSetStopTime(s->mem, tstop);
+        if (flag == 0)
+            flag = CVode(s->mem, tstop, s->y, &tret, CV_ONE_STEP);
+        CVodeSetInitStep(s->mem, s->h_init);
+    }
+    if (flag < 0) {
+        char *name = CVodeGetReturnFlagName(flag);
+        ts_fail(err, TS_EINTEGRATOR, "bdf failed at t = %.9g s (%s): %s", *t,
+                name ? name : "?", s->msg[0] ? s->msg : "no reason given");
+        free(name);
+        return TS_EINTEGRATOR;
+    }
+    *t = tret;
+    memcpy(y, N_VGetArrayPointer(s->y), (size_t)s->n * sizeof(double));
+    return TS_OK;
+}
+
 int tsi_esdirk_step(tsi_esdirk *s, double tstop, double *t, double y[],
                     ts_err *err)
 {
     s->msg[0] = '\0';
     sunrealtype tret = *t;
+    if (s->bdf)
+        return bdf_step(s, tstop, t, y, err);
     int flag = ARKStepSetStopTime(s->mem, tstop);
     if (flag == 0)
         flag = ARKStepEvolve(s->mem, tstop, s->y, &tret, ARK_ONE_STEP);
@@ -430,7 +542,8 @@ int tsi_esdirk_step(tsi_esdirk *s, double tstop, double *t, double y[],
 
 int tsi_esdirk_interpolate(tsi_esdirk *s, double t, double y[], ts_err *err)
 {
-    if (ARKStepGetDky(s->mem, t, 0, s->yi) != 0)
+    if ((s->bdf ? CVodeGetDky(s->mem, t, 0, s->yi)
+                : ARKStepGetDky(s->mem, t, 0, s->yi)) != 0)
         return ts_fail(err, TS_EINTEGRATOR, "esdirk: no solution to "
                        "interpolate at t = %.9g s: %s", t, s->msg);
     memcpy(y, N_VGetArrayPointer(s->yi), (size_t)s->n * sizeof(double));
@@ -441,6 +554,20 @@ void tsi_esdirk_get_stats(const tsi_esdirk *s, tsi_esdirk_stats *st)
 {
     long steps = 0, etf = 0, ncf = 0, setups = 0;
     sunrealtype hl = 0, hc = 0;
+    if (s->bdf) {
+        CVodeGetNumSteps(s->mem, &steps);
+        CVodeGetNumErrTestFails(s->mem, &etf);
+        CVodeGetNumNonlinSolvConvFails(s->mem, &ncf);
+        CVodeGetNumLinSolvSetups(s->mem, &setups);
+        CVodeGetLastStep(s->mem, &hl);
+        CVodeGetCurrentStep(s->mem, &hc);
+        st->steps = s->steps0 + steps;
+        st->rejected = s->rejected0 + etf + ncf;
+        st->setups = s->setups0 + setups;
+        st->h_last = hl;
+        st->h_next = hc;
+        return;
+    }
     ARKStepGetNumSteps(s->mem, &steps);
     ARKStepGetNumErrTestFails(s->mem, &etf);
     ARKStepGetNumNonlinSolvConvFails(s->mem, &ncf);

@@ -68,6 +68,13 @@ tsi_esdirk *tsi_esdirk_alloc_lsys(int n, tsi_ode_fn f,
                                   const tsi_ode_lsys *lsys, void *params,
                                   double rtol, double atol, double h_init,
                                   ts_err *err);
+/* Either of the above (jac or lsys non-NULL) with bdf = 1: SUNDIALS
+ * CVODE's variable-step BDF of order 1 to 2 instead of the ESDIRK (one
+ * Newton solve per step; A- and L-stable); bdf = 0 is the ESDIRK. */
+tsi_esdirk *tsi_esdirk_alloc_method(int n, tsi_ode_fn f, tsi_ode_jac jac,
+                                    const tsi_ode_lsys *lsys, void *params,
+                                    double rtol, double atol, double h_init,
+                                    int bdf, ts_err *err);
 void tsi_esdirk_free(tsi_esdirk *s);
 
 /* Start again from (t, y): step-size history, Jacobian and factorisation

@@ -817,10 +817,9 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
     v3_cross(om, t, b);
 }
 
-/* A vehicle's controller, inertia and loads, with the masses and loads
- * its child cables put at their starting points. */
-static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
-                          const double u[], double rho, double g)
+/* A vehicle's controller, inertia and its own loads (V->M6, V->G). */
+static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
+                              const double u[], double rho, double g)
 {
     const ts_vehicle *d = V->d;
     const double *c = y + 2 * k->nq;
@@ -867,6 +866,14 @@ static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
             V->G[3 + j] += m[j] + up[4 + j];
         }
     }
+}
+
+/* A vehicle's controller, inertia and loads, with the masses and loads
+ * its child cables put at their starting points. */
+static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
+                          const double u[], double rho, double g)
+{
+    vehicle_own_loads(k, V, y, u, rho, g);
     const ts_node *nd = &k->sys->nodes[V->node];
     for (int j = nd->child_begin; j < nd->child_end; j++) {
         int l = k->sys->child_links[j];
@@ -1794,4 +1801,39 @@ void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
         r->loop_error[l] = tsi_loop_error(&d->loop[l], V->meas, V->sp[l]);
         r->loop_output[l] = V->out[l];
     }
+}
+
+int tsi_kernel_vehicle_pull(ts_kernel *k, int v, const double y[],
+                            const double rA[3], double F[3])
+{
+    veh *V = &k->veh[v];
+    static const double zero[3] = {0, 0, 0};
+    double afr[3], ab[3], h[3];
+    tsi_vehicle_kinematics(V->d, V->chart, y + V->qoff, zero,
+                           k->frame.turn_rate, rA, zero, &V->st);
+    tsi_vehicle_flow(&k->frame, V->d, &V->st);
+    if (!(fabs(V->st.c2) >= TS_CHART_MIN))
+        return TS_CHART;
+    vehicle_own_loads(k, V, y, k->uzero, k->sys->env.water_density,
+                      k->sys->env.gravity);
+    /* At rest in the frame the joint accelerates with the frame, afr,
+     * and the body does not turn relative to it: the joint force on the
+     * body is M6_tt R^T afr - G_t (body axes), the pull its opposite. */
+    tsi_frame_accel(&k->frame, rA, zero, afr);
+    mat3_tmul(V->st.R, afr, ab);
+    for (int i = 0; i < 3; i++)
+        h[i] = V->G[i] - (V->M6[6 * i] * ab[0] + V->M6[6 * i + 1] * ab[1] +
+                          V->M6[6 * i + 2] * ab[2]);
+    mat3_mul(V->st.R, h, F);
+    return isfinite(F[0] + F[1] + F[2]) ? TS_OK : TS_EDOMAIN;
+}
+
+void tsi_kernel_vehicle_lever(const ts_kernel *k, int v, const double y[],
+                              int link, double off[3])
+{
+    const veh *V = &k->veh[v];
+    double R[9], rho[3];
+    ts_kernel_get_vehicle(k, v, y, R, NULL);
+    link_lever(V, &k->sys->links[link], rho);
+    mat3_mul(R, rho, off);
 }

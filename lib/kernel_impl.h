@@ -55,4 +55,19 @@ const double *tsi_kernel_mass(const ts_kernel *k);
 int tsi_kernel_set_link(ts_kernel *k, int l, const double d[3],
                         const double ddot[3], double threshold, double y[]);
 
+/* The force (N, M) vehicle v pulls its node with at rest in the frame:
+ * its own loads (weight, buoyancy, hydrodynamics, with the controller
+ * states of y[] and zero inputs) at attitude y[] and joint position
+ * rA[3] (m, M), less its mass and added mass times the frame's
+ * acceleration there. Its child cables are not included. TS_OK, TS_CHART
+ * (the attitude at its chart's singularity) or TS_EDOMAIN (not finite).
+ * Overwrites the vehicle's last-evaluation results. O(1). */
+int tsi_kernel_vehicle_pull(ts_kernel *k, int v, const double y[],
+                            const double rA[3], double F[3]);
+
+/* Where child link `link` of vehicle v starts relative to its joint at
+ * the attitude of y[]: off[3] = R (P - A) (m, M). */
+void tsi_kernel_vehicle_lever(const ts_kernel *k, int v, const double y[],
+                              int link, double off[3]);
+
 #endif

@@ -68,6 +68,9 @@ struct tsi_march {
     double *K;          /* [3 nn] known loads accumulated from children */
     double *Ma;         /* [6 nn] added mass from child links */
     double *extra;      /* [3 nn] extra nodal loads, or NULL */
+    tsi_march_pull_fn pull; /* vehicles' loads, or NULL */
+    void *pull_ctx;
+    const double *up_off;   /* [3 nl] start of a link on a vehicle */
     double mismatch;
 
     gsl_multiroot_fsolver *local;
@@ -625,6 +628,14 @@ int tsi_march_set_loads(tsi_march *m, const double *F)
     return TS_OK;
 }
 
+void tsi_march_set_vehicles(tsi_march *m, tsi_march_pull_fn pull, void *ctx,
+                            const double *off)
+{
+    m->pull = pull;
+    m->pull_ctx = ctx;
+    m->up_off = pull ? off : NULL;
+}
+
 int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
                    double e[], ts_err *err)
 {
@@ -661,7 +672,16 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
             const ts_body *bd = &sys->bodies[nd->body];
             if (bd->type == TS_BODY_CYLINDER) {
                 P.body = bd;
-            } else if (bd->type != TS_BODY_VEHICLE) {
+            } else if (bd->type == TS_BODY_VEHICLE) {
+                int rc = m->pull ? m->pull(m->pull_ctx, i, ri, Fb) : TS_OK;
+                if (rc != TS_OK) {
+                    m->have_n = 0;
+                    return ts_fail(err, rc, "equilibrium: bodies[%d] '%s' "
+                                   "is outside the model's range in the "
+                                   "march (%s)", nd->body, bd->name,
+                                   ts_strerror(rc));
+                }
+            } else {
                 double w[3], frac;
                 tsi_rel_velocity(f, ri, zero, w);
                 /* A sphere's load has no axis: the link's last direction
@@ -696,6 +716,9 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
         double rp[3];
         for (int j = 0; j < 3; j++)
             rp[j] = ri[j] - m->len[l] * m->n[3 * l + j];
+        if (m->up_off && L->up_body >= 0)
+            for (int j = 0; j < 3; j++)
+                rp[j] -= m->up_off[3 * l + j]; /* the vehicle's joint */
         int a = m->res_of_link[l];
         if (a >= 0) {
             const double *target = p == 0 ? sys->tow.point : m->r + 3 * p;

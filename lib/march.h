@@ -31,6 +31,20 @@ void tsi_march_free(tsi_march *m);
  * no attitudes); their child cables start at their nodes. */
 int tsi_march_set_loads(tsi_march *m, const double *F);
 
+/* The force (N, M) the vehicle at `node` pulls it with when its joint
+ * is at r[3] (m, M): TS_OK, or a code that stops the march. */
+typedef int (*tsi_march_pull_fn)(void *ctx, int node, const double r[3],
+                                 double F[3]);
+
+/* Vehicles in the march, at attitudes the caller holds: pull gives each
+ * vehicle's load on its node from the node's position; off[3 nlinks]
+ * (m, M; the caller's, read at every march) is where a link that starts
+ * on a vehicle starts relative to the vehicle's node, R (P - A), and 0
+ * for the others. NULL pull: vehicles left out, their child cables
+ * starting at their nodes. */
+void tsi_march_set_vehicles(tsi_march *m, tsi_march_pull_fn pull, void *ctx,
+                            const double *off);
+
 /* Number of shooting unknowns and residuals: 3 per free end. */
 int tsi_march_nunknown(const tsi_march *m);
 

@@ -38,10 +38,12 @@ static const char *const eig_methods[] = {"auto", "lapack", "arpack", NULL};
 static const int eig_method_values[] = {TS_EIG_AUTO, TS_EIG_LAPACK,
                                         TS_EIG_ARPACK};
 static const char *const integrators[] = {"rk8pd", "rkf45", "rk4imp",
-                                          "bsimp", "msbdf", "esdirk", NULL};
+                                          "bsimp", "msbdf", "esdirk", "bdf",
+                                          NULL};
 static const int integrator_values[] = {TS_INT_RK8PD, TS_INT_RKF45,
                                         TS_INT_RK4IMP, TS_INT_BSIMP,
-                                        TS_INT_MSBDF, TS_INT_ESDIRK};
+                                        TS_INT_MSBDF, TS_INT_ESDIRK,
+                                        TS_INT_BDF};
 static const char *const linear_methods[] = {"expm", "ode", NULL};
 static const int linear_method_values[] = {TS_LINSIM_EXPM, TS_LINSIM_ODE};
 static const char *const kinematics[] = {"linear", "nonlinear", NULL};
@@ -243,8 +245,8 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
         ts_integrator m;
         if (ts_integrator_parse(tok, &m) != 0)
             return ts_fail(err, TS_EINVAL, "%s: '%s' is not an integrator; "
-                           "expected rk8pd, rkf45, rk4imp, bsimp, msbdf or "
-                           "esdirk", w, tok);
+                           "expected rk8pd, rkf45, rk4imp, bsimp, msbdf, "
+                           "esdirk or bdf", w, tok);
         for (int i = 0; i < n; i++)
             if (c->integrators[i] == m)
                 return ts_fail(err, TS_EINVAL, "%s: %s is given twice", w,
@@ -430,7 +432,7 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
      NOLIM, .offset = OFF(simulate.output), .size = SZ(simulate.output),      \
      .only = o, .arg = "NAME",                                                \
      .help = "the channel compared and fitted, e.g. sphere.z, "               \
-             "cable.3.tension, tow.force",                                    \
+             "cable.3.tension, tow.force, fish.depth",                        \
      .deftext = "the last sphere's .z"},                                      \
     {.name = "linear_method", .type = TS_OPT_ENUM,                            \
      .section = TS_SEC_SIMULATE, NOLIM, .choices = linear_methods,            \
@@ -576,7 +578,8 @@ static const ts_option simulate_rows[] = {
      NOLIM, .offset = OFF(simulate.outputs), .size = SZ(simulate.outputs),
      .arg = "LIST",
      .help = "the channels written and printed, e.g. "
-             "fish.z,armour.1.tension,tow.force; all: the full state",
+             "fish.z,armour.1.tension,tow.force,fish.pitch,"
+             "fish.tail1.deflection; all: the full state",
      .deftext = "the output (a node's x, y, z) and tow.force"},
 };
 

@@ -73,13 +73,16 @@ json_t *ts_report_channels_json(const ts_system *sys, const ts_history *h,
                                                           i)));
         json_object_set_new(ch, outs[k].name, a);
     }
-    /* The vehicles' outputs (m, rad), every one. */
-    for (int j = 0; h->outputs && j < h->noutput; j++)
-        json_object_set_new(ch, h->output_name[j],
-                            series(h->outputs + j, h->nsamples,
-                                   (size_t)h->noutput));
     json_object_set_new(o, "outputs", ch);
     return o;
+}
+
+/* Three interleaved series base[3 i + j] (j = 0, 1, 2) as an object of
+ * arrays named key[j]. */
+static json_t *triple(const double *base, int n, const char *const key[3])
+{
+    return json_pack("{s:o,s:o,s:o}", key[0], series(base, n, 3), key[1],
+                     series(base + 1, n, 3), key[2], series(base + 2, n, 3));
 }
 
 int ts_report_history_full(json_t *o, const ts_system *sys,
@@ -90,11 +93,14 @@ int ts_report_history_full(json_t *o, const ts_system *sys,
         return TS_ENOMEM;
     if (has_forces(h)) {
         int n = h->nsamples;
-        json_object_set_new(full, "tow_force",
-                            json_pack("{s:o,s:o,s:o}", "x",
-                                      series(h->tow_force, n, 3), "y",
-                                      series(h->tow_force + 1, n, 3), "z",
-                                      series(h->tow_force + 2, n, 3)));
+        static const char *const xyz[3] = {"x", "y", "z"};
+        json_object_set_new(full, "tow_force", triple(h->tow_force, n, xyz));
+    }
+    if (h->nsamples > 0 && isfinite(h->frame[0])) {
+        /* The pose of M in the earth frame (towstab/track.h). */
+        int n = h->nsamples;
+        static const char *const pose[3] = {"x", "y", "heading"};
+        json_object_set_new(full, "frame", triple(h->frame, n, pose));
     }
     json_object_del(full, "t");
     int rc = json_object_update(o, full) ? TS_ENOMEM : TS_OK;
@@ -398,7 +404,6 @@ static void channels_header(csv_cols *c, FILE *f, const ts_history *h,
         fprintf(f, ",%s%s%s%s", prefix, c->outs[k].name, bare ? "" : "_",
                 bare ? "" : t);
     }
-    vehicle_header(f, h, prefix);
 }
 
 static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
@@ -413,7 +418,6 @@ static void channels_row(csv_cols *c, FILE *f, const ts_history *h, int i,
                                        ts_history_value(c->sys, h,
                                                         &c->outs[k], i),
                                        u, sizeof u));
-    vehicle_row(f, h, i);
 }
 
 int ts_report_channels_csv(const ts_system *sys, const ts_history *nl,

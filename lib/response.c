@@ -101,18 +101,20 @@ int ts_response_output_lookup(const ts_kernel *k, const char *name,
         return TS_OK;
     }
     int rc = ts_response_output_find(sys, name, out, err);
-    if (rc != TS_OK && err && ts_kernel_noutput(k) > 0) {
-        /* Append the vehicles' outputs to the list of valid names. */
-        char nm[TS_IO_NAME];
-        size_t len = strlen(err->msg);
-        for (int i = 0; i < ts_kernel_noutput(k) && len < sizeof err->msg;
-             i++)
-            len += (size_t)snprintf(err->msg + len, sizeof err->msg - len,
-                                    "%s%s", i ? ", " : "; vehicles: ",
-                                    ts_kernel_output_name(k, i, nm,
-                                                          sizeof nm));
-    }
+    if (rc != TS_OK)
+        tsi_response_list_vehicle_outputs(k, err);
     return rc;
+}
+
+void tsi_response_list_vehicle_outputs(const ts_kernel *k, ts_err *err)
+{
+    char nm[TS_IO_NAME];
+    size_t len = err ? strlen(err->msg) : 0;
+    for (int i = 0; err && i < ts_kernel_noutput(k) && len < sizeof err->msg;
+         i++)
+        len += (size_t)snprintf(err->msg + len, sizeof err->msg - len,
+                                "%s%s", i ? ", " : "; vehicles: ",
+                                ts_kernel_output_name(k, i, nm, sizeof nm));
 }
 
 int ts_response_output_find(const ts_system *sys, const char *name,

@@ -16,4 +16,9 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
                          ts_progress_fn progress, void *data,
                          ts_response **res, ts_err *err);
 
+/* Append "; vehicles: <names>" (every output of k's vehicles,
+ * ts_kernel_output_name) to err's message, the list of valid names of
+ * a bad output. Nothing without vehicles or err. */
+void tsi_response_list_vehicle_outputs(const ts_kernel *k, ts_err *err);
+
 #endif

@@ -35,6 +35,9 @@ void tsi_shift_free(tsi_shift *sh)
     }
     free(sh->common);
     free(sh->Sx);
+    free(sh->Sk);
+    free(sh->Sc);
+    free(sh->Sm);
     free(sh->rhs);
     free(sh->cols);
     free(sh->u1);
@@ -331,6 +334,27 @@ static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
     return TS_OK;
 }
 
+/* The rcond estimate min |u_ii| / max |u_ii| of the factors of the
+ * unscaled matrix with the same pivots. KLU factors R^-1 A (R = diag(Rs),
+ * Rs[i] row i's scale); with the row permutation P, P A Q = (P R P^T) L U
+ * with L unit lower triangular, so the unscaled factors' diagonal is
+ * u_ii Rs[Pnum[i]]. */
+static double raw_rcond(const tsi_shift *sh)
+{
+    const klu_numeric *num = sh->numeric;
+    double lo = INFINITY, hi = 0.0;
+    for (int i = 0; i < num->n; i++) {
+        double u = sh->is_complex ? cabs(((const double complex *)
+                                              num->Udiag)[i])
+                                  : fabs(((const double *)num->Udiag)[i]);
+        if (num->Rs)
+            u *= num->Rs[num->Pnum[i]];
+        lo = fmin(lo, u);
+        hi = fmax(hi, u);
+    }
+    return hi > 0 ? lo / hi : 0.0;
+}
+
 static int factor(tsi_shift *sh, ts_err *err)
 {
     const ts_descriptor *d = sh->d;
@@ -346,6 +370,7 @@ static int factor(tsi_shift *sh, ts_err *err)
         int ok = sh->is_complex ? klu_z_rcond(sym, sh->numeric, kc)
                                 : klu_rcond(sym, sh->numeric, kc);
         sh->rcond = ok ? kc->rcond : 0.0;
+        sh->rcond_raw = ok ? raw_rcond(sh) : 0.0;
         return TS_OK;
     }
     int status = kc->status;
@@ -392,19 +417,43 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
     klu_symbolic *sym = d->klu_symbolic;
     klu_numeric *num = sh->numeric;
     sh->s = s;
-    int ok;
+    if (!sh->Sk) {
+        size_t nz = (size_t)d->nnz + 1;
+        sh->Sk = malloc(nz * sizeof(double));
+        sh->Sc = malloc(nz * sizeof(double));
+        sh->Sm = malloc(nz * sizeof(double));
+        if (!sh->Sk || !sh->Sc || !sh->Sm) {
+            tsi_shift_free(sh);
+            return ts_fail(err, TS_ENOMEM, "shift: out of memory for %d "
+                           "unknowns", d->nx);
+        }
+        tsi_desc_fill_parts(d, sh->Sk, sh->Sc, sh->Sm);
+    }
+    /* S(s) from its parts: one pass, the same values as
+     * tsi_desc_fill_complex and _real. */
+    const double *Sk = sh->Sk, *Sc = sh->Sc, *Sm = sh->Sm;
+    double complex s2 = s * s;
+    double sr = creal(s), si = cimag(s), qr = creal(s2), qi = cimag(s2);
+    int ok, scale = kc->scale;
+    kc->scale = -1;
     if (cplx) {
-        tsi_desc_fill_complex(d, s, sh->Sx);
+        for (int p = 0; p < d->nnz; p++) {
+            sh->Sx[2 * p] = Sk[p] + sr * Sc[p] + qr * Sm[p];
+            sh->Sx[2 * p + 1] = si * Sc[p] + qi * Sm[p];
+        }
         ok = klu_z_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
              klu_z_rcond(sym, num, kc);
     } else {
-        tsi_desc_fill_real(d, creal(s), 0, sh->Sx);
+        for (int p = 0; p < d->nnz; p++)
+            sh->Sx[p] = Sk[p] + sr * Sc[p] + qr * Sm[p];
         ok = klu_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
              klu_rcond(sym, num, kc);
     }
+    kc->scale = scale;
     /* The old pivots serve while the factors stay as well conditioned as
-     * a fresh factorisation's, within SHIFT_REFACTOR_RCOND. */
-    if (ok && kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond)
+     * a fresh factorisation's, within SHIFT_REFACTOR_RCOND (both
+     * unscaled). */
+    if (ok && kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond_raw)
         return TS_OK;
     tsi_shift_free(sh);
     return tsi_shift_factor(sh, lin, s, err);

@@ -66,7 +66,12 @@ typedef struct tsi_shift {
     void *numeric;         /* KLU factors */
     double rcond;          /* KLU's rcond estimate of the last full
                               factorisation */
+    double rcond_raw;      /* the same of its factors without KLU's row
+                              scaling: the reference of a refactorisation,
+                              which skips the scaling */
     double *Sx;            /* [nnz] real or [2 nnz] complex values */
+    double *Sk, *Sc, *Sm;  /* [nnz] S(s) = Sk + s Sc + s^2 Sm, kept for
+                              refactorisations (tsi_desc_fill_parts) */
     double *rhs;           /* [2 nx] */
     double *cols;          /* [2 nx] */
     double *u1, *u2;       /* [3 nnodes] node displacement work */
@@ -82,9 +87,12 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
 
 /* Factor at a new shift s, reusing sh's factorisation (of the same lin)
  * when it has one of the same kind (real or complex): KLU's refactor with
- * the old pivot order, no allocation, unless the new factors' rcond
- * estimate falls below SHIFT_REFACTOR_RCOND times the last full
- * factorisation's, when it factors afresh (with pivoting). A sequence of
+ * the old pivot order and without KLU's row scaling (with the pivots
+ * fixed, scaling the rows scales the factors' rows alike and leaves their
+ * accuracy), no allocation, unless the new factors' rcond estimate falls
+ * below SHIFT_REFACTOR_RCOND times the last full factorisation's (taken
+ * without its scaling too), when it factors afresh (with pivoting and
+ * scaling). A sequence of
  * nearby shifts (a frequency sweep) then pays for pivoting now and then.
  * Otherwise as tsi_shift_factor (sh freed first). Same codes. */
 #define SHIFT_REFACTOR_RCOND 1e-2

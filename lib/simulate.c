@@ -94,16 +94,23 @@ void ts_sim_opts_default(ts_sim_opts *o)
 }
 
 static const char *const integrator_names[] = {"rk8pd", "rkf45", "rk4imp",
-                                               "bsimp", "msbdf", "esdirk"};
+                                               "bsimp", "msbdf", "esdirk",
+                                               "bdf"};
+
+/* The SUNDIALS steppers of lib/esdirk.h (ARKODE's ESDIRK, CVODE's BDF). */
+static int sundials_method(ts_integrator m)
+{
+    return m == TS_INT_ESDIRK || m == TS_INT_BDF;
+}
 
 const char *ts_integrator_name(ts_integrator m)
 {
-    return m >= TS_INT_RK8PD && m <= TS_INT_ESDIRK ? integrator_names[m] : "?";
+    return m >= TS_INT_RK8PD && m <= TS_INT_BDF ? integrator_names[m] : "?";
 }
 
 int ts_integrator_parse(const char *name, ts_integrator *m)
 {
-    for (int i = 0; i <= TS_INT_ESDIRK; i++)
+    for (int i = 0; i <= TS_INT_BDF; i++)
         if (!strcmp(name, integrator_names[i])) {
             *m = (ts_integrator)i;
             return 0;
@@ -146,7 +153,7 @@ int ts_sim_opts_check(const ts_sim_opts *o, ts_err *err)
     if (!(o->rechart > TS_CHART_MIN) || !(o->rechart < 1))
         return ts_fail(err, TS_EINVAL, "simulate: the re-chart threshold "
                        "must be in (%g, 1), got %g", TS_CHART_MIN, o->rechart);
-    if (!(o->integrator >= TS_INT_RK8PD && o->integrator <= TS_INT_ESDIRK))
+    if (!(o->integrator >= TS_INT_RK8PD && o->integrator <= TS_INT_BDF))
         return ts_fail(err, TS_EINVAL, "simulate: unknown integrator %d",
                        (int)o->integrator);
     if (o->linear_method != TS_LINSIM_EXPM && o->linear_method != TS_LINSIM_ODE)
@@ -352,6 +359,10 @@ double ts_history_value(const ts_system *sys, const ts_history *h,
         return out->comp == 0 ? f[0] + c * r[0] - sn * r[1]
                               : f[1] + sn * r[0] + c * r[1];
     }
+    if (out->kind == TS_OUT_VEHICLE)
+        return h->outputs && out->index >= 0 && out->index < h->noutput
+                   ? h->outputs[(size_t)h->noutput * s + (size_t)out->index]
+                   : NAN;
     return ts_output_value(sys, out, h->positions + 3 * (size_t)h->nnodes * s,
                            h->tensions + (size_t)h->nlinks * s,
                            h->tow_force + 3 * s);
@@ -626,7 +637,7 @@ static const gsl_odeiv2_step_type *step_type(ts_integrator m)
 static int needs_jacobian(ts_integrator m)
 {
     return m == TS_INT_RK4IMP || m == TS_INT_BSIMP || m == TS_INT_MSBDF ||
-           m == TS_INT_ESDIRK;
+           sundials_method(m);
 }
 
 void ts_sim_free(ts_sim *s)
@@ -726,18 +737,16 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         /* GSL's implicit steppers take a dense Jacobian; esdirk solves
          * with the sparse model where it covers the system (not with a
          * vehicle). */
-        sparse = o->integrator == TS_INT_ESDIRK &&
+        sparse = sundials_method(o->integrator) &&
                  ts_kernel_nvehicles(k) == 0 && s->n == 2 * s->nq;
         s->lopts.model = sparse ? TS_LIN_SPARSE : TS_LIN_DENSE;
     }
-    if (o->integrator == TS_INT_ESDIRK) {
+    if (sundials_method(o->integrator)) {
         const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk};
-        s->sd = sparse ? tsi_esdirk_alloc_lsys(s->n, rhs_esdirk, &lsys, s,
-                                               o->rel_tol, o->abs_tol, s->h,
-                                               err)
-                       : tsi_esdirk_alloc(s->n, rhs_esdirk, jacobian_esdirk,
-                                          s, o->rel_tol, o->abs_tol, s->h,
-                                          err);
+        s->sd = tsi_esdirk_alloc_method(
+            s->n, rhs_esdirk, sparse ? NULL : jacobian_esdirk,
+            sparse ? &lsys : NULL, s, o->rel_tol, o->abs_tol, s->h,
+            o->integrator == TS_INT_BDF, err);
         if (!s->sd) {
             ts_sim_free(s);
             return NULL;
@@ -1551,10 +1560,10 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                 z[part * lin->nq + i] += tmp[i];
         }
     }
-    if (o->linear_method == TS_LINSIM_ODE &&
-        o->integrator == TS_INT_ESDIRK) {
-        sd = tsi_esdirk_alloc(n, lin_rhs_esdirk, lin_jac_esdirk, &L,
-                              o->rel_tol, o->abs_tol, o->h_init, err);
+    if (o->linear_method == TS_LINSIM_ODE && sundials_method(o->integrator)) {
+        sd = tsi_esdirk_alloc_method(n, lin_rhs_esdirk, lin_jac_esdirk, NULL,
+                                     &L, o->rel_tol, o->abs_tol, o->h_init,
+                                     o->integrator == TS_INT_BDF, err);
         if (!sd || (rc = tsi_esdirk_reset(sd, 0.0, z, err))) {
             rc = rc ? rc : TS_ENOMEM;
             goto done;

@@ -24,7 +24,10 @@
  * its result must say it is not complete.
  *
  * The default run (suite unit) uses each scene's own size and 60 links;
- * suite slow runs 100, 200, 400 and 800 links (doc/linear.md, section 5).
+ * suite slow runs 100, 200 and 400 links, suite huge 800 (doc/linear.md,
+ * section 5). Arguments ending in .yaml (files or patterns) take the
+ * scenes from them instead of every example, e.g.
+ * test_eigen_search 800 'examples/kamman_ex[2-5]*.yaml'.
  * The drop tests have no equilibrium: they are reported and skipped. */
 #include <complex.h>
 #include <glob.h>
@@ -155,15 +158,32 @@ int main(int argc, char **argv)
 {
     ts_err err = {0};
     ts_units *units = ts_units_alloc(&err);
+    /* Arguments: sizes ("scene" or a total link count) and, optionally,
+     * scene files or patterns (anything ending in .yaml; default every
+     * example). */
+    static char *defaults[] = {"scene", "60"};
+    char **sizes = calloc((size_t)argc + 2, sizeof *sizes);
     glob_t g;
-    int grc = glob("examples/*.yaml", 0, NULL, &g);
-    if (!units || grc != 0) {
+    int nsizes = 0, npat = 0, grc = 0;
+    for (int i = 1; sizes && i < argc && grc == 0; i++) {
+        size_t len = strlen(argv[i]);
+        if (len > 5 && strcmp(argv[i] + len - 5, ".yaml") == 0)
+            grc = glob(argv[i], npat++ ? GLOB_APPEND : 0, NULL, &g);
+        else
+            sizes[nsizes++] = argv[i];
+    }
+    if (sizes && nsizes == 0) {
+        sizes[0] = defaults[0];
+        sizes[1] = defaults[1];
+        nsizes = 2;
+    }
+    if (npat == 0)
+        grc = glob("examples/*.yaml", 0, NULL, &g);
+    if (!units || !sizes || grc != 0) {
         printf("FAIL setup: %s\n", units ? "no examples" : err.msg);
+        free(sizes);
         return 1;
     }
-    static char *defaults[] = {"scene", "60"};
-    char **sizes = argc > 1 ? argv + 1 : defaults;
-    int nsizes = argc > 1 ? argc - 1 : 2;
     for (int si = 0; si < nsizes; si++) {
         int total = strcmp(sizes[si], "scene") ? atoi(sizes[si]) : 0;
         for (size_t i = 0; i < g.gl_pathc; i++) {
@@ -188,6 +208,7 @@ int main(int argc, char **argv)
         }
     }
     globfree(&g);
+    free(sizes);
     ts_units_free(units);
     return tc_done();
 }

@@ -13,8 +13,14 @@
  *  5. A simulation of Kamman's steady turn (example 3) from its
  *     equilibrium: the sphere at rest in M runs on a circle about the turn
  *     centre (0, V/Omega) of E, its earth channels from ts_history_value;
- *     the earth channels are refused outside a simulation.
- *  6. Bad times refused.
+ *     the earth channels are refused outside a simulation; the full
+ *     state's JSON carries the poses.
+ *  6. A straight-line speed change of a towing vehicle (a thrust step):
+ *     the steady speed over the ground from its earth track against the
+ *     Newton trim at the stepped thrust.
+ *  7. The constant-power law in the time domain: T U = P at every sample
+ *     of a towing vehicle slowed by a force step.
+ *  8. Bad times refused.
  * Tolerances are stated at each check with their reason. */
 #include "towstab/track.h"
 
@@ -25,7 +31,12 @@
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/analysis.h"
+#include "towstab/equilibrium.h"
+#include "towstab/kernel.h"
+#include "towstab/simulate.h"
+#include "towstab/vehicle.h"
 #include "towstab/output.h"
+#include "towstab/report_time.h"
 
 /* The quadrature's relative tolerance TS_TRACK_RTOL times distances of
  * tens of m, summed over up to 100 stretches, with margin. */
@@ -160,6 +171,17 @@ static void test_simulated_turn(const ts_units *u)
         CHECK(tow < TOL_TRACK,
               "the tow point's earth y is V/Omega (1 - cos Omega t) to %.2g m",
               tow);
+        /* The full state's JSON carries the poses. */
+        json_t *o = json_object();
+        int jrc = ts_report_history_full(o, sys, h);
+        json_t *hd = json_object_get(json_object_get(o, "frame"), "heading");
+        int i = h->nsamples - 1;
+        CHECK(jrc == TS_OK && json_array_size(hd) == (size_t)h->nsamples &&
+                  json_real_value(json_array_get(hd, (size_t)i)) ==
+                      h->frame[3 * i + 2],
+              "the full state's JSON has the frame's heading, %g rad at "
+              "%g s", h->frame[3 * i + 2], h->t[i]);
+        json_decref(o);
     }
     ts_result_free(r);
 
@@ -175,6 +197,155 @@ static void test_simulated_turn(const ts_units *u)
           "earth_z refused: %.90s", err.msg);
     ts_request_clear(&rq);
     ts_scene_free(sc);
+}
+
+/* A towing vehicle (test/scenes/towing_sphere.yaml, 1500 N of thrust)
+ * given a thrust step of +500 N: its steady speed over the ground, from
+ * the earth track of its tow point over the last 20 s of a 150 s run,
+ * against the Newton trim of the same scene at 2000 N (the equilibrium's
+ * solved speed). */
+static void test_speed_change(const ts_units *u)
+{
+    ts_scene *sc = tscene_load(u, "test/scenes/towing_sphere.yaml");
+    if (!sc)
+        return;
+    /* The trim at 2000 N: the same text with the thrust replaced. */
+    const char *at = strstr(sc->text, "thrust: 1500 N");
+    ts_scene *s2 = NULL;
+    if (CHECK(at != NULL, "the scene gives 1500 N of thrust")) {
+        size_t n = strlen(sc->text), k = (size_t)(at - sc->text);
+        char *t2 = malloc(n + 1);
+        if (!t2)
+            return;
+        memcpy(t2, sc->text, n + 1);
+        memcpy(t2 + k, "thrust: 2000 N", 14);
+        s2 = tscene_parse(u, t2);
+        free(t2);
+    }
+    ts_err err = {0};
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_EQUILIBRIUM);
+    ts_result *eq = NULL;
+    int rc = s2 ? ts_analysis_run(s2->system, &rq, &eq, &err) : TS_EINVAL;
+    double U2 = rc == TS_OK && eq && eq->eq ? eq->eq->speed : NAN;
+    CHECK(rc == TS_OK && isfinite(U2), "Newton trim at 2000 N: %.9f m/s "
+          "(%s)", U2, err.msg);
+    ts_result_free(eq);
+    ts_request_clear(&rq);
+
+    ts_request_init(&rq, TS_ANALYSIS_SIMULATE);
+    rq.simulate.sim.t_end = 150;
+    rq.simulate.sim.dt_sample = 1;
+    snprintf(rq.simulate.outputs, sizeof rq.simulate.outputs,
+             "tow.earth_x,tow.earth_y");
+    rq.simulate.excitation = ts_excitation_alloc(&err);
+    ts_excitation_parse(rq.simulate.excitation,
+                        "tug.thrust:step,amplitude=500,rise=1", u, "test",
+                        &err);
+    ts_result *r = NULL;
+    rc = ts_analysis_run(sc->system, &rq, &r, &err);
+    if (CHECK(rc == TS_OK && r && r->nonlinear,
+              "thrust step of the towing vehicle simulated (%s)", err.msg)) {
+        const ts_history *h = r->nonlinear;
+        int i1 = h->nsamples - 1, i0 = i1 - 20;
+        double dx = ts_history_value(r->sys, h, &r->outputs[0], i1) -
+                    ts_history_value(r->sys, h, &r->outputs[0], i0);
+        double dy = ts_history_value(r->sys, h, &r->outputs[1], i1) -
+                    ts_history_value(r->sys, h, &r->outputs[1], i0);
+        double U = hypot(dx, dy) / (h->t[i1] - h->t[i0]);
+        /* The surge settles in a few tens of seconds; what is left of
+         * the transient at 150 s (the sphere's slower depth change) is
+         * 2e-5 relative: tolerance 1e-4. */
+        CHECK(fabs(U - U2) <= 1e-4 * U2,
+              "steady speed reached by simulation %.6f m/s, Newton's %.6f "
+              "m/s (rel. diff %.2g)", U, U2, fabs(U - U2) / U2);
+    }
+    ts_result_free(r);
+    ts_request_clear(&rq);
+    ts_scene_free(s2);
+    ts_scene_free(sc);
+}
+
+/* The constant-power law in the time domain: the towing vehicle of
+ * test/scenes/towing_sphere.yaml driven at a power P = 4800 W (in place of
+ * its thrust), slowed by a step of -800 N along its axis (the input
+ * tug.force.x): at every sample of the 60 s run its thrust times its
+ * surge speed through the water is P, while the thrust changes. */
+static void test_constant_power(const ts_units *u)
+{
+    const char *path = "test/scenes/towing_sphere.yaml";
+    ts_scene *sc = tscene_load(u, path);
+    if (!sc)
+        return;
+    const char *at = strstr(sc->text, "    thrust: 1500 N\n");
+    ts_scene *sp = NULL;
+    if (at) {
+        const char *law = "    power: 4800 W\n    max_thrust: 5000 N\n";
+        size_t n = strlen(sc->text), k = (size_t)(at - sc->text);
+        size_t old = strlen("    thrust: 1500 N\n"), nl = strlen(law);
+        char *t = malloc(n - old + nl + 1);
+        if (t) {
+            memcpy(t, sc->text, k);
+            memcpy(t + k, law, nl);
+            memcpy(t + k + nl, at + old, n - k - old + 1);
+            sp = tscene_parse(u, t);
+            free(t);
+        }
+    }
+    ts_scene_free(sc);
+    if (!CHECK(sp != NULL, "the scene at constant power"))
+        return;
+    ts_err err = {0};
+    const ts_system *sys = sp->system;
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_history *h = ts_history_alloc(sys, 61, &err);
+    double *y0 = k ? malloc((size_t)ts_kernel_nstate(k) * sizeof *y0) : NULL;
+    ts_equilibrium_opts eo;
+    ts_equilibrium_opts_default(&eo);
+    int rc = k && eq && ex && h && y0 ? ts_equilibrium_solve(k, &eo, eq, &err)
+                                      : TS_ENOMEM;
+    if (rc == TS_OK)
+        rc = ts_equilibrium_state(k, eq, y0, &err);
+    if (rc == TS_OK)
+        rc = ts_excitation_parse(ex, "tug.force.x:step,amplitude=-800,rise=2",
+                                 u, "test", &err);
+    ts_sim_opts o;
+    ts_sim_opts_default(&o);
+    ts_sim *sim = rc == TS_OK ? ts_sim_alloc(k, ex, &o, &err) : NULL;
+    if (CHECK(sim && ts_sim_set_state(sim, 0, y0, &err) == TS_OK,
+              "constant power: trimmed at %.6f m/s and started (%s)",
+              eq ? eq->speed : NAN, err.msg)) {
+        int root = ts_kernel_root(k);
+        double worst = 0, tmin = INFINITY, tmax = 0;
+        for (int i = 0; i <= 60 && rc == TS_OK; i++) {
+            if (i > 0)
+                rc = ts_sim_advance(sim, i, &err);
+            if (rc == TS_OK)
+                rc = ts_sim_record(sim, h, &err);
+            ts_vehicle_result vr;
+            ts_kernel_vehicle_result(k, root, &vr);
+            worst = fmax(worst, fabs(vr.power - 4800.0));
+            tmin = fmin(tmin, vr.thrust);
+            tmax = fmax(tmax, vr.thrust);
+        }
+        CHECK(rc == TS_OK, "60 s simulated (%s)", err.msg);
+        /* T = P / U exactly, so T U = P to rounding (1e-12 relative). */
+        CHECK(worst <= 1e-12 * 4800.0,
+              "T U = P = 4800 W at every sample to %.2g W while the thrust "
+              "went from %.1f to %.1f N", worst, tmin, tmax);
+        CHECK(tmax - tmin > 0.05 * tmax,
+              "the speed changed: the thrust by %.1f %%",
+              100 * (tmax - tmin) / tmax);
+    }
+    ts_sim_free(sim);
+    free(y0);
+    ts_history_free(h);
+    ts_excitation_free(ex);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_scene_free(sp);
 }
 
 static void test_bad(void)
@@ -200,6 +371,8 @@ int main(void)
     test_ramped_turn(u);
     test_to_earth();
     test_simulated_turn(u);
+    test_speed_change(u);
+    test_constant_power(u);
     test_bad();
     ts_units_free(u);
     return tc_done();

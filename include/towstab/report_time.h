@@ -47,8 +47,10 @@ TS_API json_t *ts_report_channels_json(const ts_system *sys,
                                        const ts_output outs[]);
 
 /* The full state of h added to the object o: "nodes" (every node's x, y,
- * z), and for a nonlinear run "tensions", "tow_force" {"x", "y", "z"}
- * and "energy" (as ts_report_history_json). TS_OK or TS_ENOMEM. */
+ * z), "frame" {"x", "y", "heading"} (M's pose in the earth frame, m and
+ * rad, towstab/track.h; once h->frame is filled), and for a nonlinear run
+ * "tensions", "tow_force" {"x", "y", "z"} and "energy" (as
+ * ts_report_history_json). TS_OK or TS_ENOMEM. */
 TS_API int ts_report_history_full(json_t *o, const ts_system *sys,
                                   const ts_history *h);
 

@@ -8,10 +8,11 @@
  * (towstab/excitation.h). Explicit adaptive Runge-Kutta (rk8pd, rkf45) or
  * implicit methods for stiff scenes (GSL's rk4imp, bsimp, msbdf, and
  * esdirk: SUNDIALS ARKODE's L-stable ESDIRK 5(4), the one for elastic
- * cables) whose Jacobian df/dy comes from the linearizer
+ * cables; bdf: SUNDIALS CVODE's BDF of order 1-2 with the same Newton
+ * matrix) whose Jacobian df/dy comes from the linearizer
  * (towstab/linearize.h): GSL's the dense A, O(nlinks^2) per Jacobian and
- * O(nlinks^3) per LU; esdirk's the sparse model, O(nlinks) per Jacobian,
- * factorisation and solve. A run starts from ts_sim_start_state of its
+ * O(nlinks^3) per LU; esdirk's and bdf's the sparse model, O(nlinks) per
+ * Jacobian, factorisation and solve. A run starts from ts_sim_start_state of its
  * initial state (an impulsive start absorbed by the top links). Steps never
  * straddle an output time or a breakpoint of the excitation. After every
  * accepted step, links with |cos theta2| below the re-chart threshold are
@@ -52,8 +53,11 @@ typedef enum {
     TS_INT_RK4IMP = 2,  /* implicit Gauss 4th order (Jacobian) */
     TS_INT_BSIMP = 3,   /* implicit Bulirsch-Stoer, Bader-Deuflhard (Jacobian) */
     TS_INT_MSBDF = 4,   /* variable-order BDF, stiff (Jacobian) */
-    TS_INT_ESDIRK = 5   /* L-stable ESDIRK 5(4), SUNDIALS ARKODE, stiff and
+    TS_INT_ESDIRK = 5,  /* L-stable ESDIRK 5(4), SUNDIALS ARKODE, stiff and
                            lightly damped: elastic cables (Jacobian) */
+    TS_INT_BDF = 6      /* BDF of order 1-2 (A- and L-stable), SUNDIALS
+                           CVODE, with esdirk's Newton matrix: elastic
+                           cables at loose tolerances (Jacobian) */
 } ts_integrator;
 
 typedef enum {
@@ -110,7 +114,8 @@ TS_API int ts_sim_nsamples(const ts_sim_opts *o);
 TS_API double ts_sim_sample_time(const ts_sim_opts *o, int i);
 
 TS_API const char *ts_integrator_name(ts_integrator m);
-/* Parse "rk8pd", "rkf45", "rk4imp", "bsimp", "msbdf", "esdirk": 0 or -1. */
+/* Parse "rk8pd", "rkf45", "rk4imp", "bsimp", "msbdf", "esdirk", "bdf": 0
+ * or -1. */
 TS_API int ts_integrator_parse(const char *name, ts_integrator *m);
 
 /* Work statistics of a run. */

@@ -4,9 +4,10 @@
  * (examples/kamman_ex1_submerged.yaml) and in a towfish
  * (examples/kamman_ex1_vehicle.yaml), and of the controlled AURORA-like
  * towfish (examples/aurora_towfish.yaml: 5 control surfaces, 3 loops),
- * the kernel at 10 to 10000 links, the solve at 10 to 100. The vehicle
+ * the kernel at 10 to 10000 links, the solve at 10 to 1000. The vehicle
  * adds O(1) work per kernel call: the difference to the sphere stays flat
- * as the links grow. Medians of 9 kernel samples and of 3 solves. */
+ * as the links grow; its trim is shooting, O(links) per outer
+ * iteration. Medians of 9 kernel samples and of 3 solves. */
 #include "bench_common.h"
 #include "towstab/equilibrium.h"
 #include "towstab/kernel.h"
@@ -42,21 +43,25 @@ static double eval_time(const ts_system *sys)
     return med;
 }
 
-/* The equilibrium from scratch (s, median of 3) and its iterations; NAN
- * when it fails. */
-static double solve_time(const ts_system *sys, int *iterations)
+/* The equilibrium from scratch (s, median of 3; its CPU time in *cpu),
+ * its iterations and method; NAN when it fails. */
+static double solve_time(const ts_system *sys, int *iterations,
+                         const char **method, double *cpu)
 {
     ts_equilibrium *eq = ts_equilibrium_alloc(sys, NULL);
-    double t[3];
+    double t[3], c[3];
     int ok = eq != NULL;
     for (int r = 0; ok && r < 3; r++) {
         ts_kernel *k = ts_kernel_alloc(sys, NULL);
-        double t0 = bench_now();
+        double t0 = bench_now(), c0 = bench_cpu_now();
         ok &= k && ts_equilibrium_solve(k, NULL, eq, NULL) == TS_OK;
         t[r] = bench_now() - t0;
+        c[r] = bench_cpu_now() - c0;
         ts_kernel_free(k);
     }
+    *cpu = ok ? bench_median(c, 3) : NAN;
     *iterations = ok ? eq->iterations : 0;
+    *method = ok && eq->method == TS_EQ_SHOOTING ? "shooting" : "newton";
     ts_equilibrium_free(eq);
     return ok ? bench_median(t, 3) : NAN;
 }
@@ -80,7 +85,7 @@ int main(void)
     static const char *const labels[3] = {"ex1 + sphere", "ex1 + vehicle",
                                           "AURORA (3 loops)"};
     static const int ksizes[4] = {10, 100, 1000, 10000};
-    static const int esizes[3] = {10, 30, 100};
+    static const int esizes[3] = {10, 100, 1000};
     setvbuf(stdout, NULL, _IOLBF, 0);
     ts_units *u = ts_units_alloc(NULL);
     ts_scene *sc[3] = {NULL, NULL, NULL};
@@ -100,16 +105,18 @@ int main(void)
                    te * 1e6, te * 1e9 / ksizes[s]);
             ts_system_free(sys);
         }
-    printf("\n%-18s %6s %16s %6s\n", "equilibrium", "links", "solve [ms]",
-           "iter");
+    printf("\n%-18s %6s %12s %10s %6s  %s\n", "equilibrium", "links",
+           "solve [ms]", "CPU [ms]", "iter", "method");
     for (int s = 0; s < 3 && !bad; s++)
         for (int i = 0; i < 3; i++) {
             ts_system *sys = at_links(sc[i], esizes[s]);
             int it = 0;
-            double ts = sys ? solve_time(sys, &it) : NAN;
+            const char *method = "";
+            double cpu = NAN;
+            double ts = sys ? solve_time(sys, &it, &method, &cpu) : NAN;
             bad |= !isfinite(ts);
-            printf("%-18s %6d %16.3f %6d\n", labels[i], esizes[s], ts * 1e3,
-                   it);
+            printf("%-18s %6d %12.3f %10.3f %6d  %s\n", labels[i],
+                   esizes[s], ts * 1e3, cpu * 1e3, it, method);
             ts_system_free(sys);
         }
     for (int i = 0; i < 3; i++)

@@ -131,31 +131,43 @@ bad "--sample" "$EX4" --sample 0.5 --excite tow.heave:amplitude=0.1ft,frequency=
 bad "--frobnicate" "$EX5" --frobnicate
 
 # Vehicles: a depth change (a step of the depth set point, a vehicle's
-# input) with the controllers, linear against nonlinear; a turn with the
-# controllers (nonlinear); the vehicles' outputs in the CSV and JSON.
+# input) with the controllers, linear against nonlinear, compared on the
+# vehicle's depth; a turn with the controllers (nonlinear); the channels
+# asked for, vehicles' outputs and tensions among them, in the CSV and
+# JSON, and no others.
 A=examples/aurora_towfish.yaml
 fresh
 ts simulate $A --links 10 --excite aurora.depth.setpoint:amplitude=1m,start=1s,rise=2s \
-    --t-end 20 --sample 0.5 --output aurora.z --compare --quiet \
+    --t-end 20 --sample 0.5 --output aurora.depth --compare --quiet \
+    --outputs aurora.depth,aurora.wing.deflection,armoured.3.tension \
     --csv "$T/o/dc.csv" --json "$T/o/dc.json"
 if [ "$status" -eq 0 ] && [ "$(wc -l <"$T/o/dc.csv")" -eq 42 ] &&
-   head -1 "$T/o/dc.csv" | grep -q 'nonlinear.aurora.depth_m' &&
-   head -1 "$T/o/dc.csv" | grep -q 'linear.aurora.wing.deflection_rad' &&
+   [ "$(head -1 "$T/o/dc.csv")" = "t_s,nonlinear.aurora.depth_m,nonlinear.aurora.wing.deflection_deg,nonlinear.armoured.3.tension_N,linear.aurora.depth_m,linear.aurora.wing.deflection_deg,linear.armoured.3.tension_N" ] &&
    grep -q '"aurora.wing.deflection"' "$T/o/dc.json" &&
+   ! grep -q '"aurora.pitch"' "$T/o/dc.json" &&
    grep -q '"input": "aurora.depth.setpoint"' "$T/o/dc.json" &&
-   grep -q '^comparison of aurora.z' "$T/out"; then
-    pass "depth change with --compare: 41 samples, depth and deflections in the CSV and JSON"
+   grep -q '^comparison of aurora.depth' "$T/out" &&
+   grep -q '^mean offset \[m\] *1.00' "$T/out"; then
+    pass "depth change with --compare on aurora.depth: 41 samples, the depth, a deflection and a tension in the CSV and JSON, nothing else; both runs' mean offsets 1.00 m"
 else
-    fail "depth change: status $status; $(head -c 300 "$T/err")"
+    fail "depth change: status $status; $(head -c 300 "$T/err"); $(head -1 "$T/o/dc.csv")"
 fi
 fresh
 ts simulate $A --links 10 --manoeuvre turn_rate:to=0.02rad/s,duration=5s \
-    --t-end 10 --sample 1 --quiet --csv "$T/o/turn.csv"
-if [ "$status" -eq 0 ] && head -1 "$T/o/turn.csv" | grep -q 'aurora.yaw_rad'; then
-    pass "turn with the controllers: the vehicle's yaw in the CSV"
+    --t-end 10 --sample 1 --quiet --outputs aurora.yaw,aurora.roll --csv "$T/o/turn.csv"
+if [ "$status" -eq 0 ] && [ "$(head -1 "$T/o/turn.csv")" = "t_s,aurora.yaw_deg,aurora.roll_deg" ]; then
+    pass "turn with the controllers: the vehicle's yaw and roll in the CSV"
 else
-    fail "turn: status $status; $(head -c 300 "$T/err")"
+    fail "turn: status $status; $(head -c 300 "$T/err"); $(head -1 "$T/o/turn.csv")"
 fi
+fresh
+ts simulate $A --links 10 --t-end 1 --sample 1 --quiet --csv "$T/o/def.csv"
+if [ "$status" -eq 0 ] && ! head -1 "$T/o/def.csv" | grep -q 'aurora.depth'; then
+    pass "without --outputs no vehicle output is written"
+else
+    fail "default outputs: status $status; $(head -1 "$T/o/def.csv")"
+fi
+bad "vehicles: aurora.depth" $A --links 10 --t-end 1 --outputs aurora.dpeth
 bad "aurora.bogus" $A --links 10 --excite aurora.bogus:amplitude=1m
 bad "expected an angle" $A --links 10 --excite aurora.wing:amplitude=1m
 bad "crank" $A --links 10 --excite aurora.wing:crank,amplitude=1deg,frequency=1Hz,rod=1m
