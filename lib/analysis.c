@@ -520,16 +520,36 @@ int ts_result_equilibrium_values(const ts_result *r, ts_value **values,
 }
 
 /* Solve the equilibrium of r->sys with kernel k (re-charted by the
- * solver). Its own verdict goes to r->eq_trust. */
-static int run_equilibrium(ts_result *r, ts_kernel *k,
-                           const ts_equilibrium_opts *eo, ts_err *err)
+ * solver), with the request's equilibrium options and its progress
+ * callback (unless the options have their own). Its own verdict goes to
+ * r->eq_trust. */
+static int run_equilibrium(ts_result *r, ts_kernel *k, const ts_request *rq,
+                           ts_err *err)
 {
+    /* A stop asked for before (during the setup, or a stage that cannot
+     * poll: a shooting solve, a linearization) is taken here. */
+    ts_progress p = {"equilibrium", 0, 1, "solves"};
+    if (rq->progress && rq->progress(&p, rq->progress_data))
+        return ts_fail(err, TS_ECANCEL, "equilibrium: stopped on request "
+                                        "before it started");
     r->eq = ts_equilibrium_alloc(r->sys, err);
     if (!r->eq)
         return err && err->code ? err->code : TS_ENOMEM;
+    ts_equilibrium_opts eo = rq->setup.equilibrium;
+    if (!eo.progress) {
+        eo.progress = rq->progress;
+        eo.progress_data = rq->progress_data;
+    }
     double t0 = tsi_wall_now();
-    int rc = ts_equilibrium_solve(k, eo, r->eq, err);
+    int rc = ts_equilibrium_solve(k, &eo, r->eq, err);
     r->eq_wall_s = tsi_wall_now() - t0;
+    /* A stop asked for in the part of the solve that does not poll (a
+     * shooting solve, the last LU factorisation) is taken here; the
+     * equilibrium is kept as solved. */
+    p.done = 1;
+    if (rc == TS_OK && rq->progress && rq->progress(&p, rq->progress_data))
+        rc = ts_fail(err, TS_ECANCEL, "equilibrium: stopped on request "
+                                      "after it converged");
     r->eq_attempted = rc != TS_EINVAL && rc != TS_EDOMAIN;
     r->evaluations += r->eq->evaluations;
     if (rc == TS_OK)
@@ -573,7 +593,7 @@ static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
                                    const ts_linearize_opts *lo, ts_err *err)
 {
     ts_kernel *k = ts_kernel_alloc(r->sys, err);
-    int rc = k ? run_equilibrium(r, k, &rq->setup.equilibrium, err)
+    int rc = k ? run_equilibrium(r, k, rq, err)
                : (err && err->code ? err->code : TS_ENOMEM);
     ts_kernel_free(k);
     if (rc != TS_OK) {
@@ -590,7 +610,7 @@ static int pipeline_equilibrium(ts_result *r, const ts_request *rq,
                                 ts_err *err)
 {
     ts_kernel *k = ts_kernel_alloc(r->sys, err);
-    int rc = k ? run_equilibrium(r, k, &rq->setup.equilibrium, err)
+    int rc = k ? run_equilibrium(r, k, rq, err)
                : (err && err->code ? err->code : TS_ENOMEM);
     ts_kernel_free(k);
     if (rc == TS_OK)
@@ -847,9 +867,26 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     if (rc != TS_OK)
         return rc;
     ts_eigen_opts o = modes_eigen_opts(m, r->lin->nstate);
+    o.progress = rq->progress;
+    o.progress_data = rq->progress_data;
+    /* LAPACK's one call cannot be polled: a stop asked for during the
+     * equilibrium or the linearization is taken here, before it. */
+    ts_progress p = {"eigensolve", 0, NAN, "operator applications"};
+    if (rq->progress && rq->progress(&p, rq->progress_data))
+        return ts_fail(err, TS_ECANCEL, "modes: stopped on request after "
+                                        "the equilibrium and the "
+                                        "linearization, before the "
+                                        "eigensolve");
     double t0 = tsi_wall_now();
     rc = ts_eigen_solve(r->lin, &o, &r->eigen, err);
     r->eigen_wall_s = tsi_wall_now() - t0;
+    /* A stop asked for during LAPACK's call is taken after it. */
+    p.done = r->eigen ? r->eigen->arpack_ops : 0;
+    if (rc == TS_OK && rq->progress && rq->progress(&p, rq->progress_data))
+        return ts_fail(err, TS_ECANCEL, "modes: stopped on request after "
+                                        "the eigensolve (%s), before the "
+                                        "modes' checks",
+                       ts_eig_method_name(r->eigen->method));
     if (rc == TS_OK)
         rc = select_modes(r, m, err);
     if (rc != TS_OK)
@@ -1014,6 +1051,8 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     ts_seastate_opts_default(&so);
     so.intervals = o->intervals;
     so.duration = o->duration;
+    so.progress = rq->progress;
+    so.progress_data = rq->progress_data;
     if (rc == TS_OK)
         rc = ts_seastate_compute(r->sys, r->lin, &r->seaway, &out, &so,
                                  &r->seastate, err);
@@ -1995,7 +2034,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     /* Initial state. */
     if (rc == TS_OK && s->initial == TS_INITIAL_EQUILIBRIUM) {
         snprintf(r->initial, sizeof r->initial, "equilibrium");
-        rc = run_equilibrium(r, k, &rq->setup.equilibrium, err);
+        rc = run_equilibrium(r, k, rq, err);
         if (rc) {
             ts_err_prefix(err, "simulate: the initial equilibrium: ");
         } else {

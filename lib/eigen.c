@@ -68,6 +68,8 @@ void ts_eigen_opts_default(ts_eigen_opts *o)
     o->arpack_max_iter = 1000;
     o->vectors = 1;
     o->rightmost = 1;
+    o->progress = NULL;
+    o->progress_data = NULL;
 }
 
 const char *ts_eig_method_name(ts_eig_method m)
@@ -678,6 +680,39 @@ static const char *arpack_info_text(int info)
     }
 }
 
+/* Where an ARPACK run reports its progress (ts_eigen_opts.progress):
+ * `what`, and `shift` of `shifts` for a run of the rightmost search (its
+ * shifts are the measure), or shifts NAN: the operator applications. */
+typedef struct eig_poll {
+    const ts_eigen_opts *o;
+    const char *what;
+    double shift, shifts;
+} eig_poll;
+
+/* TS_OK to go on, TS_ECANCEL (message set) when the callback asks to
+ * stop, after `ops` operator applications of the run. */
+static int eig_poll_check(const eig_poll *pp, int ops, ts_err *err)
+{
+    if (!pp->o->progress)
+        return TS_OK;
+    int search = !isnan(pp->shifts);
+    ts_progress p = {pp->what, search ? pp->shift : ops,
+                     search ? pp->shifts : NAN,
+                     search ? "shifts" : "operator applications"};
+    if (!pp->o->progress(&p, pp->o->progress_data))
+        return TS_OK;
+    if (search)
+        return ts_fail(err, TS_ECANCEL, "eigen: stopped on request in the "
+                                        "rightmost search, at shift %.0f "
+                                        "of %.0f",
+                       pp->shift + 1, pp->shifts);
+    return ts_fail(err, TS_ECANCEL, "eigen: stopped on request in ARPACK's "
+                                    "run after %d operator applications "
+                                    "(no eigenvalue is final before the "
+                                    "run ends)",
+                   ops);
+}
+
 static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
                              ts_eigen *e, cand_list *L, ts_err *err)
 {
@@ -714,6 +749,9 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
                 ipntr, workd, workl, &lworkl, &info, 1, 2);
         if (ido != -1 && ido != 1)
             break;
+        eig_poll pp = {o, "eigensolve", 0, NAN};
+        if ((rc = eig_poll_check(&pp, e->arpack_ops, err)) != TS_OK)
+            goto out;
         tsi_shift_solve_real(&sh, workd + ipntr[0] - 1, workd + ipntr[1] - 1);
         e->arpack_ops++;
     }
@@ -785,7 +823,8 @@ typedef struct arpack_stats {
  * double). */
 static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
                        int ncv, double tol, int maxiter, int partial,
-                       cand_list *L, arpack_stats *st, ts_err *err)
+                       const eig_poll *pp, cand_list *L, arpack_stats *st,
+                       ts_err *err)
 {
     int n = lin->nstate, rc;
     tsi_shift sh;
@@ -818,6 +857,8 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
                 ipntr, workd, workl, &lworkl, rwork, &info, 1, 2);
         if (ido != -1 && ido != 1)
             break;
+        if ((rc = eig_poll_check(pp, st->ops, err)) != TS_OK)
+            goto out;
         tsi_shift_solve(&sh, workd + ipntr[0] - 1, workd + ipntr[1] - 1);
         st->ops++;
     }
@@ -908,8 +949,9 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
     if (cand_init(L, nev + 1, lin->nstate) != TS_OK)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     arpack_stats st = {0, 0, 0, 0};
+    eig_poll pp = {o, "eigensolve", 0, NAN};
     rc = arpack_near(lin, I * 2.0 * M_PI * o->target_hz, nev, ncv,
-                     o->arpack_tol, o->arpack_max_iter, 0, L, &st, err);
+                     o->arpack_tol, o->arpack_max_iter, 0, &pp, L, &st, err);
     e->arpack_iterations = st.iterations;
     e->arpack_ops = st.ops;
     e->arpack_nconv = st.nconv;
@@ -1054,18 +1096,20 @@ static int sweep_new(cand_list *L, int from, double complex sigma,
 /* One run of the search at sigma; best and radius as sweep_new. A shift
  * exactly on an eigenvalue is moved by 1e-9 of itself once. */
 static int sweep_run(const ts_linear *lin, const ts_eigen_opts *o,
-                     double complex sigma, cand_list *L, arpack_stats *st,
-                     int *best, double *radius, ts_err *err)
+                     double complex sigma, int shift, int shifts,
+                     cand_list *L, arpack_stats *st, int *best,
+                     double *radius, ts_err *err)
 {
     int from = L->n, ncv = SWEEP_NCV < lin->nstate ? SWEEP_NCV : lin->nstate;
     int nev = SWEEP_NEV < ncv - 2 ? SWEEP_NEV : ncv - 2;
     double tol = o->arpack_tol > 0 ? o->arpack_tol : SWEEP_TOL;
-    int rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, L, st,
-                         err);
+    eig_poll pp = {o, "rightmost search", shift, shifts};
+    int rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, &pp, L,
+                         st, err);
     if (rc == TS_ESINGULAR) {
         sigma *= 1.0 + 1e-9;
         rc = arpack_near(lin, sigma, nev, ncv, tol,
-                         SWEEP_RESTARTS, 1, L, st, err);
+                         SWEEP_RESTARTS, 1, &pp, L, st, err);
     }
     if (rc != TS_OK)
         return rc;
@@ -1124,7 +1168,8 @@ static int rightmost_search(const ts_linear *lin, const ts_eigen_opts *o,
     for (int i = 0; i < nu && rc == TS_OK; i++) {
         int best;
         double r;
-        rc = sweep_run(lin, o, I * seed[i], L, &st, &best, &r, err);
+        rc = sweep_run(lin, o, I * seed[i], i, nu + SWEEP_CLIMBS * SWEEP_STEPS,
+                       L, &st, &best, &r, err);
         if (rc == TS_ECONV) {
             /* A run that did not converge leaves a gap, counted; it does
              * not make the analysis fail. */
@@ -1166,7 +1211,9 @@ static int rightmost_search(const ts_linear *lin, const ts_eigen_opts *o,
                 break;
             w = cimag(lb);
             int nb;
-            rc = sweep_run(lin, o, I * w, L, &st, &nb, &r, err);
+            rc = sweep_run(lin, o, I * w, shifts,
+                           nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &nb, &r,
+                           err);
             shifts++;
             if (rc == TS_ECONV) {
                 e->sweep_failed++;

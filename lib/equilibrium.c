@@ -76,6 +76,8 @@ void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
     o->max_iter = 100;
     o->method = TS_EQ_AUTO;
     o->guess = NULL;
+    o->progress = NULL;
+    o->progress_data = NULL;
 }
 
 int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
@@ -298,6 +300,9 @@ typedef struct newton_ws {
     int ux, uy;
     int x_is_bias;  /* 1: ux is the thrust bias, 0: the speed */
     double rootpos[3]; /* the saved shape's root position */
+    ts_progress_fn progress; /* the caller's (ts_equilibrium_opts), or
+                                NULL */
+    void *progress_data;
 } newton_ws;
 
 /* Index in y of unknown i. */
@@ -540,13 +545,33 @@ static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
              sys->cables[L->cable].name, L->index);
 }
 
+/* Report `done` Jacobian columns of nu to the caller's progress callback:
+ * TS_OK to go on, TS_ECANCEL (message set) when it asks to stop. */
+static int poll_progress(const newton_ws *w, int done, const ts_equilibrium *eq,
+                         ts_err *err)
+{
+    if (!w->progress)
+        return TS_OK;
+    ts_progress p = {"equilibrium", done, w->nu, "Jacobian columns"};
+    if (!w->progress(&p, w->progress_data))
+        return TS_OK;
+    return ts_fail(err, TS_ECANCEL, "equilibrium: stopped on request in "
+                                    "Newton iteration %d (%d of %d Jacobian "
+                                    "columns formed)",
+                   eq->iterations, done, w->nu);
+}
+
 /* The Jacobian of (q'', c') at y by central differences, column by
  * column, and its LU and condition in w (w->R holds f(y)). */
+
 static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
                     ts_err *err)
 {
     int nq = w->nq, nu = w->nu;
     for (int j = 0; j < nu; j++) {
+        int prc = poll_progress(w, j, eq, err);
+        if (prc != TS_OK)
+            return prc;
         double h = NEWTON_FD_STEP * w->scale[j], y0 = uget(k, w, y, j);
         uset(k, w, y, j, y0 + h);
         int r1 = ts_kernel_eval(k, y, NULL, w->f1);
@@ -563,6 +588,9 @@ static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
         for (int i = 0; i < nu; i++)
             col[i] = (w->f1[nq + i] - w->f2[nq + i]) / (2 * h);
     }
+    int prc = poll_progress(w, nu, eq, err);
+    if (prc != TS_OK)
+        return prc;
     int info = 0;
     w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
     dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
@@ -595,7 +623,10 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         if (rel <= tol && crel <= tol) {
             /* A start that is already the answer (a straight tow with
              * vehicles) still gets the Jacobian its health needs. */
-            if (!w->have_lu && jacobian(k, y, w, eq, err) == TS_ECONV)
+            int jrc = w->have_lu ? TS_OK : jacobian(k, y, w, eq, err);
+            if (jrc == TS_ECANCEL)
+                return jrc;
+            if (jrc == TS_ECONV)
                 ts_err_clear(err);
             newton_health(k, y, w, eq);
             return TS_OK;
@@ -619,6 +650,12 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             break;
         eq->iterations++;
         rc = jacobian(k, y, w, eq, err);
+        if (rc == TS_ECANCEL)
+            return ts_fail(err, TS_ECANCEL, "equilibrium: stopped on "
+                                            "request in Newton iteration %d "
+                                            "at relative residual %.3g "
+                                            "(tolerance %.3g)",
+                           eq->iterations, rel, tol);
         if (rc == TS_ECONV)
             return rc;
         int one = 1, info = -rc;
@@ -887,7 +924,8 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             dt *= 2.0;
             continue;
         }
-        if (rc == TS_ENOMEM || dt <= CONTINUATION_MIN_STEP)
+        if (rc == TS_ENOMEM || rc == TS_ECANCEL ||
+            dt <= CONTINUATION_MIN_STEP)
             break;
         /* A path that keeps failing can halve its step ten times, each
          * try up to max_iter Newton iterations: bound the whole. */
@@ -907,7 +945,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
     }
     /* Name the continuation only where there was one: a straight tow has
      * no turn-rate path (its first Newton solve is the whole of it). */
-    if (rc != TS_OK && rc != TS_ENOMEM) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
         ts_frame f;
         ts_kernel_get_frame(k, &f);
         if (path == bending_path)
@@ -1693,6 +1731,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                            "memory for a %d x %d Newton Jacobian", nj, nj);
         goto out;
     }
+    w.progress = o.progress;
+    w.progress_data = o.progress_data;
     if (ro >= 0 && w.x_is_bias) {
         /* A speed controller holds its set speed: the bias is solved. */
         ts_frame f;
@@ -1721,7 +1761,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
         eq->continuation_steps++;
     }
-    if (rc != TS_OK && rc != TS_ENOMEM) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
         /* From the straight-tow march (bending ignored), or hanging. */
         ts_frame straight = frame;
         straight.turn_rate = 0;

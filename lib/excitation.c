@@ -1306,14 +1306,34 @@ int ts_excitation_periodic(const ts_excitation *ex, int *index)
 void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
                             size_t size)
 {
+    ts_excitation_describe_display(ex, i, NULL, buf, size);
+}
+
+void ts_excitation_describe_display(const ts_excitation *ex, int i,
+                                    const ts_display *d, char *buf,
+                                    size_t size)
+{
     const ts_signal *s = &ex->sig[i];
+    d = ts_display_or_si(d);
     const char *an = ts_signal_axis_label(s);
-    const char *u = is_tow_axis(s->axis)       ? "m"
-                    : s->axis == TS_AXIS_INPUT ? (s->input_unit[0]
-                                                      ? s->input_unit
-                                                      : "(SI)")
-                    : s->axis == TS_AXIS_SPEED ? "m/s"
-                                               : "rad/s";
+    /* The amplitude's quantity; an input of no unit of its own stays as
+     * given. */
+    int q = is_tow_axis(s->axis)              ? TS_QTY_LENGTH
+            : s->axis == TS_AXIS_SPEED        ? TS_QTY_SPEED
+            : s->axis == TS_AXIS_TURN_RATE    ? TS_QTY_ANGULAR_RATE
+            : !strcmp(s->input_unit, "m")     ? TS_QTY_LENGTH
+            : !strcmp(s->input_unit, "rad")   ? TS_QTY_ANGLE
+                                              : -1;
+    const char *u = q >= 0 ? ts_display_unit(d, (ts_quantity)q) : "(SI)";
+    double ka = q >= 0 ? ts_display_value(d, (ts_quantity)q, 1.0) : 1.0;
+    double kl = ts_display_value(d, TS_QTY_LENGTH, 1.0);
+    double kt = ts_display_value(d, TS_QTY_TIME, 1.0);
+    double kf = ts_display_value(d, TS_QTY_FREQUENCY, 1.0);
+    const char *lu = ts_display_unit(d, TS_QTY_LENGTH);
+    const char *tu = ts_display_unit(d, TS_QTY_TIME);
+    const char *fu = ts_display_unit(d, TS_QTY_FREQUENCY);
+    const char *pu = ts_display_unit(d, TS_QTY_ANGLE);
+    double phase = ts_display_value(d, TS_QTY_ANGLE, s->phase);
     const char *what = s->absolute ? "to" : !is_manoeuvre(s->axis)
                                                 ? "amplitude" : "by";
     switch (s->type) {
@@ -1321,39 +1341,42 @@ void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
     case TS_SIGNAL_CRANK: {
         char start[96];
         if (s->ramp > 0)
-            snprintf(start, sizeof start, "smooth start over %.6g s (%.3g "
-                     "periods)", s->ramp, s->ramp * s->frequency);
+            snprintf(start, sizeof start, "smooth start over %.6g %s (%.3g "
+                     "periods)", kt * s->ramp, tu, s->ramp * s->frequency);
         else
             snprintf(start, sizeof start, "impulsive start");
         if (s->type == TS_SIGNAL_SINE)
             snprintf(buf, size, "%s sine amplitude %.6g %s, frequency "
-                     "%.6g Hz, phase %.6g deg, %s", an, s->amplitude, u,
-                     s->frequency, s->phase * 180.0 / M_PI, start);
+                     "%.6g %s, phase %.6g %s, %s", an, ka * s->amplitude, u,
+                     kf * s->frequency, fu, phase, pu, start);
         else
-            snprintf(buf, size, "%s slider crank radius %.6g m, rod %.6g m, "
-                     "frequency %.6g Hz, phase %.6g deg, %s", an,
-                     s->amplitude, s->rod, s->frequency,
-                     s->phase * 180.0 / M_PI, start);
+            snprintf(buf, size, "%s slider crank radius %.6g %s, rod %.6g "
+                     "%s, frequency %.6g %s, phase %.6g %s, %s", an,
+                     kl * s->amplitude, lu, kl * s->rod, lu,
+                     kf * s->frequency, fu, phase, pu, start);
         return;
     }
     case TS_SIGNAL_STEP:
-        snprintf(buf, size, "%s step %s %.6g %s at %.6g s, rise %.6g s", an,
-                 what, s->amplitude, u, s->start, s->rise);
+        snprintf(buf, size, "%s step %s %.6g %s at %.6g %s, rise %.6g %s", an,
+                 what, ka * s->amplitude, u, kt * s->start, tu, kt * s->rise,
+                 tu);
         return;
     case TS_SIGNAL_RAMP:
-        snprintf(buf, size, "%s ramp %s %.6g %s from %.6g s over %.6g s, "
-                 "corners %.6g s", an, what, s->amplitude, u, s->start,
-                 s->duration, s->rise);
+        snprintf(buf, size, "%s ramp %s %.6g %s from %.6g %s over %.6g %s, "
+                 "corners %.6g %s", an, what, ka * s->amplitude, u,
+                 kt * s->start, tu, kt * s->duration, tu, kt * s->rise, tu);
         return;
     case TS_SIGNAL_SERIES:
-        snprintf(buf, size, "%s series (cubic spline) on [%.6g, %.6g] s, "
-                 "spacing >= %.6g s", an, s->start, s->start + s->duration,
-                 ex->series_dt[i]);
+        snprintf(buf, size, "%s series (cubic spline) on [%.6g, %.6g] %s, "
+                 "spacing >= %.6g %s", an, kt * s->start,
+                 kt * (s->start + s->duration), tu, kt * ex->series_dt[i],
+                 tu);
         return;
     case TS_SIGNAL_SUM:
-        snprintf(buf, size, "%s sum of %d sinusoids up to %.6g Hz, rms %.6g "
-                 "m, fade-in %.6g s", an, ex->sum[i]->n, s->frequency,
-                 s->amplitude, s->rise);
+        snprintf(buf, size, "%s sum of %d sinusoids up to %.6g %s, rms %.6g "
+                 "%s, fade-in %.6g %s", an, ex->sum[i]->n,
+                 kf * s->frequency, fu, kl * s->amplitude, lu, kt * s->rise,
+                 tu);
         return;
     }
     snprintf(buf, size, "%s ?", an);

@@ -9,6 +9,8 @@
  * whole number of links). Names may contain dots only where the scene
  * allows them not to: cable and body names are matched whole against the
  * system's, longest first, so "cables.a.b.length" finds a cable "a.b".
+ * The table is the scene reader's too (param_impl.h): a key's unit and
+ * limit are stated once.
  */
 #include "towstab/param.h"
 
@@ -17,87 +19,102 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* How a row's value is stored. */
-enum {
-    K_PLAIN = 0,   /* a double at the offset */
-    K_WEIGHT,      /* weight: mass = value / g */
-    K_WET_WEIGHT,  /* weight in water: mass = value / g + rho volume */
-    K_LINKS,       /* a whole number of links */
-    K_VECTOR       /* component of a 3-vector (x, y, z) */
-};
+#include "param_impl.h"
 
-typedef struct row {
-    const char *key;
-    const char *unit;
-    double min;        /* lower limit, -INFINITY for none */
-    int strict;        /* 1: value > min, 0: value >= min */
-    int kind;
-    size_t offset;
-} row;
+typedef tsi_key row;
 
 #define CAB(m) offsetof(ts_cable, m)
 #define BOD(m) offsetof(ts_body, m)
 
 static const row tow_rows[] = {
-    {"speed", "m/s", 0, 0, K_PLAIN, offsetof(ts_tow, speed)},
-    {"turn_rate", "rad/s", -INFINITY, 0, K_PLAIN, offsetof(ts_tow, turn_rate)},
-    {"point", "m", -INFINITY, 0, K_VECTOR, offsetof(ts_tow, point)},
+    {"speed", "m/s", 0, 0, TSI_KEY_PLAIN, offsetof(ts_tow, speed)},
+    {"turn_rate", "rad/s", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_tow, turn_rate)},
+    {"point", "m", -INFINITY, 0, TSI_KEY_VECTOR, offsetof(ts_tow, point)},
 };
 
 static const row env_rows[] = {
-    {"water_density", "kg/m^3", 0, 0, K_PLAIN,
+    {"water_density", "kg/m^3", 0, 0, TSI_KEY_PLAIN,
      offsetof(ts_environment, water_density)},
-    {"gravity", "m/s^2", 0, 0, K_PLAIN, offsetof(ts_environment, gravity)},
-    {"current", "m/s", -INFINITY, 0, K_VECTOR,
+    {"gravity", "m/s^2", 0, 0, TSI_KEY_PLAIN, offsetof(ts_environment, gravity)},
+    {"current", "m/s", -INFINITY, 0, TSI_KEY_VECTOR,
      offsetof(ts_environment, current)},
 };
 
 static const row cable_rows[] = {
-    {"length", "m", 0, 1, K_PLAIN, CAB(length)},
-    {"diameter", "m", 0, 1, K_PLAIN, CAB(diameter)},
-    {"mass_per_length", "kg/m", 0, 0, K_PLAIN, CAB(mass_per_length)},
-    {"weight", "N/m", 0, 0, K_WEIGHT, CAB(mass_per_length)},
-    {"wet_weight", "N/m", -INFINITY, 0, K_WET_WEIGHT, CAB(mass_per_length)},
-    {"links", "1", 1, 0, K_LINKS, CAB(nlinks)},
-    {"normal_drag", "1", 0, 0, K_PLAIN, CAB(cdn)},
-    {"tangential_drag", "1", 0, 0, K_PLAIN, CAB(cdt)},
-    {"added_mass", "1", 0, 0, K_PLAIN, CAB(can)},
-    {"EI", "N*m^2", 0, 0, K_PLAIN, CAB(ei)},
-    {"EA", "N", 0, 0, K_PLAIN, CAB(ea)},
-    {"damping", "N*s/m", 0, 0, K_PLAIN, CAB(damping)},
+    {"length", "m", 0, 1, TSI_KEY_PLAIN, CAB(length)},
+    {"diameter", "m", 0, 1, TSI_KEY_PLAIN, CAB(diameter)},
+    {"mass_per_length", "kg/m", 0, 0, TSI_KEY_PLAIN, CAB(mass_per_length)},
+    {"weight", "N/m", 0, 0, TSI_KEY_WEIGHT, CAB(mass_per_length)},
+    {"wet_weight", "N/m", -INFINITY, 0, TSI_KEY_WET_WEIGHT, CAB(mass_per_length)},
+    {"links", "1", 1, 0, TSI_KEY_LINKS, CAB(nlinks)},
+    {"normal_drag", "1", 0, 0, TSI_KEY_PLAIN, CAB(cdn)},
+    {"tangential_drag", "1", 0, 0, TSI_KEY_PLAIN, CAB(cdt)},
+    {"added_mass", "1", 0, 0, TSI_KEY_PLAIN, CAB(can)},
+    {"EI", "N*m^2", 0, 0, TSI_KEY_PLAIN, CAB(ei)},
+    {"EA", "N", 0, 0, TSI_KEY_PLAIN, CAB(ea)},
+    {"damping", "N*s/m", 0, 0, TSI_KEY_PLAIN, CAB(damping)},
 };
 
 static const row body_rows[] = {
-    {"diameter", "m", 0, 0, K_PLAIN, BOD(diameter)},
-    {"length", "m", 0, 0, K_PLAIN, BOD(length)},
-    {"mass", "kg", 0, 0, K_PLAIN, BOD(mass)},
-    {"weight", "N", 0, 0, K_WEIGHT, BOD(mass)},
-    {"wet_weight", "N", -INFINITY, 0, K_WET_WEIGHT, BOD(mass)},
-    {"drag", "1", 0, 0, K_PLAIN, BOD(cd)},
-    {"added_mass", "1", 0, 0, K_PLAIN, BOD(ca)},
-    {"cross_drag", "1", 0, 0, K_PLAIN, BOD(cd_cross)},
-    {"cross_added_mass", "1", 0, 0, K_PLAIN, BOD(ca_cross)},
+    {"diameter", "m", 0, 0, TSI_KEY_PLAIN, BOD(diameter)},
+    {"length", "m", 0, 0, TSI_KEY_PLAIN, BOD(length)},
+    {"mass", "kg", 0, 0, TSI_KEY_PLAIN, BOD(mass)},
+    {"weight", "N", 0, 0, TSI_KEY_WEIGHT, BOD(mass)},
+    {"wet_weight", "N", -INFINITY, 0, TSI_KEY_WET_WEIGHT, BOD(mass)},
+    {"drag", "1", 0, 0, TSI_KEY_PLAIN, BOD(cd)},
+    {"added_mass", "1", 0, 0, TSI_KEY_PLAIN, BOD(ca)},
+    {"cross_drag", "1", 0, 0, TSI_KEY_PLAIN, BOD(cd_cross)},
+    {"cross_added_mass", "1", 0, 0, TSI_KEY_PLAIN, BOD(ca_cross)},
 };
 
 /* A loop's keys: units depend on what it measures (unit "" here). */
 static const row loop_rows[] = {
-    {"kp", "", -INFINITY, 0, K_PLAIN, offsetof(ts_loop, kp)},
-    {"ki", "", -INFINITY, 0, K_PLAIN, offsetof(ts_loop, ki)},
-    {"kd", "", -INFINITY, 0, K_PLAIN, offsetof(ts_loop, kd)},
-    {"setpoint", "", -INFINITY, 0, K_PLAIN, offsetof(ts_loop, setpoint)},
+    {"kp", "", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_loop, kp)},
+    {"ki", "", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_loop, ki)},
+    {"kd", "", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_loop, kd)},
+    {"setpoint", "", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_loop, setpoint)},
 };
 
 static const row surface_rows[] = {
-    {"area", "m^2", 0, 1, K_PLAIN, offsetof(ts_component, area)},
-    {"span", "m", 0, 1, K_PLAIN, offsetof(ts_component, span)},
-    {"deflection", "rad", -INFINITY, 0, K_PLAIN,
+    {"area", "m^2", 0, 1, TSI_KEY_PLAIN, offsetof(ts_component, area)},
+    {"span", "m", 0, 1, TSI_KEY_PLAIN, offsetof(ts_component, span)},
+    {"deflection", "rad", -INFINITY, 0, TSI_KEY_PLAIN,
      offsetof(ts_component, deflection)},
-    {"limit", "rad", 0, 1, K_PLAIN, offsetof(ts_component, limit)},
-    {"incidence", "rad", -INFINITY, 0, K_PLAIN,
+    {"limit", "rad", 0, 1, TSI_KEY_PLAIN, offsetof(ts_component, limit)},
+    {"incidence", "rad", -INFINITY, 0, TSI_KEY_PLAIN,
      offsetof(ts_component, incidence)},
+    {"roll", "rad", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_component, roll)},
+    {"lift_slope", "1/rad", 0, 0, TSI_KEY_PLAIN,
+     offsetof(ts_component, lift_slope)},
+    {"stall", "rad", 0, 1, TSI_KEY_PLAIN, offsetof(ts_component, stall)},
+    {"stall_width", "rad", 0, 1, TSI_KEY_PLAIN,
+     offsetof(ts_component, stall_width)},
+    {"zero_lift_drag", "1", 0, 0, TSI_KEY_PLAIN,
+     offsetof(ts_component, cd0)},
+    {"efficiency", "1", 0, 1, TSI_KEY_PLAIN,
+     offsetof(ts_component, efficiency)},
+    {"cn90", "1", 0, 0, TSI_KEY_PLAIN, offsetof(ts_component, cn90)},
+    {"rate_limit", "rad/s", 0, 1, TSI_KEY_PLAIN,
+     offsetof(ts_component, rate_limit)},
+    {"time_constant", "s", 0, 0, TSI_KEY_PLAIN,
+     offsetof(ts_component, time_constant)},
 };
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
+
+static const row *find_row(const row *t, int n, const char *key);
+
+const tsi_key *tsi_key_find(tsi_keys t, const char *key)
+{
+    switch (t) {
+    case TSI_KEYS_TOW: return find_row(tow_rows, COUNT(tow_rows), key);
+    case TSI_KEYS_ENV: return find_row(env_rows, COUNT(env_rows), key);
+    case TSI_KEYS_CABLE: return find_row(cable_rows, COUNT(cable_rows), key);
+    case TSI_KEYS_BODY: return find_row(body_rows, COUNT(body_rows), key);
+    case TSI_KEYS_LOOP: return find_row(loop_rows, COUNT(loop_rows), key);
+    default: return find_row(surface_rows, COUNT(surface_rows), key);
+    }
+}
 
 static const char *const forms =
     "tow.speed, tow.turn_rate, tow.point.x|y|z, "
@@ -105,13 +122,14 @@ static const char *const forms =
     "cables.<name>.<key>, bodies.<name>.<key>, "
     "bodies.<vehicle>.loops.<loop>.kp|ki|kd|setpoint, "
     "bodies.<vehicle>.surfaces.<surface>.area|span|deflection|limit|"
-    "incidence";
+    "incidence|roll|lift_slope|stall|stall_width|zero_lift_drag|"
+    "efficiency|cn90|rate_limit|time_constant";
 
 /* A path resolved against a system (or only by its form when sys is
  * NULL). */
 typedef struct target {
     const row *r;
-    int vec;          /* K_VECTOR: 0, 1, 2 for x, y, z */
+    int vec;          /* TSI_KEY_VECTOR: 0, 1, 2 for x, y, z */
     char *base;       /* the struct the row's offset is in; NULL when
                          resolved by form only */
     int cable, body;  /* indices, -1 when not one */
@@ -162,7 +180,7 @@ static int resolve_key(const char *path, const char *key, const row *t,
 {
     tg->r = find_row(t, n, key);
     tg->vec = 0;
-    if (tg->r && tg->r->kind != K_VECTOR)
+    if (tg->r && tg->r->kind != TSI_KEY_VECTOR)
         return TS_OK;
     if (tg->r) /* a vector without its component */
         return ts_fail(err, TS_EINVAL, "%s: '%s' is a vector; name a "
@@ -173,7 +191,7 @@ static int resolve_key(const char *path, const char *key, const row *t,
         char head[TS_PARAM_PATH_MAX];
         snprintf(head, sizeof head, "%.*s", (int)(dot - key), key);
         tg->r = find_row(t, n, head);
-        if (tg->r && tg->r->kind == K_VECTOR) {
+        if (tg->r && tg->r->kind == TSI_KEY_VECTOR) {
             tg->vec = dot[1] - 'x';
             return TS_OK;
         }
@@ -475,10 +493,8 @@ static int resolve_spelled(const ts_system *sys, const char *path,
     return resolve_key(path, key, body_rows, COUNT(body_rows), tg, err);
 }
 
-/* The unit of a loop's key from what it measures. */
-static const char *loop_unit(const ts_loop *l, const char *key)
+const char *tsi_loop_unit(int depth, const char *key)
 {
-    int depth = l->measure == TS_MEASURE_DEPTH;
     if (!strcmp(key, "setpoint"))
         return depth ? "m" : "rad";
     if (!strcmp(key, "kp"))
@@ -491,7 +507,9 @@ static const char *loop_unit(const ts_loop *l, const char *key)
 static const char *target_unit(const target *tg)
 {
     if (tg->loop >= 0 && tg->base)
-        return loop_unit((const ts_loop *)tg->base, tg->r->key);
+        return tsi_loop_unit(((const ts_loop *)tg->base)->measure ==
+                                 TS_MEASURE_DEPTH,
+                             tg->r->key);
     return tg->r->unit;
 }
 
@@ -568,10 +586,10 @@ int ts_param_get(const ts_system *sys, const char *path, double *value,
     const char *at = tg.base + tg.r->offset;
     double g = sys->env.gravity;
     switch (tg.r->kind) {
-    case K_LINKS: *value = *(const int *)at; break;
-    case K_VECTOR: *value = ((const double *)at)[tg.vec]; break;
-    case K_WEIGHT: *value = *(const double *)at * g; break;
-    case K_WET_WEIGHT:
+    case TSI_KEY_LINKS: *value = *(const int *)at; break;
+    case TSI_KEY_VECTOR: *value = ((const double *)at)[tg.vec]; break;
+    case TSI_KEY_WEIGHT: *value = *(const double *)at * g; break;
+    case TSI_KEY_WET_WEIGHT:
         *value = (*(const double *)at -
                   sys->env.water_density * wet_volume(sys, &tg)) * g;
         break;
@@ -604,7 +622,7 @@ int ts_param_set(ts_system *sys, const char *path, double value,
     char *at = tg.base + r->offset;
     double g = sys->env.gravity;
     switch (r->kind) {
-    case K_LINKS: {
+    case TSI_KEY_LINKS: {
         const ts_cable *c = &sys->cables[tg.cable];
         if (value != floor(value) || value > TS_MAX_LINKS)
             return ts_fail(err, TS_EINVAL, "%s: expected a whole number of "
@@ -617,14 +635,14 @@ int ts_param_set(ts_system *sys, const char *path, double value,
         *(int *)at = (int)value;
         break;
     }
-    case K_VECTOR: ((double *)at)[tg.vec] = value; break;
-    case K_WEIGHT:
-    case K_WET_WEIGHT: {
+    case TSI_KEY_VECTOR: ((double *)at)[tg.vec] = value; break;
+    case TSI_KEY_WEIGHT:
+    case TSI_KEY_WET_WEIGHT: {
         if (!(g > 0))
             return ts_fail(err, TS_EINVAL, "%s: without gravity a weight "
                            "gives no mass; set the mass instead", path);
         double m = value / g;
-        if (r->kind == K_WET_WEIGHT)
+        if (r->kind == TSI_KEY_WET_WEIGHT)
             m += sys->env.water_density * wet_volume(sys, &tg);
         if (!(m >= 0))
             return ts_fail(err, TS_EINVAL, "%s: %g %s is a negative mass in "

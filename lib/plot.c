@@ -300,6 +300,16 @@ int ts_plot_mode_animation(const char *dir, const char *name,
     return ts_plot_check(err);
 }
 
+int ts_plot_mode_frames(const char *dir, const char *name, const char *title,
+                        ts_plot_view view, int flags, const ts_plot_shape *eq,
+                        const double *re, const double *im, const char *label,
+                        int nframes, const ts_plot_opts *opts, ts_err *err)
+{
+    (void)dir, (void)name, (void)title, (void)view, (void)flags, (void)eq;
+    (void)re, (void)im, (void)label, (void)nframes, (void)opts;
+    return ts_plot_check(err);
+}
+
 int ts_plot_bode(const char *dir, const char *name, const char *title,
                  const char *mag_label, ts_plot_quantity out_q,
                  ts_plot_quantity in_q, int ncurves,
@@ -2026,6 +2036,8 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
             plcol0(COL_GREY);
             plwidth(1.6);
             draw_shape_links(&f, c->eq, &s[0], water, work);
+            draw_cylinders(&f, c->eq, &s[0], u, CYL_MIN * extent, COL_GREY);
+            plwidth(1.6);
             draw_marks(&f, c->eq, &s[0], 0.8);
             plwidth(1.2);
             draw_outlines(&f, c->eq, view == 1, oscale, u);
@@ -2039,6 +2051,11 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
                  * not show on it, so only the +mode marks air parts. */
                 draw_shape_links(&f, &style, &s[2 * m + j], water && j == 1,
                                  work);
+                /* Cylinder towfish at the displaced node, along the
+                 * displaced link (its length from the equilibrium). */
+                draw_cylinders(&f, c->eq, &s[2 * m + j], u, CYL_MIN * extent,
+                               col);
+                plwidth(CURVE_WIDTH);
                 draw_marks(&f, c->eq, &s[2 * m + j], 0.8);
             }
             if (view == 0) {
@@ -2301,6 +2318,36 @@ typedef struct bode_ctx {
 
 /* Character scale of the minor labels of a log axis. */
 #define MINOR_SCALE 0.8
+
+/* The minor labels v[n] (tsi_plot_minor_ticks) of the log axis [lo, hi]
+ * (log10 units) of the current viewport: under the x axis (`x` 1) or left
+ * of the y axis, at MINOR_SCALE. */
+static void minor_labels(int x, double lo, double hi, const double *v, int n)
+{
+    plschr(0, MINOR_SCALE);
+    plcol0(COL_FG);
+    for (int k = 0; k < n; k++) {
+        char t[32];
+        snprintf(t, sizeof t, "%g", v[k]);
+        if (x)
+            plmtex("b", 1.6, (log10(v[k]) - lo) / (hi - lo), 0.5, t);
+        else
+            plmtex("lv", 0.7, (log10(v[k]) - lo) / (hi - lo), 1.0, t);
+    }
+    plschr(0, 1.0);
+}
+
+/* The width of the widest minor label v[n] of a y axis, in character
+ * heights, or `width` when wider. */
+static double minor_width(double width, const double *v, int n)
+{
+    for (int k = 0; k < n; k++) {
+        char t[32];
+        width = fmax(width, MINOR_SCALE * (snprintf(t, sizeof t, "%g", v[k]) +
+                                           1) * DIGIT_WIDTH);
+    }
+    return width;
+}
 /* Rows and labels of the natural frequencies of a Bode plot. */
 #define NAT_ROWS 4
 #define NAT_LABELS_MAX 64
@@ -2360,13 +2407,9 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
     double fminor[16], mminor[16];
     int nfm = tsi_plot_minor_ticks(f0, f1, fminor, 16);
     int nmm = db ? 0 : tsi_plot_minor_ticks(m0, m1, mminor, 16);
-    double mwidth = db ? tick_width(m0, m1, 0) : tick_width(m0, m1, 1);
-    for (int k = 0; k < nmm; k++) {
-        char t[32];
-        mwidth = fmax(mwidth, MINOR_SCALE * (snprintf(t, sizeof t, "%g",
-                                                      mminor[k]) + 1) *
-                                  DIGIT_WIDTH);
-    }
+    double mwidth = minor_width(db ? tick_width(m0, m1, 0)
+                                   : tick_width(m0, m1, 1),
+                                mminor, nmm);
     int nlegend = 0, lchars = 0;
     for (int i = 0; i < c->ncurves; i++)
         legend_count(c->curves[i].label, &nlegend, &lchars);
@@ -2404,18 +2447,10 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
         frame_axes(&f, panel ? "bcnstl" : "bcstl",
                    panel ? "bcnst" : db ? "bcnst" : "bcnstl",
                    panel ? ptick : 0);
-        plschr(0, MINOR_SCALE);
-        plcol0(COL_FG);
-        char t[32];
-        for (int k = 0; panel == 0 && k < nmm; k++) {
-            snprintf(t, sizeof t, "%g", mminor[k]);
-            plmtex("lv", 0.7, (log10(mminor[k]) - m0) / (m1 - m0), 1.0, t);
-        }
-        for (int k = 0; panel == 1 && k < nfm; k++) {
-            snprintf(t, sizeof t, "%g", fminor[k]);
-            plmtex("b", 1.6, (log10(fminor[k]) - f0) / (f1 - f0), 0.5, t);
-        }
-        plschr(0, 1.0);
+        if (panel == 0)
+            minor_labels(0, m0, m1, mminor, nmm);
+        else
+            minor_labels(1, f0, f1, fminor, nfm);
         /* Natural frequencies. */
         plwidth(1.2);
         for (int j = 0; j < c->nnat; j++) {
@@ -2428,6 +2463,7 @@ static int draw_bode(const void *vctx, const ts_plot_opts *o, int height,
             pljoin(x, panel ? p0 : m0, x, panel ? p1 : m1);
             pllsty(LSTY_SOLID);
             if (panel == 0 && row >= 0) {
+                char t[32];
                 snprintf(t, sizeof t, "f%d", j + 1);
                 plschr(0, 0.8);
                 plcol0(COL_FG);
@@ -2577,18 +2613,12 @@ static void anim_text(FILE *f, double x, double y, const char *anchor,
     fputs("</text>\n", f);
 }
 
-int ts_plot_mode_animation(const char *dir, const char *name,
-                           const char *title, ts_plot_view view, int flags,
-                           const ts_plot_shape *eq, const double *re,
-                           const double *im, const char *label, int nframes,
-                           double seconds, const ts_plot_opts *opts,
-                           ts_err *err)
+/* The checks of a mode's cycle (ts_plot_mode_animation, _frames). */
+static int check_mode_cycle(const char *fn, const ts_plot_shape *eq,
+                            const double *re, const double *im, int nframes,
+                            ts_err *err)
 {
-    static const char fn[] = "ts_plot_mode_animation";
-    ts_plot_opts def;
-    int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
-    if (rc)
-        return rc;
+    int rc;
     if (!eq || !re || !im)
         return ts_fail(err, TS_EINVAL, "%s: eq, re and im: expected a shape "
                                        "and two displacement arrays",
@@ -2601,30 +2631,44 @@ int ts_plot_mode_animation(const char *dir, const char *name,
         return ts_fail(err, TS_EINVAL, "%s: nframes: must be in [4, %d], got "
                                        "%d",
                        fn, TS_PLOT_MAX_FRAMES, nframes);
-    if (!(seconds > 0) || !isfinite(seconds))
-        return ts_fail(err, TS_EINVAL, "%s: seconds: must be > 0, got %g",
-                       fn, seconds);
-    int n = eq->nnodes;
+    return TS_OK;
+}
+
+/* One cycle of a mode in `view`: the equilibrium's coordinates (*base),
+ * and nframes frames (*frames, allocated) at phases 2 pi k / nframes, eq +
+ * s Re((re + i im) e^{i phi}), s making the largest node amplitude 15 %
+ * of the equilibrium's extent (*extent, in the axes' unit); lo[2], hi[2]
+ * the padded window holding them all (with the water surface in a side
+ * view with TS_PLOT_WATER). TS_OK or TS_ENOMEM; release with
+ * mode_cycle_free. */
+static int mode_cycle(const ts_plot_shape *eq, const double *re,
+                      const double *im, ts_plot_view view, int flags,
+                      int nframes, const ts_plot_opts *opts, shape_xy *base,
+                      shape_xy **frames, double lo[2], double hi[2],
+                      double *extent)
+{
+    int n = eq->nnodes, rc;
     /* Scale: the largest node displacement over the cycle (|v| per node)
      * is 15 % of the equilibrium's extent. */
-    shape_xy base = {0};
-    if ((rc = shape_coords(eq, NULL, 0, view, opts, &base)))
-        return ts_fail(err, TS_ENOMEM, "%s: out of memory", fn);
-    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    *frames = NULL;
+    if ((rc = shape_coords(eq, NULL, 0, view, opts, base)))
+        return TS_ENOMEM;
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
     double amax = 0;
     for (int k = 0; k < n; k++) {
-        bbox_update(&lo[0], &hi[0], base.h[k]);
-        bbox_update(&lo[1], &hi[1], base.v[k]);
+        bbox_update(&lo[0], &hi[0], base->h[k]);
+        bbox_update(&lo[1], &hi[1], base->v[k]);
         double a = 0;
         for (int j = 0; j < 3; j++)
             a += re[3 * k + j] * re[3 * k + j] + im[3 * k + j] * im[3 * k + j];
         amax = fmax(amax, sqrt(a));
     }
-    double extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
-    if (!(extent > 0))
-        extent = pconv(TS_PLOT_LENGTH, opts, 1.0);
-    double scale = amax > 0 ? 0.15 * extent / pconv(TS_PLOT_LENGTH, opts, 1.0) /
-                                  amax
+    *extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    if (!(*extent > 0))
+        *extent = pconv(TS_PLOT_LENGTH, opts, 1.0);
+    double scale = amax > 0 ? 0.15 * *extent /
+                                  pconv(TS_PLOT_LENGTH, opts, 1.0) / amax
                             : 0;
     /* The frames, phase 2 pi k / nframes: eq + scale Re(v e^{i phi}). */
     shape_xy *fr = calloc((size_t)nframes, sizeof *fr);
@@ -2641,11 +2685,46 @@ int ts_plot_mode_animation(const char *dir, const char *name,
     }
     if (!fr || !d)
         rc = TS_ENOMEM;
-    int water = (flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE;
-    if (water)
+    free(d);
+    *frames = fr;
+    if ((flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE)
         bbox_update(&lo[1], &hi[1], 0);
     pad_range(&lo[0], &hi[0], 0.06, 1.0);
     pad_range(&lo[1], &hi[1], 0.06, 1.0);
+    return rc == TS_OK ? TS_OK : TS_ENOMEM;
+}
+
+static void mode_cycle_free(shape_xy *base, shape_xy *frames, int nframes)
+{
+    for (int i = 0; frames && i < nframes; i++)
+        free(frames[i].h);
+    free(frames);
+    free(base->h);
+    base->h = NULL;
+}
+
+int ts_plot_mode_animation(const char *dir, const char *name,
+                           const char *title, ts_plot_view view, int flags,
+                           const ts_plot_shape *eq, const double *re,
+                           const double *im, const char *label, int nframes,
+                           double seconds, const ts_plot_opts *opts,
+                           ts_err *err)
+{
+    static const char fn[] = "ts_plot_mode_animation";
+    ts_plot_opts def;
+    int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
+    if (rc)
+        return rc;
+    if ((rc = check_mode_cycle(fn, eq, re, im, nframes, err)))
+        return rc;
+    if (!(seconds > 0) || !isfinite(seconds))
+        return ts_fail(err, TS_EINVAL, "%s: seconds: must be > 0, got %g",
+                       fn, seconds);
+    shape_xy base = {0}, *fr = NULL;
+    double lo[2], hi[2], extent;
+    rc = mode_cycle(eq, re, im, view, flags, nframes, opts, &base, &fr, lo,
+                    hi, &extent);
+    int water = (flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE;
     anim_map m = {lo[0], hi[0], lo[1], hi[1], ANIM_LEFT,
                   opts->width - ANIM_RIGHT, ANIM_TOP,
                   opts->height - ANIM_BOTTOM};
@@ -2747,11 +2826,110 @@ int ts_plot_mode_animation(const char *dir, const char *name,
         else
             tsi_outfile_abandon(&out);
     }
-    for (int i = 0; fr && i < nframes; i++)
-        free(fr[i].h);
-    free(fr);
-    free(d);
-    free(base.h);
+    mode_cycle_free(&base, fr, nframes);
+    return rc;
+}
+
+/* ---- a mode as a PNG frame sequence ------------------------------------ */
+
+typedef struct mframe_ctx {
+    const char *title, *label;
+    ts_plot_view view;
+    int water;
+    const ts_plot_shape *eq;
+    const shape_xy *base, *cur;
+    double lo[2], hi[2]; /* the window, the same in every frame */
+    double extent;       /* the equilibrium's, for the cylinders' size */
+} mframe_ctx;
+
+static int draw_mode_frame(const void *vctx, const ts_plot_opts *o,
+                           int height, ts_err *err)
+{
+    (void)height;
+    const mframe_ctx *c = vctx;
+    int top = c->view == TS_PLOT_TOP;
+    double *work = malloc(4 * ((size_t)c->eq->nnodes + 1) * sizeof *work);
+    if (!work)
+        return ts_fail(err, TS_ENOMEM, "out of memory");
+    double h0 = c->lo[0], h1 = c->hi[0], v0 = c->lo[1], v1 = c->hi[1];
+    plvpor(left_edge(tick_width(v0, v1, 0), 1.0), 0.97, 0.11, 0.85);
+    if (top)
+        equalize(&h0, &h1, &v0, &v1);
+    frame f;
+    /* Depth and starboard grow downward. */
+    frame_set(&f, h0, h1, v1, v0, 0, 0);
+    if (c->water)
+        draw_water(&f, h0, h1, v1, o);
+    frame_axes(&f, "bcnst", "bcnst", 0);
+    ts_plot_shape solid = *c->eq;
+    solid.style = TS_PLOT_SOLID;
+    plcol0(COL_GREY);
+    plwidth(1.6);
+    draw_shape_links(&f, &solid, c->base, c->water, work);
+    draw_cylinders(&f, c->eq, c->base, o, CYL_MIN * c->extent, COL_GREY);
+    plwidth(1.6);
+    draw_marks(&f, c->eq, c->base, 0.9);
+    int col = color_index(0, 0);
+    plcol0(col);
+    plwidth(CURVE_WIDTH);
+    draw_shape_links(&f, &solid, c->cur, c->water, work);
+    draw_cylinders(&f, c->eq, c->cur, o, CYL_MIN * c->extent, col);
+    plwidth(CURVE_WIDTH);
+    draw_marks(&f, c->eq, c->cur, 1.1);
+    char xl[TEXT_MAX], yl[TEXT_MAX];
+    axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, o);
+    axis_label(yl, sizeof yl, top ? "y, starboard" : "z, depth",
+               TS_PLOT_LENGTH, o);
+    label_axes(&f, xl, yl, 1.0);
+    if (c->label) {
+        char t[TEXT_MAX];
+        pl_text(t, sizeof t, c->label);
+        plcol0(col);
+        plmtex("t", 0.6, 0.0, 0.0, t);
+    }
+    page_title(c->title);
+    free(work);
+    return TS_OK;
+}
+
+int ts_plot_mode_frames(const char *dir, const char *name, const char *title,
+                        ts_plot_view view, int flags, const ts_plot_shape *eq,
+                        const double *re, const double *im, const char *label,
+                        int nframes, const ts_plot_opts *opts, ts_err *err)
+{
+    static const char fn[] = "ts_plot_mode_frames";
+    ts_plot_opts def;
+    int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
+    if (rc)
+        return rc;
+    if ((rc = check_mode_cycle(fn, eq, re, im, nframes, err)))
+        return rc;
+    /* NAME_kkk must stay a valid name. */
+    if (strlen(name) + 4 > 200)
+        return ts_fail(err, TS_EINVAL, "%s: name: at most 196 characters "
+                                       "(frames add _kkk), got %zu",
+                       fn, strlen(name));
+    shape_xy base = {0}, *fr = NULL;
+    mframe_ctx c = {title, label, view, 0, eq, &base, NULL, {0, 0}, {0, 0},
+                    0};
+    rc = mode_cycle(eq, re, im, view, flags, nframes, opts, &base, &fr, c.lo,
+                    c.hi, &c.extent);
+    if (rc)
+        ts_fail(err, rc, "%s: out of memory", fn);
+    c.water = (flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE;
+    ts_plot_opts po = *opts;
+    po.formats = TS_PLOT_PNG;
+    for (int i = 0; rc == TS_OK && i < nframes; i++) {
+        char fname[256], ftitle[TEXT_MAX];
+        snprintf(fname, sizeof fname, "%s_%03d", name, i);
+        snprintf(ftitle, sizeof ftitle, "%s (frame %d of %d, phase %.0f "
+                 "deg)", title, i + 1, nframes, 360.0 * i / nframes);
+        c.cur = &fr[i];
+        c.title = ftitle;
+        rc = render(fn, dir, fname, ftitle, &po, po.height, draw_mode_frame,
+                    &c, err);
+    }
+    mode_cycle_free(&base, fr, nframes);
     return rc;
 }
 
@@ -2967,10 +3145,17 @@ static int draw_loglog(const void *vctx, const ts_plot_opts *o, int height,
     pad_range(&y0, &y1, 0.06, 1.0);
     whole_decade(&x0, &x1);
     whole_decade(&y0, &y1);
-    plvpor(left_edge(tick_width(y0, y1, 1), 1.0), 0.97, 0.11, 0.89);
+    /* Minor labels (2 and 5 times a power of ten) on short axes. */
+    double xminor[16], yminor[16];
+    int nxm = tsi_plot_minor_ticks(x0, x1, xminor, 16);
+    int nym = tsi_plot_minor_ticks(y0, y1, yminor, 16);
+    plvpor(left_edge(minor_width(tick_width(y0, y1, 1), yminor, nym), 1.0),
+           0.97, 0.11, 0.89);
     frame f;
     frame_set(&f, x0, x1, y0, y1, nlegend, lchars);
     frame_axes(&f, "bcnstl", "bcnstl", 0);
+    minor_labels(1, x0, x1, xminor, nxm);
+    minor_labels(0, y0, y1, yminor, nym);
     legend L = {0};
     for (int i = 0; i < c->nseries; i++) {
         const ts_plot_series *S = &c->series[i];

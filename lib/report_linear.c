@@ -168,21 +168,50 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
 int ts_report_modes_csv(const ts_system *sys, const ts_linear *lin,
                         const ts_eigen *e, const char *path, ts_err *err)
 {
+    return ts_report_modes_csv_display(sys, lin, e, NULL, path, err);
+}
+
+/* A column's unit as CSV names it: the SI name `si` when the display unit
+ * of q is SI, else the display unit as a token. */
+static void column_unit(const ts_display *d, ts_quantity q, const char *si,
+                        char *buf, size_t size)
+{
+    const char *u = ts_display_unit(d, q);
+    if (!strcmp(u, ts_quantity_si(q)))
+        snprintf(buf, size, "%s", si);
+    else
+        ts_display_unit_token(u, buf, size);
+}
+
+int ts_report_modes_csv_display(const ts_system *sys, const ts_linear *lin,
+                                const ts_eigen *e, const ts_display *d,
+                                const char *path, ts_err *err)
+{
+    d = ts_display_or_si(d);
+    char iu[64], fu[64], tu[64];
+    column_unit(d, TS_QTY_ANGULAR_RATE, "rad_per_s", iu, sizeof iu);
+    column_unit(d, TS_QTY_FREQUENCY, "hz", fu, sizeof fu);
+    column_unit(d, TS_QTY_TIME, "s", tu, sizeof tu);
+    double ki = ts_display_value(d, TS_QTY_ANGULAR_RATE, 1.0);
+    double kf = ts_display_value(d, TS_QTY_FREQUENCY, 1.0);
+    double kt = ts_display_value(d, TS_QTY_TIME, 1.0);
     tsi_outfile out;
     char desc[256];
     int orc = tsi_outfile_open(&out, path, err);
     if (orc != TS_OK)
         return orc;
     FILE *f = out.f;
-    fprintf(f, "mode,re_per_s,im_rad_per_s,freq_hz,period_s,damping_ratio,"
-               "time_constant_s,condition,error_bound,description\n");
+    fprintf(f, "mode,re_per_s,im_%s,freq_%s,period_%s,damping_ratio,"
+               "time_constant_%s,condition,error_bound,description\n",
+            iu, fu, tu, tu);
     for (int m = 0; m < e->nmodes; m++) {
         const ts_mode *md = &e->modes[m];
         ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
         fprintf(f, "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%.6g,\"%s\"\n",
-                m + 1, md->re, md->im, md->freq_hz, md->period_s,
-                md->damping_ratio, md->time_constant_s, md->condition,
-                md->error_bound, desc);
+                m + 1, md->re, ki * md->im, kf * md->freq_hz,
+                kt * md->period_s, md->damping_ratio,
+                kt * md->time_constant_s, md->condition, md->error_bound,
+                desc);
     }
     return tsi_outfile_commit(&out, err);
 }
@@ -190,10 +219,27 @@ int ts_report_modes_csv(const ts_system *sys, const ts_linear *lin,
 int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
                          const ts_eigen *e, const char *path, ts_err *err)
 {
+    return ts_report_shapes_csv_display(sys, lin, e, NULL, path, err);
+}
+
+int ts_report_shapes_csv_display(const ts_system *sys, const ts_linear *lin,
+                                 const ts_eigen *e, const ts_display *d,
+                                 const char *path, ts_err *err)
+{
     if (!e->vec_re)
         return ts_fail(err, TS_EINVAL,
                        "%s: no eigenvectors were kept, so no mode shapes",
                        path);
+    d = ts_display_or_si(d);
+    char fu[64], pu[64];
+    column_unit(d, TS_QTY_FREQUENCY, "hz", fu, sizeof fu);
+    /* Angles are shown in deg by default (their SI unit is rad). */
+    const char *pa = ts_display_unit(d, TS_QTY_ANGLE);
+    if (!strcmp(pa, "deg"))
+        snprintf(pu, sizeof pu, "deg");
+    else
+        ts_display_unit_token(pa, pu, sizeof pu);
+    double kf = ts_display_value(d, TS_QTY_FREQUENCY, 1.0);
     double *amp = malloc(3 * (size_t)sys->nnodes * sizeof(double));
     double *phase = malloc(3 * (size_t)sys->nnodes * sizeof(double));
     if (!amp || !phase) {
@@ -210,8 +256,8 @@ int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
         return orc;
     }
     FILE *f = out.f;
-    fprintf(f, "mode,freq_hz,node,x_amp,x_phase_deg,y_amp,y_phase_deg,z_amp,"
-               "z_phase_deg\n");
+    fprintf(f, "mode,freq_%s,node,x_amp,x_phase_%s,y_amp,y_phase_%s,z_amp,"
+               "z_phase_%s\n", fu, pu, pu, pu);
     int rc = TS_OK;
     for (int m = 0; m < e->nmodes && rc == TS_OK; m++) {
         rc = ts_eigen_mode_shape(sys, lin, e, m, amp, phase, err);
@@ -219,8 +265,10 @@ int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
             const double *a = amp + 3 * i, *p = phase + 3 * i;
             ts_system_node_name(sys, i, name, sizeof name);
             fprintf(f, "%d,%.17g,%s,%.10g,%.6f,%.10g,%.6f,%.10g,%.6f\n", m + 1,
-                    e->modes[m].freq_hz, name, a[0], p[0] * 180 / M_PI, a[1],
-                    p[1] * 180 / M_PI, a[2], p[2] * 180 / M_PI);
+                    kf * e->modes[m].freq_hz, name, a[0],
+                    ts_display_value(d, TS_QTY_ANGLE, p[0]), a[1],
+                    ts_display_value(d, TS_QTY_ANGLE, p[1]), a[2],
+                    ts_display_value(d, TS_QTY_ANGLE, p[2]));
         }
     }
     free(amp);

@@ -542,11 +542,13 @@ int ts_report_result_csv_display(const ts_result *r, const ts_display *d,
         break;
     case TS_ANALYSIS_MODES:
         if (r->eigen)
-            return ts_report_modes_csv(r->sys, r->lin, r->eigen, path, err);
+            return ts_report_modes_csv_display(r->sys, r->lin, r->eigen, d,
+                                               path, err);
         break;
     case TS_ANALYSIS_RESPONSE:
         if (r->seastate)
-            return ts_report_seastate_csv(r->seastate, path, err);
+            return ts_report_seastate_csv_display(r->seastate, d, path,
+                                                  err);
         if (r->response)
             return ts_report_response_csv_display(r->response, d, path, err);
         break;

@@ -113,27 +113,48 @@ json_t *ts_report_seastate_json(const ts_seastate *r, const ts_seaway *w,
 int ts_report_seastate_csv(const ts_seastate *r, const char *path,
                            ts_err *err)
 {
+    return ts_report_seastate_csv_display(r, NULL, path, err);
+}
+
+int ts_report_seastate_csv_display(const ts_seastate *r, const ts_display *d,
+                                   const char *path, ts_err *err)
+{
+    d = ts_display_or_si(d);
+    char lu[64], ou[64], gu[160], ot[64], gt[160];
+    ts_display_unit_token(ts_display_unit(d, TS_QTY_LENGTH), lu, sizeof lu);
+    double kl = ts_display_value(d, TS_QTY_LENGTH, 1.0);
+    double ko = ts_display_convert(d, r->unit, 1.0, ou, sizeof ou);
+    ts_display_unit_token(ou, ot, sizeof ot);
+    /* The gain is the output per length of wave amplitude. */
+    snprintf(gu, sizeof gu, "%s/%s", ou, ts_display_unit(d, TS_QTY_LENGTH));
+    ts_display_unit_token(gu, gt, sizeof gt);
+    int si = kl == 1.0 && ko == 1.0;
     tsi_outfile out;
     int orc = tsi_outfile_open(&out, path, err);
     if (orc != TS_OK)
         return orc;
     FILE *f = out.f;
-    fprintf(f, "omega_rad_s,omega_e_rad_s,wave_m2_s_rad");
+    fprintf(f, "omega_rad_s,omega_e_rad_s,wave_%s2_s_rad", lu);
     for (int j = 0; j < r->ninputs; j++) {
         const char *nm = ts_input_name(r->channel[j]);
         fprintf(f, ",%s_re,%s_im", nm, nm);
     }
-    fprintf(f, ",gain_re,gain_im,gain_abs,density_%s2_s_rad\n", r->unit);
+    if (si)
+        fprintf(f, ",gain_re,gain_im,gain_abs,density_%s2_s_rad\n", r->unit);
+    else
+        fprintf(f, ",gain_re_%s,gain_im_%s,gain_abs_%s,density_%s2_s_rad\n",
+                gt, gt, gt, ot);
+    double kg = ko / kl;
     size_t np = (size_t)r->npoints;
     for (size_t i = 0; i < np; i++) {
         fprintf(f, "%.17g,%.17g,%.17g", r->omega[i], r->omega_e[i],
-                r->wave[i]);
+                kl * kl * r->wave[i]);
         for (int j = 0; j < r->ninputs; j++)
             fprintf(f, ",%.17g,%.17g", r->input_re[(size_t)j * np + i],
                     r->input_im[(size_t)j * np + i]);
-        fprintf(f, ",%.17g,%.17g,%.17g,%.17g\n", r->gain_re[i],
-                r->gain_im[i], hypot(r->gain_re[i], r->gain_im[i]),
-                r->density[i]);
+        fprintf(f, ",%.17g,%.17g,%.17g,%.17g\n", kg * r->gain_re[i],
+                kg * r->gain_im[i], kg * hypot(r->gain_re[i], r->gain_im[i]),
+                ko * ko * r->density[i]);
     }
     return tsi_outfile_commit(&out, err);
 }

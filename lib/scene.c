@@ -46,6 +46,7 @@
 #include <string.h>
 #include <yaml.h>
 
+#include "param_impl.h"
 #include "scene_set.h"
 
 /* Largest number of entries in any list (cables, bodies, analyses, options,
@@ -358,6 +359,28 @@ static int optional_min(const ctx *c, const char *parent, const field *f,
     return rc;
 }
 
+static int optional_any(const ctx *c, const char *parent, const field *f,
+                        const char *si, double dflt, double *value);
+
+/* An optional value of key f->key of table t, in the key's unit and
+ * checked against its limit as the key table states them (param_impl.h:
+ * the same unit and limit as a value set by path). */
+static int key_value(const ctx *c, const char *parent, const field *f,
+                     tsi_keys t, double dflt, double *value)
+{
+    const tsi_key *k = tsi_key_find(t, f->key);
+    return isfinite(k->min) ? optional_min(c, parent, f, k->unit, k->min,
+                                           k->strict, dflt, value)
+                            : optional_any(c, parent, f, k->unit, dflt,
+                                           value);
+}
+
+/* The unit of key f->key of table t (param_impl.h). */
+static const char *key_unit(tsi_keys t, const field *f)
+{
+    return tsi_key_find(t, f->key)->unit;
+}
+
 /* A list of exactly three quantities ("[x, y, z]"). */
 static int vector3(const ctx *c, const char *parent, const field *f,
                    const char *si, double v[3])
@@ -485,13 +508,14 @@ static int parse_environment(const ctx *c, const yaml_node_t *n,
     int rc = read_map(c, n, "environment", "water_density, gravity, current",
                       f, E_N);
     if (rc == TS_OK)
-        rc = optional_min(c, "environment", &f[E_RHO], "kg/m^3", 0, 0,
-                          env->water_density, &env->water_density);
+        rc = key_value(c, "environment", &f[E_RHO], TSI_KEYS_ENV,
+                       env->water_density, &env->water_density);
     if (rc == TS_OK)
-        rc = optional_min(c, "environment", &f[E_G], "m/s^2", 0, 0,
-                          env->gravity, &env->gravity);
+        rc = key_value(c, "environment", &f[E_G], TSI_KEYS_ENV,
+                       env->gravity, &env->gravity);
     if (rc == TS_OK && f[E_CURRENT].value)
-        rc = vector3(c, "environment", &f[E_CURRENT], "m/s", env->current);
+        rc = vector3(c, "environment", &f[E_CURRENT],
+                     key_unit(TSI_KEYS_ENV, &f[E_CURRENT]), env->current);
     return rc;
 }
 
@@ -511,21 +535,19 @@ static int parse_tow(const ctx *c, const yaml_node_t *n, ts_tow *tow,
 {
     enum { T_SPEED, T_TURN, T_POINT, T_N };
     field f[T_N] = {{"speed", 0, 0}, {"turn_rate", 0, 0}, {"point", 0, 0}};
-    char p[PATH_LEN];
     int rc = read_map(c, n, "tow", "speed, turn_rate, point", f, T_N);
     if (rc != TS_OK)
         return rc;
     if (!f[T_SPEED].value)
         return missing(c, "tow", n, "speed");
-    rc = field_quantity(c, join(p, "tow", "speed"), &f[T_SPEED], "m/s",
-                        &tow->speed);
+    rc = key_value(c, "tow", &f[T_SPEED], TSI_KEYS_TOW, 0.0, &tow->speed);
     if (rc == TS_OK)
-        rc = check_min(c, p, &f[T_SPEED], tow->speed, 0, 0, "m/s");
-    if (rc == TS_OK && f[T_TURN].value)
-        rc = field_quantity(c, join(p, "tow", "turn_rate"), &f[T_TURN],
-                            "rad/s", &tow->turn_rate);
+        rc = key_value(c, "tow", &f[T_TURN], TSI_KEYS_TOW, tow->turn_rate,
+                       &tow->turn_rate);
     if (rc == TS_OK && f[T_POINT].value)
-        rc = vector3(c, "tow", &f[T_POINT], "m", tow->point);
+        rc = vector3(c, "tow", &f[T_POINT], key_unit(TSI_KEYS_TOW,
+                                                     &f[T_POINT]),
+                     tow->point);
     written(&f[T_SPEED], scene->speed_text, sizeof scene->speed_text);
     written(&f[T_TURN], scene->turn_rate_text, sizeof scene->turn_rate_text);
     return rc;
@@ -726,22 +748,26 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
         return missing(c, path, n, "area");
     if (!f[K_SPAN].value)
         return missing(c, path, n, "span");
-    if ((rc = optional_min(c, path, &f[K_AREA], "m^2", 0, 1, 0, &cp->area)) ||
-        (rc = optional_min(c, path, &f[K_SPAN], "m", 0, 1, 0, &cp->span)) ||
-        (rc = optional_any(c, path, &f[K_ROLL], "rad", 0, &cp->roll)) ||
-        (rc = optional_any(c, path, &f[K_INC], "rad", 0, &cp->incidence)) ||
-        (rc = optional_min(c, path, &f[K_SLOPE], "1/rad", 0, 0, 0,
-                           &cp->lift_slope)) ||
-        (rc = optional_min(c, path, &f[K_STALL], "rad", 0, 1, cp->stall,
-                           &cp->stall)) ||
-        (rc = optional_min(c, path, &f[K_WIDTH], "rad", 0, 1,
-                           cp->stall_width, &cp->stall_width)) ||
-        (rc = optional_min(c, path, &f[K_CD0], "1", 0, 0, cp->cd0,
-                           &cp->cd0)) ||
-        (rc = optional_min(c, path, &f[K_EFF], "1", 0, 1, cp->efficiency,
-                           &cp->efficiency)) ||
-        (rc = optional_min(c, path, &f[K_CN90], "1", 0, 0, cp->cn90,
-                           &cp->cn90)))
+    if ((rc = key_value(c, path, &f[K_AREA], TSI_KEYS_SURFACE, 0,
+                        &cp->area)) ||
+        (rc = key_value(c, path, &f[K_SPAN], TSI_KEYS_SURFACE, 0,
+                        &cp->span)) ||
+        (rc = key_value(c, path, &f[K_ROLL], TSI_KEYS_SURFACE, 0,
+                        &cp->roll)) ||
+        (rc = key_value(c, path, &f[K_INC], TSI_KEYS_SURFACE, 0,
+                        &cp->incidence)) ||
+        (rc = key_value(c, path, &f[K_SLOPE], TSI_KEYS_SURFACE, 0,
+                        &cp->lift_slope)) ||
+        (rc = key_value(c, path, &f[K_STALL], TSI_KEYS_SURFACE, cp->stall,
+                        &cp->stall)) ||
+        (rc = key_value(c, path, &f[K_WIDTH], TSI_KEYS_SURFACE,
+                        cp->stall_width, &cp->stall_width)) ||
+        (rc = key_value(c, path, &f[K_CD0], TSI_KEYS_SURFACE, cp->cd0,
+                        &cp->cd0)) ||
+        (rc = key_value(c, path, &f[K_EFF], TSI_KEYS_SURFACE,
+                        cp->efficiency, &cp->efficiency)) ||
+        (rc = key_value(c, path, &f[K_CN90], TSI_KEYS_SURFACE, cp->cn90,
+                        &cp->cn90)))
         return rc;
     if (f[K_TABLE].value) {
         static const int curve_keys[] = {K_SLOPE, K_STALL, K_WIDTH, K_CD0,
@@ -767,23 +793,16 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
                 return fail_at(c, TS_ESCENE, join(p, path, f[k].key),
                                f[k].line, "applies to a control surface "
                                "(control: true)");
-    if ((rc = optional_any(c, path, &f[K_DEFL], "rad", 0, &cp->deflection)) ||
-        (rc = optional_min(c, path, &f[K_LIMIT], "rad", 0, 1, INFINITY,
+    if ((rc = key_value(c, path, &f[K_DEFL], TSI_KEYS_SURFACE, 0,
+                        &cp->deflection)) ||
+        (rc = key_value(c, path, &f[K_LIMIT], TSI_KEYS_SURFACE, INFINITY,
                            &cp->limit)) ||
-        (rc = optional_min(c, path, &f[K_RATE], "rad/s", 0, 1, INFINITY,
-                           &cp->rate_limit)) ||
-        (rc = optional_min(c, path, &f[K_TAU], "s", 0, 0, 0,
-                           &cp->time_constant)))
+        (rc = key_value(c, path, &f[K_RATE], TSI_KEYS_SURFACE, INFINITY,
+                        &cp->rate_limit)) ||
+        (rc = key_value(c, path, &f[K_TAU], TSI_KEYS_SURFACE, 0,
+                        &cp->time_constant)))
         return rc;
     return TS_OK;
-}
-
-/* Units of a loop's gains: per m (depth) or per rad (angles). */
-static const char *gain_unit(ts_measure m, int which)
-{
-    static const char *const depth[3] = {"rad/m", "rad/(m*s)", "rad*s/m"};
-    static const char *const angle[3] = {"1", "1/s", "s"};
-    return m == TS_MEASURE_DEPTH ? depth[which] : angle[which];
 }
 
 static int parse_loop(const ctx *c, const yaml_node_t *n, const char *parent,
@@ -825,13 +844,15 @@ static int parse_loop(const ctx *c, const yaml_node_t *n, const char *parent,
                        show(m, f[L_MEASURE].value->data.scalar.length, s,
                             sizeof s));
     lp->measure = (ts_measure)mi;
-    if ((rc = optional_any(c, path, &f[L_SET], mi ? "rad" : "m", 0,
-                           &lp->setpoint)) ||
-        (rc = optional_any(c, path, &f[L_KP], gain_unit(lp->measure, 0), 0,
+    /* Units from what the loop measures, as values by path take them. */
+    int depth = lp->measure == TS_MEASURE_DEPTH;
+    if ((rc = optional_any(c, path, &f[L_SET], tsi_loop_unit(depth, "setpoint"),
+                           0, &lp->setpoint)) ||
+        (rc = optional_any(c, path, &f[L_KP], tsi_loop_unit(depth, "kp"), 0,
                            &lp->kp)) ||
-        (rc = optional_any(c, path, &f[L_KI], gain_unit(lp->measure, 1), 0,
+        (rc = optional_any(c, path, &f[L_KI], tsi_loop_unit(depth, "ki"), 0,
                            &lp->ki)) ||
-        (rc = optional_any(c, path, &f[L_KD], gain_unit(lp->measure, 2), 0,
+        (rc = optional_any(c, path, &f[L_KD], tsi_loop_unit(depth, "kd"), 0,
                            &lp->kd)))
         return rc;
     /* surfaces: a list of surface names (gain 1 each) or a mapping of
@@ -1221,27 +1242,33 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
         return missing(c, path, n, "diameter");
     if (cyl && !f[B_LEN].value)
         return missing(c, path, n, "length");
-    rc = optional_min(c, path, &f[B_DIAM], "m", 0, sphere || cyl, 0.0,
+    const tsi_key *kd = tsi_key_find(TSI_KEYS_BODY, "diameter"),
+                  *kl = tsi_key_find(TSI_KEYS_BODY, "length");
+    /* A sphere's and a cylinder's size must be > 0, the key's limit
+     * aside. */
+    rc = optional_min(c, path, &f[B_DIAM], kd->unit, kd->min,
+                      kd->strict || sphere || cyl, 0.0,
                       &body->diameter);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[B_LEN], "m", 0, cyl, 0.0,
+        rc = optional_min(c, path, &f[B_LEN], kl->unit, kl->min,
+                          kl->strict || cyl, 0.0,
                           &body->length);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[B_DRAG], "1", 0, 0,
-                          sphere ? DEFAULT_SPHERE_CD
+        rc = key_value(c, path, &f[B_DRAG], TSI_KEYS_BODY,
+                       sphere ? DEFAULT_SPHERE_CD
                                  : (cyl ? DEFAULT_CYL_CD_AXIAL : 0.0),
                           &body->cd);
     if (rc == TS_OK && !veh)
-        rc = optional_min(c, path, &f[B_CA], "1", 0, 0,
-                          sphere ? DEFAULT_SPHERE_CA
+        rc = key_value(c, path, &f[B_CA], TSI_KEYS_BODY,
+                       sphere ? DEFAULT_SPHERE_CA
                                  : (cyl ? DEFAULT_CYL_CA_AXIAL : 0.0),
                           &body->ca);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[B_XDRAG], "1", 0, 0,
-                          cyl ? DEFAULT_CYL_CD_CROSS : 0.0, &body->cd_cross);
+        rc = key_value(c, path, &f[B_XDRAG], TSI_KEYS_BODY,
+                       cyl ? DEFAULT_CYL_CD_CROSS : 0.0, &body->cd_cross);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[B_XCA], "1", 0, 0,
-                          cyl ? DEFAULT_CYL_CA_CROSS : 0.0, &body->ca_cross);
+        rc = key_value(c, path, &f[B_XCA], TSI_KEYS_BODY,
+                       cyl ? DEFAULT_CYL_CA_CROSS : 0.0, &body->ca_cross);
     if (rc != TS_OK)
         return rc;
 
@@ -1257,7 +1284,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
     body->mass = 0;
     if (which >= 0) {
         const field *fm = &f[which];
-        const char *si = which == B_MASS ? "kg" : "N";
+        const char *si = key_unit(TSI_KEYS_BODY, fm);
         rc = field_quantity(c, join(p, path, fm->key), fm, si, &x);
         if (rc == TS_OK && which != B_WET)
             rc = check_min(c, p, fm, x, 0, 0, si);
@@ -1427,26 +1454,26 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
         cable->has_from_point = 1;
     }
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_LENGTH], "m", 0, 1, 0.0,
+        rc = key_value(c, path, &f[C_LENGTH], TSI_KEYS_CABLE, 0.0,
                           &cable->length);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_DIAM], "m", 0, 1, 0.0,
+        rc = key_value(c, path, &f[C_DIAM], TSI_KEYS_CABLE, 0.0,
                           &cable->diameter);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_CDN], "1", 0, 0, DEFAULT_CDN,
+        rc = key_value(c, path, &f[C_CDN], TSI_KEYS_CABLE, DEFAULT_CDN,
                           &cable->cdn);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_CDT], "1", 0, 0, DEFAULT_CDT,
+        rc = key_value(c, path, &f[C_CDT], TSI_KEYS_CABLE, DEFAULT_CDT,
                           &cable->cdt);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_CAN], "1", 0, 0, DEFAULT_CAN,
+        rc = key_value(c, path, &f[C_CAN], TSI_KEYS_CABLE, DEFAULT_CAN,
                           &cable->can);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_EI], "N*m^2", 0, 0, 0.0, &cable->ei);
+        rc = key_value(c, path, &f[C_EI], TSI_KEYS_CABLE, 0.0, &cable->ei);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_EA], "N", 0, 0, 0.0, &cable->ea);
+        rc = key_value(c, path, &f[C_EA], TSI_KEYS_CABLE, 0.0, &cable->ea);
     if (rc == TS_OK)
-        rc = optional_min(c, path, &f[C_DAMP], "N*s/m", 0, 0, 0.0,
+        rc = key_value(c, path, &f[C_DAMP], TSI_KEYS_CABLE, 0.0,
                           &cable->damping);
     if (rc == TS_OK && f[C_DAMP].value && !(cable->ea > 0))
         rc = fail_at(c, TS_EINVAL, join(p, path, "damping"), f[C_DAMP].line,
@@ -1480,7 +1507,7 @@ static int parse_cable(const ctx *c, const yaml_node_t *n, int i,
     if (rc != TS_OK)
         return rc;
     const field *fm = &f[which];
-    const char *si = which == C_MPL ? "kg/m" : "N/m";
+    const char *si = key_unit(TSI_KEYS_CABLE, fm);
     const ts_environment *env = &sys->env;
     double x;
     rc = field_quantity(c, join(p, path, fm->key), fm, si, &x);

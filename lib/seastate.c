@@ -35,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "response_impl.h"
 #include "towstab/converge.h"
 
 /* Observed orders of the three grids trusted for a Richardson error, and
@@ -279,6 +280,21 @@ static void statistics(ts_seastate *s)
     stat_total(&s->m2);
 }
 
+/* The caller's progress over the driven axes (ts_seastate_opts.progress):
+ * one axis' frequencies, counted after the axes done before it. */
+typedef struct axis_progress {
+    const ts_seastate_opts *o;
+    double before, total;
+} axis_progress;
+
+static int on_axis_progress(const ts_progress *p, void *data)
+{
+    const axis_progress *a = data;
+    ts_progress q = {"sea state", a->before + p->done, a->total,
+                     "frequencies"};
+    return a->o->progress(&q, a->o->progress_data);
+}
+
 int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
                         const ts_seaway *w, const ts_output *out,
                         const ts_seastate_opts *opts, ts_seastate **res,
@@ -337,12 +353,19 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
         freq[i] = fabs(s->omega_e[i]) / (2 * M_PI);
     }
     /* Gains of the driven inputs, summed coherently. */
+    int driven = 0;
+    for (int j = 0; j < nin; j++)
+        driven += tmax[j] != 0;
+    axis_progress ap = {&o, 0, (double)driven * np};
     for (int j = 0; j < nin && !rc; j++) {
         s->channel[j] = j;
         if (tmax[j] == 0)
             continue;
         ts_response *r = NULL;
-        rc = ts_response_compute(sys, lin, j, out, freq, np, &r, err);
+        rc = tsi_response_compute(sys, lin, j, out, freq, np,
+                                  o.progress ? on_axis_progress : NULL, &ap,
+                                  &r, err);
+        ap.before += np;
         if (rc) {
             ts_err_prefix(err, "sea state, input %s: ", ts_input_name(j));
             break;

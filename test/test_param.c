@@ -9,7 +9,10 @@
  * format's spelling (cables[0], bodies[fish], tow.point[2]) names the same
  * values, and ts_scene_set (which edits the text and reads it again)
  * gives the same system. Every error names the path; unknown names list
- * what the system has. */
+ * what the system has. A vehicle's controllers and components by the
+ * scene's words give the modes run of the same text in the scene to the
+ * last digit, and a value beyond a key's limit is refused with the same
+ * limit by path and in the scene (one key table). */
 #include "towstab/param.h"
 
 #include <stdlib.h>
@@ -365,6 +368,8 @@ static void test_scene_words(const ts_units *u)
          "bodies[aurora].controllers[depth].setpoint", "35 m"},
         {"bodies.aurora.components.wing.area",
          "bodies[aurora].components[wing].area", "0.55 m^2"},
+        {"bodies.aurora.components.tail1.time_constant",
+         "bodies[aurora].components[tail1].time_constant", "0.15 s"},
     };
     /* The scene as written, to see each setting change the run. */
     ts_request r0;
@@ -423,6 +428,44 @@ static void test_scene_words(const ts_units *u)
         ts_scene_free(t);
     }
     ts_result_free(base_run);
+
+    /* One key table: a value beyond a key's limit is refused by path and
+     * in the scene's text with the same limit and unit. */
+    static const struct {
+        const char *path, *key, *text, *limit;
+    } lim[] = {
+        {"cables.armoured.length", "cables[armoured].length", "-1",
+         "must be > 0 m, got -1 m"},
+        {"cables.armoured.EA", "cables[armoured].EA", "-5",
+         "must be >= 0 N, got -5 N"},
+        {"tow.speed", "tow.speed", "-1", "must be >= 0 m/s, got -1 m/s"},
+        {"environment.water_density", "environment.water_density", "-1",
+         "must be >= 0 kg/m^3, got -1 kg/m^3"},
+        {"bodies.aurora.components.wing.limit",
+         "bodies[aurora].components[wing].limit", "0",
+         "must be > 0 rad, got 0 rad"},
+        {"bodies.aurora.components.wing.area",
+         "bodies[aurora].components[wing].area", "0",
+         "must be > 0 m^2, got 0 m^2"},
+        {"bodies.aurora.components.wing.rate_limit",
+         "bodies[aurora].components[wing].rate_limit", "0",
+         "must be > 0 rad/s, got 0 rad/s"},
+    };
+    for (size_t i = 0; i < sizeof lim / sizeof lim[0]; i++) {
+        ts_err e1 = {0}, e2 = {0};
+        ts_system *copy = ts_system_copy(sc->system, &e1);
+        int r1 = copy ? ts_param_set(copy, lim[i].path, atof(lim[i].text),
+                                     &e1)
+                      : TS_ENOMEM;
+        ts_system_free(copy);
+        const char *key = lim[i].key, *text = lim[i].text;
+        ts_scene *t = ts_scene_set(sc, 1, &key, &text, u, &e2);
+        CHECK(r1 == TS_EINVAL && !t && strstr(e1.msg, lim[i].limit) &&
+                  strstr(e2.msg, lim[i].limit),
+              "%s = %s refused alike by path (%s) and in the scene (%s)",
+              lim[i].path, text, e1.msg, e2.msg);
+        ts_scene_free(t);
+    }
     ts_scene_free(sc);
 }
 

@@ -522,6 +522,45 @@ static void test_animation(void)
     CHECK(rc == TS_EINVAL && strstr(err.msg, "seconds"),
           "a cycle of 0 s is refused: %s", err.msg);
     CHECK(nothing_named("anim_bad"), "refused animations left no file");
+
+    /* The plan view of the same cycle, and the cycle as PNG frames: four
+     * frames in both views, PNG only, each its own picture, the
+     * equilibrium's place the same in every frame (one window). */
+    rc = ts_plot_mode_animation(dir, "anim_top", "chain: mode 1, plan",
+                                TS_PLOT_TOP, 0, &eq, re, im, NULL, 12, 2.0,
+                                &o, &err);
+    CHECK(rc == TS_OK, "mode animation in plan view (%s)", err.msg);
+    free(check_svg("anim_top", "chain: mode 1, plan"));
+    for (int v = 0; v < 2; v++) {
+        const char *nm = v ? "frames_top" : "frames_side";
+        rc = ts_plot_mode_frames(dir, nm, "chain: mode 1", v ? TS_PLOT_TOP
+                                                               : TS_PLOT_SIDE,
+                                 TS_PLOT_WATER, &eq, re, im, "mode 1: 0.5 Hz",
+                                 4, &o, &err);
+        CHECK(rc == TS_OK, "%s: four PNG frames written (%s)", nm, err.msg);
+        char f[4][64];
+        size_t n[4] = {0};
+        char *b[4];
+        for (int k = 0; k < 4; k++) {
+            snprintf(f[k], sizeof f[k], "%s_%03d", nm, k);
+            check_png(f[k], 1000, 700);
+            char path[1024];
+            snprintf(path, sizeof path, "%s/%s.png", dir, f[k]);
+            b[k] = slurp(path, &n[k]);
+        }
+        snprintf(f[0], sizeof f[0], "%s_004", nm);
+        CHECK(!file_exists(f[0], "png") && !file_exists(nm, "svg"),
+              "%s: exactly four frames, no SVG", nm);
+        CHECK(b[0] && b[1] && (n[0] != n[1] || memcmp(b[0], b[1], n[0])),
+              "%s: the frames differ", nm);
+        for (int k = 0; k < 4; k++)
+            free(b[k]);
+    }
+    rc = ts_plot_mode_frames(dir, "frames_bad", "x", TS_PLOT_SIDE, 0, &eq, re,
+                             im, NULL, 2, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "nframes"),
+          "frames: 2 frames are refused: %s", err.msg);
+    CHECK(nothing_named("frames_bad"), "refused frames left no file");
 }
 
 static void test_modes(void)
@@ -557,6 +596,26 @@ static void test_modes(void)
                              2, modes, &o, &err);
     CHECK(rc == TS_OK, "two mode shapes drawn (%s)", err.msg);
     check_png("modes2", 1000, 700);
+    /* A cylinder towfish at the end: drawn on the equilibrium and on the
+     * mode at both phases, in both views: 6 fills and 6 outlines per
+     * mode row more than without it. */
+    ts_plot_cylinder cy = {N - 1, 2.0, 0.4};
+    ts_plot_shape eqc = eq;
+    eqc.ncylinders = 1;
+    eqc.cylinders = &cy;
+    rc = ts_plot_mode_shapes(dir, "modes2_cyl", "two modes", TS_PLOT_WATER,
+                             &eqc, 2, modes, &o, &err);
+    CHECK(rc == TS_OK, "two mode shapes with a cylinder drawn (%s)",
+          err.msg);
+    char *a = check_svg("modes2", "two modes");
+    char *b = check_svg("modes2_cyl", "two modes");
+    int na = a ? count_of(a, "<path ") : 0, nb = b ? count_of(b, "<path ")
+                                                  : 0;
+    CHECK(a && b && nb == na + 2 * 2 * 6, "mode shapes: the cylinder drawn "
+          "on the equilibrium and both phases of each mode, both views (%d "
+          "paths, %d without)", nb, na);
+    free(a);
+    free(b);
 
     static double zero[3 * N];
     ts_plot_mode bad = {zero, "nothing"};
@@ -897,6 +956,35 @@ static void test_loglog(void)
           "series' colour (%d text groups, %d without)", gl, gp);
     free(plain);
     free(lab);
+    /* A short span on both axes (0.04 .. 0.25 and 0.3 .. 0.9): minor
+     * labels (2 and 5 times a power of ten) beside the decades' own, as
+     * on a Bode plot: more text drawn than the decades alone give. The
+     * same data times 10^k (k of 6 decades) have no minor labels. */
+    double sx[2] = {0.04, 0.25}, sy[2] = {0.3, 0.9};
+    double wx[2] = {1e-4, 1e2}, wy[2] = {1e-3, 1e3};
+    ts_plot_series ss = {2, sx, sy, "short", 0, TS_PLOT_LINE_MARKERS, 0, NULL};
+    ts_plot_series ws = {2, wx, wy, "short", 0, TS_PLOT_LINE_MARKERS, 0, NULL};
+    rc = ts_plot_loglog(dir, "loglog_short", "short spans", &xa, &ya, 1, &ss,
+                        &o, &err);
+    CHECK(rc == TS_OK, "log-log plot of short spans drawn (%s)", err.msg);
+    char *sh = check_svg("loglog_short", "short spans");
+    rc = ts_plot_loglog(dir, "loglog_wide", "short spans", &xa, &ya, 1, &ws,
+                        &o, &err);
+    char *wd = check_svg("loglog_wide", "short spans");
+    /* Black text groups: the title, the two axis titles and the legend
+     * (4), the decade labels (10^k: `per` groups each, base and
+     * exponent; 14 on the wide picture, 3 on the short one: 10^-1 on x,
+     * 10^-1 and 10^0 on y) and, on the short one only, the minor labels
+     * 0.05, 0.2 (x) and 0.2, 0.5 (y). */
+    static const char black[] = "<g style=\"fill:rgb(0%,0%,0%)";
+    int ns = sh ? count_of(sh, black) : 0, nw = wd ? count_of(wd, black) : 0;
+    int per = (nw - 4) / 14;
+    CHECK(sh && wd && per >= 1 && nw - 4 == 14 * per &&
+              ns - 4 - 3 * per == 4,
+          "short spans: four minor labels (%d text groups; %d on the wide "
+          "picture of 14 decade labels)", ns, nw);
+    free(sh);
+    free(wd);
     /* A title with XML specials and PLplot's escape character '#'. */
     rc = ts_plot_loglog(dir, "loglog_xml", "run #2: error & time <s>", &xa,
                         &ya, 2, s, &o, &err);
@@ -1158,8 +1246,11 @@ static void test_without_plplot(void)
     double gz[4] = {1, 2, 3, 4};
     ts_plot_grid g = {2, 2, x, y, gz};
     ts_plot_track tr = {2, x, y, "t", 0, 0, 0, NULL};
-    int rc[9];
+    double zr[3 * N] = {0};
+    int rc[10];
     rc[8] = ts_plot_tracks(dir, "n8", "t", 1, &tr, &o, &err);
+    rc[9] = ts_plot_mode_frames(dir, "n9", "t", TS_PLOT_SIDE, 0, &one, chain,
+                                zr, NULL, 4, &o, &err);
     rc[0] = ts_plot_shapes(dir, "n0", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
     rc[1] = ts_plot_mode_shapes(dir, "n1", "t", 0, &one, 1, &mode, &o, &err);
     rc[2] = ts_plot_eigenvalues(dir, "n2", "t", 1, &s, NULL, &o, &err);
@@ -1170,7 +1261,7 @@ static void test_without_plplot(void)
     rc[6] = ts_plot_panels(dir, "n6", "t", &a, 1, &a, 1, &s, &o, &err);
     rc[7] = ts_plot_map(dir, "n7", "t", &a, &a, &a, &g, NULL, 0, NULL, NULL,
                         &o, &err);
-    for (int i = 0; i < 9; i++)
+    for (int i = 0; i < 10; i++)
         CHECK(rc[i] == TS_EDOMAIN, "drawing function %d returns TS_EDOMAIN",
               i);
     CHECK(nothing_named("n"), "nothing was written");

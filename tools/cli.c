@@ -151,6 +151,25 @@ static struct {
     int shown;             /* characters of the line on the terminal */
 } line;
 
+/* After a first signal, the run must reach a poll within this many
+ * seconds (a stage that cannot poll: LAPACK's dense eigensolve, a large
+ * allocation); else towstab stops at once, writing nothing. */
+#define STOP_GRACE_S 5
+#define STR_(x) #x
+#define STR(x) STR_(x)
+
+static void on_alarm(int sig)
+{
+    (void)sig;
+    static const char late[] = "towstab: error: interrupted in a stage "
+                               "that cannot stop on request (no stop point "
+                               "within " STR(STOP_GRACE_S) " s): stopped "
+                               "at once, writing nothing\n";
+    if (write(STDERR_FILENO, late, sizeof late - 1) < 0)
+        _exit(128 + (stop_signal ? stop_signal : SIGINT));
+    _exit(128 + (stop_signal ? stop_signal : SIGINT));
+}
+
 static void on_signal(int sig)
 {
     /* A second signal, or nothing that polls the first (a dense
@@ -169,6 +188,7 @@ static void on_signal(int sig)
         _exit(128 + sig);
     }
     stop_signal = sig;
+    alarm(STOP_GRACE_S);
 }
 
 void cli_signals_install(void)
@@ -179,6 +199,8 @@ void cli_signals_install(void)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sa.sa_handler = on_alarm;
+    sigaction(SIGALRM, &sa, NULL);
     progress_tty = isatty(STDERR_FILENO);
 }
 
@@ -208,8 +230,11 @@ int cli_progress(const ts_progress *p, void *data)
 {
     (void)data;
     polled = 1;
-    if (stop_signal)
+    if (stop_signal) {
+        /* A stop point: the run stops here and writes what it has. */
+        alarm(0);
         return 1;
+    }
     if (!progress_tty)
         return 0;
     double now = cli_wall_now();
@@ -224,14 +249,25 @@ int cli_progress(const ts_progress *p, void *data)
         return 0;
     line.last = now;
     double rate = (p->done - line.done0) / elapsed;
-    char left[32], text[160];
-    duration_text(rate > 0 ? (p->total - p->done) / rate : INFINITY, left,
-                  sizeof left);
-    int n = snprintf(text, sizeof text, "towstab: %s: %.6g of %.6g %s "
+    char left[32], text[200];
+    int n;
+    if (isnan(p->total)) {
+        /* An iterative solver's work, of no known end: what is done and
+         * the rate only. */
+        n = snprintf(text, sizeof text, "towstab: %s: %.6g %s, %.3g per s, "
+                     "%.0f s so far", p->what, p->done, p->unit, rate,
+                     elapsed);
+    } else {
+        duration_text(rate > 0 ? (p->total - p->done) / rate : INFINITY,
+                      left, sizeof left);
+        n = snprintf(text, sizeof text, "towstab: %s: %.6g of %.6g %s "
                      "(%.0f%%), %.3g %s%s per s, %s left", p->what, p->done,
                      p->total, p->unit, 100 * p->done / p->total, rate,
                      strcmp(p->unit, "s") ? "" : "simulated ", p->unit,
                      left);
+    }
+    if (n >= (int)sizeof text)
+        n = (int)sizeof text - 1;
     fprintf(stderr, "\r%s%*s", text, line.shown > n ? line.shown - n : 0,
             "");
     fflush(stderr);
@@ -241,6 +277,9 @@ int cli_progress(const ts_progress *p, void *data)
 
 void cli_progress_done(void)
 {
+    /* The run is over: what follows (writing the outputs) is not cut
+     * short. */
+    alarm(0);
     if (line.shown > 0) {
         fprintf(stderr, "\r%*s\r", line.shown, "");
         fflush(stderr);
@@ -467,50 +506,73 @@ void cli_print_accuracy(const ts_result *r)
 }
 
 void cli_print_vehicles(FILE *f, const ts_system *sys,
-                        const ts_vehicle_result *vr, int nv, int quiet)
+                        const ts_vehicle_result *vr, int nv, int quiet,
+                        const ts_display *d)
 {
-    const double deg = 180.0 / M_PI;
     if (nv == 0)
         return;
-    fprintf(f, "\n%-20s %10s %10s %10s %10s %10s %12s\n", "vehicle",
-            "pitch[deg]", "roll[deg]", "yaw[deg]", "alpha[deg]",
-            "beta[deg]", "depth [m]");
+    d = ts_display_or_si(d);
+    /* Angles, depths, forces and moments (force times length) in the
+     * display units. */
+    double ka = ts_display_value(d, TS_QTY_ANGLE, 1.0);
+    double kl = ts_display_value(d, TS_QTY_LENGTH, 1.0);
+    double kf = ts_display_value(d, TS_QTY_FORCE, 1.0);
+    const char *au = ts_display_unit(d, TS_QTY_ANGLE);
+    const char *lu = ts_display_unit(d, TS_QTY_LENGTH);
+    const char *fu = ts_display_unit(d, TS_QTY_FORCE);
+    char h[7][48];
+    static const char *const ang[5] = {"pitch", "roll", "yaw", "alpha",
+                                       "beta"};
+    for (int i = 0; i < 5; i++)
+        snprintf(h[i], sizeof h[i], "%s[%s]", ang[i], au);
+    snprintf(h[5], sizeof h[5], "depth [%s]", lu);
+    fprintf(f, "\n%-20s %10s %10s %10s %10s %10s %12s\n", "vehicle", h[0],
+            h[1], h[2], h[3], h[4], h[5]);
     for (int v = 0; v < nv; v++) {
         const ts_vehicle_result *r = &vr[v];
         fprintf(f, "%-20s %10.4f %10.4f %10.4f %10.4f %10.4f %12.6f\n",
-                sys->bodies[r->body].name, r->pitch * deg, r->roll * deg,
-                r->yaw * deg, r->alpha * deg, r->beta * deg, r->origin[2]);
+                sys->bodies[r->body].name, r->pitch * ka, r->roll * ka,
+                r->yaw * ka, r->alpha * ka, r->beta * ka,
+                r->origin[2] * kl);
     }
     for (int v = 0; v < nv; v++) {
         const ts_vehicle_result *r = &vr[v];
-        const ts_vehicle *d = sys->bodies[r->body].vehicle;
+        const ts_vehicle *vd = sys->bodies[r->body].vehicle;
         for (int c = 0; c < r->ncomponents; c++)
-            if (d->component[c].control)
-                fprintf(f, "%s.%s deflection %.4f deg\n",
-                        sys->bodies[r->body].name, d->component[c].name,
-                        r->delta[c] * deg);
+            if (vd->component[c].control)
+                fprintf(f, "%s.%s deflection %.4f %s\n",
+                        sys->bodies[r->body].name, vd->component[c].name,
+                        r->delta[c] * ka, au);
         if (quiet)
             continue;
+        char hf[3][48], hm[3][64], ha[48];
+        for (int i = 0; i < 3; i++) {
+            snprintf(hf[i], sizeof hf[i], "F%c [%s]", "xyz"[i], fu);
+            snprintf(hm[i], sizeof hm[i], "M%c [%s %s]", "xyz"[i], fu, lu);
+        }
+        snprintf(ha, sizeof ha, "alpha[%s]", au);
         fprintf(f, "\n%-20s %11s %11s %11s %11s %11s %11s %9s\n",
-                "component (body axes)", "Fx [N]", "Fy [N]", "Fz [N]",
-                "Mx [N m]", "My [N m]", "Mz [N m]", "alpha[deg]");
+                "component (body axes)", hf[0], hf[1], hf[2], hm[0], hm[1],
+                hm[2], ha);
         for (int c = 0; c < r->ncomponents; c++) {
             const ts_component_load *ld = &r->load[c];
             char nm[2 * TS_NAME_MAX];
             snprintf(nm, sizeof nm, "%s.%s", sys->bodies[r->body].name,
-                     d->component[c].name);
+                     vd->component[c].name);
             fprintf(f, "%-20s %11.4f %11.4f %11.4f %11.4f %11.4f %11.4f "
                        "%9.3f\n",
-                    nm, ld->force[0], ld->force[1], ld->force[2],
-                    ld->moment[0], ld->moment[1], ld->moment[2],
-                    ld->alpha * deg);
+                    nm, kf * ld->force[0], kf * ld->force[1],
+                    kf * ld->force[2], kf * kl * ld->moment[0],
+                    kf * kl * ld->moment[1], kf * kl * ld->moment[2],
+                    ld->alpha * ka);
         }
         fprintf(f, "%-20s %11s %11s %11s %11.4f %11.4f %11.4f\n",
-                "Munk moment", "", "", "", r->munk[0], r->munk[1],
-                r->munk[2]);
-        fprintf(f, "%s (M) %.4f, %.4f, %.4f N\n",
+                "Munk moment", "", "", "", kf * kl * r->munk[0],
+                kf * kl * r->munk[1], kf * kl * r->munk[2]);
+        fprintf(f, "%s (M) %.4f, %.4f, %.4f %s\n",
                 r->towing ? "cable pull at the tow point" : "joint force",
-                r->joint_force[0], r->joint_force[1], r->joint_force[2]);
+                kf * r->joint_force[0], kf * r->joint_force[1],
+                kf * r->joint_force[2], fu);
     }
     for (int v = 0; v < nv; v++) {
         const ts_vehicle_result *r = &vr[v];

@@ -195,9 +195,11 @@ int cli_make_dir(const char *cmd, const char *opt, const char *dir);
 void cli_usage(const struct cli_command *cmd, FILE *f);
 
 /* The vehicles' attitudes, flow angles and depths, their control
- * deflections and (unless quiet) their components' loads. */
+ * deflections and (unless quiet) their components' loads, in the display
+ * units d (NULL: SI, angles in deg). */
 void cli_print_vehicles(FILE *f, const ts_system *sys,
-                        const ts_vehicle_result *vr, int nv, int quiet);
+                        const ts_vehicle_result *vr, int nv, int quiet,
+                        const ts_display *d);
 
 /* Markdown of every option of the analyses: the reference of
  * doc/manual.md (towstab options --markdown). */
@@ -304,6 +306,7 @@ const cli_command *cli_command_of(int kind);
 void cli_print_equilibrium(const ts_result *r, int quiet,
                            const ts_display *d);
 void cli_print_linearization(const ts_result *r);
-/* The sea state and its statistics (cmd_response.c; simulate too). */
-void cli_print_seastate(const ts_result *r, int quiet);
+/* The sea state and its statistics in the display units d (NULL: SI)
+ * (cmd_response.c; simulate too). */
+void cli_print_seastate(const ts_result *r, int quiet, const ts_display *d);
 #endif

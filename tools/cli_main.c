@@ -140,10 +140,14 @@ int cli_prepare(cli_run *c)
 
 /* A failed run writes its JSON and CSV when it has a result of its own
  * kind to show (an equilibrium that did not converge, the history so far,
- * the runs of a study stopped on request). */
+ * the runs of a study stopped on request, the equilibrium and linear
+ * model of modes or a response stopped on request). */
 static int has_partial(const ts_result *r)
 {
     return (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->eq_attempted) ||
+           ((r->kind == TS_ANALYSIS_MODES ||
+             r->kind == TS_ANALYSIS_RESPONSE) &&
+            r->status == TS_ECANCEL && r->eq_attempted) ||
            (r->kind == TS_ANALYSIS_SIMULATE && (r->nonlinear || r->linear)) ||
            (r->kind == TS_ANALYSIS_CONVERGE && r->status == TS_ECANCEL &&
             r->convergence && r->convergence->estimated);
@@ -162,13 +166,13 @@ int cli_execute(cli_run *c, json_t **result)
     ts_cost cost;
     if (ts_analysis_cost(c->scene->system, &c->rq, &cost, NULL) == TS_OK &&
         cost.seconds > ANNOUNCE_S) {
-        /* Simulations and studies keep what they have when stopped. */
-        int keeps = c->rq.kind == TS_ANALYSIS_SIMULATE ||
-                    c->rq.kind == TS_ANALYSIS_CONVERGE;
+        /* Every analysis keeps what it has when stopped (the
+         * equilibrium reached, the linear model, the history, the runs
+         * of a study). */
         fprintf(stderr, "towstab: warning: %s is estimated to take %s; to "
-                        "shorten it: %s (Ctrl-C stops it%s)\n",
-                ts_analysis_name(c->rq.kind), cost.what, cost.reduce,
-                keeps ? ", keeping what it has" : "");
+                        "shorten it: %s (Ctrl-C stops it, keeping what it "
+                        "has)\n",
+                ts_analysis_name(c->rq.kind), cost.what, cost.reduce);
         fflush(stderr);
     }
     int rc = ts_analysis_run(c->scene->system, &c->rq, &r, &err);

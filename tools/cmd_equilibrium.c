@@ -115,6 +115,97 @@ static void scene_names(const eq_curve *curves, int n, char *buf,
     *distinct = nn;
 }
 
+/* Points of a circle of a steady turn in the earth-frame plan view. */
+#define TURN_POINTS 361
+
+/* One point at rest in M over one steady turn, as a track in the earth
+ * frame R (doc/model.md section 1): M's origin at heading psi = Omega t is
+ * at (Rt sin psi, Rt (1 - cos psi)), Rt = V / Omega, and the point r of M
+ * at that origin plus R_z(psi) r. Exact: no integration. */
+static void turn_track(double speed, double turn_rate, const double r[3],
+                       double *x, double *y)
+{
+    double Rt = speed / turn_rate;
+    for (int k = 0; k < TURN_POINTS; k++) {
+        double psi = copysign(2 * M_PI, turn_rate) * k / (TURN_POINTS - 1);
+        double c = cos(psi), s = sin(psi);
+        x[k] = Rt * s + c * r[0] - s * r[1];
+        y[k] = Rt * (1 - c) + s * r[0] + c * r[1];
+    }
+}
+
+/* The earth-frame plan view of the converged curves in a steady turn
+ * (plan_earth): over one turn, the circle of the tow point and of every
+ * body, each marked where it is at t = 0. Nothing is drawn when no curve
+ * turns. Returns the exit status. */
+static int eq_plot_turn(const cli_plot *plot, const eq_curve *curves,
+                        int ncurves, const char *names, int distinct)
+{
+    int ntracks = 0;
+    for (int i = 0; i < ncurves; i++)
+        if (curves[i].eq && curves[i].eq->converged &&
+            curves[i].sys->tow.turn_rate != 0 && curves[i].sys->tow.speed > 0)
+            ntracks += 1 + curves[i].sys->nbodies;
+    if (ntracks == 0)
+        return 0;
+    ts_plot_track *t = calloc((size_t)ntracks, sizeof *t);
+    ts_plot_marker *m = calloc((size_t)ntracks, sizeof *m);
+    double *xy = malloc(2 * (size_t)ntracks * TURN_POINTS * sizeof *xy);
+    char (*label)[192] = calloc((size_t)ntracks, sizeof *label);
+    if (!t || !m || !xy || !label) {
+        free(t);
+        free(m);
+        free(xy);
+        free(label);
+        fprintf(stderr, "towstab: error: equilibrium: --plot: out of memory\n");
+        return EXIT_FAILED;
+    }
+    int n = 0, curve = 0;
+    for (int i = 0; i < ncurves; i++) {
+        const eq_curve *c = &curves[i];
+        if (!c->eq || !c->eq->converged || c->sys->tow.turn_rate == 0 ||
+            !(c->sys->tow.speed > 0))
+            continue;
+        char tow[128];
+        cli_plot_tow_label(c->sys, c->speed_text, c->turn_text,
+                           plot->opts.display, tow, sizeof tow);
+        for (int b = -1; b < c->sys->nbodies; b++) {
+            int node = b < 0 ? 0 : ts_system_body_node(c->sys, b);
+            const char *what = b < 0 ? "tow point" : c->sys->bodies[b].name;
+            double *x = xy + 2 * (size_t)n * TURN_POINTS, *y = x + TURN_POINTS;
+            turn_track(c->sys->tow.speed, c->sys->tow.turn_rate,
+                       c->eq->positions + 3 * node, x, y);
+            if (distinct > 1 || curve > 0)
+                snprintf(label[n], sizeof label[n], "%.40s %.40s, %.100s",
+                         distinct > 1 ? c->sys->name : "", what, tow);
+            else
+                snprintf(label[n], sizeof label[n], "%s", what);
+            m[n] = (ts_plot_marker){x[0], y[0], b < 0 ? "t = 0" : NULL};
+            /* The tow point solid, the bodies dashed. */
+            t[n] = (ts_plot_track){TURN_POINTS, x, y, label[n],
+                                   b < 0 ? TS_PLOT_SOLID : TS_PLOT_DASHED,
+                                   1 + n, 1, &m[n]};
+            n++;
+        }
+        curve++;
+    }
+    char title[640];
+    snprintf(title, sizeof title, "%s: steady turn over one revolution, "
+             "earth frame", names);
+    ts_err err = {0};
+    int status = 0;
+    if (ts_plot_tracks(plot->dir, "plan_earth", title, n, t, &plot->opts,
+                       &err) != TS_OK)
+        status = cli_report(&err, err.code);
+    else
+        cli_plot_wrote(plot, "plan_earth");
+    free(t);
+    free(m);
+    free(xy);
+    free(label);
+    return status;
+}
+
 /* Side and top views of the converged curves. Returns the exit status. */
 static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
 {
@@ -177,6 +268,8 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
         else
             cli_plot_wrote(plot, view_name[v]);
     }
+    if (status == 0)
+        status = eq_plot_turn(plot, curves, ncurves, names, distinct);
     for (int i = 0; i < n; i++)
         cli_plot_shape_free(&shapes[i]);
     return status;
@@ -270,7 +363,7 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
             fprintf(f, "\n");
         }
     }
-    cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet);
+    cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet, d);
     if (eq->ncontrol > 0)
         fprintf(f, "controllers settled to %.3g (target %.3g)\n",
                 eq->control_residual, eq->tolerance);

@@ -154,7 +154,7 @@ static void print_verdict(const ts_result *r)
                    : "");
 }
 
-static void print_modes(const ts_result *r, int quiet)
+static void print_modes(const ts_result *r, int quiet, const ts_display *d)
 {
     const ts_system *sys = r->sys;
     const ts_linear *lin = r->lin;
@@ -183,10 +183,20 @@ static void print_modes(const ts_result *r, int quiet)
                    ? "oscillatory"
                    : "chosen");
     if (!quiet) {
-        char desc[256], label[128];
+        char desc[256], label[128], hi[64], hf[64], hp[64];
+        /* The display units (--units): Im as a turn rate (rad/s or
+         * deg/s), the frequency and the period in theirs. */
+        double ki = ts_display_value(d, TS_QTY_ANGULAR_RATE, 1.0);
+        double kf = ts_display_value(d, TS_QTY_FREQUENCY, 1.0);
+        double kt = ts_display_value(d, TS_QTY_TIME, 1.0);
+        snprintf(hi, sizeof hi, "Im [%s]",
+                 ts_display_unit(d, TS_QTY_ANGULAR_RATE));
+        snprintf(hf, sizeof hf, "freq [%s]",
+                 ts_display_unit(d, TS_QTY_FREQUENCY));
+        snprintf(hp, sizeof hp, "period [%s]",
+                 ts_display_unit(d, TS_QTY_TIME));
         printf("\n%4s %14s %14s %12s %12s %10s %8s  %s\n", "mode",
-               "Re [1/s]", "Im [rad/s]", "freq [Hz]", "period [s]",
-               "damping", "disc.err", "shape");
+               "Re [1/s]", hi, hf, hp, "damping", "disc.err", "shape");
         for (int m = 0; m < e->nmodes; m++) {
             const ts_mode *md = &e->modes[m];
             ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
@@ -200,7 +210,7 @@ static void print_modes(const ts_result *r, int quiet)
             else
                 snprintf(er, sizeof er, "-");
             printf("%4d %14.6g %14.6g %12.6g %12.6g %10.6f %8s  %s", m + 1,
-                   md->re, md->im, md->freq_hz, md->period_s,
+                   md->re, ki * md->im, kf * md->freq_hz, kt * md->period_s,
                    md->damping_ratio, er, desc);
             if (r->mode_accuracy) {
                 unresolved_label(r, m, label, sizeof label);
@@ -225,9 +235,9 @@ static void print_modes(const ts_result *r, int quiet)
         char er[160];
         if (!isfinite(r->values[v].value))
             continue;
-        cli_value_error(&r->values[v], NULL, er, sizeof er); /* SI */
-        printf("%-22s %14.8g %s\n", r->values[v].name, r->values[v].value,
-               er);
+        cli_value_error(&r->values[v], d, er, sizeof er);
+        printf("%-22s %14.8g %s\n", r->values[v].name,
+               cli_value_shown(&r->values[v], d), er);
     }
     if (r->mode_accuracy)
         print_verdict(r);
@@ -290,7 +300,10 @@ static int mode_disp(const ts_system *sys, const ts_linear *lin,
 /* --plot: the eigenvalue plane (resolved and unresolved modes apart) and
  * the shapes of the lowest resolved oscillatory modes (the lowest
  * oscillatory ones, labelled unresolved, when none is resolved). */
-static int modes_plot(const ts_result *r, const cli_plot *plot)
+/* Frames a cycle of the PNG sequences of --frames (30 degrees apart). */
+#define FRAMES_PNG 12
+
+static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
 {
     const ts_system *sys = r->sys;
     const ts_linear *lin = r->lin;
@@ -392,20 +405,40 @@ static int modes_plot(const ts_result *r, const cli_plot *plot)
         else
             cli_plot_wrote(plot, "modes");
     }
-    /* Each drawn mode as an animated SVG (side view), one cycle in 2 s. */
+    /* Each drawn mode as an animated SVG, one cycle in 2 s, in the side
+     * view (modeK_animation) and in plan (modeK_animation_top); with
+     * --frames also as PNG frame sequences (modeK_side_kkk,
+     * modeK_top_kkk), FRAMES_PNG frames a cycle. */
+    static const char *const vname[2] = {"side", "top"};
     for (int i = 0; i < np && status == 0; i++) {
-        char name[32], at[300];
-        snprintf(name, sizeof name, "mode%d_animation", pick[i] + 1);
-        snprintf(at, sizeof at, "%s: mode %d, side view, one cycle",
-                 sys->name, pick[i] + 1);
         const double *d = disp + (size_t)i * 6 * sys->nnodes;
-        if (ts_plot_mode_animation(plot->dir, name, at, TS_PLOT_SIDE,
-                                   TS_PLOT_WATER, &eqs.shape, d,
-                                   d + 3 * sys->nnodes, labels[i], 36, 2.0,
-                                   &plot->opts, &err) != TS_OK)
-            status = cli_report(&err, err.code);
-        else
+        for (int v = 0; v < 2 && status == 0; v++) {
+            char name[48], at[300];
+            snprintf(name, sizeof name, "mode%d_animation%s", pick[i] + 1,
+                     v ? "_top" : "");
+            snprintf(at, sizeof at, "%s: mode %d, %s view, one cycle",
+                     sys->name, pick[i] + 1, vname[v]);
+            ts_plot_view view = v ? TS_PLOT_TOP : TS_PLOT_SIDE;
+            if (ts_plot_mode_animation(plot->dir, name, at, view,
+                                       TS_PLOT_WATER, &eqs.shape, d,
+                                       d + 3 * sys->nnodes, labels[i], 36,
+                                       2.0, &plot->opts, &err) != TS_OK) {
+                status = cli_report(&err, err.code);
+                break;
+            }
             printf("wrote %s/%s.svg\n", plot->dir, name);
+            if (!frames)
+                continue;
+            snprintf(name, sizeof name, "mode%d_%s", pick[i] + 1, vname[v]);
+            if (ts_plot_mode_frames(plot->dir, name, at, view, TS_PLOT_WATER,
+                                    &eqs.shape, d, d + 3 * sys->nnodes,
+                                    labels[i], FRAMES_PNG, &plot->opts,
+                                    &err) != TS_OK)
+                status = cli_report(&err, err.code);
+            else
+                printf("wrote %s/%s_000.png .. %s_%03d.png\n", plot->dir,
+                       name, name, FRAMES_PNG - 1);
+        }
     }
     cli_plot_shape_free(&eqs);
     free(disp);
@@ -477,16 +510,22 @@ static void modes_print(const cli_run *c, const ts_result *r)
     cli_print_equilibrium(r, 1, &c->display);
     cli_print_linearization(r);
     if (r->eigen && r->mode_health)
-        print_modes(r, c->quiet);
+        print_modes(r, c->quiet, ts_display_or_si(&c->display));
     print_margins(r);
     print_free_vehicle(r);
 }
 
 /* The extras. */
-enum { X_MATRICES, X_SHAPES };
+enum { X_MATRICES, X_SHAPES, X_FRAMES };
 
 static int modes_prepare(cli_run *c)
 {
+    if (c->nextra[X_FRAMES] && !c->plot.dir) {
+        ts_err err = {0};
+        ts_fail(&err, TS_EINVAL, "--frames: draws the modes' frames into "
+                                 "--plot DIR; give --plot DIR");
+        return cli_report(&err, err.code);
+    }
     if (c->nextra[X_MATRICES]) {
         c->json_flags |= TS_REPORT_MATRICES;
         /* The dense A and B at any size, beside the sparse model. */
@@ -512,14 +551,14 @@ static int modes_draw_or_shapes(cli_run *c, const ts_result *r)
                                shapes);
             json_decref(sj);
         } else {
-            wrc = ts_report_shapes_csv(r->sys, r->lin, r->eigen, shapes,
-                                       &werr);
+            wrc = ts_report_shapes_csv_display(r->sys, r->lin, r->eigen,
+                                               &c->display, shapes, &werr);
         }
         if (wrc != TS_OK)
             status = cli_report(&werr, werr.code);
     }
     if (c->plot.dir) {
-        int s = modes_plot(r, &c->plot);
+        int s = modes_plot(r, &c->plot, c->nextra[X_FRAMES] > 0);
         status = status ? status : s;
     }
     return status;
@@ -529,6 +568,9 @@ static const cli_extra modes_extras[] = {
     {"matrices", 0, 0, NULL, "include A and B in the JSON"},
     {"shapes", 1, 0, "FILE",
      "write the mode shapes (CSV, or JSON when FILE ends in .json)"},
+    {"frames", 0, 0, NULL,
+     "with --plot: each animated mode also as PNG frames, 12 a cycle "
+     "(modeK_side_000.png .., modeK_top_000.png ..)"},
     {NULL, 0, 0, NULL, NULL}};
 
 static const char *const modes_pictures[] = {"eigenvalues", "modes", NULL};

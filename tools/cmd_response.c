@@ -85,8 +85,8 @@ static void print_response(const ts_result *res, int quiet,
 /* Rows of the spectrum table printed (every k-th grid point). */
 #define SEA_TABLE_ROWS 32
 
-static void print_stat(const char *what, const ts_stat *s, const char *unit,
-                       int disc)
+static void print_stat(const char *what, const ts_stat *s, double k,
+                       const char *unit, int disc)
 {
     if (!isfinite(s->value)) {
         printf("  %-36s %12s (not defined here)\n", what, "none");
@@ -94,27 +94,37 @@ static void print_stat(const char *what, const ts_stat *s, const char *unit,
     }
     char dt[48] = "discretisation not estimated";
     if (disc && isfinite(s->discretisation))
-        snprintf(dt, sizeof dt, "discretisation %.2g", s->discretisation);
+        snprintf(dt, sizeof dt, "discretisation %.2g", k * s->discretisation);
     printf("  %-36s %12.6g %s +- %.2g (grid %.2g, band %.2g, %s)\n", what,
-           s->value, unit, s->error, s->grid, s->band, dt);
+           k * s->value, unit, k * s->error, k * s->grid, k * s->band, dt);
 }
 
 /* The statistics of a spectral result (towstab/seastate.h), each with its
- * error; with !quiet, the spectra on a coarse grid. */
-void cli_print_seastate(const ts_result *r, int quiet)
+ * error, in the display units d (the output's unit, lengths, speeds and
+ * times; the wave frequencies stay in rad/s); with !quiet, the spectra on
+ * a coarse grid. */
+void cli_print_seastate(const ts_result *r, int quiet, const ts_display *d)
 {
     const ts_seastate *s = r->seastate;
     const ts_seaway *w = &r->seaway;
-    char d[512];
-    ts_sea_describe(w->sea, d, sizeof d);
-    printf("sea: %s\n", d);
+    d = ts_display_or_si(d);
+    const char *lu = ts_display_unit(d, TS_QTY_LENGTH);
+    const char *su = ts_display_unit(d, TS_QTY_SPEED);
+    const char *tu = ts_display_unit(d, TS_QTY_TIME);
+    char desc[512];
+    ts_sea_describe(w->sea, desc, sizeof desc);
+    printf("sea: %s\n", desc);
     if (r->rao_file[0])
         printf("ship RAOs: %s; lever arm (tow point less reference point) "
-               "%g, %g, %g m; speed %.6g m/s\n", r->rao_file, w->lever[0],
-               w->lever[1], w->lever[2], w->speed);
+               "%g, %g, %g %s; speed %.6g %s\n", r->rao_file,
+               ts_display_value(d, TS_QTY_LENGTH, w->lever[0]),
+               ts_display_value(d, TS_QTY_LENGTH, w->lever[1]),
+               ts_display_value(d, TS_QTY_LENGTH, w->lever[2]), lu,
+               ts_display_value(d, TS_QTY_SPEED, w->speed), su);
     else
         printf("ship RAOs: none: the tow point follows the water surface; "
-               "speed %.6g m/s\n", w->speed);
+               "speed %.6g %s\n", ts_display_value(d, TS_QTY_SPEED, w->speed),
+               su);
     if (!s)
         return;
     printf("band %.4g to %.4g rad/s (%.3g %% of the wave variance outside), "
@@ -122,19 +132,23 @@ void cli_print_seastate(const ts_result *r, int quiet)
            100 * s->wave_m0_out / (s->wave_m0_band + s->wave_m0_out),
            s->npoints - 1, s->responses);
     int disc = s->disc_estimated;
+    char ou[64];
+    double k = ts_display_convert(d, s->unit, 1.0, ou, sizeof ou);
+    double kt = ts_display_value(d, TS_QTY_TIME, 1.0);
     printf("%s about its equilibrium value %.6g %s:\n", s->output.name,
-           s->mean, s->unit);
-    print_stat("standard deviation sigma", &s->sigma, s->unit, disc);
-    print_stat("significant amplitude 2 sigma", &s->significant, s->unit,
+           k * s->mean, ou);
+    print_stat("standard deviation sigma", &s->sigma, k, ou, disc);
+    print_stat("significant amplitude 2 sigma", &s->significant, k, ou,
                disc);
-    print_stat("zero up-crossing period Tz", &s->tz, "s", disc);
+    print_stat("zero up-crossing period Tz", &s->tz, kt, tu, disc);
     char mp[96];
-    snprintf(mp, sizeof mp, "most probable maximum in %.6g s", s->duration);
-    print_stat(mp, &s->mpm, s->unit, disc);
+    snprintf(mp, sizeof mp, "most probable maximum in %.6g %s",
+             kt * s->duration, tu);
+    print_stat(mp, &s->mpm, k, ou, disc);
     if (isfinite(s->mpm.value))
         printf("  (%.4g cycles: most probable largest %.6g %s, smallest %.6g "
-               "%s)\n", s->cycles, s->mean + s->mpm.value, s->unit,
-               s->mean - s->mpm.value, s->unit);
+               "%s)\n", s->cycles, k * (s->mean + s->mpm.value), ou,
+               k * (s->mean - s->mpm.value), ou);
     if (disc) {
         char order[48] = "no steady observed order";
         if (isfinite(s->disc_order))
@@ -146,15 +160,24 @@ void cli_print_seastate(const ts_result *r, int quiet)
     }
     if (quiet)
         return;
-    printf("\n%12s %12s %14s %14s %16s\n", "w [rad/s]", "w_e [rad/s]",
-           "S [m^2 s/rad]", "|G|", "S_out");
+    /* The wave's elevation spectrum in length^2 s/rad, the gain in the
+     * output's unit per length, the output's spectrum in its unit^2
+     * s/rad. */
+    double kl = ts_display_value(d, TS_QTY_LENGTH, 1.0);
+    char hs[64], hg[80], ho[80];
+    snprintf(hs, sizeof hs, "S [%s^2 s/rad]", lu);
+    snprintf(hg, sizeof hg, "|G| [%s/%s]", ou, lu);
+    snprintf(ho, sizeof ho, "S_out [%s^2 s/rad]", ou);
+    printf("\n%12s %12s %16s %16s %20s\n", "w [rad/s]", "w_e [rad/s]", hs, hg,
+           ho);
     int step = (s->npoints - 1) / SEA_TABLE_ROWS;
     if (step < 1)
         step = 1;
     for (int i = 0; i < s->npoints; i += step)
-        printf("%12.5g %12.5g %14.6g %14.6g %16.6g\n", s->omega[i],
-               s->omega_e[i], s->wave[i], hypot(s->gain_re[i], s->gain_im[i]),
-               s->density[i]);
+        printf("%12.5g %12.5g %16.6g %16.6g %20.6g\n", s->omega[i],
+               s->omega_e[i], kl * kl * s->wave[i],
+               k / kl * hypot(s->gain_re[i], s->gain_im[i]),
+               k * k * s->density[i]);
 }
 
 static void response_print(const cli_run *c, const ts_result *r)
@@ -162,7 +185,7 @@ static void response_print(const cli_run *c, const ts_result *r)
     cli_print_equilibrium(r, 1, &c->display);
     cli_print_linearization(r);
     if (r->has_sea) {
-        cli_print_seastate(r, c->quiet);
+        cli_print_seastate(r, c->quiet, &c->display);
         if (r->seastate)
             cli_print_trust(&r->trust);
         return;

@@ -721,39 +721,50 @@ static int sim_prepare(cli_run *c)
     return 0;
 }
 
-/* A record's statistics beside the spectral prediction. */
-static void print_record(const char *what, const ts_record_stats *st)
+/* A record's statistics beside the spectral prediction, the values times
+ * k (the output's display unit) and the times times kt. */
+static void print_record(const char *what, const ts_record_stats *st,
+                         double k, double kt)
 {
     char tz[32] = "none", ind[32] = "none";
     if (isfinite(st->tz))
-        snprintf(tz, sizeof tz, "%.4g", st->tz);
+        snprintf(tz, sizeof tz, "%.4g", kt * st->tz);
     if (isfinite(st->independent))
         snprintf(ind, sizeof ind, "%.4g", st->independent);
     printf("  %-10s %14.6g +- %-10.2g %14.6g +- %-10.2g %10s %8s %8.4g\n",
-           what, st->sigma.value, st->sigma.error, st->mean, st->mean_error,
-           tz, ind, st->maximum);
+           what, k * st->sigma.value, k * st->sigma.error, k * st->mean,
+           k * st->mean_error, tz, ind, k * st->maximum);
 }
 
-static void print_sea(const ts_result *r)
+static void print_sea(const ts_result *r, const ts_display *d)
 {
+    const char *tu = ts_display_unit(d, TS_QTY_TIME);
+    double kt = ts_display_value(d, TS_QTY_TIME, 1.0);
     printf("\nirregular sea, realisation: seed %lu, %d sinusoids, fade-in "
-           "%.6g s\n", r->realisation.seed, r->realisation.components,
-           r->realisation.rise);
-    cli_print_seastate(r, 1);
+           "%.6g %s\n", r->realisation.seed, r->realisation.components,
+           kt * r->realisation.rise, tu);
+    cli_print_seastate(r, 1, d);
     if (!r->has_records)
         return;
-    printf("records of %s over t = %.6g .. %.6g s:\n", r->output.name,
-           r->transient, r->sim.t_end);
-    printf("  %-10s %14s    %-10s %14s    %-10s %10s %8s %8s\n", "", "sigma [m]",
-           "(stat.)", "mean [m]", "(stat.)", "Tz [s]", "indep.", "max [m]");
+    char ou[64], h[3][96];
+    double k = ts_display_convert(d, r->output.si_unit, 1.0, ou, sizeof ou);
+    printf("records of %s over t = %.6g .. %.6g %s:\n", r->output.name,
+           kt * r->transient, kt * r->sim.t_end, tu);
+    snprintf(h[0], sizeof h[0], "sigma [%s]", ou);
+    snprintf(h[1], sizeof h[1], "mean [%s]", ou);
+    snprintf(h[2], sizeof h[2], "Tz [%s]", tu);
+    char mx[96];
+    snprintf(mx, sizeof mx, "max [%s]", ou);
+    printf("  %-10s %14s    %-10s %14s    %-10s %10s %8s %8s\n", "", h[0],
+           "(stat.)", h[1], "(stat.)", h[2], "indep.", mx);
     if (r->has_records & 2)
-        print_record("linear", &r->record_linear);
+        print_record("linear", &r->record_linear, k, kt);
     if (r->has_records & 1)
-        print_record("nonlinear", &r->record_nonlinear);
+        print_record("nonlinear", &r->record_nonlinear, k, kt);
     if (r->seastate)
         printf("  %-10s %14.6g +- %-10.2g %14.6g\n", "spectral",
-               r->seastate->sigma.value, r->seastate->sigma.error,
-               r->seastate->mean);
+               k * r->seastate->sigma.value, k * r->seastate->sigma.error,
+               k * r->seastate->mean);
 }
 
 static void sim_print(const cli_run *c, const ts_result *r)
@@ -768,7 +779,7 @@ static void sim_print(const cli_run *c, const ts_result *r)
     char desc[256];
     const ts_excitation *ex = r->excitation;
     for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
-        ts_excitation_describe(ex, i, desc, sizeof desc);
+        ts_excitation_describe_display(ex, i, d, desc, sizeof desc);
         printf("input: %s\n", desc);
     }
     ts_initial init = c->rq.simulate.initial;
@@ -810,7 +821,7 @@ static void sim_print(const cli_run *c, const ts_result *r)
         print_table(r, d);
     print_forces(r, d);
     if (r->has_sea)
-        print_sea(r);
+        print_sea(r, d);
     for (int v = 0, head = 0; !r->has_sea && v < r->nvalues; v++) {
         char er[160];
         if (!isfinite(r->values[v].value))

@@ -32,6 +32,7 @@
 
 #include "towstab/error.h"
 #include "towstab/linearize.h"
+#include "towstab/progress.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -58,6 +59,16 @@ typedef struct ts_eigen_opts {
                               whole spectrum for the eigenvalues with the
                               largest real parts (doc/linear.md, section
                               3); the verdict covers what it finds */
+    ts_progress_fn progress; /* towstab/progress.h: called with arpack as
+                              it goes, at every operator application
+                              (what "eigensolve": done the applications,
+                              total NAN, unknown; what "rightmost search":
+                              done the shifts run, of at most total); a
+                              nonzero return stops it with TS_ECANCEL
+                              (nothing kept: no Ritz value is final before
+                              its run ends). lapack (one LAPACK call) is
+                              not polled. Default NULL */
+    void *progress_data;
 } ts_eigen_opts;
 
 typedef struct ts_mode {

@@ -22,6 +22,7 @@
 
 #include "towstab/error.h"
 #include "towstab/kernel.h"
+#include "towstab/progress.h"
 #include "towstab/system.h"
 
 #ifdef __cplusplus
@@ -48,6 +49,15 @@ typedef struct ts_equilibrium_opts {
                              (elastic links at the strain of the tension
                              a rigid copy carries there) instead of the
                              straight-tow march */
+    ts_progress_fn progress; /* towstab/progress.h: called as the Newton
+                             solver goes (what "equilibrium", done: the
+                             columns of its Jacobian formed, of the
+                             unknowns); a nonzero return stops it with
+                             TS_ECANCEL, the state reached so far and its
+                             residual recorded (converged 0). Shooting
+                             (O(nlinks), fast) is not polled. Default
+                             NULL */
+    void *progress_data;
 } ts_equilibrium_opts;
 
 typedef struct ts_equilibrium {

@@ -258,6 +258,13 @@ TS_API const char *ts_signal_axis_label(const ts_signal *s);
  * "tow.heave sine amplitude 0.03048 m, frequency 0.25 Hz, phase 0 deg". */
 TS_API void ts_excitation_describe(const ts_excitation *ex, int i, char *buf,
                                    size_t size);
+/* The same in the display units d (towstab/units.h; NULL: SI): the
+ * amplitude in the unit of its axis' quantity (length, speed, turn rate;
+ * a vehicle input's "m" or "rad" as length or angle), times, frequencies
+ * and phases in theirs. */
+TS_API void ts_excitation_describe_display(const ts_excitation *ex, int i,
+                                           const ts_display *d, char *buf,
+                                           size_t size);
 
 #ifdef __cplusplus
 }

@@ -15,7 +15,10 @@
  *       added_mass | cross_drag | cross_added_mass
  *   bodies.<vehicle>.loops.<loop>.kp | ki | kd | setpoint
  *   bodies.<vehicle>.surfaces.<surface>.area | span | deflection | limit |
- *       incidence
+ *       incidence | roll | lift_slope | stall | stall_width |
+ *       zero_lift_drag | efficiency | cn90 | rate_limit | time_constant
+ *   (the scene's words `controllers` for loops and `components` for
+ *   surfaces name the same values)
  *
  * Values are SI in the unit ts_param_unit() names (the scene's unit of
  * the key). The system stores masses: `weight` and `wet_weight` are
@@ -23,6 +26,9 @@
  * of the call (as the scene reader does), and changing a diameter keeps
  * the mass. A loop's gains take the unit of what it measures (depth: rad
  * per m; an angle: rad per rad).
+ *
+ * The keys' units and limits are the scene reader's: one table serves
+ * both (lib/param_impl.h).
  *
  * ts_param_set() checks the value against the key's own limits (naming
  * the path); the system must then be rebuilt (ts_system_build, or

@@ -214,6 +214,21 @@ TS_API int ts_plot_mode_animation(const char *dir, const char *name,
                                   double seconds, const ts_plot_opts *opts,
                                   ts_err *err);
 
+/* The same cycle as a PNG frame sequence (where an SVG animation is not
+ * wanted: slides, video tools): DIR/NAME_000.png .. NAME_kkk.png, one per
+ * phase 2 pi k / nframes (whatever opts->formats), each the equilibrium
+ * in grey and the displaced shape (cylinder towfish drawn), in one fixed
+ * window for every frame (side, with TS_PLOT_WATER the water; or top,
+ * equal scales), titled with the frame and its phase, `label` above the
+ * box. Same scale and checks as ts_plot_mode_animation; NAME at most 196
+ * characters. */
+TS_API int ts_plot_mode_frames(const char *dir, const char *name,
+                               const char *title, ts_plot_view view,
+                               int flags, const ts_plot_shape *eq,
+                               const double *re, const double *im,
+                               const char *label, int nframes,
+                               const ts_plot_opts *opts, ts_err *err);
+
 /* Axis window of ts_plot_eigenvalues; a field equal to 0 is automatic. */
 typedef struct ts_plot_eig_window {
     double re_min;  /* left edge, 1/s (< 0) */

@@ -50,6 +50,21 @@ TS_API int ts_report_shapes_csv(const ts_system *sys, const ts_linear *lin,
                                 const ts_eigen *e, const char *path,
                                 ts_err *err);
 
+/* The mode table and the mode shapes in the display units d
+ * (towstab/units.h; NULL: SI, as above): Im as a turn rate, frequencies,
+ * periods, time constants and phases in theirs, a column in another unit
+ * than SI named with it ("freq_mHz", "period_min", "x_phase_rad"). */
+TS_API int ts_report_modes_csv_display(const ts_system *sys,
+                                       const ts_linear *lin,
+                                       const ts_eigen *e,
+                                       const ts_display *d, const char *path,
+                                       ts_err *err);
+TS_API int ts_report_shapes_csv_display(const ts_system *sys,
+                                        const ts_linear *lin,
+                                        const ts_eigen *e,
+                                        const ts_display *d,
+                                        const char *path, ts_err *err);
+
 /* The frequency response: {"input", "output", "unit", "static_gain",
  * "points": [{"freq_hz", "magnitude", "phase_deg", "re", "im"}]}. */
 TS_API json_t *ts_report_response_json(const ts_response *r);

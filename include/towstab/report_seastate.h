@@ -12,6 +12,7 @@
 
 #include "towstab/error.h"
 #include "towstab/seastate.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -44,6 +45,16 @@ TS_API json_t *ts_report_seastate_json(const ts_seastate *r, const ts_seaway *w,
  * gain_re, gain_im, gain_abs (output per m) and density_<unit>2_s_rad. */
 TS_API int ts_report_seastate_csv(const ts_seastate *r, const char *path,
                                   ts_err *err);
+
+/* The same in the display units d (towstab/units.h; NULL: SI): the wave
+ * spectrum in length^2 s/rad, the gains in the output's unit per length,
+ * the output's spectrum in its unit^2 s/rad, the columns named with the
+ * units shown ("wave_ft2_s_rad", "gain_re_lbf_per_ft",
+ * "density_lbf2_s_rad"); the wave frequencies stay in rad/s and the tow
+ * point's RAOs (m/m) as they are. */
+TS_API int ts_report_seastate_csv_display(const ts_seastate *r,
+                                          const ts_display *d,
+                                          const char *path, ts_err *err);
 
 /* A record's statistics: {"samples", "duration_s", "mean", "mean_error",
  * "sigma":

@@ -58,6 +58,7 @@
 #ifndef TOWSTAB_SEASTATE_H
 #define TOWSTAB_SEASTATE_H
 
+#include "towstab/progress.h"
 #include "towstab/converge.h"
 #include "towstab/error.h"
 #include "towstab/excitation.h"
@@ -127,6 +128,12 @@ typedef struct ts_seastate_opts {
     double tail;         /* for ts_seaway_band; default TS_SEASTATE_TAIL */
     double duration;     /* s, > 0: for the most probable maximum; default
                             TS_SEASTATE_DURATION */
+    ts_progress_fn progress; /* towstab/progress.h: called after every
+                            frequency of every driven tow axis (what "sea
+                            state", done of total frequencies); a nonzero
+                            return stops it with TS_ECANCEL and no
+                            result. Default NULL */
+    void *progress_data;
 } ts_seastate_opts;
 
 TS_API void ts_seastate_opts_default(ts_seastate_opts *o);

@@ -252,8 +252,10 @@ class Scene:
         the modes' A and B in the result (as --matrices). A simulation's
         JSON holds the channels of ``outputs`` (``outputs="all"``: the full
         state too); ``history()`` has every node and link whatever it is.
-        ``progress``: a callable given a Progress as a simulation, a
-        response or a convergence sweep goes (its first report, then every
+        ``progress``: a callable given a Progress as the run goes (a
+        simulation's steps, a response's frequencies, a convergence
+        sweep's runs, an equilibrium's Newton Jacobian, the stages and
+        ARPACK of modes; its first report of each, then every
         PROGRESS_INTERVAL s); a true return stops the run (Cancelled), an
         exception it raises stops the run and is raised again, with the
         partial result as its ``result``. Ctrl-C (SIGINT) stops a long run
@@ -324,8 +326,11 @@ class Scene:
 
 class Progress:
     """How far a long run is, given to a progress callable: ``what`` the
-    run ("nonlinear", "linear", "response", "sweep"), ``done`` of
-    ``total`` in ``unit`` ("s" of simulated time, "frequencies", "runs"), ``fraction`` done/total;
+    run ("nonlinear", "linear", "response", "sweep", "sea state",
+    "equilibrium", "eigensolve", "rightmost search"), ``done`` of
+    ``total`` in ``unit`` ("s" of simulated time, "frequencies", "runs",
+    "Jacobian columns", "operator applications": total nan, no end known),
+    ``fraction`` done/total;
     ``elapsed`` wall s since the run's first report, ``rate`` units done
     per wall s since then (nan before), ``left`` the wall s estimated to
     the end at that rate (nan when unknown)."""

@@ -127,6 +127,8 @@ check "--overlay-speeds: four pictures" four_pictures "$T/spd" "kamman_ex1_above
 ts equilibrium "$EX2" --quiet --plot "$T/turn" --overlay-turn-rates "0.5 rad/s"
 check "--overlay-turn-rates: exit 0 (got $status)" [ $status -eq 0 ]
 check "--overlay-turn-rates: four pictures" four_pictures "$T/turn" "kamman_ex2_branched: equilibrium"
+check "a steady turn: the earth-frame plan view over one revolution (plan_earth), none for a straight tow" \
+    bash -c "$(declare -f is_png is_svg); is_png '$T/turn/plan_earth.png' 1000 700 && is_svg '$T/turn/plan_earth.svg' 'kamman_ex2_branched: steady turn over one revolution, earth frame' && grep -q 'wrote $T/turn/plan_earth.png' '$T/out' && [ ! -e '$T/p/new/plan_earth.png' ]"
 
 # Refusals: exit 2, nothing solved, no picture.
 touch "$T/afile"
@@ -175,6 +177,16 @@ for f in "$T/modes"/mode*_animation.svg; do
 done
 check "modes --plot: the four drawn modes as animated SVGs (got $nanim)" \
     bash -c "[ $anim_ok -eq 1 ] && [ $nanim -eq 4 ]"
+ntop=$(ls "$T/modes"/mode*_animation_top.svg 2>/dev/null | wc -l)
+check "modes --plot: and in plan view (modeK_animation_top.svg, got $ntop)" \
+    bash -c "[ $ntop -eq 4 ] && grep -q '<title>kamman_ex3: mode [0-9]*, top view, one cycle</title>' $(ls "$T/modes"/mode*_animation_top.svg | head -1)"
+ts modes "$EX3" --oscillatory --count 1 --no-discretisation-error --quiet --plot "$T/frames" --frames
+nfr=$(ls "$T/frames"/mode*_side_0[0-9][0-9].png "$T/frames"/mode*_top_0[0-9][0-9].png 2>/dev/null | wc -l)
+check "modes --plot --frames: 12 PNG frames of the drawn mode in each view (got $nfr)" \
+    bash -c "[ $status -eq 0 ] && [ $nfr -eq 24 ] && $(declare -f is_png); is_png \"\$(ls '$T/frames'/mode*_top_011.png)\" 1000 700"
+ts modes "$EX3" --frames --quiet
+check "modes --frames without --plot: exit 2 naming --plot (got $status)" \
+    bash -c "[ $status -eq 2 ] && grep -q -- '--frames.*--plot' '$T/err'"
 ts modes "$EX3" --plot "$T/afile"
 check "modes --plot into a file: exit 2 (got $status)" [ $status -eq 2 ]
 

@@ -108,7 +108,7 @@ grep -E -q '(src|href)="(https?:|//|file:)' "$P" && why="$why an external refere
 grep -E -q '<link|@import|url\(' "$P" && why="$why a stylesheet or url() to fetch;"
 nimg=$(grep -o '<img ' "$P" | wc -l)
 ndata=$(grep -o '<img alt="[^"]*" src="data:image/svg+xml,' "$P" | wc -l)
-want=12
+want=15  # with the modes' plan-view animations (modeK_animation_top)
 [ "$HAVE" = yes ] || want=0
 [ "$nimg" -eq "$want" ] && [ "$ndata" -eq "$want" ] || why="$why $nimg images ($ndata SVG data URIs), not $want;"
 if [ "$HAVE" = yes ]; then

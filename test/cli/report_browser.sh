@@ -110,7 +110,7 @@ page() {
 
 # Every kind of analysis (pictures: side, top; eigenvalues, modes; bode;
 # histories, snapshots_side, snapshots_top; error_time).
-page all_kinds test/cli/report/all_kinds.yaml 12
+page all_kinds test/cli/report/all_kinds.yaml 15
 # A response in a sea (the spectral tables of doc/seastate.md; no
 # picture of a sea-state response) after an equilibrium (side, top).
 page survey_tow_sea examples/survey_tow_sea.yaml 2

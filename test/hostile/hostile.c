@@ -1261,7 +1261,9 @@ static void gen_signals(void)
                  1.0);
     args(c, "--json", "-", NULL);
     /* A frequency sweep stops after its current frequency; a dense
-     * eigensolve cannot poll: it ends at once, saying so (issue 15). */
+     * eigensolve cannot poll: the stop is taken after it (the equilibrium
+     * written, marked incomplete), or at once, writing nothing, when it
+     * has not returned within 5 s of the signal (issue 15). */
     c = add_case("signal: SIGINT during a response of 1e6 frequencies");
     args(c, "response", EX1, "--quiet", "--output", "sphere.z", "--points",
          "1000000", "--json", "@D/out.json", NULL);
@@ -1282,9 +1284,41 @@ static void gen_signals(void)
         c->expect = E_INTERRUPT;
         c->sig = SIGTERM;
         c->sig_after = 1.0;
-        c->must_name = xstrdup("stopped at once, writing nothing");
+        /* "stopped on request" after LAPACK's call, or "stopped at once"
+         * when it has not returned within the grace (under load). */
         free(t);
     }
+    /* Large modes (ARPACK on the sparse model), a Newton equilibrium and
+     * a sea-state response stop at their next poll, writing what they
+     * have marked incomplete: the equilibrium reached (with its
+     * residual), the linear model. */
+    c = add_case("signal: SIGINT during modes of 20000 links (ARPACK)");
+    args(c, "modes", EX1, "--quiet", "--links", "20000",
+         "--no-discretisation-error", "--json", "@D/out.json", NULL);
+    c->expect = E_INTERRUPT;
+    c->sig = SIGINT;
+    c->sig_after = 2.0;
+    c->must_name = xstrdup("stopped on request");
+    c->progress = -1;
+    c = add_case("signal: SIGINT during a Newton equilibrium of 2000 links");
+    args(c, "equilibrium", EX1, "--quiet", "--links", "2000",
+         "--equilibrium-method", "newton", "--no-discretisation-error",
+         "--json", "@D/out.json", NULL);
+    c->expect = E_INTERRUPT;
+    c->sig = SIGINT;
+    c->sig_after = 1.0;
+    c->must_name = xstrdup("stopped on request");
+    c->progress = -1;
+    c = add_case("progress: a sea-state response on a terminal, then SIGINT");
+    args(c, "response", "examples/survey_tow_sea.yaml", "--quiet", "--output",
+         "fish.z", "--sea", "Hs=4m,Tp=8s,gamma=3.3,heading=180deg",
+         "--intervals", "524288", "--json", "@D/out.json", NULL);
+    c->expect = E_INTERRUPT;
+    c->sig = SIGINT;
+    c->sig_after = 4.0; /* the grid takes about 2 s to set up */
+    c->must_name = xstrdup("stopped on request after");
+    c->pty = 1;
+    c->progress = 1;
     /* Progress: on a terminal, not on a file. */
     c = long_run("progress: shown when standard error is a terminal", SIGINT,
                  2.5);

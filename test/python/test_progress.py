@@ -10,6 +10,7 @@ seconds and raises KeyboardInterrupt with the partial result; the SIGINT
 handler in place before is back after every call.
 """
 
+import math
 import os
 import signal
 import threading
@@ -40,10 +41,14 @@ def sigint_default():
 
 def test_every_report_in_order(ex1, monkeypatch):
     monkeypatch.setattr(towstab, "PROGRESS_INTERVAL", 0.0)
-    seen = []
+    reports = []
     r = ex1.simulate(t_end="5 s", discretisation_error=False,
-                     progress=seen.append)
+                     progress=reports.append)
     assert r.completed is True
+    # The initial equilibrium's stage first, then the simulation's steps.
+    assert reports[0].what == "equilibrium"
+    seen = [p for p in reports if p.what != "equilibrium"]
+    assert reports[-len(seen):] == seen
     assert len(seen) > 10
     assert all(p.what == "nonlinear" and p.unit == "s" and p.total == 5.0
                for p in seen)
@@ -73,6 +78,8 @@ def test_return_true_stops(ex1):
     seen = []
 
     def stop_at_first(p):
+        if p.what == "equilibrium":
+            return False
         seen.append(p)
         return True
 
@@ -93,7 +100,8 @@ def test_exception_stops_and_is_raised(ex1):
         pass
 
     def fail(p):
-        raise Enough("seen %g s" % p.done)
+        if p.what != "equilibrium":
+            raise Enough("seen %g s" % p.done)
 
     with pytest.raises(Enough) as e:
         ex1.simulate(t_end="100 s", progress=fail)
@@ -103,7 +111,8 @@ def test_exception_stops_and_is_raised(ex1):
 
 def test_keyboard_interrupt_in_callable(ex1):
     def interrupt(p):
-        raise KeyboardInterrupt
+        if p.what != "equilibrium":
+            raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt) as e:
         ex1.simulate(t_end="100 s", progress=interrupt)
@@ -135,6 +144,8 @@ def test_response_stops_between_frequencies(monkeypatch):
     seen = []
 
     def after_three(p):
+        if p.what == "equilibrium":
+            return False
         seen.append(p)
         return p.done >= 3
 
@@ -215,3 +226,77 @@ def test_short_runs_unchanged(ex1, sigint_default):
     r = ex1.equilibrium()
     assert r.completed is True
     assert signal.getsignal(signal.SIGINT) is before
+
+
+SUB = os.path.join(ROOT, "examples/kamman_ex1_submerged.yaml")
+
+
+@pytest.fixture(scope="module")
+def sub():
+    return towstab.Scene.load(SUB)
+
+
+def _interrupted(run, after):
+    """Run `run` with SIGINT sent after `after` s: the KeyboardInterrupt
+    it raises, and the wall time it took."""
+    timer = threading.Timer(after, os.kill, (os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt) as e:
+            run()
+    finally:
+        timer.cancel()
+    return e.value, time.monotonic() - t0
+
+
+def test_sigint_stops_a_newton_equilibrium(sub, sigint_default):
+    # 2000 links by Newton: a Jacobian of 4000 columns, several seconds
+    # uninterrupted; stopped at its next column (or after its last LU).
+    before = signal.getsignal(signal.SIGINT)
+    e, wall = _interrupted(lambda: sub.equilibrium(
+        links=2000, equilibrium_method="newton",
+        discretisation_error=False), 0.5)
+    assert wall < 20, "stopped %.1f s after the start" % wall
+    r = e.result
+    assert r.completed is False and r.trustworthy is False
+    assert "stopped on request" in r.error
+    # The state reached so far, with its residual.
+    assert r.method == "newton" and r.residual >= 0
+    assert r.converged is False and len(r.nodes) == 2001
+    assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_sigint_stops_large_modes(sub, sigint_default):
+    # 20000 links: the equilibrium and the sparse linear model take about
+    # a second, ARPACK and the rightmost search many more.
+    e, wall = _interrupted(lambda: sub.modes(
+        links=20000, discretisation_error=False), 1.5)
+    assert wall < 30, "stopped %.1f s after the start" % wall
+    r = e.result
+    assert r.completed is False and "stopped on request" in r.error
+    # The equilibrium was finished before the stop: kept, converged.
+    assert r.equilibrium.converged is True
+    assert "modes" not in r or not r["modes"]
+
+
+def test_progress_of_modes_and_stop(sub, monkeypatch):
+    # The stages report in order; a true return in the eigensolve stops
+    # it (Cancelled), the equilibrium kept.
+    monkeypatch.setattr(towstab, "PROGRESS_INTERVAL", 0.0)
+    seen = []
+
+    def stop_in_eigensolve(p):
+        seen.append((p.what, p.done, p.total, p.unit))
+        return p.what == "eigensolve" and p.done >= 5
+
+    with pytest.raises(towstab.Cancelled) as e:
+        sub.modes(links=2000, discretisation_error=False,
+                  progress=stop_in_eigensolve)
+    whats = [w for w, *_ in seen]
+    assert whats[0] == "equilibrium" and "eigensolve" in whats
+    last = seen[-1]
+    assert last[0] == "eigensolve" and last[1] == 5
+    assert last[3] == "operator applications" and math.isnan(last[2])
+    assert "after 5 operator applications" in e.value.message
+    assert e.value.result.equilibrium.converged is True
