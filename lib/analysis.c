@@ -1518,6 +1518,12 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
     if (s->compare && s->linear)
         return ts_fail(err, TS_EINVAL, "linear: linear runs the linear model "
                        "alone; compare runs both: give one");
+    if (sys->tow.autopilot.on && (s->linear || s->compare))
+        return ts_fail(err, TS_EINVAL, "%s: the waypoints (line %d) steer "
+                       "the towing vehicle in the nonlinear run only; the "
+                       "linear model has no autopilot: run without it",
+                       s->linear ? "linear" : "compare",
+                       sys->tow.autopilot.g.line);
     if (!(*transient >= 0) || !(*transient < o->t_end))
         return ts_fail(err, TS_EINVAL, "transient: must be in [0, %g) s (the "
                        "run length), got %g s", o->t_end, *transient);

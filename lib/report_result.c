@@ -285,6 +285,50 @@ static json_t *sim_sea_json(const ts_result *r)
     return j;
 }
 
+/* The waypoint course of a run (the scene's autopilot): the waypoints,
+ * those reached and when, and the depth range of every body. */
+static json_t *waypoints_json(const ts_result *r, const ts_history *h)
+{
+    const ts_system *sys = r->sys;
+    const ts_guidance *g = &sys->tow.autopilot.g;
+    json_t *j = json_object(), *pts = json_array(), *reached = json_array(),
+           *depth = json_array();
+    if (!j || !pts || !reached || !depth) {
+        json_decref(j);
+        json_decref(pts);
+        json_decref(reached);
+        json_decref(depth);
+        return NULL;
+    }
+    for (int i = 0; i < g->nwaypoints; i++)
+        json_array_append_new(pts, json_pack("[o,o]", num(g->waypoint[i][0]),
+                                             num(g->waypoint[i][1])));
+    for (int i = 0; i < h->nreached; i++)
+        json_array_append_new(reached,
+                              json_pack("{s:i,s:o,s:o}", "index", i + 1,
+                                        "t_s", num(h->reached_t[i]),
+                                        "distance_m", num(h->reached_d[i])));
+    ts_depth_range dr[TS_MAX_DEPTH_RANGES];
+    int nd = ts_history_depth_ranges(sys, h, dr, TS_MAX_DEPTH_RANGES);
+    for (int k = 0; k < nd; k++)
+        json_array_append_new(
+            depth, json_pack("{s:s,s:o,s:o,s:o,s:o,s:o}", "body",
+                             sys->bodies[dr[k].body].name, "min_m",
+                             num(dr[k].min), "t_min_s", num(dr[k].t_min),
+                             "max_m", num(dr[k].max), "t_max_s",
+                             num(dr[k].t_max), "excursion_m",
+                             num(dr[k].max - dr[k].min)));
+    json_object_set_new(j, "points", pts);
+    json_object_set_new(j, "radius_m", num(g->radius));
+    json_object_set_new(j, "interval_s",
+                        num(sys->tow.autopilot.interval));
+    json_object_set_new(j, "reached", reached);
+    json_object_set_new(j, "all_reached",
+                        json_boolean(h->nreached == g->nwaypoints));
+    json_object_set_new(j, "depth", depth);
+    return j;
+}
+
 static json_t *simulate_json(const ts_result *r, int flags)
 {
     (void)flags;
@@ -343,6 +387,8 @@ static json_t *simulate_json(const ts_result *r, int flags)
     }
     if (r->tensions)
         json_object_set_new(j, "forces", forces_json(r));
+    if (r->nonlinear && sys->tow.autopilot.on)
+        json_object_set_new(j, "waypoints", waypoints_json(r, r->nonlinear));
     if (r->compared)
         json_object_set_new(j, "compare", ts_report_compare_json(&r->compare));
     if (r->has_sea)

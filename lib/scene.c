@@ -1769,13 +1769,113 @@ static int top_list(const ctx *c, const field *f, int *n)
     return TS_OK;
 }
 
+/* ------------------------------------------------------------------ */
+/* Waypoints (doc/scene-format.md, "Waypoints"; towstab/guidance.h)      */
+
+/* The waypoints entry: the autopilot of the towing vehicle. Needs a
+ * towing vehicle (parsed before) whose rudders are its control surfaces. */
+static int parse_waypoints(const ctx *c, const field *fw, ts_system *sys)
+{
+    enum { W_POINTS, W_RADIUS, W_GAIN, W_BIAS, W_RUDDERS, W_LIMIT,
+           W_INTERVAL, W_N };
+    field f[W_N] = {{"points", 0, 0}, {"radius", 0, 0}, {"gain", 0, 0},
+                    {"bias", 0, 0}, {"rudders", 0, 0}, {"limit", 0, 0},
+                    {"interval", 0, 0}};
+    const char *path = "waypoints";
+    char p[PATH_LEN], pi[PATH_LEN];
+    ts_autopilot *ap = &sys->tow.autopilot;
+    int rc = read_map(c, fw->value, path, "points, radius, gain, rudders, "
+                      "...", f, W_N);
+    if (rc != TS_OK)
+        return rc;
+    if (sys->tow.vehicle < 0)
+        return fail_at(c, TS_ESCENE, path, fw->line, "waypoints steer a "
+                       "towing vehicle's rudder: the scene has no "
+                       "towing_vehicle (a prescribed tow point follows "
+                       "tow.speed and tow.turn_rate)");
+    static const int required[] = {W_POINTS, W_GAIN, W_RUDDERS};
+    for (int k = 0; k < 3; k++)
+        if (!f[required[k]].value)
+            return missing(c, path, fw->value, f[required[k]].key);
+    ts_guidance_defaults(&ap->g);
+    ap->g.line = fw->line;
+    int n = 0;
+    rc = field_list(c, join(p, path, "points"), &f[W_POINTS],
+                    "points [x, y]", TS_GUIDANCE_MAX_WAYPOINTS, &n);
+    if (rc == TS_OK && n < 1)
+        rc = fail_at(c, TS_EINVAL, p, f[W_POINTS].line, "needs at least "
+                     "one point [x, y]");
+    for (int i = 0; rc == TS_OK && i < n; i++) {
+        yaml_node_t *item = seq_item(c, f[W_POINTS].value, i);
+        if (!item)
+            return ts_fail(c->err, TS_ESCENE, "%s: broken YAML document", p);
+        field fi = {"", item, line_of(item)};
+        double xy[2];
+        int m = 0;
+        rc = quantity_list(c, index_path(pi, p, i), &fi, "m", 2, 2, xy, &m);
+        if (rc == TS_OK && m != 2)
+            rc = fail_at(c, TS_EINVAL, pi, fi.line, "expected a point "
+                         "[x, y], got %d entries", m);
+        ap->g.waypoint[i][0] = xy[0];
+        ap->g.waypoint[i][1] = xy[1];
+    }
+    ap->g.nwaypoints = n;
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[W_RADIUS], "m", 0, 1,
+                          TS_GUIDANCE_RADIUS, &ap->g.radius);
+    if (rc == TS_OK)
+        rc = optional_any(c, path, &f[W_GAIN], "1", 1.0, &ap->g.kp);
+    if (rc == TS_OK)
+        rc = optional_any(c, path, &f[W_BIAS], "rad", 0.0, &ap->g.delta0);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[W_LIMIT], "rad", 0, 1, INFINITY,
+                          &ap->g.limit);
+    if (rc == TS_OK)
+        rc = optional_min(c, path, &f[W_INTERVAL], "s", 0, 1,
+                          TS_AUTOPILOT_INTERVAL, &ap->interval);
+    if (rc != TS_OK)
+        return rc;
+    /* The rudders: control surfaces of the towing vehicle. */
+    const ts_vehicle *v = sys->bodies[sys->tow.vehicle].vehicle;
+    join(p, path, "rudders");
+    rc = field_list(c, p, &f[W_RUDDERS], "surface names",
+                    TS_AUTOPILOT_MAX_RUDDERS, &ap->nrudders);
+    if (rc == TS_OK && ap->nrudders < 1)
+        rc = fail_at(c, TS_EINVAL, p, f[W_RUDDERS].line, "needs at least "
+                     "one control surface of the towing vehicle");
+    for (int i = 0; rc == TS_OK && i < ap->nrudders; i++) {
+        yaml_node_t *item = seq_item(c, f[W_RUDDERS].value, i);
+        if (!item)
+            return ts_fail(c->err, TS_ESCENE, "%s: broken YAML document", p);
+        field fi = {"", item, line_of(item)};
+        char name[TS_NAME_MAX];
+        rc = read_name(c, index_path(pi, p, i), &fi, name);
+        int hit = -1;
+        for (int k = 0; rc == TS_OK && k < v->ncomponents && hit < 0; k++)
+            if (!strcmp(v->component[k].name, name))
+                hit = k;
+        if (rc == TS_OK && (hit < 0 || !v->component[hit].control))
+            rc = fail_at(c, TS_EINVAL, pi, fi.line, "'%s' is not a control "
+                         "surface of the towing vehicle '%s' (a component "
+                         "with control: true)", name,
+                         sys->bodies[sys->tow.vehicle].name);
+        if (rc == TS_OK)
+            snprintf(ap->rudder[i], sizeof ap->rudder[i], "%s", name);
+    }
+    if (rc == TS_OK)
+        rc = ts_guidance_check(&ap->g, "waypoints", c->err);
+    ap->on = rc == TS_OK;
+    return rc;
+}
+
 static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
 {
     enum { K_NAME, K_ENV, K_TOW, K_CABLES, K_BODIES, K_ANALYSES, K_TOWING,
-           K_DESIGN, K_N };
+           K_DESIGN, K_WAYPOINTS, K_N };
     field f[K_N] = {{"name", 0, 0}, {"environment", 0, 0}, {"tow", 0, 0},
                     {"cables", 0, 0}, {"bodies", 0, 0}, {"analyses", 0, 0},
-                    {"towing_vehicle", 0, 0}, {"design", 0, 0}};
+                    {"towing_vehicle", 0, 0}, {"design", 0, 0},
+                    {"waypoints", 0, 0}};
     int rc = read_map(c, root, "", "name, tow, cables, ...", f, K_N);
     if (rc != TS_OK)
         return rc;
@@ -1826,6 +1926,8 @@ static int parse_root(const ctx *c, const yaml_node_t *root, ts_scene *scene)
                              sys->bodies[nbodies].line, "'%s' is also the "
                              "name of bodies[%d]", sys->bodies[b].name, b);
     }
+    if (rc == TS_OK && f[K_WAYPOINTS].value)
+        rc = parse_waypoints(c, &f[K_WAYPOINTS], sys);
     long total_links = 0;
     for (int i = 0; rc == TS_OK && i < ncables; i++) {
         yaml_node_t *item = seq_item(c, f[K_CABLES].value, i);

@@ -411,6 +411,10 @@ struct ts_sim {
                              or negative length (strain <= -1) */
     double t_start;       /* time of the last ts_sim_set_state */
     long steps_start;     /* accepted steps before it */
+    double *hold;         /* [ninput] held inputs added to the excitation's
+                             (the waypoint autopilot's rudder), or NULL */
+    double t_hold;        /* the next autopilot update: a stop of the
+                             integrator (INFINITY: none) */
 };
 
 static int needs_jacobian(ts_integrator m);
@@ -485,10 +489,11 @@ static void stiffness_note(const ts_sim *s, ts_err *err)
 static void prepare(ts_sim *s, double t, double *u)
 {
     ts_excitation_input(s->ex, t, u);
-    if (s->in_idx) {
+    if (s->in_idx || s->hold) {
         for (int j = TS_NINPUT; j < s->ninput; j++)
-            u[j] = 0.0;
-        add_inputs(s->ex, s->in_idx, t, u);
+            u[j] = s->hold ? s->hold[j] : 0.0;
+        if (s->in_idx)
+            add_inputs(s->ex, s->in_idx, t, u);
     }
     if (s->frame_varies) {
         ts_frame f;
@@ -657,6 +662,7 @@ void ts_sim_free(ts_sim *s)
     free(s->y_int);
     free(s->work);
     free(s->u);
+    free(s->hold);
     free(s->in_idx);
     free(s->breaks);
     free(s);
@@ -715,6 +721,7 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
     s->work = calloc(3 * n, sizeof(double));
     s->ninput = ts_kernel_ninput(k);
     s->u = calloc((size_t)s->ninput, sizeof(double));
+    s->t_hold = INFINITY;
     int nb = ts_excitation_breakpoints(ex, o->t_end, NULL, 0);
     s->breaks = malloc((size_t)(nb + 1) * sizeof(double));
     if (!s->y || !s->work || !s->breaks || !s->u)
@@ -850,6 +857,8 @@ void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st)
  * limit, else limit: where the next step must stop. */
 static double next_stop(const ts_sim *s, double limit)
 {
+    if (s->t_hold > s->t && s->t_hold < limit)
+        limit = s->t_hold;
     for (int b = 0; b < s->nbreaks; b++)
         if (s->breaks[b] > s->t && s->breaks[b] < limit)
             return s->breaks[b];
@@ -1075,6 +1084,155 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
     return TS_OK;
 }
 
+int ts_history_depth_ranges(const ts_system *sys, const ts_history *h,
+                            ts_depth_range *out, int max)
+{
+    int m = 0;
+    for (int n = 0; n < sys->nnodes && m < max; n++) {
+        int b = sys->nodes[n].body;
+        if (b < 0 || b == sys->tow.vehicle)
+            continue;
+        ts_depth_range *d = &out[m++];
+        d->body = b;
+        d->min = d->t_min = d->max = d->t_max = NAN;
+        for (int i = 0; i < h->nsamples; i++) {
+            double z = h->positions[(size_t)(3 * h->nnodes) * (size_t)i +
+                                    3 * (size_t)n + 2];
+            if (!(z >= d->min)) {
+                d->min = z;
+                d->t_min = h->t[i];
+            }
+            if (!(z <= d->max)) {
+                d->max = z;
+                d->t_max = h->t[i];
+            }
+        }
+    }
+    return m;
+}
+
+/* ------------------------------------------------------------------ */
+/* The waypoint autopilot (towstab/guidance.h, doc/guidance.md)          */
+
+typedef struct autopilot {
+    const ts_autopilot *ap;
+    ts_guidance g;       /* the scene's, its start the run's */
+    int index;           /* the target waypoint: the autopilot's state */
+    long updates;        /* updates so far: the next is at updates dt */
+    int root;            /* the towing vehicle's index among the vehicles */
+    const double *attach;/* its tow point in body axes, m */
+    int in[TS_AUTOPILOT_MAX_RUDDERS]; /* the rudders' kernel inputs */
+} autopilot;
+
+/* The towing vehicle's origin (x, y in E, m) and heading (rad) at the
+ * simulator's time and state. M moves at the base frame's speed V and
+ * turn rate Omega (the autopilot refuses frame manoeuvres), so its pose is
+ * closed: heading Omega t, origin (V sin(Omega t) / Omega,
+ * V (1 - cos(Omega t)) / Omega) (towstab/track.h). */
+static void ap_pose(const ts_sim *s, const autopilot *a, double xy[2],
+                    double *psi)
+{
+    double R[9], r[2];
+    ts_kernel_get_vehicle(s->k, a->root, s->y, R, NULL);
+    const double *at = a->attach;
+    int off = ts_kernel_root_offset(s->k);
+    for (int i = 0; i < 2; i++)
+        r[i] = s->y[off + i] -
+               (R[3 * i] * at[0] + R[3 * i + 1] * at[1] + R[3 * i + 2] * at[2]);
+    double V = s->base.speed, W = s->base.turn_rate, t = s->t, th = W * t;
+    double ox = fabs(th) < 1e-6 ? V * t * (1 - th * th / 6)
+                                : V * sin(th) / W;
+    double oy = fabs(th) < 1e-6 ? V * t * th / 2 * (1 - th * th / 12)
+                                : V * (1 - cos(th)) / W;
+    double c = cos(th), sn = sin(th);
+    xy[0] = ox + c * r[0] - sn * r[1];
+    xy[1] = oy + sn * r[0] + c * r[1];
+    *psi = th + atan2(R[3], R[0]);
+}
+
+/* Bind the scene's autopilot to the simulator: rudder inputs, the start
+ * of the path (the vehicle's position at t = 0, checked against the
+ * first waypoint), the held inputs. a->ap NULL when the scene has none. */
+static int ap_bind(ts_sim *s, const ts_excitation *ex, autopilot *a,
+                   ts_err *err)
+{
+    memset(a, 0, sizeof *a);
+    const ts_autopilot *ap = &s->sys->tow.autopilot;
+    if (!ap->on)
+        return TS_OK;
+    if (ts_kernel_root(s->k) < 0)
+        return ts_fail(err, TS_EINVAL, "simulate: waypoints (line %d) steer "
+                       "a towing vehicle; the scene has none", ap->g.line);
+    if (ex && ts_excitation_has_manoeuvre(ex))
+        return ts_fail(err, TS_EINVAL, "simulate: waypoints (line %d): a "
+                       "speed or turn-rate manoeuvre of the frame cannot be "
+                       "combined with the autopilot of a towing vehicle; "
+                       "remove the manoeuvre", ap->g.line);
+    a->ap = ap;
+    a->g = ap->g;
+    a->root = ts_kernel_root(s->k);
+    a->attach = s->sys->bodies[ts_kernel_vehicle_body(s->k, a->root)]
+                    .vehicle->attach;
+    const char *veh = s->sys->bodies[s->sys->tow.vehicle].name;
+    for (int i = 0; i < ap->nrudders; i++) {
+        char name[2 * TS_NAME_MAX + 8];
+        snprintf(name, sizeof name, "%s.%s", veh, ap->rudder[i]);
+        a->in[i] = ts_kernel_input_find(s->k, name);
+        if (a->in[i] < 0)
+            return ts_fail(err, TS_EINVAL, "simulate: waypoints.rudders[%d]: "
+                           "the kernel has no input '%s'", i, name);
+    }
+    if (!s->hold && !(s->hold = calloc((size_t)s->ninput, sizeof(double))))
+        return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
+    double psi;
+    ap_pose(s, a, a->g.start, &psi);
+    return ts_guidance_check(&a->g, "waypoints", err);
+}
+
+/* An autopilot update at the simulator's time: advance the target past
+ * the waypoints within the radius (recording them in h), set and hold
+ * the rudder command, schedule the next update. */
+static int ap_update(ts_sim *s, autopilot *a, ts_history *h, ts_err *err)
+{
+    double xy[2], psi;
+    ap_pose(s, a, xy, &psi);
+    int before = a->index;
+    a->index = ts_guidance_advance(&a->g, a->index, xy[0], xy[1]);
+    for (int i = before; i < a->index && h->nreached < a->g.nwaypoints; i++) {
+        h->reached_t[h->nreached] = s->t;
+        h->reached_d[h->nreached] = ts_guidance_distance(&a->g, i, xy[0],
+                                                         xy[1]);
+        h->nreached++;
+    }
+    double d = ts_guidance_rudder(&a->g, ts_guidance_error(&a->g, a->index,
+                                                           xy[0], xy[1],
+                                                           psi));
+    a->updates++;
+    s->t_hold = s->t_start + (double)a->updates * a->ap->interval;
+    if (s->hold[a->in[0]] == d)
+        return TS_OK;
+    for (int i = 0; i < a->ap->nrudders; i++)
+        s->hold[a->in[i]] = d;
+    /* The command jumps: no step may reuse derivatives from before. */
+    return restart(s, err);
+}
+
+/* Advance to t1 stopping at the autopilot's updates (a->ap NULL: none). */
+static int ap_advance(ts_sim *s, autopilot *a, ts_history *h, double t1,
+                      ts_err *err)
+{
+    int rc = TS_OK;
+    while (!rc && a->ap && s->t_hold <= t1 * (1 + 1e-12)) {
+        if (s->t_hold > s->t)
+            rc = ts_sim_advance(s, s->t_hold, err);
+        if (!rc)
+            rc = ap_update(s, a, h, err);
+    }
+    if (!rc && s->t < t1)
+        rc = ts_sim_advance(s, t1, err);
+    return rc;
+}
+
 int ts_simulate(ts_kernel *k, const ts_excitation *ex, const double y0[],
                 const ts_sim_opts *o, ts_history *h, ts_sim_stats *st,
                 double y_end[], ts_err *err)
@@ -1102,10 +1260,15 @@ int ts_simulate(ts_kernel *k, const ts_excitation *ex, const double y0[],
     }
     rc = ts_sim_set_state(s, 0.0, ys, err);
     free(ys);
+    autopilot a;
+    if (!rc)
+        rc = ap_bind(s, ex, &a, err);
+    if (!rc && a.ap)
+        rc = ap_update(s, &a, h, err);
     if (!rc)
         rc = ts_sim_record(s, h, err);
     for (int i = 1; i < N && !rc; i++) {
-        rc = ts_sim_advance(s, ts_sim_sample_time(o, i), err);
+        rc = ap_advance(s, &a, h, ts_sim_sample_time(o, i), err);
         int rr = ts_sim_record(s, h, rc ? NULL : err);
         if (!rc)
             rc = rr;

@@ -204,6 +204,52 @@ static void print_forces(const ts_result *r, const ts_display *d)
                r->nslack - SLACK_LINES);
 }
 
+/* The waypoint course of the nonlinear run: the waypoints reached and
+ * when, and the depth excursion of every body through it. */
+static void print_waypoints(const ts_result *r, const ts_display *d)
+{
+    const ts_system *sys = r->sys;
+    const ts_history *h = r->nonlinear;
+    if (!h || !sys->tow.autopilot.on)
+        return;
+    const ts_guidance *g = &sys->tow.autopilot.g;
+    const char *lu = ts_display_unit(d, TS_QTY_LENGTH);
+    const char *tu = ts_display_unit(d, TS_QTY_TIME);
+    printf("\nwaypoints of %s (radius %.6g %s, autopilot every %.6g %s): "
+           "%d of %d reached\n", sys->bodies[sys->tow.vehicle].name,
+           ts_display_value(d, TS_QTY_LENGTH, g->radius), lu,
+           ts_display_value(d, TS_QTY_TIME, sys->tow.autopilot.interval), tu,
+           h->nreached, g->nwaypoints);
+    char hx[40], hy[40], ht[40], hd[40];
+    snprintf(hx, sizeof hx, "x [%s]", lu);
+    snprintf(hy, sizeof hy, "y [%s]", lu);
+    snprintf(ht, sizeof ht, "reached at t [%s]", tu);
+    snprintf(hd, sizeof hd, "distance [%s]", lu);
+    printf("%8s %12s %12s %18s %14s\n", "waypoint", hx, hy, ht, hd);
+    for (int i = 0; i < g->nwaypoints; i++) {
+        printf("%8d %12.6g %12.6g", i + 1,
+               ts_display_value(d, TS_QTY_LENGTH, g->waypoint[i][0]),
+               ts_display_value(d, TS_QTY_LENGTH, g->waypoint[i][1]));
+        if (i < h->nreached)
+            printf(" %18.6g %14.4g\n",
+                   ts_display_value(d, TS_QTY_TIME, h->reached_t[i]),
+                   ts_display_value(d, TS_QTY_LENGTH, h->reached_d[i]));
+        else
+            printf(" %18s %14s\n", "not reached", "-");
+    }
+    ts_depth_range dr[TS_MAX_DEPTH_RANGES];
+    int nd = ts_history_depth_ranges(sys, h, dr, TS_MAX_DEPTH_RANGES);
+    for (int k = 0; k < nd; k++)
+        printf("depth of %s: %.6g %s (t = %.6g %s) to %.6g %s (t = %.6g "
+               "%s), excursion %.4g %s\n", sys->bodies[dr[k].body].name,
+               ts_display_value(d, TS_QTY_LENGTH, dr[k].min), lu,
+               ts_display_value(d, TS_QTY_TIME, dr[k].t_min), tu,
+               ts_display_value(d, TS_QTY_LENGTH, dr[k].max), lu,
+               ts_display_value(d, TS_QTY_TIME, dr[k].t_max), tu,
+               ts_display_value(d, TS_QTY_LENGTH, dr[k].max - dr[k].min),
+               lu);
+}
+
 static void print_compare(const ts_compare *c, const ts_display *d)
 {
     char u[64], ru[80], label[128], eu[64];
@@ -820,6 +866,7 @@ static void sim_print(const cli_run *c, const ts_result *r)
     if (!c->quiet)
         print_table(r, d);
     print_forces(r, d);
+    print_waypoints(r, d);
     if (r->has_sea)
         print_sea(r, d);
     for (int v = 0, head = 0; !r->has_sea && v < r->nvalues; v++) {

@@ -50,6 +50,25 @@ typedef struct ts_guidance {
     int line;         /* scene line, 0 if none */
 } ts_guidance;
 
+#define TS_AUTOPILOT_MAX_RUDDERS 4
+#define TS_AUTOPILOT_INTERVAL 0.5  /* default update interval, s */
+#define TS_AUTOPILOT_NAME_MAX 64
+
+/* A scene's waypoint autopilot (the `waypoints` entry, doc/guidance.md,
+ * "The autopilot in simulate"): the guidance (its start is the towing
+ * vehicle's position at the start of a run, set by the simulator), the
+ * towing vehicle's control surfaces that take the rudder command (each the
+ * whole command), and the update interval: the command is computed from
+ * the vehicle's earth-frame position and heading every `interval` seconds
+ * and held in between. */
+typedef struct ts_autopilot {
+    int on;                         /* 1: the scene gives waypoints */
+    ts_guidance g;
+    int nrudders;                   /* 1..TS_AUTOPILOT_MAX_RUDDERS */
+    char rudder[TS_AUTOPILOT_MAX_RUDDERS][TS_AUTOPILOT_NAME_MAX];
+    double interval;                /* s, > 0 */
+} ts_autopilot;
+
 /* Defaults: no waypoint, start at the origin, radius TS_GUIDANCE_RADIUS,
  * kp 1, delta0 0, no limit. */
 TS_API void ts_guidance_defaults(ts_guidance *g);

@@ -36,6 +36,7 @@
 #define TOWSTAB_SIMULATE_H
 
 #include "towstab/error.h"
+#include "towstab/guidance.h"
 #include "towstab/excitation.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
@@ -159,6 +160,13 @@ typedef struct ts_history {
     char (*output_name)[2 * TS_NAME_MAX + 16]; /* [noutput]
                             ts_kernel_output_name */
     const char **output_unit; /* [noutput] "m" or "rad" */
+    int nreached;        /* waypoints reached (a scene with waypoints,
+                            towstab/guidance.h; ts_simulate), in order */
+    double reached_t[TS_GUIDANCE_MAX_WAYPOINTS];  /* s: the autopilot
+                            update at which each was found within the
+                            radius */
+    double reached_d[TS_GUIDANCE_MAX_WAYPOINTS];  /* m: the vehicle's
+                            distance from it then */
 } ts_history;
 
 /* A history of `capacity` samples for system sys; NULL on failure. */
@@ -172,6 +180,22 @@ TS_API void ts_history_free(ts_history *h);
  * filled). */
 TS_API double ts_history_value(const ts_system *sys, const ts_history *h,
                                const ts_output *out, int i);
+
+/* The depth range of a towed body over a run: its least and greatest
+ * depth (z, m; the same in M and E) and their times (the depth excursion
+ * of a towfish through a manoeuvre). */
+/* Depth ranges reported at most (the reports list the first ones). */
+#define TS_MAX_DEPTH_RANGES 32
+
+typedef struct ts_depth_range {
+    int body;                 /* index into sys->bodies */
+    double min, t_min, max, t_max;   /* m, s (NaN without samples) */
+} ts_depth_range;
+
+/* The depth ranges over h's samples of every body but the towing vehicle,
+ * in node order, at most `max` into out; returns how many were written. */
+TS_API int ts_history_depth_ranges(const ts_system *sys, const ts_history *h,
+                                   ts_depth_range *out, int max);
 
 /* --- Nonlinear simulation: set / advance / read, and a driver. --- */
 

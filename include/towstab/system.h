@@ -14,6 +14,7 @@
 
 #include "towstab/error.h"
 #include "towstab/vehicle.h"
+#include "towstab/guidance.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -57,6 +58,9 @@ typedef struct ts_tow {
                                of its control surface the steady analyses
                                deflect to turn at `turn_rate`, or -1: the
                                turn rate is solved at the deflections */
+    ts_autopilot autopilot; /* the scene's waypoints (on = 0: none): a
+                               simulation steers the towing vehicle's
+                               rudder toward them (towstab/guidance.h) */
 } ts_tow;
 
 typedef struct ts_cable {

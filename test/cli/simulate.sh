@@ -281,5 +281,26 @@ big=$(wc -c <"$T/o/a.csv")
 [ -z "$why" ] && pass "--outputs: the named channels only ($small bytes of CSV); --outputs all: the full state ($big bytes)" ||
     fail "--outputs:$why"
 
+# 11. A waypoint course (test/scenes/dolphin_waypoints.yaml): the table
+# lists the waypoints reached and when and the fish's depth range; the
+# JSON's waypoints has them with all_reached; --linear is refused (2).
+fresh
+ts simulate test/scenes/dolphin_waypoints.yaml --t-end 60 --sample 0.5 \
+    --json "$T/o/w.json"
+why=""
+[ "$status" -eq 0 ] || why="$why exit $status: $(head -1 "$T/err");"
+grep -q '^waypoints of dolphin (radius 2 m, autopilot every 0.5 s): 3 of 3 reached' "$T/out" ||
+    why="$why no waypoint table;"
+grep -Eq '^ +3 +110 +100 +52.5 ' "$T/out" || why="$why waypoint 3 not at 52.5 s;"
+grep -q '^depth of fish: ' "$T/out" || why="$why no depth range;"
+grep -q '"all_reached": true' "$T/o/w.json" || why="$why JSON all_reached;"
+grep -q '"excursion_m"' "$T/o/w.json" || why="$why JSON depth excursion;"
+line=$(grep -m1 '^waypoints of' "$T/out")
+ts simulate test/scenes/dolphin_waypoints.yaml --t-end 10 --linear
+[ "$status" -eq 2 ] && grep -q 'waypoints (line' "$T/err" ||
+    why="$why --linear not refused (exit $status);"
+[ -z "$why" ] && pass "waypoints: $line" ||
+    fail "waypoints:$why"
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
