@@ -105,6 +105,7 @@ int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
         f.turn_rate = eq->turn_rate;
         ts_kernel_set_frame(k, &f);
         ts_kernel_set_thrust_bias(k, eq->thrust_bias);
+        ts_kernel_set_turn_deflection(k, eq->turn_deflection);
     }
     return TS_OK;
 }
@@ -260,6 +261,7 @@ static int record(ts_kernel *k, const double *y, ts_equilibrium *eq,
     eq->speed = fr.speed;
     eq->turn_rate = fr.turn_rate;
     eq->thrust_bias = ts_kernel_thrust_bias(k);
+    eq->turn_deflection = ts_kernel_turn_deflection(k);
     double scale;
     double worst = ts_kernel_unbalanced(k, &scale);
     eq->force_scale = scale;
@@ -299,6 +301,8 @@ typedef struct newton_ws {
      * controller's thrust bias, and the turn rate. -1 without one. */
     int ux, uy;
     int x_is_bias;  /* 1: ux is the thrust bias, 0: the speed */
+    int y_is_turn;  /* 1: uy is the turn surface's deflection (the turn
+                       rate given), 0: the turn rate */
     double rootpos[3]; /* the saved shape's root position */
     ts_progress_fn progress; /* the caller's (ts_equilibrium_opts), or
                                 NULL */
@@ -325,7 +329,7 @@ static double uget(const ts_kernel *k, const newton_ws *w, const double *y,
     ts_frame f;
     ts_kernel_get_frame(k, &f);
     if (i == w->uy)
-        return f.turn_rate;
+        return w->y_is_turn ? ts_kernel_turn_deflection(k) : f.turn_rate;
     return w->x_is_bias ? ts_kernel_thrust_bias(k) : f.speed;
 }
 
@@ -338,7 +342,9 @@ static void uset(ts_kernel *k, const newton_ws *w, double *y, int i,
     }
     ts_frame f;
     ts_kernel_get_frame(k, &f);
-    if (i == w->uy)
+    if (i == w->uy && w->y_is_turn)
+        ts_kernel_set_turn_deflection(k, v);
+    else if (i == w->uy)
         f.turn_rate = v;
     else if (w->x_is_bias)
         ts_kernel_set_thrust_bias(k, v);
@@ -399,12 +405,13 @@ static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
         w->ux = ro;
         w->uy = ro + 1;
         w->x_is_bias = bd->vehicle->propulsion.type == TS_PROP_SPEED;
+        w->y_is_turn = sys->tow.turn_surface >= 0;
         if (w->scale) {
             /* Steps of the speed, a thrust, the turn rate. */
             w->scale[ro] = w->x_is_bias
                                ? fmax(bd->mass * sys->env.gravity, 1.0)
                                : fmax(fabs(sys->tow.speed), 1.0);
-            w->scale[ro + 1] = 0.1;
+            w->scale[ro + 1] = 0.1; /* rad/s, or rad */
         }
     }
     w->J = malloc(nu * nu * sizeof(double));
@@ -859,6 +866,7 @@ static void path_at(ts_kernel *k, const newton_ws *w, path_fn path,
 {
     ts_frame f;
     double bias = ts_kernel_thrust_bias(k);
+    double turn = ts_kernel_turn_deflection(k);
     ts_kernel_get_frame(k, &f);
     path(pc, t);
     if (w->ux < 0)
@@ -869,6 +877,7 @@ static void path_at(ts_kernel *k, const newton_ws *w, path_fn path,
     g.turn_rate = f.turn_rate;
     ts_kernel_set_frame(k, &g);
     ts_kernel_set_thrust_bias(k, bias);
+    ts_kernel_set_turn_deflection(k, turn);
 }
 
 /* ", with <vehicle>.<surface> at its limit" for the first control
@@ -1848,6 +1857,7 @@ out:
         f.turn_rate = eq->turn_rate;
         ts_kernel_set_frame(k, &f);
         ts_kernel_set_thrust_bias(k, eq->thrust_bias);
+        ts_kernel_set_turn_deflection(k, eq->turn_deflection);
     }
     newton_ws_free(&w);
     tsi_march_free(m);

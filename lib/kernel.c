@@ -97,6 +97,8 @@ typedef struct veh {
                                  external force (N) and moment (N m) in
                                  body axes, TSI_NPROP in all; -1 */
     double thrust_bias;       /* the speed controller's bias, N */
+    double turn_delta;        /* the deflection added to the turn surface
+                                 (ts_tow.turn_surface), rad */
     double thrust;            /* thrust at the last evaluation, N */
 } veh;
 
@@ -373,6 +375,7 @@ ts_kernel *ts_kernel_clone(const ts_kernel *k, ts_err *err)
         memcpy(c->veh[v].frozen, k->veh[v].frozen, sizeof k->veh[v].frozen);
         memcpy(c->veh[v].sp, k->veh[v].sp, sizeof k->veh[v].sp);
         c->veh[v].thrust_bias = k->veh[v].thrust_bias;
+        c->veh[v].turn_delta = k->veh[v].turn_delta;
     }
     if (layout_controls(c, err) != TS_OK) {
         ts_kernel_free(c);
@@ -654,6 +657,15 @@ double ts_kernel_thrust_bias(const ts_kernel *k)
 {
     return k->root >= 0 ? k->veh[k->root].thrust_bias : 0.0;
 }
+void ts_kernel_set_turn_deflection(ts_kernel *k, double delta)
+{
+    if (k->root >= 0)
+        k->veh[k->root].turn_delta = delta;
+}
+double ts_kernel_turn_deflection(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].turn_delta : 0.0;
+}
 double ts_kernel_thrust(const ts_kernel *k)
 {
     return k->root >= 0 ? k->veh[k->root].thrust : 0.0;
@@ -822,6 +834,8 @@ static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
     for (int j = 0; j < d->ncomponents; j++) {
         act[j] = V->act_off[j] >= 0 ? c[V->act_off[j]] : 0.0;
         us[j] = V->in_surf[j] >= 0 ? u[V->in_surf[j]] : 0.0;
+        if (V->root && j == k->sys->tow.turn_surface)
+            us[j] += V->turn_delta;
     }
     tsi_vehicle_measure(&V->st, V->meas, V->rate);
     tsi_control_in in = {V->meas, V->rate, xi,   act,      us,

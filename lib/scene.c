@@ -1136,7 +1136,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
      * order parse_vehicle reads them; its added_mass is B_CA's node. */
     enum { B_NAME, B_TYPE, B_DIAM, B_WEIGHT, B_MASS, B_WET, B_DRAG, B_CA,
            B_LEN, B_XDRAG, B_XCA, B_VOLUME, B_INERTIA, B_MC, B_BC, B_ATTACH,
-           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_PROP, B_N };
+           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_PROP, B_TURN, B_N };
     /* The towing vehicle (sys->tow.vehicle == b): the top-level
      * towing_vehicle entry, a vehicle whose attach point is its tow
      * point, with propulsion. */
@@ -1149,7 +1149,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                     {"mass_centre", 0, 0}, {"buoyancy_centre", 0, 0},
                     {"attach", 0, 0}, {"surface_diameter", 0, 0},
                     {"components", 0, 0}, {"controllers", 0, 0},
-                    {"propulsion", 0, 0}};
+                    {"propulsion", 0, 0}, {"turn_by", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     if (towing) {
         snprintf(path, sizeof path, "towing_vehicle");
@@ -1161,7 +1161,7 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
     body->line = line_of(n);
     int rc = read_map(c, n, path, towing ? "name, mass, inertia, ..."
                                          : "name, type, diameter, weight, ...",
-                      f, towing ? B_N : B_N - 1);
+                      f, towing ? B_N : B_PROP);
     if (rc != TS_OK)
         return rc;
     for (int k = 0; k <= B_TYPE; k++)
@@ -1227,6 +1227,23 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
         if (rc == TS_OK && towing)
             rc = parse_propulsion(c, &f[B_PROP], path,
                                   &body->vehicle->propulsion);
+        if (rc == TS_OK && towing && f[B_TURN].value) {
+            /* The control surface the steady analyses deflect to turn at
+             * tow.turn_rate. */
+            const char *t = NULL;
+            rc = field_text(c, join(p, path, "turn_by"), &f[B_TURN],
+                            "a control surface's name", &t);
+            const ts_vehicle *v = body->vehicle;
+            sys->tow.turn_surface = -1;
+            for (int j = 0; rc == TS_OK && j < v->ncomponents; j++)
+                if (v->component[j].control && !strcmp(v->component[j].name, t))
+                    sys->tow.turn_surface = j;
+            if (rc == TS_OK && sys->tow.turn_surface < 0)
+                rc = fail_at(c, TS_EINVAL, p, f[B_TURN].line, "'%s' is not "
+                             "a control surface of the towing vehicle",
+                             show(t, f[B_TURN].value->data.scalar.length, s,
+                                  sizeof s));
+        }
         if (rc != TS_OK)
             return rc;
     }

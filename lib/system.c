@@ -37,6 +37,7 @@ ts_system *ts_system_alloc(int ncables, int nbodies, ts_err *err)
     s->env.water_density = 1025.0;
     s->env.gravity = 9.80665;
     s->tow.vehicle = -1;
+    s->tow.turn_surface = -1;
     return s;
 nomem:
     ts_system_free(s);
@@ -542,6 +543,14 @@ static int validate(const ts_system *s, ts_err *err)
         return ts_fail(err, TS_EINVAL, "tow.vehicle: the towing vehicle "
                        "must be a body of type vehicle, got index %d",
                        s->tow.vehicle);
+    if (s->tow.turn_surface >= 0 &&
+        (s->tow.vehicle < 0 ||
+         s->tow.turn_surface >=
+             s->bodies[s->tow.vehicle].vehicle->ncomponents ||
+         !s->bodies[s->tow.vehicle].vehicle->component[s->tow.turn_surface]
+              .control))
+        return ts_fail(err, TS_EINVAL, "towing_vehicle.turn_by: must be a "
+                       "control surface of the towing vehicle");
     if (s->tow.vehicle >= 0 && (s->tow.point[0] != 0 || s->tow.point[1] != 0))
         return ts_fail(err, TS_EINVAL, "tow.point: with a towing vehicle the "
                        "tow point starts the mean frame's origin: x and y "

@@ -23,7 +23,8 @@
  *     at 1400 N, released at 1500 N, the kernel integrated (RK4) settles
  *     on the 1500 N trim; with 3 deg of rudder, on Newton's steady
  *     turn (its tensions, attitude, depth, speed through the water, and
- *     its turn rate: the yaw rate relative to M vanishes).
+ *     its turn rate: the yaw rate relative to M vanishes); and at that
+ *     turn rate, turn_by rudder gives back the 3 deg.
  *  6. Linear and nonlinear agree at small thrust steps: their difference
  *     falls like the square of the step.
  *  7. The free vehicle (ts_free_vehicle_compare): alone, level, its
@@ -529,6 +530,34 @@ static void test_settle(void)
               ec->turn_rate, ec->speed, dtc, fabs(rc2.speed - re->speed),
               fabs(rc2.pitch - re->pitch), fabs(rc2.roll - re->roll),
               fabs(rc2.origin[2] - re->origin[2]), yawrate);
+        /* The inverse: the rudder that turns at that rate
+         * (towing_vehicle.turn_by) is the 3 deg it came from. */
+        char turn[96];
+        snprintf(turn, sizeof turn, "%.17g rad/s", ec->turn_rate);
+        const char *keys[2] = {"tow.turn_rate", "towing_vehicle.turn_by"};
+        const char *vals[2] = {turn, "rudder"};
+        ts_err e2 = {0};
+        ts_units *un = ts_units_alloc(&e2);
+        ts_scene *ci = un ? ts_scene_set(a, 2, keys, vals, un, &e2) : NULL;
+        ts_units_free(un);
+        ts_kernel *ki = NULL;
+        ts_equilibrium *ei = ci ? solve(ci->system, &ki) : NULL;
+        if (!ci)
+            printf("scene: %s\n", e2.msg);
+        const ts_vehicle_result *ri =
+            ei ? &ei->vehicles[ts_kernel_root(ki)] : NULL;
+        CHECK(ei && ei->converged &&
+                  fabs(ei->turn_deflection - 3.0 * M_PI / 180) < 1e-9 &&
+                  fabs(ri->delta[3] - 3.0 * M_PI / 180) < 1e-9 &&
+                  fabs(ei->speed - ec->speed) < 1e-8 &&
+                  fabs(ei->turn_rate - ec->turn_rate) == 0,
+              "at that turn rate, turn_by rudder: the rudder %.12g deg (3), "
+              "speed %.12g m/s (%.12g)",
+              ei ? ei->turn_deflection * 180 / M_PI : NAN,
+              ei ? ei->speed : NAN, ec->speed);
+        ts_equilibrium_free(ei);
+        ts_kernel_free(ki);
+        ts_scene_free(ci);
         ts_equilibrium_free(ec);
         ts_kernel_free(kc);
     } else {

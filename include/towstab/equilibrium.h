@@ -102,6 +102,9 @@ typedef struct ts_equilibrium {
      * solved with its trim, and its speed controller's thrust bias (N;
      * 0 without one). */
     double speed, turn_rate, thrust_bias;
+    double turn_deflection; /* the deflection added to the towing
+                             vehicle's turn surface to turn at the given
+                             rate (ts_tow.turn_surface), rad; 0 */
 } ts_equilibrium;
 
 TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);

@@ -119,6 +119,11 @@ TS_API int ts_kernel_root_offset(const ts_kernel *k);
 TS_API void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust);
 TS_API double ts_kernel_thrust_bias(const ts_kernel *k);
 TS_API double ts_kernel_thrust(const ts_kernel *k);
+/* The deflection (rad) added to the towing vehicle's turn surface
+ * (ts_tow.turn_surface), trimmed by the equilibrium to turn at the
+ * scene's turn rate; 0 without one. */
+TS_API void ts_kernel_set_turn_deflection(ts_kernel *k, double delta);
+TS_API double ts_kernel_turn_deflection(const ts_kernel *k);
 
 /* Set / read the frame motion. The default is the system's tow (speed,
  * turn rate, zero rates) with its current. */

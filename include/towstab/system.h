@@ -54,6 +54,10 @@ typedef struct ts_tow {
                                the tow point r_tow, is node 0, starting at
                                `point`; doc/towing-vehicle.md), or -1: the
                                tow point is prescribed */
+    int turn_surface;       /* with a towing vehicle: the component index
+                               of its control surface the steady analyses
+                               deflect to turn at `turn_rate`, or -1: the
+                               turn rate is solved at the deflections */
     ts_autopilot autopilot; /* the scene's waypoints (on = 0: none): a
                                simulation steers the towing vehicle's
                                rudder toward them (towstab/guidance.h) */
