@@ -419,7 +419,11 @@ void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
     const char *wu = ts_display_unit(d, TS_QTY_ANGULAR_RATE);
     char v[96], w[96];
     /* SI speeds and turn rates also in knots and deg/s. */
-    int n = snprintf(v, sizeof v, "speed %.6g %s",
+    /* With a towing vehicle the scene's speed and turn rate are where the
+     * solve starts (or its targets); the steady motion solved is on the
+     * vehicle's own line (cli_print_vehicles). */
+    int n = snprintf(v, sizeof v, "%sspeed %.6g %s",
+                     t->vehicle >= 0 ? "towing vehicle, scene " : "",
                      ts_display_value(d, TS_QTY_SPEED, t->speed), vu);
     if (!strcmp(vu, "m/s") && n > 0 && (size_t)n < sizeof v)
         snprintf(v + n, sizeof v - (size_t)n, " (%.4g knots)",
