@@ -8,34 +8,8 @@
 set -eu
 TOWSTAB=$1
 RUNS=${2:-9}
-TIMEFORMAT='%U %S'
-
-# cpu CMD...: CPU seconds (user + system) of one run of CMD.
-cpu() {
-    local t
-    t=$( { time "$@" >/dev/null 2>&1; } 2>&1 ) || true
-    awk '{ printf "%.4f\n", $1 + $2 }' <<<"$t"
-}
-
-median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
-
-# row LABEL "A options" "B options" COMMAND ARGS...
-row() {
-    local label=$1 a=$2 b=$3
-    shift 3
-    local ta=() tb=()
-    for ((i = 0; i < RUNS; i++)); do
-        # shellcheck disable=SC2086
-        ta+=("$(cpu "$TOWSTAB" "$@" $a)")
-        # shellcheck disable=SC2086
-        tb+=("$(cpu "$TOWSTAB" "$@" $b)")
-    done
-    local ma mb
-    ma=$(printf '%s\n' "${ta[@]}" | median)
-    mb=$(printf '%s\n' "${tb[@]}" | median)
-    awk -v l="$label" -v a="$ma" -v b="$mb" \
-        'BEGIN { printf "| %s | %.3f | %.3f | %.2f |\n", l, a, b, a / b }'
-}
+# shellcheck source=paired_cpu.sh
+. "$(dirname "$0")/paired_cpu.sh"
 
 echo "runs $RUNS each, $(uptime | sed 's/.*load/load/')"
 echo "| command | A cpu s | B cpu s | A/B cpu |"
