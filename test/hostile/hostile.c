@@ -964,7 +964,7 @@ static void gen_cli_misuse(void)
     c->stdin_path = xstrdup(EX1);
     c = misuse(R, "standard input", "equilibrium", "-", NULL);
     /* modes */
-    misuse(R, "80 states", "modes", EX1, "--quiet", "--eigen-method",
+    misuse(R, "160 states", "modes", EX1, "--quiet", "--eigen-method",
            "arpack", "--count", "79", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "0", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "-3", NULL);
