@@ -16,6 +16,7 @@
 #    the history so far, with "completed": false in the JSON;
 #  - bad options exit 2 with one line naming the option and write no file;
 #  - `--json -` writes one JSON document alone to standard output;
+#  - waypoints: a scene's course, and --waypoints in place of its points;
 #  - the forces' extremes are over the analysed window when the run has
 #    one (--transient), over the whole run otherwise.
 # Prints one PASS/FAIL line per check and "N passed, N failed".
@@ -304,7 +305,32 @@ ts simulate test/scenes/dolphin_waypoints.yaml --t-end 10 --linear
 [ -z "$why" ] && pass "waypoints: $line" ||
     fail "waypoints:$why"
 
-# 12. The forces over the analysed window: example 4 heaved 0.5 ft at
+# 12. --waypoints replaces the scene's points (its rudders and gain
+# kept): a port turn the scene does not have, both points reached; bad
+# lists, and a scene without a waypoints entry, exit 2 with one line
+# naming --waypoints and write no file.
+fresh
+ts simulate test/scenes/dolphin_waypoints.yaml --t-end 40 --sample 0.5 \
+    --waypoints "50 m,0;50 m,-40 m" --json "$T/o/w2.json"
+why=""
+[ "$status" -eq 0 ] || why="$why exit $status: $(head -1 "$T/err");"
+grep -q '^waypoints of dolphin (radius 2 m, autopilot every 0.5 s): 2 of 2 reached' "$T/out" ||
+    why="$why not 2 of 2 reached;"
+grep -Eq '^ +2 +50 +-40 +[0-9.]+ ' "$T/out" || why="$why waypoint 2 not (50, -40);"
+line=$(grep -m1 '^waypoints of' "$T/out")
+for bad in "60,0;110" "60 kg,0" ";" "1 m,0" "a,b"; do
+    ts simulate test/scenes/dolphin_waypoints.yaml --t-end 1 \
+        --waypoints "$bad" --json "$T/o/bad.json"
+    [ "$status" -eq 2 ] && [ "$(wc -l <"$T/err")" -eq 1 ] &&
+        grep -q -- '--waypoints' "$T/err" && [ ! -e "$T/o/bad.json" ] ||
+        why="$why '$bad': exit $status, $(head -1 "$T/err");"
+done
+ts simulate test/scenes/towing_sphere.yaml --t-end 1 --waypoints "10 m,0"
+[ "$status" -eq 2 ] && grep -q -- "--waypoints: .*the scene has none" "$T/err" ||
+    why="$why no waypoints entry: exit $status;"
+[ -z "$why" ] && pass "--waypoints: $line" || fail "--waypoints:$why"
+
+# 13. The forces over the analysed window: example 4 heaved 0.5 ft at
 # 1 Hz, its first 10 s a transient (--transient 10). The table says
 # t >= 10 s and its tow force max and min are those of the CSV's tow.force
 # over t >= 10 s, not over the run (whose start transient peaks higher:
