@@ -72,12 +72,10 @@
 /* Integrator noise of a simulated value in a links sweep: this many times
  * rel_tol of the value's scale. */
 #define SIM_TOL_NOISE 10.0
-/* Times compared within this (s) are the same sample. */
-#define TIME_EPS 1e-12
 /* Key values of a simulation under a periodic excitation: amplitude
  * ratio, mean offset, phase (SIM_FIT values), then the extreme link
- * tensions over the window; the extremes of the forces over the run
- * follow (sim_values). */
+ * tensions over the window; the extremes of the forces (over the window
+ * too, sim_forces) follow (sim_values). */
 #define SIM_FIT 3
 #define SIM_TMAX 3
 #define SIM_TMIN 4
@@ -1813,7 +1811,7 @@ static int sim_nfit(const ts_result *r)
  *    made leaves NAN values (an error only when required);
  *  - with a nonlinear run, the extremes of the force on the tow point
  *    (tow.force.max, ...) and of a tension output (force_values) over
- *    the whole run.
+ *    r->forces_from on (sim_forces).
  * `linear_only`: the request runs the linear model alone; `ran`: the
  * runs succeeded (else only the names, NAN values). */
 static int sim_values(ts_result *r, int linear_only, int ran, int required,
@@ -1869,9 +1867,7 @@ static int sim_values(ts_result *r, int linear_only, int ran, int required,
     value_name(&r->values[SIM_TMIN], "N", 0.0, "tension.min");
     if (!h || !r->eq || !ran)
         return TS_OK;
-    int first = 0;
-    while (first < h->nsamples && h->t[first] < r->transient - TIME_EPS)
-        first++;
+    int first = ts_history_first(h, r->transient);
     int n = h->nsamples - first;
     /* The extreme link tensions over the window. */
     double tmax = -INFINITY, tmin = INFINITY;
@@ -1931,10 +1927,46 @@ static int sim_values(ts_result *r, int linear_only, int ran, int required,
     return TS_OK;
 }
 
+/* Whether a simulation computes its earth-frame tracks (h->frame): when
+ * the request asks (s->tracks: the pictures), the channels reported
+ * include an earth-frame position or the full state, or the scene steers
+ * by waypoints. */
+static int sim_needs_tracks(const ts_result *r, const ts_simulate_opts *s)
+{
+    if (s->tracks || r->all_outputs || r->sys->tow.autopilot.on)
+        return 1;
+    for (int k = 0; k < r->noutputs; k++)
+        if (r->outputs[k].kind == TS_OUT_EARTH)
+            return 1;
+    return 0;
+}
+
+/* The samples a run's history starts with: those of the run, at most
+ * TS_HISTORY_INITIAL (it grows as the run fills it). */
+static int history_start(int nsamples)
+{
+    return nsamples < TS_HISTORY_INITIAL ? nsamples : TS_HISTORY_INITIAL;
+}
+
+/* The start of the window the forces' extremes are taken over
+ * (ts_result.forces_from): the transient when the run analyses a window
+ * after it (a periodic excitation's fit, a sea's statistics, or a
+ * transient given), else 0, the whole run (a manoeuvre's loads are in its
+ * transient). */
+static double forces_window(const ts_result *r, const ts_simulate_opts *s)
+{
+    int idx;
+    int windowed = r->has_sea || !isnan(s->transient) ||
+                   (r->excitation &&
+                    ts_excitation_periodic(r->excitation, &idx));
+    return windowed ? r->transient : 0.0;
+}
+
 /* The forces of the nonlinear run (ts_result: tow_force, tensions,
- * output_extremes, slack) and their verdict: a rigid link in compression
- * is a reason (a cable cannot push), an elastic link going slack a note
- * (a snap load follows). References: the initial equilibrium's values. */
+ * output_extremes over the window from forces_from on; slack over the
+ * whole run) and their verdict: a rigid link in compression is a reason
+ * (a cable cannot push), an elastic link going slack a note (a snap load
+ * follows). References: the initial equilibrium's values. */
 static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
 {
     const ts_system *sys = r->sys;
@@ -1944,19 +1976,20 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
             ? r->eq
             : NULL;
     const ts_history *ho = h ? h : r->linear;
+    double from = r->forces_from = forces_window(r, s);
     if (ho)
-        ts_extremes_compute(sys, ho, &r->output,
-                            eq ? ts_output_value(sys, &r->output,
-                                                 eq->positions, eq->tensions,
-                                                 eq->tow_force)
-                               : NAN,
-                            &r->output_extremes);
+        ts_extremes_window(sys, ho, &r->output,
+                           eq ? ts_output_value(sys, &r->output,
+                                                eq->positions, eq->tensions,
+                                                eq->tow_force)
+                              : NAN,
+                           from, &r->output_extremes);
     if (!h || h->nsamples == 0)
         return TS_OK;
     ts_output o;
     ts_output_find(sys, "tow.force", TS_OUT_ALL, &o, NULL);
-    ts_extremes_compute(sys, h, &o, eq ? eq->top_tension : NAN,
-                        &r->tow_force);
+    ts_extremes_window(sys, h, &o, eq ? eq->top_tension : NAN, from,
+                       &r->tow_force);
     r->tensions = calloc((size_t)sys->nlinks, sizeof *r->tensions);
     if (!r->tensions)
         return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
@@ -1965,7 +1998,8 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
     for (int l = 0; l < sys->nlinks; l++) {
         o.link = l;
         ts_extremes *e = &r->tensions[l];
-        ts_extremes_compute(sys, h, &o, eq ? eq->tensions[l] : NAN, e);
+        ts_extremes_window(sys, h, &o, eq ? eq->tensions[l] : NAN, from,
+                           e);
         if (e->samples == 0)
             continue;
         if (r->peak_link < 0 || e->max > r->tensions[r->peak_link].max)
@@ -2205,7 +2239,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         if (r->lin)
             r->evaluations += r->lin->evaluations;
         if (rc == TS_OK && (s->compare || s->linear)) {
-            r->linear = ts_history_alloc(sys, N, err);
+            r->linear = ts_history_alloc(sys, history_start(N), err);
             rc = r->linear ? ts_simulate_linear(k, r->lin, ex, NULL, o,
                                                 r->linear, &r->linear_stats,
                                                 err)
@@ -2217,25 +2251,13 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     }
     if (rc == TS_OK && !s->linear) {
         knl = ts_kernel_clone(k, err);
-        r->nonlinear = knl ? ts_history_alloc(sys, N, err) : NULL;
+        r->nonlinear = knl ? ts_history_alloc(sys, history_start(N), err)
+                           : NULL;
         rc = r->nonlinear ? ts_simulate(knl, ex, y0, o, r->nonlinear,
                                         &r->nonlinear_stats, NULL, err)
                           : (err && err->code ? err->code : TS_ENOMEM);
         r->evaluations += r->nonlinear_stats.evaluations;
     }
-    /* The earth-frame tracks (towstab/track.h): the frame's pose at each
-     * sample, also of a run that stopped early. */
-    ts_frame base;
-    ts_kernel_get_frame(k, &base);
-    base.speed_rate = base.turn_accel = 0.0;
-    ts_history *runs[2] = {r->nonlinear, r->linear};
-    for (int i = 0; i < 2; i++)
-        if (runs[i]) {
-            int trc = ts_track_history(runs[i], ex, &base,
-                                       rc == TS_OK ? err : NULL);
-            if (rc == TS_OK)
-                rc = trc;
-        }
     /* Health: the start, the linear model's kinks and the integrations'
      * statistics (towstab/health.h). */
     if (r->lin && r->lin->kink_tow && s->compare)
@@ -2259,6 +2281,21 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
      * run's samples so far too). */
     int frc = sim_selection(sys, s, &r->output, &r->outputs, &r->noutputs,
                             &r->all_outputs, rc == TS_OK ? err : NULL);
+    /* The earth-frame tracks (towstab/track.h), when asked for: the
+     * frame's pose at each sample, also of a run that stopped early. */
+    if (frc == TS_OK && k && sim_needs_tracks(r, s)) {
+        ts_frame base;
+        ts_kernel_get_frame(k, &base);
+        base.speed_rate = base.turn_accel = 0.0;
+        ts_history *runs[2] = {r->nonlinear, r->linear};
+        for (int i = 0; i < 2; i++)
+            if (runs[i]) {
+                int trc = ts_track_history(runs[i], ex, &base,
+                                           rc == TS_OK ? err : NULL);
+                if (rc == TS_OK)
+                    rc = trc;
+            }
+    }
     if (frc == TS_OK)
         frc = sim_forces(r, s, rc == TS_OK ? err : NULL);
     if (rc == TS_OK)
