@@ -152,6 +152,7 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
         goto nomem;
     eq->nlinks = sys->nlinks;
     eq->nnodes = sys->nnodes;
+    eq->motion_step[0] = eq->motion_step[1] = NAN;
     size_t nl = (size_t)sys->nlinks, nn = (size_t)sys->nnodes;
     /* Controller states: at most an integrator per loop and an actuator
      * per surface. */
@@ -470,6 +471,12 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
         big = fmax(big, fabs(w->dq[i]) / w->scale[i]);
     eq->condition = w->rcond > 0 ? 1.0 / w->rcond : INFINITY;
     eq->shape_error = big * total_length(ts_kernel_system(k));
+    /* The steady motion's unknowns (a towing vehicle): their own parts
+     * of the same step. */
+    if (w->ux >= 0) {
+        eq->motion_step[0] = fabs(w->dq[w->ux]);
+        eq->motion_step[1] = fabs(w->dq[w->uy]);
+    }
 }
 
 /* Where the kernel's last evaluation has its largest load or tension
@@ -1628,6 +1635,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     eq->tolerance = o.tol;
     eq->condition = NAN;
     eq->shape_error = NAN;
+    eq->motion_step[0] = eq->motion_step[1] = NAN;
     if (frame.speed_rate != 0 || frame.turn_accel != 0)
         return ts_fail(err, TS_EDOMAIN, "equilibrium: the frame is "
                                         "accelerating; set speed_rate and "
