@@ -108,6 +108,11 @@ typedef struct veh {
      * pitch moments about A (N m, body axes). */
     int dof;                  /* 6, or 3; 0 for a towed vehicle */
     double held[3];
+    /* The towing vehicle: the prescribed acceleration (body axes) of the
+     * points its cables start from relative to the body, the tow-point
+     * inputs' (wave-induced motion, doc/towing-vehicle.md section 7); 0
+     * for a towed vehicle. */
+    double shift_a[3];
 } veh;
 
 /* Inputs of a towing vehicle: thrust, force x y z, moment x y z. */
@@ -854,6 +859,15 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
     v3_cross(om, t, b);
 }
 
+/* The part of the acceleration (body axes) of the point at lever rho from
+ * A that the body's (a_A, alpha) do not give: om x (om x rho), and a
+ * towing vehicle's prescribed motion of its cables' starting points. */
+static void point_bias(const veh *V, const double rho[3], double b[3])
+{
+    centripetal(V->st.om_b, rho, b);
+    for (int j = 0; j < 3; j++)
+        b[j] += V->shift_a[j];
+}
 
 /* A vehicle's controller, inertia and its own loads (V->M6, V->G). */
 static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
@@ -919,7 +933,7 @@ static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
         link_lever(V, &k->sys->links[l], lever);
         sym3_to_body(V->st.R, k->uM + 6 * l, M3);
         mat3_tmul(V->st.R, k->uQ + 3 * l, f);
-        centripetal(V->st.om_b, lever, b);
+        point_bias(V, lever, b);
         add_point(V->M6, V->G, M3, lever, f, b);
     }
     memcpy(V->M6h, V->M6, sizeof V->M6);
@@ -1023,7 +1037,7 @@ static void vehicle_point_accel(const veh *V, const ts_link *L, double a[3])
     double lever[3], x[3], b[3], ab[3];
     link_lever(V, L, lever);
     v3_cross(V->a6 + 3, lever, x);
-    centripetal(V->st.om_b, lever, b);
+    point_bias(V, lever, b);
     for (int j = 0; j < 3; j++)
         ab[j] = V->a6[j] + x[j] + b[j];
     mat3_mul(V->st.R, ab, a);
@@ -1151,6 +1165,18 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
         if (vehicle_kinematics(k, Root, y))
             chart_bad = 1;
+        /* The tow-point inputs: a prescribed displacement, velocity and
+         * acceleration (M axes) of the points the cables start from,
+         * relative to the body (a wave-induced motion), over its own. */
+        const ts_node *n0 = &sys->nodes[0];
+        for (int c = n0->child_begin; c < n0->child_end; c++) {
+            int l = sys->child_links[c];
+            for (int j = 0; j < 3; j++) {
+                k->ur[3 * l + j] += u[j];
+                k->urd[3 * l + j] += u[3 + j];
+            }
+        }
+        mat3_tmul(Root->st.R, u + 6, Root->shift_a);
     } else {
         for (int j = 0; j < 3; j++) {
             k->r[j] = sys->tow.point[j] + u[j];
@@ -1281,7 +1307,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                 for (int c = 0; c < 3; c++)
                     M3[3 * a + c] = nb[a] * nb[c] / D;
             }
-            centripetal(V->st.om_b, lever, b);
+            point_bias(V, lever, b);
             add_point(V->M6h, V->G, M3, lever, f, b);
         } else if (p > 0) {
             sym3_add_outer(k->Mh + 6 * p, 1.0 / D, n);

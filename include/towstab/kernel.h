@@ -110,7 +110,10 @@ TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
  * coordinates after its three angles (-1 without one). Its inputs follow
  * its controllers': "<name>.thrust" (N), "<name>.force.x|y|z" (N) and
  * "<name>.moment.x|y|z" (N m, about its tow point), body axes. With a
- * towing vehicle the tow-point inputs (the first TS_NINPUT) are not used.
+ * towing vehicle the tow-point inputs (the first TS_NINPUT) move the
+ * points its cables start from relative to the body, in M axes, on top
+ * of its own motion (a wave-induced motion of the tow point; zero in
+ * the steady analyses).
  * The speed controller's thrust bias (N, towstab/vehicle.h) is a kernel
  * parameter, trimmed by the equilibrium; ts_kernel_thrust is the thrust
  * of the last evaluation. */
