@@ -50,6 +50,7 @@
 #include <string.h>
 
 #include "tcheck.h"
+#include "tmodel.h"
 #include "towstab/analysis.h"
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
@@ -112,47 +113,14 @@ static ts_scene *scene(const char *fmt, ...)
 
 /* ---- 1. energy in vacuum ------------------------------------------- */
 
-static int rk4_step(ts_kernel *k, double *y, double h, int n, double *w)
-{
-    double *k1 = w, *k2 = w + n, *k3 = w + 2 * n, *k4 = w + 3 * n,
-           *yt = w + 4 * n;
-    int rc = ts_kernel_eval(k, y, NULL, k1);
-    for (int i = 0; i < n; i++)
-        yt[i] = y[i] + 0.5 * h * k1[i];
-    rc |= ts_kernel_eval(k, yt, NULL, k2);
-    for (int i = 0; i < n; i++)
-        yt[i] = y[i] + 0.5 * h * k2[i];
-    rc |= ts_kernel_eval(k, yt, NULL, k3);
-    for (int i = 0; i < n; i++)
-        yt[i] = y[i] + h * k3[i];
-    rc |= ts_kernel_eval(k, yt, NULL, k4);
-    for (int i = 0; i < n; i++)
-        y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
-    return rc;
-}
-
-static double energy(ts_kernel *k, const double *y, double *f)
-{
-    ts_kernel_eval(k, y, NULL, f);
-    return ts_kernel_kinetic_energy(k) + ts_kernel_potential_energy(k);
-}
-
 static double drift(const ts_system *s, double h, double T, double *E0)
 {
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(s, &err);
-    int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k), nl = s->nlinks;
+    int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k);
     double *y = calloc((size_t)n, sizeof(double));
-    double *w = malloc(5 * (size_t)n * sizeof(double));
-    double *f = malloc((size_t)n * sizeof(double));
     /* A 3-D state: each link's angles and rates in its chart. */
-    for (int l = 0; l < nl; l++) {
-        int o = ts_kernel_link_offset(k, l);
-        y[o] = 0.5 + 0.3 * sin(1.7 * l);
-        y[o + 1] = 0.4 * cos(2.3 * l + 1);
-        y[nq + o] = 0.5 * cos(l + 0.2);
-        y[nq + o + 1] = -0.4 * sin(3.1 * l);
-    }
+    tm_link_state(k, s->nlinks, y);
     double om[3] = {0.2, -0.15, 0.3}, R[9], th[3] = {0.11, -0.08, 0.2};
     tsi_rot123(th, R);
     ts_kernel_set_vehicle(k, ts_kernel_root(k), R, om, TS_CHART_RECHART, y);
@@ -162,19 +130,8 @@ static double drift(const ts_system *s, double h, double T, double *E0)
         y[ro + j] = pos[j];
         y[nq + ro + j] = vel[j];
     }
-    double e0 = energy(k, y, f), worst = 0;
-    int steps = (int)lround(T / h);
-    for (int i = 0; i < steps; i++) {
-        if (rk4_step(k, y, h, n, w) != TS_OK) {
-            worst = INFINITY;
-            break;
-        }
-        worst = fmax(worst, fabs(energy(k, y, f) - e0));
-    }
-    *E0 = e0;
+    double worst = tm_energy_drift(k, y, h, T, E0);
     free(y);
-    free(w);
-    free(f);
     ts_kernel_free(k);
     return worst;
 }

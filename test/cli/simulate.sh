@@ -210,7 +210,7 @@ ts simulate "$EX1" --t-end 5 --outputs cable.1.tension,sphere.tension,tow.force 
     --csv "$T/o/t.csv" --json "$T/o/t.json"
 why=""
 [ "$status" -eq 0 ] || why="$why exit $status: $(head -1 "$T/err");"
-[ "$(head -1 "$T/o/t.csv")" = "t_s,cable.1.tension_N,cable.20.tension_N,tow.force_N" ] ||
+[ "$(head -1 "$T/o/t.csv")" = "t_s,cable.1.tension_N,cable.40.tension_N,tow.force_N" ] ||
     why="$why header '$(head -1 "$T/o/t.csv")';"
 want=$(awk -F, '$1 == "tow" {t = $5} $1 == "cable.1" {c = $5}
     $1 == "sphere" {s = $5} END {print c, s, t}' "$T/o/eq.csv")
