@@ -570,7 +570,7 @@ static int tow_values(const ts_system *sys, const ts_equilibrium *eq,
     /* The unknown along the track carries Newton's next step; thrust,
      * power and speed vary together along it (T = P / u, P = T u), so
      * what follows from it has the same relative error. */
-    double x = bias ? eq->thrust_bias : eq->speed;
+    double x = bias ? vr->thrust : eq->speed;
     double ex = fmax(EQ_NOISE_FACTOR * eq->motion_step[0],
                      rel * (bias ? eq->force_scale : fabs(x)));
     double follows = bias ? vr->power

@@ -100,6 +100,9 @@ typedef struct veh {
     double turn_delta;        /* the deflection added to the turn surface
                                  (ts_tow.turn_surface), rad */
     double thrust;            /* thrust at the last evaluation, N */
+    int spd_off;              /* a PI speed controller's integrator, offset
+                                 in c (0: the first state); -1 */
+    double spd_dot;           /* its rate at the last evaluation, m/s */
     /* A surface ship (ts_tow.dof 3): only its yaw (at qoff) and the tow
      * point's x, y (qoff + 1, + 2) are coordinates; roll and pitch are 0
      * and the tow point's depth is the scene's. held: the hull's
@@ -182,6 +185,14 @@ static int layout_controls(ts_kernel *k, ts_err *err)
 {
     k->nc = 0;
     k->nin = TS_NINPUT;
+    /* A PI speed controller's integrator first: no loop mode moves it. */
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const ts_propulsion *p = &V->d->propulsion;
+        V->spd_off = V->root && p->type == TS_PROP_SPEED && p->ki > 0
+                         ? k->nc++
+                         : -1;
+    }
     for (int v = 0; v < k->nv; v++) {
         veh *V = &k->veh[v];
         const ts_vehicle *d = V->d;
@@ -537,11 +548,21 @@ void ts_kernel_outputs(const ts_kernel *k, double out[])
     }
 }
 
+int ts_kernel_speed_integrator(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].spd_off : -1;
+}
+
 void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
 {
     cs->vehicle = cs->actuator = cs->index = -1;
     for (int v = 0; v < k->nv; v++) {
         const veh *V = &k->veh[v];
+        if (V->spd_off == i) {
+            cs->vehicle = v;
+            cs->actuator = TS_CONTROL_SPEED;
+            return;
+        }
         for (int l = 0; l < V->d->nloops; l++)
             if (V->xi_off[l] == i) {
                 cs->vehicle = v;
@@ -907,8 +928,19 @@ static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
         tsi_rel_velocity(&k->frame, V->st.rA, V->st.rdA, wA);
         double u_law = d->propulsion.type == TS_PROP_SPEED ? v3_norm(wA)
                                                            : V->st.wO_b[0];
-        V->thrust = ts_propulsion_thrust(&d->propulsion, u_law,
-                                         V->thrust_bias, up[0]);
+        /* A PI speed controller: its integral term joins the bias; the
+         * integrator holds while the law is capped and the vehicle slower
+         * than its set speed (anti-windup). */
+        const ts_propulsion *pr = &d->propulsion;
+        double bias = V->thrust_bias;
+        if (V->spd_off >= 0) {
+            double e = pr->speed - u_law;
+            bias += pr->ki * c[V->spd_off];
+            V->spd_dot = e > 0 && bias + pr->gain * e >= pr->max_thrust
+                             ? 0.0
+                             : e;
+        }
+        V->thrust = ts_propulsion_thrust(pr, u_law, bias, up[0]);
         double f[3] = {V->thrust, 0, 0}, lever[3], m[3];
         for (int j = 0; j < 3; j++)
             lever[j] = pp[j] - d->attach[j];
@@ -1140,6 +1172,8 @@ static void control_rates(const veh *V, double cdot[])
     for (int j = 0; j < V->d->ncomponents; j++)
         if (V->act_off[j] >= 0)
             cdot[V->act_off[j]] = V->act_dot[j];
+    if (V->spd_off >= 0)
+        cdot[V->spd_off] = V->spd_dot;
 }
 
 int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
