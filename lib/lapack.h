@@ -34,6 +34,9 @@ void dgeevx_(const char *balanc, const char *jobvl, const char *jobvr,
              size_t jobvl_len, size_t jobvr_len, size_t sense_len);
 void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
             int *ipiv, double complex *b, const int *ldb, int *info);
+void zgecon_(const char *norm, const int *n, const double complex *a,
+             const int *lda, const double *anorm, double *rcond,
+             double complex *work, double *rwork, int *info, size_t norm_len);
 void zgetrf_(const int *m, const int *n, double complex *a, const int *lda,
              int *ipiv, int *info);
 void zgetrs_(const char *trans, const int *n, const int *nrhs,
