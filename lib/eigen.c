@@ -1822,6 +1822,108 @@ int ts_eigen_mode_shape(const ts_system *sys, const ts_linear *lin,
     return TS_OK;
 }
 
+/* A mode is the towing vehicle's when the vehicle carries more than this
+ * share of its kinetic energy. */
+#define VEHICLE_MODE_SHARE 0.5
+/* Within the vehicle, a second degree of freedom with at least this share
+ * of the vehicle's energy is named beside the first ("sway/yaw"). */
+#define VEHICLE_DOF_SECOND 0.25
+
+/* The towing vehicle's label of mode m ("vehicle 'dolphin': heave/pitch,
+ * 87% of the kinetic energy") into buf when the vehicle carries most of
+ * the mode's kinetic energy; 0 otherwise. The energy of the mode's
+ * velocity part: the vehicle's m |r_A'|^2 + omega^T I omega (omega = R E
+ * theta', its degrees of freedom along M's axes, the body's within its
+ * trim angles; the inertia's diagonal; added mass left out) against each
+ * node's lumped mass, a towed vehicle's mass included, times its speed
+ * squared (ts_linear_node_displacements on the rates). */
+static int vehicle_label(const ts_system *sys, const ts_linear *lin,
+                         const ts_eigen *e, int m, char *buf, size_t size)
+{
+    int ro = lin->root_qoff;
+    if (ro < 0 || sys->tow.vehicle < 0 || !lin->up_map)
+        return 0;
+    const ts_body *tb = &sys->bodies[sys->tow.vehicle];
+    const double *RE = NULL;
+    for (int l = 0; l < sys->nlinks && !RE; l++)
+        if (sys->links[l].up_body == sys->tow.vehicle)
+            RE = lin->up_map + 12 * l;
+    if (!RE || !tb->vehicle)
+        return 0;
+    int n = lin->nstate, nq = lin->nq, nn = sys->nnodes;
+    int ship = sys->tow.dof == 3;
+    const double *vr = e->vec_re + (size_t)m * n, *vi = e->vec_im +
+                                                        (size_t)m * n;
+    double *dq = malloc(2 * (size_t)nq * sizeof(double));
+    double *dr = malloc(6 * (size_t)nn * sizeof(double));
+    if (!dq || !dr) {
+        free(dq);
+        free(dr);
+        return 0;
+    }
+    /* Velocities: the rate half of the eigenvector, real and imaginary
+     * parts apart (the energy is their sum). */
+    double dof[6] = {0}, cable = 0;
+    for (int part = 0; part < 2; part++) {
+        const double *v = part ? vi : vr;
+        memcpy(dq + (size_t)part * nq, v + nq, (size_t)nq * sizeof(double));
+        ts_linear_node_displacements(sys, lin, dq + (size_t)part * nq,
+                                     dr + 3 * (size_t)part * nn);
+        const double *qd = v + nq;
+        for (int c = 0; c < 3; c++) {
+            /* omega = R E theta' (a surface ship: its yaw rate alone,
+             * about z; its depth held). */
+            double w = 0;
+            if (ship)
+                w = c == 2 ? qd[ro - 1] : 0.0;
+            else
+                for (int j = 0; j < 3; j++)
+                    w += RE[3 * c + j] * qd[ro - 3 + j];
+            double u = ship && c == 2 ? 0.0 : qd[ro + c];
+            dof[c] += tb->mass * u * u;
+            dof[3 + c] += tb->vehicle->inertia[c] * w * w;
+        }
+        /* Node 0 is the tow point, part of the vehicle; a towed
+         * vehicle's own mass is not its node's (system.h): added, moving
+         * with its attach point. */
+        for (int k = 1; k < nn; k++) {
+            const double *d = dr + 3 * ((size_t)part * nn + k);
+            int bk = sys->nodes[k].body;
+            double mk = sys->nodes[k].mass +
+                        (bk >= 0 && sys->bodies[bk].vehicle
+                             ? sys->bodies[bk].mass
+                             : 0.0);
+            cable += mk * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+    }
+    free(dq);
+    free(dr);
+    double veh = 0;
+    for (int c = 0; c < 6; c++)
+        veh += dof[c];
+    if (!(veh > VEHICLE_MODE_SHARE * (veh + cable)))
+        return 0;
+    static const char *const names[6] = {"surge", "sway", "heave",
+                                          "roll",  "pitch", "yaw"};
+    int a = 0, b = -1;
+    for (int c = 1; c < 6; c++)
+        if (dof[c] > dof[a])
+            a = c;
+    for (int c = 0; c < 6; c++)
+        if (c != a && (b < 0 || dof[c] > dof[b]))
+            b = c;
+    char what[32];
+    if (b >= 0 && dof[b] >= VEHICLE_DOF_SECOND * veh)
+        snprintf(what, sizeof what, "%s/%s", names[a < b ? a : b],
+                 names[a < b ? b : a]);
+    else
+        snprintf(what, sizeof what, "%s", names[a]);
+    snprintf(buf, size, "%svehicle '%s': %s, %.0f%% of the kinetic energy",
+             e->modes[m].im > 0 ? "" : "real: ", tb->name, what,
+             100.0 * veh / (veh + cable));
+    return 1;
+}
+
 void ts_eigen_describe(const ts_system *sys, const ts_linear *lin,
                        const ts_eigen *e, int m, char *buf, size_t size)
 {
@@ -1835,6 +1937,8 @@ void ts_eigen_describe(const ts_system *sys, const ts_linear *lin,
         return;
     }
     if (!e->vec_re)
+        return;
+    if (vehicle_label(sys, lin, e, m, buf, size))
         return;
     int nn = sys->nnodes, nq = lin->nq, nl = sys->nlinks;
     double *dq = malloc((size_t)nq * sizeof(double));

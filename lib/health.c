@@ -354,6 +354,16 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
                              "rad)",
                           m + 1, e->modes[m].freq_hz, e->modes[m].im,
                           x->vector_error);
+        else if (!isfinite(x->vector_error))
+            /* An exactly repeated eigenvalue (identical actuators, say):
+             * no allowance is finite. */
+            ts_trust_note(t, "modes %d and %d (%.6g and %.6g Hz) are %.3g "
+                             "1/s apart, an exactly repeated eigenvalue: "
+                             "each shape may be any mix of the two; "
+                             "together they are determined",
+                          m < k ? m + 1 : k + 1, m < k ? k + 1 : m + 1,
+                          e->modes[m < k ? m : k].freq_hz,
+                          e->modes[m < k ? k : m].freq_hz, x->gap);
         else
             ts_trust_note(t, "modes %d and %d (%.6g and %.6g Hz) are %.3g "
                              "1/s apart, closer than their errors allow "

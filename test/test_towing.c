@@ -49,6 +49,11 @@
  *     vehicle has the same three; in a 3 deg rudder turn the heading is
  *     neutral at 0 and the turn centre's position at i |Omega|, the turn
  *     rate Newton solved for, a second, independent figure.
+ * 11. Mode labels: on a 1 m, 1 g/m stub the modes labelled the
+ *     vehicle's are exactly the free vehicle's (matched by shape), the
+ *     other two the stub link's own swing; with the 50 m cable and its sphere both kinds appear, and the
+ *     lightly damped oscillation at 2.46 rad/s, the free vehicle's roll
+ *     (section 4 of doc/towing-vehicle.md), is labelled roll.
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -625,26 +630,37 @@ static void test_settle(void)
     ts_scene_free(b);
 }
 
+/* The vehicle of vehicle_yaml at 1500 N of thrust with `cables` (the
+ * scene's cables list and anything after it). */
+static ts_scene *thrust_1500(const char *name, const char *cables)
+{
+    char vt[2048];
+    return scene("name: %s\n"
+                 "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
+                 "%s  propulsion: {thrust: 1500 N}\n"
+                 "cables:\n%s",
+                 name, vehicle_yaml(vt, sizeof vt, 1.0), cables);
+}
+
+/* A cable of almost nothing: 1 m, 0.1 mm, 1 g/m, one link. */
+static const char *stub_cable =
+    "  - {name: cable, from: tow, length: 1 m, diameter: 0.0001 m, "
+    "mass_per_length: 0.001 kg/m, links: 1}\n";
+
 /* ---- 7. the free vehicle ------------------------------------------------ */
 
 static void test_free_vehicle(void)
 {
     const double rho = 1025, D = 0.8, S = 0.4, S2 = 0.6, cd0 = 0.01,
                  cda = 0.2;
-    char vt[2048];
     const char *cables[2] = {
         /* a neutral cable streaming straight behind: level trim */
         "  - {name: cable, from: tow, length: 50 m, diameter: 0.02 m, "
         "mass_per_length: 0.32201324699295375 kg/m, links: 10}\n",
         /* almost nothing */
-        "  - {name: cable, from: tow, length: 1 m, diameter: 0.0001 m, "
-        "mass_per_length: 0.001 kg/m, links: 1}\n"};
+        stub_cable};
     for (int c = 0; c < 2; c++) {
-        ts_scene *sc = scene("name: free\n"
-                             "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
-                             "%s  propulsion: {thrust: 1500 N}\n"
-                             "cables:\n%s",
-                             vehicle_yaml(vt, sizeof vt, 1.0), cables[c]);
+        ts_scene *sc = thrust_1500("free", cables[c]);
         if (!sc) {
             CHECK(0, "free vehicle scene %d parses", c);
             continue;
@@ -886,14 +902,7 @@ static void test_neutral(void)
     free(text);
 
     /* The free vehicle: the same three. */
-    char vt[2048];
-    sc = scene("name: free\n"
-               "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
-               "%s  propulsion: {thrust: 1500 N}\n"
-               "cables:\n"
-               "  - {name: cable, from: tow, length: 1 m, diameter: 0.0001 "
-               "m, mass_per_length: 0.001 kg/m, links: 1}\n",
-               vehicle_yaml(vt, sizeof vt, 1.0));
+    sc = thrust_1500("free", stub_cable);
     lin = sc ? dense_model(sc->system, &eq) : NULL;
     el = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
     ts_free_vehicle *f = NULL;
@@ -1189,6 +1198,73 @@ static void test_turning_circle(void)
                    "wet_weight: 500 N}\n", 2700, 600, 1e-6);
 }
 
+/* ---- 11. mode labels -------------------------------------------------- */
+
+static void test_labels(void)
+{
+    char desc[256];
+    const char *cables[2] = {
+        stub_cable,
+        "  - {name: cable, from: tow, to: sphere, length: 50 m, "
+        "diameter: 0.02 m, weight: 5 N/m, links: 10}\n"
+        "bodies:\n"
+        "  - {name: sphere, type: sphere, diameter: 0.5 m, "
+        "wet_weight: 500 N}\n"};
+    for (int c = 0; c < 2; c++) {
+        ts_scene *sc = thrust_1500("labels", cables[c]);
+        ts_equilibrium *eq = NULL;
+        ts_linear *lin = sc ? dense_model(sc->system, &eq) : NULL;
+        ts_eigen *e = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
+        ts_free_vehicle *f = NULL;
+        ts_err err = {0};
+        if (e && c == 0)
+            ts_free_vehicle_compare(sc->system, eq, lin, e, &f, &err);
+        if (!CHECK(e != NULL && (c || f), "labels: scene %d modes", c)) {
+            ts_free_vehicle_free(f);
+            ts_eigen_free(e);
+            ts_linear_free(lin);
+            ts_equilibrium_free(eq);
+            ts_scene_free(sc);
+            continue;
+        }
+        int veh = 0, other = 0, roll = -1, agree = 0;
+        for (int m = 0; m < e->nmodes; m++) {
+            if (e->modes[m].neutral >= 0)
+                continue;
+            ts_eigen_describe(sc->system, lin, e, m, desc, sizeof desc);
+            int v = strstr(desc, "vehicle 'tug': ") != NULL;
+            veh += v;
+            other += !v;
+            if (fabs(e->modes[m].im - 2.46) < 0.05)
+                roll = v && strstr(desc, "roll") ? m : -2;
+            /* On the stub: a vehicle mode is one of the free vehicle's
+             * (matched by shape, MAC > 0.99), any other the stub's own
+             * swing. */
+            int is_free = 0;
+            for (int k = 0; f && k < f->nmodes; k++)
+                is_free |= f->modes[k].coupled == m && f->modes[k].mac > 0.99;
+            agree += v == is_free;
+        }
+        if (c == 0)
+            CHECK(veh == f->nmodes - f->nneutral && agree == veh + other &&
+                      other == 2,
+                  "on the 1 g/m stub: %d modes labelled the vehicle's, "
+                  "exactly the free vehicle's %d (by shape); the other %d "
+                  "the stub link's swing", veh, f->nmodes - f->nneutral,
+                  other);
+        else
+            CHECK(veh > 0 && other > 0 && roll >= 0,
+                  "with the cable and sphere: %d vehicle modes, %d others; "
+                  "the oscillation at %.4g rad/s labelled roll",
+                  veh, other, roll >= 0 ? e->modes[roll].im : NAN);
+        ts_free_vehicle_free(f);
+        ts_eigen_free(e);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_scene_free(sc);
+    }
+}
+
 int main(void)
 {
     test_energy();
@@ -1200,5 +1276,6 @@ int main(void)
     test_motion_errors();
     test_turning_circle();
     test_neutral();
+    test_labels();
     return tc_done();
 }
