@@ -413,6 +413,14 @@ void ts_accuracy_modes(const ts_system *sys0, const ts_linear *lin0,
         a->resolved = !a->grid_scale &&
                       !(isfinite(a->error) && a->error > accuracy * mag) &&
                       !(nlevels >= 2 && !isfinite(a->error));
+        if (md->neutral >= 0) {
+            /* A neutral mode by symmetry is exact at any number of links
+             * (its eigenvalue is the symmetry's). */
+            a->error = a->re_error = a->freq_error_hz = 0.0;
+            a->damping_error = 0.0;
+            a->grid_scale = 0;
+            a->resolved = 1;
+        }
     }
 }
 
@@ -438,6 +446,11 @@ void ts_accuracy_stability(const ts_eigen *e, const ts_mode_accuracy ma[],
     int rv = TS_STABLE, uv = TS_STABLE;
     for (int m = 0; m < e->nmodes; m++) {
         const ts_mode *md = &e->modes[m];
+        if (md->neutral >= 0) {
+            /* Neutral by symmetry: outside the verdict (eigen.h). */
+            st->nneutral++;
+            continue;
+        }
         double dis = isfinite(ma[m].re_error) ? ma[m].re_error : 0.0;
         /* An unresolved mode is judged as computed: its discretisation
          * "error" measures how far it is from being a mode of the cable

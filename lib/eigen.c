@@ -131,6 +131,7 @@ typedef struct cand {
     int sweep;            /* found by the rightmost search, not among the
                              modes nearest the target */
     int checked;          /* residual and error estimate computed */
+    int neutral;          /* the lin->neutral it was recognised as, or -1 */
 } cand;
 
 typedef struct cand_list {
@@ -221,6 +222,7 @@ static void cand_add(cand_list *L, double complex lam, const double *vr,
     c->verr = NAN;
     c->sweep = 0;
     c->checked = 0;
+    c->neutral = -1;
     c->vec = L->n;
     double complex *v = L->v + (size_t)L->n * L->nstate;
     for (int i = 0; i < L->nstate; i++)
@@ -736,13 +738,14 @@ static int eig_poll_check(const eig_poll *pp, int ops, ts_err *err)
 }
 
 static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
-                             ts_eigen *e, cand_list *L, ts_err *err)
+                             double sigma, ts_eigen *e, cand_list *L,
+                             ts_err *err)
 {
     int n = lin->nstate, nev, ncv, rc;
     if ((rc = arpack_sizes(n, o->count, &nev, &ncv, err)) != TS_OK)
         return rc;
     tsi_shift sh;
-    double sigma = 0.0, sigmai = 0.0;
+    double sigmai = 0.0;
     if ((rc = tsi_shift_factor(&sh, lin, sigma, err)) != TS_OK)
         return rc;
     int lworkl = 3 * ncv * ncv + 6 * ncv;
@@ -1276,14 +1279,208 @@ static void fill_mode(ts_mode *md, const cand *c)
     md->ritz_error = c->ritz;
     md->vector_condition = c->vcond;
     md->vector_error = c->verr;
+    md->neutral = -1;
     md->error_bound =
         ERROR_SAFETY * ((isfinite(c->dlam) ? c->dlam : 0.0) + c->round);
 }
 
+/* ---- Neutral modes by symmetry ------------------------------------------ */
+
+/* ARPACK's real shift when the model has neutral modes at 0 (where A is
+ * singular): this fraction of max |A_ij| to the left of 0, far below any
+ * damped mode of a towed system (the slowest, ~1e-3 1/s, against max
+ * |A_ij| >= 1) and far above rounding. */
+#define NEUTRAL_SHIFT_REL 1e-8
+/* A computed eigenvector is recognised as a neutral mode when its angle
+ * to the span of that eigenvalue's generators is below this many times
+ * the first-order allowance ||dA|| / gap (dA the linearization's error
+ * estimate, gap the distance to the nearest other eigenvalue); the
+ * allowance itself must be below NEUTRAL_ANGLE_MAX (rad), else the
+ * cluster is too close to tell. */
+#define NEUTRAL_SAFETY 10.0
+#define NEUTRAL_ANGLE_MAX 0.01
+
+/* A copy of A with the cyclic states' rows and columns zero: a cyclic
+ * state is read nowhere (its column is zero within the error) and its row
+ * [0 I] makes it the integral of its rate; cut, it is a neutral mode of
+ * its own (eigenvector e_j, eigenvalue 0) and the other eigenvalues are
+ * unchanged (A is block triangular in it). NULL on failure. */
+static double *cut_cyclic(const ts_linear *lin)
+{
+    int n = lin->nstate;
+    size_t nn = (size_t)n * (size_t)n;
+    double *a = malloc(nn * sizeof(double));
+    if (!a)
+        return NULL;
+    memcpy(a, lin->A, nn * sizeof(double));
+    for (int k = 0; k < lin->nneutral; k++) {
+        int j = lin->neutral[k].cyclic;
+        if (j < 0)
+            continue;
+        for (int i = 0; i < n; i++) {
+            a[i + (size_t)j * n] = 0.0;
+            a[j + (size_t)i * n] = 0.0;
+        }
+    }
+    return a;
+}
+
+/* Mark the candidates that are lin's neutral modes: for each eigenvalue s
+ * of the generators, the candidates within their bound of s (nearest
+ * first, at most as many as its generators) whose vectors lie in the
+ * generators' span within the allowance. */
+static int recognise_neutral(const ts_linear *lin, cand_list *L)
+{
+    int n = lin->nstate, ng = lin->nneutral;
+    double dA = isfinite(lin->trunc_norm) ? lin->trunc_norm : 1e-6 * lin->a_norm;
+    if (isfinite(lin->round_norm))
+        dA += lin->round_norm;
+    double complex *q = malloc((size_t)n * (size_t)(ng > 0 ? ng : 1) *
+                               sizeof *q);
+    if (!q)
+        return TS_ENOMEM;
+    char *done = calloc((size_t)(ng > 0 ? ng : 1), 1);
+    if (!done) {
+        free(q);
+        return TS_ENOMEM;
+    }
+    for (int k0 = 0; k0 < ng; k0++) {
+        if (done[k0])
+            continue;
+        double complex s = lin->neutral[k0].re + I * lin->neutral[k0].im;
+        /* The generators of s, orthonormalised (modified Gram-Schmidt). */
+        int gk[TS_NEUTRAL_MAX], m = 0;
+        for (int k = k0; k < ng; k++) {
+            if (lin->neutral[k].re != creal(s) ||
+                lin->neutral[k].im != cimag(s))
+                continue;
+            done[k] = 1;
+            double complex *qk = q + (size_t)m * n;
+            for (int i = 0; i < n; i++)
+                qk[i] = lin->neutral_re[(size_t)k * n + i] +
+                        I * lin->neutral_im[(size_t)k * n + i];
+            for (int r = 0; r < m; r++) {
+                double complex d = 0;
+                for (int i = 0; i < n; i++)
+                    d += conj(q[(size_t)r * n + i]) * qk[i];
+                for (int i = 0; i < n; i++)
+                    qk[i] -= d * q[(size_t)r * n + i];
+            }
+            double nr = 0;
+            for (int i = 0; i < n; i++)
+                nr += creal(qk[i] * conj(qk[i]));
+            nr = sqrt(nr);
+            if (!(nr > 0))
+                continue;
+            for (int i = 0; i < n; i++)
+                qk[i] /= nr;
+            gk[m++] = k;
+        }
+        /* Near s: within the bound (or rounding of A) of it. */
+        double floor = 100.0 * DBL_EPSILON * lin->a_norm;
+        double gap = INFINITY;
+        for (int c = 0; c < L->n; c++) {
+            double b = ERROR_SAFETY * ((isfinite(L->c[c].dlam) ? L->c[c].dlam
+                                                               : 0.0) +
+                                       L->c[c].round);
+            double d = cabs(L->c[c].lam - s);
+            if (!(d <= fmax(b, floor)))
+                gap = fmin(gap, d);
+        }
+        double tol = NEUTRAL_SAFETY * dA / gap;
+        if (!(tol <= NEUTRAL_ANGLE_MAX))
+            continue;
+        for (int taken = 0; taken < m;) {
+            int best = -1;
+            double bd = INFINITY;
+            for (int c = 0; c < L->n; c++) {
+                cand *cc = &L->c[c];
+                double b = ERROR_SAFETY * ((isfinite(cc->dlam) ? cc->dlam
+                                                               : 0.0) +
+                                           cc->round);
+                double d = cabs(cc->lam - s);
+                if (cc->neutral >= 0 || !(d <= fmax(b, floor)) || d >= bd)
+                    continue;
+                best = c;
+                bd = d;
+            }
+            if (best < 0)
+                break;
+            /* The angle to the span: |v - Q Q^H v| / |v|. */
+            const double complex *v = L->v + (size_t)L->c[best].vec * n;
+            double v2 = 0, p2 = 0;
+            for (int i = 0; i < n; i++)
+                v2 += creal(v[i] * conj(v[i]));
+            for (int r = 0; r < m; r++) {
+                double complex d = 0;
+                for (int i = 0; i < n; i++)
+                    d += conj(q[(size_t)r * n + i]) * v[i];
+                p2 += creal(d * conj(d));
+            }
+            double sin_angle = sqrt(fmax(0.0, 1.0 - p2 / v2));
+            if (!(sin_angle <= tol))
+                break;
+            /* The generator it overlaps most, not yet taken. */
+            int kb = -1;
+            double ob = -1;
+            for (int r = 0; r < m; r++) {
+                int used = 0;
+                for (int c = 0; c < L->n; c++)
+                    used |= L->c[c].neutral == gk[r];
+                if (used)
+                    continue;
+                double complex d = 0;
+                double g2 = 0;
+                for (int i = 0; i < n; i++) {
+                    double complex g = lin->neutral_re[(size_t)gk[r] * n + i] +
+                                       I * lin->neutral_im[(size_t)gk[r] * n +
+                                                           i];
+                    d += conj(g) * v[i];
+                    g2 += creal(g * conj(g));
+                }
+                double o = creal(d * conj(d)) / g2;
+                if (o > ob) {
+                    ob = o;
+                    kb = gk[r];
+                }
+            }
+            L->c[best].neutral = kb;
+            L->c[best].verr = sin_angle;
+            taken++;
+        }
+    }
+    free(q);
+    free(done);
+    return TS_OK;
+}
+
 /* ---- Driver -------------------------------------------------------------- */
+
+static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
+                       ts_eigen **out, ts_err *err);
 
 int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                    ts_eigen **out, ts_err *err)
+{
+    int ncyclic = 0;
+    for (int k = 0; k < lin->nneutral; k++)
+        ncyclic += lin->neutral[k].cyclic >= 0;
+    if (ncyclic == 0 || !lin->A)
+        return eigen_solve(lin, opts, out, err);
+    /* The cyclic states' integrator chains cut (cut_cyclic): the same
+     * eigenvalues, each neutral mode a simple eigenvector. */
+    *out = NULL;
+    ts_linear cut = *lin;
+    cut.A = cut_cyclic(lin);
+    if (!cut.A)
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    int rc = eigen_solve(&cut, opts, out, err);
+    free(cut.A);
+    return rc;
+}
+
+static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
+                       ts_eigen **out, ts_err *err)
 {
     ts_eigen_opts o;
     if (opts)
@@ -1327,8 +1524,16 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
 #ifdef _OPENMP
 #pragma omp critical(ts_arpack)
 #endif
-        rc = o.target_hz == 0.0 ? solve_arpack_real(lin, &o, e, &L, err)
-                                : solve_arpack_complex(lin, &o, e, &L, err);
+    {
+        /* Neutral modes at 0 make A singular there: shift just off it. */
+        double sigma = 0.0;
+        for (int k = 0; k < lin->nneutral; k++)
+            if (lin->neutral[k].re == 0.0 && lin->neutral[k].im == 0.0)
+                sigma = -NEUTRAL_SHIFT_REL * lin->a_scale;
+        rc = o.target_hz == 0.0
+                 ? solve_arpack_real(lin, &o, sigma, e, &L, err)
+                 : solve_arpack_complex(lin, &o, e, &L, err);
+    }
     }
     if (rc != TS_OK) {
         cand_free(&L);
@@ -1446,12 +1651,23 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                                                 : 0;
     }
 
+    /* A towing vehicle's neutral modes: recognised, and left out of the
+     * verdict (doc/linear.md section 3a). */
+    if (lin->nneutral > 0 && recognise_neutral(lin, &L) != TS_OK) {
+        free(cover);
+        cand_free(&L);
+        ts_eigen_free(e);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
+
     /* Verdict and the rightmost eigenvalue over what is covered. */
     e->max_real = -INFINITY;
     e->max_real_error = 0.0;
     int any_unstable = 0, all_stable = 1, right = -1;
     for (int q = 0; q < ncover; q++) {
         const cand *c = &L.c[cover[q]];
+        if (c->neutral >= 0)
+            continue;
         double re = creal(c->lam);
         double bound = ERROR_SAFETY * ((isfinite(c->dlam) ? c->dlam : 0.0) +
                                        c->round);
@@ -1469,7 +1685,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     if (right >= 0)
         fill_mode(&e->rightmost, &L.c[right]);
     e->verdict = any_unstable ? TS_UNSTABLE
-                              : (all_stable && ncover > 0 ? TS_STABLE
+                              : (all_stable && right >= 0 ? TS_STABLE
                                                           : TS_MARGINAL);
 
     qsort(L.c, (size_t)keep, sizeof(cand), cmp_freq);
@@ -1487,12 +1703,51 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
     e->neig = 0;
+    e->nneutral = 0;
+    double complex *gv = lin->nneutral > 0 && o.vectors
+                             ? malloc((size_t)n * sizeof *gv)
+                             : NULL;
+    if (lin->nneutral > 0 && o.vectors && !gv) {
+        cand_free(&L);
+        ts_eigen_free(e);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
     for (int i = 0; i < keep; i++) {
-        const cand *c = &L.c[i];
+        cand *c = &L.c[i];
         fill_mode(&e->modes[i], c);
+        e->modes[i].neutral = c->neutral;
         e->neig += cimag(c->lam) > 0 ? 2 : 1;
+        if (c->neutral >= 0) {
+            /* Its eigenvalue and shape are the symmetry's, exactly; the
+             * computed ones lie within their allowances of them. */
+            const ts_neutral *nm = &lin->neutral[c->neutral];
+            double bound = e->modes[i].error_bound;
+            double verr = e->modes[i].vector_error;
+            cand exact = *c;
+            exact.lam = nm->re + I * nm->im;
+            fill_mode(&e->modes[i], &exact);
+            e->modes[i].error_bound = bound;
+            e->modes[i].vector_error = verr;
+            e->modes[i].neutral = c->neutral;
+            e->nneutral++;
+        }
         if (o.vectors) {
             const double complex *v = L.v + (size_t)c->vec * n;
+            if (c->neutral >= 0) {
+                for (int k = 0; k < n; k++)
+                    gv[k] = lin->neutral_re[(size_t)c->neutral * n + k] +
+                            I * lin->neutral_im[(size_t)c->neutral * n + k];
+                v = gv;
+            } else {
+                /* A cyclic state is the integral of its rate: its entry of
+                 * the eigenvector of A is the rate's over lambda. */
+                double complex *vw = L.v + (size_t)c->vec * n;
+                for (int k = 0; k < lin->nneutral; k++) {
+                    int j = lin->neutral[k].cyclic;
+                    if (j >= 0 && cabs(c->lam) > 0)
+                        vw[j] = vw[lin->nq + j] / c->lam;
+                }
+            }
             /* Unit 2-norm, largest entry real and positive. */
             double nrm = 0, big = -1;
             int ib = 0;
@@ -1512,8 +1767,10 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
             }
         }
     }
-    /* Complete: the verdict covers every eigenvalue. */
+    /* Complete: the verdict covers every eigenvalue (the neutral modes
+     * recognised and set apart). */
     e->complete = m == TS_EIG_LAPACK;
+    free(gv);
     cand_free(&L);
     *out = e;
     return TS_OK;
@@ -1573,11 +1830,123 @@ int ts_eigen_mode_shape(const ts_system *sys, const ts_linear *lin,
     return TS_OK;
 }
 
+/* A mode is the towing vehicle's when the vehicle carries more than this
+ * share of its kinetic energy. */
+#define VEHICLE_MODE_SHARE 0.5
+/* Within the vehicle, a second degree of freedom with at least this share
+ * of the vehicle's energy is named beside the first ("sway/yaw"). */
+#define VEHICLE_DOF_SECOND 0.25
+
+/* The towing vehicle's label of mode m ("vehicle 'dolphin': heave/pitch,
+ * 87% of the kinetic energy") into buf when the vehicle carries most of
+ * the mode's kinetic energy; 0 otherwise. The energy of the mode's
+ * velocity part: the vehicle's m |r_A'|^2 + omega^T I omega (omega = R E
+ * theta', its degrees of freedom along M's axes, the body's within its
+ * trim angles; the inertia's diagonal; added mass left out) against each
+ * node's lumped mass, a towed vehicle's mass included, times its speed
+ * squared (ts_linear_node_displacements on the rates). */
+static int vehicle_label(const ts_system *sys, const ts_linear *lin,
+                         const ts_eigen *e, int m, char *buf, size_t size)
+{
+    int ro = lin->root_qoff;
+    if (ro < 0 || sys->tow.vehicle < 0 || !lin->up_map)
+        return 0;
+    const ts_body *tb = &sys->bodies[sys->tow.vehicle];
+    const double *RE = NULL;
+    for (int l = 0; l < sys->nlinks && !RE; l++)
+        if (sys->links[l].up_body == sys->tow.vehicle)
+            RE = lin->up_map + 12 * l;
+    if (!RE || !tb->vehicle)
+        return 0;
+    int n = lin->nstate, nq = lin->nq, nn = sys->nnodes;
+    int ship = sys->tow.dof == 3;
+    const double *vr = e->vec_re + (size_t)m * n, *vi = e->vec_im +
+                                                        (size_t)m * n;
+    double *dq = malloc(2 * (size_t)nq * sizeof(double));
+    double *dr = malloc(6 * (size_t)nn * sizeof(double));
+    if (!dq || !dr) {
+        free(dq);
+        free(dr);
+        return 0;
+    }
+    /* Velocities: the rate half of the eigenvector, real and imaginary
+     * parts apart (the energy is their sum). */
+    double dof[6] = {0}, cable = 0;
+    for (int part = 0; part < 2; part++) {
+        const double *v = part ? vi : vr;
+        memcpy(dq + (size_t)part * nq, v + nq, (size_t)nq * sizeof(double));
+        ts_linear_node_displacements(sys, lin, dq + (size_t)part * nq,
+                                     dr + 3 * (size_t)part * nn);
+        const double *qd = v + nq;
+        for (int c = 0; c < 3; c++) {
+            /* omega = R E theta' (a surface ship: its yaw rate alone,
+             * about z; its depth held). */
+            double w = 0;
+            if (ship)
+                w = c == 2 ? qd[ro - 1] : 0.0;
+            else
+                for (int j = 0; j < 3; j++)
+                    w += RE[3 * c + j] * qd[ro - 3 + j];
+            double u = ship && c == 2 ? 0.0 : qd[ro + c];
+            dof[c] += tb->mass * u * u;
+            dof[3 + c] += tb->vehicle->inertia[c] * w * w;
+        }
+        /* Node 0 is the tow point, part of the vehicle; a towed
+         * vehicle's own mass is not its node's (system.h): added, moving
+         * with its attach point. */
+        for (int k = 1; k < nn; k++) {
+            const double *d = dr + 3 * ((size_t)part * nn + k);
+            int bk = sys->nodes[k].body;
+            double mk = sys->nodes[k].mass +
+                        (bk >= 0 && sys->bodies[bk].vehicle
+                             ? sys->bodies[bk].mass
+                             : 0.0);
+            cable += mk * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+    }
+    free(dq);
+    free(dr);
+    double veh = 0;
+    for (int c = 0; c < 6; c++)
+        veh += dof[c];
+    if (!(veh > VEHICLE_MODE_SHARE * (veh + cable)))
+        return 0;
+    static const char *const names[6] = {"surge", "sway", "heave",
+                                          "roll",  "pitch", "yaw"};
+    int a = 0, b = -1;
+    for (int c = 1; c < 6; c++)
+        if (dof[c] > dof[a])
+            a = c;
+    for (int c = 0; c < 6; c++)
+        if (c != a && (b < 0 || dof[c] > dof[b]))
+            b = c;
+    char what[32];
+    if (b >= 0 && dof[b] >= VEHICLE_DOF_SECOND * veh)
+        snprintf(what, sizeof what, "%s/%s", names[a < b ? a : b],
+                 names[a < b ? b : a]);
+    else
+        snprintf(what, sizeof what, "%s", names[a]);
+    snprintf(buf, size, "%svehicle '%s': %s, %.0f%% of the kinetic energy",
+             e->modes[m].im > 0 ? "" : "real: ", tb->name, what,
+             100.0 * veh / (veh + cable));
+    return 1;
+}
+
 void ts_eigen_describe(const ts_system *sys, const ts_linear *lin,
                        const ts_eigen *e, int m, char *buf, size_t size)
 {
     buf[0] = '\0';
-    if (!e->vec_re || m < 0 || m >= e->nmodes || size == 0)
+    if (m < 0 || m >= e->nmodes || size == 0)
+        return;
+    int nk = e->modes[m].neutral;
+    if (nk >= 0 && nk < lin->nneutral) {
+        snprintf(buf, size, "neutral by symmetry: %s (not counted in the "
+                 "verdict)", lin->neutral[nk].name);
+        return;
+    }
+    if (!e->vec_re)
+        return;
+    if (vehicle_label(sys, lin, e, m, buf, size))
         return;
     int nn = sys->nnodes, nq = lin->nq, nl = sys->nlinks;
     double *dq = malloc((size_t)nq * sizeof(double));

@@ -232,7 +232,9 @@ static double nearest_mode(const ts_eigen *e, int m, int *who)
     double gap = e->modes[m].im > 0 ? 2.0 * e->modes[m].im : INFINITY;
     *who = -1;
     for (int k = 0; k < e->nmodes; k++) {
-        if (k == m)
+        /* Neutral modes by symmetry share an exact eigenvalue with exact,
+         * separate shapes: not close modes of each other. */
+        if (k == m || (e->modes[m].neutral >= 0 && e->modes[k].neutral >= 0))
             continue;
         double complex lk = e->modes[k].re + I * e->modes[k].im;
         double d = fmin(cabs(lm - lk), cabs(lm - conj(lk)));
@@ -268,6 +270,12 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
         x->gap = nearest_mode(e, m, &x->nearest);
         x->vector_error = md->vector_error;
         x->shape_resolved = md->vector_error <= TS_HEALTH_VECTOR_ERROR;
+        if (md->neutral >= 0) {
+            /* A neutral mode by symmetry: its eigenvalue and shape are
+             * exact (eigen.h), its damping is 0 by the symmetry. */
+            x->damping_error = 0.0;
+            x->damping_resolved = x->shape_resolved = 1;
+        }
         x->trustworthy = x->damping_resolved;
         if (!x->damping_resolved) {
             if (nbad < LIST_MAX)
@@ -346,6 +354,16 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
                              "rad)",
                           m + 1, e->modes[m].freq_hz, e->modes[m].im,
                           x->vector_error);
+        else if (!isfinite(x->vector_error))
+            /* An exactly repeated eigenvalue (identical actuators, say):
+             * no allowance is finite. */
+            ts_trust_note(t, "modes %d and %d (%.6g and %.6g Hz) are %.3g "
+                             "1/s apart, an exactly repeated eigenvalue: "
+                             "each shape may be any mix of the two; "
+                             "together they are determined",
+                          m < k ? m + 1 : k + 1, m < k ? k + 1 : m + 1,
+                          e->modes[m < k ? m : k].freq_hz,
+                          e->modes[m < k ? k : m].freq_hz, x->gap);
         else
             ts_trust_note(t, "modes %d and %d (%.6g and %.6g Hz) are %.3g "
                              "1/s apart, closer than their errors allow "

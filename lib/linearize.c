@@ -30,8 +30,10 @@
  */
 #include "towstab/linearize.h"
 
+#include <complex.h>
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -173,6 +175,8 @@ void ts_linear_free(ts_linear *lin)
     free(lin->input_unit);
     free(lin->output_name);
     free(lin->output_unit);
+    free(lin->neutral_re);
+    free(lin->neutral_im);
     free(lin);
 }
 
@@ -513,6 +517,240 @@ static void sparse_kinks(const ts_system *sys, ts_linear *lin)
         }
 }
 
+/* ---- Neutral modes by symmetry (a towing vehicle) ------------------------ */
+
+/* A generator is confirmed when every row of A g - lambda g lies within
+ * this many times its error allowance (the truncation estimate and the
+ * rounding noise of the row, applied to |g|), the safety factor of the
+ * eigenvalue bounds (lib/eigen.c). */
+#define NEUTRAL_SAFETY 10.0
+/* Without the error estimate: rows within this fraction of max |A_ij|
+ * times |g|_1. */
+#define NEUTRAL_RTOL 1e-6
+/* A finite rotation of the vehicles' attitudes (rad), differenced
+ * centrally for their angle change per radian of heading: its error,
+ * (1e-5)^2 / 6 relative, is far below the linearization's. */
+#define NEUTRAL_ROTATION 1e-5
+
+/* The error allowance of entry (i, j) of A's lower block (row i of it). */
+static double entry_allowance(const ts_linear *lin, int i, int j)
+{
+    int n = lin->nstate, nlow = n - lin->nq;
+    if (!lin->Aerr)
+        return NEUTRAL_RTOL * lin->a_scale;
+    double a = fabs(lin->Aerr[i + (size_t)j * nlow]);
+    if (lin->fnoise)
+        a += lin->fnoise[i] / (M_SQRT2 * lin->h[j]);
+    return a;
+}
+
+/* Whether state column j of A is zero within its error: a state the
+ * kernel does not read. */
+static int column_cyclic(const ts_linear *lin, int j)
+{
+    int n = lin->nstate, nq = lin->nq;
+    const double *col = lin->A + (size_t)j * n;
+    for (int i = nq; i < n; i++)
+        if (!(fabs(col[i]) <= NEUTRAL_SAFETY *
+                                  entry_allowance(lin, i - nq, j)))
+            return 0;
+    return 1;
+}
+
+/* Whether (lambda, g) is an eigenpair of A with the cyclic states' rows
+ * and columns removed (the model the eigen analysis factors), within the
+ * linearization's error. */
+static int neutral_confirmed(const ts_linear *lin, double complex lambda,
+                             const double complex *g, const char *cyclic)
+{
+    int n = lin->nstate, nq = lin->nq;
+    double gmax = 0;
+    for (int j = 0; j < n; j++)
+        gmax = fmax(gmax, cabs(g[j]));
+    for (int i = 0; i < n; i++) {
+        double complex r = cyclic[i] ? 0.0 : -lambda * g[i];
+        double allow = 0;
+        for (int j = 0; j < n; j++) {
+            if (cyclic[i] || cyclic[j] || g[j] == 0.0)
+                continue;
+            r += lin->A[i + (size_t)j * n] * g[j];
+            if (i >= nq)
+                allow += entry_allowance(lin, i - nq, j) * cabs(g[j]);
+        }
+        /* The upper rows [0 I 0] are exact: rounding of g only. */
+        allow = i < nq ? 8 * DBL_EPSILON * (1.0 + cabs(lambda)) * gmax
+                       : NEUTRAL_SAFETY * allow;
+        if (!(cabs(r) <= allow))
+            return 0;
+    }
+    return 1;
+}
+
+/* The heading generator: every link direction and every vehicle's
+ * attitude turned about M's vertical, per radian, into g (angles and
+ * strains; the tow point's part is the caller's). */
+static int heading_generator(ts_kernel *k, const ts_linear *lin,
+                             double complex *g)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int n = lin->nstate;
+    for (int l = 0; l < sys->nlinks; l++) {
+        /* w = e_z x n0, the direction's change; solve dn dtheta = w. */
+        const double *nn = lin->n0 + 3 * l, *d1 = lin->dn + 6 * l,
+                     *d2 = d1 + 3;
+        double w[3] = {-nn[1], nn[0], 0.0};
+        double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+        for (int c = 0; c < 3; c++) {
+            a11 += d1[c] * d1[c];
+            a12 += d1[c] * d2[c];
+            a22 += d2[c] * d2[c];
+            b1 += d1[c] * w[c];
+            b2 += d2[c] * w[c];
+        }
+        double det = a11 * a22 - a12 * a12;
+        if (!(fabs(det) > 0))
+            return -1;
+        g[lin->qoff[l]] = (a22 * b1 - a12 * b2) / det;
+        g[lin->qoff[l] + 1] = (a11 * b2 - a12 * b1) / det;
+    }
+    double *y = malloc((size_t)n * sizeof(double));
+    double *y2 = malloc((size_t)n * sizeof(double));
+    if (!y || !y2) {
+        free(y);
+        free(y2);
+        return -1;
+    }
+    const double eps = NEUTRAL_ROTATION;
+    for (int v = 0; v < lin->nvehicles; v++) {
+        double R[9], om[3], Rr[2][9];
+        ts_kernel_get_vehicle(k, v, lin->y0, R, om);
+        for (int s = 0; s < 2; s++) {
+            double c = cos(s ? -eps : eps), sn = sin(s ? -eps : eps);
+            for (int j = 0; j < 3; j++) {
+                Rr[s][j] = c * R[j] - sn * R[3 + j];
+                Rr[s][3 + j] = sn * R[j] + c * R[3 + j];
+                Rr[s][6 + j] = R[6 + j];
+            }
+        }
+        memcpy(y, lin->y0, (size_t)n * sizeof(double));
+        memcpy(y2, lin->y0, (size_t)n * sizeof(double));
+        ts_kernel_set_vehicle(k, v, Rr[0], om, 0.0, y);
+        ts_kernel_set_vehicle(k, v, Rr[1], om, 0.0, y2);
+        /* Its angles: three, or a surface ship's yaw alone. */
+        int qo = ts_kernel_vehicle_offset(k, v);
+        int na = v == ts_kernel_root(k) && ts_kernel_root_dof(k) == 3 ? 1 : 3;
+        for (int j = 0; j < na; j++)
+            g[qo + j] = (y[qo + j] - y2[qo + j]) / (2 * eps);
+    }
+    free(y);
+    free(y2);
+    return 0;
+}
+
+/* Add neutral mode `name` (lambda, g) to lin when A confirms it. */
+static int neutral_add(ts_linear *lin, const char *name, double complex lambda,
+                       const double complex *g, int cyclic_state,
+                       const char *cyclic)
+{
+    if (!neutral_confirmed(lin, lambda, g, cyclic))
+        return TS_OK;
+    int n = lin->nstate, m = lin->nneutral;
+    double *re = realloc(lin->neutral_re, (size_t)n * (m + 1) * sizeof *re);
+    if (!re)
+        return TS_ENOMEM;
+    lin->neutral_re = re;
+    double *im = realloc(lin->neutral_im, (size_t)n * (m + 1) * sizeof *im);
+    if (!im)
+        return TS_ENOMEM;
+    lin->neutral_im = im;
+    for (int i = 0; i < n; i++) {
+        re[(size_t)m * n + i] = creal(g[i]);
+        im[(size_t)m * n + i] = cimag(g[i]);
+    }
+    ts_neutral *nm = &lin->neutral[m];
+    nm->re = creal(lambda);
+    nm->im = cimag(lambda);
+    nm->cyclic = cyclic_state;
+    snprintf(nm->name, sizeof nm->name, "%s", name);
+    lin->nneutral = m + 1;
+    return TS_OK;
+}
+
+/* The towing vehicle's neutral modes (ts_linear.neutral; doc/linear.md
+ * section 3a): candidates from the geometry, each kept when the dense A
+ * confirms it. */
+static int neutral_modes(ts_kernel *k, const ts_frame *fr, ts_linear *lin,
+                         ts_err *err)
+{
+    lin->nneutral = 0;
+    free(lin->neutral_re);
+    free(lin->neutral_im);
+    lin->neutral_re = lin->neutral_im = NULL;
+    if (lin->root_qoff < 0 || !lin->A)
+        return TS_OK;
+    int n = lin->nstate, nq = lin->nq, ro = lin->root_qoff;
+    double complex *g = calloc((size_t)n, sizeof *g);
+    char *cyclic = calloc((size_t)n, 1);
+    int rc = g && cyclic ? TS_OK : TS_ENOMEM;
+    /* Straight: the position along and across the track are read
+     * nowhere (no frame rotation to make them matter); their columns of A
+     * are zero within the error and their rows [0 I] make each a pure
+     * integrator of its rate. */
+    int straight = rc == TS_OK && column_cyclic(lin, ro) &&
+                   column_cyclic(lin, ro + 1);
+    if (straight) {
+        cyclic[ro] = cyclic[ro + 1] = 1;
+        static const char *const names[2] = {"along-track position",
+                                             "cross-track position"};
+        for (int c = 0; c < 2 && rc == TS_OK; c++) {
+            memset(g, 0, (size_t)n * sizeof *g);
+            g[ro + c] = 1.0;
+            rc = neutral_add(lin, names[c], 0.0, g, ro + c, cyclic);
+        }
+    }
+    double V = fr->speed, W = fr->turn_rate;
+    if (rc == TS_OK && (straight || W != 0.0)) {
+        /* Heading: the whole system turned about the vertical. In a
+         * straight tow the turned motion moves sideways in M at the speed
+         * through the water (the tow point's rate per radian); in a turn
+         * it is the same circle
+         * at another phase, every point turned about the centre C = (0,
+         * V/Omega, 0): the tow point (on M's z axis) moves by e_z x (r_A -
+         * C) = (V/Omega, 0, 0), at rest in M. */
+        memset(g, 0, (size_t)n * sizeof *g);
+        if (heading_generator(k, lin, g) != 0)
+            rc = TS_ENOMEM;
+        if (straight) {
+            /* The turned motion through the water, e_z x (V e_x - c) per
+             * radian relative to M (a uniform current c turns nothing). */
+            g[nq + ro] = fr->current[1];
+            g[nq + ro + 1] = V - fr->current[0];
+        } else
+            g[ro] = V / W;
+        if (rc == TS_OK)
+            rc = neutral_add(lin, "heading", 0.0, g, -1, cyclic);
+    }
+    if (rc == TS_OK && !straight && W != 0.0) {
+        /* The turn's centre moved by d: in M, turning at Omega, a fixed
+         * offset of the earth frame is d(t) = e^(i |Omega| t) (1, i sgn
+         * Omega, 0), at the tow point and its rate; the shape unchanged. */
+        double complex lam = I * fabs(W);
+        double sg = W > 0 ? 1.0 : -1.0;
+        memset(g, 0, (size_t)n * sizeof *g);
+        g[ro] = 1.0;
+        g[ro + 1] = I * sg;
+        g[nq + ro] = lam;
+        g[nq + ro + 1] = lam * I * sg;
+        rc = neutral_add(lin, "turn centre", lam, g, -1, cyclic);
+    }
+    free(g);
+    free(cyclic);
+    if (rc != TS_OK)
+        return ts_fail(err, TS_ENOMEM, "linearize: out of memory for the "
+                                       "neutral modes");
+    return TS_OK;
+}
+
 int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                  const ts_linearize_opts *opts, ts_linear *lin, ts_err *err)
 {
@@ -775,7 +1013,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         ts_kernel_eval(k, y0, u0, ftmp);
         lin->evaluations++;
         free(ftmp);
-        return TS_OK;
+        return neutral_modes(k, &fr, lin, err);
     }
 
     /* Upper blocks: [0 I 0] and 0, exactly. */
@@ -918,7 +1156,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     }
     lin->a_scale = amax;
     lin->a_norm = sqrt(afro);
-    return TS_OK;
+    return neutral_modes(k, &fr, lin, err);
 }
 
 int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,

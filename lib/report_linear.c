@@ -121,6 +121,7 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
     json_object_set_new(o, "max_real", num(e->max_real));
     json_object_set_new(o, "max_real_error", num(e->max_real_error));
     json_object_set_new(o, "complete", json_boolean(e->complete));
+    json_object_set_new(o, "neutral_modes", json_integer(e->nneutral));
     const ts_mode *r = &e->rightmost;
     json_object_set_new(o, "rightmost",
                         json_pack("{s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "re",
@@ -157,6 +158,9 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
             "error_bound", num(md->error_bound), "residual",
             num(md->residual), "ritz_error", num(md->ritz_error),
             "description", desc);
+        if (j && md->neutral >= 0 && md->neutral < lin->nneutral)
+            json_object_set_new(j, "neutral",
+                                json_string(lin->neutral[md->neutral].name));
         if (j && shapes && e->vec_re)
             json_object_set_new(j, "shape",
                                 shape_json(sys, lin, e, m, amp, phase));
@@ -295,6 +299,9 @@ json_t *ts_report_response_json(const ts_response *r)
     json_object_set_new(o, "output", json_string(r->output.name));
     json_object_set_new(o, "unit", json_string(r->unit));
     json_object_set_new(o, "static_gain", num(r->static_gain));
+    if (r->static_note[0])
+        json_object_set_new(o, "static_gain_note",
+                            json_string(r->static_note));
     for (int i = 0; i < r->npoints; i++)
         json_array_append_new(
             pts, json_pack("{s:o,s:o,s:o,s:o,s:o}", "freq_hz",

@@ -773,11 +773,23 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     r->static_gain = creal(g);
     if (rc == TS_ESINGULAR && lin->root_qoff >= 0) {
         /* A towing vehicle's neutral modes (its position along and across
-         * its track, its heading: doc/towing-vehicle.md) make A singular:
-         * no static gain, the frequencies above 0 are regular. */
+         * its track, its heading: doc/linear.md section 3a) make A
+         * singular: no static gain, the frequencies above 0 are
+         * regular. */
         ts_err_clear(err);
         rc = TS_OK;
         r->static_gain = r->static_error = NAN;
+        char names[128] = "";
+        for (int k = 0; k < lin->nneutral; k++) {
+            size_t len = strlen(names);
+            if (lin->neutral[k].re == 0 && lin->neutral[k].im == 0)
+                snprintf(names + len, sizeof names - len, "%s%s",
+                         len ? ", " : ": ", lin->neutral[k].name);
+        }
+        snprintf(r->static_note, sizeof r->static_note,
+                 "undefined: the model is singular at 0 Hz, where the "
+                 "towing vehicle's neutral modes by symmetry lie%s; a "
+                 "steady input may drift them without bound", names);
         tsi_shift_free(&sh);
         memset(&sh, 0, sizeof sh);
     }

@@ -80,21 +80,6 @@ static int solve_modes(const ts_system *s, ts_kernel **kk,
     lo.model = TS_LIN_DENSE;
     if (rc == TS_OK)
         rc = ts_linearize_equilibrium(*kk, *eqq, &lo, *linn, err);
-    if (rc == TS_OK) {
-        /* Entries below 1e-12 of the largest are the central differences'
-         * rounding of exact zeros (the position along and across the
-         * track moves nothing: 1e-33 here), far below the linearization's
-         * error; left in, they make LAPACK's balancing scale by 1e30 and
-         * its eigenvectors lose all accuracy (residuals of order 1 seen
-         * on a 13-state vehicle). */
-        size_t nn = (size_t)(*linn)->nstate * (size_t)(*linn)->nstate;
-        double big = 0;
-        for (size_t i = 0; i < nn; i++)
-            big = fmax(big, fabs((*linn)->A[i]));
-        for (size_t i = 0; i < nn; i++)
-            if (fabs((*linn)->A[i]) <= 1e-12 * big)
-                (*linn)->A[i] = 0.0;
-    }
     ts_eigen_opts eo;
     ts_eigen_opts_default(&eo);
     eo.method = TS_EIG_LAPACK;
@@ -205,6 +190,8 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
         fm->freq_hz = md->freq_hz;
         fm->damping_ratio = md->damping_ratio;
         fm->coupled = -1;
+        fm->neutral = md->neutral >= 0;
+        f->nneutral += fm->neutral;
         const double *fr = fe->vec_re + (size_t)m * nf;
         const double *fi = fe->vec_im + (size_t)m * nf;
         double nf2 = 0;

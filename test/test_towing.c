@@ -44,8 +44,26 @@
  *     speed step from the 2.6 m/s trim settles on 3 m/s, the integrator
  *     held while the thrust is at its cap; linear against nonlinear as
  *     in 6; and (7) the free vehicle with it.
+ * 11. Neutral modes by symmetry (doc/linear.md section 3a): in the
+ *     straight tow of examples/dolphin_aurora.yaml the columns of A of
+ *     the tow point's x and y are zero, and A turns the heading
+ *     generator g into V e_y (the heading drifts the track sideways:
+ *     with y the pair is a Jordan block, which is why y is cut); LAPACK
+ *     and ARPACK both find the three modes and leave them out of the
+ *     verdict, which is then stable, not marginal; a heading loop
+ *     removes the heading mode (its eigenvalue leaves 0); the free
+ *     vehicle has the same three; in a 3 deg rudder turn the heading is
+ *     neutral at 0 and the turn centre's position at i |Omega|, the turn
+ *     rate Newton solved for, a second, independent figure.
+ * 12. Mode labels: on a 1 m, 1 g/m stub the modes labelled the
+ *     vehicle's are exactly the free vehicle's (matched by shape), the
+ *     other two the stub link's own swing; with the 50 m cable and its
+ *     sphere both kinds appear, and the
+ *     lightly damped oscillation at 2.46 rad/s, the free vehicle's roll
+ *     (section 4 of doc/towing-vehicle.md), is labelled roll.
  */
 #include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,7 +115,7 @@ static const char *vehicle_yaml(char *buf, size_t size, double heavy)
 
 static ts_scene *scene(const char *fmt, ...)
 {
-    char text[8192];
+    char text[16384];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(text, sizeof text, fmt, ap);
@@ -641,6 +659,23 @@ static void test_settle(void)
     ts_scene_free(b);
 }
 
+/* The vehicle of vehicle_yaml at 1500 N of thrust with `cables` (the
+ * scene's cables list and anything after it). */
+static ts_scene *thrust_1500(const char *name, const char *cables)
+{
+    char vt[2048];
+    return scene("name: %s\n"
+                 "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
+                 "%s  propulsion: {thrust: 1500 N}\n"
+                 "cables:\n%s",
+                 name, vehicle_yaml(vt, sizeof vt, 1.0), cables);
+}
+
+/* A cable of almost nothing: 1 m, 0.1 mm, 1 g/m, one link. */
+static const char *stub_cable =
+    "  - {name: cable, from: tow, length: 1 m, diameter: 0.0001 m, "
+    "mass_per_length: 0.001 kg/m, links: 1}\n";
+
 /* ---- 7. the free vehicle ------------------------------------------------ */
 
 static void test_free_vehicle(void)
@@ -648,16 +683,13 @@ static void test_free_vehicle(void)
     const double rho = 1025, D = 0.8, S = 0.4, S2 = 0.6, cd0 = 0.01,
                  cda = 0.2;
     char vt[2048];
-    const char *stub = "  - {name: cable, from: tow, length: 1 m, "
-                       "diameter: 0.0001 m, mass_per_length: 0.001 kg/m, "
-                       "links: 1}\n";
     const char *cables[3] = {
         /* a neutral cable streaming straight behind: level trim */
         "  - {name: cable, from: tow, length: 50 m, diameter: 0.02 m, "
         "mass_per_length: 0.32201324699295375 kg/m, links: 10}\n",
         /* almost nothing, at a thrust and with a PI speed controller
          * (its integrator a state of both systems) */
-        stub, stub};
+        stub_cable, stub_cable};
     for (int c = 0; c < 3; c++) {
         ts_scene *sc = scene("name: free\n"
                              "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
@@ -721,6 +753,244 @@ static void test_free_vehicle(void)
         ts_kernel_free(k);
         ts_scene_free(sc);
     }
+}
+
+/* ---- 11. neutral modes by symmetry ---------------------------------------- */
+
+/* The dense model of s about its equilibrium; *eqo the equilibrium. */
+static ts_linear *dense_model(const ts_system *s, ts_equilibrium **eqo)
+{
+    ts_err err = {0};
+    ts_kernel *k = NULL;
+    ts_equilibrium *eq = solve(s, &k);
+    ts_linear *lin = ts_linear_alloc(k, &err);
+    if (!lin || ts_linearize_equilibrium(k, eq, NULL, lin, &err) != TS_OK) {
+        printf("linearize: %s\n", err.msg);
+        ts_linear_free(lin);
+        lin = NULL;
+    }
+    ts_kernel_free(k);
+    if (eqo)
+        *eqo = eq;
+    else
+        ts_equilibrium_free(eq);
+    return lin;
+}
+
+static ts_eigen *eigen_of(const ts_linear *lin, ts_eig_method m, int count)
+{
+    ts_err err = {0};
+    ts_eigen_opts o;
+    ts_eigen_opts_default(&o);
+    o.method = m;
+    o.count = count;
+    ts_eigen *e = NULL;
+    if (ts_eigen_solve(lin, &o, &e, &err) != TS_OK)
+        printf("eigen: %s\n", err.msg);
+    return e;
+}
+
+/* The index of lin's neutral mode called name, -1. */
+static int neutral_named(const ts_linear *lin, const char *name)
+{
+    for (int k = 0; k < lin->nneutral; k++)
+        if (!strcmp(lin->neutral[k].name, name))
+            return k;
+    return -1;
+}
+
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *t = len > 0 ? malloc((size_t)len + 1) : NULL;
+    if (t && fread(t, 1, (size_t)len, f) != (size_t)len) {
+        free(t);
+        t = NULL;
+    }
+    if (t)
+        t[len] = '\0';
+    fclose(f);
+    return t;
+}
+
+static void test_neutral(void)
+{
+    char *text = read_text("examples/dolphin_aurora.yaml");
+    ts_scene *sc = text ? scene("%s", text) : NULL;
+    if (!CHECK(sc != NULL, "examples/dolphin_aurora.yaml loads")) {
+        free(text);
+        return;
+    }
+    ts_equilibrium *eq = NULL;
+    ts_linear *lin = dense_model(sc->system, &eq);
+    if (!CHECK(lin != NULL, "dolphin_aurora linearized")) {
+        ts_equilibrium_free(eq);
+        ts_scene_free(sc);
+        free(text);
+        return;
+    }
+    int n = lin->nstate, ro = lin->root_qoff;
+    int kx = neutral_named(lin, "along-track position"),
+        ky = neutral_named(lin, "cross-track position"),
+        kh = neutral_named(lin, "heading");
+    CHECK(lin->nneutral == 3 && kx >= 0 && ky >= 0 && kh >= 0 &&
+              lin->neutral[kx].cyclic == ro &&
+              lin->neutral[ky].cyclic == ro + 1,
+          "dolphin_aurora straight: 3 neutral modes (x, y cyclic, the "
+          "heading), %d found", lin->nneutral);
+    /* The full A: x and y read nowhere; A g = (V - c_x) e_y for the
+     * heading generator (the turned tow moves sideways). */
+    double colmax = 0, chain = 0, off = 0;
+    for (int i = 0; i < n; i++) {
+        colmax = fmax(colmax, fmax(fabs(lin->A[i + (size_t)ro * n]),
+                                   fabs(lin->A[i + (size_t)(ro + 1) * n])));
+    }
+    if (kh >= 0) {
+        const double *g = lin->neutral_re + (size_t)kh * n;
+        for (int i = 0; i < n; i++) {
+            double r = 0;
+            for (int j = 0; j < n; j++)
+                r += lin->A[i + (size_t)j * n] * g[j];
+            if (i == ro + 1)
+                chain = r;
+            else
+                off = fmax(off, fabs(r));
+        }
+    }
+    CHECK(colmax <= 1e-12 * lin->a_scale && fabs(chain - eq->speed) <=
+              1e-12 * eq->speed && off <= 1e-5 * lin->a_scale,
+          "the columns of x, y: max %.3g (of max |A| %.3g); A g_heading = "
+          "%.12g e_y (V = %.12g m/s) + %.3g elsewhere", colmax,
+          lin->a_scale, chain, eq->speed, off);
+    ts_eigen *el = eigen_of(lin, TS_EIG_LAPACK, 0);
+    ts_eigen *ea = eigen_of(lin, TS_EIG_ARPACK, 20);
+    if (el && ea) {
+        double worst = 0;
+        for (int m = 0; m < el->nmodes; m++)
+            if (el->modes[m].neutral >= 0)
+                worst = fmax(worst, el->modes[m].error_bound);
+        CHECK(el->nneutral == 3 && el->complete &&
+                  el->verdict == TS_STABLE && el->max_real < 0,
+              "LAPACK: %d neutral modes recognised (their computed "
+              "eigenvalues within %.2g of 0), verdict %s on the rest, max "
+              "Re %.6g 1/s", el->nneutral, worst,
+              ts_verdict_name(el->verdict), el->max_real);
+        /* ARPACK (shifted off 0): the same three, and each of its other
+         * modes a LAPACK eigenvalue within the sum of the bounds. */
+        double far = 0;
+        for (int m = 0; m < ea->nmodes; m++) {
+            const ts_mode *a = &ea->modes[m];
+            if (a->neutral >= 0)
+                continue;
+            double best = INFINITY, allow = 0;
+            for (int j = 0; j < el->nmodes; j++) {
+                double d = hypot(a->re - el->modes[j].re,
+                                 a->im - el->modes[j].im);
+                if (d < best) {
+                    best = d;
+                    allow = a->error_bound + el->modes[j].error_bound;
+                }
+            }
+            far = fmax(far, best / allow);
+        }
+        CHECK(ea->nneutral == 3 && far <= 1.0,
+              "ARPACK: %d neutral modes recognised; its other %d modes are "
+              "LAPACK's within %.3g of the allowance", ea->nneutral,
+              ea->nmodes - ea->nneutral, far);
+    } else {
+        CHECK(0, "dolphin_aurora: both eigen methods ran");
+    }
+    ts_eigen_free(el);
+    ts_eigen_free(ea);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_scene_free(sc);
+
+    /* A heading loop (proportional, on the rudders) restores the
+     * heading: no longer neutral. */
+    const char *at = text ? strstr(text, "  propulsion:\n") : NULL;
+    sc = at ? scene("%.*s"
+                    "    - name: heading\n"
+                    "      measure: heading\n"
+                    "      setpoint: 0\n"
+                    "      kp: 1\n"
+                    "      kd: \"2 s\"\n"
+                    "      surfaces: {rudder_upper: 1, rudder_lower: 1}\n"
+                    "%s",
+                    (int)(at - text), text, at)
+            : NULL;
+    lin = sc ? dense_model(sc->system, NULL) : NULL;
+    el = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
+    if (CHECK(el != NULL, "dolphin_aurora with a heading loop: modes")) {
+        double small = INFINITY;
+        for (int m = 0; m < el->nmodes; m++)
+            if (el->modes[m].neutral < 0)
+                small = fmin(small, hypot(el->modes[m].re, el->modes[m].im));
+        CHECK(lin->nneutral == 2 && neutral_named(lin, "heading") < 0 &&
+                  el->nneutral == 2 && small > 1e-3,
+              "with a heading loop: %d neutral modes (x, y), no heading; "
+              "the smallest other |lambda| %.3g 1/s", el->nneutral, small);
+    }
+    ts_eigen_free(el);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+    free(text);
+
+    /* The free vehicle: the same three. */
+    sc = thrust_1500("free", stub_cable);
+    lin = sc ? dense_model(sc->system, &eq) : NULL;
+    el = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
+    ts_free_vehicle *f = NULL;
+    ts_err err = {0};
+    if (el)
+        ts_free_vehicle_compare(sc->system, eq, lin, el, &f, &err);
+    if (CHECK(f != NULL, "free vehicle (%s)", f ? "ok" : err.msg)) {
+        int matched = 1;
+        for (int m = 0; m < f->nmodes; m++)
+            if (f->modes[m].neutral)
+                matched &= f->modes[m].coupled >= 0 &&
+                           el->modes[f->modes[m].coupled].neutral >= 0;
+        CHECK(f->nneutral == 3 && el->nneutral == 3 && matched,
+              "the free vehicle has %d neutral modes, each matched to one "
+              "of the coupled system's %d", f->nneutral, el->nneutral);
+    }
+    ts_free_vehicle_free(f);
+    ts_eigen_free(el);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_scene_free(sc);
+
+    /* A steady turn at 3 deg of rudder: the heading about the turn's
+     * centre at 0, the centre's position at i |Omega|. */
+    sc = thrust_scene(1500, 3.0);
+    lin = sc ? dense_model(sc->system, &eq) : NULL;
+    el = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
+    if (CHECK(el != NULL, "3 deg rudder turn: modes")) {
+        int kc = neutral_named(lin, "turn centre");
+        double im = NAN, bound = NAN;
+        for (int m = 0; m < el->nmodes; m++)
+            if (el->modes[m].neutral == kc && kc >= 0) {
+                im = el->modes[m].im;
+                bound = el->modes[m].error_bound;
+            }
+        CHECK(lin->nneutral == 2 && kc >= 0 &&
+                  neutral_named(lin, "heading") >= 0 && el->nneutral == 2 &&
+                  fabs(im - fabs(eq->turn_rate)) <= 1e-15 &&
+                  el->verdict != TS_MARGINAL,
+              "in the turn (Omega %.9g rad/s): %d neutral modes, the turn "
+              "centre's at %.9gi 1/s (computed within %.2g), verdict %s",
+              eq->turn_rate, el->nneutral, im, bound,
+              ts_verdict_name(el->verdict));
+    }
+    ts_eigen_free(el);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_scene_free(sc);
 }
 
 /* ---- 8. error estimates of the solved motion ------------------------ */
@@ -1086,6 +1356,73 @@ static void test_speed_pi(void)
     ts_scene_free(slow);
 }
 
+/* ---- 12. mode labels -------------------------------------------------- */
+
+static void test_labels(void)
+{
+    char desc[256];
+    const char *cables[2] = {
+        stub_cable,
+        "  - {name: cable, from: tow, to: sphere, length: 50 m, "
+        "diameter: 0.02 m, weight: 5 N/m, links: 10}\n"
+        "bodies:\n"
+        "  - {name: sphere, type: sphere, diameter: 0.5 m, "
+        "wet_weight: 500 N}\n"};
+    for (int c = 0; c < 2; c++) {
+        ts_scene *sc = thrust_1500("labels", cables[c]);
+        ts_equilibrium *eq = NULL;
+        ts_linear *lin = sc ? dense_model(sc->system, &eq) : NULL;
+        ts_eigen *e = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
+        ts_free_vehicle *f = NULL;
+        ts_err err = {0};
+        if (e && c == 0)
+            ts_free_vehicle_compare(sc->system, eq, lin, e, &f, &err);
+        if (!CHECK(e != NULL && (c || f), "labels: scene %d modes", c)) {
+            ts_free_vehicle_free(f);
+            ts_eigen_free(e);
+            ts_linear_free(lin);
+            ts_equilibrium_free(eq);
+            ts_scene_free(sc);
+            continue;
+        }
+        int veh = 0, other = 0, roll = -1, agree = 0;
+        for (int m = 0; m < e->nmodes; m++) {
+            if (e->modes[m].neutral >= 0)
+                continue;
+            ts_eigen_describe(sc->system, lin, e, m, desc, sizeof desc);
+            int v = strstr(desc, "vehicle 'tug': ") != NULL;
+            veh += v;
+            other += !v;
+            if (fabs(e->modes[m].im - 2.46) < 0.05)
+                roll = v && strstr(desc, "roll") ? m : -2;
+            /* On the stub: a vehicle mode is one of the free vehicle's
+             * (matched by shape, MAC > 0.99), any other the stub's own
+             * swing. */
+            int is_free = 0;
+            for (int k = 0; f && k < f->nmodes; k++)
+                is_free |= f->modes[k].coupled == m && f->modes[k].mac > 0.99;
+            agree += v == is_free;
+        }
+        if (c == 0)
+            CHECK(veh == f->nmodes - f->nneutral && agree == veh + other &&
+                      other == 2,
+                  "on the 1 g/m stub: %d modes labelled the vehicle's, "
+                  "exactly the free vehicle's %d (by shape); the other %d "
+                  "the stub link's swing", veh, f->nmodes - f->nneutral,
+                  other);
+        else
+            CHECK(veh > 0 && other > 0 && roll >= 0,
+                  "with the cable and sphere: %d vehicle modes, %d others; "
+                  "the oscillation at %.4g rad/s labelled roll",
+                  veh, other, roll >= 0 ? e->modes[roll].im : NAN);
+        ts_free_vehicle_free(f);
+        ts_eigen_free(e);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_scene_free(sc);
+    }
+}
+
 int main(void)
 {
     test_energy();
@@ -1097,5 +1434,7 @@ int main(void)
     test_motion_errors();
     test_turning_circle();
     test_speed_pi();
+    test_neutral();
+    test_labels();
     return tc_done();
 }

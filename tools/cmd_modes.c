@@ -154,6 +154,29 @@ static void print_verdict(const ts_result *r)
                    : "");
 }
 
+/* The towing vehicle's neutral modes by symmetry, which the verdict
+ * leaves out (doc/linear.md section 3a). */
+static void print_neutral(const ts_result *r)
+{
+    const ts_eigen *e = r->eigen;
+    const ts_linear *lin = r->lin;
+    if (e->nneutral == 0)
+        return;
+    printf("neutral by symmetry, not counted in the verdict (%d):",
+           e->nneutral);
+    int k = 0;
+    for (int m = 0; m < e->nmodes; m++) {
+        const ts_mode *md = &e->modes[m];
+        if (md->neutral < 0)
+            continue;
+        printf("%s mode %d, %s, lambda = %.6g%+.6gi 1/s exactly (computed "
+               "within %.2g of it)",
+               k++ ? ";" : "", m + 1, lin->neutral[md->neutral].name, md->re,
+               md->im, md->error_bound);
+    }
+    printf("\n");
+}
+
 static void print_modes(const ts_result *r, int quiet, const ts_display *d)
 {
     const ts_system *sys = r->sys;
@@ -241,6 +264,7 @@ static void print_modes(const ts_result *r, int quiet, const ts_display *d)
     }
     if (r->mode_accuracy)
         print_verdict(r);
+    print_neutral(r);
     if (!e->complete && e->sweep_shifts == 0)
         printf("note: only %d of %d eigenvalues were computed (those nearest "
                "%.6g Hz); modes elsewhere are not covered by the verdict\n",

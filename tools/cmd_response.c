@@ -37,8 +37,13 @@ static void print_response(const ts_result *res, int quiet,
     double kf = ts_display_convert(d, "Hz", 1.0, fu, sizeof fu);
     if (res->nvalues > 0)
         cli_value_error(&res->values[0], d, e, sizeof e);
-    printf("response of %s to %s (%s): static gain %.9g %s\n",
-           r->output.name, r->input_name, gu, k * r->static_gain, e);
+    if (isfinite(r->static_gain))
+        printf("response of %s to %s (%s): static gain %.9g %s\n",
+               r->output.name, r->input_name, gu, k * r->static_gain, e);
+    else
+        printf("response of %s to %s (%s): static gain %s\n",
+               r->output.name, r->input_name, gu,
+               r->static_note[0] ? r->static_note : "undefined");
     int ib = 0;
     for (int i = 1; i < r->npoints; i++)
         if (r->magnitude[i] > r->magnitude[ib])

@@ -182,6 +182,8 @@ typedef struct ts_stability {
     int estimated;       /* 1: the modes' resolution is known (a coarser
                             level was compared); 0: only the shape test */
     int nresolved, nunresolved;
+    int nneutral;        /* modes left out: a towing vehicle's neutral
+                            modes by symmetry (ts_mode.neutral) */
     int verdict;         /* of the resolved modes: TS_STABLE, TS_UNSTABLE,
                             TS_MARGINAL; -1 when none is resolved */
     int mode;            /* the resolved mode with the largest real part,

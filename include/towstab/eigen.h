@@ -127,7 +127,16 @@ typedef struct ts_mode {
                                computed eigenvalue (arpack). Large for
                                close modes, whose shapes can mix
                                (towstab/health.h); INFINITY for an
-                               exactly double eigenvalue */
+                               exactly double eigenvalue; for a neutral
+                               mode, the sine of the computed vector's
+                               angle to its symmetry's span */
+    int neutral;            /* -1, or the towing vehicle's neutral mode by
+                               symmetry this is (index in lin->neutral,
+                               towstab/linearize.h): its eigenvalue and
+                               shape are the symmetry's exact ones, the
+                               computed eigenvalue lies within
+                               error_bound of it, and the verdict leaves
+                               it out (doc/linear.md section 3a) */
 } ts_mode;
 
 typedef struct ts_eigen {
@@ -135,6 +144,8 @@ typedef struct ts_eigen {
     int nmodes;             /* modes stored */
     int neig;               /* eigenvalues they stand for (2 per complex) */
     int complete;           /* 1 when every eigenvalue of A is covered */
+    int nneutral;           /* modes recognised as neutral by symmetry
+                               (ts_mode.neutral >= 0) */
     ts_eig_method method;   /* the method used */
     double target_hz;
     ts_mode *modes;         /* [nmodes] by frequency, then |lambda| */
@@ -142,7 +153,8 @@ typedef struct ts_eigen {
                                m for mode m, unit 2-norm, largest entry
                                real; NULL unless opts.vectors */
     double max_real;        /* max Re lambda over the eigenvalues the
-                               verdict covers, 1/s */
+                               verdict covers (every one but the neutral
+                               modes by symmetry), 1/s */
     double max_real_error;  /* error_bound of that eigenvalue, 1/s */
     ts_mode rightmost;      /* that eigenvalue (Im >= 0) as a mode: every
                                field but the shape's; with lapack the

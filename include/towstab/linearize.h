@@ -73,6 +73,17 @@ typedef enum {
                           (except with a towing vehicle at the root) */
 } ts_lin_model;
 
+/* A neutral mode by symmetry of a towing vehicle (ts_linear.neutral). */
+#define TS_NEUTRAL_MAX 3
+typedef struct ts_neutral {
+    double re, im;     /* its exact eigenvalue, 1/s: 0, or i |Omega| */
+    int cyclic;        /* the state the kernel does not read (its column
+                          of A is zero; the eigen analysis cuts its
+                          integrator chain), or -1 */
+    char name[32];     /* "along-track position", "cross-track position",
+                          "heading", "turn centre" */
+} ts_neutral;
+
 typedef struct ts_linear {
     int nstate;        /* n = 2 nq + nc (nc controller states) */
     int nq;            /* generalised coordinates (ts_kernel_nq) */
@@ -189,6 +200,25 @@ typedef struct ts_linear {
                           max|K| (max|C|): the residual's own scatter
                           (doc/linear.md, section 2b); NaN without the
                           estimate or the model */
+    /* A towing vehicle's neutral modes by symmetry (doc/linear.md section
+     * 3c, doc/towing-vehicle.md section 6): motions of the whole system
+     * that the physics cannot tell from its steady motion, each an exact
+     * eigenpair (lambda, g) of the model, written from the geometry, not
+     * from A. In a straight tow: the tow point's position along and
+     * across the track (states the kernel reads nowhere: cyclic, their
+     * columns of A zero) and the heading (every link, every vehicle
+     * turned about the vertical, the tow point moving sideways at V); in
+     * a steady turn: the heading about the turn's centre (lambda 0) and
+     * the position of that centre (lambda = i |Omega|). A candidate is
+     * kept only when the dense A confirms it, A g = lambda g within the
+     * linearization's error: a current, a heading loop or anything else
+     * that breaks the symmetry leaves it out. Empty without a towing
+     * vehicle or without the dense model. */
+    int nneutral;                  /* 0 .. TS_NEUTRAL_MAX */
+    ts_neutral neutral[TS_NEUTRAL_MAX];
+    double *neutral_re, *neutral_im; /* [n * nneutral] g, column k for
+                          neutral[k] (position m, angle rad per m or rad
+                          of the motion); NULL when nneutral is 0 */
 } ts_linear;
 
 typedef struct ts_linearize_opts {

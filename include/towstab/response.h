@@ -89,6 +89,10 @@ typedef struct ts_response {
                            truncation and rounding (doc/linear.md,
                            section 4); NaN without its error estimate */
     double static_error;/* the same of the static gain */
+    char static_note[256]; /* why static_gain is NaN ("" when it is a
+                           number): the model is singular at 0 Hz (a
+                           towing vehicle's neutral modes by symmetry,
+                           doc/linear.md section 3a) */
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at

@@ -40,6 +40,8 @@ typedef struct ts_free_mode {
                                    ts_eigen's modes) it is, -1 if none */
     double coupled_re, coupled_im, coupled_freq_hz, coupled_damping_ratio;
     double mac;                 /* modal assurance criterion, 0 to 1 */
+    int neutral;                /* 1: a neutral mode by symmetry of the
+                                   free vehicle (towstab/eigen.h) */
 } ts_free_mode;
 
 typedef struct ts_free_vehicle {
@@ -48,6 +50,7 @@ typedef struct ts_free_vehicle {
     double thrust;              /* its thrust there, N */
     int nstate;                 /* states of the free vehicle */
     int nmodes;
+    int nneutral;               /* its neutral modes by symmetry */
     ts_free_mode *modes;        /* [nmodes], by frequency then |lambda| */
 } ts_free_vehicle;
 

@@ -211,5 +211,40 @@ for bad in "response $A --open-loop --input aurora.depth.setpoint --output auror
     fi
 done
 
+# A towing vehicle (examples/dolphin_aurora.yaml, straight): the
+# equilibrium's JSON speed is the solved speed (the vehicle's, printed as
+# "towing at V m/s"), not the scene's 5 m/s; modes sets the three neutral
+# modes by symmetry apart and is stable on the rest; response has no
+# static gain and says why, printing no nan.
+D=examples/dolphin_aurora.yaml
+ts equilibrium "$D" --quiet --json "$T/d.json"
+v=$(sed -n 's/^dolphin: towing at \([0-9.]*\) m\/s.*/\1/p' "$T/out")
+printf '{"rtol": 1e-5, "atol": 0, "expect": {"speed": %s}}\n' "${v:-0}" \
+    >"$T/d.expected.json"
+if [ "$status" -eq 0 ] && [ -n "$v" ] &&
+   [ "$(printf '%s\n' "$v" | cut -c1-4)" != "5" ] &&
+   "$CHECK_JSON" compare "$T/d.json" "$T/d.expected.json" >"$T/chk" 2>&1; then
+    pass "towing vehicle: the JSON speed is the solved $v m/s, not the scene's 5 m/s"
+else
+    fail "towing vehicle: JSON speed (printed $v): status $status, $(head -c 300 "$T/chk")"
+fi
+ts modes "$D" --json "$T/dm.json"
+if [ "$status" -eq 0 ] &&
+   grep -q '^neutral by symmetry, not counted in the verdict (3): mode [0-9]*, along-track position' "$T/out" &&
+   grep -q '^verdict: stable' "$T/out" && grep -q '"neutral_modes": 3' "$T/dm.json" &&
+   grep -q '"neutral": "heading"' "$T/dm.json"; then
+    pass "modes $D: 3 neutral modes by symmetry apart, $(grep -m1 '^verdict' "$T/out" | cut -c1-60)"
+else
+    fail "modes $D: status $status, $(grep -m1 '^verdict' "$T/out")"
+fi
+ts response "$D" --input dolphin.thrust --output aurora.z --quiet --json "$T/dr.json"
+if [ "$status" -eq 0 ] && grep -q 'static gain undefined: the model is singular at 0 Hz' "$T/out" &&
+   ! grep -qiw 'nan' "$T/out" && grep -q '"static_gain": null' "$T/dr.json" &&
+   grep -q '"static_gain_note": "undefined' "$T/dr.json"; then
+    pass "response $D: static gain undefined with its reason, no nan printed"
+else
+    fail "response $D: status $status, $(grep -m1 'static gain' "$T/out")"
+fi
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
