@@ -195,6 +195,14 @@ static void compare_dense(const char *name, const ts_system *sys)
         ts_kernel_free(k);
         return;
     }
+    if (sys->tow.vehicle >= 0 && !lin->desc) {
+        /* A towing vehicle at the root keeps the dense model alone. */
+        CHECK(lin->A != NULL, "%s (%d links): a towing vehicle: the dense "
+              "model only", name, sys->nlinks);
+        ts_linear_free(lin);
+        ts_kernel_free(k);
+        return;
+    }
     CHECK(lin->desc && lin->A, "%s (%d links): both models formed", name,
           sys->nlinks);
     if (!lin->desc) {

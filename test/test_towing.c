@@ -58,9 +58,9 @@
  * 12. Mode labels: on a 1 m, 1 g/m stub the modes labelled the
  *     vehicle's are exactly the free vehicle's (matched by shape), the
  *     other two the stub link's own swing; with the 50 m cable and its
- *     sphere both kinds appear, and the
- *     lightly damped oscillation at 2.46 rad/s, the free vehicle's roll
- *     (section 4 of doc/towing-vehicle.md), is labelled roll.
+ *     sphere both kinds appear, and the lightly damped oscillation at
+ *     2.46 rad/s, the free vehicle's roll (section 4 of
+ *     doc/towing-vehicle.md), is labelled roll.
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -1243,6 +1243,73 @@ static void test_turning_circle(void)
                    "wet_weight: 500 N}\n", 2700, 600, 1e-6);
 }
 
+/* ---- 12. mode labels -------------------------------------------------- */
+
+static void test_labels(void)
+{
+    char desc[256];
+    const char *cables[2] = {
+        stub_cable,
+        "  - {name: cable, from: tow, to: sphere, length: 50 m, "
+        "diameter: 0.02 m, weight: 5 N/m, links: 10}\n"
+        "bodies:\n"
+        "  - {name: sphere, type: sphere, diameter: 0.5 m, "
+        "wet_weight: 500 N}\n"};
+    for (int c = 0; c < 2; c++) {
+        ts_scene *sc = thrust_1500("labels", cables[c]);
+        ts_equilibrium *eq = NULL;
+        ts_linear *lin = sc ? dense_model(sc->system, &eq) : NULL;
+        ts_eigen *e = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
+        ts_free_vehicle *f = NULL;
+        ts_err err = {0};
+        if (e && c == 0)
+            ts_free_vehicle_compare(sc->system, eq, lin, e, &f, &err);
+        if (!CHECK(e != NULL && (c || f), "labels: scene %d modes", c)) {
+            ts_free_vehicle_free(f);
+            ts_eigen_free(e);
+            ts_linear_free(lin);
+            ts_equilibrium_free(eq);
+            ts_scene_free(sc);
+            continue;
+        }
+        int veh = 0, other = 0, roll = -1, agree = 0;
+        for (int m = 0; m < e->nmodes; m++) {
+            if (e->modes[m].neutral >= 0)
+                continue;
+            ts_eigen_describe(sc->system, lin, e, m, desc, sizeof desc);
+            int v = strstr(desc, "vehicle 'tug': ") != NULL;
+            veh += v;
+            other += !v;
+            if (fabs(e->modes[m].im - 2.46) < 0.05)
+                roll = v && strstr(desc, "roll") ? m : -2;
+            /* On the stub: a vehicle mode is one of the free vehicle's
+             * (matched by shape, MAC > 0.99), any other the stub's own
+             * swing. */
+            int is_free = 0;
+            for (int k = 0; f && k < f->nmodes; k++)
+                is_free |= f->modes[k].coupled == m && f->modes[k].mac > 0.99;
+            agree += v == is_free;
+        }
+        if (c == 0)
+            CHECK(veh == f->nmodes - f->nneutral && agree == veh + other &&
+                      other == 2,
+                  "on the 1 g/m stub: %d modes labelled the vehicle's, "
+                  "exactly the free vehicle's %d (by shape); the other %d "
+                  "the stub link's swing", veh, f->nmodes - f->nneutral,
+                  other);
+        else
+            CHECK(veh > 0 && other > 0 && roll >= 0,
+                  "with the cable and sphere: %d vehicle modes, %d others; "
+                  "the oscillation at %.4g rad/s labelled roll",
+                  veh, other, roll >= 0 ? e->modes[roll].im : NAN);
+        ts_free_vehicle_free(f);
+        ts_eigen_free(e);
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_scene_free(sc);
+    }
+}
+
 /* ---- 10. the PI speed controller --------------------------------------- */
 
 static void test_speed_pi(void)
@@ -1354,73 +1421,6 @@ static void test_speed_pi(void)
     ts_scene_free(pi);
     ts_scene_free(p);
     ts_scene_free(slow);
-}
-
-/* ---- 12. mode labels -------------------------------------------------- */
-
-static void test_labels(void)
-{
-    char desc[256];
-    const char *cables[2] = {
-        stub_cable,
-        "  - {name: cable, from: tow, to: sphere, length: 50 m, "
-        "diameter: 0.02 m, weight: 5 N/m, links: 10}\n"
-        "bodies:\n"
-        "  - {name: sphere, type: sphere, diameter: 0.5 m, "
-        "wet_weight: 500 N}\n"};
-    for (int c = 0; c < 2; c++) {
-        ts_scene *sc = thrust_1500("labels", cables[c]);
-        ts_equilibrium *eq = NULL;
-        ts_linear *lin = sc ? dense_model(sc->system, &eq) : NULL;
-        ts_eigen *e = lin ? eigen_of(lin, TS_EIG_LAPACK, 0) : NULL;
-        ts_free_vehicle *f = NULL;
-        ts_err err = {0};
-        if (e && c == 0)
-            ts_free_vehicle_compare(sc->system, eq, lin, e, &f, &err);
-        if (!CHECK(e != NULL && (c || f), "labels: scene %d modes", c)) {
-            ts_free_vehicle_free(f);
-            ts_eigen_free(e);
-            ts_linear_free(lin);
-            ts_equilibrium_free(eq);
-            ts_scene_free(sc);
-            continue;
-        }
-        int veh = 0, other = 0, roll = -1, agree = 0;
-        for (int m = 0; m < e->nmodes; m++) {
-            if (e->modes[m].neutral >= 0)
-                continue;
-            ts_eigen_describe(sc->system, lin, e, m, desc, sizeof desc);
-            int v = strstr(desc, "vehicle 'tug': ") != NULL;
-            veh += v;
-            other += !v;
-            if (fabs(e->modes[m].im - 2.46) < 0.05)
-                roll = v && strstr(desc, "roll") ? m : -2;
-            /* On the stub: a vehicle mode is one of the free vehicle's
-             * (matched by shape, MAC > 0.99), any other the stub's own
-             * swing. */
-            int is_free = 0;
-            for (int k = 0; f && k < f->nmodes; k++)
-                is_free |= f->modes[k].coupled == m && f->modes[k].mac > 0.99;
-            agree += v == is_free;
-        }
-        if (c == 0)
-            CHECK(veh == f->nmodes - f->nneutral && agree == veh + other &&
-                      other == 2,
-                  "on the 1 g/m stub: %d modes labelled the vehicle's, "
-                  "exactly the free vehicle's %d (by shape); the other %d "
-                  "the stub link's swing", veh, f->nmodes - f->nneutral,
-                  other);
-        else
-            CHECK(veh > 0 && other > 0 && roll >= 0,
-                  "with the cable and sphere: %d vehicle modes, %d others; "
-                  "the oscillation at %.4g rad/s labelled roll",
-                  veh, other, roll >= 0 ? e->modes[roll].im : NAN);
-        ts_free_vehicle_free(f);
-        ts_eigen_free(e);
-        ts_linear_free(lin);
-        ts_equilibrium_free(eq);
-        ts_scene_free(sc);
-    }
 }
 
 int main(void)

@@ -481,7 +481,10 @@ static const struct {
 static void mutant_command(hcase *c, const example *x, int in_analyses,
                            int k)
 {
-    int long_run = !strcmp(x->stem, "kamman_ex4");
+    /* Long runs: kamman_ex4's simulations; dolphin_aurora's 150 s
+     * waypoint turn behind a Newton trim (about 3 s a run). */
+    int long_run = !strcmp(x->stem, "kamman_ex4") ||
+                   !strcmp(x->stem, "dolphin_aurora");
     char *scene = fmt("@D/%s", x->file);
     if (k % 5 == 4 && !in_analyses) {
         args(c, "modes", scene, "--quiet", "--json", "@D/out.json", NULL);
