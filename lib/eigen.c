@@ -492,9 +492,9 @@ out:
  * residual itself is the rounding allowance (Bauer-Fike with kappa = 1):
  * an exact eigenpair of a matrix within ||r|| of A. */
 /* The same checks with the dense A and its error estimate (a system the
- * sparse model does not cover: vehicles), with one pass over A and one
- * over E (BLAS dgemm on the real and imaginary parts of all the unchecked
- * vectors at once). */
+ * sparse model does not cover: a towing vehicle at the root), with one
+ * pass over A and one over E (BLAS dgemm on the real and imaginary parts
+ * of all the unchecked vectors at once). */
 /* A candidate's residual ||A v - lam v|| / |v| (round) and relative to
  * |lam| (resid) from A v = ar + i ai; returns |v|^2. */
 static double set_residual(cand *c, const double complex *v,

@@ -1148,6 +1148,21 @@ static void assemble(ts_kernel *k)
     }
 }
 
+/* The controller states' rates of V's last evaluation into cdot (its
+ * integrators' and actuators' places, a PI speed controller's
+ * integrator's). */
+static void control_rates(const veh *V, double cdot[])
+{
+    for (int l = 0; l < V->d->nloops; l++)
+        if (V->xi_off[l] >= 0)
+            cdot[V->xi_off[l]] = V->xi_dot[l];
+    for (int j = 0; j < V->d->ncomponents; j++)
+        if (V->act_off[j] >= 0)
+            cdot[V->act_off[j]] = V->act_dot[j];
+    if (V->spd_off >= 0)
+        cdot[V->spd_off] = V->spd_dot;
+}
+
 int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                    double dydt[])
 {
@@ -1409,14 +1424,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                 dydt[V->qoff + na + j] = qd[V->qoff + na + j];
                 dydt[nq + V->qoff + na + j] = k->rdd[j];
             }
-        for (int l = 0; l < V->d->nloops; l++)
-            if (V->xi_off[l] >= 0)
-                cdot[V->xi_off[l]] = V->xi_dot[l];
-        for (int j = 0; j < V->d->ncomponents; j++)
-            if (V->act_off[j] >= 0)
-                cdot[V->act_off[j]] = V->act_dot[j];
-        if (V->spd_off >= 0)
-            cdot[V->spd_off] = V->spd_dot;
+        control_rates(V, cdot);
     }
     return TS_OK;
 }
@@ -1429,19 +1437,31 @@ int ts_kernel_rhs(double t, const double y[], const double u[], double dydt[],
 }
 
 int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
-                        const double a[], const double t[], double R[])
+                        const double a[], const double t[], const double yv[],
+                        const double thdd[], const double u[], double R[])
 {
     const ts_system *sys = k->sys;
     const ts_link *links = sys->links;
     const int nl = k->nl, nn = k->nn;
+    const double rho = sys->env.water_density, g = sys->env.gravity;
+    if (k->root >= 0 || (k->nv > 0 && (!yv || !thdd)))
+        return TS_EINVAL;
+    if (!u)
+        u = k->uzero;
     memcpy(k->r, r, 3 * (size_t)nn * sizeof(double));
     memcpy(k->rd, v, 3 * (size_t)nn * sizeof(double));
+    /* The vehicles' kinematics (attitude from yv, joint at their node),
+     * which place the points P their child cables start from. */
+    for (int i = 0; i < k->nv; i++)
+        if (vehicle_kinematics(k, &k->veh[i], yv))
+            return TS_CHART;
     /* Directions and strains from the positions: n = d / |d|, the strain
      * of an elastic link |d| / l - 1 (it sets only the bending lengths
      * here: the tensions are given). */
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
-        const double *rp = r + 3 * L->upper, *rk = r + 3 * L->lower;
+        const double *rp = L->up_body >= 0 ? k->ur + 3 * l : r + 3 * L->upper;
+        const double *rk = r + 3 * L->lower;
         double d[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
         double len = v3_norm(d);
         if (!(len > 0))
@@ -1462,10 +1482,150 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         v3_axpy(t[l], k->n + 3 * l, R + 3 * L->lower);
-        if (L->upper > 0)
+        if (L->upper > 0 && L->up_body < 0)
             v3_axpy(-t[l], k->n + 3 * l, R + 3 * L->upper);
     }
+    /* Vehicles: the body's equations about A in body axes, r6 = M6 (a_A,
+     * alpha) - G - sum_P J_P^T t n (its child cables at their points P,
+     * their ends' masses and loads in M6 and G), the translational part
+     * (the joint force, R r6[0..2]) added to its node's row, the
+     * rotational part its own rows; then the controller's rates. */
+    double *Rv = R + 3 * nn, *cdot = R + 3 * nn + 3 * k->nv;
+    for (int i = 0; i < k->nv; i++) {
+        veh *V = &k->veh[i];
+        vehicle_loads(k, V, yv, u, rho, g);
+        const tsi_vehicle_state *st = &V->st;
+        double aA[3], nu[6], kap[3], fr[3], am[3], r6[6];
+        for (int j = 0; j < 3; j++)
+            aA[j] = a[3 * V->node + j] + k->afr[3 * V->node + j];
+        mat3_tmul(st->R, aA, nu);
+        tsi_rate_kappa(yv + V->qoff, yv + k->nq + V->qoff, kap);
+        tsi_vehicle_frame_alpha(st, k->frame.turn_rate, k->frame.turn_accel,
+                                fr);
+        mat3_tmul(st->R, fr, am);
+        mat3_mul(st->E, thdd + 3 * i, nu + 3);
+        for (int j = 0; j < 3; j++)
+            nu[3 + j] += kap[j] + am[j];
+        for (int a6 = 0; a6 < 6; a6++) {
+            r6[a6] = -V->G[a6];
+            for (int b = 0; b < 6; b++)
+                r6[a6] += V->M6[6 * a6 + b] * nu[b];
+        }
+        const ts_node *nd = &sys->nodes[V->node];
+        for (int c = nd->child_begin; c < nd->child_end; c++) {
+            int l = sys->child_links[c];
+            double lever[3], f[3], m[3];
+            link_lever(V, &links[l], lever);
+            mat3_tmul(st->R, k->n + 3 * l, f);
+            for (int j = 0; j < 3; j++)
+                f[j] *= t[l];
+            v3_cross(lever, f, m);
+            for (int j = 0; j < 3; j++) {
+                r6[j] -= f[j];
+                r6[3 + j] -= m[j];
+            }
+        }
+        double Fj[3];
+        mat3_mul(st->R, r6, Fj);
+        v3_axpy(1.0, Fj, R + 3 * V->node);
+        for (int j = 0; j < 3; j++)
+            Rv[3 * i + j] = r6[3 + j];
+        control_rates(V, cdot);
+    }
     return TS_OK;
+}
+
+void tsi_kernel_vehicle_mass(const ts_kernel *k, int v, double Mv[36])
+{
+    /* r6 = M6 (R^T a_i, E thdd + ...): d r6 / d(a_i, thdd) = M6 diag(R^T,
+     * E); the translational rows go to M as R r6[0..2]. */
+    const veh *V = &k->veh[v];
+    const double *Rm = V->st.R, *E = V->st.E;
+    double T[36];
+    for (int a6 = 0; a6 < 6; a6++)
+        for (int c = 0; c < 3; c++) {
+            double x = 0, y = 0;
+            for (int b = 0; b < 3; b++) {
+                x += V->M6[6 * a6 + b] * Rm[3 * c + b];  /* (R^T)_{bc} */
+                y += V->M6[6 * a6 + 3 + b] * E[3 * b + c];
+            }
+            T[6 * a6 + c] = x;
+            T[6 * a6 + 3 + c] = y;
+        }
+    for (int c = 0; c < 6; c++) {
+        for (int a3 = 0; a3 < 3; a3++) {
+            Mv[6 * a3 + c] = Rm[3 * a3] * T[c] + Rm[3 * a3 + 1] * T[6 + c] +
+                             Rm[3 * a3 + 2] * T[12 + c];
+            Mv[6 * (3 + a3) + c] = T[6 * (3 + a3) + c];
+        }
+    }
+}
+
+void tsi_kernel_link_point(const ts_kernel *k, int l, const double n[3],
+                           double pg[3], double pm[3])
+{
+    const ts_link *L = &k->sys->links[l];
+    const veh *V = &k->veh[k->node_veh[L->upper]];
+    const double *R = V->st.R, *E = V->st.E;
+    double lever[3], rho[3], x[3], RE[9], nb[3];
+    link_lever(V, L, lever);
+    mat3_mul(R, lever, rho);
+    v3_cross(rho, n, x);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            RE[3 * i + j] = R[3 * i] * E[j] + R[3 * i + 1] * E[3 + j] +
+                            R[3 * i + 2] * E[6 + j];
+    mat3_tmul(RE, x, pg);
+    mat3_tmul(R, n, nb);
+    v3_cross(lever, nb, pm);
+    for (int j = 0; j < 3; j++)
+        pm[j] = -pm[j];
+}
+
+void tsi_kernel_vehicle_layout(const ts_kernel *k, int v, tsi_vehicle_layout *lay)
+{
+    const veh *V = &k->veh[v];
+    lay->node = V->node;
+    lay->qoff = V->qoff;
+    lay->c0 = -1;
+    lay->nc = 0;
+    lay->in0 = -1;
+    lay->nin = 0;
+    int cmin = k->nc, cmax = -1, imin = k->nin, imax = -1;
+    for (int l = 0; l < V->d->nloops; l++) {
+        int x[3] = {V->xi_off[l], V->in_loop[l], V->in_sp[l]};
+        if (x[0] >= 0) {
+            cmin = x[0] < cmin ? x[0] : cmin;
+            cmax = x[0] > cmax ? x[0] : cmax;
+        }
+        for (int j = 1; j < 3; j++)
+            if (x[j] >= 0) {
+                imin = x[j] < imin ? x[j] : imin;
+                imax = x[j] > imax ? x[j] : imax;
+            }
+    }
+    for (int c = 0; c < V->d->ncomponents; c++) {
+        if (V->act_off[c] >= 0) {
+            cmin = V->act_off[c] < cmin ? V->act_off[c] : cmin;
+            cmax = V->act_off[c] > cmax ? V->act_off[c] : cmax;
+        }
+        if (V->in_surf[c] >= 0) {
+            imin = V->in_surf[c] < imin ? V->in_surf[c] : imin;
+            imax = V->in_surf[c] > imax ? V->in_surf[c] : imax;
+        }
+    }
+    if (cmax >= 0) {
+        lay->c0 = cmin;
+        lay->nc = cmax - cmin + 1;
+    }
+    if (imax >= 0) {
+        lay->in0 = imin;
+        lay->nin = imax - imin + 1;
+    }
+    lay->out0 = 0;
+    for (int u = 0; u < v; u++)
+        lay->out0 += OUT_MEASURES + k->veh[u].d->nloops + nsurfaces(&k->veh[u]);
+    lay->nout = OUT_MEASURES + V->d->nloops + nsurfaces(V);
 }
 
 const double *tsi_kernel_mass(const ts_kernel *k) { return k->M; }

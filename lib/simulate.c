@@ -583,8 +583,8 @@ static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
     return esdirk_code(rhs(t, y, dydt, params));
 }
 
-/* esdirk's dense Jacobian: a system the sparse model does not cover (a
- * vehicle). */
+/* esdirk's dense Jacobian: a system with a vehicle (its Newton matrix
+ * from the sparse model is used without vehicles only). */
 static int jacobian_esdirk(double t, const double y[], double J[],
                            void *params)
 {
