@@ -1163,7 +1163,8 @@ static void assemble(ts_kernel *k)
 }
 
 /* The controller states' rates of V's last evaluation into cdot (its
- * integrators' and actuators' places). */
+ * integrators' and actuators' places, a PI speed controller's
+ * integrator's). */
 static void control_rates(const veh *V, double cdot[])
 {
     for (int l = 0; l < V->d->nloops; l++)
