@@ -570,7 +570,7 @@ static int tow_values(const ts_system *sys, const ts_equilibrium *eq,
     /* The unknown along the track carries Newton's next step; thrust,
      * power and speed vary together along it (T = P / u, P = T u), so
      * what follows from it has the same relative error. */
-    double x = bias ? eq->thrust_bias : eq->speed;
+    double x = bias ? vr->thrust : eq->speed;
     double ex = fmax(EQ_NOISE_FACTOR * eq->motion_step[0],
                      rel * (bias ? eq->force_scale : fabs(x)));
     double follows = bias ? vr->power
@@ -1157,6 +1157,10 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
     rc = equilibrium_then_linear(r, rq, &lo, err);
+    /* A towing vehicle's speed is solved: the waves meet it at that one
+     * (the encounter frequency), not at the scene's starting value. */
+    if (rc == TS_OK && r->sys->tow.vehicle >= 0)
+        r->seaway.speed = r->eq->speed;
     ts_seastate_opts so;
     ts_seastate_opts_default(&so);
     so.intervals = o->intervals;
@@ -2045,15 +2049,19 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
  * excitation (r->sea_excitation, which r->excitation then points to). */
 /* The excitation of s with its sea's realisation added, into *out (a new
  * excitation, NULL on failure), with the seaway and the realisation's
- * settings. */
+ * settings; the ship's speed through the waves is `speed` (m/s; NaN: the
+ * scene's). */
 static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
-                          ts_seaway *w, ts_sea_realisation *real,
-                          ts_excitation **out, ts_err *err)
+                          double speed, ts_seaway *w,
+                          ts_sea_realisation *real, ts_excitation **out,
+                          ts_err *err)
 {
     *out = NULL;
     int rc = sea_seaway(sys, &s->sea, w, err);
     if (rc)
         return rc;
+    if (isfinite(speed))
+        w->speed = speed;
     *out = ts_excitation_copy(s->excitation, err);
     if (!*out)
         return err && err->code ? err->code : TS_ENOMEM;
@@ -2068,9 +2076,10 @@ static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
     return rc;
 }
 
-static int sea_realise(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+static int sea_realise(ts_result *r, const ts_simulate_opts *s,
+                       double speed, ts_err *err)
 {
-    int rc = sea_excitation(r->sys, s, &r->seaway, &r->realisation,
+    int rc = sea_excitation(r->sys, s, speed, &r->seaway, &r->realisation,
                             &r->sea_excitation, err);
     if (!r->sea_excitation)
         return rc;
@@ -2158,8 +2167,11 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     r->excitation = s->excitation;
     int rc = check_simulate(sys, s, rq->setup.open_loop, &r->sim,
                             &r->transient, &r->output, err);
-    if (rc == TS_OK && s->sea.sea)
-        rc = sea_realise(r, s, err);
+    /* A towing vehicle's speed, which the waves' encounter frequency
+     * needs, is known after its equilibrium: its sea is realised there. */
+    int sea_later = s->sea.sea && sys->tow.vehicle >= 0;
+    if (rc == TS_OK && s->sea.sea && !sea_later)
+        rc = sea_realise(r, s, NAN, err);
     if (rc != TS_OK)
         return rc;
     ts_sim_opts *o = &r->sim;
@@ -2192,6 +2204,11 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         } else {
             memcpy(y0, r->eq->y, (size_t)n * sizeof *y0);
             ts_trust_merge(&r->trust, "initial equilibrium: ", &r->eq_trust);
+            if (sea_later) {
+                rc = sea_realise(r, s, r->eq->speed, err);
+                if (r->sea_excitation)
+                    ex = r->excitation;
+            }
             /* The loops open at the trim: the state loses their
              * integrators. */
             if (rq->setup.open_loop && ts_control_nloops(k) > 0) {
@@ -3378,7 +3395,8 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
         if (rq->simulate.sea.sea) {
             ts_seaway w;
             ts_sea_realisation real;
-            rc = sea_excitation(s, &rq->simulate, &w, &real, &ex, err);
+            /* (A towing vehicle's at the scene's speed: a cost bound.) */
+            rc = sea_excitation(s, &rq->simulate, NAN, &w, &real, &ex, err);
         }
         if (rc == TS_OK)
             rc = ts_cost_simulate(s, ex ? ex : rq->simulate.excitation, &o,

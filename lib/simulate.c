@@ -322,12 +322,6 @@ static int bind_inputs(const ts_kernel *k, const ts_excitation *ex,
     for (int i = 0; i < ns; i++) {
         int axis = ts_excitation_signal(ex, i)->axis;
         any |= axis == TS_AXIS_INPUT;
-        if (ts_kernel_root(k) >= 0 && axis <= TS_AXIS_HEAVE)
-            return ts_fail(err, TS_EINVAL, "excite: the tow point is the "
-                           "towing vehicle's, not prescribed: excite its "
-                           "inputs (<vehicle>.thrust, .force.x|y|z, "
-                           ".moment.x|y|z, its control surfaces) instead of "
-                           "a tow-point motion");
     }
     if (!any)
         return TS_OK;
@@ -628,8 +622,8 @@ static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
     return esdirk_code(rhs(t, y, dydt, params));
 }
 
-/* esdirk's dense Jacobian: a system the sparse model does not cover (a
- * vehicle). */
+/* esdirk's dense Jacobian: a system with a vehicle (its Newton matrix
+ * from the sparse model is used without vehicles only). */
 static int jacobian_esdirk(double t, const double y[], double J[],
                            void *params)
 {
