@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "param_impl.h"
+#include "towstab/vehicle.h"
 
 typedef tsi_key row;
 
@@ -67,6 +68,39 @@ static const row body_rows[] = {
     {"cross_added_mass", "1", 0, 0, TSI_KEY_PLAIN, BOD(ca_cross)},
 };
 
+/* A vehicle's own keys (bodies.<vehicle>.<key>; its mass keys are a
+ * body's). */
+#define VEH(m) offsetof(ts_vehicle, m)
+static const row vehicle_rows[] = {
+    {"volume", "m^3", 0, 0, TSI_KEY_PLAIN, VEH(volume)},
+    {"inertia", "kg*m^2", -INFINITY, 0, TSI_KEY_INERTIA, VEH(inertia)},
+    {"mass_centre", "m", -INFINITY, 0, TSI_KEY_VECTOR, VEH(mass_centre)},
+    {"buoyancy_centre", "m", -INFINITY, 0, TSI_KEY_VECTOR,
+     VEH(buoyancy_centre)},
+    {"attach", "m", -INFINITY, 0, TSI_KEY_VECTOR, VEH(attach)},
+    {"surface_diameter", "m", 0, 0, TSI_KEY_PLAIN, VEH(surface_diameter)},
+};
+
+/* The body keys a vehicle has besides its own. */
+static const char *const vehicle_body_keys[] = {"mass", "weight",
+                                                "wet_weight"};
+
+/* A hull's and a bluff part's keys. */
+#define CMP(m) offsetof(ts_component, m)
+static const row hull_rows[] = {
+    {"position", "m", -INFINITY, 0, TSI_KEY_VECTOR, CMP(position)},
+    {"length", "m", 0, 1, TSI_KEY_PLAIN, CMP(length)},
+    {"diameter", "m", 0, 1, TSI_KEY_PLAIN, CMP(diameter)},
+    {"axial_drag", "1", 0, 0, TSI_KEY_PLAIN, CMP(cd_axial)},
+    {"cross_drag", "1", 0, 0, TSI_KEY_PLAIN, CMP(cd_cross)},
+};
+
+static const row bluff_rows[] = {
+    {"position", "m", -INFINITY, 0, TSI_KEY_VECTOR, CMP(position)},
+    {"area", "m^2", 0, 1, TSI_KEY_PLAIN, CMP(area)},
+    {"drag", "1", 0, 0, TSI_KEY_PLAIN, CMP(drag)},
+};
+
 /* A loop's keys: units depend on what it measures (unit "" here). */
 static const row loop_rows[] = {
     {"kp", "", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_loop, kp)},
@@ -98,7 +132,12 @@ static const row surface_rows[] = {
      offsetof(ts_component, rate_limit)},
     {"time_constant", "s", 0, 0, TSI_KEY_PLAIN,
      offsetof(ts_component, time_constant)},
+    {"position", "m", -INFINITY, 0, TSI_KEY_VECTOR,
+     offsetof(ts_component, position)},
 };
+
+/* The surface row whose value may be infinite (no limit). */
+static const row *const surface_limit = &surface_rows[3];
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
 
@@ -112,6 +151,10 @@ const tsi_key *tsi_key_find(tsi_keys t, const char *key)
     case TSI_KEYS_CABLE: return find_row(cable_rows, COUNT(cable_rows), key);
     case TSI_KEYS_BODY: return find_row(body_rows, COUNT(body_rows), key);
     case TSI_KEYS_LOOP: return find_row(loop_rows, COUNT(loop_rows), key);
+    case TSI_KEYS_VEHICLE:
+        return find_row(vehicle_rows, COUNT(vehicle_rows), key);
+    case TSI_KEYS_HULL: return find_row(hull_rows, COUNT(hull_rows), key);
+    case TSI_KEYS_BLUFF: return find_row(bluff_rows, COUNT(bluff_rows), key);
     default: return find_row(surface_rows, COUNT(surface_rows), key);
     }
 }
@@ -120,10 +163,15 @@ static const char *const forms =
     "tow.speed, tow.turn_rate, tow.point.x|y|z, "
     "environment.water_density|gravity|current.x|y|z, "
     "cables.<name>.<key>, bodies.<name>.<key>, "
+    "bodies.<vehicle>.volume|surface_diameter|inertia.xx|yy|zz|xy|xz|yz|"
+    "mass_centre.x|y|z|buoyancy_centre.x|y|z|attach.x|y|z, "
     "bodies.<vehicle>.loops.<loop>.kp|ki|kd|setpoint, "
-    "bodies.<vehicle>.surfaces.<surface>.area|span|deflection|limit|"
+    "bodies.<vehicle>.components.<surface>.area|span|deflection|limit|"
     "incidence|roll|lift_slope|stall|stall_width|zero_lift_drag|"
-    "efficiency|cn90|rate_limit|time_constant";
+    "efficiency|cn90|rate_limit|time_constant|position.x|y|z, "
+    "bodies.<vehicle>.components.<hull>.length|diameter|axial_drag|"
+    "cross_drag|position.x|y|z, "
+    "bodies.<vehicle>.components.<bluff part>.area|drag|position.x|y|z";
 
 /* A path resolved against a system (or only by its form when sys is
  * NULL). */
@@ -134,6 +182,7 @@ typedef struct target {
                          resolved by form only */
     int cable, body;  /* indices, -1 when not one */
     int loop;         /* loop index, -1 */
+    int comp;         /* a vehicle's component index, -1 */
     const char *collection;
 } target;
 
@@ -145,13 +194,37 @@ static const row *find_row(const row *t, int n, const char *key)
     return NULL;
 }
 
+/* The names of a vector's or an inertia's entries, "" for a scalar. */
+static const char *entries_of(const row *r)
+{
+    return r->kind == TSI_KEY_VECTOR    ? ".x|y|z"
+           : r->kind == TSI_KEY_INERTIA ? ".xx|yy|zz|xy|xz|yz"
+                                        : "";
+}
+
+/* The index of entry `name` of row r (x, y, z; xx, yy, zz, xy, xz, yz),
+ * -1 when it has none of that name. */
+static int entry_index(const row *r, const char *name)
+{
+    static const char *const vec[3] = {"x", "y", "z"};
+    static const char *const inertia[6] = {"xx", "yy", "zz",
+                                           "xy", "xz", "yz"};
+    const char *const *names = r->kind == TSI_KEY_VECTOR ? vec : inertia;
+    int n = r->kind == TSI_KEY_VECTOR ? 3 : r->kind == TSI_KEY_INERTIA ? 6
+                                                                        : 0;
+    for (int i = 0; i < n; i++)
+        if (!strcmp(name, names[i]))
+            return i;
+    return -1;
+}
+
 static void keys_list(const row *t, int n, char *buf, size_t size)
 {
-    size_t len = 0;
-    buf[0] = '\0';
+    size_t len = strlen(buf);
     for (int i = 0; i < n; i++)
         len += (size_t)snprintf(buf + len, len < size ? size - len : 0,
-                                "%s%s", i ? ", " : "", t[i].key);
+                                "%s%s%s", len ? ", " : "", t[i].key,
+                                entries_of(&t[i]));
 }
 
 /* What a table's entries are, for messages. */
@@ -162,41 +235,59 @@ static const char *table_noun(const row *t)
            : t == cable_rows   ? "a cable"
            : t == body_rows    ? "a body"
            : t == loop_rows    ? "a loop"
+           : t == vehicle_rows ? "a vehicle"
+           : t == hull_rows    ? "a hull"
+           : t == bluff_rows   ? "a bluff part"
                                : "a surface";
 }
 
 static int unknown_key(const char *path, const char *key, const row *t,
                        int n, ts_err *err)
 {
-    char list[400];
+    char list[600] = "";
     keys_list(t, n, list, sizeof list);
     return ts_fail(err, TS_EINVAL, "%s: no key '%s' of %s; expected one of "
                    "%s", path, key, table_noun(t), list);
 }
 
-/* The key `key` of table t, or a vector component "<key>.x". */
-static int resolve_key(const char *path, const char *key, const row *t,
-                       int n, target *tg, ts_err *err)
+/* The key `key` of table t, or an entry "<key>.x" of a vector or
+ * "<key>.xy" of an inertia, into tg->r and tg->vec: TS_OK, or TS_EINVAL
+ * with tg->r the row of a vector or inertia named without its entry
+ * (NULL for no such key). No message. */
+static int find_key(const char *key, const row *t, int n, target *tg)
 {
     tg->r = find_row(t, n, key);
     tg->vec = 0;
-    if (tg->r && tg->r->kind != TSI_KEY_VECTOR)
-        return TS_OK;
-    if (tg->r) /* a vector without its component */
-        return ts_fail(err, TS_EINVAL, "%s: '%s' is a vector; name a "
-                       "component: %s.x, %s.y or %s.z", path, key, key, key,
-                       key);
+    if (tg->r)
+        return tg->r->kind == TSI_KEY_VECTOR ||
+                       tg->r->kind == TSI_KEY_INERTIA
+                   ? TS_EINVAL
+                   : TS_OK;
     const char *dot = strrchr(key, '.');
-    if (dot && dot[1] && !dot[2] && strchr("xyz", dot[1])) {
+    if (dot) {
         char head[TS_PARAM_PATH_MAX];
         snprintf(head, sizeof head, "%.*s", (int)(dot - key), key);
-        tg->r = find_row(t, n, head);
-        if (tg->r && tg->r->kind == TSI_KEY_VECTOR) {
-            tg->vec = dot[1] - 'x';
+        const row *r = find_row(t, n, head);
+        int e = r ? entry_index(r, dot + 1) : -1;
+        if (e >= 0) {
+            tg->r = r;
+            tg->vec = e;
             return TS_OK;
         }
     }
-    tg->r = NULL;
+    return TS_EINVAL;
+}
+
+/* The key `key` of table t, or an entry of a vector or an inertia. */
+static int resolve_key(const char *path, const char *key, const row *t,
+                       int n, target *tg, ts_err *err)
+{
+    if (find_key(key, t, n, tg) == TS_OK)
+        return TS_OK;
+    if (tg->r) /* a vector or an inertia without its entry */
+        return ts_fail(err, TS_EINVAL, "%s: '%s' is a %s; name an entry: "
+                       "%s%s", path, key, tg->r->kind == TSI_KEY_VECTOR
+                       ? "vector" : "list", key, entries_of(tg->r));
     return unknown_key(path, key, t, n, err);
 }
 
@@ -232,9 +323,8 @@ static void names_list(const char *names, size_t stride, int n, char *buf,
                                 names + (size_t)i * stride);
 }
 
-/* bodies.<vehicle>.loops.<loop>.<key> or .surfaces.<surface>.<key>. */
 /* The part after a vehicle's "loops." ("controllers.", the scene's
- * word) or "surfaces." ("components."); *loops says which. NULL for
+ * word) or "components." ("surfaces."); *loops says which. NULL for
  * neither. */
 static const char *vehicle_part(const char *key, int *loops)
 {
@@ -248,6 +338,50 @@ static const char *vehicle_part(const char *key, int *loops)
     return NULL;
 }
 
+/* The key table of a component of `type`. */
+static const row *component_rows(ts_component_type type, int *n)
+{
+    *n = type == TS_COMP_HULL    ? COUNT(hull_rows)
+         : type == TS_COMP_BLUFF ? COUNT(bluff_rows)
+                                 : COUNT(surface_rows);
+    return type == TS_COMP_HULL    ? hull_rows
+           : type == TS_COMP_BLUFF ? bluff_rows
+                                   : surface_rows;
+}
+
+/* By form only: `rest` (after "components.") ends in a key of a surface,
+ * a hull or a bluff part, one name ("area") or an entry ("position.x"). */
+static int component_form(const char *path, const char *rest, target *tg,
+                          ts_err *err)
+{
+    static const ts_component_type types[3] = {
+        TS_COMP_SURFACE, TS_COMP_HULL, TS_COMP_BLUFF};
+    const char *last = strrchr(rest, '.');
+    for (const char *k = last; k && k > rest; k--) {
+        if (*k != '.')
+            continue;
+        for (int i = 0; i < 3; i++) {
+            int n;
+            const row *t = component_rows(types[i], &n);
+            if (find_key(k + 1, t, n, tg) == TS_OK)
+                return TS_OK;
+        }
+        if (k != last) /* at most two names: "position.x" */
+            break;
+    }
+    char list[800] = "";
+    for (int i = 0; i < 3; i++) {
+        int n;
+        const row *t = component_rows(types[i], &n);
+        keys_list(t, n, list, sizeof list);
+    }
+    return ts_fail(err, TS_EINVAL, "%s: expected components.<name>.<key> "
+                   "with a key of a surface, a hull or a bluff part: %s",
+                   path, list);
+}
+
+/* bodies.<vehicle>.loops.<loop>.<key> or .components.<component>.<key>
+ * (key: the part after the vehicle's name). */
 static int resolve_vehicle(const char *path, const ts_system *sys, int b,
                            const char *key, target *tg, ts_err *err)
 {
@@ -257,54 +391,121 @@ static int resolve_vehicle(const char *path, const ts_system *sys, int b,
     if (bd && (bd->type != TS_BODY_VEHICLE || !bd->vehicle))
         return ts_fail(err, TS_EINVAL, "%s: body '%s' is not a vehicle; "
                        "only vehicles have %s", path, bd->name,
-                       loops ? "loops" : "surfaces");
+                       loops ? "loops" : "components");
     const char *k = strrchr(rest, '.');
     if (!k || k == rest)
         return ts_fail(err, TS_EINVAL, "%s: expected %s.<name>.<key>", path,
-                       loops ? "loops" : "surfaces");
-    k++;
-    const row *t = loops ? loop_rows : surface_rows;
-    int n = loops ? COUNT(loop_rows) : COUNT(surface_rows);
-    if (resolve_key(path, k, t, n, tg, err))
-        return TS_EINVAL;
+                       loops ? "loops" : "components");
+    if (!bd && !loops)
+        return component_form(path, rest, tg, err);
     if (!bd)
-        return TS_OK;
+        return resolve_key(path, k + 1, loop_rows, COUNT(loop_rows), tg,
+                           err);
     ts_vehicle *v = bd->vehicle;
     const char *kk = NULL;
     char list[600];
     if (loops) {
         int l = match_name(rest, v->loop[0].name, sizeof v->loop[0],
                            v->nloops, &kk);
-        if (l < 0 || strcmp(kk, k)) {
+        if (l < 0) {
             names_list(v->loop[0].name, sizeof v->loop[0], v->nloops, list,
                        sizeof list);
             return ts_fail(err, TS_EINVAL, "%s: vehicle '%s' has no loop "
                            "'%.*s'; its loops: %s", path, bd->name,
-                           (int)(k - 1 - rest), rest,
-                           list[0] ? list : "none");
+                           (int)(k - rest), rest, list[0] ? list : "none");
         }
         tg->loop = l;
         tg->base = (char *)&v->loop[l];
-        return TS_OK;
+        return resolve_key(path, kk, loop_rows, COUNT(loop_rows), tg, err);
     }
     int c = match_name(rest, v->component[0].name, sizeof v->component[0],
                        v->ncomponents, &kk);
-    if (c < 0 || strcmp(kk, k) || v->component[c].type != TS_COMP_SURFACE) {
+    if (c < 0) {
         size_t len = 0;
         list[0] = '\0';
+        static const char *const kind[3] = {"hull", "surface", "bluff"};
         for (int i = 0; i < v->ncomponents; i++)
-            if (v->component[i].type == TS_COMP_SURFACE)
-                len += (size_t)snprintf(list + len,
-                                        len < sizeof list ? sizeof list - len
-                                                          : 0,
-                                        "%s%s", len ? ", " : "",
-                                        v->component[i].name);
-        return ts_fail(err, TS_EINVAL, "%s: vehicle '%s' has no lifting "
-                       "surface '%.*s'; its surfaces: %s", path, bd->name,
-                       (int)(k - 1 - rest), rest, list[0] ? list : "none");
+            len += (size_t)snprintf(list + len,
+                                    len < sizeof list ? sizeof list - len : 0,
+                                    "%s%s (%s)", len ? ", " : "",
+                                    v->component[i].name,
+                                    kind[v->component[i].type]);
+        return ts_fail(err, TS_EINVAL, "%s: vehicle '%s' has no component "
+                       "'%.*s'; its components: %s", path, bd->name,
+                       (int)(k - rest), rest, list[0] ? list : "none");
     }
+    int n;
+    const row *t = component_rows(v->component[c].type, &n);
+    tg->comp = c;
     tg->base = (char *)&v->component[c];
-    return TS_OK;
+    return resolve_key(path, kk, t, n, tg, err);
+}
+
+/* bodies.<body>.<key> of body b (key: the part after its name): a body's
+ * key, and a vehicle's own (vehicle_rows) where b is a vehicle, which has
+ * only the mass keys of a body. By form (sys NULL) the key is the last
+ * name, or the last two for an entry ("attach.x"). */
+static int resolve_body(const char *path, const ts_system *sys, int b,
+                        const char *rest, target *tg, ts_err *err)
+{
+    ts_body *bd = sys ? &((ts_system *)sys)->bodies[b] : NULL;
+    const char *key = rest;
+    if (!bd) {
+        key = strrchr(rest, '.');
+        if (!key || key == rest)
+            return ts_fail(err, TS_EINVAL, "%s: expected bodies.<name>.<key>",
+                           path);
+        key++;
+        /* An entry of a vector or an inertia: its key is two names. */
+        for (const char *q = key - 2; q > rest; q--)
+            if (*q == '.') {
+                if (find_key(q + 1, vehicle_rows, COUNT(vehicle_rows), tg) ==
+                    TS_OK)
+                    return TS_OK;
+                break;
+            }
+    }
+    int vehicle = bd ? bd->type == TS_BODY_VEHICLE && bd->vehicle : 1;
+    if (vehicle && find_key(key, vehicle_rows, COUNT(vehicle_rows), tg) ==
+                       TS_OK) {
+        tg->base = bd ? (char *)bd->vehicle : NULL;
+        return TS_OK;
+    }
+    if (vehicle && tg->r)
+        return resolve_key(path, key, vehicle_rows, COUNT(vehicle_rows), tg,
+                           err);
+    tg->base = (char *)bd;
+    int known = find_key(key, body_rows, COUNT(body_rows), tg) == TS_OK;
+    if (known && bd && vehicle) {
+        known = 0;
+        for (int i = 0; i < COUNT(vehicle_body_keys); i++)
+            known |= !strcmp(key, vehicle_body_keys[i]);
+    }
+    if (known)
+        return TS_OK;
+    if (bd && !vehicle)
+        return resolve_key(path, key, body_rows, COUNT(body_rows), tg, err);
+    if (!bd) {
+        if (tg->r) /* a vector or an inertia without its entry */
+            return resolve_key(path, key, body_rows, COUNT(body_rows), tg,
+                               err);
+        char keys[400] = "", vkeys[400] = "";
+        keys_list(body_rows, COUNT(body_rows), keys, sizeof keys);
+        keys_list(vehicle_rows, COUNT(vehicle_rows), vkeys, sizeof vkeys);
+        return ts_fail(err, TS_EINVAL, "%s: no key '%s' of a body; expected "
+                       "one of %s; or of a vehicle %s, "
+                       "controllers.<loop>.<key>, "
+                       "components.<component>.<key>", path, key, keys,
+                       vkeys);
+    }
+    char list[600] = "";
+    for (int i = 0; i < COUNT(vehicle_body_keys); i++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s",
+                 i ? ", " : "", vehicle_body_keys[i]);
+    keys_list(vehicle_rows, COUNT(vehicle_rows), list, sizeof list);
+    return ts_fail(err, TS_EINVAL, "%s: no key '%s' of a vehicle; expected "
+                   "one of %s, controllers.<loop>.<key> or "
+                   "components.<component>.<key>", path, key, list);
 }
 
 /* The scene format's spelling of a path (doc/scene-format.md, "Setting
@@ -340,12 +541,26 @@ static int spell(const ts_system *sys, const char *path, char *out,
         const char *name = sel;
         char buf[TS_NAME_MAX + 8];
         long i = digits ? strtol(sel, NULL, 10) : -1;
-        if (!strcmp(what, "point") || !strcmp(what, "current")) {
+        static const char *const vectors[] = {
+            "point", "current", "position", "mass_centre",
+            "buoyancy_centre", "attach"};
+        static const char *const inertia[6] = {"xx", "yy", "zz",
+                                               "xy", "xz", "yz"};
+        int vector = 0;
+        for (int k = 0; k < COUNT(vectors); k++)
+            vector |= !strcmp(what, vectors[k]);
+        if (vector) {
             if (!digits || i > 2)
                 return ts_fail(err, TS_EINVAL, "%s: [%s]: expected a "
                                "component 0, 1 or 2", path, sel);
             snprintf(buf, sizeof buf, "%c", "xyz"[i]);
             name = buf;
+        } else if (!strcmp(what, "inertia")) {
+            if (!digits || i > 5)
+                return ts_fail(err, TS_EINVAL, "%s: [%s]: expected an entry "
+                               "0 to 5 of [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]",
+                               path, sel);
+            name = inertia[i];
         } else if (digits && sys && !strcmp(what, "cables")) {
             if (i >= sys->ncables)
                 return ts_fail(err, TS_EINVAL, "%s: 'cables' has no entry "
@@ -361,11 +576,6 @@ static int spell(const ts_system *sys, const char *path, char *out,
         } else if (digits) {
             snprintf(buf, sizeof buf, "[%ld]", i);
             name = buf;
-        }
-        /* A vehicle's components are its surfaces here. */
-        if (!strcmp(what, "components")) {
-            o = start;
-            o += (size_t)snprintf(out + o, size - o, "surfaces");
         }
         o += (size_t)snprintf(out + o, o < size ? size - o : 0, ".%s", name);
         p = close + 1;
@@ -387,7 +597,7 @@ static int resolve(const ts_system *sys, const char *path, target *tg,
 {
     char dotted[TS_PARAM_PATH_MAX];
     memset(tg, 0, sizeof *tg);
-    tg->cable = tg->body = tg->loop = -1;
+    tg->cable = tg->body = tg->loop = tg->comp = -1;
     if (path && strchr(path, '[')) {
         if (strlen(path) >= TS_PARAM_PATH_MAX)
             return ts_fail(err, TS_EINVAL, "path: longer than %d characters",
@@ -408,7 +618,7 @@ static int resolve_spelled(const ts_system *sys, const char *path,
                            target *tg, ts_err *err)
 {
     memset(tg, 0, sizeof *tg);
-    tg->cable = tg->body = tg->loop = -1;
+    tg->cable = tg->body = tg->loop = tg->comp = -1;
     if (!path || !path[0])
         return ts_fail(err, TS_EINVAL, "path: empty; expected one of %s",
                        forms);
@@ -451,14 +661,14 @@ static int resolve_spelled(const ts_system *sys, const char *path,
                 p = q;
         if (!cables && p)
             return resolve_vehicle(path, NULL, -1, p + 1, tg, err);
+        if (!cables)
+            return resolve_body(path, NULL, -1, rest, tg, err);
         key = strrchr(rest, '.');
         if (!key || key == rest)
             return ts_fail(err, TS_EINVAL, "%s: expected %s.<name>.<key>",
                            path, tg->collection);
-        return cables ? resolve_key(path, key + 1, cable_rows,
-                                    COUNT(cable_rows), tg, err)
-                      : resolve_key(path, key + 1, body_rows,
-                                    COUNT(body_rows), tg, err);
+        return resolve_key(path, key + 1, cable_rows, COUNT(cable_rows), tg,
+                           err);
     }
     char list[600];
     if (cables) {
@@ -489,8 +699,7 @@ static int resolve_spelled(const ts_system *sys, const char *path,
     int loops;
     if (vehicle_part(key, &loops))
         return resolve_vehicle(path, s, b, key, tg, err);
-    tg->base = (char *)&s->bodies[b];
-    return resolve_key(path, key, body_rows, COUNT(body_rows), tg, err);
+    return resolve_body(path, s, b, key, tg, err);
 }
 
 const char *tsi_loop_unit(int depth, const char *key)
@@ -547,15 +756,15 @@ int ts_param_canonical(const char *path, char *out, size_t size,
         snprintf(out, size, "tow.%s", path);
         return TS_OK;
     }
-    /* A vehicle's controllers and components by the scene's words are its
-     * loops and surfaces. */
+    /* A vehicle's controllers are its loops, its surfaces (the word of
+     * old) its components. */
     size_t o = 0;
     int loops;
     for (const char *p = dotted; *p && o + 1 < size;) {
         const char *rest = p[0] == '.' ? vehicle_part(p + 1, &loops) : NULL;
         if (rest) {
             o += (size_t)snprintf(out + o, size - o, ".%s.",
-                                  loops ? "loops" : "surfaces");
+                                  loops ? "loops" : "components");
             p = rest;
         } else {
             out[o++] = *p++;
@@ -587,13 +796,60 @@ int ts_param_get(const ts_system *sys, const char *path, double *value,
     double g = sys->env.gravity;
     switch (tg.r->kind) {
     case TSI_KEY_LINKS: *value = *(const int *)at; break;
-    case TSI_KEY_VECTOR: *value = ((const double *)at)[tg.vec]; break;
+    case TSI_KEY_VECTOR:
+    case TSI_KEY_INERTIA: *value = ((const double *)at)[tg.vec]; break;
     case TSI_KEY_WEIGHT: *value = *(const double *)at * g; break;
     case TSI_KEY_WET_WEIGHT:
         *value = (*(const double *)at -
                   sys->env.water_density * wet_volume(sys, &tg)) * g;
         break;
     default: *value = *(const double *)at;
+    }
+    return TS_OK;
+}
+
+/* The values of sys's vehicles that the scene reader derives from
+ * others (towstab/vehicle.h): the spheroid added-mass estimate (of the
+ * first hull when the scene said `spheroid`) in the water density, and a
+ * surface diameter not given (the first hull's, or a sphere's of the
+ * volume). The same formulas as the reader's, so a value set by path
+ * gives the system of the scene with it written in. TS_OK or TS_EINVAL
+ * (an estimate that cannot be made: a hull shorter than its diameter). */
+static int derive_vehicles(ts_system *sys, ts_err *err)
+{
+    for (int b = 0; b < sys->nbodies; b++) {
+        ts_vehicle *v = sys->bodies[b].type == TS_BODY_VEHICLE
+                            ? sys->bodies[b].vehicle
+                            : NULL;
+        if (!v)
+            continue;
+        const ts_component *hull = NULL;
+        for (int j = 0; j < v->ncomponents && !hull; j++)
+            if (v->component[j].type == TS_COMP_HULL)
+                hull = &v->component[j];
+        if (v->surface_diameter_derived)
+            v->surface_diameter = hull ? hull->diameter
+                                       : cbrt(6.0 * v->volume / M_PI);
+        if (!v->added_mass_estimated)
+            continue;
+        double L = v->estimate_length, D = v->estimate_diameter;
+        const double *centre = v->estimate_centre;
+        if (v->estimate_follows_hull && hull) {
+            L = hull->length;
+            D = hull->diameter;
+            centre = hull->position;
+        }
+        double A[36];
+        ts_err local = {0};
+        if (ts_added_mass_spheroid(sys->env.water_density, L, D, A, NULL,
+                                   &local) != TS_OK)
+            return ts_fail(err, TS_EINVAL, "the added mass of vehicle '%s' "
+                           "(its spheroid estimate): %s", sys->bodies[b].name,
+                           local.msg);
+        v->estimate_length = L;
+        v->estimate_diameter = D;
+        memmove(v->estimate_centre, centre, sizeof v->estimate_centre);
+        ts_added_mass_shift(A, v->estimate_centre, v->added_mass);
     }
     return TS_OK;
 }
@@ -609,7 +865,7 @@ int ts_param_set(ts_system *sys, const char *path, double value,
     const char *unit = target_unit(&tg);
     const char *u = strcmp(unit, "1") ? unit : "";
     const char *sp = u[0] ? " " : "";
-    int ok = isfinite(value) || (r == &surface_rows[3] && value == INFINITY);
+    int ok = isfinite(value) || (r == surface_limit && value == INFINITY);
     if (!ok)
         return ts_fail(err, TS_EINVAL, "%s: expected a finite number%s%s",
                        path, u[0] ? " in " : "", u);
@@ -621,6 +877,10 @@ int ts_param_set(ts_system *sys, const char *path, double value,
                        u);
     char *at = tg.base + r->offset;
     double g = sys->env.gravity;
+    double old = r->kind == TSI_KEY_LINKS ? 0
+                 : r->kind == TSI_KEY_VECTOR || r->kind == TSI_KEY_INERTIA
+                     ? ((double *)at)[tg.vec]
+                     : *(double *)at;
     switch (r->kind) {
     case TSI_KEY_LINKS: {
         const ts_cable *c = &sys->cables[tg.cable];
@@ -635,7 +895,8 @@ int ts_param_set(ts_system *sys, const char *path, double value,
         *(int *)at = (int)value;
         break;
     }
-    case TSI_KEY_VECTOR: ((double *)at)[tg.vec] = value; break;
+    case TSI_KEY_VECTOR:
+    case TSI_KEY_INERTIA: ((double *)at)[tg.vec] = value; break;
     case TSI_KEY_WEIGHT:
     case TSI_KEY_WET_WEIGHT: {
         if (!(g > 0))
@@ -654,6 +915,18 @@ int ts_param_set(ts_system *sys, const char *path, double value,
         break;
     }
     default: *(double *)at = value;
+    }
+    /* What the scene reader derives from the value follows it; when that
+     * cannot be (a hull shorter than its diameter), the value is put
+     * back and so is what was derived from it. */
+    if (r->kind != TSI_KEY_LINKS && (rc = derive_vehicles(sys, err))) {
+        if (r->kind == TSI_KEY_VECTOR || r->kind == TSI_KEY_INERTIA)
+            ((double *)at)[tg.vec] = old;
+        else
+            *(double *)at = old;
+        derive_vehicles(sys, NULL);
+        ts_err_prefix(err, "%s: ", path);
+        return rc;
     }
     return TS_OK;
 }

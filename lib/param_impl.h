@@ -15,7 +15,9 @@ enum {
     TSI_KEY_WEIGHT,      /* weight: mass = value / g */
     TSI_KEY_WET_WEIGHT,  /* weight in water: mass = value / g + rho volume */
     TSI_KEY_LINKS,       /* a whole number of links */
-    TSI_KEY_VECTOR       /* component of a 3-vector (x, y, z) */
+    TSI_KEY_VECTOR,      /* component of a 3-vector (x, y, z) */
+    TSI_KEY_INERTIA      /* entry of an inertia [Ixx, Iyy, Izz, Ixy, Ixz,
+                            Iyz] (xx, yy, zz, xy, xz, yz) */
 };
 
 typedef struct tsi_key {
@@ -29,11 +31,12 @@ typedef struct tsi_key {
 } tsi_key;
 
 /* The tables: tow (ts_tow), environment (ts_environment), a cable
- * (ts_cable), a body (ts_body), a vehicle's loop (ts_loop) and lifting
- * surface (ts_component). */
+ * (ts_cable), a body (ts_body), a vehicle's own keys (ts_vehicle), its
+ * loop (ts_loop), lifting surface, hull and bluff part (ts_component). */
 typedef enum {
     TSI_KEYS_TOW = 0, TSI_KEYS_ENV, TSI_KEYS_CABLE, TSI_KEYS_BODY,
-    TSI_KEYS_LOOP, TSI_KEYS_SURFACE
+    TSI_KEYS_LOOP, TSI_KEYS_SURFACE, TSI_KEYS_VEHICLE, TSI_KEYS_HULL,
+    TSI_KEYS_BLUFF
 } tsi_keys;
 
 /* The row of `key` in table t, NULL when the table has none. */

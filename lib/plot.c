@@ -1170,6 +1170,26 @@ static int begin(const char *fn, const char *dir, const char *name,
     return check_opts(fn, *o, err);
 }
 
+/* A list argument: at least one entry, the array given. */
+static int check_list(const char *fn, const char *what, const void *list,
+                      int n, ts_err *err)
+{
+    if (n < 1 || !list)
+        return ts_fail(err, TS_EINVAL, "%s: expected at least one %s, got "
+                       "%d", fn, what, n);
+    return TS_OK;
+}
+
+/* The point count n of entry i of list `what`: at least `min`. */
+static int check_points(const char *fn, const char *what, int i, int n,
+                        int min, ts_err *err)
+{
+    if (n < min)
+        return ts_fail(err, TS_EINVAL, "%s: %s[%d].n: must be >= %d, got "
+                       "%d", fn, what, i, min, n);
+    return TS_OK;
+}
+
 static int check_array(const char *fn, const char *what, int index,
                        const double *a, int n, int positive, ts_err *err)
 {
@@ -1195,16 +1215,13 @@ static int check_series(const char *fn, int nseries,
                         const ts_plot_series s[], int xpos, int ypos,
                         ts_err *err)
 {
-    if (nseries < 1 || !s)
-        return ts_fail(err, TS_EINVAL, "%s: expected at least one series, "
-                                       "got %d",
-                       fn, nseries);
+    int rc = check_list(fn, "series", s, nseries, err);
+    if (rc)
+        return rc;
     for (int i = 0; i < nseries; i++) {
-        if (s[i].n < 1)
-            return ts_fail(err, TS_EINVAL, "%s: series[%d].n: must be >= 1, "
-                                           "got %d",
-                           fn, i, s[i].n);
-        int rc = check_array(fn, "x", i, s[i].x, s[i].n, xpos, err);
+        if ((rc = check_points(fn, "series", i, s[i].n, 1, err)))
+            return rc;
+        rc = check_array(fn, "x", i, s[i].x, s[i].n, xpos, err);
         if (!rc)
             rc = check_array(fn, "y", i, s[i].y, s[i].n, ypos, err);
         if (rc)
@@ -1756,10 +1773,8 @@ int ts_plot_shapes(const char *dir, const char *name, const char *title,
     if (flags & ~(TS_PLOT_WATER | TS_PLOT_EQUAL))
         return ts_fail(err, TS_EINVAL, "%s: flags: unknown bits in %#x", fn,
                        (unsigned)flags);
-    if (nshapes < 1 || !shapes)
-        return ts_fail(err, TS_EINVAL, "%s: expected at least one shape, got "
-                                       "%d",
-                       fn, nshapes);
+    if ((rc = check_list(fn, "shape", shapes, nshapes, err)))
+        return rc;
     for (int i = 0; i < nshapes; i++)
         if ((rc = check_shape(fn, "shapes", i, &shapes[i], err)))
             return rc;
@@ -1892,17 +1907,12 @@ int ts_plot_tracks(const char *dir, const char *name, const char *title,
     int rc = begin(fn, dir, name, title, &opts, &def, err);
     if (rc)
         return rc;
-    if (ntracks < 1 || !tracks)
-        return ts_fail(err, TS_EINVAL, "%s: expected at least one track, got "
-                                       "%d",
-                       fn, ntracks);
+    if ((rc = check_list(fn, "track", tracks, ntracks, err)))
+        return rc;
     for (int i = 0; i < ntracks; i++) {
         const ts_plot_track *t = &tracks[i];
-        if (t->n < 1)
-            return ts_fail(err, TS_EINVAL, "%s: tracks[%d].n: must be >= 1, "
-                                           "got %d",
-                           fn, i, t->n);
-        if ((rc = check_array(fn, "x", i, t->x, t->n, 0, err)) ||
+        if ((rc = check_points(fn, "tracks", i, t->n, 1, err)) ||
+            (rc = check_array(fn, "x", i, t->x, t->n, 0, err)) ||
             (rc = check_array(fn, "y", i, t->y, t->n, 0, err)))
             return rc;
         if (t->style < TS_PLOT_SOLID || t->style > TS_PLOT_LINE_MARKERS)
@@ -2522,17 +2532,12 @@ int ts_plot_bode(const char *dir, const char *name, const char *title,
     if (rc || (rc = check_quantity(fn, "out_q", out_q, err)) ||
         (rc = check_quantity(fn, "in_q", in_q, err)))
         return rc;
-    if (ncurves < 1 || !curves)
-        return ts_fail(err, TS_EINVAL, "%s: expected at least one curve, got "
-                                       "%d",
-                       fn, ncurves);
+    if ((rc = check_list(fn, "curve", curves, ncurves, err)))
+        return rc;
     for (int i = 0; i < ncurves; i++) {
         const ts_plot_bode_curve *C = &curves[i];
-        if (C->n < 2)
-            return ts_fail(err, TS_EINVAL, "%s: curves[%d].n: must be >= 2, "
-                                           "got %d",
-                           fn, i, C->n);
-        if ((rc = check_array(fn, "freq", i, C->freq, C->n, 1, err)) ||
+        if ((rc = check_points(fn, "curves", i, C->n, 2, err)) ||
+            (rc = check_array(fn, "freq", i, C->freq, C->n, 1, err)) ||
             (rc = check_array(fn, "mag", i, C->mag, C->n, 1, err)) ||
             (rc = check_array(fn, "phase", i, C->phase, C->n, 0, err)))
             return rc;

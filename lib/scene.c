@@ -716,19 +716,22 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
             return fail_at(c, TS_ESCENE, join(p, path, f[k].key), f[k].line,
                            "does not apply to a %s component", type);
     }
+    /* The key table of the component's type (param_impl.h). */
+    tsi_keys keys = hull ? TSI_KEYS_HULL : bluff ? TSI_KEYS_BLUFF
+                                                 : TSI_KEYS_SURFACE;
     if (f[K_POS].value)
-        rc = vector3(c, path, &f[K_POS], "m", cp->position);
+        rc = vector3(c, path, &f[K_POS], key_unit(keys, &f[K_POS]),
+                     cp->position);
     if (rc == TS_OK && hull) {
         for (int k = K_LEN; k <= K_DIAM; k++)
             if (!f[k].value)
                 return missing(c, path, n, f[k].key);
-        if ((rc = optional_min(c, path, &f[K_LEN], "m", 0, 1, 0, &cp->length)) ||
-            (rc = optional_min(c, path, &f[K_DIAM], "m", 0, 1, 0,
-                               &cp->diameter)) ||
-            (rc = optional_min(c, path, &f[K_AXD], "1", 0, 0, cp->cd_axial,
-                               &cp->cd_axial)) ||
-            (rc = optional_min(c, path, &f[K_XD], "1", 0, 0, cp->cd_cross,
-                               &cp->cd_cross)))
+        if ((rc = key_value(c, path, &f[K_LEN], keys, 0, &cp->length)) ||
+            (rc = key_value(c, path, &f[K_DIAM], keys, 0, &cp->diameter)) ||
+            (rc = key_value(c, path, &f[K_AXD], keys, cp->cd_axial,
+                            &cp->cd_axial)) ||
+            (rc = key_value(c, path, &f[K_XD], keys, cp->cd_cross,
+                            &cp->cd_cross)))
             return rc;
         return TS_OK;
     }
@@ -737,10 +740,9 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
     if (bluff) {
         if (!f[K_AREA].value)
             return missing(c, path, n, "area");
-        if ((rc = optional_min(c, path, &f[K_AREA], "m^2", 0, 1, 0,
-                               &cp->area)) ||
-            (rc = optional_min(c, path, &f[K_DRAG], "1", 0, 0, cp->drag,
-                               &cp->drag)))
+        if ((rc = key_value(c, path, &f[K_AREA], keys, 0, &cp->area)) ||
+            (rc = key_value(c, path, &f[K_DRAG], keys, cp->drag,
+                            &cp->drag)))
             return rc;
         return TS_OK;
     }
@@ -937,6 +939,7 @@ static int parse_added_mass(const ctx *c, const char *parent, const field *f,
             return TS_OK; /* no hull, nothing given: no added mass */
         }
         v->added_mass_estimated = 1;
+        v->estimate_follows_hull = 1;
         v->estimate_length = hull->length;
         v->estimate_diameter = hull->diameter;
         memcpy(v->estimate_centre, hull->position, sizeof v->estimate_centre);
@@ -1011,23 +1014,29 @@ static int parse_vehicle(const ctx *c, const yaml_node_t *n, const char *path,
     for (int k = 0; k < 4; k++)
         if (!g[required[k]].value)
             return missing(c, path, n, g[required[k]].key);
-    int rc = optional_min(c, path, &g[V_VOLUME], "m^3", 0, 0, 0, &v->volume);
+    int rc = key_value(c, path, &g[V_VOLUME], TSI_KEYS_VEHICLE, 0,
+                       &v->volume);
     double I[6] = {0};
     int ni = 0;
     if (rc == TS_OK)
         rc = quantity_list(c, join(p, path, "inertia"), &g[V_INERTIA],
-                           "kg*m^2", 3, 6, I, &ni);
+                           key_unit(TSI_KEYS_VEHICLE, &g[V_INERTIA]), 3, 6,
+                           I, &ni);
     if (rc == TS_OK && ni != 3 && ni != 6)
         rc = fail_at(c, TS_EINVAL, p, g[V_INERTIA].line, "expected [Ixx, "
                      "Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], got %d "
                      "entries", ni);
     memcpy(v->inertia, I, sizeof I);
     if (rc == TS_OK && g[V_MC].value)
-        rc = vector3(c, path, &g[V_MC], "m", v->mass_centre);
+        rc = vector3(c, path, &g[V_MC], key_unit(TSI_KEYS_VEHICLE, &g[V_MC]),
+                     v->mass_centre);
     if (rc == TS_OK && g[V_BC].value)
-        rc = vector3(c, path, &g[V_BC], "m", v->buoyancy_centre);
+        rc = vector3(c, path, &g[V_BC], key_unit(TSI_KEYS_VEHICLE, &g[V_BC]),
+                     v->buoyancy_centre);
     if (rc == TS_OK)
-        rc = vector3(c, path, &g[V_ATTACH], "m", v->attach);
+        rc = vector3(c, path, &g[V_ATTACH], /* a towing vehicle's tow_point */
+                     tsi_key_find(TSI_KEYS_VEHICLE, "attach")->unit,
+                     v->attach);
     int nc = 0;
     if (rc == TS_OK)
         rc = field_list(c, join(p, path, "components"), &g[V_COMPONENTS],
@@ -1051,9 +1060,10 @@ static int parse_vehicle(const ctx *c, const yaml_node_t *n, const char *path,
     for (int j = nc - 1; j >= 0; j--)
         if (v->component[j].type == TS_COMP_HULL)
             dflt = v->component[j].diameter;
+    v->surface_diameter_derived = !g[V_SURF].value;
     if (rc == TS_OK)
-        rc = optional_min(c, path, &g[V_SURF], "m", 0, 0, dflt,
-                          &v->surface_diameter);
+        rc = key_value(c, path, &g[V_SURF], TSI_KEYS_VEHICLE, dflt,
+                       &v->surface_diameter);
     int nl = 0;
     if (rc == TS_OK && g[V_CONTROLLERS].value)
         rc = field_list(c, join(p, path, "controllers"), &g[V_CONTROLLERS],

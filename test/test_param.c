@@ -12,7 +12,11 @@
  * what the system has. A vehicle's controllers and components by the
  * scene's words give the modes run of the same text in the scene to the
  * last digit, and a value beyond a key's limit is refused with the same
- * limit by path and in the scene (one key table). */
+ * limit by path and in the scene (one key table). So do a vehicle's own
+ * keys (its inertia, centres, attach point) and its components'
+ * positions and hull keys, whose spheroid added mass follows the hull as
+ * the scene reader derives it; a hull that cannot have one is refused
+ * with nothing changed. Unknown keys list the accepted ones. */
 #include "towstab/param.h"
 
 #include <stdlib.h>
@@ -168,7 +172,13 @@ static void test_get(const ts_units *u)
                  {"cables.x.links", "1"},
                  {"bodies.y.wet_weight", "N"},
                  {"bodies.v.loops.depth.kp", ""},
-                 {"bodies.v.surfaces.elevator.limit", "rad"}};
+                 {"bodies.v.surfaces.elevator.limit", "rad"},
+                 {"bodies.v.volume", "m^3"},
+                 {"bodies.v.inertia.xy", "kg*m^2"},
+                 {"bodies.v.mass_centre.z", "m"},
+                 {"bodies.v.components.hull.axial_drag", "1"},
+                 {"bodies.v.components.fin.position.y", "m"},
+                 {"bodies.v.components.nose.drag", "1"}};
     for (size_t i = 0; i < sizeof units / sizeof units[0]; i++) {
         int rc = ts_param_unit(NULL, units[i].path, unit, sizeof unit, &err);
         CHECK(rc == TS_OK && !strcmp(unit, units[i].unit),
@@ -265,7 +275,7 @@ static void test_errors(const ts_units *u)
         {"bodies.fsh.mass", 1, "the bodies: fish"},
         {"bodies.fish.mass", -1, "bodies.fish.mass: must be >= 0 kg"},
         {"bodies.fish.loops.depth.kp", 1, "'fish' is not a vehicle"},
-        {"tow.point", 1, "name a component: point.x"},
+        {"tow.point", 1, "name an entry: point.x|y|z"},
         {"tow.speed", -2, "tow.speed: must be >= 0 m/s"},
         {"ship.speed", 1, "not a path of the scene"},
         {"", 1, "path: empty"},
@@ -339,8 +349,43 @@ static void test_vehicle(void)
     CHECK(rc == TS_OK && v->component[1].limit == 0.2,
           "elevator limit set: %g rad", v->component[1].limit);
     rc = ts_param_set(s, "bodies.fish.surfaces.hull.limit", 0.2, &err);
-    CHECK(rc == TS_EINVAL && strstr(err.msg, "its surfaces: elevator"),
-          "the hull is no surface: %s", err.msg);
+    CHECK(rc == TS_EINVAL &&
+              strstr(err.msg, "no key 'limit' of a hull; expected one of "
+                              "position.x|y|z, length, diameter"),
+          "the hull is no surface, its keys listed: %s", err.msg);
+    rc = ts_param_set(s, "bodies.fish.components.fin.area", 0.2, &err);
+    CHECK(rc == TS_EINVAL &&
+              strstr(err.msg, "its components: hull (hull), elevator "
+                              "(surface)"),
+          "no fin, the components listed: %s", err.msg);
+    /* A vehicle's own keys, an inertia's entry and a vector's. */
+    rc = ts_param_set(s, "bodies.fish.inertia.xz", -0.5, &err);
+    CHECK(rc == TS_OK && v->inertia[4] == -0.5, "inertia.xz (Ixz) set: %g",
+          v->inertia[4]);
+    rc = ts_param_set(s, "bodies[fish].inertia[1]", 7.5, &err);
+    CHECK(rc == TS_OK && v->inertia[1] == 7.5,
+          "inertia[1] (Iyy), the scene format's spelling: %g", v->inertia[1]);
+    rc = ts_param_set(s, "bodies.fish.attach.z", -0.25, &err);
+    CHECK(rc == TS_OK && v->attach[2] == -0.25, "attach.z set: %g",
+          v->attach[2]);
+    rc = ts_param_set(s, "bodies.fish.components.elevator.position.x", -1.1,
+                      &err);
+    CHECK(rc == TS_OK && v->component[1].position[0] == -1.1,
+          "a surface's position.x set: %g", v->component[1].position[0]);
+    rc = ts_param_set(s, "bodies.fish.volum", 0.2, &err);
+    CHECK(rc == TS_EINVAL &&
+              strstr(err.msg, "bodies.fish.volum: no key 'volum' of a "
+                              "vehicle; expected one of mass, weight, "
+                              "wet_weight, volume, inertia.xx|yy|zz|xy|xz|yz"),
+          "an unknown vehicle key lists the accepted ones: %s", err.msg);
+    rc = ts_param_set(s, "bodies.fish.diameter", 0.2, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "no key 'diameter' of a "
+                                             "vehicle"),
+          "a sphere's key is not a vehicle's: %s", err.msg);
+    rc = ts_param_set(s, "bodies.fish.inertia", 1, &err);
+    CHECK(rc == TS_EINVAL &&
+              strstr(err.msg, "name an entry: inertia.xx|yy|zz|xy|xz|yz"),
+          "the inertia without an entry: %s", err.msg);
     rc = ts_param_set(s, "bodies.fish.loops.roll.kp", 1, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "its loops: depth, pitch"),
           "no roll loop: %s", err.msg);
@@ -370,6 +415,23 @@ static void test_scene_words(const ts_units *u)
          "bodies[aurora].components[wing].area", "0.55 m^2"},
         {"bodies.aurora.components.tail1.time_constant",
          "bodies[aurora].components[tail1].time_constant", "0.15 s"},
+        {"bodies.aurora.inertia.yy", "bodies[aurora].inertia[1]",
+         "80 kg*m^2"},
+        {"bodies.aurora.mass_centre.z", "bodies[aurora].mass_centre[2]",
+         "0.03 m"},
+        {"bodies.aurora.buoyancy_centre.x",
+         "bodies[aurora].buoyancy_centre[0]", "0.05 m"},
+        {"bodies.aurora.attach.x", "bodies[aurora].attach[0]", "0.6 m"},
+        {"bodies.aurora.components.wing.position.x",
+         "bodies[aurora].components[wing].position[0]", "0.2 m"},
+        /* The hull's: the spheroid added mass (and the surface diameter)
+         * follow it, as the scene reader derives them. */
+        {"bodies.aurora.components.hull.length",
+         "bodies[aurora].components[hull].length", "2.4 m"},
+        {"bodies.aurora.components.hull.diameter",
+         "bodies[aurora].components[hull].diameter", "0.38 m"},
+        {"bodies.aurora.components.hull.cross_drag",
+         "bodies[aurora].components[hull].cross_drag", "1.0"},
     };
     /* The scene as written, to see each setting change the run. */
     ts_request r0;
@@ -450,6 +512,14 @@ static void test_scene_words(const ts_units *u)
         {"bodies.aurora.components.wing.rate_limit",
          "bodies[aurora].components[wing].rate_limit", "0",
          "must be > 0 rad/s, got 0 rad/s"},
+        {"bodies.aurora.volume", "bodies[aurora].volume", "-1",
+         "must be >= 0 m^3, got -1 m^3"},
+        {"bodies.aurora.components.hull.length",
+         "bodies[aurora].components[hull].length", "0",
+         "must be > 0 m, got 0 m"},
+        {"bodies.aurora.components.hull.axial_drag",
+         "bodies[aurora].components[hull].axial_drag", "-1",
+         "must be >= 0, got -1"},
     };
     for (size_t i = 0; i < sizeof lim / sizeof lim[0]; i++) {
         ts_err e1 = {0}, e2 = {0};
@@ -465,6 +535,26 @@ static void test_scene_words(const ts_units *u)
               "%s = %s refused alike by path (%s) and in the scene (%s)",
               lim[i].path, text, e1.msg, e2.msg);
         ts_scene_free(t);
+    }
+    /* A hull shorter than its diameter has no spheroid estimate: refused,
+     * the length and the added mass as they were. */
+    {
+        ts_err e = {0};
+        ts_system *copy = ts_system_copy(sc->system, &e);
+        ts_vehicle *v = copy ? copy->bodies[0].vehicle : NULL;
+        double A11 = v ? v->added_mass[0] : NAN, L = NAN;
+        int r = v ? ts_param_set(copy, "bodies.aurora.components.hull.length",
+                                 0.3, &e)
+                  : TS_ENOMEM;
+        if (v)
+            ts_param_get(copy, "bodies.aurora.components.hull.length", &L,
+                         NULL);
+        CHECK(r == TS_EINVAL && strstr(e.msg, "the added mass of vehicle "
+                                              "'aurora'") &&
+                  L == 2.6 && v->added_mass[0] == A11,
+              "a hull of 0.3 m (diameter 0.35 m) refused, nothing changed: "
+              "%s", e.msg);
+        ts_system_free(copy);
     }
     ts_scene_free(sc);
 }

@@ -13,19 +13,29 @@
  *       EI | EA | damping
  *   bodies.<name>.diameter | length | mass | weight | wet_weight | drag |
  *       added_mass | cross_drag | cross_added_mass
+ *   bodies.<vehicle>.mass | weight | wet_weight | volume |
+ *       surface_diameter | inertia.xx|yy|zz|xy|xz|yz |
+ *       mass_centre.x|y|z | buoyancy_centre.x|y|z | attach.x|y|z
  *   bodies.<vehicle>.loops.<loop>.kp | ki | kd | setpoint
- *   bodies.<vehicle>.surfaces.<surface>.area | span | deflection | limit |
- *       incidence | roll | lift_slope | stall | stall_width |
- *       zero_lift_drag | efficiency | cn90 | rate_limit | time_constant
- *   (the scene's words `controllers` for loops and `components` for
- *   surfaces name the same values)
+ *   bodies.<vehicle>.components.<surface>.area | span | deflection |
+ *       limit | incidence | roll | lift_slope | stall | stall_width |
+ *       zero_lift_drag | efficiency | cn90 | rate_limit | time_constant |
+ *       position.x|y|z
+ *   bodies.<vehicle>.components.<hull>.length | diameter | axial_drag |
+ *       cross_drag | position.x|y|z
+ *   bodies.<vehicle>.components.<bluff part>.area | drag | position.x|y|z
+ *   (the scene's word `controllers` and the word `loops` name the same
+ *   loops; `surfaces` the same components)
  *
  * Values are SI in the unit ts_param_unit() names (the scene's unit of
  * the key). The system stores masses: `weight` and `wet_weight` are
  * converted with the environment's gravity and water density at the time
  * of the call (as the scene reader does), and changing a diameter keeps
- * the mass. A loop's gains take the unit of what it measures (depth: rad
- * per m; an angle: rad per rad).
+ * the mass (so does a vehicle's volume). A loop's gains take the unit of
+ * what it measures (depth: rad per m; an angle: rad per rad). What the
+ * scene reader derives from a vehicle's values follows them: the
+ * spheroid added mass of its first hull (in the water density) and a
+ * surface diameter not given (towstab/vehicle.h).
  *
  * The keys' units and limits are the scene reader's: one table serves
  * both (lib/param_impl.h).

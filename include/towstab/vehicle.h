@@ -175,8 +175,16 @@ typedef struct ts_vehicle {
                              estimate of estimate_length/diameter */
     double estimate_length, estimate_diameter; /* m */
     double estimate_centre[3]; /* ellipsoid centre, body axes, m */
+    int estimate_follows_hull; /* 1: the estimate is the first hull's
+                             (added_mass: spheroid): its length, diameter
+                             and position, in the water density; a value
+                             set by path re-derives it (towstab/param.h) */
     double surface_diameter;  /* m: height of the hull used for the
                              submerged fraction near z = 0 */
+    int surface_diameter_derived; /* 1: not given: the first hull's
+                             diameter, or without a hull that of a sphere
+                             of the volume (re-derived as they are set by
+                             path) */
     int ncomponents;
     ts_component component[TS_VEHICLE_MAX_COMPONENTS];
     int nloops;

@@ -972,6 +972,21 @@ static void gen_cli_misuse(void)
     c = misuse(E_RUN, NULL, "equilibrium", "-", "--quiet", NULL);
     c->stdin_path = xstrdup(EX1);
     c = misuse(R, "standard input", "equilibrium", "-", NULL);
+    /* --set on a vehicle's keys: an unknown key names the path and lists
+     * the keys a vehicle takes; a hull shorter than its diameter (no
+     * spheroid added mass) names the vehicle. */
+    misuse(R, "bodies.aurora.volum: no key 'volum' of a body; expected one "
+              "of diameter, length, mass, weight, wet_weight, drag, "
+              "added_mass, cross_drag, cross_added_mass; or of a vehicle "
+              "volume, inertia.xx|yy|zz|xy|xz|yz", "equilibrium",
+           "examples/aurora_towfish.yaml", "--quiet", "--set",
+           "bodies.aurora.volum=0.2", NULL);
+    misuse(R, "the added mass of vehicle 'aurora'", "equilibrium",
+           "examples/aurora_towfish.yaml", "--quiet", "--set",
+           "bodies.aurora.components.hull.length=0.3", NULL);
+    misuse(R, "name an entry: inertia.xx|yy|zz|xy|xz|yz", "equilibrium",
+           "examples/aurora_towfish.yaml", "--quiet", "--set",
+           "bodies.aurora.inertia=3", NULL);
     /* modes */
     misuse(R, "160 states", "modes", EX1, "--quiet", "--eigen-method",
            "arpack", "--count", "79", NULL);
