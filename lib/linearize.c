@@ -32,6 +32,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -69,11 +70,13 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
         ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory");
         return NULL;
     }
-    int n = ts_kernel_nstate(k), ni = ts_kernel_ninput(k);
+    int n = ts_kernel_nstate(k), fin = ts_kernel_ninput(k);
+    int ni = fin + TS_NFRAME_INPUT;
     size_t sn = (size_t)n;
     lin->nstate = n;
     lin->nq = ts_kernel_nq(k);
     lin->ninput = ni;
+    lin->frame_input = fin;
     lin->nlinks = sys->nlinks;
     lin->nnodes = sys->nnodes;
     lin->y0 = calloc(sn, sizeof(double));
@@ -109,8 +112,14 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->output_unit = calloc((size_t)lin->noutput + 1,
                               sizeof *lin->output_unit);
     for (int j = 0; lin->input_name && lin->input_unit && j < ni; j++) {
-        ts_kernel_input_name(k, j, lin->input_name[j], TS_IO_NAME);
-        lin->input_unit[j] = ts_kernel_input_unit(k, j);
+        if (j < fin) {
+            ts_kernel_input_name(k, j, lin->input_name[j], TS_IO_NAME);
+            lin->input_unit[j] = ts_kernel_input_unit(k, j);
+        } else {
+            snprintf(lin->input_name[j], TS_IO_NAME, "%s",
+                     ts_frame_input_name(j - fin));
+            lin->input_unit[j] = ts_frame_input_unit(j - fin);
+        }
     }
     for (int j = 0; lin->output_name && lin->output_unit &&
                     j < lin->noutput;
@@ -177,6 +186,43 @@ void ts_linear_free(ts_linear *lin)
 
 const char *ts_input_name(int j) { return tsi_tow_input_name(j); }
 
+static const char *const frame_names[TS_NFRAME_INPUT] = {
+    "tow.speed", "tow.turn_rate", "tow.speed_rate", "tow.turn_accel"};
+static const char *const frame_units[TS_NFRAME_INPUT] = {
+    "m/s", "rad/s", "m/s^2", "rad/s^2"};
+
+const char *ts_frame_input_name(int c)
+{
+    return c >= 0 && c < TS_NFRAME_INPUT ? frame_names[c] : NULL;
+}
+
+const char *ts_frame_input_unit(int c)
+{
+    return c >= 0 && c < TS_NFRAME_INPUT ? frame_units[c] : NULL;
+}
+
+/* f(y, u) into f with the frame inputs u[fin .. fin + TS_NFRAME_INPUT)
+ * added to the frame `base` for this evaluation (the kernel reads its own
+ * inputs u[0 .. fin) only); k's frame is base again on return, its
+ * last-evaluation results (positions, tensions, outputs) those of the
+ * moved frame. */
+static int eval_frame(ts_kernel *k, const ts_frame *base, int fin,
+                      const double *y, const double *u, double *f)
+{
+    const double *du = u + fin;
+    if (du[0] == 0 && du[1] == 0 && du[2] == 0 && du[3] == 0)
+        return ts_kernel_eval(k, y, u, f);
+    ts_frame fr = *base;
+    fr.speed += du[TS_FRAME_SPEED];
+    fr.turn_rate += du[TS_FRAME_TURN_RATE];
+    fr.speed_rate += du[TS_FRAME_SPEED_RATE];
+    fr.turn_accel += du[TS_FRAME_TURN_ACCEL];
+    ts_kernel_set_frame(k, &fr);
+    int rc = ts_kernel_eval(k, y, u, f);
+    ts_kernel_set_frame(k, base);
+    return rc;
+}
+
 /* The step of one column: rel * max(|x|, scale), rounded so that x + h is
  * a machine number (then (x + h) - x == h exactly). */
 static double step_for(double x, double scale, double rel)
@@ -190,6 +236,8 @@ static double step_for(double x, double scale, double rel)
 typedef struct col_ws {
     ts_kernel *k;
     double *y, *u;
+    int fin;        /* the frame inputs' offset in u */
+    ts_frame base;  /* the frame they move */
     double *f[4];   /* f(x+h), f(x-h), f(x+2h), f(x-2h) */
     double *t[4];   /* tensions at the same states */
 } col_ws;
@@ -225,6 +273,8 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
         return TS_ENOMEM;
     memcpy(w->y, y0, (size_t)n * sizeof(double));
     memcpy(w->u, u0, (size_t)ni * sizeof(double));
+    w->fin = ni - TS_NFRAME_INPUT;
+    ts_kernel_get_frame(k, &w->base);
     return TS_OK;
 }
 
@@ -232,7 +282,7 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
  * tensions, then the vehicles' outputs). */
 static int eval_into(col_ws *w, int slot, int nl)
 {
-    int rc = ts_kernel_eval(w->k, w->y, w->u, w->f[slot]);
+    int rc = eval_frame(w->k, &w->base, w->fin, w->y, w->u, w->f[slot]);
     if (rc == TS_OK) {
         memcpy(w->t[slot], ts_kernel_tensions(w->k),
                (size_t)nl * sizeof(double));
@@ -392,9 +442,14 @@ static int column(col_ws *w, int j, int n, int nq, int nl, int nout,
 #define STRAIN_FLOOR 1e-14
 
 /* Scale of column j (see linearize.h): scale[] holds the coordinates'
- * and rates' own (state columns), then the inputs follow. */
+ * and rates' own (state columns), then the inputs follow; the frame
+ * inputs start at input `fin`. A turn rate moves a point at distance r
+ * from the tow point by Omega r, so its scale is the tow velocity's over
+ * the system's reach (every link's length and the tow point's distance
+ * from M's origin): the step then changes no velocity by more than a
+ * tow velocity's step does. */
 static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
-                           int n, const double *scale)
+                           int n, int fin, const double *scale)
 {
     if (j < n)
         return scale[j];
@@ -408,6 +463,21 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
         return sqrt(g * l0) + V;
     if (c < TS_NINPUT)
         return g;
+    if (c >= fin && c < fin + TS_NFRAME_INPUT) {
+        double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
+                            sys->tow.point[1] * sys->tow.point[1] +
+                            sys->tow.point[2] * sys->tow.point[2]);
+        for (int l = 0; l < sys->nlinks; l++)
+            reach += sys->links[l].length;
+        if (!(reach > 0))
+            reach = 1.0;
+        switch (c - fin) {
+        case 0: return sqrt(g * l0) + V;           /* speed, m/s */
+        case 1: return (sqrt(g * l0) + V) / reach; /* turn rate, rad/s */
+        case 2: return g;                          /* speed rate, m/s^2 */
+        default: return g / reach;                 /* turn accel, rad/s^2 */
+        }
+    }
     return 1.0; /* a deflection or a loop input, rad */
 }
 
@@ -519,7 +589,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     else
         ts_linearize_opts_default(&o);
     int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k), nl = sys->nlinks;
-    int ni = ts_kernel_ninput(k), ncol = n + ni, nlow = n - nq;
+    int fin = ts_kernel_ninput(k), ni = fin + TS_NFRAME_INPUT;
+    int ncol = n + ni, nlow = n - nq;
     int nout = lin->noutput;
     if (lin->nstate != n || lin->nlinks != nl || lin->ninput != ni ||
         lin->nq != nq)
@@ -545,10 +616,9 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                 (o.model == TS_LIN_AUTO &&
                  (n < o.dense_max_states || vehicles));
     int sparse = o.model != TS_LIN_DENSE && !vehicles;
+    memset(lin->u0, 0, (size_t)ni * sizeof(double));
     if (u0)
-        memcpy(lin->u0, u0, (size_t)ni * sizeof(double));
-    else
-        memset(lin->u0, 0, (size_t)ni * sizeof(double));
+        memcpy(lin->u0, u0, (size_t)fin * sizeof(double));
     u0 = lin->u0;
     memcpy(lin->y0, y0, (size_t)n * sizeof(double));
     lin->evaluations = 0;
@@ -710,7 +780,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     state_scales(k, &fr, scale);
     for (int j = 0; j < ncol; j++) {
         double x = j < n ? y0[j] : u0[j - n];
-        lin->h[j] = step_for(x, column_scale(sys, &fr, j, n, scale),
+        lin->h[j] = step_for(x, column_scale(sys, &fr, j, n, fin, scale),
                              o.rel_step);
     }
     free(scale);
@@ -882,12 +952,11 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                            "%.3g left the model (%s)",
                            bad_col - 2 * nq, lin->h[bad_col],
                            ts_strerror(bad_rc));
-        char name[2 * TS_NAME_MAX + 8];
         return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
                        "linearize: input %s perturbed by %.3g left the model "
                        "(%s)",
-                       ts_kernel_input_name(k, bad_col - n, name, sizeof name),
-                       lin->h[bad_col], ts_strerror(bad_rc));
+                       lin->input_name[bad_col - n], lin->h[bad_col],
+                       ts_strerror(bad_rc));
     }
     lin->trunc_err = estimate ? max_a : NAN;
     lin->trunc_norm = estimate ? sqrt(sum2_a) : NAN;
