@@ -780,12 +780,48 @@ static void unit_max(double complex *w, int m)
             w[i] /= big;
 }
 
+/* w^T S(lam) [x; 0] from S's parts P[3 nnz] (Sk, Sc, Sm: S(s) = Sk + s Sc
+ * + s^2 Sm), its node columns times the node displacements x[3 nn] (the
+ * tensions' columns left out), summed against w[nx]. O(nnz). */
+static double complex pencil_form(const ts_descriptor *d, const double *P,
+                                  const double complex *w,
+                                  const double complex *x, double complex lam)
+{
+    const double *Sk = P, *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+    double complex sum = 0;
+    for (int k = 1; k < d->nn; k++)
+        for (int a = 0; a < 3; a++) {
+            int j = XR(k, a);
+            double complex xj = x[3 * k + a];
+            for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
+                sum += w[d->Si[p]] * (Sk[p] + lam * (Sc[p] + lam * Sm[p])) *
+                       xj;
+        }
+    return sum;
+}
+
+/* z[nx] = S'(lam)^T w[nx], S'(s) = Sc + 2 s Sm from S's parts P[3 nnz]
+ * (zero on the tensions' columns). O(nnz). */
+static void pencil_dtmul(const ts_descriptor *d, const double *P,
+                         const double complex *w, double complex lam,
+                         double complex *z)
+{
+    const double *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+    for (int j = 0; j < d->nx; j++) {
+        double complex sum = 0;
+        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
+            sum += w[d->Si[p]] * (Sc[p] + 2.0 * lam * Sm[p]);
+        z[j] = sum;
+    }
+}
+
 int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
                         double complex lam, const double complex v[],
-                        double *dlam, ts_err *err)
+                        double *dlam, double *ritz, ts_err *err)
 {
     const ts_descriptor *d = lin->desc;
     *dlam = NAN;
+    *ritz = NAN;
     if (!d)
         return ts_fail(err, TS_EINVAL, "shift: the linear model has no "
                        "sparse form");
@@ -793,15 +829,17 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         return TS_OK;
     int nx = d->nx, nq = lin->nq, nn = d->nn;
     size_t n3 = 3 * (size_t)nn;
-    double complex *w = malloc(((size_t)nx + 1) * sizeof *w);
+    double complex *w = malloc(2 * ((size_t)nx + 1) * sizeof *w);
     double complex *x = malloc(n3 * sizeof *x);
     double *q = malloc(((size_t)nq + 1) * sizeof *q);
     double *u = malloc(2 * n3 * sizeof *u);
-    if (!w || !x || !q || !u) {
+    double *P = malloc(3 * ((size_t)d->nnz + 1) * sizeof *P);
+    if (!w || !x || !q || !u || !P) {
         free(w);
         free(x);
         free(q);
         free(u);
+        free(P);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory for the error "
                        "estimate");
     }
@@ -814,9 +852,21 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     if (rc == TS_ENOMEM)
         ts_fail(err, rc, "eigen: out of memory for the error estimate");
     if (rc == TS_OK) {
+        /* Inverse iteration for the left vector of the quadratic pencil:
+         * S(lam)^-T b grows along w by x^T b / (lam - lam*), so from the
+         * second step on b = S'(lam)^T w (x^T S'^T w = w^T S' x is the
+         * pencil's normalisation, never zero for a simple eigenvalue,
+         * while w^T x itself may vanish: then S^-T w would not grow
+         * along w at all). */
+        tsi_desc_fill_parts(d, P, P + d->nnz, P + 2 * (size_t)d->nnz);
+        double complex *z = w + nx;
         for (int i = 0; i < nx; i++)
             w[i] = 1.0 + (double)(i % 7) / 7.0;
         for (int it = 0; it < 2; it++) {
+            if (it > 0) {
+                pencil_dtmul(d, P, w, lam, z);
+                memcpy(w, z, (size_t)nx * sizeof *w);
+            }
             tsi_shift_tsolve(sh, w);
             unit_max(w, nx);
         }
@@ -863,6 +913,9 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         double tr, ro;
         tsi_desc_error_terms(d, w, x, lam, &tr, &ro);
         *dlam = cabs(den) > 0 ? (tr + ro) / cabs(den) : INFINITY;
+        /* The Ritz value's own error: the pencil's Newton correction. */
+        double complex num = pencil_form(d, P, w, x, lam);
+        *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
     } else if (rc == TS_ESINGULAR) {
         ts_fail(err, rc, "eigen: the pencil is singular beside %g%+gi 1/s",
                 creal(lam), cimag(lam));
@@ -874,5 +927,6 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     free(x);
     free(q);
     free(u);
+    free(P);
     return rc;
 }
