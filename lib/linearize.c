@@ -131,11 +131,14 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     if (lin->nvehicles > 0) {
         lin->up_qoff = malloc((size_t)sys->nlinks * sizeof(int));
         lin->up_map = calloc(12 * (size_t)sys->nlinks, sizeof(double));
+        lin->veh_rot = calloc(9 * (size_t)lin->nvehicles, sizeof(double));
+        lin->veh_qoff = malloc((size_t)lin->nvehicles * sizeof(int));
     }
     if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
         !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
         !lin->u0 ||
-        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map)) ||
+        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map ||
+                                !lin->veh_rot || !lin->veh_qoff)) ||
         (lin->noutput > 0 && (!lin->Vy || !lin->Vu || !lin->v0)) ||
         !lin->input_name || !lin->input_unit || !lin->output_name ||
         !lin->output_unit) {
@@ -172,6 +175,8 @@ void ts_linear_free(ts_linear *lin)
     free(lin->u0);
     free(lin->up_qoff);
     free(lin->up_map);
+    free(lin->veh_rot);
+    free(lin->veh_qoff);
     free(lin->Vy);
     free(lin->Vu);
     free(lin->Terr);
@@ -748,24 +753,15 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         }
     }
 
-    /* A cable starting at a point P of a vehicle moves with the body:
-     * dr_P = dr_A + (R E dtheta) x rho_P (rho_P = R (P - A)). */
-    for (int l = 0; lin->nvehicles > 0 && l < nl; l++) {
-        const ts_link *L = &sys->links[l];
-        lin->up_qoff[l] = -1;
-        if (L->up_body < 0)
-            continue;
-        int v = 0;
-        while (ts_kernel_vehicle_body(k, v) != L->up_body)
-            v++;
-        const ts_vehicle *d = sys->bodies[L->up_body].vehicle;
-        double R[9], om[3], E[9], lev[3];
+    /* Each vehicle's small rotation per change of its angles, R E. */
+    for (int v = 0; v < lin->nvehicles; v++) {
+        double R[9], om[3], E[9];
         int qo = ts_kernel_vehicle_offset(k, v);
         int ship = v == ts_kernel_root(k) && ts_kernel_root_dof(k) == 3;
         double th[3] = {0, 0, y0[qo]};
         ts_kernel_get_vehicle(k, v, y0, R, om);
         tsi_rate_matrix(ship ? th : y0 + qo, E);
-        double *map = lin->up_map + 12 * l;
+        double *map = lin->veh_rot + 9 * v;
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
                 map[3 * i + j] = R[3 * i] * E[j] + R[3 * i + 1] * E[3 + j] +
@@ -777,6 +773,25 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                 map[3 * i] = map[3 * i + 2];
                 map[3 * i + 1] = map[3 * i + 2] = 0.0;
             }
+        lin->veh_qoff[v] = qo;
+    }
+
+    /* A cable starting at a point P of a vehicle moves with the body:
+     * dr_P = dr_A + (R E dtheta) x rho_P (rho_P = R (P - A)). */
+    for (int l = 0; lin->nvehicles > 0 && l < nl; l++) {
+        const ts_link *L = &sys->links[l];
+        lin->up_qoff[l] = -1;
+        if (L->up_body < 0)
+            continue;
+        int v = 0;
+        while (ts_kernel_vehicle_body(k, v) != L->up_body)
+            v++;
+        const ts_vehicle *d = sys->bodies[L->up_body].vehicle;
+        double R[9], om[3], lev[3];
+        int qo = ts_kernel_vehicle_offset(k, v);
+        ts_kernel_get_vehicle(k, v, y0, R, om);
+        double *map = lin->up_map + 12 * l;
+        memcpy(map, lin->veh_rot + 9 * v, 9 * sizeof(double));
         for (int j = 0; j < 3; j++)
             lev[j] = L->up_point[j] - d->attach[j];
         for (int j = 0; j < 3; j++)
@@ -1009,6 +1024,18 @@ int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
         rc = ts_linearize(k, y, NULL, opts, lin, err);
     free(y);
     return rc;
+}
+
+void ts_linear_vehicle_rotations(const ts_linear *lin, const double dq[],
+                                 double phi[])
+{
+    for (int v = 0; v < lin->nvehicles; v++) {
+        const double *map = lin->veh_rot + 9 * v;
+        const double *dth = dq + lin->veh_qoff[v];
+        for (int c = 0; c < 3; c++)
+            phi[3 * v + c] = map[3 * c] * dth[0] + map[3 * c + 1] * dth[1] +
+                             map[3 * c + 2] * dth[2];
+    }
 }
 
 void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,

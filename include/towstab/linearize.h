@@ -134,6 +134,12 @@ typedef struct ts_linear {
                           at y0 (M frame, 9 row-major: the small rotation
                           of the body per angle change) and rho_P = R (P -
                           A) (3, m); NULL without vehicles */
+    double *veh_rot;   /* [9 nvehicles] R E of each vehicle at y0 (M
+                          frame, row-major): its small rotation (rad) per
+                          change of its three angles, in kernel vehicle
+                          order; NULL without vehicles */
+    int *veh_qoff;     /* [nvehicles] offset of each vehicle's angles in
+                          q; NULL without vehicles */
     double *Ty;        /* [nlinks * n] dT/dy (N/rad, N s/rad) column-major,
                           or NULL unless opts.tensions */
     double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
@@ -266,6 +272,13 @@ TS_API int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
 TS_API void ts_linear_node_displacements(const ts_system *sys,
                                          const ts_linear *lin,
                                          const double dq[], double dr[]);
+
+/* The small rotation phi[3 nvehicles] (rad, M axes, kernel vehicle
+ * order) of every vehicle produced by coordinate perturbations dq[nq]
+ * about lin->y0, to first order: phi = R E dtheta (R the attitude at y0,
+ * E the rate matrix of its angles). Nothing without vehicles. */
+TS_API void ts_linear_vehicle_rotations(const ts_linear *lin,
+                                        const double dq[], double phi[]);
 
 /* Name of input column j ("tow.surge", "tow.sway", "tow.heave",
  * "tow.surge_velocity", ..., "tow.heave_acceleration"); NULL outside
