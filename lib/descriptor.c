@@ -33,6 +33,17 @@
  * carries rnoise_i / (sqrt(2) h_j). Cost: NOISE_SAMPLES + 1 residual
  * evaluations and block products, O(nlinks).
  *
+ * Vehicles. A towed vehicle's angles are a point of their own (its
+ * rotational rows; a neighbour of its node and of the lower nodes of the
+ * cables leaving it), coloured and differenced as a node; its controller
+ * states and inputs get one group each (the vehicles' k-th together: each
+ * reaches its own vehicle's rows only), which fills the local blocks Lv
+ * (controller rows, and the force rows' controller and input columns)
+ * and Ov (its outputs, from ts_kernel_outputs after each evaluation).
+ * Its inertia Mv and the coefficients of the cables leaving it at points
+ * P (pg, pm) are exact, from the kernel (tsi_kernel_vehicle_mass,
+ * tsi_kernel_link_point).
+ *
  * The mass matrices M (dR/da), the tension columns N (dR/dt = +-n) and the
  * link rows are exact: they are read off the base state, not differenced.
  * An elastic link's tension enters the residual as an unknown, so that a
@@ -64,27 +75,46 @@
 
 /* ---- The tree's neighbourhoods ----------------------------------------- */
 
-/* Neighbours of node x in the tree: its parent and its children. */
-static int tree_nbrs(const ts_system *sys, int x, int *out)
+/* Neighbours of point x: a node's parent, children and vehicle point; a
+ * vehicle point's node and the lower nodes of the cables leaving it (they
+ * start at its points P). */
+static int point_nbrs(const ts_descriptor *d, const int *node_vp, int x,
+                      int *out)
 {
+    const ts_system *sys = d->sys;
     int m = 0;
-    if (x > 0)
-        out[m++] = sys->links[sys->nodes[x].link].upper;
+    if (x >= d->nn) {
+        int i = d->vl[x - d->nn].node;
+        out[m++] = i;
+        for (int c = sys->nodes[i].child_begin; c < sys->nodes[i].child_end;
+             c++)
+            out[m++] = sys->links[sys->child_links[c]].lower;
+        return m;
+    }
+    if (x > 0) {
+        const ts_link *L = &sys->links[sys->nodes[x].link];
+        out[m++] = L->upper;
+        if (L->up_body >= 0)
+            out[m++] = node_vp[L->upper];
+    }
     for (int c = sys->nodes[x].child_begin; c < sys->nodes[x].child_end; c++)
         out[m++] = sys->links[sys->child_links[c]].lower;
+    if (node_vp[x] >= 0)
+        out[m++] = node_vp[x];
     return m;
 }
 
 /* Work for breadth-first balls: a stamp per node and a queue. */
 typedef struct ball_ws {
     int *stamp, *dist, *queue, *adj;
+    const int *node_vp; /* [nn] the vehicle point at a node, -1 */
     int now;
 } ball_ws;
 
 /* Nodes within `depth` links of x (x included) into out[] with their
  * distances in dist_out (may be NULL); returns how many. */
-static int ball(const ts_system *sys, ball_ws *w, int x, int depth, int *out,
-                int *dist_out)
+static int ball(const ts_descriptor *d, ball_ws *w, int x, int depth,
+                int *out, int *dist_out)
 {
     w->now++;
     int head = 0, tail = 0;
@@ -95,7 +125,7 @@ static int ball(const ts_system *sys, ball_ws *w, int x, int depth, int *out,
         int y = w->queue[head++];
         if (w->dist[y] == depth)
             continue;
-        int m = tree_nbrs(sys, y, w->adj);
+        int m = point_nbrs(d, w->node_vp, y, w->adj);
         for (int i = 0; i < m; i++) {
             int z = w->adj[i];
             if (w->stamp[z] == w->now)
@@ -115,17 +145,17 @@ static int ball(const ts_system *sys, ball_ws *w, int x, int depth, int *out,
 
 /* Greedy colouring: nodes more than `sep` links apart may share a colour.
  * Returns the number of colours, or -1 when out of memory. */
-static int colour_tree(const ts_system *sys, ball_ws *w, int sep, int *colour,
-                       int *buf)
+static int colour_tree(const ts_descriptor *d, ball_ws *w, int sep,
+                       int *colour, int *buf)
 {
-    int nn = sys->nnodes, ncol = 0;
+    int nn = d->np, ncol = 0;
     int *used = calloc((size_t)nn + 1, sizeof(int));
     if (!used)
         return -1;
     for (int x = 0; x < nn; x++)
         colour[x] = -1;
     for (int x = 0; x < nn; x++) {
-        int m = ball(sys, w, x, sep, buf, NULL);
+        int m = ball(d, w, x, sep, buf, NULL);
         for (int i = 0; i < m; i++)
             if (colour[buf[i]] >= 0)
                 used[colour[buf[i]]] = x + 1;
@@ -146,32 +176,17 @@ void tsi_desc_free(ts_descriptor *d)
 {
     if (!d)
         return;
-    free(d->r0);
-    free(d->v0);
-    free(d->a0);
-    free(d->t0);
-    free(d->M);
-    free(d->n);
-    free(d->len);
-    free(d->ka);
-    free(d->ca);
-    free(d->kind);
-    free(d->bptr);
-    free(d->bcol);
-    free(d->btr);
-    free(d->bdist);
-    free(d->K);
-    free(d->C);
-    free(d->Kerr);
-    free(d->Cerr);
-    free(d->rnoise);
-    free(d->rcolour);
-    free(d->vcolour);
-    free(d->hr);
-    free(d->hv);
-    free(d->Sp);
-    free(d->Si);
-    free(d->pos);
+    void *arrays[] = {d->vl,     d->r0,     d->v0,      d->a0,   d->t0,
+                      d->y0,     d->u0,     d->M,       d->Mv,   d->pg,
+                      d->pm,     d->n,      d->len,     d->ka,   d->ca,
+                      d->kind,   d->bptr,   d->bcol,    d->btr,  d->bdist,
+                      d->K,      d->C,      d->Kerr,    d->Cerr, d->lv_off,
+                      d->Lv,     d->Lerr,   d->hc,      d->hu,   d->rnoise,
+                      d->rcolour, d->vcolour, d->hr,    d->hv,   d->Sp,
+                      d->Si,     d->pos,    d->lvp_off, d->ov_off, d->Ov,
+                      d->Oerr,   d->onoise};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        free(arrays[i]);
     if (d->klu_symbolic)
         klu_free_symbolic((klu_symbolic **)&d->klu_symbolic, d->klu_common);
     free(d->klu_common);
@@ -193,20 +208,63 @@ static int cmp_entry(const void *a, const void *b)
     return 0;
 }
 
-/* Row or column of node k's component c (k >= 1), of link l's row or
- * tension. */
-#define XR(k, c) (4 * ((k)-1) + (c))
-#define XT(l) (4 * (l) + 3)
+#define XR(k, c) tsi_desc_xr(d, (k), (c))
+#define XT(l) TSI_XT(l)
+#define XC(j) tsi_desc_xc(d, (j))
+
+/* The vehicle point a link leaves from (at its point P), -1. */
+static int link_vp(const ts_descriptor *d, int l)
+{
+    const ts_link *L = &d->sys->links[l];
+    if (L->up_body < 0)
+        return -1;
+    for (int v = 0; v < d->nv; v++)
+        if (d->vl[v].node == L->upper)
+            return d->nn + v;
+    return -1;
+}
+
+/* Columns of a vehicle's local block that S holds (its node's
+ * displacement, its angles, its controller states): unknown of local
+ * column lc, -1 for the rates and inputs. */
+static int lv_unknown(const ts_descriptor *d, int v, int lc)
+{
+    const tsi_vehicle_layout *L = &d->vl[v];
+    if (lc < TSI_LV_TH)
+        return XR(L->node, lc);
+    if (lc < TSI_LV_V)
+        return XR(d->nn + v, lc - TSI_LV_TH);
+    if (lc < TSI_LV_C)
+        return -1;
+    if (lc < TSI_LV_C + L->nc)
+        return XC(L->c0 + lc - TSI_LV_C);
+    return -1;
+}
+
+/* Row of a vehicle's local block: its node's force rows, its rotational
+ * rows, its controller rows. */
+static int lv_row(const ts_descriptor *d, int v, int lr)
+{
+    const tsi_vehicle_layout *L = &d->vl[v];
+    if (lr < 3)
+        return XR(L->node, lr);
+    if (lr < 6)
+        return XR(d->nn + v, lr - 3);
+    return XC(L->c0 + lr - 6);
+}
 
 static int build_pattern(ts_descriptor *d)
 {
     const ts_system *sys = d->sys;
     int nl = d->nl;
-    size_t cap = 9 * (size_t)d->nblocks + 13 * (size_t)nl;
+    size_t nlv = d->lvp_off[d->nv];
+    size_t cap = 9 * (size_t)d->nblocks + 19 * (size_t)nl + nlv;
     entry *e = malloc((cap > 0 ? cap : 1) * sizeof *e);
     /* Tags index d->pos: [9 nblocks] blocks, then [6 nl] tension columns
-     * of the node rows, [6 nl] link rows on positions, [nl] diagonals. */
-    size_t npos = 9 * (size_t)d->nblocks + 13 * (size_t)nl;
+     * of the node rows, [6 nl] link rows on positions, [nl] diagonals,
+     * [3 nl] tension columns of rotational rows, [3 nl] link rows on a
+     * vehicle's angles, then the local blocks. */
+    size_t npos = cap;
     d->pos = malloc((npos > 0 ? npos : 1) * sizeof(int));
     if (!e || !d->pos) {
         free(e);
@@ -218,8 +276,11 @@ static int build_pattern(ts_descriptor *d)
     d->pos_n = d->pos + 9 * (size_t)d->nblocks;
     d->pos_row = d->pos_n + 6 * (size_t)nl;
     d->pos_diag = d->pos_row + 6 * (size_t)nl;
+    d->pos_pm = d->pos_diag + nl;
+    d->pos_pg = d->pos_pm + 3 * (size_t)nl;
+    d->pos_lv = d->pos_pg + 3 * (size_t)nl;
     size_t m = 0;
-    for (int k = 1; k < d->nn; k++)
+    for (int k = 1; k < d->np; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             int j = d->bcol[b];
             if (j == 0)
@@ -229,9 +290,11 @@ static int build_pattern(ts_descriptor *d)
                     e[m++] = (entry){XR(j, c), XR(k, a), 9 * b + 3 * a + c};
         }
     int base_n = 9 * d->nblocks, base_row = base_n + 6 * nl,
-        base_diag = base_row + 6 * nl;
+        base_diag = base_row + 6 * nl, base_pm = base_diag + nl,
+        base_pg = base_pm + 3 * nl, base_lv = base_pg + 3 * nl;
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &sys->links[l];
+        int vp = link_vp(d, l);
         for (int c = 0; c < 3; c++) {
             e[m++] = (entry){XT(l), XR(L->lower, c), base_n + 6 * l + c};
             e[m++] = (entry){XR(L->lower, c), XT(l), base_row + 6 * l + c};
@@ -241,8 +304,26 @@ static int build_pattern(ts_descriptor *d)
                 e[m++] = (entry){XR(L->upper, c), XT(l),
                                  base_row + 6 * l + 3 + c};
             }
+            if (vp >= 0) {
+                e[m++] = (entry){XT(l), XR(vp, c), base_pm + 3 * l + c};
+                e[m++] = (entry){XR(vp, c), XT(l), base_pg + 3 * l + c};
+            }
         }
         e[m++] = (entry){XT(l), XT(l), base_diag + l};
+    }
+    /* The local blocks: the controller columns of the force and
+     * rotational rows, the controller rows on the node's displacement,
+     * the angles and the controller states (the diagonal always: s). */
+    for (int v = 0; v < d->nv; v++) {
+        int nr = 6 + d->vl[v].nc, p0 = d->lvp_off[v];
+        for (int lr = 0; lr < nr; lr++)
+            for (int c = 0; c < nr; c++) {
+                int lc = c < 6 ? c : TSI_LV_C + c - 6;
+                if (lr < 6 && c < 6)
+                    continue; /* the point blocks' */
+                e[m++] = (entry){lv_unknown(d, v, lc), lv_row(d, v, lr),
+                                 base_lv + p0 + nr * lr + c};
+            }
     }
     qsort(e, m, sizeof *e, cmp_entry);
     d->nnz = (int)m;
@@ -263,50 +344,99 @@ static int build_pattern(ts_descriptor *d)
     return TS_OK;
 }
 
-ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err)
+ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
 {
+    const ts_system *sys = ts_kernel_system(kern);
+    if (ts_kernel_root(kern) >= 0) {
+        ts_fail(err, TS_EINVAL, "descriptor: a towing vehicle at the root "
+                "is not covered by the sparse model");
+        return NULL;
+    }
     ts_descriptor *d = calloc(1, sizeof *d);
     if (!d) {
         ts_fail(err, TS_ENOMEM, "descriptor: out of memory");
         return NULL;
     }
-    int nn = sys->nnodes, nl = sys->nlinks;
-    size_t snn = (size_t)nn, snl = (size_t)(nl > 0 ? nl : 1);
+    int nn = sys->nnodes, nl = sys->nlinks, nv = ts_kernel_nvehicles(kern);
     d->sys = sys;
     d->nn = nn;
     d->nl = nl;
-    d->nx = 4 * (nn - 1);
+    d->nv = nv;
+    d->np = nn + nv;
+    d->nq = ts_kernel_nq(kern);
+    d->nstate = ts_kernel_nstate(kern);
+    d->nc = ts_kernel_ncontrol(kern);
+    d->nin = ts_kernel_ninput(kern);
+    d->nx = 4 * (nn - 1) + 3 * nv + d->nc;
+    size_t snp = (size_t)d->np, snl = (size_t)(nl > 0 ? nl : 1);
+    size_t snv = (size_t)(nv > 0 ? nv : 1);
     int dist_r = sys->has_bending ? 2 : 1;
     ball_ws w = {0};
-    w.stamp = calloc(snn, sizeof(int));
-    w.dist = calloc(snn, sizeof(int));
-    w.queue = malloc(snn * sizeof(int));
-    w.adj = malloc(snn * sizeof(int));
-    int *buf = malloc(snn * sizeof(int)), *bd = malloc(snn * sizeof(int));
-    d->r0 = calloc(3 * snn, sizeof(double));
-    d->v0 = calloc(3 * snn, sizeof(double));
-    d->a0 = calloc(3 * snn, sizeof(double));
+    w.stamp = calloc(snp, sizeof(int));
+    w.dist = calloc(snp, sizeof(int));
+    w.queue = malloc(snp * sizeof(int));
+    w.adj = malloc(snp * sizeof(int));
+    int *node_vp = malloc((size_t)nn * sizeof(int));
+    w.node_vp = node_vp;
+    int *buf = malloc(snp * sizeof(int)), *bd = malloc(snp * sizeof(int));
+    d->vl = calloc(snv, sizeof *d->vl);
+    d->lv_off = calloc(snv + 1, sizeof(int));
+    d->lvp_off = calloc(snv + 1, sizeof(int));
+    d->ov_off = calloc(snv + 1, sizeof(int));
+    d->r0 = calloc(3 * snp, sizeof(double));
+    d->v0 = calloc(3 * snp, sizeof(double));
+    d->a0 = calloc(3 * snp, sizeof(double));
     d->t0 = calloc(snl, sizeof(double));
-    d->M = calloc(6 * snn, sizeof(double));
+    d->y0 = calloc((size_t)d->nstate + 1, sizeof(double));
+    d->u0 = calloc((size_t)d->nin + 1, sizeof(double));
+    d->M = calloc(6 * (size_t)nn, sizeof(double));
+    d->Mv = calloc(36 * snv, sizeof(double));
+    d->pg = calloc(3 * snl, sizeof(double));
+    d->pm = calloc(3 * snl, sizeof(double));
     d->n = calloc(3 * snl, sizeof(double));
     d->len = calloc(snl, sizeof(double));
     d->ka = calloc(snl, sizeof(double));
     d->ca = calloc(snl, sizeof(double));
     d->kind = calloc(snl, 1);
-    d->bptr = calloc(snn + 1, sizeof(int));
-    d->rcolour = malloc(snn * sizeof(int));
-    d->vcolour = malloc(snn * sizeof(int));
-    d->hr = calloc(3 * snn, sizeof(double));
-    d->hv = calloc(3 * snn, sizeof(double));
-    int ok = w.stamp && w.dist && w.queue && w.adj && buf && bd && d->r0 &&
-             d->v0 && d->a0 && d->t0 && d->M && d->n && d->len && d->ka &&
-             d->ca && d->kind && d->bptr && d->rcolour && d->vcolour &&
-             d->hr && d->hv;
-    /* Blocks: every node's ball of radius dist_r, sorted. */
-    for (int k = 0; ok && k < nn; k++)
-        d->bptr[k + 1] = d->bptr[k] + ball(sys, &w, k, dist_r, buf, NULL);
+    d->bptr = calloc(snp + 1, sizeof(int));
+    d->rcolour = malloc(snp * sizeof(int));
+    d->vcolour = malloc(snp * sizeof(int));
+    d->hr = calloc(3 * snp, sizeof(double));
+    d->hv = calloc(3 * snp, sizeof(double));
+    d->hc = calloc((size_t)d->nc + 1, sizeof(double));
+    d->hu = calloc((size_t)d->nin + 1, sizeof(double));
+    int ok = w.stamp && w.dist && w.queue && w.adj && node_vp && buf && bd &&
+             d->vl && d->lv_off && d->lvp_off && d->ov_off && d->r0 && d->v0 && d->a0 &&
+             d->t0 && d->y0 && d->u0 && d->M && d->Mv && d->pg && d->pm &&
+             d->n && d->len && d->ka && d->ca && d->kind && d->bptr &&
+             d->rcolour && d->vcolour && d->hr && d->hv && d->hc && d->hu;
+    for (int i = 0; ok && i < nn; i++)
+        node_vp[i] = -1;
+    for (int v = 0; ok && v < nv; v++) {
+        tsi_vehicle_layout *L = &d->vl[v];
+        tsi_kernel_vehicle_layout(kern, v, L);
+        node_vp[L->node] = nn + v;
+        int nr = 6 + L->nc;
+        d->lv_off[v + 1] = d->lv_off[v] + nr * (TSI_LV_C + L->nc + L->nin);
+        d->lvp_off[v + 1] = d->lvp_off[v] + nr * nr;
+        d->ov_off[v + 1] =
+            d->ov_off[v] + L->nout * (TSI_LV_C + L->nc + L->nin);
+        d->nout += L->nout;
+        if (L->nc > d->ncgroups)
+            d->ncgroups = L->nc;
+        if (L->nin > d->nugroups)
+            d->nugroups = L->nin;
+    }
     if (ok) {
-        d->nblocks = d->bptr[nn];
+        d->Lv = calloc((size_t)d->lv_off[nv] + 1, sizeof(double));
+        d->Ov = calloc((size_t)d->ov_off[nv] + 1, sizeof(double));
+        ok = d->Lv && d->Ov;
+    }
+    /* Blocks: every point's ball of radius dist_r, sorted. */
+    for (int k = 0; ok && k < d->np; k++)
+        d->bptr[k + 1] = d->bptr[k] + ball(d, &w, k, dist_r, buf, NULL);
+    if (ok) {
+        d->nblocks = d->bptr[d->np];
         size_t nb = (size_t)d->nblocks;
         d->bcol = malloc(nb * sizeof(int));
         d->btr = malloc(nb * sizeof(int));
@@ -315,9 +445,9 @@ ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err)
         d->C = calloc(9 * nb, sizeof(double));
         ok = d->bcol && d->btr && d->bdist && d->K && d->C;
     }
-    for (int k = 0; ok && k < nn; k++) {
-        int m = ball(sys, &w, k, dist_r, buf, bd);
-        /* Insertion sort by node (balls are small). */
+    for (int k = 0; ok && k < d->np; k++) {
+        int m = ball(d, &w, k, dist_r, buf, bd);
+        /* Insertion sort by point (balls are small). */
         for (int i = 1; i < m; i++)
             for (int j = i; j > 0 && buf[j - 1] > buf[j]; j--) {
                 int t = buf[j];
@@ -333,7 +463,7 @@ ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err)
         }
     }
     /* The transpose of every block, by binary search in j's sorted row. */
-    for (int k = 0; ok && k < nn; k++)
+    for (int k = 0; ok && k < d->np; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             int j = d->bcol[b], lo = d->bptr[j], hi = d->bptr[j + 1] - 1;
             while (lo < hi) {
@@ -346,8 +476,8 @@ ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err)
             d->btr[b] = lo;
         }
     if (ok) {
-        d->nrcolour = colour_tree(sys, &w, 2 * dist_r, d->rcolour, buf);
-        d->nvcolour = colour_tree(sys, &w, 2, d->vcolour, buf);
+        d->nrcolour = colour_tree(d, &w, 2 * dist_r, d->rcolour, buf);
+        d->nvcolour = colour_tree(d, &w, 2, d->vcolour, buf);
         ok = d->nrcolour > 0 && d->nvcolour > 0;
     }
     if (ok)
@@ -368,6 +498,7 @@ ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err)
     free(w.dist);
     free(w.queue);
     free(w.adj);
+    free(node_vp);
     free(buf);
     free(bd);
     if (!ok) {
@@ -376,7 +507,7 @@ ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err)
                 nl);
         return NULL;
     }
-    d->groups = 3 * (d->nrcolour + d->nvcolour);
+    d->groups = 3 * (d->nrcolour + d->nvcolour) + d->ncgroups + d->nugroups;
     return d;
 }
 
@@ -394,8 +525,12 @@ static double step_for(double x, double scale, double rel)
 /* Per-thread work. */
 typedef struct grp_ws {
     ts_kernel *k;
-    double *r, *v;     /* [3 nn] perturbed copies */
-    double *R[4];      /* [3 nn] residuals at +h, -h, +2h, -2h */
+    double *r, *v;     /* [3 np] perturbed copies */
+    double *y, *u;     /* [nstate], [nin] the state (vehicle angles, rates,
+                          controller states) and inputs */
+    double *thdd;      /* [3 nv] angle accelerations */
+    double *R[4];      /* [3 np + nc] residuals at +h, -h, +2h, -2h */
+    double *O[4];      /* [nout] the vehicles' outputs there */
 } grp_ws;
 
 static void grp_ws_free(grp_ws *w, const ts_kernel *owner)
@@ -404,81 +539,222 @@ static void grp_ws_free(grp_ws *w, const ts_kernel *owner)
         ts_kernel_free(w->k);
     free(w->r);
     free(w->v);
-    for (int i = 0; i < 4; i++)
+    free(w->y);
+    free(w->u);
+    free(w->thdd);
+    for (int i = 0; i < 4; i++) {
         free(w->R[i]);
+        free(w->O[i]);
+    }
 }
 
 static int grp_ws_alloc(grp_ws *w, ts_kernel *k, int own, const ts_descriptor *d)
 {
-    size_t n3 = 3 * (size_t)d->nn;
+    size_t n3 = 3 * (size_t)d->np, nr = n3 + (size_t)d->nc;
     memset(w, 0, sizeof *w);
     w->k = own ? k : ts_kernel_clone(k, NULL);
     w->r = malloc(n3 * sizeof(double));
     w->v = malloc(n3 * sizeof(double));
-    int ok = w->k && w->r && w->v;
-    for (int i = 0; i < 4; i++)
-        ok = ok && (w->R[i] = malloc(n3 * sizeof(double)));
+    w->y = malloc(((size_t)d->nstate + 1) * sizeof(double));
+    w->u = malloc(((size_t)d->nin + 1) * sizeof(double));
+    w->thdd = malloc((3 * (size_t)d->nv + 1) * sizeof(double));
+    int ok = w->k && w->r && w->v && w->y && w->u && w->thdd;
+    for (int i = 0; i < 4; i++) {
+        ok = ok && (w->R[i] = malloc(nr * sizeof(double)));
+        ok = ok && (w->O[i] = malloc(((size_t)d->nout + 1) * sizeof(double)));
+    }
     if (!ok)
         return TS_ENOMEM;
     memcpy(w->r, d->r0, n3 * sizeof(double));
     memcpy(w->v, d->v0, n3 * sizeof(double));
+    memcpy(w->y, d->y0, (size_t)d->nstate * sizeof(double));
+    memcpy(w->u, d->u0, (size_t)d->nin * sizeof(double));
     return TS_OK;
 }
 
-/* Group g: kind (0 position, 1 velocity), colour, component. Evaluates
- * the residual at the perturbed states and writes the columns of the
- * group's nodes into K or C (and the error estimate). */
+/* The residual at the points' positions r and velocities pv[3 np] (the
+ * vehicles' angles and rates into y), the controller states and inputs
+ * of y and u. */
+static int residual_at(const ts_descriptor *d, ts_kernel *k, const double *r,
+                       const double *pv, double *y, const double *u,
+                       double *thdd, double *R)
+{
+    for (int v = 0; v < d->nv; v++) {
+        int o = d->vl[v].qoff;
+        for (int c = 0; c < 3; c++) {
+            y[o + c] = r[3 * (d->nn + v) + c];
+            y[d->nq + o + c] = pv[3 * (d->nn + v) + c];
+            thdd[3 * v + c] = d->a0[3 * (d->nn + v) + c];
+        }
+    }
+    return tsi_kernel_residual(k, r, pv, d->a0, d->t0, d->nv > 0 ? y : NULL,
+                               d->nv > 0 ? thdd : NULL, u, R);
+}
+
+/* The vehicle whose node or angles point j is: its index, with *col its
+ * local column of a displacement (TSI_LV_R or TSI_LV_TH); -1. */
+static int point_vehicle(const ts_descriptor *d, int j, int *col)
+{
+    if (j >= d->nn) {
+        *col = TSI_LV_TH;
+        return j - d->nn;
+    }
+    for (int v = 0; v < d->nv; v++)
+        if (d->vl[v].node == j) {
+            *col = TSI_LV_R;
+            return v;
+        }
+    return -1;
+}
+
+/* Central difference of row i between the residuals at +-h (and +-2h):
+ * into *D, and its truncation estimate into *E when E. */
+static void central(double *const R[4], size_t i, double h, double *D,
+                    double *E)
+{
+    double dh = (R[0][i] - R[1][i]) / (2.0 * h);
+    *D = dh;
+    if (E)
+        *E = ((R[2][i] - R[3][i]) / (4.0 * h) - dh) / 3.0;
+}
+
+/* The residual (and the vehicles' outputs) of evaluation s of a group. */
+static int group_eval(const ts_descriptor *d, grp_ws *w, int s)
+{
+    int rc = residual_at(d, w->k, w->r, w->v, w->y, w->u, w->thdd, w->R[s]);
+    if (rc == TS_OK && d->nout > 0)
+        ts_kernel_outputs(w->k, w->O[s]);
+    return rc;
+}
+
+/* The output rows of vehicle v at local column lc, step h. */
+static void output_column(ts_descriptor *d, const grp_ws *w, int v, int lc,
+                          double h)
+{
+    const tsi_vehicle_layout *L = &d->vl[v];
+    int ncol = TSI_LV_C + L->nc + L->nin;
+    for (int r = 0; r < L->nout; r++) {
+        size_t at = (size_t)d->ov_off[v] + (size_t)r * ncol + lc;
+        central(w->O, (size_t)(L->out0 + r), h, d->Ov + at,
+                d->Oerr ? d->Oerr + at : NULL);
+    }
+}
+
+static const double mult[4] = {1.0, -1.0, 2.0, -2.0};
+
+/* A group of controller states (kind 2) or inputs (kind 3): local index
+ * m of every vehicle that has one, perturbed together (each reaches its
+ * own vehicle's rows only). */
+static int local_group(ts_descriptor *d, grp_ws *w, int kind, int m,
+                       int estimate)
+{
+    int nev = estimate ? 4 : 2, rc = TS_OK;
+    size_t n3 = 3 * (size_t)d->np;
+    for (int s = 0; s < nev && rc == TS_OK; s++) {
+        for (int v = 0; v < d->nv; v++) {
+            const tsi_vehicle_layout *L = &d->vl[v];
+            if (kind == 2 && m < L->nc) {
+                int j = 2 * d->nq + L->c0 + m;
+                w->y[j] = d->y0[j] + mult[s] * d->hc[L->c0 + m];
+            } else if (kind == 3 && m < L->nin) {
+                int j = L->in0 + m;
+                w->u[j] = d->u0[j] + mult[s] * d->hu[j];
+            }
+        }
+        rc = group_eval(d, w, s);
+    }
+    memcpy(w->y, d->y0, (size_t)d->nstate * sizeof(double));
+    memcpy(w->u, d->u0, (size_t)d->nin * sizeof(double));
+    if (rc != TS_OK)
+        return rc;
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *L = &d->vl[v];
+        if (m >= (kind == 2 ? L->nc : L->nin))
+            continue;
+        int nr = 6 + L->nc, ncol = TSI_LV_C + L->nc + L->nin;
+        int lc = kind == 2 ? TSI_LV_C + m : TSI_LV_C + L->nc + m;
+        double h = kind == 2 ? d->hc[L->c0 + m] : d->hu[L->in0 + m];
+        for (int lr = 0; lr < nr; lr++) {
+            size_t i = lr < 3 ? 3 * (size_t)L->node + lr
+                       : lr < 6 ? 3 * (size_t)(d->nn + v) + lr - 3
+                                : n3 + (size_t)(L->c0 + lr - 6);
+            size_t at = (size_t)d->lv_off[v] + (size_t)lr * ncol + lc;
+            central(w->R, i, h, d->Lv + at, d->Lerr ? d->Lerr + at : NULL);
+        }
+        output_column(d, w, v, lc, h);
+    }
+    return TS_OK;
+}
+
+/* Group g: kind (0 position, 1 velocity), colour, component; after them
+ * the controller and input groups. Evaluates the residual at the
+ * perturbed states and writes the columns of the group's points into K
+ * or C, and the controller rows' (and the error estimate). */
 static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
 {
-    int nr = 3 * d->nrcolour;
+    int nr = 3 * d->nrcolour, nv3 = 3 * d->nvcolour;
+    if (g >= nr + nv3) {
+        int m = g - nr - nv3;
+        return m < d->ncgroups ? local_group(d, w, 2, m, estimate)
+                               : local_group(d, w, 3, m - d->ncgroups,
+                                             estimate);
+    }
     int kind = g < nr ? 0 : 1, gg = g < nr ? g : g - nr;
     int colour = gg / 3, comp = gg % 3;
     const int *col = kind ? d->vcolour : d->rcolour;
     const double *h = kind ? d->hv : d->hr;
     double *x = kind ? w->v : w->r;
-    static const double mult[4] = {1.0, -1.0, 2.0, -2.0};
     int nev = estimate ? 4 : 2, rc = TS_OK;
+    size_t n3 = 3 * (size_t)d->np;
     for (int s = 0; s < nev && rc == TS_OK; s++) {
-        for (int j = 0; j < d->nn; j++)
+        for (int j = 0; j < d->np; j++)
             if (col[j] == colour)
                 x[3 * j + comp] = (kind ? d->v0 : d->r0)[3 * j + comp] +
                                   mult[s] * h[3 * j + comp];
-        rc = tsi_kernel_residual(w->k, w->r, w->v, d->a0, d->t0, w->R[s]);
+        rc = group_eval(d, w, s);
     }
-    for (int j = 0; j < d->nn; j++)
+    for (int j = 0; j < d->np; j++)
         if (col[j] == colour)
             x[3 * j + comp] = (kind ? d->v0 : d->r0)[3 * j + comp];
     if (rc != TS_OK)
         return rc;
     double *D = kind ? d->C : d->K, *E = kind ? d->Cerr : d->Kerr;
-    for (int j = 0; j < d->nn; j++) {
+    for (int j = 0; j < d->np; j++) {
         if (col[j] != colour)
             continue;
         double hj = h[3 * j + comp];
-        double inv = 1.0 / (2.0 * hj), inv2 = 1.0 / (4.0 * hj);
         for (int b = d->bptr[j]; b < d->bptr[j + 1]; b++) {
             int k = d->bcol[b];
             if (k == 0)
                 continue;
             /* A velocity reaches one link only: farther blocks of C are
-             * zero, and their rows may see another node of the colour. */
+             * zero, and their rows may see another point of the colour. */
             double *blk = D + 9 * (size_t)d->btr[b];
             double *eblk = E ? E + 9 * (size_t)d->btr[b] : NULL;
             int far = kind && d->bdist[b] > 1;
             for (int a = 0; a < 3; a++) {
-                double dh = far ? 0.0
-                                : (w->R[0][3 * k + a] - w->R[1][3 * k + a]) *
-                                      inv;
+                double dh = 0.0, eh = 0.0;
+                if (!far)
+                    central(w->R, 3 * (size_t)k + a, hj, &dh,
+                            eblk ? &eh : NULL);
                 blk[3 * a + comp] = dh;
-                if (eblk) {
-                    double d2 = far ? 0.0
-                                    : (w->R[2][3 * k + a] -
-                                       w->R[3][3 * k + a]) *
-                                          inv2;
-                    eblk[3 * a + comp] = (d2 - dh) / 3.0;
-                }
+                if (eblk)
+                    eblk[3 * a + comp] = eh;
             }
         }
+        /* The controller rows of the vehicle at this point. */
+        int lc0, v = point_vehicle(d, j, &lc0);
+        if (v < 0)
+            continue;
+        const tsi_vehicle_layout *L = &d->vl[v];
+        int ncol = TSI_LV_C + L->nc + L->nin;
+        int lc = lc0 + comp + (kind ? TSI_LV_V : 0);
+        for (int m = 0; m < L->nc; m++) {
+            size_t at = (size_t)d->lv_off[v] + (size_t)(6 + m) * ncol + lc;
+            central(w->R, n3 + (size_t)(L->c0 + m), hj, d->Lv + at,
+                    d->Lerr ? d->Lerr + at : NULL);
+        }
+        output_column(d, w, v, lc, hj);
     }
     return TS_OK;
 }
@@ -486,24 +762,67 @@ static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
 #define NOISE_SAMPLES 8
 #define NOISE_REL 1e-4
 
-/* The residual's rounding noise d->rnoise (see the head of the file).
- * Needs K and C. */
+/* out[nout] = Ov z over the vehicles' local columns: the point
+ * displacements p and rates pv (may be NULL) and the controller states c
+ * (may be NULL); inputs zero. */
+static void outputs_mul(const ts_descriptor *d, const double *p,
+                        const double *pv, const double *c, double *out)
+{
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *L = &d->vl[v];
+        int ncol = TSI_LV_C + L->nc + L->nin;
+        for (int r = 0; r < L->nout; r++) {
+            const double *row = d->Ov + d->ov_off[v] + r * ncol;
+            double acc = 0;
+            for (int lc = 0; lc < 6; lc++) {
+                int i = lc < 3 ? 3 * L->node + lc : 3 * (d->nn + v) + lc - 3;
+                acc += row[lc] * p[i] + (pv ? row[TSI_LV_V + lc] * pv[i] : 0);
+            }
+            for (int m = 0; c && m < L->nc; m++)
+                acc += row[TSI_LV_C + m] * c[L->c0 + m];
+            out[L->out0 + r] = acc;
+        }
+    }
+}
+
+/* The residual's rounding noise d->rnoise (see the head of the file),
+ * and the outputs' d->onoise. Needs K, C and the local blocks. */
 static int residual_noise(ts_descriptor *d, ts_kernel *k)
 {
-    size_t n3 = 3 * (size_t)d->nn;
+    size_t n3 = 3 * (size_t)d->np, nr = n3 + (size_t)d->nc;
+    size_t nc = (size_t)d->nc;
     double *r = malloc(n3 * sizeof *r), *v = malloc(n3 * sizeof *v);
     double *dr = malloc(n3 * sizeof *dr), *dv = malloc(n3 * sizeof *dv);
-    double *R0 = malloc(n3 * sizeof *R0), *R = malloc(n3 * sizeof *R);
-    double *f = malloc(n3 * sizeof *f), *acc = calloc(n3, sizeof *acc);
-    int rc = r && v && dr && dv && R0 && R && f && acc ? TS_OK : TS_ENOMEM;
-    if (rc == TS_OK)
-        rc = tsi_kernel_residual(k, d->r0, d->v0, d->a0, d->t0, R0);
+    double *R0 = malloc(nr * sizeof *R0), *R = malloc(nr * sizeof *R);
+    double *f = malloc(nr * sizeof *f), *acc = calloc(nr, sizeof *acc);
+    double *y = malloc(((size_t)d->nstate + 1) * sizeof *y);
+    double *dc = malloc((nc + 1) * sizeof *dc);
+    double *thdd = malloc((3 * (size_t)d->nv + 1) * sizeof *thdd);
+    size_t no = (size_t)d->nout + 1;
+    double *O0 = malloc(no * sizeof *O0), *O = malloc(no * sizeof *O);
+    double *Of = malloc(no * sizeof *Of), *oacc = calloc(no, sizeof *oacc);
+    int rc = r && v && dr && dv && R0 && R && f && acc && y && dc && thdd &&
+                     O0 && O && Of && oacc
+                 ? TS_OK
+                 : TS_ENOMEM;
+    if (rc == TS_OK) {
+        memcpy(y, d->y0, (size_t)d->nstate * sizeof *y);
+        rc = residual_at(d, k, d->r0, d->v0, y, d->u0, thdd, R0);
+        if (d->nout > 0)
+            ts_kernel_outputs(k, O0);
+    }
     unsigned long long seq = 0x9E3779B97F4A7C15ULL;
     int used = 0;
     for (int s = 0; rc == TS_OK && s < NOISE_SAMPLES; s++) {
-        for (size_t i = 0; i < 2 * n3; i++) {
+        for (size_t i = 0; i < 2 * n3 + nc; i++) {
             seq = seq * 6364136223846793005ULL + 1442695040888963407ULL;
             double sg = seq >> 63 ? 1.0 : -1.0;
+            if (i >= 2 * n3) {
+                size_t j = i - 2 * n3, yj = 2 * (size_t)d->nq + j;
+                y[yj] = d->y0[yj] + sg * NOISE_REL * d->hc[j];
+                dc[j] = y[yj] - d->y0[yj];
+                continue;
+            }
             size_t j = i < n3 ? i : i - n3;
             double *x = i < n3 ? r : v, *dx = i < n3 ? dr : dv;
             const double *x0 = i < n3 ? d->r0 : d->v0;
@@ -513,13 +832,22 @@ static int residual_noise(ts_descriptor *d, ts_kernel *k)
             x[j] = x0[j] + sg * NOISE_REL * h;
             dx[j] = x[j] - x0[j]; /* exactly what was added */
         }
-        if (tsi_kernel_residual(k, r, v, d->a0, d->t0, R) != TS_OK)
+        if (residual_at(d, k, r, v, y, d->u0, thdd, R) != TS_OK)
             continue; /* a state off the chart: another sample */
         tsi_desc_block_mul(d, d->K, dr, f, 0);
         tsi_desc_block_mul(d, d->C, dv, f, 1);
-        for (size_t i = 3; i < n3; i++) {
+        tsi_desc_local_mul(d, dr, dv, dc, NULL, f + n3, f, 0);
+        for (size_t i = 3; i < nr; i++) {
             double e = R[i] - R0[i] - f[i];
             acc[i] += e * e;
+        }
+        if (d->nout > 0) {
+            ts_kernel_outputs(k, O);
+            outputs_mul(d, dr, dv, dc, Of);
+            for (int i = 0; i < d->nout; i++) {
+                double e = O[i] - O0[i] - Of[i];
+                oacc[i] += e * e;
+            }
         }
         used++;
     }
@@ -527,9 +855,11 @@ static int residual_noise(ts_descriptor *d, ts_kernel *k)
         rc = TS_ECONV;
     if (rc == TS_OK) {
         d->k_round = d->c_round = 0.0;
-        for (size_t i = 0; i < n3; i++)
+        for (size_t i = 0; i < nr; i++)
             d->rnoise[i] = sqrt(acc[i] / (2.0 * used));
-        for (int kk = 1; kk < d->nn; kk++)
+        for (int i = 0; i < d->nout; i++)
+            d->onoise[i] = sqrt(oacc[i] / (2.0 * used));
+        for (int kk = 1; kk < d->np; kk++)
             for (int b = d->bptr[kk]; b < d->bptr[kk + 1]; b++) {
                 int j = d->bcol[b];
                 for (int a = 0; a < 3; a++)
@@ -550,20 +880,42 @@ static int residual_noise(ts_descriptor *d, ts_kernel *k)
     free(R);
     free(f);
     free(acc);
+    free(y);
+    free(dc);
+    free(thdd);
+    free(O0);
+    free(O);
+    free(Of);
+    free(oacc);
     return rc;
+}
+
+static double abs2(double complex z)
+{
+    return creal(z) * creal(z) + cimag(z) * cimag(z);
+}
+
+/* Point displacement of a vehicle's local column lc < 6 in x[3 np]. */
+static double complex lv_point(const ts_descriptor *d, int v, int lc,
+                               const double complex *x, int *idx)
+{
+    int i = lc < 3 ? 3 * d->vl[v].node + lc : 3 * (d->nn + v) + lc - 3;
+    *idx = i;
+    return x[i];
 }
 
 void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
                           const double complex x[], double complex s,
                           double *trunc, double *round)
 {
-    if (!d->Kerr || !d->Cerr || !d->rnoise) {
+    if (!d->Kerr || !d->Cerr || !d->rnoise || (d->nv > 0 && !d->Lerr)) {
         *trunc = *round = NAN;
         return;
     }
     double complex t = 0;
-    double r2 = 0, as2 = creal(s) * creal(s) + cimag(s) * cimag(s);
-    for (int k = 1; k < d->nn; k++) {
+    double r2 = 0, as2 = abs2(s);
+    const double complex *xc = x + 3 * (size_t)d->np;
+    for (int k = 1; k < d->np; k++) {
         double complex e[3] = {0, 0, 0};
         double xk = 0;
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
@@ -575,11 +927,25 @@ void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
                 for (int c = 0; c < 3; c++)
                     e[a] += (Kb[3 * a + c] + s * Cb[3 * a + c]) * xj[c];
             for (int c = 0; c < 3; c++) {
-                double ax = creal(xj[c]) * creal(xj[c]) +
-                            cimag(xj[c]) * cimag(xj[c]);
+                double ax = abs2(xj[c]);
                 double hr = d->hr[3 * j + c], hv = d->hv[3 * j + c];
                 xk += ax / (hr * hr) + (d->bdist[b] <= 1 ? as2 * ax / (hv * hv)
                                                          : 0.0);
+            }
+        }
+        /* A vehicle's force and rotational rows on its controller
+         * states. */
+        int lc0, v = point_vehicle(d, k, &lc0);
+        if (v >= 0) {
+            const tsi_vehicle_layout *L = &d->vl[v];
+            int ncol = TSI_LV_C + L->nc + L->nin, lr0 = lc0 == TSI_LV_R ? 0 : 3;
+            for (int m = 0; m < L->nc; m++) {
+                double complex x_m = xc[L->c0 + m];
+                double hc = d->hc[L->c0 + m];
+                for (int a = 0; a < 3; a++)
+                    e[a] += d->Lerr[d->lv_off[v] + (lr0 + a) * ncol +
+                                    TSI_LV_C + m] * x_m;
+                xk += abs2(x_m) / (hc * hc);
             }
         }
         double wk = 0;
@@ -587,24 +953,64 @@ void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
             double complex wa = w[XR(k, a)];
             t += wa * e[a];
             double rho = d->rnoise[3 * k + a];
-            wk += (creal(wa) * creal(wa) + cimag(wa) * cimag(wa)) * rho * rho;
+            wk += abs2(wa) * rho * rho;
         }
         r2 += wk * xk;
+    }
+    /* Controller rows: -(dHr + s dHv) x_points - dHc x_c. */
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *L = &d->vl[v];
+        int ncol = TSI_LV_C + L->nc + L->nin;
+        for (int m = 0; m < L->nc; m++) {
+            const double *row = d->Lerr + d->lv_off[v] + (6 + m) * ncol;
+            double complex e = 0;
+            double xk = 0;
+            for (int lc = 0; lc < 6; lc++) {
+                int i;
+                double complex xp = lv_point(d, v, lc, x, &i);
+                e += (row[lc] + s * row[lc + TSI_LV_V]) * xp;
+                xk += abs2(xp) * (1.0 / (d->hr[i] * d->hr[i]) +
+                                  as2 / (d->hv[i] * d->hv[i]));
+            }
+            for (int m2 = 0; m2 < L->nc; m2++) {
+                double hc = d->hc[L->c0 + m2];
+                e += row[TSI_LV_C + m2] * xc[L->c0 + m2];
+                xk += abs2(xc[L->c0 + m2]) / (hc * hc);
+            }
+            double complex wm = w[XC(L->c0 + m)];
+            double rho = d->rnoise[3 * (size_t)d->np + L->c0 + m];
+            t -= wm * e;
+            r2 += abs2(wm) * rho * rho * xk;
+        }
     }
     *trunc = cabs(t);
     *round = sqrt(0.5 * r2);
 }
 
-int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
+int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
+                       const double u0[], const double f0[], double rel_step,
                        int estimate, int threads, ts_err *err)
 {
     const ts_system *sys = d->sys;
-    int nn = d->nn, nl = d->nl;
-    size_t n3 = 3 * (size_t)nn;
+    int nn = d->nn, nl = d->nl, np = d->np;
+    size_t n3 = 3 * (size_t)nn, nr = 3 * (size_t)np + (size_t)d->nc;
     memcpy(d->r0, ts_kernel_positions(k), n3 * sizeof(double));
     memcpy(d->v0, ts_kernel_velocities(k), n3 * sizeof(double));
     memcpy(d->a0, ts_kernel_rel_accelerations(k), n3 * sizeof(double));
     memcpy(d->t0, ts_kernel_tensions(k), (size_t)nl * sizeof(double));
+    memcpy(d->y0, y0, (size_t)d->nstate * sizeof(double));
+    if (u0)
+        memcpy(d->u0, u0, (size_t)d->nin * sizeof(double));
+    else
+        memset(d->u0, 0, (size_t)d->nin * sizeof(double));
+    for (int v = 0; v < d->nv; v++) {
+        int o = d->vl[v].qoff;
+        for (int c = 0; c < 3; c++) {
+            d->r0[3 * (nn + v) + c] = y0[o + c];
+            d->v0[3 * (nn + v) + c] = y0[d->nq + o + c];
+            d->a0[3 * (nn + v) + c] = f0[d->nq + o + c];
+        }
+    }
     /* The kernel's link directions, not d / |d| of the positions: the maps
      * to and from the kernel's coordinates use the kernel's direction
      * derivatives, orthogonal to these to rounding (1e-16), while d / |d|
@@ -616,6 +1022,8 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
         const double *rp = d->r0 + 3 * L->upper, *rk = d->r0 + 3 * L->lower;
         double dv[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
         double len = sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]);
+        if (L->up_body >= 0)
+            len = L->length; /* from P, which the kernel placed */
         if (!(len > 0))
             return ts_fail(err, TS_ESINGULAR, "descriptor: link %d has zero "
                            "length", l);
@@ -625,51 +1033,95 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
         d->kind[l] = !L->elastic ? TSI_LINK_RIGID
                      : d->t0[l] > 0 ? TSI_LINK_TAUT : TSI_LINK_SLACK;
     }
-    if (estimate && (!d->Kerr || !d->Cerr)) {
+    size_t nlv = (size_t)d->lv_off[d->nv] + 1;
+    size_t nov = (size_t)d->ov_off[d->nv] + 1;
+    if (estimate && (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr)) {
+        free(d->Kerr);
+        free(d->Cerr);
+        free(d->Lerr);
+        free(d->Oerr);
         d->Kerr = calloc(9 * (size_t)d->nblocks, sizeof(double));
         d->Cerr = calloc(9 * (size_t)d->nblocks, sizeof(double));
-        if (!d->Kerr || !d->Cerr)
+        d->Lerr = calloc(nlv, sizeof(double));
+        d->Oerr = calloc(nov, sizeof(double));
+        if (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr)
             return ts_fail(err, TS_ENOMEM, "descriptor: out of memory for "
                            "the error estimate");
     }
     if (estimate && !d->rnoise &&
-        !(d->rnoise = calloc(3 * (size_t)nn, sizeof(double))))
+        (!(d->rnoise = calloc(nr, sizeof(double))) ||
+         !(d->onoise = calloc((size_t)d->nout + 1, sizeof(double)))))
         return ts_fail(err, TS_ENOMEM, "descriptor: out of memory for the "
                        "error estimate");
     if (!estimate) {
         free(d->Kerr);
         free(d->Cerr);
+        free(d->Lerr);
+        free(d->Oerr);
         free(d->rnoise);
-        d->Kerr = d->Cerr = d->rnoise = NULL;
+        free(d->onoise);
+        d->Kerr = d->Cerr = d->Lerr = d->Oerr = d->rnoise = d->onoise = NULL;
     }
     /* Steps. */
     ts_frame fr;
     ts_kernel_get_frame(k, &fr);
     double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
-    for (int j = 0; j < nn; j++) {
-        double l = sys->links[j > 0 ? sys->nodes[j].link : 0].length;
+    for (int j = 0; j < np; j++) {
+        int node = j < nn ? j : d->vl[j - nn].node;
+        double l = sys->links[node > 0 ? sys->nodes[node].link : 0].length;
         double vs = sqrt(g * l) + fabs(fr.speed);
+        if (j >= nn) {
+            /* A vehicle's angles: 1 rad; their rates (sqrt(g l) + |V|) /
+             * l, l its hull's length (or 1 m), as the dense model's. */
+            const ts_vehicle *vd =
+                sys->bodies[sys->nodes[node].body].vehicle;
+            l = 1.0;
+            for (int c = 0; c < vd->ncomponents; c++)
+                if (vd->component[c].type == TS_COMP_HULL)
+                    l = vd->component[c].length;
+            vs = (sqrt(g * l) + fabs(fr.speed)) / l;
+        }
         for (int c = 0; c < 3; c++) {
             /* Loads vary on the scale of a link, l: truncation error
              * ~(h / l)^2. A position |x| far from the origin costs
              * eps |x| in every link vector, rounding ~eps |x| / h: the
              * two balance at h ~ eps^(1/3) (|x| l^2)^(1/3). */
             double x = d->r0[3 * j + c], v = d->v0[3 * j + c];
-            d->hr[3 * j + c] = step_for(x, fmax(l, cbrt(fabs(x) * l * l)),
-                                        rel_step);
+            double sc = j < nn ? fmax(l, cbrt(fabs(x) * l * l))
+                               : fmax(fabs(x), 1.0);
+            d->hr[3 * j + c] = step_for(x, sc, rel_step);
             d->hv[3 * j + c] = step_for(v, fmax(fabs(v), vs), rel_step);
         }
     }
-    /* The base residual sets the mass matrices. */
-    double *R = malloc(n3 * sizeof(double));
-    if (!R)
-        return ts_fail(err, TS_ENOMEM, "descriptor: out of memory");
-    int rc = tsi_kernel_residual(k, d->r0, d->v0, d->a0, d->t0, R);
+    for (int j = 0; j < d->nc; j++) {
+        double x = y0[2 * d->nq + j];
+        d->hc[j] = step_for(x, fmax(fabs(x), 1.0), rel_step);
+    }
+    for (int j = 0; j < d->nin; j++)
+        d->hu[j] = step_for(d->u0[j], fmax(fabs(d->u0[j]), 1.0), rel_step);
+    /* The base residual sets the mass matrices, the vehicles' inertia and
+     * the coefficients of the links leaving a vehicle. */
+    double *R = malloc(nr * sizeof(double));
+    double *yw = malloc(((size_t)d->nstate + 1) * sizeof(double));
+    double *thdd = malloc((3 * (size_t)d->nv + 1) * sizeof(double));
+    int rc = R && yw && thdd ? TS_OK : TS_ENOMEM;
+    if (rc == TS_OK) {
+        memcpy(yw, y0, (size_t)d->nstate * sizeof(double));
+        rc = residual_at(d, k, d->r0, d->v0, yw, d->u0, thdd, R);
+    }
     free(R);
+    free(yw);
+    free(thdd);
     if (rc != TS_OK)
         return ts_fail(err, rc, "descriptor: the residual fails at the base "
                        "state (%s)", ts_strerror(rc));
     memcpy(d->M, tsi_kernel_mass(k), 6 * (size_t)nn * sizeof(double));
+    for (int v = 0; v < d->nv; v++)
+        tsi_kernel_vehicle_mass(k, v, d->Mv + 36 * v);
+    for (int l = 0; l < nl; l++)
+        if (sys->links[l].up_body >= 0)
+            tsi_kernel_link_point(k, l, d->n + 3 * l, d->pg + 3 * l,
+                                  d->pm + 3 * l);
 
     int ngroups = d->groups, nthreads = threads > 0 ? threads : 1;
 #ifdef _OPENMP
@@ -736,8 +1188,11 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
 
 /* ---- Maps and products -------------------------------------------------- */
 
-void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
-                         const double dr[], double dq[])
+/* dq of the links from node (point) displacements dr; with th, a cable
+ * leaving a vehicle starts at P, displaced by (R E dtheta) x rho_P, the
+ * vehicle's angles dtheta read from dq (set before). */
+static void links_from_nodes(const ts_system *sys, const ts_linear *lin,
+                             const double dr[], double dq[], int th)
 {
     for (int l = 0; l < lin->nlinks; l++) {
         const ts_link *L = &sys->links[l];
@@ -745,6 +1200,18 @@ void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
         int o = lin->qoff[l];
         const double *rk = dr + 3 * L->lower, *rp = dr + 3 * L->upper;
         double dd[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
+        if (th && lin->up_qoff && lin->up_qoff[l] >= 0) {
+            const double *map = lin->up_map + 12 * l, *dth = dq + lin->up_qoff[l];
+            double om[3], x[3];
+            for (int i = 0; i < 3; i++)
+                om[i] = map[3 * i] * dth[0] + map[3 * i + 1] * dth[1] +
+                        map[3 * i + 2] * dth[2];
+            x[0] = om[1] * map[11] - om[2] * map[10];
+            x[1] = om[2] * map[9] - om[0] * map[11];
+            x[2] = om[0] * map[10] - om[1] * map[9];
+            for (int c = 0; c < 3; c++)
+                dd[c] -= x[c];
+        }
         double len = lin->len0[l];
         dq[o] = (d1[0] * dd[0] + d1[1] * dd[1] + d1[2] * dd[2]) /
                 (len * (d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]));
@@ -758,12 +1225,36 @@ void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
     }
 }
 
+void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
+                         const double dr[], double dq[])
+{
+    links_from_nodes(sys, lin, dr, dq, 0);
+}
+
+void tsi_desc_to_points(const ts_descriptor *d, const ts_linear *lin,
+                        const double dq[], double p[])
+{
+    ts_linear_node_displacements(d->sys, lin, dq, p);
+    for (int v = 0; v < d->nv; v++)
+        for (int c = 0; c < 3; c++)
+            p[3 * (d->nn + v) + c] = dq[d->vl[v].qoff + c];
+}
+
+void tsi_desc_from_points(const ts_descriptor *d, const ts_linear *lin,
+                          const double p[], double dq[])
+{
+    for (int v = 0; v < d->nv; v++)
+        for (int c = 0; c < 3; c++)
+            dq[d->vl[v].qoff + c] = p[3 * (d->nn + v) + c];
+    links_from_nodes(d->sys, lin, p, dq, 1);
+}
+
 void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
                         const double x[], double y[], int acc)
 {
     if (!acc)
         y[0] = y[1] = y[2] = 0.0;
-    for (int k = 1; k < d->nn; k++) {
+    for (int k = 1; k < d->np; k++) {
         double s0 = 0, s1 = 0, s2 = 0;
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             const double *blk = B + 9 * (size_t)b, *xj = x + 3 * d->bcol[b];
@@ -783,9 +1274,94 @@ void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
     }
 }
 
+/* The symmetric 3x3 mass matrix entry (a, b) of node k. */
+static double mass_at(const ts_descriptor *d, int k, int a, int b)
+{
+    static const int idx[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    return d->M[6 * k + idx[a][b]];
+}
+
+/* The inertia entry of row point k, component a, on the acceleration of
+ * point j, component c: the node's mass, and a vehicle's Mv between its
+ * node and its angles. */
+static double inertia_at(const ts_descriptor *d, int k, int a, int j, int c)
+{
+    double m = j == k && k < d->nn ? mass_at(d, k, a, c) : 0.0;
+    int rk, rj;
+    int vk = point_vehicle(d, k, &rk), vj = point_vehicle(d, j, &rj);
+    if (vk >= 0 && vk == vj) {
+        int r = (rk == TSI_LV_R ? 0 : 3) + a, q = (rj == TSI_LV_R ? 0 : 3) + c;
+        m += d->Mv[36 * vk + 6 * r + q];
+    }
+    return m;
+}
+
+void tsi_desc_mass_mul(const ts_descriptor *d, const double x[], double y[])
+{
+    memset(y, 0, 3 * (size_t)d->np * sizeof(double));
+    for (int k = 1; k < d->nn; k++) {
+        const double *S = d->M + 6 * k, *xk = x + 3 * k;
+        y[3 * k] = S[0] * xk[0] + S[3] * xk[1] + S[4] * xk[2];
+        y[3 * k + 1] = S[3] * xk[0] + S[1] * xk[1] + S[5] * xk[2];
+        y[3 * k + 2] = S[4] * xk[0] + S[5] * xk[1] + S[2] * xk[2];
+    }
+    for (int v = 0; v < d->nv; v++) {
+        const double *Mv = d->Mv + 36 * v;
+        int i = d->vl[v].node;
+        double z[6], out[6];
+        for (int c = 0; c < 3; c++) {
+            z[c] = x[3 * i + c];
+            z[3 + c] = x[3 * (d->nn + v) + c];
+        }
+        for (int r = 0; r < 6; r++) {
+            out[r] = 0;
+            for (int c = 0; c < 6; c++)
+                out[r] += Mv[6 * r + c] * z[c];
+        }
+        for (int c = 0; c < 3; c++) {
+            y[3 * i + c] += out[c];
+            y[3 * (d->nn + v) + c] += out[3 + c];
+        }
+    }
+}
+
+void tsi_desc_local_mul(const ts_descriptor *d, const double p[],
+                        const double pv[], const double c[], const double u[],
+                        double hc[], double f[], int err)
+{
+    const double *Lv = err ? d->Lerr : d->Lv;
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *L = &d->vl[v];
+        int ncol = TSI_LV_C + L->nc + L->nin, nr = 6 + L->nc;
+        double z[TSI_LV_C];
+        for (int lc = 0; lc < 6; lc++) {
+            int i;
+            i = lc < 3 ? 3 * L->node + lc : 3 * (d->nn + v) + lc - 3;
+            z[lc] = p ? p[i] : 0.0;
+            z[lc + TSI_LV_V] = pv ? pv[i] : 0.0;
+        }
+        for (int lr = 0; lr < nr; lr++) {
+            const double *row = Lv ? Lv + d->lv_off[v] + lr * ncol : NULL;
+            double acc = 0;
+            if (row) {
+                if (lr >= 6)
+                    for (int lc = 0; lc < TSI_LV_C; lc++)
+                        acc += row[lc] * z[lc];
+                for (int m = 0; c && m < L->nc; m++)
+                    acc += row[TSI_LV_C + m] * c[L->c0 + m];
+                for (int m = 0; u && m < L->nin; m++)
+                    acc += row[TSI_LV_C + L->nc + m] * u[L->in0 + m];
+            }
+            if (lr >= 6)
+                hc[L->c0 + lr - 6] = acc;
+            else if (f)
+                f[lr < 3 ? 3 * L->node + lr : 3 * (d->nn + v) + lr - 3] += acc;
+        }
+    }
+}
+
 /* The link row's coefficients on dr_lower (g, and -g on dr_upper) at
- * shift s for a taut elastic link: (EA/l + s Cv) n + Cv (I - n n^T) dd'
- * / |d| (dd' the base rate of the link vector). */
+ * shift s for a taut elastic link: (EA/l + s Cv) n. */
 void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,
                        double complex g[3])
 {
@@ -794,17 +1370,10 @@ void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,
         g[c] = (d->ka[l] + s * d->ca[l]) * n[c];
 }
 
-/* The symmetric 3x3 mass matrix entry (a, b) of node k. */
-static double mass_at(const ts_descriptor *d, int k, int a, int b)
-{
-    static const int idx[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
-    return d->M[6 * k + idx[a][b]];
-}
-
 /* S's entries as k + s c + s^2 m (S_inf: k + m, with the blocks' K and C
- * and the elastic rows left out): each entry's three parts into kp, cp,
- * mp when kp is given, else S(s) for complex s into z (interleaved) or
- * real s into x. */
+ * and the elastic rows left out; the controller rows the identity): each
+ * entry's three parts into kp, cp, mp when kp is given, else S(s) for
+ * complex s into z (interleaved) or real s into x. */
 static void fill(const ts_descriptor *d, double complex s, int inf,
                  double *x, double *z, double *kp, double *cp, double *mp)
 {
@@ -828,7 +1397,7 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
             }                                                                 \
         }                                                                     \
     } while (0)
-    for (int k = 1; k < d->nn; k++)
+    for (int k = 1; k < d->np; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             int j = d->bcol[b];
             if (j == 0)
@@ -838,7 +1407,7 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
                 for (int c = 0; c < 3; c++)
                     PUT(d->pos_blk[9 * b + 3 * a + c],
                         inf ? 0.0 : Kb[3 * a + c], inf ? 0.0 : Cb[3 * a + c],
-                        j == k ? mass_at(d, k, a, c) : 0.0);
+                        inertia_at(d, k, a, j, c));
         }
     for (int l = 0; l < d->nl; l++) {
         const ts_link *L = &sys->links[l];
@@ -856,9 +1425,40 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
                 PUT(d->pos_n[6 * l + 3 + c], -n[c], 0.0, 0.0);
                 PUT(d->pos_row[6 * l + 3 + c], -gk * n[c], -gc * n[c], 0.0);
             }
+            if (d->pos_pm[3 * l + c] >= 0) {
+                /* From a vehicle's point P: its rotational rows, and the
+                 * link row on its angles (P moves with them). */
+                PUT(d->pos_pm[3 * l + c], d->pm[3 * l + c], 0.0, 0.0);
+                PUT(d->pos_pg[3 * l + c], -gk * d->pg[3 * l + c],
+                    -gc * d->pg[3 * l + c], 0.0);
+            }
         }
         PUT(d->pos_diag[l], d->kind[l] == TSI_LINK_RIGID ? 0.0 : -1.0, 0.0,
             0.0);
+    }
+    /* Controller rows s dc - (Hr + s Hv) dp - Hc dc, and the force and
+     * rotational rows' Kc dc (S_inf: the identity, Kc to the right). */
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *L = &d->vl[v];
+        int nr = 6 + L->nc, ncol = TSI_LV_C + L->nc + L->nin;
+        const int *pp = d->pos_lv + d->lvp_off[v];
+        for (int lr = 0; lr < nr; lr++)
+            for (int c = 0; c < nr; c++) {
+                if (lr < 6 && c < 6)
+                    continue;
+                const double *row = d->Lv + d->lv_off[v] + lr * ncol;
+                int lc = c < 6 ? c : TSI_LV_C + c - 6;
+                double kk = 0, cc = 0;
+                if (inf) {
+                    kk = lr == c ? 1.0 : 0.0;
+                } else if (lr < 6) {
+                    kk = row[lc];
+                } else {
+                    kk = -row[lc];
+                    cc = c < 6 ? -row[lc + TSI_LV_V] : (lr == c ? 1.0 : 0.0);
+                }
+                PUT(pp[nr * lr + c], kk, cc, 0.0);
+            }
     }
 #undef PUT
 }

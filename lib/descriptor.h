@@ -36,59 +36,120 @@
  * in O(nlinks) each (lib/shift.c). The unknowns are ordered node by node:
  * free node j >= 1 owns columns 4 (j - 1) .. + 2 (its displacement) and
  * 4 (j - 1) + 3 (the tension of the link ending at it, link j - 1); its
- * rows likewise (its 3 force equations, then that link's row).
+ * rows likewise (its 3 force equations, then that link's row). Then each
+ * towed vehicle's 3 angles (a point of their own: rows its rotational
+ * equations), then the controller states (rows their rates): KLU orders
+ * them for the factorisation.
  *
- * A node with extra unknowns (a rigid body's rotations) would add its
- * rows and columns to its own block: the layout is per node.
+ * A towed vehicle (doc/linear.md, section 2b, "Vehicles") adds its angles
+ * as a point beside its node, with blocks of K and C like a node's; its
+ * inertia couples its node's acceleration and its angle accelerations
+ * (Mv); its controller states, inputs and outputs are small dense local
+ * blocks (Lv, Ov) on its node and angles. A towing vehicle at the root is
+ * not covered (its tow point is free).
  */
 #ifndef TOWSTAB_DESCRIPTOR_H
 #define TOWSTAB_DESCRIPTOR_H
 
 #include <complex.h>
 
+#include "kernel_impl.h"
 #include "towstab/linearize.h"
 
 /* Link kinds in the constraint rows. */
 enum { TSI_LINK_RIGID = 0, TSI_LINK_TAUT = 1, TSI_LINK_SLACK = 2 };
 
+/* Points: the nn nodes (3 unknowns each: the displacement), then one per
+ * vehicle (its three angles, rad): the blocks, the colouring and the
+ * steps treat both alike. A vehicle point is a neighbour of its node and
+ * of the lower nodes of the cables leaving it (which start at its points
+ * P, moving with its attitude). */
+
+/* A vehicle's local block (tsi_desc Lv): rows its node's 3 force rows, its
+ * 3 rotational rows, then its nc controller rows; columns its node's
+ * displacement (3), its angles (3), their rates (3 + 3), its controller
+ * states (nc), its inputs (nin). Only the parts the point blocks K and C
+ * do not hold are filled: the force and rotational rows' controller and
+ * input columns, and every column of the controller rows. */
+enum { TSI_LV_R = 0, TSI_LV_TH = 3, TSI_LV_V = 6, TSI_LV_W = 9,
+       TSI_LV_C = 12 };
+
 struct ts_descriptor {
     const ts_system *sys;
     int nn, nl;          /* nodes (node 0 the tow point), links */
-    int nx;              /* unknowns 4 (nn - 1) */
+    int nv, np;          /* vehicles; points nn + nv */
+    int nq, nstate;      /* the kernel's coordinates and states */
+    int nc, nin;         /* controller states, inputs (ts_kernel_ninput) */
+    tsi_vehicle_layout *vl; /* [nv] each vehicle's node, angles, controller
+                            states and inputs */
+    int nx;              /* unknowns 4 (nn - 1) + 3 nv + nc */
     /* The state linearized about. */
-    double *r0, *v0, *a0; /* [3 nn] node positions, velocities and
-                            accelerations relative to M (m, m/s, m/s^2) */
+    double *r0, *v0, *a0; /* [3 np] node positions, velocities and
+                            accelerations relative to M (m, m/s, m/s^2);
+                            then each vehicle's angles, rates and angle
+                            accelerations (rad, rad/s, rad/s^2) */
     double *t0;          /* [nl] tensions, N */
+    double *y0;          /* [nstate] the state (vehicle rates and
+                            controller states are read from it) */
+    double *u0;          /* [nin] the input */
     double *M;           /* [6 nn] nodal mass matrices (sym packed), kg */
+    double *Mv;          /* [36 nv] each vehicle's inertia in its rows
+                            (tsi_kernel_vehicle_mass) */
+    double *pg;          /* [3 nl] a link leaving a vehicle at P: the
+                            displacement of P along n per angle change,
+                            (R E)^T (rho_P x n) (m/rad); 0 otherwise */
+    double *pm;          /* [3 nl] such a link's tension in its vehicle's
+                            rotational rows, -(rho_b x R^T n) (m) */
     double *n;           /* [3 nl] link directions d / |d| */
     double *len;         /* [nl] |d|, m */
     double *ka, *ca;     /* [nl] EA / l (N/m) and Cv (N s/m) of elastic
                             links, 0 for rigid ones */
     char *kind;          /* [nl] TSI_LINK_* */
-    /* K and C as 3x3 blocks: row node k >= 1 has blocks bptr[k] ..
-     * bptr[k + 1] - 1 with column nodes bcol[] (sorted, node 0 included:
+    /* K and C as 3x3 blocks: row point k >= 1 has blocks bptr[k] ..
+     * bptr[k + 1] - 1 with column points bcol[] (sorted, node 0 included:
      * the tow point's columns are the inputs). Row-major blocks. */
-    int *bptr;           /* [nn + 1] */
+    int *bptr;           /* [np + 1] */
     int *bcol;           /* [nblocks] */
     int *btr;            /* [nblocks] index of block (j, k) for (k, j) */
     char *bdist;         /* [nblocks] links between k and j */
     int nblocks;
     double *K, *C;       /* [9 nblocks] dR/dr (N/m), dR/dv (N s/m) */
     double *Kerr, *Cerr; /* [9 nblocks] (D(2h) - D(h)) / 3, or NULL */
-    double *rnoise;      /* [3 nn] rounding noise of one residual
-                            evaluation of each node row (N; rows of node
-                            0 unused): entry (i, j) of K carries noise
-                            rnoise[i] / (sqrt(2) hr[j]), of C
-                            rnoise[i] / (sqrt(2) hv[j]); NULL without the
+    int *lv_off;         /* [nv + 1] offsets of the vehicles' local
+                            blocks in Lv */
+    double *Lv, *Lerr;   /* local blocks (TSI_LV_*), row-major with 12 +
+                            nc + nin columns; Lerr NULL without the
                             estimate */
+    int nout;            /* the vehicles' outputs (ts_kernel_noutput) */
+    int *ov_off;         /* [nv + 1] offsets of the output blocks in Ov */
+    double *Ov, *Oerr;   /* each vehicle's outputs (depth, pitch, roll,
+                            yaw, loop outputs, deflections) on its local
+                            columns (TSI_LV_*; rows its nout, row-major
+                            with 12 + nc + nin columns); Oerr NULL
+                            without the estimate */
+    double *onoise;      /* [nout] the outputs' rounding noise (m, rad);
+                            NULL without the estimate */
+    double *hc, *hu;     /* [nc], [nin] steps of the controller states and
+                            the vehicles' inputs */
+    double *rnoise;      /* [3 np + nc] rounding noise of one residual
+                            evaluation of each row (node force N,
+                            vehicle moment N m, controller rate; rows of
+                            node 0 unused): entry (i, j) of K carries
+                            noise rnoise[i] / (sqrt(2) hr[j]), of C
+                            rnoise[i] / (sqrt(2) hv[j]), of a controller
+                            column rnoise[i] / (sqrt(2) hc[j]); NULL
+                            without the estimate */
     /* Colouring of the finite differences. */
-    int *rcolour, *vcolour; /* [nn] */
+    int *rcolour, *vcolour; /* [np] */
     int nrcolour, nvcolour;
-    double *hr, *hv;     /* [3 nn] steps of r and v, m and m/s */
+    int ncgroups, nugroups; /* the most controller states and inputs of a
+                            vehicle: one group each */
+    double *hr, *hv;     /* [3 np] steps of r and v, m and m/s (rad and
+                            rad/s for a vehicle point) */
     /* Sparse pattern of S(s) (and S_inf) in compressed columns. */
     int nnz;
     int *Sp, *Si;        /* [nx + 1], [nnz] */
-    int *pos;            /* the four position arrays below, one block */
+    int *pos;            /* the position arrays below, one block */
     int *pos_blk;        /* [9 nblocks] position of block (k, j) entry
                             (row a, column b) at 9 b' + 3 a + b, -1 when
                             j = 0 or k = 0 */
@@ -97,12 +158,21 @@ struct ts_descriptor {
     int *pos_row;        /* [2 * 3 nl] link row l on dr_lower (3) and
                             dr_upper (3, -1 at the tow point) */
     int *pos_diag;       /* [nl] link row l on dt_l */
+    int *pos_pm;         /* [3 nl] rotational rows on dt_l (links leaving
+                            a vehicle), -1 */
+    int *pos_pg;         /* [3 nl] link row l on its vehicle's angles, -1 */
+    int *pos_lv;         /* [per vehicle (6 + nc) (6 + nc)] the local
+                            block's entries in S: rows as Lv, columns its
+                            node's displacement, its angles, its
+                            controller states; -1 where S has none */
+    int *lvp_off;        /* [nv + 1] offsets in pos_lv */
     void *klu_symbolic;  /* KLU's ordering of the pattern (klu_symbolic *),
                             computed once by tsi_desc_alloc */
     void *klu_common;    /* KLU's default parameters (klu_common *); each
                             factorisation works on its own copy */
     /* Statistics. */
-    int groups;          /* perturbation groups (colours x components) */
+    int groups;          /* perturbation groups (colours x components,
+                            controller states, inputs) */
     long evaluations;    /* residual evaluations */
     double k_scale, c_scale; /* max |K|, max |C| entries */
     double k_err, c_err; /* max |Kerr|, max |Cerr| */
@@ -110,41 +180,83 @@ struct ts_descriptor {
                             entries of K and C */
 };
 
-/* A descriptor for the built system sys: neighbours, colouring and the
- * pattern of S (O(nlinks)). NULL with err set on failure. */
-ts_descriptor *tsi_desc_alloc(const ts_system *sys, ts_err *err);
+/* Unknown of point k's component c (k >= 1), of link l's tension, of
+ * controller state j. */
+static inline int tsi_desc_xr(const ts_descriptor *d, int k, int c)
+{
+    return k < d->nn ? 4 * (k - 1) + c : 4 * (d->nn - 1) + 3 * (k - d->nn) + c;
+}
+#define TSI_XT(l) (4 * (l) + 3)
+static inline int tsi_desc_xc(const ts_descriptor *d, int j)
+{
+    return 4 * (d->nn - 1) + 3 * d->nv + j;
+}
+
+/* A descriptor for kernel k's system (k gives the vehicles' places in
+ * the state and the inputs): neighbours, colouring and the pattern of S
+ * (O(nlinks)). NULL with err set on failure (a towing vehicle at the
+ * root is not covered: TS_EINVAL). */
+ts_descriptor *tsi_desc_alloc(const ts_kernel *k, ts_err *err);
 void tsi_desc_free(ts_descriptor *d);
 
-/* Linearize the node residual of kernel k about the state of its last
- * evaluation (positions, velocities, accelerations, tensions), with
- * steps rel_step * max(|x|, scale) (scales: the length of the link ending
- * at the node, m; sqrt(g l) + |V|, m/s) and, with estimate, the error
- * estimate from steps 2h. threads: 1 serial, more with OpenMP (kernel
- * clones). Returns TS_OK, TS_ESINGULAR (a link of zero length) or
- * TS_ENOMEM. */
-int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, double rel_step,
+/* Linearize the residual of kernel k about y0[nstate], u0[ninput] and
+ * f0 = f(y0, u0), whose evaluation must be k's last (positions,
+ * velocities, accelerations, tensions are read from it), with steps
+ * rel_step * max(|x|, scale) (scales: the length of the link ending at
+ * the node, m; sqrt(g l) + |V|, m/s; a vehicle's angles 1 rad and their
+ * rates (sqrt(g l) + |V|) / l, l its hull's length; controller states
+ * and inputs 1) and, with estimate, the error estimate from steps 2h.
+ * threads: 1 serial, more with OpenMP (kernel clones). Returns TS_OK,
+ * TS_ESINGULAR (a link of zero length) or TS_ENOMEM. */
+int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
+                       const double u0[], const double f0[], double rel_step,
                        int estimate, int threads, ts_err *err);
 
 /* The linearization's error in the bilinear form w^T dS(s) x over the
- * node rows, dS(s) = dK + s dC (the errors of K and C; M, N and the link
- * rows are exact): w[nx] (complex; its node rows XR(k, a) are used),
- * x[3 nn] node displacements (complex; x_0, the tow point's, is an input
- * column). *trunc = |w^T (Kerr + s Cerr) x|; *round = the root mean
- * square of w^T N x for the noise N of the differences, independent
- * entries rnoise_i / (sqrt(2) hr_j) in K and |s| rnoise_i / (sqrt(2)
- * hv_j) in C (within one link), i.e. sqrt(sum_k sum_a |w_ka|^2
- * rnoise_ka^2 X_k / 2), X_k = sum over k's blocks j of sum_c |x_jc|^2
- * (1 / hr_jc^2 + |s|^2 / hv_jc^2). NaN without the estimate. O(nlinks). */
+ * rows of points and controller states, dS(s) = dK + s dC and the local
+ * blocks' errors (M, N and the link rows are exact): w[nx] (complex),
+ * x[3 np + nc] point displacements then controller states (complex; x_0,
+ * the tow point's, is an input column). *trunc = |w^T dS x|; *round =
+ * the root mean square of w^T N x for the noise N of the differences,
+ * independent entries rnoise_i / (sqrt(2) h_j) (|s| rnoise_i / (sqrt(2)
+ * hv_j) in C, within one link), i.e. sqrt(sum_i |w_i|^2 rnoise_i^2 X_i
+ * / 2), X_i = sum over row i's columns j of |x_j|^2 / h_j^2 (|s|^2 /
+ * hv_j^2 for a rate). NaN without the estimate. O(nlinks). */
 void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
                           const double complex x[], double complex s,
                           double *trunc, double *round);
 
-/* Node displacements dr[3 nn] (dr_0 = 0) of coordinate perturbations
- * dq[nq] (ts_linear_node_displacements), and back: dq[nq] of node
- * displacements dr (which must keep every rigid link's length, n.dd = 0;
- * the normal part is ignored). Real arrays; O(nlinks). */
+/* dq[nq] of node displacements dr[3 nn] (which must keep every rigid
+ * link's length, n.dd = 0; the normal part is ignored), a cable leaving a
+ * vehicle taken from the vehicle's attach node (its rotation ignored).
+ * Real arrays; O(nlinks). */
 void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
                          const double dr[], double dq[]);
+
+/* Point displacements p[3 np] (p_0 = 0) of coordinate perturbations
+ * dq[nq] (node displacements by ts_linear_node_displacements, then the
+ * vehicles' angles), and back: dq[nq] of point displacements that keep
+ * the rigid links' lengths (a cable leaving a vehicle starts at its
+ * point P, displaced with the body). Real arrays; O(nlinks). */
+void tsi_desc_to_points(const ts_descriptor *d, const ts_linear *lin,
+                        const double dq[], double p[]);
+void tsi_desc_from_points(const ts_descriptor *d, const ts_linear *lin,
+                          const double p[], double dq[]);
+
+/* y[3 np] = M x: the nodal masses and the vehicles' inertia (x[3 np],
+ * the accelerations of the points; rows of node 0 zero). */
+void tsi_desc_mass_mul(const ts_descriptor *d, const double x[], double y[]);
+
+/* The controller rows' and the force rows' local terms (TSI_LV_*): with
+ * the points' displacements p[3 np] and rates pv[3 np] (pv may be NULL:
+ * zero), the controller states c[nc] (NULL: zero) and inputs u[nin]
+ * (NULL: zero), into hc[nc] the controller rates' change (Hr p + Hv pv
+ * + Hc c + Hu u) and with f[3 np] (may be NULL) f += the force rows'
+ * change through the controller states and inputs (Kc c + Ku u). err:
+ * the local blocks' error estimate instead (zero without it). */
+void tsi_desc_local_mul(const ts_descriptor *d, const double p[],
+                        const double pv[], const double c[], const double u[],
+                        double hc[], double f[], int err);
 
 /* Values of S(s) (S_inf when inf) into Sx[nnz] (real s) or Sz[2 nnz]
  * (interleaved complex s): see the head of this file. */
@@ -164,8 +276,9 @@ void tsi_desc_fill_parts(const ts_descriptor *d, double Sk[], double Sc[],
 void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,
                        double complex g[3]);
 
-/* y[3 nn] = sum_j B[k, j] x[j] over the blocks of row nodes k >= 1
- * (B = K, C, Kerr or Cerr; y_0 = 0); with acc, y += instead of =. */
+/* y[3 np] = sum_j B[k, j] x[j] over the blocks of row points k >= 1
+ * (B = K, C, Kerr or Cerr; x[3 np]; y_0 = 0); with acc, y += instead of
+ * =. */
 void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
                         const double x[], double y[], int acc);
 

@@ -100,6 +100,9 @@ typedef struct veh {
     double turn_delta;        /* the deflection added to the turn surface
                                  (ts_tow.turn_surface), rad */
     double thrust;            /* thrust at the last evaluation, N */
+    int spd_off;              /* a PI speed controller's integrator, offset
+                                 in c (0: the first state); -1 */
+    double spd_dot;           /* its rate at the last evaluation, m/s */
     /* A surface ship (ts_tow.dof 3): only its yaw (at qoff) and the tow
      * point's x, y (qoff + 1, + 2) are coordinates; roll and pitch are 0
      * and the tow point's depth is the scene's. held: the hull's
@@ -108,6 +111,11 @@ typedef struct veh {
      * pitch moments about A (N m, body axes). */
     int dof;                  /* 6, or 3; 0 for a towed vehicle */
     double held[3];
+    /* The towing vehicle: the prescribed acceleration (body axes) of the
+     * points its cables start from relative to the body, the tow-point
+     * inputs' (wave-induced motion, doc/towing-vehicle.md section 7); 0
+     * for a towed vehicle. */
+    double shift_a[3];
 } veh;
 
 /* Inputs of a towing vehicle: thrust, force x y z, moment x y z. */
@@ -177,6 +185,14 @@ static int layout_controls(ts_kernel *k, ts_err *err)
 {
     k->nc = 0;
     k->nin = TS_NINPUT;
+    /* A PI speed controller's integrator first: no loop mode moves it. */
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const ts_propulsion *p = &V->d->propulsion;
+        V->spd_off = V->root && p->type == TS_PROP_SPEED && p->ki > 0
+                         ? k->nc++
+                         : -1;
+    }
     for (int v = 0; v < k->nv; v++) {
         veh *V = &k->veh[v];
         const ts_vehicle *d = V->d;
@@ -532,11 +548,21 @@ void ts_kernel_outputs(const ts_kernel *k, double out[])
     }
 }
 
+int ts_kernel_speed_integrator(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].spd_off : -1;
+}
+
 void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
 {
     cs->vehicle = cs->actuator = cs->index = -1;
     for (int v = 0; v < k->nv; v++) {
         const veh *V = &k->veh[v];
+        if (V->spd_off == i) {
+            cs->vehicle = v;
+            cs->actuator = TS_CONTROL_SPEED;
+            return;
+        }
         for (int l = 0; l < V->d->nloops; l++)
             if (V->xi_off[l] == i) {
                 cs->vehicle = v;
@@ -854,6 +880,15 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
     v3_cross(om, t, b);
 }
 
+/* The part of the acceleration (body axes) of the point at lever rho from
+ * A that the body's (a_A, alpha) do not give: om x (om x rho), and a
+ * towing vehicle's prescribed motion of its cables' starting points. */
+static void point_bias(const veh *V, const double rho[3], double b[3])
+{
+    centripetal(V->st.om_b, rho, b);
+    for (int j = 0; j < 3; j++)
+        b[j] += V->shift_a[j];
+}
 
 /* A vehicle's controller, inertia and its own loads (V->M6, V->G). */
 static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
@@ -893,8 +928,19 @@ static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
         tsi_rel_velocity(&k->frame, V->st.rA, V->st.rdA, wA);
         double u_law = d->propulsion.type == TS_PROP_SPEED ? v3_norm(wA)
                                                            : V->st.wO_b[0];
-        V->thrust = ts_propulsion_thrust(&d->propulsion, u_law,
-                                         V->thrust_bias, up[0]);
+        /* A PI speed controller: its integral term joins the bias; the
+         * integrator holds while the law is capped and the vehicle slower
+         * than its set speed (anti-windup). */
+        const ts_propulsion *pr = &d->propulsion;
+        double bias = V->thrust_bias;
+        if (V->spd_off >= 0) {
+            double e = pr->speed - u_law;
+            bias += pr->ki * c[V->spd_off];
+            V->spd_dot = e > 0 && bias + pr->gain * e >= pr->max_thrust
+                             ? 0.0
+                             : e;
+        }
+        V->thrust = ts_propulsion_thrust(pr, u_law, bias, up[0]);
         double f[3] = {V->thrust, 0, 0}, lever[3], m[3];
         for (int j = 0; j < 3; j++)
             lever[j] = pp[j] - d->attach[j];
@@ -919,7 +965,7 @@ static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
         link_lever(V, &k->sys->links[l], lever);
         sym3_to_body(V->st.R, k->uM + 6 * l, M3);
         mat3_tmul(V->st.R, k->uQ + 3 * l, f);
-        centripetal(V->st.om_b, lever, b);
+        point_bias(V, lever, b);
         add_point(V->M6, V->G, M3, lever, f, b);
     }
     memcpy(V->M6h, V->M6, sizeof V->M6);
@@ -1023,7 +1069,7 @@ static void vehicle_point_accel(const veh *V, const ts_link *L, double a[3])
     double lever[3], x[3], b[3], ab[3];
     link_lever(V, L, lever);
     v3_cross(V->a6 + 3, lever, x);
-    centripetal(V->st.om_b, lever, b);
+    point_bias(V, lever, b);
     for (int j = 0; j < 3; j++)
         ab[j] = V->a6[j] + x[j] + b[j];
     mat3_mul(V->st.R, ab, a);
@@ -1116,6 +1162,20 @@ static void assemble(ts_kernel *k)
     }
 }
 
+/* The controller states' rates of V's last evaluation into cdot (its
+ * integrators' and actuators' places). */
+static void control_rates(const veh *V, double cdot[])
+{
+    for (int l = 0; l < V->d->nloops; l++)
+        if (V->xi_off[l] >= 0)
+            cdot[V->xi_off[l]] = V->xi_dot[l];
+    for (int j = 0; j < V->d->ncomponents; j++)
+        if (V->act_off[j] >= 0)
+            cdot[V->act_off[j]] = V->act_dot[j];
+    if (V->spd_off >= 0)
+        cdot[V->spd_off] = V->spd_dot;
+}
+
 int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                    double dydt[])
 {
@@ -1139,6 +1199,18 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
         if (vehicle_kinematics(k, Root, y))
             chart_bad = 1;
+        /* The tow-point inputs: a prescribed displacement, velocity and
+         * acceleration (M axes) of the points the cables start from,
+         * relative to the body (a wave-induced motion), over its own. */
+        const ts_node *n0 = &sys->nodes[0];
+        for (int c = n0->child_begin; c < n0->child_end; c++) {
+            int l = sys->child_links[c];
+            for (int j = 0; j < 3; j++) {
+                k->ur[3 * l + j] += u[j];
+                k->urd[3 * l + j] += u[3 + j];
+            }
+        }
+        mat3_tmul(Root->st.R, u + 6, Root->shift_a);
     } else {
         for (int j = 0; j < 3; j++) {
             k->r[j] = sys->tow.point[j] + u[j];
@@ -1269,7 +1341,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                 for (int c = 0; c < 3; c++)
                     M3[3 * a + c] = nb[a] * nb[c] / D;
             }
-            centripetal(V->st.om_b, lever, b);
+            point_bias(V, lever, b);
             add_point(V->M6h, V->G, M3, lever, f, b);
         } else if (p > 0) {
             sym3_add_outer(k->Mh + 6 * p, 1.0 / D, n);
@@ -1377,12 +1449,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                 dydt[V->qoff + na + j] = qd[V->qoff + na + j];
                 dydt[nq + V->qoff + na + j] = k->rdd[j];
             }
-        for (int l = 0; l < V->d->nloops; l++)
-            if (V->xi_off[l] >= 0)
-                cdot[V->xi_off[l]] = V->xi_dot[l];
-        for (int j = 0; j < V->d->ncomponents; j++)
-            if (V->act_off[j] >= 0)
-                cdot[V->act_off[j]] = V->act_dot[j];
+        control_rates(V, cdot);
     }
     return TS_OK;
 }
@@ -1395,19 +1462,31 @@ int ts_kernel_rhs(double t, const double y[], const double u[], double dydt[],
 }
 
 int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
-                        const double a[], const double t[], double R[])
+                        const double a[], const double t[], const double yv[],
+                        const double thdd[], const double u[], double R[])
 {
     const ts_system *sys = k->sys;
     const ts_link *links = sys->links;
     const int nl = k->nl, nn = k->nn;
+    const double rho = sys->env.water_density, g = sys->env.gravity;
+    if (k->root >= 0 || (k->nv > 0 && (!yv || !thdd)))
+        return TS_EINVAL;
+    if (!u)
+        u = k->uzero;
     memcpy(k->r, r, 3 * (size_t)nn * sizeof(double));
     memcpy(k->rd, v, 3 * (size_t)nn * sizeof(double));
+    /* The vehicles' kinematics (attitude from yv, joint at their node),
+     * which place the points P their child cables start from. */
+    for (int i = 0; i < k->nv; i++)
+        if (vehicle_kinematics(k, &k->veh[i], yv))
+            return TS_CHART;
     /* Directions and strains from the positions: n = d / |d|, the strain
      * of an elastic link |d| / l - 1 (it sets only the bending lengths
      * here: the tensions are given). */
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
-        const double *rp = r + 3 * L->upper, *rk = r + 3 * L->lower;
+        const double *rp = L->up_body >= 0 ? k->ur + 3 * l : r + 3 * L->upper;
+        const double *rk = r + 3 * L->lower;
         double d[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
         double len = v3_norm(d);
         if (!(len > 0))
@@ -1428,10 +1507,150 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         v3_axpy(t[l], k->n + 3 * l, R + 3 * L->lower);
-        if (L->upper > 0)
+        if (L->upper > 0 && L->up_body < 0)
             v3_axpy(-t[l], k->n + 3 * l, R + 3 * L->upper);
     }
+    /* Vehicles: the body's equations about A in body axes, r6 = M6 (a_A,
+     * alpha) - G - sum_P J_P^T t n (its child cables at their points P,
+     * their ends' masses and loads in M6 and G), the translational part
+     * (the joint force, R r6[0..2]) added to its node's row, the
+     * rotational part its own rows; then the controller's rates. */
+    double *Rv = R + 3 * nn, *cdot = R + 3 * nn + 3 * k->nv;
+    for (int i = 0; i < k->nv; i++) {
+        veh *V = &k->veh[i];
+        vehicle_loads(k, V, yv, u, rho, g);
+        const tsi_vehicle_state *st = &V->st;
+        double aA[3], nu[6], kap[3], fr[3], am[3], r6[6];
+        for (int j = 0; j < 3; j++)
+            aA[j] = a[3 * V->node + j] + k->afr[3 * V->node + j];
+        mat3_tmul(st->R, aA, nu);
+        tsi_rate_kappa(yv + V->qoff, yv + k->nq + V->qoff, kap);
+        tsi_vehicle_frame_alpha(st, k->frame.turn_rate, k->frame.turn_accel,
+                                fr);
+        mat3_tmul(st->R, fr, am);
+        mat3_mul(st->E, thdd + 3 * i, nu + 3);
+        for (int j = 0; j < 3; j++)
+            nu[3 + j] += kap[j] + am[j];
+        for (int a6 = 0; a6 < 6; a6++) {
+            r6[a6] = -V->G[a6];
+            for (int b = 0; b < 6; b++)
+                r6[a6] += V->M6[6 * a6 + b] * nu[b];
+        }
+        const ts_node *nd = &sys->nodes[V->node];
+        for (int c = nd->child_begin; c < nd->child_end; c++) {
+            int l = sys->child_links[c];
+            double lever[3], f[3], m[3];
+            link_lever(V, &links[l], lever);
+            mat3_tmul(st->R, k->n + 3 * l, f);
+            for (int j = 0; j < 3; j++)
+                f[j] *= t[l];
+            v3_cross(lever, f, m);
+            for (int j = 0; j < 3; j++) {
+                r6[j] -= f[j];
+                r6[3 + j] -= m[j];
+            }
+        }
+        double Fj[3];
+        mat3_mul(st->R, r6, Fj);
+        v3_axpy(1.0, Fj, R + 3 * V->node);
+        for (int j = 0; j < 3; j++)
+            Rv[3 * i + j] = r6[3 + j];
+        control_rates(V, cdot);
+    }
     return TS_OK;
+}
+
+void tsi_kernel_vehicle_mass(const ts_kernel *k, int v, double Mv[36])
+{
+    /* r6 = M6 (R^T a_i, E thdd + ...): d r6 / d(a_i, thdd) = M6 diag(R^T,
+     * E); the translational rows go to M as R r6[0..2]. */
+    const veh *V = &k->veh[v];
+    const double *Rm = V->st.R, *E = V->st.E;
+    double T[36];
+    for (int a6 = 0; a6 < 6; a6++)
+        for (int c = 0; c < 3; c++) {
+            double x = 0, y = 0;
+            for (int b = 0; b < 3; b++) {
+                x += V->M6[6 * a6 + b] * Rm[3 * c + b];  /* (R^T)_{bc} */
+                y += V->M6[6 * a6 + 3 + b] * E[3 * b + c];
+            }
+            T[6 * a6 + c] = x;
+            T[6 * a6 + 3 + c] = y;
+        }
+    for (int c = 0; c < 6; c++) {
+        for (int a3 = 0; a3 < 3; a3++) {
+            Mv[6 * a3 + c] = Rm[3 * a3] * T[c] + Rm[3 * a3 + 1] * T[6 + c] +
+                             Rm[3 * a3 + 2] * T[12 + c];
+            Mv[6 * (3 + a3) + c] = T[6 * (3 + a3) + c];
+        }
+    }
+}
+
+void tsi_kernel_link_point(const ts_kernel *k, int l, const double n[3],
+                           double pg[3], double pm[3])
+{
+    const ts_link *L = &k->sys->links[l];
+    const veh *V = &k->veh[k->node_veh[L->upper]];
+    const double *R = V->st.R, *E = V->st.E;
+    double lever[3], rho[3], x[3], RE[9], nb[3];
+    link_lever(V, L, lever);
+    mat3_mul(R, lever, rho);
+    v3_cross(rho, n, x);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            RE[3 * i + j] = R[3 * i] * E[j] + R[3 * i + 1] * E[3 + j] +
+                            R[3 * i + 2] * E[6 + j];
+    mat3_tmul(RE, x, pg);
+    mat3_tmul(R, n, nb);
+    v3_cross(lever, nb, pm);
+    for (int j = 0; j < 3; j++)
+        pm[j] = -pm[j];
+}
+
+void tsi_kernel_vehicle_layout(const ts_kernel *k, int v, tsi_vehicle_layout *lay)
+{
+    const veh *V = &k->veh[v];
+    lay->node = V->node;
+    lay->qoff = V->qoff;
+    lay->c0 = -1;
+    lay->nc = 0;
+    lay->in0 = -1;
+    lay->nin = 0;
+    int cmin = k->nc, cmax = -1, imin = k->nin, imax = -1;
+    for (int l = 0; l < V->d->nloops; l++) {
+        int x[3] = {V->xi_off[l], V->in_loop[l], V->in_sp[l]};
+        if (x[0] >= 0) {
+            cmin = x[0] < cmin ? x[0] : cmin;
+            cmax = x[0] > cmax ? x[0] : cmax;
+        }
+        for (int j = 1; j < 3; j++)
+            if (x[j] >= 0) {
+                imin = x[j] < imin ? x[j] : imin;
+                imax = x[j] > imax ? x[j] : imax;
+            }
+    }
+    for (int c = 0; c < V->d->ncomponents; c++) {
+        if (V->act_off[c] >= 0) {
+            cmin = V->act_off[c] < cmin ? V->act_off[c] : cmin;
+            cmax = V->act_off[c] > cmax ? V->act_off[c] : cmax;
+        }
+        if (V->in_surf[c] >= 0) {
+            imin = V->in_surf[c] < imin ? V->in_surf[c] : imin;
+            imax = V->in_surf[c] > imax ? V->in_surf[c] : imax;
+        }
+    }
+    if (cmax >= 0) {
+        lay->c0 = cmin;
+        lay->nc = cmax - cmin + 1;
+    }
+    if (imax >= 0) {
+        lay->in0 = imin;
+        lay->nin = imax - imin + 1;
+    }
+    lay->out0 = 0;
+    for (int u = 0; u < v; u++)
+        lay->out0 += OUT_MEASURES + k->veh[u].d->nloops + nsurfaces(&k->veh[u]);
+    lay->nout = OUT_MEASURES + V->d->nloops + nsurfaces(V);
 }
 
 const double *tsi_kernel_mass(const ts_kernel *k) { return k->M; }

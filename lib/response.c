@@ -10,8 +10,15 @@
  * displacement and every link's tension: O(nlinks) per frequency. At
  * w = 0 the solve is real and gives the static gain.
  *
- * A system the sparse model does not cover (vehicles) takes the dense
- * way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1 b by the dense shifted
+ * A towed vehicle's input (a control surface, a loop, a set point) is a
+ * column of the model's G, its own rows' -Ku and +Hu, with the tow point
+ * at rest; a vehicle's output (depth, pitch, roll, yaw, a loop's output,
+ * a deflection) is its row Ov on its node's displacement, its angles,
+ * their rates, its controller states and its inputs (lib/descriptor.h).
+ *
+ * A system the sparse model does not cover (a towing vehicle at the
+ * root) takes the dense way: b = B_x + s B_v + s^2 B_a, Z = (s I - A)^-1
+ * b by the dense shifted
  * solve of lib/shift.h (one LU of P(s), O(nq^3)), then positions through
  * the link geometry plus the tow displacement, tensions through dT/dy and
  * dT/du. Each gain gets the linearization's error allowance, the sparse
@@ -61,14 +68,10 @@ void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
 int ts_response_input_lookup(const ts_kernel *k, const char *name,
                              int *channel, ts_err *err)
 {
-    if (ts_response_input_find(name, channel, NULL) == TS_OK) {
-        if (ts_kernel_root(k) < 0)
-            return TS_OK;
-        return ts_fail(err, TS_EINVAL, "input '%s': the tow point is the "
-                       "towing vehicle's, not prescribed; its inputs are "
-                       "<vehicle>.thrust, .force.x|y|z, .moment.x|y|z and "
-                       "its control surfaces and loops", name);
-    }
+    /* With a towing vehicle the tow-point inputs move the tow point
+     * relative to the vehicle (a wave-induced motion; the kernel). */
+    if (ts_response_input_find(name, channel, NULL) == TS_OK)
+        return TS_OK;
     int j = ts_kernel_input_find(k, name);
     int fin = ts_kernel_ninput(k);
     for (int c = 0; c < TS_NFRAME_INPUT && j < 0; c++)
@@ -236,6 +239,8 @@ typedef struct resp_ws {
     double *dq, *drr, *m; /* m: a position output's row of the node
                              displacement map (for the error) */
     double complex *wt;   /* [nx] the sparse way's transposed solution */
+    double complex *z;    /* a vehicle output's local vector (TSI_LV_*) */
+    double *zh;           /* its columns' steps */
 } resp_ws;
 
 /* The dense way's error allowance of the gain g = c^T x (+ parts free of
@@ -450,27 +455,146 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     }
 }
 
-/* The sparse way's error allowance of the gain g = c^T x, S(s) x = b
- * (x the node displacements and link tensions, c the output's unit
- * vector): errors dK, dC of the model change it by dg = -w^T dS x_full
- * with S(s)^T w = c (one transposed solve with the same factors) and
- * x_full the node displacements with the tow point's (the input columns
- * of K and C are the right-hand side's). tsi_desc_error_terms gives the
- * truncation and rounding parts (doc/linear.md, section 4); the allowance
- * is 10 times their sum, as the dense way's. A tension is an unknown of
- * the model: its gain needs no Jacobian of its own. NaN without the
- * estimate. Cost: one transposed solve, O(nlinks). */
-static double sparse_gain_error(tsi_shift *sh, const ts_output *out,
-                                resp_ws *w)
+/* The vehicle of output j (its index; *row its row in the vehicle's
+ * output block), -1. */
+static int output_vehicle(const ts_descriptor *d, int j, int *row)
+{
+    for (int v = 0; v < d->nv; v++)
+        if (j >= d->vl[v].out0 && j < d->vl[v].out0 + d->vl[v].nout) {
+            *row = j - d->vl[v].out0;
+            return v;
+        }
+    return -1;
+}
+
+/* A vehicle output's local vector z (TSI_LV_*: its node's displacement,
+ * its angles, their rates s x, its controller states, its inputs) of the
+ * solution x[3 np + nc] to the input `input` at s; with h, the steps of
+ * those columns. Returns the number of columns. */
+static int local_vector(const ts_descriptor *d, int v, int input,
+                        double complex s, const double complex *x,
+                        double complex *z, double *h)
+{
+    const tsi_vehicle_layout *L = &d->vl[v];
+    for (int lc = 0; lc < 6; lc++) {
+        int i = lc < 3 ? 3 * L->node + lc : 3 * (d->nn + v) + lc - 3;
+        z[lc] = x[i];
+        z[TSI_LV_V + lc] = s * x[i];
+        if (h) {
+            h[lc] = d->hr[i];
+            h[TSI_LV_V + lc] = d->hv[i];
+        }
+    }
+    for (int m = 0; m < L->nc; m++) {
+        z[TSI_LV_C + m] = x[3 * (size_t)d->np + L->c0 + m];
+        if (h)
+            h[TSI_LV_C + m] = d->hc[L->c0 + m];
+    }
+    for (int m = 0; m < L->nin; m++) {
+        z[TSI_LV_C + L->nc + m] = L->in0 + m == input ? 1.0 : 0.0;
+        if (h)
+            h[TSI_LV_C + L->nc + m] = d->hu[L->in0 + m];
+    }
+    return TSI_LV_C + L->nc + L->nin;
+}
+
+/* The gain of output out in the sparse solution (dr, dt) to `input`. */
+static double complex sparse_gain(const ts_descriptor *d, int input,
+                                  const ts_output *out, double complex s,
+                                  resp_ws *w)
+{
+    if (out->kind == TS_OUT_POSITION)
+        return w->dr[3 * out->node + out->comp];
+    if (out->kind == TS_OUT_TENSION)
+        return w->dt[out->link];
+    int row = 0, v = output_vehicle(d, out->index, &row);
+    int ncol = local_vector(d, v, input, s, w->dr, w->z, NULL);
+    const double *Ov = d->Ov + d->ov_off[v] + row * ncol;
+    double complex g = 0;
+    for (int lc = 0; lc < ncol; lc++)
+        g += Ov[lc] * w->z[lc];
+    return g;
+}
+
+/* The sparse way's error allowance of the gain g = c^T x (+ a vehicle
+ * output's input term), S(s) x = b (x the point displacements, link
+ * tensions and controller states, c the output's row: a unit vector for
+ * a position or a tension, a vehicle output's Ov on its local columns at
+ * s): errors dS of the model and db of a vehicle input's column change it
+ * by dg = w^T (db - dS x_full) with S(s)^T w = c (one transposed solve
+ * with the same factors) and x_full the point displacements with the tow
+ * point's (the input columns of K and C are the right-hand side's).
+ * tsi_desc_error_terms gives dS's truncation and rounding parts
+ * (doc/linear.md, section 4), db's are its local block's (Lerr, and
+ * rnoise_i / (sqrt(2) hu) per row); a vehicle output adds its own row's
+ * truncation |Oerr z| and rounding onoise sqrt(sum |z_j|^2 / h_j^2) /
+ * sqrt 2. The allowance is 10 times their sum, as the dense way's. NaN
+ * without the estimate. Cost: one transposed solve, O(nlinks). */
+static double sparse_gain_error(tsi_shift *sh, int input,
+                                const ts_output *out, resp_ws *w)
 {
     const ts_descriptor *d = sh->d;
+    double complex s = sh->s;
+    if (!d->Oerr || !d->onoise)
+        return NAN;
     memset(w->wt, 0, (size_t)d->nx * sizeof(double complex));
-    w->wt[out->kind == TS_OUT_POSITION ? 4 * (out->node - 1) + out->comp
-                                       : 4 * out->link + 3] = 1.0;
+    int row = 0, v = -1, ncol = 0;
+    if (out->kind == TS_OUT_POSITION) {
+        w->wt[tsi_desc_xr(d, out->node, out->comp)] = 1.0;
+    } else if (out->kind == TS_OUT_TENSION) {
+        w->wt[TSI_XT(out->link)] = 1.0;
+    } else {
+        v = output_vehicle(d, out->index, &row);
+        const tsi_vehicle_layout *L = &d->vl[v];
+        ncol = TSI_LV_C + L->nc + L->nin;
+        const double *Ov = d->Ov + d->ov_off[v] + row * ncol;
+        for (int a = 0; a < 3; a++) {
+            w->wt[tsi_desc_xr(d, L->node, a)] = Ov[a] + s * Ov[TSI_LV_V + a];
+            w->wt[tsi_desc_xr(d, d->nn + v, a)] =
+                Ov[TSI_LV_TH + a] + s * Ov[TSI_LV_W + a];
+        }
+        for (int m = 0; m < L->nc; m++)
+            w->wt[tsi_desc_xc(d, L->c0 + m)] = Ov[TSI_LV_C + m];
+    }
     tsi_shift_tsolve(sh, w->wt);
     double tr, ro;
-    tsi_desc_error_terms(d, w->wt, w->dr, sh->s, &tr, &ro);
-    return 10.0 * (tr + ro);
+    tsi_desc_error_terms(d, w->wt, w->dr, s, &tr, &ro);
+    double complex tb = 0;
+    double rb2 = 0;
+    for (int u = 0; input >= TS_NINPUT && u < d->nv; u++) {
+        const tsi_vehicle_layout *L = &d->vl[u];
+        if (input < L->in0 || input >= L->in0 + L->nin)
+            continue;
+        int nc = TSI_LV_C + L->nc + L->nin, uc = TSI_LV_C + L->nc +
+                                                 input - L->in0;
+        double hu = d->hu[input];
+        for (int lr = 0; lr < 6 + L->nc; lr++) {
+            int x = lr < 3 ? tsi_desc_xr(d, L->node, lr)
+                    : lr < 6 ? tsi_desc_xr(d, d->nn + u, lr - 3)
+                             : tsi_desc_xc(d, L->c0 + lr - 6);
+            size_t ri = lr < 3 ? 3 * (size_t)L->node + lr
+                        : lr < 6 ? 3 * (size_t)(d->nn + u) + lr - 3
+                                 : 3 * (size_t)d->np + L->c0 + lr - 6;
+            double e = d->Lerr[d->lv_off[u] + lr * nc + uc];
+            tb += w->wt[x] * (lr < 6 ? -e : e);
+            double a = cabs(w->wt[x]) * d->rnoise[ri] / hu;
+            rb2 += 0.5 * a * a;
+        }
+    }
+    double e = tr + cabs(tb) + sqrt(ro * ro + rb2);
+    if (v >= 0) {
+        local_vector(d, v, input, s, w->dr, w->z, w->zh);
+        const double *Oe = d->Oerr + d->ov_off[v] + row * ncol;
+        double complex ot = 0;
+        double zh2 = 0;
+        for (int lc = 0; lc < ncol; lc++) {
+            ot += Oe[lc] * w->z[lc];
+            double a = cabs(w->z[lc]) / w->zh[lc];
+            zh2 += a * a;
+        }
+        e += cabs(ot) + d->onoise[out->index] * sqrt(0.5 * zh2);
+    }
+    return 10.0 * e;
 }
 
 /* The gain at omega; sh holds the factors of the previous frequency
@@ -493,10 +617,9 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
     }
     if (lin->desc) {
         tsi_shift_input(sh, input, w->dr, w->dt);
-        *g = out->kind == TS_OUT_POSITION ? w->dr[3 * out->node + out->comp]
-                                          : w->dt[out->link];
+        *g = sparse_gain(lin->desc, input, out, sh->s, w);
         if (gerr)
-            *gerr = sparse_gain_error(sh, out, w);
+            *gerr = sparse_gain_error(sh, input, out, w);
     } else {
         dense_gain(sys, lin, input, out, sh, w, g, gerr);
     }
@@ -523,10 +646,6 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
         return ts_fail(err, TS_EINVAL, "response: %s needs the dense "
                        "model (linearize with TS_LIN_DENSE)",
                        lin->input_name[input]);
-    if (lin->desc && (input >= TS_NINPUT || out->kind == TS_OUT_VEHICLE))
-        return ts_fail(err, TS_EINVAL, "response: a vehicle's input or "
-                       "output needs the dense model (the sparse one has no "
-                       "vehicles)");
     if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
                        "response: output %s needs a linear model (sparse, "
@@ -563,12 +682,17 @@ static int ws_alloc(resp_ws *w, const ts_linear *lin, const ts_system *sys,
                     const ts_output *out)
 {
     memset(w, 0, sizeof *w);
-    w->dr = malloc(3 * (size_t)lin->nnodes * sizeof(double complex));
+    size_t ndr = lin->desc ? 3 * (size_t)lin->desc->np + (size_t)lin->desc->nc
+                           : 3 * (size_t)lin->nnodes;
+    w->dr = malloc(ndr * sizeof(double complex));
     w->dt = malloc((size_t)(lin->nlinks > 0 ? lin->nlinks : 1) *
                    sizeof(double complex));
     if (lin->desc) {
         w->wt = malloc(((size_t)lin->desc->nx + 1) * sizeof(double complex));
-        if (!w->wt)
+        size_t nz = TSI_LV_C + (size_t)lin->desc->nc + (size_t)lin->ninput;
+        w->z = malloc(nz * sizeof(double complex));
+        w->zh = malloc(nz * sizeof(double));
+        if (!w->wt || !w->z || !w->zh)
             return 0;
     } else {
         w->b = malloc((size_t)lin->nstate * sizeof(double complex));
@@ -611,6 +735,8 @@ static void ws_free(resp_ws *w)
     free(w->t3);
     free(w->m);
     free(w->wt);
+    free(w->z);
+    free(w->zh);
 }
 
 int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,

@@ -16,8 +16,9 @@
 
 #include "lapack.h"
 
-#define XR(k, c) (4 * ((k)-1) + (c))
-#define XT(l) (4 * (l) + 3)
+#define XR(k, c) tsi_desc_xr(d, (k), (c))
+#define XT(l) TSI_XT(l)
+#define XC(j) tsi_desc_xc(d, (j))
 
 void tsi_shift_free(tsi_shift *sh)
 {
@@ -316,13 +317,13 @@ static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
     sh->lin = lin;
     sh->d = d;
     sh->sys = d->sys;
-    size_t n3 = 3 * (size_t)d->nn;
+    size_t n3 = 3 * (size_t)d->np + (size_t)d->nc;
     sh->common = malloc(sizeof(klu_common));
     sh->Sx = malloc(2 * ((size_t)d->nnz + 1) * sizeof(double));
     sh->rhs = malloc(2 * ((size_t)d->nx + 1) * sizeof(double));
     sh->cols = malloc(2 * ((size_t)d->nx + 1) * sizeof(double));
     sh->u1 = malloc(2 * n3 * sizeof(double));
-    sh->u2 = malloc(4 * n3 * sizeof(double));
+    sh->u2 = malloc((6 * n3 + (size_t)d->nin) * sizeof(double));
     sh->w = malloc(2 * ((size_t)lin->nq + 1) * sizeof(double));
     if (!sh->common || !sh->Sx || !sh->rhs || !sh->cols || !sh->u1 ||
         !sh->u2 || !sh->w) {
@@ -474,17 +475,19 @@ int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err)
 
 void tsi_shift_nodes_to_q(const tsi_shift *sh, const double *dr, double *dq)
 {
-    tsi_desc_from_nodes(sh->sys, sh->lin, dr, dq);
+    tsi_desc_from_points(sh->d, sh->lin, dr, dq);
 }
 
-/* dr[3 nn] (dr_0 = 0) from the displacement part of a real solution. */
-static void solution_nodes(const ts_descriptor *d, const double *x, int stride,
-                           double *dr)
+/* p[3 np] (p_0 = 0) and c[nc] from a real solution at stride. */
+static void solution_points(const ts_descriptor *d, const double *x,
+                            int stride, double *p, double *c)
 {
-    dr[0] = dr[1] = dr[2] = 0.0;
-    for (int k = 1; k < d->nn; k++)
-        for (int c = 0; c < 3; c++)
-            dr[3 * k + c] = x[stride * XR(k, c)];
+    p[0] = p[1] = p[2] = 0.0;
+    for (int k = 1; k < d->np; k++)
+        for (int a = 0; a < 3; a++)
+            p[3 * k + a] = x[stride * XR(k, a)];
+    for (int j = 0; c && j < d->nc; j++)
+        c[j] = x[stride * XC(j)];
 }
 
 /* The link rows' right-hand side of taut elastic links, the damping's
@@ -504,26 +507,30 @@ static void taut_rates(const tsi_shift *sh, const double *wq, double *rhs,
     }
 }
 
-static void mass_mul(const ts_descriptor *d, int k, const double x[3],
-                     double y[3])
+/* One real part of (s I - A)^-1 w's right-hand side, w = (wq, wqd, wc)
+ * (nq, nq, nc): into rhs at stride the parts free of s, M J wqd + C J wq
+ * in the point rows, Cv n.(J wq) in the taut links' rows and wc - Hv J wq
+ * in the controller rows, and J wq into u1 and M J wq into mu (the
+ * caller adds s mu). u2 [3 np + nc] work. */
+static void rhs_part(const tsi_shift *sh, const double *w, double *u1,
+                     double *mu, double *u2, double *rhs, int stride)
 {
-    const double *S = d->M + 6 * k;
-    y[0] = S[0] * x[0] + S[3] * x[1] + S[4] * x[2];
-    y[1] = S[3] * x[0] + S[1] * x[1] + S[5] * x[2];
-    y[2] = S[4] * x[0] + S[5] * x[1] + S[2] * x[2];
-}
-
-/* The real or imaginary part (part 0, 1) of (s I - A)^-1 w's right-hand
- * side, w given by its parts wq, wqd (nq each): node rows M (s J wq +
- * J wqd) + C J wq, link rows of taut links Cv n.(J wq). Only for real s
- * is this the whole right-hand side; for complex s the caller combines
- * the parts. u1, u2, cu: [3 nn] work. */
-static void rhs_parts(const tsi_shift *sh, const double *wq, const double *wqd,
-                      double *u1, double *u2, double *cu)
-{
-    ts_linear_node_displacements(sh->sys, sh->lin, wq, u1);
-    ts_linear_node_displacements(sh->sys, sh->lin, wqd, u2);
-    tsi_desc_block_mul(sh->d, sh->d->C, u1, cu, 0);
+    const ts_descriptor *d = sh->d;
+    int nq = sh->lin->nq;
+    size_t n3 = 3 * (size_t)d->np;
+    double *hc = u2 + n3;
+    tsi_desc_to_points(d, sh->lin, w, u1);
+    tsi_desc_to_points(d, sh->lin, w + nq, u2);
+    tsi_desc_mass_mul(d, u2, mu);
+    tsi_desc_block_mul(d, d->C, u1, mu, 1);
+    for (int k = 1; k < d->np; k++)
+        for (int a = 0; a < 3; a++)
+            rhs[stride * XR(k, a)] = mu[3 * k + a];
+    taut_rates(sh, w, rhs, stride);
+    tsi_desc_local_mul(d, NULL, u1, NULL, NULL, hc, NULL, 0);
+    for (int j = 0; j < d->nc; j++)
+        rhs[stride * XC(j)] = w[2 * nq + j] - hc[j];
+    tsi_desc_mass_mul(d, u1, mu);
 }
 
 void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
@@ -533,26 +540,21 @@ void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
         return;
     }
     const ts_descriptor *d = sh->d;
-    int nq = sh->lin->nq;
-    size_t n3 = 3 * (size_t)d->nn;
+    int nq = sh->lin->nq, nc = d->nc;
+    size_t m = 3 * (size_t)d->np + (size_t)nc;
     double s = creal(sh->s);
-    double *u1 = sh->u1, *u2 = sh->u2, *cu = sh->u2 + n3, *w = sh->w;
+    double *u1 = sh->u1, *mu = sh->u1 + m, *u2 = sh->u2, *p = sh->u2 + 2 * m;
+    double *w = sh->cols;
     /* (A - s I) x = b  <=>  (s I - A) x = -b = w. */
-    for (int i = 0; i < 2 * nq; i++)
+    for (int i = 0; i < 2 * nq + nc; i++)
         w[i] = -b[i];
-    rhs_parts(sh, w, w + nq, u1, u2, cu);
-    for (int k = 1; k < d->nn; k++) {
-        double v[3], Mv[3];
-        for (int c = 0; c < 3; c++)
-            v[c] = s * u1[3 * k + c] + u2[3 * k + c];
-        mass_mul(d, k, v, Mv);
-        for (int c = 0; c < 3; c++)
-            sh->rhs[XR(k, c)] = Mv[c] + cu[3 * k + c];
-    }
-    taut_rates(sh, w, sh->rhs, 1);
+    rhs_part(sh, w, u1, mu, u2, sh->rhs, 1);
+    for (int k = 1; k < d->np; k++)
+        for (int a = 0; a < 3; a++)
+            sh->rhs[XR(k, a)] += s * mu[3 * k + a];
     klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
-    solution_nodes(d, sh->rhs, 1, u2);
-    tsi_shift_nodes_to_q(sh, u2, x);
+    solution_points(d, sh->rhs, 1, p, x + 2 * nq);
+    tsi_shift_nodes_to_q(sh, p, x);
     for (int i = 0; i < nq; i++)
         x[nq + i] = s * x[i] - w[i];
 }
@@ -582,38 +584,25 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
         return;
     }
     const ts_descriptor *d = sh->d;
-    int nq = sh->lin->nq;
-    size_t n3 = 3 * (size_t)d->nn;
+    int nq = sh->lin->nq, nc = d->nc, n = 2 * nq + nc;
+    size_t m = 3 * (size_t)d->np + (size_t)nc;
     double complex s = sh->s;
-    double *ur = sh->u1, *ui = sh->u1 + n3, *u2 = sh->u2, *cu = sh->u2 + n3;
-    double *w = sh->w, *rhs = sh->rhs;
-    /* Real and imaginary parts of w = -b, one map each: node rows
-     * M (s J wq + J wqd) + C J wq; parts combined below. */
+    double *u1 = sh->u1, *u2 = sh->u2, *mu = sh->u2 + 2 * m;
+    double *w = sh->cols, *rhs = sh->rhs;
+    /* The real and imaginary parts of w = -b, one map each; then + s M J
+     * wq, complex. */
     for (int part = 0; part < 2; part++) {
-        for (int i = 0; i < 2 * nq; i++)
+        for (int i = 0; i < n; i++)
             w[i] = part ? -cimag(b[i]) : -creal(b[i]);
-        double *u1 = part ? ui : ur;
-        rhs_parts(sh, w, w + nq, u1, u2, cu);
-        /* rhs += (M J wqd + C J wq) of this part, as that part. */
-        for (int k = 1; k < d->nn; k++) {
-            double Mv[3];
-            mass_mul(d, k, u2 + 3 * k, Mv);
-            for (int c = 0; c < 3; c++)
-                rhs[2 * XR(k, c) + part] = Mv[c] + cu[3 * k + c];
-        }
-        taut_rates(sh, w, rhs + part, 2);
+        rhs_part(sh, w, u1 + part * m, mu + part * m, u2, rhs + part, 2);
     }
-    /* + s M J wq, complex. */
-    for (int k = 1; k < d->nn; k++) {
-        double Mr[3], Mi[3];
-        mass_mul(d, k, ur + 3 * k, Mr);
-        mass_mul(d, k, ui + 3 * k, Mi);
-        for (int c = 0; c < 3; c++) {
-            double complex v = s * (Mr[c] + I * Mi[c]);
-            rhs[2 * XR(k, c)] += creal(v);
-            rhs[2 * XR(k, c) + 1] += cimag(v);
+    const double *mr = mu, *mi = mu + m;
+    for (int k = 1; k < d->np; k++)
+        for (int a = 0; a < 3; a++) {
+            double complex v = s * (mr[3 * k + a] + I * mi[3 * k + a]);
+            rhs[2 * XR(k, a)] += creal(v);
+            rhs[2 * XR(k, a) + 1] += cimag(v);
         }
-    }
     if (sh->is_complex) {
         klu_z_solve(d->klu_symbolic, sh->numeric, d->nx, 1, rhs, sh->common);
     } else {
@@ -621,35 +610,57 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
          * sides. */
         two_columns(sh);
     }
-    double *xr = sh->w, *xi = sh->w + nq;
-    solution_nodes(d, rhs, 2, u2);
-    tsi_shift_nodes_to_q(sh, u2, xr);
-    solution_nodes(d, rhs + 1, 2, u2);
-    tsi_shift_nodes_to_q(sh, u2, xi);
+    double *xr = sh->w, *xi = sh->w + nq, *p = u2, *cr = u1, *ci = u1 + m;
+    solution_points(d, rhs, 2, p, cr);
+    tsi_shift_nodes_to_q(sh, p, xr);
+    solution_points(d, rhs + 1, 2, p, ci);
+    tsi_shift_nodes_to_q(sh, p, xi);
     for (int i = 0; i < nq; i++) {
         x[i] = xr[i] + I * xi[i];
         x[nq + i] = s * x[i] + b[i]; /* s x_q - w_q, w = -b */
     }
+    for (int j = 0; j < nc; j++)
+        x[2 * nq + j] = cr[j] + I * ci[j];
+}
+
+/* Solve with S_inf for the force change f[3 np] (rhs -f), the link rows
+ * rhs_t (NULL: zero) and the controller rates hc[nc]; into y the
+ * accelerations' coordinates q''[nq] and the rates c'[nc]. */
+static void inf_solve(tsi_shift *sh, const double *f, const double *rhs_t,
+                      const double *hc, double *qdd, double *cd)
+{
+    const ts_descriptor *d = sh->d;
+    size_t m = 3 * (size_t)d->np + (size_t)d->nc;
+    for (int k = 1; k < d->np; k++)
+        for (int a = 0; a < 3; a++)
+            sh->rhs[XR(k, a)] = -f[3 * k + a];
+    for (int l = 0; l < d->nl; l++)
+        sh->rhs[XT(l)] = rhs_t ? rhs_t[l] : 0.0;
+    for (int j = 0; j < d->nc; j++)
+        sh->rhs[XC(j)] = hc[j];
+    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
+    double *p = sh->u1 + m;
+    solution_points(d, sh->rhs, 1, p, cd);
+    tsi_shift_nodes_to_q(sh, p, qdd);
 }
 
 void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
 {
     const ts_descriptor *d = sh->d;
-    int nq = sh->lin->nq;
-    size_t n3 = 3 * (size_t)d->nn;
-    double *u1 = sh->u1, *u2 = sh->u1 + n3, *f = sh->u2;
+    int nq = sh->lin->nq, nc = d->nc;
+    size_t n3 = 3 * (size_t)d->np, m = n3 + (size_t)nc;
+    double *u1 = sh->u1, *u2 = sh->u2, *f = sh->u2 + m, *hc = sh->u2 + 2 * m;
+    double *rt = sh->u2 + 3 * m;
     const double *K = err ? d->Kerr : d->K, *C = err ? d->Cerr : d->C;
-    ts_linear_node_displacements(sh->sys, sh->lin, x, u1);
-    ts_linear_node_displacements(sh->sys, sh->lin, x + nq, u2);
+    tsi_desc_to_points(d, sh->lin, x, u1);
+    tsi_desc_to_points(d, sh->lin, x + nq, u2);
     if (K && C) {
         tsi_desc_block_mul(d, K, u1, f, 0);
         tsi_desc_block_mul(d, C, u2, f, 1);
     } else {
         memset(f, 0, n3 * sizeof(double));
     }
-    for (int k = 1; k < d->nn; k++)
-        for (int c = 0; c < 3; c++)
-            sh->rhs[XR(k, c)] = -f[3 * k + c];
+    tsi_desc_local_mul(d, u1, u2, x + 2 * nq, NULL, hc, f, err);
     /* Link rows: rigid n.(a_k - a_p) = 0; elastic -dt = -(the tension
      * change), EA de + Cv l de' from the coordinates themselves (exact,
      * so zero for the error estimate). */
@@ -660,12 +671,10 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
             int o = sh->lin->qoff[l];
             v = L->ea * x[o + 2] + d->ca[l] * L->length * x[nq + o + 2];
         }
-        sh->rhs[XT(l)] = -v;
+        rt[l] = -v;
     }
-    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
-    solution_nodes(d, sh->rhs, 1, u1);
     memcpy(y, x + nq, (size_t)nq * sizeof(double));
-    tsi_shift_nodes_to_q(sh, u1, y + nq);
+    inf_solve(sh, f, rt, hc, y + nq, y + 2 * nq);
 }
 
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
@@ -677,9 +686,26 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
     int nx = d->nx;
     double *rhs = sh->rhs;
     memset(rhs, 0, 2 * (size_t)nx * sizeof(double));
-    /* Node rows: -(K_k0 + s C_k0) e_input, the tow point's displacement
+    if (input >= TS_NINPUT) {
+        /* A vehicle's input: its own rows, -Ku in the force and
+         * rotational rows, +Hu in the controller rows; the tow point
+         * stays. */
+        size_t m = 3 * (size_t)d->np + (size_t)d->nc;
+        double *f = sh->u2, *hc = sh->u2 + m, *u = sh->u2 + 3 * m;
+        memset(f, 0, 3 * (size_t)d->np * sizeof(double));
+        memset(u, 0, (size_t)d->nin * sizeof(double));
+        u[input] = 1.0;
+        tsi_desc_local_mul(d, NULL, NULL, NULL, u, hc, f, 0);
+        for (int k = 1; k < d->np; k++)
+            for (int a = 0; a < 3; a++)
+                rhs[2 * XR(k, a)] = -f[3 * k + a];
+        for (int j = 0; j < d->nc; j++)
+            rhs[2 * XC(j)] = hc[j];
+        input = -1;
+    }
+    /* Point rows: -(K_k0 + s C_k0) e_input, the tow point's displacement
      * and velocity seen by its neighbours. */
-    for (int k = 1; k < d->nn; k++)
+    for (int k = 1; input >= 0 && k < d->np; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             if (d->bcol[b] != 0)
                 continue;
@@ -693,7 +719,7 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
     /* Rows of the links leaving the tow point: their constraint (or
      * tension law) on dr_k - e_input. */
     for (int l = 0; l < d->nl; l++) {
-        if (sys->links[l].upper != 0)
+        if (sys->links[l].upper != 0 || input < 0)
             continue;
         double complex g[3] = {d->n[3 * l], d->n[3 * l + 1], d->n[3 * l + 2]};
         if (d->kind[l] == TSI_LINK_TAUT)
@@ -709,9 +735,11 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
         two_columns(sh);
     for (int c = 0; c < 3; c++)
         dr[c] = c == input ? 1.0 : 0.0;
-    for (int k = 1; k < d->nn; k++)
+    for (int k = 1; k < d->np; k++)
         for (int c = 0; c < 3; c++)
             dr[3 * k + c] = rhs[2 * XR(k, c)] + I * rhs[2 * XR(k, c) + 1];
+    for (int j = 0; j < d->nc; j++)
+        dr[3 * d->np + j] = rhs[2 * XC(j)] + I * rhs[2 * XC(j) + 1];
     for (int l = 0; l < d->nl; l++)
         dt[l] = rhs[2 * XT(l)] + I * rhs[2 * XT(l) + 1];
 }
@@ -719,35 +747,39 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
 void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
 {
     const ts_descriptor *d = sh->d;
-    int nq = sh->lin->nq, c = j % 3;
-    double *f = sh->u2;
-    /* Node rows: the force change of the input with the coordinates
-     * fixed; every node moves with a tow displacement or velocity. */
-    for (int k = 1; k < d->nn; k++) {
-        double acc[3] = {0, 0, 0};
+    int nq = sh->lin->nq, nc = d->nc, c = j % 3;
+    size_t n3 = 3 * (size_t)d->np, m = n3 + (size_t)nc;
+    double *f = sh->u2, *hc = sh->u2 + m, *e = sh->u2 + 2 * m;
+    double *u = sh->u2 + 3 * m;
+    memset(f, 0, n3 * sizeof(double));
+    memset(e, 0, n3 * sizeof(double));
+    if (j < TS_NINPUT) {
+        /* The force change of a tow input with the coordinates fixed:
+         * every node moves with a tow displacement or velocity (the
+         * vehicles' angles do not). */
+        for (int k = 0; k < d->nn; k++)
+            e[3 * k + c] = 1.0;
         if (j < TS_IN_ACC) {
             const double *B = j < TS_IN_VEL ? (err ? d->Kerr : d->K)
                                             : (err ? d->Cerr : d->C);
-            for (int b = d->bptr[k]; B && b < d->bptr[k + 1]; b++)
-                for (int a = 0; a < 3; a++)
-                    acc[a] += B[9 * (size_t)b + 3 * a + c];
-        } else if (!err) {
-            double e[3] = {0, 0, 0};
-            e[c] = 1.0;
-            mass_mul(d, k, e, acc);
+            if (B)
+                tsi_desc_block_mul(d, B, e, f, 0);
+            tsi_desc_local_mul(d, j < TS_IN_VEL ? e : NULL,
+                               j < TS_IN_VEL ? NULL : e, NULL, NULL, hc, NULL,
+                               err);
+        } else {
+            if (!err)
+                tsi_desc_mass_mul(d, e, f);
+            memset(hc, 0, (size_t)nc * sizeof(double));
         }
-        for (int a = 0; a < 3; a++)
-            f[3 * k + a] = acc[a];
+    } else {
+        /* A vehicle's input: its own rows only. */
+        memset(u, 0, (size_t)d->nin * sizeof(double));
+        u[j] = 1.0;
+        tsi_desc_local_mul(d, NULL, NULL, NULL, u, hc, f, err);
     }
-    for (int k = 1; k < d->nn; k++)
-        for (int a = 0; a < 3; a++)
-            sh->rhs[XR(k, a)] = -f[3 * k + a];
-    for (int l = 0; l < d->nl; l++)
-        sh->rhs[XT(l)] = 0.0;
-    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
-    solution_nodes(d, sh->rhs, 1, sh->u1);
     memset(col, 0, (size_t)nq * sizeof(double));
-    tsi_shift_nodes_to_q(sh, sh->u1, col + nq);
+    inf_solve(sh, f, NULL, hc, col + nq, col + 2 * nq);
 }
 
 void tsi_shift_tsolve(tsi_shift *sh, double complex *w)
@@ -780,23 +812,22 @@ static void unit_max(double complex *w, int m)
             w[i] /= big;
 }
 
-/* w^T S(lam) [x; 0] from S's parts P[3 nnz] (Sk, Sc, Sm: S(s) = Sk + s Sc
- * + s^2 Sm), its node columns times the node displacements x[3 nn] (the
- * tensions' columns left out), summed against w[nx]. O(nnz). */
+/* w^T S(lam) X from S's parts P[3 nnz] (Sk, Sc, Sm: S(s) = Sk + s Sc
+ * + s^2 Sm), X[nx] the unknowns (points and controller states; the
+ * tensions' entries zero), summed against w[nx]. O(nnz). */
 static double complex pencil_form(const ts_descriptor *d, const double *P,
                                   const double complex *w,
-                                  const double complex *x, double complex lam)
+                                  const double complex *X, double complex lam)
 {
     const double *Sk = P, *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
     double complex sum = 0;
-    for (int k = 1; k < d->nn; k++)
-        for (int a = 0; a < 3; a++) {
-            int j = XR(k, a);
-            double complex xj = x[3 * k + a];
-            for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
-                sum += w[d->Si[p]] * (Sk[p] + lam * (Sc[p] + lam * Sm[p])) *
-                       xj;
-        }
+    for (int j = 0; j < d->nx; j++) {
+        if (X[j] == 0)
+            continue;
+        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
+            sum += w[d->Si[p]] * (Sk[p] + lam * (Sc[p] + lam * Sm[p])) *
+                   X[j];
+    }
     return sum;
 }
 
@@ -827,16 +858,18 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
                        "sparse form");
     if (!d->Kerr || !d->rnoise)
         return TS_OK;
-    int nx = d->nx, nq = lin->nq, nn = d->nn;
-    size_t n3 = 3 * (size_t)nn;
+    int nx = d->nx, nq = lin->nq, nc = d->nc;
+    size_t m = 3 * (size_t)d->np + (size_t)nc;
     double complex *w = malloc(2 * ((size_t)nx + 1) * sizeof *w);
-    double complex *x = malloc(n3 * sizeof *x);
+    double complex *x = malloc(m * sizeof *x);
+    double complex *X = calloc((size_t)nx + 1, sizeof *X);
     double *q = malloc(((size_t)nq + 1) * sizeof *q);
-    double *u = malloc(2 * n3 * sizeof *u);
+    double *u = malloc(2 * m * sizeof *u);
     double *P = malloc(3 * ((size_t)d->nnz + 1) * sizeof *P);
-    if (!w || !x || !q || !u || !P) {
+    if (!w || !x || !X || !q || !u || !P) {
         free(w);
         free(x);
+        free(X);
         free(q);
         free(u);
         free(P);
@@ -870,51 +903,35 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
             tsi_shift_tsolve(sh, w);
             unit_max(w, nx);
         }
-        /* The right vector in node displacements. */
+        /* The right vector as point displacements and controller states
+         * (x), and in the unknowns (X; tensions 0: S' has no tension
+         * columns). */
         for (int part = 0; part < 2; part++) {
             for (int i = 0; i < nq; i++)
                 q[i] = part ? cimag(v[i]) : creal(v[i]);
-            ts_linear_node_displacements(d->sys, lin, q, u + part * n3);
+            tsi_desc_to_points(d, lin, q, u + part * m);
         }
+        size_t n3 = 3 * (size_t)d->np;
         for (size_t i = 0; i < n3; i++)
-            x[i] = u[i] + I * u[n3 + i];
-        /* w^T S'(lam) x. */
-        double complex den = 0;
-        for (int k = 1; k < nn; k++) {
-            double complex y[3] = {0, 0, 0};
-            for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
-                const double *Cb = d->C + 9 * (size_t)b;
-                const double complex *xj = x + 3 * d->bcol[b];
-                for (int a = 0; a < 3; a++)
-                    y[a] += Cb[3 * a] * xj[0] + Cb[3 * a + 1] * xj[1] +
-                            Cb[3 * a + 2] * xj[2];
-            }
-            for (int part = 0; part < 2; part++) {
-                double xs[3], Mx[3];
-                for (int c = 0; c < 3; c++)
-                    xs[c] = part ? cimag(x[3 * k + c]) : creal(x[3 * k + c]);
-                mass_mul(d, k, xs, Mx);
-                for (int a = 0; a < 3; a++)
-                    y[a] += 2.0 * lam * (part ? I * Mx[a] : Mx[a]);
-            }
+            x[i] = u[i] + I * u[m + i];
+        for (int j = 0; j < nc; j++)
+            x[n3 + j] = v[2 * nq + j];
+        for (int k = 1; k < d->np; k++)
             for (int a = 0; a < 3; a++)
-                den += w[XR(k, a)] * y[a];
-        }
-        for (int l = 0; l < d->nl; l++) {
-            if (d->kind[l] != TSI_LINK_TAUT)
-                continue;
-            const ts_link *L = &d->sys->links[l];
-            const double *n = d->n + 3 * l;
-            double complex dd = 0;
-            for (int c = 0; c < 3; c++)
-                dd += n[c] * (x[3 * L->lower + c] - x[3 * L->upper + c]);
-            den += w[XT(l)] * d->ca[l] * dd;
-        }
+                X[XR(k, a)] = x[3 * k + a];
+        for (int j = 0; j < nc; j++)
+            X[XC(j)] = x[n3 + j];
+        /* w^T S'(lam) X, S'(s) = Sc + 2 s Sm. */
+        const double *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+        double complex den = 0;
+        for (int col = 0; col < nx; col++)
+            for (int p = d->Sp[col]; p < d->Sp[col + 1]; p++)
+                den += w[d->Si[p]] * (Sc[p] + 2.0 * lam * Sm[p]) * X[col];
         double tr, ro;
         tsi_desc_error_terms(d, w, x, lam, &tr, &ro);
         *dlam = cabs(den) > 0 ? (tr + ro) / cabs(den) : INFINITY;
         /* The Ritz value's own error: the pencil's Newton correction. */
-        double complex num = pencil_form(d, P, w, x, lam);
+        double complex num = pencil_form(d, P, w, X, lam);
         *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
     } else if (rc == TS_ESINGULAR) {
         ts_fail(err, rc, "eigen: the pencil is singular beside %g%+gi 1/s",
@@ -925,6 +942,7 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     }
     free(w);
     free(x);
+    free(X);
     free(q);
     free(u);
     free(P);

@@ -22,7 +22,13 @@
  * about a moving state they omit the terms of J' (first order in the link
  * rates), which the stiff integrator's Newton iteration absorbs.
  *
- * Without the sparse model (a system with vehicles: ts_linear.desc NULL)
+ * Towed vehicles are in the sparse model (their angles among the points,
+ * their controller states among the unknowns, lib/descriptor.h): y =
+ * (q, q', c), the controller rows' right-hand side wc - Hv J wq, S_inf's
+ * controller rows the identity (c' = Hr p + Hv p' + Hc c).
+ *
+ * Without the sparse model (a towing vehicle at the root: ts_linear.desc
+ * NULL)
  * the same solves use the dense A = [[0, I, 0], [K, C, E], [F, G, H]]
  * (nc controller states last): with x = (x1, x2, x3), x2 = b1 + s x1,
  * x3 = (H - sI)^-1 (b3 - F x1 - G x2) and P(s) x1 = b2 - (C - sI) b1 -
@@ -125,9 +131,12 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err);
 
 /* The response to a unit harmonic tow-point displacement along input
  * (0 x, 1 y, 2 z) at the factored s: the tow point moves by e_input,
- * with velocity s e_input and acceleration s^2 e_input. Writes the
- * absolute node displacements dr[3 nnodes] (dr_0 = e_input; m per m)
- * and the link tensions dt[nlinks] (N per m), complex. */
+ * with velocity s e_input and acceleration s^2 e_input; or to a unit
+ * harmonic vehicle input (input >= TS_NINPUT: a control surface, a loop,
+ * a set point), the tow point at rest (dr_0 = 0). Writes the
+ * absolute point displacements dr[3 np] (dr_0 = e_input; m per m; then
+ * the vehicles' angles, rad per m) followed by the controller states
+ * (dr[3 np + j]), and the link tensions dt[nlinks] (N per m), complex. */
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
                      double complex *dt);
 

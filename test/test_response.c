@@ -28,8 +28,9 @@
  *     where rounding dominates: every gain within its allowance of that
  *     of a tight, fourth-order linearization, for the dense model and
  *     the sparse one (test_rounding).
- *  6. The same with a vehicle: controller states, the vehicle's own
- *     inputs and outputs, a tension output (test_vehicle_allowance).
+ *  6. The same with a vehicle, dense and sparse: controller states, the
+ *     vehicle's own inputs and outputs, a tension output
+ *     (test_vehicle_allowance).
  */
 #include "towstab/response.h"
 
@@ -770,7 +771,9 @@ static void test_rounding(void)
  * allowance of a tight linearization's (A, B, Ty, Tu, Vy, Vu
  * Richardson-extrapolated from steps 5e-4 and 1e-3), up to that
  * reference's own uncertainty (its distance to the same from 1e-3 and
- * 2e-3). Before, these allowances were NaN. */
+ * 2e-3). Both models: the dense A (Vy, Vu, Ty, Tu and their errors)
+ * and the sparse one (the vehicle's rows, its inputs' columns and its
+ * outputs' rows, each with its entry-wise truncation and rounding). */
 static void test_vehicle_allowance(void)
 {
     ts_err err = {0};
@@ -791,8 +794,11 @@ static void test_vehicle_allowance(void)
     CHECK(k && ref && ref2 && ts_kernel_ncontrol(k) > 0,
           "aurora, 10 links: tight linearizations, %d controller states",
           k ? ts_kernel_ncontrol(k) : 0);
-    for (int s = 0; s < 3 && k && ref && ref2; s++) {
-        ts_linear *lin = linearize_at(sys, TS_LIN_DENSE, steps[s], NULL);
+    for (int s = 0; s < 6 && k && ref && ref2; s++) {
+        int sparse = s >= 3;
+        ts_linear *lin = linearize_at(sys, sparse ? TS_LIN_SPARSE
+                                                  : TS_LIN_DENSE,
+                                      steps[s % 3], NULL);
         tally t = {0, 0, 1, 0.0, NAN, NAN};
         int ok = lin != NULL;
         for (int a = 0; a < 3 && ok; a++)
@@ -807,13 +813,13 @@ static void test_vehicle_allowance(void)
                                  &err);
             }
         CHECK(ok && t.finite && t.worst <= 1 &&
-                  (s < 2 || t.clear >= t.n / 3),
-              "aurora, 10 links, step %.3g: every gain (%d; %d with errors "
-              "10 times the reference's uncertainty) has a finite allowance "
-              "and lies within it of the tight one (closest %.2f: error "
-              "%.3g, allowance %.3g) (%s)",
-              steps[s], t.n, t.clear, t.worst, t.we, t.wb,
-              ok ? "" : err.msg);
+                  (s % 3 < 2 || t.clear >= t.n / 3),
+              "aurora, 10 links, %s model, step %.3g: every gain (%d; %d "
+              "with errors 10 times the reference's uncertainty) has a "
+              "finite allowance and lies within it of the tight one "
+              "(closest %.2f: error %.3g, allowance %.3g) (%s)",
+              sparse ? "sparse" : "dense", steps[s % 3], t.n, t.clear,
+              t.worst, t.we, t.wb, ok ? "" : err.msg);
         ts_linear_free(lin);
     }
     ts_linear_free(ref);

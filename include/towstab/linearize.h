@@ -81,12 +81,13 @@ typedef struct ts_descriptor ts_descriptor;
 /* Which linear models ts_linearize forms. */
 typedef enum {
     TS_LIN_AUTO = 0,   /* the sparse model always; the dense A and B too
-                          when nstate < dense_max_states. A system with a
-                          vehicle: the dense model only */
+                          when nstate < dense_max_states. A towing
+                          vehicle at the root: the dense model only */
     TS_LIN_DENSE = 1,  /* the dense A and B only */
-    TS_LIN_SPARSE = 2, /* the sparse model only (refused with a vehicle) */
+    TS_LIN_SPARSE = 2, /* the sparse model only (refused with a towing
+                          vehicle at the root) */
     TS_LIN_BOTH = 3    /* the dense model at any size, and the sparse one
-                          (except with a vehicle) */
+                          (except with a towing vehicle at the root) */
 } ts_lin_model;
 
 typedef struct ts_linear {
@@ -103,8 +104,9 @@ typedef struct ts_linear {
     double *B;         /* [n * ninput] column-major; rows 0..nq-1 zero;
                           NULL with A */
     ts_descriptor *desc; /* the sparse model E x' = F x + G u of the node
-                          equations (O(nlinks) memory), NULL unless
-                          formed (never with vehicles); the eigen,
+                          and towed vehicles' equations (O(nlinks)
+                          memory), NULL unless formed (never with a
+                          towing vehicle at the root); the eigen,
                           response and stiff simulation solvers use it at
                           any size */
     double *y0;        /* [n] state linearized about (kernel's charts) */

@@ -7,6 +7,11 @@
  *    and the rightmost search of the whole spectrum (the verdict);
  *  - response: the same cable, sphere.z to tow.heave at 100 frequencies
  *    (0.01 to 10 Hz, the default), without the natural frequencies;
+ *  - vehicle modes and response: examples/aurora_towfish.yaml (a towed
+ *    vehicle with lagged control surfaces and a PID depth loop in the
+ *    sparse model) at 100, 1000 and 10 000 links: modes as above (the
+ *    loop margins left out), and aurora.depth to aurora.wing at 100
+ *    frequencies;
  *  - esdirk: examples/kamman_ex1_elastic.yaml (EA 1e9 N) with 100 and 500
  *    links, heaved 0.1 ft at 0.25 Hz (smooth start over two periods, the
  *    default) for T_SIM simulated seconds, rtol 1e-6, atol 1e-9: wall
@@ -22,7 +27,8 @@
  * OpenBLAS on one thread, as towstab runs it (tools/towstab.c): meson
  * sets OPENBLAS_NUM_THREADS=1 for it.
  * Run from the project root: meson test -C build --benchmark sparse, or
- * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS]. */
+ * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS [vehicle]]
+ * (vehicle: the vehicle cases only). */
 #define _GNU_SOURCE /* wait4 */
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,7 +46,7 @@
 #define REPS 3
 #define T_SIM 2.0
 
-enum { MODES, RESPONSE, ESDIRK };
+enum { MODES, RESPONSE, ESDIRK, VMODES, VRESPONSE };
 
 /* What a child reports back through its pipe. */
 typedef struct figures {
@@ -57,7 +63,9 @@ static void run_case(int kind, int links, figures *f)
 {
     ts_err err = {0};
     ts_units *u = ts_units_alloc(&err);
+    int veh = kind == VMODES || kind == VRESPONSE;
     const char *path = kind == ESDIRK ? "examples/kamman_ex1_elastic.yaml"
+                       : veh          ? "examples/aurora_towfish.yaml"
                                       : "examples/kamman_ex1_submerged.yaml";
     ts_scene *sc = u ? ts_scene_load(path, u, &err) : NULL;
     if (!sc) {
@@ -65,15 +73,22 @@ static void run_case(int kind, int links, figures *f)
         return;
     }
     ts_request rq;
-    ts_request_init(&rq, kind == MODES      ? TS_ANALYSIS_MODES
-                         : kind == RESPONSE ? TS_ANALYSIS_RESPONSE
-                                            : TS_ANALYSIS_SIMULATE);
+    ts_request_init(&rq, kind == MODES || kind == VMODES ? TS_ANALYSIS_MODES
+                         : kind == RESPONSE || kind == VRESPONSE
+                             ? TS_ANALYSIS_RESPONSE
+                             : TS_ANALYSIS_SIMULATE);
     rq.setup.links = links;
     rq.setup.discretisation_error = 0;
-    if (kind == RESPONSE) {
-        snprintf(rq.response.output, sizeof rq.response.output, "sphere.z");
+    if (kind == RESPONSE || kind == VRESPONSE) {
+        snprintf(rq.response.output, sizeof rq.response.output, "%s",
+                 veh ? "aurora.depth" : "sphere.z");
+        if (veh)
+            snprintf(rq.response.input, sizeof rq.response.input,
+                     "aurora.wing");
         rq.response.natural = 0;
     }
+    if (kind == VMODES)
+        rq.modes.margins = 0;
     if (kind == ESDIRK) {
         ts_sim_opts *o = &rq.simulate.sim;
         o->integrator = TS_INT_ESDIRK;
@@ -169,10 +184,11 @@ static double measure(int kind, int links, int reps, figures *last,
     for (int r = 0; r < reps && r < 16; r++) {
         double p;
         if (run_child(kind, links, last, &p, &c[n]) != 0 || !last->ok) {
-            printf("FAIL %s at %d links: %s\n",
-                   kind == MODES ? "modes" : kind == RESPONSE ? "response"
-                                                              : "esdirk",
-                   links, last->msg[0] ? last->msg : "child failed");
+            static const char *const names[] = {
+                "modes", "response", "esdirk", "vehicle modes",
+                "vehicle response"};
+            printf("FAIL %s at %d links: %s\n", names[kind], links,
+                   last->msg[0] ? last->msg : "child failed");
             failures++;
             return NAN;
         }
@@ -191,14 +207,15 @@ static const char *met(int ok)
 int main(int argc, char **argv)
 {
     int reps = argc > 1 ? atoi(argv[1]) : REPS;
+    int only_vehicle = argc > 2 && strcmp(argv[2], "vehicle") == 0;
     if (reps < 1)
         reps = 1;
     figures f;
-    double t[2], mem[2], cpu;
+    double t[2] = {NAN, NAN}, mem[2], cpu;
     const int sizes[2] = {1000, 10000};
     printf("medians of %d runs; wall s of the whole analysis (equilibrium, "
            "linearization, solve)\n", reps);
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < 2 && !only_vehicle; i++) {
         t[i] = measure(MODES, sizes[i], reps, &f, &mem[i], &cpu);
         if (isnan(t[i]))
             continue;
@@ -212,11 +229,11 @@ int main(int argc, char **argv)
                met(t[i] < (i ? 1.0 : 0.1)), i ? 300.0 : 50.0,
                met(mem[i] < (i ? 300.0 : 50.0)));
     }
-    if (!isnan(t[0]) && !isnan(t[1]))
+    if (!only_vehicle && !isnan(t[0]) && !isnan(t[1]))
         printf("modes    growth 1000 -> 10000: %.1fx time, %.1fx memory; "
                "target < 15x %s\n", t[1] / t[0], mem[1] / mem[0],
                met(t[1] / t[0] < 15 && mem[1] / mem[0] < 15));
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < 2 && !only_vehicle; i++) {
         t[i] = measure(RESPONSE, sizes[i], reps, &f, &mem[i], &cpu);
         if (isnan(t[i]))
             continue;
@@ -227,11 +244,40 @@ int main(int argc, char **argv)
                sizes[i], t[i], f.eq, f.lin, t[i] - f.eq - f.lin, cpu, mem[i],
                i ? 1.0 : 0.1, met(t[i] < (i ? 1.0 : 0.1)));
     }
-    if (!isnan(t[0]) && !isnan(t[1]))
+    if (!only_vehicle && !isnan(t[0]) && !isnan(t[1]))
         printf("response growth 1000 -> 10000: %.1fx; target < 15x %s\n",
                t[1] / t[0], met(t[1] / t[0] < 15));
+    const int vsizes[3] = {100, 1000, 10000};
+    double tv[3];
+    for (int i = 0; i < 3; i++) {
+        tv[i] = measure(VMODES, vsizes[i], reps, &f, &mem[0], &cpu);
+        if (isnan(tv[i]))
+            continue;
+        printf("vehicle modes    %5d links: %.3f s (equilibrium %.3f, "
+               "linearize %.3f, eigen %.3f; CPU %.3f s), peak %.0f MB; %d "
+               "modes, rightmost search %d shifts to %.4g Hz, max Re %.3g "
+               "1/s\n",
+               vsizes[i], tv[i], f.eq, f.lin, f.eig, cpu, mem[0], f.nmodes,
+               f.shifts, f.top_hz, f.rightmost);
+    }
+    if (!isnan(tv[1]) && !isnan(tv[2]))
+        printf("vehicle modes    growth 1000 -> 10000: %.1fx\n",
+               tv[2] / tv[1]);
+    for (int i = 0; i < 3; i++) {
+        tv[i] = measure(VRESPONSE, vsizes[i], reps, &f, &mem[0], &cpu);
+        if (isnan(tv[i]))
+            continue;
+        printf("vehicle response %5d links: %.3f s (equilibrium %.3f, "
+               "linearize %.3f, 100 frequencies %.3f; CPU %.3f s), peak "
+               "%.0f MB\n",
+               vsizes[i], tv[i], f.eq, f.lin, tv[i] - f.eq - f.lin, cpu,
+               mem[0]);
+    }
+    if (!isnan(tv[1]) && !isnan(tv[2]))
+        printf("vehicle response growth 1000 -> 10000: %.1fx\n",
+               tv[2] / tv[1]);
     const int elastic[2] = {100, 500};
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < 2 && !only_vehicle; i++) {
         t[i] = measure(ESDIRK, elastic[i], reps, &f, &mem[i], &cpu);
         if (isnan(t[i]))
             continue;
@@ -242,7 +288,7 @@ int main(int argc, char **argv)
                                 : "; target <= 1.5 MISSED")
                  : "");
     }
-    if (!isnan(t[0]) && !isnan(t[1]))
+    if (!only_vehicle && !isnan(t[0]) && !isnan(t[1]))
         printf("esdirk   growth 100 -> 500: %.1fx; target < 8x %s\n",
                t[1] / t[0], met(t[1] / t[0] < 8));
     printf("%d failed\n", failures);
