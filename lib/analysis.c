@@ -1254,6 +1254,12 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
     }
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
+    /* The frame inputs are columns of the dense B only (doc/linear.md,
+     * section 1). */
+    if (input >= TS_NINPUT && (!strcmp(o->input, "tow.speed") ||
+                               !strcmp(o->input, "tow.turn_rate")) &&
+        lo.model != TS_LIN_DENSE)
+        lo.model = TS_LIN_DENSE;
     rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc == TS_OK)
         rc = tsi_response_compute(r->sys, r->lin, input, &out, freq,
@@ -1689,10 +1695,15 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         return ts_fail(err, TS_EINVAL, "initial: the linear model starts at "
                        "the equilibrium, so %s needs the initial state "
                        "'equilibrium'", lw);
-    if (use_linear && ex && ts_excitation_has_manoeuvre(ex))
-        return ts_fail(err, TS_EINVAL, "manoeuvre: the linear model has no "
-                       "frame inputs; a manoeuvre can only be simulated "
-                       "nonlinearly (drop %s)", lw);
+    if (use_linear && ex && ts_excitation_has_manoeuvre(ex)) {
+        ts_kernel *k = ts_kernel_alloc(sys, err);
+        if (!k)
+            return err && err->code ? err->code : TS_ENOMEM;
+        rc = ts_sim_check_linear_manoeuvre(k, ex, err);
+        ts_kernel_free(k);
+        if (rc)
+            return rc;
+    }
     if ((rc = check_sim_inputs(sys, ex, open_loop, err)))
         return rc;
     /* What the comparison will need. */

@@ -1168,8 +1168,6 @@ double ts_excitation_time_scale(const ts_excitation *ex)
     double ts = INFINITY;
     for (int i = 0; i < ex->n; i++) {
         const ts_signal *s = &ex->sig[i];
-        if (is_manoeuvre(s->axis))
-            continue;
         double v = INFINITY;
         switch (s->type) {
         case TS_SIGNAL_SINE: v = 1.0 / (2.0 * M_PI * s->frequency); break;

@@ -71,11 +71,13 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
         ts_fail(err, TS_ENOMEM, "ts_linear_alloc: out of memory");
         return NULL;
     }
-    int n = ts_kernel_nstate(k), ni = ts_kernel_ninput(k);
+    int n = ts_kernel_nstate(k), fin = ts_kernel_ninput(k);
+    int ni = fin + TS_NFRAME_INPUT;
     size_t sn = (size_t)n;
     lin->nstate = n;
     lin->nq = ts_kernel_nq(k);
     lin->ninput = ni;
+    lin->frame_input = fin;
     lin->nlinks = sys->nlinks;
     lin->nnodes = sys->nnodes;
     lin->y0 = calloc(sn, sizeof(double));
@@ -112,8 +114,14 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->output_unit = calloc((size_t)lin->noutput + 1,
                               sizeof *lin->output_unit);
     for (int j = 0; lin->input_name && lin->input_unit && j < ni; j++) {
-        ts_kernel_input_name(k, j, lin->input_name[j], TS_IO_NAME);
-        lin->input_unit[j] = ts_kernel_input_unit(k, j);
+        if (j < fin) {
+            ts_kernel_input_name(k, j, lin->input_name[j], TS_IO_NAME);
+            lin->input_unit[j] = ts_kernel_input_unit(k, j);
+        } else {
+            snprintf(lin->input_name[j], TS_IO_NAME, "%s",
+                     ts_frame_input_name(j - fin));
+            lin->input_unit[j] = ts_frame_input_unit(j - fin);
+        }
     }
     for (int j = 0; lin->output_name && lin->output_unit &&
                     j < lin->noutput;
@@ -124,11 +132,14 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     if (lin->nvehicles > 0) {
         lin->up_qoff = malloc((size_t)sys->nlinks * sizeof(int));
         lin->up_map = calloc(12 * (size_t)sys->nlinks, sizeof(double));
+        lin->veh_rot = calloc(9 * (size_t)lin->nvehicles, sizeof(double));
+        lin->veh_qoff = malloc((size_t)lin->nvehicles * sizeof(int));
     }
     if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
         !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
         !lin->u0 ||
-        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map)) ||
+        (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map ||
+                                !lin->veh_rot || !lin->veh_qoff)) ||
         (lin->noutput > 0 && (!lin->Vy || !lin->Vu || !lin->v0)) ||
         !lin->input_name || !lin->input_unit || !lin->output_name ||
         !lin->output_unit) {
@@ -165,6 +176,8 @@ void ts_linear_free(ts_linear *lin)
     free(lin->u0);
     free(lin->up_qoff);
     free(lin->up_map);
+    free(lin->veh_rot);
+    free(lin->veh_qoff);
     free(lin->Vy);
     free(lin->Vu);
     free(lin->Terr);
@@ -182,6 +195,43 @@ void ts_linear_free(ts_linear *lin)
 
 const char *ts_input_name(int j) { return tsi_tow_input_name(j); }
 
+static const char *const frame_names[TS_NFRAME_INPUT] = {
+    "tow.speed", "tow.turn_rate", "tow.speed_rate", "tow.turn_accel"};
+static const char *const frame_units[TS_NFRAME_INPUT] = {
+    "m/s", "rad/s", "m/s^2", "rad/s^2"};
+
+const char *ts_frame_input_name(int c)
+{
+    return c >= 0 && c < TS_NFRAME_INPUT ? frame_names[c] : NULL;
+}
+
+const char *ts_frame_input_unit(int c)
+{
+    return c >= 0 && c < TS_NFRAME_INPUT ? frame_units[c] : NULL;
+}
+
+/* f(y, u) into f with the frame inputs u[fin .. fin + TS_NFRAME_INPUT)
+ * added to the frame `base` for this evaluation (the kernel reads its own
+ * inputs u[0 .. fin) only); k's frame is base again on return, its
+ * last-evaluation results (positions, tensions, outputs) those of the
+ * moved frame. */
+static int eval_frame(ts_kernel *k, const ts_frame *base, int fin,
+                      const double *y, const double *u, double *f)
+{
+    const double *du = u + fin;
+    if (du[0] == 0 && du[1] == 0 && du[2] == 0 && du[3] == 0)
+        return ts_kernel_eval(k, y, u, f);
+    ts_frame fr = *base;
+    fr.speed += du[TS_FRAME_SPEED];
+    fr.turn_rate += du[TS_FRAME_TURN_RATE];
+    fr.speed_rate += du[TS_FRAME_SPEED_RATE];
+    fr.turn_accel += du[TS_FRAME_TURN_ACCEL];
+    ts_kernel_set_frame(k, &fr);
+    int rc = ts_kernel_eval(k, y, u, f);
+    ts_kernel_set_frame(k, base);
+    return rc;
+}
+
 /* The step of one column: rel * max(|x|, scale), rounded so that x + h is
  * a machine number (then (x + h) - x == h exactly). */
 static double step_for(double x, double scale, double rel)
@@ -195,6 +245,8 @@ static double step_for(double x, double scale, double rel)
 typedef struct col_ws {
     ts_kernel *k;
     double *y, *u;
+    int fin;        /* the frame inputs' offset in u */
+    ts_frame base;  /* the frame they move */
     double *f[4];   /* f(x+h), f(x-h), f(x+2h), f(x-2h) */
     double *t[4];   /* tensions at the same states */
 } col_ws;
@@ -230,6 +282,8 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
         return TS_ENOMEM;
     memcpy(w->y, y0, (size_t)n * sizeof(double));
     memcpy(w->u, u0, (size_t)ni * sizeof(double));
+    w->fin = ni - TS_NFRAME_INPUT;
+    ts_kernel_get_frame(k, &w->base);
     return TS_OK;
 }
 
@@ -237,7 +291,7 @@ static int col_ws_alloc(col_ws *w, ts_kernel *k, int use_k, const double *y0,
  * tensions, then the vehicles' outputs). */
 static int eval_into(col_ws *w, int slot, int nl)
 {
-    int rc = ts_kernel_eval(w->k, w->y, w->u, w->f[slot]);
+    int rc = eval_frame(w->k, &w->base, w->fin, w->y, w->u, w->f[slot]);
     if (rc == TS_OK) {
         memcpy(w->t[slot], ts_kernel_tensions(w->k),
                (size_t)nl * sizeof(double));
@@ -397,9 +451,14 @@ static int column(col_ws *w, int j, int n, int nq, int nl, int nout,
 #define STRAIN_FLOOR 1e-14
 
 /* Scale of column j (see linearize.h): scale[] holds the coordinates'
- * and rates' own (state columns), then the inputs follow. */
+ * and rates' own (state columns), then the inputs follow; the frame
+ * inputs start at input `fin`. A turn rate moves a point at distance r
+ * from the tow point by Omega r, so its scale is the tow velocity's over
+ * the system's reach (every link's length and the tow point's distance
+ * from M's origin): the step then changes no velocity by more than a
+ * tow velocity's step does. */
 static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
-                           int n, const double *scale)
+                           int n, int fin, const double *scale)
 {
     if (j < n)
         return scale[j];
@@ -413,6 +472,21 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
         return sqrt(g * l0) + V;
     if (c < TS_NINPUT)
         return g;
+    if (c >= fin && c < fin + TS_NFRAME_INPUT) {
+        double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
+                            sys->tow.point[1] * sys->tow.point[1] +
+                            sys->tow.point[2] * sys->tow.point[2]);
+        for (int l = 0; l < sys->nlinks; l++)
+            reach += sys->links[l].length;
+        if (!(reach > 0))
+            reach = 1.0;
+        switch (c - fin) {
+        case 0: return sqrt(g * l0) + V;           /* speed, m/s */
+        case 1: return (sqrt(g * l0) + V) / reach; /* turn rate, rad/s */
+        case 2: return g;                          /* speed rate, m/s^2 */
+        default: return g / reach;                 /* turn accel, rad/s^2 */
+        }
+    }
     return 1.0; /* a deflection or a loop input, rad */
 }
 
@@ -761,7 +835,8 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     else
         ts_linearize_opts_default(&o);
     int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k), nl = sys->nlinks;
-    int ni = ts_kernel_ninput(k), ncol = n + ni, nlow = n - nq;
+    int fin = ts_kernel_ninput(k), ni = fin + TS_NFRAME_INPUT;
+    int ncol = n + ni, nlow = n - nq;
     int nout = lin->noutput;
     if (lin->nstate != n || lin->nlinks != nl || lin->ninput != ni ||
         lin->nq != nq)
@@ -788,10 +863,9 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                 (o.model == TS_LIN_AUTO &&
                  (n < o.dense_max_states || root));
     int sparse = o.model != TS_LIN_DENSE && !root;
+    memset(lin->u0, 0, (size_t)ni * sizeof(double));
     if (u0)
-        memcpy(lin->u0, u0, (size_t)ni * sizeof(double));
-    else
-        memset(lin->u0, 0, (size_t)ni * sizeof(double));
+        memcpy(lin->u0, u0, (size_t)fin * sizeof(double));
     u0 = lin->u0;
     memcpy(lin->y0, y0, (size_t)n * sizeof(double));
     lin->evaluations = 0;
@@ -917,24 +991,15 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         }
     }
 
-    /* A cable starting at a point P of a vehicle moves with the body:
-     * dr_P = dr_A + (R E dtheta) x rho_P (rho_P = R (P - A)). */
-    for (int l = 0; lin->nvehicles > 0 && l < nl; l++) {
-        const ts_link *L = &sys->links[l];
-        lin->up_qoff[l] = -1;
-        if (L->up_body < 0)
-            continue;
-        int v = 0;
-        while (ts_kernel_vehicle_body(k, v) != L->up_body)
-            v++;
-        const ts_vehicle *d = sys->bodies[L->up_body].vehicle;
-        double R[9], om[3], E[9], lev[3];
+    /* Each vehicle's small rotation per change of its angles, R E. */
+    for (int v = 0; v < lin->nvehicles; v++) {
+        double R[9], om[3], E[9];
         int qo = ts_kernel_vehicle_offset(k, v);
         int ship = v == ts_kernel_root(k) && ts_kernel_root_dof(k) == 3;
         double th[3] = {0, 0, y0[qo]};
         ts_kernel_get_vehicle(k, v, y0, R, om);
         tsi_rate_matrix(ship ? th : y0 + qo, E);
-        double *map = lin->up_map + 12 * l;
+        double *map = lin->veh_rot + 9 * v;
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
                 map[3 * i + j] = R[3 * i] * E[j] + R[3 * i + 1] * E[3 + j] +
@@ -946,6 +1011,25 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                 map[3 * i] = map[3 * i + 2];
                 map[3 * i + 1] = map[3 * i + 2] = 0.0;
             }
+        lin->veh_qoff[v] = qo;
+    }
+
+    /* A cable starting at a point P of a vehicle moves with the body:
+     * dr_P = dr_A + (R E dtheta) x rho_P (rho_P = R (P - A)). */
+    for (int l = 0; lin->nvehicles > 0 && l < nl; l++) {
+        const ts_link *L = &sys->links[l];
+        lin->up_qoff[l] = -1;
+        if (L->up_body < 0)
+            continue;
+        int v = 0;
+        while (ts_kernel_vehicle_body(k, v) != L->up_body)
+            v++;
+        const ts_vehicle *d = sys->bodies[L->up_body].vehicle;
+        double R[9], om[3], lev[3];
+        int qo = ts_kernel_vehicle_offset(k, v);
+        ts_kernel_get_vehicle(k, v, y0, R, om);
+        double *map = lin->up_map + 12 * l;
+        memcpy(map, lin->veh_rot + 9 * v, 9 * sizeof(double));
         for (int j = 0; j < 3; j++)
             lev[j] = L->up_point[j] - d->attach[j];
         for (int j = 0; j < 3; j++)
@@ -962,7 +1046,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     state_scales(k, &fr, scale);
     for (int j = 0; j < ncol; j++) {
         double x = j < n ? y0[j] : u0[j - n];
-        lin->h[j] = step_for(x, column_scale(sys, &fr, j, n, scale),
+        lin->h[j] = step_for(x, column_scale(sys, &fr, j, n, fin, scale),
                              o.rel_step);
     }
     free(scale);
@@ -1134,12 +1218,11 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                            "%.3g left the model (%s)",
                            bad_col - 2 * nq, lin->h[bad_col],
                            ts_strerror(bad_rc));
-        char name[2 * TS_NAME_MAX + 8];
         return ts_fail(err, bad_rc < 0 ? bad_rc : TS_CHART,
                        "linearize: input %s perturbed by %.3g left the model "
                        "(%s)",
-                       ts_kernel_input_name(k, bad_col - n, name, sizeof name),
-                       lin->h[bad_col], ts_strerror(bad_rc));
+                       lin->input_name[bad_col - n], lin->h[bad_col],
+                       ts_strerror(bad_rc));
     }
     lin->trunc_err = estimate ? max_a : NAN;
     lin->trunc_norm = estimate ? sqrt(sum2_a) : NAN;
@@ -1179,6 +1262,18 @@ int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
         rc = ts_linearize(k, y, NULL, opts, lin, err);
     free(y);
     return rc;
+}
+
+void ts_linear_vehicle_rotations(const ts_linear *lin, const double dq[],
+                                 double phi[])
+{
+    for (int v = 0; v < lin->nvehicles; v++) {
+        const double *map = lin->veh_rot + 9 * v;
+        const double *dth = dq + lin->veh_qoff[v];
+        for (int c = 0; c < 3; c++)
+            phi[3 * v + c] = map[3 * c] * dth[0] + map[3 * c + 1] * dth[1] +
+                             map[3 * c + 2] * dth[2];
+    }
 }
 
 void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,

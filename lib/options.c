@@ -563,8 +563,9 @@ static const ts_option response_rows[] = {
     {.name = "input", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.input), .size = SZ(response.input),
      .flag_offset = OFF(response.frequency_given), .arg = "NAME",
-     .help = "tow.surge, tow.sway or tow.heave, or a vehicle's input: "
-             "<vehicle>.<surface>, <vehicle>.<loop>, <vehicle>.<loop>.setpoint"},
+     .help = "tow.surge, tow.sway or tow.heave, tow.speed or "
+             "tow.turn_rate, or a vehicle's input: <vehicle>.<surface>, "
+             "<vehicle>.<loop>, <vehicle>.<loop>.setpoint"},
     {.name = "output", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.output), .size = SZ(response.output),
      .arg = "NAME",

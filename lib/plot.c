@@ -1360,10 +1360,55 @@ static double outline_scale(int nshapes, const ts_plot_shape *shapes,
     return fmax(1.0, TS_PLOT_OUTLINE_MIN * extent / smallest);
 }
 
+/* The rigid motion of ts_plot_outline_moved: point p of an outline with
+ * anchor A to q = A + s t + mag R(s phi) (p - A), R by Rodrigues'
+ * formula R v = v cos a + (k x v) sin a + k (k . v) (1 - cos a), a =
+ * |s phi|, k its direction. */
+static void outline_point(const double A[3], const double *motion, double s,
+                          double mag, const double p[3], double q[3])
+{
+    double v[3] = {mag * (p[0] - A[0]), mag * (p[1] - A[1]),
+                   mag * (p[2] - A[2])};
+    if (!motion) {
+        for (int j = 0; j < 3; j++)
+            q[j] = A[j] + v[j];
+        return;
+    }
+    double w[3] = {s * motion[3], s * motion[4], s * motion[5]};
+    double a = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (a > 0) {
+        double k[3] = {w[0] / a, w[1] / a, w[2] / a}, c = cos(a),
+               sn = sin(a);
+        double kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+        double kx[3] = {k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2],
+                        k[0] * v[1] - k[1] * v[0]};
+        for (int j = 0; j < 3; j++)
+            v[j] = v[j] * c + kx[j] * sn + k[j] * kv * (1 - c);
+    }
+    for (int j = 0; j < 3; j++)
+        q[j] = A[j] + s * motion[j] + v[j];
+}
+
+void ts_plot_outline_moved(const ts_plot_outline *o, const double motion[6],
+                           double s, double mag, double out[])
+{
+    for (int k = 0; k < o->npoints; k++) {
+        const double *p = o->pts + 3 * (size_t)k;
+        double *q = out + 3 * (size_t)k;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+            q[0] = q[1] = q[2] = NAN;
+        else
+            outline_point(o->anchor, motion, s, mag, p, q);
+    }
+}
+
 /* Draw the outlines of s in the side view (top 0) or the top view,
- * magnified by `scale` about their anchors. */
+ * magnified by `scale` about their anchors; moved by a mode at scale
+ * `ms` when motion ([6 noutlines], ts_plot_mode.outline_motion) is not
+ * NULL. */
 static void draw_outlines(frame *f, const ts_plot_shape *s, int top,
-                          double scale, const ts_plot_opts *u)
+                          double scale, const double *motion, double ms,
+                          const ts_plot_opts *u)
 {
     for (int b = 0; b < s->noutlines; b++) {
         const ts_plot_outline *o = &s->outlines[b];
@@ -1376,8 +1421,8 @@ static void draw_outlines(frame *f, const ts_plot_shape *s, int top,
                 continue;
             }
             double q[3];
-            for (int j = 0; j < 3; j++)
-                q[j] = o->anchor[j] + scale * (p[j] - o->anchor[j]);
+            outline_point(o->anchor, motion ? motion + 6 * b : NULL, ms,
+                          scale, p, q);
             ph[1] = pconv(TS_PLOT_LENGTH, u, q[0]);
             pv[1] = pconv(TS_PLOT_LENGTH, u, top ? q[1] : q[2]);
             if (have)
@@ -1729,7 +1774,7 @@ static int draw_shapes(const void *vctx, const ts_plot_opts *o, int height,
         plwidth(CURVE_WIDTH);
         draw_marks(&f, s, &xy[i], 1.1);
         plwidth(1.4);
-        draw_outlines(&f, s, top, oscale, u);
+        draw_outlines(&f, s, top, oscale, NULL, 0.0, u);
     }
     char xl[TEXT_MAX], yl[TEXT_MAX];
     axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, u);
@@ -2050,7 +2095,7 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
             plwidth(1.6);
             draw_marks(&f, c->eq, &s[0], 0.8);
             plwidth(1.2);
-            draw_outlines(&f, c->eq, view == 1, oscale, u);
+            draw_outlines(&f, c->eq, view == 1, oscale, NULL, 0.0, u);
             int col = color_index(0, m);
             for (int j = 1; j <= 2; j++) {
                 ts_plot_shape style = *c->eq;
@@ -2067,6 +2112,14 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
                                col);
                 plwidth(CURVE_WIDTH);
                 draw_marks(&f, c->eq, &s[2 * m + j], 0.8);
+                /* The vehicles moved and rotated by the mode at its
+                 * scale, about their magnified size. */
+                if (c->modes[m].outline_motion) {
+                    plwidth(1.2);
+                    draw_outlines(&f, c->eq, view == 1, oscale,
+                                  c->modes[m].outline_motion,
+                                  (j == 1 ? 1 : -1) * c->scale[m], u);
+                }
             }
             if (view == 0) {
                 pl_text(lab, sizeof lab, c->modes[m].label);
@@ -2085,9 +2138,17 @@ static int draw_modes(const void *vctx, const ts_plot_opts *o, int height,
                       "opposite phases, largest displacement %.0f %% of the "
                       "cable's extent",
                       100 * MODE_AMPLITUDE);
+    int moved = 0;
+    for (int m = 0; m < c->nmodes; m++)
+        moved |= c->modes[m].outline_motion != NULL;
+    if (c->eq->noutlines > 0 && nl > 0 && (size_t)nl < sizeof lab)
+        nl += snprintf(lab + nl, sizeof lab - (size_t)nl, "; vehicles %s",
+                       moved ? "at trim grey, moved and turned by the mode "
+                               "coloured"
+                             : "at their trim attitude");
     if (oscale > 1.0 && nl > 0 && (size_t)nl < sizeof lab)
-        snprintf(lab + nl, sizeof lab - (size_t)nl, "; vehicles at their "
-                 "trim attitude, drawn %.3g times their size", oscale);
+        snprintf(lab + nl, sizeof lab - (size_t)nl, ", drawn %.3g times "
+                 "their size", oscale);
     plschr(0, 1.0);
     {
         double w, h;
@@ -2139,6 +2200,11 @@ int ts_plot_mode_shapes(const char *dir, const char *name, const char *title,
     for (int m = 0; m < nmodes; m++) {
         if ((rc = check_array(fn, "modes.disp", m, modes[m].disp,
                               3 * eq->nnodes, 0, err)))
+            return rc;
+        if (modes[m].outline_motion && eq->noutlines > 0 &&
+            (rc = check_array(fn, "modes.outline_motion", m,
+                              modes[m].outline_motion, 6 * eq->noutlines, 0,
+                              err)))
             return rc;
         double dmax = 0;
         for (int k = 0; k < eq->nnodes; k++)

@@ -73,6 +73,29 @@ int ts_response_input_lookup(const ts_kernel *k, const char *name,
     if (ts_response_input_find(name, channel, NULL) == TS_OK)
         return TS_OK;
     int j = ts_kernel_input_find(k, name);
+    int fin = ts_kernel_ninput(k);
+    for (int c = 0; c < TS_NFRAME_INPUT && j < 0; c++)
+        if (!strcmp(name, ts_frame_input_name(c)))
+            j = fin + c;
+    if (j >= fin + 2)
+        return ts_fail(err, TS_EINVAL, "input '%s': the rate of a frame "
+                       "input comes with it; give %s", name,
+                       j == fin + 2 ? "tow.speed" : "tow.turn_rate");
+    if (j >= fin) {
+        const ts_system *sys = ts_kernel_system(k);
+        if (ts_kernel_root(k) >= 0)
+            return ts_fail(err, TS_EINVAL, "input '%s': the mean frame is "
+                           "the towing vehicle's own steady motion, not "
+                           "prescribed; its speed and turn come from its "
+                           "thrust, rudder and loops", name);
+        if (j == fin + 1 && (sys->env.current[0] != 0 ||
+                             sys->env.current[1] != 0))
+            return ts_fail(err, TS_EINVAL, "input '%s': a horizontal "
+                           "current (%g, %g m/s) turns in the mean frame "
+                           "by the heading change, which the linear model "
+                           "has no state for", name, sys->env.current[0],
+                           sys->env.current[1]);
+    }
     if (j >= TS_NINPUT) {
         *channel = j;
         return TS_OK;
@@ -80,14 +103,41 @@ int ts_response_input_lookup(const ts_kernel *k, const char *name,
     char list[1024], nm[TS_IO_NAME];
     size_t len = 0;
     list[0] = '\0';
-    for (int i = TS_NINPUT; i < ts_kernel_ninput(k) && len < sizeof list;
-         i++)
+    for (int i = TS_NINPUT; i < fin + 2 && len < sizeof list; i++)
         len += (size_t)snprintf(list + len, sizeof list - len, ", %s",
-                                ts_kernel_input_name(k, i, nm, sizeof nm));
+                                i < fin ? ts_kernel_input_name(k, i, nm,
+                                                               sizeof nm)
+                                        : ts_frame_input_name(i - fin));
     return ts_fail(err, TS_EINVAL,
                    "input '%s': not an input; expected tow.surge, tow.sway, "
                    "tow.heave%s",
                    name, list);
+}
+
+/* The columns of B an input brings, into cols, with their factors at s
+ * (the input's value X: its velocity s X, its acceleration s^2 X), and
+ * how many: a tow displacement its velocity and acceleration columns, a
+ * frame input (speed, turn rate) its rate's, a vehicle's input its own
+ * column alone. */
+static int input_columns(const ts_linear *lin, int input, double complex s,
+                         int cols[3], double complex fac[3])
+{
+    if (input < TS_NINPUT) {
+        for (int q = 0; q < 3; q++)
+            cols[q] = TS_IN_DISP + 3 * q + input;
+        fac[0] = 1.0;
+        fac[1] = s;
+        fac[2] = s * s;
+        return 3;
+    }
+    cols[0] = input;
+    fac[0] = 1.0;
+    if (input == lin->frame_input || input == lin->frame_input + 1) {
+        cols[1] = input + 2;
+        fac[1] = s;
+        return 2;
+    }
+    return 1;
 }
 
 int ts_response_output_lookup(const ts_kernel *k, const char *name,
@@ -228,7 +278,6 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
         return NAN;
     int n = lin->nstate, nq = lin->nq, nc = n - 2 * nq, nlow = n - nq;
     int one = 1, info = 0, nl = lin->nlinks, nout = lin->noutput;
-    int tow = input < TS_NINPUT;
     double complex s = sh->s;
     const double *A = lin->A;
     /* The output's weights c on the state and its Jacobian's error. */
@@ -308,10 +357,9 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
         }
     }
     /* The input's columns of B and their factors. */
-    int cols[3] = {tow ? TS_IN_DISP + input : input, TS_IN_VEL + input,
-                   TS_IN_ACC + input};
-    double complex fac[3] = {1.0, tow ? s : 0.0, tow ? s * s : 0.0};
-    int ncols = tow ? 3 : 1;
+    int cols[3];
+    double complex fac[3];
+    int ncols = input_columns(lin, input, s, cols, fac);
     const double *hu = lin->h + n;
     double complex trunc = 0, otrunc = 0;
     double wn2 = 0, xh2 = 0;
@@ -347,42 +395,43 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
 
 /* Row `row` of an output Jacobian pair (Jy [rows x n], Ju [rows x
  * ninput], column-major with leading dimension `rows`) applied to the
- * state response x and the input columns cols[3] (displacement, velocity,
- * acceleration; cv, ca their factors): Jy x + Ju (b0 + cv b1 + ca b2). */
+ * state response x and the input columns cols[ncols] with their factors
+ * fac (input_columns): Jy x + sum_q fac_q Ju[:, cols_q]. */
 static double complex row_gain(const double *Jy, const double *Ju, int row,
                                int rows, int n, const double complex *x,
-                               const int cols[3], double complex cv,
-                               double complex ca)
+                               int ncols, const int cols[3],
+                               const double complex fac[3])
 {
     double complex acc = 0;
     for (int j = 0; j < n; j++)
         acc += Jy[row + (size_t)j * rows] * x[j];
-    return acc + Ju[row + (size_t)cols[0] * rows] +
-           cv * Ju[row + (size_t)cols[1] * rows] +
-           ca * Ju[row + (size_t)cols[2] * rows];
+    for (int q = 0; q < ncols; q++)
+        acc += fac[q] * Ju[row + (size_t)cols[q] * rows];
+    return acc;
 }
 
 /* The dense way (see the head of the file); lin holds A, B, Ty, Tu and
  * the vehicles' output Jacobians Vy, Vu. A tow displacement input brings
- * its velocity and acceleration columns; a vehicle's input (>= TS_NINPUT)
- * is its column alone. With gerr, the gain's error allowance (gain_error)
- * into *gerr. */
+ * its velocity and acceleration columns, a frame input (speed, turn
+ * rate) its rate's; a vehicle's input is its column alone
+ * (input_columns). With gerr, the gain's error allowance
+ * (gain_error) into *gerr. */
 static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
                        const ts_output *out, tsi_shift *sh, resp_ws *w,
                        double complex *g, double *gerr)
 {
     int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
-    double complex s = sh->s;
     int tow = input < TS_NINPUT;
-    int cols[3] = {tow ? TS_IN_DISP + input : input,
-                   TS_IN_VEL + (tow ? input : 0),
-                   TS_IN_ACC + (tow ? input : 0)};
-    double complex cv = tow ? s : 0.0, ca = tow ? s * s : 0.0;
-    const double *Bx = lin->B + (size_t)cols[0] * n;
-    const double *Bv = lin->B + (size_t)cols[1] * n;
-    const double *Ba = lin->B + (size_t)cols[2] * n;
+    int cols[3];
+    double complex fac[3];
+    int ncols = input_columns(lin, input, sh->s, cols, fac);
     for (int i = 0; i < n; i++)
-        w->b[i] = -(Bx[i] + cv * Bv[i] + ca * Ba[i]);
+        w->b[i] = 0.0;
+    for (int q = 0; q < ncols; q++) {
+        const double *Bq = lin->B + (size_t)cols[q] * n;
+        for (int i = 0; i < n; i++)
+            w->b[i] -= fac[q] * Bq[i];
+    }
     tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
     if (gerr)
         *gerr = gain_error(sh, lin, input, out, w);
@@ -398,10 +447,11 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
         double gi = w->drr[idx];
         *g = gr + I * gi + (tow && out->comp == input ? 1.0 : 0.0);
     } else if (out->kind == TS_OUT_TENSION) {
-        *g = row_gain(lin->Ty, lin->Tu, out->link, nl, n, w->x, cols, cv, ca);
+        *g = row_gain(lin->Ty, lin->Tu, out->link, nl, n, w->x, ncols,
+                      cols, fac);
     } else {
         *g = row_gain(lin->Vy, lin->Vu, out->index, lin->noutput, n, w->x,
-                      cols, cv, ca);
+                      ncols, cols, fac);
     }
 }
 
@@ -585,12 +635,17 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
                        "%d",
                        lin->nlinks, sys->nlinks);
     if (!((input >= 0 && input <= 2) ||
-          (input >= TS_NINPUT && input < lin->ninput)))
+          (input >= TS_NINPUT && input < lin->frame_input + 2)))
         return ts_fail(err, TS_EINVAL,
                        "response: input channel must be 0, 1 or 2 "
-                       "(tow.surge, tow.sway, tow.heave) or a vehicle's "
-                       "input, %d to %d, got %d",
-                       TS_NINPUT, lin->ninput - 1, input);
+                       "(tow.surge, tow.sway, tow.heave), a vehicle's "
+                       "input or tow.speed or tow.turn_rate, %d to %d, "
+                       "got %d",
+                       TS_NINPUT, lin->frame_input + 1, input);
+    if (lin->desc && input >= lin->frame_input)
+        return ts_fail(err, TS_EINVAL, "response: %s needs the dense "
+                       "model (linearize with TS_LIN_DENSE)",
+                       lin->input_name[input]);
     if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
                        "response: output %s needs a linear model (sparse, "
@@ -765,7 +820,9 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     const char *ou = out->kind == TS_OUT_POSITION  ? "m"
                      : out->kind == TS_OUT_TENSION ? "N"
                                                    : out->unit;
-    snprintf(r->unit, sizeof r->unit, "%s/%s", ou, lin->input_unit[input]);
+    const char *iu = lin->input_unit[input];
+    snprintf(r->unit, sizeof r->unit, strchr(iu, '/') ? "%s/(%s)" : "%s/%s",
+             ou, iu);
     double complex g = 0;
     tsi_shift sh = {0};
     rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,

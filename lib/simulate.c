@@ -373,6 +373,31 @@ int ts_sim_check_inputs(const ts_kernel *k, const ts_excitation *ex,
     return rc;
 }
 
+int ts_sim_check_linear_manoeuvre(const ts_kernel *k,
+                                  const ts_excitation *ex, ts_err *err)
+{
+    if (!ex || !ts_excitation_has_manoeuvre(ex))
+        return TS_OK;
+    if (ts_kernel_root(k) >= 0)
+        return ts_fail(err, TS_EINVAL, "manoeuvre: the mean frame is the "
+                       "towing vehicle's own steady motion, which its "
+                       "thrust, rudder and loops set; the linear model "
+                       "takes no frame manoeuvre with a towing vehicle "
+                       "(excite its inputs instead)");
+    ts_frame f;
+    ts_kernel_get_frame(k, &f);
+    for (int i = 0; i < ts_excitation_nsignals(ex); i++)
+        if (ts_excitation_signal(ex, i)->axis == TS_AXIS_TURN_RATE &&
+            (f.current[0] != 0 || f.current[1] != 0))
+            return ts_fail(err, TS_EINVAL, "manoeuvre: a turn-rate change "
+                           "turns the horizontal current (%g, %g m/s) in "
+                           "the mean frame by the heading change, without "
+                           "bound; the linear model has no heading state "
+                           "(simulate it nonlinearly)", f.current[0],
+                           f.current[1]);
+    return TS_OK;
+}
+
 /* Add the vehicle-input signals at t into u[ninput] (idx from
  * bind_inputs; nothing when NULL). */
 static void add_inputs(const ts_excitation *ex, const int *idx, double t,
@@ -1460,8 +1485,11 @@ typedef struct lin_sim {
     const ts_linear *lin;
     const ts_excitation *ex;
     int n, m;          /* states; inputs driven: TS_NINPUT, or every input
-                          when a signal drives a vehicle's input */
+                          when a signal drives a vehicle's input or the
+                          frame (a manoeuvre) */
     const int *in_idx; /* bind_inputs; NULL: none */
+    int manoeuvre;     /* 1: the frame inputs follow the excitation */
+    ts_frame base;     /* the frame linearized in (t = 0) */
     double *tmp;       /* [n] */
     double *v;         /* [6 m]: four input samples, two for df/dt */
     double *p;         /* [4 m]: the cubic's coefficients */
@@ -1469,7 +1497,9 @@ typedef struct lin_sim {
 } lin_sim;
 
 /* v[m] = u(t) - u0: the tow channels from the excitation, the vehicles'
- * inputs (when driven) the signals on them. */
+ * inputs (when driven) the signals on them, the frame inputs (under a
+ * manoeuvre) the frame's change from the base frame: speed, turn rate
+ * and their rates (ts_excitation_frame). */
 static void lin_input(const lin_sim *L, double t, double *v)
 {
     if (L->ex)
@@ -1483,6 +1513,15 @@ static void lin_input(const lin_sim *L, double t, double *v)
         v[j] = 0.0;
     if (L->in_idx)
         add_inputs(L->ex, L->in_idx, t, v);
+    if (L->manoeuvre) {
+        ts_frame f;
+        ts_excitation_frame(L->ex, &L->base, t, &f);
+        double *vf = v + L->lin->frame_input;
+        vf[0] = f.speed - L->base.speed;
+        vf[1] = f.turn_rate - L->base.turn_rate;
+        vf[2] = f.speed_rate;
+        vf[3] = f.turn_accel;
+    }
 }
 
 /* Phi and G of step h: top blocks of exp(M h). */
@@ -1651,12 +1690,10 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
             if (z[j] != 0)
                 for (size_t l = 0; l < nl; l++)
                     ten[l] += lin->Ty[l + nl * (size_t)j] * z[j];
-        for (int j = 0; j < TS_NINPUT; j++) {
-            double v = u[j] - lin->u0[j];
-            if (v != 0)
+        for (int j = 0; j < L->m; j++)
+            if (dv[j] != 0)
                 for (size_t l = 0; l < nl; l++)
-                    ten[l] += lin->Tu[l + nl * (size_t)j] * v;
-        }
+                    ten[l] += lin->Tu[l + nl * (size_t)j] * dv[j];
     }
     for (int c = 0; c < 3; c++)
         h->tow_force[3 * i + (size_t)c] = NAN;
@@ -1697,10 +1734,11 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EINVAL, "simulate (linear): the linear "
                        "simulation needs the dense A and B (linearize with "
                        "model TS_LIN_DENSE or BOTH)");
-    if (ex && ts_excitation_has_manoeuvre(ex))
-        return ts_fail(err, TS_EDOMAIN, "simulate (linear): the linear model "
-                       "has no frame inputs: a speed or turn-rate manoeuvre "
-                       "can only be simulated nonlinearly");
+    int manoeuvre = ex && ts_excitation_has_manoeuvre(ex);
+    ts_frame base;
+    ts_kernel_get_frame(k, &base);
+    if ((rc = ts_sim_check_linear_manoeuvre(k, ex, err)))
+        return rc;
     int N = ts_sim_nsamples(o);
     if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err)))
         return rc;
@@ -1710,8 +1748,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     double w0 = tsi_wall_now();
     size_t sn = (size_t)n;
     /* Only the tow channels are driven unless a signal drives a vehicle's
-     * input (the exponential's order is n + 4 m). */
-    int m = in_idx ? lin->ninput : TS_NINPUT;
+     * input or the frame (the exponential's order is n + 4 m). */
+    int m = in_idx || manoeuvre ? lin->ninput : TS_NINPUT;
     double *z = calloc(sn, sizeof(double));
     double *tmp = calloc(sn, sizeof(double));
     /* y0 + z, f there, the whole input, and its deviation. */
@@ -1724,7 +1762,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         H[c].Phi = malloc(sn * sn * sizeof(double));
         H[c].G = malloc(sn * 4 * (size_t)m * sizeof(double));
     }
-    lin_sim L = {lin, ex, n, m, in_idx, tmp, vbuf, vbuf + 6 * m, 0};
+    lin_sim L = {lin,  ex,   n,           m, in_idx, manoeuvre,
+                 base, tmp,  vbuf, vbuf + 6 * m, 0};
     gsl_odeiv2_driver *drv = NULL;
     tsi_esdirk *sd = NULL;
     gsl_odeiv2_system gsys = {lin_rhs, lin_jac, sn, &L};

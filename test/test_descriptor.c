@@ -241,7 +241,9 @@ static void compare_dense(const char *name, const ts_system *sys)
           "%s (%d links): E^-1 F = A within the error estimates, every "
           "column (largest difference %.3g of the allowance, column %d)",
           name, sys->nlinks, worst, wj);
-    for (int j = 0; rc == TS_OK && j < lin->ninput; j++) {
+    /* The kernel's inputs; the frame inputs after them are columns of
+     * the dense B only (doc/linear.md, section 1). */
+    for (int j = 0; rc == TS_OK && j < lin->frame_input; j++) {
         if (lin->kink_tow && j < TS_NINPUT && j % 3 == 2)
             continue;
         tsi_shift_apply_input(&acc, j, col, 0);

@@ -102,7 +102,7 @@ static void test_structure_threads_and_second_method(void)
                    0;
     CHECK(same, "A, B, dT/dy, dT/du identical with 1 and %d threads",
           l2->threads);
-    CHECK(l1->evaluations == 1 + 4L * (n + TS_NINPUT) + 8 + 1,
+    CHECK(l1->evaluations == 1 + 4L * (n + l1->ninput) + 8 + 1,
           "evaluations: 4 per column, base, 8 for the rounding noise, "
           "restore (%ld)", l1->evaluations);
 

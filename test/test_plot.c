@@ -584,6 +584,7 @@ static void test_modes(void)
                  0.2385 * (m + 1));
         modes[m].disp = disp[m];
         modes[m].label = label[m];
+        modes[m].outline_motion = NULL;
     }
     ts_plot_shape eq = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     int rc = ts_plot_mode_shapes(dir, "modes", "chain: lowest modes",
@@ -617,8 +618,46 @@ static void test_modes(void)
     free(a);
     free(b);
 
+    /* A vehicle's outline moved and rotated by the mode: drawn at both
+     * phases in both views of each row, in the mode's colour, beside its
+     * grey trim outline (a square of 4 points, 3 segments). */
+    const double *e = chain + 3 * (N - 1);
+    double sq[15] = {e[0], e[1], e[2], e[0] - 0.2, e[1], e[2],
+                     e[0] - 0.2, e[1], e[2] + 0.2, e[0], e[1], e[2] + 0.2,
+                     e[0], e[1], e[2]};
+    ts_plot_outline ol = {5, sq, {e[0], e[1], e[2]}};
+    ts_plot_shape eqo = eq;
+    eqo.noutlines = 1;
+    eqo.outlines = &ol;
+    rc = ts_plot_mode_shapes(dir, "modes2_trim", "two modes", TS_PLOT_WATER,
+                             &eqo, 2, modes, &o, &err);
+    double motion[2][6] = {{0.01, 0, 0.02, 0, 0.3, 0},
+                           {0, 0.02, 0, 0.1, 0, 0.2}};
+    ts_plot_mode moved[2] = {modes[0], modes[1]};
+    moved[0].outline_motion = motion[0];
+    moved[1].outline_motion = motion[1];
+    if (rc == TS_OK)
+        rc = ts_plot_mode_shapes(dir, "modes2_moved", "two modes",
+                                 TS_PLOT_WATER, &eqo, 2, moved, &o, &err);
+    a = check_svg("modes2_trim", "two modes");
+    b = check_svg("modes2_moved", "two modes");
+    na = a ? count_of(a, "<path ") : 0;
+    nb = b ? count_of(b, "<path ") : 0;
+    CHECK(rc == TS_OK && a && b && nb - na >= 2 * 2 * 2,
+          "mode shapes: the vehicle's outline moved by each mode at both "
+          "phases, both views: %d paths more than at the trim only (%d; at "
+          "least one per mode, phase and view)", nb - na, na);
+    free(a);
+    free(b);
+    motion[1][4] = NAN;
+    ts_err_clear(&err);
+    rc = ts_plot_mode_shapes(dir, "modes_badmotion", "x", 0, &eqo, 2, moved,
+                             &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "outline_motion"),
+          "a non-finite outline motion is refused: %s", err.msg);
+
     static double zero[3 * N];
-    ts_plot_mode bad = {zero, "nothing"};
+    ts_plot_mode bad = {zero, "nothing", NULL};
     ts_err_clear(&err);
     rc = ts_plot_mode_shapes(dir, "modes_zero", "x", 0, &eq, 1, &bad, &o,
                              &err);
@@ -631,6 +670,66 @@ static void test_modes(void)
                              &err);
     CHECK(rc == TS_EINVAL, "nmodes = 9 is refused: %s", err.msg);
     CHECK(nothing_named("modes_"), "refused mode plots left no file");
+}
+
+/* ts_plot_outline_moved: the rigid motion of an outline in a mode,
+ * against a rotation matrix written out independently and its
+ * invariants. */
+static void test_outline_moved(void)
+{
+    /* A triangle off its anchor, rotated about y (pitch) by s * 0.35 rad,
+     * translated by s t, magnified 2.5 times; s = -1.7. */
+    double pts[12] = {1.0, 0.5, 2.0, 1.4, 0.5, 2.0, 1.0, 0.9, 2.3,
+                      NAN, NAN, NAN};
+    ts_plot_outline o = {4, pts, {1.2, 0.3, 1.9}};
+    double motion[6] = {0.05, -0.02, 0.11, 0, 0.35, 0};
+    double s = -1.7, mag = 2.5, out[12];
+    ts_plot_outline_moved(&o, motion, s, mag, out);
+    double a = s * motion[4], c = cos(a), sn = sin(a), worst = 0;
+    for (int k = 0; k < 3; k++) {
+        double v[3], q[3];
+        for (int j = 0; j < 3; j++)
+            v[j] = mag * (pts[3 * k + j] - o.anchor[j]);
+        /* R_y(a): x' = c x + s z, z' = -s x + c z. */
+        q[0] = o.anchor[0] + s * motion[0] + c * v[0] + sn * v[2];
+        q[1] = o.anchor[1] + s * motion[1] + v[1];
+        q[2] = o.anchor[2] + s * motion[2] - sn * v[0] + c * v[2];
+        for (int j = 0; j < 3; j++)
+            worst = fmax(worst, fabs(out[3 * k + j] - q[j]));
+    }
+    CHECK(worst < 1e-15, "outline moved: a pitch of %.3f rad and a "
+          "translation match the rotation matrix R_y to %.2g m", a, worst);
+    CHECK(isnan(out[9]) && isnan(out[10]) && isnan(out[11]),
+          "outline moved: a pen lift stays a pen lift");
+    /* A general rotation: rigid (distances times mag), and the rotation
+     * axis through the anchor fixed (but for the translation). */
+    double axis[6] = {0, 0, 0, 0.2, -0.4, 0.7}, ax[3] = {0.2, -0.4, 0.7};
+    double pa[6] = {o.anchor[0] + 0.1 * ax[0], o.anchor[1] + 0.1 * ax[1],
+                    o.anchor[2] + 0.1 * ax[2], 0.3, -1.1, 2.9};
+    ts_plot_outline oa = {2, pa, {o.anchor[0], o.anchor[1], o.anchor[2]}};
+    double qa[6];
+    ts_plot_outline_moved(&oa, axis, 1.3, 1.0, qa);
+    double da = 0, d0 = 0, d1 = 0;
+    for (int j = 0; j < 3; j++) {
+        da = fmax(da, fabs(qa[j] - pa[j]));
+        d0 += (pa[3 + j] - o.anchor[j]) * (pa[3 + j] - o.anchor[j]);
+        d1 += (qa[3 + j] - o.anchor[j]) * (qa[3 + j] - o.anchor[j]);
+    }
+    double moved = 0;
+    for (int j = 0; j < 3; j++)
+        moved = fmax(moved, fabs(qa[3 + j] - pa[3 + j]));
+    CHECK(da < 1e-15 && fabs(sqrt(d1) - sqrt(d0)) < 1e-14 && moved > 0.1,
+          "outline moved: a point on the rotation axis stays (%.2g m), "
+          "another keeps its distance from the anchor (%.2g m) and moves "
+          "(%.3f m)", da, fabs(sqrt(d1) - sqrt(d0)), moved);
+    double same[6];
+    ts_plot_outline_moved(&oa, NULL, 1.3, 1.0, same);
+    double dsame = 0;
+    for (int j = 0; j < 6; j++)
+        dsame = fmax(dsame, fabs(same[j] - pa[j]));
+    CHECK(dsame < 1e-15, "outline moved: no motion, no magnification: the "
+          "points themselves (to %.2g m, the rounding of A + (p - A))",
+          dsame);
 }
 
 static void test_eigenvalues(void)
@@ -1238,7 +1337,7 @@ static void test_without_plplot(void)
               strstr(err.msg, "plplot-driver-cairo"),
           "ts_plot_check names the missing packages: %s", err.msg);
     ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
-    ts_plot_mode mode = {chain, "m"};
+    ts_plot_mode mode = {chain, "m", NULL};
     double x[2] = {1, 2}, y[2] = {1, 2}, ph[2] = {0, 0}, nat[1] = {1};
     ts_plot_series s = {2, x, y, "s", 0, 0, 0};
     ts_plot_bode_curve b = {2, x, y, ph, "b", 0, 0};
@@ -1401,6 +1500,7 @@ int main(int argc, char **argv)
     test_cylinder();
     test_animation();
     test_modes();
+    test_outline_moved();
     test_eigenvalues();
     test_bode();
     test_histories();

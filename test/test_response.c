@@ -11,7 +11,9 @@
  *     0.1 m of the waterline (checked), far from the kink.
  *  2. Static gain, surge in a turn (Kamman ex. 3, 0.5 rad/s): moving the
  *     tow point forward changes its radius, so the sphere moves sideways;
- *     the same comparison for sphere.y.
+ *     the same comparison for sphere.y. The frame inputs tow.speed and
+ *     tow.turn_rate, straight and in the turn: their static gains against
+ *     the equilibrium re-solved at V +- dV, Omega +- dOmega (1e-5).
  *  3. Resonance: for a chain hanging in vacuum, tow.surge -> bottom node x
  *     has a local maximum of |G| on a fine grid next to each of its three
  *     lowest in-plane natural frequencies (from the eigen solver), none
@@ -71,13 +73,14 @@ static const char *turn_yaml =
     "  - {name: sphere, type: sphere, diameter: \"2 in\", weight: \"0.246 "
     "lbf\"}\n";
 
-/* Equilibrium output value with the tow point displaced by d along axis. */
-static double displaced(ts_system *sys, int axis, double d,
-                        const ts_output *out, int *ok)
+/* Equilibrium output value with the scene value *value (of sys) changed
+ * by d, then restored. */
+static double resolved_with(ts_system *sys, double *value, double d,
+                            const ts_output *out, int *ok)
 {
     ts_err err = {0};
-    double p0 = sys->tow.point[axis];
-    sys->tow.point[axis] = p0 + d;
+    double p0 = *value;
+    *value = p0 + d;
     ts_kernel *k = ts_kernel_alloc(sys, &err);
     ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
     ts_equilibrium_opts o;
@@ -85,7 +88,7 @@ static double displaced(ts_system *sys, int axis, double d,
     o.tol = 1e-12;
     int rc = ts_equilibrium_solve(k, &o, eq, &err);
     if (rc != TS_OK) {
-        printf("  displaced equilibrium: %s\n", err.msg);
+        printf("  re-solved equilibrium: %s\n", err.msg);
         *ok = 0;
     }
     double v = out->kind == TS_OUT_POSITION
@@ -93,9 +96,10 @@ static double displaced(ts_system *sys, int axis, double d,
                    : eq->tensions[out->link];
     ts_equilibrium_free(eq);
     ts_kernel_free(k);
-    sys->tow.point[axis] = p0;
+    *value = p0;
     return v;
 }
+
 
 static ts_linear *linearize_at(const ts_system *sys, ts_lin_model model,
                                double step, double *zmin);
@@ -142,6 +146,37 @@ static ts_linear *linearize_at(const ts_system *sys, ts_lin_model model,
     return lin;
 }
 
+/* The static gain of input `in` to out at w = 0 and at 1e-6 Hz against
+ * the central difference of the equilibria re-solved with the scene value
+ * *value changed by +-d; returns that difference. */
+static double static_check(ts_system *sys, ts_linear *lin, int in,
+                           const ts_output *out, double *value, double d,
+                           const char *in_name, const char *out_name)
+{
+    ts_err err = {0};
+    int ok = 1;
+    double ref = (resolved_with(sys, value, d, out, &ok) -
+                  resolved_with(sys, value, -d, out, &ok)) / (2 * d);
+    double g0r = NAN, g0i = NAN, glr = NAN, gli = NAN;
+    int rc = ts_response_at(sys, lin, in, out, 0.0, &g0r, &g0i, &err);
+    rc |= ts_response_at(sys, lin, in, out, 2 * M_PI * 1e-6, &glr, &gli,
+                         &err);
+    printf("  %s -> %s: re-solved %.10g, w = 0 %.10g, 1e-6 Hz %.10g%+.3gi\n",
+           in_name, out_name, ref, g0r, glr, gli);
+    CHECK(ok && rc == TS_OK, "%s -> %s: responses and re-solved equilibria "
+          "computed (%s)", in_name, out_name, err.msg);
+    /* 1e-5 relative: the central difference of the re-solved equilibria
+     * is good to ~1e-7 ((d / scale)^2), their residuals to 1e-12, the
+     * linearization to ~1e-9. */
+    CHECK(fabs(g0r - ref) <= 1e-5 * fabs(ref), "%s -> %s: static gain at "
+          "w = 0 vs re-solved (%.3g relative <= 1e-5)", in_name, out_name,
+          fabs(g0r - ref) / fabs(ref));
+    CHECK(fabs(hypot(glr, gli) - fabs(ref)) <= 1e-5 * fabs(ref), "%s -> %s: "
+          "|gain| at 1e-6 Hz vs re-solved", in_name, out_name);
+    CHECK(g0i == 0.0, "%s -> %s: gain at w = 0 is real", in_name, out_name);
+    return ref;
+}
+
 static void static_case(ts_system *sys, ts_linear *lin, const char *in_name,
                         const char *out_name, double not_trivial)
 {
@@ -152,29 +187,33 @@ static void static_case(ts_system *sys, ts_linear *lin, const char *in_name,
     rc |= ts_response_output_find(sys, out_name, &out, &err);
     CHECK(rc == TS_OK, "%s -> %s: names found (%s)", in_name, out_name,
           err.msg);
-    double d = 1e-3;
-    int ok = 1;
-    double ref = (displaced(sys, in, d, &out, &ok) -
-                  displaced(sys, in, -d, &out, &ok)) /
-                 (2 * d);
-    double g0r, g0i, glr, gli;
-    rc = ts_response_at(sys, lin, in, &out, 0.0, &g0r, &g0i, &err);
-    rc |= ts_response_at(sys, lin, in, &out, 2 * M_PI * 1e-6, &glr, &gli,
-                         &err);
-    printf("  %s -> %s: re-solved %.10g, w = 0 %.10g, 1e-6 Hz %.10g%+.3gi\n",
-           in_name, out_name, ref, g0r, glr, gli);
-
-    CHECK(ok && rc == TS_OK, "%s -> %s: responses and displaced equilibria "
-                             "computed",
-          in_name, out_name);
-    /* 1e-5 relative: the central difference of the re-solved equilibria
-     * is good to ~1e-7, the linearization to ~1e-9. */
-    CHECK_REL(g0r, ref, 1e-5, "static gain at w = 0 vs re-solved");
-    CHECK_REL(hypot(glr, gli), fabs(ref), 1e-5,
-              "|gain| at 1e-6 Hz vs re-solved");
-    CHECK(g0i == 0.0, "gain at w = 0 is real");
+    double ref = static_check(sys, lin, in, &out, &sys->tow.point[in], 1e-3,
+                              in_name, out_name);
     CHECK(fabs(ref - round(ref)) > not_trivial,
           "%s -> %s: the gain %.6g is not trivially an integer", in_name,
+          out_name, ref);
+}
+
+/* The zero-frequency response to the frame inputs tow.speed and
+ * tow.turn_rate (dense B columns) against the static sensitivity from
+ * re-solving the equilibrium at V +- dV, Omega +- dOmega. */
+static void frame_static_case(ts_system *sys, ts_linear *lin,
+                              const char *in_name, const char *out_name,
+                              double d)
+{
+    ts_err err = {0};
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    int in = -1, c = strcmp(in_name, "tow.speed") ? 1 : 0;
+    ts_output out;
+    int rc = ts_response_input_lookup(k, in_name, &in, &err);
+    rc |= ts_response_output_find(sys, out_name, &out, &err);
+    ts_kernel_free(k);
+    CHECK(rc == TS_OK && in == lin->frame_input + c, "%s -> %s: names "
+          "found, input column %d (%s)", in_name, out_name, in, err.msg);
+    double ref = static_check(sys, lin, in, &out,
+                              c == 0 ? &sys->tow.speed : &sys->tow.turn_rate,
+                              d, in_name, out_name);
+    CHECK(fabs(ref) > 1e-3, "%s -> %s: the gain %.6g is not nil", in_name,
           out_name, ref);
 }
 
@@ -196,6 +235,23 @@ static void test_static_gain(void)
     sc = tscene_parse(units, turn_yaml);
     lin = linearize(sc->system, TS_LIN_BOTH, NULL);
     static_case(sc->system, lin, "tow.surge", "sphere.y", 0.01);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+
+    /* The frame inputs, in straight tow and in the turn. */
+    sc = tscene_parse(units, above_yaml);
+    lin = linearize(sc->system, TS_LIN_DENSE, NULL);
+    frame_static_case(sc->system, lin, "tow.speed", "sphere.z", 1e-3);
+    frame_static_case(sc->system, lin, "tow.speed", "cable.1.tension", 1e-3);
+    frame_static_case(sc->system, lin, "tow.turn_rate", "sphere.y", 1e-4);
+    ts_linear_free(lin);
+    ts_scene_free(sc);
+    sc = tscene_parse(units, turn_yaml);
+    lin = linearize(sc->system, TS_LIN_DENSE, NULL);
+    frame_static_case(sc->system, lin, "tow.speed", "sphere.y", 1e-4);
+    frame_static_case(sc->system, lin, "tow.turn_rate", "sphere.x", 1e-4);
+    frame_static_case(sc->system, lin, "tow.turn_rate", "cable.20.tension",
+                      1e-4);
     ts_linear_free(lin);
     ts_scene_free(sc);
 }
@@ -527,7 +583,30 @@ static void test_names(void)
     CHECK(rc == TS_EINVAL, "channel 3 refused: %s", err.msg);
     rc = ts_response_at(sys, lin, 2, &out, -1.0, &re, &im, &err);
     CHECK(rc == TS_EINVAL, "negative frequency refused: %s", err.msg);
+    rc = ts_response_at(sys, lin, lin->frame_input, &out, 0.0, &re, &im,
+                        &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow.speed needs the dense"),
+          "tow.speed with the sparse model refused: %s", err.msg);
     ts_linear_free(lin);
+
+    /* The frame inputs by name: their rates come with them; a turn in a
+     * horizontal current has no linear model. */
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    rc = ts_response_input_lookup(k, "tow.speed_rate", &in, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "give tow.speed"),
+          "tow.speed_rate refused: %s", err.msg);
+    rc = ts_response_input_lookup(k, "nosuch", &in, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow.speed, tow.turn_rate"),
+          "a bad input's message lists the frame inputs: %s", err.msg);
+    ts_kernel_free(k);
+    sc->system->env.current[1] = 0.3;
+    k = ts_kernel_alloc(sys, &err);
+    rc = ts_response_input_lookup(k, "tow.turn_rate", &in, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "heading change"),
+          "tow.turn_rate in a horizontal current refused: %s", err.msg);
+    rc = ts_response_input_lookup(k, "tow.speed", &in, &err);
+    CHECK(rc == TS_OK, "tow.speed in a current is an input");
+    ts_kernel_free(k);
     ts_scene_free(sc);
 }
 

@@ -285,9 +285,12 @@ static int ends_with(const char *s, const char *suffix)
 /* Real node displacements of mode m at the phase of largest excursion:
  * with d = a + i b (node displacements of the real and imaginary parts of
  * the eigenvector's coordinate half), Re(d e^{i phi}) = a cos phi -
- * b sin phi is largest at tan 2 phi = -2 a.b / (|a|^2 - |b|^2). */
+ * b sin phi is largest at tan 2 phi = -2 a.b / (|a|^2 - |b|^2). With
+ * rot, each vehicle's small rotation at that phase, rot[3 nvehicles]
+ * (ts_linear_vehicle_rotations). */
 static int mode_disp(const ts_system *sys, const ts_linear *lin,
-                     const ts_eigen *e, int m, double *out, double *im_out)
+                     const ts_eigen *e, int m, double *out, double *im_out,
+                     double *rot)
 {
     int nq = lin->nq, nn = sys->nnodes;
     double *dq = malloc((size_t)nq * sizeof(double));
@@ -315,6 +318,12 @@ static int mode_disp(const ts_system *sys, const ts_linear *lin,
         if (im_out)
             im_out[i] = out[i] * sn + b[i] * c;
         out[i] = out[i] * c - b[i] * sn;
+    }
+    /* Each vehicle's small rotation at the same phase. */
+    if (rot) {
+        for (int i = 0; i < nq; i++)
+            dq[i] = vr[i] * c - vi[i] * sn;
+        ts_linear_vehicle_rotations(lin, dq, rot);
     }
     free(dq);
     free(b);
@@ -394,8 +403,10 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
     if (np < 1 || !e->vec_re || !e->vec_im)
         return status;
     cli_shape eqs;
-    double *disp = malloc((size_t)np * 6 * (size_t)sys->nnodes *
-                          sizeof(double));
+    /* Per mode: the displacements at two phases, then each vehicle's
+     * rotation and its outline's motion (ts_plot_mode.outline_motion). */
+    size_t per = 6 * (size_t)sys->nnodes + 9 * (size_t)lin->nvehicles;
+    double *disp = malloc((size_t)np * per * sizeof(double));
     char labels[PLOT_MODES][160];
     ts_plot_mode modes[PLOT_MODES];
     if (!disp || cli_plot_shape(sys, pos, &eqs) != 0 ||
@@ -407,11 +418,23 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
     for (int i = 0; i < np; i++) {
         int m = pick[i];
         const ts_mode *md = &e->modes[m];
-        double *d = disp + (size_t)i * 6 * sys->nnodes;
-        if (mode_disp(sys, lin, e, m, d, d + 3 * sys->nnodes) != 0) {
+        double *d = disp + (size_t)i * per;
+        double *rot = d + 6 * sys->nnodes, *motion = rot + 3 * lin->nvehicles;
+        if (mode_disp(sys, lin, e, m, d, d + 3 * sys->nnodes, rot) != 0) {
             status = EXIT_FAILED;
             break;
         }
+        /* The outlines are the equilibrium's vehicles in order
+         * (cli_plot_add_vehicles), each anchored at its body's node. */
+        int nout = r->eq ? eqs.shape.noutlines : 0;
+        for (int v = 0; v < nout; v++) {
+            int node = ts_system_body_node(sys, r->eq->vehicles[v].body);
+            for (int j = 0; j < 3; j++) {
+                motion[6 * v + j] = d[3 * node + j];
+                motion[6 * v + 3 + j] = rot[3 * v + j];
+            }
+        }
+        modes[i].outline_motion = nout > 0 ? motion : NULL;
         snprintf(labels[i], sizeof labels[i],
                  "mode %d: %.4g Hz, damping ratio %.3g%s", m + 1,
                  md->freq_hz, md->damping_ratio,
@@ -435,7 +458,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
      * modeK_top_kkk), FRAMES_PNG frames a cycle. */
     static const char *const vname[2] = {"side", "top"};
     for (int i = 0; i < np && status == 0; i++) {
-        const double *d = disp + (size_t)i * 6 * sys->nnodes;
+        const double *d = disp + (size_t)i * per;
         for (int v = 0; v < 2 && status == 0; v++) {
             char name[48], at[300];
             snprintf(name, sizeof name, "mode%d_animation%s", pick[i] + 1,

@@ -216,10 +216,11 @@ TS_API double ts_excitation_heading(const ts_excitation *ex,
 TS_API int ts_excitation_breakpoints(const ts_excitation *ex, double t_end,
                                      double out[], int max);
 
-/* The shortest time scale of the tow-point and vehicle-input signals (s): 1/(2 pi f) for a
- * sine, 1/(4 pi f) for a crank (its second harmonic), the rise of steps and
- * ramps, the smallest sample spacing of a series, 1/max |w_k| for a sum
- * (and its fade-in time, if shorter); INFINITY without such signals. The linear simulator sizes its steps on it. */
+/* The shortest time scale of the signals (s): 1/(2 pi f) for a sine,
+ * 1/(4 pi f) for a crank (its second harmonic), the rise of steps and
+ * ramps (manoeuvres included), the smallest sample spacing of a series,
+ * 1/max |w_k| for a sum (and its fade-in time, if shorter); INFINITY
+ * without signals. The linear simulator sizes its steps on it. */
 TS_API double ts_excitation_time_scale(const ts_excitation *ex);
 
 /* Bounds of the motion under ex from the frame `base` (ex may be NULL:

@@ -27,10 +27,15 @@
  * h result is (A(2h) - A(h)) / 3 to leading order; the rounding noise of
  * the differences from the kernel's own scatter (fnoise).
  *
- * Inputs v (TS_NINPUT = 9): tow-point displacement x, y, z (m), velocity
- * (m/s), acceleration (m/s^2) in the mean ship frame, named tow.surge,
- * tow.sway, tow.heave for displacement (their velocity and acceleration
- * columns follow in the same order). Matrices are column-major: A[i + j n].
+ * Inputs v (ts_kernel_ninput): tow-point displacement x, y, z (m),
+ * velocity (m/s), acceleration (m/s^2) in the mean ship frame, named
+ * tow.surge, tow.sway, tow.heave for displacement (their velocity and
+ * acceleration columns follow in the same order: TS_NINPUT = 9); the
+ * vehicles' inputs; last the frame's speed, turn rate and their rates
+ * (tow.speed, tow.turn_rate, tow.speed_rate, tow.turn_accel; m/s, rad/s,
+ * m/s^2, rad/s^2): a change of the mean frame's motion, the state staying
+ * the deviation from y0 in the frame so moved (doc/linear.md, section
+ * 1). Matrices are column-major: A[i + j n].
  *
  * Besides A and B the result holds what the mode and response reports map
  * through: the tension Jacobians (optional) and the derivatives of every
@@ -53,6 +58,18 @@ enum {
     TS_IN_DISP = 0,   /* tow displacement x, y, z: columns 0, 1, 2 */
     TS_IN_VEL = 3,    /* tow velocity x, y, z: columns 3, 4, 5 */
     TS_IN_ACC = 6     /* tow acceleration x, y, z: columns 6, 7, 8 */
+};
+
+/* The frame inputs, the last TS_NFRAME_INPUT columns of B (from
+ * ts_linear.frame_input on): changes of the mean frame's speed V (m/s),
+ * turn rate Omega (rad/s) and their rates (m/s^2, rad/s^2), added to the
+ * kernel's frame (ts_kernel_set_frame) for each evaluation. */
+#define TS_NFRAME_INPUT 4
+enum {
+    TS_FRAME_SPEED = 0,      /* "tow.speed" */
+    TS_FRAME_TURN_RATE = 1,  /* "tow.turn_rate" */
+    TS_FRAME_SPEED_RATE = 2, /* "tow.speed_rate" */
+    TS_FRAME_TURN_ACCEL = 3  /* "tow.turn_accel" */
 };
 
 /* Room for an input or output name ("<vehicle>.<loop>.setpoint"). */
@@ -87,8 +104,11 @@ typedef struct ts_neutral {
 typedef struct ts_linear {
     int nstate;        /* n = 2 nq + nc (nc controller states) */
     int nq;            /* generalised coordinates (ts_kernel_nq) */
-    int ninput;        /* ts_kernel_ninput: TS_NINPUT tow inputs, then the
-                          vehicles' surfaces and loops */
+    int ninput;        /* ts_kernel_ninput + TS_NFRAME_INPUT: TS_NINPUT
+                          tow inputs, the vehicles' surfaces and loops
+                          (the kernel's inputs), then the frame inputs */
+    int frame_input;   /* index of the first frame input, "tow.speed":
+                          ts_kernel_ninput, the kernel's inputs before */
     int nlinks, nnodes;
     double *A;         /* [n * n] column-major; rows 0..nq-1 are [0 I 0];
                           NULL unless the dense model was formed */
@@ -101,7 +121,8 @@ typedef struct ts_linear {
                           response and stiff simulation solvers use it at
                           any size */
     double *y0;        /* [n] state linearized about (kernel's charts) */
-    double *u0;        /* [ninput] input linearized about */
+    double *u0;        /* [ninput] input linearized about (its frame
+                          inputs zero) */
     double *f0;        /* [n] f(y0, u0): zero at an exact equilibrium */
     double *r0;        /* [3 nnodes] node positions at y0, m */
     double *t0;        /* [nlinks] link tensions at y0, N */
@@ -126,6 +147,12 @@ typedef struct ts_linear {
                           at y0 (M frame, 9 row-major: the small rotation
                           of the body per angle change) and rho_P = R (P -
                           A) (3, m); NULL without vehicles */
+    double *veh_rot;   /* [9 nvehicles] R E of each vehicle at y0 (M
+                          frame, row-major): its small rotation (rad) per
+                          change of its three angles, in kernel vehicle
+                          order; NULL without vehicles */
+    int *veh_qoff;     /* [nvehicles] offset of each vehicle's angles in
+                          q; NULL without vehicles */
     double *Ty;        /* [nlinks * n] dT/dy (N/rad, N s/rad) column-major,
                           or NULL unless opts.tensions */
     double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
@@ -171,7 +198,7 @@ typedef struct ts_linear {
                           fnoise[i] / (sqrt(2) h[j]), which the truncation
                           estimate samples only by chance; NULL unless
                           estimate_error */
-    double *Berr;      /* [(n - nq) * TS_NINPUT] the same for B's lower
+    double *Berr;      /* [(n - nq) * ninput] the same for B's lower
                           block; NULL unless estimate_error */
     double round_norm; /* the Frobenius norm of that noise over the state
                           columns (units of A); NaN unless estimate_error */
@@ -240,9 +267,10 @@ TS_API void ts_linearize_opts_default(ts_linearize_opts *o);
 TS_API ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err);
 TS_API void ts_linear_free(ts_linear *lin);
 
-/* Linearize kernel k about state y0[nstate] and input u0[ninput] (NULL:
- * zero), forming the models opts->model asks for. The kernel's charts must
- * be those of y0; the kernel's frame is used as set. Cost: sparse model
+/* Linearize kernel k about state y0[nstate] and input
+ * u0[ts_kernel_ninput(k)] (NULL: zero; the frame inputs are zero there:
+ * the kernel's frame, used as set), forming the models opts->model asks
+ * for. The kernel's charts must be those of y0. Cost: sparse model
  * 2 or 4 residual evaluations per group (18 to 24 groups), O(nlinks);
  * dense model (2 or 4) (n + 9) kernel evaluations, O(nlinks) each, so
  * O(nlinks^2); both divided among the threads. The sparse model is exact
@@ -277,10 +305,24 @@ TS_API void ts_linear_node_displacements(const ts_system *sys,
                                          const ts_linear *lin,
                                          const double dq[], double dr[]);
 
+/* The small rotation phi[3 nvehicles] (rad, M axes, kernel vehicle
+ * order) of every vehicle produced by coordinate perturbations dq[nq]
+ * about lin->y0, to first order: phi = R E dtheta (R the attitude at y0,
+ * E the rate matrix of its angles). Nothing without vehicles. */
+TS_API void ts_linear_vehicle_rotations(const ts_linear *lin,
+                                        const double dq[], double phi[]);
+
 /* Name of input column j ("tow.surge", "tow.sway", "tow.heave",
  * "tow.surge_velocity", ..., "tow.heave_acceleration"); NULL outside
  * [0, TS_NINPUT). */
 TS_API const char *ts_input_name(int j);
+
+/* Name and unit of frame input c (TS_FRAME_SPEED ...): "tow.speed",
+ * "tow.turn_rate", "tow.speed_rate", "tow.turn_accel"; "m/s", "rad/s",
+ * "m/s^2", "rad/s^2". NULL outside [0, TS_NFRAME_INPUT). Its column of B
+ * is ts_linear.frame_input + c. */
+TS_API const char *ts_frame_input_name(int c);
+TS_API const char *ts_frame_input_unit(int c);
 
 #ifdef __cplusplus
 }

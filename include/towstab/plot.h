@@ -193,7 +193,24 @@ typedef enum {
 typedef struct ts_plot_mode {
     const double *disp;  /* [3 nnodes] node displacements (any scale) */
     const char *label;   /* e.g. "mode 1: 0.412 Hz, damping 3.1 %" */
+    const double *outline_motion; /* [6 noutlines] of the equilibrium's
+                            outlines, at the scale of disp: each one's
+                            anchor displacement (3, m) and small rotation
+                            vector (3, rad, M axes) in the mode; NULL:
+                            the outlines are drawn at the trim only */
 } ts_plot_mode;
+
+/* The points out[3 npoints] of outline o moved by a mode at scale s and
+ * magnified by mag about its anchor A: each point p goes to
+ *     A + s t + mag R(s phi) (p - A),
+ * (t, phi) = (motion[0..3), motion[3..6)) the anchor's displacement (m)
+ * and small rotation vector (rad, M axes) per unit of the mode, R(w) the
+ * rotation by the angle |w| about w / |w| (Rodrigues: a rigid motion at
+ * any angle). motion NULL: no motion (the trim). Non-finite points (pen
+ * lifts) stay non-finite. */
+TS_API void ts_plot_outline_moved(const ts_plot_outline *o,
+                                  const double motion[6], double s,
+                                  double mag, double out[]);
 
 /* A mode as an animation: DIR/NAME.svg only (whatever opts->formats), an
  * SVG whose cable path runs through one cycle of the mode every `seconds`
@@ -317,7 +334,10 @@ TS_API int ts_plot_tracks(const char *dir, const char *name,
 /* Mode shapes: one row per mode (1 <= nmodes <= 8), side view on the left
  * and top view (equal scales) on the right. Each shows the equilibrium
  * `eq` (grey) and eq +- s disp (solid and dashed), s chosen so that the
- * largest node displacement is 15 % of the cable's largest extent. The
+ * largest node displacement is 15 % of the cable's largest extent; the
+ * outlines of eq at the trim (grey) and, for a mode with its
+ * outline_motion, moved and rotated by +- s of it in the mode's colour
+ * (ts_plot_outline_moved). The
  * picture is 95 + 220 nmodes + 50 px tall when that exceeds
  * opts->height (nmodes >= 3 at the default 700 px). `eq` gives nodes,
  * links and marks; its label, style, colour and turn radius are not

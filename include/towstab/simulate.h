@@ -272,17 +272,30 @@ TS_API int ts_sim_check_inputs(const ts_kernel *k, const ts_excitation *ex,
 
 /* --- Linear simulation. --- */
 
+/* Check that the linear model can follow the manoeuvres of ex (a step or
+ * ramp of the frame's speed or turn rate, the frame inputs of
+ * towstab/linearize.h): refused (TS_EINVAL) with a towing vehicle, whose
+ * own steady motion is the frame, and a turn-rate change in a horizontal
+ * current, which turns the current in the frame by the heading change
+ * (no state of the linear model). TS_OK without manoeuvres. */
+TS_API int ts_sim_check_linear_manoeuvre(const ts_kernel *k,
+                                         const ts_excitation *ex,
+                                         ts_err *err);
+
 /* Simulate z' = A z + B (u(t) - u0) from z(0) = z0 (NULL: 0) over
  * [0, o->t_end], recording positions into h, and the link tensions
  * T0 + dT/dy z + dT/du (u - u0) when lin has the tension Jacobians
  * (ts_linearize_opts.tensions; else NaN); energies and the tow force are
  * NaN.
  * `k` must be the kernel lin was computed with, in the same charts (its
- * frame too); it is used for the nonlinear kinematics only. The linear
- * model has no frame inputs: an excitation with a manoeuvre is refused
- * (TS_EDOMAIN). Cost per output interval: expm O(n^2) per step plus one
- * O((n + 36)^3) exponential per distinct step size; ode: O(n^2) per
- * evaluation. */
+ * frame too, the base of the manoeuvres); it is used for the nonlinear
+ * kinematics only. A manoeuvre drives the frame inputs with the frame's
+ * change from k's frame (ts_excitation_frame): the state z stays the
+ * deviation from the initial equilibrium in the mean frame so moved, as
+ * the nonlinear run's (doc/simulate.md); refused as
+ * ts_sim_check_linear_manoeuvre says. Cost per output interval: expm
+ * O(n^2) per step plus one O((n + 4 m)^3) exponential per distinct step
+ * size (m inputs driven); ode: O(n^2) per evaluation. */
 TS_API int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                               const ts_excitation *ex, const double z0[],
                               const ts_sim_opts *o, ts_history *h,
