@@ -62,6 +62,9 @@
  * (at least EQ_NOISE_MIN_REL) times the length or force scale. */
 #define EQ_NOISE_FACTOR 10.0
 #define EQ_NOISE_MIN_REL (16.0 * DBL_EPSILON)
+/* A towing vehicle's solved rudder deflection is judged relative to
+ * itself, or to this (rad: a degree) when smaller. */
+#define DEFLECTION_SCALE (M_PI / 180.0)
 /* Noise of a mode value in a step sweep, relative. */
 #define STEP_NOISE_REL (64.0 * DBL_EPSILON)
 /* Rounding noise of a simulated value: this many eps per sqrt(step). */
@@ -241,15 +244,46 @@ static int check_setup(const ts_setup *s, ts_err *err)
     return TS_OK;
 }
 
-/* A copy of sys with the setup applied, built; NULL on failure. */
-static ts_system *setup_system(const ts_system *sys, const ts_setup *s,
+/* A simulation's waypoints (simulate.waypoints) in place of the points of
+ * the scene's waypoints entry. */
+static int set_waypoints(ts_system *c, const ts_simulate_opts *s,
+                         ts_err *err)
+{
+    ts_autopilot *ap = &c->tow.autopilot;
+    if (!ap->on)
+        return ts_fail(err, TS_EINVAL, "waypoints: they replace the points "
+                       "of the scene's waypoints entry, which gives the "
+                       "rudders and the heading law's gain; the scene has "
+                       "none%s", c->tow.vehicle < 0 ? " (and no "
+                       "towing_vehicle to steer)" : "");
+    ts_guidance g = ap->g;
+    g.nwaypoints = s->nwaypoints;
+    memcpy(g.waypoint, s->waypoints,
+           (size_t)s->nwaypoints * sizeof g.waypoint[0]);
+    int rc = ts_guidance_check(&g, "waypoints", err);
+    if (rc == TS_OK)
+        ap->g = g;
+    else
+        ts_err_prefix(err, "waypoints: ");
+    return rc;
+}
+
+/* A copy of sys with the request's setup (and a simulation's waypoints)
+ * applied, built; NULL on failure. */
+static ts_system *setup_system(const ts_system *sys, const ts_request *rq,
                                ts_err *err)
 {
+    const ts_setup *s = &rq->setup;
     if (check_setup(s, err) != TS_OK)
         return NULL;
     ts_system *c = ts_system_copy(sys, err);
     if (!c)
         return NULL;
+    if (rq->kind == TS_ANALYSIS_SIMULATE && rq->simulate.nwaypoints > 0 &&
+        set_waypoints(c, &rq->simulate, err) != TS_OK) {
+        ts_system_free(c);
+        return NULL;
+    }
     for (int i = 0; i < s->nsets; i++)
         if (ts_param_set(c, s->sets[i].path, s->sets[i].value, err) !=
             TS_OK) {
@@ -491,11 +525,88 @@ static void eq_values_into(const ts_system *sys, const ts_equilibrium *eq,
     v0[3 * np].error.solver = EQ_NOISE_FACTOR * rel * eq->force_scale;
 }
 
+/* The solved steady motion of a towing vehicle (doc/towing-vehicle.md,
+ * section 3) as key values after the top tension: what the equilibrium
+ * solved for, not what the scene gave. Along the track, the speed and the
+ * power at a given thrust, the speed and the thrust at a given power, the
+ * thrust and the power of a speed controller; across it, the turn rate at
+ * the given deflections, or with turn_by the turn surface's deflection.
+ * Returns their number (0 without a towing vehicle); with v0 non-NULL
+ * names them into v0[] and, when eq has converged, fills them. */
+static int tow_values(const ts_system *sys, const ts_equilibrium *eq,
+                      ts_value *v0)
+{
+    if (sys->tow.vehicle < 0)
+        return 0;
+    const ts_body *b = &sys->bodies[sys->tow.vehicle];
+    const char *nm = b->name;
+    int bias = b->vehicle->propulsion.type == TS_PROP_SPEED;
+    int turn_by = sys->tow.turn_surface >= 0;
+    if (!v0)
+        return 3;
+    /* Along the track: the unknown solved, then what follows from it. */
+    if (bias) {
+        value_name(&v0[0], "N", 0.0, "%.63s.thrust", nm);
+        value_name(&v0[1], "W", 0.0, "%.63s.power", nm);
+    } else {
+        value_name(&v0[0], "m/s", 0.0, "%.63s.speed", nm);
+        value_name(&v0[1], b->vehicle->propulsion.type == TS_PROP_POWER
+                               ? "N" : "W", 0.0,
+                   b->vehicle->propulsion.type == TS_PROP_POWER
+                       ? "%.63s.thrust" : "%.63s.power", nm);
+    }
+    if (turn_by)
+        value_name(&v0[2], "rad", 0.0, "%.63s.%.63s.deflection", nm,
+                   b->vehicle->component[sys->tow.turn_surface].name);
+    else
+        value_name(&v0[2], "rad/s", 0.0, "%.63s.turn_rate", nm);
+    if (!eq || !eq->converged)
+        return 3;
+    const ts_vehicle_result *vr = NULL;
+    for (int v = 0; v < eq->nvehicles; v++)
+        if (eq->vehicles[v].towing)
+            vr = &eq->vehicles[v];
+    if (!vr)
+        return 3;
+    double rel = EQ_NOISE_FACTOR * fmax(eq->residual, EQ_NOISE_MIN_REL);
+    /* The unknown along the track carries Newton's next step; thrust,
+     * power and speed vary together along it (T = P / u, P = T u), so
+     * what follows from it has the same relative error. */
+    double x = bias ? eq->thrust_bias : eq->speed;
+    double ex = fmax(EQ_NOISE_FACTOR * eq->motion_step[0],
+                     rel * (bias ? eq->force_scale : fabs(x)));
+    double follows = bias ? vr->power
+                     : b->vehicle->propulsion.type == TS_PROP_POWER
+                         ? vr->thrust : vr->power;
+    v0[0].value = bias ? vr->thrust : eq->speed;
+    v0[0].error.solver = ex;
+    v0[1].value = follows;
+    v0[1].error.solver = fabs(x) > 0 ? fabs(follows) * ex / fabs(x) : NAN;
+    /* Across it: a turn rate relative to itself or, near zero, to V / L
+     * (the turn whose radius is the cables' length); a deflection
+     * relative to itself or to DEFLECTION_SCALE. */
+    double y = turn_by ? vr->delta[sys->tow.turn_surface] : eq->turn_rate;
+    double yscale = turn_by ? DEFLECTION_SCALE
+                            : fabs(eq->speed) / total_length(sys);
+    v0[2].value = y;
+    v0[2].scale = fmax(fabs(y), yscale);
+    v0[2].error.solver = fmax(EQ_NOISE_FACTOR * eq->motion_step[1],
+                              rel * v0[2].scale);
+    return 3;
+}
+
+static int eq_nvalues(const ts_system *sys)
+{
+    return 3 * npoints(sys) + 1 + tow_values(sys, NULL, NULL);
+}
+
 static int eq_values(ts_result *r, ts_err *err)
 {
-    int rc = values_alloc(r, 3 * npoints(r->sys) + 1, err);
-    if (rc == TS_OK)
+    int rc = values_alloc(r, eq_nvalues(r->sys), err);
+    if (rc == TS_OK) {
         eq_values_into(r->sys, r->eq, r->values);
+        tow_values(r->sys, r->eq, r->values + 3 * npoints(r->sys) + 1);
+    }
     return rc;
 }
 
@@ -510,10 +621,11 @@ int ts_result_equilibrium_values(const ts_result *r, ts_value **values,
     ts_result tmp;
     memset(&tmp, 0, sizeof tmp);
     tmp.kind = TS_ANALYSIS_EQUILIBRIUM;
-    int rc = values_alloc(&tmp, 3 * npoints(r->sys) + 1, err);
+    int rc = values_alloc(&tmp, eq_nvalues(r->sys), err);
     if (rc)
         return rc;
     eq_values_into(r->sys, r->eq, tmp.values);
+    tow_values(r->sys, r->eq, tmp.values + 3 * npoints(r->sys) + 1);
     *values = tmp.values;
     *n = tmp.nvalues;
     return TS_OK;
@@ -2859,7 +2971,7 @@ static int named_result(const ts_system *sys, const ts_request *rq,
     ts_result *r = *out = result_alloc(kind, err);
     int rc = r ? TS_OK : TS_ENOMEM;
     if (rc == TS_OK) {
-        r->sys = setup_system(sys, &rq->setup, err);
+        r->sys = setup_system(sys, rq, err);
         rc = r->sys ? TS_OK : (err && err->code ? err->code : TS_ENOMEM);
     }
     if (rc == TS_OK && kind == TS_ANALYSIS_EQUILIBRIUM)
@@ -3200,7 +3312,7 @@ static int check_kind(const ts_system *sys, const ts_request *rq,
 int ts_analysis_check(const ts_system *sys, const ts_request *rq,
                       ts_err *err)
 {
-    ts_system *s = setup_system(sys, &rq->setup, err);
+    ts_system *s = setup_system(sys, rq, err);
     if (!s)
         return err && err->code ? err->code : TS_ENOMEM;
     int rc = check_kind(s, rq, err);
@@ -3216,7 +3328,7 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
     memset(e, 0, sizeof *e);
     if (rq->kind != TS_ANALYSIS_SIMULATE && rq->kind != TS_ANALYSIS_MODES)
         return TS_OK;
-    ts_system *s = setup_system(sys, &rq->setup, err);
+    ts_system *s = setup_system(sys, rq, err);
     if (!s)
         return err && err->code ? err->code : TS_ENOMEM;
     int rc = TS_OK;
@@ -3276,7 +3388,7 @@ static int run_once(const ts_system *sys, const ts_request *rq,
     if (!*out)
         return TS_ENOMEM;
     ts_result *r = *out;
-    r->sys = setup_system(sys, &rq->setup, &e);
+    r->sys = setup_system(sys, rq, &e);
     int rc = r->sys ? check_kind(r->sys, rq, &e) : (e.code ? e.code
                                                            : TS_ENOMEM);
     if (rc == TS_OK && rq->kind == TS_ANALYSIS_CONVERGE)

@@ -182,10 +182,15 @@ int ts_design_value(const ts_result *r, const char *name, ts_value *out)
     int neq = 0, found = 0;
     if (!r->sys || ts_result_equilibrium_values(r, &eqv, &neq, NULL))
         return 0;
-    if (!strcmp(name, "layback") && neq >= 4) {
-        /* The last point's x and y: the values before top_tension. */
+    /* The points' x, y, z come first, then top_tension (a towing
+     * vehicle's solved motion after it). */
+    int top = 0;
+    while (top < neq && strcmp(eqv[top].name, "top_tension"))
+        top++;
+    if (!strcmp(name, "layback") && top >= 3 && top < neq) {
+        /* The last point's x and y. */
         const double *tp = r->sys->tow.point;
-        const ts_value *x = &eqv[neq - 4], *y = &eqv[neq - 3];
+        const ts_value *x = &eqv[top - 3], *y = &eqv[top - 2];
         /* The result's own x and y carry the discretisation estimate. */
         const ts_value *rx = ts_result_value(r, x->name),
                        *ry = ts_result_value(r, y->name);

@@ -105,7 +105,14 @@ void ts_eigen_free(ts_eigen *e)
 typedef struct cand {
     double complex lam;   /* Im >= 0 */
     double cond, resid;
-    double round;         /* rounding error allowance, kappa eps ||A|| */
+    double round;         /* rounding error allowance, kappa eps ||A||
+                             (lapack), the Ritz value's own error (arpack:
+                             ritz) */
+    double ritz;          /* the Ritz value's own error estimate (arpack):
+                             the pencil's Newton correction with the sparse
+                             model (tsi_shift_eig_error), the residual
+                             ||A v - lam v|| / |v| on the dense A; NaN with
+                             lapack */
     double dlam;          /* first-order change of lam by the linearization
                              error estimate, |u^H E v| / |u^H v| (or
                              |E v| / |v| without u); NaN if unknown */
@@ -202,6 +209,7 @@ static void cand_add(cand_list *L, double complex lam, const double *vr,
     c->resid = resid;
     c->dlam = dlam;
     c->round = DBL_EPSILON * cond; /* times ||A||: set by the caller */
+    c->ritz = NAN;
     c->vcond = NAN;
     c->verr = NAN;
     c->sweep = 0;
@@ -544,6 +552,7 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
         const double *ar = AW + (size_t)j * n, *ai = ar + n;
         double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
+        L->c[c].ritz = L->c[c].round;
         if (EW) {
             const double *er = EW + (size_t)j * nlow, *ei = er + nlow;
             for (int i = 0; i < nlow; i++)
@@ -588,16 +597,24 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
         tsi_shift_apply(acc, vr, ar, 0);
         tsi_shift_apply(acc, vi, ai, 0);
         set_residual(&L->c[c], v, ar, ai, n);
+        L->c[c].ritz = L->c[c].round;
         /* A Ritz pair of the search that has not converged is dropped by
          * the caller: no error estimate for it. */
         if (with_err && !(L->c[c].sweep && L->c[c].resid > SWEEP_RESIDUAL)) {
+            double ritz;
             int rc = tsi_shift_eig_error(&es, lin, L->c[c].lam, v,
-                                         &L->c[c].dlam, err);
+                                         &L->c[c].dlam, &ritz, err);
             if (rc != TS_OK) {
                 tsi_shift_free(&es);
                 free(w);
                 return rc;
             }
+            /* The Ritz value's error from the pencil replaces the
+             * residual, whose floor, the rounding of A's application
+             * through S_inf, is not the Ritz pair's (doc/linear.md,
+             * section 3). */
+            if (isfinite(ritz))
+                L->c[c].ritz = L->c[c].round = ritz;
         }
     }
     tsi_shift_free(&es);
@@ -1250,6 +1267,7 @@ static void fill_mode(ts_mode *md, const cand *c)
     md->time_constant_s = re != 0 ? -1.0 / re : INFINITY;
     md->condition = c->cond;
     md->residual = c->resid;
+    md->ritz_error = c->ritz;
     md->vector_condition = c->vcond;
     md->vector_error = c->verr;
     md->error_bound =

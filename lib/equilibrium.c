@@ -80,6 +80,13 @@ void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
     o->progress_data = NULL;
 }
 
+/* The towing vehicle's position coordinates in q: x, y, z of its tow
+ * point, or x, y for a surface ship (its depth is held). */
+static int root_npos(const ts_kernel *k)
+{
+    return ts_kernel_root_dof(k) == 3 ? 2 : 3;
+}
+
 int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
                               double y[], ts_err *err)
 {
@@ -98,7 +105,7 @@ int ts_equilibrium_set_bodies(ts_kernel *k, const ts_equilibrium *eq,
     if (ro >= 0) {
         /* The towing vehicle: its position, and the steady motion solved
          * with it becomes the kernel's frame. */
-        memcpy(y + ro, eq->y + ro, 3 * sizeof(double));
+        memcpy(y + ro, eq->y + ro, (size_t)root_npos(k) * sizeof(double));
         ts_frame f;
         ts_kernel_get_frame(k, &f);
         f.speed = eq->speed;
@@ -145,6 +152,7 @@ ts_equilibrium *ts_equilibrium_alloc(const ts_system *sys, ts_err *err)
         goto nomem;
     eq->nlinks = sys->nlinks;
     eq->nnodes = sys->nnodes;
+    eq->motion_step[0] = eq->motion_step[1] = NAN;
     size_t nl = (size_t)sys->nlinks, nn = (size_t)sys->nnodes;
     /* Controller states: at most an integrator per loop and an actuator
      * per surface. */
@@ -463,6 +471,12 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
         big = fmax(big, fabs(w->dq[i]) / w->scale[i]);
     eq->condition = w->rcond > 0 ? 1.0 / w->rcond : INFINITY;
     eq->shape_error = big * total_length(ts_kernel_system(k));
+    /* The steady motion's unknowns (a towing vehicle): their own parts
+     * of the same step. */
+    if (w->ux >= 0) {
+        eq->motion_step[0] = fabs(w->dq[w->ux]);
+        eq->motion_step[1] = fabs(w->dq[w->uy]);
+    }
 }
 
 /* Where the kernel's last evaluation has its largest load or tension
@@ -529,15 +543,17 @@ static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
         return;
     }
     if (ts_kernel_root(k) >= 0 && i >= ts_kernel_root_offset(k) &&
-        i < ts_kernel_root_offset(k) + 3) {
+        i < ts_kernel_root_offset(k) + root_npos(k)) {
         int b = sys->tow.vehicle;
         snprintf(buf, size, "bodies[%d] '%s' (its steady motion: speed, "
-                 "turn rate, depth)", b, sys->bodies[b].name);
+                 "turn rate%s)", b, sys->bodies[b].name,
+                 root_npos(k) == 3 ? ", depth" : "");
         return;
     }
     for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
         int o = ts_kernel_vehicle_offset(k, v);
-        if (i >= o && i < o + 3) {
+        int na = v == ts_kernel_root(k) && root_npos(k) == 2 ? 1 : 3;
+        if (i >= o && i < o + na) {
             int b = ts_kernel_vehicle_body(k, v);
             snprintf(buf, size, "bodies[%d] '%s' (its attitude)", b,
                      sys->bodies[b].name);
@@ -871,10 +887,14 @@ static void path_at(ts_kernel *k, const newton_ws *w, path_fn path,
     path(pc, t);
     if (w->ux < 0)
         return;
+    /* A towing vehicle's speed and turn rate are Newton's unknowns: the
+     * path leaves them; with turn_by the turn rate is the scene's, a
+     * parameter the path moves, and the rudder the unknown. */
     ts_frame g;
     ts_kernel_get_frame(k, &g);
     g.speed = f.speed;
-    g.turn_rate = f.turn_rate;
+    if (!w->y_is_turn)
+        g.turn_rate = f.turn_rate;
     ts_kernel_set_frame(k, &g);
     ts_kernel_set_thrust_bias(k, bias);
     ts_kernel_set_turn_deflection(k, turn);
@@ -1615,6 +1635,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     eq->tolerance = o.tol;
     eq->condition = NAN;
     eq->shape_error = NAN;
+    eq->motion_step[0] = eq->motion_step[1] = NAN;
     if (frame.speed_rate != 0 || frame.turn_accel != 0)
         return ts_fail(err, TS_EDOMAIN, "equilibrium: the frame is "
                                         "accelerating; set speed_rate and "
@@ -1664,7 +1685,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     newton_ws w = {0};
     int ro = ts_kernel_root_offset(k);
     if (y && ro >= 0)
-        memcpy(y + ro, sys->tow.point, 3 * sizeof(double));
+        memcpy(y + ro, sys->tow.point, (size_t)root_npos(k) * sizeof(double));
     if (!m && nl > 0) {
         rc = err ? err->code : TS_ENOMEM; /* the march named its size */
         goto out;

@@ -30,8 +30,8 @@
 
 #include "towstab/system.h"
 
-/* An ARPACK Ritz pair with a larger residual (relative to ||A||_F |v|)
- * is not an eigenpair to trust. */
+/* An ARPACK Ritz pair whose Ritz value's own error (ritz_error, relative
+ * to |lambda|) is larger is not an eigenpair to trust. */
 #define ARPACK_RESIDUAL_MAX 1e-6
 /* Modes listed by name in one aggregated reason. */
 #define LIST_MAX 4
@@ -275,7 +275,7 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
             nbad++;
         }
         if (e->method == TS_EIG_ARPACK &&
-            !(md->residual <= ARPACK_RESIDUAL_MAX)) {
+            !(md->ritz_error <= ARPACK_RESIDUAL_MAX * mag)) {
             x->trustworthy = 0;
             nres++;
         }
@@ -311,8 +311,8 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
                       nbad > LIST_MAX ? "; ..." : "");
     }
     if (nres > 0)
-        ts_trust_fail(t, "%d ARPACK Ritz pair%s with a residual above %.0e "
-                         "of |lambda|",
+        ts_trust_fail(t, "%d ARPACK Ritz pair%s whose Ritz value's error "
+                         "exceeds %.0e of |lambda|",
                       nres, nres == 1 ? "" : "s", ARPACK_RESIDUAL_MAX);
 
     /* The stability margin: the linearization error against the smallest

@@ -100,6 +100,14 @@ typedef struct veh {
     double turn_delta;        /* the deflection added to the turn surface
                                  (ts_tow.turn_surface), rad */
     double thrust;            /* thrust at the last evaluation, N */
+    /* A surface ship (ts_tow.dof 3): only its yaw (at qoff) and the tow
+     * point's x, y (qoff + 1, + 2) are coordinates; roll and pitch are 0
+     * and the tow point's depth is the scene's. held: the hull's
+     * hydrostatic reaction that holds them, at the last evaluation: the
+     * vertical force on the hull at A (N, down > 0) and the roll and
+     * pitch moments about A (N m, body axes). */
+    int dof;                  /* 6, or 3; 0 for a towed vehicle */
+    double held[3];
 } veh;
 
 /* Inputs of a towing vehicle: thrust, force x y z, moment x y z. */
@@ -285,8 +293,11 @@ ts_kernel *ts_kernel_alloc(const ts_system *sys, ts_err *err)
         k->nq += 3;
         if (b == sys->tow.vehicle) {
             V->root = 1;
+            V->dof = sys->tow.dof == 3 ? 3 : 6;
             k->root = v;
-            k->nq += 3; /* the position of A (node 0) in M */
+            /* The position of A (node 0) in M; a surface ship keeps only
+             * its yaw of the angles and x, y of the position. */
+            k->nq += V->dof == 3 ? 0 : 3;
             V->thrust_bias = V->d->propulsion.thrust;
         }
         /* A body whose points all sit at A has no lever: its unbalanced
@@ -646,7 +657,14 @@ int ts_kernel_vehicle_body(const ts_kernel *k, int v) { return k->veh[v].body; }
 int ts_kernel_root(const ts_kernel *k) { return k->root; }
 int ts_kernel_root_offset(const ts_kernel *k)
 {
-    return k->root >= 0 ? k->veh[k->root].qoff + 3 : -1;
+    if (k->root < 0)
+        return -1;
+    const veh *V = &k->veh[k->root];
+    return V->qoff + (V->dof == 3 ? 1 : 3);
+}
+int ts_kernel_root_dof(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].dof : 0;
 }
 void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust)
 {
@@ -743,12 +761,31 @@ static void link_lever(const veh *V, const ts_link *L, double rho[3])
         rho[j] = L->up_point[j] - V->d->attach[j];
 }
 
+/* A vehicle's three 1-2-3 angles and their rates in state y: a surface
+ * ship's roll and pitch are 0, its yaw the one angle coordinate. */
+static void vehicle_angles(const ts_kernel *k, const veh *V, const double y[],
+                           double th[3], double thd[3])
+{
+    const double *a = y + V->qoff, *ad = y + k->nq + V->qoff;
+    if (V->dof == 3) {
+        th[0] = th[1] = thd[0] = thd[1] = 0.0;
+        th[2] = a[0];
+        thd[2] = ad[0];
+        return;
+    }
+    for (int j = 0; j < 3; j++) {
+        th[j] = a[j];
+        thd[j] = ad[j];
+    }
+}
+
 /* A vehicle's kinematics once its node's position and velocity are known,
  * and the points its child cables start from. Returns 1 when its chart is
  * singular. */
 static int vehicle_kinematics(ts_kernel *k, veh *V, const double y[])
 {
-    const double *th = y + V->qoff, *thd = y + k->nq + V->qoff;
+    double th[3], thd[3];
+    vehicle_angles(k, V, y, th, thd);
     tsi_vehicle_kinematics(V->d, V->chart, th, thd, k->frame.turn_rate,
                            k->r + 3 * V->node, k->rd + 3 * V->node, &V->st);
     tsi_vehicle_flow(&k->frame, V->d, &V->st);
@@ -816,6 +853,7 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
     v3_cross(om, rho, t);
     v3_cross(om, t, b);
 }
+
 
 /* A vehicle's controller, inertia and its own loads (V->M6, V->G). */
 static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
@@ -953,6 +991,32 @@ static void vehicle_accelerate(veh *V, const double aA[3])
     mat3_mul(V->st.R, V->a6 + 3, V->alpha_m);
 }
 
+/* A surface ship's accelerations (doc/model.md section 8): heave, roll
+ * and pitch are held, a_A,z = alpha_x = alpha_y = 0 in body axes (whose z
+ * is M's with roll and pitch 0), so M6h (a_A, alpha) = Gh + (0, 0, h_z,
+ * h_x, h_y, 0) leaves the 3x3 system of surge, sway and yaw; the hull's
+ * reactions h follow, V->held. Returns -1 when that 3x3 is not positive
+ * definite. */
+static int root_surface_solve(veh *V)
+{
+    static const int fr[3] = {0, 1, 5}, hc[3] = {2, 3, 4};
+    const double *M = V->M6h;
+    double S[6] = {M[0], M[7], M[35], M[1], M[5], M[11]}, L[6], x[3];
+    if (sym3_chol(S, L) != 0)
+        return -1;
+    for (int i = 0; i < 3; i++)
+        x[i] = V->G[fr[i]];
+    sym3_chol_solve(L, x);
+    memset(V->a6, 0, sizeof V->a6);
+    for (int i = 0; i < 3; i++) {
+        V->a6[fr[i]] = x[i];
+        V->held[i] = -V->G[hc[i]];
+        for (int j = 0; j < 3; j++)
+            V->held[i] += M[6 * hc[i] + fr[j]] * x[j];
+    }
+    return 0;
+}
+
 /* Inertial acceleration (M) of the point link l starts from on V. */
 static void vehicle_point_accel(const veh *V, const ts_link *L, double a[3])
 {
@@ -1080,9 +1144,10 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     int chart_bad = 0, slack_bad = 0;
     veh *Root = k->root >= 0 ? &k->veh[k->root] : NULL;
     if (Root) {
+        int ro = ts_kernel_root_offset(k), np = Root->dof == 3 ? 2 : 3;
         for (int j = 0; j < 3; j++) {
-            k->r[j] = y[Root->qoff + 3 + j];
-            k->rd[j] = qd[Root->qoff + 3 + j];
+            k->r[j] = j < np ? y[ro + j] : sys->tow.point[j];
+            k->rd[j] = j < np ? qd[ro + j] : 0.0;
         }
         if (vehicle_kinematics(k, Root, y))
             chart_bad = 1;
@@ -1226,7 +1291,13 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
 
     /* 3b. Tow point to free ends: tensions and accelerations. The towing
      * vehicle has absorbed the whole tree: M6h (a_A, alpha) = G. */
-    if (Root) {
+    if (Root && Root->dof == 3) {
+        if (root_surface_solve(Root) != 0)
+            return refuse(k, dydt, TS_ESINGULAR);
+        mat3_mul(Root->st.R, Root->a6 + 3, Root->alpha_m);
+        mat3_mul(Root->st.R, Root->a6, k->a);
+        v3_set(Root->Fj, 0, 0, 0);
+    } else if (Root) {
         if (tsi_chol6(Root->M6h, Root->L6) != 0)
             return refuse(k, dydt, TS_ESINGULAR);
         memcpy(Root->a6, Root->G, sizeof Root->a6);
@@ -1303,16 +1374,20 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
     double *cdot = dydt + 2 * nq;
     for (int v = 0; v < k->nv; v++) {
         veh *V = &k->veh[v];
-        const double *th = y + V->qoff, *thd = qd + V->qoff;
-        for (int j = 0; j < 3; j++)
-            dydt[V->qoff + j] = thd[j];
+        double th[3], thd[3], thdd[3];
+        vehicle_angles(k, V, y, th, thd);
         tsi_vehicle_angle_accel(&V->st, th, thd, k->frame.turn_rate,
-                                k->frame.turn_accel, V->alpha_m,
-                                dydt + nq + V->qoff);
+                                k->frame.turn_accel, V->alpha_m, thdd);
+        /* A surface ship: its yaw, then x and y of its tow point. */
+        int na = V->dof == 3 ? 1 : 3, np = V->dof == 3 ? 2 : 3;
+        for (int j = 0; j < na; j++) {
+            dydt[V->qoff + j] = thd[3 - na + j];
+            dydt[nq + V->qoff + j] = thdd[3 - na + j];
+        }
         if (V->root)
-            for (int j = 0; j < 3; j++) {
-                dydt[V->qoff + 3 + j] = thd[3 + j];
-                dydt[nq + V->qoff + 3 + j] = k->rdd[j];
+            for (int j = 0; j < np; j++) {
+                dydt[V->qoff + na + j] = qd[V->qoff + na + j];
+                dydt[nq + V->qoff + na + j] = k->rdd[j];
             }
         control_rates(V, cdot);
     }
@@ -1811,6 +1886,14 @@ static int vehicle_set(ts_kernel *k, int v, const double R[9],
             Rc[3 * i + j] = V->chart[i] * R[j] + V->chart[3 + i] * R[3 + j] +
                             V->chart[6 + i] * R[6 + j];
     angles123(Rc, th);
+    if (V->dof == 3) {
+        /* A surface ship: its yaw alone, in the identity chart. */
+        th[0] = th[1] = 0.0;
+        tsi_rates_from_omega(th, om ? om : zero, thd);
+        y[V->qoff] = th[2];
+        y[k->nq + V->qoff] = thd[2];
+        return 0;
+    }
     if (!(fabs(cos(th[1])) >= threshold)) {
         memcpy(V->chart, R, sizeof V->chart);
         V->charted = 1;
@@ -1831,16 +1914,17 @@ static void vehicle_get(const ts_kernel *k, int v, const double y[],
                         double R[9], double om[3])
 {
     const veh *V = &k->veh[v];
-    double R123[9], E[9];
-    tsi_rot123(y + V->qoff, R123);
+    double R123[9], E[9], th[3], thd[3];
+    vehicle_angles(k, V, y, th, thd);
+    tsi_rot123(th, R123);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
             R[3 * i + j] = V->chart[3 * i] * R123[j] +
                            V->chart[3 * i + 1] * R123[3 + j] +
                            V->chart[3 * i + 2] * R123[6 + j];
     if (om) {
-        tsi_rate_matrix(y + V->qoff, E);
-        mat3_mul(E, y + k->nq + V->qoff, om);
+        tsi_rate_matrix(th, E);
+        mat3_mul(E, thd, om);
     }
 }
 
@@ -1871,7 +1955,7 @@ int ts_kernel_rechart(ts_kernel *k, double y[], double threshold)
         moved++;
     }
     for (int v = 0; v < k->nv; v++) {
-        if (fabs(cos(y[k->veh[v].qoff + 1])) >= threshold)
+        if (k->veh[v].dof == 3 || fabs(cos(y[k->veh[v].qoff + 1])) >= threshold)
             continue;
         double R[9], om[3];
         vehicle_get(k, v, y, R, om);
@@ -1939,6 +2023,9 @@ void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
     v3_copy(V->Fj, r->joint_force);
     if (V->root) {
         r->towing = 1;
+        r->dof = V->dof;
+        if (V->dof == 3)
+            memcpy(r->held, V->held, sizeof r->held);
         ts_kernel_tow_force(k, r->joint_force);
         r->thrust = V->thrust;
         r->power = V->thrust * w[0];
@@ -1967,8 +2054,9 @@ int tsi_kernel_vehicle_pull(ts_kernel *k, int v, const double y[],
 {
     veh *V = &k->veh[v];
     static const double zero[3] = {0, 0, 0};
-    double afr[3], ab[3], h[3];
-    tsi_vehicle_kinematics(V->d, V->chart, y + V->qoff, zero,
+    double afr[3], ab[3], h[3], th[3], thd[3];
+    vehicle_angles(k, V, y, th, thd);
+    tsi_vehicle_kinematics(V->d, V->chart, th, zero,
                            k->frame.turn_rate, rA, zero, &V->st);
     tsi_vehicle_flow(&k->frame, V->d, &V->st);
     if (!(fabs(V->st.c2) >= TS_CHART_MIN))

@@ -95,6 +95,7 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->desc_err = lin->desc_round = NAN;
     lin->nvehicles = ts_kernel_nvehicles(k);
     lin->root_qoff = ts_kernel_root_offset(k);
+    lin->root_dof = ts_kernel_root_dof(k);
     lin->noutput = ts_kernel_noutput(k);
     if (lin->noutput > 0) {
         size_t no = (size_t)lin->noutput;
@@ -441,13 +442,16 @@ static void state_scales(const ts_kernel *k, const ts_frame *fr,
             if (d->component[c].type == TS_COMP_HULL)
                 l = d->component[c].length;
         int o = ts_kernel_vehicle_offset(k, v);
-        for (int j = 0; j < 3; j++) {
+        /* A surface ship's yaw alone, then x and y. */
+        int root = v == ts_kernel_root(k);
+        int na = root && ts_kernel_root_dof(k) == 3 ? 1 : 3;
+        for (int j = 0; j < na; j++) {
             scale[o + j] = 1.0;
             scale[nq + o + j] = (sqrt(g * l) + V) / l;
         }
-        if (v == ts_kernel_root(k))
+        if (root)
             /* The towing vehicle's position: its length, and speeds. */
-            for (int j = 3; j < 6; j++) {
+            for (int j = na; j < ts_kernel_root_dof(k); j++) {
                 scale[o + j] = l;
                 scale[nq + o + j] = sqrt(g * l) + V;
             }
@@ -688,13 +692,22 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         const ts_vehicle *d = sys->bodies[L->up_body].vehicle;
         double R[9], om[3], E[9], lev[3];
         int qo = ts_kernel_vehicle_offset(k, v);
+        int ship = v == ts_kernel_root(k) && ts_kernel_root_dof(k) == 3;
+        double th[3] = {0, 0, y0[qo]};
         ts_kernel_get_vehicle(k, v, y0, R, om);
-        tsi_rate_matrix(y0 + qo, E);
+        tsi_rate_matrix(ship ? th : y0 + qo, E);
         double *map = lin->up_map + 12 * l;
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
                 map[3 * i + j] = R[3 * i] * E[j] + R[3 * i + 1] * E[3 + j] +
                                  R[3 * i + 2] * E[6 + j];
+        if (ship)
+            /* A surface ship's one angle is its yaw, followed in q by its
+             * position: the yaw's column first, the others none. */
+            for (int i = 0; i < 3; i++) {
+                map[3 * i] = map[3 * i + 2];
+                map[3 * i + 1] = map[3 * i + 2] = 0.0;
+            }
         for (int j = 0; j < 3; j++)
             lev[j] = L->up_point[j] - d->attach[j];
         for (int j = 0; j < 3; j++)
@@ -935,7 +948,7 @@ void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,
 {
     dr[0] = dr[1] = dr[2] = 0.0;
     if (lin->root_qoff >= 0)
-        for (int c = 0; c < 3; c++)
+        for (int c = 0; c < (lin->root_dof == 3 ? 2 : 3); c++)
             dr[c] = dq[lin->root_qoff + c];
     for (int l = 0; l < sys->nlinks; l++) {
         const ts_link *L = &sys->links[l];

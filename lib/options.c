@@ -227,6 +227,47 @@ static int parse_sweep(const ts_option *o, ts_request *rq, const char *text,
     return TS_OK;
 }
 
+/* "x1,y1;x2,y2;...": lengths, each with its unit or in metres. */
+static int parse_waypoints(const ts_option *o, ts_request *rq,
+                           const char *text, const char *w,
+                           const ts_units *u, ts_err *err)
+{
+    (void)o;
+    ts_simulate_opts *s = &rq->simulate;
+    char buf[2048];
+    if (strlen(text) >= sizeof buf)
+        return ts_fail(err, TS_EINVAL, "%s: list too long", w);
+    strcpy(buf, text);
+    double xy[TS_GUIDANCE_MAX_WAYPOINTS][2];
+    int n = 0;
+    /* Split at every ';' and ',' (an empty item is an error, unlike
+     * strtok). */
+    for (char *pt = buf, *next; pt; pt = next, n++) {
+        next = strchr(pt, ';');
+        if (next)
+            *next++ = '\0';
+        char *y = strchr(pt, ',');
+        if (n == TS_GUIDANCE_MAX_WAYPOINTS || !y || strchr(y + 1, ','))
+            return ts_fail(err, TS_EINVAL, "%s: expected 1 to %d waypoints "
+                           "'x1,y1;x2,y2;...' (lengths, e.g. "
+                           "'100 m,0 m;200 m,50 m'), got '%s'", w,
+                           TS_GUIDANCE_MAX_WAYPOINTS, text);
+        *y++ = '\0';
+        const char *xyz[2] = {pt, y};
+        for (int j = 0; j < 2; j++) {
+            char where[WHERE_MAX + 48];
+            snprintf(where, sizeof where, "%s: waypoint %d %c", w, n + 1,
+                     "xy"[j]);
+            int rc = ts_units_parse(u, xyz[j], "m", where, &xy[n][j], err);
+            if (rc)
+                return rc;
+        }
+    }
+    s->nwaypoints = n;
+    memcpy(s->waypoints, xy, (size_t)n * sizeof xy[0]);
+    return TS_OK;
+}
+
 static int parse_integrators(const ts_option *o, ts_request *rq,
                              const char *text, const char *w,
                              const ts_units *u, ts_err *err)
@@ -574,6 +615,12 @@ static const ts_option simulate_rows[] = {
      .unit = "s", .min = 0, .max = INFINITY,
      .offset = OFF(simulate.fade_in), .arg = "T",
      .help = "the sea's fade-in from rest", .deftext = "2 Tp"},
+    {.name = "waypoints", .type = TS_OPT_CUSTOM, .section = TS_SEC_SIMULATE,
+     NOLIM, .offset = OFF(simulate.nwaypoints), .parse = parse_waypoints,
+     .arg = "LIST",
+     .help = "waypoints x1,y1;x2,y2;... (earth frame, lengths) in place "
+             "of the points of the scene's waypoints entry",
+     .deftext = "the scene's"},
     {.name = "outputs", .type = TS_OPT_TEXT, .section = TS_SEC_SIMULATE,
      NOLIM, .offset = OFF(simulate.outputs), .size = SZ(simulate.outputs),
      .arg = "LIST",

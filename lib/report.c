@@ -93,6 +93,13 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
         json_object_set_new(o, "turn_rate", num(r->turn_rate));
         json_object_set_new(o, "thrust", num(r->thrust));
         json_object_set_new(o, "power", num(r->power));
+        json_object_set_new(o, "dof", json_integer(r->dof));
+        if (r->dof == 3)
+            json_object_set_new(
+                o, "hydrostatic_reaction",
+                json_pack("{s:o,s:o,s:o}", "force_z", num(r->held[0]),
+                          "moment_x", num(r->held[1]), "moment_y",
+                          num(r->held[2])));
     }
     return o;
 }

@@ -123,12 +123,13 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
     json_object_set_new(o, "complete", json_boolean(e->complete));
     const ts_mode *r = &e->rightmost;
     json_object_set_new(o, "rightmost",
-                        json_pack("{s:o,s:o,s:o,s:o,s:o,s:o}", "re",
+                        json_pack("{s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "re",
                                   num(r->re), "im", num(r->im), "freq_hz",
                                   num(r->freq_hz), "damping_ratio",
                                   num(r->damping_ratio), "error_bound",
                                   num(r->error_bound), "residual",
-                                  num(r->residual)));
+                                  num(r->residual), "ritz_error",
+                                  num(r->ritz_error)));
     if (e->sweep_shifts > 0)
         json_object_set_new(o, "search",
                             json_pack("{s:i,s:i,s:i,s:i,s:o}", "shifts",
@@ -148,12 +149,14 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
         const ts_mode *md = &e->modes[m];
         ts_eigen_describe(sys, lin, e, m, desc, sizeof desc);
         json_t *j = json_pack(
-            "{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:s}", "re", num(md->re),
-            "im", num(md->im), "freq_hz", num(md->freq_hz), "period_s",
-            num(md->period_s), "damping_ratio", num(md->damping_ratio),
-            "time_constant_s", num(md->time_constant_s), "condition",
-            num(md->condition), "error_bound", num(md->error_bound),
-            "residual", num(md->residual), "description", desc);
+            "{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:s}", "re",
+            num(md->re), "im", num(md->im), "freq_hz", num(md->freq_hz),
+            "period_s", num(md->period_s), "damping_ratio",
+            num(md->damping_ratio), "time_constant_s",
+            num(md->time_constant_s), "condition", num(md->condition),
+            "error_bound", num(md->error_bound), "residual",
+            num(md->residual), "ritz_error", num(md->ritz_error),
+            "description", desc);
         if (j && shapes && e->vec_re)
             json_object_set_new(j, "shape",
                                 shape_json(sys, lin, e, m, amp, phase));

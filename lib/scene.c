@@ -1136,7 +1136,8 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
      * order parse_vehicle reads them; its added_mass is B_CA's node. */
     enum { B_NAME, B_TYPE, B_DIAM, B_WEIGHT, B_MASS, B_WET, B_DRAG, B_CA,
            B_LEN, B_XDRAG, B_XCA, B_VOLUME, B_INERTIA, B_MC, B_BC, B_ATTACH,
-           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_PROP, B_TURN, B_N };
+           B_SURF, B_COMPONENTS, B_CONTROLLERS, B_PROP, B_TURN, B_DOF,
+           B_N };
     /* The towing vehicle (sys->tow.vehicle == b): the top-level
      * towing_vehicle entry, a vehicle whose attach point is its tow
      * point, with propulsion. */
@@ -1149,7 +1150,8 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
                     {"mass_centre", 0, 0}, {"buoyancy_centre", 0, 0},
                     {"attach", 0, 0}, {"surface_diameter", 0, 0},
                     {"components", 0, 0}, {"controllers", 0, 0},
-                    {"propulsion", 0, 0}, {"turn_by", 0, 0}};
+                    {"propulsion", 0, 0}, {"turn_by", 0, 0},
+                    {"dof", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     if (towing) {
         snprintf(path, sizeof path, "towing_vehicle");
@@ -1227,6 +1229,15 @@ static int parse_body(const ctx *c, const yaml_node_t *n, int b,
         if (rc == TS_OK && towing)
             rc = parse_propulsion(c, &f[B_PROP], path,
                                   &body->vehicle->propulsion);
+        if (rc == TS_OK && towing && f[B_DOF].value) {
+            /* 3: a surface ship held to the free surface. */
+            rc = read_count(c, join(p, path, "dof"), &f[B_DOF], 6,
+                            &sys->tow.dof);
+            if (rc == TS_OK && sys->tow.dof != 6 && sys->tow.dof != 3)
+                rc = fail_at(c, TS_EINVAL, p, f[B_DOF].line, "must be 6 or "
+                             "3 (a surface ship: surge, sway and yaw), got "
+                             "%d", sys->tow.dof);
+        }
         if (rc == TS_OK && towing && f[B_TURN].value) {
             /* The control surface the steady analyses deflect to turn at
              * tow.turn_rate. */

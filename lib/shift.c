@@ -812,35 +812,67 @@ static void unit_max(double complex *w, int m)
             w[i] /= big;
 }
 
+/* w^T S(lam) X from S's parts P[3 nnz] (Sk, Sc, Sm: S(s) = Sk + s Sc
+ * + s^2 Sm), X[nx] the unknowns (points and controller states; the
+ * tensions' entries zero), summed against w[nx]. O(nnz). */
+static double complex pencil_form(const ts_descriptor *d, const double *P,
+                                  const double complex *w,
+                                  const double complex *X, double complex lam)
+{
+    const double *Sk = P, *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+    double complex sum = 0;
+    for (int j = 0; j < d->nx; j++) {
+        if (X[j] == 0)
+            continue;
+        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
+            sum += w[d->Si[p]] * (Sk[p] + lam * (Sc[p] + lam * Sm[p])) *
+                   X[j];
+    }
+    return sum;
+}
+
+/* z[nx] = S'(lam)^T w[nx], S'(s) = Sc + 2 s Sm from S's parts P[3 nnz]
+ * (zero on the tensions' columns). O(nnz). */
+static void pencil_dtmul(const ts_descriptor *d, const double *P,
+                         const double complex *w, double complex lam,
+                         double complex *z)
+{
+    const double *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+    for (int j = 0; j < d->nx; j++) {
+        double complex sum = 0;
+        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
+            sum += w[d->Si[p]] * (Sc[p] + 2.0 * lam * Sm[p]);
+        z[j] = sum;
+    }
+}
+
 int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
                         double complex lam, const double complex v[],
-                        double *dlam, ts_err *err)
+                        double *dlam, double *ritz, ts_err *err)
 {
     const ts_descriptor *d = lin->desc;
     *dlam = NAN;
+    *ritz = NAN;
     if (!d)
         return ts_fail(err, TS_EINVAL, "shift: the linear model has no "
                        "sparse form");
     if (!d->Kerr || !d->rnoise)
         return TS_OK;
     int nx = d->nx, nq = lin->nq, nc = d->nc;
-    size_t m = 3 * (size_t)d->np + (size_t)nc, nz = (size_t)d->nnz + 1;
-    double complex *w = malloc(((size_t)nx + 1) * sizeof *w);
+    size_t m = 3 * (size_t)d->np + (size_t)nc;
+    double complex *w = malloc(2 * ((size_t)nx + 1) * sizeof *w);
     double complex *x = malloc(m * sizeof *x);
     double complex *X = calloc((size_t)nx + 1, sizeof *X);
     double *q = malloc(((size_t)nq + 1) * sizeof *q);
     double *u = malloc(2 * m * sizeof *u);
-    double *Sk = malloc(nz * sizeof *Sk), *Sc = malloc(nz * sizeof *Sc);
-    double *Sm = malloc(nz * sizeof *Sm);
-    if (!w || !x || !X || !q || !u || !Sk || !Sc || !Sm) {
+    double *P = malloc(3 * ((size_t)d->nnz + 1) * sizeof *P);
+    if (!w || !x || !X || !q || !u || !P) {
         free(w);
         free(x);
         free(X);
         free(q);
         free(u);
-        free(Sk);
-        free(Sc);
-        free(Sm);
+        free(P);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory for the error "
                        "estimate");
     }
@@ -853,9 +885,21 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     if (rc == TS_ENOMEM)
         ts_fail(err, rc, "eigen: out of memory for the error estimate");
     if (rc == TS_OK) {
+        /* Inverse iteration for the left vector of the quadratic pencil:
+         * S(lam)^-T b grows along w by x^T b / (lam - lam*), so from the
+         * second step on b = S'(lam)^T w (x^T S'^T w = w^T S' x is the
+         * pencil's normalisation, never zero for a simple eigenvalue,
+         * while w^T x itself may vanish: then S^-T w would not grow
+         * along w at all). */
+        tsi_desc_fill_parts(d, P, P + d->nnz, P + 2 * (size_t)d->nnz);
+        double complex *z = w + nx;
         for (int i = 0; i < nx; i++)
             w[i] = 1.0 + (double)(i % 7) / 7.0;
         for (int it = 0; it < 2; it++) {
+            if (it > 0) {
+                pencil_dtmul(d, P, w, lam, z);
+                memcpy(w, z, (size_t)nx * sizeof *w);
+            }
             tsi_shift_tsolve(sh, w);
             unit_max(w, nx);
         }
@@ -878,7 +922,7 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         for (int j = 0; j < nc; j++)
             X[XC(j)] = x[n3 + j];
         /* w^T S'(lam) X, S'(s) = Sc + 2 s Sm. */
-        tsi_desc_fill_parts(d, Sk, Sc, Sm);
+        const double *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
         double complex den = 0;
         for (int col = 0; col < nx; col++)
             for (int p = d->Sp[col]; p < d->Sp[col + 1]; p++)
@@ -886,6 +930,9 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         double tr, ro;
         tsi_desc_error_terms(d, w, x, lam, &tr, &ro);
         *dlam = cabs(den) > 0 ? (tr + ro) / cabs(den) : INFINITY;
+        /* The Ritz value's own error: the pencil's Newton correction. */
+        double complex num = pencil_form(d, P, w, X, lam);
+        *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
     } else if (rc == TS_ESINGULAR) {
         ts_fail(err, rc, "eigen: the pencil is singular beside %g%+gi 1/s",
                 creal(lam), cimag(lam));
@@ -898,8 +945,6 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     free(X);
     free(q);
     free(u);
-    free(Sk);
-    free(Sc);
-    free(Sm);
+    free(P);
     return rc;
 }

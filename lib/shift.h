@@ -155,14 +155,20 @@ void tsi_shift_tsolve(tsi_shift *sh, double complex *w);
  *
  * dS = dK + lam dC and N the rounding noise (tsi_desc_error_terms),
  * S'(lam) = [[2 lam M + C, 0], [Cv n^T rows of taut elastic links, 0]].
- * Into *dlam (1/s; NaN without the estimate). sh: the caller's (zeroed
+ * Into *dlam (1/s; NaN without the estimate). Into *ritz (1/s; NaN
+ * without the estimate) the Ritz value's own error, the pencil's Newton
+ * correction |w^T S(lam) [x; 0]| / |w^T S'(lam) x| (the tensions' columns
+ * left out: w^T S(lam) vanishes on them to second order in the error of
+ * lam, S' and S'' having none), a product with S and no solve, so free of
+ * the rounding of a solve with S_inf that the residual ||A v - lam v||
+ * carries (its floor grows like the cube of the links). sh: the caller's (zeroed
  * before the first call, freed with tsi_shift_free after the last), whose
  * factors are refactored at each lam (tsi_shift_refactor). Cost: one KLU
  * (re)factorisation and two transposed solves, O(nlinks). Returns TS_OK,
  * TS_EINVAL (no sparse model), TS_ESINGULAR or TS_ENOMEM. */
 int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
                         double complex lam, const double complex v[],
-                        double *dlam, ts_err *err);
+                        double *dlam, double *ritz, ts_err *err);
 
 /* dq[nq] of node displacements, the inverse of
  * ts_linear_node_displacements (for displacements that keep the rigid

@@ -38,6 +38,7 @@ ts_system *ts_system_alloc(int ncables, int nbodies, ts_err *err)
     s->env.gravity = 9.80665;
     s->tow.vehicle = -1;
     s->tow.turn_surface = -1;
+    s->tow.dof = 6;
     return s;
 nomem:
     ts_system_free(s);
@@ -551,6 +552,9 @@ static int validate(const ts_system *s, ts_err *err)
               .control))
         return ts_fail(err, TS_EINVAL, "towing_vehicle.turn_by: must be a "
                        "control surface of the towing vehicle");
+    if (s->tow.dof != 6 && s->tow.dof != 3)
+        return ts_fail(err, TS_EINVAL, "towing_vehicle.dof: must be 6 or 3 "
+                       "(a surface ship), got %d", s->tow.dof);
     if (s->tow.vehicle >= 0 && (s->tow.point[0] != 0 || s->tow.point[1] != 0))
         return ts_fail(err, TS_EINVAL, "tow.point: with a towing vehicle the "
                        "tow point starts the mean frame's origin: x and y "

@@ -171,12 +171,14 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
     f->nstate = fl->nstate;
     f->nmodes = fe->nmodes;
     /* Free state i is coupled state map[i]: the vehicle's angles and
-     * position, their rates, then its controller states, the last block
-     * of the coupled system's (the towing vehicle is its last body). */
+     * position (a surface ship's yaw, x and y), their rates, then its
+     * controller states, the last block of the coupled system's (the
+     * towing vehicle is its last body). */
     int nf = fl->nstate, nqf = fl->nq, ncf = nf - 2 * nqf;
-    int qo = lin->root_qoff - 3, nc = lin->nstate - 2 * lin->nq;
+    int dof = lin->root_dof, qo = lin->root_qoff - (dof == 3 ? 1 : 3);
+    int nc = lin->nstate - 2 * lin->nq;
     int *map = malloc((size_t)nf * sizeof *map);
-    if (!map || nqf != 6 || ncf > nc) {
+    if (!map || nqf != dof || ncf > nc) {
         free(map);
         ts_free_vehicle_free(f);
         release(k, feq, fl, fe);
@@ -184,12 +186,12 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
         return ts_fail(err, map ? TS_EINVAL : TS_ENOMEM, "free vehicle: "
                        "its states do not map onto the coupled system's");
     }
-    for (int i = 0; i < 6; i++) {
+    for (int i = 0; i < dof; i++) {
         map[i] = qo + i;
-        map[6 + i] = lin->nq + qo + i;
+        map[dof + i] = lin->nq + qo + i;
     }
     for (int j = 0; j < ncf; j++)
-        map[12 + j] = 2 * lin->nq + nc - ncf + j;
+        map[2 * dof + j] = 2 * lin->nq + nc - ncf + j;
     int n = lin->nstate;
     for (int m = 0; m < fe->nmodes; m++) {
         ts_free_mode *fm = &f->modes[m];

@@ -59,7 +59,7 @@ static void test_equilibrium(const ts_scene *sc)
         return;
     }
     CHECK(r->sys->tow.speed == 2.385 && r->sys->nlinks == 13 &&
-              sc->system->nlinks == 20 && sc->system->tow.speed != 2.385,
+              sc->system->nlinks == 40 && sc->system->tow.speed != 2.385,
           "settings applied to a copy: speed %g, %d links; the scene keeps "
           "%d links", r->sys->tow.speed, r->sys->nlinks,
           sc->system->nlinks);

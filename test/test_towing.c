@@ -31,16 +31,27 @@
  *     thrust at the coupled speed is its own drag, 1/2 rho U^2 (Cd_axial
  *     pi D^2 / 4 + sum S Cd0); on a cable of almost nothing (1 m, 0.1 mm,
  *     1 g/m) each of its modes is a coupled mode, same eigenvalue, MAC 1.
+ *  8. The solved motion's error estimates (the equilibrium analysis' key
+ *     values: speed, thrust, power, turn rate, turn_by deflection) at 10
+ *     links cover the difference from 40 links (discretisation) and, at
+ *     tolerance 1e-6, from tolerance 1e-12 (solver).
+ *  9. The turning circle: from the straight trim, a rudder step to 3 deg
+ *     settles the tow point's earth track on a circle of Newton's steady
+ *     turn (radius V / |Omega|, swept at Omega), alone and coupled.
  */
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "tcheck.h"
+#include "tmodel.h"
+#include "towstab/analysis.h"
 #include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
+#include "towstab/excitation.h"
 #include "towstab/linearize.h"
 #include "towstab/kernel.h"
+#include "towstab/output.h"
 #include "towstab/scene.h"
 #include "towstab/towing.h"
 #include "towstab/units.h"
@@ -96,47 +107,14 @@ static ts_scene *scene(const char *fmt, ...)
 
 /* ---- 1. energy in vacuum ------------------------------------------- */
 
-static int rk4_step(ts_kernel *k, double *y, double h, int n, double *w)
-{
-    double *k1 = w, *k2 = w + n, *k3 = w + 2 * n, *k4 = w + 3 * n,
-           *yt = w + 4 * n;
-    int rc = ts_kernel_eval(k, y, NULL, k1);
-    for (int i = 0; i < n; i++)
-        yt[i] = y[i] + 0.5 * h * k1[i];
-    rc |= ts_kernel_eval(k, yt, NULL, k2);
-    for (int i = 0; i < n; i++)
-        yt[i] = y[i] + 0.5 * h * k2[i];
-    rc |= ts_kernel_eval(k, yt, NULL, k3);
-    for (int i = 0; i < n; i++)
-        yt[i] = y[i] + h * k3[i];
-    rc |= ts_kernel_eval(k, yt, NULL, k4);
-    for (int i = 0; i < n; i++)
-        y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
-    return rc;
-}
-
-static double energy(ts_kernel *k, const double *y, double *f)
-{
-    ts_kernel_eval(k, y, NULL, f);
-    return ts_kernel_kinetic_energy(k) + ts_kernel_potential_energy(k);
-}
-
 static double drift(const ts_system *s, double h, double T, double *E0)
 {
     ts_err err = {0};
     ts_kernel *k = ts_kernel_alloc(s, &err);
-    int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k), nl = s->nlinks;
+    int n = ts_kernel_nstate(k), nq = ts_kernel_nq(k);
     double *y = calloc((size_t)n, sizeof(double));
-    double *w = malloc(5 * (size_t)n * sizeof(double));
-    double *f = malloc((size_t)n * sizeof(double));
     /* A 3-D state: each link's angles and rates in its chart. */
-    for (int l = 0; l < nl; l++) {
-        int o = ts_kernel_link_offset(k, l);
-        y[o] = 0.5 + 0.3 * sin(1.7 * l);
-        y[o + 1] = 0.4 * cos(2.3 * l + 1);
-        y[nq + o] = 0.5 * cos(l + 0.2);
-        y[nq + o + 1] = -0.4 * sin(3.1 * l);
-    }
+    tm_link_state(k, s->nlinks, y);
     double om[3] = {0.2, -0.15, 0.3}, R[9], th[3] = {0.11, -0.08, 0.2};
     tsi_rot123(th, R);
     ts_kernel_set_vehicle(k, ts_kernel_root(k), R, om, TS_CHART_RECHART, y);
@@ -146,19 +124,8 @@ static double drift(const ts_system *s, double h, double T, double *E0)
         y[ro + j] = pos[j];
         y[nq + ro + j] = vel[j];
     }
-    double e0 = energy(k, y, f), worst = 0;
-    int steps = (int)lround(T / h);
-    for (int i = 0; i < steps; i++) {
-        if (rk4_step(k, y, h, n, w) != TS_OK) {
-            worst = INFINITY;
-            break;
-        }
-        worst = fmax(worst, fabs(energy(k, y, f) - e0));
-    }
-    *E0 = e0;
+    double worst = tm_energy_drift(k, y, h, T, E0);
     free(y);
-    free(w);
-    free(f);
     ts_kernel_free(k);
     return worst;
 }
@@ -427,7 +394,9 @@ static void rk4_u(ts_kernel *k, double *y, const double *u, double h, int n,
         y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
 }
 
-static ts_scene *thrust_scene(double T, double rudder_deg)
+/* The vehicle with its rudder at `rudder_deg`, propulsion `prop` (the
+ * entries of its map), pulling the sphere on 50 m of cable in `links`. */
+static ts_scene *tow_scene(const char *prop, double rudder_deg, int links)
 {
     char vt[2048], *p = vt;
     vehicle_yaml(vt, sizeof vt, 1.0);
@@ -439,14 +408,21 @@ static ts_scene *thrust_scene(double T, double rudder_deg)
              r + strlen("roll: 90 deg, control: true}"));
     return scene("name: step\n"
                  "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
-                 "%s  propulsion: {thrust: %g N}\n"
+                 "%s  propulsion: {%s}\n"
                  "cables:\n"
                  "  - {name: cable, from: tow, to: sphere, length: 50 m, "
-                 "diameter: 0.02 m, weight: 5 N/m, links: 4}\n"
+                 "diameter: 0.02 m, weight: 5 N/m, links: %d}\n"
                  "bodies:\n"
                  "  - {name: sphere, type: sphere, diameter: 0.5 m, "
                  "wet_weight: 500 N}\n",
-                 buf, T);
+                 buf, prop, links);
+}
+
+static ts_scene *thrust_scene(double T, double rudder_deg)
+{
+    char prop[64];
+    snprintf(prop, sizeof prop, "thrust: %g N", T);
+    return tow_scene(prop, rudder_deg, 4);
 }
 
 static void test_settle(void)
@@ -711,6 +687,251 @@ static void test_free_vehicle(void)
     }
 }
 
+/* ---- 8. error estimates of the solved motion ------------------------ */
+
+/* The equilibrium analysis of sc (links 0: the scene's; tol 0: the
+ * default) with its discretisation error estimate. */
+static ts_result *eq_analysis(const ts_scene *sc, int links, double tol)
+{
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_EQUILIBRIUM);
+    rq.setup.links = links;
+    if (tol > 0)
+        rq.setup.equilibrium.tol = tol;
+    ts_err err = {0};
+    ts_result *r = NULL;
+    if (ts_analysis_run(sc->system, &rq, &r, &err) != TS_OK)
+        printf("equilibrium: %s\n", err.msg);
+    ts_request_clear(&rq);
+    return r;
+}
+
+static void test_motion_errors(void)
+{
+    /* Thrust and rudder given (speed, power, turn rate solved); power
+     * and rudder given (speed, thrust, turn rate); a speed controller at
+     * a given turn rate, turn_by rudder (thrust, power, rudder). */
+    const char *props[3] = {"thrust: 1500 N",
+                            "power: 5 kW, max_thrust: 4 kN",
+                            "speed: 3 m/s, gain: 800 N*s/m"};
+    const char *names[3][3] = {{"tug.speed", "tug.power", "tug.turn_rate"},
+                               {"tug.speed", "tug.thrust", "tug.turn_rate"},
+                               {"tug.thrust", "tug.power",
+                                "tug.rudder.deflection"}};
+    for (int c = 0; c < 3; c++) {
+        ts_scene *sc = tow_scene(props[c], c < 2 ? 3.0 : 0.0, 10);
+        if (sc && c == 2) {
+            const char *keys[2] = {"tow.turn_rate", "towing_vehicle.turn_by"};
+            const char *vals[2] = {"-0.02 rad/s", "rudder"};
+            ts_err e2 = {0};
+            ts_units *un = ts_units_alloc(&e2);
+            ts_scene *si = ts_scene_set(sc, 2, keys, vals, un, &e2);
+            ts_units_free(un);
+            ts_scene_free(sc);
+            sc = si;
+        }
+        if (!CHECK(sc != NULL, "scene with %s parses", props[c]))
+            continue;
+        /* 10 links (estimate from 5 and 3) against 40; tolerance 1e-6
+         * against 1e-12 at 10 links. */
+        ts_result *r = eq_analysis(sc, 0, 0), *ref = eq_analysis(sc, 40, 0);
+        ts_result *loose = eq_analysis(sc, 0, 1e-6),
+                  *tight = eq_analysis(sc, 0, 1e-12);
+        for (int v = 0; r && ref && loose && tight && v < 3; v++) {
+            const ts_value *x = ts_result_value(r, names[c][v]);
+            const ts_value *xr = ts_result_value(ref, names[c][v]);
+            const ts_value *xl = ts_result_value(loose, names[c][v]);
+            const ts_value *xt = ts_result_value(tight, names[c][v]);
+            if (!CHECK(x && xr && xl && xt, "%s: key value %s reported",
+                       props[c], names[c][v]))
+                continue;
+            /* Richardson at order 2 from 10 and 5 links: the error
+             * against 40 links is 15/16 of the error against the
+             * continuum; the estimate covers it, and is not more than 4
+             * times it (the observed order from 3 links may lower the
+             * order used, which raises the estimate). */
+            double dis = fabs(x->value - xr->value);
+            double est = x->error.discretisation + x->error.solver;
+            CHECK(dis <= est && est <= 4 * dis + x->error.solver,
+                  "%s: %s = %.9g %s, against 40 links off by %.3g; "
+                  "estimate %.3g (discretisation, order %.3g) + %.3g "
+                  "(solver)", props[c], names[c][v], x->value, x->unit,
+                  dis, x->error.discretisation, x->order, x->error.solver);
+            /* The solver's error at a loose tolerance covers the
+             * difference from a tight one. */
+            double sol = fabs(xl->value - xt->value);
+            CHECK(sol <= xl->error.solver && isfinite(xl->error.solver),
+                  "%s: %s at tolerance 1e-6 off by %.3g from 1e-12; its "
+                  "solver error %.3g (at 1e-12: %.3g)", props[c],
+                  names[c][v], sol, xl->error.solver, xt->error.solver);
+        }
+        ts_result_free(r);
+        ts_result_free(ref);
+        ts_result_free(loose);
+        ts_result_free(tight);
+        ts_scene_free(sc);
+    }
+}
+
+/* ---- 9. the turning circle at a fixed rudder ------------------------- */
+
+/* The least-squares circle through points (x[i], y[i]), i in [0, n): Kasa's
+ * fit, x^2 + y^2 + D x + E y + F = 0 linear in D, E, F, about the points'
+ * mean (for conditioning). Centre c[2], radius *R; *spread the largest
+ * |distance to c - R| (how far the points are from a circle). */
+static void fit_circle(const double *x, const double *y, int n, double c[2],
+                       double *R, double *spread)
+{
+    double mx = 0, my = 0;
+    for (int i = 0; i < n; i++) {
+        mx += x[i] / n;
+        my += y[i] / n;
+    }
+    /* Normal equations A [D E F] = b of rows (u, v, 1) . (D, E, F) =
+     * -(u^2 + v^2). */
+    double A[3][4] = {{0}};
+    for (int i = 0; i < n; i++) {
+        double u = x[i] - mx, v = y[i] - my, row[3] = {u, v, 1.0};
+        double rhs = -(u * u + v * v);
+        for (int a = 0; a < 3; a++) {
+            for (int b = 0; b < 3; b++)
+                A[a][b] += row[a] * row[b];
+            A[a][3] += row[a] * rhs;
+        }
+    }
+    /* Gauss-Jordan with partial pivoting on the 3x4 system. */
+    for (int col = 0; col < 3; col++) {
+        int piv = col;
+        for (int r = col + 1; r < 3; r++)
+            if (fabs(A[r][col]) > fabs(A[piv][col]))
+                piv = r;
+        for (int j = 0; j < 4; j++) {
+            double t = A[col][j];
+            A[col][j] = A[piv][j];
+            A[piv][j] = t;
+        }
+        for (int r = 0; r < 3; r++) {
+            if (r == col)
+                continue;
+            double f = A[r][col] / A[col][col];
+            for (int j = col; j < 4; j++)
+                A[r][j] -= f * A[col][j];
+        }
+    }
+    double D = A[0][3] / A[0][0], E = A[1][3] / A[1][1],
+           F = A[2][3] / A[2][2];
+    c[0] = mx - D / 2;
+    c[1] = my - E / 2;
+    *R = sqrt(D * D / 4 + E * E / 4 - F);
+    *spread = 0;
+    for (int i = 0; i < n; i++)
+        *spread = fmax(*spread, fabs(hypot(x[i] - c[0], y[i] - c[1]) - *R));
+}
+
+/* Released from its straight trim, the rudder stepped to 3 deg (the input
+ * tug.rudder, rising over 1 s): after the transient the tow point's earth
+ * track (lib/track.c) is a circle of Newton's steady turn, radius V /
+ * |Omega| (the tow point is M's origin in the steady turn), swept at
+ * Omega. `cable` is the scene's cable and bodies; `t_end` the run, the
+ * last `t_fit` seconds fitted. */
+static void turning_circle(const char *what, const char *cable,
+                           double t_end, double t_fit, double tol)
+{
+    char vt[2048], scn[6144];
+    snprintf(scn, sizeof scn, "name: circle\n"
+             "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
+             "%s  propulsion: {thrust: 1500 N}\n%s",
+             vehicle_yaml(vt, sizeof vt, 1.0), cable);
+    char *r = strstr(scn, "roll: 90 deg, control: true}");
+    ts_scene *sc = scene("%s", scn), *turn = NULL;
+    if (sc && r) {
+        char buf[6400];
+        snprintf(buf, sizeof buf, "%.*sroll: 90 deg, control: true, "
+                 "deflection: 3 deg}%s", (int)(r - scn), scn,
+                 r + strlen("roll: 90 deg, control: true}"));
+        turn = scene("%s", buf);
+    }
+    if (!CHECK(sc && turn, "%s: scenes parse", what)) {
+        ts_scene_free(sc);
+        ts_scene_free(turn);
+        return;
+    }
+    ts_equilibrium *et = solve(turn->system, NULL);
+    double Rn = et->speed / fabs(et->turn_rate);
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_SIMULATE);
+    rq.simulate.sim.t_end = t_end;
+    rq.simulate.sim.dt_sample = 1;
+    snprintf(rq.simulate.outputs, sizeof rq.simulate.outputs,
+             "tow.earth_x,tow.earth_y");
+    rq.simulate.excitation = ts_excitation_alloc(&err);
+    int rc = ts_excitation_parse(rq.simulate.excitation,
+                                 "tug.rudder:step,amplitude=3deg,rise=1", u,
+                                 "test", &err);
+    ts_result *res = NULL;
+    if (rc == TS_OK)
+        rc = ts_analysis_run(sc->system, &rq, &res, &err);
+    if (CHECK(rc == TS_OK && res && res->nonlinear && et->converged,
+              "%s: rudder step simulated for %g s (%s)", what, t_end,
+              err.msg)) {
+        const ts_history *h = res->nonlinear;
+        int n = (int)lround(t_fit), i0 = h->nsamples - 1 - n;
+        double *x = malloc(2 * (size_t)(n + 1) * sizeof *x), *y = x + n + 1;
+        for (int i = 0; x && i <= n; i++) {
+            x[i] = ts_history_value(res->sys, h, &res->outputs[0], i0 + i);
+            y[i] = ts_history_value(res->sys, h, &res->outputs[1], i0 + i);
+        }
+        double c[2] = {NAN, NAN}, R = NAN, spread = NAN, swept = 0;
+        if (x) {
+            fit_circle(x, y, n + 1, c, &R, &spread);
+            /* The angle swept about the centre, unwrapped. */
+            double a0 = atan2(y[0] - c[1], x[0] - c[0]), prev = a0;
+            for (int i = 1; i <= n; i++) {
+                double a = atan2(y[i] - c[1], x[i] - c[0]);
+                swept += remainder(a - prev, 2 * M_PI);
+                prev = a;
+            }
+        }
+        double om = swept / (h->t[h->nsamples - 1] - h->t[i0]);
+        CHECK(fabs(R - Rn) <= tol * Rn && fabs(om - et->turn_rate) <=
+                  tol * fabs(et->turn_rate) && spread <= tol * Rn,
+              "%s: over the last %g s of %g s the tow point's earth track "
+              "is a circle of radius %.6f m (points within %.2g m of it), "
+              "swept at %.8f rad/s; Newton's steady turn %.6f m at %.8f "
+              "rad/s (%.6f m/s): relative differences %.2g, %.2g "
+              "(tolerance %.0e)", what, t_fit, t_end, R, spread, om, Rn,
+              et->turn_rate, et->speed, fabs(R - Rn) / Rn,
+              fabs(om - et->turn_rate) / fabs(et->turn_rate), tol);
+        free(x);
+    }
+    ts_result_free(res);
+    ts_request_clear(&rq);
+    ts_units_free(u);
+    ts_equilibrium_free(et);
+    ts_scene_free(sc);
+    ts_scene_free(turn);
+}
+
+static void test_turning_circle(void)
+{
+    /* Alone: the vehicle on a 1 m stub of 1 g/m (1.4 g against its 4 t,
+     * as in 7). */
+    turning_circle("free vehicle",
+                   "cables:\n  - {name: cable, from: tow, length: 1 m, "
+                   "diameter: 0.0001 m, mass_per_length: 0.001 kg/m, "
+                   "links: 1}\n", 900, 200, 1e-6);
+    /* Coupled: the sphere on 50 m of cable in 4 links (5b: a roll-yaw
+     * mode of about 600 s period decays slowly). */
+    turning_circle("coupled", "cables:\n"
+                   "  - {name: cable, from: tow, to: sphere, length: 50 m, "
+                   "diameter: 0.02 m, weight: 5 N/m, links: 4}\n"
+                   "bodies:\n"
+                   "  - {name: sphere, type: sphere, diameter: 0.5 m, "
+                   "wet_weight: 500 N}\n", 2700, 600, 1e-6);
+}
+
 int main(void)
 {
     test_energy();
@@ -719,5 +940,7 @@ int main(void)
     test_thrust_drag();
     test_settle();
     test_free_vehicle();
+    test_motion_errors();
+    test_turning_circle();
     return tc_done();
 }

@@ -14,7 +14,7 @@
 static char tf_dir[512];
 
 /* Make the folder "towstab-test-<name>-XXXXXX"; 0 on success. */
-static int tf_begin(const char *name)
+static inline int tf_begin(const char *name)
 {
     const char *t = getenv("TMPDIR");
     snprintf(tf_dir, sizeof tf_dir, "%s/towstab-test-%s-XXXXXX",
@@ -23,7 +23,7 @@ static int tf_begin(const char *name)
 }
 
 /* The path exists (a link counts, also a dangling one). */
-static int tf_exists(const char *path)
+static inline int tf_exists(const char *path)
 {
     struct stat st;
     return lstat(path, &st) == 0;
@@ -31,7 +31,7 @@ static int tf_exists(const char *path)
 
 /* Number of entries in the folder whose name contains `part` ("" counts
  * every entry, "." and ".." included). */
-static int tf_count(const char *part)
+static inline int tf_count(const char *part)
 {
     DIR *d = opendir(tf_dir);
     int n = 0;
@@ -46,7 +46,7 @@ static int tf_count(const char *part)
 
 /* The text of a file (at most 64 KiB; a static buffer), NULL when it
  * cannot be read. */
-static char *tf_slurp(const char *path)
+static inline char *tf_slurp(const char *path)
 {
     FILE *f = fopen(path, "r");
     if (!f)
@@ -59,7 +59,7 @@ static char *tf_slurp(const char *path)
 }
 
 /* Remove the folder; 1 when it was empty. */
-static int tf_end(void)
+static inline int tf_end(void)
 {
     int empty = tf_count("") == 2;
     rmdir(tf_dir);

@@ -590,6 +590,13 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
                     sqrt(r->joint_force[0] * r->joint_force[0] +
                          r->joint_force[1] * r->joint_force[1] +
                          r->joint_force[2] * r->joint_force[2]));
+        if (r->towing && r->dof == 3)
+            fprintf(f, "%s: surface ship (3 dof), the hull's hydrostatic "
+                       "reaction at the tow point: vertical force %.6g N "
+                       "(down > 0), roll moment %.6g N m, pitch moment "
+                       "%.6g N m (body axes)\n",
+                    sys->bodies[r->body].name, r->held[0], r->held[1],
+                    r->held[2]);
     }
 }
 

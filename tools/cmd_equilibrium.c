@@ -342,9 +342,13 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
         }
     }
     /* The key values of an equilibrium are x, y, z of each body (or free
-     * cable end), then the top tension: their errors go beside them. */
-    int own = r->kind == TS_ANALYSIS_EQUILIBRIUM &&
-              r->nvalues == 3 * (sys->nbodies > 0 ? sys->nbodies : 0) + 1;
+     * cable end), then the top tension, then a towing vehicle's solved
+     * motion: their errors go beside them. */
+    const ts_value *top = r->kind == TS_ANALYSIS_EQUILIBRIUM
+                              ? ts_result_value(r, "top_tension")
+                              : NULL;
+    int ntop = top ? (int)(top - r->values) : -1;
+    int own = top && ntop == 3 * (sys->nbodies > 0 ? sys->nbodies : 0);
     if (sys->nbodies > 0) {
         for (int c = 0; c < 3; c++)
             snprintf(h[c], sizeof h[c], "%c [%s]%s", "xyz"[c], lu,
@@ -364,6 +368,15 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
         }
     }
     cli_print_vehicles(f, sys, eq->vehicles, eq->nvehicles, quiet, d);
+    /* A towing vehicle's solved motion with its errors. */
+    for (int v = ntop + 1; top && v < r->nvalues; v++) {
+        char e[128], u[64];
+        cli_value_error(&r->values[v], d, e, sizeof e);
+        ts_display_convert(ts_display_or_si(d), r->values[v].unit, 1.0, u,
+                           sizeof u);
+        fprintf(f, "%s %.9g %s %s\n", r->values[v].name,
+                cli_value_shown(&r->values[v], d), u, e);
+    }
     if (eq->ncontrol > 0)
         fprintf(f, "controllers settled to %.3g (target %.3g)\n",
                 eq->control_residual, eq->tolerance);
@@ -378,9 +391,9 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
                     len / sys->cables[c].length - 1);
         }
     fprintf(f, "\ntop tension %.6f %s", F_(eq->top_tension), fu);
-    if (r->kind == TS_ANALYSIS_EQUILIBRIUM && r->nvalues > 0) {
+    if (top) {
         char e[128];
-        cli_value_error(&r->values[r->nvalues - 1], d, e, sizeof e);
+        cli_value_error(top, d, e, sizeof e);
         fprintf(f, " %s", e);
     }
     fprintf(f, " (force on the tow point %.6f, %.6f, %.6f %s)\n",
@@ -391,7 +404,7 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
             eq->condition, L_(eq->shape_error), lu);
     if (r->kind == TS_ANALYSIS_EQUILIBRIUM) {
         /* Free cable ends (no bodies): their key values. */
-        for (int v = 0; sys->nbodies == 0 && v + 1 < r->nvalues; v++) {
+        for (int v = 0; sys->nbodies == 0 && v < ntop; v++) {
             char e[128];
             cli_value_error(&r->values[v], d, e, sizeof e);
             fprintf(f, "%s %.6f %s %s\n", r->values[v].name,

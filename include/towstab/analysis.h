@@ -274,6 +274,12 @@ typedef struct ts_simulate_opts {
                               has settled and is periodic
                               (ts_accuracy_window); 0: not (the runs of a
                               convergence study) */
+    int nwaypoints;        /* > 0: these waypoints replace the points of
+                              the scene's `waypoints` entry (its rudders,
+                              gain, radius and interval kept; the scene
+                              must have one); 0 (default): the scene's */
+    double waypoints[TS_GUIDANCE_MAX_WAYPOINTS][2]; /* m, earth frame x, y
+                              (towstab/guidance.h) */
 } ts_simulate_opts;
 
 /* Integrators of one convergence study, at most (one series each). */

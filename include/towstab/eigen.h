@@ -90,11 +90,21 @@ typedef struct ts_mode {
                                error estimate), plus rounding
                                kappa eps ||A_bal|| (lapack: the balanced
                                matrix's 1-norm and condition number from
-                               dgeevx) or the residual ||A v - lambda v||
-                               / |v| (arpack) */
-    double residual;        /* ||A v - lambda v|| / (|lambda| |v|); NaN
-                               when not computed (lapack: backward
-                               stable) */
+                               dgeevx) or ritz_error (arpack) */
+    double residual;        /* ||A v - lambda v|| / (|lambda| |v|), A
+                               applied through the sparse model's S_inf
+                               when there is one (whose rounding floor,
+                               growing like links^3, dominates it on long
+                               cables: 3e-5 at 10 000 links); NaN when not
+                               computed (lapack: backward stable) */
+    double ritz_error;      /* the Ritz value's own error estimate, 1/s
+                               (arpack): with the sparse model and its
+                               error estimate the pencil's Newton
+                               correction |w^T S(lambda) x| /
+                               |w^T S'(lambda) x| (w the left null vector,
+                               doc/linear.md section 3), otherwise the
+                               residual ||A v - lambda v|| / |v|; NaN with
+                               lapack */
     double vector_condition;/* conditioning of the right eigenvector: the
                                largest kappa_k ||A_bal||_1 / |lambda -
                                lambda_k| over the other eigenvalues k

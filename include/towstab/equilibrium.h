@@ -105,6 +105,14 @@ typedef struct ts_equilibrium {
     double turn_deflection; /* the deflection added to the towing
                              vehicle's turn surface to turn at the given
                              rate (ts_tow.turn_surface), rad; 0 */
+    double motion_step[2]; /* with a towing vehicle, Newton's next step
+                             (from the last Jacobian) of the two unknowns
+                             of the steady motion: [0] the speed (m/s) or
+                             the speed controller's bias (N), [1] the turn
+                             rate (rad/s) or turn_deflection (rad), as
+                             solved; their solver error to first order
+                             (doc/towing-vehicle.md, section 3). NaN
+                             without a towing vehicle or a Jacobian */
 } ts_equilibrium;
 
 TS_API void ts_equilibrium_opts_default(ts_equilibrium_opts *o);

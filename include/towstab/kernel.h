@@ -116,6 +116,12 @@ TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
  * of the last evaluation. */
 TS_API int ts_kernel_root(const ts_kernel *k);
 TS_API int ts_kernel_root_offset(const ts_kernel *k);
+/* Its degrees of freedom: 6, or 3 for a surface ship held to the free
+ * surface (ts_tow.dof: surge, sway and yaw; roll and pitch 0, the tow
+ * point's depth the scene's tow.point z); 0 without a towing vehicle. A
+ * surface ship's q holds its yaw alone at ts_kernel_vehicle_offset and
+ * the tow point's x and y at ts_kernel_root_offset (one after it). */
+TS_API int ts_kernel_root_dof(const ts_kernel *k);
 TS_API void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust);
 TS_API double ts_kernel_thrust_bias(const ts_kernel *k);
 TS_API double ts_kernel_thrust(const ts_kernel *k);

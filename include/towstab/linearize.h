@@ -105,6 +105,9 @@ typedef struct ts_linear {
     int nvehicles;
     int root_qoff;     /* offset in q of the towing vehicle's position
                           (its tow point, node 0), -1 without one */
+    int root_dof;      /* its degrees of freedom (ts_kernel_root_dof): 6,
+                          3 for a surface ship (x, y at root_qoff, its yaw
+                          just before), 0 without one */
     int *up_qoff;      /* [nlinks] for a link starting at a point P of a
                           vehicle, the offset of that vehicle's angles in
                           q; -1 otherwise; NULL without vehicles */

@@ -58,6 +58,12 @@ typedef struct ts_tow {
                                of its control surface the steady analyses
                                deflect to turn at `turn_rate`, or -1: the
                                turn rate is solved at the deflections */
+    int dof;                /* with a towing vehicle: its degrees of
+                               freedom, 6 (default) or 3: a surface ship
+                               held to the free surface, surge, sway and
+                               yaw dynamic, roll and pitch 0 and its tow
+                               point at the depth point[2] (the hull's
+                               hydrostatics react the rest) */
     ts_autopilot autopilot; /* the scene's waypoints (on = 0: none): a
                                simulation steers the towing vehicle's
                                rudder toward them (towstab/guidance.h) */

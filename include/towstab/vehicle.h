@@ -223,6 +223,15 @@ typedef struct ts_vehicle_result {
     double track_speed, turn_rate; /* the towing vehicle's: the frame's
                              speed V (m/s) and turn rate Omega (rad/s), its
                              steady motion in an equilibrium */
+    int dof;              /* the towing vehicle's degrees of freedom: 6, or
+                             3 for a surface ship (0: a towed vehicle) */
+    double held[3];       /* a surface ship's: the hull's hydrostatic
+                             reaction that holds its heave, roll and pitch:
+                             the vertical force on the hull at its tow
+                             point (N, down > 0: a negative value carries
+                             weight and the cable's downward pull), the
+                             roll and pitch moments about it (N m, body
+                             axes) */
     double hydro_force[3], hydro_moment[3]; /* all components, body axes,
                              moment about O */
     double munk[3];       /* the added mass's -v x p moment, body axes */

@@ -16,13 +16,13 @@ echo "| command | A cpu s | B cpu s | A/B cpu |"
 echo "|---|---|---|---|"
 ex1=examples/kamman_ex1_submerged.yaml
 row "modes, ex. 1, 20 links" "" "--no-discretisation-error" \
-    modes $ex1 --quiet
+    modes $ex1 --quiet --links 20
 row "modes, ex. 1, 80 links" "" "--no-discretisation-error" \
     modes $ex1 --quiet --links 80
 row "equilibrium, ex. 1, 200 links" "" "--no-discretisation-error" \
     equilibrium $ex1 --quiet --links 200
-row "response, ex. 1, sphere.z (100 frequencies)" "" \
-    "--no-discretisation-error" response $ex1 --quiet --output sphere.z
+row "response, ex. 1, 20 links, sphere.z (100 frequencies)" "" \
+    "--no-discretisation-error" response $ex1 --quiet --links 20 --output sphere.z
 row "simulate, ex. 4, heave 0.1 ft at 1 Hz, 20 s" "--discretisation-error" "" \
     simulate examples/kamman_ex4.yaml --quiet --no-compare \
     --excite tow.heave:amplitude=0.1ft,frequency=1Hz --t-end 20 --transient 10

@@ -5,9 +5,9 @@
 #   accuracy.sh TOWSTAB CHECK_JSON
 #
 # - equilibrium: the header gives knots, deg/s and the turn radius; every
-#   key value has a finite discretisation error in JSON; Kamman ex. 1 at 20
-#   links misses the accuracy 1e-3 (trustworthy: NO, --links named) and
-#   --refine meets it; --accuracy 0.01 accepts it; --accuracy 2 and
+#   key value has a finite discretisation error in JSON; Kamman ex. 1 at
+#   its 40 links meets the accuracy 1e-3 (trustworthy: yes); at 20 links
+#   it misses it (trustworthy: NO, --links named) and --refine meets it; --accuracy 0.01 accepts it; --accuracy 2 and
 #   accuracy: 0 in a scene entry are refused (exit 2, naming the option);
 #   --no-discretisation-error says why there is no estimate;
 # - modes: oscillatory modes first, --count 5 --near 0.1 lists five
@@ -30,7 +30,16 @@ EX3=examples/kamman_ex3_turn.yaml
 EX4=examples/kamman_ex4.yaml
 
 # Equilibrium: header, errors, verdict.
-ts equilibrium "$EX1" --quiet --json "$T/e.json"
+ts equilibrium "$EX1" --quiet --json "$T/d.json"
+if [ "$status" -eq 0 ] &&
+   grep -q 'top tension 329.896452 N +- 0.13 (discretisation)' "$T/out" &&
+   grep -q 'Richardson from 40, 20 and 10 links' "$T/out" &&
+   grep -q 'trustworthy: yes' "$T/out" && grep -q '"met": true' "$T/d.json"; then
+    pass "equilibrium ex. 1 as given (40 links): accuracy met, trustworthy"
+else
+    fail "equilibrium ex. 1 as given: status $status; $(tail -4 "$T/out")"
+fi
+ts equilibrium "$EX1" --quiet --links 20 --json "$T/e.json"
 if [ "$status" -eq 0 ] && grep -q '(4.944 knots), turn rate 0 rad/s (straight)' "$T/out" &&
    grep -q '^  +- discretisation' "$T/out" &&
    grep -q 'top tension 329.582160 N +- 0.67 (discretisation)' "$T/out" &&
@@ -43,7 +52,7 @@ if [ "$status" -eq 0 ] && grep -q '(4.944 knots), turn rate 0 rad/s (straight)' 
 else
     fail "equilibrium ex. 1: status $status; $(tail -4 "$T/out")"
 fi
-ts equilibrium "$EX1" --quiet --refine --json "$T/r.json"
+ts equilibrium "$EX1" --quiet --links 20 --refine --json "$T/r.json"
 if [ "$status" -eq 0 ] && grep -q 'refined: 1 rerun from 20 to 29 links' "$T/out" &&
    grep -q 'trustworthy: yes' "$T/out" && grep -q '"refined_from": 20' "$T/r.json"; then
     pass "equilibrium --refine: 20 to 29 links, trustworthy"

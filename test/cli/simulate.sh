@@ -15,7 +15,8 @@
 #  - an integrator failure (step below --h-min) exits 1 and still writes
 #    the history so far, with "completed": false in the JSON;
 #  - bad options exit 2 with one line naming the option and write no file;
-#  - `--json -` writes one JSON document alone to standard output.
+#  - `--json -` writes one JSON document alone to standard output;
+#  - waypoints: a scene's course, and --waypoints in place of its points.
 # Prints one PASS/FAIL line per check and "N passed, N failed".
 set -u
 if [ $# -ne 1 ]; then
@@ -209,7 +210,7 @@ ts simulate "$EX1" --t-end 5 --outputs cable.1.tension,sphere.tension,tow.force 
     --csv "$T/o/t.csv" --json "$T/o/t.json"
 why=""
 [ "$status" -eq 0 ] || why="$why exit $status: $(head -1 "$T/err");"
-[ "$(head -1 "$T/o/t.csv")" = "t_s,cable.1.tension_N,cable.20.tension_N,tow.force_N" ] ||
+[ "$(head -1 "$T/o/t.csv")" = "t_s,cable.1.tension_N,cable.40.tension_N,tow.force_N" ] ||
     why="$why header '$(head -1 "$T/o/t.csv")';"
 want=$(awk -F, '$1 == "tow" {t = $5} $1 == "cable.1" {c = $5}
     $1 == "sphere" {s = $5} END {print c, s, t}' "$T/o/eq.csv")
@@ -301,6 +302,31 @@ ts simulate test/scenes/dolphin_waypoints.yaml --t-end 10 --linear
     why="$why --linear not refused (exit $status);"
 [ -z "$why" ] && pass "waypoints: $line" ||
     fail "waypoints:$why"
+
+# 12. --waypoints replaces the scene's points (its rudders and gain
+# kept): a port turn the scene does not have, both points reached; bad
+# lists, and a scene without a waypoints entry, exit 2 with one line
+# naming --waypoints and write no file.
+fresh
+ts simulate test/scenes/dolphin_waypoints.yaml --t-end 40 --sample 0.5 \
+    --waypoints "50 m,0;50 m,-40 m" --json "$T/o/w2.json"
+why=""
+[ "$status" -eq 0 ] || why="$why exit $status: $(head -1 "$T/err");"
+grep -q '^waypoints of dolphin (radius 2 m, autopilot every 0.5 s): 2 of 2 reached' "$T/out" ||
+    why="$why not 2 of 2 reached;"
+grep -Eq '^ +2 +50 +-40 +[0-9.]+ ' "$T/out" || why="$why waypoint 2 not (50, -40);"
+line=$(grep -m1 '^waypoints of' "$T/out")
+for bad in "60,0;110" "60 kg,0" ";" "1 m,0" "a,b"; do
+    ts simulate test/scenes/dolphin_waypoints.yaml --t-end 1 \
+        --waypoints "$bad" --json "$T/o/bad.json"
+    [ "$status" -eq 2 ] && [ "$(wc -l <"$T/err")" -eq 1 ] &&
+        grep -q -- '--waypoints' "$T/err" && [ ! -e "$T/o/bad.json" ] ||
+        why="$why '$bad': exit $status, $(head -1 "$T/err");"
+done
+ts simulate test/scenes/towing_sphere.yaml --t-end 1 --waypoints "10 m,0"
+[ "$status" -eq 2 ] && grep -q -- "--waypoints: .*the scene has none" "$T/err" ||
+    why="$why no waypoints entry: exit $status;"
+[ -z "$why" ] && pass "--waypoints: $line" || fail "--waypoints:$why"
 
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

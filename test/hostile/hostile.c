@@ -661,7 +661,7 @@ static void gen_sizes(void)
     static const char *const nl[] = {"1", "100000", "100001", "10000000"};
     for (size_t i = 0; i < sizeof nl / sizeof nl[0]; i++) {
         size_t len;
-        const char *at = strstr(ex1->text, "links: 20");
+        const char *at = strstr(ex1->text, "links: 40");
         size_t a = (size_t)(at - ex1->text);
         char *v = fmt("links: %s", nl[i]);
         char *t = replaced(ex1, a, a + 9, v, strlen(v), &len);
@@ -1272,7 +1272,7 @@ static void gen_signals(void)
     c->must_name = xstrdup("stopped on request after");
     c->sig_after = 2.0; /* well into the sweep */
     const example *ex1 = find_example("kamman_ex1_submerged");
-    const char *at = ex1 ? strstr(ex1->text, "links: 20") : NULL;
+    const char *at = ex1 ? strstr(ex1->text, "links: 40") : NULL;
     if (at) {
         size_t len, a = (size_t)(at - ex1->text);
         char *t = replaced(ex1, a, a + 9, "links: 400", 10, &len);
