@@ -72,12 +72,10 @@
 /* Integrator noise of a simulated value in a links sweep: this many times
  * rel_tol of the value's scale. */
 #define SIM_TOL_NOISE 10.0
-/* Times compared within this (s) are the same sample. */
-#define TIME_EPS 1e-12
 /* Key values of a simulation under a periodic excitation: amplitude
  * ratio, mean offset, phase (SIM_FIT values), then the extreme link
- * tensions over the window; the extremes of the forces over the run
- * follow (sim_values). */
+ * tensions over the window; the extremes of the forces (over the window
+ * too, sim_forces) follow (sim_values). */
 #define SIM_FIT 3
 #define SIM_TMAX 3
 #define SIM_TMIN 4
@@ -572,7 +570,7 @@ static int tow_values(const ts_system *sys, const ts_equilibrium *eq,
     /* The unknown along the track carries Newton's next step; thrust,
      * power and speed vary together along it (T = P / u, P = T u), so
      * what follows from it has the same relative error. */
-    double x = bias ? eq->thrust_bias : eq->speed;
+    double x = bias ? vr->thrust : eq->speed;
     double ex = fmax(EQ_NOISE_FACTOR * eq->motion_step[0],
                      rel * (bias ? eq->force_scale : fabs(x)));
     double follows = bias ? vr->power
@@ -1159,6 +1157,10 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
     rc = equilibrium_then_linear(r, rq, &lo, err);
+    /* A towing vehicle's speed is solved: the waves meet it at that one
+     * (the encounter frequency), not at the scene's starting value. */
+    if (rc == TS_OK && r->sys->tow.vehicle >= 0)
+        r->seaway.speed = r->eq->speed;
     ts_seastate_opts so;
     ts_seastate_opts_default(&so);
     so.intervals = o->intervals;
@@ -1813,7 +1815,7 @@ static int sim_nfit(const ts_result *r)
  *    made leaves NAN values (an error only when required);
  *  - with a nonlinear run, the extremes of the force on the tow point
  *    (tow.force.max, ...) and of a tension output (force_values) over
- *    the whole run.
+ *    r->forces_from on (sim_forces).
  * `linear_only`: the request runs the linear model alone; `ran`: the
  * runs succeeded (else only the names, NAN values). */
 static int sim_values(ts_result *r, int linear_only, int ran, int required,
@@ -1869,9 +1871,7 @@ static int sim_values(ts_result *r, int linear_only, int ran, int required,
     value_name(&r->values[SIM_TMIN], "N", 0.0, "tension.min");
     if (!h || !r->eq || !ran)
         return TS_OK;
-    int first = 0;
-    while (first < h->nsamples && h->t[first] < r->transient - TIME_EPS)
-        first++;
+    int first = ts_history_first(h, r->transient);
     int n = h->nsamples - first;
     /* The extreme link tensions over the window. */
     double tmax = -INFINITY, tmin = INFINITY;
@@ -1931,10 +1931,46 @@ static int sim_values(ts_result *r, int linear_only, int ran, int required,
     return TS_OK;
 }
 
+/* Whether a simulation computes its earth-frame tracks (h->frame): when
+ * the request asks (s->tracks: the pictures), the channels reported
+ * include an earth-frame position or the full state, or the scene steers
+ * by waypoints. */
+static int sim_needs_tracks(const ts_result *r, const ts_simulate_opts *s)
+{
+    if (s->tracks || r->all_outputs || r->sys->tow.autopilot.on)
+        return 1;
+    for (int k = 0; k < r->noutputs; k++)
+        if (r->outputs[k].kind == TS_OUT_EARTH)
+            return 1;
+    return 0;
+}
+
+/* The samples a run's history starts with: those of the run, at most
+ * TS_HISTORY_INITIAL (it grows as the run fills it). */
+static int history_start(int nsamples)
+{
+    return nsamples < TS_HISTORY_INITIAL ? nsamples : TS_HISTORY_INITIAL;
+}
+
+/* The start of the window the forces' extremes are taken over
+ * (ts_result.forces_from): the transient when the run analyses a window
+ * after it (a periodic excitation's fit, a sea's statistics, or a
+ * transient given), else 0, the whole run (a manoeuvre's loads are in its
+ * transient). */
+static double forces_window(const ts_result *r, const ts_simulate_opts *s)
+{
+    int idx;
+    int windowed = r->has_sea || !isnan(s->transient) ||
+                   (r->excitation &&
+                    ts_excitation_periodic(r->excitation, &idx));
+    return windowed ? r->transient : 0.0;
+}
+
 /* The forces of the nonlinear run (ts_result: tow_force, tensions,
- * output_extremes, slack) and their verdict: a rigid link in compression
- * is a reason (a cable cannot push), an elastic link going slack a note
- * (a snap load follows). References: the initial equilibrium's values. */
+ * output_extremes over the window from forces_from on; slack over the
+ * whole run) and their verdict: a rigid link in compression is a reason
+ * (a cable cannot push), an elastic link going slack a note (a snap load
+ * follows). References: the initial equilibrium's values. */
 static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
 {
     const ts_system *sys = r->sys;
@@ -1944,19 +1980,20 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
             ? r->eq
             : NULL;
     const ts_history *ho = h ? h : r->linear;
+    double from = r->forces_from = forces_window(r, s);
     if (ho)
-        ts_extremes_compute(sys, ho, &r->output,
-                            eq ? ts_output_value(sys, &r->output,
-                                                 eq->positions, eq->tensions,
-                                                 eq->tow_force)
-                               : NAN,
-                            &r->output_extremes);
+        ts_extremes_window(sys, ho, &r->output,
+                           eq ? ts_output_value(sys, &r->output,
+                                                eq->positions, eq->tensions,
+                                                eq->tow_force)
+                              : NAN,
+                           from, &r->output_extremes);
     if (!h || h->nsamples == 0)
         return TS_OK;
     ts_output o;
     ts_output_find(sys, "tow.force", TS_OUT_ALL, &o, NULL);
-    ts_extremes_compute(sys, h, &o, eq ? eq->top_tension : NAN,
-                        &r->tow_force);
+    ts_extremes_window(sys, h, &o, eq ? eq->top_tension : NAN, from,
+                       &r->tow_force);
     r->tensions = calloc((size_t)sys->nlinks, sizeof *r->tensions);
     if (!r->tensions)
         return ts_fail(err, TS_ENOMEM, "simulate: out of memory");
@@ -1965,7 +2002,8 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
     for (int l = 0; l < sys->nlinks; l++) {
         o.link = l;
         ts_extremes *e = &r->tensions[l];
-        ts_extremes_compute(sys, h, &o, eq ? eq->tensions[l] : NAN, e);
+        ts_extremes_window(sys, h, &o, eq ? eq->tensions[l] : NAN, from,
+                           e);
         if (e->samples == 0)
             continue;
         if (r->peak_link < 0 || e->max > r->tensions[r->peak_link].max)
@@ -2011,15 +2049,19 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
  * excitation (r->sea_excitation, which r->excitation then points to). */
 /* The excitation of s with its sea's realisation added, into *out (a new
  * excitation, NULL on failure), with the seaway and the realisation's
- * settings. */
+ * settings; the ship's speed through the waves is `speed` (m/s; NaN: the
+ * scene's). */
 static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
-                          ts_seaway *w, ts_sea_realisation *real,
-                          ts_excitation **out, ts_err *err)
+                          double speed, ts_seaway *w,
+                          ts_sea_realisation *real, ts_excitation **out,
+                          ts_err *err)
 {
     *out = NULL;
     int rc = sea_seaway(sys, &s->sea, w, err);
     if (rc)
         return rc;
+    if (isfinite(speed))
+        w->speed = speed;
     *out = ts_excitation_copy(s->excitation, err);
     if (!*out)
         return err && err->code ? err->code : TS_ENOMEM;
@@ -2034,9 +2076,10 @@ static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
     return rc;
 }
 
-static int sea_realise(ts_result *r, const ts_simulate_opts *s, ts_err *err)
+static int sea_realise(ts_result *r, const ts_simulate_opts *s,
+                       double speed, ts_err *err)
 {
-    int rc = sea_excitation(r->sys, s, &r->seaway, &r->realisation,
+    int rc = sea_excitation(r->sys, s, speed, &r->seaway, &r->realisation,
                             &r->sea_excitation, err);
     if (!r->sea_excitation)
         return rc;
@@ -2124,8 +2167,11 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     r->excitation = s->excitation;
     int rc = check_simulate(sys, s, rq->setup.open_loop, &r->sim,
                             &r->transient, &r->output, err);
-    if (rc == TS_OK && s->sea.sea)
-        rc = sea_realise(r, s, err);
+    /* A towing vehicle's speed, which the waves' encounter frequency
+     * needs, is known after its equilibrium: its sea is realised there. */
+    int sea_later = s->sea.sea && sys->tow.vehicle >= 0;
+    if (rc == TS_OK && s->sea.sea && !sea_later)
+        rc = sea_realise(r, s, NAN, err);
     if (rc != TS_OK)
         return rc;
     ts_sim_opts *o = &r->sim;
@@ -2158,6 +2204,11 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         } else {
             memcpy(y0, r->eq->y, (size_t)n * sizeof *y0);
             ts_trust_merge(&r->trust, "initial equilibrium: ", &r->eq_trust);
+            if (sea_later) {
+                rc = sea_realise(r, s, r->eq->speed, err);
+                if (r->sea_excitation)
+                    ex = r->excitation;
+            }
             /* The loops open at the trim: the state loses their
              * integrators. */
             if (rq->setup.open_loop && ts_control_nloops(k) > 0) {
@@ -2205,7 +2256,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         if (r->lin)
             r->evaluations += r->lin->evaluations;
         if (rc == TS_OK && (s->compare || s->linear)) {
-            r->linear = ts_history_alloc(sys, N, err);
+            r->linear = ts_history_alloc(sys, history_start(N), err);
             rc = r->linear ? ts_simulate_linear(k, r->lin, ex, NULL, o,
                                                 r->linear, &r->linear_stats,
                                                 err)
@@ -2217,25 +2268,13 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
     }
     if (rc == TS_OK && !s->linear) {
         knl = ts_kernel_clone(k, err);
-        r->nonlinear = knl ? ts_history_alloc(sys, N, err) : NULL;
+        r->nonlinear = knl ? ts_history_alloc(sys, history_start(N), err)
+                           : NULL;
         rc = r->nonlinear ? ts_simulate(knl, ex, y0, o, r->nonlinear,
                                         &r->nonlinear_stats, NULL, err)
                           : (err && err->code ? err->code : TS_ENOMEM);
         r->evaluations += r->nonlinear_stats.evaluations;
     }
-    /* The earth-frame tracks (towstab/track.h): the frame's pose at each
-     * sample, also of a run that stopped early. */
-    ts_frame base;
-    ts_kernel_get_frame(k, &base);
-    base.speed_rate = base.turn_accel = 0.0;
-    ts_history *runs[2] = {r->nonlinear, r->linear};
-    for (int i = 0; i < 2; i++)
-        if (runs[i]) {
-            int trc = ts_track_history(runs[i], ex, &base,
-                                       rc == TS_OK ? err : NULL);
-            if (rc == TS_OK)
-                rc = trc;
-        }
     /* Health: the start, the linear model's kinks and the integrations'
      * statistics (towstab/health.h). */
     if (r->lin && r->lin->kink_tow && s->compare)
@@ -2259,6 +2298,21 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
      * run's samples so far too). */
     int frc = sim_selection(sys, s, &r->output, &r->outputs, &r->noutputs,
                             &r->all_outputs, rc == TS_OK ? err : NULL);
+    /* The earth-frame tracks (towstab/track.h), when asked for: the
+     * frame's pose at each sample, also of a run that stopped early. */
+    if (frc == TS_OK && k && sim_needs_tracks(r, s)) {
+        ts_frame base;
+        ts_kernel_get_frame(k, &base);
+        base.speed_rate = base.turn_accel = 0.0;
+        ts_history *runs[2] = {r->nonlinear, r->linear};
+        for (int i = 0; i < 2; i++)
+            if (runs[i]) {
+                int trc = ts_track_history(runs[i], ex, &base,
+                                           rc == TS_OK ? err : NULL);
+                if (rc == TS_OK)
+                    rc = trc;
+            }
+    }
     if (frc == TS_OK)
         frc = sim_forces(r, s, rc == TS_OK ? err : NULL);
     if (rc == TS_OK)
@@ -3341,7 +3395,8 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
         if (rq->simulate.sea.sea) {
             ts_seaway w;
             ts_sea_realisation real;
-            rc = sea_excitation(s, &rq->simulate, &w, &real, &ex, err);
+            /* (A towing vehicle's at the scene's speed: a cost bound.) */
+            rc = sea_excitation(s, &rq->simulate, NAN, &w, &real, &ex, err);
         }
         if (rc == TS_OK)
             rc = ts_cost_simulate(s, ex ? ex : rq->simulate.excitation, &o,

@@ -109,6 +109,11 @@ int ts_control_open(ts_kernel *k, const ts_equilibrium *eq, double y[],
     if (rc == TS_OK) {
         memset(y, 0, (size_t)ts_kernel_nstate(k) * sizeof(double));
         memcpy(y, y0, 2 * (size_t)nq * sizeof(double));
+        /* A speed integrator is the first controller state in every
+         * layout. */
+        int zs = ts_kernel_speed_integrator(k);
+        if (zs >= 0)
+            y[2 * nq + zs] = y0[2 * nq + zs];
         for (int v = 0; v < nv; v++) {
             double *xi = ctl + (size_t)v * CTL_STRIDE;
             ts_kernel_set_controls(k, v, xi, xi + TS_VEHICLE_MAX_LOOPS, y);

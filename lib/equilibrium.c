@@ -220,11 +220,28 @@ static double control_weight(const ts_kernel *k, int i)
     ts_kernel_control_state(k, i, &cs);
     const ts_vehicle *d =
         sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
+    if (cs.actuator == TS_CONTROL_SPEED)
+        return 1.0 / d->propulsion.speed;
     if (cs.actuator)
         return d->component[cs.index].time_constant;
     return d->loop[cs.index].measure == TS_MEASURE_DEPTH
                ? 1.0 / total_length(sys)
                : 1.0;
+}
+
+/* Size of controller state i, the step of its unknown: 1 rad for an
+ * actuator, 1 rad / |ki| for a loop's integrator, the vehicle's weight
+ * (at least 1 N) / ki for a speed integrator. */
+static double control_scale(const ts_kernel *k, int i)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_control_state cs;
+    ts_kernel_control_state(k, i, &cs);
+    const ts_body *b = &sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)];
+    if (cs.actuator == TS_CONTROL_SPEED)
+        return fmax(b->mass * sys->env.gravity, 1.0) /
+               b->vehicle->propulsion.ki;
+    return cs.actuator ? 1.0 : 1.0 / fabs(b->vehicle->loop[cs.index].ki);
 }
 
 /* The largest weighted |c'| of f = f(y); 0 without controllers. */
@@ -397,14 +414,8 @@ static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
              * large against rounding. */
             if (sys->links[l].elastic)
                 w->scale[ts_kernel_link_offset(k, l) + 2] = 1e-3;
-        for (int i = 0; i < nc; i++) {
-            ts_control_state cs;
-            ts_kernel_control_state(k, i, &cs);
-            const ts_vehicle *d =
-                sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
-            w->scale[nq + i] =
-                cs.actuator ? 1.0 : 1.0 / fabs(d->loop[cs.index].ki);
-        }
+        for (int i = 0; i < nc; i++)
+            w->scale[nq + i] = control_scale(k, i);
     }
     w->ux = w->uy = -1;
     int ro = ts_kernel_root_offset(k);
@@ -412,7 +423,11 @@ static int newton_ws_alloc(newton_ws *w, const ts_kernel *k)
         const ts_body *bd = &sys->bodies[sys->tow.vehicle];
         w->ux = ro;
         w->uy = ro + 1;
-        w->x_is_bias = bd->vehicle->propulsion.type == TS_PROP_SPEED;
+        /* A PI speed controller's integrator carries the thrust: the
+         * speed is the unknown (its integrator holds it at the set
+         * speed), as with a thrust or a power. */
+        w->x_is_bias = bd->vehicle->propulsion.type == TS_PROP_SPEED &&
+                       !(bd->vehicle->propulsion.ki > 0);
         w->y_is_turn = sys->tow.turn_surface >= 0;
         if (w->scale) {
             /* Steps of the speed, a thrust, the turn rate. */
@@ -476,6 +491,15 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
     if (w->ux >= 0) {
         eq->motion_step[0] = fabs(w->dq[w->ux]);
         eq->motion_step[1] = fabs(w->dq[w->uy]);
+        /* A PI speed controller: the thrust's step is its integral
+         * term's. */
+        int zs = ts_kernel_speed_integrator(k);
+        if (zs >= 0) {
+            const ts_system *sys = ts_kernel_system(k);
+            eq->motion_step[0] =
+                sys->bodies[sys->tow.vehicle].vehicle->propulsion.ki *
+                fabs(w->dq[nq + zs]);
+        }
     }
 }
 
@@ -536,10 +560,15 @@ static void singular_place(const ts_kernel *k, int i, char *buf, size_t size)
         ts_kernel_control_state(k, i - 2 * nq, &cs);
         int b = ts_kernel_vehicle_body(k, cs.vehicle);
         const ts_vehicle *v = sys->bodies[b].vehicle;
-        snprintf(buf, size, "bodies[%d] '%s' %s '%s'", b, sys->bodies[b].name,
-                 cs.actuator ? "control surface" : "controller",
-                 cs.actuator ? v->component[cs.index].name
-                             : v->loop[cs.index].name);
+        if (cs.actuator == TS_CONTROL_SPEED)
+            snprintf(buf, size, "bodies[%d] '%s' speed controller", b,
+                     sys->bodies[b].name);
+        else
+            snprintf(buf, size, "bodies[%d] '%s' %s '%s'", b,
+                     sys->bodies[b].name,
+                     cs.actuator ? "control surface" : "controller",
+                     cs.actuator ? v->component[cs.index].name
+                                 : v->loop[cs.index].name);
         return;
     }
     if (ts_kernel_root(k) >= 0 && i >= ts_kernel_root_offset(k) &&
@@ -1501,13 +1530,8 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
         }
     }
     for (int i = 0; i < nc; i++) {
-        ts_control_state cs;
-        ts_kernel_control_state(k, i, &cs);
-        const ts_vehicle *d =
-            sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)].vehicle;
         s.zy[3 * nv + i] = 2 * nq + i;
-        s.zscale[3 * nv + i] =
-            cs.actuator ? 1.0 : 1.0 / fabs(d->loop[cs.index].ki);
+        s.zscale[3 * nv + i] = control_scale(k, i);
         s.zw[3 * nv + i] = control_weight(k, i);
     }
 

@@ -1,9 +1,10 @@
 /* extremes.c: extremes of output channels over a history and the links
  * whose tension leaves a cable's range (towstab/extremes.h).
  *
- * One pass over the samples per channel: the largest and smallest finite
- * sample, the trapezoidal integral for the mean, and the parabola through
- * each extreme's neighbours for its sampling error. The links are
+ * One pass over the samples per channel (those of the window, t >=
+ * t_from, when one is given): the largest and smallest finite sample,
+ * the trapezoidal integral for the mean, and the parabola through each
+ * extreme's neighbours for its sampling error. The links are
  * scanned sample by sample (rows of h->tensions are contiguous), keeping
  * per link the first and last time out of range.
  */
@@ -13,17 +14,19 @@
 #include <stdlib.h>
 
 /* The sampling error of the extreme at sample i of h (sign +1 for a
- * maximum, -1 for a minimum): how far the parabola through three samples
- * around it (shifted inward at the run's ends) goes beyond it, when its
- * vertex lies within a sample of i and inside the run; else 0 (the
- * extreme is the run's own end value). */
+ * maximum, -1 for a minimum), over the samples first..n-1: how far the
+ * parabola through three samples around it (shifted inward at the
+ * window's ends) goes beyond it, when its vertex lies within a sample of
+ * i and inside the window; else 0 (the extreme is the window's own end
+ * value). */
 static double peak_error(const ts_system *sys, const ts_history *h,
-                         const ts_output *out, int i, double sign)
+                         const ts_output *out, int first, int i,
+                         double sign)
 {
     int n = h->nsamples;
-    if (n < 3)
+    if (n - first < 3)
         return 0.0;
-    int c = i < 1 ? 1 : i > n - 2 ? n - 2 : i;
+    int c = i < first + 1 ? first + 1 : i > n - 2 ? n - 2 : i;
     double t0 = h->t[c - 1], t1 = h->t[c], t2 = h->t[c + 1];
     double a = ts_history_value(sys, h, out, c - 1);
     double b = ts_history_value(sys, h, out, c);
@@ -35,7 +38,8 @@ static double peak_error(const ts_system *sys, const ts_history *h,
     if (!(sign * q < 0) || !isfinite(q + x))
         return 0.0;
     double ts = 0.5 * (t0 + t1) - d1 / (2 * q);
-    double lo = h->t[i > 0 ? i - 1 : 0], hi = h->t[i < n - 1 ? i + 1 : n - 1];
+    double lo = h->t[i > first ? i - 1 : first];
+    double hi = h->t[i < n - 1 ? i + 1 : n - 1];
     if (!(ts >= lo && ts <= hi))
         return 0.0;
     double p = a + d1 * (ts - t0) + q * (ts - t0) * (ts - t1);
@@ -46,13 +50,22 @@ void ts_extremes_compute(const ts_system *sys, const ts_history *h,
                          const ts_output *out, double reference,
                          ts_extremes *e)
 {
+    ts_extremes_window(sys, h, out, reference, -INFINITY, e);
+}
+
+void ts_extremes_window(const ts_system *sys, const ts_history *h,
+                        const ts_output *out, double reference,
+                        double t_from, ts_extremes *e)
+{
     e->max = e->t_max = e->min = e->t_min = NAN;
     e->max_error = e->min_error = e->mean = e->amplification = NAN;
     e->reference = reference;
     e->samples = 0;
+    int first = ts_history_first(h, t_from);
+    e->t_from = first < h->nsamples ? h->t[first] : NAN;
     int imax = -1, imin = -1, prev = -1;
     double integral = 0, span = 0, xmax = 0, xmin = 0, xprev = 0;
-    for (int i = 0; i < h->nsamples; i++) {
+    for (int i = first; i < h->nsamples; i++) {
         double x = ts_history_value(sys, h, out, i);
         if (!isfinite(x))
             continue;
@@ -79,8 +92,8 @@ void ts_extremes_compute(const ts_system *sys, const ts_history *h,
     e->t_max = h->t[imax];
     e->min = xmin;
     e->t_min = h->t[imin];
-    e->max_error = peak_error(sys, h, out, imax, 1.0);
-    e->min_error = peak_error(sys, h, out, imin, -1.0);
+    e->max_error = peak_error(sys, h, out, first, imax, 1.0);
+    e->min_error = peak_error(sys, h, out, first, imin, -1.0);
     e->mean = span > 0 ? integral / span : xmax;
     if (isfinite(reference) && reference != 0)
         e->amplification = e->max / reference;

@@ -100,6 +100,9 @@ typedef struct veh {
     double turn_delta;        /* the deflection added to the turn surface
                                  (ts_tow.turn_surface), rad */
     double thrust;            /* thrust at the last evaluation, N */
+    int spd_off;              /* a PI speed controller's integrator, offset
+                                 in c (0: the first state); -1 */
+    double spd_dot;           /* its rate at the last evaluation, m/s */
     /* A surface ship (ts_tow.dof 3): only its yaw (at qoff) and the tow
      * point's x, y (qoff + 1, + 2) are coordinates; roll and pitch are 0
      * and the tow point's depth is the scene's. held: the hull's
@@ -108,6 +111,11 @@ typedef struct veh {
      * pitch moments about A (N m, body axes). */
     int dof;                  /* 6, or 3; 0 for a towed vehicle */
     double held[3];
+    /* The towing vehicle: the prescribed acceleration (body axes) of the
+     * points its cables start from relative to the body, the tow-point
+     * inputs' (wave-induced motion, doc/towing-vehicle.md section 7); 0
+     * for a towed vehicle. */
+    double shift_a[3];
 } veh;
 
 /* Inputs of a towing vehicle: thrust, force x y z, moment x y z. */
@@ -177,6 +185,14 @@ static int layout_controls(ts_kernel *k, ts_err *err)
 {
     k->nc = 0;
     k->nin = TS_NINPUT;
+    /* A PI speed controller's integrator first: no loop mode moves it. */
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const ts_propulsion *p = &V->d->propulsion;
+        V->spd_off = V->root && p->type == TS_PROP_SPEED && p->ki > 0
+                         ? k->nc++
+                         : -1;
+    }
     for (int v = 0; v < k->nv; v++) {
         veh *V = &k->veh[v];
         const ts_vehicle *d = V->d;
@@ -532,11 +548,21 @@ void ts_kernel_outputs(const ts_kernel *k, double out[])
     }
 }
 
+int ts_kernel_speed_integrator(const ts_kernel *k)
+{
+    return k->root >= 0 ? k->veh[k->root].spd_off : -1;
+}
+
 void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
 {
     cs->vehicle = cs->actuator = cs->index = -1;
     for (int v = 0; v < k->nv; v++) {
         const veh *V = &k->veh[v];
+        if (V->spd_off == i) {
+            cs->vehicle = v;
+            cs->actuator = TS_CONTROL_SPEED;
+            return;
+        }
         for (int l = 0; l < V->d->nloops; l++)
             if (V->xi_off[l] == i) {
                 cs->vehicle = v;
@@ -854,6 +880,15 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
     v3_cross(om, t, b);
 }
 
+/* The part of the acceleration (body axes) of the point at lever rho from
+ * A that the body's (a_A, alpha) do not give: om x (om x rho), and a
+ * towing vehicle's prescribed motion of its cables' starting points. */
+static void point_bias(const veh *V, const double rho[3], double b[3])
+{
+    centripetal(V->st.om_b, rho, b);
+    for (int j = 0; j < 3; j++)
+        b[j] += V->shift_a[j];
+}
 
 /* A vehicle's controller, inertia and its own loads (V->M6, V->G). */
 static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
@@ -893,8 +928,19 @@ static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
         tsi_rel_velocity(&k->frame, V->st.rA, V->st.rdA, wA);
         double u_law = d->propulsion.type == TS_PROP_SPEED ? v3_norm(wA)
                                                            : V->st.wO_b[0];
-        V->thrust = ts_propulsion_thrust(&d->propulsion, u_law,
-                                         V->thrust_bias, up[0]);
+        /* A PI speed controller: its integral term joins the bias; the
+         * integrator holds while the law is capped and the vehicle slower
+         * than its set speed (anti-windup). */
+        const ts_propulsion *pr = &d->propulsion;
+        double bias = V->thrust_bias;
+        if (V->spd_off >= 0) {
+            double e = pr->speed - u_law;
+            bias += pr->ki * c[V->spd_off];
+            V->spd_dot = e > 0 && bias + pr->gain * e >= pr->max_thrust
+                             ? 0.0
+                             : e;
+        }
+        V->thrust = ts_propulsion_thrust(pr, u_law, bias, up[0]);
         double f[3] = {V->thrust, 0, 0}, lever[3], m[3];
         for (int j = 0; j < 3; j++)
             lever[j] = pp[j] - d->attach[j];
@@ -919,7 +965,7 @@ static void vehicle_loads(ts_kernel *k, veh *V, const double y[],
         link_lever(V, &k->sys->links[l], lever);
         sym3_to_body(V->st.R, k->uM + 6 * l, M3);
         mat3_tmul(V->st.R, k->uQ + 3 * l, f);
-        centripetal(V->st.om_b, lever, b);
+        point_bias(V, lever, b);
         add_point(V->M6, V->G, M3, lever, f, b);
     }
     memcpy(V->M6h, V->M6, sizeof V->M6);
@@ -1023,7 +1069,7 @@ static void vehicle_point_accel(const veh *V, const ts_link *L, double a[3])
     double lever[3], x[3], b[3], ab[3];
     link_lever(V, L, lever);
     v3_cross(V->a6 + 3, lever, x);
-    centripetal(V->st.om_b, lever, b);
+    point_bias(V, lever, b);
     for (int j = 0; j < 3; j++)
         ab[j] = V->a6[j] + x[j] + b[j];
     mat3_mul(V->st.R, ab, a);
@@ -1126,6 +1172,8 @@ static void control_rates(const veh *V, double cdot[])
     for (int j = 0; j < V->d->ncomponents; j++)
         if (V->act_off[j] >= 0)
             cdot[V->act_off[j]] = V->act_dot[j];
+    if (V->spd_off >= 0)
+        cdot[V->spd_off] = V->spd_dot;
 }
 
 int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
@@ -1151,6 +1199,18 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
         if (vehicle_kinematics(k, Root, y))
             chart_bad = 1;
+        /* The tow-point inputs: a prescribed displacement, velocity and
+         * acceleration (M axes) of the points the cables start from,
+         * relative to the body (a wave-induced motion), over its own. */
+        const ts_node *n0 = &sys->nodes[0];
+        for (int c = n0->child_begin; c < n0->child_end; c++) {
+            int l = sys->child_links[c];
+            for (int j = 0; j < 3; j++) {
+                k->ur[3 * l + j] += u[j];
+                k->urd[3 * l + j] += u[3 + j];
+            }
+        }
+        mat3_tmul(Root->st.R, u + 6, Root->shift_a);
     } else {
         for (int j = 0; j < 3; j++) {
             k->r[j] = sys->tow.point[j] + u[j];
@@ -1281,7 +1341,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                 for (int c = 0; c < 3; c++)
                     M3[3 * a + c] = nb[a] * nb[c] / D;
             }
-            centripetal(V->st.om_b, lever, b);
+            point_bias(V, lever, b);
             add_point(V->M6h, V->G, M3, lever, f, b);
         } else if (p > 0) {
             sym3_add_outer(k->Mh + 6 * p, 1.0 / D, n);

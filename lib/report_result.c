@@ -210,6 +210,7 @@ static json_t *forces_json(const ts_result *r)
         json_decref(slack);
         return NULL;
     }
+    json_object_set_new(f, "from_s", num(r->forces_from));
     json_object_set_new(f, "tow", ts_report_extremes_json(&r->tow_force));
     for (int l = 0; l < sys->nlinks; l++) {
         json_t *e = ts_report_extremes_json(&r->tensions[l]);
@@ -309,7 +310,8 @@ static json_t *waypoints_json(const ts_result *r, const ts_history *h)
                                         "t_s", num(h->reached_t[i]),
                                         "distance_m", num(h->reached_d[i])));
     ts_depth_range dr[TS_MAX_DEPTH_RANGES];
-    int nd = ts_history_depth_ranges(sys, h, dr, TS_MAX_DEPTH_RANGES);
+    int nd = ts_history_depth_ranges(sys, h, r->forces_from, dr,
+                                     TS_MAX_DEPTH_RANGES);
     for (int k = 0; k < nd; k++)
         json_array_append_new(
             depth, json_pack("{s:s,s:o,s:o,s:o,s:o,s:o}", "body",

@@ -110,12 +110,13 @@ int ts_report_history_full(json_t *o, const ts_system *sys,
 
 json_t *ts_report_extremes_json(const ts_extremes *e)
 {
-    return json_pack("{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "max",
+    return json_pack("{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "max",
                      num(e->max), "t_max", num(e->t_max), "max_error",
                      num(e->max_error), "min", num(e->min), "t_min",
                      num(e->t_min), "min_error", num(e->min_error), "mean",
                      num(e->mean), "static", num(e->reference),
-                     "amplification", num(e->amplification));
+                     "amplification", num(e->amplification), "from_s",
+                     num(e->t_from));
 }
 
 json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,

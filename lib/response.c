@@ -68,14 +68,10 @@ void ts_response_output_names(const ts_system *sys, char *buf, size_t size)
 int ts_response_input_lookup(const ts_kernel *k, const char *name,
                              int *channel, ts_err *err)
 {
-    if (ts_response_input_find(name, channel, NULL) == TS_OK) {
-        if (ts_kernel_root(k) < 0)
-            return TS_OK;
-        return ts_fail(err, TS_EINVAL, "input '%s': the tow point is the "
-                       "towing vehicle's, not prescribed; its inputs are "
-                       "<vehicle>.thrust, .force.x|y|z, .moment.x|y|z and "
-                       "its control surfaces and loops", name);
-    }
+    /* With a towing vehicle the tow-point inputs move the tow point
+     * relative to the vehicle (a wave-induced motion; the kernel). */
+    if (ts_response_input_find(name, channel, NULL) == TS_OK)
+        return TS_OK;
     int j = ts_kernel_input_find(k, name);
     if (j >= TS_NINPUT) {
         *channel = j;

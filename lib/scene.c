@@ -1069,14 +1069,17 @@ static int parse_vehicle(const ctx *c, const yaml_node_t *n, const char *path,
 
 /* A towing vehicle's propulsion (towstab/vehicle.h, ts_propulsion):
  * exactly one of thrust, power (with max_thrust) or speed (a speed
- * controller with gain, its thrust the starting bias), and the point `at`
- * where the thrust acts. */
+ * controller with gain and integral_gain, its bias solved, or with an
+ * integral gain 0 and the integrator carrying the thrust, max_thrust its
+ * cap), and the point `at` where the thrust acts. */
 static int parse_propulsion(const ctx *c, const field *fp, const char *parent,
                             ts_propulsion *pr)
 {
-    enum { P_THRUST, P_POWER, P_SPEED, P_MAX, P_GAIN, P_AT, P_N };
-    field f[P_N] = {{"thrust", 0, 0}, {"power", 0, 0}, {"speed", 0, 0},
-                    {"max_thrust", 0, 0}, {"gain", 0, 0}, {"at", 0, 0}};
+    enum { P_THRUST, P_POWER, P_SPEED, P_MAX, P_GAIN, P_KI, P_AT, P_N };
+    field f[P_N] = {{"thrust", 0, 0},     {"power", 0, 0},
+                    {"speed", 0, 0},      {"max_thrust", 0, 0},
+                    {"gain", 0, 0},       {"integral_gain", 0, 0},
+                    {"at", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN];
     join(path, parent, "propulsion");
     pr->line = fp->line;
@@ -1117,13 +1120,21 @@ static int parse_propulsion(const ctx *c, const field *fp, const char *parent,
         if (rc == TS_OK)
             rc = optional_min(c, path, &f[P_GAIN], "N*s/m", 0, 0, 0.0,
                               &pr->gain);
+        if (rc == TS_OK)
+            rc = optional_min(c, path, &f[P_KI], "N/m", 0, 0, 0.0, &pr->ki);
+        if (rc == TS_OK)
+            rc = optional_min(c, path, &f[P_MAX], "N", 0, 1, INFINITY,
+                              &pr->max_thrust);
     }
-    if (rc == TS_OK && which != P_POWER && f[P_MAX].value)
+    if (rc == TS_OK && which == P_THRUST && f[P_MAX].value)
         rc = fail_at(c, TS_ESCENE, join(p, path, "max_thrust"), f[P_MAX].line,
-                     "applies to a power law only");
+                     "applies to a power law or a speed controller only");
     if (rc == TS_OK && which != P_SPEED && f[P_GAIN].value)
         rc = fail_at(c, TS_ESCENE, join(p, path, "gain"), f[P_GAIN].line,
                      "applies to a speed controller only");
+    if (rc == TS_OK && which != P_SPEED && f[P_KI].value)
+        rc = fail_at(c, TS_ESCENE, join(p, path, "integral_gain"),
+                     f[P_KI].line, "applies to a speed controller only");
     if (rc == TS_OK && f[P_AT].value)
         rc = vector3(c, path, &f[P_AT], "m", pr->position);
     return rc;

@@ -54,6 +54,7 @@
 #include <float.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -219,6 +220,50 @@ nomem:
     return NULL;
 }
 
+/* One array of h grown from `old` to `c` samples of `width` values each
+ * (the new part NaN when `nan`); 0, or -1 with *a unchanged. */
+static int grow(double **a, size_t old, size_t c, size_t width, int nan)
+{
+    if (!*a)
+        return 0;
+    double *p = realloc(*a, c * width * sizeof(double));
+    if (!p)
+        return -1;
+    for (size_t i = old * width; nan && i < c * width; i++)
+        p[i] = NAN;
+    *a = p;
+    return 0;
+}
+
+/* Room in h for one more sample: the arrays are doubled when full, so
+ * that a history holds what a run reached, not what it may reach. */
+static int history_reserve(ts_history *h, ts_err *err)
+{
+    if (h->nsamples < h->capacity)
+        return TS_OK;
+    size_t old = (size_t)h->capacity;
+    size_t c = old < (size_t)INT_MAX / 2 ? 2 * old : (size_t)INT_MAX;
+    size_t nn = (size_t)h->nnodes, nl = (size_t)h->nlinks;
+    if (c == old ||
+        grow(&h->t, old, c, 1, 0) || grow(&h->positions, old, c, 3 * nn, 0) ||
+        grow(&h->tensions, old, c, nl, 0) ||
+        grow(&h->tow_force, old, c, 3, 0) || grow(&h->energy, old, c, 2, 0) ||
+        grow(&h->input, old, c, TS_NINPUT, 0) ||
+        grow(&h->frame, old, c, 3, 1) ||
+        grow(&h->outputs, old, c, (size_t)h->noutput, 0)) {
+        /* The arrays grown so far keep the old samples; the capacity
+         * stays that of the smallest. */
+        return ts_fail_nomem(err, 8.0 * (double)c * (9.0 + 3.0 * nn + nl +
+                                                     TS_NINPUT + h->noutput),
+                             "a coarser sample interval, a shorter t_end or "
+                             "fewer links",
+                             "simulate: out of memory for a history of %zu "
+                             "samples of %d nodes", c, h->nnodes);
+    }
+    h->capacity = (int)c;
+    return TS_OK;
+}
+
 void ts_history_free(ts_history *h)
 {
     if (!h)
@@ -277,12 +322,6 @@ static int bind_inputs(const ts_kernel *k, const ts_excitation *ex,
     for (int i = 0; i < ns; i++) {
         int axis = ts_excitation_signal(ex, i)->axis;
         any |= axis == TS_AXIS_INPUT;
-        if (ts_kernel_root(k) >= 0 && axis <= TS_AXIS_HEAVE)
-            return ts_fail(err, TS_EINVAL, "excite: the tow point is the "
-                           "towing vehicle's, not prescribed: excite its "
-                           "inputs (<vehicle>.thrust, .force.x|y|z, "
-                           ".moment.x|y|z, its control surfaces) instead of "
-                           "a tow-point motion");
     }
     if (!any)
         return TS_OK;
@@ -1050,16 +1089,16 @@ int ts_sim_advance(ts_sim *s, double t1, ts_err *err)
 
 int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
 {
-    if (h->nsamples >= h->capacity)
-        return ts_fail(err, TS_EINVAL, "simulate: the history is full (%d "
-                       "samples)", h->capacity);
     if (h->nnodes != s->sys->nnodes || h->nlinks != s->sys->nlinks)
         return ts_fail(err, TS_EINVAL, "simulate: the history is sized for "
                        "%d links, the system has %d", h->nlinks,
                        s->sys->nlinks);
+    int rc = history_reserve(h, err);
+    if (rc)
+        return rc;
     double *u = s->u;
     prepare(s, s->t, u);
-    int rc = ts_kernel_eval(s->k, s->y, u, s->work);
+    rc = ts_kernel_eval(s->k, s->y, u, s->work);
     if (rc)
         return ts_fail(err, rc < 0 ? rc : TS_EINTEGRATOR, "simulate: the "
                        "kernel refused the state at t = %.9g s (%s)", s->t,
@@ -1084,9 +1123,19 @@ int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err)
     return TS_OK;
 }
 
-int ts_history_depth_ranges(const ts_system *sys, const ts_history *h,
-                            ts_depth_range *out, int max)
+int ts_history_first(const ts_history *h, double t_from)
 {
+    int first = 0;
+    while (first < h->nsamples &&
+           h->t[first] < t_from - TS_HISTORY_TIME_EPS)
+        first++;
+    return first;
+}
+
+int ts_history_depth_ranges(const ts_system *sys, const ts_history *h,
+                            double t_from, ts_depth_range *out, int max)
+{
+    int first = ts_history_first(h, t_from);
     int m = 0;
     for (int n = 0; n < sys->nnodes && m < max; n++) {
         int b = sys->nodes[n].body;
@@ -1095,7 +1144,7 @@ int ts_history_depth_ranges(const ts_system *sys, const ts_history *h,
         ts_depth_range *d = &out[m++];
         d->body = b;
         d->min = d->t_min = d->max = d->t_max = NAN;
-        for (int i = 0; i < h->nsamples; i++) {
+        for (int i = first; i < h->nsamples; i++) {
             double z = h->positions[(size_t)(3 * h->nnodes) * (size_t)i +
                                     3 * (size_t)n + 2];
             if (!(z >= d->min)) {
@@ -1243,10 +1292,6 @@ int ts_simulate(ts_kernel *k, const ts_excitation *ex, const double y0[],
     if (rc)
         return rc;
     int N = ts_sim_nsamples(o);
-    if (h->capacity - h->nsamples < N)
-        return ts_fail(err, TS_EINVAL, "simulate: the history has room for "
-                       "%d samples, the run needs %d",
-                       h->capacity - h->nsamples, N);
     if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err)))
         return rc;
     double *ys = malloc((size_t)ts_kernel_nstate(k) * sizeof(double));
@@ -1561,6 +1606,9 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
                       ts_history *h, double *ywork, double *dr, ts_err *err)
 {
     const ts_system *sys = ts_kernel_system(k);
+    int rc = history_reserve(h, err);
+    if (rc)
+        return rc;
     size_t i = (size_t)h->nsamples, nn = (size_t)h->nnodes,
            nl = (size_t)h->nlinks;
     /* The input deviation (ywork's last part), then the tow channels. */
@@ -1583,7 +1631,7 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
             ywork[j] = lin->y0[j] + z[j];
         for (int j = 0; j < lin->ninput; j++)
             ufull[j] = lin->u0[j] + (j < L->m ? dv[j] : 0.0);
-        int rc = ts_kernel_eval(k, ywork, ufull, ywork + n);
+        rc = ts_kernel_eval(k, ywork, ufull, ywork + n);
         if (rc)
             return ts_fail(err, rc < 0 ? rc : TS_EDOMAIN, "simulate "
                            "(linear): the state y0 + z at t = %.9g s is "
@@ -1653,13 +1701,9 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EDOMAIN, "simulate (linear): the linear model "
                        "has no frame inputs: a speed or turn-rate manoeuvre "
                        "can only be simulated nonlinearly");
+    int N = ts_sim_nsamples(o);
     if (ex && (rc = ts_excitation_check_span(ex, o->t_end, err)))
         return rc;
-    int N = ts_sim_nsamples(o);
-    if (h->capacity - h->nsamples < N)
-        return ts_fail(err, TS_EINVAL, "simulate (linear): the history has "
-                       "room for %d samples, the run needs %d",
-                       h->capacity - h->nsamples, N);
     int *in_idx = NULL;
     if ((rc = bind_inputs(k, ex, &in_idx, err)))
         return rc;

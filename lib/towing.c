@@ -172,7 +172,8 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
     f->nmodes = fe->nmodes;
     /* Free state i is coupled state map[i]: the vehicle's angles and
      * position (a surface ship's yaw, x and y), their rates, then its
-     * controller states, the last block of the coupled system's (the
+     * controller states: a PI speed controller's integrator first in
+     * both, the others the last block of the coupled system's (the
      * towing vehicle is its last body). */
     int nf = fl->nstate, nqf = fl->nq, ncf = nf - 2 * nqf;
     int dof = lin->root_dof, qo = lin->root_qoff - (dof == 3 ? 1 : 3);
@@ -190,8 +191,11 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
         map[i] = qo + i;
         map[dof + i] = lin->nq + qo + i;
     }
+    int speed_pi = p0->type == TS_PROP_SPEED && p0->ki > 0;
     for (int j = 0; j < ncf; j++)
-        map[2 * dof + j] = 2 * lin->nq + nc - ncf + j;
+        map[2 * dof + j] = speed_pi && j == 0
+                               ? 2 * lin->nq
+                               : 2 * lin->nq + nc - ncf + j;
     int n = lin->nstate;
     for (int m = 0; m < fe->nmodes; m++) {
         ts_free_mode *fm = &f->modes[m];

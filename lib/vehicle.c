@@ -411,8 +411,13 @@ int ts_vehicle_check(const ts_vehicle *v, double mass, const char *where,
             break;
         case TS_PROP_SPEED:
             if ((rc = check_value(err, w, pl, "speed", pr->speed, 0, 1)) ||
-                (rc = check_value(err, w, pl, "gain", pr->gain, 0, 0)))
+                (rc = check_value(err, w, pl, "gain", pr->gain, 0, 0)) ||
+                (rc = check_value(err, w, pl, "integral_gain", pr->ki, 0,
+                                  0)))
                 return rc;
+            if (!(pr->max_thrust > 0))
+                return bad(err, w, pl, "max_thrust", "must be > 0 N, got %g",
+                           pr->max_thrust);
             if (!isfinite(pr->thrust))
                 return bad(err, w, pl, "thrust", "must be finite, got %g",
                            pr->thrust);
@@ -438,7 +443,7 @@ double ts_propulsion_thrust(const ts_propulsion *p, double u, double bias,
         T = u > p->power / p->max_thrust ? p->power / u : p->max_thrust;
         break;
     case TS_PROP_SPEED:
-        T = bias + p->gain * (p->speed - u);
+        T = fmin(bias + p->gain * (p->speed - u), p->max_thrust);
         break;
     default:
         break;

@@ -17,7 +17,11 @@
  *     may be wider: they cover the rightmost eigenvalues the search
  *     found, and the modes, with the pencil's left and right vectors and
  *     the model's entry-wise truncation and rounding, doc/linear.md
- *     section 3).
+ *     section 3), or the dense one is marginal through its bounds alone
+ *     (every dense eigenvalue has Re < 0) while the sparse one is stable
+ *     (its bounds may be narrower: the dense bounds of ill-conditioned
+ *     eigenvalues hold kappa eps ||A||, and a cable with bending has a
+ *     large ||A||).
  *
  * Scenes with towed vehicles take the same path: the sparse model holds
  * their attitude, rates and controller states (doc/linear.md, section
@@ -136,11 +140,19 @@ static void compare(const char *name, const ts_system *sys)
           "within their bounds (largest difference %.3g of the allowance)",
           name, sys->nlinks, ar->nmodes, worst);
 
-    /* 3. The verdicts: equal, or the sparse one marginal. */
+    /* 3. The verdicts: equal, or the sparse one marginal, or the dense one
+     * marginal through its bounds alone while the sparse one is stable:
+     * every dense eigenvalue has Re < 0, and only the dense bounds of
+     * ill-conditioned eigenvalues (the two-part tow's, condition numbers
+     * up to 2.6e5 against an ||A|| set by its stiff bending tops) reach
+     * the axis. */
     CHECK(ar->verdict == all->verdict ||
-              ar->verdict == TS_MARGINAL,
-          "%s (%d links): verdict %s, dense %s", name, sys->nlinks,
-          ts_verdict_name(ar->verdict), ts_verdict_name(all->verdict));
+              ar->verdict == TS_MARGINAL ||
+              (ar->verdict == TS_STABLE && all->verdict == TS_MARGINAL &&
+               all->max_real < 0),
+          "%s (%d links): verdict %s, dense %s (dense max Re %.3g 1/s)",
+          name, sys->nlinks, ts_verdict_name(ar->verdict),
+          ts_verdict_name(all->verdict), all->max_real);
     ts_eigen_free(all);
     ts_eigen_free(ar);
     ts_linear_free(lin);

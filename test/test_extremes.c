@@ -12,7 +12,10 @@
  *     times are those of the extreme samples; amplification = max /
  *     reference; no reference gives NAN; NAN samples are skipped (the
  *     sample count says so); a monotonic channel's extremes at the run's
- *     ends have no sampling error.
+ *     ends have no sampling error. Over a window t >= 5 s a start spike
+ *     of 1000 N (the whole run's max) is left out, the extremes are
+ *     within their sampling errors of the closed form's on [5, 10] s, the
+ *     mean is the window's average; a window past the end is empty.
  *  2. Slack: a rigid link at -2.5 N from t = 0.3 to 0.5 s is in
  *     compression (3 samples, lowest -2.5 N); rounding noise of -1e-12 of
  *     the run's largest tension is not; an elastic link at exactly 0 from
@@ -103,6 +106,43 @@ static void test_extremes(const ts_system *sys)
     ts_extremes_compute(sys, h, &f, NAN, &ef);
     CHECK(ef.max == e.max && ef.min == e.min,
           "tow.force: the same extremes from its components");
+    /* A window t >= 5 s (the analysed window after a transient): a start
+     * spike of 1000 N at 1 s is left out; its extremes are those of T on
+     * [5, 10] s (closed form: the sinusoid's crest and trough inside it,
+     * or the window's ends), with their sampling errors, and its mean is
+     * the window's trapezoidal average. */
+    double spike = h->tensions[nl * 10];
+    h->tensions[nl * 10] = 1000.0;
+    ts_extremes_compute(sys, h, &o, 287.5, &e);
+    ts_extremes ew;
+    ts_extremes_window(sys, h, &o, 287.5, 5.0, &ew);
+    double wmax = -INFINITY, wmin = INFINITY;
+    for (int j = 0; j <= 50000; j++) {
+        double x = T_of(5.0 + 5.0 * j / 50000);
+        wmax = fmax(wmax, x);
+        wmin = fmin(wmin, x);
+    }
+    double wmean = 300.0 + 40.0 * (cos(5 * w + 0.4) - cos(10 * w + 0.4)) /
+                               (5 * w);
+    CHECK(e.max == 1000.0 && e.t_max == 1.0 && e.t_from == 0.0,
+          "the whole run's max is the start spike (%g N at %g s)", e.max,
+          e.t_max);
+    CHECK(ew.samples == 51 && ew.t_from == 5.0 && ew.t_max >= 5.0 &&
+              ew.t_min >= 5.0 && ew.max <= wmax && ew.min >= wmin &&
+              wmax - ew.max <= ew.max_error + para &&
+              ew.min - wmin <= ew.min_error + para,
+          "window t >= %g s (%d samples): max %.9g N at %g s, min %.9g N at "
+          "%g s; true %.9g and %.9g N, within the sampling errors %.3g, "
+          "%.3g N", ew.t_from, ew.samples, ew.max, ew.t_max, ew.min,
+          ew.t_min, wmax, wmin, ew.max_error, ew.min_error);
+    CHECK_NEAR(ew.mean, wmean, dt * dt / 12 * 40 * w * w,
+               "window: the mean is the window's trapezoidal average");
+    CHECK_NEAR(ew.amplification, ew.max / 287.5, 0,
+               "window: amplification = the window's max / reference");
+    ts_extremes_window(sys, h, &o, 287.5, 20.0, &ew);
+    CHECK(ew.samples == 0 && isnan(ew.max) && isnan(ew.t_from),
+          "a window after the run's end has no samples");
+    h->tensions[nl * 10] = spike;
     /* NAN samples are skipped. */
     h->tensions[nl * imax] = NAN;
     ts_extremes_compute(sys, h, &o, NAN, &e);

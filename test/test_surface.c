@@ -25,6 +25,15 @@
  *     straight trim with the rudder over, RK4 on the kernel reaches
  *     Newton's steady turn (tensions, speed, yaw, turn rate); and turn_by
  *     rudder at that turn rate gives the rudder back.
+ *  6. Wave-induced motion of the tow point (the tow-point inputs with a
+ *     towing vehicle, doc/towing-vehicle.md section 7): with the ship's
+ *     mass and inertias 1e3 and 1e4 times, the depressor's response to
+ *     tow.heave, tow.surge and tow.sway is the prescribed tow's at the
+ *     ship's speed, the distance falling like 1 / mass.
+ *  7. Linear against nonlinear for a heaving tow point: the kernel (RK4)
+ *     and x' = A x + B u under a sine heave of 0.4 and 0.2 m at 0.02 Hz
+ *     (one period, 50 s, from the trim) differ by the square of the
+ *     amplitude.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +46,7 @@
 #include "towstab/equilibrium.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
+#include "towstab/response.h"
 
 #define SHIP "test/scenes/survey_ship.yaml"
 
@@ -77,6 +87,15 @@ static ts_scene *ship_variant(const char *const *lines)
     *o = '\0';
     ts_scene *s = tscene_parse(units, out);
     free(out);
+    return s;
+}
+
+/* The ship on 6 links (a check that fails when it does not parse). */
+static ts_scene *ship_six_links(void)
+{
+    static const char *const few[] = {"    links: 6", NULL};
+    ts_scene *s = ship_variant(few);
+    CHECK(s != NULL, "the ship on 6 links parses");
     return s;
 }
 
@@ -265,12 +284,9 @@ static double farthest(const ts_eigen *a, const ts_eigen *b)
 static void test_stiff_modes(void)
 {
     /* 6 links: the cable's modes stay below the springs' frequencies. */
-    static const char *const few[] = {"    links: 6", NULL};
-    ts_scene *s3 = ship_variant(few);
-    if (!s3) {
-        CHECK(0, "6-link ship parses");
+    ts_scene *s3 = ship_six_links();
+    if (!s3)
         return;
-    }
     ts_kernel *k3, *kh, *k6;
     ts_equilibrium *e3 = solve(s3->system, &k3);
     ts_scene *t3 = six_dof(s3->system,
@@ -460,6 +476,244 @@ static void test_turn(void)
     ts_scene_free(sc);
 }
 
+/* ---- 6. heavy ship: the motion input is the prescribed tow's ---------- */
+
+/* The gains of `out` to tow.surge, tow.sway, tow.heave at freq[nf] Hz
+ * (g[3][nf][2]) of system s about the equilibrium of system se (the same
+ * state and inputs: s itself, or a heavier copy). */
+static int gains(const ts_system *se, const ts_system *s, const char *out,
+                 const double *freq, int nf, double g[3][4][2],
+                 double *speed)
+{
+    ts_kernel *ke, *k;
+    ts_equilibrium *eq = solve(se, &ke);
+    ts_err err = {0};
+    k = ts_kernel_alloc(s, &err);
+    ts_linear *lin = k ? ts_linear_alloc(k, &err) : NULL;
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    lo.model = TS_LIN_DENSE;
+    ts_output o;
+    int rc = eq && eq->converged ? ts_linearize_equilibrium(k, eq, &lo, lin,
+                                                            &err)
+                                 : TS_ECONV;
+    if (rc == TS_OK)
+        rc = ts_response_output_lookup(k, out, &o, &err);
+    for (int c = 0; c < 3 && rc == TS_OK; c++)
+        for (int i = 0; i < nf && rc == TS_OK; i++)
+            rc = ts_response_at(s, lin, c, &o, 2 * M_PI * freq[i], &g[c][i][0],
+                                &g[c][i][1], &err);
+    if (rc != TS_OK)
+        printf("gains: %s\n", err.msg);
+    *speed = eq ? eq->speed : NAN;
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_kernel_free(ke);
+    return rc;
+}
+
+static void test_heavy_motion(void)
+{
+    const double freq[4] = {0.01, 0.05, 0.2, 0.8};
+    double d[2] = {NAN, NAN}, speed = NAN, gs[3][4][2], gp[3][4][2];
+    const ts_system *s0 = NULL;
+    ts_scene *base = tscene_load(units, SHIP);
+    if (!base)
+        return;
+    s0 = base->system;
+    const ts_body *b = &s0->bodies[s0->tow.vehicle];
+    for (int h = 0; h < 2; h++) {
+        double heavy = h ? 1e4 : 1e3;
+        char mass[96], inertia[160];
+        snprintf(mass, sizeof mass, "  mass: %.17g kg", b->mass * heavy);
+        snprintf(inertia, sizeof inertia, "  inertia: [%.17g kg*m^2, %.17g "
+                 "kg*m^2, %.17g kg*m^2]", b->vehicle->inertia[0] * heavy,
+                 b->vehicle->inertia[1] * heavy,
+                 b->vehicle->inertia[2] * heavy);
+        /* Its straight trim is the ship's (the weight goes into the
+         * hull's reaction): linearized there, as its Newton solve would
+         * balance forces 1e4 times smaller than its weight. */
+        const char *lines[] = {"    links: 8", mass, inertia, NULL};
+        const char *same[] = {"    links: 8", NULL};
+        ts_scene *sc = ship_variant(lines), *s1 = ship_variant(same);
+        if (!sc || !s1 ||
+            gains(s1->system, sc->system, "depressor.z", freq, 4, gs,
+                  &speed)) {
+            CHECK(0, "heavy ship x %g: gains", heavy);
+            ts_scene_free(sc);
+            ts_scene_free(s1);
+            continue;
+        }
+        /* The same cable and depressor from a prescribed tow point at
+         * the ship's tow point, at its speed. */
+        char pt[160];
+        snprintf(pt, sizeof pt, "name: prescribed\n"
+                 "tow: {speed: %.17g m/s, point: [0, 0, -3 m]}\n", speed);
+        char *text = strstr(ship_text, "cables:");
+        size_t n = strlen(pt) + strlen(text) + 1;
+        char *yaml = malloc(n);
+        snprintf(yaml, n, "%s%s", pt, text);
+        char *lk = strstr(yaml, "links: 20");
+        if (lk)
+            memcpy(lk, "links: 8 ", 9);
+        ts_scene *sp = tscene_parse(units, yaml);
+        free(yaml);
+        double sp_speed;
+        if (!sp || gains(sp->system, sp->system, "depressor.z", freq, 4, gp,
+                         &sp_speed)) {
+            CHECK(0, "prescribed tow: gains");
+        } else {
+            d[h] = 0;
+            double big = 0;
+            for (int c = 0; c < 3; c++)
+                for (int i = 0; i < 4; i++) {
+                    d[h] = fmax(d[h], hypot(gs[c][i][0] - gp[c][i][0],
+                                            gs[c][i][1] - gp[c][i][1]));
+                    big = fmax(big, hypot(gp[c][i][0], gp[c][i][1]));
+                }
+            d[h] /= big;
+            printf("ship x %g: depressor.z per m of tow.surge, sway, heave "
+                   "at %g .. %g Hz: largest distance from the prescribed "
+                   "tow's %.3g of the largest gain %.3g (heave at 0.2 Hz: "
+                   "%.6f%+.6fi against %.6f%+.6fi)\n", heavy, freq[0],
+                   freq[3], d[h], big, gs[2][2][0], gs[2][2][1],
+                   gp[2][2][0], gp[2][2][1]);
+        }
+        ts_scene_free(sp);
+        ts_scene_free(sc);
+        ts_scene_free(s1);
+    }
+    /* A 1e3 times heavier ship still yields to the cable's pull: its
+     * surge and sway responses, and so the difference, fall like 1 /
+     * mass (ratio 10). */
+    CHECK(d[0] / d[1] > 8 && d[0] / d[1] < 12 && d[1] < 1e-3,
+          "heavy ship: the tow-point motion input is the prescribed tow's "
+          "(relative distance %.3g, %.3g; ratio %.3g)", d[0], d[1],
+          d[0] / d[1]);
+    ts_scene_free(base);
+}
+
+/* ---- 7. linear against nonlinear: a slow heave --------------------------- */
+
+/* The kernel (lin NULL) or the linear model x' = A x + B u under a heave
+ * of amplitude a at om rad/s; u[ninput] holds the input of the last
+ * evaluation. */
+typedef struct heave_run {
+    ts_kernel *k;
+    const ts_linear *lin;
+    double a, om;
+    double *u;
+} heave_run;
+
+static void heave_rhs(heave_run *h, double t, const double *x, double *out)
+{
+    double *u = h->u, a = h->a, om = h->om;
+    u[2] = a * sin(om * t);
+    u[5] = a * om * cos(om * t);
+    u[8] = -a * om * om * sin(om * t);
+    if (!h->lin) {
+        ts_kernel_eval(h->k, x, u, out);
+        return;
+    }
+    int n = h->lin->nstate;
+    for (int r = 0; r < n; r++) {
+        double v = 0;
+        for (int j = 0; j < n; j++)
+            v += h->lin->A[r + (size_t)j * n] * x[j];
+        for (int j = 0; j < TS_NINPUT; j++)
+            v += h->lin->B[r + (size_t)j * n] * u[j];
+        out[r] = v;
+    }
+}
+
+/* One RK4 step of length dt from t, x[n] in place; w[5 n] scratch. */
+static void heave_step(heave_run *h, double t, double dt, double *x,
+                       double *w)
+{
+    int n = ts_kernel_nstate(h->k);
+    double *st[4] = {w, w + n, w + 2 * n, w + 3 * n}, *xt = w + 4 * n;
+    static const double cs[4] = {0, 0.5, 0.5, 1};
+    for (int s = 0; s < 4; s++) {
+        for (int j = 0; j < n; j++)
+            xt[j] = x[j] + (s ? cs[s] * dt * st[s - 1][j] : 0);
+        heave_rhs(h, t + cs[s] * dt, xt, st[s]);
+    }
+    for (int j = 0; j < n; j++)
+        x[j] += dt / 6 * (st[0][j] + 2 * st[1][j] + 2 * st[2][j] + st[3][j]);
+}
+
+static void test_heave_linear(void)
+{
+    ts_scene *sc = ship_six_links();
+    if (!sc)
+        return;
+    ts_kernel *k;
+    ts_equilibrium *eq = solve(sc->system, &k);
+    ts_err err = {0};
+    ts_linear *lin = ts_linear_alloc(k, &err);
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    lo.model = TS_LIN_DENSE;
+    int rc = ts_linearize_equilibrium(k, eq, &lo, lin, &err);
+    CHECK(rc == TS_OK, "linearized (%s)", rc ? err.msg : "ok");
+    int n = ts_kernel_nstate(k), nin = ts_kernel_ninput(k);
+    int nl = sc->system->nlinks;
+    double *y0 = calloc((size_t)n, sizeof(double)), *y = calloc((size_t)n,
+                                                              sizeof(double));
+    double *x = calloc((size_t)n, sizeof(double)), *u = calloc((size_t)nin,
+                                                             sizeof(double));
+    double *w = malloc(5 * (size_t)n * sizeof(double)), *f = malloc(
+        (size_t)n * sizeof(double));
+    double diff[2] = {0, 0}, resp[2] = {0, 0}, dt = 0.02, om = 2 * M_PI * 0.02;
+    const double *z0 = NULL;
+    double *dr = malloc(3 * ((size_t)nl + 1) * sizeof(double));
+    for (int c = 0; rc == TS_OK && c < 2; c++) {
+        double a = c ? 0.2 : 0.4;
+        ts_equilibrium_state(k, eq, y0, NULL);
+        memcpy(y, y0, (size_t)n * sizeof(double));
+        memset(x, 0, (size_t)n * sizeof(double));
+        /* 50 s: one period of the heave; the depressor's depth. */
+        heave_run hn = {k, NULL, a, om, u}, hl = {k, lin, a, om, u};
+        for (int i = 0; i < 2500; i++) {
+            double t = i * dt;
+            heave_step(&hn, t, dt, y, w);
+            heave_step(&hl, t, dt, x, w);
+            /* The depressor's depth: nonlinear from the kernel, linear
+             * from the node displacements of x. */
+            ts_kernel_eval(k, y, u, f);
+            z0 = ts_kernel_positions(k);
+            ts_linear_node_displacements(sc->system, lin, x, dr);
+            /* The linear depth: the links' part and the tow point's own
+             * displacement, which every node below it shares. */
+            double zl = dr[3 * nl + 2] + u[2];
+            double zn = z0[3 * nl + 2] - eq->positions[3 * nl + 2];
+            diff[c] = fmax(diff[c], fabs(zn - zl));
+            resp[c] = fmax(resp[c], fabs(zl));
+        }
+    }
+    printf("tow.heave 0.4 and 0.2 m at 0.02 Hz: depressor depth linear "
+           "less nonlinear %.3g and %.3g m of responses %.3g and %.3g m\n",
+           diff[0], diff[1], resp[0], resp[1]);
+    /* Second order in the amplitude (ratio 4), and small against the
+     * response. */
+    CHECK(rc == TS_OK && diff[0] / diff[1] > 3.5 && diff[0] / diff[1] < 4.5 &&
+              diff[0] < 0.02 * resp[0],
+          "slow heave: linear and nonlinear agree to second order in the "
+          "amplitude (ratio %.3g)", diff[0] / diff[1]);
+    free(dr);
+    free(y0);
+    free(y);
+    free(x);
+    free(u);
+    free(w);
+    free(f);
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     units = tscene_units();
@@ -472,6 +726,8 @@ int main(void)
     test_stiff_modes();
     test_thrust_drag();
     test_turn();
+    test_heavy_motion();
+    test_heave_linear();
     free(ship_text);
     ts_units_free(units);
     return tc_done();

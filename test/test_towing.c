@@ -38,6 +38,12 @@
  *  9. The turning circle: from the straight trim, a rudder step to 3 deg
  *     settles the tow point's earth track on a circle of Newton's steady
  *     turn (radius V / |Omega|, swept at Omega), alone and coupled.
+ * 10. The PI speed controller: its trim is at the set speed with the
+ *     integrator carrying the P controller's thrust; the linear model
+ *     holds the integrator (z' = speed - U: -1 against the surge); a
+ *     speed step from the 2.6 m/s trim settles on 3 m/s, the integrator
+ *     held while the thrust is at its cap; linear against nonlinear as
+ *     in 6; and (7) the free vehicle with it.
  */
 #include <stdarg.h>
 #include <stdlib.h>
@@ -425,6 +431,92 @@ static ts_scene *thrust_scene(double T, double rudder_deg)
     return tow_scene(prop, rudder_deg, 4);
 }
 
+/* y[nstate] of kernel k (left at the frame of the trim `at`, its own)
+ * set to the trim `from` of another scene of the same layout, moving back
+ * in at's frame at the speed difference. */
+static void start_from(ts_kernel *k, const ts_equilibrium *from,
+                       const ts_equilibrium *at, double *y)
+{
+    ts_frame fa;
+    ts_kernel_get_frame(k, &fa);
+    ts_equilibrium_state(k, from, y, NULL);
+    ts_kernel_set_frame(k, &fa);
+    y[ts_kernel_nq(k) + ts_kernel_root_offset(k)] = from->speed - at->speed;
+}
+
+/* 6. Thrust steps of 20 and 10 N for 20 s from the trim e of kernel k
+ * (left at that trim): linear (x' = A x + B u) against nonlinear, both
+ * RK4 at 0.01 s; their difference falls like the square of the step. */
+static void linear_nonlinear(ts_kernel *ka, const ts_equilibrium *ea,
+                             const char *what)
+{
+    int n = ts_kernel_nstate(ka), nq = ts_kernel_nq(ka);
+    double *y = calloc((size_t)n, sizeof(double));
+    double *w = malloc(5 * (size_t)n * sizeof(double));
+    ts_err err = {0};
+    ts_linear *lin = ts_linear_alloc(ka, &err);
+    int rc = ts_linearize_equilibrium(ka, ea, NULL, lin, &err);
+    int ju = ts_kernel_input_find(ka, "tug.thrust");
+    CHECK(rc == TS_OK && ju >= 0, "%s: linearized about the trim, input "
+          "tug.thrust %d", what, ju);
+    double diff[2] = {0, 0}, resp[2] = {0, 0};
+    double *y0 = calloc((size_t)n, sizeof(double));
+    double *x = calloc((size_t)n, sizeof(double));
+    double *u = calloc((size_t)ts_kernel_ninput(ka), sizeof(double));
+    double *k4 = malloc(5 * (size_t)n * sizeof(double));
+    for (int c = 0; rc == TS_OK && c < 2; c++) {
+        double dT = c == 0 ? 20.0 : 10.0;
+        ts_equilibrium_state(ka, ea, y0, NULL);
+        memcpy(y, y0, (size_t)n * sizeof(double));
+        memset(x, 0, (size_t)n * sizeof(double));
+        u[ju] = dT;
+        const double *A = lin->A, *Bc = lin->B + (size_t)ju * n;
+        double h = 0.01;
+        for (int i = 0; i < 2000; i++) {
+            rk4_u(ka, y, u, h, n, w);
+            /* RK4 on the linear model */
+            double *s1 = k4, *s2 = k4 + n, *s3 = k4 + 2 * n,
+                   *s4 = k4 + 3 * n, *xt = k4 + 4 * n;
+            double *st[4] = {s1, s2, s3, s4};
+            for (int stage = 0; stage < 4; stage++) {
+                const double *xs = x;
+                if (stage > 0) {
+                    double a = stage == 3 ? h : 0.5 * h;
+                    for (int j = 0; j < n; j++)
+                        xt[j] = x[j] + a * st[stage - 1][j];
+                    xs = xt;
+                }
+                for (int r2 = 0; r2 < n; r2++) {
+                    double v = Bc[r2] * dT;
+                    for (int j = 0; j < n; j++)
+                        v += A[r2 + (size_t)j * n] * xs[j];
+                    st[stage][r2] = v;
+                }
+            }
+            for (int j = 0; j < n; j++)
+                x[j] += h / 6 * (s1[j] + 2 * s2[j] + 2 * s3[j] + s4[j]);
+            for (int j = 0; j < nq; j++) {
+                diff[c] = fmax(diff[c], fabs(y[j] - y0[j] - x[j]));
+                resp[c] = fmax(resp[c], fabs(x[j]));
+            }
+        }
+    }
+    CHECK(rc == TS_OK && diff[0] < 0.02 * resp[0] &&
+              diff[0] / diff[1] > 3 && diff[0] / diff[1] < 5,
+          "%s: thrust steps 20, 10 N over 20 s: linear less nonlinear "
+          "%.3g, %.3g of responses %.3g, %.3g (coordinates; ratio %.3g, "
+          "the square of the step's)",
+          what, diff[0], diff[1], resp[0], resp[1], diff[0] / diff[1]);
+    ts_equilibrium_state(ka, ea, y0, NULL);
+    free(y0);
+    free(x);
+    free(u);
+    free(k4);
+    ts_linear_free(lin);
+    free(y);
+    free(w);
+}
+
 static void test_settle(void)
 {
     ts_scene *a = thrust_scene(1500, 0), *b = thrust_scene(1400, 0);
@@ -439,13 +531,8 @@ static void test_settle(void)
     double *y = calloc((size_t)n, sizeof(double));
     double *w = malloc(5 * (size_t)n * sizeof(double));
     double *f = malloc((size_t)n * sizeof(double));
-    ts_frame fa;
-    ts_kernel_get_frame(ka, &fa);
-    /* The 1400 N trim in the 1500 N trim's frame: moving back at the
-     * speed difference. */
-    ts_equilibrium_state(ka, eb, y, NULL);
-    ts_kernel_set_frame(ka, &fa);
-    y[nq + ro] = eb->speed - ea->speed;
+    /* The 1400 N trim in the 1500 N trim's frame. */
+    start_from(ka, eb, ea, y);
     /* Slowest decay 0.02 1/s (a modes' run): 900 s leaves e^-18. */
     for (int i = 0; i < 45000; i++)
         rk4_u(ka, y, NULL, 0.02, n, w);
@@ -541,67 +628,8 @@ static void test_settle(void)
     }
     ts_scene_free(c);
 
-    /* 6. Thrust steps of 20 and 10 N from the 1500 N trim, 20 s: linear
-     * (x' = A x + B u) against nonlinear. */
-    ts_err err = {0};
-    ts_linear *lin = ts_linear_alloc(ka, &err);
-    int rc = ts_linearize_equilibrium(ka, ea, NULL, lin, &err);
-    int ju = ts_kernel_input_find(ka, "tug.thrust");
-    CHECK(rc == TS_OK && ju >= 0, "linearized about the 1500 N trim, input "
-          "tug.thrust %d", ju);
-    double diff[2] = {0, 0}, resp[2] = {0, 0};
-    double *y0 = calloc((size_t)n, sizeof(double));
-    double *x = calloc((size_t)n, sizeof(double));
-    double *u = calloc((size_t)ts_kernel_ninput(ka), sizeof(double));
-    double *k4 = malloc(5 * (size_t)n * sizeof(double));
-    for (int c = 0; rc == TS_OK && c < 2; c++) {
-        double dT = c == 0 ? 20.0 : 10.0;
-        ts_equilibrium_state(ka, ea, y0, NULL);
-        memcpy(y, y0, (size_t)n * sizeof(double));
-        memset(x, 0, (size_t)n * sizeof(double));
-        u[ju] = dT;
-        const double *A = lin->A, *Bc = lin->B + (size_t)ju * n;
-        double h = 0.01;
-        for (int i = 0; i < 2000; i++) {
-            rk4_u(ka, y, u, h, n, w);
-            /* RK4 on the linear model */
-            double *s1 = k4, *s2 = k4 + n, *s3 = k4 + 2 * n,
-                   *s4 = k4 + 3 * n, *xt = k4 + 4 * n;
-            double *st[4] = {s1, s2, s3, s4};
-            for (int stage = 0; stage < 4; stage++) {
-                const double *xs = x;
-                if (stage > 0) {
-                    double a = stage == 3 ? h : 0.5 * h;
-                    for (int j = 0; j < n; j++)
-                        xt[j] = x[j] + a * st[stage - 1][j];
-                    xs = xt;
-                }
-                for (int r2 = 0; r2 < n; r2++) {
-                    double v = Bc[r2] * dT;
-                    for (int j = 0; j < n; j++)
-                        v += A[r2 + (size_t)j * n] * xs[j];
-                    st[stage][r2] = v;
-                }
-            }
-            for (int j = 0; j < n; j++)
-                x[j] += h / 6 * (s1[j] + 2 * s2[j] + 2 * s3[j] + s4[j]);
-            for (int j = 0; j < nq; j++) {
-                diff[c] = fmax(diff[c], fabs(y[j] - y0[j] - x[j]));
-                resp[c] = fmax(resp[c], fabs(x[j]));
-            }
-        }
-    }
-    CHECK(rc == TS_OK && diff[0] < 0.02 * resp[0] &&
-              diff[0] / diff[1] > 3 && diff[0] / diff[1] < 5,
-          "thrust steps 20, 10 N over 20 s: linear less nonlinear %.3g, "
-          "%.3g of responses %.3g, %.3g (coordinates; ratio %.3g, the "
-          "square of the step's)",
-          diff[0], diff[1], resp[0], resp[1], diff[0] / diff[1]);
-    free(y0);
-    free(x);
-    free(u);
-    free(k4);
-    ts_linear_free(lin);
+    /* 6. Thrust steps of 20 and 10 N from the 1500 N trim. */
+    linear_nonlinear(ka, ea, "1500 N");
     free(y);
     free(w);
     free(f);
@@ -620,19 +648,26 @@ static void test_free_vehicle(void)
     const double rho = 1025, D = 0.8, S = 0.4, S2 = 0.6, cd0 = 0.01,
                  cda = 0.2;
     char vt[2048];
-    const char *cables[2] = {
+    const char *stub = "  - {name: cable, from: tow, length: 1 m, "
+                       "diameter: 0.0001 m, mass_per_length: 0.001 kg/m, "
+                       "links: 1}\n";
+    const char *cables[3] = {
         /* a neutral cable streaming straight behind: level trim */
         "  - {name: cable, from: tow, length: 50 m, diameter: 0.02 m, "
         "mass_per_length: 0.32201324699295375 kg/m, links: 10}\n",
-        /* almost nothing */
-        "  - {name: cable, from: tow, length: 1 m, diameter: 0.0001 m, "
-        "mass_per_length: 0.001 kg/m, links: 1}\n"};
-    for (int c = 0; c < 2; c++) {
+        /* almost nothing, at a thrust and with a PI speed controller
+         * (its integrator a state of both systems) */
+        stub, stub};
+    for (int c = 0; c < 3; c++) {
         ts_scene *sc = scene("name: free\n"
                              "tow: {speed: 3 m/s, point: [0, 0, 20 m]}\n"
-                             "%s  propulsion: {thrust: 1500 N}\n"
+                             "%s  propulsion: {%s}\n"
                              "cables:\n%s",
-                             vehicle_yaml(vt, sizeof vt, 1.0), cables[c]);
+                             vehicle_yaml(vt, sizeof vt, 1.0),
+                             c < 2 ? "thrust: 1500 N"
+                                   : "speed: 3 m/s, gain: 2000 N*s/m, "
+                                     "integral_gain: 300 N/m",
+                             cables[c]);
         if (!sc) {
             CHECK(0, "free vehicle scene %d parses", c);
             continue;
@@ -661,7 +696,7 @@ static void test_free_vehicle(void)
                       "free vehicle at the coupled speed: thrust = its own "
                       "drag");
         }
-        if (rc == TS_OK && c == 1) {
+        if (rc == TS_OK && c >= 1) {
             double worst = 0, mac = 1;
             for (int m = 0; m < f->nmodes; m++) {
                 const ts_free_mode *fm = &f->modes[m];
@@ -674,9 +709,10 @@ static void test_free_vehicle(void)
             /* The stub's 1.4 g against 4 t: eigenvalues to 1e-4
              * relative (1e-3 1/s near zero), the shapes the same. */
             CHECK(f->nmodes > 5 && worst < 1e-4 && mac > 0.999,
-                  "on a 1 m, 1 g/m stub: the %d free modes are coupled "
-                  "modes to %.3g (relative), smallest MAC %.6f (modes "
-                  "off zero)", f->nmodes, worst, mac);
+                  "on a 1 m, 1 g/m stub, %s: the %d free modes are "
+                  "coupled modes to %.3g (relative), smallest MAC %.6f "
+                  "(modes off zero)", c == 1 ? "1500 N" : "PI at 3 m/s",
+                  f->nmodes, worst, mac);
         }
         ts_free_vehicle_free(f);
         ts_eigen_free(e);
@@ -709,18 +745,23 @@ static ts_result *eq_analysis(const ts_scene *sc, int links, double tol)
 static void test_motion_errors(void)
 {
     /* Thrust and rudder given (speed, power, turn rate solved); power
-     * and rudder given (speed, thrust, turn rate); a speed controller at
-     * a given turn rate, turn_by rudder (thrust, power, rudder). */
-    const char *props[3] = {"thrust: 1500 N",
+     * and rudder given (speed, thrust, turn rate); a speed controller,
+     * proportional and PI, at a given turn rate, turn_by rudder (thrust,
+     * power, rudder). */
+    const char *props[4] = {"thrust: 1500 N",
                             "power: 5 kW, max_thrust: 4 kN",
-                            "speed: 3 m/s, gain: 800 N*s/m"};
-    const char *names[3][3] = {{"tug.speed", "tug.power", "tug.turn_rate"},
+                            "speed: 3 m/s, gain: 800 N*s/m",
+                            "speed: 3 m/s, gain: 2000 N*s/m, integral_gain: "
+                            "300 N/m"};
+    const char *names[4][3] = {{"tug.speed", "tug.power", "tug.turn_rate"},
                                {"tug.speed", "tug.thrust", "tug.turn_rate"},
                                {"tug.thrust", "tug.power",
+                                "tug.rudder.deflection"},
+                               {"tug.thrust", "tug.power",
                                 "tug.rudder.deflection"}};
-    for (int c = 0; c < 3; c++) {
+    for (int c = 0; c < 4; c++) {
         ts_scene *sc = tow_scene(props[c], c < 2 ? 3.0 : 0.0, 10);
-        if (sc && c == 2) {
+        if (sc && c >= 2) {
             const char *keys[2] = {"tow.turn_rate", "towing_vehicle.turn_by"};
             const char *vals[2] = {"-0.02 rad/s", "rudder"};
             ts_err e2 = {0};
@@ -932,6 +973,119 @@ static void test_turning_circle(void)
                    "wet_weight: 500 N}\n", 2700, 600, 1e-6);
 }
 
+/* ---- 10. the PI speed controller --------------------------------------- */
+
+static void test_speed_pi(void)
+{
+    /* PI at 3 m/s (gain 2000 N s/m, integral gain 300 N/m; 1600 N cap,
+     * above the 1338 N it needs), against the proportional controller at
+     * 3 m/s, and the PI trim at 2.6 m/s as the start of a speed step
+     * (about 1000 N + 2000 N s/m x 0.4 m/s: above the cap). */
+    ts_scene *pi = tow_scene("speed: 3 m/s, gain: 2000 N*s/m, integral_gain: "
+                             "300 N/m, max_thrust: 1600 N", 0.0, 4);
+    ts_scene *p = tow_scene("speed: 3 m/s, gain: 2000 N*s/m", 0.0, 4);
+    ts_scene *slow = tow_scene("speed: 2.6 m/s, gain: 2000 N*s/m, "
+                               "integral_gain: 300 N/m, max_thrust: 1600 N",
+                               0.0, 4);
+    if (!CHECK(pi && p && slow, "PI, P and slow PI scenes parse")) {
+        ts_scene_free(pi);
+        ts_scene_free(p);
+        ts_scene_free(slow);
+        return;
+    }
+    ts_kernel *kpi, *kp, *ks;
+    ts_equilibrium *epi = solve(pi->system, &kpi), *ep = solve(p->system, &kp);
+    ts_equilibrium *es = solve(slow->system, &ks);
+    int zs = ts_kernel_speed_integrator(kpi);
+    int nq = ts_kernel_nq(kpi), ro = ts_kernel_root_offset(kpi);
+    const ts_vehicle_result *rpi = &epi->vehicles[ts_kernel_root(kpi)];
+    const ts_vehicle_result *rp = &ep->vehicles[ts_kernel_root(kp)];
+    CHECK(epi->converged && ep->converged && es->converged && zs == 0 &&
+              ts_kernel_speed_integrator(kp) < 0 &&
+              ts_kernel_nstate(kpi) == ts_kernel_nstate(kp) + 1,
+          "PI: converged, its integrator the first controller state (%d), "
+          "one state more than P (%d, %d)", zs, ts_kernel_nstate(kpi),
+          ts_kernel_nstate(kp));
+    /* Steady state: the speed error is zero (the speed is the unknown
+     * the integrator holds), the integrator carries the whole thrust
+     * (bias 0), and that thrust is the P controller's trimmed bias at
+     * the same speed (the same steady state). */
+    double z = epi->controls[zs];
+    CHECK(fabs(epi->speed - 3.0) < 1e-9 && fabs(300 * z - rpi->thrust) <
+              1e-9 * rpi->thrust && fabs(rpi->thrust - rp->thrust) <
+              1e-8 * rp->thrust,
+          "PI trim: speed %.12g m/s (set 3), thrust %.9g N = ki z (%.9g "
+          "N), the P controller's %.9g N", epi->speed, rpi->thrust, 300 * z,
+          rp->thrust);
+    /* The linear model holds the integrator: its row is z' = speed - U,
+     * -1 against the tow point's velocity along the track; its column
+     * drives the surge (ki per unit of z, positive). */
+    ts_err err = {0};
+    ts_linear *lin = ts_linear_alloc(kpi, &err);
+    int rc = ts_linearize_equilibrium(kpi, epi, NULL, lin, &err);
+    int n = lin ? lin->nstate : 0, iz = 2 * nq + zs;
+    double dz = rc == TS_OK ? lin->A[iz + (size_t)(nq + ro) * n] : NAN;
+    double acc = rc == TS_OK ? lin->A[(nq + ro) + (size_t)iz * n] : NAN;
+    ts_eigen *e = NULL;
+    ts_eigen_opts eo;
+    ts_eigen_opts_default(&eo);
+    if (rc == TS_OK)
+        rc = ts_eigen_solve(lin, &eo, &e, &err);
+    double right = -INFINITY;
+    for (int m = 0; e && m < e->nmodes; m++)
+        right = fmax(right, e->modes[m].re);
+    CHECK(rc == TS_OK && n == ts_kernel_nstate(kpi) && fabs(dz + 1) < 1e-6 &&
+              acc > 0,
+          "PI modes: %d states with the integrator; dz'/dU %.9g (-1), "
+          "d(surge accel)/dz %.4g 1/s^2 (> 0); rightmost Re %.3g 1/s",
+          n, dz, acc, right);
+    ts_eigen_free(e);
+    ts_linear_free(lin);
+
+    /* A speed step: from the 2.6 m/s trim (its integrator too) to the 3
+     * m/s set speed. The law reaches the 1600 N cap at the start: the
+     * integrator holds while it is capped (anti-windup), then the speed
+     * settles on 3 m/s with the thrust on the integrator. */
+    int ns = ts_kernel_nstate(kpi);
+    double *y = calloc((size_t)ns, sizeof(double));
+    double *w = malloc(5 * (size_t)ns * sizeof(double));
+    double *f = malloc((size_t)ns * sizeof(double));
+    start_from(kpi, es, epi, y);
+    int capped = 0, held = 1;
+    double h = 0.02;
+    for (int i = 0; i < 30000; i++) {
+        ts_kernel_eval(kpi, y, NULL, f);
+        if (ts_kernel_thrust(kpi) >= 1600 - 1e-9) {
+            capped++;
+            held &= f[2 * nq + zs] == 0.0;
+        }
+        rk4_u(kpi, y, NULL, h, ns, w);
+    }
+    ts_vehicle_result r;
+    ts_kernel_eval(kpi, y, NULL, f);
+    ts_kernel_vehicle_result(kpi, ts_kernel_root(kpi), &r);
+    /* 600 s: the slowest mode's decay leaves far below 1e-6 m/s. */
+    CHECK(capped > 0 && held && fabs(y[nq + ro]) < 1e-6 &&
+              fabs(r.thrust - rpi->thrust) < 1e-4 * rpi->thrust,
+          "PI speed step 2.6 -> 3 m/s: %d samples at the 1600 N cap, the "
+          "integrator held at each: %s; after 600 s the speed is the set "
+          "speed to %.3g m/s, thrust %.6f N (trim %.6f N)", capped,
+          held ? "yes" : "no", fabs(y[nq + ro]), r.thrust, rpi->thrust);
+    free(y);
+    free(w);
+    free(f);
+    linear_nonlinear(kpi, epi, "PI at 3 m/s");
+    ts_equilibrium_free(epi);
+    ts_equilibrium_free(ep);
+    ts_equilibrium_free(es);
+    ts_kernel_free(kpi);
+    ts_kernel_free(kp);
+    ts_kernel_free(ks);
+    ts_scene_free(pi);
+    ts_scene_free(p);
+    ts_scene_free(slow);
+}
+
 int main(void)
 {
     test_energy();
@@ -942,5 +1096,6 @@ int main(void)
     test_free_vehicle();
     test_motion_errors();
     test_turning_circle();
+    test_speed_pi();
     return tc_done();
 }

@@ -14,7 +14,9 @@
  *     equilibrium: the sphere at rest in M runs on a circle about the turn
  *     centre (0, V/Omega) of E, its earth channels from ts_history_value;
  *     the earth channels are refused outside a simulation; the full
- *     state's JSON carries the poses.
+ *     state's JSON carries the poses. The tracks are computed only when
+ *     asked (the pictures, an earth channel, the full state): the frame
+ *     stays NaN otherwise, and is the same however it was asked.
  *  6. A straight-line speed change of a towing vehicle (a thrust step):
  *     the steady speed over the ground from its earth track against the
  *     Newton trim at the stepped thrust.
@@ -127,6 +129,66 @@ static void test_to_earth(void)
     CHECK_NEAR(e[0], 10.5 + c * -1.5 - s * 0.75, 1e-14, "to earth: x");
     CHECK_NEAR(e[1], -4.25 + s * -1.5 + c * 0.75, 1e-14, "to earth: y");
     CHECK_NEAR(e[2], 12.0, 0, "to earth: depth unchanged");
+}
+
+/* Kamman's steady turn at 8 links over 15 s with the channels `outputs`,
+ * asking for the tracks when `tracks`; NULL on failure. */
+static ts_result *turn_run(const ts_scene *sc, const char *outputs,
+                           int tracks)
+{
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_SIMULATE);
+    rq.setup.links = 8;
+    rq.simulate.sim.t_end = 15;
+    rq.simulate.sim.dt_sample = 0.5;
+    rq.simulate.tracks = tracks;
+    snprintf(rq.simulate.outputs, sizeof rq.simulate.outputs, "%s",
+             outputs);
+    ts_err err = {0};
+    ts_result *r = NULL;
+    int rc = ts_analysis_run(sc->system, &rq, &r, &err);
+    ts_request_clear(&rq);
+    if (!CHECK(rc == TS_OK && r && r->nonlinear, "turn simulated with %s "
+               "(tracks %d): %s", outputs, tracks, err.msg)) {
+        ts_result_free(r);
+        return NULL;
+    }
+    return r;
+}
+
+/* The tracks cost a few per cent of a run: computed only when asked (the
+ * pictures: ts_simulate_opts.tracks; an earth channel; the full state). */
+static void test_tracks_on_request(const ts_units *u)
+{
+    ts_scene *sc = tscene_load(u, "examples/kamman_ex3_turn.yaml");
+    if (!sc)
+        return;
+    ts_result *plain = turn_run(sc, "sphere.x", 0);
+    ts_result *asked = turn_run(sc, "sphere.x", 1);
+    ts_result *earth = turn_run(sc, "sphere.earth_x", 0);
+    ts_result *all = turn_run(sc, "all", 0);
+    if (plain && asked && earth && all) {
+        const ts_history *hp = plain->nonlinear, *ha = asked->nonlinear,
+                         *he = earth->nonlinear, *hl = all->nonlinear;
+        int none = 1, same = ha->nsamples == he->nsamples &&
+                             hl->nsamples == he->nsamples;
+        for (int i = 0; i < 3 * hp->nsamples; i++)
+            none &= isnan(hp->frame[i]);
+        for (int i = 0; same && i < 3 * he->nsamples; i++)
+            same &= isfinite(he->frame[i]) &&
+                    ha->frame[i] == he->frame[i] &&
+                    hl->frame[i] == he->frame[i];
+        CHECK(none, "without earth channels or the pictures the tracks are "
+                    "not computed (the frame stays NaN)");
+        CHECK(same, "asked for (the pictures), by an earth channel or by "
+                    "the full state, the same tracks, at all %d samples",
+              he->nsamples);
+    }
+    ts_result_free(plain);
+    ts_result_free(asked);
+    ts_result_free(earth);
+    ts_result_free(all);
+    ts_scene_free(sc);
 }
 
 static void test_simulated_turn(const ts_units *u)
@@ -371,6 +433,7 @@ int main(void)
     test_ramped_turn(u);
     test_to_earth();
     test_simulated_turn(u);
+    test_tracks_on_request(u);
     test_speed_change(u);
     test_constant_power(u);
     test_bad();

@@ -97,7 +97,7 @@ static void test_course(const ts_units *u)
     /* The fish (node 6) sinks as the vehicle slows in the turns and the
      * cable's pull drops; it starts at its equilibrium depth. */
     ts_depth_range dr[2];
-    int nd = ts_history_depth_ranges(sys, h, dr, 2);
+    int nd = ts_history_depth_ranges(sys, h, -INFINITY, dr, 2);
     double lo = dr[0].min, hi = dr[0].max, thi = dr[0].t_max;
     CHECK(nd == 1 && !strcmp(sys->bodies[dr[0].body].name, "fish"),
           "one towed body's depth range: %d", nd);

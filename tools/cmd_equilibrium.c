@@ -425,10 +425,28 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
 }
 
 
+/* Solve an overlay's equilibrium (before the main analysis prints
+ * anything: a refused overlay refuses the run). Returns the exit status
+ * (0 when converged). */
+static int overlay_solve(const cli_run *c, eq_curve *cv)
+{
+    ts_err err = {0};
+    const ts_system *sys = (cv->scene ? cv->scene : c->scene)->system;
+    int rc = ts_analysis_run(sys, &cv->rq, &cv->res, &err);
+    if (rc != TS_OK) {
+        ts_err_prefix(&err, "%s: ", cv->what);
+        return cli_report(&err, rc);
+    }
+    cv->sys = cv->res->sys;
+    cv->eq = cv->res->eq;
+    return 0;
+}
+
 /* The extras: --overlay-speeds, --overlay-turn-rates, --overlay. */
 enum { X_SPEEDS, X_TURNS, X_SCENES };
 
-/* Check the overlays and build their requests (before anything runs). */
+/* Check the overlays, build their requests and solve them (before the
+ * main analysis runs). */
 static int eq_prepare(cli_run *c)
 {
     int given = c->nextra[X_SPEEDS] + c->nextra[X_TURNS] +
@@ -515,26 +533,11 @@ static int eq_prepare(cli_run *c)
             return cli_report(&err, rc);
         }
     }
-    return 0;
-}
-
-/* Solve an overlay's equilibrium and print one line. Returns the exit
- * status (0 when converged). */
-static int overlay_solve(const cli_run *c, eq_curve *cv)
-{
-    ts_err err = {0};
-    const ts_system *sys = (cv->scene ? cv->scene : c->scene)->system;
-    int rc = ts_analysis_run(sys, &cv->rq, &cv->res, &err);
-    if (rc != TS_OK) {
-        ts_err_prefix(&err, "%s: ", cv->what);
-        return cli_report(&err, rc);
+    for (int i = 1; i < st->ncurves; i++) {
+        int status = overlay_solve(c, &st->curves[i]);
+        if (status)
+            return status;
     }
-    cv->sys = cv->res->sys;
-    cv->eq = cv->res->eq;
-    printf("overlay %s: converged (%s), top tension %.6f %s\n", cv->what,
-           ts_eq_method_name(cv->eq->method),
-           ts_display_value(&c->display, TS_QTY_FORCE, cv->eq->top_tension),
-           ts_display_unit(&c->display, TS_QTY_FORCE));
     return 0;
 }
 
@@ -548,16 +551,16 @@ static int eq_draw(cli_run *c, const ts_result *r)
     eq_state *st = c->state;
     if (!st)
         return 0;
-    int status = 0;
     st->curves[0].sys = r->sys;
     st->curves[0].eq = r->eq && r->eq->converged ? r->eq : NULL;
     for (int i = 1; i < st->ncurves; i++) {
-        int s = overlay_solve(c, &st->curves[i]);
-        status = status ? status : s;
+        const eq_curve *cv = &st->curves[i];
+        printf("overlay %s: converged (%s), top tension %.6f %s\n", cv->what,
+               ts_eq_method_name(cv->eq->method),
+               ts_display_value(&c->display, TS_QTY_FORCE,
+                                cv->eq->top_tension),
+               ts_display_unit(&c->display, TS_QTY_FORCE));
     }
-    /* A failed or refused overlay: no pictures (nothing half-drawn). */
-    if (status)
-        return status;
     return eq_plot(&c->plot, st->curves, st->ncurves);
 }
 

@@ -154,8 +154,14 @@ static void print_forces(const ts_result *r, const ts_display *d)
     snprintf(h[2], sizeof h[2], "min [%s]", fu);
     snprintf(h[3], sizeof h[3], "mean [%s]", fu);
     snprintf(h[4], sizeof h[4], "static [%s]", fu);
-    printf("\nforces of the nonlinear run (static: the initial "
-           "equilibrium's; amplification: max / static)\n");
+    if (r->forces_from > 0)
+        printf("\nforces of the nonlinear run over the analysed window, t "
+               ">= %.6g %s (the transient before it left out; static: the "
+               "initial equilibrium's; amplification: max / static)\n",
+               ts_display_value(d, TS_QTY_TIME, r->forces_from), tu);
+    else
+        printf("\nforces of the nonlinear run over the whole run (static: "
+               "the initial equilibrium's; amplification: max / static)\n");
     printf("%-32s %14s %9s %14s %9s %14s %14s %13s\n", "channel", h[0], h[1],
            h[2], h[1], h[3], h[4], "amplification");
     print_extremes("tow.force (top tension)", &r->tow_force, d);
@@ -238,11 +244,16 @@ static void print_waypoints(const ts_result *r, const ts_display *d)
             printf(" %18s %14s\n", "not reached", "-");
     }
     ts_depth_range dr[TS_MAX_DEPTH_RANGES];
-    int nd = ts_history_depth_ranges(sys, h, dr, TS_MAX_DEPTH_RANGES);
+    int nd = ts_history_depth_ranges(sys, h, r->forces_from, dr,
+                                     TS_MAX_DEPTH_RANGES);
+    char window[80] = "";
+    if (r->forces_from > 0)
+        snprintf(window, sizeof window, " over t >= %.6g %s",
+                 ts_display_value(d, TS_QTY_TIME, r->forces_from), tu);
     for (int k = 0; k < nd; k++)
-        printf("depth of %s: %.6g %s (t = %.6g %s) to %.6g %s (t = %.6g "
+        printf("depth of %s%s: %.6g %s (t = %.6g %s) to %.6g %s (t = %.6g "
                "%s), excursion %.4g %s\n", sys->bodies[dr[k].body].name,
-               ts_display_value(d, TS_QTY_LENGTH, dr[k].min), lu,
+               window, ts_display_value(d, TS_QTY_LENGTH, dr[k].min), lu,
                ts_display_value(d, TS_QTY_TIME, dr[k].t_min), tu,
                ts_display_value(d, TS_QTY_LENGTH, dr[k].max), lu,
                ts_display_value(d, TS_QTY_TIME, dr[k].t_max), tu,
@@ -742,6 +753,7 @@ static int sim_prepare(cli_run *c)
     }
     if (!c->plot.dir)
         return 0;
+    c->rq.simulate.tracks = 1; /* the tracks and plan_earth pictures */
     sim_state *st = calloc(1, sizeof *st);
     if (!st) {
         fprintf(stderr, "towstab: error: simulate: out of memory\n");
@@ -894,9 +906,10 @@ static void sim_print(const cli_run *c, const ts_result *r)
             continue;
         if (!head++)
             printf("\nkey values (nonlinear run; fits and tension.max|min "
-                   "over t >= %.6g %s, forces over the run):\n",
+                   "over t >= %.6g %s, forces over %s):\n",
                    ts_display_value(d, TS_QTY_TIME, r->transient),
-                   ts_display_unit(d, TS_QTY_TIME));
+                   ts_display_unit(d, TS_QTY_TIME),
+                   r->forces_from > 0 ? "the same window" : "the run");
         cli_value_error(&r->values[v], d, er, sizeof er);
         printf("%-34s %14.8g %s\n", r->values[v].name,
                cli_value_shown(&r->values[v], d), er);

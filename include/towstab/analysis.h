@@ -270,6 +270,12 @@ typedef struct ts_simulate_opts {
     long seed;             /* the realisation's seed, >= 0 (default 1) */
     int components;        /* its sinusoids (default TS_SEA_COMPONENTS) */
     double fade_in;        /* s, >= 0; NAN (default): 2 Tp */
+    int tracks;            /* 1: compute the earth-frame tracks (the
+                              history's frame: the tracks and plan_earth
+                              pictures); 0 (default): only when the
+                              outputs include an earth-frame position or
+                              the full state ("all"), or the scene steers
+                              by waypoints */
     int check_window;      /* 1 (default): check that the analysed window
                               has settled and is periodic
                               (ts_accuracy_window); 0: not (the runs of a
@@ -484,8 +490,9 @@ typedef struct ts_result {
     /* Forces of the nonlinear run (towstab/extremes.h), also of a run
      * that stopped early (its samples so far): the size of the force on
      * the tow point, every link's tension, the output's extremes (NAN
-     * fields when the run gives it none), the links in compression or
-     * slack. The references are the initial equilibrium's values (NAN
+     * fields when the run gives it none), over the analysed window
+     * (forces_from); the links in compression or slack over the whole
+     * run. The references are the initial equilibrium's values (NAN
      * when the run did not start from it). */
     ts_extremes tow_force;
     ts_extremes *tensions;      /* [sys->nlinks], NULL without a
@@ -493,6 +500,12 @@ typedef struct ts_result {
     int peak_link;              /* the link of the largest tension, -1 */
     int low_link;               /* the link of the smallest, -1 */
     ts_extremes output_extremes;
+    double forces_from;         /* s: the extremes above (and the bodies'
+                                   depth ranges) are over t >= forces_from:
+                                   the transient when the run analyses a
+                                   window after it (a periodic excitation,
+                                   a sea, or a transient given), else 0
+                                   (the whole run) */
     int nslack;
     ts_slack *slack;            /* [nslack] ordered by first time */
     ts_window window;           /* the analysed window of the nonlinear run

@@ -51,8 +51,10 @@ typedef struct ts_eigen_opts {
                               default 0: the lowest modes */
     int arpack_min_states; /* auto uses arpack from this size on when
                               count > 0; default 1200 */
-    double arpack_tol;     /* relative Ritz tolerance; default 0: machine
-                              precision */
+    double arpack_tol;     /* relative Ritz tolerance of the modes' runs
+                              (0: machine precision); default 1e-10; the
+                              rightmost search uses 1e-6 or this when
+                              looser */
     int arpack_max_iter;   /* restarts; default 1000 */
     int vectors;           /* 1 (default): keep the right eigenvectors */
     int rightmost;         /* 1 (default): with arpack, also search the

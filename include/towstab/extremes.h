@@ -14,6 +14,9 @@
  * (a - c)^2 / (8 |a - 2 b + c|)); zero when the extreme is the run's own
  * end value. The estimate errs by O(h^4) of the channel's fourth
  * derivative. The mean is the trapezoidal time average over the run.
+ * A window (ts_extremes_window: the samples at t >= t_from, the analysed
+ * window of a run after its start transient) is treated as the run: its
+ * first sample is an end.
  *
  * A rigid link carries compression as a rod would; a cable cannot, so a
  * rigid link whose tension falls below -TS_SLACK_RTOL of the run's
@@ -52,6 +55,9 @@ typedef struct ts_extremes {
                             NAN without a reference */
     int samples;         /* finite samples used (0: every field NAN but
                             reference) */
+    double t_from;       /* s: the time of the first sample considered
+                            (the window's start; the run's first sample
+                            without a window); NAN without samples */
 } ts_extremes;
 
 /* Extremes of output `out` over the samples of h, with `reference` the
@@ -60,6 +66,11 @@ typedef struct ts_extremes {
 TS_API void ts_extremes_compute(const ts_system *sys, const ts_history *h,
                                 const ts_output *out, double reference,
                                 ts_extremes *e);
+
+/* The same over the samples of h at t >= t_from (s; -INFINITY: all). */
+TS_API void ts_extremes_window(const ts_system *sys, const ts_history *h,
+                               const ts_output *out, double reference,
+                               double t_from, ts_extremes *e);
 
 /* A link whose tension left the range of a cable. */
 typedef struct ts_slack {

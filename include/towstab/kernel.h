@@ -110,7 +110,10 @@ TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
  * coordinates after its three angles (-1 without one). Its inputs follow
  * its controllers': "<name>.thrust" (N), "<name>.force.x|y|z" (N) and
  * "<name>.moment.x|y|z" (N m, about its tow point), body axes. With a
- * towing vehicle the tow-point inputs (the first TS_NINPUT) are not used.
+ * towing vehicle the tow-point inputs (the first TS_NINPUT) move the
+ * points its cables start from relative to the body, in M axes, on top
+ * of its own motion (a wave-induced motion of the tow point; zero in
+ * the steady analyses).
  * The speed controller's thrust bias (N, towstab/vehicle.h) is a kernel
  * parameter, trimmed by the equilibrium; ts_kernel_thrust is the thrust
  * of the last evaluation. */
@@ -125,6 +128,10 @@ TS_API int ts_kernel_root_dof(const ts_kernel *k);
 TS_API void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust);
 TS_API double ts_kernel_thrust_bias(const ts_kernel *k);
 TS_API double ts_kernel_thrust(const ts_kernel *k);
+/* A PI speed controller's integrator z (m, the integral of the speed
+ * error; T includes ki z): its offset in the controller states (it is
+ * the first, y[2 nq], whatever the loops' modes), or -1 without one. */
+TS_API int ts_kernel_speed_integrator(const ts_kernel *k);
 /* The deflection (rad) added to the towing vehicle's turn surface
  * (ts_tow.turn_surface), trimmed by the equilibrium to turn at the
  * scene's turn rate; 0 without one. */
@@ -182,12 +189,16 @@ TS_API double ts_kernel_kinetic_energy(const ts_kernel *k);
 TS_API double ts_kernel_potential_energy(const ts_kernel *k);
 
 /* What controller state i (0 <= i < nc, at y[2 nq + i]) is: the
- * integral of loop `index`'s error (rad s or m s) or the deflection of
- * control surface `index` (its actuator, rad), of vehicle `vehicle`. */
+ * integral of loop `index`'s error (rad s or m s), the deflection of
+ * control surface `index` (its actuator, rad), or the integral of the
+ * towing vehicle's speed error (m; TS_CONTROL_SPEED, index -1), of
+ * vehicle `vehicle`. */
+#define TS_CONTROL_SPEED 2
 typedef struct ts_control_state {
     int vehicle;      /* vehicle index (ts_kernel_vehicle_body) */
-    int actuator;     /* 1: an actuator, 0: an integrator */
-    int index;        /* component (actuator) or loop (integrator) */
+    int actuator;     /* 1: an actuator, 0: an integrator, TS_CONTROL_SPEED:
+                         the speed controller's integrator */
+    int index;        /* component (actuator) or loop (integrator); -1 */
 } ts_control_state;
 TS_API void ts_kernel_control_state(const ts_kernel *k, int i,
                                     ts_control_state *cs);

@@ -56,7 +56,8 @@ TS_API int ts_report_history_full(json_t *o, const ts_system *sys,
 
 /* Extremes (towstab/extremes.h) as a new JSON object {"max", "t_max",
  * "max_error", "min", "t_min", "min_error", "mean", "static",
- * "amplification"}; NaN values are null. */
+ * "amplification", "from_s" (the first time considered: the window's
+ * start)}; NaN values are null. */
 TS_API json_t *ts_report_extremes_json(const ts_extremes *e);
 
 /* The comparison summary as a new JSON object:

@@ -136,7 +136,8 @@ typedef struct ts_sim_stats {
 /* Sampled results. */
 typedef struct ts_history {
     int nnodes, nlinks;
-    int capacity;        /* samples allocated */
+    int capacity;        /* samples allocated (doubled as a run fills
+                            them: ts_sim_record) */
     int nsamples;        /* samples filled */
     double *t;           /* [capacity] s */
     double *positions;   /* [capacity][3 nnodes] m, M frame, node 0 = tow */
@@ -169,7 +170,10 @@ typedef struct ts_history {
                             distance from it then */
 } ts_history;
 
-/* A history of `capacity` samples for system sys; NULL on failure. */
+/* A history of `capacity` samples for system sys, to begin with: the
+ * runs that record into it double it when it is full, so a history holds
+ * what a run reached, not what it may reach (a run of t_end 1e9 s is
+ * stopped long before its 1e7 samples); NULL on failure. */
 TS_API ts_history *ts_history_alloc(const ts_system *sys, int capacity,
                                     ts_err *err);
 TS_API void ts_history_free(ts_history *h);
@@ -192,10 +196,23 @@ typedef struct ts_depth_range {
     double min, t_min, max, t_max;   /* m, s (NaN without samples) */
 } ts_depth_range;
 
-/* The depth ranges over h's samples of every body but the towing vehicle,
- * in node order, at most `max` into out; returns how many were written. */
+/* Samples a run's history starts with (ts_history_alloc; it grows as
+ * the run fills it). */
+#define TS_HISTORY_INITIAL 1024
+
+/* Samples within this (s) of a window's start belong to the window. */
+#define TS_HISTORY_TIME_EPS 1e-12
+
+/* The index of h's first sample at t >= t_from (within
+ * TS_HISTORY_TIME_EPS); h->nsamples when there is none. */
+TS_API int ts_history_first(const ts_history *h, double t_from);
+
+/* The depth ranges over h's samples at t >= t_from (s; -INFINITY: the
+ * whole run) of every body but the towing vehicle, in node order, at most
+ * `max` into out; returns how many were written. */
 TS_API int ts_history_depth_ranges(const ts_system *sys, const ts_history *h,
-                                   ts_depth_range *out, int max);
+                                   double t_from, ts_depth_range *out,
+                                   int max);
 
 /* --- Nonlinear simulation: set / advance / read, and a driver. --- */
 
@@ -230,7 +247,8 @@ TS_API void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st);
 
 /* Evaluate the kernel at the current time and state (so that its
  * accessors hold positions, tensions, energies) and append a sample to h
- * (TS_EINVAL when h is full). */
+ * (doubling h when it is full: TS_ENOMEM when that fails, the samples so
+ * far kept). */
 TS_API int ts_sim_record(ts_sim *s, ts_history *h, ts_err *err);
 
 /* Driver: simulate from y0 (kernel charts; the system before the tow

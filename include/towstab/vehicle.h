@@ -135,9 +135,13 @@ typedef enum {
                            U the surge speed through the water (Buckham's
                            T = T_E U_steady / U with T_E U_steady = power) */
     TS_PROP_SPEED = 3   /* speed controller: T = thrust + gain (speed - U)
-                           with U the tow point's speed through the water,
+                           + ki z, z' = speed - U, with U the tow point's
+                           speed through the water; proportional (ki = 0):
                            `thrust` the bias the steady analyses trim so
-                           that U = speed */
+                           that U = speed; PI (ki > 0): the integrator z
+                           a controller state, `thrust` a fixed bias, T
+                           at most max_thrust, z held while T is capped
+                           and U below the set speed (anti-windup) */
 } ts_propulsion_type;
 
 typedef struct ts_propulsion {
@@ -146,9 +150,12 @@ typedef struct ts_propulsion {
                            controller's bias (TS_PROP_SPEED) */
     double power;       /* W, > 0 (TS_PROP_POWER) */
     double max_thrust;  /* N, > 0: the power law's cap at low speed (its
-                           bollard thrust); INFINITY: none */
+                           bollard thrust), the PI speed controller's
+                           cap; INFINITY: none */
     double speed;       /* m/s, > 0: the speed controller's set speed */
     double gain;        /* N s/m, >= 0: the speed controller's gain */
+    double ki;          /* N/m, >= 0: the speed controller's integral
+                           gain; 0: proportional only */
     double position[3]; /* where the thrust acts, body axes from O, m */
     int line;           /* scene line, 0 if none */
 } ts_propulsion;
@@ -182,8 +189,10 @@ typedef struct ts_vehicle {
  * the surge, the velocity of the body origin relative to the water along
  * body x; the speed controller's the tow point's speed through the water)
  * with `bias` the
- * speed controller's trimmed bias (N; ignored by the other laws), plus
- * `input` (N, the thrust input of a linear model or an excitation).
+ * speed controller's trimmed bias, with an integral gain its bias plus
+ * ki z (N; ignored by the other laws), plus
+ * `input` (N, the thrust input of a linear model or an excitation); a
+ * speed controller's law (before the input) at most max_thrust.
  * The one place the law is written (the kernel and the manoeuvres). */
 TS_API double ts_propulsion_thrust(const ts_propulsion *p, double u,
                                    double bias, double input);

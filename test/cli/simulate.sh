@@ -16,7 +16,9 @@
 #    the history so far, with "completed": false in the JSON;
 #  - bad options exit 2 with one line naming the option and write no file;
 #  - `--json -` writes one JSON document alone to standard output;
-#  - waypoints: a scene's course, and --waypoints in place of its points.
+#  - waypoints: a scene's course, and --waypoints in place of its points;
+#  - the forces' extremes are over the analysed window when the run has
+#    one (--transient), over the whole run otherwise.
 # Prints one PASS/FAIL line per check and "N passed, N failed".
 set -u
 if [ $# -ne 1 ]; then
@@ -327,6 +329,37 @@ ts simulate test/scenes/towing_sphere.yaml --t-end 1 --waypoints "10 m,0"
 [ "$status" -eq 2 ] && grep -q -- "--waypoints: .*the scene has none" "$T/err" ||
     why="$why no waypoints entry: exit $status;"
 [ -z "$why" ] && pass "--waypoints: $line" || fail "--waypoints:$why"
+
+# 13. The forces over the analysed window: example 4 heaved 0.5 ft at
+# 1 Hz, its first 10 s a transient (--transient 10). The table says
+# t >= 10 s and its tow force max and min are those of the CSV's tow.force
+# over t >= 10 s, not over the run (whose start transient peaks higher:
+# checked, so that the check can fail); the JSON's forces.from_s is 10.
+# A manoeuvre without a window (example 3 into its turn) reports its
+# forces over the whole run (from_s 0).
+fresh
+ts simulate "$EX4" --excite tow.heave:amplitude=0.5ft,frequency=1Hz --t-end 20 \
+    --transient 10 --no-compare --outputs tow.force --quiet \
+    --csv "$T/o/f.csv" --json "$T/o/f.json"
+why=""
+[ "$status" -eq 0 ] || why="$why exit $status: $(head -1 "$T/err");"
+grep -q '^forces of the nonlinear run over the analysed window, t >= 10 s' "$T/out" ||
+    why="$why no window in the forces header;"
+read -r tmax tmin < <(awk '/^tow.force \(top tension\)/ {print $4, $6}' "$T/out")
+read -r whole wmax wmin < <(awk -F, 'NR > 1 { if (NR == 2 || $2 > m) m = $2;
+    if ($1 >= 10 - 1e-9) { if (w == "" || $2 > w) w = $2; if (v == "" || $2 < v) v = $2 } }
+    END { printf "%.6g %.6g %.6g\n", m, w, v }' "$T/o/f.csv")
+[ "$tmax" = "$wmax" ] && [ "$tmin" = "$wmin" ] ||
+    why="$why table max $tmax, min $tmin; the CSV's over t >= 10 s $wmax, $wmin;"
+awk -v a="$whole" -v b="$wmax" 'BEGIN { exit !(a > b) }' ||
+    why="$why the run's max $whole is not above the window's $wmax;"
+grep -q '"from_s": 10' "$T/o/f.json" || why="$why JSON forces.from_s;"
+ts simulate "$EX3" --t-end 10 --quiet --json "$T/o/g.json"
+grep -q '^forces of the nonlinear run over the whole run' "$T/out" ||
+    why="$why the manoeuvre's forces not over the whole run;"
+grep -q '"from_s": 0' "$T/o/g.json" || why="$why the manoeuvre's from_s;"
+[ -z "$why" ] && pass "forces over the window t >= 10 s: tow force $tmin to $tmax N (the run's max $whole N); a manoeuvre's over the whole run" ||
+    fail "forces over the window:$why"
 
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

@@ -243,6 +243,12 @@ typedef struct hcase {
     char *user_text;      /* a value the scene gives, which the report may
                              echo (a name "nan"): not checked for nan */
     int announce_ok;      /* may be interrupted after announcing its cost */
+    int vm_limit_mb;      /* its address space is limited to this (MiB,
+                             RLIMIT_AS; not under the sanitizers, which
+                             reserve terabytes of shadow memory); 0: no
+                             limit */
+    int must_start;       /* must not be refused: it runs, or announces
+                             its cost and is stopped */
     int write_fault;      /* the analysis runs, writing its output fails:
                              the report may say trustworthy */
     /* the xfail list's reason, when the case is listed */
@@ -964,7 +970,7 @@ static void gen_cli_misuse(void)
     c->stdin_path = xstrdup(EX1);
     c = misuse(R, "standard input", "equilibrium", "-", NULL);
     /* modes */
-    misuse(R, "80 states", "modes", EX1, "--quiet", "--eigen-method",
+    misuse(R, "160 states", "modes", EX1, "--quiet", "--eigen-method",
            "arpack", "--count", "79", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "0", NULL);
     misuse(R, "--count", "modes", EX1, "--count", "-3", NULL);
@@ -1076,6 +1082,18 @@ static void gen_cli_misuse(void)
     c = misuse(E_ANY, NULL, "simulate", EX1, "--quiet", "--t-end", "1e9",
                "--sample", "100", "--json", "@D/out.json", NULL);
     c->announce_ok = 1;
+    /* The same in 1 GiB of address space: its history of 1e7 samples
+     * (14 GB at 40 links) grows as the run fills it instead of being
+     * reserved up front, so the run starts, says what it will cost and is
+     * stopped (it was refused, out of memory, before). */
+    c = misuse(E_ANY, NULL, "simulate", EX1, "--quiet", "--t-end", "1e9",
+               "--sample", "100", "--json", "@D/out.json", NULL);
+    char *in_1g = fmt("%s, in 1 GiB of address space", c->name);
+    free(c->name);
+    c->name = in_1g;
+    c->announce_ok = 1;
+    c->vm_limit_mb = 1024;
+    c->must_start = 1;
     /* converge */
     misuse(R, "--links", "converge", EX1, "--links", "5,abc", NULL);
     misuse(R, "--links", "converge", EX1, "--links", "", NULL);
@@ -1733,6 +1751,11 @@ static int start_case(run *r, int idx, int serial)
         /* SIGXCPU at the limit, SIGKILL a little after. */
         struct rlimit cpu = {(rlim_t)(limit + 0.999), (rlim_t)(limit + 5.999)};
         setrlimit(RLIMIT_CPU, &cpu);
+        if (c->vm_limit_mb > 0 && time_scale == 1.0) {
+            rlim_t bytes = (rlim_t)c->vm_limit_mb << 20;
+            struct rlimit as = {bytes, bytes};
+            setrlimit(RLIMIT_AS, &as);
+        }
         int fi = open(in, O_RDONLY);
         int fo = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0600);
         int fe = slave ? open(slave, O_RDWR | O_NOCTTY)
@@ -2062,6 +2085,9 @@ static void finish_case(run *r)
                 problem(&v, "exit %d", code);
             break;
         }
+        if (c->must_start && outcome == O_REFUSED)
+            problem(&v, "refused (exit %d), expected to run or to be "
+                    "stopped after announcing its cost", code);
         if (code != 0 && outcome == O_REFUSED) {
             if (!msgs[0])
                 problem(&v, "no 'towstab: error:' line on standard error");
