@@ -1020,7 +1020,9 @@ static void zigzag_freq(const ts_descriptor *d, int k, double *wt,
     const double *n = d->n + 3 * sys->nodes[k].link;
     double G[9] = {0};
     for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
-        if (d->bcol[b] == 0)
+        /* The tow point's columns are inputs; a vehicle's angles are not
+         * a displacement (N/rad): neither is in the zig-zag. */
+        if (d->bcol[b] == 0 || d->bcol[b] >= d->nn)
             continue;
         double sg = d->bdist[b] % 2 ? -1.0 : 1.0;
         for (int i = 0; i < 9; i++)

@@ -17,8 +17,9 @@
  *     own uncertainty, as for eigenvalue bounds) plus 1e-8 of the column's
  *     size (rounding, see ROUNDING); the same for the nine columns of B
  *     (the heave columns excepted when the tow point is at the waterline,
- *     a kink both report). A scene with a vehicle has the dense model
- *     only; the sparse one alone is refused, naming the vehicles.
+ *     a kink both report). The vehicle examples alike: their angles,
+ *     rates and controller states are columns of A, their inputs columns
+ *     of B.
  *  3. The shifted solve: (A - s I)^-1 b by the sparse model equals the
  *     dense solve (LAPACK) at real and complex s, to 1e-7 relative (the
  *     two A differ by ~1e-9 relative; (A - s I)^-1 amplifies by the
@@ -464,6 +465,33 @@ static void test_groups(void)
           groups[2], groups[3], evals[2], evals[3]);
 }
 
+/* A towing vehicle at the root (its tow point free) is not covered: the
+ * sparse model alone is refused, naming it; the default forms the dense
+ * one. */
+static void test_towing_refused(void)
+{
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load("test/scenes/towing_sphere.yaml", units,
+                                 &err);
+    if (!CHECK(sc != NULL, "towing_sphere: %s", err.msg))
+        return;
+    ts_kernel *k = ts_kernel_alloc(sc->system, &err);
+    ts_linear *lin = k ? ts_linear_alloc(k, &err) : NULL;
+    int n = k ? ts_kernel_nstate(k) : 0;
+    double *y = calloc((size_t)n + 1, sizeof(double));
+    ts_linearize_opts o;
+    ts_linearize_opts_default(&o);
+    o.model = TS_LIN_SPARSE;
+    int rc = lin && y ? ts_linearize(k, y, NULL, &o, lin, &err) : TS_ENOMEM;
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "towing vehicle"),
+          "towing vehicle at the root: the sparse model alone refused: %s",
+          err.msg);
+    free(y);
+    ts_linear_free(lin);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     units = tscene_units();
@@ -473,6 +501,7 @@ int main(void)
     test_examples();
     test_shifted_solve();
     test_groups();
+    test_towing_refused();
     ts_units_free(units);
     return tc_done();
 }

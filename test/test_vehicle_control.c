@@ -5,9 +5,10 @@
  * references.
  *
  *  1. Structured solvers with controller states: ts_response_at (the
- *     Schur complement of the controller block) against a dense complex
- *     LU of i w I - A with C and D from the output Jacobians; ARPACK's
- *     shift-invert eigenvalues against LAPACK's.
+ *     Schur complement of the controller block of the dense model, and
+ *     the sparse model's solve) against a dense complex LU of i w I - A
+ *     with C and D from the output Jacobians; ARPACK's shift-invert
+ *     eigenvalues (dense and sparse models) against LAPACK's.
  *  2. The open loop is the plant without controllers: opening the loops
  *     at the trim (ts_linearize_open_loop) gives the eigenvalues of the
  *     same vehicle with no loops and each surface's bias set to its trim
@@ -107,16 +108,26 @@ static int component(const ts_vehicle *v, const char *name)
     return -1;
 }
 
-static ts_linear *linearize(ts_kernel *k, const ts_equilibrium *eq)
+static ts_linear *linearize_model(ts_kernel *k, const ts_equilibrium *eq,
+                                  ts_lin_model model)
 {
     ts_err err = {0};
     ts_linear *lin = ts_linear_alloc(k, &err);
-    if (lin && ts_linearize_equilibrium(k, eq, NULL, lin, &err) != TS_OK) {
+    ts_linearize_opts o;
+    ts_linearize_opts_default(&o);
+    o.model = model;
+    if (lin && ts_linearize_equilibrium(k, eq, &o, lin, &err) != TS_OK) {
         printf("  linearize: %s\n", err.msg);
         ts_linear_free(lin);
         return NULL;
     }
     return lin;
+}
+
+/* The default models: the sparse one and, this small, the dense one. */
+static ts_linear *linearize(ts_kernel *k, const ts_equilibrium *eq)
+{
+    return linearize_model(k, eq, TS_LIN_AUTO);
 }
 
 /* Output row of a vehicle output or a node coordinate (C), and its D entry
@@ -189,17 +200,20 @@ static void test_structured(void)
     solved s;
     if (!CHECK(solve(base, &s) == TS_OK, "closed-loop trim solves"))
         return;
-    ts_linear *lin = linearize(s.k, s.eq);
-    CHECK(lin && ts_kernel_ncontrol(s.k) > 0,
-          "closed-loop model has %d controller states",
+    /* The dense model alone: the structured solver is its Schur
+     * complement; the default (sparse) model's solves after. */
+    ts_linear *lin = linearize_model(s.k, s.eq, TS_LIN_DENSE);
+    ts_linear *sp = linearize(s.k, s.eq);
+    CHECK(lin && sp && sp->desc && ts_kernel_ncontrol(s.k) > 0,
+          "closed-loop model has %d controller states (dense, and sparse)",
           ts_kernel_ncontrol(s.k));
     const char *ins[3] = {"aurora.wing", "aurora.depth.setpoint",
                           "aurora.tail1"};
     const char *outs[3] = {"aurora.depth", "aurora.pitch",
                            "aurora.pitch.output"};
     const double hz[3] = {0.001, 0.05, 1.0};
-    double worst = 0.0;
-    for (int a = 0; lin && a < 3; a++)
+    double worst = 0.0, sworst = 0.0;
+    for (int a = 0; lin && sp && a < 3; a++)
         for (int b = 0; b < 3; b++) {
             int j;
             ts_output o;
@@ -207,10 +221,14 @@ static void test_structured(void)
             for (int f = 0; f < 3; f++) {
                 double w = 2 * M_PI * hz[f];
                 double complex gs = structured_gain(base, lin, j, &o, w);
+                double complex gp = structured_gain(base, sp, j, &o, w);
                 double complex gd = dense_gain(lin, j, &o, w);
                 double e = cabs(gs - gd) / fmax(cabs(gd), 1e-12);
                 if (!(e <= worst))
                     worst = e;
+                e = cabs(gp - gd) / fmax(cabs(gd), 1e-12);
+                if (!(e <= sworst))
+                    sworst = e;
             }
         }
     /* Both are direct solves of the same matrix (condition ~1e4): their
@@ -218,6 +236,12 @@ static void test_structured(void)
     CHECK(worst <= 1e-9, "structured response with controller states = "
           "dense LU over 27 input/output/frequency cases: worst relative "
           "difference %.3g <= 1e-9", worst);
+    /* The sparse model is another linearization: each one's relative
+     * error is ~1e-9 (desc_err, trunc_err / a_scale), amplified by the
+     * condition of i w I - A near the lightly damped modes. */
+    CHECK(sworst <= 1e-7, "the sparse model's response (the vehicle's rows, "
+          "inputs and outputs) = the dense LU over the same 27 cases: worst "
+          "relative difference %.3g <= 1e-7", sworst);
 
     ts_eigen *el = NULL, *ea = NULL;
     ts_eigen_opts o;
@@ -229,6 +253,9 @@ static void test_structured(void)
     o.target_hz = 0.3;
     int r2 = lin ? ts_eigen_solve(lin, &o, &ea, NULL) : -1;
     double dmax = 0.0;
+    ts_eigen *es = NULL;
+    int r3 = sp ? ts_eigen_solve(sp, &o, &es, NULL) : -1;
+    double smax = 0.0;
     for (int m = 0; r1 == TS_OK && r2 == TS_OK && m < ea->nmodes; m++) {
         double best = INFINITY;
         for (int q = 0; q < el->nmodes; q++)
@@ -237,14 +264,33 @@ static void test_structured(void)
                                   hypot(el->modes[q].re, el->modes[q].im));
         dmax = fmax(dmax, best);
     }
+    for (int m = 0; r1 == TS_OK && r3 == TS_OK && m < es->nmodes; m++) {
+        double best = INFINITY;
+        for (int q = 0; q < el->nmodes; q++)
+            best = fmin(best, hypot(es->modes[m].re - el->modes[q].re,
+                                    es->modes[m].im - el->modes[q].im) /
+                                  (es->modes[m].error_bound +
+                                   el->modes[q].error_bound));
+        smax = fmax(smax, best);
+    }
     /* Shift-invert on the same A: agreement to ARPACK's tolerance. */
     CHECK(r1 == TS_OK && r2 == TS_OK && ea->nmodes > 0 && dmax <= 1e-8,
           "ARPACK's %d modes near 0.3 Hz (Schur complement of the "
           "controller block) are LAPACK's: worst relative distance %.3g <= "
           "1e-8", ea ? ea->nmodes : 0, dmax);
+    /* On the sparse model (another linearization): within the sum of the
+     * two error bounds. */
+    CHECK(r1 == TS_OK && r3 == TS_OK && es->nmodes == ea->nmodes &&
+              smax <= 1.0,
+          "ARPACK's %d modes near 0.3 Hz on the sparse model (the vehicle's "
+          "angles and controller states among its unknowns) are LAPACK's "
+          "within the sum of their error bounds (largest %.3g of it)",
+          es ? es->nmodes : 0, smax);
     ts_eigen_free(el);
     ts_eigen_free(ea);
+    ts_eigen_free(es);
     ts_linear_free(lin);
+    ts_linear_free(sp);
     solved_free(&s);
 }
 

@@ -92,7 +92,7 @@ TS_API int ts_cost_simulate(const ts_system *sys, const ts_excitation *ex,
  * formed: its LU, 2/3 n^3 flops; ARPACK on the sparse model: O(links),
  * counted as 0), plus the linearization: the dense model's 2 (n + 9)
  * evaluations of sys's kernel (below the linearizer's dense_max_states,
- * with LAPACK, or with a vehicle) or the sparse model's
+ * with LAPACK, or with a towing vehicle at the root) or the sparse model's
  * TS_COST_SPARSE_EVALUATIONS. */
 TS_API int ts_cost_modes(const ts_system *sys, int n, ts_eig_method m,
                              ts_cost *e, ts_err *err);
