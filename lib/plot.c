@@ -290,23 +290,28 @@ int ts_plot_eigenvalues(const char *dir, const char *name, const char *title,
 int ts_plot_mode_animation(const char *dir, const char *name,
                            const char *title, ts_plot_view view, int flags,
                            const ts_plot_shape *eq, const double *re,
-                           const double *im, const char *label, int nframes,
-                           double seconds, const ts_plot_opts *opts,
-                           ts_err *err)
+                           const double *im, const double *outline_re,
+                           const double *outline_im, const char *label,
+                           int nframes, double seconds,
+                           const ts_plot_opts *opts, ts_err *err)
 {
     (void)dir, (void)name, (void)title, (void)view, (void)flags, (void)eq;
-    (void)re, (void)im, (void)label, (void)nframes, (void)seconds;
+    (void)re, (void)im, (void)outline_re, (void)outline_im, (void)label;
+    (void)nframes, (void)seconds;
     (void)opts;
     return ts_plot_check(err);
 }
 
 int ts_plot_mode_frames(const char *dir, const char *name, const char *title,
                         ts_plot_view view, int flags, const ts_plot_shape *eq,
-                        const double *re, const double *im, const char *label,
-                        int nframes, const ts_plot_opts *opts, ts_err *err)
+                        const double *re, const double *im,
+                        const double *outline_re, const double *outline_im,
+                        const char *label, int nframes,
+                        const ts_plot_opts *opts, ts_err *err)
 {
     (void)dir, (void)name, (void)title, (void)view, (void)flags, (void)eq;
-    (void)re, (void)im, (void)label, (void)nframes, (void)opts;
+    (void)re, (void)im, (void)outline_re, (void)outline_im, (void)label;
+    (void)nframes, (void)opts;
     return ts_plot_check(err);
 }
 
@@ -1400,6 +1405,26 @@ void ts_plot_outline_moved(const ts_plot_outline *o, const double motion[6],
         else
             outline_point(o->anchor, motion, s, mag, p, q);
     }
+}
+
+/* The motion m[6] of an outline at phase ph of a mode whose real and
+ * imaginary parts move it by re[6] and im[6]: Re((re + i im) e^{i ph}). */
+static void outline_phase_motion(const double re[6], const double im[6],
+                                 double ph, double m[6])
+{
+    double c = cos(ph), sn = sin(ph);
+    for (int j = 0; j < 6; j++)
+        m[j] = re[j] * c - im[j] * sn;
+}
+
+void ts_plot_outline_at_phase(const ts_plot_outline *o,
+                              const double motion_re[6],
+                              const double motion_im[6], double phase,
+                              double s, double mag, double out[])
+{
+    double m[6];
+    outline_phase_motion(motion_re, motion_im, phase, m);
+    ts_plot_outline_moved(o, m, s, mag, out);
 }
 
 /* Draw the outlines of s in the side view (top 0) or the top view,
@@ -2686,8 +2711,9 @@ static void anim_text(FILE *f, double x, double y, const char *anchor,
 
 /* The checks of a mode's cycle (ts_plot_mode_animation, _frames). */
 static int check_mode_cycle(const char *fn, const ts_plot_shape *eq,
-                            const double *re, const double *im, int nframes,
-                            ts_err *err)
+                            const double *re, const double *im,
+                            const double *ore, const double *oim,
+                            int nframes, ts_err *err)
 {
     int rc;
     if (!eq || !re || !im)
@@ -2698,6 +2724,16 @@ static int check_mode_cycle(const char *fn, const ts_plot_shape *eq,
         (rc = check_array(fn, "re", 0, re, 3 * eq->nnodes, 0, err)) ||
         (rc = check_array(fn, "im", 0, im, 3 * eq->nnodes, 0, err)))
         return rc;
+    if (!ore != !oim)
+        return ts_fail(err, TS_EINVAL, "%s: outline_re and outline_im: "
+                                       "expected both or neither",
+                       fn);
+    if (ore && eq->noutlines > 0 &&
+        ((rc = check_array(fn, "outline_re", 0, ore, 6 * eq->noutlines, 0,
+                           err)) ||
+         (rc = check_array(fn, "outline_im", 0, oim, 6 * eq->noutlines, 0,
+                           err))))
+        return rc;
     if (nframes < 4 || nframes > TS_PLOT_MAX_FRAMES)
         return ts_fail(err, TS_EINVAL, "%s: nframes: must be in [4, %d], got "
                                        "%d",
@@ -2705,42 +2741,91 @@ static int check_mode_cycle(const char *fn, const ts_plot_shape *eq,
     return TS_OK;
 }
 
-/* One cycle of a mode in `view`: the equilibrium's coordinates (*base),
- * and nframes frames (*frames, allocated) at phases 2 pi k / nframes, eq +
- * s Re((re + i im) e^{i phi}), s making the largest node amplitude 15 %
- * of the equilibrium's extent (*extent, in the axes' unit); lo[2], hi[2]
- * the padded window holding them all (with the water surface in a side
- * view with TS_PLOT_WATER). TS_OK or TS_ENOMEM; release with
- * mode_cycle_free. */
+/* One cycle of a mode in a view (mode_cycle). */
+typedef struct mode_cyc {
+    shape_xy base;      /* the equilibrium's coordinates */
+    shape_xy *frames;   /* [nframes], phase 2 pi k / nframes */
+    int nframes;
+    double scale;       /* the mode's scale: m of displacement (and rad of
+                           rotation) per unit of re, im */
+    double oscale;      /* the outlines' magnification (outline_scale) */
+    double *motion;     /* [nframes][6 noutlines]: each outline's motion
+                           per unit of the mode at each frame's phase;
+                           NULL: the outlines stay at the trim */
+    double lo[2], hi[2]; /* the padded window holding it all */
+    double extent;      /* the equilibrium's, in the axes' unit */
+} mode_cyc;
+
+/* Widen lo[2], hi[2] to hold the outlines of eq in `view`, moved by
+ * motion ([6 noutlines] or NULL) at scale s, magnified by mag. */
+static void outline_bbox(const ts_plot_shape *eq, const double *motion,
+                         double s, double mag, ts_plot_view view,
+                         const ts_plot_opts *u, double lo[2], double hi[2])
+{
+    for (int b = 0; b < eq->noutlines; b++) {
+        const ts_plot_outline *o = &eq->outlines[b];
+        for (int k = 0; k < o->npoints; k++) {
+            const double *p = o->pts + 3 * (size_t)k;
+            if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+                continue;
+            double q[3];
+            outline_point(o->anchor, motion ? motion + 6 * b : NULL, s, mag,
+                          p, q);
+            bbox_update(&lo[0], &hi[0], pconv(TS_PLOT_LENGTH, u, q[0]));
+            bbox_update(&lo[1], &hi[1],
+                        pconv(TS_PLOT_LENGTH, u,
+                              view == TS_PLOT_TOP ? q[1] : q[2]));
+        }
+    }
+}
+
+/* One cycle of a mode in `view` (*c): the equilibrium's coordinates and
+ * nframes frames at phases 2 pi k / nframes, eq + s Re((re + i im)
+ * e^{i phi}), s making the largest node amplitude 15 % of the
+ * equilibrium's extent; with ore, oim ([6 noutlines] each) each outline's
+ * motion Re((ore + i oim) e^{i phi}) at every frame, drawn at the same s;
+ * the padded window holding it all, outlines included (with the water
+ * surface in a side view with TS_PLOT_WATER). TS_OK or TS_ENOMEM; release
+ * with mode_cycle_free. */
 static int mode_cycle(const ts_plot_shape *eq, const double *re,
-                      const double *im, ts_plot_view view, int flags,
-                      int nframes, const ts_plot_opts *opts, shape_xy *base,
-                      shape_xy **frames, double lo[2], double hi[2],
-                      double *extent)
+                      const double *im, const double *ore, const double *oim,
+                      ts_plot_view view, int flags, int nframes,
+                      const ts_plot_opts *opts, mode_cyc *cy)
 {
     int n = eq->nnodes, rc;
+    double *lo = cy->lo, *hi = cy->hi;
+    memset(cy, 0, sizeof *cy);
+    cy->nframes = nframes;
     /* Scale: the largest node displacement over the cycle (|v| per node)
      * is 15 % of the equilibrium's extent. */
-    *frames = NULL;
-    if ((rc = shape_coords(eq, NULL, 0, view, opts, base)))
+    if ((rc = shape_coords(eq, NULL, 0, view, opts, &cy->base)))
         return TS_ENOMEM;
     lo[0] = lo[1] = INFINITY;
     hi[0] = hi[1] = -INFINITY;
     double amax = 0;
     for (int k = 0; k < n; k++) {
-        bbox_update(&lo[0], &hi[0], base->h[k]);
-        bbox_update(&lo[1], &hi[1], base->v[k]);
+        bbox_update(&lo[0], &hi[0], cy->base.h[k]);
+        bbox_update(&lo[1], &hi[1], cy->base.v[k]);
         double a = 0;
         for (int j = 0; j < 3; j++)
             a += re[3 * k + j] * re[3 * k + j] + im[3 * k + j] * im[3 * k + j];
         amax = fmax(amax, sqrt(a));
     }
-    *extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
-    if (!(*extent > 0))
-        *extent = pconv(TS_PLOT_LENGTH, opts, 1.0);
-    double scale = amax > 0 ? 0.15 * *extent /
-                                  pconv(TS_PLOT_LENGTH, opts, 1.0) / amax
-                            : 0;
+    cy->extent = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    if (!(cy->extent > 0))
+        cy->extent = pconv(TS_PLOT_LENGTH, opts, 1.0);
+    double unit = pconv(TS_PLOT_LENGTH, opts, 1.0);
+    cy->scale = amax > 0 ? 0.15 * cy->extent / unit / amax : 0;
+    /* The outlines magnified as in ts_plot_mode_shapes (extent in m). */
+    cy->oscale = outline_scale(1, eq, cy->extent / unit);
+    outline_bbox(eq, NULL, 0, cy->oscale, view, opts, lo, hi);
+    int no = eq->noutlines;
+    if (ore && no > 0) {
+        cy->motion = malloc((size_t)nframes * 6 * (size_t)no *
+                            sizeof *cy->motion);
+        if (!cy->motion)
+            rc = TS_ENOMEM;
+    }
     /* The frames, phase 2 pi k / nframes: eq + scale Re(v e^{i phi}). */
     shape_xy *fr = calloc((size_t)nframes, sizeof *fr);
     double *d = malloc(3 * (size_t)n * sizeof *d);
@@ -2748,16 +2833,23 @@ static int mode_cycle(const ts_plot_shape *eq, const double *re,
         double ph = 2 * M_PI * i / nframes, c = cos(ph), s = sin(ph);
         for (int j = 0; j < 3 * n; j++)
             d[j] = re[j] * c - im[j] * s;
-        rc = shape_coords(eq, d, scale, view, opts, &fr[i]);
+        rc = shape_coords(eq, d, cy->scale, view, opts, &fr[i]);
         for (int k = 0; rc == TS_OK && k < n; k++) {
             bbox_update(&lo[0], &hi[0], fr[i].h[k]);
             bbox_update(&lo[1], &hi[1], fr[i].v[k]);
+        }
+        if (cy->motion) {
+            double *m = cy->motion + (size_t)i * 6 * (size_t)no;
+            for (int b = 0; b < no; b++)
+                outline_phase_motion(ore + 6 * b, oim + 6 * b, ph,
+                                     m + 6 * b);
+            outline_bbox(eq, m, cy->scale, cy->oscale, view, opts, lo, hi);
         }
     }
     if (!fr || !d)
         rc = TS_ENOMEM;
     free(d);
-    *frames = fr;
+    cy->frames = fr;
     if ((flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE)
         bbox_update(&lo[1], &hi[1], 0);
     pad_range(&lo[0], &hi[0], 0.06, 1.0);
@@ -2765,36 +2857,64 @@ static int mode_cycle(const ts_plot_shape *eq, const double *re,
     return rc == TS_OK ? TS_OK : TS_ENOMEM;
 }
 
-static void mode_cycle_free(shape_xy *base, shape_xy *frames, int nframes)
+static void mode_cycle_free(mode_cyc *cy)
 {
-    for (int i = 0; frames && i < nframes; i++)
-        free(frames[i].h);
-    free(frames);
-    free(base->h);
-    base->h = NULL;
+    for (int i = 0; cy->frames && i < cy->nframes; i++)
+        free(cy->frames[i].h);
+    free(cy->frames);
+    free(cy->base.h);
+    free(cy->motion);
+    memset(cy, 0, sizeof *cy);
+}
+
+/* Outline o moved by motion ([6] or NULL) at scale s, magnified by mag,
+ * as SVG path data: a move at the start and after each pen lift. */
+static void anim_outline(FILE *f, const ts_plot_outline *o,
+                         const double *motion, double s, double mag,
+                         ts_plot_view view, const ts_plot_opts *u,
+                         const anim_map *m)
+{
+    int pen = 0, first = 1;
+    for (int k = 0; k < o->npoints; k++) {
+        const double *p = o->pts + 3 * (size_t)k;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+            pen = 0;
+            continue;
+        }
+        double q[3];
+        outline_point(o->anchor, motion, s, mag, p, q);
+        double h = pconv(TS_PLOT_LENGTH, u, q[0]);
+        double v = pconv(TS_PLOT_LENGTH, u, view == TS_PLOT_TOP ? q[1] : q[2]);
+        fprintf(f, "%s%c%.2f %.2f", first ? "" : " ", pen ? 'L' : 'M',
+                anim_x(m, h), anim_y(m, v));
+        pen = 1;
+        first = 0;
+    }
 }
 
 int ts_plot_mode_animation(const char *dir, const char *name,
                            const char *title, ts_plot_view view, int flags,
                            const ts_plot_shape *eq, const double *re,
-                           const double *im, const char *label, int nframes,
-                           double seconds, const ts_plot_opts *opts,
-                           ts_err *err)
+                           const double *im, const double *outline_re,
+                           const double *outline_im, const char *label,
+                           int nframes, double seconds,
+                           const ts_plot_opts *opts, ts_err *err)
 {
     static const char fn[] = "ts_plot_mode_animation";
     ts_plot_opts def;
     int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
     if (rc)
         return rc;
-    if ((rc = check_mode_cycle(fn, eq, re, im, nframes, err)))
+    if ((rc = check_mode_cycle(fn, eq, re, im, outline_re, outline_im,
+                               nframes, err)))
         return rc;
     if (!(seconds > 0) || !isfinite(seconds))
         return ts_fail(err, TS_EINVAL, "%s: seconds: must be > 0, got %g",
                        fn, seconds);
-    shape_xy base = {0}, *fr = NULL;
-    double lo[2], hi[2], extent;
-    rc = mode_cycle(eq, re, im, view, flags, nframes, opts, &base, &fr, lo,
-                    hi, &extent);
+    mode_cyc cy;
+    rc = mode_cycle(eq, re, im, outline_re, outline_im, view, flags, nframes,
+                    opts, &cy);
+    const double *lo = cy.lo, *hi = cy.hi;
     int water = (flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE;
     anim_map m = {lo[0], hi[0], lo[1], hi[1], ANIM_LEFT,
                   opts->width - ANIM_RIGHT, ANIM_TOP,
@@ -2878,18 +2998,54 @@ int ts_plot_mode_animation(const char *dir, const char *name,
         /* The equilibrium (grey), then the mode's cycle. */
         fputs("<path fill=\"none\" stroke=\"rgb(140,140,140)\" "
               "stroke-width=\"1.6\" d=\"", f);
-        anim_path(f, eq, &base, &m);
+        anim_path(f, eq, &cy.base, &m);
         fputs("\"/>\n<path fill=\"none\" stroke=\"rgb(0,114,178)\" "
               "stroke-width=\"2.2\" d=\"", f);
-        anim_path(f, eq, &fr[0], &m);
+        anim_path(f, eq, &cy.frames[0], &m);
         fprintf(f, "\">\n<animate attributeName=\"d\" dur=\"%gs\" "
                    "repeatCount=\"indefinite\" values=\"",
                 seconds);
         for (int i = 0; i <= nframes; i++) {
-            anim_path(f, eq, &fr[i % nframes], &m);
+            anim_path(f, eq, &cy.frames[i % nframes], &m);
             fputs(i < nframes ? ";" : "", f);
         }
-        fputs("\"/>\n</path>\n</svg>\n", f);
+        fputs("\"/>\n</path>\n", f);
+        /* The vehicles: grey at their trim; with the mode's motion, each
+         * moved and rotated at every frame's phase (one <animate> of its
+         * outline's path, the same geometry as ts_plot_mode_shapes). */
+        for (int b = 0; b < eq->noutlines; b++) {
+            const ts_plot_outline *o = &eq->outlines[b];
+            fprintf(f, "<path class=\"vehicle-trim\" fill=\"none\" "
+                       "stroke=\"rgb(140,140,140)\" stroke-width=\"1.2\" "
+                       "d=\"");
+            anim_outline(f, o, NULL, 0, cy.oscale, view, opts, &m);
+            fputs("\"/>\n", f);
+            if (!cy.motion)
+                continue;
+            size_t per = 6 * (size_t)eq->noutlines;
+            fprintf(f, "<path class=\"vehicle\" fill=\"none\" "
+                       "stroke=\"rgb(0,114,178)\" stroke-width=\"1.6\" "
+                       "d=\"");
+            anim_outline(f, o, cy.motion + 6 * b, cy.scale, cy.oscale, view,
+                         opts, &m);
+            fprintf(f, "\">\n<animate attributeName=\"d\" dur=\"%gs\" "
+                       "repeatCount=\"indefinite\" values=\"",
+                    seconds);
+            for (int i = 0; i <= nframes; i++) {
+                anim_outline(f, o, cy.motion + (size_t)(i % nframes) * per +
+                                       6 * b,
+                             cy.scale, cy.oscale, view, opts, &m);
+                fputs(i < nframes ? ";" : "", f);
+            }
+            fputs("\"/>\n</path>\n", f);
+        }
+        if (eq->noutlines > 0 && cy.oscale > 1.0) {
+            char note[TEXT_MAX];
+            snprintf(note, sizeof note, "vehicles drawn %.3g times their "
+                     "size", cy.oscale);
+            anim_text(f, m.x1, ANIM_TOP - 12, "end", 15, note);
+        }
+        fputs("</svg>\n", f);
         rc = ferror(f) ? ts_fail(err, TS_EIO, "%s: write failed", path)
                        : TS_OK;
         if (rc == TS_OK)
@@ -2897,7 +3053,7 @@ int ts_plot_mode_animation(const char *dir, const char *name,
         else
             tsi_outfile_abandon(&out);
     }
-    mode_cycle_free(&base, fr, nframes);
+    mode_cycle_free(&cy);
     return rc;
 }
 
@@ -2908,9 +3064,8 @@ typedef struct mframe_ctx {
     ts_plot_view view;
     int water;
     const ts_plot_shape *eq;
-    const shape_xy *base, *cur;
-    double lo[2], hi[2]; /* the window, the same in every frame */
-    double extent;       /* the equilibrium's, for the cylinders' size */
+    const mode_cyc *cy;  /* the cycle, its window the same in every frame */
+    int k;               /* the frame drawn */
 } mframe_ctx;
 
 static int draw_mode_frame(const void *vctx, const ts_plot_opts *o,
@@ -2918,11 +3073,14 @@ static int draw_mode_frame(const void *vctx, const ts_plot_opts *o,
 {
     (void)height;
     const mframe_ctx *c = vctx;
+    const mode_cyc *cy = c->cy;
+    const shape_xy *base = &cy->base, *cur = &cy->frames[c->k];
+    double extent = cy->extent; /* the equilibrium's, for the cylinders */
     int top = c->view == TS_PLOT_TOP;
     double *work = malloc(4 * ((size_t)c->eq->nnodes + 1) * sizeof *work);
     if (!work)
         return ts_fail(err, TS_ENOMEM, "out of memory");
-    double h0 = c->lo[0], h1 = c->hi[0], v0 = c->lo[1], v1 = c->hi[1];
+    double h0 = cy->lo[0], h1 = cy->hi[0], v0 = cy->lo[1], v1 = cy->hi[1];
     plvpor(left_edge(tick_width(v0, v1, 0), 1.0), 0.97, 0.11, 0.85);
     if (top)
         equalize(&h0, &h1, &v0, &v1);
@@ -2936,17 +3094,28 @@ static int draw_mode_frame(const void *vctx, const ts_plot_opts *o,
     solid.style = TS_PLOT_SOLID;
     plcol0(COL_GREY);
     plwidth(1.6);
-    draw_shape_links(&f, &solid, c->base, c->water, work);
-    draw_cylinders(&f, c->eq, c->base, o, CYL_MIN * c->extent, COL_GREY);
+    draw_shape_links(&f, &solid, base, c->water, work);
+    draw_cylinders(&f, c->eq, base, o, CYL_MIN * extent, COL_GREY);
     plwidth(1.6);
-    draw_marks(&f, c->eq, c->base, 0.9);
+    draw_marks(&f, c->eq, base, 0.9);
+    plcol0(COL_GREY);
+    plwidth(1.2);
+    draw_outlines(&f, c->eq, top, cy->oscale, NULL, 0.0, o);
     int col = color_index(0, 0);
     plcol0(col);
     plwidth(CURVE_WIDTH);
-    draw_shape_links(&f, &solid, c->cur, c->water, work);
-    draw_cylinders(&f, c->eq, c->cur, o, CYL_MIN * c->extent, col);
+    draw_shape_links(&f, &solid, cur, c->water, work);
+    draw_cylinders(&f, c->eq, cur, o, CYL_MIN * extent, col);
     plwidth(CURVE_WIDTH);
-    draw_marks(&f, c->eq, c->cur, 1.1);
+    draw_marks(&f, c->eq, cur, 1.1);
+    /* The vehicles moved and rotated at this frame's phase. */
+    if (cy->motion) {
+        plcol0(col);
+        plwidth(1.6);
+        draw_outlines(&f, c->eq, top, cy->oscale,
+                      cy->motion + (size_t)c->k * 6 * c->eq->noutlines,
+                      cy->scale, o);
+    }
     char xl[TEXT_MAX], yl[TEXT_MAX];
     axis_label(xl, sizeof xl, "x, forward", TS_PLOT_LENGTH, o);
     axis_label(yl, sizeof yl, top ? "y, starboard" : "z, depth",
@@ -2958,6 +3127,15 @@ static int draw_mode_frame(const void *vctx, const ts_plot_opts *o,
         plcol0(col);
         plmtex("t", 0.6, 0.0, 0.0, t);
     }
+    if (c->eq->noutlines > 0 && cy->oscale > 1.0) {
+        char t[TEXT_MAX];
+        snprintf(t, sizeof t, "vehicles drawn %.3g times their size",
+                 cy->oscale);
+        plcol0(COL_FG);
+        plschr(0, 0.8);
+        plmtex("t", 2.4, 1.0, 1.0, t);
+        plschr(0, 1.0);
+    }
     page_title(c->title);
     free(work);
     return TS_OK;
@@ -2965,26 +3143,28 @@ static int draw_mode_frame(const void *vctx, const ts_plot_opts *o,
 
 int ts_plot_mode_frames(const char *dir, const char *name, const char *title,
                         ts_plot_view view, int flags, const ts_plot_shape *eq,
-                        const double *re, const double *im, const char *label,
-                        int nframes, const ts_plot_opts *opts, ts_err *err)
+                        const double *re, const double *im,
+                        const double *outline_re, const double *outline_im,
+                        const char *label, int nframes,
+                        const ts_plot_opts *opts, ts_err *err)
 {
     static const char fn[] = "ts_plot_mode_frames";
     ts_plot_opts def;
     int rc = begin_view(fn, dir, name, title, &opts, &def, view, err);
     if (rc)
         return rc;
-    if ((rc = check_mode_cycle(fn, eq, re, im, nframes, err)))
+    if ((rc = check_mode_cycle(fn, eq, re, im, outline_re, outline_im,
+                               nframes, err)))
         return rc;
     /* NAME_kkk must stay a valid name. */
     if (strlen(name) + 4 > 200)
         return ts_fail(err, TS_EINVAL, "%s: name: at most 196 characters "
                                        "(frames add _kkk), got %zu",
                        fn, strlen(name));
-    shape_xy base = {0}, *fr = NULL;
-    mframe_ctx c = {title, label, view, 0, eq, &base, NULL, {0, 0}, {0, 0},
-                    0};
-    rc = mode_cycle(eq, re, im, view, flags, nframes, opts, &base, &fr, c.lo,
-                    c.hi, &c.extent);
+    mode_cyc cy;
+    mframe_ctx c = {title, label, view, 0, eq, &cy, 0};
+    rc = mode_cycle(eq, re, im, outline_re, outline_im, view, flags, nframes,
+                    opts, &cy);
     if (rc)
         ts_fail(err, rc, "%s: out of memory", fn);
     c.water = (flags & TS_PLOT_WATER) && view == TS_PLOT_SIDE;
@@ -2995,12 +3175,12 @@ int ts_plot_mode_frames(const char *dir, const char *name, const char *title,
         snprintf(fname, sizeof fname, "%s_%03d", name, i);
         snprintf(ftitle, sizeof ftitle, "%s (frame %d of %d, phase %.0f "
                  "deg)", title, i + 1, nframes, 360.0 * i / nframes);
-        c.cur = &fr[i];
+        c.k = i;
         c.title = ftitle;
         rc = render(fn, dir, fname, ftitle, &po, po.height, draw_mode_frame,
                     &c, err);
     }
-    mode_cycle_free(&base, fr, nframes);
+    mode_cycle_free(&cy);
     return rc;
 }
 

@@ -486,7 +486,7 @@ static void test_animation(void)
     ts_plot_shape eq = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
                         0, NULL, 0, NULL};
     int rc = ts_plot_mode_animation(dir, "anim", "chain: mode 1", TS_PLOT_SIDE,
-                                    TS_PLOT_WATER, &eq, re, im,
+                                    TS_PLOT_WATER, &eq, re, im, NULL, NULL,
                                     "mode 1: 0.5 Hz", 12, 2.0, &o, &err);
     CHECK(rc == TS_OK, "mode animation written (%s)", err.msg);
     char *svg = check_svg("anim", "chain: mode 1");
@@ -514,11 +514,11 @@ static void test_animation(void)
     }
     free(svg);
     rc = ts_plot_mode_animation(dir, "anim_bad", "x", TS_PLOT_SIDE, 0, &eq,
-                                re, im, NULL, 2, 2.0, &o, &err);
+                                re, im, NULL, NULL, NULL, 2, 2.0, &o, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "nframes"),
           "2 frames are refused: %s", err.msg);
     rc = ts_plot_mode_animation(dir, "anim_bad", "x", TS_PLOT_SIDE, 0, &eq,
-                                re, im, NULL, 12, 0.0, &o, &err);
+                                re, im, NULL, NULL, NULL, 12, 0.0, &o, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "seconds"),
           "a cycle of 0 s is refused: %s", err.msg);
     CHECK(nothing_named("anim_bad"), "refused animations left no file");
@@ -527,16 +527,16 @@ static void test_animation(void)
      * frames in both views, PNG only, each its own picture, the
      * equilibrium's place the same in every frame (one window). */
     rc = ts_plot_mode_animation(dir, "anim_top", "chain: mode 1, plan",
-                                TS_PLOT_TOP, 0, &eq, re, im, NULL, 12, 2.0,
-                                &o, &err);
+                                TS_PLOT_TOP, 0, &eq, re, im, NULL, NULL,
+                                NULL, 12, 2.0, &o, &err);
     CHECK(rc == TS_OK, "mode animation in plan view (%s)", err.msg);
     free(check_svg("anim_top", "chain: mode 1, plan"));
     for (int v = 0; v < 2; v++) {
         const char *nm = v ? "frames_top" : "frames_side";
         rc = ts_plot_mode_frames(dir, nm, "chain: mode 1", v ? TS_PLOT_TOP
                                                                : TS_PLOT_SIDE,
-                                 TS_PLOT_WATER, &eq, re, im, "mode 1: 0.5 Hz",
-                                 4, &o, &err);
+                                 TS_PLOT_WATER, &eq, re, im, NULL, NULL,
+                                 "mode 1: 0.5 Hz", 4, &o, &err);
         CHECK(rc == TS_OK, "%s: four PNG frames written (%s)", nm, err.msg);
         char f[4][64];
         size_t n[4] = {0};
@@ -557,10 +557,194 @@ static void test_animation(void)
             free(b[k]);
     }
     rc = ts_plot_mode_frames(dir, "frames_bad", "x", TS_PLOT_SIDE, 0, &eq, re,
-                             im, NULL, 2, &o, &err);
+                             im, NULL, NULL, NULL, 2, &o, &err);
     CHECK(rc == TS_EINVAL && strstr(err.msg, "nframes"),
           "frames: 2 frames are refused: %s", err.msg);
     CHECK(nothing_named("frames_bad"), "refused frames left no file");
+}
+
+/* The first side of a vehicle's outline in SVG path data "Mx y Lx y ...":
+ * its angle (rad, page axes) and length (px); 0 when it does not parse. */
+static int first_side(const char *d, double *angle, double *length)
+{
+    double x0, y0, x1, y1;
+    if (sscanf(d, "M%lf %lf L%lf %lf", &x0, &y0, &x1, &y1) != 4)
+        return 0;
+    *angle = atan2(y1 - y0, x1 - x0);
+    *length = hypot(x1 - x0, y1 - y0);
+    return 1;
+}
+
+/* A vehicle in the animations: its outline drawn grey at the trim and,
+ * with the mode's outline motion, moved and rotated at every frame. A
+ * square in the plan view yawed by Re((a + i b) e^{i phi}) per unit of
+ * the mode: the first side of frame k turns from the trim's by
+ * s (a cos phi_k - b sin phi_k), s the cycle's scale (0.15 of the
+ * equilibrium's extent over the largest node amplitude), and keeps its
+ * length (a yaw is a rigid motion in plan, equal scales). */
+static void test_animation_vehicle(void)
+{
+    ts_plot_opts o;
+    ts_plot_opts_default(&o);
+    ts_err err = {0};
+    static double re[3 * N], im[3 * N];
+    double amax = 0;
+    for (int k = 0; k < N; k++) {
+        double s = (double)k / (N - 1);
+        re[3 * k + 2] = sin(M_PI * s);
+        im[3 * k] = 0.5 * sin(2 * M_PI * s);
+        amax = fmax(amax, hypot(re[3 * k + 2], im[3 * k]));
+    }
+    const double *e = chain_sub + 3 * (N - 1);
+    double sq[15] = {e[0], e[1], e[2], e[0] - 0.2, e[1], e[2],
+                     e[0] - 0.2, e[1] + 0.2, e[2], e[0], e[1] + 0.2, e[2],
+                     e[0], e[1], e[2]};
+    ts_plot_outline ol = {5, sq, {e[0], e[1], e[2]}};
+    ts_plot_shape eq = {N, chain_sub, NULL, 1, end_mark, 0, NULL, 0, 0,
+                        0, NULL, 1, &ol};
+    /* The anchor moves with the chain's end; the yaw is a, b. */
+    const double a = 0.04, b = 0.02;
+    double ore[6] = {re[3 * (N - 1)], 0, re[3 * (N - 1) + 2], 0, 0, a};
+    double oim[6] = {im[3 * (N - 1)], 0, im[3 * (N - 1) + 2], 0, 0, b};
+    enum { NF = 12 };
+    int rc = ts_plot_mode_animation(dir, "anim_vehicle", "vehicle: mode 1",
+                                    TS_PLOT_TOP, 0, &eq, re, im, ore, oim,
+                                    NULL, NF, 2.0, &o, &err);
+    CHECK(rc == TS_OK, "animation with a vehicle written (%s)", err.msg);
+    char *svg = check_svg("anim_vehicle", "vehicle: mode 1");
+    const char *trim = svg ? strstr(svg, "class=\"vehicle-trim\"") : NULL;
+    const char *veh = svg ? strstr(svg, "class=\"vehicle\"") : NULL;
+    const char *vals = veh ? strstr(veh, "values=\"") : NULL;
+    const char *td = trim ? strstr(trim, "d=\"") : NULL;
+    double a0 = 0, l0 = 0;
+    int ok = vals && td && first_side(td + 3, &a0, &l0);
+    CHECK(ok, "the vehicle drawn grey at its trim and as an animated path");
+    /* Extent 50 m (x from 0 to -50, y = 0 in plan). */
+    double scale = 0.15 * 50 / amax, worst_angle = 0, worst_len = 0;
+    double turned = 0;
+    int nfr = 0;
+    const char *p = ok ? vals + 8 : NULL;
+    while (p && *p != '"' && nfr <= NF) {
+        double ak, lk;
+        if (!first_side(p, &ak, &lk))
+            break;
+        double phi = 2 * M_PI * (nfr % NF) / NF;
+        double want = scale * (a * cos(phi) - b * sin(phi));
+        double got = remainder(ak - a0, 2 * M_PI);
+        worst_angle = fmax(worst_angle, fabs(got - want));
+        worst_len = fmax(worst_len, fabs(lk - l0));
+        turned = fmax(turned, fabs(got));
+        nfr++;
+        p += strcspn(p, ";\"");
+        if (*p == ';')
+            p++;
+    }
+    /* Coordinates are written to 0.01 px on a side of some 40 px: the
+     * angle to about 5e-4 rad, the length to 0.02 px. */
+    CHECK(nfr == NF + 1 && worst_angle < 2e-3 && worst_len < 0.03 &&
+              turned > 0.2,
+          "animation: the vehicle yawed by s Re((a + i b) e^{i phi}) in each "
+          "of %d frames to %.2g rad (up to %.3f rad), its side kept to %.2g "
+          "px", nfr, worst_angle, turned, worst_len);
+    free(svg);
+
+    /* Without the outline motion the vehicle stays at its trim: no
+     * animated outline. */
+    rc = ts_plot_mode_animation(dir, "anim_vehicle_trim", "trim",
+                                TS_PLOT_SIDE, TS_PLOT_WATER, &eq, re, im,
+                                NULL, NULL, NULL, NF, 2.0, &o, &err);
+    svg = rc == TS_OK ? check_svg("anim_vehicle_trim", "trim") : NULL;
+    CHECK(svg && strstr(svg, "class=\"vehicle-trim\"") &&
+              !strstr(svg, "class=\"vehicle\""),
+          "animation without outline motion: the vehicle at its trim only");
+    free(svg);
+    rc = ts_plot_mode_animation(dir, "anim_vehicle_bad", "x", TS_PLOT_SIDE,
+                                0, &eq, re, im, ore, NULL, NULL, NF, 2.0, &o,
+                                &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "outline_im"),
+          "an outline motion without its imaginary part is refused: %s",
+          err.msg);
+    oim[5] = NAN;
+    rc = ts_plot_mode_frames(dir, "anim_vehicle_bad", "x", TS_PLOT_SIDE, 0,
+                             &eq, re, im, ore, oim, NULL, 4, &o, &err);
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "outline_im"),
+          "frames: a non-finite outline motion is refused: %s", err.msg);
+    CHECK(nothing_named("anim_vehicle_bad"), "refused: no file");
+    oim[5] = b;
+
+    /* The PNG frames: with the motion, each frame differs from the same
+     * frame with the vehicle at its trim (the cable is the same). */
+    int differ = 0;
+    for (int v = 0; v < 2; v++) {
+        const char *nm[2] = {v ? "vframes_top" : "vframes_side",
+                             v ? "vframes_top_trim" : "vframes_side_trim"};
+        for (int t = 0; t < 2; t++) {
+            rc = ts_plot_mode_frames(dir, nm[t], "vehicle", v ? TS_PLOT_TOP
+                                                              : TS_PLOT_SIDE,
+                                     TS_PLOT_WATER, &eq, re, im,
+                                     t ? NULL : ore, t ? NULL : oim, NULL,
+                                     4, &o, &err);
+            CHECK(rc == TS_OK, "%s: frames written (%s)", nm[t], err.msg);
+        }
+        for (int k = 1; k < 4; k++) {
+            char path[2][1024];
+            size_t n[2] = {0};
+            char *bf[2];
+            for (int t = 0; t < 2; t++) {
+                snprintf(path[t], sizeof path[t], "%s/%s_%03d.png", dir,
+                         nm[t], k);
+                bf[t] = slurp(path[t], &n[t]);
+            }
+            differ += bf[0] && bf[1] &&
+                      (n[0] != n[1] || memcmp(bf[0], bf[1], n[0]));
+            free(bf[0]);
+            free(bf[1]);
+        }
+    }
+    CHECK(differ == 6, "frames: the moved vehicle changes frames 1-3 of both "
+          "views (%d of 6 differ from the trim-only frames)", differ);
+}
+
+/* ts_plot_outline_at_phase: the motion Re((re + i im) e^{i phase}). At
+ * phase 0 the real part's; at pi / 2 minus the imaginary part's, a yaw
+ * written out as R_z; at pi minus the real part's. */
+static void test_outline_at_phase(void)
+{
+    double pts[9] = {1.0, 0.5, 2.0, 1.4, 0.5, 2.0, 1.0, 0.9, 2.3};
+    ts_plot_outline o = {3, pts, {1.2, 0.3, 1.9}};
+    double mre[6] = {0.05, -0.02, 0.11, 0, 0.35, 0};
+    double mim[6] = {0.01, 0.03, -0.04, 0, 0, 0.25};
+    double s = 1.3, mag = 2.0, out[9], ref[9], neg[6];
+    ts_plot_outline_at_phase(&o, mre, mim, 0.0, s, mag, out);
+    ts_plot_outline_moved(&o, mre, s, mag, ref);
+    double d0 = 0;
+    for (int j = 0; j < 9; j++)
+        d0 = fmax(d0, fabs(out[j] - ref[j]));
+    ts_plot_outline_at_phase(&o, mre, mim, M_PI, s, mag, out);
+    for (int j = 0; j < 6; j++)
+        neg[j] = -mre[j];
+    ts_plot_outline_moved(&o, neg, s, mag, ref);
+    double dpi = 0;
+    for (int j = 0; j < 9; j++)
+        dpi = fmax(dpi, fabs(out[j] - ref[j]));
+    ts_plot_outline_at_phase(&o, mre, mim, M_PI / 2, s, mag, out);
+    double a = -s * mim[5], c = cos(a), sn = sin(a), d90 = 0;
+    for (int k = 0; k < 3; k++) {
+        double v[3], q[3];
+        for (int j = 0; j < 3; j++)
+            v[j] = mag * (pts[3 * k + j] - o.anchor[j]);
+        /* R_z(a): x' = c x - s y, y' = s x + c y. */
+        q[0] = o.anchor[0] - s * mim[0] + c * v[0] - sn * v[1];
+        q[1] = o.anchor[1] - s * mim[1] + sn * v[0] + c * v[1];
+        q[2] = o.anchor[2] - s * mim[2] + v[2];
+        for (int j = 0; j < 3; j++)
+            d90 = fmax(d90, fabs(out[3 * k + j] - q[j]));
+    }
+    /* cos(pi / 2) is 6e-17, not 0: the real part leaks in at that level. */
+    CHECK(d0 < 1e-15 && dpi < 1e-14 && d90 < 1e-14,
+          "outline at phase: 0 the real part's motion (%.2g m), pi its "
+          "opposite (%.2g m), pi/2 a yaw of %.3f rad by R_z (%.2g m)", d0,
+          dpi, a, d90);
 }
 
 static void test_modes(void)
@@ -1349,7 +1533,7 @@ static void test_without_plplot(void)
     int rc[10];
     rc[8] = ts_plot_tracks(dir, "n8", "t", 1, &tr, &o, &err);
     rc[9] = ts_plot_mode_frames(dir, "n9", "t", TS_PLOT_SIDE, 0, &one, chain,
-                                zr, NULL, 4, &o, &err);
+                                zr, NULL, NULL, NULL, 4, &o, &err);
     rc[0] = ts_plot_shapes(dir, "n0", "t", TS_PLOT_SIDE, 0, 1, &one, &o, &err);
     rc[1] = ts_plot_mode_shapes(dir, "n1", "t", 0, &one, 1, &mode, &o, &err);
     rc[2] = ts_plot_eigenvalues(dir, "n2", "t", 1, &s, NULL, &o, &err);
@@ -1499,6 +1683,8 @@ int main(int argc, char **argv)
     test_shapes();
     test_cylinder();
     test_animation();
+    test_animation_vehicle();
+    test_outline_at_phase();
     test_modes();
     test_outline_moved();
     test_eigenvalues();

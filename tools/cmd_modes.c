@@ -287,10 +287,11 @@ static int ends_with(const char *s, const char *suffix)
  * the eigenvector's coordinate half), Re(d e^{i phi}) = a cos phi -
  * b sin phi is largest at tan 2 phi = -2 a.b / (|a|^2 - |b|^2). With
  * rot, each vehicle's small rotation at that phase, rot[3 nvehicles]
- * (ts_linear_vehicle_rotations). */
+ * (ts_linear_vehicle_rotations), and with rot_im that of the imaginary
+ * part of v e^{i phi} (as im_out of the displacements). */
 static int mode_disp(const ts_system *sys, const ts_linear *lin,
                      const ts_eigen *e, int m, double *out, double *im_out,
-                     double *rot)
+                     double *rot, double *rot_im)
 {
     int nq = lin->nq, nn = sys->nnodes;
     double *dq = malloc((size_t)nq * sizeof(double));
@@ -324,6 +325,11 @@ static int mode_disp(const ts_system *sys, const ts_linear *lin,
         for (int i = 0; i < nq; i++)
             dq[i] = vr[i] * c - vi[i] * sn;
         ts_linear_vehicle_rotations(lin, dq, rot);
+    }
+    if (rot_im) {
+        for (int i = 0; i < nq; i++)
+            dq[i] = vr[i] * sn + vi[i] * c;
+        ts_linear_vehicle_rotations(lin, dq, rot_im);
     }
     free(dq);
     free(b);
@@ -403,9 +409,11 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
     if (np < 1 || !e->vec_re || !e->vec_im)
         return status;
     cli_shape eqs;
-    /* Per mode: the displacements at two phases, then each vehicle's
-     * rotation and its outline's motion (ts_plot_mode.outline_motion). */
-    size_t per = 6 * (size_t)sys->nnodes + 9 * (size_t)lin->nvehicles;
+    /* Per mode: the displacements at two phases (the real and imaginary
+     * parts of the mode at its phase of largest excursion), then each
+     * vehicle's rotation in both parts and its outline's motion in both
+     * (ts_plot_mode.outline_motion the real part's). */
+    size_t per = 6 * (size_t)sys->nnodes + 18 * (size_t)lin->nvehicles;
     double *disp = malloc((size_t)np * per * sizeof(double));
     char labels[PLOT_MODES][160];
     ts_plot_mode modes[PLOT_MODES];
@@ -419,8 +427,11 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
         int m = pick[i];
         const ts_mode *md = &e->modes[m];
         double *d = disp + (size_t)i * per;
-        double *rot = d + 6 * sys->nnodes, *motion = rot + 3 * lin->nvehicles;
-        if (mode_disp(sys, lin, e, m, d, d + 3 * sys->nnodes, rot) != 0) {
+        double *rot = d + 6 * sys->nnodes, *rot_im = rot + 3 * lin->nvehicles;
+        double *motion = rot_im + 3 * lin->nvehicles;
+        double *motion_im = motion + 6 * lin->nvehicles;
+        if (mode_disp(sys, lin, e, m, d, d + 3 * sys->nnodes, rot,
+                      rot_im) != 0) {
             status = EXIT_FAILED;
             break;
         }
@@ -432,6 +443,8 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
             for (int j = 0; j < 3; j++) {
                 motion[6 * v + j] = d[3 * node + j];
                 motion[6 * v + 3 + j] = rot[3 * v + j];
+                motion_im[6 * v + j] = d[3 * (sys->nnodes + node) + j];
+                motion_im[6 * v + 3 + j] = rot_im[3 * v + j];
             }
         }
         modes[i].outline_motion = nout > 0 ? motion : NULL;
@@ -455,10 +468,13 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
     /* Each drawn mode as an animated SVG, one cycle in 2 s, in the side
      * view (modeK_animation) and in plan (modeK_animation_top); with
      * --frames also as PNG frame sequences (modeK_side_kkk,
-     * modeK_top_kkk), FRAMES_PNG frames a cycle. */
+     * modeK_top_kkk), FRAMES_PNG frames a cycle; the vehicles moved and
+     * rotated at every frame's phase. */
     static const char *const vname[2] = {"side", "top"};
     for (int i = 0; i < np && status == 0; i++) {
         const double *d = disp + (size_t)i * per;
+        const double *ore = modes[i].outline_motion;
+        const double *oim = ore ? ore + 6 * lin->nvehicles : NULL;
         for (int v = 0; v < 2 && status == 0; v++) {
             char name[48], at[300];
             snprintf(name, sizeof name, "mode%d_animation%s", pick[i] + 1,
@@ -468,7 +484,8 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
             ts_plot_view view = v ? TS_PLOT_TOP : TS_PLOT_SIDE;
             if (ts_plot_mode_animation(plot->dir, name, at, view,
                                        TS_PLOT_WATER, &eqs.shape, d,
-                                       d + 3 * sys->nnodes, labels[i], 36,
+                                       d + 3 * sys->nnodes, ore, oim,
+                                       labels[i], 36,
                                        2.0, &plot->opts, &err) != TS_OK) {
                 status = cli_report(&err, err.code);
                 break;
@@ -478,8 +495,8 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
                 continue;
             snprintf(name, sizeof name, "mode%d_%s", pick[i] + 1, vname[v]);
             if (ts_plot_mode_frames(plot->dir, name, at, view, TS_PLOT_WATER,
-                                    &eqs.shape, d, d + 3 * sys->nnodes,
-                                    labels[i], FRAMES_PNG, &plot->opts,
+                                    &eqs.shape, d, d + 3 * sys->nnodes, ore,
+                                    oim, labels[i], FRAMES_PNG, &plot->opts,
                                     &err) != TS_OK)
                 status = cli_report(&err, err.code);
             else

@@ -212,6 +212,19 @@ TS_API void ts_plot_outline_moved(const ts_plot_outline *o,
                                   const double motion[6], double s,
                                   double mag, double out[]);
 
+/* The points out[3 npoints] of outline o at phase `phase` (rad) of a
+ * complex mode: ts_plot_outline_moved with the motion
+ *     Re((motion_re + i motion_im) e^{i phase}),
+ * motion_re and motion_im [6] the anchor displacement (m) and small
+ * rotation vector (rad, M axes) of the mode's real and imaginary parts
+ * (as ts_plot_mode.outline_motion); s and mag as there. The frames of
+ * ts_plot_mode_animation and ts_plot_mode_frames draw each outline so. */
+TS_API void ts_plot_outline_at_phase(const ts_plot_outline *o,
+                                     const double motion_re[6],
+                                     const double motion_im[6],
+                                     double phase, double s, double mag,
+                                     double out[]);
+
 /* A mode as an animation: DIR/NAME.svg only (whatever opts->formats), an
  * SVG whose cable path runs through one cycle of the mode every `seconds`
  * seconds and loops (SMIL <animate> of its path, nframes frames at phases
@@ -220,6 +233,12 @@ TS_API void ts_plot_outline_moved(const ts_plot_outline *o,
  * in grey, in one view (side, with TS_PLOT_WATER the water; or top, equal
  * scales), titled, with `label` above the box (may be NULL). re and im:
  * [3 nnodes] node displacements of the mode's real and imaginary parts.
+ * The outlines of eq (vehicles) are drawn grey at their trim and, when
+ * outline_re and outline_im ([6 noutlines] each, as
+ * ts_plot_mode.outline_motion, of the mode's real and imaginary parts) are
+ * given, in the mode's colour at every frame moved and rotated by the mode
+ * at the same phase and scale (ts_plot_outline_at_phase), magnified as in
+ * ts_plot_mode_shapes; both NULL: the outlines stay at the trim.
  * nframes in [4, TS_PLOT_MAX_FRAMES]. Browsers play it; a still viewer
  * shows the first frame. */
 #define TS_PLOT_MAX_FRAMES 360
@@ -227,6 +246,8 @@ TS_API int ts_plot_mode_animation(const char *dir, const char *name,
                                   const char *title, ts_plot_view view,
                                   int flags, const ts_plot_shape *eq,
                                   const double *re, const double *im,
+                                  const double *outline_re,
+                                  const double *outline_im,
                                   const char *label, int nframes,
                                   double seconds, const ts_plot_opts *opts,
                                   ts_err *err);
@@ -234,15 +255,18 @@ TS_API int ts_plot_mode_animation(const char *dir, const char *name,
 /* The same cycle as a PNG frame sequence (where an SVG animation is not
  * wanted: slides, video tools): DIR/NAME_000.png .. NAME_kkk.png, one per
  * phase 2 pi k / nframes (whatever opts->formats), each the equilibrium
- * in grey and the displaced shape (cylinder towfish drawn), in one fixed
- * window for every frame (side, with TS_PLOT_WATER the water; or top,
- * equal scales), titled with the frame and its phase, `label` above the
- * box. Same scale and checks as ts_plot_mode_animation; NAME at most 196
- * characters. */
+ * in grey and the displaced shape (cylinder towfish drawn, vehicle
+ * outlines moved and rotated at the frame's phase as in
+ * ts_plot_mode_animation), in one fixed window for every frame (side, with
+ * TS_PLOT_WATER the water; or top, equal scales), titled with the frame
+ * and its phase, `label` above the box. Same scale and checks as
+ * ts_plot_mode_animation; NAME at most 196 characters. */
 TS_API int ts_plot_mode_frames(const char *dir, const char *name,
                                const char *title, ts_plot_view view,
                                int flags, const ts_plot_shape *eq,
                                const double *re, const double *im,
+                               const double *outline_re,
+                               const double *outline_im,
                                const char *label, int nframes,
                                const ts_plot_opts *opts, ts_err *err);
 
