@@ -1,7 +1,8 @@
 /* eigen.c: modes of the linear model z' = A z (towstab/eigen.h;
  * doc/model.md section 6; doc/linear.md).
  *
- * lapack: dgeevx on a copy of A (balancing, Hessenberg QR; ~25 n^3 flops
+ * lapack: dgeevx on a copy of A, its entries below their own error
+ * estimate zeroed (balancing, Hessenberg QR; ~25 n^3 flops
  * with both eigenvector sets) gives every eigenvalue with its right
  * eigenvector v, left eigenvector u and condition number kappa (of the
  * balanced matrix). A perturbation dA moves a simple eigenvalue by
@@ -345,6 +346,29 @@ static void vector_health(const ts_linear *lin, const double *vl,
     c->verr = sqrt(sum2);
 }
 
+/* Zero the entries of the lower block of a (a copy of lin->A) smaller
+ * than their own error estimate, |Aerr_ij| + fnoise_i / (sqrt(2) h_j)
+ * (ts_linear): zero within the linearization's accuracy. Left in, such
+ * entries (1e-33 where central differences round an exact zero) make
+ * dgeevx's scaling balance a row against nothing, by factors up to 1e30,
+ * and the eigenvectors lose their accuracy (doc/linear.md section 3).
+ * Nothing without the error estimate. */
+static void clean_below_error(const ts_linear *lin, double *a)
+{
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    if (!lin->Aerr)
+        return;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < nlow; i++) {
+            double bound = fabs(lin->Aerr[i + (size_t)j * nlow]);
+            if (lin->fnoise && lin->h)
+                bound += lin->fnoise[i] / (M_SQRT2 * lin->h[j]);
+            double *x = &a[nq + i + (size_t)j * n];
+            if (fabs(*x) < bound)
+                *x = 0.0;
+        }
+}
+
 static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
 {
     int n = lin->nstate, info = 0, lwork = -1;
@@ -365,9 +389,12 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
         goto out;
     }
     memcpy(a, lin->A, nn * sizeof(double));
+    clean_below_error(lin, a);
     /* dgeevx: balance (permute and scale), then QR; the reciprocal
      * condition numbers and the norm refer to the balanced matrix, the
-     * one whose rounding errors matter. */
+     * one whose rounding errors matter. Scaling is needed: without it
+     * (BALANC 'P' or 'N') the stiff elastic examples' eigenvalues move by
+     * some 40 times their error bounds (doc/linear.md section 3). */
     int ilo, ihi;
     double abnrm;
     scale = malloc((size_t)n * sizeof(double));
