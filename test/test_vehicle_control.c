@@ -27,8 +27,9 @@
  *     has magnitude 1 and phase -180 deg + the phase margin.
  *  6. Closed-loop eigenvalues against the time domain: the nonlinear
  *     simulation started from the trim displaced along one mode's shape
- *     (its real part, scaled to 1e-6) stays on that mode; fitting the
- *     state's deviation onto the shape's real and imaginary parts at each
+ *     (its real part, scaled to +1e-6 and to -1e-6) stays on that mode;
+ *     fitting half the two runs' difference onto the shape's real and
+ *     imaginary parts at each
  *     sample gives its decay rate and frequency, which equal the
  *     eigenvalue's, for the slowest mode and for the mode the depth
  *     integrator moves most.
@@ -667,9 +668,13 @@ static void fit_shape(const double *z, const double *a, const double *b,
     *be = (zb * aa - za * ab) / det;
 }
 
-/* Simulate from y0 + eps Re(v) of mode m and fit lambda: the slope of
+/* Simulate from y0 + eps Re(v) and from y0 - eps Re(v) of mode m and fit
+ * lambda to half their difference over eps, z(t) = c(t) v: the slope of
  * log|c(t)| and of the unwrapped angle of c(t) = alpha - i beta over
- * NS samples in [0, T]. */
+ * DECAY_SAMPLES samples in [0, T]. The pair cancels what does not change
+ * sign with the disturbance: the trim's own drift (a trim off by delta
+ * moves both runs alike; alone it would add delta / eps to z) and the
+ * second-order terms of the nonlinear model, leaving O(eps^2). */
 #define DECAY_SAMPLES 20
 static int decay_fit(const solved *s, const ts_linear *lin,
                      const ts_eigen *e, int m, double complex *fit)
@@ -695,20 +700,26 @@ static int decay_fit(const solved *s, const ts_linear *lin,
     o.t_end = T;
     o.rel_tol = 1e-11;
     o.abs_tol = 1e-16;
-    for (int i = 0; i < n; i++)
-        y[i] = lin->y0[i] + eps * a[i];
-    ts_sim *sim = y ? ts_sim_alloc(s->k, NULL, &o, &err) : NULL;
-    int rc = sim ? ts_sim_set_state(sim, 0.0, y, &err) : -1;
+    ts_sim *sim[2] = {NULL, NULL};
+    int rc = y ? TS_OK : -1;
+    for (int p = 0; p < 2 && rc == TS_OK; p++) {
+        for (int i = 0; i < n; i++)
+            y[i] = lin->y0[i] + (p ? -eps : eps) * a[i];
+        sim[p] = ts_sim_alloc(s->k, NULL, &o, &err);
+        rc = sim[p] ? ts_sim_set_state(sim[p], 0.0, y, &err) : -1;
+    }
     double st = 0, stt = 0, sl = 0, stl = 0, sp = 0, stp = 0, prev = 0,
            unwrap = 0;
     for (int k = 1; k <= DECAY_SAMPLES && rc == TS_OK; k++) {
         double t = T * k / DECAY_SAMPLES;
-        rc = ts_sim_advance(sim, t, &err);
+        rc = ts_sim_advance(sim[0], t, &err);
+        if (rc == TS_OK)
+            rc = ts_sim_advance(sim[1], t, &err);
         if (rc != TS_OK)
             break;
-        const double *yt = ts_sim_state(sim);
+        const double *yp = ts_sim_state(sim[0]), *ym = ts_sim_state(sim[1]);
         for (int i = 0; i < n; i++)
-            z[i] = (yt[i] - lin->y0[i]) / eps;
+            z[i] = (yp[i] - ym[i]) / (2 * eps);
         double al, be;
         fit_shape(z, a, b, n, &al, &be);
         double l = log(hypot(al, be)), p = atan2(-be, al);
@@ -732,7 +743,8 @@ static int decay_fit(const solved *s, const ts_linear *lin,
     if (rc != TS_OK)
         printf("  simulate: %s\n", err.msg);
     *fit = stl / stt + I * (stp / stt);
-    ts_sim_free(sim);
+    ts_sim_free(sim[0]);
+    ts_sim_free(sim[1]);
     free(y);
     return rc;
 }
@@ -742,14 +754,16 @@ static void test_decay(void)
     solved s;
     ts_linear *lin;
     ts_eigen *e;
-    /* The decay of the depth integrator's slow mode over 20 s, fitted to
-     * 1e-5, shows the trim's own residual: a depth error of 4e-12 m (the
-     * shooting march's rounding, relative residual 3e-14) moves the fit
-     * by 2e-5 (moving the integrator's state by 1e-11 moves it by 7e-6).
-     * Newton's last, quadratic step leaves none. */
-    int rc = solve_modes_by(base, TS_EQ_NEWTON, &s, &lin, &e);
+    /* The default trim. Its depth carries the shooting march's rounding,
+     * 4e-12 m (relative residual 3e-14): the trim drifts by that much, and
+     * a single disturbance of 1e-6 would read the drift as 4e-6 of the
+     * mode, which moved the depth integrator's fitted decay by 5.6e-5.
+     * decay_fit takes half the difference of a +eps and a -eps run, in
+     * which the drift cancels: 2.4e-7 with this trim, 4.0e-7 with
+     * Newton's (a single run from Newton's trim: 4.8e-7). */
+    int rc = solve_modes(base, &s, &lin, &e);
     CHECK(rc == TS_OK && e->vec_re, "closed-loop modes with their shapes "
-          "(trim by Newton)");
+          "(the default trim)");
     if (rc != TS_OK)
         goto done;
     /* The slowest mode, and the mode the depth integrator moves most
@@ -783,11 +797,13 @@ static void test_decay(void)
         const ts_mode *md = &e->modes[which[c]];
         double complex lam = md->re + I * md->im, fit = 0;
         rc = decay_fit(&s, lin, e, which[c], &fit);
-        /* 1e-5 of |lambda|: the disturbance's own nonlinearity (1e-6),
-         * the integrator's tolerance (1e-11) and the linearization's
-         * truncation error (the modes' error bound) are all far below
-         * it; a wrong closed-loop model (a controller state missing or
-         * mis-signed) moves the eigenvalues by far more. */
+        /* 1e-5 of |lambda|: the disturbance's own nonlinearity (eps^2,
+         * 1e-12, the pair cancelling its second order), the trim's
+         * drift (cancelled by the pair to first order), the integrator's
+         * tolerance (1e-11) and the linearization's truncation error (the
+         * modes' error bound) are all far below it; a wrong closed-loop
+         * model (a controller state missing or mis-signed) moves the
+         * eigenvalues by far more. */
         double d = cabs(fit - lam) / cabs(lam);
         CHECK(rc == TS_OK && d < 1e-5, "%s: simulated decay %.6g 1/s, "
               "frequency %.6g rad/s against the eigenvalue %.6g%+.6gi "
