@@ -346,27 +346,36 @@ static void vector_health(const ts_linear *lin, const double *vl,
     c->verr = sqrt(sum2);
 }
 
+/* The error estimate of entry (i, j) of A: |Aerr_ij| + fnoise_i /
+ * (sqrt(2) h_j) in the lower block (ts_linear), 0 in the exact upper
+ * block [0 I] and without the estimate. */
+static double entry_error(const ts_linear *lin, int i, int j)
+{
+    int nq = lin->nq, nlow = lin->nstate - nq;
+    if (i < nq || !lin->Aerr)
+        return 0.0;
+    double bound = fabs(lin->Aerr[(i - nq) + (size_t)j * nlow]);
+    if (lin->fnoise && lin->h)
+        bound += lin->fnoise[i - nq] / (M_SQRT2 * lin->h[j]);
+    return bound;
+}
+
 /* Zero the entries of the lower block of a (a copy of lin->A) smaller
- * than their own error estimate, |Aerr_ij| + fnoise_i / (sqrt(2) h_j)
- * (ts_linear): zero within the linearization's accuracy. Left in, such
+ * than their own error estimate (entry_error): zero within the
+ * linearization's accuracy. Left in, such
  * entries (1e-33 where central differences round an exact zero) make
  * dgeevx's scaling balance a row against nothing, by factors up to 1e30,
  * and the eigenvectors lose their accuracy (doc/linear.md section 3).
  * Nothing without the error estimate. */
 static void clean_below_error(const ts_linear *lin, double *a)
 {
-    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    int n = lin->nstate;
     if (!lin->Aerr)
         return;
     for (int j = 0; j < n; j++)
-        for (int i = 0; i < nlow; i++) {
-            double bound = fabs(lin->Aerr[i + (size_t)j * nlow]);
-            if (lin->fnoise && lin->h)
-                bound += lin->fnoise[i] / (M_SQRT2 * lin->h[j]);
-            double *x = &a[nq + i + (size_t)j * n];
-            if (fabs(*x) < bound)
-                *x = 0.0;
-        }
+        for (int i = lin->nq; i < n; i++)
+            if (fabs(a[i + (size_t)j * n]) < entry_error(lin, i, j))
+                a[i + (size_t)j * n] = 0.0;
 }
 
 static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
@@ -1363,10 +1372,12 @@ static double *cut_cyclic(const ts_linear *lin)
 
 /* The largest |A' g - s g| / |g| over the generators gk[0..m) of s, A'
  * the dense A with the cyclic states' rows and columns cut as the
- * eigensolvers see it (cut_cyclic); INFINITY without the dense A. O(n^2)
- * per generator: the dense path's cost, below its eigensolver's. */
+ * eigensolvers see it (cut_cyclic), with `cleaned` also its entries below
+ * their error zeroed as LAPACK sees it (clean_below_error); INFINITY
+ * without the dense A. O(n^2) per generator: the dense path's cost, below
+ * its eigensolver's. */
 static double generator_residual(const ts_linear *lin, double complex s,
-                                 const int *gk, int m)
+                                 const int *gk, int m, int cleaned)
 {
     if (!lin->A)
         return INFINITY;
@@ -1387,9 +1398,12 @@ static double generator_residual(const ts_linear *lin, double complex s,
         for (int i = 0; i < n; i++) {
             double complex ag = 0;
             if (!cut[i])
-                for (int j = 0; j < n; j++)
-                    if (!cut[j])
-                        ag += lin->A[i + (size_t)j * n] * (gr[j] + I * gi[j]);
+                for (int j = 0; j < n; j++) {
+                    double aij = lin->A[i + (size_t)j * n];
+                    if (!cut[j] &&
+                        !(cleaned && fabs(aij) < entry_error(lin, i, j)))
+                        ag += aij * (gr[j] + I * gi[j]);
+                }
             ag -= s * (gr[i] + I * gi[i]);
             r2 += creal(ag * conj(ag));
         }
@@ -1404,7 +1418,8 @@ static double generator_residual(const ts_linear *lin, double complex s,
  * of the generators, the candidates within their bound of s (nearest
  * first, at most as many as its generators) whose vectors lie in the
  * generators' span within the allowance. */
-static int recognise_neutral(const ts_linear *lin, cand_list *L)
+static int recognise_neutral(const ts_linear *lin, cand_list *L,
+                             int cleaned)
 {
     int n = lin->nstate, ng = lin->nneutral;
     double dA = isfinite(lin->trunc_norm) ? lin->trunc_norm : 1e-6 * lin->a_norm;
@@ -1462,7 +1477,7 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L)
             if (!(d <= fmax(b, floor)))
                 gap = fmin(gap, d);
         }
-        double res = generator_residual(lin, s, gk, m);
+        double res = generator_residual(lin, s, gk, m, cleaned);
         if (!(NEUTRAL_SAFETY * fmin(dA, res + floor) / gap <=
               NEUTRAL_ANGLE_MAX))
             continue;
@@ -1733,7 +1748,8 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
 
     /* A towing vehicle's neutral modes: recognised, and left out of the
      * verdict (doc/linear.md section 3a). */
-    if (lin->nneutral > 0 && recognise_neutral(lin, &L) != TS_OK) {
+    if (lin->nneutral > 0 &&
+        recognise_neutral(lin, &L, m == TS_EIG_LAPACK) != TS_OK) {
         free(cover);
         cand_free(&L);
         ts_eigen_free(e);
