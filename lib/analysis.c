@@ -3387,6 +3387,31 @@ int ts_analysis_check(const ts_system *sys, const ts_request *rq,
     return rc;
 }
 
+/* With a towing vehicle, the steady motion the run starts from is
+ * solved, not the scene's tow.speed and tow.turn_rate (their starting
+ * values): the estimate solves the same equilibrium (the request's
+ * options, no progress) and puts its speed and turn rate into s. *speed
+ * is the solved speed, NaN when there is no towing vehicle or its trim
+ * did not converge (then the scene's stay). */
+static void cost_trim(ts_system *s, const ts_request *rq, double *speed)
+{
+    *speed = NAN;
+    if (s->tow.vehicle < 0)
+        return;
+    ts_kernel *k = ts_kernel_alloc(s, NULL);
+    ts_equilibrium *eq = k ? ts_equilibrium_alloc(s, NULL) : NULL;
+    ts_equilibrium_opts eo = rq->setup.equilibrium;
+    eo.progress = NULL;
+    eo.progress_data = NULL;
+    if (eq && ts_equilibrium_solve(k, &eo, eq, NULL) == TS_OK &&
+        eq->converged && isfinite(eq->speed)) {
+        *speed = s->tow.speed = eq->speed;
+        s->tow.turn_rate = eq->turn_rate;
+    }
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+}
+
 int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
                      ts_cost *e, ts_err *err)
 {
@@ -3399,20 +3424,28 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
     int rc = TS_OK;
     if (rq->kind == TS_ANALYSIS_SIMULATE && !rq->simulate.linear) {
         ts_sim_opts o;
-        double transient;
+        double transient, trimmed;
         sim_resolve(&rq->simulate, &o, &transient);
-        /* With a sea, its realisation is part of the excitation. */
+        cost_trim(s, rq, &trimmed);
+        /* With a sea, its realisation is part of the excitation (a
+         * towing vehicle meets it at its solved speed, as in the run). */
         ts_excitation *ex = NULL;
         if (rq->simulate.sea.sea) {
             ts_seaway w;
             ts_sea_realisation real;
-            /* (A towing vehicle's at the scene's speed: a cost bound.) */
-            rc = sea_excitation(s, &rq->simulate, NAN, &w, &real, &ex, err);
+            rc = sea_excitation(s, &rq->simulate, trimmed, &w, &real, &ex,
+                                err);
         }
         if (rc == TS_OK)
             rc = ts_cost_simulate(s, ex ? ex : rq->simulate.excitation, &o,
                                   e, err);
         ts_excitation_free(ex);
+        size_t len = strlen(e->what);
+        if (rc == TS_OK && s->tow.vehicle >= 0)
+            snprintf(e->what + len, sizeof e->what - len, isfinite(trimmed)
+                     ? "; at the towing vehicle's solved speed %.4g m/s"
+                     : "; at the scene's speed %.4g m/s (the towing "
+                       "vehicle's trim did not converge)", s->tow.speed);
     } else if (rq->kind == TS_ANALYSIS_MODES) {
         ts_kernel *k = ts_kernel_alloc(s, err);
         int n = k ? ts_kernel_nstate(k) : 0;

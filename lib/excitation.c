@@ -625,9 +625,10 @@ static int input_amplitude(const ts_units *units, const char *text,
         snprintf(s->input_unit, sizeof s->input_unit, "rad");
         return TS_OK;
     }
-    /* A towing vehicle's thrust or external force, or moment. */
-    static const char *const other[2] = {"N", "N*m"};
-    for (int i = 0; i < 2; i++)
+    /* A towing vehicle's thrust or external force, moment, or its speed
+     * controller's set speed. */
+    static const char *const other[3] = {"N", "N*m", "m/s"};
+    for (int i = 0; i < 3; i++)
         if (ts_units_parse(units, text, other[i], where, &s->amplitude, &e) ==
             TS_OK) {
             snprintf(s->input_unit, sizeof s->input_unit, "%s", other[i]);
@@ -635,7 +636,8 @@ static int input_amplitude(const ts_units *units, const char *text,
         }
     return ts_fail(err, TS_EUNIT, "%s: '%.40s' is neither a length (m, for "
                    "a depth set point), an angle (rad, deg), a force (N, a "
-                   "towing vehicle's thrust or force) nor a moment (N*m)",
+                   "towing vehicle's thrust or force), a moment (N*m) nor a "
+                   "speed (m/s, a towing vehicle's speed_set)",
                    where, text);
 }
 

@@ -96,6 +96,9 @@ typedef struct veh {
     int in_prop;              /* its first input: thrust (N), then the
                                  external force (N) and moment (N m) in
                                  body axes, TSI_NPROP in all; -1 */
+    int in_spd;               /* a speed controller's set-speed input
+                                 (m/s, added to its set speed), after
+                                 the TSI_NPROP; -1 */
     double thrust_bias;       /* the speed controller's bias, N */
     double turn_delta;        /* the deflection added to the turn surface
                                  (ts_tow.turn_surface), rad */
@@ -215,10 +218,12 @@ static int layout_controls(ts_kernel *k, ts_err *err)
             V->in_loop[l] = k->nin++;
             V->in_sp[l] = k->nin++;
         }
-        V->in_prop = -1;
+        V->in_prop = V->in_spd = -1;
         if (V->root) {
             V->in_prop = k->nin;
             k->nin += TSI_NPROP;
+            if (d->propulsion.type == TS_PROP_SPEED)
+                V->in_spd = k->nin++;
         }
     }
     free(k->uzero);
@@ -629,6 +634,10 @@ const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
             snprintf(buf, size, "%s.%s", body, prop_input[j - V->in_prop]);
             return buf;
         }
+        if (V->in_spd >= 0 && j == V->in_spd) {
+            snprintf(buf, size, "%s.speed_set", body);
+            return buf;
+        }
     }
     return NULL;
 }
@@ -645,6 +654,8 @@ const char *ts_kernel_input_unit(const ts_kernel *k, int j)
                                                                  : "rad";
         if (V->in_prop >= 0 && j >= V->in_prop && j < V->in_prop + TSI_NPROP)
             return j - V->in_prop < 4 ? "N" : "N*m";
+        if (V->in_spd >= 0 && j == V->in_spd)
+            return "m/s";
     }
     return j < k->nin ? "rad" : NULL; /* a deflection or a loop's output */
 }
@@ -931,7 +942,11 @@ static void vehicle_own_loads(ts_kernel *k, veh *V, const double y[],
         /* A PI speed controller: its integral term joins the bias; the
          * integrator holds while the law is capped and the vehicle slower
          * than its set speed (anti-windup). */
-        const ts_propulsion *pr = &d->propulsion;
+        /* The set-speed input moves the speed controller's set speed. */
+        ts_propulsion law = d->propulsion;
+        const ts_propulsion *pr = &law;
+        if (V->in_spd >= 0)
+            law.speed += u[V->in_spd];
         double bias = V->thrust_bias;
         if (V->spd_off >= 0) {
             double e = pr->speed - u_law;

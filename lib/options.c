@@ -565,7 +565,9 @@ static const ts_option response_rows[] = {
      .flag_offset = OFF(response.frequency_given), .arg = "NAME",
      .help = "tow.surge, tow.sway or tow.heave, tow.speed or "
              "tow.turn_rate, or a vehicle's input: <vehicle>.<surface>, "
-             "<vehicle>.<loop>, <vehicle>.<loop>.setpoint"},
+             "<vehicle>.<loop>, <vehicle>.<loop>.setpoint; a towing "
+             "vehicle's <name>.thrust, .force.x|y|z, .moment.x|y|z, "
+             ".speed_set (a speed controller's)"},
     {.name = "output", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.output), .size = SZ(response.output),
      .arg = "NAME",

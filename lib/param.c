@@ -2,7 +2,8 @@
  * (towstab/param.h; doc/scene-format.md, "Values by path").
  *
  * A path is split at its dots into a collection (tow, environment,
- * cables, bodies), an entry name where the collection has entries, and a
+ * cables, bodies, towing_vehicle: the body ts_tow.vehicle, with its
+ * propulsion), an entry name where the collection has entries, and a
  * key; vehicle loops and surfaces add a second name. Each key is one row
  * of a table: its SI unit, its lower limit and where it lives in the
  * struct (an offset), or a conversion (weight and wet weight to mass, a
@@ -139,6 +140,30 @@ static const row surface_rows[] = {
 /* The surface row whose value may be infinite (no limit). */
 static const row *const surface_limit = &surface_rows[3];
 
+/* A towing vehicle's propulsion (towing_vehicle.propulsion.<key>; each
+ * key but `at` belongs to one law or two, prop_laws). */
+#define PRP(m) offsetof(ts_propulsion, m)
+static const row propulsion_rows[] = {
+    {"thrust", "N", -INFINITY, 0, TSI_KEY_PLAIN, PRP(thrust)},
+    {"power", "W", 0, 1, TSI_KEY_PLAIN, PRP(power)},
+    {"speed", "m/s", 0, 1, TSI_KEY_PLAIN, PRP(speed)},
+    {"max_thrust", "N", 0, 1, TSI_KEY_PLAIN, PRP(max_thrust)},
+    {"gain", "N*s/m", 0, 0, TSI_KEY_PLAIN, PRP(gain)},
+    {"integral_gain", "N/m", 0, 0, TSI_KEY_PLAIN, PRP(ki)},
+    {"at", "m", -INFINITY, 0, TSI_KEY_VECTOR, PRP(position)},
+};
+
+/* The propulsion row whose value may be infinite (no cap). */
+static const row *const propulsion_cap = &propulsion_rows[3];
+
+/* The laws (bits of 1 << ts_propulsion_type) each propulsion row
+ * applies to, in the rows' order. */
+static const unsigned prop_laws[] = {
+    1u << TS_PROP_THRUST, 1u << TS_PROP_POWER, 1u << TS_PROP_SPEED,
+    1u << TS_PROP_POWER | 1u << TS_PROP_SPEED, 1u << TS_PROP_SPEED,
+    1u << TS_PROP_SPEED,
+    1u << TS_PROP_THRUST | 1u << TS_PROP_POWER | 1u << TS_PROP_SPEED};
+
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
 
 static const row *find_row(const row *t, int n, const char *key);
@@ -155,6 +180,8 @@ const tsi_key *tsi_key_find(tsi_keys t, const char *key)
         return find_row(vehicle_rows, COUNT(vehicle_rows), key);
     case TSI_KEYS_HULL: return find_row(hull_rows, COUNT(hull_rows), key);
     case TSI_KEYS_BLUFF: return find_row(bluff_rows, COUNT(bluff_rows), key);
+    case TSI_KEYS_PROPULSION:
+        return find_row(propulsion_rows, COUNT(propulsion_rows), key);
     default: return find_row(surface_rows, COUNT(surface_rows), key);
     }
 }
@@ -171,7 +198,10 @@ static const char *const forms =
     "efficiency|cn90|rate_limit|time_constant|position.x|y|z, "
     "bodies.<vehicle>.components.<hull>.length|diameter|axial_drag|"
     "cross_drag|position.x|y|z, "
-    "bodies.<vehicle>.components.<bluff part>.area|drag|position.x|y|z";
+    "bodies.<vehicle>.components.<bluff part>.area|drag|position.x|y|z, "
+    "towing_vehicle.<key> (a vehicle's keys, its attach point tow_point), "
+    "towing_vehicle.propulsion.thrust|power|speed|max_thrust|gain|"
+    "integral_gain|at.x|y|z";
 
 /* A path resolved against a system (or only by its form when sys is
  * NULL). */
@@ -238,6 +268,7 @@ static const char *table_noun(const row *t)
            : t == vehicle_rows ? "a vehicle"
            : t == hull_rows    ? "a hull"
            : t == bluff_rows   ? "a bluff part"
+           : t == propulsion_rows ? "the propulsion"
                                : "a surface";
 }
 
@@ -508,6 +539,114 @@ static int resolve_body(const char *path, const ts_system *sys, int b,
                    "components.<component>.<key>", path, key, list);
 }
 
+/* The names of a towing vehicle's propulsion laws, for messages. */
+static const char *law_name(ts_propulsion_type t)
+{
+    return t == TS_PROP_THRUST  ? "thrust"
+           : t == TS_PROP_POWER ? "power (the constant-power law)"
+           : t == TS_PROP_SPEED ? "speed (a speed controller)"
+                                : "none";
+}
+
+/* Refuse a propulsion key of a law other than p's: the scene takes it
+ * only with its law (lib/scene.c), so the path does too. */
+static int propulsion_applies(const char *path, const ts_propulsion *p,
+                              const row *r, ts_err *err)
+{
+    unsigned laws = prop_laws[r - propulsion_rows];
+    if (laws & 1u << p->type)
+        return TS_OK;
+    char list[200] = "";
+    for (int i = 0; i < COUNT(propulsion_rows); i++)
+        if (prop_laws[i] & 1u << p->type)
+            snprintf(list + strlen(list), sizeof list - strlen(list),
+                     "%s%s%s", list[0] ? ", " : "", propulsion_rows[i].key,
+                     entries_of(&propulsion_rows[i]));
+    return ts_fail(err, TS_EINVAL, "%s: the towing vehicle's propulsion is "
+                   "%s, which has no '%s'; its keys: %s", path,
+                   law_name(p->type), r->key, list);
+}
+
+/* What a towing vehicle takes by path, for messages: its mass keys, a
+ * vehicle's own (its attach point named tow_point, as in the scene),
+ * controllers, components and propulsion. */
+static int towing_unknown(const char *path, const char *key, ts_err *err)
+{
+    char list[900] = "";
+    for (int i = 0; i < COUNT(vehicle_body_keys); i++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s",
+                 i ? ", " : "", vehicle_body_keys[i]);
+    for (int i = 0; i < COUNT(vehicle_rows); i++) {
+        const row *r = &vehicle_rows[i];
+        snprintf(list + strlen(list), sizeof list - strlen(list), ", %s%s",
+                 strcmp(r->key, "attach") ? r->key : "tow_point",
+                 entries_of(r));
+    }
+    snprintf(list + strlen(list), sizeof list - strlen(list),
+             ", controllers.<loop>.<key>, components.<component>.<key>, "
+             "propulsion.<key> (");
+    keys_list(propulsion_rows, COUNT(propulsion_rows), list + strlen(list),
+              sizeof list - strlen(list));
+    snprintf(list + strlen(list), sizeof list - strlen(list), ")");
+    return ts_fail(err, TS_EINVAL, "%s: no key '%s' of the towing vehicle; "
+                   "expected one of %s", path, key, list);
+}
+
+/* towing_vehicle.<key> (rest: the part after "towing_vehicle."): the
+ * towing vehicle is a body of the system (ts_tow.vehicle) whose attach
+ * point the scene calls tow_point, with a propulsion. By form when s is
+ * NULL. */
+static int resolve_towing(const char *path, ts_system *s, const char *rest,
+                          target *tg, ts_err *err)
+{
+    tg->collection = "towing_vehicle";
+    if (s && s->tow.vehicle < 0)
+        return ts_fail(err, TS_EINVAL, "%s: the scene has no towing_vehicle "
+                       "(its tow point is prescribed: tow.speed, "
+                       "tow.turn_rate, tow.point.x|y|z)", path);
+    int b = s ? s->tow.vehicle : -1;
+    ts_vehicle *v = s ? s->bodies[b].vehicle : NULL;
+    tg->body = b;
+    if (!strncmp(rest, "propulsion.", 11)) {
+        tg->base = v ? (char *)&v->propulsion : NULL;
+        int rc = resolve_key(path, rest + 11, propulsion_rows,
+                             COUNT(propulsion_rows), tg, err);
+        return rc || !v ? rc
+                        : propulsion_applies(path, &v->propulsion, tg->r,
+                                             err);
+    }
+    int loops;
+    if (vehicle_part(rest, &loops))
+        return resolve_vehicle(path, s, b, rest, tg, err);
+    /* The scene's tow_point is the vehicle's attach point; "attach" is
+     * not a key of the towing vehicle. */
+    char key[TS_PARAM_PATH_MAX];
+    const char *tp = "tow_point";
+    size_t n = strlen(tp);
+    int attach = !strncmp(rest, "attach", 6) &&
+                 (rest[6] == '\0' || rest[6] == '.');
+    if (!strncmp(rest, tp, n) && (rest[n] == '\0' || rest[n] == '.'))
+        snprintf(key, sizeof key, "attach%s", rest + n);
+    else
+        snprintf(key, sizeof key, "%s", rest);
+    if (!attach && find_key(key, vehicle_rows, COUNT(vehicle_rows), tg) ==
+                       TS_OK) {
+        tg->base = (char *)v;
+        return TS_OK;
+    }
+    if (!attach && tg->r) /* a vector or an inertia without its entry */
+        return ts_fail(err, TS_EINVAL, "%s: '%s' is a %s; name an entry: "
+                       "%s%s", path, rest, tg->r->kind == TSI_KEY_VECTOR
+                       ? "vector" : "list", rest, entries_of(tg->r));
+    for (int i = 0; !attach && i < COUNT(vehicle_body_keys); i++)
+        if (!strcmp(key, vehicle_body_keys[i])) {
+            tg->r = find_row(body_rows, COUNT(body_rows), key);
+            tg->base = s ? (char *)&s->bodies[b] : NULL;
+            return TS_OK;
+        }
+    return towing_unknown(path, rest, err);
+}
+
 /* The scene format's spelling of a path (doc/scene-format.md, "Setting
  * values": "cables[armour].length", "cables[0].length",
  * "bodies[fish].components[tailplane].area", "tow.point[2]") into ours
@@ -543,7 +682,7 @@ static int spell(const ts_system *sys, const char *path, char *out,
         long i = digits ? strtol(sel, NULL, 10) : -1;
         static const char *const vectors[] = {
             "point", "current", "position", "mass_centre",
-            "buoyancy_centre", "attach"};
+            "buoyancy_centre", "attach", "tow_point", "at"};
         static const char *const inertia[6] = {"xx", "yy", "zz",
                                                "xy", "xz", "yz"};
         int vector = 0;
@@ -644,6 +783,8 @@ static int resolve_spelled(const ts_system *sys, const char *path,
         return resolve_key(path, path + 12, env_rows, COUNT(env_rows), tg,
                            err);
     }
+    if (!strncmp(path, "towing_vehicle.", 15))
+        return resolve_towing(path, s, path + 15, tg, err);
     int cables = !strncmp(path, "cables.", 7);
     if (!cables && strncmp(path, "bodies.", 7))
         return ts_fail(err, TS_EINVAL, "%s: not a path of the scene; expected "
@@ -695,6 +836,10 @@ static int resolve_spelled(const ts_system *sys, const char *path,
         return ts_fail(err, TS_EINVAL, "%s: no body of that name; the "
                        "bodies: %s", path, s->nbodies > 0 ? list : "none");
     }
+    if (b == s->tow.vehicle)
+        return ts_fail(err, TS_EINVAL, "%s: '%s' is the towing vehicle; its "
+                       "values are towing_vehicle.<key> (towing_vehicle.%s)",
+                       path, s->bodies[b].name, key);
     tg->body = b;
     int loops;
     if (vehicle_part(key, &loops))
@@ -865,7 +1010,9 @@ int ts_param_set(ts_system *sys, const char *path, double value,
     const char *unit = target_unit(&tg);
     const char *u = strcmp(unit, "1") ? unit : "";
     const char *sp = u[0] ? " " : "";
-    int ok = isfinite(value) || (r == surface_limit && value == INFINITY);
+    int ok = isfinite(value) ||
+             ((r == surface_limit || r == propulsion_cap) &&
+              value == INFINITY);
     if (!ok)
         return ts_fail(err, TS_EINVAL, "%s: expected a finite number%s%s",
                        path, u[0] ? " in " : "", u);

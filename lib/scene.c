@@ -1102,11 +1102,12 @@ static int parse_propulsion(const ctx *c, const field *fp, const char *parent,
     rc = one_of(c, path, fp->value, f, laws, 3, 1, &which);
     if (rc != TS_OK)
         return rc;
+    /* Units and limits: the key table's (param_impl.h), as by path. */
+    const tsi_keys t = TSI_KEYS_PROPULSION;
     pr->max_thrust = INFINITY;
     if (which == P_THRUST) {
         pr->type = TS_PROP_THRUST;
-        rc = field_quantity(c, join(p, path, "thrust"), &f[P_THRUST], "N",
-                            &pr->thrust);
+        rc = key_value(c, path, &f[P_THRUST], t, 0.0, &pr->thrust);
     } else if (which == P_POWER) {
         pr->type = TS_PROP_POWER;
         if (!f[P_MAX].value)
@@ -1114,27 +1115,18 @@ static int parse_propulsion(const ctx *c, const field *fp, const char *parent,
                            "'max_thrust': the constant-power law T = P / U "
                            "needs its cap at low speed (the bollard "
                            "thrust)");
-        rc = field_quantity(c, join(p, path, "power"), &f[P_POWER], "W",
-                            &pr->power);
+        rc = key_value(c, path, &f[P_POWER], t, 0.0, &pr->power);
         if (rc == TS_OK)
-            rc = check_min(c, p, &f[P_POWER], pr->power, 0, 1, "W");
-        if (rc == TS_OK)
-            rc = optional_min(c, path, &f[P_MAX], "N", 0, 1, INFINITY,
-                              &pr->max_thrust);
+            rc = key_value(c, path, &f[P_MAX], t, INFINITY, &pr->max_thrust);
     } else {
         pr->type = TS_PROP_SPEED;
-        rc = field_quantity(c, join(p, path, "speed"), &f[P_SPEED], "m/s",
-                            &pr->speed);
+        rc = key_value(c, path, &f[P_SPEED], t, 0.0, &pr->speed);
         if (rc == TS_OK)
-            rc = check_min(c, p, &f[P_SPEED], pr->speed, 0, 1, "m/s");
+            rc = key_value(c, path, &f[P_GAIN], t, 0.0, &pr->gain);
         if (rc == TS_OK)
-            rc = optional_min(c, path, &f[P_GAIN], "N*s/m", 0, 0, 0.0,
-                              &pr->gain);
+            rc = key_value(c, path, &f[P_KI], t, 0.0, &pr->ki);
         if (rc == TS_OK)
-            rc = optional_min(c, path, &f[P_KI], "N/m", 0, 0, 0.0, &pr->ki);
-        if (rc == TS_OK)
-            rc = optional_min(c, path, &f[P_MAX], "N", 0, 1, INFINITY,
-                              &pr->max_thrust);
+            rc = key_value(c, path, &f[P_MAX], t, INFINITY, &pr->max_thrust);
     }
     if (rc == TS_OK && which == P_THRUST && f[P_MAX].value)
         rc = fail_at(c, TS_ESCENE, join(p, path, "max_thrust"), f[P_MAX].line,
@@ -1146,7 +1138,7 @@ static int parse_propulsion(const ctx *c, const field *fp, const char *parent,
         rc = fail_at(c, TS_ESCENE, join(p, path, "integral_gain"),
                      f[P_KI].line, "applies to a speed controller only");
     if (rc == TS_OK && f[P_AT].value)
-        rc = vector3(c, path, &f[P_AT], "m", pr->position);
+        rc = vector3(c, path, &f[P_AT], key_unit(t, &f[P_AT]), pr->position);
     return rc;
 }
 

@@ -311,6 +311,17 @@ static double *history_outputs(ts_history *h, const ts_kernel *k,
     return h->outputs + (size_t)no * (size_t)h->nsamples;
 }
 
+/* What an input's unit measures, for messages. */
+static const char *quantity_of(const char *unit)
+{
+    return !strcmp(unit, "m")     ? "a length (m)"
+           : !strcmp(unit, "rad") ? "an angle (rad, deg)"
+           : !strcmp(unit, "N")   ? "a force (N)"
+           : !strcmp(unit, "N*m") ? "a moment (N*m)"
+           : !strcmp(unit, "m/s") ? "a speed (m/s)"
+                                  : unit;
+}
+
 /* Kernel input indices of the excitation's vehicle-input signals,
  * idx[nsignals] (-1 for the other signals); checks each name and unit
  * against the kernel. NULL (and *idx NULL) without such signals. */
@@ -352,11 +363,8 @@ static int bind_inputs(const ts_kernel *k, const ts_excitation *ex,
         if (sg->input_unit[0] && strcmp(sg->input_unit, unit)) {
             free(x);
             return ts_fail(err, TS_EUNIT, "excite: %.80s: the amplitude is "
-                           "in %s, expected %s", sg->input,
-                           !strcmp(sg->input_unit, "m") ? "a length"
-                                                        : "an angle",
-                           !strcmp(unit, "m") ? "a length (m)"
-                                              : "an angle (rad, deg)");
+                           "%s, expected %s", sg->input,
+                           quantity_of(sg->input_unit), quantity_of(unit));
         }
         x[i] = j;
     }

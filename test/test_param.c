@@ -16,7 +16,9 @@
  * keys (its inertia, centres, attach point) and its components'
  * positions and hull keys, whose spheroid added mass follows the hull as
  * the scene reader derives it; a hull that cannot have one is refused
- * with nothing changed. Unknown keys list the accepted ones. */
+ * with nothing changed. Unknown keys list the accepted ones. The towing
+ * vehicle's values (towing_vehicle.<key>, its propulsion under each law)
+ * give the runs of the scene with them written in, to the last digit. */
 #include "towstab/param.h"
 
 #include <stdlib.h>
@@ -559,6 +561,273 @@ static void test_scene_words(const ts_units *u)
     ts_scene_free(sc);
 }
 
+/* Run `kind` on sys at 10 links with the settings of `set` (path,
+ * value; NULL for none), no discretisation estimate. */
+static ts_result *towing_run(const ts_system *sys, ts_analysis_kind kind,
+                             const char *path, double value, ts_err *err)
+{
+    ts_request rq;
+    ts_request_init(&rq, kind);
+    rq.setup.discretisation_error = 0;
+    rq.setup.links = 10;
+    ts_result *r = NULL;
+    if (path && ts_setup_set(&rq.setup, path, value, err) != TS_OK)
+        return NULL;
+    if (ts_analysis_run(sys, &rq, &r, err) != TS_OK) {
+        ts_result_free(r);
+        return NULL;
+    }
+    return r;
+}
+
+/* Results a and b agree to the last digit: key values, equilibrium
+ * positions and controller states, eigenvalues. */
+static int same_result(const ts_result *a, const ts_result *b)
+{
+    if (!a || !b || a->nvalues != b->nvalues)
+        return 0;
+    for (int k = 0; k < a->nvalues; k++)
+        if (memcmp(&a->values[k].value, &b->values[k].value,
+                   sizeof(double)))
+            return 0;
+    if (a->eq && b->eq) {
+        if (a->eq->nnodes != b->eq->nnodes ||
+            a->eq->ncontrol != b->eq->ncontrol ||
+            memcmp(a->eq->positions, b->eq->positions,
+                   3 * (size_t)a->eq->nnodes * sizeof(double)) ||
+            (a->eq->ncontrol &&
+             memcmp(a->eq->controls, b->eq->controls,
+                    (size_t)a->eq->ncontrol * sizeof(double))))
+            return 0;
+    }
+    if (!a->eigen != !b->eigen)
+        return 0;
+    if (a->eigen) {
+        if (a->eigen->nmodes != b->eigen->nmodes)
+            return 0;
+        for (int m = 0; m < a->eigen->nmodes; m++)
+            if (a->eigen->modes[m].re != b->eigen->modes[m].re ||
+                a->eigen->modes[m].im != b->eigen->modes[m].im)
+                return 0;
+    }
+    return 1;
+}
+
+/* Results a and b differ somewhere (the setting changed the run). */
+static int changed_result(const ts_result *a, const ts_result *b)
+{
+    int d = 0;
+    for (int k = 0; k < a->nvalues && k < b->nvalues; k++)
+        d |= a->values[k].value != b->values[k].value;
+    for (int m = 0; a->eigen && b->eigen && m < a->eigen->nmodes &&
+                    m < b->eigen->nmodes; m++)
+        d |= a->eigen->modes[m].re != b->eigen->modes[m].re;
+    return d;
+}
+
+/* The towing vehicle's values by path (towing_vehicle.<key>): each set by
+ * path gives the run of the scene with the same text written in at that
+ * key (ts_scene_set) to the last digit, on DOLPHIN-AURORA with each of
+ * its three propulsion laws; a static key by the equilibrium, an inertia
+ * or a gain by the modes. Keys of another law, the vehicle's "attach"
+ * (the scene says tow_point), a towing vehicle named as a body, and
+ * towing_vehicle in a scene without one are refused by name. */
+static void test_towing_paths(const ts_units *u)
+{
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load("examples/dolphin_aurora.yaml", u, &err);
+    if (!CHECK(sc != NULL, "the DOLPHIN-AURORA scene loads (%s)", err.msg))
+        return;
+    /* The same scene with constant power and with a PI speed
+     * controller. */
+    const char *pk = "towing_vehicle.propulsion";
+    const char *power = "{power: \"22 kW\", max_thrust: \"9000 N\", "
+                        "at: [\"-4 m\", 0, 0]}";
+    const char *speed = "{speed: \"5 m/s\", gain: \"900 N*s/m\", "
+                        "integral_gain: \"40 N/m\", max_thrust: "
+                        "\"9000 N\", at: [\"-4 m\", 0, 0]}";
+    ts_scene *scenes[3] = {sc, ts_scene_set(sc, 1, &pk, &power, u, &err),
+                           ts_scene_set(sc, 1, &pk, &speed, u, &err)};
+    CHECK(scenes[1] && scenes[2], "the power and speed laws written in "
+          "(%s)", err.msg);
+    enum { EQ = TS_ANALYSIS_EQUILIBRIUM, MO = TS_ANALYSIS_MODES };
+    static const struct {
+        int scene, kind;
+        const char *path, *key, *text;
+    } cases[] = {
+        {0, EQ, "towing_vehicle.mass", "towing_vehicle.mass", "4100 kg"},
+        {0, EQ, "towing_vehicle.volume", "towing_vehicle.volume",
+         "3.9 m^3"},
+        {0, MO, "towing_vehicle.inertia.yy", "towing_vehicle.inertia[1]",
+         "16000 kg*m^2"},
+        {0, EQ, "towing_vehicle.mass_centre.z",
+         "towing_vehicle.mass_centre[2]", "0.15 m"},
+        {0, EQ, "towing_vehicle.buoyancy_centre.x",
+         "towing_vehicle.buoyancy_centre[0]", "0.02 m"},
+        {0, EQ, "towing_vehicle.tow_point.z", "towing_vehicle.tow_point[2]",
+         "1.0 m"},
+        {0, EQ, "towing_vehicle.components.hull.length",
+         "towing_vehicle.components[hull].length", "8.2 m"},
+        {0, EQ, "towing_vehicle.components.keel.area",
+         "towing_vehicle.components[keel].area", "0.65 m^2"},
+        {0, EQ, "towing_vehicle.controllers.depth.setpoint",
+         "towing_vehicle.controllers[depth].setpoint", "2.4 m"},
+        {0, MO, "towing_vehicle.controllers.depth.kp",
+         "towing_vehicle.controllers[depth].kp", "0.12 rad/m"},
+        {0, EQ, "towing_vehicle.propulsion.thrust",
+         "towing_vehicle.propulsion.thrust", "4200 N"},
+        {0, EQ, "towing_vehicle.propulsion.at.z",
+         "towing_vehicle.propulsion.at[2]", "0.2 m"},
+        {1, EQ, "towing_vehicle.propulsion.power",
+         "towing_vehicle.propulsion.power", "20 kW"},
+        {1, EQ, "towing_vehicle.propulsion.max_thrust",
+         "towing_vehicle.propulsion.max_thrust", "4400 N"},
+        {2, EQ, "towing_vehicle.propulsion.speed",
+         "towing_vehicle.propulsion.speed", "4.5 m/s"},
+        {2, MO, "towing_vehicle.propulsion.gain",
+         "towing_vehicle.propulsion.gain", "1200 N*s/m"},
+        {2, MO, "towing_vehicle.propulsion.integral_gain",
+         "towing_vehicle.propulsion.integral_gain", "60 N/m"},
+    };
+    ts_result *base[3][2] = {{NULL}};
+    for (size_t i = 0; scenes[1] && scenes[2] &&
+                       i < sizeof cases / sizeof cases[0]; i++) {
+        int s = cases[i].scene, kind = cases[i].kind;
+        const ts_system *sys = scenes[s]->system;
+        int bk = kind == MO;
+        if (!base[s][bk])
+            base[s][bk] = towing_run(sys, kind, NULL, 0, &err);
+        char unit[TS_PARAM_UNIT_MAX];
+        double x = NAN;
+        int rc = ts_param_unit(sys, cases[i].path, unit, sizeof unit, &err);
+        if (!rc)
+            rc = ts_units_parse(u, cases[i].text, unit, cases[i].path, &x,
+                                &err);
+        const char *key = cases[i].key, *text = cases[i].text;
+        ts_scene *t = rc ? NULL
+                         : ts_scene_set(scenes[s], 1, &key, &text, u, &err);
+        ts_result *a = t ? towing_run(sys, kind, cases[i].path, x, &err)
+                         : NULL;
+        ts_result *b = a ? towing_run(t->system, kind, NULL, 0, &err) : NULL;
+        int same = same_result(a, b);
+        int changed = same && base[s][bk] && changed_result(a, base[s][bk]);
+        CHECK(same && changed, "%s = %s (%.17g %s) by path gives the %s run "
+              "of the scene with %s: %s to the last digit, and not the "
+              "scene's as written (%s)", cases[i].path, text, x, unit,
+              kind == MO ? "modes" : "equilibrium", key,
+              same ? "the same" : "NOT the same", err.msg);
+        ts_result_free(a);
+        ts_result_free(b);
+        ts_scene_free(t);
+    }
+    for (int s = 0; s < 3; s++)
+        for (int k = 0; k < 2; k++)
+            ts_result_free(base[s][k]);
+
+    /* Refusals, by path and alike in the scene's text where the scene has
+     * the key (one key table). */
+    static const struct {
+        int scene;
+        const char *path, *key, *text, *says;
+    } bad[] = {
+        {1, "towing_vehicle.propulsion.power",
+         "towing_vehicle.propulsion.power", "0", "must be > 0 W, got 0 W"},
+        {2, "towing_vehicle.propulsion.speed",
+         "towing_vehicle.propulsion.speed", "-1",
+         "must be > 0 m/s, got -1 m/s"},
+        {2, "towing_vehicle.propulsion.gain",
+         "towing_vehicle.propulsion.gain", "-1",
+         "must be >= 0 N*s/m, got -1 N*s/m"},
+        {2, "towing_vehicle.propulsion.max_thrust",
+         "towing_vehicle.propulsion.max_thrust", "0",
+         "must be > 0 N, got 0 N"},
+        {0, "towing_vehicle.volume", "towing_vehicle.volume", "-1",
+         "must be >= 0 m^3, got -1 m^3"},
+    };
+    for (size_t i = 0; scenes[1] && scenes[2] &&
+                       i < sizeof bad / sizeof bad[0]; i++) {
+        ts_err e1 = {0}, e2 = {0};
+        ts_system *copy = ts_system_copy(scenes[bad[i].scene]->system, &e1);
+        int r1 = copy ? ts_param_set(copy, bad[i].path, atof(bad[i].text),
+                                     &e1)
+                      : TS_ENOMEM;
+        ts_system_free(copy);
+        const char *key = bad[i].key, *text = bad[i].text;
+        ts_scene *t = ts_scene_set(scenes[bad[i].scene], 1, &key, &text, u,
+                                   &e2);
+        CHECK(r1 == TS_EINVAL && !t && strstr(e1.msg, bad[i].says) &&
+                  strstr(e2.msg, bad[i].says),
+              "%s = %s refused alike by path (%s) and in the scene (%s)",
+              bad[i].path, text, e1.msg, e2.msg);
+        ts_scene_free(t);
+    }
+    static const struct {
+        int scene;
+        const char *path, *says;
+    } refused[] = {
+        {0, "towing_vehicle.propulsion.power",
+         "propulsion is thrust, which has no 'power'; its keys: thrust, "
+         "at.x|y|z"},
+        {1, "towing_vehicle.propulsion.gain",
+         "which has no 'gain'; its keys: power, max_thrust, at.x|y|z"},
+        {2, "towing_vehicle.propulsion.thrust", "which has no 'thrust'"},
+        {0, "towing_vehicle.attach.x",
+         "no key 'attach.x' of the towing vehicle; expected one of mass, "
+         "weight, wet_weight, volume"},
+        {0, "towing_vehicle.drag", "tow_point.x|y|z"},
+        {0, "towing_vehicle.propulsion.torque",
+         "no key 'torque' of the propulsion; expected one of thrust, "
+         "power, speed, max_thrust, gain, integral_gain, at.x|y|z"},
+        {0, "towing_vehicle.tow_point", "'tow_point' is a vector; name an "
+         "entry: tow_point.x|y|z"},
+        {0, "towing_vehicle.controllers.heading.kp",
+         "vehicle 'dolphin' has no loop 'heading'; its loops: depth"},
+        {0, "bodies.dolphin.mass", "'dolphin' is the towing vehicle; its "
+         "values are towing_vehicle.<key> (towing_vehicle.mass)"},
+        {0, "towing_vehicle.propulsion.thrust", NULL},
+    };
+    for (size_t i = 0; scenes[1] && scenes[2] &&
+                       i < sizeof refused / sizeof refused[0]; i++) {
+        ts_err e = {0};
+        ts_system *copy = ts_system_copy(scenes[refused[i].scene]->system,
+                                         &e);
+        int r = copy ? ts_param_set(copy, refused[i].path, 1.0, &e)
+                     : TS_ENOMEM;
+        ts_system_free(copy);
+        if (!refused[i].says)
+            CHECK(r == TS_OK, "%s of the thrust law is set (%s)",
+                  refused[i].path, e.msg);
+        else
+            CHECK(r == TS_EINVAL && strstr(e.msg, refused[i].path) &&
+                      strstr(e.msg, refused[i].says),
+                  "%s refused: %s", refused[i].path, e.msg);
+    }
+    {
+        ts_scene *fish = ts_scene_load("examples/aurora_towfish.yaml", u,
+                                       &err);
+        ts_err e = {0};
+        int r = fish ? ts_param_set(fish->system, "towing_vehicle.mass", 1,
+                                    &e)
+                     : TS_EINVAL;
+        CHECK(r == TS_EINVAL && strstr(e.msg, "the scene has no "
+                                              "towing_vehicle"),
+              "towing_vehicle.mass without one: %s", e.msg);
+        ts_scene_free(fish);
+    }
+    /* By form only (a sweep's canonical path): the scene's words. */
+    char canon[TS_PARAM_PATH_MAX];
+    int rc = ts_param_canonical("towing_vehicle.controllers[depth].kp",
+                                canon, sizeof canon, &err);
+    CHECK(rc == TS_OK && !strcmp(canon, "towing_vehicle.loops.depth.kp"),
+          "towing_vehicle.controllers[depth].kp by form: %s", canon);
+    rc = ts_param_canonical("towing_vehicle.propulsion.at[2]", canon,
+                            sizeof canon, &err);
+    CHECK(rc == TS_OK && !strcmp(canon, "towing_vehicle.propulsion.at.z"),
+          "towing_vehicle.propulsion.at[2] by form: %s", canon);
+    for (int s = 2; s >= 0; s--)
+        ts_scene_free(scenes[s]);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -570,6 +839,7 @@ int main(void)
         test_errors(u);
         test_scene_spelling(u);
         test_scene_words(u);
+        test_towing_paths(u);
     }
     test_vehicle();
     ts_units_free(u);

@@ -462,11 +462,13 @@ static void start_from(ts_kernel *k, const ts_equilibrium *from,
     y[ts_kernel_nq(k) + ts_kernel_root_offset(k)] = from->speed - at->speed;
 }
 
-/* 6. Thrust steps of 20 and 10 N for 20 s from the trim e of kernel k
- * (left at that trim): linear (x' = A x + B u) against nonlinear, both
- * RK4 at 0.01 s; their difference falls like the square of the step. */
-static void linear_nonlinear(ts_kernel *ka, const ts_equilibrium *ea,
-                             const char *what)
+/* 6. Steps of `amp` and amp / 2 of input `input` (unit `unit`) for 20 s
+ * from the trim e of kernel k (left at that trim): linear (x' = A x + B
+ * u) against nonlinear, both RK4 at 0.01 s; their difference falls like
+ * the square of the step. */
+static void linear_nonlinear_input(ts_kernel *ka, const ts_equilibrium *ea,
+                                   const char *what, const char *input,
+                                   double amp, const char *unit)
 {
     int n = ts_kernel_nstate(ka), nq = ts_kernel_nq(ka);
     double *y = calloc((size_t)n, sizeof(double));
@@ -474,16 +476,16 @@ static void linear_nonlinear(ts_kernel *ka, const ts_equilibrium *ea,
     ts_err err = {0};
     ts_linear *lin = ts_linear_alloc(ka, &err);
     int rc = ts_linearize_equilibrium(ka, ea, NULL, lin, &err);
-    int ju = ts_kernel_input_find(ka, "tug.thrust");
+    int ju = ts_kernel_input_find(ka, input);
     CHECK(rc == TS_OK && ju >= 0, "%s: linearized about the trim, input "
-          "tug.thrust %d", what, ju);
+          "%s %d", what, input, ju);
     double diff[2] = {0, 0}, resp[2] = {0, 0};
     double *y0 = calloc((size_t)n, sizeof(double));
     double *x = calloc((size_t)n, sizeof(double));
     double *u = calloc((size_t)ts_kernel_ninput(ka), sizeof(double));
     double *k4 = malloc(5 * (size_t)n * sizeof(double));
     for (int c = 0; rc == TS_OK && c < 2; c++) {
-        double dT = c == 0 ? 20.0 : 10.0;
+        double dT = c == 0 ? amp : 0.5 * amp;
         ts_equilibrium_state(ka, ea, y0, NULL);
         memcpy(y, y0, (size_t)n * sizeof(double));
         memset(x, 0, (size_t)n * sizeof(double));
@@ -521,10 +523,11 @@ static void linear_nonlinear(ts_kernel *ka, const ts_equilibrium *ea,
     }
     CHECK(rc == TS_OK && diff[0] < 0.02 * resp[0] &&
               diff[0] / diff[1] > 3 && diff[0] / diff[1] < 5,
-          "%s: thrust steps 20, 10 N over 20 s: linear less nonlinear "
+          "%s: %s steps %g, %g %s over 20 s: linear less nonlinear "
           "%.3g, %.3g of responses %.3g, %.3g (coordinates; ratio %.3g, "
           "the square of the step's)",
-          what, diff[0], diff[1], resp[0], resp[1], diff[0] / diff[1]);
+          what, input, amp, 0.5 * amp, unit, diff[0], diff[1], resp[0],
+          resp[1], diff[0] / diff[1]);
     ts_equilibrium_state(ka, ea, y0, NULL);
     free(y0);
     free(x);
@@ -533,6 +536,12 @@ static void linear_nonlinear(ts_kernel *ka, const ts_equilibrium *ea,
     ts_linear_free(lin);
     free(y);
     free(w);
+}
+
+static void linear_nonlinear(ts_kernel *ka, const ts_equilibrium *ea,
+                             const char *what)
+{
+    linear_nonlinear_input(ka, ea, what, "tug.thrust", 20.0, "N");
 }
 
 static void test_settle(void)
@@ -1423,6 +1432,121 @@ static void test_speed_pi(void)
     ts_scene_free(slow);
 }
 
+/* The linear model's speed (the tow point's velocity along the track,
+ * state nq + ro) T s after a step `amp` of input ju, by RK4 at h on x' =
+ * A x + B u from the trim, over amp: its static gain once settled. */
+static double linear_gain(const ts_linear *lin, int ju, int iv, double amp,
+                          double T, double h)
+{
+    int n = lin->nstate;
+    double *x = calloc((size_t)n, sizeof(double));
+    double *w = malloc(5 * (size_t)n * sizeof(double));
+    const double *A = lin->A, *B = lin->B + (size_t)ju * n;
+    for (long i = 0; i < (long)(T / h + 0.5); i++) {
+        double *st[4] = {w, w + n, w + 2 * n, w + 3 * n}, *xt = w + 4 * n;
+        for (int stage = 0; stage < 4; stage++) {
+            const double *xs = x;
+            if (stage > 0) {
+                double a = stage == 3 ? h : 0.5 * h;
+                for (int j = 0; j < n; j++)
+                    xt[j] = x[j] + a * st[stage - 1][j];
+                xs = xt;
+            }
+            for (int r = 0; r < n; r++) {
+                double v = B[r] * amp;
+                for (int j = 0; j < n; j++)
+                    v += A[r + (size_t)j * n] * xs[j];
+                st[stage][r] = v;
+            }
+        }
+        for (int j = 0; j < n; j++)
+            x[j] += h / 6 * (st[0][j] + 2 * st[1][j] + 2 * st[2][j] +
+                             st[3][j]);
+    }
+    double g = x[iv] / amp;
+    free(x);
+    free(w);
+    return g;
+}
+
+/* The set speed as an input (doc/towing-vehicle.md, section 2):
+ * tug.speed_set (m/s, added to the speed controller's set speed), a
+ * column of B by the linearizer's central differences, only with a speed
+ * controller. Its static gain to the speed: 1 with the PI controller
+ * (the integrator holds the set speed exactly); with the proportional
+ * one, whose bias T0 stays at the trim, the speed settles where T0 +
+ * gain (speed_set - U) = D(U), a gain of gain / (gain + D'(U)) with D(U)
+ * the thrust that holds the steady speed U, taken from equilibria
+ * re-solved at 3 -/+ 0.01 m/s (the trimmed bias is D). The linear model
+ * run 600 s gives both to 1e-5. Linear against nonlinear at set-speed
+ * steps of 0.1 and 0.05 m/s: the difference falls like the step's
+ * square. */
+static void test_speed_input(void)
+{
+    ts_scene *pi = tow_scene("speed: 3 m/s, gain: 2000 N*s/m, integral_gain: "
+                             "300 N/m, max_thrust: 1600 N", 0.0, 4);
+    ts_scene *p = tow_scene("speed: 3 m/s, gain: 2000 N*s/m", 0.0, 4);
+    ts_scene *lo = tow_scene("speed: 2.99 m/s, gain: 2000 N*s/m", 0.0, 4);
+    ts_scene *hi = tow_scene("speed: 3.01 m/s, gain: 2000 N*s/m", 0.0, 4);
+    ts_scene *th = thrust_scene(1400, 0);
+    if (!CHECK(pi && p && lo && hi && th, "speed-input scenes parse")) {
+        ts_scene_free(pi);
+        ts_scene_free(p);
+        ts_scene_free(lo);
+        ts_scene_free(hi);
+        ts_scene_free(th);
+        return;
+    }
+    ts_kernel *kpi, *kp, *klo, *khi, *kth;
+    ts_equilibrium *epi = solve(pi->system, &kpi), *ep = solve(p->system, &kp);
+    ts_equilibrium *elo = solve(lo->system, &klo),
+                   *ehi = solve(hi->system, &khi);
+    ts_equilibrium *eth = solve(th->system, &kth);
+    int jpi = ts_kernel_input_find(kpi, "tug.speed_set");
+    int jp = ts_kernel_input_find(kp, "tug.speed_set");
+    CHECK(jpi >= 0 && jp >= 0 &&
+              ts_kernel_input_find(kth, "tug.speed_set") < 0 &&
+              !strcmp(ts_kernel_input_unit(kpi, jpi), "m/s"),
+          "tug.speed_set is an input (m/s) with a speed controller (%d, "
+          "%d), none with a thrust", jpi, jp);
+    double dlo = elo->vehicles[ts_kernel_root(klo)].thrust;
+    double dhi = ehi->vehicles[ts_kernel_root(khi)].thrust;
+    double Dp = (dhi - dlo) / 0.02, gain = 2000.0;
+    double want_p = gain / (gain + Dp);
+    ts_err err = {0};
+    ts_linear *lpi = ts_linear_alloc(kpi, &err), *lp = ts_linear_alloc(kp, &err);
+    int rc = lpi && lp ? ts_linearize_equilibrium(kpi, epi, NULL, lpi, &err)
+                       : TS_ENOMEM;
+    if (rc == TS_OK)
+        rc = ts_linearize_equilibrium(kp, ep, NULL, lp, &err);
+    int iv = ts_kernel_nq(kpi) + ts_kernel_root_offset(kpi);
+    int ivp = ts_kernel_nq(kp) + ts_kernel_root_offset(kp);
+    double gpi = rc == TS_OK ? linear_gain(lpi, jpi, iv, 0.1, 600, 0.02)
+                             : NAN;
+    double gp = rc == TS_OK ? linear_gain(lp, jp, ivp, 0.1, 600, 0.02) : NAN;
+    CHECK(rc == TS_OK && fabs(gpi - 1) < 1e-5,
+          "PI: static gain of the speed to tug.speed_set %.9f (1: the "
+          "integrator holds the set speed) (%s)", gpi, err.msg);
+    CHECK(rc == TS_OK && want_p < 0.9 && fabs(gp - want_p) < 1e-5 * want_p,
+          "P: static gain %.9f, re-solved equilibria's gain / (gain + "
+          "dD/dU) %.9f (dD/dU %.6g N s/m from %.6f and %.6f N at 2.99 and "
+          "3.01 m/s)", gp, want_p, Dp, dlo, dhi);
+    ts_linear_free(lpi);
+    ts_linear_free(lp);
+    linear_nonlinear_input(kpi, epi, "PI at 3 m/s", "tug.speed_set", 0.1,
+                           "m/s");
+    linear_nonlinear_input(kp, ep, "P at 3 m/s", "tug.speed_set", 0.1,
+                           "m/s");
+    ts_equilibrium *eqs[5] = {epi, ep, elo, ehi, eth};
+    ts_kernel *ks[5] = {kpi, kp, klo, khi, kth};
+    ts_scene *ss[5] = {pi, p, lo, hi, th};
+    for (int i = 0; i < 5; i++) {
+        ts_equilibrium_free(eqs[i]);
+        ts_kernel_free(ks[i]);
+        ts_scene_free(ss[i]);
+    }
+}
+
 int main(void)
 {
     test_energy();
@@ -1434,6 +1558,7 @@ int main(void)
     test_motion_errors();
     test_turning_circle();
     test_speed_pi();
+    test_speed_input();
     test_neutral();
     test_labels();
     return tc_done();

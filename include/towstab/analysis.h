@@ -525,8 +525,11 @@ TS_API int ts_analysis_check(const ts_system *sys, const ts_request *rq,
 /* What the analysis of rq will cost at least (towstab/cost.h):
  * simulations (nonlinear, else the linear model's: nothing), modes (the
  * eigen solve), with the discretisation estimate's runs when asked for;
- * zero for the others. Meant to be said before a long run starts (the
- * command line does above a minute). TS_OK or TS_ENOMEM. */
+ * zero for the others. With a towing vehicle a simulation's estimate is
+ * at the steady speed and turn rate it solves first (the run's
+ * equilibrium), not the scene's starting values. Meant to be said before
+ * a long run starts (the command line does above a minute). TS_OK or
+ * TS_ENOMEM. */
 TS_API int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
                             ts_cost *e, ts_err *err);
 

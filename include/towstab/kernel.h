@@ -109,8 +109,9 @@ TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
  * the position of its attach point (the tow point, node 0) in M, three
  * coordinates after its three angles (-1 without one). Its inputs follow
  * its controllers': "<name>.thrust" (N), "<name>.force.x|y|z" (N) and
- * "<name>.moment.x|y|z" (N m, about its tow point), body axes. With a
- * towing vehicle the tow-point inputs (the first TS_NINPUT) move the
+ * "<name>.moment.x|y|z" (N m, about its tow point), body axes, and with
+ * a speed controller "<name>.speed_set" (m/s, added to its set speed).
+ * With a towing vehicle the tow-point inputs (the first TS_NINPUT) move the
  * points its cables start from relative to the body, in M axes, on top
  * of its own motion (a wave-induced motion of the tow point; zero in
  * the steady analyses).

@@ -24,6 +24,10 @@
  *   bodies.<vehicle>.components.<hull>.length | diameter | axial_drag |
  *       cross_drag | position.x|y|z
  *   bodies.<vehicle>.components.<bluff part>.area | drag | position.x|y|z
+ *   towing_vehicle.<a vehicle's key above>, with tow_point.x|y|z for
+ *     attach (the towing vehicle is not named as a body)
+ *   towing_vehicle.propulsion.thrust | power | speed | max_thrust | gain |
+ *     integral_gain | at.x|y|z (those of the scene's law)
  *   (the scene's word `controllers` and the word `loops` name the same
  *   loops; `surfaces` the same components)
  *

@@ -381,5 +381,32 @@ grep -q '"from_s": 0' "$T/o/g.json" || why="$why the manoeuvre's from_s;"
 [ -z "$why" ] && pass "forces over the window t >= 10 s: tow force $tmin to $tmax N (the run's max $whole N); a manoeuvre's over the whole run" ||
     fail "forces over the window:$why"
 
+# 14. A commanded speed change: test/scenes/towing_sphere.yaml with a PI
+# speed controller takes a step of its set speed
+# (--excite tug.speed_set:step,amplitude=0.2m/s) and response takes it as
+# its input; a length as its amplitude, and speed_set on the vehicle
+# driven by a constant thrust, are refused (exit 2) naming what was
+# expected.
+fresh
+sed 's/^    thrust: 1500 N$/    speed: 3 m\/s\n    gain: 2000 N*s\/m\n    integral_gain: 300 N\/m\n    max_thrust: 3000 N/' \
+    test/scenes/towing_sphere.yaml >"$T/o/pi.yaml"
+why=""
+ts simulate "$T/o/pi.yaml" --links 4 --t-end 5 --quiet \
+    --excite tug.speed_set:step,amplitude=0.2m/s,rise=1s --json "$T/o/pi.json"
+[ "$status" -eq 0 ] || why="$why step: exit $status: $(head -1 "$T/err");"
+ts response "$T/o/pi.yaml" --links 4 --input tug.speed_set --output sphere.z \
+    --points 5 --quiet
+[ "$status" -eq 0 ] || why="$why response: exit $status: $(head -1 "$T/err");"
+ts simulate "$T/o/pi.yaml" --links 4 --t-end 1 --quiet \
+    --excite tug.speed_set:step,amplitude=2m
+[ "$status" -eq 2 ] && grep -q "a length (m), expected a speed (m/s)" "$T/err" ||
+    why="$why a length for speed_set: exit $status, $(head -1 "$T/err");"
+ts simulate test/scenes/towing_sphere.yaml --links 4 --t-end 1 --quiet \
+    --excite tug.speed_set:step,amplitude=0.2m/s
+[ "$status" -eq 2 ] && grep -q "tug.thrust" "$T/err" ||
+    why="$why speed_set with a thrust: exit $status, $(head -1 "$T/err");"
+[ -z "$why" ] && pass "tug.speed_set: a step in simulate, an input of response; wrong units and a thrust-driven vehicle refused" ||
+    fail "tug.speed_set:$why"
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

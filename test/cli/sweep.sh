@@ -17,6 +17,9 @@
 #   another sweep is refused (2).
 # - The stability boundary of examples/kamman_ex1_above.yaml is found
 #   between 8 and 9 m/s; maps are drawn (with PLplot).
+# - The towing vehicle's propulsion (thrust, and power on the same scene
+#   with constant power) by path: each point is the single run with --set;
+#   a key of another law is refused.
 # - Bad input exits 2 naming the option: an unknown path, a malformed
 #   --vary, a column --output does not have, --no-boundary without modes,
 #   --analysis converge, no --vary.
@@ -151,6 +154,50 @@ if [ "$PLOT" = yes ]; then
     else
         fail "--plot maps: status $status $(head -c 200 "$T/err")"
     fi
+fi
+
+# ---- the towing vehicle's propulsion by path --------------------------------
+# examples/dolphin_aurora.yaml (thrust) over towing_vehicle.propulsion.thrust,
+# and the same scene with constant power over towing_vehicle.propulsion.power:
+# each point's solved speed and top tension are those of the single
+# equilibrium with --set to the last digit, and more power is more speed.
+DA=examples/dolphin_aurora.yaml
+sed 's/^    thrust: "4500 N"$/    power: "22 kW"\n    max_thrust: "9000 N"/' "$DA" \
+    >"$T/da_power.yaml"
+for spec in "$DA towing_vehicle.propulsion.thrust 4000:5000:3" \
+            "$T/da_power.yaml towing_vehicle.propulsion.power 20000:24000:3"; do
+    set -- $spec
+    scene=$1 path=$2 range=$3
+    ts sweep "$scene" --vary "$path=$range" --links 10 --chain 1 --csv "$T/tv.csv" \
+        --quiet
+    if [ "$status" -ne 0 ]; then
+        fail "sweep over $path: status $status $(head -c 200 "$T/err")"
+        continue
+    fi
+    why=""
+    prev=""
+    for p in 0 1 2; do
+        x=$(csv_value "$T/tv.csv" $p "$path")
+        [ "$(csv_value "$T/tv.csv" $p status)" = ok ] || why="$why point $p not ok;"
+        "$TOWSTAB" equilibrium "$scene" --links 10 --set "$path=$x" \
+            --json "$T/single.json" --quiet >/dev/null 2>&1 || why="$why single run $p failed;"
+        for col in dolphin.speed top_tension; do
+            a=$(csv_value "$T/tv.csv" $p $col)
+            b=$(json_key_value "$T/single.json" $col)
+            same "$a" "$b" || why="$why point $p $col $a vs $b;"
+        done
+        v=$(csv_value "$T/tv.csv" $p dolphin.speed)
+        [ -z "$prev" ] || awk -v a="$prev" -v b="$v" 'BEGIN { exit !(b > a) }' ||
+            why="$why speed $v not above $prev;"
+        prev=$v
+    done
+    check "sweep over $path: each point is the single run with --set, speed rising to $prev m/s" "$why"
+done
+ts sweep "$DA" --vary "towing_vehicle.propulsion.power=20000:24000:3"
+if [ "$status" -eq 2 ] && grep -q "propulsion is thrust, which has no 'power'" "$T/err"; then
+    pass "power on a thrust-propelled vehicle refused: $(head -c 160 "$T/err")"
+else
+    fail "power on a thrust-propelled vehicle: status $status $(head -c 200 "$T/err")"
 fi
 
 # ---- bad input --------------------------------------------------------------

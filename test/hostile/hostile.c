@@ -987,6 +987,40 @@ static void gen_cli_misuse(void)
     misuse(R, "name an entry: inertia.xx|yy|zz|xy|xz|yz", "equilibrium",
            "examples/aurora_towfish.yaml", "--quiet", "--set",
            "bodies.aurora.inertia=3", NULL);
+    /* --set on the towing vehicle (towing_vehicle.<key>): an unknown key
+     * lists what it takes, a key of another propulsion law names the
+     * law, a value beyond its limit, a non-number, a unit of another
+     * quantity, the vehicle named as a body, and towing_vehicle in a
+     * scene without one. */
+    {
+        static const char *const tv[][2] = {
+            {"towing_vehicle.mas=4000", "no key 'mas' of the towing vehicle; "
+             "expected one of mass, weight, wet_weight, volume"},
+            {"towing_vehicle.propulsion.power=20kW", "propulsion is thrust, "
+             "which has no 'power'; its keys: thrust, at.x|y|z"},
+            {"towing_vehicle.propulsion.thrust=nan",
+             "towing_vehicle.propulsion.thrust"},
+            {"towing_vehicle.propulsion.thrust=3 kg",
+             "towing_vehicle.propulsion.thrust"},
+            {"towing_vehicle.propulsion.thrust=1e400",
+             "towing_vehicle.propulsion.thrust"},
+            {"towing_vehicle.volume=-1", "must be >= 0 m^3"},
+            {"towing_vehicle.tow_point=1", "name an entry: tow_point.x|y|z"},
+            {"towing_vehicle.attach.x=1", "no key 'attach.x' of the towing "
+             "vehicle"},
+            {"towing_vehicle.components.fin.area=1", "vehicle 'dolphin' has "
+             "no component 'fin'"},
+            {"towing_vehicle.controllers.depth.kq=1", "no key 'kq' of a loop"},
+            {"bodies.dolphin.mass=1", "'dolphin' is the towing vehicle"},
+            {"towing_vehicle.=1", "towing_vehicle."},
+        };
+        for (size_t i = 0; i < sizeof tv / sizeof tv[0]; i++)
+            misuse(R, tv[i][1], "equilibrium", "examples/dolphin_aurora.yaml",
+                   "--quiet", "--set", tv[i][0], NULL);
+        misuse(R, "the scene has no towing_vehicle", "equilibrium",
+               "examples/aurora_towfish.yaml", "--quiet", "--set",
+               "towing_vehicle.mass=4000", NULL);
+    }
     /* modes */
     misuse(R, "160 states", "modes", EX1, "--quiet", "--eigen-method",
            "arpack", "--count", "79", NULL);
