@@ -910,6 +910,34 @@ static void test_neutral(void)
               "ARPACK: %d neutral modes recognised; its other %d modes are "
               "LAPACK's within %.3g of the allowance", ea->nneutral,
               ea->nmodes - ea->nneutral, far);
+        /* Coincident modes matched as a span: the free DOLPHIN's five
+         * surface actuators lag at exactly -10 1/s, as the coupled
+         * system's do; any mix of them is a mode, so one by one their
+         * MACs were 0.70 to 0.76, three paired with the same coupled
+         * mode. Over the span, each has its own partner at -10, MAC 1. */
+        ts_free_vehicle *fv = NULL;
+        ts_err ferr = {0};
+        ts_free_vehicle_compare(sc->system, eq, lin, el, &fv, &ferr);
+        int lag = 0, distinct = 1;
+        double worst_mac = 1.0;
+        for (int m = 0; fv && m < fv->nmodes; m++) {
+            const ts_free_mode *fm = &fv->modes[m];
+            if (fabs(fm->re + 10.0) > 1e-9 || fm->im != 0.0)
+                continue;
+            lag++;
+            worst_mac = fmin(worst_mac, fm->mac);
+            distinct &= fm->span >= 2;
+            distinct &= fm->coupled >= 0 &&
+                        fabs(el->modes[fm->coupled].re + 10.0) <= 1e-9;
+            for (int j = 0; j < m; j++)
+                distinct &= fabs(fv->modes[j].re + 10.0) > 1e-9 ||
+                            fv->modes[j].coupled != fm->coupled;
+        }
+        CHECK(fv && lag == 5 && distinct && worst_mac > 0.999,
+              "free DOLPHIN: %d coincident actuator lags at -10 1/s, each "
+              "paired with its own coupled lag over their span, smallest "
+              "MAC %.6f (%s)", lag, worst_mac, fv ? "ok" : ferr.msg);
+        ts_free_vehicle_free(fv);
     } else {
         CHECK(0, "dolphin_aurora: both eigen methods ran");
     }
@@ -958,14 +986,25 @@ static void test_neutral(void)
     if (el)
         ts_free_vehicle_compare(sc->system, eq, lin, el, &f, &err);
     if (CHECK(f != NULL, "free vehicle (%s)", f ? "ok" : err.msg)) {
-        int matched = 1;
+        /* Matched over the span of the coupled neutral modes, each to
+         * the one of its own symmetry, one to one. */
+        int matched = 1, used = 0;
+        double mac = 1.0;
         for (int m = 0; m < f->nmodes; m++)
-            if (f->modes[m].neutral)
-                matched &= f->modes[m].coupled >= 0 &&
-                           el->modes[f->modes[m].coupled].neutral >= 0;
-        CHECK(f->nneutral == 3 && el->nneutral == 3 && matched,
-              "the free vehicle has %d neutral modes, each matched to one "
-              "of the coupled system's %d", f->nneutral, el->nneutral);
+            if (f->modes[m].neutral) {
+                int c = f->modes[m].coupled;
+                int kn = c >= 0 ? el->modes[c].neutral : -1;
+                matched &= kn >= 0 && f->modes[m].span == 3 &&
+                           !(used & (1 << kn));
+                if (kn >= 0)
+                    used |= 1 << kn;
+                mac = fmin(mac, f->modes[m].mac);
+            }
+        CHECK(f->nneutral == 3 && el->nneutral == 3 && matched &&
+                  mac > 0.999999,
+              "the free vehicle has %d neutral modes, each matched over "
+              "the span of the coupled system's %d to a distinct one "
+              "(MAC at least %.9f)", f->nneutral, el->nneutral, mac);
     }
     ts_free_vehicle_free(f);
     ts_eigen_free(el);
