@@ -95,6 +95,8 @@ static json_t *free_vehicle_json(const ts_result *r)
             num(m->coupled_im), "coupled_freq_hz", num(m->coupled_freq_hz),
             "coupled_damping_ratio", num(m->coupled_damping_ratio), "mac",
             num(m->mac));
+        if (e)
+            json_object_set_new(e, "mac_span", json_integer(m->span));
         json_array_append_new(a, e);
     }
     json_object_set_new(o, "speed", num(f->speed));

@@ -271,38 +271,57 @@ typedef struct resp_ws {
  * doc/linear.md section 3), NaN without an error estimate. Cost: one
  * transposed solve, products with Aerr and the controller blocks,
  * O(nq^2 + nq nc). */
+/* An output's weights on the state (w->c: the row of its Jacobian, or of
+ * the node displacement map w->m for a position) and what its error
+ * allowance needs of its Jacobian (none for a position, whose map is
+ * exact). */
+typedef struct out_row {
+    const double *J, *Jerr; /* [rows x ...] Ty/Terr, Vy/Verr; NULL */
+    int rows, row;
+    double onoise;          /* the output's own rounding noise */
+} out_row;
+
+static void output_weights(const ts_linear *lin, const ts_output *out,
+                           resp_ws *w, out_row *o)
+{
+    int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
+    memset(o, 0, sizeof *o);
+    if (out->kind == TS_OUT_TENSION) {
+        o->J = lin->Ty;
+        o->Jerr = lin->Terr;
+        o->rows = nl;
+        o->row = out->link;
+        o->onoise = lin->onoise ? lin->onoise[o->row] : NAN;
+    } else if (out->kind == TS_OUT_VEHICLE) {
+        o->J = lin->Vy;
+        o->Jerr = lin->Verr;
+        o->rows = lin->noutput;
+        o->row = out->index;
+        o->onoise = lin->onoise ? lin->onoise[nl + o->row] : NAN;
+    }
+    for (int j = 0; j < n; j++)
+        w->c[j] = o->J ? o->J[o->row + (size_t)j * o->rows]
+                       : (j < nq ? w->m[j] : 0.0);
+}
+
+static double error_terms(const ts_linear *lin, int input, double complex s,
+                          const out_row *o, resp_ws *w);
+
 static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
                          const ts_output *out, resp_ws *w)
 {
     if (!lin->Aerr || !lin->Berr || !lin->fnoise)
         return NAN;
     int n = lin->nstate, nq = lin->nq, nc = n - 2 * nq, nlow = n - nq;
-    int one = 1, info = 0, nl = lin->nlinks, nout = lin->noutput;
+    int one = 1, info = 0;
     double complex s = sh->s;
     const double *A = lin->A;
     /* The output's weights c on the state and its Jacobian's error. */
-    const double *J = NULL, *Jerr = NULL;
-    int rows = 0, row = 0;
-    double onoise = 0.0;
-    if (out->kind == TS_OUT_TENSION) {
-        J = lin->Ty;
-        Jerr = lin->Terr;
-        rows = nl;
-        row = out->link;
-        onoise = lin->onoise ? lin->onoise[row] : NAN;
-    } else if (out->kind == TS_OUT_VEHICLE) {
-        J = lin->Vy;
-        Jerr = lin->Verr;
-        rows = nout;
-        row = out->index;
-        onoise = lin->onoise ? lin->onoise[nl + row] : NAN;
-    }
-    if (J && (!Jerr || !(onoise >= 0)))
+    out_row o;
+    output_weights(lin, out, w, &o);
+    if (o.J && (!o.Jerr || !(o.onoise >= 0)))
         return NAN;
     double complex *c = w->c, *W = w->W;
-    for (int j = 0; j < n; j++)
-        c[j] = J ? J[row + (size_t)j * rows]
-                 : (j < nq ? w->m[j] : 0.0);
     if (sh->full) {
         /* H - sI singular: W from the whole (A - sI)^T. */
         memcpy(W, c, (size_t)n * sizeof(double complex));
@@ -356,6 +375,19 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
                     1);
         }
     }
+    return error_terms(lin, input, s, &o, w);
+}
+
+/* The parts of the error allowance (gain_error) from W (w->W, the lower
+ * part of the transposed solution) and the state response w->x at s. */
+static double error_terms(const ts_linear *lin, int input, double complex s,
+                          const out_row *o, resp_ws *w)
+{
+    int n = lin->nstate, nlow = n - lin->nq;
+    const double *J = o->J, *Jerr = o->Jerr;
+    int rows = o->rows, row = o->row;
+    double onoise = o->onoise;
+    double complex *W = w->W;
     /* The input's columns of B and their factors. */
     int cols[3];
     double complex fac[3];
@@ -410,6 +442,11 @@ static double complex row_gain(const double *Jy, const double *Ju, int row,
     return acc;
 }
 
+static double complex output_gain(const ts_system *sys, const ts_linear *lin,
+                                  int input, const ts_output *out,
+                                  resp_ws *w, int ncols, const int cols[3],
+                                  const double complex fac[3]);
+
 /* The dense way (see the head of the file); lin holds A, B, Ty, Tu and
  * the vehicles' output Jacobians Vy, Vu. A tow displacement input brings
  * its velocity and acceleration columns, a frame input (speed, turn
@@ -420,8 +457,7 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
                        const ts_output *out, tsi_shift *sh, resp_ws *w,
                        double complex *g, double *gerr)
 {
-    int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
-    int tow = input < TS_NINPUT;
+    int n = lin->nstate;
     int cols[3];
     double complex fac[3];
     int ncols = input_columns(lin, input, sh->s, cols, fac);
@@ -435,6 +471,21 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
     tsi_shift_solve(sh, w->b, w->x); /* x = -(A - sI)^-1 b = (sI - A)^-1 B */
     if (gerr)
         *gerr = gain_error(sh, lin, input, out, w);
+    *g = output_gain(sys, lin, input, out, w, ncols, cols, fac);
+}
+
+/* The output of the state response w->x and the input's columns cols
+ * with their factors fac (input_columns): a position through the node
+ * displacement map (plus the tow displacement itself), a tension or a
+ * vehicle's output through its Jacobians. */
+static double complex output_gain(const ts_system *sys, const ts_linear *lin,
+                                  int input, const ts_output *out,
+                                  resp_ws *w, int ncols, const int cols[3],
+                                  const double complex fac[3])
+{
+    int n = lin->nstate, nq = lin->nq, nl = lin->nlinks;
+    int tow = input < TS_NINPUT;
+    double complex g;
     if (out->kind == TS_OUT_POSITION) {
         int idx = 3 * out->node + out->comp;
         for (int i = 0; i < nq; i++)
@@ -445,14 +496,137 @@ static void dense_gain(const ts_system *sys, const ts_linear *lin, int input,
             w->dq[i] = cimag(w->x[i]);
         ts_linear_node_displacements(sys, lin, w->dq, w->drr);
         double gi = w->drr[idx];
-        *g = gr + I * gi + (tow && out->comp == input ? 1.0 : 0.0);
+        g = gr + I * gi + (tow && out->comp == input ? 1.0 : 0.0);
     } else if (out->kind == TS_OUT_TENSION) {
-        *g = row_gain(lin->Ty, lin->Tu, out->link, nl, n, w->x, ncols,
-                      cols, fac);
+        g = row_gain(lin->Ty, lin->Tu, out->link, nl, n, w->x, ncols, cols,
+                     fac);
     } else {
-        *g = row_gain(lin->Vy, lin->Vu, out->index, lin->noutput, n, w->x,
-                      ncols, cols, fac);
+        g = row_gain(lin->Vy, lin->Vu, out->index, lin->noutput, n, w->x,
+                     ncols, cols, fac);
     }
+    return g;
+}
+
+/* An output sees a neutral mode g when |c^T g| > NEUTRAL_SEEN |c| |g| (c
+ * its weights on the state): doc/linear.md section 4a. */
+#define NEUTRAL_SEEN 1e-6
+/* The bordered system below counts as singular under this reciprocal
+ * condition number (another mode at 0 that no symmetry explains). */
+#define BORDER_RCOND 1e-13
+
+/* The static gain of a towing vehicle's scene, whose A is singular at 0
+ * (its neutral modes by symmetry, doc/linear.md section 3a): the limit w
+ * -> 0 of the gain, finite for an output whose weights c are orthogonal
+ * to every neutral mode R of eigenvalue 0 (the generalised null space of
+ * A: the poles' residues at 0 lie in its span, and (sI - J)^-1 of the
+ * nilpotent block J there has no constant term). Then the limit is c^T z
+ * with
+ *
+ *     [A   R] [z ]   [-b]
+ *     [R^T 0] [mu] = [ 0],
+ *
+ * regular when R spans that null space (z is the part of the response
+ * outside it, mu its drive). Its error allowance comes from the
+ * transposed system's W as for any gain (gain_error: errors dA change g
+ * by -W^T dA z). Returns TS_OK with *g, *gerr; otherwise note says why
+ * the gain is undefined (the output drifts with the named mode, or the
+ * system is singular beyond the symmetries) and the return is
+ * TS_ESINGULAR. */
+static int neutral_static(const ts_system *sys, const ts_linear *lin,
+                          int input, const ts_output *out, resp_ws *w,
+                          double *g, double *gerr, char *note, size_t size)
+{
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    int idx[TS_NEUTRAL_MAX], k = 0;
+    for (int j = 0; j < lin->nneutral && lin->neutral_re; j++)
+        if (lin->neutral[j].re == 0 && lin->neutral[j].im == 0)
+            idx[k++] = j;
+    if (k == 0 || !lin->A)
+        return TS_ESINGULAR;
+    out_row o;
+    output_weights(lin, out, w, &o);
+    double cn = 0;
+    for (int i = 0; i < n; i++)
+        cn += creal(w->c[i]) * creal(w->c[i]);
+    cn = sqrt(cn);
+    size_t len = 0;
+    for (int j = 0; j < k; j++) {
+        const double *r = lin->neutral_re + (size_t)idx[j] * n;
+        double dot = 0, rn = 0;
+        for (int i = 0; i < n; i++) {
+            dot += creal(w->c[i]) * r[i];
+            rn += r[i] * r[i];
+        }
+        if (fabs(dot) > NEUTRAL_SEEN * cn * sqrt(rn))
+            len += (size_t)snprintf(note + len, len < size ? size - len : 0,
+                                    "%s%s", len ? ", " : "undefined: the "
+                                    "output drifts with the towing "
+                                    "vehicle's neutral modes by symmetry "
+                                    "(", lin->neutral[idx[j]].name);
+    }
+    if (len) {
+        if (len < size)
+            snprintf(note + len, size - len, "): a steady input moves it "
+                     "without bound");
+        return TS_ESINGULAR;
+    }
+    int N = n + k, one = 1, info = 0;
+    double *M = calloc((size_t)N * N + 2 * (size_t)N + 4 * (size_t)N,
+                       sizeof(double));
+    int *piv = malloc((size_t)N * 2 * sizeof(int));
+    if (!M || !piv) {
+        free(M);
+        free(piv);
+        return TS_ENOMEM;
+    }
+    double *z = M + (size_t)N * N, *Wt = z + N, *work = Wt + N;
+    for (int j = 0; j < n; j++)
+        memcpy(M + (size_t)j * N, lin->A + (size_t)j * n,
+               (size_t)n * sizeof(double));
+    for (int j = 0; j < k; j++) {
+        const double *r = lin->neutral_re + (size_t)idx[j] * n;
+        for (int i = 0; i < n; i++) {
+            M[i + (size_t)(n + j) * N] = r[i];
+            M[n + j + (size_t)i * N] = r[i];
+        }
+    }
+    int cols[3];
+    double complex fac[3];
+    int ncols = input_columns(lin, input, 0.0, cols, fac);
+    for (int q = 0; q < ncols; q++) {
+        const double *Bq = lin->B + (size_t)cols[q] * n;
+        for (int i = 0; i < n; i++)
+            z[i] -= creal(fac[q]) * Bq[i];
+    }
+    double anorm = dlange_("1", &N, &N, M, &N, work, 1), rcond = 0;
+    dgetrf_(&N, &N, M, &N, piv, &info);
+    if (info == 0)
+        dgecon_("1", &N, M, &N, &anorm, &rcond, work, piv + N, &info, 1);
+    if (info != 0 || !(rcond > BORDER_RCOND)) {
+        snprintf(note, size, "undefined: the model is singular at 0 Hz "
+                 "beyond the towing vehicle's neutral modes by symmetry "
+                 "(reciprocal condition %.2g)", rcond);
+        free(M);
+        free(piv);
+        return TS_ESINGULAR;
+    }
+    dgetrs_("N", &N, &one, M, &N, piv, z, &N, &info, 1);
+    for (int i = 0; i < n; i++)
+        w->x[i] = z[i];
+    *g = creal(output_gain(sys, lin, input, out, w, ncols, cols, fac));
+    *gerr = NAN;
+    if (lin->Aerr && lin->Berr && lin->fnoise &&
+        !(o.J && (!o.Jerr || !(o.onoise >= 0)))) {
+        for (int i = 0; i < N; i++)
+            Wt[i] = i < n ? creal(w->c[i]) : 0.0;
+        dgetrs_("T", &N, &one, M, &N, piv, Wt, &N, &info, 1);
+        for (int i = 0; i < nlow; i++)
+            w->W[i] = Wt[nq + i];
+        *gerr = error_terms(lin, input, 0.0, &o, w);
+    }
+    free(M);
+    free(piv);
+    return TS_OK;
 }
 
 /* The vehicle of output j (its index; *row its row in the vehicle's
@@ -825,30 +999,45 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
              ou, iu);
     double complex g = 0;
     tsi_shift sh = {0};
-    rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g, &r->static_error,
-                 err);
-    r->static_gain = creal(g);
-    if (rc == TS_ESINGULAR && lin->root_qoff >= 0) {
-        /* A towing vehicle's neutral modes (its position along and across
-         * its track, its heading: doc/linear.md section 3a) make A
-         * singular: no static gain, the frequencies above 0 are
-         * regular. */
+    int neutral0 = 0;
+    for (int k = 0; k < lin->nneutral; k++)
+        neutral0 |= lin->neutral[k].re == 0 && lin->neutral[k].im == 0;
+    if (neutral0 && !lin->desc) {
+        /* A towing vehicle's neutral modes at 0 (its position along and
+         * across its track, its heading: doc/linear.md section 3a) make
+         * A singular, exactly or to its rounding (in a turn the heading's
+         * column is not exactly dependent): the limit w -> 0 for an
+         * output they do not move, else no static gain; the frequencies
+         * above 0 are regular. */
+        rc = neutral_static(sys, lin, input, out, &w, &r->static_gain,
+                            &r->static_error, r->static_note,
+                            sizeof r->static_note);
+    } else {
+        rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g,
+                     &r->static_error, err);
+        r->static_gain = creal(g);
+    }
+    if (rc == TS_ENOMEM) {
+        rc = ts_fail(err, rc, "response: out of memory");
+    } else if (rc == TS_ESINGULAR && lin->root_qoff >= 0) {
         ts_err_clear(err);
-        rc = TS_OK;
-        r->static_gain = r->static_error = NAN;
-        char names[128] = "";
-        for (int k = 0; k < lin->nneutral; k++) {
-            size_t len = strlen(names);
-            if (lin->neutral[k].re == 0 && lin->neutral[k].im == 0)
-                snprintf(names + len, sizeof names - len, "%s%s",
-                         len ? ", " : ": ", lin->neutral[k].name);
-        }
-        snprintf(r->static_note, sizeof r->static_note,
-                 "undefined: the model is singular at 0 Hz, where the "
-                 "towing vehicle's neutral modes by symmetry lie%s; a "
-                 "steady input may drift them without bound", names);
         tsi_shift_free(&sh);
         memset(&sh, 0, sizeof sh);
+        rc = TS_OK;
+        r->static_gain = r->static_error = NAN;
+        if (!r->static_note[0]) {
+            char names[128] = "";
+            for (int k = 0; k < lin->nneutral; k++) {
+                size_t len = strlen(names);
+                if (lin->neutral[k].re == 0 && lin->neutral[k].im == 0)
+                    snprintf(names + len, sizeof names - len, "%s%s",
+                             len ? ", " : ": ", lin->neutral[k].name);
+            }
+            snprintf(r->static_note, sizeof r->static_note,
+                     "undefined: the model is singular at 0 Hz, where the "
+                     "towing vehicle's neutral modes by symmetry lie%s; a "
+                     "steady input may drift them without bound", names);
+        }
     }
     for (int i = 0; i < npoints && rc == TS_OK; i++) {
         rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,

@@ -98,6 +98,156 @@ static void release(ts_kernel *k, ts_equilibrium *eq, ts_linear *lin,
     ts_kernel_free(k);
 }
 
+/* Free mode fm's partner: coupled mode cm of e, with its MAC. */
+static void pair(ts_free_mode *fm, const ts_eigen *e, int cm, double mac)
+{
+    const ts_mode *c2 = &e->modes[cm];
+    fm->mac = mac;
+    fm->coupled = cm;
+    fm->coupled_re = c2->re;
+    fm->coupled_im = c2->im;
+    fm->coupled_freq_hz = c2->freq_hz;
+    fm->coupled_damping_ratio = c2->damping_ratio;
+}
+
+/* Modes of e that coincide (within the sum of their error bounds, or to
+ * rounding, 1e-12 of their size) form a group; g[m] its first mode. */
+static int coincide(const ts_mode *a, const ts_mode *b)
+{
+    double d = hypot(a->re - b->re, a->im - b->im);
+    double ea = isfinite(a->error_bound) ? a->error_bound : 0.0;
+    double eb = isfinite(b->error_bound) ? b->error_bound : 0.0;
+    double size = fmax(1.0, fmax(hypot(a->re, a->im), hypot(b->re, b->im)));
+    return d <= fmax(ea + eb, 1e-12 * size);
+}
+
+static void groups(const ts_eigen *e, int g[])
+{
+    for (int m = 0; m < e->nmodes; m++) {
+        g[m] = m;
+        for (int j = 0; j < m; j++)
+            if (g[j] == j && coincide(&e->modes[j], &e->modes[m])) {
+                g[m] = j;
+                break;
+            }
+    }
+}
+
+static int group_size(const int g[], int n, int id)
+{
+    int c = 0;
+    for (int m = 0; m < n; m++)
+        c += g[m] == id;
+    return c;
+}
+
+/* The vector of mode m of e (n states) at the states map[0..nf). */
+static void restricted(const ts_eigen *e, int n, int m, const int *map,
+                       int nf, double complex *v)
+{
+    const double *re = e->vec_re + (size_t)m * n, *im = e->vec_im +
+                                                         (size_t)m * n;
+    for (int i = 0; i < nf; i++)
+        v[i] = map ? re[map[i]] + I * im[map[i]] : re[i] + I * im[i];
+}
+
+/* Free mode m is one of several coincident free modes (group fg[m]):
+ * any mix of them is a mode too, so its vector is compared with the span
+ * of each group of coincident coupled modes no larger than its own (a
+ * larger span would match anything better), the MAC being the share of
+ * its norm in that span, |P v_f|^2 / |v_f|^2. The best group, unless
+ * the single best MAC beats it, is its partner; within it the mode of the
+ * same symmetry for a neutral mode, else the best single MAC not taken
+ * by an earlier member of its own group. */
+static void match_span(const ts_eigen *fe, const ts_linear *fl,
+                       const ts_eigen *e, const ts_linear *lin,
+                       const int *fg, const int *cg, const int *map, int nf,
+                       int m, ts_free_mode *modes)
+{
+    int n = lin->nstate, fsize = group_size(fg, fe->nmodes, fg[m]);
+    double complex *v = malloc((size_t)nf * (size_t)(fsize + 2) *
+                               sizeof *v);
+    if (!v)
+        return;
+    double complex *Q = v + nf;
+    restricted(fe, fl->nstate, m, NULL, nf, v);
+    double vn = 0;
+    for (int i = 0; i < nf; i++)
+        vn += creal(v[i] * conj(v[i]));
+    ts_free_mode *fm = &modes[m];
+    double best = fm->mac;
+    int bestg = -1, bests = 0;
+    for (int c0 = 0; c0 < e->nmodes; c0++) {
+        int cs = cg[c0] == c0 ? group_size(cg, e->nmodes, c0) : 0;
+        if (cs < 2 || cs > fsize)
+            continue;
+        /* Orthonormal basis of the group's vectors (Gram-Schmidt, twice),
+         * then the share of v in it. */
+        int r = 0;
+        for (int cm = c0; cm < e->nmodes; cm++) {
+            if (cg[cm] != c0)
+                continue;
+            double complex *q = Q + (size_t)r * nf;
+            restricted(e, n, cm, map, nf, q);
+            for (int pass = 0; pass < 2; pass++)
+                for (int j = 0; j < r; j++) {
+                    const double complex *p = Q + (size_t)j * nf;
+                    double complex d = 0;
+                    for (int i = 0; i < nf; i++)
+                        d += conj(p[i]) * q[i];
+                    for (int i = 0; i < nf; i++)
+                        q[i] -= d * p[i];
+                }
+            double qn = 0;
+            for (int i = 0; i < nf; i++)
+                qn += creal(q[i] * conj(q[i]));
+            if (qn > 1e-20) {
+                for (int i = 0; i < nf; i++)
+                    q[i] /= sqrt(qn);
+                r++;
+            }
+        }
+        double share = 0;
+        for (int j = 0; j < r; j++) {
+            const double complex *p = Q + (size_t)j * nf;
+            double complex d = 0;
+            for (int i = 0; i < nf; i++)
+                d += conj(p[i]) * v[i];
+            share += creal(d * conj(d));
+        }
+        share = vn > 0 ? share / vn : 0.0;
+        if (share > best - 1e-12) { /* the span, at a tie too */
+            best = share;
+            bestg = c0;
+            bests = cs;
+        }
+    }
+    free(v);
+    if (bestg < 0)
+        return;
+    /* The partner within the group. */
+    int pick = -1;
+    const ts_mode *md = &fe->modes[m];
+    for (int cm = bestg; cm < e->nmodes && md->neutral >= 0; cm++)
+        if (cg[cm] == bestg && e->modes[cm].neutral >= 0 &&
+            !strcmp(fl->neutral[md->neutral].name,
+                    lin->neutral[e->modes[cm].neutral].name))
+            pick = cm;
+    for (int cm = bestg; cm < e->nmodes && pick < 0; cm++) {
+        if (cg[cm] != bestg)
+            continue;
+        int taken = 0;
+        for (int j = 0; j < m; j++)
+            taken |= fg[j] == fg[m] && modes[j].coupled == cm;
+        if (!taken)
+            pick = cm;
+    }
+    if (pick < 0)
+        pick = bestg;
+    pair(fm, e, pick, best);
+    fm->span = bests;
+}
+
 int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
                             const ts_linear *lin, const ts_eigen *e,
                             ts_free_vehicle **out, ts_err *err)
@@ -182,6 +332,18 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
                                ? 2 * lin->nq
                                : 2 * lin->nq + nc - ncf + j;
     int n = lin->nstate;
+    /* Coincident modes: each the first index of its group. */
+    int *fg = malloc(((size_t)fe->nmodes + (size_t)e->nmodes) * sizeof *fg);
+    if (!fg) {
+        free(map);
+        ts_free_vehicle_free(f);
+        release(k, feq, fl, fe);
+        ts_system_free(fs);
+        return ts_fail(err, TS_ENOMEM, "free vehicle: out of memory");
+    }
+    int *cg = fg + fe->nmodes;
+    groups(fe, fg);
+    groups(e, cg);
     for (int m = 0; m < fe->nmodes; m++) {
         ts_free_mode *fm = &f->modes[m];
         const ts_mode *md = &fe->modes[m];
@@ -211,17 +373,14 @@ int ts_free_vehicle_compare(const ts_system *sys, const ts_equilibrium *eq,
             double mac = nc2 > 0 && nf2 > 0
                              ? creal(dot * conj(dot)) / (nf2 * nc2)
                              : 0.0;
-            if (mac > fm->mac) {
-                const ts_mode *c2 = &e->modes[cm];
-                fm->mac = mac;
-                fm->coupled = cm;
-                fm->coupled_re = c2->re;
-                fm->coupled_im = c2->im;
-                fm->coupled_freq_hz = c2->freq_hz;
-                fm->coupled_damping_ratio = c2->damping_ratio;
-            }
+            if (mac > fm->mac)
+                pair(fm, e, cm, mac);
         }
+        fm->span = fm->coupled >= 0;
+        if (group_size(fg, fe->nmodes, fg[m]) > 1)
+            match_span(fe, fl, e, lin, fg, cg, map, nf, m, f->modes);
     }
+    free(fg);
     free(map);
     release(k, feq, fl, fe);
     ts_system_free(fs);

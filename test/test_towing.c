@@ -61,6 +61,13 @@
  *     sphere both kinds appear, and the lightly damped oscillation at
  *     2.46 rad/s, the free vehicle's roll (section 4 of
  *     doc/towing-vehicle.md), is labelled roll.
+ * 13. Static gains through the neutral modes (doc/linear.md section 4):
+ *     the response's zero-frequency limit from the thrust input to the
+ *     outputs the neutral modes do not move (the sphere's depth, the
+ *     tensions, the vehicle's pitch and depth) equals the central
+ *     difference of two Newton trims at T +- dT, straight and in a 3 deg
+ *     rudder turn; the outputs that drift with them (the sphere's x and
+ *     y, the vehicle's yaw) stay undefined, with the modes named.
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -76,6 +83,7 @@
 #include "towstab/linearize.h"
 #include "towstab/kernel.h"
 #include "towstab/output.h"
+#include "towstab/response.h"
 #include "towstab/scene.h"
 #include "towstab/towing.h"
 #include "towstab/units.h"
@@ -911,6 +919,34 @@ static void test_neutral(void)
               "ARPACK: %d neutral modes recognised; its other %d modes are "
               "LAPACK's within %.3g of the allowance", ea->nneutral,
               ea->nmodes - ea->nneutral, far);
+        /* Coincident modes matched as a span: the free DOLPHIN's five
+         * surface actuators lag at exactly -10 1/s, as the coupled
+         * system's do; any mix of them is a mode, so one by one their
+         * MACs were 0.70 to 0.76, three paired with the same coupled
+         * mode. Over the span, each has its own partner at -10, MAC 1. */
+        ts_free_vehicle *fv = NULL;
+        ts_err ferr = {0};
+        ts_free_vehicle_compare(sc->system, eq, lin, el, &fv, &ferr);
+        int lag = 0, distinct = 1;
+        double worst_mac = 1.0;
+        for (int m = 0; fv && m < fv->nmodes; m++) {
+            const ts_free_mode *fm = &fv->modes[m];
+            if (fabs(fm->re + 10.0) > 1e-9 || fm->im != 0.0)
+                continue;
+            lag++;
+            worst_mac = fmin(worst_mac, fm->mac);
+            distinct &= fm->span >= 2;
+            distinct &= fm->coupled >= 0 &&
+                        fabs(el->modes[fm->coupled].re + 10.0) <= 1e-9;
+            for (int j = 0; j < m; j++)
+                distinct &= fabs(fv->modes[j].re + 10.0) > 1e-9 ||
+                            fv->modes[j].coupled != fm->coupled;
+        }
+        CHECK(fv && lag == 5 && distinct && worst_mac > 0.999,
+              "free DOLPHIN: %d coincident actuator lags at -10 1/s, each "
+              "paired with its own coupled lag over their span, smallest "
+              "MAC %.6f (%s)", lag, worst_mac, fv ? "ok" : ferr.msg);
+        ts_free_vehicle_free(fv);
     } else {
         CHECK(0, "dolphin_aurora: both eigen methods ran");
     }
@@ -959,14 +995,25 @@ static void test_neutral(void)
     if (el)
         ts_free_vehicle_compare(sc->system, eq, lin, el, &f, &err);
     if (CHECK(f != NULL, "free vehicle (%s)", f ? "ok" : err.msg)) {
-        int matched = 1;
+        /* Matched over the span of the coupled neutral modes, each to
+         * the one of its own symmetry, one to one. */
+        int matched = 1, used = 0;
+        double mac = 1.0;
         for (int m = 0; m < f->nmodes; m++)
-            if (f->modes[m].neutral)
-                matched &= f->modes[m].coupled >= 0 &&
-                           el->modes[f->modes[m].coupled].neutral >= 0;
-        CHECK(f->nneutral == 3 && el->nneutral == 3 && matched,
-              "the free vehicle has %d neutral modes, each matched to one "
-              "of the coupled system's %d", f->nneutral, el->nneutral);
+            if (f->modes[m].neutral) {
+                int c = f->modes[m].coupled;
+                int kn = c >= 0 ? el->modes[c].neutral : -1;
+                matched &= kn >= 0 && f->modes[m].span == 3 &&
+                           !(used & (1 << kn));
+                if (kn >= 0)
+                    used |= 1 << kn;
+                mac = fmin(mac, f->modes[m].mac);
+            }
+        CHECK(f->nneutral == 3 && el->nneutral == 3 && matched &&
+                  mac > 0.999999,
+              "the free vehicle has %d neutral modes, each matched over "
+              "the span of the coupled system's %d to a distinct one "
+              "(MAC at least %.9f)", f->nneutral, el->nneutral, mac);
     }
     ts_free_vehicle_free(f);
     ts_eigen_free(el);
@@ -1545,6 +1592,130 @@ static void test_speed_input(void)
         ts_kernel_free(ks[i]);
         ts_scene_free(ss[i]);
     }
+
+/* ---- 13. static gains through the neutral modes ------------------------ */
+
+/* Output `name` of trim eq of system s (kernel k): a node's depth, a
+ * link's tension or a vehicle's output. */
+static double trim_output(ts_kernel *k, const ts_equilibrium *eq,
+                          const ts_output *o)
+{
+    if (o->kind == TS_OUT_POSITION)
+        return eq->positions[3 * o->node + o->comp];
+    if (o->kind == TS_OUT_TENSION)
+        return eq->tensions[o->link];
+    int n = ts_kernel_nstate(k), nin = ts_kernel_ninput(k);
+    double *d = malloc((size_t)(n + nin + ts_kernel_noutput(k)) *
+                       sizeof *d);
+    double *u = d + n, *out = u + nin, v = NAN;
+    memset(u, 0, (size_t)nin * sizeof *u);
+    if (ts_kernel_eval(k, eq->y, u, d) == TS_OK) {
+        ts_kernel_outputs(k, out);
+        v = out[o->index];
+    }
+    free(d);
+    return v;
+}
+
+/* The linear static gain of `name` to tug.thrust at the trim of thrust T
+ * (rudder_deg) against the central differences of the trims at T +- dT,
+ * dT = 20 and 10 N, extrapolated (Richardson, second order). */
+static void static_case(double rudder_deg, const char *const *finite,
+                        int nfinite, const char *const *drift, int ndrift)
+{
+    const double T = 1500, dT[2] = {20, 10};
+    ts_err err = {0};
+    ts_scene *sc = thrust_scene(T, rudder_deg);
+    ts_kernel *k = NULL;
+    ts_equilibrium *eq = sc ? solve(sc->system, &k) : NULL;
+    ts_linear *lin = k ? ts_linear_alloc(k, &err) : NULL;
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    lo.tensions = 1;
+    lo.model = TS_LIN_DENSE;
+    if (!CHECK(lin && ts_linearize_equilibrium(k, eq, &lo, lin, &err) ==
+                          TS_OK,
+               "static gains, rudder %g deg: linearized (%s)", rudder_deg,
+               err.msg)) {
+        ts_linear_free(lin);
+        ts_equilibrium_free(eq);
+        ts_kernel_free(k);
+        ts_scene_free(sc);
+        return;
+    }
+    /* The trims at T +- dT. */
+    ts_scene *sp[2][2] = {{0}};
+    ts_kernel *kp[2][2] = {{0}};
+    ts_equilibrium *ep[2][2] = {{0}};
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++) {
+            sp[a][b] = thrust_scene(T + (b ? -dT[a] : dT[a]), rudder_deg);
+            ep[a][b] = sp[a][b] ? solve(sp[a][b]->system, &kp[a][b]) : NULL;
+        }
+    int input = -1;
+    ts_response_input_lookup(k, "tug.thrust", &input, &err);
+    double f = 0.01;
+    for (int i = 0; i < nfinite + ndrift; i++) {
+        const char *name = i < nfinite ? finite[i] : drift[i - nfinite];
+        ts_output o;
+        ts_response *r = NULL;
+        if (ts_response_output_lookup(k, name, &o, &err) != TS_OK ||
+            ts_response_compute(sc->system, lin, input, &o, &f, 1, &r,
+                                &err) != TS_OK) {
+            CHECK(0, "static gain of %s: %s", name, err.msg);
+            continue;
+        }
+        if (i >= nfinite) {
+            CHECK(isnan(r->static_gain) &&
+                      strstr(r->static_note, "drifts with") != NULL,
+                  "rudder %g deg: %s to tug.thrust undefined: %s",
+                  rudder_deg, name, r->static_note);
+            ts_response_free(r);
+            continue;
+        }
+        double D[2];
+        for (int a = 0; a < 2; a++)
+            D[a] = (trim_output(kp[a][0], ep[a][0], &o) -
+                    trim_output(kp[a][1], ep[a][1], &o)) /
+                   (2 * dT[a]);
+        /* Richardson: the differences' error falls like dT^2; what is
+         * left is the trims' rounding over dT and the linear model's
+         * allowance. */
+        double rich = (4 * D[1] - D[0]) / 3, g = r->static_gain;
+        double tol = r->static_error + fabs(D[1] - D[0]) / 3 +
+                     1e-9 * fmax(fabs(g), 1e-12);
+        /* And the allowance itself small: a gain from a nearly singular
+         * solve (the heading's column in a turn) has a large one. Zero
+         * gains (the depth loop's integrator holds the depth; roll in a
+         * straight tow, by symmetry) are zero on both sides. */
+        int zero = fabs(g) < 1e-12 && fabs(rich) < 1e-12;
+        CHECK(fabs(g - rich) <= tol && (zero || tol <= 1e-3 * fabs(rich)),
+              "rudder %g deg: static gain of %s to tug.thrust %.9g %s, "
+              "Newton's trims %.9g (dT 20 N), %.9g (10 N), extrapolated "
+              "%.9g: off by %.2g, allowance %.2g", rudder_deg, name, g,
+              r->unit, D[0], D[1], rich, fabs(g - rich), tol);
+        ts_response_free(r);
+    }
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++) {
+            ts_equilibrium_free(ep[a][b]);
+            ts_kernel_free(kp[a][b]);
+            ts_scene_free(sp[a][b]);
+        }
+    ts_linear_free(lin);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
+static void test_static_gain(void)
+{
+    static const char *const finite[] = {"sphere.z", "sphere.tension",
+                                         "cable.1.tension", "tug.pitch",
+                                         "tug.depth", "tug.roll"};
+    static const char *const drift[] = {"sphere.x", "sphere.y", "tug.yaw"};
+    static_case(0.0, finite, 6, drift, 3);
+    static_case(3.0, finite, 6, drift + 2, 1);
 }
 
 int main(void)
@@ -1561,5 +1732,6 @@ int main(void)
     test_speed_input();
     test_neutral();
     test_labels();
+    test_static_gain();
     return tc_done();
 }

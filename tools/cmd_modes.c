@@ -558,15 +558,21 @@ static void print_free_vehicle(const ts_result *r)
     printf("%4s %12s %12s %9s   %5s %12s %12s %9s %6s\n", "free", "Re [1/s]",
            "Im [rad/s]", "damping", "mode", "Re [1/s]", "Im [rad/s]",
            "damping", "MAC");
+    int spans = 0;
     for (int i = 0; i < f->nmodes; i++) {
         const ts_free_mode *m = &f->modes[i];
         char cm[16];
         snprintf(cm, sizeof cm, "%d", m->coupled + 1);
-        printf("%4d %12.6g %12.6g %9.4g   %5s %12.6g %12.6g %9.4g %6.3f\n",
+        printf("%4d %12.6g %12.6g %9.4g   %5s %12.6g %12.6g %9.4g %6.3f%s\n",
                i + 1, m->re, m->im, m->damping_ratio,
                m->coupled >= 0 ? cm : "-", m->coupled_re, m->coupled_im,
-               m->coupled_damping_ratio, m->mac);
+               m->coupled_damping_ratio, m->mac, m->span > 1 ? " *" : "");
+        spans |= m->span > 1;
     }
+    if (spans)
+        printf("* one of coincident modes (any mix of them is a mode): "
+               "the MAC is over the span of the coincident coupled modes "
+               "it is paired within\n");
 }
 
 static void modes_print(const cli_run *c, const ts_result *r)

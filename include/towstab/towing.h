@@ -17,7 +17,13 @@
  * v_c the coupled mode's vector restricted to the vehicle's coordinates,
  * rates and controller states (the same coordinates as v_f's). A MAC near
  * 1 is the same motion of the vehicle; a small one says the cable has
- * mixed it into the cable's modes.
+ * mixed it into the cable's modes. Coincident modes (an exactly repeated
+ * eigenvalue: the neutral modes at 0, equal actuator lags) have no
+ * single shape, any mix of them being a mode: a free mode among them is
+ * matched to the span of coincident coupled modes, MAC = |P v_f|^2 /
+ * |v_f|^2 with P the projection on that span (ts_free_mode.span), and
+ * paired within it by symmetry (a neutral mode with the coupled mode of
+ * the same symmetry) or else one to one.
  */
 #ifndef TOWSTAB_TOWING_H
 #define TOWSTAB_TOWING_H
@@ -39,7 +45,17 @@ typedef struct ts_free_mode {
     int coupled;                /* the coupled mode (index in the coupled
                                    ts_eigen's modes) it is, -1 if none */
     double coupled_re, coupled_im, coupled_freq_hz, coupled_damping_ratio;
-    double mac;                 /* modal assurance criterion, 0 to 1 */
+    double mac;                 /* modal assurance criterion, 0 to 1:
+                                   with the coupled mode, or, when span
+                                   > 1, with the span of that many
+                                   coincident coupled modes */
+    int span;                   /* 1, or the size of that span: this
+                                   mode is one of several coincident free
+                                   modes (any mix of them is a mode), so
+                                   its shape is matched to the span of a
+                                   group of coincident coupled modes, no
+                                   larger than its own; 0 without a
+                                   partner */
     int neutral;                /* 1: a neutral mode by symmetry of the
                                    free vehicle (towstab/eigen.h) */
 } ts_free_mode;

@@ -237,13 +237,20 @@ if [ "$status" -eq 0 ] &&
 else
     fail "modes $D: status $status, $(grep -m1 '^verdict' "$T/out")"
 fi
-ts response "$D" --input dolphin.thrust --output aurora.z --quiet --json "$T/dr.json"
-if [ "$status" -eq 0 ] && grep -q 'static gain undefined: the model is singular at 0 Hz' "$T/out" &&
+ts response "$D" --input dolphin.thrust --output aurora.y --quiet --json "$T/dr.json"
+if [ "$status" -eq 0 ] && grep -q 'static gain undefined: the output drifts with the towing vehicle.s neutral modes by symmetry (cross-track position, heading)' "$T/out" &&
    ! grep -qiw 'nan' "$T/out" && grep -q '"static_gain": null' "$T/dr.json" &&
    grep -q '"static_gain_note": "undefined' "$T/dr.json"; then
-    pass "response $D: static gain undefined with its reason, no nan printed"
+    pass "response $D: the cross-track position's static gain undefined with its reason, no nan printed"
 else
     fail "response $D: status $status, $(grep -m1 'static gain' "$T/out")"
+fi
+ts response "$D" --input dolphin.thrust --output aurora.z --quiet --json "$T/dz.json"
+if [ "$status" -eq 0 ] && grep -q 'static gain -2.62[0-9]*e-06 +- ' "$T/out" &&
+   ! grep -q '"static_gain_note"' "$T/dz.json"; then
+    pass "response $D: the depth's static gain is finite through the neutral modes: $(grep -o 'static gain [^ ]*' "$T/out" | head -1)"
+else
+    fail "response $D: depth: status $status, $(grep -m1 'static gain' "$T/out")"
 fi
 
 echo "$npass passed, $nfail failed"
