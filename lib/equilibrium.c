@@ -954,6 +954,14 @@ static void saturated(ts_kernel *k, const double *y, char *buf, size_t size)
                          cp->name, cp->limit * 180 / M_PI);
                 break;
             }
+            if (cp->type == TS_COMP_BALLAST &&
+                (r.delta[c] <= 1e-9 * cp->capacity ||
+                 r.delta[c] >= cp->capacity * (1 - 1e-9))) {
+                snprintf(buf, size, ", with the ballast tank %s.%s %s: a "
+                         "set point out of its reach?", b->name, cp->name,
+                         r.delta[c] > 0.5 * cp->capacity ? "full" : "empty");
+                break;
+            }
         }
     }
 }

@@ -648,6 +648,10 @@ const char *ts_kernel_input_unit(const ts_kernel *k, int j)
         return j < 3 ? "m" : (j < 6 ? "m/s" : "m/s^2");
     for (int v = 0; v < k->nv; v++) {
         const veh *V = &k->veh[v];
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] == j &&
+                V->d->component[c].type == TS_COMP_BALLAST)
+                return "kg";
         for (int l = 0; l < V->d->nloops; l++)
             if (V->in_sp[l] == j)
                 return V->d->loop[l].measure == TS_MEASURE_DEPTH ? "m"
@@ -665,9 +669,16 @@ const char *ts_kernel_output_unit(const ts_kernel *k, int j)
     for (int v = 0; v < k->nv && j >= 0; v++) {
         if (j < OUT_MEASURES)
             return j == 0 ? "m" : "rad";
-        j -= OUT_MEASURES + k->veh[v].d->nloops + nsurfaces(&k->veh[v]);
+        const veh *V = &k->veh[v];
+        j -= OUT_MEASURES + V->d->nloops;
         if (j < 0)
             return "rad";
+        /* The deflections, in the order of the control components: a
+         * ballast tank's fill in kg. */
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] >= 0 && j-- == 0)
+                return V->d->component[c].type == TS_COMP_BALLAST ? "kg"
+                                                                  : "rad";
     }
     return NULL;
 }
@@ -2114,6 +2125,11 @@ void ts_kernel_vehicle_result(const ts_kernel *k, int v, ts_vehicle_result *r)
     tsi_vehicle_hydro(d, V->ws, sys->env.water_density, V->st.frac, w,
                       V->st.om_b, V->delta, r->hydro_force, r->hydro_moment,
                       r->load);
+    /* The masts' and tanks' entries: their static loads (not part of
+     * hydro_force). */
+    double Fm[3], Mm[3];
+    tsi_vehicle_statics(d, sys->env.water_density, sys->env.gravity, &V->st,
+                        V->delta, Fm, Mm, r->load);
     /* The Munk moment: the -v x p part of the loads, with gravity off. */
     double G[6];
     tsi_vehicle_loads(d, V->ws, V->mass, sys->env.water_density, 0.0, &V->st,

@@ -102,6 +102,22 @@ static const row bluff_rows[] = {
     {"drag", "1", 0, 0, TSI_KEY_PLAIN, CMP(drag)},
 };
 
+static const row mast_rows[] = {
+    {"position", "m", -INFINITY, 0, TSI_KEY_VECTOR, CMP(position)},
+    {"length", "m", 0, 1, TSI_KEY_PLAIN, CMP(length)},
+    {"area", "m^2", 0, 1, TSI_KEY_PLAIN, CMP(area)},
+    {"chord", "m", 0, 1, TSI_KEY_PLAIN, CMP(chord)},
+    {"thickness", "m", 0, 1, TSI_KEY_PLAIN, CMP(thickness)},
+};
+
+static const row ballast_rows[] = {
+    {"position", "m", -INFINITY, 0, TSI_KEY_VECTOR, CMP(position)},
+    {"capacity", "kg", 0, 1, TSI_KEY_PLAIN, CMP(capacity)},
+    {"fill", "kg", 0, 0, TSI_KEY_PLAIN, CMP(deflection)},
+    {"rate_limit", "kg/s", 0, 1, TSI_KEY_PLAIN, CMP(rate_limit)},
+    {"time_constant", "s", 0, 0, TSI_KEY_PLAIN, CMP(time_constant)},
+};
+
 /* A loop's keys: units depend on what it measures (unit "" here). */
 static const row loop_rows[] = {
     {"kp", "", -INFINITY, 0, TSI_KEY_PLAIN, offsetof(ts_loop, kp)},
@@ -182,6 +198,9 @@ const tsi_key *tsi_key_find(tsi_keys t, const char *key)
     case TSI_KEYS_BLUFF: return find_row(bluff_rows, COUNT(bluff_rows), key);
     case TSI_KEYS_PROPULSION:
         return find_row(propulsion_rows, COUNT(propulsion_rows), key);
+    case TSI_KEYS_MAST: return find_row(mast_rows, COUNT(mast_rows), key);
+    case TSI_KEYS_BALLAST:
+        return find_row(ballast_rows, COUNT(ballast_rows), key);
     default: return find_row(surface_rows, COUNT(surface_rows), key);
     }
 }
@@ -269,6 +288,8 @@ static const char *table_noun(const row *t)
            : t == hull_rows    ? "a hull"
            : t == bluff_rows   ? "a bluff part"
            : t == propulsion_rows ? "the propulsion"
+           : t == mast_rows    ? "a mast"
+           : t == ballast_rows ? "a ballast tank"
                                : "a surface";
 }
 
@@ -374,9 +395,13 @@ static const row *component_rows(ts_component_type type, int *n)
 {
     *n = type == TS_COMP_HULL    ? COUNT(hull_rows)
          : type == TS_COMP_BLUFF ? COUNT(bluff_rows)
+         : type == TS_COMP_MAST  ? COUNT(mast_rows)
+         : type == TS_COMP_BALLAST ? COUNT(ballast_rows)
                                  : COUNT(surface_rows);
     return type == TS_COMP_HULL    ? hull_rows
            : type == TS_COMP_BLUFF ? bluff_rows
+           : type == TS_COMP_MAST  ? mast_rows
+           : type == TS_COMP_BALLAST ? ballast_rows
                                    : surface_rows;
 }
 
@@ -385,13 +410,14 @@ static const row *component_rows(ts_component_type type, int *n)
 static int component_form(const char *path, const char *rest, target *tg,
                           ts_err *err)
 {
-    static const ts_component_type types[3] = {
-        TS_COMP_SURFACE, TS_COMP_HULL, TS_COMP_BLUFF};
+    static const ts_component_type types[5] = {
+        TS_COMP_SURFACE, TS_COMP_HULL, TS_COMP_BLUFF, TS_COMP_MAST,
+        TS_COMP_BALLAST};
     const char *last = strrchr(rest, '.');
     for (const char *k = last; k && k > rest; k--) {
         if (*k != '.')
             continue;
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 5; i++) {
             int n;
             const row *t = component_rows(types[i], &n);
             if (find_key(k + 1, t, n, tg) == TS_OK)
@@ -401,13 +427,14 @@ static int component_form(const char *path, const char *rest, target *tg,
             break;
     }
     char list[800] = "";
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 5; i++) {
         int n;
         const row *t = component_rows(types[i], &n);
         keys_list(t, n, list, sizeof list);
     }
     return ts_fail(err, TS_EINVAL, "%s: expected components.<name>.<key> "
-                   "with a key of a surface, a hull or a bluff part: %s",
+                   "with a key of a surface, a hull, a bluff part, a mast "
+                   "or a ballast tank: %s",
                    path, list);
 }
 

@@ -32,12 +32,12 @@ typedef struct tsi_key {
 
 /* The tables: tow (ts_tow), environment (ts_environment), a cable
  * (ts_cable), a body (ts_body), a vehicle's own keys (ts_vehicle), its
- * loop (ts_loop), lifting surface, hull and bluff part (ts_component),
- * and a towing vehicle's propulsion (ts_propulsion). */
+ * loop (ts_loop), lifting surface, hull, bluff part, mast and ballast
+ * tank (ts_component), and a towing vehicle's propulsion (ts_propulsion). */
 typedef enum {
     TSI_KEYS_TOW = 0, TSI_KEYS_ENV, TSI_KEYS_CABLE, TSI_KEYS_BODY,
     TSI_KEYS_LOOP, TSI_KEYS_SURFACE, TSI_KEYS_VEHICLE, TSI_KEYS_HULL,
-    TSI_KEYS_BLUFF, TSI_KEYS_PROPULSION
+    TSI_KEYS_BLUFF, TSI_KEYS_PROPULSION, TSI_KEYS_MAST, TSI_KEYS_BALLAST
 } tsi_keys;
 
 /* The row of `key` in table t, NULL when the table has none. */

@@ -73,11 +73,17 @@ json_t *ts_report_vehicle_json(const ts_system *sys,
             "{s:s,s:s,s:o,s:o,s:o,s:o}", "name", cp->name, "type",
             cp->type == TS_COMP_HULL    ? "hull"
             : cp->type == TS_COMP_BLUFF ? "bluff"
+            : cp->type == TS_COMP_MAST  ? "mast"
+            : cp->type == TS_COMP_BALLAST ? "ballast"
                                         : "surface",
             "force", vec3(ld->force), "moment", vec3(ld->moment), "alpha_deg",
             num(ld->alpha * DEG), "speed", num(ld->speed));
-        if (e && cp->control)
+        if (e && cp->type == TS_COMP_BALLAST)
+            json_object_set_new(e, "fill_kg", num(r->delta[c]));
+        else if (e && cp->control)
             json_object_set_new(e, "deflection_deg", num(r->delta[c] * DEG));
+        if (e && cp->type == TS_COMP_MAST)
+            json_object_set_new(e, "submerged_length", num(ld->submerged));
         json_array_append_new(comps, e);
     }
     for (int l = 0; l < r->nloops; l++)

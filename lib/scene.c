@@ -668,7 +668,8 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
 {
     enum { K_NAME, K_TYPE, K_POS, K_LEN, K_DIAM, K_AXD, K_XD, K_AREA, K_DRAG,
            K_SPAN, K_ROLL, K_INC, K_SLOPE, K_STALL, K_WIDTH, K_CD0, K_EFF,
-           K_CN90, K_TABLE, K_CONTROL, K_DEFL, K_LIMIT, K_RATE, K_TAU, K_N };
+           K_CN90, K_TABLE, K_CONTROL, K_DEFL, K_LIMIT, K_RATE, K_TAU,
+           K_CHORD, K_THICK, K_CAP, K_FILL, K_N };
     field f[K_N] = {{"name", 0, 0}, {"type", 0, 0}, {"position", 0, 0},
                     {"length", 0, 0}, {"diameter", 0, 0},
                     {"axial_drag", 0, 0}, {"cross_drag", 0, 0},
@@ -679,7 +680,9 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
                     {"zero_lift_drag", 0, 0}, {"efficiency", 0, 0},
                     {"cn90", 0, 0}, {"table", 0, 0}, {"control", 0, 0},
                     {"deflection", 0, 0}, {"limit", 0, 0},
-                    {"rate_limit", 0, 0}, {"time_constant", 0, 0}};
+                    {"rate_limit", 0, 0}, {"time_constant", 0, 0},
+                    {"chord", 0, 0}, {"thickness", 0, 0},
+                    {"capacity", 0, 0}, {"fill", 0, 0}};
     char path[PATH_LEN], p[PATH_LEN], s[SHOW_BUF];
     index_path(path, parent, j);
     int rc = read_map(c, n, path, "name, type, position, ...", f, K_N);
@@ -690,35 +693,48 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
             return missing(c, path, n, f[k].key);
     const char *type = NULL;
     rc = field_text(c, join(p, path, "type"), &f[K_TYPE],
-                    "hull, surface or bluff", &type);
+                    "hull, surface, bluff, mast or ballast", &type);
     if (rc != TS_OK)
         return rc;
     int hull = !strcmp(type, "hull"), bluff = !strcmp(type, "bluff");
-    if (!hull && !bluff && strcmp(type, "surface"))
+    int mast = !strcmp(type, "mast"), tank = !strcmp(type, "ballast");
+    if (!hull && !bluff && !mast && !tank && strcmp(type, "surface"))
         return fail_at(c, TS_EINVAL, p, f[K_TYPE].line, "unknown component "
-                       "type \"%s\"; expected hull, surface or bluff",
+                       "type \"%s\"; expected hull, surface, bluff, mast or "
+                       "ballast",
                        show(type, f[K_TYPE].value->data.scalar.length, s,
                             sizeof s));
     ts_component_defaults(cp, hull    ? TS_COMP_HULL
                               : bluff ? TS_COMP_BLUFF
+                              : mast  ? TS_COMP_MAST
+                              : tank  ? TS_COMP_BALLAST
                                       : TS_COMP_SURFACE);
     cp->line = line_of(n);
     rc = read_name(c, join(p, path, "name"), &f[K_NAME], cp->name);
     if (rc != TS_OK)
         return rc;
     /* Keys of the other types are refused: a hull's run to K_XD, a
-     * bluff part has an area and a drag, a surface an area and the rest. */
-    for (int k = K_LEN; k <= K_TAU; k++) {
-        int ok = hull ? k <= K_XD
-                      : (bluff ? (k == K_AREA || k == K_DRAG)
-                               : (k >= K_AREA && k != K_DRAG));
+     * bluff part has an area and a drag, a mast a length, an area, a
+     * chord and a thickness, a ballast tank a capacity, a fill, a rate
+     * limit and a time constant, a surface an area and the rest. */
+    for (int k = K_LEN; k <= K_FILL; k++) {
+        int ok = hull    ? k <= K_XD
+                 : bluff ? (k == K_AREA || k == K_DRAG)
+                 : mast  ? (k == K_LEN || k == K_AREA || k == K_CHORD ||
+                            k == K_THICK)
+                 : tank  ? (k == K_CAP || k == K_FILL || k == K_RATE ||
+                            k == K_TAU)
+                         : (k >= K_AREA && k != K_DRAG && k < K_CHORD);
         if (f[k].value && !ok)
             return fail_at(c, TS_ESCENE, join(p, path, f[k].key), f[k].line,
                            "does not apply to a %s component", type);
     }
     /* The key table of the component's type (param_impl.h). */
-    tsi_keys keys = hull ? TSI_KEYS_HULL : bluff ? TSI_KEYS_BLUFF
-                                                 : TSI_KEYS_SURFACE;
+    tsi_keys keys = hull    ? TSI_KEYS_HULL
+                    : bluff ? TSI_KEYS_BLUFF
+                    : mast  ? TSI_KEYS_MAST
+                    : tank  ? TSI_KEYS_BALLAST
+                            : TSI_KEYS_SURFACE;
     if (f[K_POS].value)
         rc = vector3(c, path, &f[K_POS], key_unit(keys, &f[K_POS]),
                      cp->position);
@@ -737,6 +753,40 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
     }
     if (rc != TS_OK)
         return rc;
+    if (tank) {
+        /* A tank is a control component: its fill (kg) the deflection. */
+        cp->control = 1;
+        if (!f[K_CAP].value)
+            return missing(c, path, n, "capacity");
+        if ((rc = key_value(c, path, &f[K_CAP], keys, 0, &cp->capacity)) ||
+            (rc = key_value(c, path, &f[K_FILL], keys, 0,
+                            &cp->deflection)) ||
+            (rc = key_value(c, path, &f[K_RATE], keys, INFINITY,
+                            &cp->rate_limit)) ||
+            (rc = key_value(c, path, &f[K_TAU], keys, 0,
+                            &cp->time_constant)))
+            return rc;
+        if (cp->deflection > cp->capacity)
+            return fail_at(c, TS_EINVAL, join(p, path, "fill"),
+                           f[K_FILL].line, "%g kg is more than the tank's "
+                           "capacity %g kg", cp->deflection, cp->capacity);
+        return TS_OK;
+    }
+    if (mast) {
+        static const int need[4] = {K_LEN, K_AREA, K_CHORD, K_THICK};
+        for (int k = 0; k < 4; k++)
+            if (!f[need[k]].value)
+                return missing(c, path, n, f[need[k]].key);
+        for (int k = 0; k < 4; k++) {
+            double *dst = need[k] == K_LEN    ? &cp->length
+                          : need[k] == K_AREA ? &cp->area
+                          : need[k] == K_CHORD ? &cp->chord
+                                               : &cp->thickness;
+            if ((rc = key_value(c, path, &f[need[k]], keys, 0, dst)))
+                return rc;
+        }
+        return TS_OK;
+    }
     if (bluff) {
         if (!f[K_AREA].value)
             return missing(c, path, n, "area");

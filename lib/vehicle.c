@@ -74,6 +74,17 @@ void ts_component_defaults(ts_component *c, ts_component_type type)
     c->rate_limit = INFINITY;
 }
 
+void ts_component_range(const ts_component *c, double *lo, double *hi)
+{
+    if (c->type == TS_COMP_BALLAST) {
+        *lo = 0.0;
+        *hi = c->capacity;
+    } else {
+        *lo = -c->limit;
+        *hi = c->limit;
+    }
+}
+
 double ts_lift_slope_helmbold(double ar)
 {
     return 2.0 * M_PI * ar / (2.0 + sqrt(ar * ar + 4.0));
@@ -223,6 +234,36 @@ static int check_component(const ts_component *c, const char *w,
             return rc;
         if (c->control)
             return bad(err, w, ln, "control", "a hull is not a control "
+                       "surface");
+        return TS_OK;
+    }
+    if (c->type == TS_COMP_BALLAST) {
+        if ((rc = check_value(err, w, ln, "capacity", c->capacity, 0, 1)) ||
+            (rc = check_value(err, w, ln, "time_constant", c->time_constant,
+                              0, 0)))
+            return rc;
+        if (!c->control)
+            return bad(err, w, ln, "control", "a ballast tank is a control "
+                       "component");
+        if (!(c->deflection >= 0 && c->deflection <= c->capacity))
+            return bad(err, w, ln, "fill", "must lie in [0, capacity = %g "
+                       "kg], got %g kg", c->capacity, c->deflection);
+        if (!(c->rate_limit > 0))
+            return bad(err, w, ln, "rate_limit", "must be > 0 kg/s, got %g",
+                       c->rate_limit);
+        if (isfinite(c->rate_limit) && !(c->time_constant > 0))
+            return bad(err, w, ln, "rate_limit", "a rate limit needs an "
+                       "actuator with time_constant > 0 s");
+        return TS_OK;
+    }
+    if (c->type == TS_COMP_MAST) {
+        if ((rc = check_value(err, w, ln, "length", c->length, 0, 1)) ||
+            (rc = check_value(err, w, ln, "area", c->area, 0, 1)) ||
+            (rc = check_value(err, w, ln, "chord", c->chord, 0, 1)) ||
+            (rc = check_value(err, w, ln, "thickness", c->thickness, 0, 1)))
+            return rc;
+        if (c->control)
+            return bad(err, w, ln, "control", "a mast is not a control "
                        "surface");
         return TS_OK;
     }
@@ -873,6 +914,13 @@ void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
         v3_cross(om_b, cp->position, x);
         for (int j = 0; j < 3; j++)
             wp[j] = wO_b[j] + x[j];
+        if (cp->type == TS_COMP_MAST || cp->type == TS_COMP_BALLAST) {
+            /* Statics only (tsi_vehicle_statics). */
+            memset(&ld, 0, sizeof ld);
+            if (each)
+                each[c] = ld;
+            continue;
+        }
         if (cp->type == TS_COMP_HULL) {
             hull_load(v, w, c, qrho, wp, om_b, &ld);
         } else if (cp->type == TS_COMP_BLUFF) {
@@ -887,9 +935,120 @@ void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
                          delta && cp->control ? delta[c] : 0.0, &ld);
             v3_set(ld.moment, 0, 0, 0);
         }
+        ld.submerged = 0.0;
         /* Moment about O: the component's own plus position x force. */
         v3_cross(cp->position, ld.force, x);
         v3_axpy(1.0, x, ld.moment);
+        v3_axpy(1.0, ld.force, F);
+        v3_axpy(1.0, ld.moment, Mo);
+        if (each)
+            each[c] = ld;
+    }
+}
+
+/* The cumulative distributions over a unit disc of u = n.(X, Y) for a
+ * unit vector n, as fractions of its area: P(u) the area with n.(X, Y) <
+ * u, Q1 and Q2 its first and second moments in u (the semicircle law
+ * (2 / pi) sqrt(1 - u^2) du, integrated in closed form). */
+static void disc_moments(double u, double *P, double *Q1, double *Q2)
+{
+    double r = sqrt(fmax(0.0, 1.0 - u * u)), as = asin(u);
+    *P = 0.5 + (u * r + as) / M_PI;
+    *Q1 = -2.0 / (3.0 * M_PI) * r * r * r;
+    *Q2 = (2.0 / M_PI) * (as / 8 - u * r * (1 - 2 * u * u) / 8 + M_PI / 16);
+}
+
+void tsi_mast_buoyancy(const ts_component *cp, double rho, double g,
+                       double zO, const double ez_b[3], double F[3],
+                       double Mo[3], double *submerged)
+{
+    /* Along the axis a = (0, 0, -1) from the foot p, at section offset q
+     * = (xi, eta), a point is at depth z_p - s cz + xi ez0 + eta ez1:
+     * under water (z > 0) below s = L(q) = s_c + k.q when cz > 0, with
+     * s_c = z_p / cz, k = (ez0, ez1) / cz. Over the elliptic section
+     * (semi-axes chord/2, thickness/2) k.q = m u with u distributed by
+     * the semicircle law, so the clamped length f = clamp(L, 0, h) and
+     * its moments integrate in closed form (doc/vehicle.md section 4):
+     * I0 = <f>, I1 = <u f>, I2 = <f^2 / 2> over the section. */
+    const double *p = cp->position;
+    double h = cp->length, A = cp->area;
+    double zp = zO + ez_b[0] * p[0] + ez_b[1] * p[1] + ez_b[2] * p[2];
+    double cz = ez_b[2];
+    if (fabs(cz) < 1e-12)
+        cz = cz < 0 ? -1e-12 : 1e-12;
+    double s = zp / cz, k0 = ez_b[0] / cz, k1 = ez_b[1] / cz;
+    double a0 = 0.5 * cp->chord, a1 = 0.5 * cp->thickness;
+    double m = hypot(k0 * a0, k1 * a1);
+    double I0, I1, I2;
+    if (!(m > 1e-12 * (h + fabs(s)))) {
+        double f = fmax(0.0, fmin(h, s));
+        I0 = f;
+        I1 = 0.0;
+        I2 = 0.5 * f * f;
+    } else {
+        double ul = fmax(-1.0, fmin(1.0, -s / m));
+        double uh = fmax(-1.0, fmin(1.0, (h - s) / m));
+        double Pl, Q1l, Q2l, Ph, Q1h, Q2h;
+        disc_moments(ul, &Pl, &Q1l, &Q2l);
+        disc_moments(uh, &Ph, &Q1h, &Q2h);
+        double dP = Ph - Pl, d1 = Q1h - Q1l, d2 = Q2h - Q2l;
+        I0 = s * dP + m * d1 + h * (1 - Ph);
+        I1 = s * d1 + m * d2 - h * Q1h;
+        I2 = 0.5 * (s * s * dP + 2 * s * m * d1 + m * m * d2) +
+             0.5 * h * h * (1 - Ph);
+    }
+    if (cz < 0) {
+        /* Mast pointing down: under water above L(q), the rest. */
+        I0 = h - I0;
+        I1 = -I1;
+        I2 = 0.5 * h * h - I2;
+    }
+    /* First moment of the submerged volume about O: V p + a <s> A + the
+     * section's, A I1 (a0^2 k0, a1^2 k1) / m (u's direction n = (a0 k0,
+     * a1 k1) / m scaled back to the section). */
+    double V = A * I0, S[3];
+    for (int j = 0; j < 3; j++)
+        S[j] = V * p[j];
+    S[2] -= A * I2;
+    if (I1 != 0.0) {
+        S[0] += A * I1 * a0 * a0 * k0 / m;
+        S[1] += A * I1 * a1 * a1 * k1 / m;
+    }
+    double wb = rho * g;
+    for (int j = 0; j < 3; j++)
+        F[j] = -wb * V * ez_b[j];
+    /* Moment about O: S x F / V = -rho g S x ez_b. */
+    double x[3];
+    v3_cross(S, ez_b, x);
+    for (int j = 0; j < 3; j++)
+        Mo[j] = -wb * x[j];
+    if (submerged)
+        *submerged = I0;
+}
+
+void tsi_vehicle_statics(const ts_vehicle *v, double rho, double g,
+                         const tsi_vehicle_state *st, const double delta[],
+                         double F[3], double Mo[3], ts_component_load *each)
+{
+    double ez[3] = {0, 0, 1}, ez_b[3];
+    mat3_tmul(st->R, ez, ez_b);
+    v3_set(F, 0, 0, 0);
+    v3_set(Mo, 0, 0, 0);
+    for (int c = 0; c < v->ncomponents; c++) {
+        const ts_component *cp = &v->component[c];
+        ts_component_load ld = {{0, 0, 0}, {0, 0, 0}, 0, 0, 0};
+        if (cp->type == TS_COMP_MAST) {
+            tsi_mast_buoyancy(cp, rho, g, st->rO[2], ez_b, ld.force,
+                              ld.moment, &ld.submerged);
+        } else if (cp->type == TS_COMP_BALLAST) {
+            /* The water beyond the fill in the vehicle's mass. */
+            double dm = (delta ? delta[c] : cp->deflection) - cp->deflection;
+            for (int j = 0; j < 3; j++)
+                ld.force[j] = dm * g * ez_b[j];
+            v3_cross(cp->position, ld.force, ld.moment);
+        } else {
+            continue;
+        }
         v3_axpy(1.0, ld.force, F);
         v3_axpy(1.0, ld.moment, Mo);
         if (each)
@@ -919,6 +1078,12 @@ void tsi_vehicle_loads(const ts_vehicle *v, const tsi_vehicle_ws *w,
     v3_axpy(1.0, x, Mo);
     v3_cross(v->buoyancy_centre, Fb, x);
     v3_axpy(1.0, x, Mo);
+    /* Surface-piercing masts (the buoyancy of their submerged parts) and
+     * ballast tanks (the weight of their water beyond the trim fill). */
+    double Fm[3], Mm[3];
+    tsi_vehicle_statics(v, rho, g, st, delta, Fm, Mm, NULL);
+    v3_axpy(1.0, Fm, F);
+    v3_axpy(1.0, Mm, Mo);
 
     /* Added mass (Kirchhoff, Fossen 2011 eq. 6.43): with p = A11 v + A12
      * om and L = A21 v + A22 om about O, the velocity terms are
@@ -1052,7 +1217,9 @@ void tsi_vehicle_control(const ts_vehicle *v, const tsi_control_in *in,
         }
         /* Deflection limit, then the actuator (a first-order lag whose
          * rate saturates). */
-        double d = fmax(-cp->limit, fmin(cp->limit, cmd[c]));
+        double lo, hi;
+        ts_component_range(cp, &lo, &hi);
+        double d = fmax(lo, fmin(hi, cmd[c]));
         if (cp->time_constant > 0) {
             double a = in->act ? in->act[c] : d;
             double r = (d - a) / cp->time_constant;
@@ -1146,9 +1313,22 @@ int ts_vehicle_outline(const ts_vehicle *v, const double R[9],
                            corner[k][1] * 0.5 * cp->span * sa[i];
                 outline_put(R, origin, b, pts, max, &n);
             }
+        } else if (cp->type == TS_COMP_MAST) {
+            /* Its side: a rectangle of its chord and length, up the body's
+             * -z axis from its foot. */
+            static const double corner[5][2] = {
+                {0.5, 0}, {0.5, 1}, {-0.5, 1}, {-0.5, 0}, {0.5, 0}};
+            for (int k = 0; k < 5; k++) {
+                double b[3] = {x0[0] + corner[k][0] * cp->chord, x0[1],
+                               x0[2] - corner[k][1] * cp->length};
+                outline_put(R, origin, b, pts, max, &n);
+            }
         } else {
-            /* A bluff part: a cross of its frontal area's side. */
-            double h = 0.5 * sqrt(cp->area);
+            /* A bluff part: a cross of its frontal area's side; a ballast
+             * tank: of the side of a cube of its capacity's water. */
+            double h = cp->type == TS_COMP_BALLAST
+                           ? 0.5 * cbrt(cp->capacity / 1000.0)
+                           : 0.5 * sqrt(cp->area);
             for (int axis = 0; axis < 3; axis++) {
                 if (axis > 0)
                     outline_put(R, origin, NULL, pts, max, &n);

@@ -103,9 +103,31 @@ void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
                        const double om_b[3], const double delta[],
                        double F[3], double Mo[3], ts_component_load *each);
 
+/* The buoyancy of mast component cp (TS_COMP_MAST) with the body origin
+ * at depth zO (m, down > 0) and ez_b the body components of M's e_z:
+ * force (body axes, N) and moment about O (N m) of its part under the
+ * free surface z = 0, exact for its elliptic section however the
+ * waterline cuts it (doc/vehicle.md section 4); `submerged` (may be
+ * NULL) receives the mean submerged length, m. */
+void tsi_mast_buoyancy(const ts_component *cp, double rho, double g,
+                       double zO, const double ez_b[3], double F[3],
+                       double Mo[3], double *submerged);
+
+/* The static loads of v's masts and ballast tanks at state st (R and
+ * rO) with fills delta (rad or kg per component; NULL: the trim fills):
+ * each mast's buoyancy (tsi_mast_buoyancy) and each tank's water beyond
+ * its trim fill (`deflection`, in the vehicle's mass), (delta - fill) g
+ * down at the tank. Force and moment about O in body axes; each (may be
+ * NULL) receives every mast's and tank's load. */
+void tsi_vehicle_statics(const ts_vehicle *v, double rho, double g,
+                         const tsi_vehicle_state *st, const double delta[],
+                         double F[3], double Mo[3], ts_component_load *each);
+
 /* Everything on the body but the joint and the child cables, as the
  * generalised force about A in body axes, G[6] = (force, moment): weight
- * at the mass centre, buoyancy at the buoyancy centre (times frac), the
+ * at the mass centre, buoyancy at the buoyancy centre (times frac) and
+ * of the masts' submerged parts, the ballast beyond its trim fill
+ * (tsi_vehicle_statics), the
  * components' hydrodynamics, the added mass's velocity terms (Kirchhoff)
  * and the rigid body's (gyroscopic and centripetal), both written about A:
  * M6 (a_A, alpha) = G + (F_joint, 0) + child cables. `munk` (may be NULL)

@@ -348,7 +348,8 @@ static void test_bad_fixtures(const ts_units *u)
          "missing key 'components'"},
         {"bad_vehicle_component_type", TS_EINVAL,
          "bodies[0].components[0].type", 23,
-         "unknown component type \"wing\"; expected hull, surface or bluff"},
+         "unknown component type \"wing\"; expected hull, surface, bluff, "
+         "mast or ballast"},
         {"bad_vehicle_inertia", TS_EINVAL, "bodies[0].inertia", 19,
          "needs 3 to 6 entries, got 2"},
         {"bad_vehicle_inertia_not_definite", TS_EINVAL, "bodies[0].inertia",

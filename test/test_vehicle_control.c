@@ -66,23 +66,11 @@
 static ts_system *base;   /* the scene's system at LINKS links */
 
 /* A solved closed-loop equilibrium of sys with its kernel. */
-typedef struct solved {
-    ts_kernel *k;
-    ts_equilibrium *eq;
-} solved;
+typedef tscene_solved solved;
 
 static int solve_by(const ts_system *sys, solved *s, ts_eq_method method)
 {
-    ts_err err = {0};
-    ts_equilibrium_opts o;
-    ts_equilibrium_opts_default(&o);
-    o.method = method;
-    s->k = ts_kernel_alloc(sys, &err);
-    s->eq = s->k ? ts_equilibrium_alloc(sys, &err) : NULL;
-    int rc = s->eq ? ts_equilibrium_solve(s->k, &o, s->eq, &err) : -1;
-    if (rc != TS_OK)
-        printf("  equilibrium: %s\n", err.msg);
-    return rc;
+    return tscene_solve(sys, s, method);
 }
 
 static int solve(const ts_system *sys, solved *s)
@@ -92,8 +80,7 @@ static int solve(const ts_system *sys, solved *s)
 
 static void solved_free(solved *s)
 {
-    ts_equilibrium_free(s->eq);
-    ts_kernel_free(s->k);
+    tscene_solved_free(s);
 }
 
 static ts_vehicle *vehicle_of(ts_system *sys)

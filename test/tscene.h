@@ -1,12 +1,14 @@
 /* tscene.h: loading a scene in a test program (a file or YAML text): one
- * checked line, PASS or FAIL with the reader's message. Needs tcheck.h
- * and <string.h>. */
+ * checked line, PASS or FAIL with the reader's message; and a system's
+ * equilibrium solved with its kernel. Needs tcheck.h and <string.h>. */
 #ifndef TOWSTAB_TSCENE_H
 #define TOWSTAB_TSCENE_H
 
 #include <stdio.h>
 #include <string.h>
 
+#include "towstab/equilibrium.h"
+#include "towstab/kernel.h"
 #include "towstab/scene.h"
 #include "towstab/units.h"
 
@@ -38,6 +40,35 @@ static inline ts_units *tscene_units(void)
     if (!u)
         printf("FAIL units: %s\n", err.msg);
     return u;
+}
+
+/* A solved equilibrium of a system with its kernel. */
+typedef struct tscene_solved {
+    ts_kernel *k;
+    ts_equilibrium *eq;
+} tscene_solved;
+
+/* Solve sys's equilibrium by `method` into s (free with
+ * tscene_solved_free, also on failure); the message printed on failure. */
+static inline int tscene_solve(const ts_system *sys, tscene_solved *s,
+                               ts_eq_method method)
+{
+    ts_err err = {0};
+    ts_equilibrium_opts o;
+    ts_equilibrium_opts_default(&o);
+    o.method = method;
+    s->k = ts_kernel_alloc(sys, &err);
+    s->eq = s->k ? ts_equilibrium_alloc(sys, &err) : NULL;
+    int rc = s->eq ? ts_equilibrium_solve(s->k, &o, s->eq, &err) : -1;
+    if (rc != TS_OK)
+        printf("  equilibrium: %s\n", err.msg);
+    return rc;
+}
+
+static inline void tscene_solved_free(tscene_solved *s)
+{
+    ts_equilibrium_free(s->eq);
+    ts_kernel_free(s->k);
 }
 
 #endif

@@ -543,7 +543,10 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
         const ts_vehicle_result *r = &vr[v];
         const ts_vehicle *vd = sys->bodies[r->body].vehicle;
         for (int c = 0; c < r->ncomponents; c++)
-            if (vd->component[c].control)
+            if (vd->component[c].type == TS_COMP_BALLAST)
+                fprintf(f, "%s.%s fill %.4f kg\n", sys->bodies[r->body].name,
+                        vd->component[c].name, r->delta[c]);
+            else if (vd->component[c].control)
                 fprintf(f, "%s.%s deflection %.4f %s\n",
                         sys->bodies[r->body].name, vd->component[c].name,
                         r->delta[c] * ka, au);
@@ -573,6 +576,12 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
         fprintf(f, "%-20s %11s %11s %11s %11.4f %11.4f %11.4f\n",
                 "Munk moment", "", "", "", kf * kl * r->munk[0],
                 kf * kl * r->munk[1], kf * kl * r->munk[2]);
+        for (int c = 0; c < r->ncomponents; c++)
+            if (vd->component[c].type == TS_COMP_MAST)
+                fprintf(f, "%s.%s submerged length %.4f %s (its force: "
+                           "buoyancy)\n",
+                        sys->bodies[r->body].name, vd->component[c].name,
+                        r->load[c].submerged * kl, lu);
         fprintf(f, "%s (M) %.4f, %.4f, %.4f %s\n",
                 r->towing ? "cable pull at the tow point" : "joint force",
                 kf * r->joint_force[0], kf * r->joint_force[1],

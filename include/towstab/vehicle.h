@@ -32,8 +32,24 @@ extern "C" {
 typedef enum {
     TS_COMP_HULL = 0,     /* slender hull: axial and cross-flow drag */
     TS_COMP_SURFACE = 1,  /* lifting surface: lift and drag curves */
-    TS_COMP_BLUFF = 2     /* bluff part (a ballast weight, a bulb): drag
+    TS_COMP_BLUFF = 2,    /* bluff part (a ballast weight, a bulb): drag
                              -1/2 rho Cd A |w| w whatever the direction */
+    TS_COMP_MAST = 3,     /* surface-piercing mast: a straight prism up
+                             the body's -z axis from its foot `position`,
+                             `length` high, of section `area` (chord along
+                             x, thickness along y); the buoyancy of its
+                             part under the free surface z = 0, which
+                             follows the vehicle's depth and attitude
+                             (doc/vehicle.md section 4); no drag (give
+                             its drag as bluff parts) */
+    TS_COMP_BALLAST = 4   /* ballast tank at `position`: controlled
+                             buoyancy. Its fill (kg of water, in [0,
+                             capacity]) is a control component's
+                             deflection (control is 1): an input, an
+                             output, driven by loops, through an actuator
+                             with a rate limit (kg/s); the fill beyond
+                             `deflection` (the fill included in the
+                             vehicle's mass) weighs at the tank. */
 } ts_component_type;
 
 typedef enum {
@@ -55,6 +71,15 @@ typedef struct ts_component {
     double diameter;      /* m, > 0 */
     double cd_axial;      /* axial drag coefficient on pi D^2 / 4 */
     double cd_cross;      /* cross-flow drag coefficient on D dx */
+    /* Mast (and `length`, `area`): its section's chord (along body x)
+     * and thickness (along y), m, > 0; the waterplane's second moments
+     * are those of an ellipse of the section's area, area chord^2 / 16
+     * and area thickness^2 / 16 (exact for an elliptic or circular
+     * section). */
+    double chord, thickness;
+    /* Ballast tank: the most water it holds, kg, > 0 (its fill, the
+     * deflection, lies in [0, capacity]; `limit` stays INFINITY). */
+    double capacity;
     /* Lifting surface: chord along body x, normal (0, -sin roll, cos
      * roll): roll 0 is a horizontal surface with its normal down, +-pi/2
      * a vertical fin, +-pi/4 and +-3pi/4 an X tail. */
@@ -206,13 +231,16 @@ TS_API double ts_propulsion_thrust(const ts_propulsion *p, double u,
                                    double bias, double input);
 
 /* Loads of one component (body axes): force (N), moment about the body
- * origin O (N m), its angle of attack (a surface: with incidence and
+ * origin O (N m) (a mast: its buoyancy), its angle of attack (a surface: with incidence and
  * deflection; the hull: of the flow at its centre, atan2(w_z, w_x)) and
  * the speed of the flow past it (m/s; a surface: in its chord-normal
  * plane). */
 typedef struct ts_component_load {
     double force[3], moment[3];
     double alpha, speed;
+    double submerged;     /* a mast: its mean submerged length along its
+                             axis (its submerged volume over its section
+                             area), m; 0 for the other components */
 } ts_component_load;
 
 /* A vehicle at one state (ts_kernel_vehicle_result). Angles in rad. */
@@ -264,6 +292,11 @@ typedef struct ts_vehicle_result {
  * cross 1.2; surface lifting line, Helmbold slope, stall 15 deg, width 3
  * deg, cd0 0.01, efficiency 0.9, cn90 1.2, no limits, ideal actuator. */
 TS_API void ts_component_defaults(ts_component *c, ts_component_type type);
+
+/* The range of a control component's command: a surface's [-limit,
+ * limit] (rad), a ballast tank's [0, capacity] (kg). */
+TS_API void ts_component_range(const ts_component *c, double *lo,
+                               double *hi);
 
 /* Validate a vehicle description (finite values, ranges, tables, loops
  * referring to control surfaces, symmetric added mass with a
