@@ -1301,10 +1301,17 @@ static void fill_mode(ts_mode *md, const cand *c)
 #define NEUTRAL_SHIFT_REL 1e-8
 /* A computed eigenvector is recognised as a neutral mode when its angle
  * to the span of that eigenvalue's generators is below this many times
- * the first-order allowance ||dA|| / gap (dA the linearization's error
- * estimate, gap the distance to the nearest other eigenvalue); the
- * allowance itself must be below NEUTRAL_ANGLE_MAX (rad), else the
- * cluster is too close to tell. */
+ * the first-order allowance max(|dA g|, |dlambda|) / gap (gap the
+ * distance to the nearest other eigenvalue, dlambda the computed
+ * eigenvalue's distance from the exact one). The generators g are exact
+ * eigenvectors of the exact A (by symmetry), so dA g = A g - s g is the
+ * computed A's residual on them, measured, not bounded: it is what moves
+ * the computed eigenvector off their span, by more where the eigenvalue
+ * is ill-conditioned, which dlambda shows. Without the dense A the bound ||dA|| of the
+ * linearization's error estimate stands in for it (far larger on a long
+ * cable: its norm is that of the finest links' rows). The allowance
+ * itself must be below NEUTRAL_ANGLE_MAX (rad), else the cluster is too
+ * close to tell. */
 #define NEUTRAL_SAFETY 10.0
 #define NEUTRAL_ANGLE_MAX 0.01
 
@@ -1331,6 +1338,45 @@ static double *cut_cyclic(const ts_linear *lin)
         }
     }
     return a;
+}
+
+/* The largest |A' g - s g| / |g| over the generators gk[0..m) of s, A'
+ * the dense A with the cyclic states' rows and columns cut as the
+ * eigensolvers see it (cut_cyclic); INFINITY without the dense A. O(n^2)
+ * per generator: the dense path's cost, below its eigensolver's. */
+static double generator_residual(const ts_linear *lin, double complex s,
+                                 const int *gk, int m)
+{
+    if (!lin->A)
+        return INFINITY;
+    int n = lin->nstate;
+    char *cut = calloc((size_t)n, 1);
+    if (!cut)
+        return INFINITY;
+    for (int k = 0; k < lin->nneutral; k++)
+        if (lin->neutral[k].cyclic >= 0)
+            cut[lin->neutral[k].cyclic] = 1;
+    double worst = 0;
+    for (int r = 0; r < m; r++) {
+        const double *gr = lin->neutral_re + (size_t)gk[r] * n;
+        const double *gi = lin->neutral_im + (size_t)gk[r] * n;
+        double g2 = 0, r2 = 0;
+        for (int i = 0; i < n; i++)
+            g2 += gr[i] * gr[i] + gi[i] * gi[i];
+        for (int i = 0; i < n; i++) {
+            double complex ag = 0;
+            if (!cut[i])
+                for (int j = 0; j < n; j++)
+                    if (!cut[j])
+                        ag += lin->A[i + (size_t)j * n] * (gr[j] + I * gi[j]);
+            ag -= s * (gr[i] + I * gi[i]);
+            r2 += creal(ag * conj(ag));
+        }
+        if (g2 > 0)
+            worst = fmax(worst, sqrt(r2 / g2));
+    }
+    free(cut);
+    return worst;
 }
 
 /* Mark the candidates that are lin's neutral modes: for each eigenvalue s
@@ -1395,8 +1441,9 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L)
             if (!(d <= fmax(b, floor)))
                 gap = fmin(gap, d);
         }
-        double tol = NEUTRAL_SAFETY * dA / gap;
-        if (!(tol <= NEUTRAL_ANGLE_MAX))
+        double res = generator_residual(lin, s, gk, m);
+        if (!(NEUTRAL_SAFETY * fmin(dA, res + floor) / gap <=
+              NEUTRAL_ANGLE_MAX))
             continue;
         for (int taken = 0; taken < m;) {
             int best = -1;
@@ -1426,7 +1473,11 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L)
                 p2 += creal(d * conj(d));
             }
             double sin_angle = sqrt(fmax(0.0, 1.0 - p2 / v2));
-            if (!(sin_angle <= tol))
+            /* The same dA moved the eigenvalue by bd: through its
+             * condition number that can exceed |dA g|, and the vector
+             * moves with it. */
+            double tol = NEUTRAL_SAFETY * fmin(dA, fmax(res, bd) + floor) / gap;
+            if (!(sin_angle <= tol && tol <= NEUTRAL_ANGLE_MAX))
                 break;
             /* The generator it overlaps most, not yet taken. */
             int kb = -1;
