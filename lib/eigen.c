@@ -620,8 +620,12 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
  * this fraction of |lambda| has not converged and is dropped. */
 #define SWEEP_RESIDUAL 1e-6
 
-static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
-                        ts_err *err)
+/* The residuals and error estimates of L's unchecked candidates: A
+ * applied with acc (S_inf), S(lambda) factored in es (the caller's,
+ * zeroed before the first call, tsi_shift_free after the last: each
+ * estimate refactors the previous one's factors, lib/shift.h). */
+static int batch_checks(const ts_linear *lin, tsi_shift *acc, tsi_shift *es,
+                        cand_list *L, ts_err *err)
 {
     int n = lin->nstate;
     double *w = malloc(4 * (size_t)n * sizeof(double));
@@ -629,9 +633,13 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     double *vr = w, *vi = w + n, *ar = w + 2 * n, *ai = w + 3 * n;
     int with_err = lin->desc_err == lin->desc_err; /* not NaN */
-    tsi_shift es = {0}; /* S(lambda) of each error estimate */
-    for (int c = 0; c < L->n; c++) {
-        if (L->c[c].checked)
+    /* The real eigenvalues first, then the complex ones: each estimate
+     * refactors S(lambda) with the previous one's pivots, which a change
+     * between real and complex arithmetic cannot reuse. */
+    for (int pass = 0; pass < 2 * L->n; pass++) {
+        int c = pass % L->n;
+        if (L->c[c].checked ||
+            (cimag(L->c[c].lam) != 0.0) != (pass >= L->n))
             continue;
         L->c[c].checked = 1;
         const double complex *v = L->v + (size_t)L->c[c].vec * n;
@@ -645,10 +653,9 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
         L->c[c].ritz = L->c[c].round;
         if (with_err) {
             double ritz;
-            int rc = tsi_shift_eig_error(&es, lin, L->c[c].lam, v,
+            int rc = tsi_shift_eig_error(es, lin, L->c[c].lam, v,
                                          &L->c[c].dlam, &ritz, err);
             if (rc != TS_OK) {
-                tsi_shift_free(&es);
                 free(w);
                 return rc;
             }
@@ -660,7 +667,6 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, cand_list *L,
                 L->c[c].ritz = L->c[c].round = ritz;
         }
     }
-    tsi_shift_free(&es);
     free(w);
     return TS_OK;
 }
@@ -1682,11 +1688,11 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     } else {
         for (int i = 0; i < L.n; i++)
             L.c[i].checked = i < keep ? 0 : -1;
-        tsi_shift acc = {0};
+        tsi_shift acc = {0}, es = {0};
         if (lin->desc) {
             rc = tsi_shift_factor_inf(&acc, lin, err);
             if (rc == TS_OK)
-                rc = batch_checks(lin, &acc, &L, err);
+                rc = batch_checks(lin, &acc, &es, &L, err);
         } else {
             rc = dense_checks(lin, &L, err);
         }
@@ -1702,7 +1708,7 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
             if (best < 0)
                 break;
             L.c[best].checked = 0;
-            rc = batch_checks(lin, &acc, &L, err);
+            rc = batch_checks(lin, &acc, &es, &L, err);
             if (L.c[best].ritz > SWEEP_RESIDUAL * cabs(L.c[best].lam)) {
                 L.c[best].sweep = 3;
                 e->sweep_rejected++;
@@ -1712,6 +1718,7 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
         }
         if (acc.numeric || acc.lu || acc.zlu)
             tsi_shift_free(&acc);
+        tsi_shift_free(&es);
         for (int i = 0; i < L.n; i++)
             if (L.c[i].checked == 1 && L.c[i].sweep != 3)
                 cover[ncover++] = i;

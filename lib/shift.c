@@ -20,13 +20,9 @@
 #define XT(l) TSI_XT(l)
 #define XC(j) tsi_desc_xc(d, (j))
 
-void tsi_shift_free(tsi_shift *sh)
+/* Release KLU's factors (of the kind sh->is_complex says). */
+static void free_numeric(tsi_shift *sh)
 {
-    free(sh->lu);
-    free(sh->zlu);
-    free(sh->ipiv);
-    free(sh->zw);
-    free(sh->wr);
     if (sh->numeric) {
         klu_numeric *num = sh->numeric;
         if (sh->is_complex)
@@ -34,6 +30,17 @@ void tsi_shift_free(tsi_shift *sh)
         else
             klu_free_numeric(&num, sh->common);
     }
+    sh->numeric = NULL;
+}
+
+void tsi_shift_free(tsi_shift *sh)
+{
+    free(sh->lu);
+    free(sh->zlu);
+    free(sh->ipiv);
+    free(sh->zw);
+    free(sh->wr);
+    free_numeric(sh);
     free(sh->common);
     free(sh->Sx);
     free(sh->Sk);
@@ -44,6 +51,7 @@ void tsi_shift_free(tsi_shift *sh)
     free(sh->u1);
     free(sh->u2);
     free(sh->w);
+    free(sh->ework);
     free(sh->hlu);
     free(sh->hpiv);
     free(sh->wc);
@@ -404,60 +412,74 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
     return factor(sh, err);
 }
 
+/* S's parts Sk, Sc, Sm (tsi_desc_fill_parts), computed once per sh. */
+static int ensure_parts(tsi_shift *sh, ts_err *err)
+{
+    if (sh->Sk)
+        return TS_OK;
+    const ts_descriptor *d = sh->d;
+    size_t nz = (size_t)d->nnz + 1;
+    sh->Sk = malloc(nz * sizeof(double));
+    sh->Sc = malloc(nz * sizeof(double));
+    sh->Sm = malloc(nz * sizeof(double));
+    if (!sh->Sk || !sh->Sc || !sh->Sm) {
+        tsi_shift_free(sh);
+        return ts_fail(err, TS_ENOMEM, "shift: out of memory for %d "
+                       "unknowns", d->nx);
+    }
+    tsi_desc_fill_parts(d, sh->Sk, sh->Sc, sh->Sm);
+    return TS_OK;
+}
+
 int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
                        ts_err *err)
 {
     int cplx = cimag(s) != 0.0;
-    if (!sh->numeric || sh->inf || cplx != sh->is_complex ||
-        sh->lin != lin) {
+    if (!sh->numeric || sh->inf || sh->lin != lin) {
         tsi_shift_free(sh);
         return tsi_shift_factor(sh, lin, s, err);
     }
+    int rc = ensure_parts(sh, err);
+    if (rc != TS_OK)
+        return rc;
     const ts_descriptor *d = sh->d;
     klu_common *kc = sh->common;
     klu_symbolic *sym = d->klu_symbolic;
     klu_numeric *num = sh->numeric;
     sh->s = s;
-    if (!sh->Sk) {
-        size_t nz = (size_t)d->nnz + 1;
-        sh->Sk = malloc(nz * sizeof(double));
-        sh->Sc = malloc(nz * sizeof(double));
-        sh->Sm = malloc(nz * sizeof(double));
-        if (!sh->Sk || !sh->Sc || !sh->Sm) {
-            tsi_shift_free(sh);
-            return ts_fail(err, TS_ENOMEM, "shift: out of memory for %d "
-                           "unknowns", d->nx);
-        }
-        tsi_desc_fill_parts(d, sh->Sk, sh->Sc, sh->Sm);
-    }
     /* S(s) from its parts: one pass, the same values as
      * tsi_desc_fill_complex and _real. */
     const double *Sk = sh->Sk, *Sc = sh->Sc, *Sm = sh->Sm;
     double complex s2 = s * s;
     double sr = creal(s), si = cimag(s), qr = creal(s2), qi = cimag(s2);
-    int ok, scale = kc->scale;
-    kc->scale = -1;
     if (cplx) {
         for (int p = 0; p < d->nnz; p++) {
             sh->Sx[2 * p] = Sk[p] + sr * Sc[p] + qr * Sm[p];
             sh->Sx[2 * p + 1] = si * Sc[p] + qi * Sm[p];
         }
-        ok = klu_z_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
-             klu_z_rcond(sym, num, kc);
     } else {
         for (int p = 0; p < d->nnz; p++)
             sh->Sx[p] = Sk[p] + sr * Sc[p] + qr * Sm[p];
-        ok = klu_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
-             klu_rcond(sym, num, kc);
     }
-    kc->scale = scale;
-    /* The old pivots serve while the factors stay as well conditioned as
-     * a fresh factorisation's, within SHIFT_REFACTOR_RCOND (both
-     * unscaled). */
-    if (ok && kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond_raw)
-        return TS_OK;
-    tsi_shift_free(sh);
-    return tsi_shift_factor(sh, lin, s, err);
+    if (cplx == sh->is_complex) {
+        int ok, scale = kc->scale;
+        kc->scale = -1;
+        ok = cplx ? klu_z_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
+                        klu_z_rcond(sym, num, kc)
+                  : klu_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
+                        klu_rcond(sym, num, kc);
+        kc->scale = scale;
+        /* The old pivots serve while the factors stay as well conditioned
+         * as a fresh factorisation's, within SHIFT_REFACTOR_RCOND (both
+         * unscaled). */
+        if (ok && kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond_raw)
+            return TS_OK;
+    }
+    /* Afresh, with pivoting and scaling (and of the other kind when s
+     * crossed the real axis), in the arrays already held. */
+    free_numeric(sh);
+    sh->is_complex = cplx;
+    return factor(sh, err);
 }
 
 int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err)
@@ -812,14 +834,15 @@ static void unit_max(double complex *w, int m)
             w[i] /= big;
 }
 
-/* w^T S(lam) X from S's parts P[3 nnz] (Sk, Sc, Sm: S(s) = Sk + s Sc
- * + s^2 Sm), X[nx] the unknowns (points and controller states; the
+/* w^T S(lam) X from S's parts in sh (Sk, Sc, Sm: S(s) = Sk + s Sc +
+ * s^2 Sm), X[nx] the unknowns (points and controller states; the
  * tensions' entries zero), summed against w[nx]. O(nnz). */
-static double complex pencil_form(const ts_descriptor *d, const double *P,
+static double complex pencil_form(const tsi_shift *sh,
                                   const double complex *w,
                                   const double complex *X, double complex lam)
 {
-    const double *Sk = P, *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+    const ts_descriptor *d = sh->d;
+    const double *Sk = sh->Sk, *Sc = sh->Sc, *Sm = sh->Sm;
     double complex sum = 0;
     for (int j = 0; j < d->nx; j++) {
         if (X[j] == 0)
@@ -831,13 +854,13 @@ static double complex pencil_form(const ts_descriptor *d, const double *P,
     return sum;
 }
 
-/* z[nx] = S'(lam)^T w[nx], S'(s) = Sc + 2 s Sm from S's parts P[3 nnz]
+/* z[nx] = S'(lam)^T w[nx], S'(s) = Sc + 2 s Sm from S's parts in sh
  * (zero on the tensions' columns). O(nnz). */
-static void pencil_dtmul(const ts_descriptor *d, const double *P,
-                         const double complex *w, double complex lam,
-                         double complex *z)
+static void pencil_dtmul(const tsi_shift *sh, const double complex *w,
+                         double complex lam, double complex *z)
 {
-    const double *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
+    const ts_descriptor *d = sh->d;
+    const double *Sc = sh->Sc, *Sm = sh->Sm;
     for (int j = 0; j < d->nx; j++) {
         double complex sum = 0;
         for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
@@ -860,91 +883,76 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         return TS_OK;
     int nx = d->nx, nq = lin->nq, nc = d->nc;
     size_t m = 3 * (size_t)d->np + (size_t)nc;
-    double complex *w = malloc(2 * ((size_t)nx + 1) * sizeof *w);
-    double complex *x = malloc(m * sizeof *x);
-    double complex *X = calloc((size_t)nx + 1, sizeof *X);
-    double *q = malloc(((size_t)nq + 1) * sizeof *q);
-    double *u = malloc(2 * m * sizeof *u);
-    double *P = malloc(3 * ((size_t)d->nnz + 1) * sizeof *P);
-    if (!w || !x || !X || !q || !u || !P) {
-        free(w);
-        free(x);
-        free(X);
-        free(q);
-        free(u);
-        free(P);
-        return ts_fail(err, TS_ENOMEM, "eigen: out of memory for the error "
-                       "estimate");
-    }
     /* S(lam), or a shift beside it when lam is an eigenvalue to working
      * precision (inverse iteration needs only to be near). */
     int rc = TS_ESINGULAR;
     double nudge = 1e-10 * (cabs(lam) > 0 ? cabs(lam) : 1.0);
     for (int t = 0; t < 3 && rc == TS_ESINGULAR; t++, nudge *= 100.0)
         rc = tsi_shift_refactor(sh, lin, t == 0 ? lam : lam + nudge, NULL);
+    /* The work (w, z, X complex [nx + 1] each, x complex [m], q [nq + 1],
+     * u [2 m]) and S's parts are kept in sh for the next eigenvalue. */
+    size_t nw = 6 * ((size_t)nx + 1) + 4 * m + (size_t)nq + 1;
+    if (rc == TS_OK && !sh->ework && !(sh->ework = malloc(nw * sizeof(double))))
+        rc = TS_ENOMEM;
+    if (rc == TS_OK && ensure_parts(sh, NULL) != TS_OK)
+        rc = TS_ENOMEM;
     if (rc == TS_ENOMEM)
-        ts_fail(err, rc, "eigen: out of memory for the error estimate");
-    if (rc == TS_OK) {
-        /* Inverse iteration for the left vector of the quadratic pencil:
-         * S(lam)^-T b grows along w by x^T b / (lam - lam*), so from the
-         * second step on b = S'(lam)^T w (x^T S'^T w = w^T S' x is the
-         * pencil's normalisation, never zero for a simple eigenvalue,
-         * while w^T x itself may vanish: then S^-T w would not grow
-         * along w at all). */
-        tsi_desc_fill_parts(d, P, P + d->nnz, P + 2 * (size_t)d->nnz);
-        double complex *z = w + nx;
-        for (int i = 0; i < nx; i++)
-            w[i] = 1.0 + (double)(i % 7) / 7.0;
-        for (int it = 0; it < 2; it++) {
-            if (it > 0) {
-                pencil_dtmul(d, P, w, lam, z);
-                memcpy(w, z, (size_t)nx * sizeof *w);
-            }
-            tsi_shift_tsolve(sh, w);
-            unit_max(w, nx);
+        return ts_fail(err, rc, "eigen: out of memory for the error "
+                       "estimate");
+    if (rc == TS_ESINGULAR)
+        return ts_fail(err, rc, "eigen: the pencil is singular beside "
+                       "%g%+gi 1/s", creal(lam), cimag(lam));
+    if (rc != TS_OK)
+        return ts_fail(err, rc, "eigen: KLU failed at %g%+gi 1/s",
+                       creal(lam), cimag(lam));
+    double complex *w = (double complex *)sh->ework;
+    double complex *z = w + nx + 1, *X = z + nx + 1, *x = X + nx + 1;
+    double *q = (double *)(x + m), *u = q + nq + 1;
+    memset(X, 0, ((size_t)nx + 1) * sizeof *X);
+    /* Inverse iteration for the left vector of the quadratic pencil:
+     * S(lam)^-T b grows along w by x^T b / (lam - lam*), so from the
+     * second step on b = S'(lam)^T w (x^T S'^T w = w^T S' x is the
+     * pencil's normalisation, never zero for a simple eigenvalue, while
+     * w^T x itself may vanish: then S^-T w would not grow along w at
+     * all). */
+    for (int i = 0; i < nx; i++)
+        w[i] = 1.0 + (double)(i % 7) / 7.0;
+    for (int it = 0; it < 2; it++) {
+        if (it > 0) {
+            pencil_dtmul(sh, w, lam, z);
+            memcpy(w, z, (size_t)nx * sizeof *w);
         }
-        /* The right vector as point displacements and controller states
-         * (x), and in the unknowns (X; tensions 0: S' has no tension
-         * columns). */
-        for (int part = 0; part < 2; part++) {
-            for (int i = 0; i < nq; i++)
-                q[i] = part ? cimag(v[i]) : creal(v[i]);
-            tsi_desc_to_points(d, lin, q, u + part * m);
-        }
-        size_t n3 = 3 * (size_t)d->np;
-        for (size_t i = 0; i < n3; i++)
-            x[i] = u[i] + I * u[m + i];
-        for (int j = 0; j < nc; j++)
-            x[n3 + j] = v[2 * nq + j];
-        for (int k = 1; k < d->np; k++)
-            for (int a = 0; a < 3; a++)
-                X[XR(k, a)] = x[3 * k + a];
-        for (int j = 0; j < nc; j++)
-            X[XC(j)] = x[n3 + j];
-        /* w^T S'(lam) X, S'(s) = Sc + 2 s Sm. */
-        const double *Sc = P + d->nnz, *Sm = P + 2 * (size_t)d->nnz;
-        double complex den = 0;
-        for (int col = 0; col < nx; col++)
-            for (int p = d->Sp[col]; p < d->Sp[col + 1]; p++)
-                den += w[d->Si[p]] * (Sc[p] + 2.0 * lam * Sm[p]) * X[col];
-        double tr, ro;
-        tsi_desc_error_terms(d, w, x, lam, &tr, &ro);
-        *dlam = cabs(den) > 0 ? (tr + ro) / cabs(den) : INFINITY;
-        /* The Ritz value's own error: the pencil's Newton correction. */
-        double complex num = pencil_form(d, P, w, X, lam);
-        *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
-    } else if (rc == TS_ESINGULAR) {
-        ts_fail(err, rc, "eigen: the pencil is singular beside %g%+gi 1/s",
-                creal(lam), cimag(lam));
-    } else if (rc != TS_ENOMEM) {
-        ts_fail(err, rc, "eigen: KLU failed at %g%+gi 1/s", creal(lam),
-                cimag(lam));
+        tsi_shift_tsolve(sh, w);
+        unit_max(w, nx);
     }
-    free(w);
-    free(x);
-    free(X);
-    free(q);
-    free(u);
-    free(P);
-    return rc;
+    /* The right vector as point displacements and controller states (x),
+     * and in the unknowns (X; tensions 0: S' has no tension columns). */
+    for (int part = 0; part < 2; part++) {
+        for (int i = 0; i < nq; i++)
+            q[i] = part ? cimag(v[i]) : creal(v[i]);
+        tsi_desc_to_points(d, lin, q, u + part * m);
+    }
+    size_t n3 = 3 * (size_t)d->np;
+    for (size_t i = 0; i < n3; i++)
+        x[i] = u[i] + I * u[m + i];
+    for (int j = 0; j < nc; j++)
+        x[n3 + j] = v[2 * nq + j];
+    for (int k = 1; k < d->np; k++)
+        for (int a = 0; a < 3; a++)
+            X[XR(k, a)] = x[3 * k + a];
+    for (int j = 0; j < nc; j++)
+        X[XC(j)] = x[n3 + j];
+    /* w^T S'(lam) X, S'(s) = Sc + 2 s Sm. */
+    const double *Sc = sh->Sc, *Sm = sh->Sm;
+    double complex den = 0;
+    for (int col = 0; col < nx; col++)
+        for (int p = d->Sp[col]; p < d->Sp[col + 1]; p++)
+            den += w[d->Si[p]] * (Sc[p] + 2.0 * lam * Sm[p]) * X[col];
+    double tr, ro;
+    tsi_desc_error_terms(d, w, x, lam, &tr, &ro);
+    *dlam = cabs(den) > 0 ? (tr + ro) / cabs(den) : INFINITY;
+    /* The Ritz value's own error: the pencil's Newton correction. */
+    double complex num = pencil_form(sh, w, X, lam);
+    *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
+    return TS_OK;
 }

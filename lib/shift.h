@@ -82,6 +82,8 @@ typedef struct tsi_shift {
     double *cols;          /* [2 nx] */
     double *u1, *u2;       /* [3 nnodes] node displacement work */
     double *w;             /* [2 nq] */
+    double *ework;         /* the eigenvalue error estimates' work
+                              (tsi_shift_eig_error), kept across calls */
 } tsi_shift;
 
 /* Factor S(s) (real arithmetic when Im s == 0) of lin's sparse model, or
@@ -98,9 +100,10 @@ int tsi_shift_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
  * accuracy), no allocation, unless the new factors' rcond estimate falls
  * below SHIFT_REFACTOR_RCOND times the last full factorisation's (taken
  * without its scaling too), when it factors afresh (with pivoting and
- * scaling). A sequence of
- * nearby shifts (a frequency sweep) then pays for pivoting now and then.
- * Otherwise as tsi_shift_factor (sh freed first). Same codes. */
+ * scaling) in the arrays it holds; so too when s has crossed to the other
+ * kind. A sequence of nearby shifts (a frequency sweep) then pays for
+ * pivoting now and then. Without a factorisation of lin's sparse model in
+ * sh, as tsi_shift_factor (sh freed first). Same codes. */
 #define SHIFT_REFACTOR_RCOND 1e-2
 int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
                        ts_err *err);
