@@ -1592,6 +1592,7 @@ static void test_speed_input(void)
         ts_kernel_free(ks[i]);
         ts_scene_free(ss[i]);
     }
+}
 
 /* ---- 13. static gains through the neutral modes ------------------------ */
 
