@@ -481,13 +481,16 @@ static int resolve_vehicle(const char *path, const ts_system *sys, int b,
     if (c < 0) {
         size_t len = 0;
         list[0] = '\0';
-        static const char *const kind[3] = {"hull", "surface", "bluff"};
+        static const char *const kind[] = {"hull", "surface", "bluff",
+                                           "mast", "ballast tank"};
         for (int i = 0; i < v->ncomponents; i++)
             len += (size_t)snprintf(list + len,
                                     len < sizeof list ? sizeof list - len : 0,
                                     "%s%s (%s)", len ? ", " : "",
                                     v->component[i].name,
-                                    kind[v->component[i].type]);
+                                    (int)v->component[i].type < COUNT(kind)
+                                        ? kind[v->component[i].type]
+                                        : "component");
         return ts_fail(err, TS_EINVAL, "%s: vehicle '%s' has no component "
                        "'%.*s'; its components: %s", path, bd->name,
                        (int)(k - rest), rest, list[0] ? list : "none");

@@ -782,6 +782,13 @@ static void test_towing_paths(const ts_units *u)
          "entry: tow_point.x|y|z"},
         {0, "towing_vehicle.controllers.heading.kp",
          "vehicle 'dolphin' has no loop 'heading'; its loops: depth"},
+        /* Every kind of component named, a mast and ballast tanks
+         * among them. */
+        {0, "towing_vehicle.components.fin.area",
+         "vehicle 'dolphin' has no component 'fin'; its components: hull "
+         "(hull), mast (mast), mast_drag (bluff)"},
+        {0, "towing_vehicle.components.fin.area",
+         "ballast_front (ballast tank), ballast_rear (ballast tank)"},
         {0, "bodies.dolphin.mass", "'dolphin' is the towing vehicle; its "
          "values are towing_vehicle.<key> (towing_vehicle.mass)"},
         {0, "towing_vehicle.propulsion.thrust", NULL},
