@@ -291,7 +291,8 @@ static double complex vec_at(const double *x, const double *wi, int n, int k,
 static void vector_health(const ts_linear *lin, const double *vl,
                           const double *wr, const double *wi,
                           const double *rconde, const double *kap0,
-                          const double *ev, double abnrm, int j, cand *c)
+                          const double *ev, const double *ez,
+                          double abnrm, int j, cand *c)
 {
     int n = lin->nstate, nq = lin->nq, nlow = n - nq;
     double complex lj = eig_at(wr, wi, j);
@@ -317,6 +318,8 @@ static void vector_health(const ts_linear *lin, const double *vl,
     double sum2 = 0.0;
     const double *er = ev ? ev + (size_t)j * nlow : NULL;
     const double *ei = ev && wi[j] != 0.0 ? ev + (size_t)(j + 1) * nlow : NULL;
+    const double *zr = ez ? ez + (size_t)j * nlow : NULL;
+    const double *zi = ez && wi[j] != 0.0 ? ez + (size_t)(j + 1) * nlow : NULL;
     for (int m = 0; m < nn; m++) {
         int k = near[m];
         double gap = gaps[m];
@@ -330,6 +333,7 @@ static void vector_health(const ts_linear *lin, const double *vl,
                                         : vl + (size_t)(wi[k] < 0 ? k : k + 1) *
                                                    n + nq;
         double sg = wi[k] < 0 ? -1.0 : 1.0, sr = 0.0, si = 0.0;
+        double zsr = 0.0, zsi = 0.0;
         for (int i = 0; er && i < nlow; i++) {
             /* conj(a + i b) (x + i y) = (a x + b y) + i (a y - b x) */
             double a = ur[i], b = ui ? sg * ui[i] : 0.0;
@@ -337,7 +341,15 @@ static void vector_health(const ts_linear *lin, const double *vl,
             sr += a * x + b * y;
             si += a * y - b * x;
         }
-        double ck = er ? hypot(sr, si) * kap0[k] / gap
+        for (int i = 0; zr && i < nlow; i++) {
+            double a = ur[i], b = ui ? sg * ui[i] : 0.0;
+            double x = zr[i], y = zi ? zi[i] : 0.0;
+            zsr += a * x + b * y;
+            zsi += a * y - b * x;
+        }
+        /* F = E + Z: the error estimate and the entries zeroed below it
+         * (clean_below_error), each term's size added. */
+        double ck = er ? (hypot(sr, si) + hypot(zsr, zsi)) * kap0[k] / gap
                        : (lin->Aerr ? lin->trunc_norm : 0.0) * kap0[k] / gap;
         ck += DBL_EPSILON * abnrm / (rconde[k] * gap);
         sum2 += ck * ck;
@@ -366,16 +378,29 @@ static double entry_error(const ts_linear *lin, int i, int j)
  * entries (1e-33 where central differences round an exact zero) make
  * dgeevx's scaling balance a row against nothing, by factors up to 1e30,
  * and the eigenvectors lose their accuracy (doc/linear.md section 3).
- * Nothing without the error estimate. */
-static void clean_below_error(const ts_linear *lin, double *a)
+ * The entries zeroed go to z (the lower block, nlow x n, column-major;
+ * the rest 0): a perturbation Z of A, A = a + Z, whose first-order
+ * change of every eigenvalue and eigenvector the allowances add to the
+ * error estimate's. Returns the number zeroed; nothing without the
+ * error estimate. */
+static long clean_below_error(const ts_linear *lin, double *a, double *z)
 {
-    int n = lin->nstate;
+    int n = lin->nstate, nq = lin->nq, nlow = n - nq;
+    long count = 0;
     if (!lin->Aerr)
-        return;
+        return 0;
     for (int j = 0; j < n; j++)
-        for (int i = lin->nq; i < n; i++)
-            if (fabs(a[i + (size_t)j * n]) < entry_error(lin, i, j))
-                a[i + (size_t)j * n] = 0.0;
+        for (int i = nq; i < n; i++) {
+            double *aij = &a[i + (size_t)j * n];
+            double *zij = &z[(i - nq) + (size_t)j * nlow];
+            *zij = 0.0;
+            if (*aij != 0.0 && fabs(*aij) < entry_error(lin, i, j)) {
+                *zij = *aij;
+                *aij = 0.0;
+                count++;
+            }
+        }
+    return count;
 }
 
 static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
@@ -387,7 +412,8 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     double *vr = malloc(nn * sizeof(double));
     double *wr = malloc((size_t)n * sizeof(double));
     double *wi = malloc((size_t)n * sizeof(double));
-    double *work = NULL, *ev = NULL, wq;
+    double *work = NULL, *ev = NULL, *z = NULL, *ez = NULL, wq;
+    long nzeroed = 0;
     double *scale = NULL, *rconde = NULL, *rcondv = NULL, *kap0 = NULL;
     int rc = TS_OK;
     if (!a || !vl || !vr || !wr || !wi) {
@@ -398,7 +424,14 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
         goto out;
     }
     memcpy(a, lin->A, nn * sizeof(double));
-    clean_below_error(lin, a);
+    if (lin->Aerr) {
+        z = malloc((size_t)(n - lin->nq) * (size_t)n * sizeof(double));
+        if (!z) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+            goto out;
+        }
+        nzeroed = clean_below_error(lin, a, z);
+    }
     /* dgeevx: balance (permute and scale), then QR; the reciprocal
      * condition numbers and the norm refer to the balanced matrix, the
      * one whose rounding errors matter. Scaling is needed: without it
@@ -450,6 +483,17 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
                    &zero, ev, &nlow, 1, 1);
         }
     }
+    /* EZ = Z VR: the entries zeroed, on every right eigenvector. */
+    if (ev && nzeroed > 0) {
+        ez = malloc((size_t)nlow * (size_t)n * sizeof(double));
+        if (!ez) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+            goto out;
+        }
+        double pone = 1.0, zero = 0.0;
+        dgemm_("N", "N", &nlow, &n, &n, &pone, z, &nlow, vr, &n, &zero, ez,
+               &nlow, 1, 1);
+    }
     /* 1 / |u_k^H v_k| of every eigenvalue (unit vectors): O(n^2). */
     kap0 = malloc((size_t)n * sizeof(double));
     if (!kap0) {
@@ -465,8 +509,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
     for (int j = 0; j < n; j++) {
         const double *vrj = vr + (size_t)j * n, *vlj = vl + (size_t)j * n;
         const double *evj = ev ? ev + (size_t)j * nlow : NULL;
+        const double *ezj = ez ? ez + (size_t)j * nlow : NULL;
         if (wi[j] == 0.0) {
-            double uv = 0, uu = 0, vv = 0, uev = 0;
+            double uv = 0, uu = 0, vv = 0, uev = 0, uez = 0;
             for (int i = 0; i < n; i++) {
                 uv += vlj[i] * vrj[i];
                 uu += vlj[i] * vlj[i];
@@ -474,19 +519,21 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
             }
             for (int i = 0; evj && i < nlow; i++)
                 uev += vlj[nq + i] * evj[i];
+            for (int i = 0; ezj && i < nlow; i++)
+                uez += vlj[nq + i] * ezj[i];
             (void)uu;
             (void)vv;
             cand_add(L, wr[j], vrj, NULL, 1.0 / rconde[j], NAN,
-                     evj ? fabs(uev / uv) +
+                     evj ? fabs(uev / uv) + fabs(uez / uv) +
                                rounding_change(lin, vlj, NULL, vrj, NULL) /
                                    fabs(uv)
                          : NAN);
             L->c[L->n - 1].round = DBL_EPSILON * abnrm / rconde[j];
-            vector_health(lin, vl, wr, wi, rconde, kap0, ev, abnrm, j,
+            vector_health(lin, vl, wr, wi, rconde, kap0, ev, ez, abnrm, j,
                           &L->c[L->n - 1]);
         } else if (wi[j] > 0.0 && j + 1 < n) {
             const double *vrk = vrj + n, *vlk = vlj + n;
-            double complex uv = 0, uev = 0;
+            double complex uv = 0, uev = 0, uez = 0;
             double uu = 0, vv = 0;
             for (int i = 0; i < n; i++) {
                 double complex u = vlj[i] + I * vlk[i];
@@ -498,15 +545,18 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
             for (int i = 0; evj && i < nlow; i++)
                 uev += conj(vlj[nq + i] + I * vlk[nq + i]) *
                        (evj[i] + I * evj[nlow + i]);
+            for (int i = 0; ezj && i < nlow; i++)
+                uez += conj(vlj[nq + i] + I * vlk[nq + i]) *
+                       (ezj[i] + I * ezj[nlow + i]);
             (void)uu;
             (void)vv;
             cand_add(L, wr[j] + I * wi[j], vrj, vrk, 1.0 / rconde[j], NAN,
-                     evj ? cabs(uev / uv) +
+                     evj ? cabs(uev / uv) + cabs(uez / uv) +
                                rounding_change(lin, vlj, vlk, vrj, vrk) /
                                    cabs(uv)
                          : NAN);
             L->c[L->n - 1].round = DBL_EPSILON * abnrm / rconde[j];
-            vector_health(lin, vl, wr, wi, rconde, kap0, ev, abnrm, j,
+            vector_health(lin, vl, wr, wi, rconde, kap0, ev, ez, abnrm, j,
                           &L->c[L->n - 1]);
             j++;
         }
@@ -517,6 +567,8 @@ out:
     free(rcondv);
     free(kap0);
     free(ev);
+    free(ez);
+    free(z);
     free(a);
     free(vl);
     free(vr);
