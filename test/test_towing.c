@@ -25,8 +25,8 @@
  *     turn (its tensions, attitude, depth, speed through the water, and
  *     its turn rate: the yaw rate relative to M vanishes); and at that
  *     turn rate, turn_by rudder gives back the 3 deg.
- *  6. Linear and nonlinear agree at small thrust steps: their difference
- *     falls like the square of the step.
+ *  6. Linear and nonlinear agree at small thrust and rudder steps: their
+ *     difference falls like the square of the step.
  *  7. The free vehicle (ts_free_vehicle_compare): alone, level, its
  *     thrust at the coupled speed is its own drag, 1/2 rho U^2 (Cd_axial
  *     pi D^2 / 4 + sum S Cd0); on a cable of almost nothing (1 m, 0.1 mm,
@@ -663,8 +663,11 @@ static void test_settle(void)
     }
     ts_scene_free(c);
 
-    /* 6. Thrust steps of 20 and 10 N from the 1500 N trim. */
+    /* 6. Thrust steps of 20 and 10 N from the 1500 N trim, and rudder
+     * steps of 0.004 and 0.002 rad (0.23 and 0.11 deg): the heading then
+     * drifts (a neutral mode), which the linear model follows too. */
     linear_nonlinear(ka, ea, "1500 N");
+    linear_nonlinear_input(ka, ea, "1500 N", "tug.rudder", 0.004, "rad");
     free(y);
     free(w);
     free(f);
