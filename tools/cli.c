@@ -410,41 +410,78 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     return 0;
 }
 
-void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
-                  size_t size)
+/* A towing vehicle's solved turn rate below this fraction of V / L (L the
+ * cables' length: the turn whose radius is that length) is rounding: a
+ * symmetric vehicle solves to 1e-19 rad/s, 1e-17 of V / L. */
+#define TURN_ROUNDING 1e-12
+
+void cli_steady_motion(const ts_system *sys, const ts_equilibrium *eq,
+                       double *speed, double *turn_rate)
+{
+    *speed = sys->tow.speed;
+    *turn_rate = sys->tow.turn_rate;
+    if (!cli_motion_solved(sys, eq))
+        return;
+    *speed = eq->speed;
+    *turn_rate = eq->turn_rate;
+    double L = 0.0;
+    for (int c = 0; c < sys->ncables; c++)
+        L += sys->cables[c].length;
+    if (sys->tow.turn_surface < 0 &&
+        fabs(eq->turn_rate) * L <= TURN_ROUNDING * fabs(eq->speed))
+        *turn_rate = 0.0;
+}
+
+int cli_motion_solved(const ts_system *sys, const ts_equilibrium *eq)
+{
+    return sys->tow.vehicle >= 0 && eq && eq->converged &&
+           isfinite(eq->speed) && isfinite(eq->turn_rate);
+}
+
+void cli_tow_text(const ts_system *sys, const ts_equilibrium *eq,
+                  const ts_display *d, char *buf, size_t size)
 {
     d = ts_display_or_si(d);
-    const ts_tow *t = &sys->tow;
+    double speed, turn_rate;
+    cli_steady_motion(sys, eq, &speed, &turn_rate);
     const char *vu = ts_display_unit(d, TS_QTY_SPEED);
     const char *wu = ts_display_unit(d, TS_QTY_ANGULAR_RATE);
-    char v[96], w[96];
-    /* SI speeds and turn rates also in knots and deg/s. */
-    /* With a towing vehicle the scene's speed and turn rate are where the
-     * solve starts (or its targets); the steady motion solved is on the
-     * vehicle's own line (cli_print_vehicles). */
-    int n = snprintf(v, sizeof v, "%sspeed %.6g %s",
-                     t->vehicle >= 0 ? "towing vehicle, scene " : "",
-                     ts_display_value(d, TS_QTY_SPEED, t->speed), vu);
-    if (!strcmp(vu, "m/s") && n > 0 && (size_t)n < sizeof v)
-        snprintf(v + n, sizeof v - (size_t)n, " (%.4g knots)",
-                 t->speed / (1852.0 / 3600.0));
-    if (t->turn_rate == 0.0) {
+    char v[160], w[96];
+    /* SI speeds and turn rates also in knots and deg/s. With a towing
+     * vehicle the steady motion is solved: its speed and turn rate once
+     * the equilibrium converged (the scene's are where the solve starts,
+     * or its targets), else the scene's, said so. */
+    const char *what = sys->tow.vehicle < 0 ? ""
+                       : cli_motion_solved(sys, eq) ? "towing vehicle, solved "
+                                                    : "towing vehicle, scene ";
+    int n = snprintf(v, sizeof v, "%sspeed %.6g %s", what,
+                     ts_display_value(d, TS_QTY_SPEED, speed), vu);
+    int knots = !strcmp(vu, "m/s"), solved = cli_motion_solved(sys, eq);
+    if (knots && n > 0 && (size_t)n < sizeof v)
+        n += snprintf(v + n, sizeof v - (size_t)n, " (%.4g knots%s",
+                      speed / (1852.0 / 3600.0), solved ? "; " : ")");
+    else if (solved && n > 0 && (size_t)n < sizeof v)
+        n += snprintf(v + n, sizeof v - (size_t)n, " (");
+    if (solved && n > 0 && (size_t)n < sizeof v)
+        snprintf(v + n, sizeof v - (size_t)n, "scene %.6g %s)",
+                 ts_display_value(d, TS_QTY_SPEED, sys->tow.speed), vu);
+    if (turn_rate == 0.0) {
         snprintf(buf, size, "%s, turn rate 0 %s (straight)", v, wu);
         return;
     }
     n = snprintf(w, sizeof w, "turn rate %.6g %s",
-                 ts_display_value(d, TS_QTY_ANGULAR_RATE, t->turn_rate), wu);
+                 ts_display_value(d, TS_QTY_ANGULAR_RATE, turn_rate), wu);
     if (!strcmp(wu, "rad/s") && n > 0 && (size_t)n < sizeof w)
         snprintf(w + n, sizeof w - (size_t)n, " (%.4g deg/s,",
-                 t->turn_rate * 180.0 / M_PI);
+                 turn_rate * 180.0 / M_PI);
     else if (n > 0 && (size_t)n < sizeof w)
         snprintf(w + n, sizeof w - (size_t)n, " (");
-    double R = t->speed / fabs(t->turn_rate);
+    double R = speed / fabs(turn_rate);
     snprintf(buf, size, "%s, %s%sturn radius %.4g %s, to %s)", v, w,
              strcmp(wu, "rad/s") ? "" : " ",
              ts_display_value(d, TS_QTY_LENGTH, R),
              ts_display_unit(d, TS_QTY_LENGTH),
-             t->turn_rate > 0 ? "starboard" : "port");
+             turn_rate > 0 ? "starboard" : "port");
 }
 
 /* An error for a table: "%.2g", or "-" when not known. */

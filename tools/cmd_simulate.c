@@ -648,9 +648,10 @@ static int plot_tracks(const ts_system *sys, const ts_history *hn,
     return status;
 }
 
-static int plot_snapshots(const ts_system *sys, const ts_history *h,
-                          const ts_excitation *ex, double interval,
-                          double exaggerate, const cli_plot *plot)
+static int plot_snapshots(const ts_system *sys, const ts_equilibrium *eq,
+                          const ts_history *h, const ts_excitation *ex,
+                          double interval, double exaggerate,
+                          const cli_plot *plot)
 {
     double t_end = h->t[h->nsamples - 1];
     int nsnap = 0;
@@ -686,7 +687,7 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
                        exaggerate * (pos[j] - h->positions[j]);
             pos = e;
         }
-        if (cli_plot_shape(sys, pos, &shapes[k]) != 0 ||
+        if (cli_plot_shape(sys, eq, pos, &shapes[k]) != 0 ||
             snapshot_vehicles(sys, h, idx[k], &shapes[k]) != 0) {
             fprintf(stderr,
                     "towstab: error: simulate: --plot: out of memory\n");
@@ -851,7 +852,7 @@ static void sim_print(const cli_run *c, const ts_result *r)
         return;
     const ts_display *d = &c->display;
     char tow[256];
-    cli_tow_text(sys, d, tow, sizeof tow);
+    cli_tow_text(sys, r->eq, d, tow, sizeof tow);
     printf("simulate %s: %d links, %s\n", sys->name, sys->nlinks, tow);
     char desc[256];
     const ts_excitation *ex = r->excitation;
@@ -954,8 +955,8 @@ static int sim_draw(cli_run *c, const ts_result *r)
     int status = plot_histories(r->sys, &r->output, r->excitation,
                                 r->nonlinear, r->linear, &c->plot);
     if (!status)
-        status = plot_snapshots(r->sys, h, r->excitation, st->snapshot,
-                                st->exaggerate, &c->plot);
+        status = plot_snapshots(r->sys, r->eq, h, r->excitation,
+                                st->snapshot, st->exaggerate, &c->plot);
     if (!status && ((r->excitation &&
                      ts_excitation_has_manoeuvre(r->excitation)) ||
                     r->sys->tow.turn_rate != 0 || r->sys->tow.vehicle >= 0))
