@@ -484,6 +484,98 @@ void cli_tow_text(const ts_system *sys, const ts_equilibrium *eq,
              turn_rate > 0 ? "starboard" : "port");
 }
 
+/* The longest bare value given the shared unit. */
+#define CLI_VALUE_TEXT_MAX 256
+
+/* The unit written after the number of `text` (spaces trimmed) into
+ * unit: "" for a bare number; -1 when text does not start with a number
+ * (ts_units_parse then names it). */
+static int written_unit(const char *text, char *unit, size_t size)
+{
+    char *end;
+    strtod(text, &end);
+    if (end == text)
+        return -1;
+    while (*end == ' ')
+        end++;
+    size_t len = strlen(end);
+    while (len > 0 && end[len - 1] == ' ')
+        len--;
+    snprintf(unit, size, "%.*s", (int)len, end);
+    return 0;
+}
+
+int cli_shared_unit(const char *cmd, const char *where,
+                    const char *const text[], int n, char *unit,
+                    size_t size)
+{
+    unit[0] = '\0';
+    int bare = 0, mixed = 0;
+    char u[CLI_UNIT_TEXT_MAX];
+    for (int i = 0; i < n; i++) {
+        if (written_unit(text[i], u, sizeof u))
+            continue;
+        if (!u[0])
+            bare = 1;
+        else if (!unit[0])
+            snprintf(unit, size, "%s", u);
+        else if (strcmp(unit, u))
+            mixed = 1;
+    }
+    if (bare && mixed) {
+        fprintf(stderr, "towstab: error: %s: %s: values in different units "
+                        "('%s' and others) and values without one: give "
+                        "each value its unit\n", cmd, where, unit);
+        return EXIT_BADINPUT;
+    }
+    if (mixed || !bare)
+        unit[0] = '\0';
+    return 0;
+}
+
+int cli_parse_values(const ts_units *units, const char *cmd,
+                     const char *where, const char *const text[], int n,
+                     const char *si_unit, double *out)
+{
+    ts_err err = {0};
+    int plain = !si_unit[0] || !strcmp(si_unit, "1");
+    char shared[CLI_UNIT_TEXT_MAX];
+    if (!plain &&
+        cli_shared_unit(cmd, where, text, n, shared, sizeof shared))
+        return EXIT_BADINPUT;
+    for (int i = 0; i < n; i++) {
+        int rc;
+        char u[CLI_UNIT_TEXT_MAX], with[CLI_VALUE_TEXT_MAX + CLI_UNIT_TEXT_MAX];
+        if (plain) {
+            char *end;
+            out[i] = strtod(text[i], &end);
+            while (*end == ' ')
+                end++;
+            rc = end == text[i] || *end || !isfinite(out[i]) ? TS_EINVAL
+                                                             : TS_OK;
+            if (rc)
+                ts_fail(&err, rc, "%s: expected a plain number, got '%s'",
+                        where, text[i]);
+        } else {
+            /* A bare value takes the unit the others are written in. */
+            const char *t = text[i];
+            if (shared[0] && !written_unit(t, u, sizeof u) && !u[0] &&
+                strlen(t) < CLI_VALUE_TEXT_MAX - 1) {
+                snprintf(with, sizeof with, "%.*s %.*s",
+                         CLI_VALUE_TEXT_MAX - 2, t, CLI_UNIT_TEXT_MAX - 1,
+                         shared);
+                t = with;
+            }
+            rc = ts_units_parse(units, t, si_unit, where, &out[i], &err);
+        }
+        if (rc) {
+            fprintf(stderr, "towstab: error: %s: %s\n", cmd, err.msg);
+            return EXIT_BADINPUT;
+        }
+    }
+    return 0;
+}
+
 /* An error for a table: "%.2g", or "-" when not known. */
 static void err_text(double e, char *buf, size_t size)
 {

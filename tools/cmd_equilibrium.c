@@ -73,19 +73,22 @@ static int split_list(const char *opt, const char *text,
                 opt, text);
         return -1;
     }
-    /* The unit of the last item, if any: the text after its number. */
-    char *end;
-    strtod(items[n - 1], &end);
-    while (*end == ' ')
-        end++;
-    for (int i = 0; *end && i < n - 1; i++) {
+    /* A unit written on some items applies to those written without one
+     * ('2,4,6 knot'). */
+    const char *text_of[MAX_OVERLAYS];
+    for (int i = 0; i < n; i++)
+        text_of[i] = items[i];
+    char unit[CLI_UNIT_TEXT_MAX];
+    if (cli_shared_unit("equilibrium", opt, text_of, n, unit, sizeof unit))
+        return -1;
+    for (int i = 0; unit[0] && i < n; i++) {
         char *e;
         strtod(items[i], &e);
         while (*e == ' ')
             e++;
-        if (*e == '\0' && strlen(items[i]) + strlen(end) + 2 < ITEM_MAX) {
+        if (*e == '\0' && strlen(items[i]) + strlen(unit) + 2 < ITEM_MAX) {
             strcat(items[i], " ");
-            strcat(items[i], end);
+            strcat(items[i], unit);
         }
     }
     return n;
