@@ -708,9 +708,10 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
         for (int c = 0; c < r->ncomponents; c++)
             if (vd->component[c].type == TS_COMP_MAST)
                 fprintf(f, "%s.%s submerged length %.4f %s (its force: "
-                           "buoyancy)\n",
+                           "buoyancy%s)\n",
                         sys->bodies[r->body].name, vd->component[c].name,
-                        r->load[c].submerged * kl, lu);
+                        r->load[c].submerged * kl, lu,
+                        vd->component[c].drag > 0 ? " and drag" : "");
         fprintf(f, "%s (M) %.4f, %.4f, %.4f %s\n",
                 r->towing ? "cable pull at the tow point" : "joint force",
                 kf * r->joint_force[0], kf * r->joint_force[1],
