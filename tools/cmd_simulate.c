@@ -261,6 +261,17 @@ static void print_waypoints(const ts_result *r, const ts_display *d)
                lu);
 }
 
+/* A number of the comparison's table in `fmt` (a width of 16), or "-"
+ * where it has none (an amplitude ratio or phase without a periodic
+ * excitation): no "nan" printed. */
+static void cmp_cell(const char *fmt, double v)
+{
+    if (isfinite(v))
+        printf(fmt, v);
+    else
+        printf(" %16s", "-");
+}
+
 static void print_compare(const ts_compare *c, const ts_display *d)
 {
     char u[64], ru[80], label[128], eu[64];
@@ -283,21 +294,28 @@ static void print_compare(const ts_compare *c, const ts_display *d)
     printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
            "freq. response");
     snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
-    printf("%-30s %16.6g %16.6g %16.6g\n", label,
-           kr * c->linear.amplitude_ratio, kr * c->nonlinear.amplitude_ratio,
-           kr * c->pred_ratio);
-    printf("%-30s %16.4f %16.4f %16.4f\n", "phase [deg]", c->linear.phase_deg,
-           c->nonlinear.phase_deg, c->pred_phase_deg);
+    printf("%-30s", label);
+    cmp_cell(" %16.6g", kr * c->linear.amplitude_ratio);
+    cmp_cell(" %16.6g", kr * c->nonlinear.amplitude_ratio);
+    cmp_cell(" %16.6g", kr * c->pred_ratio);
+    printf("\n%-30s", "phase [deg]");
+    cmp_cell(" %16.4f", c->linear.phase_deg);
+    cmp_cell(" %16.4f", c->nonlinear.phase_deg);
+    cmp_cell(" %16.4f", c->pred_phase_deg);
+    printf("\n");
     snprintf(label, sizeof label, "mean offset [%s]", u);
     printf("%-30s %16.6g %16.6g\n", label, k * c->linear.mean_offset,
            k * c->nonlinear.mean_offset);
     snprintf(label, sizeof label, "half range [%s]", u);
     printf("%-30s %16.6g %16.6g\n", label, k * c->linear.half_range,
            k * c->nonlinear.half_range);
-    printf("amplitude difference %.4g %%, mean difference %.4g %% (linear "
-           "less nonlinear, relative to nonlinear)\n",
-           c->amplitude_difference_pct, c->mean_difference_pct);
-    if (!strcmp(c->output.si_unit, "m"))
+    if (isfinite(c->amplitude_difference_pct))
+        printf("amplitude difference %.4g %%, ", c->amplitude_difference_pct);
+    printf("mean difference %.4g %% (linear less nonlinear, relative to "
+           "nonlinear)\n", c->mean_difference_pct);
+    if (!isfinite(c->rms_difference_ratio))
+        printf("rms difference %.6g %s\n", k * c->rms_difference, u);
+    else if (!strcmp(c->output.si_unit, "m"))
         printf("rms difference %.6g %s (%.4g %% of the excitation "
                "amplitude)\n", k * c->rms_difference, u,
                100 * c->rms_difference_ratio);
