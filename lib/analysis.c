@@ -1078,9 +1078,8 @@ static int response_channels(const ts_system *sys, const ts_response_opts *o,
     int rc = ts_response_input_lookup(k, o->input, input, err);
     if (rc != TS_OK)
         ts_err_prefix(err, "input: ");
-    const char *dot = strrchr(o->input, '.');
-    if (rc == TS_OK && open_loop && *input >= TS_NINPUT && dot &&
-        strcmp(dot, ".setpoint") == 0 && ts_control_nloops(k) > 0)
+    if (rc == TS_OK && open_loop && ts_control_nloops(k) > 0 &&
+        ts_kernel_input_is_setpoint(k, *input))
         rc = ts_fail(err, TS_EINVAL, "input: %s does nothing with the loops "
                      "open (open_loop): the loop's output is held at its "
                      "trim value", o->input);
@@ -1434,8 +1433,11 @@ static int check_sim_inputs(const ts_system *sys, const ts_excitation *ex,
         const ts_signal *sg = ts_excitation_signal(ex, i);
         int j = sg->axis == TS_AXIS_INPUT ? ts_kernel_input_find(k, sg->input)
                                           : -1;
-        if (j >= TS_NINPUT && ts_control_nloops(k) > 0 &&
-            !ts_kernel_input_is_surface(k, j))
+        /* Only a set point does nothing with the loops open: a loop's
+         * input adds to its frozen output, and a towing vehicle's
+         * thrust, forces, moments and commanded speed act on the plant
+         * (its speed controller stays closed), as in response. */
+        if (ts_control_nloops(k) > 0 && ts_kernel_input_is_setpoint(k, j))
             rc = ts_fail(err, TS_EINVAL, "excite: %s does nothing with the "
                          "loops open (open_loop): the loop's output is held "
                          "at its trim value", sg->input);

@@ -110,12 +110,17 @@ static int min_damping(const ts_result *r, int vehicles, ts_value *out)
     return 1;
 }
 
-/* The fin use: over every control surface c with a finite limit, (|delta_c|
- * + |sum over depth loops l of kp_l g_lc step|) / limit_c, the steady
- * deflection plus the command's jump when the depth set points step by
- * `step` (m; the derivative term acts on the measured rate, the integral
- * starts from its trim, so the jump is the proportional term's), at its
- * largest. 0 when no vehicle has a limited control surface. */
+/* The fin use: over every control component c with a finite range [lo,
+ * hi] (ts_component_range: a surface's [-limit, limit] rad, a ballast
+ * tank's [0, capacity] kg), (|delta_c - mid| + |sum over depth loops l of
+ * kp_l g_lc step|) / half, mid and half the middle and half the width of
+ * the range: the steady deflection (or fill) plus the command's jump when
+ * the depth set points step by `step` (m; either sign; the derivative
+ * term acts on the measured rate, the integral starts from its trim, so
+ * the jump is the proportional term's), at its largest. 1 is the range's
+ * end: for a surface (|delta| + |jump|) / limit, for a tank a fill that
+ * empties or fills it. 0 when no vehicle has a limited control
+ * component. */
 static int fin_use(const ts_result *r, double step, ts_value *out)
 {
     const ts_equilibrium *eq = r->eq;
@@ -127,7 +132,10 @@ static int fin_use(const ts_result *r, double step, ts_value *out)
         const ts_vehicle *v = r->sys->bodies[vr->body].vehicle;
         for (int c = 0; v && c < v->ncomponents; c++) {
             const ts_component *cp = &v->component[c];
-            if (!cp->control || !isfinite(cp->limit) || !(cp->limit > 0))
+            double lo = -INFINITY, hi = INFINITY;
+            if (cp->control)
+                ts_component_range(cp, &lo, &hi);
+            if (!isfinite(lo) || !isfinite(hi) || !(hi > lo))
                 continue;
             double kick = 0;
             for (int l = 0; l < v->nloops; l++) {
@@ -137,7 +145,8 @@ static int fin_use(const ts_result *r, double step, ts_value *out)
                     if (lp->surface[k] == c)
                         kick += lp->kp * lp->gain[k] * step;
             }
-            use = fmax(use, (fabs(vr->delta[c]) + fabs(kick)) / cp->limit);
+            double mid = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+            use = fmax(use, (fabs(vr->delta[c] - mid) + fabs(kick)) / half);
         }
     }
     if (!(use >= 0))

@@ -683,13 +683,31 @@ const char *ts_kernel_output_unit(const ts_kernel *k, int j)
     return NULL;
 }
 
+/* What a vehicle's input j is: a surface's deflection, a loop's set
+ * point, or another (a loop's input, a towing vehicle's). */
+enum { INPUT_OTHER, INPUT_SURFACE, INPUT_SETPOINT };
+static int input_kind(const ts_kernel *k, int j)
+{
+    for (int v = 0; v < k->nv && j >= TS_NINPUT; v++) {
+        const veh *V = &k->veh[v];
+        for (int c = 0; c < V->d->ncomponents; c++)
+            if (V->in_surf[c] == j)
+                return INPUT_SURFACE;
+        for (int l = 0; l < V->d->nloops; l++)
+            if (V->in_sp[l] == j)
+                return INPUT_SETPOINT;
+    }
+    return INPUT_OTHER;
+}
+
 int ts_kernel_input_is_surface(const ts_kernel *k, int j)
 {
-    for (int v = 0; v < k->nv && j >= TS_NINPUT; v++)
-        for (int c = 0; c < k->veh[v].d->ncomponents; c++)
-            if (k->veh[v].in_surf[c] == j)
-                return 1;
-    return 0;
+    return input_kind(k, j) == INPUT_SURFACE;
+}
+
+int ts_kernel_input_is_setpoint(const ts_kernel *k, int j)
+{
+    return input_kind(k, j) == INPUT_SETPOINT;
 }
 
 int ts_kernel_input_find(const ts_kernel *k, const char *name)

@@ -108,6 +108,7 @@ static const row mast_rows[] = {
     {"area", "m^2", 0, 1, TSI_KEY_PLAIN, CMP(area)},
     {"chord", "m", 0, 1, TSI_KEY_PLAIN, CMP(chord)},
     {"thickness", "m", 0, 1, TSI_KEY_PLAIN, CMP(thickness)},
+    {"drag", "1", 0, 0, TSI_KEY_PLAIN, CMP(drag)},
 };
 
 static const row ballast_rows[] = {

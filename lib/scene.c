@@ -721,7 +721,7 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
         int ok = hull    ? k <= K_XD
                  : bluff ? (k == K_AREA || k == K_DRAG)
                  : mast  ? (k == K_LEN || k == K_AREA || k == K_CHORD ||
-                            k == K_THICK)
+                            k == K_THICK || k == K_DRAG)
                  : tank  ? (k == K_CAP || k == K_FILL || k == K_RATE ||
                             k == K_TAU)
                          : (k >= K_AREA && k != K_DRAG && k < K_CHORD);
@@ -785,7 +785,8 @@ static int parse_component(const ctx *c, const yaml_node_t *n,
             if ((rc = key_value(c, path, &f[need[k]], keys, 0, dst)))
                 return rc;
         }
-        return TS_OK;
+        /* Optional: the drag on its submerged frontal area (0: none). */
+        return key_value(c, path, &f[K_DRAG], keys, cp->drag, &cp->drag);
     }
     if (bluff) {
         if (!f[K_AREA].value)

@@ -63,7 +63,7 @@ void ts_component_defaults(ts_component *c, ts_component_type type)
     c->type = type;
     c->cd_axial = 0.2;
     c->cd_cross = 1.2;
-    c->drag = 0.5;
+    c->drag = type == TS_COMP_MAST ? 0.0 : 0.5; /* a mast: no drag */
     c->curve = TS_CURVE_LIFTING_LINE;
     c->stall = 15.0 * M_PI / 180.0;
     c->stall_width = 3.0 * M_PI / 180.0;
@@ -260,7 +260,8 @@ static int check_component(const ts_component *c, const char *w,
         if ((rc = check_value(err, w, ln, "length", c->length, 0, 1)) ||
             (rc = check_value(err, w, ln, "area", c->area, 0, 1)) ||
             (rc = check_value(err, w, ln, "chord", c->chord, 0, 1)) ||
-            (rc = check_value(err, w, ln, "thickness", c->thickness, 0, 1)))
+            (rc = check_value(err, w, ln, "thickness", c->thickness, 0, 1)) ||
+            (rc = check_value(err, w, ln, "drag", c->drag, 0, 0)))
             return rc;
         if (c->control)
             return bad(err, w, ln, "control", "a mast is not a control "
@@ -960,7 +961,7 @@ static void disc_moments(double u, double *P, double *Q1, double *Q2)
 
 void tsi_mast_buoyancy(const ts_component *cp, double rho, double g,
                        double zO, const double ez_b[3], double F[3],
-                       double Mo[3], double *submerged)
+                       double Mo[3], double *submerged, double centre[3])
 {
     /* Along the axis a = (0, 0, -1) from the foot p, at section offset q
      * = (xi, eta), a point is at depth z_p - s cz + xi ez0 + eta ez1:
@@ -1024,6 +1025,25 @@ void tsi_mast_buoyancy(const ts_component *cp, double rho, double g,
         Mo[j] = -wb * x[j];
     if (submerged)
         *submerged = I0;
+    /* The submerged part's centroid S / V; the foot when it is dry. */
+    for (int j = 0; centre && j < 3; j++)
+        centre[j] = V > 0 ? S[j] / V : p[j];
+}
+
+void tsi_mast_drag(const ts_component *cp, double rho, double submerged,
+                   const double centre[3], const double wO_b[3],
+                   const double om_b[3], double F[3], double Mo[3])
+{
+    /* The flow across the mast (body x and y) at the submerged part's
+     * centroid, on the frontal area thickness x submerged length. */
+    double x[3], w[3];
+    v3_cross(om_b, centre, x);
+    for (int j = 0; j < 3; j++)
+        w[j] = wO_b[j] + x[j];
+    double k = -0.5 * rho * cp->drag * cp->thickness * submerged *
+               hypot(w[0], w[1]);
+    v3_set(F, k * w[0], k * w[1], 0.0);
+    v3_cross(centre, F, Mo);
 }
 
 void tsi_vehicle_statics(const ts_vehicle *v, double rho, double g,
@@ -1038,8 +1058,17 @@ void tsi_vehicle_statics(const ts_vehicle *v, double rho, double g,
         const ts_component *cp = &v->component[c];
         ts_component_load ld = {{0, 0, 0}, {0, 0, 0}, 0, 0, 0};
         if (cp->type == TS_COMP_MAST) {
+            /* Its buoyancy, and its drag on the same submerged part. */
+            double centre[3];
             tsi_mast_buoyancy(cp, rho, g, st->rO[2], ez_b, ld.force,
-                              ld.moment, &ld.submerged);
+                              ld.moment, &ld.submerged, centre);
+            if (cp->drag > 0) {
+                double Fd[3], Md[3];
+                tsi_mast_drag(cp, rho, ld.submerged, centre, st->wO_b,
+                              st->om_b, Fd, Md);
+                v3_axpy(1.0, Fd, ld.force);
+                v3_axpy(1.0, Md, ld.moment);
+            }
         } else if (cp->type == TS_COMP_BALLAST) {
             /* The water beyond the fill in the vehicle's mass. */
             double dm = (delta ? delta[c] : cp->deflection) - cp->deflection;

@@ -108,14 +108,28 @@ void tsi_vehicle_hydro(const ts_vehicle *v, const tsi_vehicle_ws *w,
  * force (body axes, N) and moment about O (N m) of its part under the
  * free surface z = 0, exact for its elliptic section however the
  * waterline cuts it (doc/vehicle.md section 4); `submerged` (may be
- * NULL) receives the mean submerged length, m. */
+ * NULL) receives the mean submerged length, m, and `centre` (may be
+ * NULL) the centroid of the submerged part (body axes from O, m; the
+ * foot when none is submerged). */
 void tsi_mast_buoyancy(const ts_component *cp, double rho, double g,
                        double zO, const double ez_b[3], double F[3],
-                       double Mo[3], double *submerged);
+                       double Mo[3], double *submerged, double centre[3]);
+
+/* The drag of mast cp on its submerged part (tsi_mast_buoyancy's mean
+ * submerged length `submerged`, m, and centroid `centre`, body axes from
+ * O): with w the velocity of that centroid through the water (wO_b + om_b
+ * x centre, body axes, m/s) and w_perp = (w_x, w_y, 0) its part across
+ * the mast, F = -1/2 rho drag thickness submerged |w_perp| w_perp at the
+ * centroid: force (body axes, N) and moment about O (N m). */
+void tsi_mast_drag(const ts_component *cp, double rho, double submerged,
+                   const double centre[3], const double wO_b[3],
+                   const double om_b[3], double F[3], double Mo[3]);
 
 /* The static loads of v's masts and ballast tanks at state st (R and
  * rO) with fills delta (rad or kg per component; NULL: the trim fills):
- * each mast's buoyancy (tsi_mast_buoyancy) and each tank's water beyond
+ * each mast's buoyancy (tsi_mast_buoyancy) with its drag on the same
+ * submerged part (tsi_mast_drag, from st's wO_b and om_b; none with drag
+ * 0, the default) and each tank's water beyond
  * its trim fill (`deflection`, in the vehicle's mass), (delta - fill) g
  * down at the tank. Force and moment about O in body axes; each (may be
  * NULL) receives every mast's and tank's load. */

@@ -34,6 +34,11 @@
  *     reported damping to the last digit; fin_use there is |steady wing
  *     deflection| + kp 2 m over the 25 deg limit, recomputed here from the
  *     equilibrium's deflection.
+ *  8. Ballast tanks in fin_use: DOLPHIN's tanks, driven by its depth
+ *     loop, count by their fill range, |fill - capacity/2| / (capacity /
+ *     2) plus the step's jump: the steady use against the trim's fill,
+ *     and the largest depth kp for a 1 m step against fill / (400 kg/rad
+ *     x 1 m), where the jump empties the tanks.
  */
 #include "towstab/design.h"
 
@@ -394,6 +399,20 @@ static int aurora_at(const ts_system *sys, double kp, double kd,
     return ok;
 }
 
+/* Maximise `goal` under fin_use <= 1 for a depth step of `step` m. */
+static void maximise_within_fins(ts_design_spec *sp, const char *goal,
+                                 double step)
+{
+    sp->goal.kind = TS_DESIGN_MAXIMISE;
+    snprintf(sp->goal.name, sizeof sp->goal.name, "%s", goal);
+    snprintf(sp->constraints[0].name, sizeof sp->constraints[0].name,
+             "fin_use");
+    sp->constraints[0].upper = 1;
+    sp->constraints[0].bound = 1.0;
+    sp->nconstraints = 1;
+    sp->fin_step = step;
+}
+
 static void test_controller(const ts_system *aurora)
 {
     ts_design_spec sp;
@@ -401,14 +420,7 @@ static void test_controller(const ts_system *aurora)
     sp.rq.setup.discretisation_error = 0;
     add_free(&sp, "bodies.aurora.controllers.depth.kp", 0.01, 0.3);
     add_free(&sp, "bodies.aurora.controllers.depth.kd", 0.0, 0.5);
-    sp.goal.kind = TS_DESIGN_MAXIMISE;
-    snprintf(sp.goal.name, sizeof sp.goal.name, "control_damping");
-    snprintf(sp.constraints[0].name, sizeof sp.constraints[0].name,
-             "fin_use");
-    sp.constraints[0].upper = 1;
-    sp.constraints[0].bound = 1.0;
-    sp.nconstraints = 1;
-    sp.fin_step = 2.0;
+    maximise_within_fins(&sp, "control_damping", 2.0);
     ts_design *d = NULL;
     ts_err err = {0};
     int rc = ts_design_run(aurora, &sp, &d, &err);
@@ -458,6 +470,69 @@ static void test_controller(const ts_system *aurora)
     ts_design_free(d);
 }
 
+/* 8. fin_use counts ballast tanks: DOLPHIN's depth loop drives its
+ * foreplanes (20 deg) and two tanks of 130 kg (-400 kg per rad of the
+ * loop's output). A tank's use is |fill - 65 kg| / 65 kg (1: empty or
+ * full), plus its command's jump 400 kp step / 65 kg; the trim's fill
+ * (11.84 kg) makes the tanks the largest use, 0.818 (the fins' 0.154).
+ * With the depth integrator the trim does not depend on kp, so the
+ * largest kp for a 1 m step is where the jump empties the tanks: kp* =
+ * fill / (400 kg/rad x 1 m), by hand, against the study's optimum
+ * (maximise kp, fin_use <= 1). AURORA's own depth loop (its wing, 25 deg,
+ * kp 0.05) steps too but stays far inside. */
+static void test_ballast(const ts_system *dolphin)
+{
+    ts_request rq;
+    ts_request_init(&rq, TS_ANALYSIS_EQUILIBRIUM);
+    rq.setup.discretisation_error = 0;
+    ts_result *r = NULL;
+    ts_value v;
+    int ok = ts_analysis_run(dolphin, &rq, &r, NULL) == TS_OK &&
+             ts_design_value(r, "fin_use", &v);
+    double fill = NAN, fins = 0;
+    for (int i = 0; ok && i < r->eq->nvehicles; i++) {
+        const ts_vehicle_result *vr = &r->eq->vehicles[i];
+        const ts_vehicle *vd = dolphin->bodies[vr->body].vehicle;
+        for (int c = 0; c < vd->ncomponents; c++) {
+            const ts_component *cp = &vd->component[c];
+            if (cp->type == TS_COMP_BALLAST &&
+                !strcmp(cp->name, "ballast_front"))
+                fill = vr->delta[c];
+            else if (cp->control && isfinite(cp->limit))
+                fins = fmax(fins, fabs(vr->delta[c]) / cp->limit);
+        }
+    }
+    double want = fabs(fill - 65.0) / 65.0;
+    CHECK(ok && fabs(v.value - want) <= 1e-12 && want > fins,
+          "DOLPHIN: fin_use %.10g = |front tank's fill %.6f kg - 65 kg| / "
+          "65 kg = %.10g, above every surface's |deflection| / limit "
+          "(%.4f)", ok ? v.value : NAN, fill, want, fins);
+    ts_result_free(r);
+
+    ts_design_spec sp;
+    spec_init(&sp, TS_ANALYSIS_EQUILIBRIUM);
+    sp.rq.setup.discretisation_error = 0;
+    add_free(&sp, "towing_vehicle.controllers.depth.kp", 0.005, 0.2);
+    maximise_within_fins(&sp, "towing_vehicle.controllers.depth.kp", 1.0);
+    ts_design *d = NULL;
+    ts_err err = {0};
+    int rc = ts_design_run(dolphin, &sp, &d, &err);
+    double kp_hand = fill / 400.0;
+    /* The study stops within its tolerances: xtol of the range in kp, the
+     * constraint within target_rtol (a kp of target_rtol x 65 / 400). */
+    double tol = d ? d->spec.xtol * (0.2 - 0.005) +
+                         d->spec.target_rtol * 65.0 / 400.0
+                   : 0;
+    CHECK(rc == TS_OK && d && d->success &&
+              fabs(d->x[0] - kp_hand) <= tol,
+          "DOLPHIN: the largest depth kp with fin_use <= 1 for a 1 m step "
+          "%.8f rad/m in %d runs, by hand fill / (400 kg/rad x 1 m) = "
+          "%.8f (within %.2g); fin_use there %.6f (%s)",
+          d ? d->x[0] : NAN, d ? d->neval : 0, kp_hand, tol,
+          d ? d->constraint_value[0].value : NAN, err.msg);
+    ts_design_free(d);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -465,17 +540,20 @@ int main(void)
     ts_scene *ex1 = tscene_load(u, "examples/kamman_ex1_submerged.yaml");
     ts_scene *above = tscene_load(u, "examples/kamman_ex1_above.yaml");
     ts_scene *aurora = tscene_load(u, "examples/aurora_towfish.yaml");
-    if (ex1 && above && aurora) {
+    ts_scene *dolphin = tscene_load(u, "examples/dolphin_aurora.yaml");
+    if (ex1 && above && aurora && dolphin) {
         test_target(ex1->system);
         test_constraints(ex1->system);
         test_stability(above->system);
         test_values_and_refusals(ex1->system);
         test_gradient(ex1->system);
         test_controller(aurora->system);
+        test_ballast(dolphin->system);
     }
     ts_scene_free(ex1);
     ts_scene_free(above);
     ts_scene_free(aurora);
+    ts_scene_free(dolphin);
     ts_units_free(u);
     return tc_done();
 }

@@ -670,6 +670,8 @@ static void test_towing_paths(const ts_units *u)
          "towing_vehicle.components[hull].length", "8.2 m"},
         {0, EQ, "towing_vehicle.components.keel.area",
          "towing_vehicle.components[keel].area", "0.65 m^2"},
+        {0, EQ, "towing_vehicle.components.mast.drag",
+         "towing_vehicle.components[mast].drag", "0.1"},
         {0, EQ, "towing_vehicle.controllers.depth.setpoint",
          "towing_vehicle.controllers[depth].setpoint", "2.4 m"},
         {0, MO, "towing_vehicle.controllers.depth.kp",

@@ -1559,6 +1559,24 @@ static void test_speed_input(void)
               !strcmp(ts_kernel_input_unit(kpi, jpi), "m/s"),
           "tug.speed_set is an input (m/s) with a speed controller (%d, "
           "%d), none with a thrust", jpi, jp);
+    /* The kinds of input: the one set point is the only input that does
+     * nothing with the loops open; the speed set point is not a loop's. */
+    int nsp = 0, nsurf = 0, right = 1;
+    for (int j = 0; j < ts_kernel_ninput(kpi); j++) {
+        char nm[128];
+        ts_kernel_input_name(kpi, j, nm, sizeof nm);
+        int sp = ts_kernel_input_is_setpoint(kpi, j);
+        int sf = ts_kernel_input_is_surface(kpi, j);
+        nsp += sp;
+        nsurf += sf;
+        right &= sp == !strcmp(nm, "tug.depth.setpoint") &&
+                 sf == (!strcmp(nm, "tug.foreplane") ||
+                        !strcmp(nm, "tug.rudder"));
+    }
+    CHECK(right && nsp == 1 && nsurf == 2,
+          "input kinds: tug.depth.setpoint the one set point (%d), "
+          "tug.foreplane and tug.rudder the surfaces (%d); tug.speed_set, "
+          "tug.thrust neither", nsp, nsurf);
     double dlo = elo->vehicles[ts_kernel_root(klo)].thrust;
     double dhi = ehi->vehicles[ts_kernel_root(khi)].thrust;
     double Dp = (dhi - dlo) / 0.02, gain = 2000.0;

@@ -15,6 +15,9 @@
  *  4. A floating spar (hull deep, a mast through the surface): under an
  *     added weight dm g it sinks by dm / (rho A), the static sinkage of
  *     the waterplane, found by root-finding on tsi_vehicle_loads.
+ *  5. Its drag on the submerged part's frontal area, at that part's
+ *     centroid, against a hand computation upright at two depths and
+ *     pitched and heeled.
  * Tolerances are stated at each check with their reason. */
 #include "vehicle.h"
 
@@ -114,7 +117,7 @@ static void test_vertical_cylinder(void)
     ts_component c = mast(d, d, h, foot);
     double A = c.area, ez[3] = {0, 0, 1}, F0[3], M0[3], F[3], M[3], s;
     double z0 = 2.0; /* foot at 1.55 m: 1.55 m submerged */
-    tsi_mast_buoyancy(&c, RHO, G, z0, ez, F0, M0, &s);
+    tsi_mast_buoyancy(&c, RHO, G, z0, ez, F0, M0, &s, NULL);
     CHECK_REL(s, z0 + foot[2], 1e-15, "upright: submerged length = the "
               "foot's depth (m)");
     CHECK_REL(F0[2], -RHO * G * A * (z0 + foot[2]), 1e-14,
@@ -129,17 +132,17 @@ static void test_vertical_cylinder(void)
     static const double dzs[] = {1e-3, 0.1, -0.5, 1.2};
     double worst = 0;
     for (size_t i = 0; i < sizeof dzs / sizeof dzs[0]; i++) {
-        tsi_mast_buoyancy(&c, RHO, G, z0 + dzs[i], ez, F, M, NULL);
+        tsi_mast_buoyancy(&c, RHO, G, z0 + dzs[i], ez, F, M, NULL, NULL);
         double want = -RHO * G * A * dzs[i];
         worst = fmax(worst, fabs(F[2] - F0[2] - want) / fabs(F0[2]));
     }
     /* Rounding of a few operations on F0 ~ 500 N. */
     CHECK(worst < 1e-14, "upright: buoyancy change = -rho g A dz exactly "
           "for dz = 1 mm .. 1.2 m (worst %.2g of the buoyancy)", worst);
-    tsi_mast_buoyancy(&c, RHO, G, 10.0, ez, F, M, &s);
+    tsi_mast_buoyancy(&c, RHO, G, 10.0, ez, F, M, &s, NULL);
     CHECK(s == h && fabs(F[2] + RHO * G * A * h) <= 1e-14 * RHO * G * A * h,
           "deep: the whole mast, %.6g m, %.8g N", s, F[2]);
-    tsi_mast_buoyancy(&c, RHO, G, 0.4, ez, F, M, &s);
+    tsi_mast_buoyancy(&c, RHO, G, 0.4, ez, F, M, &s, NULL);
     CHECK(s == 0 && F[2] == 0, "above the water (foot 5 cm up): none");
 }
 
@@ -161,7 +164,7 @@ static void test_tilted(void)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         double ez[3], F[3], M[3], Fb[3], Mb[3];
         ez_body(cases[i].th, ez);
-        tsi_mast_buoyancy(&c, RHO, G, cases[i].zO, ez, F, M, NULL);
+        tsi_mast_buoyancy(&c, RHO, G, cases[i].zO, ez, F, M, NULL, NULL);
         brute(&c, cases[i].th, cases[i].zO, Fb, Mb);
         double fs = RHO * G * c.area * c.length, e = 0;
         for (int j = 0; j < 3; j++)
@@ -192,7 +195,7 @@ static void test_metacentre(void)
             double th[3] = {0, 0, 0}, ez[3], F[3], M[3];
             th[axis] = phi;
             ez_body(th, ez);
-            tsi_mast_buoyancy(&c, RHO, G, zO, ez, F, M, NULL);
+            tsi_mast_buoyancy(&c, RHO, G, zO, ez, F, M, NULL, NULL);
             /* Heel about x (roll): the waterplane's moment about x is
              * the thickness's, J_y; pitch about y: the chord's, J_x. */
             double J = axis == 0 ? Jy : Jx;
@@ -288,6 +291,86 @@ static void test_sinkage(void)
     tsi_vehicle_ws_free(ws);
 }
 
+/* 5. The mast's drag (tsi_mast_drag through tsi_vehicle_statics) against
+ * a hand computation. With the waterline across the mast's sides, the
+ * submerged length of the generator at section offset q is f(q) = s_c +
+ * k.q (s_c = z_foot / cz, k = (ez_x, ez_y) / cz), so over the elliptic
+ * section (semi-axes a0 = chord/2, a1 = thickness/2, second moments a0^2
+ * / 4 and a1^2 / 4 of the area) its mean is s_c and the submerged
+ * part's centroid is the foot plus (a0^2 k_x / (4 s_c), a1^2 k_y / (4
+ * s_c), -(s_c^2 + (k_x^2 a0^2 + k_y^2 a1^2) / 4) / (2 s_c)): upright,
+ * the middle of the submerged length. The drag there is -1/2 rho Cd
+ * thickness s_c |w_perp| w_perp, w the centroid's velocity through the
+ * water (wO + om x centroid) and w_perp its part across the mast (body x,
+ * y). Upright at two depths (0.55 and 1.55 m of the mast under water)
+ * and pitched 0.1 rad and heeled 0.05 rad at the second: the statics
+ * less the drag-free mast's (its buoyancy, the same to the last bit) are
+ * the hand's force and moment about O to 1e-12 relative (rounding). */
+static void test_drag(void)
+{
+    static ts_vehicle v, v0;
+    memset(&v, 0, sizeof v);
+    v.volume = 3.0;
+    v.inertia[0] = v.inertia[1] = v.inertia[2] = 1000;
+    double foot[3] = {0.3, -0.1, -0.45};
+    v.ncomponents = 1;
+    v.component[0] = mast(0.45, 0.15, 3.0, foot);
+    v0 = v;
+    CHECK(v0.component[0].drag == 0.0, "a mast's drag is 0 by default");
+    ts_component *c = &v.component[0];
+    c->drag = 1.17;
+    static const struct {
+        double zO, th[3];
+    } cases[] = {{1.0, {0, 0, 0}}, {2.0, {0, 0, 0}}, {2.0, {0.05, 0.1, 0}}};
+    const double wO[3] = {2.3, 0.4, 0.35}, om[3] = {0.03, -0.08, 0.05};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        tsi_vehicle_state st;
+        memset(&st, 0, sizeof st);
+        double C[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, z3[3] = {0, 0, 0};
+        double rA[3] = {0, 0, cases[i].zO};
+        tsi_vehicle_kinematics(&v, C, cases[i].th, z3, 0.0, rA, z3, &st);
+        memcpy(st.wO_b, wO, sizeof st.wO_b);
+        memcpy(st.om_b, om, sizeof st.om_b);
+        st.frac = 1.0;
+        double F[3], M[3], F0[3], M0[3];
+        tsi_vehicle_statics(&v, RHO, G, &st, NULL, F, M, NULL);
+        tsi_vehicle_statics(&v0, RHO, G, &st, NULL, F0, M0, NULL);
+        /* The hand's geometry. */
+        double ez[3];
+        ez_body(cases[i].th, ez);
+        double zp = cases[i].zO + ez[0] * foot[0] + ez[1] * foot[1] +
+                    ez[2] * foot[2];
+        double sc = zp / ez[2], kx = ez[0] / ez[2], ky = ez[1] / ez[2];
+        double a0 = 0.5 * c->chord, a1 = 0.5 * c->thickness;
+        double m2 = kx * kx * a0 * a0 + ky * ky * a1 * a1;
+        double cen[3] = {foot[0] + a0 * a0 * kx / (4 * sc),
+                         foot[1] + a1 * a1 * ky / (4 * sc),
+                         foot[2] - (sc * sc + m2 / 4) / (2 * sc)};
+        double w[3] = {wO[0] + om[1] * cen[2] - om[2] * cen[1],
+                       wO[1] + om[2] * cen[0] - om[0] * cen[2], 0};
+        double k = -0.5 * RHO * c->drag * c->thickness * sc *
+                   hypot(w[0], w[1]);
+        double Fh[3] = {k * w[0], k * w[1], 0};
+        double Mh[3] = {cen[1] * Fh[2] - cen[2] * Fh[1],
+                        cen[2] * Fh[0] - cen[0] * Fh[2],
+                        cen[0] * Fh[1] - cen[1] * Fh[0]};
+        double ef = 0, em = 0, nf = hypot(Fh[0], Fh[1]), nm = 0;
+        for (int j = 0; j < 3; j++) {
+            ef = fmax(ef, fabs(F[j] - F0[j] - Fh[j]));
+            em = fmax(em, fabs(M[j] - M0[j] - Mh[j]));
+            nm = fmax(nm, fabs(Mh[j]));
+        }
+        CHECK(sc - sqrt(m2) > 0 && sc + sqrt(m2) < c->length &&
+                  ef <= 1e-12 * nf && em <= 1e-12 * nm,
+              "mast drag, O at %.2f m, pitch %.2f, roll %.2f rad: %.4f m "
+              "submerged, centroid (%.4f, %.4f, %.4f) m; force %.6f, %.6f "
+              "N, moment %.6f, %.6f, %.6f N m by hand; statics less the "
+              "buoyancy off by %.2g N, %.2g N m",
+              cases[i].zO, cases[i].th[1], cases[i].th[0], sc, cen[0],
+              cen[1], cen[2], Fh[0], Fh[1], Mh[0], Mh[1], Mh[2], ef, em);
+    }
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
@@ -295,5 +378,6 @@ int main(void)
     test_tilted();
     test_metacentre();
     test_sinkage();
+    test_drag();
     return tc_done();
 }

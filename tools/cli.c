@@ -410,41 +410,170 @@ int cli_parse_int(const char *opt, const char *text, long lo, long hi,
     return 0;
 }
 
-void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
-                  size_t size)
+/* A towing vehicle's solved turn rate below this fraction of V / L (L the
+ * cables' length: the turn whose radius is that length) is rounding: a
+ * symmetric vehicle solves to 1e-19 rad/s, 1e-17 of V / L. */
+#define TURN_ROUNDING 1e-12
+
+void cli_steady_motion(const ts_system *sys, const ts_equilibrium *eq,
+                       double *speed, double *turn_rate)
+{
+    *speed = sys->tow.speed;
+    *turn_rate = sys->tow.turn_rate;
+    if (!cli_motion_solved(sys, eq))
+        return;
+    *speed = eq->speed;
+    *turn_rate = eq->turn_rate;
+    double L = 0.0;
+    for (int c = 0; c < sys->ncables; c++)
+        L += sys->cables[c].length;
+    if (sys->tow.turn_surface < 0 &&
+        fabs(eq->turn_rate) * L <= TURN_ROUNDING * fabs(eq->speed))
+        *turn_rate = 0.0;
+}
+
+int cli_motion_solved(const ts_system *sys, const ts_equilibrium *eq)
+{
+    return sys->tow.vehicle >= 0 && eq && eq->converged &&
+           isfinite(eq->speed) && isfinite(eq->turn_rate);
+}
+
+void cli_tow_text(const ts_system *sys, const ts_equilibrium *eq,
+                  const ts_display *d, char *buf, size_t size)
 {
     d = ts_display_or_si(d);
-    const ts_tow *t = &sys->tow;
+    double speed, turn_rate;
+    cli_steady_motion(sys, eq, &speed, &turn_rate);
     const char *vu = ts_display_unit(d, TS_QTY_SPEED);
     const char *wu = ts_display_unit(d, TS_QTY_ANGULAR_RATE);
-    char v[96], w[96];
-    /* SI speeds and turn rates also in knots and deg/s. */
-    /* With a towing vehicle the scene's speed and turn rate are where the
-     * solve starts (or its targets); the steady motion solved is on the
-     * vehicle's own line (cli_print_vehicles). */
-    int n = snprintf(v, sizeof v, "%sspeed %.6g %s",
-                     t->vehicle >= 0 ? "towing vehicle, scene " : "",
-                     ts_display_value(d, TS_QTY_SPEED, t->speed), vu);
-    if (!strcmp(vu, "m/s") && n > 0 && (size_t)n < sizeof v)
-        snprintf(v + n, sizeof v - (size_t)n, " (%.4g knots)",
-                 t->speed / (1852.0 / 3600.0));
-    if (t->turn_rate == 0.0) {
+    char v[160], w[96];
+    /* SI speeds and turn rates also in knots and deg/s. With a towing
+     * vehicle the steady motion is solved: its speed and turn rate once
+     * the equilibrium converged (the scene's are where the solve starts,
+     * or its targets), else the scene's, said so. */
+    const char *what = sys->tow.vehicle < 0 ? ""
+                       : cli_motion_solved(sys, eq) ? "towing vehicle, solved "
+                                                    : "towing vehicle, scene ";
+    int n = snprintf(v, sizeof v, "%sspeed %.6g %s", what,
+                     ts_display_value(d, TS_QTY_SPEED, speed), vu);
+    int knots = !strcmp(vu, "m/s"), solved = cli_motion_solved(sys, eq);
+    if (knots && n > 0 && (size_t)n < sizeof v)
+        n += snprintf(v + n, sizeof v - (size_t)n, " (%.4g knots%s",
+                      speed / (1852.0 / 3600.0), solved ? "; " : ")");
+    else if (solved && n > 0 && (size_t)n < sizeof v)
+        n += snprintf(v + n, sizeof v - (size_t)n, " (");
+    if (solved && n > 0 && (size_t)n < sizeof v)
+        snprintf(v + n, sizeof v - (size_t)n, "scene %.6g %s)",
+                 ts_display_value(d, TS_QTY_SPEED, sys->tow.speed), vu);
+    if (turn_rate == 0.0) {
         snprintf(buf, size, "%s, turn rate 0 %s (straight)", v, wu);
         return;
     }
     n = snprintf(w, sizeof w, "turn rate %.6g %s",
-                 ts_display_value(d, TS_QTY_ANGULAR_RATE, t->turn_rate), wu);
+                 ts_display_value(d, TS_QTY_ANGULAR_RATE, turn_rate), wu);
     if (!strcmp(wu, "rad/s") && n > 0 && (size_t)n < sizeof w)
         snprintf(w + n, sizeof w - (size_t)n, " (%.4g deg/s,",
-                 t->turn_rate * 180.0 / M_PI);
+                 turn_rate * 180.0 / M_PI);
     else if (n > 0 && (size_t)n < sizeof w)
         snprintf(w + n, sizeof w - (size_t)n, " (");
-    double R = t->speed / fabs(t->turn_rate);
+    double R = speed / fabs(turn_rate);
     snprintf(buf, size, "%s, %s%sturn radius %.4g %s, to %s)", v, w,
              strcmp(wu, "rad/s") ? "" : " ",
              ts_display_value(d, TS_QTY_LENGTH, R),
              ts_display_unit(d, TS_QTY_LENGTH),
-             t->turn_rate > 0 ? "starboard" : "port");
+             turn_rate > 0 ? "starboard" : "port");
+}
+
+/* The longest bare value given the shared unit. */
+#define CLI_VALUE_TEXT_MAX 256
+
+/* The unit written after the number of `text` (spaces trimmed) into
+ * unit: "" for a bare number; -1 when text does not start with a number
+ * (ts_units_parse then names it). */
+static int written_unit(const char *text, char *unit, size_t size)
+{
+    char *end;
+    strtod(text, &end);
+    if (end == text)
+        return -1;
+    while (*end == ' ')
+        end++;
+    size_t len = strlen(end);
+    while (len > 0 && end[len - 1] == ' ')
+        len--;
+    snprintf(unit, size, "%.*s", (int)len, end);
+    return 0;
+}
+
+int cli_shared_unit(const char *cmd, const char *where,
+                    const char *const text[], int n, char *unit,
+                    size_t size)
+{
+    unit[0] = '\0';
+    int bare = 0, mixed = 0;
+    char u[CLI_UNIT_TEXT_MAX];
+    for (int i = 0; i < n; i++) {
+        if (written_unit(text[i], u, sizeof u))
+            continue;
+        if (!u[0])
+            bare = 1;
+        else if (!unit[0])
+            snprintf(unit, size, "%s", u);
+        else if (strcmp(unit, u))
+            mixed = 1;
+    }
+    if (bare && mixed) {
+        fprintf(stderr, "towstab: error: %s: %s: values in different units "
+                        "('%s' and others) and values without one: give "
+                        "each value its unit\n", cmd, where, unit);
+        return EXIT_BADINPUT;
+    }
+    if (mixed || !bare)
+        unit[0] = '\0';
+    return 0;
+}
+
+int cli_parse_values(const ts_units *units, const char *cmd,
+                     const char *where, const char *const text[], int n,
+                     const char *si_unit, double *out)
+{
+    ts_err err = {0};
+    int plain = !si_unit[0] || !strcmp(si_unit, "1");
+    char shared[CLI_UNIT_TEXT_MAX];
+    if (!plain &&
+        cli_shared_unit(cmd, where, text, n, shared, sizeof shared))
+        return EXIT_BADINPUT;
+    for (int i = 0; i < n; i++) {
+        int rc;
+        char u[CLI_UNIT_TEXT_MAX], with[CLI_VALUE_TEXT_MAX + CLI_UNIT_TEXT_MAX];
+        if (plain) {
+            char *end;
+            out[i] = strtod(text[i], &end);
+            while (*end == ' ')
+                end++;
+            rc = end == text[i] || *end || !isfinite(out[i]) ? TS_EINVAL
+                                                             : TS_OK;
+            if (rc)
+                ts_fail(&err, rc, "%s: expected a plain number, got '%s'",
+                        where, text[i]);
+        } else {
+            /* A bare value takes the unit the others are written in. */
+            const char *t = text[i];
+            if (shared[0] && !written_unit(t, u, sizeof u) && !u[0] &&
+                strlen(t) < CLI_VALUE_TEXT_MAX - 1) {
+                snprintf(with, sizeof with, "%.*s %.*s",
+                         CLI_VALUE_TEXT_MAX - 2, t, CLI_UNIT_TEXT_MAX - 1,
+                         shared);
+                t = with;
+            }
+            rc = ts_units_parse(units, t, si_unit, where, &out[i], &err);
+        }
+        if (rc) {
+            fprintf(stderr, "towstab: error: %s: %s\n", cmd, err.msg);
+            return EXIT_BADINPUT;
+        }
+    }
+    return 0;
 }
 
 /* An error for a table: "%.2g", or "-" when not known. */
@@ -579,9 +708,10 @@ void cli_print_vehicles(FILE *f, const ts_system *sys,
         for (int c = 0; c < r->ncomponents; c++)
             if (vd->component[c].type == TS_COMP_MAST)
                 fprintf(f, "%s.%s submerged length %.4f %s (its force: "
-                           "buoyancy)\n",
+                           "buoyancy%s)\n",
                         sys->bodies[r->body].name, vd->component[c].name,
-                        r->load[c].submerged * kl, lu);
+                        r->load[c].submerged * kl, lu,
+                        vd->component[c].drag > 0 ? " and drag" : "");
         fprintf(f, "%s (M) %.4f, %.4f, %.4f %s\n",
                 r->towing ? "cable pull at the tow point" : "joint force",
                 kf * r->joint_force[0], kf * r->joint_force[1],

@@ -277,9 +277,39 @@ void cli_print_trust_as(const ts_trust *t, const char *what);
 /* "speed V m/s (K knots), turn rate W rad/s (D deg/s, turn radius R m, to
  * starboard)" or "... turn rate 0 rad/s (straight)" in SI; in the display
  * units d otherwise ("speed 5 knot, turn rate 2 deg/s (turn radius 480
- * ft, to port)"). */
-void cli_tow_text(const ts_system *sys, const ts_display *d, char *buf,
-                  size_t size);
+ * ft, to port)"). With a towing vehicle, the steady motion eq solved
+ * ("towing vehicle, solved speed 3.19825 m/s (6.217 knots; scene 3
+ * m/s) ..."), or the scene's when eq is NULL or did not converge ("towing
+ * vehicle, scene speed ..."). */
+void cli_tow_text(const ts_system *sys, const ts_equilibrium *eq,
+                  const ts_display *d, char *buf, size_t size);
+/* The longest unit text of a value (after its number). */
+#define CLI_UNIT_TEXT_MAX 64
+
+/* The unit shared by the values of a range or list (text[n], each a
+ * number with or without a unit, "2", "4 knot"): when some are written
+ * without a unit and the others all in one, that unit ("knot"); else ""
+ * (none written, or every value has its own). Values in different units
+ * beside bare ones are ambiguous: a message "towstab: error: CMD: WHERE:
+ * ..." and EXIT_BADINPUT; else 0. */
+int cli_shared_unit(const char *cmd, const char *where,
+                    const char *const text[], int n, char *unit,
+                    size_t size);
+/* The values text[n] of a range or list into out[n], SI, in the key's
+ * unit si_unit ("" or "1": plain numbers only): a value without a unit
+ * takes the one the others are written in (cli_shared_unit: "2:4 knot"
+ * is 2 to 4 knots), or is SI when none has one. 0, or EXIT_BADINPUT with
+ * a message naming `where`. */
+int cli_parse_values(const ts_units *units, const char *cmd,
+                     const char *where, const char *const text[], int n,
+                     const char *si_unit, double *out);
+/* 1 when sys has a towing vehicle whose steady motion eq solved. */
+int cli_motion_solved(const ts_system *sys, const ts_equilibrium *eq);
+/* The steady motion of the mean frame: the scene's speed and turn rate
+ * (m/s, rad/s), or, when cli_motion_solved, those eq solved (a turn rate
+ * that is rounding of a straight tow, below 1e-12 of V / L, as 0). */
+void cli_steady_motion(const ts_system *sys, const ts_equilibrium *eq,
+                       double *speed, double *turn_rate);
 
 /* A key value as shown in the display units d, and "+- D
  * (discretisation) +- S (solver) UNIT" of it, "-" where not estimated. */

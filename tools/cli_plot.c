@@ -65,7 +65,8 @@ int cli_display_begin(const ts_units *units, const char *spec,
     return rc ? cli_report(&err, rc) : 0;
 }
 
-int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out)
+int cli_plot_shape(const ts_system *sys, const ts_equilibrium *eq,
+                   const double *pos, cli_shape *out)
 {
     memset(out, 0, sizeof *out);
     out->link_upper = malloc(((size_t)sys->nlinks + 1) * sizeof(int));
@@ -98,10 +99,11 @@ int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out)
     s->marks = out->marks;
     s->ncylinders = ncyl;
     s->cylinders = out->cylinders;
-    /* doc/model.md section 1: the turn centre is at (0, V / Omega, 0). */
-    s->turn_radius = sys->tow.turn_rate != 0
-                         ? sys->tow.speed / sys->tow.turn_rate
-                         : 0;
+    /* doc/model.md section 1: the turn centre is at (0, V / Omega, 0),
+     * with a towing vehicle at its solved motion. */
+    double V, W;
+    cli_steady_motion(sys, eq, &V, &W);
+    s->turn_radius = W != 0 ? V / W : 0;
     s->label = out->label;
     return 0;
 }
@@ -161,19 +163,24 @@ int cli_plot_add_vehicles(cli_shape *s, const ts_system *sys,
     return 0;
 }
 
-void cli_plot_tow_label(const ts_system *sys, const char *speed_text,
-                        const char *turn_text, const ts_display *d,
-                        char *buf, size_t size)
+void cli_plot_tow_label(const ts_system *sys, const ts_equilibrium *eq,
+                        const char *speed_text, const char *turn_text,
+                        const ts_display *d, char *buf, size_t size)
 {
     d = ts_display_or_si(d);
     char v[ITEM_TEXT], w[ITEM_TEXT];
+    /* A towing vehicle's solved motion replaces the texts as written
+     * (the solve's start). */
+    double V, W;
+    cli_steady_motion(sys, eq, &V, &W);
+    if (cli_motion_solved(sys, eq))
+        speed_text = turn_text = NULL;
     if (speed_text && speed_text[0])
         snprintf(v, sizeof v, "%s", speed_text);
     else
-        snprintf(v, sizeof v, "%.4g %s",
-                 ts_display_value(d, TS_QTY_SPEED, sys->tow.speed),
+        snprintf(v, sizeof v, "%.4g %s", ts_display_value(d, TS_QTY_SPEED, V),
                  ts_display_unit(d, TS_QTY_SPEED));
-    if (sys->tow.turn_rate == 0) {
+    if (W == 0) {
         snprintf(buf, size, "%s, straight", v);
         return;
     }
@@ -181,9 +188,8 @@ void cli_plot_tow_label(const ts_system *sys, const char *speed_text,
         snprintf(w, sizeof w, "%s", turn_text);
     else
         snprintf(w, sizeof w, "%.4g %s",
-                 ts_display_value(d, TS_QTY_ANGULAR_RATE,
-                                  fabs(sys->tow.turn_rate)),
+                 ts_display_value(d, TS_QTY_ANGULAR_RATE, fabs(W)),
                  ts_display_unit(d, TS_QTY_ANGULAR_RATE));
     snprintf(buf, size, "%s, turn %s (%s)", v, w,
-             sys->tow.turn_rate > 0 ? "starboard" : "port");
+             W > 0 ? "starboard" : "port");
 }

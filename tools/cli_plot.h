@@ -56,7 +56,8 @@ typedef struct cli_shape {
     ts_plot_outline *outlines; /* [nbodies]: vehicles with their attitude */
 } cli_shape;
 
-int cli_plot_shape(const ts_system *sys, const double *pos, cli_shape *out);
+int cli_plot_shape(const ts_system *sys, const ts_equilibrium *eq,
+                   const double *pos, cli_shape *out);
 void cli_plot_shape_free(cli_shape *s);
 
 /* Add vehicle body `b` of sys to the shape, drawn with attitude R (body
@@ -73,8 +74,9 @@ int cli_plot_add_vehicles(cli_shape *s, const ts_system *sys,
 /* "5 knot, straight" or "1.48 knot, turn 0.5 rad/s (starboard)": the tow
  * of `sys` as a legend label: the speed and turn rate as the user wrote
  * them (speed_text, turn_text; NULL or "": in the display units d). */
-void cli_plot_tow_label(const ts_system *sys, const char *speed_text,
-                        const char *turn_text, const ts_display *d,
+void cli_plot_tow_label(const ts_system *sys, const ts_equilibrium *eq,
+                        const char *speed_text, const char *turn_text,
+                        const ts_display *d,
                         char *buf, size_t size);
 
 #endif

@@ -64,23 +64,7 @@ static int bad(const char *fmt, const char *a, const char *b)
 static int quantity(const cli_run *c, const char *where, const char *text,
                     const char *unit, double *out)
 {
-    ts_err err = {0};
-    int rc;
-    if (unit[0] && strcmp(unit, "1")) {
-        rc = ts_units_parse(c->units, text, unit, where, out, &err);
-    } else {
-        char *end;
-        *out = strtod(text, &end);
-        while (*end == ' ')
-            end++;
-        rc = end == text || *end || !isfinite(*out) ? TS_EINVAL : TS_OK;
-        if (rc)
-            ts_fail(&err, rc, "%s: expected a plain number, got '%s'", where,
-                    text);
-    }
-    if (rc)
-        fprintf(stderr, "towstab: error: design: %s\n", err.msg);
-    return rc ? EXIT_BADINPUT : 0;
+    return cli_parse_values(c->units, "design", where, &text, 1, unit, out);
 }
 
 /* A setting's value: `text`, given where `src` says ("--free", or
@@ -118,11 +102,15 @@ static int parse_free(const cli_run *c, const given *g, ts_design_var *f)
     if (nf < 2 || nf > 3)
         return bad("%s: expected LOWER:UPPER or LOWER:UPPER:START, got '%s'",
                    where, eq + 1);
-    double *dst[3] = {&f->lower, &f->upper, &f->start};
-    f->start = NAN;
-    for (int i = 0; i < nf; i++)
-        if (quantity(c, where, field[i], unit, dst[i]))
-            return EXIT_BADINPUT;
+    /* A unit written on one bound applies to those written without one
+     * ("1:5 knot"). */
+    double v[3] = {NAN, NAN, NAN};
+    if (cli_parse_values(c->units, "design", where,
+                         (const char *const *)field, nf, unit, v))
+        return EXIT_BADINPUT;
+    f->lower = v[0];
+    f->upper = v[1];
+    f->start = v[2];
     return 0;
 }
 

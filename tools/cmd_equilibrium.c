@@ -73,19 +73,22 @@ static int split_list(const char *opt, const char *text,
                 opt, text);
         return -1;
     }
-    /* The unit of the last item, if any: the text after its number. */
-    char *end;
-    strtod(items[n - 1], &end);
-    while (*end == ' ')
-        end++;
-    for (int i = 0; *end && i < n - 1; i++) {
+    /* A unit written on some items applies to those written without one
+     * ('2,4,6 knot'). */
+    const char *text_of[MAX_OVERLAYS];
+    for (int i = 0; i < n; i++)
+        text_of[i] = items[i];
+    char unit[CLI_UNIT_TEXT_MAX];
+    if (cli_shared_unit("equilibrium", opt, text_of, n, unit, sizeof unit))
+        return -1;
+    for (int i = 0; unit[0] && i < n; i++) {
         char *e;
         strtod(items[i], &e);
         while (*e == ' ')
             e++;
-        if (*e == '\0' && strlen(items[i]) + strlen(end) + 2 < ITEM_MAX) {
+        if (*e == '\0' && strlen(items[i]) + strlen(unit) + 2 < ITEM_MAX) {
             strcat(items[i], " ");
-            strcat(items[i], end);
+            strcat(items[i], unit);
         }
     }
     return n;
@@ -134,6 +137,20 @@ static void turn_track(double speed, double turn_rate, const double r[3],
     }
 }
 
+/* 1 when curve (sys, eq) is a steady turn, with its speed and turn rate
+ * (a towing vehicle's solved ones) in *speed, *turn_rate (either NULL). */
+static int turning(const ts_system *sys, const ts_equilibrium *eq,
+                   double *speed, double *turn_rate)
+{
+    double V, W;
+    cli_steady_motion(sys, eq, &V, &W);
+    if (speed)
+        *speed = V;
+    if (turn_rate)
+        *turn_rate = W;
+    return W != 0 && V > 0;
+}
+
 /* The earth-frame plan view of the converged curves in a steady turn
  * (plan_earth): over one turn, the circle of the tow point and of every
  * body, each marked where it is at t = 0. Nothing is drawn when no curve
@@ -144,7 +161,7 @@ static int eq_plot_turn(const cli_plot *plot, const eq_curve *curves,
     int ntracks = 0;
     for (int i = 0; i < ncurves; i++)
         if (curves[i].eq && curves[i].eq->converged &&
-            curves[i].sys->tow.turn_rate != 0 && curves[i].sys->tow.speed > 0)
+            turning(curves[i].sys, curves[i].eq, NULL, NULL))
             ntracks += 1 + curves[i].sys->nbodies;
     if (ntracks == 0)
         return 0;
@@ -163,18 +180,17 @@ static int eq_plot_turn(const cli_plot *plot, const eq_curve *curves,
     int n = 0, curve = 0;
     for (int i = 0; i < ncurves; i++) {
         const eq_curve *c = &curves[i];
-        if (!c->eq || !c->eq->converged || c->sys->tow.turn_rate == 0 ||
-            !(c->sys->tow.speed > 0))
+        double V, W;
+        if (!c->eq || !c->eq->converged || !turning(c->sys, c->eq, &V, &W))
             continue;
         char tow[128];
-        cli_plot_tow_label(c->sys, c->speed_text, c->turn_text,
+        cli_plot_tow_label(c->sys, c->eq, c->speed_text, c->turn_text,
                            plot->opts.display, tow, sizeof tow);
         for (int b = -1; b < c->sys->nbodies; b++) {
             int node = b < 0 ? 0 : ts_system_body_node(c->sys, b);
             const char *what = b < 0 ? "tow point" : c->sys->bodies[b].name;
             double *x = xy + 2 * (size_t)n * TURN_POINTS, *y = x + TURN_POINTS;
-            turn_track(c->sys->tow.speed, c->sys->tow.turn_rate,
-                       c->eq->positions + 3 * node, x, y);
+            turn_track(V, W, c->eq->positions + 3 * node, x, y);
             if (distinct > 1 || curve > 0)
                 snprintf(label[n], sizeof label[n], "%.40s %.40s, %.100s",
                          distinct > 1 ? c->sys->name : "", what, tow);
@@ -220,14 +236,14 @@ static int eq_plot(const cli_plot *plot, eq_curve *curves, int ncurves)
         const eq_curve *c = &curves[i];
         if (!c->eq || !c->eq->converged)
             continue;
-        if (cli_plot_shape(c->sys, c->eq->positions, &shapes[n]) != 0 ||
+        if (cli_plot_shape(c->sys, c->eq, c->eq->positions, &shapes[n]) != 0 ||
             cli_plot_add_vehicles(&shapes[n], c->sys, c->eq) != 0) {
             fprintf(stderr, "towstab: error: equilibrium: --plot: out of memory\n");
             status = EXIT_FAILED;
             break;
         }
         char tow[128];
-        cli_plot_tow_label(c->sys, c->speed_text, c->turn_text,
+        cli_plot_tow_label(c->sys, c->eq, c->speed_text, c->turn_text,
                            plot->opts.display, tow, sizeof tow);
         if (distinct > 1)
             snprintf(shapes[n].label, sizeof shapes[n].label, "%.63s: %.120s",
@@ -293,7 +309,7 @@ void cli_print_equilibrium(const ts_result *r, int quiet,
 #define L_(v) ts_display_value(d, TS_QTY_LENGTH, (v))
 #define F_(v) ts_display_value(d, TS_QTY_FORCE, (v))
     char tow[256];
-    cli_tow_text(sys, d, tow, sizeof tow);
+    cli_tow_text(sys, eq, d, tow, sizeof tow);
     fprintf(f, "%s, %d cable%s, %d links, %d bod%s\n", tow, sys->ncables,
             sys->ncables == 1 ? "" : "s", sys->nlinks, sys->nbodies,
             sys->nbodies == 1 ? "y" : "ies");

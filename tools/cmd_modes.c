@@ -417,7 +417,7 @@ static int modes_plot(const ts_result *r, const cli_plot *plot, int frames)
     double *disp = malloc((size_t)np * per * sizeof(double));
     char labels[PLOT_MODES][160];
     ts_plot_mode modes[PLOT_MODES];
-    if (!disp || cli_plot_shape(sys, pos, &eqs) != 0 ||
+    if (!disp || cli_plot_shape(sys, r->eq, pos, &eqs) != 0 ||
         (r->eq && cli_plot_add_vehicles(&eqs, sys, r->eq) != 0)) {
         free(disp);
         fprintf(stderr, "towstab: error: modes: --plot: out of memory\n");

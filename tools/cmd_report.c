@@ -155,11 +155,18 @@ static void inputs(FILE *f, const ts_scene *scene)
         snprintf(name, sizeof name, "current %s", axis[k]);
         input_row(f, name, s->env.current[k], "m/s");
     }
-    input_row(f, "tow speed", s->tow.speed, "m/s");
-    input_row(f, "tow speed", s->tow.speed / KNOT, "knot");
-    input_row(f, "turn rate", s->tow.turn_rate, "rad/s");
-    input_row(f, "turn rate", s->tow.turn_rate / DEG, "deg/s");
-    if (s->tow.turn_rate != 0)
+    /* With a towing vehicle these are where its solve starts (or its
+     * targets): the solved motion is the results' (the vehicle's line). */
+    int towing = s->tow.vehicle >= 0;
+    const char *sp = towing ? "tow speed (the towing vehicle's start)"
+                            : "tow speed";
+    const char *tr = towing ? "turn rate (the towing vehicle's start)"
+                            : "turn rate";
+    input_row(f, sp, s->tow.speed, "m/s");
+    input_row(f, sp, s->tow.speed / KNOT, "knot");
+    input_row(f, tr, s->tow.turn_rate, "rad/s");
+    input_row(f, tr, s->tow.turn_rate / DEG, "deg/s");
+    if (s->tow.turn_rate != 0 && !towing)
         input_row(f, "turn radius V/Omega", s->tow.speed / s->tow.turn_rate,
                   "m");
     for (int k = 0; k < 3; k++) {

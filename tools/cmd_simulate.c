@@ -261,6 +261,17 @@ static void print_waypoints(const ts_result *r, const ts_display *d)
                lu);
 }
 
+/* A number of the comparison's table in `fmt` (a width of 16), or "-"
+ * where it has none (an amplitude ratio or phase without a periodic
+ * excitation): no "nan" printed. */
+static void cmp_cell(const char *fmt, double v)
+{
+    if (isfinite(v))
+        printf(fmt, v);
+    else
+        printf(" %16s", "-");
+}
+
 static void print_compare(const ts_compare *c, const ts_display *d)
 {
     char u[64], ru[80], label[128], eu[64];
@@ -283,21 +294,28 @@ static void print_compare(const ts_compare *c, const ts_display *d)
     printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
            "freq. response");
     snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
-    printf("%-30s %16.6g %16.6g %16.6g\n", label,
-           kr * c->linear.amplitude_ratio, kr * c->nonlinear.amplitude_ratio,
-           kr * c->pred_ratio);
-    printf("%-30s %16.4f %16.4f %16.4f\n", "phase [deg]", c->linear.phase_deg,
-           c->nonlinear.phase_deg, c->pred_phase_deg);
+    printf("%-30s", label);
+    cmp_cell(" %16.6g", kr * c->linear.amplitude_ratio);
+    cmp_cell(" %16.6g", kr * c->nonlinear.amplitude_ratio);
+    cmp_cell(" %16.6g", kr * c->pred_ratio);
+    printf("\n%-30s", "phase [deg]");
+    cmp_cell(" %16.4f", c->linear.phase_deg);
+    cmp_cell(" %16.4f", c->nonlinear.phase_deg);
+    cmp_cell(" %16.4f", c->pred_phase_deg);
+    printf("\n");
     snprintf(label, sizeof label, "mean offset [%s]", u);
     printf("%-30s %16.6g %16.6g\n", label, k * c->linear.mean_offset,
            k * c->nonlinear.mean_offset);
     snprintf(label, sizeof label, "half range [%s]", u);
     printf("%-30s %16.6g %16.6g\n", label, k * c->linear.half_range,
            k * c->nonlinear.half_range);
-    printf("amplitude difference %.4g %%, mean difference %.4g %% (linear "
-           "less nonlinear, relative to nonlinear)\n",
-           c->amplitude_difference_pct, c->mean_difference_pct);
-    if (!strcmp(c->output.si_unit, "m"))
+    if (isfinite(c->amplitude_difference_pct))
+        printf("amplitude difference %.4g %%, ", c->amplitude_difference_pct);
+    printf("mean difference %.4g %% (linear less nonlinear, relative to "
+           "nonlinear)\n", c->mean_difference_pct);
+    if (!isfinite(c->rms_difference_ratio))
+        printf("rms difference %.6g %s\n", k * c->rms_difference, u);
+    else if (!strcmp(c->output.si_unit, "m"))
         printf("rms difference %.6g %s (%.4g %% of the excitation "
                "amplitude)\n", k * c->rms_difference, u,
                100 * c->rms_difference_ratio);
@@ -648,9 +666,10 @@ static int plot_tracks(const ts_system *sys, const ts_history *hn,
     return status;
 }
 
-static int plot_snapshots(const ts_system *sys, const ts_history *h,
-                          const ts_excitation *ex, double interval,
-                          double exaggerate, const cli_plot *plot)
+static int plot_snapshots(const ts_system *sys, const ts_equilibrium *eq,
+                          const ts_history *h, const ts_excitation *ex,
+                          double interval, double exaggerate,
+                          const cli_plot *plot)
 {
     double t_end = h->t[h->nsamples - 1];
     int nsnap = 0;
@@ -686,7 +705,7 @@ static int plot_snapshots(const ts_system *sys, const ts_history *h,
                        exaggerate * (pos[j] - h->positions[j]);
             pos = e;
         }
-        if (cli_plot_shape(sys, pos, &shapes[k]) != 0 ||
+        if (cli_plot_shape(sys, eq, pos, &shapes[k]) != 0 ||
             snapshot_vehicles(sys, h, idx[k], &shapes[k]) != 0) {
             fprintf(stderr,
                     "towstab: error: simulate: --plot: out of memory\n");
@@ -851,7 +870,7 @@ static void sim_print(const cli_run *c, const ts_result *r)
         return;
     const ts_display *d = &c->display;
     char tow[256];
-    cli_tow_text(sys, d, tow, sizeof tow);
+    cli_tow_text(sys, r->eq, d, tow, sizeof tow);
     printf("simulate %s: %d links, %s\n", sys->name, sys->nlinks, tow);
     char desc[256];
     const ts_excitation *ex = r->excitation;
@@ -954,8 +973,8 @@ static int sim_draw(cli_run *c, const ts_result *r)
     int status = plot_histories(r->sys, &r->output, r->excitation,
                                 r->nonlinear, r->linear, &c->plot);
     if (!status)
-        status = plot_snapshots(r->sys, h, r->excitation, st->snapshot,
-                                st->exaggerate, &c->plot);
+        status = plot_snapshots(r->sys, r->eq, h, r->excitation,
+                                st->snapshot, st->exaggerate, &c->plot);
     if (!status && ((r->excitation &&
                      ts_excitation_has_manoeuvre(r->excitation)) ||
                     r->sys->tow.turn_rate != 0 || r->sys->tow.vehicle >= 0))

@@ -129,25 +129,11 @@ static int parse_vary(cli_run *c, sweep_state *st, int a, const char *text,
     if (!vals)
         return bad("--vary %s: out of memory%s", ax->path, "");
     st->values[a] = vals;
-    for (int i = 0; i < nv; i++) {
-        double *dst = colon ? &v[i] : &vals[i];
-        int rc;
-        if (unit[0]) {
-            rc = ts_units_parse(c->units, field[i], unit, where, dst, &err);
-        } else {
-            char *end;
-            *dst = strtod(field[i], &end);
-            rc = end == field[i] || *end || !isfinite(*dst) ? TS_EINVAL
-                                                            : TS_OK;
-            if (rc)
-                ts_fail(&err, rc, "%s: expected a plain SI number, got '%s'",
-                        where, field[i]);
-        }
-        if (rc) {
-            fprintf(stderr, "towstab: error: sweep: %s\n", err.msg);
-            return EXIT_BADINPUT;
-        }
-    }
+    /* A unit written on one value applies to those written without one
+     * ("2:4 knot", "2,3,4 knot"). */
+    if (cli_parse_values(c->units, "sweep", where, (const char *const *)field,
+                         nv, unit, colon ? v : vals))
+        return EXIT_BADINPUT;
     if (!colon) {
         ax->n = nf;
         ax->values = vals;

@@ -105,7 +105,8 @@ typedef struct ts_design_spec {
     double target_rtol;           /* 0: TS_DESIGN_TARGET_RTOL */
     double xtol;                  /* 0: TS_DESIGN_XTOL */
     double fin_step;              /* m: fin_use adds, on every limited
-                                     control surface, |the jump of its
+                                     control surface and ballast tank,
+                                     |the jump of its
                                      command| when the depth loops' set
                                      points step by this: sum over depth
                                      loops of kp gain fin_step; 0: the
@@ -169,8 +170,11 @@ typedef struct ts_design {
  *                  (the largest node displacement of the shape is at a
  *                  vehicle: the modes its controllers act on), 1;
  *   fin_use        the largest |steady deflection| / limit over the
- *                  vehicles' control surfaces with a limit, 1 (a study
- *                  adds the jump of a depth set-point step, fin_step);
+ *                  vehicles' control surfaces with a limit, and |fill -
+ *                  capacity / 2| / (capacity / 2) over their ballast
+ *                  tanks (1: at a limit, a tank empty or full), 1 (a
+ *                  study adds the jump of a depth set-point step,
+ *                  fin_step);
  *   a free value's path (its value in the run's system).
  * Returns 1, or 0 when r has no such value (or it is NaN). */
 TS_API int ts_design_value(const ts_result *r, const char *name,

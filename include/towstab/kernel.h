@@ -101,6 +101,11 @@ TS_API int ts_kernel_input_find(const ts_kernel *k, const char *name);
 TS_API const char *ts_kernel_input_unit(const ts_kernel *k, int j);
 /* 1 when input j is a control surface's deflection. */
 TS_API int ts_kernel_input_is_surface(const ts_kernel *k, int j);
+/* 1 when input j is a loop's set point ("<vehicle>.<loop>.setpoint"): the
+ * one kind of input that does nothing with the loops open (a loop's
+ * input adds to its frozen output, a towing vehicle's thrust, forces,
+ * moments and speed set point act on the plant). */
+TS_API int ts_kernel_input_is_setpoint(const ts_kernel *k, int j);
 /* Offset of link `link`'s coordinates in q (2 for rigid, 3 for elastic). */
 TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
 

@@ -40,8 +40,10 @@ typedef enum {
                              x, thickness along y); the buoyancy of its
                              part under the free surface z = 0, which
                              follows the vehicle's depth and attitude
-                             (doc/vehicle.md section 4); no drag (give
-                             its drag as bluff parts) */
+                             (doc/vehicle.md section 4); with `drag`
+                             (default 0), the drag of that part across
+                             the flow on thickness x submerged length,
+                             at its centroid */
     TS_COMP_BALLAST = 4   /* ballast tank at `position`: controlled
                              buoyancy. Its fill (kg of water, in [0,
                              capacity]) is a control component's
@@ -65,7 +67,8 @@ typedef struct ts_component {
     double position[3];   /* hull, bluff part: its centre; surface: its
                              centre of pressure; body axes from O, m */
     /* Bluff part (and a surface's planform area below). */
-    double drag;          /* drag coefficient on `area` */
+    double drag;          /* drag coefficient on `area`; a mast's on its
+                             submerged frontal area (0 by default) */
     /* Hull (axis along body x). */
     double length;        /* m, > 0 */
     double diameter;      /* m, > 0 */

@@ -53,6 +53,18 @@ else
     fail "target 15 m: status $status $(head -c 300 "$T/err") $(grep wanted "$T/out")"
 fi
 
+# A unit on one bound applies to the bare one: "30:200 ft" is the study
+# of "30ft:200ft": lower bound 9.144 m, the same optimum to the last digit.
+ts design "$EX1" --free "cables.cable.length=30:200 ft" --target "sphere.z=15m" \
+    --json "$T/du.json" --quiet
+if [ "$status" -eq 0 ] && grep -q '"lower": 9.144' "$T/du.json" &&
+   awk -v a="$(json_num "$T/du.json" optimum)" -v b="$(json_num "$T/d.json" optimum)" \
+       'BEGIN { exit !(a != "" && a + 0 == b + 0) }'; then
+    pass "--free cables.cable.length=30:200 ft: both bounds in feet, the optimum of 30ft:200ft ($(json_num "$T/du.json" optimum) m)"
+else
+    fail "--free 30:200 ft: status $status, $(grep -m1 '"lower"' "$T/du.json" 2>/dev/null) $(head -c 200 "$T/err")"
+fi
+
 ts design "$EX1" --free "cables.cable.length=10:60" --target "sphere.z=20m" \
     --json "$T/u.json" --quiet
 if [ "$status" -eq 1 ] && grep -q "NOT REACHED" "$T/out" &&

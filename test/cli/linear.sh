@@ -253,5 +253,39 @@ else
     fail "response $D: depth: status $status, $(grep -m1 'static gain' "$T/out")"
 fi
 
+# The headers of a towing-vehicle run state the solved steady motion, not
+# the scene's tow.speed (3 m/s, where the solve starts): modes, response
+# and simulate on test/scenes/towing_sphere.yaml print the speed the
+# vehicle's own line gives ("tug: towing at V m/s"), straight; with the
+# rudder at 3 deg the solved turn rate, and the turn radius V / |Omega|
+# from the solved values (164.3 m, doc/towing-vehicle.md section 5).
+W=test/scenes/towing_sphere.yaml
+for run in "modes $W --links 4" \
+           "response $W --links 4 --input tug.thrust --output sphere.z --points 3" \
+           "simulate $W --links 4 --t-end 0.5" \
+           "modes $W --links 4 --set towing_vehicle.components.rudder.deflection=3deg"; do
+    eval ts $run --no-discretisation-error
+    v=$(sed -n 's/^tug: towing at \([0-9.]*\) m\/s.*/\1/p' "$T/out")
+    w=$(sed -n 's/^tug: towing at .*turn rate \([-0-9.e]*\) rad\/s.*/\1/p' "$T/out")
+    case $run in
+    simulate*) # its vehicle line is the equilibrium's, in the JSON
+        ts equilibrium $W --links 4 --no-discretisation-error --quiet
+        v=$(sed -n 's/^tug: towing at \([0-9.]*\) m\/s.*/\1/p' "$T/out")
+        eval ts $run --no-discretisation-error
+        h=$(sed -n 1p "$T/out") ;;
+    *) h=$(sed -n 2p "$T/out") ;;
+    esac
+    case $run in
+    *deflection*) turn="turn rate $(printf '%.6g' "$w") rad/s (.*turn radius 164.3 m, to port)" ;;
+    *) turn="turn rate 0 rad/s (straight)" ;;
+    esac
+    if [ "$status" -eq 0 ] && [ -n "$v" ] && [ "$v" != 3 ] &&
+       printf '%s\n' "$h" | grep -q "towing vehicle, solved speed $(printf '%.6g' "$v") m/s ([0-9.]* knots; scene 3 m/s), $turn"; then
+        pass "${run%% *}: the header states the solved speed $v m/s${w:+, turn rate $w rad/s}"
+    else
+        fail "${run%% *} ($run): status $status, vehicle line $v m/s, header: $h"
+    fi
+done
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

@@ -408,5 +408,63 @@ ts simulate test/scenes/towing_sphere.yaml --links 4 --t-end 1 --quiet \
 [ -z "$why" ] && pass "tug.speed_set: a step in simulate, an input of response; wrong units and a thrust-driven vehicle refused" ||
     fail "tug.speed_set:$why"
 
+# 15. A towing vehicle's propulsion inputs with the loops open
+# (--open-loop: the depth loop's output frozen at its trim, the speed
+# controller closed): steps of tug.thrust (20 and 10 N) and, with the PI
+# speed controller of 14, tug.speed_set (0.1 and 0.05 m/s) run linear and
+# nonlinear over 20 s; their rms difference falls like the step's square
+# (ratio 3.99 and 3.96: the ratio in [3.5, 4.5]). The survey ship with a
+# heading loop (kp 2, kd 20 s on its rudder): a thrust step leaves the yaw
+# at 0 by symmetry, so the loop does not act and the open-loop run is the
+# closed-loop one, CSV byte for byte; a yaw moment step, which the loop
+# acts against, differs (0.11 deg closed, 2.98 deg open at 30 s). These
+# inputs were refused with the loops open. The comparison of a step
+# prints "-" for the amplitude ratio and phase it does not have.
+rms_ratio() { # SCENE INPUT AMP1 AMP2 UNIT: the ratio of the rms differences
+    local a b
+    "$TOWSTAB" simulate "$1" --links 4 --no-discretisation-error --t-end 20 \
+        --open-loop --compare --output sphere.z --excite "$2:step,amplitude=$3$5" >"$T/r1" 2>&1 &&
+    "$TOWSTAB" simulate "$1" --links 4 --no-discretisation-error --t-end 20 \
+        --open-loop --compare --output sphere.z --excite "$2:step,amplitude=$4$5" >"$T/r2" 2>&1 || return 1
+    # A step has no amplitude ratio or phase: "-", no nan printed.
+    ! grep -qiw nan "$T/r1" "$T/r2" || return 1
+    a=$(sed -n 's/^rms difference \([0-9.e-]*\) m.*/\1/p' "$T/r1")
+    b=$(sed -n 's/^rms difference \([0-9.e-]*\) m.*/\1/p' "$T/r2")
+    awk -v a="$a" -v b="$b" 'BEGIN { if (a == "" || !(b > 0)) exit 1; printf "%.4g %.3g %.3g", a / b, a, b }'
+}
+r=$(rms_ratio test/scenes/towing_sphere.yaml tug.thrust 20 10 N)
+if [ -n "$r" ] && awk -v r="${r%% *}" 'BEGIN { exit !(r > 3.5 && r < 4.5) }'; then
+    pass "--open-loop tug.thrust steps 20, 10 N: linear less nonlinear falls like the step's square (ratio, rms differences: $r m)"
+else
+    fail "--open-loop tug.thrust: ratio '$r', $(head -c 200 "$T/r1")"
+fi
+r=$(rms_ratio "$T/o/pi.yaml" tug.speed_set 0.1 0.05 m/s)
+if [ -n "$r" ] && awk -v r="${r%% *}" 'BEGIN { exit !(r > 3.5 && r < 4.5) }'; then
+    pass "--open-loop tug.speed_set steps 0.1, 0.05 m/s: linear less nonlinear falls like the step's square ($r m)"
+else
+    fail "--open-loop tug.speed_set: ratio '$r', $(head -c 200 "$T/r1")"
+fi
+fresh
+sed 's/^  propulsion:$/  controllers:\n    - {name: heading, measure: heading, setpoint: 0, kp: 2, kd: "20 s", surfaces: {rudder: 1}}\n  propulsion:/' \
+    test/scenes/survey_ship.yaml >"$T/o/ship.yaml"
+why=""
+for ex in "ship.thrust:step,amplitude=500N,rise=1s" "ship.moment.z:step,amplitude=5kN*m,rise=1s"; do
+    for ol in closed open; do
+        ts simulate "$T/o/ship.yaml" --links 6 --no-discretisation-error --t-end 30 \
+            --quiet --outputs depressor.z,cable.1.tension,ship.yaw \
+            --excite "$ex" --csv "$T/o/${ex%%:*}.$ol.csv" $([ $ol = open ] && echo --open-loop)
+        [ "$status" -eq 0 ] || why="$why $ex $ol: exit $status, $(head -1 "$T/err");"
+    done
+done
+cmp -s "$T/o/ship.thrust.closed.csv" "$T/o/ship.thrust.open.csv" ||
+    why="$why the thrust step differs with the loop open;"
+[ -s "$T/o/ship.moment.z.closed.csv" ] &&
+    ! cmp -s "$T/o/ship.moment.z.closed.csv" "$T/o/ship.moment.z.open.csv" ||
+    why="$why the yaw moment step does not see the loop open;"
+[ "$(tail -n 1 "$T/o/ship.thrust.open.csv" | cut -d, -f4)" = 0 ] ||
+    why="$why the thrust step moved the yaw;"
+[ -z "$why" ] && pass "survey ship with a heading loop: a thrust step open-loop is the closed-loop run byte for byte (the yaw stays 0); a yaw moment step differs (yaw $(tail -n 1 "$T/o/ship.moment.z.closed.csv" | cut -d, -f4) against $(tail -n 1 "$T/o/ship.moment.z.open.csv" | cut -d, -f4) deg)" ||
+    fail "heading loop open and closed:$why"
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

@@ -20,8 +20,10 @@
 # - The towing vehicle's propulsion (thrust, and power on the same scene
 #   with constant power) by path: each point is the single run with --set;
 #   a key of another law is refused.
+# - A unit on a range or list ("2:4 knot:3", "2,3,4 knot") applies to
+#   the values written without one.
 # - Bad input exits 2 naming the option: an unknown path, a malformed
-#   --vary, a column --output does not have, --no-boundary without modes,
+#   --vary, a bare value beside values in different units, a column --output does not have, --no-boundary without modes,
 #   --analysis converge, no --vary.
 set -u
 if [ $# -ne 2 ]; then
@@ -200,6 +202,24 @@ else
     fail "power on a thrust-propelled vehicle: status $status $(head -c 200 "$T/err")"
 fi
 
+# ---- a unit on a range or a list applies to its bare values ---------------
+# "2:4 knot:3" is 2 to 4 knots (1.0289 to 2.0578 m/s), the sweep of
+# "2 knot:4 knot:3"; "2,3,4 knot" the list of each in knots; both CSVs
+# byte for byte the one with every value's unit written. Before, FROM was
+# read as 2 m/s.
+for pair in "2:4 knot:3|2 knot:4 knot:3" "2,3,4 knot|2 knot,3 knot,4 knot"; do
+    ts sweep "$EX1" --vary "speed=${pair%%|*}" --jobs 1 --quiet --csv "$T/u1.csv"
+    s1=$status
+    ts sweep "$EX1" --vary "speed=${pair#*|}" --jobs 1 --quiet --csv "$T/u2.csv"
+    v0=$(csv_value "$T/u1.csv" 0 tow.speed)
+    if [ "$s1" -eq 0 ] && [ "$status" -eq 0 ] && cmp -s "$T/u1.csv" "$T/u2.csv" &&
+       awk -v v="$v0" 'BEGIN { exit !(v == 2 * 1852 / 3600) }'; then
+        pass "--vary speed=${pair%%|*}: the unit applies to every value (first $v0 m/s = 2 knots)"
+    else
+        fail "--vary speed=${pair%%|*}: status $s1/$status, first value $v0 m/s, $(head -c 200 "$T/err")"
+    fi
+done
+
 # ---- bad input --------------------------------------------------------------
 bad() { # WHAT EXPECTED-TEXT ARGS...
     local what=$1 want=$2
@@ -218,5 +238,6 @@ bad "--no-boundary without modes" "no-boundary" "$EX1" --vary speed=1:2:2 --no-b
 bad "--analysis converge" "not an analysis to sweep" "$EX1" --analysis converge --vary speed=1:2:2
 bad "no --vary" "at least one --vary" "$EX1"
 bad "a value out of range" "must be >= 0 m/s" "$EX1" --vary speed=-1:2:3
+bad "a bare value beside two units" "values in different units" "$EX1" --vary "speed=2 knot,3 m/s,4"
 
 finish
