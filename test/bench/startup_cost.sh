@@ -19,16 +19,12 @@ RUNS=${3:-31}
 row_preload() {
     local label=$1
     shift
-    local ta=() tb=()
+    ta=() tb=()
     for ((i = 0; i < RUNS; i++)); do
         ta+=("$(cpu env "$TOWSTAB" "$@")")
         tb+=("$(cpu env LD_PRELOAD="$MODULE" "$TOWSTAB" "$@")")
     done
-    local ma mb
-    ma=$(printf '%s\n' "${ta[@]}" | median)
-    mb=$(printf '%s\n' "${tb[@]}" | median)
-    awk -v l="$label" -v a="$ma" -v b="$mb" \
-        'BEGIN { printf "| %s | %.4f | %.4f | %.2f |\n", l, a, b, a / b }'
+    DIGITS=4 row_of "$label"
 }
 
 [ -f "$MODULE" ] || { echo "no drawing module $MODULE (a build without PLplot)"; exit 0; }
