@@ -11,150 +11,45 @@
  * a lookup. A run that draws nothing loads none of it (doc/performance.md,
  * "Start-up"). No state is kept here: the dynamic loader keeps the module.
  *
- * Where the module is looked for, the first that exists:
- *  1. TOWSTAB_PLOT_MODULE, when set: that file and no other (an
- *     environment variable, ignored in a set-user-ID process);
- *  2. beside the file the library was loaded from (the build tree:
- *     build/lib holds both), then in its towstab/ subdirectory (an
- *     installed tree, moved or not: LIBDIR/towstab holds the modules),
- *     both found with dladdr on an object of the library. Not $ORIGIN in
- *     dlopen's name: glibc expands it from the caller of dlopen, which
- *     under AddressSanitizer is the sanitizer's interceptor;
- *  3. TS_PLOT_MODULE, where meson installs it (a program linked to the
- *     static archive, whose file is the program's own).
- * When none can be opened, the message names the file and the dynamic
- * loader's reason (dlerror), and nothing is drawn or written.
+ * Where the module is looked for: lib/dlmodule.h (TOWSTAB_PLOT_MODULE
+ * names it for the tests). When it cannot be opened, the message names
+ * the file and the dynamic loader's reason, and nothing is drawn or
+ * written.
  *
  * The pure parts (options, units, the output directory, outline motion)
  * are in lib/plot_geom.c and need no module.
  */
-#define _GNU_SOURCE /* dladdr, RTLD_NODELETE, secure_getenv */
 #include "towstab/plot.h"
 
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
-
-#ifdef TS_HAVE_PLPLOT
-#include <dlfcn.h>
-#include <limits.h>
-#endif
-
+#include "dlmodule.h"
 #include "plot_module.h"
 
 #define NO_PLPLOT_MSG                                                         \
     "towstab was built without PLplot; install libplplot-dev and "           \
     "plplot-driver-cairo and rebuild"
 
-/* An open module: the handle to close and its table. */
+/* An open module and its table. */
 typedef struct module {
-    void *handle;
+    tsi_module dl;
     const tsi_plot_module *table;
 } module;
 
+static int module_open(module *m, ts_err *err)
+{
 #ifdef TS_HAVE_PLPLOT
-
-/* An object of the library: dladdr maps its address to the file the
- * library was loaded from. */
-static const char library_anchor = 0;
-
-/* Open the module at `path`, check its table. TS_EDOMAIN naming the file
- * and the reason when it cannot be used; `also` ends the message of a file
- * that cannot be opened. */
-static int open_path(const char *path, const char *also, module *m,
-                     ts_err *err)
-{
-    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
-    if (!h) {
-        const char *why = dlerror();
-        return ts_fail(err, TS_EDOMAIN,
-                       "cannot load the plotting module %s: %s%s", path,
-                       why ? why : "no reason given", also);
-    }
-    const tsi_plot_module *t = dlsym(h, TSI_PLOT_MODULE_SYMBOL);
-    if (!t) {
-        /* The reason first: dlclose may reuse dlerror's text. */
-        const char *why = dlerror();
-        int rc = ts_fail(err, TS_EDOMAIN,
-                         "%s is not a towstab plotting module: %s", path,
-                         why ? why : "no table " TSI_PLOT_MODULE_SYMBOL);
-        dlclose(h);
-        return rc;
-    }
-    if (t->version != TSI_PLOT_MODULE_VERSION ||
-        strcmp(t->release, TSI_PLOT_RELEASE) != 0) {
-        int version = t->version;
-        const char *release = t->release;
-        int rc = ts_fail(err, TS_EDOMAIN,
-                         "the plotting module %s is of towstab %s (table "
-                         "%d), the library of %s (table %d): install them "
-                         "together",
-                         path, release, version, TSI_PLOT_RELEASE,
-                         TSI_PLOT_MODULE_VERSION);
-        dlclose(h);
-        return rc;
-    }
-    m->handle = h;
-    m->table = t;
-    return TS_OK;
-}
-
-/* The directory of the library's file into dir (without the final
- * '/'), or "" when dladdr does not say. */
-static void library_dir(char *dir, size_t size)
-{
-    Dl_info info;
-    dir[0] = '\0';
-    if (!dladdr(&library_anchor, &info) || !info.dli_fname)
-        return;
-    const char *slash = strrchr(info.dli_fname, '/');
-    if (!slash || (size_t)(slash - info.dli_fname) >= size)
-        return;
-    memcpy(dir, info.dli_fname, (size_t)(slash - info.dli_fname));
-    dir[slash - info.dli_fname] = '\0';
-}
-
-static int module_open(module *m, ts_err *err)
-{
-    const char *forced = secure_getenv("TOWSTAB_PLOT_MODULE");
-    if (forced && forced[0])
-        return open_path(forced, " (TOWSTAB_PLOT_MODULE)", m, err);
-    char dir[PATH_MAX], where[2][PATH_MAX + 32], also[2 * PATH_MAX + 96];
-    int n = 0;
-    library_dir(dir, sizeof dir);
-    if (dir[0]) {
-        snprintf(where[n++], sizeof where[0], "%s/%s", dir,
-                 TSI_PLOT_MODULE_FILE);
-        snprintf(where[n++], sizeof where[0], "%s/towstab/%s", dir,
-                 TSI_PLOT_MODULE_FILE);
-    }
-    for (int i = 0; i < n; i++)
-        if (access(where[i], F_OK) == 0)
-            return open_path(where[i], "", m, err);
-    /* Else where it is installed; when not there either, the message says
-     * where else it was looked for. */
-    also[0] = '\0';
-    if (n == 2)
-        snprintf(also, sizeof also, " (nor is it at %s or %s)", where[0],
-                 where[1]);
-    return open_path(TS_PLOT_MODULE, also, m, err);
-}
-
-static void module_close(module *m) { dlclose(m->handle); }
-
-#else /* no PLplot */
-
-static int module_open(module *m, ts_err *err)
-{
-    m->handle = NULL;
+    int rc = tsi_module_open(&m->dl, "plotting module", TSI_PLOT_MODULE_FILE,
+                             "TOWSTAB_PLOT_MODULE", TSI_PLOT_MODULE_SYMBOL,
+                             TSI_PLOT_MODULE_VERSION, err);
+    m->table = m->dl.table;
+    return rc;
+#else
+    m->dl.handle = NULL;
     m->table = NULL;
     return ts_fail(err, TS_EDOMAIN, NO_PLPLOT_MSG);
+#endif
 }
 
-static void module_close(module *m) { (void)m; }
-
-#endif
+static void module_close(module *m) { tsi_module_close(&m->dl); }
 
 /* Open the module, call its entry with the arguments, close it. */
 #define CALL_MODULE(entry, ...)                                               \

@@ -3438,7 +3438,7 @@ static int plot_map(const char *dir, const char *name, const char *title,
 /* What the library looks up (TSI_PLOT_MODULE_SYMBOL). */
 __attribute__((visibility("default"))) const tsi_plot_module
     towstab_plot_module = {
-        TSI_PLOT_MODULE_VERSION, TSI_PLOT_RELEASE,
+        {TSI_PLOT_MODULE_VERSION, TSI_MODULE_RELEASE},
         check_devices, plot_shapes, plot_tracks, plot_mode_shapes,
         plot_eigenvalues, plot_mode_animation, plot_mode_frames, plot_bode,
         plot_histories, plot_loglog, plot_panels, plot_map};

@@ -3,26 +3,20 @@
  * TSI_PLOT_MODULE_SYMBOL, and the library (lib/plot.c) calls through once
  * it has opened the module. Each entry does what the public function of
  * the same name with the prefix ts_plot_ does (towstab/plot.h); `check`
- * is ts_plot_check's test of PLplot's devices. The module is built from
- * the same sources as the library: one of another table version or
- * another release is refused. */
+ * is ts_plot_check's test of PLplot's devices. The library opens it as
+ * lib/dlmodule.h says. */
 #ifndef TOWSTAB_PLOT_MODULE_H
 #define TOWSTAB_PLOT_MODULE_H
 
+#include "dlmodule.h"
 #include "towstab/plot.h"
 
 #define TSI_PLOT_MODULE_SYMBOL "towstab_plot_module"
 #define TSI_PLOT_MODULE_VERSION 1
-/* The module's file name; the build passes TS_PLOT_MODULE, where it is
- * installed, and TSI_PLOT_RELEASE, the project version. */
 #define TSI_PLOT_MODULE_FILE "towstab-plot.so"
-#ifndef TSI_PLOT_RELEASE
-#define TSI_PLOT_RELEASE "unknown"
-#endif
 
 typedef struct tsi_plot_module {
-    int version;         /* TSI_PLOT_MODULE_VERSION */
-    const char *release; /* TSI_PLOT_RELEASE of the module's build */
+    tsi_module_head head; /* TSI_PLOT_MODULE_VERSION */
     int (*check)(ts_err *err);
     int (*shapes)(const char *dir, const char *name, const char *title,
                   ts_plot_view view, int flags, int nshapes,

@@ -17,7 +17,9 @@
 #  5. the sweep's depths and top tensions at three speeds equal those of
 #     the installed `towstab equilibrium --speed V --json` (relative 1e-12:
 #     the same computation, read back from 17 significant digits);
-#  6. with PLOT yes (a build with PLplot): the installed drawing module
+#  6. the installed `towstab simulate --integrator esdirk` loads the
+#     installed SUNDIALS module (LIBDIR/towstab/towstab-sundials.so); with
+#     PLOT yes (a build with PLplot): the installed drawing module
 #     (LIBDIR/towstab/towstab-plot.so) is what the installed
 #     `towstab equilibrium --plot DIR` loads (LD_DEBUG=files), and it draws
 #     the side and top views; a run without --plot loads neither the
@@ -155,7 +157,18 @@ for prog in shared static whole; do
     [ "$ok" -eq 1 ] && pass "$prog: depth and top tension at ${speeds[*]} equal towstab equilibrium's (rtol 1e-12): $(grep -v '^#' "$T/$prog.out" | awk '{printf "%.6g m %.6g N; ", $3, $4}')"
 done
 
-# 6. Pictures from the installed tree.
+# 6. The modules of the installed tree: SUNDIALS' steppers, pictures.
+smodule=$libdir/towstab/towstab-sundials.so
+LD_LIBRARY_PATH=$libdir LD_DEBUG=files "$tool" simulate examples/kamman_ex4.yaml \
+    --quiet --no-compare --t-end 2 --no-discretisation-error --integrator esdirk \
+    >"$T/out" 2>"$T/files"
+st=$?
+if [ $st -eq 0 ] && grep -qF "file=$smodule " "$T/files"; then
+    pass "installed towstab simulate --integrator esdirk loads the installed LIBDIR/towstab/towstab-sundials.so"
+else
+    bad "installed simulate --integrator esdirk (exit $st): $(grep -v 'file=\|^ *[0-9]*: *$' "$T/files" | head -c 500); modules loaded: $(grep -o 'file=[^ ]*towstab-sundials[^ ]*' "$T/files")"
+fi
+
 if [ "$PLOT" = yes ]; then
     module=$libdir/towstab/towstab-plot.so
     [ -f "$module" ] && pass "the drawing module is installed as LIBDIR/towstab/towstab-plot.so" ||
