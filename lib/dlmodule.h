@@ -1,8 +1,8 @@
 /* dlmodule.h (internal): opening a module of towstab's own, a shared
  * object that carries a heavy dependency the library loads only when a
- * run needs it: the drawing module (towstab-plot.so: PLplot, cairo,
- * pango, fontconfig) and the SUNDIALS module (towstab-sundials.so: ARKODE,
- * CVODE). doc/performance.md, "Start-up".
+ * run needs it: the drawing module (towstab-plot.so: PLplot, and through
+ * its cairo driver cairo, pango and fontconfig) and the SUNDIALS module
+ * (towstab-sundials.so: ARKODE, CVODE). doc/performance.md, "Start-up".
  *
  * A module exports one table under a name of its own; the table starts
  * with a tsi_module_head, checked against the library's: the table's

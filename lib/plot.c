@@ -2,8 +2,9 @@
  * of the drawing module.
  *
  * The drawing itself (lib/plot_draw.c) is a module of its own,
- * towstab-plot.so, linked to PLplot and through it to cairo, pango,
- * fontconfig, freetype and a dozen more; the library is not. Each drawing
+ * towstab-plot.so, linked to PLplot and its eleven libraries (freetype,
+ * png, qhull, ...; PLplot's cairo driver brings cairo, pango and
+ * fontconfig when it draws); the library is not. Each drawing
  * function, and ts_plot_check, opens the module with dlopen, calls the
  * entry of the same name in its table (plot_module.h) and closes it
  * again. The module is opened with RTLD_NODELETE, so only the first call

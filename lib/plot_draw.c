@@ -1,8 +1,8 @@
 /* plot_draw.c: pictures of results with PLplot's cairo devices
  * (towstab/plot.h, doc/plots.md), built as a module of its own,
  * towstab-plot.so, that the library (lib/plot.c) opens only when a picture
- * is asked for: a run that draws nothing does not load PLplot, cairo,
- * pango, fontconfig and the rest (doc/performance.md, "Start-up"). The
+ * is asked for: a run that draws nothing does not load PLplot and its
+ * libraries (doc/performance.md, "Start-up"). The
  * module exports one table (plot_module.h); each entry is the public
  * function of the same name less its prefix.
  *
