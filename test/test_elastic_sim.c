@@ -161,7 +161,7 @@ static void test_rigid_limit(const ts_units *u)
         CHECK(rc == TS_OK, "esdirk at EA %g N completes (%s; %ld steps)",
               eas[i], err.msg, st.steps);
         /* The modified Newton iteration keeps its matrix over many steps
-         * (lib/esdirk.c, NEWTON_ITERS): with too few iterations allowed
+         * (lib/esdirk_sundials.c, NEWTON_ITERS): with too few iterations allowed
          * each stage that needs one more fails, with a new Jacobian, about
          * once a step. */
         CHECK(st.jacobians * 5 <= st.steps && st.rejected * 5 <= st.steps,

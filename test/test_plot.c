@@ -705,47 +705,6 @@ static void test_animation_vehicle(void)
           "views (%d of 6 differ from the trim-only frames)", differ);
 }
 
-/* ts_plot_outline_at_phase: the motion Re((re + i im) e^{i phase}). At
- * phase 0 the real part's; at pi / 2 minus the imaginary part's, a yaw
- * written out as R_z; at pi minus the real part's. */
-static void test_outline_at_phase(void)
-{
-    double pts[9] = {1.0, 0.5, 2.0, 1.4, 0.5, 2.0, 1.0, 0.9, 2.3};
-    ts_plot_outline o = {3, pts, {1.2, 0.3, 1.9}};
-    double mre[6] = {0.05, -0.02, 0.11, 0, 0.35, 0};
-    double mim[6] = {0.01, 0.03, -0.04, 0, 0, 0.25};
-    double s = 1.3, mag = 2.0, out[9], ref[9], neg[6];
-    ts_plot_outline_at_phase(&o, mre, mim, 0.0, s, mag, out);
-    ts_plot_outline_moved(&o, mre, s, mag, ref);
-    double d0 = 0;
-    for (int j = 0; j < 9; j++)
-        d0 = fmax(d0, fabs(out[j] - ref[j]));
-    ts_plot_outline_at_phase(&o, mre, mim, M_PI, s, mag, out);
-    for (int j = 0; j < 6; j++)
-        neg[j] = -mre[j];
-    ts_plot_outline_moved(&o, neg, s, mag, ref);
-    double dpi = 0;
-    for (int j = 0; j < 9; j++)
-        dpi = fmax(dpi, fabs(out[j] - ref[j]));
-    ts_plot_outline_at_phase(&o, mre, mim, M_PI / 2, s, mag, out);
-    double a = -s * mim[5], c = cos(a), sn = sin(a), d90 = 0;
-    for (int k = 0; k < 3; k++) {
-        double v[3], q[3];
-        for (int j = 0; j < 3; j++)
-            v[j] = mag * (pts[3 * k + j] - o.anchor[j]);
-        /* R_z(a): x' = c x - s y, y' = s x + c y. */
-        q[0] = o.anchor[0] - s * mim[0] + c * v[0] - sn * v[1];
-        q[1] = o.anchor[1] - s * mim[1] + sn * v[0] + c * v[1];
-        q[2] = o.anchor[2] - s * mim[2] + v[2];
-        for (int j = 0; j < 3; j++)
-            d90 = fmax(d90, fabs(out[3 * k + j] - q[j]));
-    }
-    /* cos(pi / 2) is 6e-17, not 0: the real part leaks in at that level. */
-    CHECK(d0 < 1e-15 && dpi < 1e-14 && d90 < 1e-14,
-          "outline at phase: 0 the real part's motion (%.2g m), pi its "
-          "opposite (%.2g m), pi/2 a yaw of %.3f rad by R_z (%.2g m)", d0,
-          dpi, a, d90);
-}
 
 static void test_modes(void)
 {
@@ -856,65 +815,6 @@ static void test_modes(void)
     CHECK(nothing_named("modes_"), "refused mode plots left no file");
 }
 
-/* ts_plot_outline_moved: the rigid motion of an outline in a mode,
- * against a rotation matrix written out independently and its
- * invariants. */
-static void test_outline_moved(void)
-{
-    /* A triangle off its anchor, rotated about y (pitch) by s * 0.35 rad,
-     * translated by s t, magnified 2.5 times; s = -1.7. */
-    double pts[12] = {1.0, 0.5, 2.0, 1.4, 0.5, 2.0, 1.0, 0.9, 2.3,
-                      NAN, NAN, NAN};
-    ts_plot_outline o = {4, pts, {1.2, 0.3, 1.9}};
-    double motion[6] = {0.05, -0.02, 0.11, 0, 0.35, 0};
-    double s = -1.7, mag = 2.5, out[12];
-    ts_plot_outline_moved(&o, motion, s, mag, out);
-    double a = s * motion[4], c = cos(a), sn = sin(a), worst = 0;
-    for (int k = 0; k < 3; k++) {
-        double v[3], q[3];
-        for (int j = 0; j < 3; j++)
-            v[j] = mag * (pts[3 * k + j] - o.anchor[j]);
-        /* R_y(a): x' = c x + s z, z' = -s x + c z. */
-        q[0] = o.anchor[0] + s * motion[0] + c * v[0] + sn * v[2];
-        q[1] = o.anchor[1] + s * motion[1] + v[1];
-        q[2] = o.anchor[2] + s * motion[2] - sn * v[0] + c * v[2];
-        for (int j = 0; j < 3; j++)
-            worst = fmax(worst, fabs(out[3 * k + j] - q[j]));
-    }
-    CHECK(worst < 1e-15, "outline moved: a pitch of %.3f rad and a "
-          "translation match the rotation matrix R_y to %.2g m", a, worst);
-    CHECK(isnan(out[9]) && isnan(out[10]) && isnan(out[11]),
-          "outline moved: a pen lift stays a pen lift");
-    /* A general rotation: rigid (distances times mag), and the rotation
-     * axis through the anchor fixed (but for the translation). */
-    double axis[6] = {0, 0, 0, 0.2, -0.4, 0.7}, ax[3] = {0.2, -0.4, 0.7};
-    double pa[6] = {o.anchor[0] + 0.1 * ax[0], o.anchor[1] + 0.1 * ax[1],
-                    o.anchor[2] + 0.1 * ax[2], 0.3, -1.1, 2.9};
-    ts_plot_outline oa = {2, pa, {o.anchor[0], o.anchor[1], o.anchor[2]}};
-    double qa[6];
-    ts_plot_outline_moved(&oa, axis, 1.3, 1.0, qa);
-    double da = 0, d0 = 0, d1 = 0;
-    for (int j = 0; j < 3; j++) {
-        da = fmax(da, fabs(qa[j] - pa[j]));
-        d0 += (pa[3 + j] - o.anchor[j]) * (pa[3 + j] - o.anchor[j]);
-        d1 += (qa[3 + j] - o.anchor[j]) * (qa[3 + j] - o.anchor[j]);
-    }
-    double moved = 0;
-    for (int j = 0; j < 3; j++)
-        moved = fmax(moved, fabs(qa[3 + j] - pa[3 + j]));
-    CHECK(da < 1e-15 && fabs(sqrt(d1) - sqrt(d0)) < 1e-14 && moved > 0.1,
-          "outline moved: a point on the rotation axis stays (%.2g m), "
-          "another keeps its distance from the anchor (%.2g m) and moves "
-          "(%.3f m)", da, fabs(sqrt(d1) - sqrt(d0)), moved);
-    double same[6];
-    ts_plot_outline_moved(&oa, NULL, 1.3, 1.0, same);
-    double dsame = 0;
-    for (int j = 0; j < 6; j++)
-        dsame = fmax(dsame, fabs(same[j] - pa[j]));
-    CHECK(dsame < 1e-15, "outline moved: no motion, no magnification: the "
-          "points themselves (to %.2g m, the rounding of A + (p - A))",
-          dsame);
-}
 
 static void test_eigenvalues(void)
 {
@@ -1523,7 +1423,7 @@ static void test_without_plplot(void)
     ts_plot_shape one = {N, chain, NULL, 1, end_mark, 0, NULL, 0, 0, 0, NULL, 0, NULL};
     ts_plot_mode mode = {chain, "m", NULL};
     double x[2] = {1, 2}, y[2] = {1, 2}, ph[2] = {0, 0}, nat[1] = {1};
-    ts_plot_series s = {2, x, y, "s", 0, 0, 0};
+    ts_plot_series s = {2, x, y, "s", 0, 0, 0, NULL};
     ts_plot_bode_curve b = {2, x, y, ph, "b", 0, 0};
     ts_plot_axis a = {"a", TS_PLOT_NONE, NULL};
     double gz[4] = {1, 2, 3, 4};
@@ -1551,6 +1451,110 @@ static void test_without_plplot(void)
 }
 
 #endif
+
+/* The outline motion needs no PLplot (lib/plot_geom.c). */
+
+/* ts_plot_outline_moved: the rigid motion of an outline in a mode,
+ * against a rotation matrix written out independently and its
+ * invariants. */
+static void test_outline_moved(void)
+{
+    /* A triangle off its anchor, rotated about y (pitch) by s * 0.35 rad,
+     * translated by s t, magnified 2.5 times; s = -1.7. */
+    double pts[12] = {1.0, 0.5, 2.0, 1.4, 0.5, 2.0, 1.0, 0.9, 2.3,
+                      NAN, NAN, NAN};
+    ts_plot_outline o = {4, pts, {1.2, 0.3, 1.9}};
+    double motion[6] = {0.05, -0.02, 0.11, 0, 0.35, 0};
+    double s = -1.7, mag = 2.5, out[12];
+    ts_plot_outline_moved(&o, motion, s, mag, out);
+    double a = s * motion[4], c = cos(a), sn = sin(a), worst = 0;
+    for (int k = 0; k < 3; k++) {
+        double v[3], q[3];
+        for (int j = 0; j < 3; j++)
+            v[j] = mag * (pts[3 * k + j] - o.anchor[j]);
+        /* R_y(a): x' = c x + s z, z' = -s x + c z. */
+        q[0] = o.anchor[0] + s * motion[0] + c * v[0] + sn * v[2];
+        q[1] = o.anchor[1] + s * motion[1] + v[1];
+        q[2] = o.anchor[2] + s * motion[2] - sn * v[0] + c * v[2];
+        for (int j = 0; j < 3; j++)
+            worst = fmax(worst, fabs(out[3 * k + j] - q[j]));
+    }
+    CHECK(worst < 1e-15, "outline moved: a pitch of %.3f rad and a "
+          "translation match the rotation matrix R_y to %.2g m", a, worst);
+    CHECK(isnan(out[9]) && isnan(out[10]) && isnan(out[11]),
+          "outline moved: a pen lift stays a pen lift");
+    /* A general rotation: rigid (distances times mag), and the rotation
+     * axis through the anchor fixed (but for the translation). */
+    double axis[6] = {0, 0, 0, 0.2, -0.4, 0.7}, ax[3] = {0.2, -0.4, 0.7};
+    double pa[6] = {o.anchor[0] + 0.1 * ax[0], o.anchor[1] + 0.1 * ax[1],
+                    o.anchor[2] + 0.1 * ax[2], 0.3, -1.1, 2.9};
+    ts_plot_outline oa = {2, pa, {o.anchor[0], o.anchor[1], o.anchor[2]}};
+    double qa[6];
+    ts_plot_outline_moved(&oa, axis, 1.3, 1.0, qa);
+    double da = 0, d0 = 0, d1 = 0;
+    for (int j = 0; j < 3; j++) {
+        da = fmax(da, fabs(qa[j] - pa[j]));
+        d0 += (pa[3 + j] - o.anchor[j]) * (pa[3 + j] - o.anchor[j]);
+        d1 += (qa[3 + j] - o.anchor[j]) * (qa[3 + j] - o.anchor[j]);
+    }
+    double moved = 0;
+    for (int j = 0; j < 3; j++)
+        moved = fmax(moved, fabs(qa[3 + j] - pa[3 + j]));
+    CHECK(da < 1e-15 && fabs(sqrt(d1) - sqrt(d0)) < 1e-14 && moved > 0.1,
+          "outline moved: a point on the rotation axis stays (%.2g m), "
+          "another keeps its distance from the anchor (%.2g m) and moves "
+          "(%.3f m)", da, fabs(sqrt(d1) - sqrt(d0)), moved);
+    double same[6];
+    ts_plot_outline_moved(&oa, NULL, 1.3, 1.0, same);
+    double dsame = 0;
+    for (int j = 0; j < 6; j++)
+        dsame = fmax(dsame, fabs(same[j] - pa[j]));
+    CHECK(dsame < 1e-15, "outline moved: no motion, no magnification: the "
+          "points themselves (to %.2g m, the rounding of A + (p - A))",
+          dsame);
+}
+
+/* ts_plot_outline_at_phase: the motion Re((re + i im) e^{i phase}). At
+ * phase 0 the real part's; at pi / 2 minus the imaginary part's, a yaw
+ * written out as R_z; at pi minus the real part's. */
+static void test_outline_at_phase(void)
+{
+    double pts[9] = {1.0, 0.5, 2.0, 1.4, 0.5, 2.0, 1.0, 0.9, 2.3};
+    ts_plot_outline o = {3, pts, {1.2, 0.3, 1.9}};
+    double mre[6] = {0.05, -0.02, 0.11, 0, 0.35, 0};
+    double mim[6] = {0.01, 0.03, -0.04, 0, 0, 0.25};
+    double s = 1.3, mag = 2.0, out[9], ref[9], neg[6];
+    ts_plot_outline_at_phase(&o, mre, mim, 0.0, s, mag, out);
+    ts_plot_outline_moved(&o, mre, s, mag, ref);
+    double d0 = 0;
+    for (int j = 0; j < 9; j++)
+        d0 = fmax(d0, fabs(out[j] - ref[j]));
+    ts_plot_outline_at_phase(&o, mre, mim, M_PI, s, mag, out);
+    for (int j = 0; j < 6; j++)
+        neg[j] = -mre[j];
+    ts_plot_outline_moved(&o, neg, s, mag, ref);
+    double dpi = 0;
+    for (int j = 0; j < 9; j++)
+        dpi = fmax(dpi, fabs(out[j] - ref[j]));
+    ts_plot_outline_at_phase(&o, mre, mim, M_PI / 2, s, mag, out);
+    double a = -s * mim[5], c = cos(a), sn = sin(a), d90 = 0;
+    for (int k = 0; k < 3; k++) {
+        double v[3], q[3];
+        for (int j = 0; j < 3; j++)
+            v[j] = mag * (pts[3 * k + j] - o.anchor[j]);
+        /* R_z(a): x' = c x - s y, y' = s x + c y. */
+        q[0] = o.anchor[0] - s * mim[0] + c * v[0] - sn * v[1];
+        q[1] = o.anchor[1] - s * mim[1] + sn * v[0] + c * v[1];
+        q[2] = o.anchor[2] - s * mim[2] + v[2];
+        for (int j = 0; j < 3; j++)
+            d90 = fmax(d90, fabs(out[3 * k + j] - q[j]));
+    }
+    /* cos(pi / 2) is 6e-17, not 0: the real part leaks in at that level. */
+    CHECK(d0 < 1e-15 && dpi < 1e-14 && d90 < 1e-14,
+          "outline at phase: 0 the real part's motion (%.2g m), pi its "
+          "opposite (%.2g m), pi/2 a yaw of %.3f rad by R_z (%.2g m)", d0,
+          dpi, a, d90);
+}
 
 /* Conversions and unit names (no PLplot needed), against udunits2. */
 /* The label placement: minor labels of short log axes (2 and 5 times
@@ -1676,6 +1680,8 @@ int main(int argc, char **argv)
     make_data();
     test_units();
     test_labels();
+    test_outline_moved();
+    test_outline_at_phase();
 #ifdef TS_HAVE_PLPLOT
     ts_err err = {0};
     CHECK(ts_plot_check(&err) == TS_OK,
@@ -1684,9 +1690,7 @@ int main(int argc, char **argv)
     test_cylinder();
     test_animation();
     test_animation_vehicle();
-    test_outline_at_phase();
     test_modes();
-    test_outline_moved();
     test_eigenvalues();
     test_bode();
     test_histories();

@@ -4,7 +4,10 @@
  * environment names a rank), so that a build with MPI runs alone exactly
  * as one without. Only then is the MPI module (tools/mpi_module.c,
  * towstab-mpi.so) opened with dlopen: first beside the executable (the
- * build tree), then where it is installed (TS_MPI_MODULE). Every other
+ * build tree; its directory read from /proc/self/exe, not $ORIGIN in
+ * dlopen's name, which glibc expands from the caller of dlopen: under
+ * AddressSanitizer the sanitizer's interceptor), then where it is
+ * installed (TS_MPI_MODULE). Every other
  * run loads neither the module nor MPI's libraries, which would cost
  * several of the few milliseconds a small analysis takes (doc/
  * performance.md, "Start-up"). Without the module (a build without MPI,
@@ -17,6 +20,9 @@
 
 #ifdef TS_MPI_MODULE
 #include <dlfcn.h>
+#include <limits.h>
+#include <string.h>
+#include <unistd.h>
 #endif
 
 #include "cli.h"
@@ -27,14 +33,35 @@
 static const cli_mpi_module *mod;
 
 #ifdef TS_MPI_MODULE
+/* The module beside the running executable into path, or "" when its
+ * directory is not known. */
+static void beside_executable(char *path, size_t size)
+{
+    static const char file[] = "/towstab-mpi.so";
+    ssize_t n = readlink("/proc/self/exe", path, size - sizeof file);
+    char *slash = NULL;
+    if (n > 0) {
+        path[n] = '\0';
+        slash = strrchr(path, '/');
+    }
+    if (!slash) {
+        path[0] = '\0';
+        return;
+    }
+    memcpy(slash, file, sizeof file);
+}
+
 /* Open the module and check its table; prints why not and returns NULL
  * when it cannot. */
 static const cli_mpi_module *open_module(void)
 {
-    static const char *const where[] = {"$ORIGIN/towstab-mpi.so",
-                                        TS_MPI_MODULE};
+    char beside[PATH_MAX];
+    beside_executable(beside, sizeof beside);
+    const char *const where[] = {beside, TS_MPI_MODULE};
     const char *why = "";
     for (size_t i = 0; i < sizeof where / sizeof where[0]; i++) {
+        if (!where[i][0])
+            continue;
         /* Global: MPI's own plugins look up its symbols. */
         void *h = dlopen(where[i], RTLD_NOW | RTLD_GLOBAL);
         if (!h) {

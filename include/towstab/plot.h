@@ -24,7 +24,16 @@
  * infinite data, a non-positive value on a log axis, a bad name or size,
  * DIR not a directory); TS_EIO when a file cannot be written; TS_EDOMAIN
  * when towstab was built without PLplot or PLplot's cairo driver is
- * missing (message says what to install).
+ * missing (message says what to install), or the drawing module cannot
+ * be loaded (message names its file and the dynamic loader's reason).
+ *
+ * The drawing functions and ts_plot_check open the drawing module
+ * (towstab-plot.so, which alone links PLplot) when called: a program
+ * that draws nothing does not load PLplot. It is looked for as
+ * TOWSTAB_PLOT_MODULE names it, else beside the library's file or in its
+ * towstab/ subdirectory, else where it is installed (doc/plots.md, "The
+ * drawing module"). The other functions need neither PLplot nor the
+ * module.
  *
  * Not thread-safe: PLplot keeps its stream table and current stream global
  * to the process, and its cairo driver has file-scope state. Call these

@@ -17,17 +17,23 @@ median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 row() {
     local label=$1 a=$2 b=$3
     shift 3
-    local ta=() tb=()
+    ta=() tb=()
     for ((i = 0; i < RUNS; i++)); do
         # shellcheck disable=SC2086
         ta+=("$(cpu "$TOWSTAB" "$@" $a)")
         # shellcheck disable=SC2086
         tb+=("$(cpu "$TOWSTAB" "$@" $b)")
     done
+    row_of "$label"
+}
+
+# row_of LABEL: the row of the CPU seconds in the arrays ta and tb, with
+# DIGITS decimals (default 3).
+row_of() {
     local ma mb
     ma=$(printf '%s\n' "${ta[@]}" | median)
     mb=$(printf '%s\n' "${tb[@]}" | median)
-    awk -v l="$label" -v a="$ma" -v b="$mb" \
-        'BEGIN { printf "| %s | %.3f | %.3f | %.2f |\n", l, a, b, a / b }'
+    awk -v l="$1" -v a="$ma" -v b="$mb" -v d="${DIGITS:-3}" \
+        'BEGIN { printf "| %s | %.*f | %.*f | %.2f |\n", l, d, a, d, b, a / b }'
 }
 

@@ -19,7 +19,12 @@
 #   with --snapshot-interval in the title; converge writes error_time;
 #   simulate and converge refuse --plot into a file (exit 2, nothing run),
 #   --snapshot-interval without --plot or giving too many snapshots;
-#   --units without --plot sets the tables (test/cli/units.sh).
+#   --units without --plot sets the tables (test/cli/units.sh). A run
+#   without --plot loads neither the drawing module nor PLplot (LD_DEBUG),
+#   one with it both; a drawing module that is missing, not a shared
+#   object, or another library (TOWSTAB_PLOT_MODULE) makes --plot fail
+#   with exit status 2, the file and the reason named, before anything is
+#   solved or written.
 # no: --plot is refused with exit status 2 and the message naming the
 #   packages to install, while the analysis without --plot still runs.
 #
@@ -107,6 +112,48 @@ check "--plot: side and top PNG and SVG, titled with the scene" \
 check "--plot: says where the pictures went" grep -q "wrote $T/p/new/side.png" "$T/out"
 check "--plot: no temporary file left" \
     bash -c "[ \$(ls -A '$T/p/new' | wc -l) -eq 4 ]"
+
+# PLplot is loaded with the drawing module (towstab-plot.so, lib/plot.c)
+# only by a run that draws: the dynamic loader's list of the files it
+# opens (LD_DEBUG=files) names neither for a run without --plot, both for
+# one with it (which shows the check can see them).
+loaded() { # loaded ARGS...: the files the run opened, in $T/files
+    LD_DEBUG=files "$TOWSTAB" "$@" >"$T/out" 2>"$T/files"
+    status=$?
+}
+loaded equilibrium "$EX1S" --links 20 --quiet
+check "no --plot: exit 0, and neither towstab-plot.so nor libplplot is loaded ($(grep -c 'file=' "$T/files") files opened)" \
+    bash -c "[ $status -eq 0 ] && grep -q 'file=' '$T/files' &&
+             ! grep -q 'file=[^ ]*\(towstab-plot\|libplplot\|libcairo\)' '$T/files'"
+loaded equilibrium "$EX1S" --links 20 --quiet --plot "$T/p/loaded"
+check "--plot: the run loads towstab-plot.so and libplplot" \
+    bash -c "[ $status -eq 0 ] && grep -q 'file=[^ ]*towstab-plot\.so' '$T/files' &&
+             grep -q 'file=[^ ]*libplplot' '$T/files'"
+
+# A module that cannot be loaded: --plot fails before anything is solved,
+# naming the file and the loader's reason; nothing is written. The
+# module's place is forced with TOWSTAB_PLOT_MODULE.
+plot_with_module() { # plot_with_module FILE
+    TOWSTAB_PLOT_MODULE=$1 "$TOWSTAB" equilibrium "$EX1" --plot "$T/p/nomod" \
+        >"$T/out" 2>"$T/err"
+    status=$?
+}
+plot_with_module "$T/missing/towstab-plot.so"
+check "missing module: exit 2 (got $status)" [ $status -eq 2 ]
+check "missing module: the message names the file and the reason ($(head -c 300 "$T/err"))" \
+    grep -qF "cannot load the plotting module $T/missing/towstab-plot.so: $T/missing/towstab-plot.so: cannot open shared object file" "$T/err"
+check "missing module: nothing solved, no directory made" \
+    bash -c "! grep -q converged '$T/out' && [ ! -e '$T/p/nomod' ]"
+echo "not a shared object" >"$T/broken.so"
+plot_with_module "$T/broken.so"
+check "broken module: exit 2, the file named ($(head -c 300 "$T/err"))" \
+    bash -c "[ $status -eq 2 ] && grep -qF 'cannot load the plotting module $T/broken.so: ' '$T/err' && [ ! -e '$T/p/nomod' ]"
+libm=$(ldd "$TOWSTAB" | awk '$1 ~ /^libm\.so/ {print $3}')
+if [ -n "$libm" ]; then
+    plot_with_module "$libm"
+    check "a library that is no plotting module: refused ($(head -c 300 "$T/err"))" \
+        bash -c "[ $status -eq 2 ] && grep -qF '$libm is not a towstab plotting module' '$T/err' && [ ! -e '$T/p/nomod' ]"
+fi
 
 # Imperial units and an overlaid scene.
 ts equilibrium "$EX1" --quiet --plot "$T/imp" --units imperial --overlay "$EX1S"

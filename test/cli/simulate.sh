@@ -18,7 +18,10 @@
 #  - `--json -` writes one JSON document alone to standard output;
 #  - waypoints: a scene's course, and --waypoints in place of its points;
 #  - the forces' extremes are over the analysed window when the run has
-#    one (--transient), over the whole run otherwise.
+#    one (--transient), over the whole run otherwise;
+#  - SUNDIALS and its module are loaded by esdirk only (LD_DEBUG=files),
+#    and a SUNDIALS module that cannot be loaded fails esdirk with the file
+#    and the reason named, while rk8pd runs.
 # Prints one PASS/FAIL line per check and "N passed, N failed".
 set -u
 if [ $# -ne 1 ]; then
@@ -465,6 +468,38 @@ cmp -s "$T/o/ship.thrust.closed.csv" "$T/o/ship.thrust.open.csv" ||
     why="$why the thrust step moved the yaw;"
 [ -z "$why" ] && pass "survey ship with a heading loop: a thrust step open-loop is the closed-loop run byte for byte (the yaw stays 0); a yaw moment step differs (yaw $(tail -n 1 "$T/o/ship.moment.z.closed.csv" | cut -d, -f4) against $(tail -n 1 "$T/o/ship.moment.z.open.csv" | cut -d, -f4) deg)" ||
     fail "heading loop open and closed:$why"
+# SUNDIALS is loaded with its module (towstab-sundials.so, lib/esdirk.c)
+# only by a run that steps with esdirk or bdf: the dynamic loader's list
+# of the files it opens (LD_DEBUG=files) names neither for an equilibrium
+# or a simulation with rk8pd, both for one with esdirk.
+sim=(simulate examples/kamman_ex4.yaml --quiet --no-compare --t-end 2
+     --no-discretisation-error)
+sundials_loaded() { grep -q 'file=[^ ]*\(towstab-sundials\|libsundials\)' "$T/files"; }
+LD_DEBUG=files "$TOWSTAB" equilibrium examples/kamman_ex4.yaml --quiet >"$T/out" 2>"$T/files"
+status=$?
+[ $status -eq 0 ] && grep -q 'file=' "$T/files" && ! sundials_loaded &&
+    pass "equilibrium: neither towstab-sundials.so nor libsundials is loaded" ||
+    fail "equilibrium (exit $status) loaded: $(grep -o 'file=[^ ]*sundials[^ ]*' "$T/files" | sort -u | tr '\n' ' ')"
+LD_DEBUG=files "$TOWSTAB" "${sim[@]}" --integrator rk8pd >"$T/out" 2>"$T/files"
+status=$?
+[ $status -eq 0 ] && ! sundials_loaded &&
+    pass "simulate --integrator rk8pd: SUNDIALS is not loaded" ||
+    fail "simulate --integrator rk8pd (exit $status) loaded SUNDIALS"
+LD_DEBUG=files "$TOWSTAB" "${sim[@]}" --integrator esdirk >"$T/out" 2>"$T/files"
+status=$?
+[ $status -eq 0 ] && grep -q 'file=[^ ]*towstab-sundials\.so' "$T/files" &&
+    grep -q 'file=[^ ]*libsundials_arkode' "$T/files" &&
+    pass "simulate --integrator esdirk: loads towstab-sundials.so and ARKODE" ||
+    fail "simulate --integrator esdirk (exit $status): $(grep -v 'file=' "$T/files" | head -c 300)"
+# A SUNDIALS module that cannot be loaded: esdirk fails naming the file and
+# the reason; rk8pd, which does not need it, runs.
+TOWSTAB_SUNDIALS_MODULE=$T/missing/towstab-sundials.so ts "${sim[@]}" --integrator esdirk
+[ $status -ne 0 ] && grep -qF "cannot load the SUNDIALS module $T/missing/towstab-sundials.so: $T/missing/towstab-sundials.so: cannot open shared object file" "$T/err" &&
+    pass "missing SUNDIALS module: esdirk exits $status naming the file and the reason" ||
+    fail "missing SUNDIALS module: exit $status, $(head -c 400 "$T/err")"
+TOWSTAB_SUNDIALS_MODULE=$T/missing/towstab-sundials.so ts "${sim[@]}" --integrator rk8pd
+[ $status -eq 0 ] && pass "missing SUNDIALS module: rk8pd still runs" ||
+    fail "missing SUNDIALS module: rk8pd exit $status, $(head -c 300 "$T/err")"
 
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

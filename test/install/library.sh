@@ -1,6 +1,6 @@
 #!/bin/bash
 # library.sh: the installed library is one others can build on.
-#   library.sh MESON BUILD_DIR VERSION CHECK_JSON SANITIZE CC [CC_ARGS...]
+#   library.sh MESON BUILD_DIR VERSION CHECK_JSON SANITIZE PLOT CC [CC_ARGS...]
 # Installs the build into a temporary folder (meson install --destdir),
 # points pkg-config at it (PKG_CONFIG_PATH, PKG_CONFIG_SYSROOT_DIR) and
 # checks:
@@ -16,17 +16,25 @@
 #     Requires.private list every dependency;
 #  5. the sweep's depths and top tensions at three speeds equal those of
 #     the installed `towstab equilibrium --speed V --json` (relative 1e-12:
-#     the same computation, read back from 17 significant digits).
+#     the same computation, read back from 17 significant digits);
+#  6. the installed `towstab simulate --integrator esdirk` loads the
+#     installed SUNDIALS module (LIBDIR/towstab/towstab-sundials.so); with
+#     PLOT yes (a build with PLplot): the installed drawing module
+#     (LIBDIR/towstab/towstab-plot.so) is what the installed
+#     `towstab equilibrium --plot DIR` loads (LD_DEBUG=files), and it draws
+#     the side and top views; a run without --plot loads neither the
+#     module nor libplplot; with the module moved away, --plot fails
+#     (exit 2) naming the installed file, and writes nothing.
 # SANITIZE is the build's b_sanitize ("none" or e.g. "address,undefined"):
 # an instrumented library needs the same flags at link time.
 # Run from the project root.
 set -u
-if [ $# -lt 6 ]; then
-    echo "usage: library.sh MESON BUILD_DIR VERSION CHECK_JSON SANITIZE CC [CC_ARGS...]" >&2
+if [ $# -lt 7 ]; then
+    echo "usage: library.sh MESON BUILD_DIR VERSION CHECK_JSON SANITIZE PLOT CC [CC_ARGS...]" >&2
     exit 2
 fi
-MESON=$1 BUILD=$2 VERSION=$3 CHECK_JSON=$4 SANITIZE=$5
-shift 5
+MESON=$1 BUILD=$2 VERSION=$3 CHECK_JSON=$4 SANITIZE=$5 PLOT=$6
+shift 6
 CC=("$@")
 command -v pkg-config >/dev/null || { echo "SKIP: no pkg-config"; exit 77; }
 T=$(mktemp -d) || exit 2
@@ -148,4 +156,52 @@ for prog in shared static whole; do
     done < <(grep -v '^#' "$T/$prog.out")
     [ "$ok" -eq 1 ] && pass "$prog: depth and top tension at ${speeds[*]} equal towstab equilibrium's (rtol 1e-12): $(grep -v '^#' "$T/$prog.out" | awk '{printf "%.6g m %.6g N; ", $3, $4}')"
 done
+
+# 6. The modules of the installed tree: SUNDIALS' steppers, pictures.
+smodule=$libdir/towstab/towstab-sundials.so
+LD_LIBRARY_PATH=$libdir LD_DEBUG=files "$tool" simulate examples/kamman_ex4.yaml \
+    --quiet --no-compare --t-end 2 --no-discretisation-error --integrator esdirk \
+    >"$T/out" 2>"$T/files"
+st=$?
+if [ $st -eq 0 ] && grep -qF "file=$smodule " "$T/files"; then
+    pass "installed towstab simulate --integrator esdirk loads the installed LIBDIR/towstab/towstab-sundials.so"
+else
+    bad "installed simulate --integrator esdirk (exit $st): $(grep -v 'file=\|^ *[0-9]*: *$' "$T/files" | head -c 500); modules loaded: $(grep -o 'file=[^ ]*towstab-sundials[^ ]*' "$T/files")"
+fi
+
+if [ "$PLOT" = yes ]; then
+    module=$libdir/towstab/towstab-plot.so
+    [ -f "$module" ] && pass "the drawing module is installed as LIBDIR/towstab/towstab-plot.so" ||
+        bad "no $module; installed: $(find "$D" -name '*.so' | sed "s|^$D||" | tr '\n' ' ')"
+    LD_LIBRARY_PATH=$libdir LD_DEBUG=files "$tool" equilibrium "$scene" --quiet \
+        --plot "$T/pics" >"$T/out" 2>"$T/files"
+    st=$?
+    if [ $st -eq 0 ] && grep -qF "file=$module " "$T/files" &&
+        [ "$(head -c 4 "$T/pics/side.png" | tail -c 3)" = PNG ] &&
+        grep -q '</svg>' "$T/pics/top.svg"; then
+        pass "installed towstab --plot loads the installed module and draws side.png, top.svg"
+    else
+        bad "installed towstab --plot (exit $st): $(grep -v 'file=\|^ *[0-9]*: *$' "$T/files" | head -c 500); modules loaded: $(grep -o 'file=[^ ]*towstab-plot[^ ]*' "$T/files")"
+    fi
+    LD_LIBRARY_PATH=$libdir LD_DEBUG=files "$tool" equilibrium "$scene" --quiet \
+        >"$T/out" 2>"$T/files"
+    st=$?
+    if [ $st -eq 0 ] && grep -q 'file=' "$T/files" &&
+        ! grep -q 'file=[^ ]*\(towstab-plot\|libplplot\)' "$T/files"; then
+        pass "installed towstab without --plot loads neither the module nor libplplot"
+    else
+        bad "installed towstab without --plot (exit $st) loaded: $(grep -o 'file=[^ ]*\(towstab-plot\|libplplot\)[^ ]*' "$T/files" | sort -u | tr '\n' ' ')"
+    fi
+    mv "$module" "$module.away"
+    LD_LIBRARY_PATH=$libdir "$tool" equilibrium "$scene" --quiet \
+        --plot "$T/pics2" >"$T/out" 2>"$T/err"
+    st=$?
+    if [ $st -eq 2 ] && grep -qF "towstab-plot.so" "$T/err" &&
+        grep -q "cannot open shared object file" "$T/err" && [ ! -e "$T/pics2" ]; then
+        pass "module moved away: --plot exits 2 naming it, nothing written: $(head -c 400 "$T/err")"
+    else
+        bad "module moved away: exit $st, $(head -c 400 "$T/err")"
+    fi
+    mv "$module.away" "$module"
+fi
 exit $fail
