@@ -263,7 +263,7 @@ static void print_waypoints(const ts_result *r, const ts_display *d)
 
 static void print_compare(const ts_compare *c, const ts_display *d)
 {
-    char u[64], ru[80], label[128], eu[64];
+    char u[64], ru[160], label[192], eu[64];
     double k = ts_display_convert(d, c->output.si_unit, 1.0, u, sizeof u);
     char gain[16];
     snprintf(gain, sizeof gain, "%s/m", c->output.si_unit);
@@ -271,6 +271,16 @@ static void print_compare(const ts_compare *c, const ts_display *d)
                                           ? "m/m" : gain,
                                    1.0, ru, sizeof ru);
     double ke = ts_display_convert(d, "m", 1.0, eu, sizeof eu);
+    /* A rotation of the ship: its amplitude an angle, the ratio the
+     * output per angle. */
+    int rot = c->exc_axis == TS_AXIS_ROLL || c->exc_axis == TS_AXIS_PITCH ||
+              c->exc_axis == TS_AXIS_YAW;
+    if (rot) {
+        snprintf(eu, sizeof eu, "%s", ts_display_unit(d, TS_QTY_ANGLE));
+        ke = ts_display_value(d, TS_QTY_ANGLE, 1.0);
+        kr = k / ke;
+        snprintf(ru, sizeof ru, "%s/%s", u, eu);
+    }
     const char *tu = ts_display_unit(d, TS_QTY_TIME);
     printf("\ncomparison of %s over t = %.6g .. %.6g %s (%d samples; the "
            "transient before is discarded)\n",
@@ -297,7 +307,7 @@ static void print_compare(const ts_compare *c, const ts_display *d)
     printf("amplitude difference %.4g %%, mean difference %.4g %% (linear "
            "less nonlinear, relative to nonlinear)\n",
            c->amplitude_difference_pct, c->mean_difference_pct);
-    if (!strcmp(c->output.si_unit, "m"))
+    if (!strcmp(c->output.si_unit, "m") && !rot)
         printf("rms difference %.6g %s (%.4g %% of the excitation "
                "amplitude)\n", k * c->rms_difference, u,
                100 * c->rms_difference_ratio);
