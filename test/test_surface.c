@@ -50,7 +50,13 @@
  *     is kinked and the difference would be first order): a pitch sine of
  *     0.02 and 0.01 rad at 0.05 Hz, the second sphere's depth, second
  *     order in the amplitude.
+ * 10. A sea with a pure-pitch RAO on that two-cable ship, referred to the
+ *     ship's origin: the spectral gain of the second sphere's depth is
+ *     the tow.pitch input's gain times the RAO at every grid point (the
+ *     RAO's rotation turns each cable's start about the origin), unlike
+ *     one translation of the tow point; a realisation drives tow.pitch.
  */
+#include <complex.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -63,6 +69,7 @@
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
 #include "towstab/response.h"
+#include "towstab/seastate.h"
 
 #define SHIP "test/scenes/survey_ship.yaml"
 
@@ -980,6 +987,107 @@ static void test_pitch_linear(void)
     trim_free(&c);
 }
 
+/* ---- 10. a ship's RAOs feed its rotations -------------------------------- */
+
+static void test_rao_rotation(void)
+{
+    trim c;
+    if (!trim_open(&c, ship_two_cables(), "the two-cable ship (sea)"))
+        return;
+    const ts_system *s = c.sc->system;
+    ts_err err = {0};
+    /* A pure-pitch RAO, one heading (head seas): the wave slope with a
+     * lead, in long waves. */
+    enum { NF = 24 };
+    double w[NF], hd[1] = {M_PI};
+    for (int k = 0; k < NF; k++)
+        w[k] = 0.3 + k * (2.0 - 0.3) / (NF - 1);
+    ts_rao *rao = ts_rao_alloc(1, hd, NF, w, &err);
+    for (int k = 0; rao && k < NF; k++)
+        ts_rao_set(rao, TS_DOF_PITCH, 0, k,
+                   w[k] * w[k] / 9.80665 / (1 + w[k] * w[k]), 1.1 + 0.3 * w[k],
+                   &err);
+    if (rao)
+        ts_rao_finish(rao, &err);
+    ts_sea *sea = ts_sea_jonswap(1.5, 7.0, 3.3, M_PI, &err);
+    /* The reference point: the ship's origin at its trim, from the
+     * kernel (r_A less R times the attach point), so that the RAOs'
+     * translation there is zero and the rotation is all. */
+    double *y = calloc((size_t)ts_kernel_nstate(c.k), sizeof(double));
+    double R[9], ref[3];
+    ts_equilibrium_state(c.k, c.eq, y, NULL);
+    ts_kernel_get_vehicle(c.k, ts_kernel_root(c.k), y, R, NULL);
+    const double *p = s->bodies[s->tow.vehicle].vehicle->attach;
+    for (int i = 0; i < 3; i++)
+        ref[i] = c.eq->positions[i] - (R[3 * i] * p[0] + R[3 * i + 1] * p[1] +
+                                       R[3 * i + 2] * p[2]);
+    ts_seaway way;
+    ts_seastate_opts so;
+    ts_seastate_opts_default(&so);
+    so.intervals = 32;
+    ts_output out;
+    ts_seastate *st = NULL;
+    int rc = rao && sea ? ts_seaway_init(&way, s, sea, rao, ref, &err)
+                        : TS_ENOMEM;
+    if (rc == TS_OK)
+        rc = ts_response_output_lookup(c.k, "fish.z", &out, &err);
+    if (rc == TS_OK)
+        rc = ts_seastate_compute(s, c.lin, &way, &out, &so, &st, &err);
+    CHECK(rc == TS_OK && way.rotations && st->ninputs == 6,
+          "a towing ship's sea drives its translations and rotations (%s)",
+          rc ? err.msg : "ok");
+    /* Against the pitch input's gain times the RAO at every grid point,
+     * and against one translation of the tow point (the start of the
+     * first cable, theta x r_A), which the second cable does not see. */
+    double dmax = 0, gmax = 0, dold = 0;
+    for (int i = 0; rc == TS_OK && i < st->npoints; i++) {
+        double xr[TS_NDOF], xi[TS_NDOF], h[2], t[3][2];
+        ts_rao_eval(rao, M_PI, st->omega[i], xr, xi, &err);
+        double complex th = xr[TS_DOF_PITCH] + I * xi[TS_DOF_PITCH];
+        double we = st->omega_e[i];
+        ts_response_at(s, c.lin, TS_IN_ROT + 1, &out, we, &h[0], &h[1], &err);
+        for (int a = 0; a < 3; a++)
+            ts_response_at(s, c.lin, a, &out, we, &t[a][0], &t[a][1], &err);
+        double complex g = st->gain_re[i] + I * st->gain_im[i];
+        double complex want = (h[0] + I * h[1]) * th;
+        /* theta_y e_y x r = (r_z, 0, -r_x) theta_y */
+        double complex old = ((t[0][0] + I * t[0][1]) * c.r[2] -
+                              (t[2][0] + I * t[2][1]) * c.r[0]) * th;
+        dmax = fmax(dmax, cabs(g - want));
+        dold = fmax(dold, cabs(g - old));
+        gmax = fmax(gmax, cabs(want));
+    }
+    printf("pure-pitch RAO, two cables: the second sphere's gain per m of "
+           "wave less the pitch input's gain times the RAO %.3g of %.3g; "
+           "less one translation of the tow point %.3g\n", dmax, gmax, dold);
+    /* The same gains, summed in another order: rounding (1e-12), and the
+     * origin's translation, theta x (the origin from the linearization
+     * less the kernel's), rounding too. */
+    CHECK(rc == TS_OK && dmax <= 1e-10 * gmax && gmax > 0,
+          "sea: the rotation RAO is the pitch input (%.3g of %.3g)", dmax,
+          gmax);
+    CHECK(rc == TS_OK && dold > 0.05 * gmax,
+          "sea: not one translation of the tow point (that would differ by "
+          "%.3g of %.3g)", dold, gmax);
+    /* A realisation drives tow.pitch. */
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_sea_realisation real;
+    ts_seaway_set_trim(&way, c.k, y);
+    ts_sea_realisation_default(&way, &real);
+    real.components = 16;
+    int pitch = 0;
+    if (ex && ts_seaway_excitation(&way, &real, ex, NULL, &err) == TS_OK)
+        for (int i = 0; i < ts_excitation_nsignals(ex); i++)
+            pitch |= ts_excitation_signal(ex, i)->axis == TS_AXIS_PITCH;
+    CHECK(pitch, "a realisation of that sea drives tow.pitch");
+    ts_excitation_free(ex);
+    free(y);
+    ts_seastate_free(st);
+    ts_sea_free(sea);
+    ts_rao_free(rao);
+    trim_free(&c);
+}
+
 int main(void)
 {
     units = tscene_units();
@@ -996,6 +1104,7 @@ int main(void)
     test_heave_linear();
     test_rotation_columns();
     test_pitch_linear();
+    test_rao_rotation();
     free(ship_text);
     ts_units_free(units);
     return tc_done();
