@@ -116,7 +116,7 @@ typedef struct veh {
     double held[3];
     /* The towing vehicle: the prescribed acceleration (body axes) of the
      * points its cables start from relative to the body, the tow-point
-     * inputs' (wave-induced motion, doc/towing-vehicle.md section 7):
+     * inputs' (wave-induced motion, doc/towing-vehicle.md section 8):
      * shift_a + shift_al x p at the point p (body axes from O); 0 for a
      * towed vehicle. */
     double shift_a[3], shift_al[3];
@@ -1232,7 +1232,7 @@ static void control_rates(const veh *V, double cdot[])
         cdot[V->spd_off] = V->spd_dot;
 }
 
-/* The tow inputs (doc/towing-vehicle.md section 7): a translation x and
+/* The tow inputs (doc/towing-vehicle.md section 8): a translation x and
  * a small rotation theta (u[TS_TOW_ROT..]) of the ship, with their rates
  * and accelerations, move a cable's start point r by x + theta x r (M
  * axes), its velocity by x' + theta' x r, its acceleration by x'' +

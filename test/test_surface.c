@@ -1,5 +1,5 @@
 /* test_surface.c: the towing vehicle as a surface ship of 3 degrees of
- * freedom (doc/towing-vehicle.md section 6; lib/kernel.c, towing_vehicle
+ * freedom (doc/towing-vehicle.md section 7; lib/kernel.c, towing_vehicle
  * dof: 3), on test/scenes/survey_ship.yaml and variants of it.
  *
  *  1. Energy: the ship (no thrust) pulling its cable and sphere in vacuum
@@ -26,7 +26,7 @@
  *     Newton's steady turn (tensions, speed, yaw, turn rate); and turn_by
  *     rudder at that turn rate gives the rudder back.
  *  6. Wave-induced motion of the tow point (the tow-point inputs with a
- *     towing vehicle, doc/towing-vehicle.md section 7): with the ship's
+ *     towing vehicle, doc/towing-vehicle.md section 8): with the ship's
  *     mass and inertias 1e3 and 1e4 times, the depressor's response to
  *     tow.heave, tow.surge and tow.sway is the prescribed tow's at the
  *     ship's speed, the distance falling like 1 / mass.
@@ -55,6 +55,8 @@
  *     the tow.pitch input's gain times the RAO at every grid point (the
  *     RAO's rotation turns each cable's start about the origin), unlike
  *     one translation of the tow point; a realisation drives tow.pitch.
+ * 11. A prescribed tow point p: a rotation about M's origin is the
+ *     translation theta x p, in the dense and the sparse model.
  */
 #include <complex.h>
 #include <stdlib.h>
@@ -1088,6 +1090,64 @@ static void test_rao_rotation(void)
     trim_free(&c);
 }
 
+/* ---- 11. a prescribed tow point's rotations --------------------------- */
+
+/* The ship's rotation about M's origin moves a prescribed tow point p by
+ * theta x p: on examples/survey_tow_sea.yaml (p = (0, 0, -5) m) the
+ * fish's depth per rad of tow.pitch is -5 times its gain per m of
+ * tow.surge, per rad of tow.roll 5 times that per m of tow.sway, in the
+ * dense model (the columns differenced at their own steps: 1e-6) and the
+ * sparse one (the tow point's displacement e x p itself: rounding). */
+static void test_prescribed_rotation(void)
+{
+    ts_scene *sc = tscene_load(units, "examples/survey_tow_sea.yaml");
+    if (!sc)
+        return;
+    const ts_system *s = sc->system;
+    ts_err err = {0};
+    ts_kernel *k;
+    ts_equilibrium *eq = solve(s, &k);
+    const double *p = s->tow.point;
+    for (int m = 0; m < 2; m++) {
+        ts_linearize_opts lo;
+        ts_linearize_opts_default(&lo);
+        lo.model = m ? TS_LIN_SPARSE : TS_LIN_DENSE;
+        ts_linear *lin = ts_linear_alloc(k, &err);
+        ts_output out;
+        int rc = lin && eq && eq->converged
+                     ? ts_linearize_equilibrium(k, eq, &lo, lin, &err)
+                     : TS_ECONV;
+        if (!rc)
+            rc = ts_response_output_lookup(k, "fish.z", &out, &err);
+        double d = 0, big = 0;
+        for (int i = 0; !rc && i < 3; i++) {
+            double w = 2 * M_PI * (0.02 + 0.1 * i), g[4][2];
+            const int in[4] = {TS_IN_DISP, TS_IN_DISP + 1, TS_IN_ROT + 1,
+                               TS_IN_ROT};
+            for (int j = 0; !rc && j < 4; j++)
+                rc = ts_response_at(s, lin, in[j], &out, w, &g[j][0],
+                                    &g[j][1], &err);
+            for (int c = 0; !rc && c < 2; c++) {
+                /* e_y x p = (p_z, 0, -p_x), e_x x p = (0, -p_z, p_y) */
+                d = fmax(d, fabs(g[2][c] - p[2] * g[0][c]));
+                d = fmax(d, fabs(g[3][c] + p[2] * g[1][c]));
+                big = fmax(big, fabs(p[2] * g[0][c]));
+            }
+        }
+        printf("prescribed tow point (%s): fish.z per rad of tow.pitch less "
+               "p_z tow.surge's, of tow.roll less -p_z tow.sway's: %.3g of "
+               "%.3g\n", m ? "sparse" : "dense", d, big);
+        CHECK(rc == TS_OK && big > 0 && d <= (m ? 1e-12 : 1e-6) * big,
+              "prescribed tow point, %s model: a rotation is the translation "
+              "theta x p (%.3g of %.3g) %s", m ? "sparse" : "dense", d, big,
+              rc ? err.msg : "");
+        ts_linear_free(lin);
+    }
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     units = tscene_units();
@@ -1105,6 +1165,7 @@ int main(void)
     test_rotation_columns();
     test_pitch_linear();
     test_rao_rotation();
+    test_prescribed_rotation();
     free(ship_text);
     ts_units_free(units);
     return tc_done();
