@@ -1674,7 +1674,7 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         ts_excitation_bound(ex, &f0, &mb);
         if ((rc = ts_system_check_loads(sys, &mb, err))) {
             ts_motion_bound_steady(sys, &st);
-            mb.tow_speed = mb.tow_accel = 0.0;
+            mb.tow_speed = mb.tow_accel = mb.rot_rate = mb.rot_accel = 0.0;
             if (ts_system_check_loads(sys, &st, NULL))
                 ts_err_prefix(err, "simulate: ");
             else if (ts_system_check_loads(sys, &mb, NULL))
@@ -1869,12 +1869,18 @@ static int sim_values(ts_result *r, int linear_only, int ran, int required,
     const ts_signal *sg = ts_excitation_signal(ex, idx);
     static const char *const suffix[3] = {"amplitude_ratio", "mean_offset",
                                           "phase_deg"};
-    /* A position's ratio is m/m ("1"), a tension's N/m. */
+    /* A position's ratio is m/m ("1"), a tension's N/m; per rad for a
+     * rotation of the ship (tow.roll, tow.pitch, tow.yaw). */
     const char *ou = r->output.si_unit;
-    int position = !strcmp(ou, "m");
+    int rot = sg->axis == TS_AXIS_ROLL || sg->axis == TS_AXIS_PITCH ||
+              sg->axis == TS_AXIS_YAW;
+    int position = !strcmp(ou, "m") && !rot;
     char ratio_unit[TS_VALUE_UNIT_MAX];
-    snprintf(ratio_unit, sizeof ratio_unit, "%s",
-             position ? "1" : r->output.unit);
+    if (rot)
+        snprintf(ratio_unit, sizeof ratio_unit, "%s/rad", ou);
+    else
+        snprintf(ratio_unit, sizeof ratio_unit, "%s",
+                 position ? "1" : r->output.unit);
     const char *unit[3] = {ratio_unit, ou, "deg"};
     double scale[3] = {0.0, position ? sg->amplitude : 0.0, 360.0};
     for (int v = 0; v < 3; v++)
@@ -2063,9 +2069,11 @@ static int sim_forces(ts_result *r, const ts_simulate_opts *s, ts_err *err)
 /* The excitation of s with its sea's realisation added, into *out (a new
  * excitation, NULL on failure), with the seaway and the realisation's
  * settings; the ship's speed through the waves is `speed` (m/s; NaN: the
- * scene's). */
+ * scene's); a towing vehicle's trim y on kernel k (NULL: none), which
+ * places the origin its rotations turn about. */
 static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
-                          double speed, ts_seaway *w,
+                          double speed, const ts_kernel *k,
+                          const double *y, ts_seaway *w,
                           ts_sea_realisation *real, ts_excitation **out,
                           ts_err *err)
 {
@@ -2075,6 +2083,8 @@ static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
         return rc;
     if (isfinite(speed))
         w->speed = speed;
+    if (k && y)
+        ts_seaway_set_trim(w, k, y);
     *out = ts_excitation_copy(s->excitation, err);
     if (!*out)
         return err && err->code ? err->code : TS_ENOMEM;
@@ -2090,10 +2100,11 @@ static int sea_excitation(const ts_system *sys, const ts_simulate_opts *s,
 }
 
 static int sea_realise(ts_result *r, const ts_simulate_opts *s,
-                       double speed, ts_err *err)
+                       double speed, const ts_kernel *k, const double *y,
+                       ts_err *err)
 {
-    int rc = sea_excitation(r->sys, s, speed, &r->seaway, &r->realisation,
-                            &r->sea_excitation, err);
+    int rc = sea_excitation(r->sys, s, speed, k, y, &r->seaway,
+                            &r->realisation, &r->sea_excitation, err);
     if (!r->sea_excitation)
         return rc;
     r->has_sea = 1;
@@ -2184,7 +2195,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
      * needs, is known after its equilibrium: its sea is realised there. */
     int sea_later = s->sea.sea && sys->tow.vehicle >= 0;
     if (rc == TS_OK && s->sea.sea && !sea_later)
-        rc = sea_realise(r, s, NAN, err);
+        rc = sea_realise(r, s, NAN, NULL, NULL, err);
     if (rc != TS_OK)
         return rc;
     ts_sim_opts *o = &r->sim;
@@ -2218,7 +2229,7 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
             memcpy(y0, r->eq->y, (size_t)n * sizeof *y0);
             ts_trust_merge(&r->trust, "initial equilibrium: ", &r->eq_trust);
             if (sea_later) {
-                rc = sea_realise(r, s, r->eq->speed, err);
+                rc = sea_realise(r, s, r->eq->speed, k, y0, err);
                 if (r->sea_excitation)
                     ex = r->excitation;
             }
@@ -3435,7 +3446,7 @@ int ts_analysis_cost(const ts_system *sys, const ts_request *rq,
         if (rq->simulate.sea.sea) {
             ts_seaway w;
             ts_sea_realisation real;
-            rc = sea_excitation(s, &rq->simulate, trimmed, &w, &real, &ex,
+            rc = sea_excitation(s, &rq->simulate, trimmed, NULL, NULL, &w, &real, &ex,
                                 err);
         }
         if (rc == TS_OK)

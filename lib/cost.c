@@ -63,9 +63,11 @@ double ts_cost_fastest_mode(const ts_system *sys,
     double R = 0, T = 0;
     for (int c = 0; c < sys->ncables; c++)
         R += sys->cables[c].length;
-    double flow = mb->speed + mb->turn_rate * R + mb->tow_speed;
+    double flow = mb->speed + mb->turn_rate * R + mb->tow_speed +
+                  mb->rot_rate * R;
     double acc = mb->turn_rate * mb->turn_rate * R +
-                 mb->turn_rate * mb->speed + mb->tow_accel;
+                 mb->turn_rate * mb->speed + mb->tow_accel +
+                 mb->rot_accel * R;
     double lmin = INFINITY, mmin = INFINITY, wmax = 0.0;
     for (int l = 0; l < sys->nlinks; l++) {
         const ts_link *L = &sys->links[l];

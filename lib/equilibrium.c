@@ -1685,7 +1685,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                        "cables with bending stiffness (EI > 0); use newton "
                        "or auto");
     /* Loads that overflow are the input's fault: say which input. */
-    ts_motion_bound mb = {fabs(frame.speed), fabs(frame.turn_rate), 0, 0};
+    ts_motion_bound mb = {fabs(frame.speed), fabs(frame.turn_rate), 0, 0,
+                          0, 0};
     int lrc = ts_system_check_loads(sys, &mb, err);
     if (lrc != TS_OK) {
         ts_err_prefix(err, "equilibrium: ");

@@ -58,9 +58,10 @@
 typedef struct sum_group {
     int n;                 /* components */
     double *omega;         /* [n] rad/s */
-    double *c;             /* [6 n]: re, im of axes 0, 1, 2 per component */
+    double *c;             /* [2 TS_SUM_AXES n]: re, im of each axis per
+                              component */
     double rise;           /* fade-in, s (0: none) */
-    int axes[3];           /* 1: the group drives tow axis j */
+    int axes[TS_SUM_AXES]; /* 1: the group drives axis j */
 } sum_group;
 
 struct ts_excitation {
@@ -120,14 +121,16 @@ ts_excitation *ts_excitation_copy(const ts_excitation *ex, ts_err *err)
             continue; /* added with its group's lead */
         if (ex->sum[i]) {
             const sum_group *g = ex->sum[i];
-            double *re = malloc(3 * (size_t)g->n * sizeof *re);
-            double *im = malloc(3 * (size_t)g->n * sizeof *im);
+            const size_t na = TS_SUM_AXES;
+            double *re = malloc(na * (size_t)g->n * sizeof *re);
+            double *im = malloc(na * (size_t)g->n * sizeof *im);
             if (!re || !im)
                 rc = ts_fail(err, TS_ENOMEM, "excitation: out of memory");
             for (int k = 0; rc == TS_OK && k < g->n; k++)
-                for (int j = 0; j < 3; j++) {
-                    re[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j] : 0.0;
-                    im[3 * k + j] = g->axes[j] ? g->c[6 * k + 2 * j + 1] : 0.0;
+                for (size_t j = 0; j < na; j++) {
+                    const double *c = g->c + 2 * na * k + 2 * j;
+                    re[na * k + j] = g->axes[j] ? c[0] : 0.0;
+                    im[na * k + j] = g->axes[j] ? c[1] : 0.0;
                 }
             if (rc == TS_OK)
                 rc = ts_excitation_add_sum(c, g->n, g->omega, re, im, g->rise,
@@ -159,6 +162,9 @@ const char *ts_axis_name(ts_axis a)
     case TS_AXIS_SPEED: return "speed";
     case TS_AXIS_TURN_RATE: return "turn_rate";
     case TS_AXIS_INPUT: return "input";
+    case TS_AXIS_ROLL: return "tow.roll";
+    case TS_AXIS_PITCH: return "tow.pitch";
+    case TS_AXIS_YAW: return "tow.yaw";
     }
     return "?";
 }
@@ -176,7 +182,22 @@ const char *ts_signal_type_name(ts_signal_type t)
     return "?";
 }
 
-static int is_tow_axis(int a) { return a >= TS_AXIS_SURGE && a <= TS_AXIS_HEAVE; }
+/* A rotation axis of the ship (tow.roll, tow.pitch, tow.yaw). */
+static int is_rot_axis(int a)
+{
+    return a >= TS_AXIS_ROLL && a <= TS_AXIS_YAW;
+}
+/* An axis of the tow inputs: a translation or a rotation; its value is
+ * the index of its displacement among the kernel's inputs. */
+static int is_tow_axis(int a)
+{
+    return (a >= TS_AXIS_SURGE && a <= TS_AXIS_HEAVE) || is_rot_axis(a);
+}
+/* The axis of sum axis j (0..TS_SUM_AXES). */
+static ts_axis sum_axis(int j)
+{
+    return j < 3 ? (ts_axis)j : (ts_axis)(TS_AXIS_ROLL + j - 3);
+}
 static int is_manoeuvre(int a)
 {
     return a == TS_AXIS_SPEED || a == TS_AXIS_TURN_RATE;
@@ -216,10 +237,15 @@ static int grow(ts_excitation *ex, ts_err *err)
 int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
 {
     const char *an = ts_signal_axis_label(s), *tn = ts_signal_type_name(s->type);
-    if (!(s->axis >= TS_AXIS_SURGE && s->axis <= TS_AXIS_INPUT))
+    if (!((s->axis >= TS_AXIS_SURGE && s->axis <= TS_AXIS_INPUT) ||
+          is_rot_axis(s->axis)))
         return ts_fail(err, TS_EINVAL, "excitation: axis %d is not one of "
                        "tow.surge, tow.sway, tow.heave, speed, turn_rate, "
-                       "input", (int)s->axis);
+                       "input, tow.roll, tow.pitch, tow.yaw", (int)s->axis);
+    if (is_rot_axis(s->axis) && s->type == TS_SIGNAL_CRANK)
+        return ts_fail(err, TS_EINVAL, "excitation %s: a rotation takes a "
+                       "sine, a step or a ramp (a crank is a slider's "
+                       "translation), got crank", an);
     if (s->axis == TS_AXIS_INPUT &&
         (!memchr(s->input, '\0', sizeof s->input) || !strchr(s->input, '.')))
         return ts_fail(err, TS_EINVAL, "excitation: a vehicle input's name "
@@ -253,6 +279,14 @@ int ts_excitation_add(ts_excitation *ex, const ts_signal *s, ts_err *err)
             return ts_fail(err, TS_EINVAL, "excitation %s (%s): ramp (the "
                            "smooth start) must be >= 0 s, got %g s", an, tn,
                            s->ramp);
+        /* An impulsive start jumps the tow point's velocity, which the
+         * simulators pass down the cable as the same jump at every start
+         * point (ts_sim_start_state); a rotation's differs from point to
+         * point. */
+        if (is_rot_axis(s->axis) && s->ramp == 0 && s->amplitude != 0)
+            return ts_fail(err, TS_EINVAL, "excitation %s (%s): a rotation "
+                           "starts smoothly: ramp (the smooth start) must be "
+                           "> 0 s, got 0 s", an, tn);
     }
     if (s->type == TS_SIGNAL_CRANK &&
         (!(s->rod > s->amplitude) || !isfinite(s->rod)))
@@ -361,32 +395,35 @@ int ts_excitation_add_sum(ts_excitation *ex, int n, const double omega[],
     if (!(rise >= 0) || !isfinite(rise))
         return ts_fail(err, TS_EINVAL, "excitation sum: the fade-in time "
                        "must be >= 0 s, got %g s", rise);
-    double ms[3] = {0, 0, 0}, wmax = 0;
+    enum { NA = TS_SUM_AXES };
+    double ms[NA] = {0}, wmax = 0;
     for (int k = 0; k < n; k++) {
         if (!isfinite(omega[k]))
             return ts_fail(err, TS_EINVAL, "excitation sum: component %d: "
                            "frequency must be finite, got %g rad/s", k,
                            omega[k]);
         wmax = fmax(wmax, fabs(omega[k]));
-        for (int j = 0; j < 3; j++) {
-            double a = re[3 * k + j], b = im[3 * k + j];
+        for (int j = 0; j < NA; j++) {
+            double a = re[NA * k + j], b = im[NA * k + j];
             if (!isfinite(a) || !isfinite(b))
                 return ts_fail(err, TS_EINVAL, "excitation sum: component "
                                "%d, %s: the amplitude overflows (is not a "
                                "finite number): the wave heights or the "
                                "motions per metre of wave are too large",
-                               k, ts_axis_name((ts_axis)j));
+                               k, ts_axis_name(sum_axis(j)));
             ms[j] += 0.5 * (a * a + b * b);
         }
     }
-    int naxes = (ms[0] > 0) + (ms[1] > 0) + (ms[2] > 0);
+    int naxes = 0;
+    for (int j = 0; j < NA; j++)
+        naxes += ms[j] > 0;
     if (naxes == 0)
         return ts_fail(err, TS_EINVAL, "excitation sum: every coefficient "
                        "is zero: no axis is driven");
     sum_group *g = calloc(1, sizeof *g);
     if (g) {
         g->omega = malloc((size_t)n * sizeof(double));
-        g->c = malloc(6 * (size_t)n * sizeof(double));
+        g->c = malloc(2 * NA * (size_t)n * sizeof(double));
     }
     if (!g || !g->omega || !g->c) {
         sum_group_free(g);
@@ -396,11 +433,11 @@ int ts_excitation_add_sum(ts_excitation *ex, int n, const double omega[],
     g->rise = rise;
     memcpy(g->omega, omega, (size_t)n * sizeof(double));
     for (int k = 0; k < n; k++)
-        for (int j = 0; j < 3; j++) {
-            g->c[6 * k + 2 * j] = re[3 * k + j];
-            g->c[6 * k + 2 * j + 1] = im[3 * k + j];
+        for (int j = 0; j < NA; j++) {
+            g->c[2 * NA * k + 2 * j] = re[NA * k + j];
+            g->c[2 * NA * k + 2 * j + 1] = im[NA * k + j];
         }
-    for (int j = 0; j < 3; j++)
+    for (int j = 0; j < NA; j++)
         g->axes[j] = ms[j] > 0;
     /* Room for every axis first, so that a failure adds nothing (grow()
      * enlarges a full table). */
@@ -415,12 +452,12 @@ int ts_excitation_add_sum(ts_excitation *ex, int n, const double omega[],
         }
     }
     int lead = 1;
-    for (int j = 0; j < 3; j++) {
+    for (int j = 0; j < NA; j++) {
         if (!g->axes[j])
             continue;
         ts_signal sg = {0};
         sg.type = TS_SIGNAL_SUM;
-        sg.axis = (ts_axis)j;
+        sg.axis = sum_axis(j);
         sg.amplitude = sqrt(ms[j]);
         sg.frequency = wmax / (2.0 * M_PI);
         sg.rise = rise;
@@ -584,7 +621,9 @@ static int parse_axis(const char *name, ts_axis *a)
         {"tow.surge", TS_AXIS_SURGE}, {"tow.x", TS_AXIS_SURGE},
         {"tow.sway", TS_AXIS_SWAY},   {"tow.y", TS_AXIS_SWAY},
         {"tow.heave", TS_AXIS_HEAVE}, {"tow.z", TS_AXIS_HEAVE},
-        {"speed", TS_AXIS_SPEED},     {"turn_rate", TS_AXIS_TURN_RATE}};
+        {"speed", TS_AXIS_SPEED},     {"turn_rate", TS_AXIS_TURN_RATE},
+        {"tow.roll", TS_AXIS_ROLL},   {"tow.pitch", TS_AXIS_PITCH},
+        {"tow.yaw", TS_AXIS_YAW}};
     for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++)
         if (!strcmp(name, tab[i].name)) {
             *a = tab[i].axis;
@@ -664,8 +703,8 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
             strlen(axis_name) >= TS_SIGNAL_INPUT_MAX)
             return ts_fail(err, TS_EINVAL, "%s: unknown axis '%.60s'; "
                            "expected tow.surge, tow.sway, tow.heave (or "
-                           "tow.x, tow.y, tow.z), speed, turn_rate or a "
-                           "vehicle's input (<vehicle>.<surface>, "
+                           "tow.x, tow.y, tow.z), tow.roll, tow.pitch, "
+                           "tow.yaw, speed, turn_rate or a vehicle's input (<vehicle>.<surface>, "
                            "<vehicle>.<loop>, <vehicle>.<loop>.setpoint)",
                            where, axis_name);
         axis = TS_AXIS_INPUT;
@@ -772,7 +811,10 @@ int ts_excitation_parse(ts_excitation *ex, const char *spec,
     }
 
     /* Quantities, each with its SI unit. */
-    const char *amp_unit = tow ? "m" : axis == TS_AXIS_SPEED ? "m/s" : "rad/s";
+    const char *amp_unit = is_rot_axis(axis)     ? "rad"
+                           : tow                 ? "m"
+                           : axis == TS_AXIS_SPEED ? "m/s"
+                                                   : "rad/s";
     double period = 0;
     const struct { int key; const char *unit; double *dst; } q[] = {
         {K_AMPLITUDE, amp_unit, &s.amplitude}, {K_TO, amp_unit, &s.amplitude},
@@ -964,10 +1006,10 @@ static void signal_eval(const ts_excitation *ex, int i, double amp, double t,
     *a = Rdd * x0 + 2.0 * Rd * v0 + R * a0;
 }
 
-int ts_excitation_start_jump(const ts_excitation *ex, double du[6])
+int ts_excitation_start_jump(const ts_excitation *ex, double du[TS_NINPUT])
 {
     int jump = 0;
-    for (int j = 0; j < 6; j++)
+    for (int j = 0; j < TS_NINPUT; j++)
         du[j] = 0.0;
     for (int i = 0; i < ex->n; i++) {
         const ts_signal *s = &ex->sig[i];
@@ -996,11 +1038,12 @@ static double signal_integral(const ts_signal *s, double amp, double t)
  * u (each driven axis). */
 static void sum_eval(const sum_group *g, double t, double u[TS_NINPUT])
 {
-    double x[3] = {0, 0, 0}, v[3] = {0, 0, 0}, a[3] = {0, 0, 0};
+    enum { NA = TS_SUM_AXES };
+    double x[NA] = {0}, v[NA] = {0}, a[NA] = {0};
     for (int k = 0; k < g->n; k++) {
         double w = g->omega[k], sn = sin(w * t), cs = cos(w * t);
-        const double *c = g->c + 6 * k;
-        for (int j = 0; j < 3; j++) {
+        const double *c = g->c + 2 * NA * k;
+        for (int j = 0; j < NA; j++) {
             double re = c[2 * j], im = c[2 * j + 1];
             double p = re * cs - im * sn, q = re * sn + im * cs;
             x[j] += p;
@@ -1015,11 +1058,12 @@ static void sum_eval(const sum_group *g, double t, double u[TS_NINPUT])
         r1 = s5d(xi) / g->rise;
         r2 = s5dd(xi) / (g->rise * g->rise);
     }
-    for (int j = 0; j < 3; j++)
+    for (int j = 0; j < NA; j++)
         if (g->axes[j]) {
-            u[j] += r * x[j];
-            u[3 + j] += r1 * x[j] + r * v[j];
-            u[6 + j] += r2 * x[j] + 2.0 * r1 * v[j] + r * a[j];
+            int d = (int)sum_axis(j);
+            u[d] += r * x[j];
+            u[3 + d] += r1 * x[j] + r * v[j];
+            u[6 + d] += r2 * x[j] + 2.0 * r1 * v[j] + r * a[j];
         }
 }
 
@@ -1200,7 +1244,7 @@ void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
 {
     m->speed = fabs(base->speed);
     m->turn_rate = fabs(base->turn_rate);
-    m->tow_speed = m->tow_accel = 0.0;
+    m->tow_speed = m->tow_accel = m->rot_rate = m->rot_accel = 0.0;
     for (int i = 0; ex && i < ex->n; i++) {
         const ts_signal *s = &ex->sig[i];
         double A = fabs(s->amplitude), w = 2.0 * M_PI * s->frequency;
@@ -1228,10 +1272,12 @@ void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
             /* Sum of |c_k| w_k (and w_k^2) on this axis, plus the fade-in's
              * slopes times the sum of |c_k|. */
             const sum_group *g = ex->sum[i];
-            int j = (int)s->axis;
+            int j = is_rot_axis(s->axis) ? 3 + (int)s->axis - TS_AXIS_ROLL
+                                         : (int)s->axis;
             double c = 0.0;
             for (int k = 0; k < g->n; k++) {
-                double ck = hypot(g->c[6 * k + 2 * j], g->c[6 * k + 2 * j + 1]);
+                const double *gc = g->c + 2 * TS_SUM_AXES * k + 2 * j;
+                double ck = hypot(gc[0], gc[1]);
                 double wk = fabs(g->omega[k]);
                 c += ck;
                 v += ck * wk;
@@ -1262,7 +1308,10 @@ void ts_excitation_bound(const ts_excitation *ex, const ts_frame *base,
             m->speed += A;
         else if (s->axis == TS_AXIS_TURN_RATE)
             m->turn_rate += A;
-        else if (s->axis != TS_AXIS_INPUT) {
+        else if (is_rot_axis(s->axis)) {
+            m->rot_rate += v;
+            m->rot_accel += a;
+        } else if (s->axis != TS_AXIS_INPUT) {
             m->tow_speed += v;
             m->tow_accel += a;
         }
@@ -1318,7 +1367,8 @@ void ts_excitation_describe_display(const ts_excitation *ex, int i,
     const char *an = ts_signal_axis_label(s);
     /* The amplitude's quantity; an input of no unit of its own stays as
      * given. */
-    int q = is_tow_axis(s->axis)              ? TS_QTY_LENGTH
+    int q = is_rot_axis(s->axis)              ? TS_QTY_ANGLE
+            : is_tow_axis(s->axis)            ? TS_QTY_LENGTH
             : s->axis == TS_AXIS_SPEED        ? TS_QTY_SPEED
             : s->axis == TS_AXIS_TURN_RATE    ? TS_QTY_ANGULAR_RATE
             : !strcmp(s->input_unit, "m")     ? TS_QTY_LENGTH

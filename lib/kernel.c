@@ -116,9 +116,10 @@ typedef struct veh {
     double held[3];
     /* The towing vehicle: the prescribed acceleration (body axes) of the
      * points its cables start from relative to the body, the tow-point
-     * inputs' (wave-induced motion, doc/towing-vehicle.md section 7); 0
-     * for a towed vehicle. */
-    double shift_a[3];
+     * inputs' (wave-induced motion, doc/towing-vehicle.md section 8):
+     * shift_a + shift_al x p at the point p (body axes from O); 0 for a
+     * towed vehicle. */
+    double shift_a[3], shift_al[3];
 } veh;
 
 /* Inputs of a towing vehicle: thrust, force x y z, moment x y z. */
@@ -171,6 +172,8 @@ struct ts_kernel {
     double *g, *w;            /* [3 nn] Mh^-1 Fh, Mh^-1 n */
     double *a;                /* [3 nn] inertial acceleration */
     double *rdd;              /* [3 nn] acceleration relative to M */
+    double tow_acc[3];        /* a prescribed tow point's acceleration
+                                 from the tow inputs, M */
 };
 
 static void *zalloc(size_t n, size_t size, int *fail)
@@ -585,6 +588,16 @@ void ts_kernel_control_state(const ts_kernel *k, int i, ts_control_state *cs)
     }
 }
 
+void ts_kernel_root_position(const ts_kernel *k, const double y[],
+                             double r[3])
+{
+    const double *p = k->sys->tow.point;
+    int ro = ts_kernel_root_offset(k);
+    int np = ro < 0 ? 0 : ts_kernel_root_dof(k) == 3 ? 2 : 3;
+    for (int j = 0; j < 3; j++)
+        r[j] = j < np ? y[ro + j] : p[j];
+}
+
 const char *tsi_tow_input_name(int j)
 {
     static const char *const names[TS_NINPUT] = {
@@ -596,7 +609,16 @@ const char *tsi_tow_input_name(int j)
         "tow.heave_velocity",
         "tow.surge_acceleration",
         "tow.sway_acceleration",
-        "tow.heave_acceleration"};
+        "tow.heave_acceleration",
+        "tow.roll",
+        "tow.pitch",
+        "tow.yaw",
+        "tow.roll_velocity",
+        "tow.pitch_velocity",
+        "tow.yaw_velocity",
+        "tow.roll_acceleration",
+        "tow.pitch_acceleration",
+        "tow.yaw_acceleration"};
     return j >= 0 && j < TS_NINPUT ? names[j] : NULL;
 }
 
@@ -644,8 +666,11 @@ const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
 
 const char *ts_kernel_input_unit(const ts_kernel *k, int j)
 {
-    if (j >= 0 && j < TS_NINPUT)
-        return j < 3 ? "m" : (j < 6 ? "m/s" : "m/s^2");
+    if (j >= 0 && j < TS_NINPUT) {
+        static const char *const units[6] = {"m", "m/s", "m/s^2",
+                                             "rad", "rad/s", "rad/s^2"};
+        return units[j / 3];
+    }
     for (int v = 0; v < k->nv; v++) {
         const veh *V = &k->veh[v];
         for (int c = 0; c < V->d->ncomponents; c++)
@@ -925,9 +950,13 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
  * towing vehicle's prescribed motion of its cables' starting points. */
 static void point_bias(const veh *V, const double rho[3], double b[3])
 {
+    double p[3], x[3];
     centripetal(V->st.om_b, rho, b);
     for (int j = 0; j < 3; j++)
-        b[j] += V->shift_a[j];
+        p[j] = rho[j] + V->d->attach[j];
+    v3_cross(V->shift_al, p, x);
+    for (int j = 0; j < 3; j++)
+        b[j] += V->shift_a[j] + x[j];
 }
 
 /* A vehicle's controller, inertia and its own loads (V->M6, V->G). */
@@ -1221,6 +1250,51 @@ static void control_rates(const veh *V, double cdot[])
         cdot[V->spd_off] = V->spd_dot;
 }
 
+/* The tow inputs (doc/towing-vehicle.md section 8): a translation x and
+ * a small rotation theta (u[TS_TOW_ROT..]) of the ship, with their rates
+ * and accelerations, move a cable's start point r by x + theta x r (M
+ * axes), its velocity by x' + theta' x r, its acceleration by x'' +
+ * theta'' x r: linear in the inputs. A prescribed tow point is the one
+ * start point, r = tow.point from M's origin: k->r, k->rd of node 0 and
+ * k->tow_acc. With a towing vehicle the points its cables start from move
+ * relative to the body, r = R p from its origin O (p body axes, the
+ * cable's `at`), on top of the body's own motion (vehicle_kinematics has
+ * placed them): k->ur, k->urd, and the accelerations (body axes)
+ * shift_a + shift_al x p that point_bias adds. */
+static void root_tow_inputs(ts_kernel *k, veh *Root, const double u[])
+{
+    const ts_system *sys = k->sys;
+    const double *x = u, *xd = u + 3, *xdd = u + 6;
+    const double *th = u + TS_TOW_ROT, *thd = th + 3, *thdd = th + 6;
+    double dr[3], dv[3], da[3];
+    if (!Root) {
+        const double *r = sys->tow.point;
+        v3_cross(th, r, dr);
+        v3_cross(thd, r, dv);
+        v3_cross(thdd, r, da);
+        for (int j = 0; j < 3; j++) {
+            k->r[j] = r[j] + x[j] + dr[j];
+            k->rd[j] = xd[j] + dv[j];
+            k->tow_acc[j] = xdd[j] + da[j];
+        }
+        return;
+    }
+    const ts_node *n0 = &sys->nodes[0];
+    for (int c = n0->child_begin; c < n0->child_end; c++) {
+        int l = sys->child_links[c];
+        double r[3];
+        mat3_mul(Root->st.R, sys->links[l].up_point, r);
+        v3_cross(th, r, dr);
+        v3_cross(thd, r, dv);
+        for (int j = 0; j < 3; j++) {
+            k->ur[3 * l + j] += x[j] + dr[j];
+            k->urd[3 * l + j] += xd[j] + dv[j];
+        }
+    }
+    mat3_tmul(Root->st.R, xdd, Root->shift_a);
+    mat3_tmul(Root->st.R, thdd, Root->shift_al);
+}
+
 int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
                    double dydt[])
 {
@@ -1244,24 +1318,8 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         }
         if (vehicle_kinematics(k, Root, y))
             chart_bad = 1;
-        /* The tow-point inputs: a prescribed displacement, velocity and
-         * acceleration (M axes) of the points the cables start from,
-         * relative to the body (a wave-induced motion), over its own. */
-        const ts_node *n0 = &sys->nodes[0];
-        for (int c = n0->child_begin; c < n0->child_end; c++) {
-            int l = sys->child_links[c];
-            for (int j = 0; j < 3; j++) {
-                k->ur[3 * l + j] += u[j];
-                k->urd[3 * l + j] += u[3 + j];
-            }
-        }
-        mat3_tmul(Root->st.R, u + 6, Root->shift_a);
-    } else {
-        for (int j = 0; j < 3; j++) {
-            k->r[j] = sys->tow.point[j] + u[j];
-            k->rd[j] = u[3 + j];
-        }
     }
+    root_tow_inputs(k, Root, u);
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
         const int o = k->off[l];
@@ -1412,7 +1470,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
         v3_set(Root->Fj, 0, 0, 0);
     } else {
         for (int j = 0; j < 3; j++)
-            k->a[j] = k->afr[j] + u[6 + j];
+            k->a[j] = k->afr[j] + k->tow_acc[j];
     }
     for (int l = 0; l < nl; l++) {
         const ts_link *L = &links[l];
@@ -1437,7 +1495,7 @@ int ts_kernel_eval(ts_kernel *k, const double y[], const double u[],
 
     /* 4. Relative accelerations and angle accelerations. */
     for (int j = 0; j < 3; j++)
-        k->rdd[j] = Root ? k->a[j] - k->afr[j] : u[6 + j];
+        k->rdd[j] = Root ? k->a[j] - k->afr[j] : k->tow_acc[j];
     for (int i = 1; i < nn; i++)
         for (int j = 0; j < 3; j++)
             k->rdd[3 * i + j] = k->a[3 * i + j] - k->afr[3 * i + j];

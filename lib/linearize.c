@@ -42,6 +42,7 @@
 #endif
 
 #include "descriptor.h"
+#include "vec3.h"
 #include "kernel_impl.h"
 #include "lapack.h"
 #include "vehicle.h"
@@ -87,6 +88,7 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     lin->dn = calloc(6 * (size_t)sys->nlinks, sizeof(double));
     lin->n0 = calloc(3 * (size_t)sys->nlinks, sizeof(double));
     lin->len0 = calloc((size_t)sys->nlinks, sizeof(double));
+    lin->tow_lever = calloc(3 * (size_t)sys->nnodes, sizeof(double));
     lin->qoff = calloc((size_t)sys->nlinks, sizeof(int));
     lin->elastic = calloc((size_t)sys->nlinks, 1);
     for (int l = 0; lin->qoff && lin->elastic && l < sys->nlinks; l++) {
@@ -137,6 +139,7 @@ ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
     }
     if (!lin->y0 || !lin->f0 || !lin->r0 || !lin->t0 || !lin->dn ||
         !lin->n0 || !lin->len0 || !lin->qoff || !lin->elastic || !lin->h ||
+        !lin->tow_lever ||
         !lin->u0 ||
         (lin->nvehicles > 0 && (!lin->up_qoff || !lin->up_map ||
                                 !lin->veh_rot || !lin->veh_qoff)) ||
@@ -164,6 +167,7 @@ void ts_linear_free(ts_linear *lin)
     free(lin->dn);
     free(lin->n0);
     free(lin->len0);
+    free(lin->tow_lever);
     free(lin->qoff);
     free(lin->elastic);
     free(lin->Ty);
@@ -440,6 +444,34 @@ static int column(col_ws *w, int j, int n, int nq, int nl, int nout,
     return TS_OK;
 }
 
+/* The lever of every node for the tow rotations (ts_linear.tow_lever):
+ * the start point of the cable each node hangs on, from M's origin (a
+ * prescribed tow point: tow.point, node 0 included) or from the towing
+ * vehicle's origin O (R p, p the cable's start in body axes), as the
+ * kernel's root_tow_inputs moves it. Links come in tree order, so a
+ * link's upper node is done before its lower one. */
+static void tow_levers(const ts_kernel *k, const ts_system *sys,
+                       const double y0[], double lever[])
+{
+    int root = ts_kernel_root(k);
+    double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, om[3];
+    if (root >= 0)
+        ts_kernel_get_vehicle(k, root, y0, R, om);
+    for (int j = 0; j < 3; j++)
+        lever[j] = root >= 0 ? 0.0 : sys->tow.point[j];
+    for (int l = 0; l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        double *r = lever + 3 * L->lower;
+        if (L->upper == 0 && root >= 0 && L->up_body >= 0)
+            for (int j = 0; j < 3; j++)
+                r[j] = R[3 * j] * L->up_point[0] +
+                       R[3 * j + 1] * L->up_point[1] +
+                       R[3 * j + 2] * L->up_point[2];
+        else
+            memcpy(r, lever + 3 * L->upper, 3 * sizeof(double));
+    }
+}
+
 /* Scale of a strain rate's column: equilibrium strains are ~T/EA, 1e-10
  * to 1e-3, and their rates zero. */
 #define STRAIN_SCALE 1e-4
@@ -466,20 +498,28 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
     double V = fabs(fr->speed);
     double l0 = sys->nlinks > 0 ? sys->links[0].length : 1.0;
     int c = j - n;
+    double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
+                        sys->tow.point[1] * sys->tow.point[1] +
+                        sys->tow.point[2] * sys->tow.point[2]);
+    for (int l = 0; l < sys->nlinks; l++)
+        reach += sys->links[l].length;
+    if (!(reach > 0))
+        reach = 1.0;
     if (c < TS_IN_VEL)
         return l0;
     if (c < TS_IN_ACC)
         return sqrt(g * l0) + V;
-    if (c < TS_NINPUT)
+    if (c < TS_IN_ROT)
         return g;
+    /* A tow rotation moves a point at distance r by theta r: over the
+     * reach, as the turn rate below. */
+    if (c < TS_IN_ROT_VEL)
+        return l0 / reach;
+    if (c < TS_IN_ROT_ACC)
+        return (sqrt(g * l0) + V) / reach;
+    if (c < TS_NINPUT)
+        return g / reach;
     if (c >= fin && c < fin + TS_NFRAME_INPUT) {
-        double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
-                            sys->tow.point[1] * sys->tow.point[1] +
-                            sys->tow.point[2] * sys->tow.point[2]);
-        for (int l = 0; l < sys->nlinks; l++)
-            reach += sys->links[l].length;
-        if (!(reach > 0))
-            reach = 1.0;
         switch (c - fin) {
         case 0: return sqrt(g * l0) + V;           /* speed, m/s */
         case 1: return (sqrt(g * l0) + V) / reach; /* turn rate, rad/s */
@@ -1037,6 +1077,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
                          R[3 * j + 2] * lev[2];
         lin->up_qoff[l] = qo;
     }
+    tow_levers(k, sys, y0, lin->tow_lever);
 
     ts_frame fr;
     ts_kernel_get_frame(k, &fr);
@@ -1273,6 +1314,21 @@ void ts_linear_vehicle_rotations(const ts_linear *lin, const double dq[],
         for (int c = 0; c < 3; c++)
             phi[3 * v + c] = map[3 * c] * dth[0] + map[3 * c + 1] * dth[1] +
                              map[3 * c + 2] * dth[2];
+    }
+}
+
+void ts_linear_tow_shift(const ts_linear *lin, int node, int input,
+                         double d[3])
+{
+    d[0] = d[1] = d[2] = 0.0;
+    if (node == 0 && lin->root_qoff >= 0)
+        return;
+    if (input >= TS_IN_DISP && input < TS_IN_DISP + 3) {
+        d[input - TS_IN_DISP] = 1.0;
+    } else if (input >= TS_IN_ROT && input < TS_IN_ROT + 3) {
+        double e[3] = {0, 0, 0};
+        e[input - TS_IN_ROT] = 1.0;
+        v3_cross(e, lin->tow_lever + 3 * node, d);
     }
 }
 

@@ -487,8 +487,9 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
     {.name = "excite", .type = TS_OPT_SPECS, .section = TS_SEC_SIMULATE,      \
      NOLIM, .flags = TS_OPT_REPEAT, .offset = OFF(simulate.excitation),       \
      .only = o, .arg = "SPEC",                                                \
-     .help = "tow-point or vehicle-input excitation, e.g. "                   \
-             "tow.heave:amplitude=0.1ft,frequency=1Hz or "                    \
+     .help = "tow-point (tow.surge, tow.sway, tow.heave), ship rotation "    \
+             "(tow.roll, tow.pitch, tow.yaw) or vehicle-input excitation, "  \
+             "e.g. tow.heave:amplitude=0.1ft,frequency=1Hz or "               \
              "fish.depth.setpoint:step,amplitude=5m",                         \
      .deftext = "none"},                                                      \
     {.name = "manoeuvre", .type = TS_OPT_SPECS, .section = TS_SEC_SIMULATE,   \
@@ -519,7 +520,8 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
     {.name = "rao_reference", .type = TS_OPT_CUSTOM, .section = sec, NOLIM,   \
      .offset = OFF(field), .parse = parse_reference, .arg = "X,Y,Z",          \
      .help = "the RAOs' reference point in M (the lever arm is the tow "      \
-             "point less it)",                                                \
+             "point less it; with a towing vehicle its rotations turn "       \
+             "each cable's start about the vehicle's origin)",               \
      .deftext = "0,0,0 m (M's origin)"}
 
 static const ts_option eq_rows[] = {SETUP_ROWS, LINKS_ROW, ACCURACY_ROWS};
@@ -563,7 +565,8 @@ static const ts_option response_rows[] = {
     {.name = "input", .type = TS_OPT_TEXT, .section = TS_SEC_RESPONSE, NOLIM,
      .offset = OFF(response.input), .size = SZ(response.input),
      .flag_offset = OFF(response.frequency_given), .arg = "NAME",
-     .help = "tow.surge, tow.sway or tow.heave, tow.speed or "
+     .help = "tow.surge, tow.sway or tow.heave, tow.roll, tow.pitch or "
+             "tow.yaw (a small rotation of the ship), tow.speed or "
              "tow.turn_rate, or a vehicle's input: <vehicle>.<surface>, "
              "<vehicle>.<loop>, <vehicle>.<loop>.setpoint; a towing "
              "vehicle's <name>.thrust, .force.x|y|z, .moment.x|y|z, "

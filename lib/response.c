@@ -38,19 +38,20 @@
 #include "shift.h"
 #include "towstab/system.h"
 
-static const char *const input_names[3] = {"tow.surge", "tow.sway",
-                                           "tow.heave"};
-
 int ts_response_input_find(const char *name, int *channel, ts_err *err)
 {
-    for (int j = 0; j < 3; j++)
-        if (strcmp(name, input_names[j]) == 0) {
+    for (int a = 0; a < 6; a++) {
+        int j = a < 3 ? TS_IN_DISP + a : TS_IN_ROT + a - 3;
+        if (strcmp(name, ts_input_name(j)) == 0) {
             *channel = j;
             return TS_OK;
         }
+    }
     return ts_fail(err, TS_EINVAL,
-                   "input '%s': not an input; expected tow.surge, tow.sway "
-                   "or tow.heave (tow-point displacement along x, y, z)",
+                   "input '%s': not an input; expected tow.surge, tow.sway, "
+                   "tow.heave (tow-point displacement along x, y, z) or "
+                   "tow.roll, tow.pitch, tow.yaw (a small rotation about "
+                   "them)",
                    name);
 }
 
@@ -110,7 +111,7 @@ int ts_response_input_lookup(const ts_kernel *k, const char *name,
                                         : ts_frame_input_name(i - fin));
     return ts_fail(err, TS_EINVAL,
                    "input '%s': not an input; expected tow.surge, tow.sway, "
-                   "tow.heave%s",
+                   "tow.heave, tow.roll, tow.pitch, tow.yaw%s",
                    name, list);
 }
 
@@ -123,8 +124,10 @@ static int input_columns(const ts_linear *lin, int input, double complex s,
                          int cols[3], double complex fac[3])
 {
     if (input < TS_NINPUT) {
+        /* A displacement's velocity is 3 columns after it, its
+         * acceleration 6 (TS_IN_VEL, TS_IN_ROT_VEL, ...). */
         for (int q = 0; q < 3; q++)
-            cols[q] = TS_IN_DISP + 3 * q + input;
+            cols[q] = input + 3 * q;
         fac[0] = 1.0;
         fac[1] = s;
         fac[2] = s * s;
@@ -496,7 +499,9 @@ static double complex output_gain(const ts_system *sys, const ts_linear *lin,
             w->dq[i] = cimag(w->x[i]);
         ts_linear_node_displacements(sys, lin, w->dq, w->drr);
         double gi = w->drr[idx];
-        g = gr + I * gi + (tow && out->comp == input ? 1.0 : 0.0);
+        double shift[3];
+        ts_linear_tow_shift(lin, out->node, tow ? input : -1, shift);
+        g = gr + I * gi + shift[out->comp];
     } else if (out->kind == TS_OUT_TENSION) {
         g = row_gain(lin->Ty, lin->Tu, out->link, nl, n, w->x, ncols, cols,
                      fac);
@@ -808,13 +813,16 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
                        "response: the linear model has %d links, the system "
                        "%d",
                        lin->nlinks, sys->nlinks);
-    if (!((input >= 0 && input <= 2) ||
+    if (!((input >= TS_IN_DISP && input < TS_IN_DISP + 3) ||
+          (input >= TS_IN_ROT && input < TS_IN_ROT + 3) ||
           (input >= TS_NINPUT && input < lin->frame_input + 2)))
         return ts_fail(err, TS_EINVAL,
                        "response: input channel must be 0, 1 or 2 "
-                       "(tow.surge, tow.sway, tow.heave), a vehicle's "
+                       "(tow.surge, tow.sway, tow.heave), %d, %d or %d "
+                       "(tow.roll, tow.pitch, tow.yaw), a vehicle's "
                        "input or tow.speed or tow.turn_rate, %d to %d, "
                        "got %d",
+                       TS_IN_ROT, TS_IN_ROT + 1, TS_IN_ROT + 2,
                        TS_NINPUT, lin->frame_input + 1, input);
     if (lin->desc && input >= lin->frame_input)
         return ts_fail(err, TS_EINVAL, "response: %s needs the dense "

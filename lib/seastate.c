@@ -73,12 +73,17 @@ int ts_seaway_init(ts_seaway *w, const ts_system *sys, const ts_sea *sea,
         if (rc)
             return rc;
     }
+    w->rotations = sys->tow.vehicle >= 0;
+    const double *attach =
+        w->rotations ? sys->bodies[sys->tow.vehicle].vehicle->attach : NULL;
     for (int c = 0; c < 3; c++) {
         double r = reference ? reference[c] : 0.0;
         if (!isfinite(r))
             return ts_fail(err, TS_EINVAL, "sea state: the RAO reference "
                            "point must be finite");
         w->lever[c] = sys->tow.point[c] - r;
+        w->reference[c] = r;
+        w->origin[c] = sys->tow.point[c] - (attach ? attach[c] : 0.0);
     }
     w->sea = sea;
     w->rao = rao;
@@ -87,18 +92,50 @@ int ts_seaway_init(ts_seaway *w, const ts_system *sys, const ts_sea *sea,
     return TS_OK;
 }
 
-int ts_seaway_tow(const ts_seaway *w, double omega, double re[3],
-                  double im[3], ts_err *err)
+int ts_seaway_tow(const ts_seaway *w, double omega,
+                  double re[TS_SUM_AXES], double im[TS_SUM_AXES],
+                  ts_err *err)
 {
+    for (int j = 0; j < TS_SUM_AXES; j++)
+        re[j] = im[j] = 0.0;
     if (!w->rao) {
-        re[0] = re[1] = im[0] = im[1] = im[2] = 0.0;
         re[2] = -1.0; /* z is down: the surface rises by eta */
         return TS_OK;
     }
     ts_sea_info si;
     ts_sea_get_info(w->sea, &si);
-    return ts_rao_tow_point(w->rao, si.heading, omega, w->lever, re, im,
-                            err);
+    if (!w->rotations)
+        return ts_rao_tow_point(w->rao, si.heading, omega, w->lever, re, im,
+                                err);
+    /* The origin O's translation; the rotation about O moves each start
+     * point r from O by theta x r in the kernel. */
+    double lever[3], xr[TS_NDOF], xi[TS_NDOF];
+    for (int c = 0; c < 3; c++)
+        lever[c] = w->origin[c] - w->reference[c];
+    int rc = ts_rao_tow_point(w->rao, si.heading, omega, lever, re, im, err);
+    if (!rc)
+        rc = ts_rao_eval(w->rao, si.heading, omega, xr, xi, err);
+    for (int j = 3; j < 6 && !rc; j++) {
+        re[j] = xr[TS_DOF_ROLL + j - 3];
+        im[j] = xi[TS_DOF_ROLL + j - 3];
+    }
+    return rc;
+}
+
+void ts_seaway_set_trim(ts_seaway *w, const ts_kernel *k, const double y[])
+{
+    int v = ts_kernel_root(k);
+    if (v < 0)
+        return;
+    const ts_system *sys = ts_kernel_system(k);
+    const double *attach = sys->bodies[sys->tow.vehicle].vehicle->attach;
+    double R[9], rA[3];
+    ts_kernel_get_vehicle(k, v, y, R, NULL);
+    ts_kernel_root_position(k, y, rA);
+    for (int c = 0; c < 3; c++)
+        w->origin[c] = rA[c] - (R[3 * c] * attach[0] +
+                                R[3 * c + 1] * attach[1] +
+                                R[3 * c + 2] * attach[2]);
 }
 
 int ts_seaway_band(const ts_seaway *w, double tail, double *lo, double *hi,
@@ -295,12 +332,35 @@ static int on_axis_progress(const ts_progress *p, void *data)
     return a->o->progress(&q, a->o->progress_data);
 }
 
+/* The towing vehicle's origin O at the linearization's trim: from a
+ * cable starting on it, O = r_A + R (p - A) - R p (ts_linear.up_map's
+ * lever and tow_lever of its lower node). */
+static void linear_origin(const ts_system *sys, const ts_linear *lin,
+                          double origin[3])
+{
+    for (int l = 0; lin->up_map && l < sys->nlinks; l++) {
+        const ts_link *L = &sys->links[l];
+        if (L->upper != 0 || L->up_body < 0)
+            continue;
+        const double *lev = lin->up_map + 12 * l + 9;
+        const double *r = lin->tow_lever + 3 * L->lower;
+        for (int c = 0; c < 3; c++)
+            origin[c] = lin->r0[c] + lev[c] - r[c];
+        return;
+    }
+}
+
 int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
-                        const ts_seaway *w, const ts_output *out,
+                        const ts_seaway *way, const ts_output *out,
                         const ts_seastate_opts *opts, ts_seastate **res,
                         ts_err *err)
 {
     *res = NULL;
+    /* With a towing vehicle, its origin at this linearization's trim. */
+    ts_seaway wl = *way;
+    const ts_seaway *w = &wl;
+    if (wl.rotations)
+        linear_origin(sys, lin, wl.origin);
     ts_seastate_opts o;
     if (opts)
         o = *opts;
@@ -312,7 +372,7 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
         rc = grid_band(w, o.omega_lo, o.omega_hi, o.tail, &lo, &hi, err);
     if (rc)
         return rc;
-    int n = o.intervals, np = n + 1, nin = 3;
+    int n = o.intervals, np = n + 1, nin = w->rotations ? 6 : 3;
     ts_seastate *s = calloc(1, sizeof *s);
     double *freq = malloc((size_t)np * sizeof *freq);
     double *f2 = malloc((size_t)np * sizeof *f2);
@@ -336,16 +396,16 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
     ts_trust_init(&s->trust);
     /* Uniform in u = ln w: the integrands are f(w) w du. */
     double h = log(hi / lo) / n;
-    double tmax[3] = {0, 0, 0};
+    double tmax[TS_SUM_AXES] = {0};
     for (int i = 0; i < np && !rc; i++) {
         double wv = i == 0 ? lo : i == n ? hi : lo * exp(i * h);
         s->omega[i] = wv;
         s->omega_e[i] = ts_sea_encounter(wv, w->speed, si.heading,
                                          w->gravity);
         s->wave[i] = ts_sea_density(w->sea, wv);
-        double tr[3], ti[3];
+        double tr[TS_SUM_AXES], ti[TS_SUM_AXES];
         rc = ts_seaway_tow(w, wv, tr, ti, err);
-        for (int j = 0; j < 3 && !rc; j++) {
+        for (int j = 0; j < nin && !rc; j++) {
             s->input_re[(size_t)j * np + i] = tr[j];
             s->input_im[(size_t)j * np + i] = ti[j];
             tmax[j] = fmax(tmax[j], hypot(tr[j], ti[j]));
@@ -358,16 +418,17 @@ int ts_seastate_compute(const ts_system *sys, const ts_linear *lin,
         driven += tmax[j] != 0;
     axis_progress ap = {&o, 0, (double)driven * np};
     for (int j = 0; j < nin && !rc; j++) {
-        s->channel[j] = j;
+        int ch = j < 3 ? TS_IN_DISP + j : TS_IN_ROT + j - 3;
+        s->channel[j] = ch;
         if (tmax[j] == 0)
             continue;
         ts_response *r = NULL;
-        rc = tsi_response_compute(sys, lin, j, out, freq, np,
+        rc = tsi_response_compute(sys, lin, ch, out, freq, np,
                                   o.progress ? on_axis_progress : NULL, &ap,
                                   &r, err);
         ap.before += np;
         if (rc) {
-            ts_err_prefix(err, "sea state, input %s: ", ts_input_name(j));
+            ts_err_prefix(err, "sea state, input %s: ", ts_input_name(ch));
             break;
         }
         s->responses += np;
@@ -489,8 +550,8 @@ int ts_seaway_excitation(const ts_seaway *w, const ts_sea_realisation *r,
         return rc;
     int n = r->components;
     double *we = malloc((size_t)n * sizeof *we);
-    double *cre = malloc(3 * (size_t)n * sizeof *cre);
-    double *cim = malloc(3 * (size_t)n * sizeof *cim);
+    double *cre = malloc(TS_SUM_AXES * (size_t)n * sizeof *cre);
+    double *cim = malloc(TS_SUM_AXES * (size_t)n * sizeof *cim);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!we || !cre || !cim || !rng) {
         rc = ts_fail(err, TS_ENOMEM, "sea realisation: out of memory");
@@ -506,13 +567,13 @@ int ts_seaway_excitation(const ts_seaway *w, const ts_sea_realisation *r,
         double wk = lo * exp((k + gsl_rng_uniform(rng)) * du);
         double phi = 2.0 * M_PI * gsl_rng_uniform(rng);
         double a = sqrt(2.0 * ts_sea_density(w->sea, wk) * wk * du);
-        double tr[3], ti[3];
+        double tr[TS_SUM_AXES], ti[TS_SUM_AXES];
         rc = ts_seaway_tow(w, wk, tr, ti, err);
         double complex e = a * cexp(I * phi);
-        for (int j = 0; j < 3 && !rc; j++) {
+        for (int j = 0; j < TS_SUM_AXES && !rc; j++) {
             double complex c = (tr[j] + I * ti[j]) * e;
-            cre[3 * k + j] = creal(c);
-            cim[3 * k + j] = cimag(c);
+            cre[TS_SUM_AXES * k + j] = creal(c);
+            cim[TS_SUM_AXES * k + j] = cimag(c);
         }
         we[k] = ts_sea_encounter(wk, w->speed, si.heading, w->gravity);
     }

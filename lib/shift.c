@@ -699,6 +699,28 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
     inf_solve(sh, f, rt, hc, y + nq, y + 2 * nq);
 }
 
+/* The tow point's displacement d[3] (M) per unit of tow input j (any of
+ * the TS_NINPUT: a displacement, a velocity or an acceleration): e_a
+ * for a translation along a, e_a x tow.point for a rotation about a (the
+ * kernel's root_tow_inputs, M's origin the centre); the order 0, 1, 2
+ * (displacement, velocity, acceleration) into *order. */
+static void tow_direction(const ts_system *sys, int j, double d[3],
+                          int *order)
+{
+    int rot = j >= TS_TOW_ROT, c = rot ? j - TS_TOW_ROT : j;
+    double e[3] = {0, 0, 0};
+    e[c % 3] = 1.0;
+    *order = c / 3;
+    if (!rot) {
+        memcpy(d, e, sizeof e);
+        return;
+    }
+    const double *p = sys->tow.point;
+    d[0] = e[1] * p[2] - e[2] * p[1];
+    d[1] = e[2] * p[0] - e[0] * p[2];
+    d[2] = e[0] * p[1] - e[1] * p[0];
+}
+
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
                      double complex *dt)
 {
@@ -725,6 +747,12 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
             rhs[2 * XC(j)] = hc[j];
         input = -1;
     }
+    /* A tow input moves the tow point by d0 (a rotation: about M's
+     * origin, the tow point's translation). */
+    double d0[3] = {0, 0, 0};
+    int order = 0;
+    if (input >= 0)
+        tow_direction(sys, input, d0, &order);
     /* Point rows: -(K_k0 + s C_k0) e_input, the tow point's displacement
      * and velocity seen by its neighbours. */
     for (int k = 1; input >= 0 && k < d->np; k++)
@@ -733,7 +761,9 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
                 continue;
             const double *Kb = d->K + 9 * (size_t)b, *Cb = d->C + 9 * (size_t)b;
             for (int a = 0; a < 3; a++) {
-                double complex v = -(Kb[3 * a + input] + s * Cb[3 * a + input]);
+                double complex v = 0;
+                for (int c = 0; c < 3; c++)
+                    v -= (Kb[3 * a + c] + s * Cb[3 * a + c]) * d0[c];
                 rhs[2 * XR(k, a)] = creal(v);
                 rhs[2 * XR(k, a) + 1] = cimag(v);
             }
@@ -746,17 +776,19 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
         double complex g[3] = {d->n[3 * l], d->n[3 * l + 1], d->n[3 * l + 2]};
         if (d->kind[l] == TSI_LINK_TAUT)
             tsi_desc_taut_row(d, l, s, g);
-        else if (d->kind[l] == TSI_LINK_SLACK)
-            g[input] = 0.0;
-        rhs[2 * XT(l)] = creal(g[input]);
-        rhs[2 * XT(l) + 1] = cimag(g[input]);
+        /* A slack link's row does not see the tow point. */
+        double complex gd = 0;
+        for (int c = 0; d->kind[l] != TSI_LINK_SLACK && c < 3; c++)
+            gd += g[c] * d0[c];
+        rhs[2 * XT(l)] = creal(gd);
+        rhs[2 * XT(l) + 1] = cimag(gd);
     }
     if (sh->is_complex)
         klu_z_solve(d->klu_symbolic, sh->numeric, nx, 1, rhs, sh->common);
     else
         two_columns(sh);
     for (int c = 0; c < 3; c++)
-        dr[c] = c == input ? 1.0 : 0.0;
+        dr[c] = d0[c];
     for (int k = 1; k < d->np; k++)
         for (int c = 0; c < 3; c++)
             dr[3 * k + c] = rhs[2 * XR(k, c)] + I * rhs[2 * XR(k, c) + 1];
@@ -769,7 +801,7 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
 void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
 {
     const ts_descriptor *d = sh->d;
-    int nq = sh->lin->nq, nc = d->nc, c = j % 3;
+    int nq = sh->lin->nq, nc = d->nc;
     size_t n3 = 3 * (size_t)d->np, m = n3 + (size_t)nc;
     double *f = sh->u2, *hc = sh->u2 + m, *e = sh->u2 + 2 * m;
     double *u = sh->u2 + 3 * m;
@@ -779,15 +811,19 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
         /* The force change of a tow input with the coordinates fixed:
          * every node moves with a tow displacement or velocity (the
          * vehicles' angles do not). */
+        double d0[3];
+        int order;
+        tow_direction(sh->sys, j, d0, &order);
         for (int k = 0; k < d->nn; k++)
-            e[3 * k + c] = 1.0;
-        if (j < TS_IN_ACC) {
-            const double *B = j < TS_IN_VEL ? (err ? d->Kerr : d->K)
-                                            : (err ? d->Cerr : d->C);
+            for (int c = 0; c < 3; c++)
+                e[3 * k + c] = d0[c];
+        if (order < 2) {
+            const double *B = order == 0 ? (err ? d->Kerr : d->K)
+                                         : (err ? d->Cerr : d->C);
             if (B)
                 tsi_desc_block_mul(d, B, e, f, 0);
-            tsi_desc_local_mul(d, j < TS_IN_VEL ? e : NULL,
-                               j < TS_IN_VEL ? NULL : e, NULL, NULL, hc, NULL,
+            tsi_desc_local_mul(d, order == 0 ? e : NULL,
+                               order == 0 ? NULL : e, NULL, NULL, hc, NULL,
                                err);
         } else {
             if (!err)

@@ -127,17 +127,21 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
 void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err);
 
 /* With S_inf: column j of B (y-space, TS_NINPUT columns: tow
- * displacement, velocity, acceleration along x, y, z), each input alone
+ * displacement, velocity, acceleration along x, y, z, then the same of a
+ * rotation about them, which moves the tow point by e x tow.point), each
+ * input alone
  * with the coordinates fixed, into col[n]; with err, its error estimate
  * (from the blocks' (D(2h) - D(h)) / 3). */
 void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err);
 
 /* The response to a unit harmonic tow-point displacement along input
- * (0 x, 1 y, 2 z) at the factored s: the tow point moves by e_input,
- * with velocity s e_input and acceleration s^2 e_input; or to a unit
+ * (0 x, 1 y, 2 z; or a rotation about x, y, z, TS_TOW_ROT + 0..2, which
+ * moves it by d = e x tow.point, else d = e_input) at the factored s: the
+ * tow point moves by d, with velocity s d and acceleration s^2 d; or to a
+ * unit
  * harmonic vehicle input (input >= TS_NINPUT: a control surface, a loop,
  * a set point), the tow point at rest (dr_0 = 0). Writes the
- * absolute point displacements dr[3 np] (dr_0 = e_input; m per m; then
+ * absolute point displacements dr[3 np] (dr_0 = d; m per m; then
  * the vehicles' angles, rad per m) followed by the controller states
  * (dr[3 np + j]), and the link tensions dt[nlinks] (N per m), complex. */
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,

@@ -1369,7 +1369,7 @@ int ts_sim_start_state(ts_kernel *k, const ts_excitation *ex,
     int n = ts_kernel_nstate(k), nn = sys->nnodes;
     if (y != y0)
         memcpy(y, y0, (size_t)n * sizeof(double));
-    double du[6];
+    double du[TS_NINPUT];
     if (!ex || !ts_excitation_start_jump(ex, du) ||
         (du[3] == 0 && du[4] == 0 && du[5] == 0))
         return TS_OK;
@@ -1504,21 +1504,28 @@ typedef struct lin_sim {
     long nfev;
 } lin_sim;
 
+/* 1 when a signal of ex drives a tow rotation (tow.roll ...). */
+static int drives_rotation(const ts_excitation *ex)
+{
+    for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
+        ts_axis a = ts_excitation_signal(ex, i)->axis;
+        if (a == TS_AXIS_ROLL || a == TS_AXIS_PITCH || a == TS_AXIS_YAW)
+            return 1;
+    }
+    return 0;
+}
+
 /* v[m] = u(t) - u0: the tow channels from the excitation, the vehicles'
  * inputs (when driven) the signals on them, the frame inputs (under a
  * manoeuvre) the frame's change from the base frame: speed, turn rate
  * and their rates (ts_excitation_frame). */
 static void lin_input(const lin_sim *L, double t, double *v)
 {
+    double u[TS_NINPUT] = {0};
     if (L->ex)
-        ts_excitation_input(L->ex, t, v);
-    else
-        for (int j = 0; j < TS_NINPUT; j++)
-            v[j] = 0.0;
-    for (int j = 0; j < TS_NINPUT; j++)
-        v[j] -= L->lin->u0[j];
-    for (int j = TS_NINPUT; j < L->m; j++)
-        v[j] = 0.0;
+        ts_excitation_input(L->ex, t, u);
+    for (int j = 0; j < L->m; j++)
+        v[j] = j < TS_NINPUT ? u[j] - L->lin->u0[j] : 0.0;
     if (L->in_idx)
         add_inputs(L->ex, L->in_idx, t, v);
     if (L->manoeuvre) {
@@ -1664,14 +1671,25 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
     lin_input(L, t, dv);
     double u[TS_NINPUT];
     for (int j = 0; j < TS_NINPUT; j++)
-        u[j] = dv[j] + lin->u0[j];
+        u[j] = (j < L->m ? dv[j] : 0.0) + lin->u0[j];
     double *pos = h->positions + 3 * nn * i;
     if (o->kinematics == TS_KIN_LINEAR) {
+        /* The tow inputs move every node with the coordinates held:
+         * ts_linear_tow_shift (a rotation by theta x its cable's start). */
         ts_linear_node_displacements(sys, lin, z, dr);
-        for (size_t a = 0; a < nn; a++)
+        for (size_t a = 0; a < nn; a++) {
             for (int c = 0; c < 3; c++)
-                pos[3 * a + c] = lin->r0[3 * a + c] + dr[3 * a + c] +
-                                 (u[c] - lin->u0[c]);
+                pos[3 * a + c] = lin->r0[3 * a + c] + dr[3 * a + c];
+            for (int j = 0; j < 6; j++) {
+                int in = j < 3 ? TS_IN_DISP + j : TS_IN_ROT + j - 3;
+                double d[3];
+                if (in >= L->m || dv[in] == 0)
+                    continue;
+                ts_linear_tow_shift(lin, (int)a, in, d);
+                for (int c = 0; c < 3; c++)
+                    pos[3 * a + c] += d[c] * dv[in];
+            }
+        }
     } else {
         double *ufull = ywork + 2 * n;
         for (int j = 0; j < n; j++)
@@ -1756,8 +1774,11 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     double w0 = tsi_wall_now();
     size_t sn = (size_t)n;
     /* Only the tow channels are driven unless a signal drives a vehicle's
-     * input or the frame (the exponential's order is n + 4 m). */
-    int m = in_idx || manoeuvre ? lin->ninput : TS_NINPUT;
+     * input or the frame (the exponential's order is n + 4 m), and only
+     * the translations' unless a signal drives a rotation. */
+    int m = in_idx || manoeuvre          ? lin->ninput
+            : drives_rotation(ex) ? TS_NINPUT
+                                          : TS_TOW_ROT;
     double *z = calloc(sn, sizeof(double));
     double *tmp = calloc(sn, sizeof(double));
     /* y0 + z, f there, the whole input, and its deviation. */
@@ -1789,7 +1810,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
      * node velocities relative to the tow point that this makes (the jump
      * a node takes less the tow point's), and the rates follow
      * (tsi_desc_from_nodes). */
-    double du[6];
+    double du[TS_NINPUT];
     if (ex && ts_excitation_start_jump(ex, du)) {
         const ts_system *sys = ts_kernel_system(k);
         for (int part = 1; part < 2; part++) {

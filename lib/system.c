@@ -220,6 +220,8 @@ void ts_motion_bound_steady(const ts_system *sys, ts_motion_bound *m)
     m->turn_rate = fabs(sys->tow.turn_rate);
     m->tow_speed = 0.0;
     m->tow_accel = 0.0;
+    m->rot_rate = 0.0;
+    m->rot_accel = 0.0;
 }
 
 /* The load sizes of one part (a link or a body) under the bounds: mass in
@@ -319,11 +321,14 @@ int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
         R += sys->cables[k].length;
     double current = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     /* The flow speed bound and what makes it up, largest named. */
+    /* A tow rotation moves a point at R by its rate times R. */
+    const double tow_speed = m->tow_speed + m->rot_rate * R;
+    const double tow_accel = m->tow_accel + m->rot_accel * R;
     const double flow_part[4] = {m->speed, m->turn_rate * R, current,
-                                 m->tow_speed};
+                                 tow_speed};
     double flow = flow_part[0] + flow_part[1] + flow_part[2] + flow_part[3];
     double acc = m->turn_rate * m->turn_rate * R + m->turn_rate * m->speed +
-                 m->tow_accel;
+                 tow_accel;
     load_worst w = {0.0, 0, -1, -1};
     double total = 0.0; /* bounds every tension */
     for (int l = 0; l < sys->nlinks; l++) {
@@ -375,13 +380,13 @@ int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
                                             "current %.3g m/s",
                                             "tow-point velocity %.3g m/s"};
         int big = 0;
-        double val[4] = {m->speed, m->turn_rate, current, m->tow_speed};
+        double val[4] = {m->speed, m->turn_rate, current, tow_speed};
         for (int i = 1; i < 4; i++)
             if (!(flow_part[i] <= flow_part[big]))
                 big = i;
-        if (w.kind == 3 && !(m->tow_accel <= acc - m->tow_accel))
+        if (w.kind == 3 && !(tow_accel <= acc - tow_accel))
             snprintf(cause, sizeof cause, "tow-point acceleration %.3g "
-                     "m/s^2", m->tow_accel);
+                     "m/s^2", tow_accel);
         else
             snprintf(cause, sizeof cause, what[big], val[big]);
     } else if (w.kind == 1 && !(rho <= 1e100))

@@ -59,7 +59,7 @@ static ts_system *chain(int n, double L, double mu, double ea)
 
 static void test_fastest_mode(void)
 {
-    ts_motion_bound rest = {0, 0, 0, 0};
+    ts_motion_bound rest = {0, 0, 0, 0, 0, 0};
     ts_system *s = chain(8, 3.7, 0.45, 0);
     double l = 3.7 / 8, m = 0.5 * 0.45 * l, T = 0.45 * 3.7 * G;
     double want = 2 * sqrt(T / (m * l)), got = ts_cost_fastest_mode(s, &rest);

@@ -475,7 +475,7 @@ static void test_impulsive_start(const ts_units *u)
     sig.frequency = 0.25;
     sig.phase = 0.7;
     ts_excitation_add(ex, &sig, &err);
-    double du[6];
+    double du[TS_NINPUT];
     ts_excitation_start_jump(ex, du);
     for (int pass = 0; pass < 2; pass++) {
         set_ea(s, pass ? 0.0 : 1e9, 4000.0);

@@ -46,7 +46,7 @@ static void fd_check(const ts_excitation *ex, int axis, double t0, double t1,
     *ev = *ea = 0.0;
     for (int i = 0; i < n; i++) {
         double t = t0 + (t1 - t0) * (i + 0.37) / n;
-        double u[9], up[9], um[9];
+        double u[TS_NINPUT], up[TS_NINPUT], um[TS_NINPUT];
         ts_excitation_input(ex, t, u);
         ts_excitation_input(ex, t + h, up);
         ts_excitation_input(ex, t - h, um);
@@ -82,7 +82,7 @@ static void test_shapes(void)
     s.frequency = 0.8375;
     s.phase = 0.4;
     ts_excitation *ex = one(&s);
-    double u[9], w = 2 * M_PI * s.frequency, t = 2.385;
+    double u[TS_NINPUT], w = 2 * M_PI * s.frequency, t = 2.385;
     ts_excitation_input(ex, t, u);
     CHECK_NEAR(u[2], s.amplitude * sin(w * t + 0.4), 1e-16, "sine x");
     CHECK_NEAR(u[5], s.amplitude * w * cos(w * t + 0.4), 1e-15, "sine v");
@@ -220,7 +220,7 @@ static void test_series(void)
     double ex_, ev = 0, ea = 0;
     ex_ = 0;
     for (int i = 0; i < 97; i++) {
-        double tt = 0.3 + 9.4 * i / 96.0, u[9];
+        double tt = 0.3 + 9.4 * i / 96.0, u[TS_NINPUT];
         ts_excitation_input(ex, tt, u);
         ex_ = fmax(ex_, fabs(u[0] - A * sin(w * tt)));
         ev = fmax(ev, fabs(u[3] - A * w * cos(w * tt)));
@@ -250,7 +250,7 @@ static void test_series(void)
     ex = ts_excitation_alloc(&err);
     int rc = ts_excitation_read_series(ex, TS_AXIS_HEAVE, path, &err);
     CHECK(rc == TS_OK, "CSV with header and comment read");
-    double u[9];
+    double u[TS_NINPUT];
     ts_excitation_input(ex, 1.005, u);
     CHECK_NEAR(u[2], A * sin(w * 1.005), 1e-9, "CSV series value");
     ts_excitation_free(ex);
@@ -465,7 +465,10 @@ static void test_parse(void)
           "a ramp shorter than the default rise gets rise = duration");
 
     struct { const char *spec; int code; const char *want; } bad[] = {
-        {"tow.roll:amplitude=1,frequency=1", TS_EINVAL, "unknown axis 'tow.roll'"},
+        {"tow.spin:amplitude=1,frequency=1", TS_EINVAL, "unknown axis 'tow.spin'"},
+        {"tow.pitch:crank,amplitude=0.1,frequency=1,rod=1", TS_EINVAL, "a rotation takes a sine"},
+        {"tow.pitch:amplitude=0.1,frequency=1,ramp=0", TS_EINVAL, "a rotation starts smoothly"},
+        {"tow.pitch:amplitude=1m,frequency=1", TS_EUNIT, "tow.pitch"},
         {"tow.heave:amplitud=1,frequency=1", TS_EINVAL, "unknown parameter 'amplitud'"},
         {"tow.heave:amplitude=1,frequency=1,rod=2", TS_EINVAL, "'rod' does not apply to type sine"},
         {"tow.heave:amplitude=1,frequency=-1Hz", TS_EINVAL, "frequency must be > 0 Hz, got -1"},
@@ -514,8 +517,12 @@ static void test_sum(void)
     ts_excitation *ex = ts_excitation_alloc(&err);
     /* Three components; sway is not driven. */
     const double w[3] = {0.43, -0.91, 1.7};
-    const double re[9] = {0.3, 0, -0.2, 0.1, 0, 0.05, -0.02, 0, 0.07};
-    const double im[9] = {0.1, 0, 0.4, -0.2, 0, 0.01, 0.03, 0, -0.06};
+    /* TS_SUM_AXES = 6 per component: surge, sway, heave, then the
+     * rotations (none here). */
+    const double re[18] = {0.3, 0, -0.2, 0, 0, 0, 0.1, 0, 0.05, 0, 0, 0,
+                           -0.02, 0, 0.07, 0, 0, 0};
+    const double im[18] = {0.1, 0, 0.4, 0, 0, 0, -0.2, 0, 0.01, 0, 0, 0,
+                           0.03, 0, -0.06, 0, 0, 0};
     int rc = ts_excitation_add_sum(ex, 3, w, re, im, 5.0, &err);
     CHECK(rc == TS_OK && ts_excitation_nsignals(ex) == 2,
           "sum: one signal per driven axis (%d): %s",
@@ -531,12 +538,12 @@ static void test_sum(void)
                            0.01 * 0.01 + 0.07 * 0.07 + 0.06 * 0.06)),
                1e-15, "sum: heave rms sqrt(sum |c|^2 / 2)");
     /* Full amplitude after the fade-in: x = sum Re(c e^(i w t)). */
-    double t = 11.3, u[9];
+    double t = 11.3, u[TS_NINPUT];
     ts_excitation_input(ex, t, u);
     double x0 = 0, x2 = 0;
     for (int k = 0; k < 3; k++) {
-        x0 += re[3 * k] * cos(w[k] * t) - im[3 * k] * sin(w[k] * t);
-        x2 += re[3 * k + 2] * cos(w[k] * t) - im[3 * k + 2] * sin(w[k] * t);
+        x0 += re[6 * k] * cos(w[k] * t) - im[6 * k] * sin(w[k] * t);
+        x2 += re[6 * k + 2] * cos(w[k] * t) - im[6 * k + 2] * sin(w[k] * t);
     }
     CHECK(fabs(u[0] - x0) < 1e-15 && fabs(u[2] - x2) < 1e-15 &&
               u[1] == 0 && u[4] == 0 && u[7] == 0,
@@ -569,7 +576,7 @@ static void test_sum(void)
     ts_excitation_free(ex);
     /* Refusals add nothing. */
     ex = ts_excitation_alloc(&err);
-    const double zero[9] = {0};
+    const double zero[18] = {0};
     const double bad_w[1] = {NAN};
     ts_err e = {0};
     CHECK(ts_excitation_add_sum(ex, 3, w, zero, zero, 0, &e) == TS_EINVAL,
@@ -615,7 +622,7 @@ static void test_sum(void)
     ts_frame base = {0}, fa, fb;
     base.speed = 2;
     for (int i = 0; same && i < 30; i++) {
-        double ua[9], ub[9], t = 0.11 * i;
+        double ua[TS_NINPUT], ub[TS_NINPUT], t = 0.11 * i;
         ts_excitation_input(ex, t, ua);
         ts_excitation_input(cp, t, ub);
         ts_excitation_frame(ex, &base, t, &fa);
@@ -624,7 +631,7 @@ static void test_sum(void)
                fa.turn_accel == fb.turn_accel;
     }
     ts_excitation_free(ex);
-    double uc[9];
+    double uc[TS_NINPUT];
     if (cp)
         ts_excitation_input(cp, 1.3, uc);
     CHECK(same && cp && isfinite(uc[2]), "a copy gives the same inputs and "
@@ -693,7 +700,7 @@ static void test_smooth_start(void)
     s.phase = 0.4;
     s.ramp = 2.3;
     ts_excitation *ex = one(&s);
-    double u[9], w = 2 * M_PI * s.frequency, maxd = 0;
+    double u[TS_NINPUT], w = 2 * M_PI * s.frequency, maxd = 0;
     for (int i = 0; i < 30; i++) {
         double t = 0.1 * i + 0.013, xi = t / 2.3;
         double R = xi >= 1 ? 1 : xi * xi * xi * (10 - 15 * xi + 6 * xi * xi);
@@ -707,7 +714,7 @@ static void test_smooth_start(void)
     fd_check(ex, 2, 0.0, 5.0, 80, 1e-5, &ev, &ea);
     CHECK(ev < 1e-8 && ea < 1e-7, "smooth sine: v, a are the derivatives "
           "through the start (max err %.2g m/s, %.2g m/s^2)", ev, ea);
-    double du[6];
+    double du[TS_NINPUT];
     ts_excitation_input(ex, 0.0, u);
     CHECK(!ts_excitation_start_jump(ex, du) && u[2] == 0 && u[5] == 0 &&
               u[8] == 0,
@@ -766,8 +773,81 @@ static void test_smooth_start(void)
     ts_units_free(units);
 }
 
+/* A rotation of the ship (tow.pitch) as a parsed sine: its angle,
+ * rate and acceleration land in u[TS_TOW_ROT + 1], + 3, + 6, the
+ * translations untouched; it starts smoothly by default (two periods),
+ * its derivatives are the angle's (central differences); a sum drives
+ * the rotation axes from its last three coefficients; the bound counts
+ * it as a rotation. */
+static void test_rotation(void)
+{
+    ts_err err = {0};
+    ts_units *units = ts_units_alloc(&err);
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    int rc = ts_excitation_parse(ex, "tow.pitch:amplitude=2.385deg,"
+                                 "frequency=0.15Hz", units, "--excite", &err);
+    const ts_signal *s = ts_excitation_signal(ex, 0);
+    CHECK(rc == TS_OK && s->axis == TS_AXIS_PITCH &&
+              fabs(s->amplitude - 2.385 * M_PI / 180) < 1e-15 &&
+              fabs(s->ramp - 2 / 0.15) < 1e-12,
+          "tow.pitch parsed in rad with the default smooth start (%s)",
+          err.msg);
+    double u[TS_NINPUT], w = 2 * M_PI * 0.15, A = s->amplitude;
+    ts_excitation_input(ex, 0.0, u);
+    int zero = 1;
+    for (int j = 0; j < TS_NINPUT; j++)
+        zero &= u[j] == 0;
+    CHECK(zero, "tow.pitch at t = 0: at rest (faded in)");
+    ts_excitation_input(ex, 5.0, u);
+    double full = A * sin(w * 5.0);
+    CHECK(fabs(u[TS_TOW_ROT + 1]) < fabs(full) && u[TS_TOW_ROT + 1] != 0,
+          "tow.pitch during the smooth start: less than the sine (%.4g of "
+          "%.4g rad)", u[TS_TOW_ROT + 1], full);
+    double t = 20.0;
+    ts_excitation_input(ex, t, u);
+    int others = 1;
+    for (int j = 0; j < TS_NINPUT; j++)
+        if (j % 3 != 1 || j < TS_TOW_ROT)
+            others &= u[j] == 0;
+    CHECK(fabs(u[TS_TOW_ROT + 1] - A * sin(w * t)) < 1e-15 &&
+              fabs(u[TS_TOW_ROT + 4] - A * w * cos(w * t)) < 1e-15 &&
+              fabs(u[TS_TOW_ROT + 7] + A * w * w * sin(w * t)) < 1e-15 &&
+              others,
+          "tow.pitch after the start: angle, rate and acceleration of the "
+          "sine at u[10], u[13], u[16], nothing else");
+    double ev, ea;
+    fd_check(ex, TS_TOW_ROT + 1, 0.01, 30, 60, 1e-5, &ev, &ea);
+    CHECK(ev < 1e-8 && ea < 1e-8, "tow.pitch: rate and acceleration are "
+          "the derivatives, in the start too (%.2g, %.2g)", ev, ea);
+    int idx;
+    CHECK(ts_excitation_periodic(ex, &idx) && idx == 0,
+          "a rotation sine is the periodic excitation (amplitude ratios)");
+    ts_frame f0 = {0};
+    ts_motion_bound mb;
+    ts_excitation_bound(ex, &f0, &mb);
+    CHECK(mb.tow_speed == 0 && fabs(mb.rot_rate - A * w) < 1e-15 &&
+              fabs(mb.rot_accel - A * w * w) < 1e-15,
+          "bound: a rotation's rate and acceleration, not the tow point's");
+    ts_excitation_free(ex);
+    /* A sum on yaw alone. */
+    ex = ts_excitation_alloc(&err);
+    const double om[1] = {0.7}, re[6] = {0, 0, 0, 0, 0, 0.01},
+                 im[6] = {0, 0, 0, 0, 0, -0.02};
+    rc = ts_excitation_add_sum(ex, 1, om, re, im, 0, &err);
+    ts_excitation_input(ex, 3.0, u);
+    CHECK(rc == TS_OK && ts_excitation_nsignals(ex) == 1 &&
+              ts_excitation_signal(ex, 0)->axis == TS_AXIS_YAW &&
+              fabs(u[TS_TOW_ROT + 2] - (0.01 * cos(2.1) + 0.02 * sin(2.1))) <
+                  1e-15 &&
+              u[2] == 0,
+          "a sum's sixth coefficient drives tow.yaw");
+    ts_excitation_free(ex);
+    ts_units_free(units);
+}
+
 int main(void)
 {
+    test_rotation();
     test_vehicle_inputs();
     test_sum();
     test_shapes();

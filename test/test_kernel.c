@@ -240,7 +240,7 @@ static void test_loads(ts_drag_law law)
     /* Tow point 0.62 m above water, link 55 deg down and 20 deg to port:
      * the link crosses the surface; the sphere sits in it (cap). */
     double y[4] = {17 * M_PI / 180, 20 * M_PI / 180, 0.37, -0.29};
-    double u[9] = {0.013, -0.021, 0.017, 0.11, -0.07, 0.05, 0, 0, 0};
+    double u[TS_NINPUT] = {0.013, -0.021, 0.017, 0.11, -0.07, 0.05, 0, 0, 0};
     double dydt[4];
     int rc = ts_kernel_eval(k, y, u, dydt);
     CHECK(rc == TS_OK, "loads (%s): eval ok", lname);
@@ -420,7 +420,7 @@ static void test_lagrange(gsl_rng *rng, int N)
             y[nq + 2 * i] = qd[i];
         }
         /* Tow-point acceleration (x, z): an extra uniform field. */
-        double u[9] = {0};
+        double u[TS_NINPUT] = {0};
         u[6] = trial ? uniform(rng, -3, 3) : 0;
         u[8] = trial ? uniform(rng, -3, 3) : 0;
         double Gx = -u[6], Gz = e.g - u[8];
@@ -531,7 +531,7 @@ static void test_newton_nodes(gsl_rng *rng)
     int wet_links = 0, dry_links = 0, cut_links = 0;
     for (int trial = 0; trial < 20; trial++) {
         random_state(rng, nl, y, 1.0, 1.5);
-        double u[9];
+        double u[TS_NINPUT] = {0};
         for (int j = 0; j < 9; j++)
             u[j] = uniform(rng, -0.3, 0.3);
         if (ts_kernel_eval(k, y, u, dydt) != TS_OK) {
@@ -754,7 +754,7 @@ static void test_charts(gsl_rng *rng)
     double *r2 = calloc(9 * (size_t)nn, sizeof(double));
     double *m1 = calloc(9 * (size_t)nn, sizeof(double));
     double *m2 = calloc(9 * (size_t)nn, sizeof(double));
-    double u[9] = {0.01, 0.02, -0.03, 0.1, 0.05, -0.2, 0.3, -0.1, 0.2};
+    double u[TS_NINPUT] = {0.01, 0.02, -0.03, 0.1, 0.05, -0.2, 0.3, -0.1, 0.2};
 
     for (int trial = 0; trial < 5; trial++) {
         ts_kernel *kc = ts_kernel_alloc(s, NULL);

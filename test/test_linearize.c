@@ -322,7 +322,12 @@ static void test_kinks(void)
     CHECK(strcmp(ts_input_name(2), "tow.heave") == 0 &&
               strcmp(ts_input_name(0), "tow.surge") == 0 &&
               strcmp(ts_input_name(8), "tow.heave_acceleration") == 0 &&
-              ts_input_name(9) == NULL && ts_input_name(-1) == NULL,
+              strcmp(ts_input_name(TS_IN_ROT + 1), "tow.pitch") == 0 &&
+              strcmp(ts_input_name(TS_IN_ROT_VEL + 1),
+                     "tow.pitch_velocity") == 0 &&
+              strcmp(ts_input_name(TS_IN_ROT_ACC + 2),
+                     "tow.yaw_acceleration") == 0 &&
+              ts_input_name(TS_NINPUT) == NULL && ts_input_name(-1) == NULL,
           "input names");
 }
 

@@ -537,9 +537,13 @@ static void test_names(void)
     rc = ts_response_input_find("tow.heave", &in, &err);
     CHECK(rc == TS_OK && in == 2, "tow.heave is channel 2");
     rc = ts_response_input_find("sphere.z", &in, &err);
-    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow.surge, tow.sway or "
-                                             "tow.heave"),
+    CHECK(rc == TS_EINVAL && strstr(err.msg, "tow.surge, tow.sway, "
+                                             "tow.heave") &&
+              strstr(err.msg, "tow.roll, tow.pitch, tow.yaw"),
           "bad input refused: %s", err.msg);
+    rc = ts_response_input_find("tow.pitch", &in, &err);
+    CHECK(rc == TS_OK && in == TS_IN_ROT + 1, "tow.pitch is channel %d",
+          TS_IN_ROT + 1);
 
     double f[4];
     rc = ts_response_logspace(0.01, 10, 4, f, &err);

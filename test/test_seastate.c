@@ -595,7 +595,7 @@ static void test_realisation(setup *s)
     ts_seaway_excitation(&w, &r, c, NULL, &err);
     int same = 1, differ = 0;
     for (int i = 0; i < 50; i++) {
-        double ua[9], ub[9], uc[9];
+        double ua[TS_NINPUT], ub[TS_NINPUT], uc[TS_NINPUT];
         ts_excitation_input(a, 20 + i * 1.3, ua);
         ts_excitation_input(b, 20 + i * 1.3, ub);
         ts_excitation_input(c, 20 + i * 1.3, uc);
@@ -625,7 +625,7 @@ static void test_realisation(setup *s)
         ts_excitation *ex = ts_excitation_alloc(&err);
         ts_seaway_excitation(&w, &r, ex, NULL, &err);
         for (int i = 0; i < n; i++) {
-            double u[9];
+            double u[TS_NINPUT];
             ts_excitation_input(ex, i * dt, u);
             x[i] = u[2];
         }

@@ -1,5 +1,5 @@
 /* test_surface.c: the towing vehicle as a surface ship of 3 degrees of
- * freedom (doc/towing-vehicle.md section 6; lib/kernel.c, towing_vehicle
+ * freedom (doc/towing-vehicle.md section 7; lib/kernel.c, towing_vehicle
  * dof: 3), on test/scenes/survey_ship.yaml and variants of it.
  *
  *  1. Energy: the ship (no thrust) pulling its cable and sphere in vacuum
@@ -26,7 +26,7 @@
  *     Newton's steady turn (tensions, speed, yaw, turn rate); and turn_by
  *     rudder at that turn rate gives the rudder back.
  *  6. Wave-induced motion of the tow point (the tow-point inputs with a
- *     towing vehicle, doc/towing-vehicle.md section 7): with the ship's
+ *     towing vehicle, doc/towing-vehicle.md section 8): with the ship's
  *     mass and inertias 1e3 and 1e4 times, the depressor's response to
  *     tow.heave, tow.surge and tow.sway is the prescribed tow's at the
  *     ship's speed, the distance falling like 1 / mass.
@@ -34,7 +34,31 @@
  *     and x' = A x + B u under a sine heave of 0.4 and 0.2 m at 0.02 Hz
  *     (one period, 50 s, from the trim) differ by the square of the
  *     amplitude.
+ *  8. The ship's rotations (tow.roll, tow.pitch, tow.yaw): a small
+ *     rotation theta about e moves the cable's start point r (from the
+ *     ship's origin) by theta e x r, so each of the rotations' columns of
+ *     B (displacement, rate, acceleration) is the combination (e x r) of
+ *     the translations' columns, to the differencing error; the
+ *     depressor's pitch gain is r_z surge - r_x heave; roll and yaw of a
+ *     ship whose tow point is on its centreline move it sideways only:
+ *     the vertical plane does not respond (symmetry), and the sideways
+ *     response is -r_z and r_x times the sway's.
+ *  9. Linear against nonlinear for a pitching ship with two cables, one
+ *     from its tow point and one from a point 4 m forward of it, 2 m to
+ *     starboard, 1.5 m below the waterline (below it so that no node of
+ *     its light cable sits on the waterline, where the submerged fraction
+ *     is kinked and the difference would be first order): a pitch sine of
+ *     0.02 and 0.01 rad at 0.05 Hz, the second sphere's depth, second
+ *     order in the amplitude.
+ * 10. A sea with a pure-pitch RAO on that two-cable ship, referred to the
+ *     ship's origin: the spectral gain of the second sphere's depth is
+ *     the tow.pitch input's gain times the RAO at every grid point (the
+ *     RAO's rotation turns each cable's start about the origin), unlike
+ *     one translation of the tow point; a realisation drives tow.pitch.
+ * 11. A prescribed tow point p: a rotation about M's origin is the
+ *     translation theta x p, in the dense and the sparse model.
  */
+#include <complex.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,6 +71,7 @@
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
 #include "towstab/response.h"
+#include "towstab/seastate.h"
 
 #define SHIP "test/scenes/survey_ship.yaml"
 
@@ -596,22 +621,24 @@ static void test_heavy_motion(void)
 
 /* ---- 7. linear against nonlinear: a slow heave --------------------------- */
 
-/* The kernel (lin NULL) or the linear model x' = A x + B u under a heave
- * of amplitude a at om rad/s; u[ninput] holds the input of the last
- * evaluation. */
+/* The kernel (lin NULL) or the linear model x' = A x + B u under a sine
+ * of amplitude a at om rad/s on tow input `axis` (its displacement's
+ * index: 2 heave, TS_IN_ROT + 1 pitch); u[ninput] holds the input of the
+ * last evaluation. */
 typedef struct heave_run {
     ts_kernel *k;
     const ts_linear *lin;
     double a, om;
     double *u;
+    int axis;
 } heave_run;
 
 static void heave_rhs(heave_run *h, double t, const double *x, double *out)
 {
     double *u = h->u, a = h->a, om = h->om;
-    u[2] = a * sin(om * t);
-    u[5] = a * om * cos(om * t);
-    u[8] = -a * om * om * sin(om * t);
+    u[h->axis] = a * sin(om * t);
+    u[h->axis + 3] = a * om * cos(om * t);
+    u[h->axis + 6] = -a * om * om * sin(om * t);
     if (!h->lin) {
         ts_kernel_eval(h->k, x, u, out);
         return;
@@ -674,7 +701,7 @@ static void test_heave_linear(void)
         memcpy(y, y0, (size_t)n * sizeof(double));
         memset(x, 0, (size_t)n * sizeof(double));
         /* 50 s: one period of the heave; the depressor's depth. */
-        heave_run hn = {k, NULL, a, om, u}, hl = {k, lin, a, om, u};
+        heave_run hn = {k, NULL, a, om, u, 2}, hl = {k, lin, a, om, u, 2};
         for (int i = 0; i < 2500; i++) {
             double t = i * dt;
             heave_step(&hn, t, dt, y, w);
@@ -714,6 +741,413 @@ static void test_heave_linear(void)
     ts_scene_free(sc);
 }
 
+/* ---- 8. the rotations' columns and gains --------------------------------- */
+
+/* A scene's trim, linearized (dense), and the start point r (M axes,
+ * from the ship's origin) of its first cable: R times the ship's attach
+ * point. */
+typedef struct trim {
+    ts_scene *sc;
+    ts_kernel *k;
+    ts_equilibrium *eq;
+    ts_linear *lin;
+    double r[3];
+} trim;
+
+static void trim_free(trim *c)
+{
+    ts_linear_free(c->lin);
+    ts_equilibrium_free(c->eq);
+    ts_kernel_free(c->k);
+    ts_scene_free(c->sc);
+}
+
+/* Solve and linearize sc (owned by c from here); 0 with a check that
+ * failed (c freed). */
+static int trim_open(trim *c, ts_scene *sc, const char *what)
+{
+    memset(c, 0, sizeof *c);
+    c->sc = sc;
+    if (!sc)
+        return 0;
+    c->eq = solve(sc->system, &c->k);
+    ts_err err = {0};
+    const ts_system *s = sc->system;
+    if (c->eq && c->eq->converged) {
+        double *y = calloc((size_t)ts_kernel_nstate(c->k), sizeof(double));
+        double R[9];
+        ts_equilibrium_state(c->k, c->eq, y, NULL);
+        ts_kernel_get_vehicle(c->k, ts_kernel_root(c->k), y, R, NULL);
+        const double *p = s->bodies[s->tow.vehicle].vehicle->attach;
+        for (int i = 0; i < 3; i++)
+            c->r[i] = R[3 * i] * p[0] + R[3 * i + 1] * p[1] +
+                      R[3 * i + 2] * p[2];
+        free(y);
+        ts_linearize_opts lo;
+        ts_linearize_opts_default(&lo);
+        lo.model = TS_LIN_DENSE;
+        c->lin = ts_linear_alloc(c->k, &err);
+        if (c->lin &&
+            ts_linearize_equilibrium(c->k, c->eq, &lo, c->lin, &err)) {
+            printf("linearize: %s\n", err.msg);
+            ts_linear_free(c->lin);
+            c->lin = NULL;
+        }
+    }
+    CHECK(c->lin != NULL, "%s linearized", what);
+    if (!c->lin)
+        trim_free(c);
+    return c->lin != NULL;
+}
+
+static void test_rotation_columns(void)
+{
+    trim c;
+    if (!trim_open(&c, ship_six_links(), "the ship"))
+        return;
+    ts_kernel *k = c.k;
+    const ts_linear *lin = c.lin;
+    const ts_scene *sc = c.sc;
+    const double *r = c.r;
+    int n = lin->nstate, nq = lin->nq, nr = n - nq;
+    /* Column j of B's lower part, its error estimate. */
+#define BCOL(j) (lin->B + (size_t)(j) * n + nq)
+#define BERR(j) (lin->Berr + (size_t)(j) * nr)
+    /* Each rotation column against (e_a x r) . the translation columns
+     * of the same order: the difference within ten times the error
+     * estimates of the columns combined (central differences: their
+     * truncation estimates, and the rounding noise of f over each
+     * column's step, fnoise / (sqrt 2 h): doc/linear.md). */
+    double worst = 0, big = 0;
+    for (int a = 0; a < 3; a++) {
+        double e[3] = {0, 0, 0}, c[3];
+        e[a] = 1;
+        c[0] = e[1] * r[2] - e[2] * r[1];
+        c[1] = e[2] * r[0] - e[0] * r[2];
+        c[2] = e[0] * r[1] - e[1] * r[0];
+        for (int q = 0; q < 3; q++) {
+            int jr = TS_IN_ROT + 3 * q + a, jt = 3 * q;
+            for (int i = 0; i < nr; i++) {
+                double nz = lin->fnoise ? lin->fnoise[i] / sqrt(2.0) : 0;
+                double comb = 0, allow = fabs(BERR(jr)[i]) +
+                                         nz / lin->h[n + jr];
+                for (int m = 0; m < 3; m++) {
+                    comb += c[m] * BCOL(jt + m)[i];
+                    allow += fabs(c[m]) * (fabs(BERR(jt + m)[i]) +
+                                           nz / lin->h[n + jt + m]);
+                }
+                double d = fabs(BCOL(jr)[i] - comb);
+                big = fmax(big, fabs(comb));
+                allow *= 10;
+                if (d > 0)
+                    worst = fmax(worst, d / allow);
+            }
+        }
+    }
+    printf("rotations' columns of B against (e x r) . translations' (r = "
+           "%.3f, %.3f, %.3f m): largest difference %.3g of the allowance "
+           "(largest entry %.3g)\n", r[0], r[1], r[2], worst, big);
+    CHECK(worst <= 1 && big > 0, "B: every rotation column is (e x r) . "
+          "the translation columns within the differencing error (%.3g of "
+          "the allowance)", worst);
+#undef BCOL
+#undef BERR
+
+    /* Gains: pitch = r_z surge - r_x heave; roll = -r_z sway and yaw =
+     * r_x sway (r_y = 0: on the centreline); roll and yaw leave the
+     * vertical plane at rest. */
+    const double freq[3] = {0.01, 0.1, 0.4};
+    const char *outs[2] = {"depressor.z", "depressor.y"};
+    double dp = 0, dry = 0, plane = 0, scale = 0;
+    ts_err err = {0};
+    for (int o = 0; o < 2; o++) {
+        ts_output out;
+        if (ts_response_output_lookup(k, outs[o], &out, &err)) {
+            CHECK(0, "output %s: %s", outs[o], err.msg);
+            continue;
+        }
+        for (int i = 0; i < 3; i++) {
+            double w = 2 * M_PI * freq[i], g[6][2];
+            for (int a = 0; a < 6; a++)
+                ts_response_at(sc->system, lin,
+                               a < 3 ? a : TS_IN_ROT + a - 3, &out, w,
+                               &g[a][0], &g[a][1], &err);
+            for (int c = 0; c < 2; c++) {
+                scale = fmax(scale, fabs(g[o ? 1 : 2][c]));
+                if (o == 0) {
+                    dp = fmax(dp, fabs(g[4][c] - (r[2] * g[0][c] -
+                                                  r[0] * g[2][c])));
+                    plane = fmax(plane, fmax(fabs(g[3][c]), fabs(g[5][c])));
+                } else {
+                    dry = fmax(dry, fmax(fabs(g[3][c] + r[2] * g[1][c]),
+                                         fabs(g[5][c] - r[0] * g[1][c])));
+                }
+            }
+        }
+    }
+    printf("gains at 0.01, 0.1, 0.4 Hz: pitch less r_z surge - r_x heave "
+           "%.3g; roll, yaw less -r_z, r_x sway %.3g; roll and yaw in the "
+           "vertical plane %.3g (largest translation gain %.3g)\n", dp, dry,
+           plane, scale);
+    /* The gains of a column combination are the combination of the
+     * gains to the columns' error (checked above): 1e-6 of the largest
+     * gain; the vertical plane's to the rounding of a symmetric trim. */
+    CHECK(dp <= 1e-6 * scale && dry <= 1e-6 * scale,
+          "pitch gain = r_z surge - r_x heave, roll = -r_z sway, yaw = "
+          "r_x sway (%.3g, %.3g of %.3g)", dp, dry, scale);
+    CHECK(plane <= 1e-9 * scale, "roll and yaw do not move the depressor "
+          "up or down (symmetry: %.3g)", plane);
+    trim_free(&c);
+}
+
+/* ---- 9. two cables: linear against nonlinear under pitch ------------------ */
+
+/* The ship on 6 links with a second cable from a point forward of the
+ * tow point, to starboard and below the waterline, and a second sphere. */
+static ts_scene *ship_two_cables(void)
+{
+    static const char *const two[] = {
+        "    links: 6",
+        "bodies:>  - name: cable2\n"
+        "    from: ship\n"
+        "    at: [-8 m, 2 m, 1.5 m]\n"
+        "    to: fish\n"
+        "    length: 60 m\n"
+        "    diameter: 0.0173 m\n"
+        "    weight: 9.6 N/m\n"
+        "    links: 6\n"
+        "bodies:\n"
+        "  - name: fish\n"
+        "    type: sphere\n"
+        "    diameter: 0.5 m\n"
+        "    wet_weight: 3000 N",
+        NULL};
+    ts_scene *s = ship_variant(two);
+    CHECK(s != NULL, "the ship with two cables parses");
+    return s;
+}
+
+static void test_pitch_linear(void)
+{
+    trim c;
+    if (!trim_open(&c, ship_two_cables(), "the two-cable ship"))
+        return;
+    ts_kernel *k = c.k;
+    const ts_linear *lin = c.lin;
+    const ts_equilibrium *eq = c.eq;
+    const ts_system *s = c.sc->system;
+    int fish = -1;
+    for (int i = 0; i < s->nnodes; i++)
+        if (s->nodes[i].body >= 0 &&
+            !strcmp(s->bodies[s->nodes[i].body].name, "fish"))
+            fish = i;
+    int n = ts_kernel_nstate(k), nin = ts_kernel_ninput(k);
+    double *y = calloc((size_t)n, sizeof(double));
+    double *x = calloc((size_t)n, sizeof(double));
+    double *u = calloc((size_t)nin, sizeof(double));
+    double *w = malloc(5 * (size_t)n * sizeof(double));
+    double *f = malloc((size_t)n * sizeof(double));
+    double *dr = malloc(3 * (size_t)s->nnodes * sizeof(double));
+    double diff[2] = {0, 0}, resp[2] = {0, 0}, dt = 0.02;
+    double om = 2 * M_PI * 0.05, shift[3];
+    int pitch = TS_IN_ROT + 1;
+    for (int c = 0; lin && fish > 0 && c < 2; c++) {
+        double a = c ? 0.01 : 0.02;
+        ts_equilibrium_state(k, eq, y, NULL);
+        memset(x, 0, (size_t)n * sizeof(double));
+        heave_run hn = {k, NULL, a, om, u, pitch}, hl = {k, lin, a, om, u,
+                                                        pitch};
+        /* 20 s: one period of the pitch. */
+        for (int i = 0; i < 1000; i++) {
+            double t = i * dt;
+            heave_step(&hn, t, dt, y, w);
+            heave_step(&hl, t, dt, x, w);
+            ts_kernel_eval(k, y, u, f);
+            const double *z = ts_kernel_positions(k);
+            ts_linear_node_displacements(s, lin, x, dr);
+            ts_linear_tow_shift(lin, fish, pitch, shift);
+            double zl = dr[3 * fish + 2] + shift[2] * u[pitch];
+            double zn = z[3 * fish + 2] - eq->positions[3 * fish + 2];
+            diff[c] = fmax(diff[c], fabs(zn - zl));
+            resp[c] = fmax(resp[c], fabs(zl));
+        }
+    }
+    printf("tow.pitch 0.02 and 0.01 rad at 0.05 Hz, two cables: the second "
+           "sphere's depth linear less nonlinear %.3g and %.3g m of "
+           "responses %.3g and %.3g m\n", diff[0], diff[1], resp[0],
+           resp[1]);
+    CHECK(fish > 0 && diff[0] / diff[1] > 3.5 && diff[0] / diff[1] < 4.5 &&
+              diff[0] < 0.02 * resp[0],
+          "pitch: linear and nonlinear agree to second order in the "
+          "amplitude (ratio %.3g)", diff[0] / diff[1]);
+    free(y);
+    free(x);
+    free(u);
+    free(w);
+    free(f);
+    free(dr);
+    trim_free(&c);
+}
+
+/* ---- 10. a ship's RAOs feed its rotations -------------------------------- */
+
+static void test_rao_rotation(void)
+{
+    trim c;
+    if (!trim_open(&c, ship_two_cables(), "the two-cable ship (sea)"))
+        return;
+    const ts_system *s = c.sc->system;
+    ts_err err = {0};
+    /* A pure-pitch RAO, one heading (head seas): the wave slope with a
+     * lead, in long waves. */
+    enum { NF = 24 };
+    double w[NF], hd[1] = {M_PI};
+    for (int k = 0; k < NF; k++)
+        w[k] = 0.3 + k * (2.0 - 0.3) / (NF - 1);
+    ts_rao *rao = ts_rao_alloc(1, hd, NF, w, &err);
+    for (int k = 0; rao && k < NF; k++)
+        ts_rao_set(rao, TS_DOF_PITCH, 0, k,
+                   w[k] * w[k] / 9.80665 / (1 + w[k] * w[k]), 1.1 + 0.3 * w[k],
+                   &err);
+    if (rao)
+        ts_rao_finish(rao, &err);
+    ts_sea *sea = ts_sea_jonswap(1.5, 7.0, 3.3, M_PI, &err);
+    /* The reference point: the ship's origin at its trim, from the
+     * kernel (r_A less R times the attach point), so that the RAOs'
+     * translation there is zero and the rotation is all. */
+    double *y = calloc((size_t)ts_kernel_nstate(c.k), sizeof(double));
+    double R[9], ref[3];
+    ts_equilibrium_state(c.k, c.eq, y, NULL);
+    ts_kernel_get_vehicle(c.k, ts_kernel_root(c.k), y, R, NULL);
+    const double *p = s->bodies[s->tow.vehicle].vehicle->attach;
+    for (int i = 0; i < 3; i++)
+        ref[i] = c.eq->positions[i] - (R[3 * i] * p[0] + R[3 * i + 1] * p[1] +
+                                       R[3 * i + 2] * p[2]);
+    ts_seaway way;
+    ts_seastate_opts so;
+    ts_seastate_opts_default(&so);
+    so.intervals = 32;
+    ts_output out;
+    ts_seastate *st = NULL;
+    int rc = rao && sea ? ts_seaway_init(&way, s, sea, rao, ref, &err)
+                        : TS_ENOMEM;
+    if (rc == TS_OK)
+        rc = ts_response_output_lookup(c.k, "fish.z", &out, &err);
+    if (rc == TS_OK)
+        rc = ts_seastate_compute(s, c.lin, &way, &out, &so, &st, &err);
+    CHECK(rc == TS_OK && way.rotations && st->ninputs == 6,
+          "a towing ship's sea drives its translations and rotations (%s)",
+          rc ? err.msg : "ok");
+    /* Against the pitch input's gain times the RAO at every grid point,
+     * and against one translation of the tow point (the start of the
+     * first cable, theta x r_A), which the second cable does not see. */
+    double dmax = 0, gmax = 0, dold = 0;
+    for (int i = 0; rc == TS_OK && i < st->npoints; i++) {
+        double xr[TS_NDOF], xi[TS_NDOF], h[2], t[3][2];
+        ts_rao_eval(rao, M_PI, st->omega[i], xr, xi, &err);
+        double complex th = xr[TS_DOF_PITCH] + I * xi[TS_DOF_PITCH];
+        double we = st->omega_e[i];
+        ts_response_at(s, c.lin, TS_IN_ROT + 1, &out, we, &h[0], &h[1], &err);
+        for (int a = 0; a < 3; a++)
+            ts_response_at(s, c.lin, a, &out, we, &t[a][0], &t[a][1], &err);
+        double complex g = st->gain_re[i] + I * st->gain_im[i];
+        double complex want = (h[0] + I * h[1]) * th;
+        /* theta_y e_y x r = (r_z, 0, -r_x) theta_y */
+        double complex old = ((t[0][0] + I * t[0][1]) * c.r[2] -
+                              (t[2][0] + I * t[2][1]) * c.r[0]) * th;
+        dmax = fmax(dmax, cabs(g - want));
+        dold = fmax(dold, cabs(g - old));
+        gmax = fmax(gmax, cabs(want));
+    }
+    printf("pure-pitch RAO, two cables: the second sphere's gain per m of "
+           "wave less the pitch input's gain times the RAO %.3g of %.3g; "
+           "less one translation of the tow point %.3g\n", dmax, gmax, dold);
+    /* The same gains, summed in another order: rounding (1e-12), and the
+     * origin's translation, theta x (the origin from the linearization
+     * less the kernel's), rounding too. */
+    CHECK(rc == TS_OK && dmax <= 1e-10 * gmax && gmax > 0,
+          "sea: the rotation RAO is the pitch input (%.3g of %.3g)", dmax,
+          gmax);
+    CHECK(rc == TS_OK && dold > 0.05 * gmax,
+          "sea: not one translation of the tow point (that would differ by "
+          "%.3g of %.3g)", dold, gmax);
+    /* A realisation drives tow.pitch. */
+    ts_excitation *ex = ts_excitation_alloc(&err);
+    ts_sea_realisation real;
+    ts_seaway_set_trim(&way, c.k, y);
+    ts_sea_realisation_default(&way, &real);
+    real.components = 16;
+    int pitch = 0;
+    if (ex && ts_seaway_excitation(&way, &real, ex, NULL, &err) == TS_OK)
+        for (int i = 0; i < ts_excitation_nsignals(ex); i++)
+            pitch |= ts_excitation_signal(ex, i)->axis == TS_AXIS_PITCH;
+    CHECK(pitch, "a realisation of that sea drives tow.pitch");
+    ts_excitation_free(ex);
+    free(y);
+    ts_seastate_free(st);
+    ts_sea_free(sea);
+    ts_rao_free(rao);
+    trim_free(&c);
+}
+
+/* ---- 11. a prescribed tow point's rotations --------------------------- */
+
+/* The ship's rotation about M's origin moves a prescribed tow point p by
+ * theta x p: on examples/survey_tow_sea.yaml (p = (0, 0, -5) m) the
+ * fish's depth per rad of tow.pitch is -5 times its gain per m of
+ * tow.surge, per rad of tow.roll 5 times that per m of tow.sway, in the
+ * dense model (the columns differenced at their own steps: 1e-6) and the
+ * sparse one (the tow point's displacement e x p itself: rounding). */
+static void test_prescribed_rotation(void)
+{
+    ts_scene *sc = tscene_load(units, "examples/survey_tow_sea.yaml");
+    if (!sc)
+        return;
+    const ts_system *s = sc->system;
+    ts_err err = {0};
+    ts_kernel *k;
+    ts_equilibrium *eq = solve(s, &k);
+    const double *p = s->tow.point;
+    for (int m = 0; m < 2; m++) {
+        ts_linearize_opts lo;
+        ts_linearize_opts_default(&lo);
+        lo.model = m ? TS_LIN_SPARSE : TS_LIN_DENSE;
+        ts_linear *lin = ts_linear_alloc(k, &err);
+        ts_output out;
+        int rc = lin && eq && eq->converged
+                     ? ts_linearize_equilibrium(k, eq, &lo, lin, &err)
+                     : TS_ECONV;
+        if (!rc)
+            rc = ts_response_output_lookup(k, "fish.z", &out, &err);
+        double d = 0, big = 0;
+        for (int i = 0; !rc && i < 3; i++) {
+            double w = 2 * M_PI * (0.02 + 0.1 * i), g[4][2];
+            const int in[4] = {TS_IN_DISP, TS_IN_DISP + 1, TS_IN_ROT + 1,
+                               TS_IN_ROT};
+            for (int j = 0; !rc && j < 4; j++)
+                rc = ts_response_at(s, lin, in[j], &out, w, &g[j][0],
+                                    &g[j][1], &err);
+            for (int c = 0; !rc && c < 2; c++) {
+                /* e_y x p = (p_z, 0, -p_x), e_x x p = (0, -p_z, p_y) */
+                d = fmax(d, fabs(g[2][c] - p[2] * g[0][c]));
+                d = fmax(d, fabs(g[3][c] + p[2] * g[1][c]));
+                big = fmax(big, fabs(p[2] * g[0][c]));
+            }
+        }
+        printf("prescribed tow point (%s): fish.z per rad of tow.pitch less "
+               "p_z tow.surge's, of tow.roll less -p_z tow.sway's: %.3g of "
+               "%.3g\n", m ? "sparse" : "dense", d, big);
+        CHECK(rc == TS_OK && big > 0 && d <= (m ? 1e-12 : 1e-6) * big,
+              "prescribed tow point, %s model: a rotation is the translation "
+              "theta x p (%.3g of %.3g) %s", m ? "sparse" : "dense", d, big,
+              rc ? err.msg : "");
+        ts_linear_free(lin);
+    }
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     units = tscene_units();
@@ -728,6 +1162,10 @@ int main(void)
     test_turn();
     test_heavy_motion();
     test_heave_linear();
+    test_rotation_columns();
+    test_pitch_linear();
+    test_rao_rotation();
+    test_prescribed_rotation();
     free(ship_text);
     ts_units_free(units);
     return tc_done();

@@ -274,7 +274,7 @@ static void cmp_cell(const char *fmt, double v)
 
 static void print_compare(const ts_compare *c, const ts_display *d)
 {
-    char u[64], ru[80], label[128], eu[64];
+    char u[64], ru[160], label[192], eu[64];
     double k = ts_display_convert(d, c->output.si_unit, 1.0, u, sizeof u);
     char gain[16];
     snprintf(gain, sizeof gain, "%s/m", c->output.si_unit);
@@ -282,6 +282,16 @@ static void print_compare(const ts_compare *c, const ts_display *d)
                                           ? "m/m" : gain,
                                    1.0, ru, sizeof ru);
     double ke = ts_display_convert(d, "m", 1.0, eu, sizeof eu);
+    /* A rotation of the ship: its amplitude an angle, the ratio the
+     * output per angle. */
+    int rot = c->exc_axis == TS_AXIS_ROLL || c->exc_axis == TS_AXIS_PITCH ||
+              c->exc_axis == TS_AXIS_YAW;
+    if (rot) {
+        snprintf(eu, sizeof eu, "%s", ts_display_unit(d, TS_QTY_ANGLE));
+        ke = ts_display_value(d, TS_QTY_ANGLE, 1.0);
+        kr = k / ke;
+        snprintf(ru, sizeof ru, "%s/%s", u, eu);
+    }
     const char *tu = ts_display_unit(d, TS_QTY_TIME);
     printf("\ncomparison of %s over t = %.6g .. %.6g %s (%d samples; the "
            "transient before is discarded)\n",
@@ -315,7 +325,7 @@ static void print_compare(const ts_compare *c, const ts_display *d)
            "nonlinear)\n", c->mean_difference_pct);
     if (!isfinite(c->rms_difference_ratio))
         printf("rms difference %.6g %s\n", k * c->rms_difference, u);
-    else if (!strcmp(c->output.si_unit, "m"))
+    else if (!strcmp(c->output.si_unit, "m") && !rot)
         printf("rms difference %.6g %s (%.4g %% of the excitation "
                "amplitude)\n", k * c->rms_difference, u,
                100 * c->rms_difference_ratio);
@@ -340,24 +350,25 @@ static int nearest_sample(const ts_history *h, double t)
 }
 
 /* Time histories: the output (nonlinear solid, linear dashed), the
- * tow-point displacement on every excited tow axis, and the force on the
- * tow point (the top tension; nonlinear run). */
+ * tow-point displacement on every excited tow axis, the ship's rotation
+ * on every excited rotation axis, and the force on the tow point (the top
+ * tension; nonlinear run). */
 static int plot_histories(const ts_system *sys, const ts_output *out,
                           const ts_excitation *ex, const ts_history *hn,
                           const ts_history *hl, const cli_plot *plot)
 {
     const ts_history *hf = hn ? hn : hl;
     int n = hf->nsamples;
-    double *buf = malloc(7 * (size_t)(n > 0 ? n : 1) * sizeof(double));
+    double *buf = malloc(10 * (size_t)(n > 0 ? n : 1) * sizeof(double));
     if (!buf) {
         fprintf(stderr, "towstab: error: simulate: --plot: out of memory\n");
         return EXIT_FAILED;
     }
     double *xn = buf, *xl = buf + n, *tens = buf + 2 * n, *tow = buf + 3 * n;
-    ts_plot_axis panels[3];
-    ts_plot_series ser[6];
+    ts_plot_axis panels[4];
+    ts_plot_series ser[9];
     int np = 0, ns = 0;
-    char outlabel[160], towlabel[3][64];
+    char outlabel[160], towlabel[6][64];
     snprintf(outlabel, sizeof outlabel, "%s", out->name);
     panels[np].label = outlabel;
     panels[np].quantity = out->kind == TS_OUT_STRAIN ? TS_PLOT_NONE
@@ -378,30 +389,38 @@ static int plot_histories(const ts_system *sys, const ts_output *out,
         ser[ns++] = a;
     }
     np++;
-    /* Tow axes some signal drives. */
-    int used[3] = {0, 0, 0}, nused = 0;
+    /* Tow axes some signal drives: the translations (k 0..2), then the
+     * rotations (3..5, their axis TS_AXIS_ROLL + k - 3), a panel each. */
+    int used[6] = {0}, nused[2] = {0, 0};
     for (int i = 0; ex && i < ts_excitation_nsignals(ex); i++) {
         ts_axis ax = ts_excitation_signal(ex, i)->axis;
-        if (ax <= TS_AXIS_HEAVE && !used[ax]) {
-            used[ax] = 1;
-            nused++;
+        int k = ax <= TS_AXIS_HEAVE ? (int)ax
+                : ax >= TS_AXIS_ROLL && ax <= TS_AXIS_YAW
+                    ? 3 + (int)(ax - TS_AXIS_ROLL)
+                    : -1;
+        if (k >= 0 && !used[k]) {
+            used[k] = 1;
+            nused[k / 3]++;
         }
     }
-    if (nused > 0) {
-        panels[np].label = "tow point";
-        panels[np].quantity = TS_PLOT_LENGTH;
-        for (int ax = 0, k = 0; ax < 3; ax++) {
-            if (!used[ax])
+    for (int g = 0, m = 0; g < 2; g++) {
+        if (nused[g] == 0)
+            continue;
+        panels[np].label = g ? "ship rotation" : "tow point";
+        panels[np].quantity = g ? TS_PLOT_ANGLE : TS_PLOT_LENGTH;
+        for (int k = 3 * g; k < 3 * g + 3; k++) {
+            if (!used[k])
                 continue;
-            double *d = tow + (size_t)k * n;
+            int ax = k < 3 ? k : TS_AXIS_ROLL + k - 3;
+            double *d = tow + (size_t)m * n;
             for (int i = 0; i < n; i++)
                 d[i] = hf->input[TS_NINPUT * (size_t)i + (size_t)ax];
-            snprintf(towlabel[k], sizeof towlabel[k], "%s",
+            snprintf(towlabel[m], sizeof towlabel[m], "%s",
                      ts_axis_name((ts_axis)ax));
-            ts_plot_series a = {n, hf->t, d, towlabel[k], np, TS_PLOT_SOLID,
-                                3 + k, NULL};
+            ts_plot_series a = {n, hf->t, d, towlabel[m], np, TS_PLOT_SOLID,
+                                3 + m, NULL};
             ser[ns++] = a;
-            k++;
+            m++;
         }
         np++;
     }

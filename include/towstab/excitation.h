@@ -4,9 +4,12 @@
  * An excitation is a list of signals. A signal drives one axis:
  *  - a tow-point axis (surge x, sway y, heave z of the mean ship frame M):
  *    the signal is the tow point's displacement from its nominal position
- *    (m); the kernel's input u[TS_NINPUT] (displacement, velocity,
- *    acceleration, each x, y, z) is the sum of the signals on each axis with
- *    their analytic first and second time derivatives;
+ *    (m); or a rotation axis (roll, pitch, yaw: a small rotation of the
+ *    ship about x, y, z of M, rad, which moves a cable start point r by
+ *    theta x r, towstab/kernel.h); the kernel's tow inputs u[TS_NINPUT]
+ *    (displacement, velocity, acceleration, each x, y, z, then the same
+ *    of the rotation) are the sum of the signals on each axis with their
+ *    analytic first and second time derivatives;
  *  - a manoeuvre axis (the speed V of M, or its turn rate Omega): the
  *    signal is the change of V (m/s) or Omega (rad/s) from the base frame,
  *    and the frame of time t carries the matching speed_rate / turn_accel
@@ -81,8 +84,18 @@ typedef enum {
     TS_AXIS_HEAVE = 2,     /* tow point, z of M (down) */
     TS_AXIS_SPEED = 3,     /* speed V of M */
     TS_AXIS_TURN_RATE = 4, /* turn rate Omega of M */
-    TS_AXIS_INPUT = 5      /* a vehicle's input, named by ts_signal.input */
+    TS_AXIS_INPUT = 5,     /* a vehicle's input, named by ts_signal.input */
+    /* A small rotation of the ship about x, y, z of M (rad; towstab/
+     * kernel.h): each value is the index of its kernel input, as the
+     * translations' are (its rate 3 after, its acceleration 6 after). */
+    TS_AXIS_ROLL = 9,
+    TS_AXIS_PITCH = 10,
+    TS_AXIS_YAW = 11
 } ts_axis;
+
+/* Axes of a sum of sinusoids (ts_excitation_add_sum): surge, sway,
+ * heave, roll, pitch, yaw. */
+#define TS_SUM_AXES 6
 
 /* Longest name of a vehicle input (TS_IO_NAME of towstab/linearize.h). */
 #define TS_SIGNAL_INPUT_MAX (2 * TS_NAME_MAX + 16)
@@ -140,8 +153,9 @@ TS_API int ts_excitation_add_series(ts_excitation *ex, ts_axis axis, int n,
                                     ts_err *err);
 
 /* Add a sum of n >= 1 sinusoids driving the tow axes, with shared
- * components: axis j (0 surge, 1 sway, 2 heave) moves by
- *   x_j(t) = r(t) sum_k (re[3 k + j] cos(w_k t) - im[3 k + j] sin(w_k t)),
+ * components: axis j (0 surge, 1 sway, 2 heave, m; 3 roll, 4 pitch, 5
+ * yaw, rad; TS_SUM_AXES) moves by
+ *   x_j(t) = r(t) sum_k (re[6 k + j] cos(w_k t) - im[6 k + j] sin(w_k t)),
  * w_k = omega[k] (rad/s, finite, any sign), r the quintic fade-in over
  * [0, rise] (rise >= 0 s; 0: none, the motion starts at full amplitude).
  * Adds one TS_SIGNAL_SUM signal for each axis with a nonzero coefficient
@@ -162,7 +176,8 @@ TS_API int ts_excitation_read_series(ts_excitation *ex, ts_axis axis,
 
 /* Parse a signal description and add it:
  *   AXIS[:key=value,key=value,...]
- * AXIS is tow.surge (tow.x), tow.sway (tow.y), tow.heave (tow.z), speed,
+ * AXIS is tow.surge (tow.x), tow.sway (tow.y), tow.heave (tow.z), tow.roll,
+ * tow.pitch, tow.yaw (amplitude in rad or deg; no crank), speed,
  * turn_rate, or a vehicle's input (any other name with a '.', e.g.
  * fish.depth.setpoint: a step by default, its amplitude in m or rad). Keys: type (sine, crank, step, ramp, csv; default sine on tow
  * axes, ramp on manoeuvres), amplitude, frequency or period, phase, rod,
@@ -184,17 +199,21 @@ TS_API const ts_signal *ts_excitation_signal(const ts_excitation *ex, int i);
  * in the input's unit). */
 TS_API double ts_excitation_value(const ts_excitation *ex, int i, double t);
 
-/* The jump of the tow point's displacement and velocity at t = 0 (u(0+)
- * less the rest state before, zero): nonzero only for a sine or crank
- * started impulsively (ramp 0). du[0..3) displacement (m), du[3..6)
- * velocity (m/s). Returns 1 when there is a jump. */
-TS_API int ts_excitation_start_jump(const ts_excitation *ex, double du[6]);
+/* The jump of the tow inputs' displacements and velocities at t = 0
+ * (u(0+) less the rest state before, zero): nonzero only for a sine or
+ * crank started impulsively (ramp 0). du[TS_NINPUT] in the kernel's
+ * layout (du[0..3) displacement, m, du[3..6) velocity, m/s, the
+ * accelerations zero, then the rotations' alike). Returns 1 when there
+ * is a jump. */
+TS_API int ts_excitation_start_jump(const ts_excitation *ex,
+                                    double du[TS_NINPUT]);
 
 /* 1 when any signal drives the speed or the turn rate. */
 TS_API int ts_excitation_has_manoeuvre(const ts_excitation *ex);
 
 /* The tow-point input at time t: u[0..3) displacement (m), u[3..6)
- * velocity (m/s), u[6..9) acceleration (m/s^2), in M. */
+ * velocity (m/s), u[6..9) acceleration (m/s^2), in M; u[9..18) the
+ * rotation's (rad, rad/s, rad/s^2). */
 TS_API void ts_excitation_input(const ts_excitation *ex, double t,
                                 double u[TS_NINPUT]);
 
@@ -247,7 +266,8 @@ TS_API int ts_excitation_periodic(const ts_excitation *ex, int *index);
 /* Number of components of sum signal i (0 for other signals). */
 TS_API int ts_excitation_sum_components(const ts_excitation *ex, int i);
 
-/* Names: "tow.surge", "tow.sway", "tow.heave", "speed", "turn_rate";
+/* Names: "tow.surge", "tow.sway", "tow.heave", "speed", "turn_rate",
+ * "input", "tow.roll", "tow.pitch", "tow.yaw";
  * "sine", "crank", "step", "ramp", "csv", "sum". */
 TS_API const char *ts_axis_name(ts_axis a);
 TS_API const char *ts_signal_type_name(ts_signal_type t);

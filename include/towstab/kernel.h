@@ -17,9 +17,14 @@
  * integral gain) and the deflections of control surfaces with an actuator
  * (time constant > 0), vehicle by vehicle.
  *
- * Input u[ninput]: u[0..TS_NINPUT) the tow-point displacement (m),
- * velocity (m/s) and acceleration (m/s^2) relative to its nominal position
- * in the mean ship frame M, each as x, y, z; then, vehicle by vehicle, a
+ * Input u[ninput]: u[0..9) the tow-point displacement (m), velocity
+ * (m/s) and acceleration (m/s^2) relative to its nominal position in the
+ * mean ship frame M, each as x, y, z; u[9..18) a small rotation theta of
+ * the ship about M's axes (rad), its rate (rad/s) and its acceleration
+ * (rad/s^2), each as roll, pitch, yaw (x, y, z): it moves a cable's start
+ * point r by theta x r (r from M's origin for a prescribed tow point,
+ * from the towing vehicle's origin O otherwise; TS_TOW_ROT); then,
+ * vehicle by vehicle, a
  * deflection command (rad) per control surface, added to its open-loop
  * deflection, and two inputs per controller loop: one added to the loop's
  * output (rad), one to its set point (m or rad) (ts_kernel_input_name). The motion of M (speed V, turn
@@ -51,7 +56,11 @@
 extern "C" {
 #endif
 
-#define TS_NINPUT 9
+#define TS_NINPUT 18
+/* The tow inputs: translation along axis j (0 x, 1 y, 2 z) at u[j],
+ * rotation about axis j at u[TS_TOW_ROT + j]; each displacement's
+ * velocity is 3 after it, its acceleration 6 after it. */
+#define TS_TOW_ROT 9
 #define TS_CHART_MIN 1e-6        /* |cos theta2| below which f refuses */
 #define TS_CHART_RECHART 0.25    /* default re-chart threshold */
 
@@ -97,7 +106,8 @@ TS_API const char *ts_kernel_input_name(const ts_kernel *k, int j, char *buf,
                                         size_t size);
 /* Index of the input called `name`, -1 if none. */
 TS_API int ts_kernel_input_find(const ts_kernel *k, const char *name);
-/* Unit of input j ("m", "m/s", "m/s^2", "rad"), NULL out of range. */
+/* Unit of input j ("m", "m/s", "m/s^2", "rad", "rad/s", "rad/s^2", ...),
+ * NULL out of range. */
 TS_API const char *ts_kernel_input_unit(const ts_kernel *k, int j);
 /* 1 when input j is a control surface's deflection. */
 TS_API int ts_kernel_input_is_surface(const ts_kernel *k, int j);
@@ -119,7 +129,9 @@ TS_API int ts_kernel_link_offset(const ts_kernel *k, int link);
  * With a towing vehicle the tow-point inputs (the first TS_NINPUT) move the
  * points its cables start from relative to the body, in M axes, on top
  * of its own motion (a wave-induced motion of the tow point; zero in
- * the steady analyses).
+ * the steady analyses): a start point at r from the vehicle's origin O
+ * (M axes, r = R p, p its body-axes position) moves by x + theta x r,
+ * with velocity x' + theta' x r and acceleration x'' + theta'' x r.
  * The speed controller's thrust bias (N, towstab/vehicle.h) is a kernel
  * parameter, trimmed by the equilibrium; ts_kernel_thrust is the thrust
  * of the last evaluation. */
@@ -131,6 +143,10 @@ TS_API int ts_kernel_root_offset(const ts_kernel *k);
  * surface ship's q holds its yaw alone at ts_kernel_vehicle_offset and
  * the tow point's x and y at ts_kernel_root_offset (one after it). */
 TS_API int ts_kernel_root_dof(const ts_kernel *k);
+/* The tow point's position r_A (M, m) in state y: its coordinates, with a
+ * surface ship's depth the scene's; tow.point without a towing vehicle. */
+TS_API void ts_kernel_root_position(const ts_kernel *k, const double y[],
+                                    double r[3]);
 TS_API void ts_kernel_set_thrust_bias(ts_kernel *k, double thrust);
 TS_API double ts_kernel_thrust_bias(const ts_kernel *k);
 TS_API double ts_kernel_thrust(const ts_kernel *k);

@@ -30,7 +30,9 @@
  * Inputs v (ts_kernel_ninput): tow-point displacement x, y, z (m),
  * velocity (m/s), acceleration (m/s^2) in the mean ship frame, named
  * tow.surge, tow.sway, tow.heave for displacement (their velocity and
- * acceleration columns follow in the same order: TS_NINPUT = 9); the
+ * acceleration columns follow in the same order), then the rotations
+ * tow.roll, tow.pitch, tow.yaw (rad; rad/s, rad/s^2 after them; the
+ * kernel's u[TS_TOW_ROT..], towstab/kernel.h): TS_NINPUT = 18; the
  * vehicles' inputs; last the frame's speed, turn rate and their rates
  * (tow.speed, tow.turn_rate, tow.speed_rate, tow.turn_accel; m/s, rad/s,
  * m/s^2, rad/s^2): a change of the mean frame's motion, the state staying
@@ -57,7 +59,10 @@ extern "C" {
 enum {
     TS_IN_DISP = 0,   /* tow displacement x, y, z: columns 0, 1, 2 */
     TS_IN_VEL = 3,    /* tow velocity x, y, z: columns 3, 4, 5 */
-    TS_IN_ACC = 6     /* tow acceleration x, y, z: columns 6, 7, 8 */
+    TS_IN_ACC = 6,    /* tow acceleration x, y, z: columns 6, 7, 8 */
+    TS_IN_ROT = 9,    /* tow rotation about x, y, z: columns 9, 10, 11 */
+    TS_IN_ROT_VEL = 12, /* its rate: 12, 13, 14 */
+    TS_IN_ROT_ACC = 15  /* its acceleration: 15, 16, 17 */
 };
 
 /* The frame inputs, the last TS_NFRAME_INPUT columns of B (from
@@ -153,6 +158,12 @@ typedef struct ts_linear {
                           order; NULL without vehicles */
     int *veh_qoff;     /* [nvehicles] offset of each vehicle's angles in
                           q; NULL without vehicles */
+    double *tow_lever; /* [3 nnodes] the lever r (M axes, m, at y0) by
+                          which a tow rotation theta moves node i with
+                          the coordinates held (theta x r): the start
+                          point of the cable it hangs on, from M's origin
+                          (a prescribed tow: tow.point) or from the towing
+                          vehicle's origin; ts_linear_tow_shift */
     double *Ty;        /* [nlinks * n] dT/dy (N/rad, N s/rad) column-major,
                           or NULL unless opts.tensions */
     double *Tu;        /* [nlinks * ninput] dT/du (N/m, N s/m, N s^2/m),
@@ -301,6 +312,15 @@ TS_API int ts_linearize_equilibrium(ts_kernel *k, const ts_equilibrium *eq,
  * (+ l n de for an elastic link; l_k its length at y0) down the tree; a
  * cable starting at a point P of a vehicle starts from dr_A + (R E
  * dtheta) x rho_P. Exact geometry, O(nlinks). */
+/* The displacement d[3] (M axes) of node `node` per unit of tow input
+ * `input` (a displacement channel: TS_IN_DISP + j, or TS_IN_ROT + j)
+ * with the coordinates held: e_j for a translation, e_j x r for a
+ * rotation (r = lin->tow_lever of the node); zero for node 0 of a towing
+ * vehicle (its own point, which the inputs do not move) and for any
+ * other input. */
+TS_API void ts_linear_tow_shift(const ts_linear *lin, int node, int input,
+                                double d[3]);
+
 TS_API void ts_linear_node_displacements(const ts_system *sys,
                                          const ts_linear *lin,
                                          const double dq[], double dr[]);

@@ -74,8 +74,9 @@
 extern "C" {
 #endif
 
-/* The sea's inputs to the linear model: the three tow-point axes today
- * (channels of ts_response_compute); room for more (fins). */
+/* The sea's inputs to the linear model: the three tow-point axes, and
+ * with a towing vehicle its three rotations (channels of
+ * ts_response_compute); room for more (fins). */
 #define TS_SEA_MAX_INPUTS 8
 
 /* Defaults. */
@@ -98,6 +99,18 @@ typedef struct ts_seaway {
     double lever[3];       /* tow point less the RAO reference point, m, M */
     double speed;          /* ship speed, m/s */
     double gravity;        /* m/s^2 */
+    /* With a towing vehicle the RAOs' rotations are the tow rotation
+     * inputs (tow.roll, tow.pitch, tow.yaw: about the vehicle's origin O,
+     * so that each cable start point r gets theta x r, towstab/kernel.h),
+     * and the translation is the one of O: xi + theta x (O less the
+     * reference point). Without one (a prescribed tow point, the one start
+     * point) the rotations enter through the lever alone. */
+    int rotations;         /* 1: drive the rotation inputs */
+    double reference[3];   /* the RAO reference point, m, M */
+    double origin[3];      /* the vehicle's origin O in M at its trim, m
+                              (ts_seaway_set_trim; ts_seaway_init puts it
+                              at tow.point less the attach point, the
+                              vehicle level) */
 } ts_seaway;
 
 /* A seaway for system sys: lever = sys->tow.point - reference (reference
@@ -109,11 +122,19 @@ TS_API int ts_seaway_init(ts_seaway *w, const ts_system *sys,
                           const ts_sea *sea, const ts_rao *rao,
                           const double reference[3], ts_err *err);
 
-/* The tow point's translation per metre of wave amplitude at wave
- * frequency omega: re[3], im[3] (M axes). TS_EDOMAIN outside the RAO
+/* The tow inputs per metre of wave amplitude at wave frequency omega:
+ * re[TS_SUM_AXES], im[TS_SUM_AXES] (M axes): the tow point's translation
+ * (m/m; with rotations, the vehicle origin's) and, with rotations, the
+ * ship's rotation (rad/m; zero without). TS_EDOMAIN outside the RAO
  * table. */
-TS_API int ts_seaway_tow(const ts_seaway *w, double omega, double re[3],
-                         double im[3], ts_err *err);
+TS_API int ts_seaway_tow(const ts_seaway *w, double omega,
+                         double re[TS_SUM_AXES], double im[TS_SUM_AXES],
+                         ts_err *err);
+
+/* The towing vehicle's origin at its trim y (ts_kernel_root; nothing
+ * without a towing vehicle): w->origin. */
+TS_API void ts_seaway_set_trim(ts_seaway *w, const ts_kernel *k,
+                               const double y[]);
 
 /* The band the analyses cover: the sea's band holding all but `tail` of
  * its m0, cut to the RAO table's frequencies. TS_EDOMAIN when they do not

@@ -229,6 +229,9 @@ typedef struct ts_motion_bound {
     double turn_rate;  /* |Omega|, rad/s */
     double tow_speed;  /* tow-point velocity of an excitation, m/s */
     double tow_accel;  /* its acceleration, m/s^2 */
+    double rot_rate;   /* the rate of a tow rotation (tow.roll ...),
+                          rad/s: it moves a point at r by rot_rate r */
+    double rot_accel;  /* its acceleration, rad/s^2 */
 } ts_motion_bound;
 
 /* The bounds of a steady tow at the system's speed and turn rate. */

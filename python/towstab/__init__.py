@@ -594,7 +594,7 @@ class History:
     nodes, 3] m (node 0 the tow point), ``tensions`` [samples, links] N
     (a linear run's from the tension Jacobians), ``tow_force`` [samples,
     3] N (the force on the tow point; nan in a linear run), ``energy``
-    [samples, 2] J (nan in a linear run), ``input`` [samples, 9]
+    [samples, 2] J (nan in a linear run), ``input`` [samples, 18]
     (towstab/job.h)."""
 
     def __init__(self, job, run):

@@ -131,7 +131,7 @@ int main(void)
         r.components = comps[j];
         ts_excitation *ex = ts_excitation_alloc(&err);
         ts_seaway_excitation(&w, &r, ex, NULL, &err);
-        double t[REPS], u9[9], sink = 0;
+        double t[REPS], u9[TS_NINPUT], sink = 0;
         const int calls = 20000;
         for (int i = 0; i < REPS; i++) {
             double t0 = bench_now();

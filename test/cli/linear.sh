@@ -113,7 +113,7 @@ else
     fail "response: status $status; $(head -c 300 "$T/err")"
 fi
 
-for bad in "--output nowhere.z" "--output sphere.w" "--input tow.roll --output sphere.z" \
+for bad in "--output nowhere.z" "--output sphere.w" "--input tow.spin --output sphere.z" \
            "--output sphere.z --from 1 --to 1" "--output sphere.z --from -1" \
            "--output sphere.z --from 5 --to 1" "--output sphere.z --points 1"; do
     rm -rf "$T/o"

@@ -151,4 +151,19 @@ refuse "a sea state starts from the equilibrium" simulate "$EX" \
 refuse "which a sea-state response has not" response "$EX" --output fish.z \
     --sea Hs=4m,Tp=8s --plot "$T/pictures"
 
+# A towing ship's RAO rotations are its rotation inputs: the CSV carries
+# tow.roll ... tow.yaw beside the translations (test_surface checks the
+# gains they give).
+"$TOWSTAB" response test/scenes/survey_ship.yaml --links 8 \
+    --output depressor.z --sea Hs=2m,Tp=6s --rao examples/ship_rao.csv \
+    --rao-reference "12 m,0,0" --no-discretisation-error --quiet \
+    --csv "$T/ship.csv" >"$T/ship.out" 2>"$T/ship.err"
+st=$?
+if [ "$st" -eq 0 ] && head -1 "$T/ship.csv" | grep -q 'tow.pitch_re,tow.pitch_im' &&
+    grep -q 'standard deviation sigma' "$T/ship.out"; then
+    pass "towing ship with RAOs: its rotations are inputs (tow.pitch_re in the CSV)"
+else
+    fail "towing ship with RAOs: exit $st, $(head -1 "$T/ship.err"), CSV header $(head -c 200 "$T/ship.csv" 2>/dev/null)"
+fi
+
 finish
