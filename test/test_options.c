@@ -170,13 +170,13 @@ static int bad_texts(const ts_option *o, const char *out[], int max)
     case TS_OPT_ENUM: ADD("frobnicate"); break;
     case TS_OPT_TEXT:
         if (o->choices)
-            ADD("tow.roll");
+            ADD("tow.spin");
         else
             ADD("nowhere.w");
         break;
     case TS_OPT_SPECS:
         ADD(" ; ");
-        ADD("tow.roll:amplitude=1,frequency=1");
+        ADD("tow.spin:amplitude=1,frequency=1");
         if (!strcmp(o->name, "manoeuvre")) {
             ADD("speed:to=-5,duration=1s");
             ADD("tow.heave:amplitude=1,frequency=1");
