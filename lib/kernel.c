@@ -950,8 +950,10 @@ static void centripetal(const double om[3], const double rho[3], double b[3])
  * towing vehicle's prescribed motion of its cables' starting points. */
 static void point_bias(const veh *V, const double rho[3], double b[3])
 {
-    double p[3], x[3];
     centripetal(V->st.om_b, rho, b);
+    if (!V->root)
+        return; /* a towed vehicle: no prescribed motion */
+    double p[3], x[3];
     for (int j = 0; j < 3; j++)
         p[j] = rho[j] + V->d->attach[j];
     v3_cross(V->shift_al, p, x);
