@@ -43,6 +43,7 @@
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/equilibrium.h"
+#include "towstab/response.h"
 #include "towstab/scene.h"
 
 static ts_units *units;
@@ -178,6 +179,44 @@ static double col_max(const double *x, int n)
     return m;
 }
 
+/* The largest difference between the columns of B from the sparse model
+ * (S_inf solves, acc) and the dense B, over the kernel's inputs (the tow
+ * heave columns left out at a kinked tow point), as a fraction of its
+ * allowance: ten times the two truncation estimates (the sparse column's,
+ * and the dense model's largest, b_trunc_err, or with own its column's
+ * Berr) plus ROUNDING of the column. The worst column into *wj (may be
+ * NULL). */
+static double b_worst(const ts_linear *lin, tsi_shift *acc, int own,
+                      int *wj)
+{
+    int n = lin->nstate, nlow = n - lin->nq;
+    double *col = malloc((size_t)n * sizeof(double));
+    double *ecol = malloc((size_t)n * sizeof(double));
+    double wb = 0;
+    for (int j = 0; j < lin->frame_input; j++) {
+        if (lin->kink_tow && j < TS_NINPUT && j % 3 == 2)
+            continue;
+        tsi_shift_apply_input(acc, j, col, 0);
+        tsi_shift_apply_input(acc, j, ecol, 1);
+        const double *Bd = lin->B + (size_t)j * n;
+        double diff = 0;
+        for (int i = 0; i < n; i++)
+            diff = fmax(diff, fabs(col[i] - Bd[i]));
+        double dense = own ? col_max(lin->Berr + (size_t)j * nlow, nlow)
+                           : lin->b_trunc_err;
+        double allow = 10.0 * (dense + col_max(ecol, n)) +
+                       ROUNDING * col_max(Bd, n);
+        if (diff / allow > wb) {
+            wb = diff / allow;
+            if (wj)
+                *wj = j;
+        }
+    }
+    free(col);
+    free(ecol);
+    return wb;
+}
+
 /* Section 2: A and B from the sparse model against the dense ones. */
 static void compare_dense(const char *name, const ts_system *sys)
 {
@@ -244,19 +283,8 @@ static void compare_dense(const char *name, const ts_system *sys)
           name, sys->nlinks, worst, wj);
     /* The kernel's inputs; the frame inputs after them are columns of
      * the dense B only (doc/linear.md, section 1). */
-    for (int j = 0; rc == TS_OK && j < lin->frame_input; j++) {
-        if (lin->kink_tow && j < TS_NINPUT && j % 3 == 2)
-            continue;
-        tsi_shift_apply_input(&acc, j, col, 0);
-        tsi_shift_apply_input(&acc, j, ecol, 1);
-        const double *Bd = lin->B + (size_t)j * n;
-        double diff = 0;
-        for (int i = 0; i < n; i++)
-            diff = fmax(diff, fabs(col[i] - Bd[i]));
-        double allow = 10.0 * (lin->b_trunc_err + col_max(ecol, n)) +
-                       ROUNDING * col_max(Bd, n);
-        wb = fmax(wb, diff / allow);
-    }
+    if (rc == TS_OK)
+        wb = b_worst(lin, &acc, 0, NULL);
     CHECK(rc == TS_OK && wb <= 1.0,
           "%s (%d links): the columns of B agree within their error "
           "estimates (largest difference %.3g of the allowance)",
@@ -465,31 +493,155 @@ static void test_groups(void)
           groups[2], groups[3], evals[2], evals[3]);
 }
 
-/* A towing vehicle at the root (its tow point free) is not covered: the
- * sparse model alone is refused, naming it; the default forms the dense
- * one. */
-static void test_towing_refused(void)
+/* A scene's linear model about its equilibrium with the model asked for
+ * (tensions for the dense tension Jacobians); NULL when it fails. */
+static ts_linear *linear_of(const ts_system *sys, ts_lin_model model,
+                            ts_kernel **kout)
 {
     ts_err err = {0};
-    ts_scene *sc = ts_scene_load("test/scenes/towing_sphere.yaml", units,
-                                 &err);
-    if (!CHECK(sc != NULL, "towing_sphere: %s", err.msg))
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_linear *lin = NULL;
+    if (k && eq && ts_equilibrium_solve(k, NULL, eq, &err) == TS_OK) {
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = model;
+        o.tensions = 1;
+        lin = ts_linear_alloc(k, &err);
+        if (lin && ts_linearize_equilibrium(k, eq, &o, lin, &err) != TS_OK) {
+            printf("  linearize: %s\n", err.msg);
+            ts_linear_free(lin);
+            lin = NULL;
+        }
+    } else {
+        printf("  equilibrium: %s\n", err.msg);
+    }
+    ts_equilibrium_free(eq);
+    *kout = k;
+    return lin;
+}
+
+/* 6. A towing vehicle at the root (6 degrees of freedom, and a surface
+ * ship of 3): E^-1 F = A and E^-1 G = B (section 2's allowance: ten times
+ * the two models' truncation estimates plus ROUNDING of the column),
+ * here with each column of B judged against its own estimate (Berr) and
+ * the tow inputs' columns named; then the frequency response by the
+ * sparse model (one sparse complex solve per frequency) against the
+ * dense one's at four frequencies, for a position, a tension, a tow
+ * input and a vehicle input: the difference within the sum of the two
+ * gains' error allowances (each ten times its model's error estimate,
+ * lib/response.c). */
+static void towing_case(const char *path, const char *pos_name,
+                        const char *out2, const char *tow_input,
+                        const char *input_name)
+{
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load(path, units, &err);
+    if (!CHECK(sc != NULL, "%s: %s", path, err.msg))
         return;
-    ts_kernel *k = ts_kernel_alloc(sc->system, &err);
-    ts_linear *lin = k ? ts_linear_alloc(k, &err) : NULL;
-    int n = k ? ts_kernel_nstate(k) : 0;
-    double *y = calloc((size_t)n + 1, sizeof(double));
-    ts_linearize_opts o;
-    ts_linearize_opts_default(&o);
-    o.model = TS_LIN_SPARSE;
-    int rc = lin && y ? ts_linearize(k, y, NULL, &o, lin, &err) : TS_ENOMEM;
-    CHECK(rc == TS_EINVAL && strstr(err.msg, "towing vehicle"),
-          "towing vehicle at the root: the sparse model alone refused: %s",
-          err.msg);
-    free(y);
+    const ts_system *sys = sc->system;
+    ts_kernel *k, *kd;
+    ts_linear *lin = linear_of(sys, TS_LIN_BOTH, &k);
+    ts_linear *lsp = linear_of(sys, TS_LIN_SPARSE, &kd);
+    CHECK(lin && lin->desc && lin->A && lsp && lsp->desc && !lsp->A,
+          "%s: a towing vehicle at the root: the sparse model formed (alone "
+          "when asked)", path);
+    if (!lin || !lin->desc || !lsp) {
+        ts_linear_free(lin);
+        ts_linear_free(lsp);
+        ts_kernel_free(k);
+        ts_kernel_free(kd);
+        ts_scene_free(sc);
+        return;
+    }
+    tsi_shift acc;
+    int rc = tsi_shift_factor_inf(&acc, lin, &err);
+    int wj = -1;
+    double wb = rc == TS_OK ? b_worst(lin, &acc, 1, &wj) : INFINITY;
+    CHECK(rc == TS_OK && wb <= 1.0,
+          "%s: every column of B (%d inputs: the tow inputs, the vehicles') "
+          "within its own error estimates: largest %.3g of the allowance "
+          "(%s)", path, lin->frame_input, wb,
+          wj >= 0 ? lin->input_name[wj] : "-");
+    if (rc == TS_OK)
+        tsi_shift_free(&acc);
+
+    /* The response, sparse against dense. */
+    ts_linear *ld = linear_of(sys, TS_LIN_DENSE, &kd);
+    static const double freq[4] = {0.0137, 0.071, 0.33, 1.9};
+    const char *outs[3] = {pos_name, out2, NULL};
+    int inputs[2] = {-1, -1};
+    if (ts_response_input_lookup(k, tow_input, &inputs[0], &err) != TS_OK ||
+        ts_response_input_lookup(k, input_name, &inputs[1], &err) != TS_OK)
+        CHECK(0, "%s: %s", path, err.msg);
+    double worst = 0, rel = 0;
+    int nchecks = 0;
+    for (int oi = 0; ld && oi < 2; oi++) {
+        ts_output out;
+        if (ts_response_output_lookup(k, outs[oi], &out, &err) != TS_OK) {
+            CHECK(0, "%s: %s", path, err.msg);
+            continue;
+        }
+        for (int ii = 0; ii < 2; ii++) {
+            if (inputs[ii] < 0)
+                continue;
+            ts_response *rs = NULL, *rd = NULL;
+            int r1 = ts_response_compute(sys, lsp, inputs[ii], &out, freq, 4,
+                                         &rs, &err);
+            int r2 = r1 == TS_OK ? ts_response_compute(sys, ld, inputs[ii],
+                                                       &out, freq, 4, &rd,
+                                                       &err)
+                                 : r1;
+            if (!CHECK(r1 == TS_OK && r2 == TS_OK, "%s: response of %s: %s",
+                       path, out.name, err.msg)) {
+                ts_response_free(rs);
+                ts_response_free(rd);
+                continue;
+            }
+            for (int i = 0; i < 4; i++) {
+                double d = hypot(rs->re[i] - rd->re[i], rs->im[i] - rd->im[i]);
+                double allow = rs->error[i] + rd->error[i];
+                worst = fmax(worst, d / allow);
+                rel = fmax(rel, allow / rd->magnitude[i]);
+                nchecks++;
+            }
+            ts_response_free(rs);
+            ts_response_free(rd);
+        }
+    }
+    CHECK(ld && nchecks == 16 && worst <= 1.0,
+          "%s: the sparse response equals the dense one at 4 frequencies "
+          "(%s and %s to %s and %s, %d gains): largest difference "
+          "%.3g of the two error allowances (themselves at most %.2g of "
+          "the gain)", path, pos_name, out2, tow_input, input_name, nchecks,
+          worst, rel);
+    ts_linear_free(ld);
     ts_linear_free(lin);
+    ts_linear_free(lsp);
     ts_kernel_free(k);
+    ts_kernel_free(kd);
     ts_scene_free(sc);
+}
+
+static void test_towing(void)
+{
+    towing_case("examples/dolphin_aurora.yaml", "aurora.z",
+                "armoured.1.tension", "tow.heave", "dolphin.thrust");
+    /* A straight tow is symmetric: the lateral outputs to the lateral
+     * inputs. */
+    towing_case("test/scenes/survey_ship.yaml", "depressor.y", "ship.yaw",
+                "tow.sway", "ship.rudder");
+    /* Section 2 on the test scenes with a towing vehicle. */
+    const char *scenes[2] = {"test/scenes/survey_ship.yaml",
+                             "test/scenes/towing_sphere.yaml"};
+    for (int i = 0; i < 2; i++) {
+        ts_err err = {0};
+        ts_scene *sc = ts_scene_load(scenes[i], units, &err);
+        if (!CHECK(sc != NULL, "%s: %s", scenes[i], err.msg))
+            continue;
+        compare_dense(scenes[i], sc->system);
+        ts_scene_free(sc);
+    }
 }
 
 int main(void)
@@ -501,7 +653,7 @@ int main(void)
     test_examples();
     test_shifted_solve();
     test_groups();
-    test_towing_refused();
+    test_towing();
     ts_units_free(units);
     return tc_done();
 }
