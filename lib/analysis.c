@@ -2688,6 +2688,9 @@ static int check_window(ts_result *r, const ts_request *rq, ts_err *err)
     if (!lin) {
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
+        /* A towing vehicle's modes come from the dense model. */
+        if (r->sys->tow.vehicle >= 0)
+            lo.model = TS_LIN_DENSE;
         lo.estimate_error = 0;
         ts_kernel *k = ts_kernel_alloc(r->sys, err);
         own = k ? ts_linear_alloc(k, err) : NULL;

@@ -48,6 +48,7 @@
 #include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
+#include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
 #include "towstab/response.h"
 #include "towstab/scene.h"
@@ -635,6 +636,29 @@ static void towing_case(const char *path, const char *pos_name,
             ts_response_free(rd);
         }
     }
+    /* With the sparse model alone: no static gain (the neutral modes are
+     * the dense model's), said so; no modes (refused, naming the dense
+     * model). */
+    ts_output o1;
+    ts_response *ra = NULL;
+    if (ts_response_output_lookup(k, pos_name, &o1, &err) == TS_OK &&
+        ts_response_compute(sys, lsp, inputs[0], &o1, freq, 1, &ra, &err) ==
+            TS_OK)
+        CHECK(isnan(ra->static_gain) && strstr(ra->static_note, "dense") &&
+                  isfinite(ra->re[0]),
+              "%s: the sparse model alone: the gain at %g Hz, no static "
+              "gain: %s", path, freq[0], ra->static_note);
+    else
+        CHECK(0, "%s: response with the sparse model alone: %s", path,
+              err.msg);
+    ts_response_free(ra);
+    ts_eigen *eg = NULL;
+    ts_err_clear(&err);
+    int erc = ts_eigen_solve(lsp, NULL, &eg, &err);
+    CHECK(erc == TS_EINVAL && !eg && strstr(err.msg, "dense model"),
+          "%s: modes with the sparse model alone refused: %s", path,
+          err.msg);
+    ts_eigen_free(eg);
     CHECK(ld && nchecks == 16 && worst <= 1.0,
           "%s: the sparse response equals the dense one at 4 frequencies "
           "(%s and %s to %s and %s, %d gains): largest difference "
