@@ -673,20 +673,106 @@ static void towing_case(const char *path, const char *pos_name,
     ts_scene_free(sc);
 }
 
+/* towing_sphere's tug with a PI speed controller (its integrator the
+ * first controller state, then its depth loop's). */
+static const char *pi_yaml =
+    "name: pi\n"
+    "tow: {speed: 2.5 m/s, point: [0, 0, 20 m]}\n"
+    "towing_vehicle:\n"
+    "  name: tug\n"
+    "  mass: 4126.1375 kg\n"
+    "  volume: 4.0255 m^3\n"
+    "  inertia: [330 kg*m^2, 22000 kg*m^2, 22000 kg*m^2]\n"
+    "  mass_centre: [0, 0, 0.05 m]\n"
+    "  tow_point: [-4 m, 0, 0]\n"
+    "  added_mass: spheroid\n"
+    "  components:\n"
+    "    - {name: hull, type: hull, length: 8 m, diameter: 0.8 m}\n"
+    "    - {name: foreplane, type: surface, position: [0.5 m, 0, 0],\n"
+    "       area: 0.4 m^2, span: 1.2 m, control: true, time_constant: 0.1 s}\n"
+    "    - {name: tailplane, type: surface, position: [-3.6 m, 0, 0],\n"
+    "       area: 0.6 m^2, span: 1.2 m}\n"
+    "    - {name: rudder, type: surface, position: [-3.6 m, 0, 0],\n"
+    "       area: 0.6 m^2, span: 1.2 m, roll: 90 deg, control: true}\n"
+    "  controllers:\n"
+    "    - {name: depth, measure: depth, setpoint: 20 m, kp: 0.05 rad/m,\n"
+    "       ki: 0.005 rad/(m*s), kd: 0.2 rad*s/m, surfaces: {foreplane: 1}}\n"
+    "  propulsion: {speed: 3 m/s, gain: 2000 N*s/m, integral_gain: 300 N/m,\n"
+    "               max_thrust: 1600 N}\n"
+    "cables:\n"
+    "  - {name: cable, from: tow, to: sphere, length: 50 m, diameter: 0.02 m,\n"
+    "     weight: 5 N/m, links: 8}\n"
+    "bodies:\n"
+    "  - {name: sphere, type: sphere, diameter: 0.5 m, wet_weight: 500 N}\n";
+
 static void test_towing(void)
 {
+    /* A PI speed controller: its integrator in the tug's local block
+     * (the speed set point among its inputs). */
+    ts_scene *pi = tscene_parse(units, pi_yaml);
+    if (CHECK(pi != NULL, "PI speed controller scene parsed")) {
+        ts_err err = {0};
+        ts_kernel *k = ts_kernel_alloc(pi->system, &err);
+        CHECK(k && ts_kernel_speed_integrator(k) == 0 &&
+                  ts_kernel_ncontrol(k) == 3,
+              "PI speed controller: its integrator the first of 3 "
+              "controller states (%d of %d)",
+              k ? ts_kernel_speed_integrator(k) : -1,
+              k ? ts_kernel_ncontrol(k) : -1);
+        ts_kernel_free(k);
+        compare_dense("PI speed controller", pi->system);
+    }
+    ts_scene_free(pi);
+
     towing_case("examples/dolphin_aurora.yaml", "aurora.z",
                 "armoured.1.tension", "tow.heave", "dolphin.thrust");
     /* A straight tow is symmetric: the lateral outputs to the lateral
      * inputs. */
     towing_case("test/scenes/survey_ship.yaml", "depressor.y", "ship.yaw",
                 "tow.sway", "ship.rudder");
+    /* DOLPHIN with a PI speed controller: its integrator is the first
+     * controller state and its own states the last (it is the last
+     * vehicle), AURORA's between: not one block of its own. The sparse
+     * model alone is refused, saying so; the default forms the dense
+     * one (ts_linearize). */
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load("examples/dolphin_aurora.yaml", units, &err);
+    if (CHECK(sc != NULL, "dolphin_aurora: %s", err.msg)) {
+        ts_system *sys = sc->system;
+        ts_propulsion *pr = &sys->bodies[sys->tow.vehicle].vehicle->propulsion;
+        pr->type = TS_PROP_SPEED;
+        pr->speed = 5.0;
+        pr->gain = 2000.0;
+        pr->ki = 300.0;
+        pr->max_thrust = INFINITY;
+        ts_kernel *k = ts_kernel_alloc(sys, &err);
+        ts_descriptor *d = k ? tsi_desc_alloc(k, &err) : NULL;
+        CHECK(k && !d && err.code == TS_EINVAL &&
+                  strstr(err.msg, "one block of its own"),
+              "dolphin_aurora with a PI speed controller: no sparse model: "
+              "%s", err.msg);
+        ts_linear *lin = k ? ts_linear_alloc(k, &err) : NULL;
+        int n = k ? ts_kernel_nstate(k) : 0;
+        double *y = calloc((size_t)n + 1, sizeof(double));
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = TS_LIN_SPARSE;
+        ts_err_clear(&err);
+        int rc = lin && y ? ts_linearize(k, y, NULL, &o, lin, &err) : TS_ENOMEM;
+        CHECK(rc == TS_EINVAL && strstr(err.msg, "one block of its own"),
+              "the same: the sparse model alone refused: %s", err.msg);
+        tsi_desc_free(d);
+        free(y);
+        ts_linear_free(lin);
+        ts_kernel_free(k);
+        ts_scene_free(sc);
+    }
     /* Section 2 on the test scenes with a towing vehicle. */
     const char *scenes[2] = {"test/scenes/survey_ship.yaml",
                              "test/scenes/towing_sphere.yaml"};
     for (int i = 0; i < 2; i++) {
-        ts_err err = {0};
-        ts_scene *sc = ts_scene_load(scenes[i], units, &err);
+        ts_err_clear(&err);
+        sc = ts_scene_load(scenes[i], units, &err);
         if (!CHECK(sc != NULL, "%s: %s", scenes[i], err.msg))
             continue;
         compare_dense(scenes[i], sc->system);
