@@ -594,7 +594,8 @@ static void towing_case(const char *path, const char *pos_name,
     }
 
     /* The response, sparse against dense. */
-    ts_linear *ld = linear_of(sys, TS_LIN_DENSE, &kd);
+    ts_kernel *kdd;
+    ts_linear *ld = linear_of(sys, TS_LIN_DENSE, &kdd);
     static const double freq[4] = {0.0137, 0.071, 0.33, 1.9};
     const char *outs[3] = {pos_name, out2, NULL};
     int inputs[2] = {-1, -1};
@@ -670,6 +671,7 @@ static void towing_case(const char *path, const char *pos_name,
     ts_linear_free(lsp);
     ts_kernel_free(k);
     ts_kernel_free(kd);
+    ts_kernel_free(kdd);
     ts_scene_free(sc);
 }
 
