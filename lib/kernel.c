@@ -1574,7 +1574,7 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
     const ts_link *links = sys->links;
     const int nl = k->nl, nn = k->nn;
     const double rho = sys->env.water_density, g = sys->env.gravity;
-    if (k->root >= 0 || (k->nv > 0 && (!yv || !thdd)))
+    if (k->nv > 0 && (!yv || !thdd))
         return TS_EINVAL;
     if (!u)
         u = k->uzero;
@@ -1585,6 +1585,11 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
     for (int i = 0; i < k->nv; i++)
         if (vehicle_kinematics(k, &k->veh[i], yv))
             return TS_CHART;
+    /* A towing vehicle: the tow inputs move the points its cables start
+     * from relative to the body (the same code as ts_kernel_eval: the
+     * sparse model differences its input columns through this residual). */
+    if (k->root >= 0)
+        root_tow_inputs(k, &k->veh[k->root], u);
     /* Directions and strains from the positions: n = d / |d|, the strain
      * of an elastic link |d| / l - 1 (it sets only the bending lengths
      * here: the tensions are given). */
@@ -1743,6 +1748,18 @@ void tsi_kernel_vehicle_layout(const ts_kernel *k, int v, tsi_vehicle_layout *la
             imin = V->in_surf[c] < imin ? V->in_surf[c] : imin;
             imax = V->in_surf[c] > imax ? V->in_surf[c] : imax;
         }
+    }
+    if (V->root) {
+        /* A towing vehicle: its speed controller's integrator, and its
+         * propulsion inputs (thrust, force, moment, set speed). */
+        int x[3] = {V->spd_off, V->in_prop, V->in_spd};
+        if (x[0] >= 0) {
+            cmin = x[0] < cmin ? x[0] : cmin;
+            cmax = x[0] > cmax ? x[0] : cmax;
+        }
+        int last = x[2] >= 0 ? x[2] : x[1] + TSI_NPROP - 1;
+        imin = x[1] < imin ? x[1] : imin;
+        imax = last > imax ? last : imax;
     }
     if (cmax >= 0) {
         lay->c0 = cmin;
