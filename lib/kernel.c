@@ -191,31 +191,49 @@ static int layout_controls(ts_kernel *k, ts_err *err)
 {
     k->nc = 0;
     k->nin = TS_NINPUT;
-    /* A PI speed controller's integrator first: no loop mode moves it. */
+    /* A PI speed controller's integrator first: no loop mode moves it.
+     * Its vehicle's own controller states follow it, so that each
+     * vehicle's states are one block (the sparse model's local blocks,
+     * lib/descriptor.h); the other vehicles' follow in their order. */
+    int first = -1;
     for (int v = 0; v < k->nv; v++) {
         veh *V = &k->veh[v];
         const ts_propulsion *p = &V->d->propulsion;
         V->spd_off = V->root && p->type == TS_PROP_SPEED && p->ki > 0
                          ? k->nc++
                          : -1;
+        if (V->spd_off >= 0)
+            first = v;
     }
-    for (int v = 0; v < k->nv; v++) {
+    for (int i = -1; i < k->nv; i++) {
+        int v = i < 0 ? first : i;
+        if (v < 0 || (i >= 0 && v == first))
+            continue;
         veh *V = &k->veh[v];
         const ts_vehicle *d = V->d;
         for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++) {
-            V->xi_off[l] = V->in_loop[l] = V->in_sp[l] = -1;
-            if (l >= d->nloops)
-                continue;
-            if (d->loop[l].ki != 0 && V->mode[l] != TS_LOOP_OPEN)
+            V->xi_off[l] = -1;
+            if (l < d->nloops && d->loop[l].ki != 0 &&
+                V->mode[l] != TS_LOOP_OPEN)
                 V->xi_off[l] = k->nc++;
         }
         for (int c = 0; c < TS_VEHICLE_MAX_COMPONENTS; c++) {
-            V->act_off[c] = V->in_surf[c] = -1;
-            if (c >= d->ncomponents || !d->component[c].control)
-                continue;
-            V->in_surf[c] = k->nin++;
-            if (d->component[c].time_constant > 0)
+            V->act_off[c] = -1;
+            if (c < d->ncomponents && d->component[c].control &&
+                d->component[c].time_constant > 0)
                 V->act_off[c] = k->nc++;
+        }
+    }
+    /* The inputs, each vehicle's in its order. */
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const ts_vehicle *d = V->d;
+        for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++)
+            V->in_loop[l] = V->in_sp[l] = -1;
+        for (int c = 0; c < TS_VEHICLE_MAX_COMPONENTS; c++) {
+            V->in_surf[c] = -1;
+            if (c < d->ncomponents && d->component[c].control)
+                V->in_surf[c] = k->nin++;
         }
         for (int l = 0; l < d->nloops; l++) {
             V->in_loop[l] = k->nin++;
