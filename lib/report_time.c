@@ -27,11 +27,13 @@ static json_t *series(const double *base, int n, size_t stride)
 json_t *ts_report_sim_stats_json(const ts_sim_stats *st, const char *method)
 {
     double ratio = st->wall_s > 0 ? st->t_reached / st->wall_s : NAN;
-    return json_pack("{s:s,s:I,s:I,s:I,s:I,s:I,s:I,s:o,s:o,s:o,s:o}",
+    static const char *const newton[] = {NULL, "dense", "sparse"};
+    return json_pack("{s:s,s:I,s:I,s:I,s:I,s:s?,s:I,s:I,s:o,s:o,s:o,s:o}",
                      "method", method, "steps", (json_int_t)st->steps,
                      "rejected", (json_int_t)st->rejected, "evaluations",
                      (json_int_t)st->evaluations, "jacobians",
-                     (json_int_t)st->jacobians, "recharts",
+                     (json_int_t)st->jacobians, "newton_matrix",
+                     newton[st->newton], "recharts",
                      (json_int_t)st->recharts, "restarts",
                      (json_int_t)st->restarts, "t_reached",
                      num(st->t_reached), "h_last", num(st->h_last), "wall_s",
