@@ -589,6 +589,34 @@ static double tension_diff(const ts_history *a, const ts_history *b,
     return d;
 }
 
+/* A heave of 0.05 m at freq Hz from a smooth start (ramp 2 s). */
+static ts_excitation *heave(double freq, ts_err *err)
+{
+    ts_excitation *ex = ts_excitation_alloc(err);
+    ts_signal sig = {0};
+    sig.type = TS_SIGNAL_SINE;
+    sig.axis = TS_AXIS_HEAVE;
+    sig.amplitude = 0.05;
+    sig.frequency = freq;
+    sig.ramp = 2.0;
+    if (ex)
+        ts_excitation_add(ex, &sig, err);
+    return ex;
+}
+
+/* A reference run's options: integrator m to t_end, samples every dt,
+ * rtol 1e-10, atol 1e-12. */
+static void sim_opts(ts_sim_opts *o, ts_integrator m, double t_end,
+                     double dt)
+{
+    ts_sim_opts_default(o);
+    o->integrator = m;
+    o->t_end = t_end;
+    o->dt_sample = dt;
+    o->rel_tol = 1e-10;
+    o->abs_tol = 1e-12;
+}
+
 /* The elastic examples (kamman_ex1_elastic at its 20 links, EA 1e9 N;
  * the two-part tow at 10 + 2 + 6 links, EA 4.5e6 N), heaved 0.05 m at
  * 0.5 Hz from a smooth start for 2 s: bdf (CVODE, order <= 2, the sparse
@@ -616,21 +644,9 @@ static void test_bdf(const ts_units *u)
             s->cables[2].nlinks = 6;
             CHECK(ts_system_build(s, &err) == TS_OK, "coarse two-part tow");
         }
-        ts_excitation *ex = ts_excitation_alloc(&err);
-        ts_signal sig = {0};
-        sig.type = TS_SIGNAL_SINE;
-        sig.axis = TS_AXIS_HEAVE;
-        sig.amplitude = 0.05;
-        sig.frequency = 0.5;
-        sig.ramp = 2.0;
-        ts_excitation_add(ex, &sig, &err);
+        ts_excitation *ex = heave(0.5, &err);
         ts_sim_opts o;
-        ts_sim_opts_default(&o);
-        o.integrator = TS_INT_ESDIRK;
-        o.t_end = 2.0;
-        o.dt_sample = 0.05;
-        o.rel_tol = 1e-10;
-        o.abs_tol = 1e-12;
+        sim_opts(&o, TS_INT_ESDIRK, 2.0, 0.05);
         int rc;
         ts_sim_stats st;
         ts_history *ref = run(s, ex, &o, &rc, &st, &err);
@@ -687,21 +703,9 @@ static void test_vehicles_sparse(const ts_units *u)
             continue;
         ts_system *s = sc->system;
         ts_err err = {0};
-        ts_excitation *ex = ts_excitation_alloc(&err);
-        ts_signal sig = {0};
-        sig.type = TS_SIGNAL_SINE;
-        sig.axis = TS_AXIS_HEAVE;
-        sig.amplitude = 0.05;
-        sig.frequency = 0.2;
-        sig.ramp = 2.0;
-        ts_excitation_add(ex, &sig, &err);
+        ts_excitation *ex = heave(0.2, &err);
         ts_sim_opts o;
-        ts_sim_opts_default(&o);
-        o.integrator = TS_INT_RK8PD;
-        o.t_end = 4.0;
-        o.dt_sample = 0.1;
-        o.rel_tol = 1e-10;
-        o.abs_tol = 1e-12;
+        sim_opts(&o, TS_INT_RK8PD, 4.0, 0.1);
         int rc;
         ts_sim_stats st;
         ts_history *ref = run(s, ex, &o, &rc, &st, &err);
