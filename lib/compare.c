@@ -9,12 +9,15 @@
  * the response do not alias onto the fundamental, and a fit over a window
  * that is not a whole number of periods still returns the fundamental of
  * a pure sinusoid exactly (unlike a plain mean or a DFT bin). The linear
- * prediction is ts_response_at (response.c), the same algebra as
- * (i w I - A)^-1 (B_x + i w B_v - w^2 B_a) plus the tow feedthrough.
+ * prediction is ts_response_compute (response.c), the same algebra as
+ * (i w I - A)^-1 (B_x + i w B_v - w^2 B_a) plus the tow feedthrough, for
+ * the column of B the excitation drives (lin_input), whose unit makes
+ * the ratio's.
  */
 #include "towstab/compare.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -69,6 +72,63 @@ double ts_compare_wrap_deg(double d)
     if (d <= -180.0)
         d += 360.0;
     return d;
+}
+
+int ts_compare_periodic(const ts_excitation *ex, int *index)
+{
+    if (ts_excitation_periodic(ex, index))
+        return 1;
+    int found = -1, n = ts_excitation_nsignals(ex);
+    for (int i = 0; i < n; i++) {
+        const ts_signal *s = ts_excitation_signal(ex, i);
+        if (s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK ||
+            s->type == TS_SIGNAL_SUM) {
+            if (found >= 0 || s->type != TS_SIGNAL_SINE ||
+                s->axis != TS_AXIS_INPUT)
+                return 0;
+            found = i;
+        }
+    }
+    if (found < 0)
+        return 0;
+    *index = found;
+    return 1;
+}
+
+/* The column of lin's B that signal s drives: a tow axis' displacement or
+ * rotation, a manoeuvre's frame input, a vehicle's input by its name; -1
+ * when lin has none (a name it does not know). */
+static int lin_input(const ts_linear *lin, const ts_signal *s)
+{
+    switch (s->axis) {
+    case TS_AXIS_SURGE:
+    case TS_AXIS_SWAY:
+    case TS_AXIS_HEAVE:
+        return TS_IN_DISP + (int)s->axis;
+    case TS_AXIS_ROLL:
+    case TS_AXIS_PITCH:
+    case TS_AXIS_YAW:
+        return TS_IN_ROT + (int)(s->axis - TS_AXIS_ROLL);
+    case TS_AXIS_SPEED:
+        return lin->frame_input + TS_FRAME_SPEED;
+    case TS_AXIS_TURN_RATE:
+        return lin->frame_input + TS_FRAME_TURN_RATE;
+    case TS_AXIS_INPUT:
+        for (int j = TS_NINPUT; lin->input_name && j < lin->frame_input; j++)
+            if (!strcmp(lin->input_name[j], s->input))
+                return j;
+        return -1;
+    }
+    return -1;
+}
+
+/* The input's unit and the ratio's, output per input, written as
+ * ts_response's ("m/rad", "N/(m/s)"). */
+static void ratio_unit(ts_compare *c, const char *iu)
+{
+    snprintf(c->input_unit, sizeof c->input_unit, "%s", iu);
+    snprintf(c->ratio_unit, sizeof c->ratio_unit,
+             strchr(iu, '/') ? "%s/(%s)" : "%s/%s", c->output.si_unit, iu);
 }
 
 static void run_stats(const double *t, const double *x, int n, double eq,
@@ -157,17 +217,23 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
         }
     }
 
-    int idx, rc = TS_OK;
-    c->periodic = ex && ts_excitation_periodic(ex, &idx);
+    int idx = 0, rc = TS_OK;
+    c->periodic = ex && ts_compare_periodic(ex, &idx);
     double f = 0, exc_amp = NAN, exc_phase = 0;
+    c->pred_ratio = c->pred_phase_deg = NAN;
+    c->exc_amplitude = c->exc_frequency_hz = c->exc_fit_amplitude = NAN;
     if (c->periodic) {
         const ts_signal *s = ts_excitation_signal(ex, idx);
         c->exc_axis = s->axis;
         c->exc_type = s->type;
         c->exc_amplitude = s->amplitude;
         c->exc_frequency_hz = f = s->frequency;
+        int col = lin_input(lin, s);
         double period = 1.0 / f, dt = (c->t_to - c->t_from) / (n - 1);
-        if (c->t_to - c->t_from < period * (1.0 - 1e-9))
+        if (col < 0)
+            rc = ts_fail(err, TS_EINVAL, "compare: the linear model has no "
+                         "input %s", s->input);
+        else if (c->t_to - c->t_from < period * (1.0 - 1e-9))
             rc = ts_fail(err, TS_EINVAL, "compare: the window %g..%g s is "
                          "shorter than one period (%g s) of the %g Hz "
                          "excitation; run longer or discard less",
@@ -178,8 +244,14 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
                          "per period) are needed", dt, f,
                          period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
                          TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
+        /* A tow axis: the history's input, the sum of every signal on
+         * it; a vehicle's input: its signal (the history keeps the tow
+         * inputs only). */
         for (int i = 0; i < n && !rc; i++)
-            xe[i] = nl->input[TS_NINPUT * (size_t)(first + i) + s->axis];
+            xe[i] = s->axis == TS_AXIS_INPUT
+                        ? ts_excitation_value(ex, idx, tt[i])
+                        : nl->input[TS_NINPUT * (size_t)(first + i) +
+                                    s->axis];
         double ce;
         if (!rc)
             rc = ts_compare_fit_sinusoid(tt, xe, n, f, &ce, &exc_amp,
@@ -187,14 +259,15 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
         c->exc_fit_amplitude = exc_amp;
         if (!rc) {
             double re, im;
-            rc = ts_response_at(sys, lin, (int)s->axis, out, 2.0 * M_PI * f,
-                                &re, &im, err);
+            rc = ts_response_at(sys, lin, col, out, 2.0 * M_PI * f, &re, &im,
+                                err);
             c->pred_ratio = hypot(re, im);
             c->pred_phase_deg = atan2(im, re) * 180.0 / M_PI;
+            snprintf(c->input, sizeof c->input, "%s",
+                     s->axis == TS_AXIS_INPUT ? s->input
+                                              : ts_axis_name(s->axis));
+            ratio_unit(c, lin->input_unit[col]);
         }
-    } else {
-        c->pred_ratio = c->pred_phase_deg = NAN;
-        c->exc_amplitude = c->exc_frequency_hz = c->exc_fit_amplitude = NAN;
     }
     if (!rc) {
         run_stats(tt, xl, n, c->equilibrium, c->periodic, f, exc_amp,

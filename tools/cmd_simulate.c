@@ -276,21 +276,15 @@ static void print_compare(const ts_compare *c, const ts_display *d)
 {
     char u[64], ru[160], label[192], eu[64];
     double k = ts_display_convert(d, c->output.si_unit, 1.0, u, sizeof u);
-    char gain[16];
-    snprintf(gain, sizeof gain, "%s/m", c->output.si_unit);
-    double kr = ts_display_convert(d, !strcmp(c->output.si_unit, "m")
-                                          ? "m/m" : gain,
-                                   1.0, ru, sizeof ru);
-    double ke = ts_display_convert(d, "m", 1.0, eu, sizeof eu);
-    /* A rotation of the ship: its amplitude an angle, the ratio the
-     * output per angle. */
-    int rot = c->exc_axis == TS_AXIS_ROLL || c->exc_axis == TS_AXIS_PITCH ||
-              c->exc_axis == TS_AXIS_YAW;
-    if (rot) {
-        snprintf(eu, sizeof eu, "%s", ts_display_unit(d, TS_QTY_ANGLE));
-        ke = ts_display_value(d, TS_QTY_ANGLE, 1.0);
-        kr = k / ke;
-        snprintf(ru, sizeof ru, "%s/%s", u, eu);
+    /* The ratio: the output's unit per the excited input's (m/m for a
+     * tow displacement, per an angle for a rotation of the ship or a
+     * fin, per N for a thrust); "-" without a periodic excitation. */
+    double kr = 1.0, ke = 1.0;
+    snprintf(ru, sizeof ru, "-");
+    snprintf(eu, sizeof eu, "-");
+    if (c->ratio_unit[0]) {
+        ke = ts_display_convert(d, c->input_unit, 1.0, eu, sizeof eu);
+        kr = ts_display_convert(d, c->ratio_unit, 1.0, ru, sizeof ru);
     }
     const char *tu = ts_display_unit(d, TS_QTY_TIME);
     printf("\ncomparison of %s over t = %.6g .. %.6g %s (%d samples; the "
@@ -298,9 +292,9 @@ static void print_compare(const ts_compare *c, const ts_display *d)
            c->output.name, ts_display_value(d, TS_QTY_TIME, c->t_from),
            ts_display_value(d, TS_QTY_TIME, c->t_to), tu, c->nsamples);
     if (c->periodic)
-        printf("excitation %s %s, amplitude %.6g %s, %.6g Hz\n",
-               ts_axis_name(c->exc_axis), ts_signal_type_name(c->exc_type),
-               ke * c->exc_amplitude, eu, c->exc_frequency_hz);
+        printf("excitation %s %s, amplitude %.6g %s, %.6g Hz\n", c->input,
+               ts_signal_type_name(c->exc_type), ke * c->exc_amplitude, eu,
+               c->exc_frequency_hz);
     printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
            "freq. response");
     snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
@@ -325,7 +319,7 @@ static void print_compare(const ts_compare *c, const ts_display *d)
            "nonlinear)\n", c->mean_difference_pct);
     if (!isfinite(c->rms_difference_ratio))
         printf("rms difference %.6g %s\n", k * c->rms_difference, u);
-    else if (!strcmp(c->output.si_unit, "m") && !rot)
+    else if (!strcmp(c->ratio_unit, "m/m"))
         printf("rms difference %.6g %s (%.4g %% of the excitation "
                "amplitude)\n", k * c->rms_difference, u,
                100 * c->rms_difference_ratio);
