@@ -122,13 +122,38 @@ static int lin_input(const ts_linear *lin, const ts_signal *s)
     return -1;
 }
 
-/* The input's unit and the ratio's, output per input, written as
- * ts_response's ("m/rad", "N/(m/s)"). */
-static void ratio_unit(ts_compare *c, const char *iu)
+/* The name and unit of lin's input col and the ratio's unit, output per
+ * input, written as ts_response's ("m/rad", "N/(m/s)"). */
+static void ratio_unit(ts_compare *c, const ts_linear *lin, int col)
 {
+    const char *iu = lin->input_unit[col];
+    snprintf(c->input, sizeof c->input, "%s", lin->input_name[col]);
     snprintf(c->input_unit, sizeof c->input_unit, "%s", iu);
     snprintf(c->ratio_unit, sizeof c->ratio_unit,
              strchr(iu, '/') ? "%s/(%s)" : "%s/%s", c->output.si_unit, iu);
+}
+
+/* The change du of the single step or ramp of ex (its only signal) once
+ * it has reached its final value at t (else NaN): its amplitude; a
+ * manoeuvre given as its final value (`absolute`) changes the system's
+ * speed or turn rate by that value less the base. */
+static double step_change(const ts_system *sys, const ts_excitation *ex,
+                          double t)
+{
+    if (ts_excitation_nsignals(ex) != 1)
+        return NAN;
+    const ts_signal *s = ts_excitation_signal(ex, 0);
+    double end = s->type == TS_SIGNAL_STEP   ? s->start + s->rise
+                 : s->type == TS_SIGNAL_RAMP ? s->start + s->duration + s->rise
+                                             : INFINITY;
+    if (!(t >= end))
+        return NAN;
+    double du = s->amplitude;
+    if (s->absolute && s->axis == TS_AXIS_SPEED)
+        du -= sys->tow.speed;
+    else if (s->absolute && s->axis == TS_AXIS_TURN_RATE)
+        du -= sys->tow.turn_rate;
+    return du != 0 ? du : NAN;
 }
 
 static void run_stats(const double *t, const double *x, int n, double eq,
@@ -144,6 +169,7 @@ static void run_stats(const double *t, const double *x, int n, double eq,
     }
     r->half_range = 0.5 * (hi - lo);
     r->amplitude = r->amplitude_ratio = r->phase_deg = NAN;
+    r->final_gain = NAN;
     r->mean_offset = sum / n - eq;
     if (!periodic || *rc)
         return;
@@ -220,7 +246,7 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
     int idx = 0, rc = TS_OK;
     c->periodic = ex && ts_compare_periodic(ex, &idx);
     double f = 0, exc_amp = NAN, exc_phase = 0;
-    c->pred_ratio = c->pred_phase_deg = NAN;
+    c->pred_ratio = c->pred_phase_deg = c->static_gain = NAN;
     c->exc_amplitude = c->exc_frequency_hz = c->exc_fit_amplitude = NAN;
     if (c->periodic) {
         const ts_signal *s = ts_excitation_signal(ex, idx);
@@ -263,17 +289,51 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
                                 err);
             c->pred_ratio = hypot(re, im);
             c->pred_phase_deg = atan2(im, re) * 180.0 / M_PI;
-            snprintf(c->input, sizeof c->input, "%s",
-                     s->axis == TS_AXIS_INPUT ? s->input
-                                              : ts_axis_name(s->axis));
-            ratio_unit(c, lin->input_unit[col]);
+            ratio_unit(c, lin, col);
         }
+    } else if (ex && isfinite(step_change(sys, ex, c->t_to))) {
+        const ts_signal *s = ts_excitation_signal(ex, 0);
+        int col = lin_input(lin, s);
+        ts_response *res = NULL;
+        /* Any frequency above 0: the static gain comes with it. */
+        double f1 = 1.0;
+        if (col >= 0)
+            rc = ts_response_compute(sys, lin, col, out, &f1, 1, &res, err);
+        /* A model singular at 0 Hz (an undamped neutral mode), or one
+         * whose response to this input is not formed (a turn rate needs
+         * the dense model), has no static gain here, but the runs still
+         * have their final values. */
+        if (col >= 0 && (rc == TS_ESINGULAR || rc == TS_EINVAL)) {
+            c->step = 1;
+            snprintf(c->static_note, sizeof c->static_note, "%s: %.200s",
+                     rc == TS_ESINGULAR ? "undefined" : "not available",
+                     err ? err->msg : "");
+            ts_err_clear(err);
+            rc = TS_OK;
+        } else if (!rc) {
+            c->step = 1;
+            c->static_gain = res->static_gain;
+            snprintf(c->static_note, sizeof c->static_note, "%s",
+                     res->static_note);
+        }
+        if (c->step) {
+            c->exc_axis = s->axis;
+            c->exc_type = s->type;
+            c->exc_amplitude = step_change(sys, ex, c->t_to);
+            ratio_unit(c, lin, col);
+        }
+        ts_response_free(res);
     }
     if (!rc) {
         run_stats(tt, xl, n, c->equilibrium, c->periodic, f, exc_amp,
                   exc_phase, &c->linear, err, &rc);
         run_stats(tt, xn, n, c->equilibrium, c->periodic, f, exc_amp,
                   exc_phase, &c->nonlinear, err, &rc);
+    }
+    if (!rc && c->step) {
+        c->linear.final_gain = (xl[n - 1] - c->equilibrium) / c->exc_amplitude;
+        c->nonlinear.final_gain =
+            (xn[n - 1] - c->equilibrium) / c->exc_amplitude;
     }
     if (!rc) {
         double ss = 0.0;

@@ -295,18 +295,31 @@ static void print_compare(const ts_compare *c, const ts_display *d)
         printf("excitation %s %s, amplitude %.6g %s, %.6g Hz\n", c->input,
                ts_signal_type_name(c->exc_type), ke * c->exc_amplitude, eu,
                c->exc_frequency_hz);
+    if (c->step)
+        printf("excitation %s %s, change %.6g %s (no amplitude or phase: "
+               "the gain is the output's final change over it)\n", c->input,
+               ts_signal_type_name(c->exc_type), ke * c->exc_amplitude, eu);
     printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
-           "freq. response");
-    snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
-    printf("%-30s", label);
-    cmp_cell(" %16.6g", kr * c->linear.amplitude_ratio);
-    cmp_cell(" %16.6g", kr * c->nonlinear.amplitude_ratio);
-    cmp_cell(" %16.6g", kr * c->pred_ratio);
-    printf("\n%-30s", "phase [deg]");
-    cmp_cell(" %16.4f", c->linear.phase_deg);
-    cmp_cell(" %16.4f", c->nonlinear.phase_deg);
-    cmp_cell(" %16.4f", c->pred_phase_deg);
-    printf("\n");
+           c->step ? "static gain" : "freq. response");
+    if (c->step) {
+        snprintf(label, sizeof label, "final-value gain [%s]", ru);
+        printf("%-30s", label);
+        cmp_cell(" %16.6g", kr * c->linear.final_gain);
+        cmp_cell(" %16.6g", kr * c->nonlinear.final_gain);
+        cmp_cell(" %16.6g", kr * c->static_gain);
+        printf("\n");
+    } else {
+        snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
+        printf("%-30s", label);
+        cmp_cell(" %16.6g", kr * c->linear.amplitude_ratio);
+        cmp_cell(" %16.6g", kr * c->nonlinear.amplitude_ratio);
+        cmp_cell(" %16.6g", kr * c->pred_ratio);
+        printf("\n%-30s", "phase [deg]");
+        cmp_cell(" %16.4f", c->linear.phase_deg);
+        cmp_cell(" %16.4f", c->nonlinear.phase_deg);
+        cmp_cell(" %16.4f", c->pred_phase_deg);
+        printf("\n");
+    }
     snprintf(label, sizeof label, "mean offset [%s]", u);
     printf("%-30s %16.6g %16.6g\n", label, k * c->linear.mean_offset,
            k * c->nonlinear.mean_offset);
@@ -326,6 +339,8 @@ static void print_compare(const ts_compare *c, const ts_display *d)
     else
         printf("rms difference %.6g %s (%.6g %s of excitation)\n",
                k * c->rms_difference, u, kr * c->rms_difference_ratio, ru);
+    if (c->step && c->static_note[0])
+        printf("static gain %s\n", c->static_note);
 }
 
 /* ---- pictures (--plot) ------------------------------------------------- */

@@ -573,5 +573,53 @@ ts simulate test/scenes/towing_sphere.yaml --links 4 --output sphere.z --compare
 [ -z "$why" ] && pass "a fin sine compared: ratios $lin, $nl m/deg, frequency response $pred m/deg (2e-4, 1 %), JSON in m/rad; a thrust's in m/N" ||
     fail "fin sine compared:$why"
 
+# A step compared: no amplitude or phase (null in the JSON), but each
+# run's final-value gain and the linear model's static gain, checked
+# against what the model must give: AURORA's depth loop has integral
+# action, so a 1 m set-point step ends 1 m deeper (gain 1 m/m) and a
+# constant wing offset is rejected (gain 0), in both runs to 1e-6 of the
+# step after 200 s (3e-8 measured) and in H(0) to 1e-8; with the loops
+# open a wing step settles at H(0), the linear run's final gain within
+# 1e-3 of it at 120 s (1e-4 measured: the slow pitch-depth mode still
+# settling), the nonlinear run within 1 %. A towing vehicle's thrust: H(0)
+# is the static gain `towstab response` prints.
+fresh
+why=""
+fg() { sed -n 's/^final-value gain \[[^]]*\] *//p' "$T/out"; }
+ts simulate "$A" --links 10 --excite aurora.depth.setpoint:step,amplitude=1m,start=1s,rise=2s \
+    --output aurora.depth --compare --t-end 200 --quiet --json "$T/o/s.json"
+read -r l n h <<<"$(fg)"
+awk -v l="$l" -v n="$n" -v h="$h" 'BEGIN { exit !(l != "" && h != "" &&
+    (l - 1) ^ 2 < 1e-12 && (n - 1) ^ 2 < 1e-12 && (h - 1) ^ 2 < 1e-16) }' ||
+    why="$why set point: exit $status, gains '$l' '$n' '$h' not 1;"
+grep -q '"ratio_unit": "m/m"' "$T/o/s.json" && grep -q '"final_gain": 0.99999' "$T/o/s.json" &&
+    grep -q '"static_gain": 0.99999' "$T/o/s.json" && grep -q '"amplitude_ratio": null' "$T/o/s.json" ||
+    why="$why set point JSON;"
+sp="$l $n $h"
+ts simulate "$A" --links 10 --excite aurora.wing:step,amplitude=1deg,start=1s,rise=2s \
+    --output aurora.depth --compare --t-end 200 --quiet
+read -r l n h <<<"$(fg)"
+awk -v l="$l" -v n="$n" -v h="$h" 'BEGIN { exit !(l != "" && h != "" &&
+    l ^ 2 < 1e-12 && n ^ 2 < 1e-12 && h ^ 2 < 1e-16) }' ||
+    why="$why wing, closed: exit $status, gains '$l' '$n' '$h' m/deg not 0;"
+ts simulate "$A" --links 10 --excite aurora.wing:step,amplitude=1deg,start=1s,rise=2s \
+    --open-loop --output aurora.depth --compare --t-end 120 --quiet
+grep -q '^excitation aurora.wing step, change 1 deg' "$T/out" || why="$why no step line;"
+read -r l n h <<<"$(fg)"
+awk -v l="$l" -v n="$n" -v h="$h" 'BEGIN { exit !(h < 0 &&
+    (l - h) ^ 2 < (1e-3 * h) ^ 2 && (n - h) ^ 2 < (0.01 * h) ^ 2) }' ||
+    why="$why wing, open: gains '$l' '$n' '$h' m/deg;"
+op="$l $n $h"
+ts simulate test/scenes/towing_sphere.yaml --links 4 --excite tug.thrust:step,amplitude=20N \
+    --output sphere.z --compare --t-end 60 --quiet
+read -r l n h <<<"$(fg)"
+"$TOWSTAB" response test/scenes/towing_sphere.yaml --links 4 --input tug.thrust \
+    --output sphere.z --points 2 >"$T/r" 2>&1
+g=$(sed -n 's/.*static gain \([0-9.e+-]*\) .*/\1/p' "$T/r")
+awk -v h="$h" -v g="$g" 'BEGIN { exit !(g < 0 && (h - g) ^ 2 < (1e-5 * g) ^ 2) }' ||
+    why="$why thrust: static gain '$h' m/N, response's '$g';"
+[ -z "$why" ] && pass "steps compared: final-value gains and H(0): set point $sp m/m (1), wing closed loop ~0, open $op m/deg; thrust H(0) $h = response's $g m/N" ||
+    fail "steps compared:$why"
+
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
