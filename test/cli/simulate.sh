@@ -618,7 +618,22 @@ read -r l n h <<<"$(fg)"
 g=$(sed -n 's/.*static gain \([0-9.e+-]*\) .*/\1/p' "$T/r")
 awk -v h="$h" -v g="$g" 'BEGIN { exit !(g < 0 && (h - g) ^ 2 < (1e-5 * g) ^ 2) }' ||
     why="$why thrust: static gain '$h' m/N, response's '$g';"
-[ -z "$why" ] && pass "steps compared: final-value gains and H(0): set point $sp m/m (1), wing closed loop ~0, open $op m/deg; thrust H(0) $h = response's $g m/N" ||
+th=$h
+# A speed manoeuvre to 2.6 m/s (from example 1's 8.345 ft/s): the
+# nonlinear run's final gain is the change of the equilibrium's sphere.z
+# between the two speeds over the change, to 0.5 % (4e-4 measured: the
+# run settling).
+ts simulate examples/kamman_ex1_submerged.yaml --compare --t-end 40 --output sphere.z \
+    --quiet --manoeuvre speed:to=2.6m/s,duration=1s
+read -r l n h <<<"$(fg)"
+z0=$("$TOWSTAB" equilibrium examples/kamman_ex1_submerged.yaml --quiet --json - 2>/dev/null |
+    sed -n 's/.*"z": \([0-9.e+-]*\).*/\1/p' | tail -1)
+z1=$("$TOWSTAB" equilibrium examples/kamman_ex1_submerged.yaml --speed 2.6m/s --quiet --json - 2>/dev/null |
+    sed -n 's/.*"z": \([0-9.e+-]*\).*/\1/p' | tail -1)
+awk -v n="$n" -v a="$z0" -v b="$z1" 'BEGIN { g = (b - a) / (2.6 - 8.345 * 0.3048)
+    exit !(n != "" && a != "" && (n - g) ^ 2 < (0.005 * g) ^ 2) }' ||
+    why="$why speed: final gain '$n' m/(m/s), equilibria $z0, $z1 m;"
+[ -z "$why" ] && pass "steps compared: final-value gains and H(0): set point $sp m/m (1), wing closed loop ~0, open $op m/deg; thrust H(0) $th = response's $g m/N; speed to 2.6 m/s $n m/(m/s) = the equilibria's" ||
     fail "steps compared:$why"
 
 echo "$npass passed, $nfail failed"
