@@ -1713,7 +1713,7 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         return rc;
     /* What the comparison will need. */
     int idx;
-    if (s->compare && ex && ts_excitation_periodic(ex, &idx)) {
+    if (s->compare && ex && ts_compare_periodic(ex, &idx)) {
         double f = ts_excitation_signal(ex, idx)->frequency;
         double period = 1.0 / f;
         if (o->dt_sample > period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD)
