@@ -491,11 +491,13 @@ status=$?
     grep -q 'file=[^ ]*libsundials_arkode' "$T/files" &&
     pass "simulate --integrator esdirk: loads towstab-sundials.so and ARKODE" ||
     fail "simulate --integrator esdirk (exit $status): $(grep -v 'file=' "$T/files" | head -c 300)"
-# A SUNDIALS module that cannot be loaded: esdirk fails naming the file and
-# the reason; rk8pd, which does not need it, runs.
+# A SUNDIALS module that cannot be loaded: esdirk fails, exit status 1 (a
+# fault of the installation, not bad input), naming the file, the reason
+# and the repair; rk8pd, which does not need it, runs.
 TOWSTAB_SUNDIALS_MODULE=$T/missing/towstab-sundials.so ts "${sim[@]}" --integrator esdirk
-[ $status -ne 0 ] && grep -qF "cannot load the SUNDIALS module $T/missing/towstab-sundials.so: $T/missing/towstab-sundials.so: cannot open shared object file" "$T/err" &&
-    pass "missing SUNDIALS module: esdirk exits $status naming the file and the reason" ||
+[ $status -eq 1 ] && grep -qF "cannot load the SUNDIALS module $T/missing/towstab-sundials.so: $T/missing/towstab-sundials.so: cannot open shared object file" "$T/err" &&
+    grep -qF "(TOWSTAB_SUNDIALS_MODULE): unset TOWSTAB_SUNDIALS_MODULE, or set it to the SUNDIALS module of this towstab" "$T/err" &&
+    pass "missing SUNDIALS module: esdirk exits 1 (an installation fault) naming the file, the reason and the repair" ||
     fail "missing SUNDIALS module: exit $status, $(head -c 400 "$T/err")"
 TOWSTAB_SUNDIALS_MODULE=$T/missing/towstab-sundials.so ts "${sim[@]}" --integrator rk8pd
 [ $status -eq 0 ] && pass "missing SUNDIALS module: rk8pd still runs" ||
