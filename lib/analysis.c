@@ -274,6 +274,21 @@ static ts_system *setup_system(const ts_system *sys, const ts_request *rq,
     const ts_setup *s = &rq->setup;
     if (check_setup(s, err) != TS_OK)
         return NULL;
+    /* A towing vehicle solves its speed and turn rate: the options
+     * would only move the solve's start (given by tow.speed in the
+     * scene, or --set). */
+    static const char *const own[2] = {"speed", "turn_rate"};
+    static const char *const why[2] = {
+        "the run would not be at the speed given",
+        "the run would not turn at the rate given"};
+    double given[2] = {s->speed, s->turn_rate};
+    for (int k = 0; k < 2; k++)
+        if (!isnan(given[k]) &&
+            ts_param_solved(sys, k ? "tow.turn_rate" : "tow.speed", why[k],
+                            "set", err) != TS_OK) {
+            ts_err_prefix(err, "%s: ", own[k]);
+            return NULL;
+        }
     ts_system *c = ts_system_copy(sys, err);
     if (!c)
         return NULL;

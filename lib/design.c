@@ -358,6 +358,11 @@ int ts_design_check(const ts_system *sys, const ts_design_spec *sp,
         int rc = ts_param_canonical(f->path, canon, sizeof canon, err);
         if (!rc)
             rc = ts_param_unit(sys, canon, unit, sizeof unit, err);
+        /* A towing vehicle's solved speed or turn rate: a flat
+         * direction the optimiser would move along without effect. */
+        if (!rc)
+            rc = ts_param_solved(sys, canon, "the result would not change "
+                                 "with it", "free", err);
         if (rc) {
             ts_err_prefix(err, "free: ");
             return rc;

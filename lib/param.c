@@ -1108,3 +1108,37 @@ int ts_param_set(ts_system *sys, const char *path, double value,
     }
     return TS_OK;
 }
+
+int ts_param_solved(const ts_system *sys, const char *canon, const char *why,
+                    const char *verb, ts_err *err)
+{
+    if (sys->tow.vehicle < 0)
+        return TS_OK;
+    const ts_body *b = &sys->bodies[sys->tow.vehicle];
+    if (!strcmp(canon, "tow.speed")) {
+        ts_propulsion_type t = b->vehicle->propulsion.type;
+        const char *key = t == TS_PROP_POWER   ? "power"
+                          : t == TS_PROP_SPEED ? "speed"
+                                               : "thrust";
+        const char *what =
+            t == TS_PROP_POWER   ? "its power: the speed is solved at it"
+            : t == TS_PROP_SPEED ? "its speed controller's set speed, which "
+                                   "the steady speed equals"
+                                 : "its thrust: the speed is solved at it";
+        return ts_fail(err, TS_EINVAL, "tow.speed: the towing vehicle '%s' "
+                       "solves its speed from its propulsion, and tow.speed "
+                       "is only the solve's start value (%s); %s "
+                       "towing_vehicle.propulsion.%s (%s)", b->name, why,
+                       verb, key, what);
+    }
+    if (!strcmp(canon, "tow.turn_rate") && sys->tow.turn_surface < 0)
+        return ts_fail(err, TS_EINVAL, "tow.turn_rate: the towing vehicle "
+                       "'%s' solves its turn rate at its control "
+                       "deflections, and tow.turn_rate is only the solve's "
+                       "start value (%s); give it `turn_by: <rudder>` in the "
+                       "scene (the rudder's deflection is then solved at the "
+                       "turn rate), or %s "
+                       "towing_vehicle.components.<rudder>.deflection",
+                       b->name, why, verb);
+    return TS_OK;
+}

@@ -83,6 +83,7 @@
 #include "towstab/linearize.h"
 #include "towstab/kernel.h"
 #include "towstab/output.h"
+#include "towstab/param.h"
 #include "towstab/response.h"
 #include "towstab/scene.h"
 #include "towstab/towing.h"
@@ -1740,6 +1741,82 @@ static void test_static_gain(void)
     static_case(3.0, finite, 6, drift + 2, 1);
 }
 
+/* ---- tow.speed and tow.turn_rate of a towing vehicle ---------------- */
+
+/* With a towing vehicle they are only the start values of the speed and
+ * turn rate its equilibrium solves: ts_param_solved names the key that
+ * sets each for the scene's propulsion law (or turn_by), nothing for a
+ * scene without one; the setup's speed and turn rate are refused, a set
+ * tow.speed (the scene's start value written over) is not. */
+static void test_solved_keys(void)
+{
+    static const struct {
+        const char *prop, *key;
+    } laws[] = {{"thrust: 1500 N", "towing_vehicle.propulsion.thrust ("},
+                {"speed: 3 m/s, gain: 2000 N*s/m",
+                 "towing_vehicle.propulsion.speed (its speed controller"}};
+    for (size_t l = 0; l < sizeof laws / sizeof laws[0]; l++) {
+        ts_scene *sc = tow_scene(laws[l].prop, 0.0, 4);
+        CHECK(sc, "solved keys: scene %s", laws[l].prop);
+        if (!sc)
+            continue;
+        const ts_system *sys = sc->system;
+        ts_err err = {0};
+        int rc = ts_param_solved(sys, "tow.speed", "WHY", "VERB", &err);
+        CHECK(rc == TS_EINVAL && strstr(err.msg, laws[l].key) &&
+                  strstr(err.msg, "(WHY); VERB "),
+              "%s: tow.speed is solved, naming %s: %d %s", laws[l].prop,
+              laws[l].key, rc, err.msg);
+        ts_err_clear(&err);
+        rc = ts_param_solved(sys, "tow.turn_rate", "WHY", "VERB", &err);
+        CHECK(rc == TS_EINVAL && strstr(err.msg, "turn_by: <rudder>"),
+              "%s: tow.turn_rate is solved, naming turn_by: %d %s",
+              laws[l].prop, rc, err.msg);
+        CHECK(ts_param_solved(sys, "cables.cable.length", "", "", NULL) ==
+                  TS_OK, "%s: a cable's length is no solved value",
+              laws[l].prop);
+        ts_request rq;
+        ts_request_init(&rq, TS_ANALYSIS_EQUILIBRIUM);
+        rq.setup.speed = 2.0;
+        ts_err_clear(&err);
+        rc = ts_analysis_check(sys, &rq, &err);
+        CHECK(rc == TS_EINVAL && !strncmp(err.msg, "speed: tow.speed: ", 18)
+                  && strstr(err.msg, laws[l].key),
+              "%s: the setup's speed refused: %d %s", laws[l].prop, rc,
+              err.msg);
+        rq.setup.speed = NAN;
+        rq.setup.turn_rate = 0.01;
+        ts_err_clear(&err);
+        rc = ts_analysis_check(sys, &rq, &err);
+        CHECK(rc == TS_EINVAL && !strncmp(err.msg, "turn_rate: ", 11),
+              "%s: the setup's turn rate refused: %d %s", laws[l].prop, rc,
+              err.msg);
+        rq.setup.turn_rate = NAN;
+        ts_err_clear(&err);
+        rc = ts_setup_set(&rq.setup, "speed", 2.0, &err);
+        if (rc == TS_OK)
+            rc = ts_analysis_check(sys, &rq, &err);
+        CHECK(rc == TS_OK, "%s: a set tow.speed (the start value) is "
+              "taken: %d %s", laws[l].prop, rc, err.msg);
+        ts_request_clear(&rq);
+        ts_scene_free(sc);
+    }
+    /* No towing vehicle: the scene's speed and turn rate are the run's. */
+    ts_scene *sc = scene("name: plain\ntow: {speed: 3 m/s}\n%s"
+                         "bodies:\n  - {name: sphere, type: sphere, "
+                         "diameter: 0.5 m, wet_weight: 500 N}\n",
+                         "cables:\n  - {name: cable, from: tow, to: sphere, "
+                         "length: 50 m, diameter: 0.02 m, weight: 5 N/m, "
+                         "links: 4}\n");
+    CHECK(sc && ts_param_solved(sc->system, "tow.speed", "", "", NULL) ==
+                    TS_OK &&
+              ts_param_solved(sc->system, "tow.turn_rate", "", "", NULL) ==
+                  TS_OK,
+          "no towing vehicle: tow.speed and tow.turn_rate are no solved "
+          "values");
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     test_energy();
@@ -1755,5 +1832,6 @@ int main(void)
     test_neutral();
     test_labels();
     test_static_gain();
+    test_solved_keys();
     return tc_done();
 }

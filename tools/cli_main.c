@@ -133,6 +133,18 @@ int cli_prepare(cli_run *c)
     }
     if (rc)
         return cli_report(&err, rc);
+    /* tow.speed or tow.turn_rate set on a towing vehicle's scene: the
+     * start of the solve it is in the scene file, so it runs, with a
+     * word that the value is not the run's (doc/manual.md). */
+    for (int i = 0; i < c->rq.setup.nsets; i++) {
+        ts_err w = {0};
+        const char *path = c->rq.setup.sets[i].path;
+        if (ts_param_solved(c->scene->system, path, "the run's solve "
+                            "starts there and ends at the solved value",
+                            strcmp(path, "tow.speed") ? "to change the turn "
+                            "rate, set" : "to change the speed, set", &w))
+            fprintf(stderr, "towstab: warning: set: %s\n", w.msg);
+    }
     /* Long runs poll SIGINT and SIGTERM and show their progress. */
     c->rq.progress = cli_progress;
     return c->cmd->prepare ? c->cmd->prepare(c) : 0;

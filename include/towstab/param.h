@@ -95,6 +95,19 @@ TS_API int ts_param_set(ts_system *sys, const char *path, double value,
 TS_API int ts_param_canonical(const char *path, char *out, size_t size,
                               ts_err *err);
 
+/* Whether the canonical path `canon` is a value the towing vehicle of
+ * sys solves (doc/towing-vehicle.md section 3): tow.speed, solved from its
+ * propulsion, and tow.turn_rate, solved at its deflections unless
+ * `turn_by` names the surface deflected for it, are then only the start
+ * values of its equilibrium's V and Omega. TS_OK when it is not (no
+ * towing vehicle, another path); else TS_EINVAL with "CANON: the towing
+ * vehicle 'NAME' solves ..., and CANON is only the solve's start value
+ * (WHY); VERB <the key that sets it>", naming
+ * towing_vehicle.propulsion.thrust, .power or .speed (the scene's law),
+ * or turn_by. */
+TS_API int ts_param_solved(const ts_system *sys, const char *canon,
+                           const char *why, const char *verb, ts_err *err);
+
 #ifdef __cplusplus
 }
 #endif

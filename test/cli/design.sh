@@ -204,4 +204,24 @@ bad "no goal" "expected a target" "$EX1" $F
 bad "control_damping without modes" "no value 'control_damping'" "$EX1" $F --maximise control_damping
 bad "--fin-step in the wrong unit" "fin-step" "$EX1" $F --target sphere.z=15 --fin-step 2kg
 
+# A towing vehicle solves its speed (and turn rate): freeing tow.speed
+# would move nothing. Refused before any run, naming the key to free;
+# the key named does move it (a thrust that brings the pull to 2000 N,
+# within the target tolerance: 1e-6 of it, 0.002 N).
+DA=examples/dolphin_aurora.yaml
+rm -f "$T/tv.json"
+bad "tow.speed free on a towing vehicle" "free: tow.speed: .*free towing_vehicle.propulsion.thrust (" \
+    "$DA" --free tow.speed=3:6 --maximise top_tension --json "$T/tv.json"
+[ -e "$T/tv.json" ] && fail "tow.speed free on a towing vehicle wrote its JSON"
+bad "tow.turn_rate free on a towing vehicle" "free: tow.turn_rate: .*turn_by: <rudder>" \
+    "$DA" --free turn_rate=0:0.02 --maximise top_tension
+ts design "$DA" --free towing_vehicle.propulsion.thrust=4000:5000 --target "top_tension=2000 N" \
+    --links 6 --no-discretisation-error --json "$T/tv.json" --quiet
+t=$(json_num "$T/tv.json" top_tension)
+if [ "$status" -eq 0 ] && awk -v t="$t" 'BEGIN { d = t - 2000; exit !(t != "" && d <= 0.002 && d >= -0.002) }'; then
+    pass "the thrust named does set the pull: top_tension $t N at the target 2000 N"
+else
+    fail "design of the thrust: status $status, top_tension '$t', $(head -c 200 "$T/err")"
+fi
+
 finish

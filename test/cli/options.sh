@@ -168,6 +168,54 @@ for kv in "speed: -1" "manoeuvre: 'speed:to=-5,duration=1s'" "excite: ' ; '"; do
     refused "scene entry $kv" "analyses[0].$key (line" run "$T/e.yaml"
 done
 
+# A towing vehicle solves its speed and turn rate (tow.speed and
+# tow.turn_rate are the solve's start values): --speed and --turn-rate
+# (without turn_by) would not be the run's, refused naming the key that
+# sets each; a --set tow.speed runs from that start, with a warning, and
+# ends at the same solved speed.
+DA=examples/dolphin_aurora.yaml
+refused "--speed on a towing vehicle" "set towing_vehicle.propulsion.thrust (its thrust" equilibrium "$DA" --speed 5
+refused "--turn-rate on a towing vehicle" "turn_by: <rudder>" modes "$DA" --turn-rate 0.01
+if [ "$PLPLOT" = yes ]; then
+    refused "--overlay-speeds on a towing vehicle" "--overlay-speeds '4': speed: tow.speed" equilibrium "$DA" --overlay-speeds 4,5 --plot "$T/o/pics"
+fi
+sed '/^analyses:/,$d' "$DA" >"$T/da_entry.yaml"
+printf 'analyses:\n  - type: equilibrium\n    speed: 4\n' >>"$T/da_entry.yaml"
+refused "scene entry speed: 4 on a towing vehicle" "analyses[0].speed (line" run "$T/da_entry.yaml"
+q="--links 10 --no-discretisation-error --quiet"
+ts equilibrium "$DA" $q --json "$T/da.json"
+v0=$(jget "$T/da.json" speed)
+why="" vals=""
+for set in tow.speed=4.2 "speed=9.5 knot" tow.turn_rate=0.01; do
+    fresh
+    ts equilibrium "$DA" $q --set "$set" --json "$T/o/w.json"
+    v=$(jget "$T/o/w.json" speed) w=$(jget "$T/o/w.json" turn_rate)
+    key=${set%%=*}
+    [ "$key" = speed ] && key=tow.speed
+    [ "$status" -eq 0 ] || why="$why --set $set: exit $status;"
+    want="to change the speed, set towing_vehicle.propulsion.thrust ("
+    [ "$key" = tow.turn_rate ] && want="turn_by: <rudder>"
+    grep "^towstab: warning: set: $key: .*only the solve's start value" "$T/err" |
+        grep -qF -- "$want" || why="$why --set $set: no warning naming $want;"
+    # The solved speed whatever the start (4.2 m/s, 4.89 m/s, the scene's
+    # 5 m/s): equal to 1e-8 relative (the solver's error is 6e-10 m/s of
+    # 4.44); the symmetric vehicle, rudder amidships, goes straight.
+    awk -v a="$v" -v b="$v0" -v w="$w" 'BEGIN { d = a - b; if (d < 0) d = -d
+        if (w < 0) w = -w; exit !(a != "" && b > 0 && d <= 1e-8 * b && w < 1e-9) }' ||
+        why="$why --set $set: speed $v (from the scene's start $v0), turn rate $w;"
+    vals="$vals $set: $v m/s;"
+done
+check "--set tow.speed or tow.turn_rate on a towing vehicle: a warning, and the solved speed ($v0 m/s):$vals" "$why"
+# With turn_by the turn rate is the run's: --turn-rate taken, no warning.
+sed 's/^  name: dolphin$/  name: dolphin\n  turn_by: rudder_upper/' "$DA" >"$T/da_turn.yaml"
+ts equilibrium "$T/da_turn.yaml" $q --turn-rate 0.01 --json "$T/dt.json"
+w=$(jget "$T/dt.json" turn_rate)
+why=""
+[ "$status" -eq 0 ] || why="$why exit $status: $(head -c 200 "$T/err");"
+[ -s "$T/err" ] && why="$why stderr: $(head -c 200 "$T/err");"
+awk -v w="$w" 'BEGIN { exit !(w != "" && w - 0.01 < 1e-9 && 0.01 - w < 1e-9) }' || why="$why turn rate $w;"
+check "--turn-rate 0.01 with turn_by: taken, turn rate $w rad/s" "$why"
+
 # 6. Help and the reference come from the table.
 for cmd in equilibrium modes response simulate converge; do
     ts "$cmd" --help

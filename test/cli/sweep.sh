@@ -240,6 +240,21 @@ for spec in "$DA|speed=4:5:2|propulsion.thrust" \
         fail "--vary $vary on a towing vehicle: status $status, $(head -c 300 "$T/err")"
     fi
 done
+# The analysis' --speed and --turn-rate on such a scene, beside a --vary
+# of something else: refused the same way (exit 2, no file).
+for spec in "--speed|4|set towing_vehicle.propulsion.thrust (" \
+            "--turn-rate|0.01|turn_by: <rudder>"; do
+    IFS='|' read -r opt val want <<<"$spec"
+    rm -f "$T/tw.csv" "$T/tw.json"
+    ts sweep "$DA" "$opt" "$val" --vary towing_vehicle.propulsion.thrust=4000:5000:2 \
+        --csv "$T/tw.csv" --json "$T/tw.json"
+    if [ "$status" -eq 2 ] && grep -qF -- "$want" "$T/err" && grep -q "^towstab: error: $opt: " "$T/err" &&
+       [ ! -e "$T/tw.csv" ] && [ ! -e "$T/tw.json" ] && [ "$(wc -l <"$T/err")" -eq 1 ]; then
+        pass "sweep $opt $val on a towing vehicle refused, naming $want: $(head -c 120 "$T/err")"
+    else
+        fail "sweep $opt $val on a towing vehicle: status $status, $(head -c 300 "$T/err")"
+    fi
+done
 # The keys named do vary the motion: the set speed (more thrust at 5 m/s
 # than at 4), and tow.turn_rate with turn_by (more rudder at 0.02 rad/s).
 sed 's/^  name: dolphin$/  name: dolphin\n  turn_by: rudder_upper/' "$DA" >"$T/da_turn.yaml"
