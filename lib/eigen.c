@@ -212,12 +212,11 @@ static double rounding_change(const ts_linear *lin, const double *ur,
     return sqrt(0.5 * su * sv);
 }
 
-static void cand_add(cand_list *L, double complex lam, const double *vr,
-                     const double *vi, double cond, double resid,
-                     double dlam)
+/* The fields of a new candidate L->c[L->n] (its vector to be stored at
+ * column L->n); lam in the lower half plane is conjugated. */
+static cand *cand_new(cand_list *L, double complex lam, double cond,
+                      double resid, double dlam)
 {
-    if (L->n >= L->cap)
-        return;
     int sign = cimag(lam) < 0 ? -1 : 1;
     cand *c = &L->c[L->n];
     c->lam = sign > 0 ? lam : conj(lam);
@@ -232,9 +231,38 @@ static void cand_add(cand_list *L, double complex lam, const double *vr,
     c->checked = 0;
     c->neutral = -1;
     c->vec = L->n;
+    return c;
+}
+
+static void cand_add(cand_list *L, double complex lam, const double *vr,
+                     const double *vi, double cond, double resid,
+                     double dlam)
+{
+    if (L->n >= L->cap)
+        return;
+    int sign = cimag(lam) < 0 ? -1 : 1;
+    cand_new(L, lam, cond, resid, dlam);
     double complex *v = L->v + (size_t)L->n * L->nstate;
     for (int i = 0; i < L->nstate; i++)
         v[i] = vr[i] + I * (vi ? sign * vi[i] : 0.0);
+    L->n++;
+}
+
+/* cand_add with a complex vector z (ARPACK's complex runs): copied as it
+ * is, or conjugated with lam. */
+static void cand_add_complex(cand_list *L, double complex lam,
+                             const double complex *z)
+{
+    if (L->n >= L->cap)
+        return;
+    cand_new(L, lam, NAN, NAN, NAN);
+    double complex *v = L->v + (size_t)L->n * L->nstate;
+    if (cimag(lam) < 0) {
+        for (int i = 0; i < L->nstate; i++)
+            v[i] = conj(z[i]);
+    } else {
+        memcpy(v, z, (size_t)L->nstate * sizeof *v);
+    }
     L->n++;
 }
 
@@ -987,10 +1015,9 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
     double complex *workev = malloc(2 * (size_t)ncv * szc);
     double *rwork = malloc((size_t)ncv * sizeof(double));
     int *select = calloc((size_t)ncv, sizeof(int));
-    double *t1 = malloc(2 * (size_t)n * sizeof(double));
     int *used = calloc((size_t)(nev + 1), sizeof(int));
     if (!resid || !v || !workd || !workl || !d || !z || !workev || !rwork ||
-        !select || !t1 || !used) {
+        !select || !used) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
@@ -1062,13 +1089,7 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
     for (int j = 0; j < nconv; j++) {
         if (used[j] < 0)
             continue;
-        double complex *zj = z + (size_t)j * n;
-        double *re = t1, *im = t1 + n;
-        for (int i = 0; i < n; i++) {
-            re[i] = creal(zj[i]);
-            im[i] = cimag(zj[i]);
-        }
-        cand_add(L, d[j], re, im, NAN, NAN, NAN);
+        cand_add_complex(L, d[j], z + (size_t)j * n);
     }
 out:
     tsi_shift_free(&sh);
@@ -1081,7 +1102,6 @@ out:
     free(workev);
     free(rwork);
     free(select);
-    free(t1);
     free(used);
     return rc;
 }
