@@ -1342,6 +1342,13 @@ static int rightmost_search(const ts_linear *lin, const ts_eigen_opts *o,
     for (int i = 0; i < ns; i++)
         if (nu == 0 || seed[i] > seed[nu - 1] * (1 + SWEEP_SEED_RTOL))
             seed[nu++] = seed[i];
+    /* Room for every run's eigenvalues at once: the vectors are tens of
+     * MB, and each growth copies them all. */
+    if (cand_grow(L, (nu + SWEEP_CLIMBS * SWEEP_STEPS) * (SWEEP_NEV + 1)) !=
+        TS_OK) {
+        free(top);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
     arpack_stats st = {0, 0, 0, 0};
     int rc = TS_OK, runs = 0;
     double run_re[64], run_w[64], run_r[64];
