@@ -60,8 +60,7 @@ typedef struct ts_eigen_opts {
                               model's error estimate (each Ritz value's
                               own error is then measured, ritz_error),
                               1e-10 otherwise; the rightmost search uses
-                              1e-3 (1e-6 without the error estimate) or
-                              this when looser */
+                              1e-6 or this when looser */
     int arpack_max_iter;   /* restarts; default 1000 */
     int vectors;           /* 1 (default): keep the right eigenvectors */
     int rightmost;         /* 1 (default): with arpack, also search the
