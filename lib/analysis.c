@@ -969,10 +969,13 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     if (m->free_vehicle && m->eigen.method == TS_EIG_ARPACK)
         return ts_fail(err, TS_EINVAL, "free_vehicle: needs every coupled "
                        "mode with its shape: eigen_method lapack or auto");
-    /* LAPACK needs the dense A at any size. */
+    /* LAPACK needs the dense A at any size; so do a towing vehicle's
+     * modes (its neutral modes are found in it). */
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
         lo.model = TS_LIN_BOTH;
+    if (r->sys->tow.vehicle >= 0 && lo.model == TS_LIN_AUTO)
+        lo.model = TS_LIN_DENSE;
     int rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc != TS_OK)
         return rc;
@@ -1710,7 +1713,7 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
         return rc;
     /* What the comparison will need. */
     int idx;
-    if (s->compare && ex && ts_excitation_periodic(ex, &idx)) {
+    if (s->compare && ex && ts_compare_periodic(ex, &idx)) {
         double f = ts_excitation_signal(ex, idx)->frequency;
         double period = 1.0 / f;
         if (o->dt_sample > period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD)
@@ -2698,6 +2701,9 @@ static int check_window(ts_result *r, const ts_request *rq, ts_err *err)
     if (!lin) {
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
+        /* A towing vehicle's modes come from the dense model. */
+        if (r->sys->tow.vehicle >= 0)
+            lo.model = TS_LIN_DENSE;
         lo.estimate_error = 0;
         ts_kernel *k = ts_kernel_alloc(r->sys, err);
         own = k ? ts_linear_alloc(k, err) : NULL;

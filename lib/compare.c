@@ -9,12 +9,15 @@
  * the response do not alias onto the fundamental, and a fit over a window
  * that is not a whole number of periods still returns the fundamental of
  * a pure sinusoid exactly (unlike a plain mean or a DFT bin). The linear
- * prediction is ts_response_at (response.c), the same algebra as
- * (i w I - A)^-1 (B_x + i w B_v - w^2 B_a) plus the tow feedthrough.
+ * prediction is ts_response_compute (response.c), the same algebra as
+ * (i w I - A)^-1 (B_x + i w B_v - w^2 B_a) plus the tow feedthrough, for
+ * the column of B the excitation drives (lin_input), whose unit makes
+ * the ratio's.
  */
 #include "towstab/compare.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -71,6 +74,88 @@ double ts_compare_wrap_deg(double d)
     return d;
 }
 
+int ts_compare_periodic(const ts_excitation *ex, int *index)
+{
+    if (ts_excitation_periodic(ex, index))
+        return 1;
+    int found = -1, n = ts_excitation_nsignals(ex);
+    for (int i = 0; i < n; i++) {
+        const ts_signal *s = ts_excitation_signal(ex, i);
+        if (s->type == TS_SIGNAL_SINE || s->type == TS_SIGNAL_CRANK ||
+            s->type == TS_SIGNAL_SUM) {
+            if (found >= 0 || s->type != TS_SIGNAL_SINE ||
+                s->axis != TS_AXIS_INPUT)
+                return 0;
+            found = i;
+        }
+    }
+    if (found < 0)
+        return 0;
+    *index = found;
+    return 1;
+}
+
+/* The column of lin's B that signal s drives: a tow axis' displacement or
+ * rotation, a manoeuvre's frame input, a vehicle's input by its name; -1
+ * when lin has none (a name it does not know). */
+static int lin_input(const ts_linear *lin, const ts_signal *s)
+{
+    switch (s->axis) {
+    case TS_AXIS_SURGE:
+    case TS_AXIS_SWAY:
+    case TS_AXIS_HEAVE:
+        return TS_IN_DISP + (int)s->axis;
+    case TS_AXIS_ROLL:
+    case TS_AXIS_PITCH:
+    case TS_AXIS_YAW:
+        return TS_IN_ROT + (int)(s->axis - TS_AXIS_ROLL);
+    case TS_AXIS_SPEED:
+        return lin->frame_input + TS_FRAME_SPEED;
+    case TS_AXIS_TURN_RATE:
+        return lin->frame_input + TS_FRAME_TURN_RATE;
+    case TS_AXIS_INPUT:
+        for (int j = TS_NINPUT; lin->input_name && j < lin->frame_input; j++)
+            if (!strcmp(lin->input_name[j], s->input))
+                return j;
+        return -1;
+    }
+    return -1;
+}
+
+/* The name and unit of lin's input col and the ratio's unit, output per
+ * input, written as ts_response's ("m/rad", "N/(m/s)"). */
+static void ratio_unit(ts_compare *c, const ts_linear *lin, int col)
+{
+    const char *iu = lin->input_unit[col];
+    snprintf(c->input, sizeof c->input, "%s", lin->input_name[col]);
+    snprintf(c->input_unit, sizeof c->input_unit, "%s", iu);
+    snprintf(c->ratio_unit, sizeof c->ratio_unit,
+             strchr(iu, '/') ? "%s/(%s)" : "%s/%s", c->output.si_unit, iu);
+}
+
+/* The change du of the single step or ramp of ex (its only signal) once
+ * it has reached its final value at t (else NaN): its amplitude; a
+ * manoeuvre given as its final value (`absolute`) changes the system's
+ * speed or turn rate by that value less the base. */
+static double step_change(const ts_system *sys, const ts_excitation *ex,
+                          double t)
+{
+    if (ts_excitation_nsignals(ex) != 1)
+        return NAN;
+    const ts_signal *s = ts_excitation_signal(ex, 0);
+    double end = s->type == TS_SIGNAL_STEP   ? s->start + s->rise
+                 : s->type == TS_SIGNAL_RAMP ? s->start + s->duration + s->rise
+                                             : INFINITY;
+    if (!(t >= end))
+        return NAN;
+    double du = s->amplitude;
+    if (s->absolute && s->axis == TS_AXIS_SPEED)
+        du -= sys->tow.speed;
+    else if (s->absolute && s->axis == TS_AXIS_TURN_RATE)
+        du -= sys->tow.turn_rate;
+    return du != 0 ? du : NAN;
+}
+
 static void run_stats(const double *t, const double *x, int n, double eq,
                       int periodic, double f, double exc_amp,
                       double exc_phase, ts_compare_run *r, ts_err *err,
@@ -84,6 +169,7 @@ static void run_stats(const double *t, const double *x, int n, double eq,
     }
     r->half_range = 0.5 * (hi - lo);
     r->amplitude = r->amplitude_ratio = r->phase_deg = NAN;
+    r->final_gain = NAN;
     r->mean_offset = sum / n - eq;
     if (!periodic || *rc)
         return;
@@ -157,17 +243,23 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
         }
     }
 
-    int idx, rc = TS_OK;
-    c->periodic = ex && ts_excitation_periodic(ex, &idx);
+    int idx = 0, rc = TS_OK;
+    c->periodic = ex && ts_compare_periodic(ex, &idx);
     double f = 0, exc_amp = NAN, exc_phase = 0;
+    c->pred_ratio = c->pred_phase_deg = c->static_gain = NAN;
+    c->exc_amplitude = c->exc_frequency_hz = c->exc_fit_amplitude = NAN;
     if (c->periodic) {
         const ts_signal *s = ts_excitation_signal(ex, idx);
         c->exc_axis = s->axis;
         c->exc_type = s->type;
         c->exc_amplitude = s->amplitude;
         c->exc_frequency_hz = f = s->frequency;
+        int col = lin_input(lin, s);
         double period = 1.0 / f, dt = (c->t_to - c->t_from) / (n - 1);
-        if (c->t_to - c->t_from < period * (1.0 - 1e-9))
+        if (col < 0)
+            rc = ts_fail(err, TS_EINVAL, "compare: the linear model has no "
+                         "input %s", s->input);
+        else if (c->t_to - c->t_from < period * (1.0 - 1e-9))
             rc = ts_fail(err, TS_EINVAL, "compare: the window %g..%g s is "
                          "shorter than one period (%g s) of the %g Hz "
                          "excitation; run longer or discard less",
@@ -178,8 +270,14 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
                          "per period) are needed", dt, f,
                          period / TS_COMPARE_MIN_SAMPLES_PER_PERIOD,
                          TS_COMPARE_MIN_SAMPLES_PER_PERIOD);
+        /* A tow axis: the history's input, the sum of every signal on
+         * it; a vehicle's input: its signal (the history keeps the tow
+         * inputs only). */
         for (int i = 0; i < n && !rc; i++)
-            xe[i] = nl->input[TS_NINPUT * (size_t)(first + i) + s->axis];
+            xe[i] = s->axis == TS_AXIS_INPUT
+                        ? ts_excitation_value(ex, idx, tt[i])
+                        : nl->input[TS_NINPUT * (size_t)(first + i) +
+                                    s->axis];
         double ce;
         if (!rc)
             rc = ts_compare_fit_sinusoid(tt, xe, n, f, &ce, &exc_amp,
@@ -187,20 +285,55 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
         c->exc_fit_amplitude = exc_amp;
         if (!rc) {
             double re, im;
-            rc = ts_response_at(sys, lin, (int)s->axis, out, 2.0 * M_PI * f,
-                                &re, &im, err);
+            rc = ts_response_at(sys, lin, col, out, 2.0 * M_PI * f, &re, &im,
+                                err);
             c->pred_ratio = hypot(re, im);
             c->pred_phase_deg = atan2(im, re) * 180.0 / M_PI;
+            ratio_unit(c, lin, col);
         }
-    } else {
-        c->pred_ratio = c->pred_phase_deg = NAN;
-        c->exc_amplitude = c->exc_frequency_hz = c->exc_fit_amplitude = NAN;
+    } else if (ex && isfinite(step_change(sys, ex, c->t_to))) {
+        const ts_signal *s = ts_excitation_signal(ex, 0);
+        int col = lin_input(lin, s);
+        ts_response *res = NULL;
+        /* Any frequency above 0: the static gain comes with it. */
+        double f1 = 1.0;
+        if (col >= 0)
+            rc = ts_response_compute(sys, lin, col, out, &f1, 1, &res, err);
+        /* A model singular at 0 Hz (an undamped neutral mode), or one
+         * whose response to this input is not formed (a turn rate needs
+         * the dense model), has no static gain here, but the runs still
+         * have their final values. */
+        if (col >= 0 && (rc == TS_ESINGULAR || rc == TS_EINVAL)) {
+            c->step = 1;
+            snprintf(c->static_note, sizeof c->static_note, "%s: %.200s",
+                     rc == TS_ESINGULAR ? "undefined" : "not available",
+                     err ? err->msg : "");
+            ts_err_clear(err);
+            rc = TS_OK;
+        } else if (!rc) {
+            c->step = 1;
+            c->static_gain = res->static_gain;
+            snprintf(c->static_note, sizeof c->static_note, "%s",
+                     res->static_note);
+        }
+        if (c->step) {
+            c->exc_axis = s->axis;
+            c->exc_type = s->type;
+            c->exc_amplitude = step_change(sys, ex, c->t_to);
+            ratio_unit(c, lin, col);
+        }
+        ts_response_free(res);
     }
     if (!rc) {
         run_stats(tt, xl, n, c->equilibrium, c->periodic, f, exc_amp,
                   exc_phase, &c->linear, err, &rc);
         run_stats(tt, xn, n, c->equilibrium, c->periodic, f, exc_amp,
                   exc_phase, &c->nonlinear, err, &rc);
+    }
+    if (!rc && c->step) {
+        c->linear.final_gain = (xl[n - 1] - c->equilibrium) / c->exc_amplitude;
+        c->nonlinear.final_gain =
+            (xn[n - 1] - c->equilibrium) / c->exc_amplitude;
     }
     if (!rc) {
         double ss = 0.0;

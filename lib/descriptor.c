@@ -184,7 +184,7 @@ void tsi_desc_free(ts_descriptor *d)
                       d->Lv,     d->Lerr,   d->hc,      d->hu,   d->rnoise,
                       d->rcolour, d->vcolour, d->hr,    d->hv,   d->Sp,
                       d->Si,     d->pos,    d->lvp_off, d->ov_off, d->Ov,
-                      d->Oerr,   d->onoise};
+                      d->Oerr,   d->onoise, d->Gt,   d->Gterr};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         free(arrays[i]);
     if (d->klu_symbolic)
@@ -280,10 +280,10 @@ static int build_pattern(ts_descriptor *d)
     d->pos_pg = d->pos_pm + 3 * (size_t)nl;
     d->pos_lv = d->pos_pg + 3 * (size_t)nl;
     size_t m = 0;
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             int j = d->bcol[b];
-            if (j == 0)
+            if (j < d->p0)
                 continue;
             for (int a = 0; a < 3; a++)
                 for (int c = 0; c < 3; c++)
@@ -298,7 +298,7 @@ static int build_pattern(ts_descriptor *d)
         for (int c = 0; c < 3; c++) {
             e[m++] = (entry){XT(l), XR(L->lower, c), base_n + 6 * l + c};
             e[m++] = (entry){XR(L->lower, c), XT(l), base_row + 6 * l + c};
-            if (L->upper > 0) {
+            if (L->upper >= d->p0) {
                 e[m++] = (entry){XT(l), XR(L->upper, c),
                                  base_n + 6 * l + 3 + c};
                 e[m++] = (entry){XR(L->upper, c), XT(l),
@@ -344,14 +344,32 @@ static int build_pattern(ts_descriptor *d)
     return TS_OK;
 }
 
+/* Whether the vehicles' controller states and inputs are disjoint
+ * blocks that, with the tow inputs, cover every one (each vehicle's
+ * local block then holds its own alone). */
+static int layouts_disjoint(const ts_descriptor *d)
+{
+    int nc = 0, nin = TS_NINPUT;
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *A = &d->vl[v];
+        nc += A->nc;
+        nin += A->nin;
+        for (int u = 0; u < v; u++) {
+            const tsi_vehicle_layout *B = &d->vl[u];
+            if (A->nc > 0 && B->nc > 0 && A->c0 < B->c0 + B->nc &&
+                B->c0 < A->c0 + A->nc)
+                return 0;
+            if (A->nin > 0 && B->nin > 0 && A->in0 < B->in0 + B->nin &&
+                B->in0 < A->in0 + A->nin)
+                return 0;
+        }
+    }
+    return nc == d->nc && nin == d->nin;
+}
+
 ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
 {
     const ts_system *sys = ts_kernel_system(kern);
-    if (ts_kernel_root(kern) >= 0) {
-        ts_fail(err, TS_EINVAL, "descriptor: a towing vehicle at the root "
-                "is not covered by the sparse model");
-        return NULL;
-    }
     ts_descriptor *d = calloc(1, sizeof *d);
     if (!d) {
         ts_fail(err, TS_ENOMEM, "descriptor: out of memory");
@@ -367,7 +385,10 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
     d->nstate = ts_kernel_nstate(kern);
     d->nc = ts_kernel_ncontrol(kern);
     d->nin = ts_kernel_ninput(kern);
-    d->nx = 4 * (nn - 1) + 3 * nv + d->nc;
+    d->root = ts_kernel_root(kern);
+    d->rdof = d->root >= 0 ? ts_kernel_root_dof(kern) : 0;
+    d->p0 = d->root >= 0 ? 0 : 1;
+    d->nx = 4 * (nn - 1) + 3 * nv + d->nc + (d->root >= 0 ? 3 : 0);
     size_t snp = (size_t)d->np, snl = (size_t)(nl > 0 ? nl : 1);
     size_t snv = (size_t)(nv > 0 ? nv : 1);
     int dist_r = sys->has_bending ? 2 : 1;
@@ -426,6 +447,13 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
             d->ncgroups = L->nc;
         if (L->nin > d->nugroups)
             d->nugroups = L->nin;
+    }
+    int disjoint = !ok || layouts_disjoint(d);
+    ok = ok && disjoint;
+    if (ok && d->root >= 0) {
+        size_t ng = TS_NINPUT * (3 * snp + (size_t)d->nc);
+        d->Gt = calloc(ng, sizeof(double));
+        ok = d->Gt != NULL;
     }
     if (ok) {
         d->Lv = calloc((size_t)d->lv_off[nv] + 1, sizeof(double));
@@ -489,6 +517,14 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
         klu_common *kc = malloc(sizeof *kc);
         d->klu_common = kc;
         ok = kc && klu_defaults(kc);
+        /* With a towing vehicle (node 0 free) AMD's symmetric ordering,
+         * made for pivots on the diagonal, let partial pivoting leave the
+         * rigid links' tension columns (zero on the diagonal) down the
+         * whole cable: on dolphin_aurora at 100 links the factors held
+         * 105 000 entries against S's 4384. COLAMD orders the columns
+         * for any row pivots: 7600 to 8800 there. */
+        if (ok && d->root >= 0)
+            kc->ordering = 1;
         if (ok && d->nx > 0) {
             d->klu_symbolic = klu_analyze(d->nx, d->Sp, d->Si, kc);
             ok = d->klu_symbolic != NULL;
@@ -503,11 +539,16 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
     free(bd);
     if (!ok) {
         tsi_desc_free(d);
-        ts_fail(err, TS_ENOMEM, "descriptor: out of memory for %d links",
-                nl);
+        if (!disjoint)
+            ts_fail(err, TS_EINVAL, "descriptor: a vehicle's controller "
+                    "states or inputs are not one block of its own");
+        else
+            ts_fail(err, TS_ENOMEM, "descriptor: out of memory for %d "
+                    "links", nl);
         return NULL;
     }
-    d->groups = 3 * (d->nrcolour + d->nvcolour) + d->ncgroups + d->nugroups;
+    d->groups = 3 * (d->nrcolour + d->nvcolour) + d->ncgroups + d->nugroups +
+                (d->root >= 0 ? TS_NINPUT : 0);
     return d;
 }
 
@@ -582,9 +623,14 @@ static int residual_at(const ts_descriptor *d, ts_kernel *k, const double *r,
     for (int v = 0; v < d->nv; v++) {
         int o = d->vl[v].qoff;
         for (int c = 0; c < 3; c++) {
-            y[o + c] = r[3 * (d->nn + v) + c];
-            y[d->nq + o + c] = pv[3 * (d->nn + v) + c];
             thdd[3 * v + c] = d->a0[3 * (d->nn + v) + c];
+            /* A surface ship's one angle is its yaw (its roll and pitch
+             * are held at 0). */
+            if (v == d->root && d->rdof == 3 && c < 2)
+                continue;
+            int q = v == d->root && d->rdof == 3 ? o : o + c;
+            y[q] = r[3 * (d->nn + v) + c];
+            y[d->nq + q] = pv[3 * (d->nn + v) + c];
         }
     }
     return tsi_kernel_residual(k, r, pv, d->a0, d->t0, d->nv > 0 ? y : NULL,
@@ -686,13 +732,36 @@ static int local_group(ts_descriptor *d, grp_ws *w, int kind, int m,
     return TS_OK;
 }
 
+/* A towing vehicle's tow input j alone: its column of Gt over every row
+ * (the points stay; what the input moves, the residual says). */
+static int tow_group(ts_descriptor *d, grp_ws *w, int j, int estimate)
+{
+    int nev = estimate ? 4 : 2, rc = TS_OK;
+    for (int s = 0; s < nev && rc == TS_OK; s++) {
+        w->u[j] = d->u0[j] + mult[s] * d->hu[j];
+        rc = group_eval(d, w, s);
+    }
+    w->u[j] = d->u0[j];
+    if (rc != TS_OK)
+        return rc;
+    size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
+    double *G = d->Gt + (size_t)j * nrow;
+    double *E = d->Gterr ? d->Gterr + (size_t)j * nrow : NULL;
+    for (size_t i = 0; i < nrow; i++)
+        central(w->R, i, d->hu[j], G + i, E ? E + i : NULL);
+    return TS_OK;
+}
+
 /* Group g: kind (0 position, 1 velocity), colour, component; after them
- * the controller and input groups. Evaluates the residual at the
+ * the controller and input groups, then a towing vehicle's tow inputs. Evaluates the residual at the
  * perturbed states and writes the columns of the group's points into K
  * or C, and the controller rows' (and the error estimate). */
 static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
 {
     int nr = 3 * d->nrcolour, nv3 = 3 * d->nvcolour;
+    int nlocal = d->ncgroups + d->nugroups;
+    if (g >= nr + nv3 + nlocal)
+        return tow_group(d, w, g - nr - nv3 - nlocal, estimate);
     if (g >= nr + nv3) {
         int m = g - nr - nv3;
         return m < d->ncgroups ? local_group(d, w, 2, m, estimate)
@@ -725,7 +794,7 @@ static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
         double hj = h[3 * j + comp];
         for (int b = d->bptr[j]; b < d->bptr[j + 1]; b++) {
             int k = d->bcol[b];
-            if (k == 0)
+            if (k < d->p0)
                 continue;
             /* A velocity reaches one link only: farther blocks of C are
              * zero, and their rows may see another point of the colour. */
@@ -826,9 +895,9 @@ static int residual_noise(ts_descriptor *d, ts_kernel *k)
             size_t j = i < n3 ? i : i - n3;
             double *x = i < n3 ? r : v, *dx = i < n3 ? dr : dv;
             const double *x0 = i < n3 ? d->r0 : d->v0;
-            /* The tow point stays: at the waterline its columns are
-             * kinked (counted as kink_tow), not noisy. */
-            double h = j < 3 ? 0.0 : (i < n3 ? d->hr : d->hv)[j];
+            /* A prescribed tow point stays: at the waterline its columns
+             * are kinked (counted as kink_tow), not noisy. */
+            double h = j < 3 && d->root < 0 ? 0.0 : (i < n3 ? d->hr : d->hv)[j];
             x[j] = x0[j] + sg * NOISE_REL * h;
             dx[j] = x[j] - x0[j]; /* exactly what was added */
         }
@@ -837,7 +906,7 @@ static int residual_noise(ts_descriptor *d, ts_kernel *k)
         tsi_desc_block_mul(d, d->K, dr, f, 0);
         tsi_desc_block_mul(d, d->C, dv, f, 1);
         tsi_desc_local_mul(d, dr, dv, dc, NULL, f + n3, f, 0);
-        for (size_t i = 3; i < nr; i++) {
+        for (size_t i = 3 * (size_t)d->p0; i < nr; i++) {
             double e = R[i] - R0[i] - f[i];
             acc[i] += e * e;
         }
@@ -859,7 +928,7 @@ static int residual_noise(ts_descriptor *d, ts_kernel *k)
             d->rnoise[i] = sqrt(acc[i] / (2.0 * used));
         for (int i = 0; i < d->nout; i++)
             d->onoise[i] = sqrt(oacc[i] / (2.0 * used));
-        for (int kk = 1; kk < d->np; kk++)
+        for (int kk = d->p0; kk < d->np; kk++)
             for (int b = d->bptr[kk]; b < d->bptr[kk + 1]; b++) {
                 int j = d->bcol[b];
                 for (int a = 0; a < 3; a++)
@@ -915,7 +984,7 @@ void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
     double complex t = 0;
     double r2 = 0, as2 = abs2(s);
     const double complex *xc = x + 3 * (size_t)d->np;
-    for (int k = 1; k < d->np; k++) {
+    for (int k = d->p0; k < d->np; k++) {
         double complex e[3] = {0, 0, 0};
         double xk = 0;
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
@@ -987,6 +1056,56 @@ void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
     *round = sqrt(0.5 * r2);
 }
 
+/* A surface ship's held components (tsi_desc_held): their rows' K the
+ * identity, their C, inertia, tension coefficients, local blocks, tow
+ * input columns, errors and noise zero, so that every product with them
+ * gives 0 there and S(s), S_inf hold them at 0. */
+static void hold_rows(ts_descriptor *d)
+{
+    size_t n3 = 3 * (size_t)d->np, nrow = n3 + (size_t)d->nc;
+    for (int k = 0; k < d->np; k++)
+        for (int a = 0; a < 3; a++) {
+            if (!tsi_desc_held(d, k, a))
+                continue;
+            for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++)
+                for (int c = 0; c < 3; c++) {
+                    size_t i = 9 * (size_t)b + 3 * (size_t)a + (size_t)c;
+                    d->K[i] = d->bcol[b] == k && c == a ? 1.0 : 0.0;
+                    d->C[i] = 0.0;
+                    if (d->Kerr) {
+                        d->Kerr[i] = 0.0;
+                        d->Cerr[i] = 0.0;
+                    }
+                }
+            size_t i = 3 * (size_t)k + (size_t)a;
+            for (int j = 0; j < TS_NINPUT; j++) {
+                d->Gt[(size_t)j * nrow + i] = 0.0;
+                if (d->Gterr)
+                    d->Gterr[(size_t)j * nrow + i] = 0.0;
+            }
+            if (d->rnoise)
+                d->rnoise[i] = 0.0;
+        }
+    const tsi_vehicle_layout *L = &d->vl[d->root];
+    int ncol = TSI_LV_C + L->nc + L->nin;
+    double *Mv = d->Mv + 36 * d->root;
+    /* Local rows: node 0's z (2), roll (3) and pitch (4). */
+    static const int held_lr[3] = {2, 3, 4};
+    for (int h = 0; h < 3; h++) {
+        int lr = held_lr[h];
+        for (int c = 0; c < 6; c++)
+            Mv[6 * lr + c] = 0.0;
+        for (int c = 0; c < ncol; c++) {
+            d->Lv[d->lv_off[d->root] + lr * ncol + c] = 0.0;
+            if (d->Lerr)
+                d->Lerr[d->lv_off[d->root] + lr * ncol + c] = 0.0;
+        }
+    }
+    for (int l = 0; l < d->nl; l++)
+        if (d->sys->links[l].upper == 0)
+            d->pm[3 * l] = d->pm[3 * l + 1] = 0.0;
+}
+
 int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
                        const double u0[], const double f0[], double rel_step,
                        int estimate, int threads, ts_err *err)
@@ -1006,9 +1125,13 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
     for (int v = 0; v < d->nv; v++) {
         int o = d->vl[v].qoff;
         for (int c = 0; c < 3; c++) {
-            d->r0[3 * (nn + v) + c] = y0[o + c];
-            d->v0[3 * (nn + v) + c] = y0[d->nq + o + c];
-            d->a0[3 * (nn + v) + c] = f0[d->nq + o + c];
+            /* A surface ship: roll and pitch 0, its yaw at o. */
+            int ship = v == d->root && d->rdof == 3;
+            int q = ship ? o : o + c;
+            int held = ship && c < 2;
+            d->r0[3 * (nn + v) + c] = held ? 0.0 : y0[q];
+            d->v0[3 * (nn + v) + c] = held ? 0.0 : y0[d->nq + q];
+            d->a0[3 * (nn + v) + c] = held ? 0.0 : f0[d->nq + q];
         }
     }
     /* The kernel's link directions, not d / |d| of the positions: the maps
@@ -1035,16 +1158,21 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
     }
     size_t nlv = (size_t)d->lv_off[d->nv] + 1;
     size_t nov = (size_t)d->ov_off[d->nv] + 1;
-    if (estimate && (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr)) {
+    size_t ngt = d->root >= 0 ? TS_NINPUT * nr : 0;
+    if (estimate && (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr ||
+                     (ngt > 0 && !d->Gterr))) {
         free(d->Kerr);
         free(d->Cerr);
         free(d->Lerr);
         free(d->Oerr);
+        free(d->Gterr);
         d->Kerr = calloc(9 * (size_t)d->nblocks, sizeof(double));
         d->Cerr = calloc(9 * (size_t)d->nblocks, sizeof(double));
         d->Lerr = calloc(nlv, sizeof(double));
         d->Oerr = calloc(nov, sizeof(double));
-        if (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr)
+        d->Gterr = ngt > 0 ? calloc(ngt, sizeof(double)) : NULL;
+        if (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr ||
+            (ngt > 0 && !d->Gterr))
             return ts_fail(err, TS_ENOMEM, "descriptor: out of memory for "
                            "the error estimate");
     }
@@ -1058,9 +1186,11 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
         free(d->Cerr);
         free(d->Lerr);
         free(d->Oerr);
+        free(d->Gterr);
         free(d->rnoise);
         free(d->onoise);
         d->Kerr = d->Cerr = d->Lerr = d->Oerr = d->rnoise = d->onoise = NULL;
+        d->Gterr = NULL;
     }
     /* Steps. */
     ts_frame fr;
@@ -1116,6 +1246,10 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
         return ts_fail(err, rc, "descriptor: the residual fails at the base "
                        "state (%s)", ts_strerror(rc));
     memcpy(d->M, tsi_kernel_mass(k), 6 * (size_t)nn * sizeof(double));
+    if (d->root >= 0)
+        /* Node 0 is the towing vehicle's attach point: its inertia is
+         * the body's (Mv), and no node's. */
+        memset(d->M, 0, 6 * sizeof(double));
     for (int v = 0; v < d->nv; v++)
         tsi_kernel_vehicle_mass(k, v, d->Mv + 36 * v);
     for (int l = 0; l < nl; l++)
@@ -1172,6 +1306,8 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
                            "noise (%s)", ts_strerror(rc));
         d->evaluations += 1 + NOISE_SAMPLES;
     }
+    if (d->rdof == 3)
+        hold_rows(d);
     d->k_scale = d->c_scale = d->k_err = d->c_err = 0.0;
     for (size_t i = 0; i < 9 * (size_t)d->nblocks; i++) {
         d->k_scale = fmax(d->k_scale, fabs(d->K[i]));
@@ -1231,21 +1367,42 @@ void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
     links_from_nodes(sys, lin, dr, dq, 0);
 }
 
+/* The coordinate of component c of vehicle v's angle point in q, -1 for
+ * a surface ship's held roll and pitch. */
+static int angle_coordinate(const ts_descriptor *d, int v, int c)
+{
+    if (v == d->root && d->rdof == 3)
+        return c == 2 ? d->vl[v].qoff : -1;
+    return d->vl[v].qoff + c;
+}
+
 void tsi_desc_to_points(const ts_descriptor *d, const ts_linear *lin,
                         const double dq[], double p[])
 {
     ts_linear_node_displacements(d->sys, lin, dq, p);
     for (int v = 0; v < d->nv; v++)
-        for (int c = 0; c < 3; c++)
-            p[3 * (d->nn + v) + c] = dq[d->vl[v].qoff + c];
+        for (int c = 0; c < 3; c++) {
+            int q = angle_coordinate(d, v, c);
+            p[3 * (d->nn + v) + c] = q >= 0 ? dq[q] : 0.0;
+        }
 }
 
 void tsi_desc_from_points(const ts_descriptor *d, const ts_linear *lin,
                           const double p[], double dq[])
 {
     for (int v = 0; v < d->nv; v++)
-        for (int c = 0; c < 3; c++)
-            dq[d->vl[v].qoff + c] = p[3 * (d->nn + v) + c];
+        for (int c = 0; c < 3; c++) {
+            int q = angle_coordinate(d, v, c);
+            if (q >= 0)
+                dq[q] = p[3 * (d->nn + v) + c];
+        }
+    if (d->root >= 0) {
+        /* The towing vehicle's position: node 0's displacement (a surface
+         * ship's x and y). */
+        int ro = lin->root_qoff, npos = d->rdof == 3 ? 2 : 3;
+        for (int c = 0; c < npos; c++)
+            dq[ro + c] = p[c];
+    }
     links_from_nodes(d->sys, lin, p, dq, 1);
 }
 
@@ -1254,7 +1411,7 @@ void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
 {
     if (!acc)
         y[0] = y[1] = y[2] = 0.0;
-    for (int k = 1; k < d->np; k++) {
+    for (int k = d->p0; k < d->np; k++) {
         double s0 = 0, s1 = 0, s2 = 0;
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             const double *blk = B + 9 * (size_t)b, *xj = x + 3 * d->bcol[b];
@@ -1397,17 +1554,24 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
             }                                                                 \
         }                                                                     \
     } while (0)
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
             int j = d->bcol[b];
-            if (j == 0)
+            if (j < d->p0)
                 continue;
             const double *Kb = d->K + 9 * (size_t)b, *Cb = d->C + 9 * (size_t)b;
             for (int a = 0; a < 3; a++)
-                for (int c = 0; c < 3; c++)
+                for (int c = 0; c < 3; c++) {
+                    if (tsi_desc_held(d, k, a)) {
+                        /* An identity row, in S_inf too. */
+                        PUT(d->pos_blk[9 * b + 3 * a + c],
+                            j == k && c == a ? 1.0 : 0.0, 0.0, 0.0);
+                        continue;
+                    }
                     PUT(d->pos_blk[9 * b + 3 * a + c],
                         inf ? 0.0 : Kb[3 * a + c], inf ? 0.0 : Cb[3 * a + c],
                         inertia_at(d, k, a, j, c));
+                }
         }
     for (int l = 0; l < d->nl; l++) {
         const ts_link *L = &sys->links[l];
@@ -1421,8 +1585,9 @@ static void fill(const ts_descriptor *d, double complex s, int inf,
         for (int c = 0; c < 3; c++) {
             PUT(d->pos_n[6 * l + c], n[c], 0.0, 0.0);
             PUT(d->pos_row[6 * l + c], gk * n[c], gc * n[c], 0.0);
-            if (L->upper > 0) {
-                PUT(d->pos_n[6 * l + 3 + c], -n[c], 0.0, 0.0);
+            if (L->upper >= d->p0) {
+                PUT(d->pos_n[6 * l + 3 + c],
+                    tsi_desc_held(d, L->upper, c) ? 0.0 : -n[c], 0.0, 0.0);
                 PUT(d->pos_row[6 * l + 3 + c], -gk * n[c], -gc * n[c], 0.0);
             }
             if (d->pos_pm[3 * l + c] >= 0) {

@@ -45,8 +45,18 @@
  * as a point beside its node, with blocks of K and C like a node's; its
  * inertia couples its node's acceleration and its angle accelerations
  * (Mv); its controller states, inputs and outputs are small dense local
- * blocks (Lv, Ov) on its node and angles. A towing vehicle at the root is
- * not covered (its tow point is free).
+ * blocks (Lv, Ov) on its node and angles.
+ *
+ * A towing vehicle at the root (doc/linear.md, section 2c) is a vehicle
+ * whose node is node 0, the tow point, which is then free: its
+ * displacement takes the three unknowns after the controller states, and
+ * node 0's rows are the body's translational equations. A surface ship
+ * (3 degrees of freedom) keeps the same points; the components it holds
+ * (node 0's z, the roll and pitch of its angles) get identity rows
+ * (their displacement is 0) and no inertia, no loads, no error. The tow
+ * inputs then move the points the cables start from relative to the
+ * body: their columns (Gt) are the residual's central differences, at
+ * fixed points, over every row.
  */
 #ifndef TOWSTAB_DESCRIPTOR_H
 #define TOWSTAB_DESCRIPTOR_H
@@ -82,7 +92,17 @@ struct ts_descriptor {
     int nc, nin;         /* controller states, inputs (ts_kernel_ninput) */
     tsi_vehicle_layout *vl; /* [nv] each vehicle's node, angles, controller
                             states and inputs */
-    int nx;              /* unknowns 4 (nn - 1) + 3 nv + nc */
+    int nx;              /* unknowns 4 (nn - 1) + 3 nv + nc (+ 3 with a
+                            towing vehicle: node 0's displacement) */
+    int root;            /* the towing vehicle's index among the vehicles,
+                            -1: the tow point is prescribed */
+    int rdof;            /* its degrees of freedom, 6 or 3; 0 */
+    int p0;              /* the first point with unknowns: 0 with a towing
+                            vehicle, else 1 */
+    double *Gt, *Gterr;  /* [TS_NINPUT (3 np + nc)] a towing vehicle's
+                            tow inputs: the residual's change per unit
+                            input at fixed points, and its estimate (NULL
+                            without the towing vehicle / the estimate) */
     /* The state linearized about. */
     double *r0, *v0, *a0; /* [3 np] node positions, velocities and
                             accelerations relative to M (m, m/s, m/s^2);
@@ -184,7 +204,18 @@ struct ts_descriptor {
  * controller state j. */
 static inline int tsi_desc_xr(const ts_descriptor *d, int k, int c)
 {
+    if (k == 0)
+        return 4 * (d->nn - 1) + 3 * d->nv + d->nc + c; /* a towing vehicle */
     return k < d->nn ? 4 * (k - 1) + c : 4 * (d->nn - 1) + 3 * (k - d->nn) + c;
+}
+
+/* Whether component c of point k is held by a surface ship (node 0's z,
+ * its roll and pitch): an identity row, displacement 0. */
+static inline int tsi_desc_held(const ts_descriptor *d, int k, int c)
+{
+    if (d->rdof != 3)
+        return 0;
+    return (k == 0 && c == 2) || (k == d->nn + d->root && c < 2);
 }
 #define TSI_XT(l) (4 * (l) + 3)
 static inline int tsi_desc_xc(const ts_descriptor *d, int j)
@@ -194,8 +225,9 @@ static inline int tsi_desc_xc(const ts_descriptor *d, int j)
 
 /* A descriptor for kernel k's system (k gives the vehicles' places in
  * the state and the inputs): neighbours, colouring and the pattern of S
- * (O(nlinks)). NULL with err set on failure (a towing vehicle at the
- * root is not covered: TS_EINVAL). */
+ * (O(nlinks)). NULL with err set on failure (TS_ENOMEM; TS_EINVAL when
+ * a vehicle's controller states or inputs are not one block of its
+ * own). */
 ts_descriptor *tsi_desc_alloc(const ts_kernel *k, ts_err *err);
 void tsi_desc_free(ts_descriptor *d);
 

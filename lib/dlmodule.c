@@ -20,34 +20,39 @@ static const char library_anchor = 0;
 extern const char *const tsi_module_build_dir
     __attribute__((weak, visibility("hidden")));
 
+/* What a module that cannot be used asks for: the installation is
+ * incomplete or mixed, which is no fault of the run's input. */
+#define REPAIR "reinstall towstab, or rebuild it (the modules are built " \
+               "and installed with the library)"
+
 /* Open the module at `path` and check its table. `also` ends the message
- * of a file that cannot be opened. */
+ * of a file that cannot be opened; `fix` says how to repair it. */
 static int open_path(tsi_module *m, const char *what, const char *path,
-                     const char *also, const char *symbol, int version,
-                     ts_err *err)
+                     const char *also, const char *fix, const char *symbol,
+                     int version, ts_err *err)
 {
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
     if (!h) {
         const char *why = dlerror();
-        return ts_fail(err, TS_EDOMAIN, "cannot load the %s %s: %s%s", what,
-                       path, why ? why : "no reason given", also);
+        return ts_fail(err, TS_EIO, "cannot load the %s %s: %s%s: %s", what,
+                       path, why ? why : "no reason given", also, fix);
     }
     const tsi_module_head *t = dlsym(h, symbol);
     if (!t) {
         /* The reason first: dlclose may reuse dlerror's text. */
         const char *why = dlerror();
-        int rc = ts_fail(err, TS_EDOMAIN, "%s is not a towstab %s: %s", path,
-                         what, why ? why : "no table");
+        int rc = ts_fail(err, TS_EIO, "%s is not a towstab %s: %s: %s", path,
+                         what, why ? why : "no table", fix);
         dlclose(h);
         return rc;
     }
     if (t->version != version ||
         strcmp(t->release, TSI_MODULE_RELEASE) != 0) {
-        int rc = ts_fail(err, TS_EDOMAIN,
+        int rc = ts_fail(err, TS_EIO,
                          "the %s %s is of towstab %s (table %d), the "
-                         "library of %s (table %d): install them together",
+                         "library of %s (table %d): %s",
                          what, path, t->release, t->version,
-                         TSI_MODULE_RELEASE, version);
+                         TSI_MODULE_RELEASE, version, fix);
         dlclose(h);
         return rc;
     }
@@ -80,8 +85,11 @@ int tsi_module_open(tsi_module *m, const char *what, const char *file,
     char also[4 * PATH_MAX];
     const char *forced = secure_getenv(env);
     if (forced && forced[0]) {
+        char fix[128];
         snprintf(also, sizeof also, " (%s)", env);
-        return open_path(m, what, forced, also, symbol, version, err);
+        snprintf(fix, sizeof fix, "unset %s, or set it to the %s of this "
+                 "towstab", env, what);
+        return open_path(m, what, forced, also, fix, symbol, version, err);
     }
     char dir[PATH_MAX], where[3][PATH_MAX + 64], installed[PATH_MAX + 64];
     int n = 0;
@@ -95,7 +103,8 @@ int tsi_module_open(tsi_module *m, const char *what, const char *file,
                  file);
     for (int i = 0; i < n; i++)
         if (access(where[i], F_OK) == 0)
-            return open_path(m, what, where[i], "", symbol, version, err);
+            return open_path(m, what, where[i], "", REPAIR, symbol, version,
+                             err);
     /* Else where it is installed; when not there either, the message says
      * where else it was looked for. */
     snprintf(installed, sizeof installed, "%s/%s", TS_MODULE_DIR, file);
@@ -105,7 +114,7 @@ int tsi_module_open(tsi_module *m, const char *what, const char *file,
         used += (size_t)snprintf(also + used, sizeof also - used, "%s%s%s",
                                  i == 0 ? " (nor is it at " : " or ",
                                  where[i], i == n - 1 ? ")" : "");
-    return open_path(m, what, installed, also, symbol, version, err);
+    return open_path(m, what, installed, also, REPAIR, symbol, version, err);
 }
 
 void tsi_module_close(tsi_module *m)

@@ -27,8 +27,9 @@
  *     lib/ directory (dlmodule_build.c);
  *  4. TS_MODULE_DIR/FILE, where meson installs it (any other program
  *     linked to the static archive).
- * When none can be opened, TS_EDOMAIN names the file and the dynamic
- * loader's reason (dlerror). */
+ * When none can be opened, TS_EIO names the file, the dynamic loader's
+ * reason (dlerror) and the repair: a module that is missing, broken or of
+ * another build is a fault of the installation, not of a run's input. */
 #ifndef TOWSTAB_LIB_DLMODULE_H
 #define TOWSTAB_LIB_DLMODULE_H
 
@@ -55,7 +56,8 @@ typedef struct tsi_module {
 /* Open module `file` (e.g. "towstab-plot.so"), called `what` in messages
  * ("plotting module"), looked for as above with the environment variable
  * `env`, and find its table `symbol` of layout `version`. TS_OK, or
- * TS_EDOMAIN with the file and the reason in err (m is then not open). */
+ * TS_EIO with the file, the reason and the repair in err (m is then not
+ * open). */
 int tsi_module_open(tsi_module *m, const char *what, const char *file,
                     const char *env, const char *symbol, int version,
                     ts_err *err);

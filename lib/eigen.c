@@ -1677,6 +1677,22 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
 int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                    ts_eigen **out, ts_err *err)
 {
+    ts_linear dense;
+    if (lin->root_qoff >= 0 && lin->desc) {
+        /* A towing vehicle: its modes come from the dense model, where
+         * its neutral modes by symmetry are recognised and cut
+         * (doc/linear.md section 3a); the sparse model serves the
+         * response and sweeps. */
+        *out = NULL;
+        if (!lin->A)
+            return ts_fail(err, TS_EINVAL, "eigen: the modes of a scene "
+                           "with a towing vehicle need the dense model "
+                           "(linearize with model TS_LIN_DENSE or BOTH)");
+        dense = *lin;
+        dense.desc = NULL;
+        dense.desc_err = dense.desc_round = NAN;
+        lin = &dense;
+    }
     int ncyclic = 0;
     for (int k = 0; k < lin->nneutral; k++)
         ncyclic += lin->neutral[k].cyclic >= 0;

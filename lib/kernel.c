@@ -191,31 +191,49 @@ static int layout_controls(ts_kernel *k, ts_err *err)
 {
     k->nc = 0;
     k->nin = TS_NINPUT;
-    /* A PI speed controller's integrator first: no loop mode moves it. */
+    /* A PI speed controller's integrator first: no loop mode moves it.
+     * Its vehicle's own controller states follow it, so that each
+     * vehicle's states are one block (the sparse model's local blocks,
+     * lib/descriptor.h); the other vehicles' follow in their order. */
+    int first = -1;
     for (int v = 0; v < k->nv; v++) {
         veh *V = &k->veh[v];
         const ts_propulsion *p = &V->d->propulsion;
         V->spd_off = V->root && p->type == TS_PROP_SPEED && p->ki > 0
                          ? k->nc++
                          : -1;
+        if (V->spd_off >= 0)
+            first = v;
     }
-    for (int v = 0; v < k->nv; v++) {
+    for (int i = -1; i < k->nv; i++) {
+        int v = i < 0 ? first : i;
+        if (v < 0 || (i >= 0 && v == first))
+            continue;
         veh *V = &k->veh[v];
         const ts_vehicle *d = V->d;
         for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++) {
-            V->xi_off[l] = V->in_loop[l] = V->in_sp[l] = -1;
-            if (l >= d->nloops)
-                continue;
-            if (d->loop[l].ki != 0 && V->mode[l] != TS_LOOP_OPEN)
+            V->xi_off[l] = -1;
+            if (l < d->nloops && d->loop[l].ki != 0 &&
+                V->mode[l] != TS_LOOP_OPEN)
                 V->xi_off[l] = k->nc++;
         }
         for (int c = 0; c < TS_VEHICLE_MAX_COMPONENTS; c++) {
-            V->act_off[c] = V->in_surf[c] = -1;
-            if (c >= d->ncomponents || !d->component[c].control)
-                continue;
-            V->in_surf[c] = k->nin++;
-            if (d->component[c].time_constant > 0)
+            V->act_off[c] = -1;
+            if (c < d->ncomponents && d->component[c].control &&
+                d->component[c].time_constant > 0)
                 V->act_off[c] = k->nc++;
+        }
+    }
+    /* The inputs, each vehicle's in its order. */
+    for (int v = 0; v < k->nv; v++) {
+        veh *V = &k->veh[v];
+        const ts_vehicle *d = V->d;
+        for (int l = 0; l < TS_VEHICLE_MAX_LOOPS; l++)
+            V->in_loop[l] = V->in_sp[l] = -1;
+        for (int c = 0; c < TS_VEHICLE_MAX_COMPONENTS; c++) {
+            V->in_surf[c] = -1;
+            if (c < d->ncomponents && d->component[c].control)
+                V->in_surf[c] = k->nin++;
         }
         for (int l = 0; l < d->nloops; l++) {
             V->in_loop[l] = k->nin++;
@@ -1574,7 +1592,7 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
     const ts_link *links = sys->links;
     const int nl = k->nl, nn = k->nn;
     const double rho = sys->env.water_density, g = sys->env.gravity;
-    if (k->root >= 0 || (k->nv > 0 && (!yv || !thdd)))
+    if (k->nv > 0 && (!yv || !thdd))
         return TS_EINVAL;
     if (!u)
         u = k->uzero;
@@ -1585,6 +1603,11 @@ int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
     for (int i = 0; i < k->nv; i++)
         if (vehicle_kinematics(k, &k->veh[i], yv))
             return TS_CHART;
+    /* A towing vehicle: the tow inputs move the points its cables start
+     * from relative to the body (the same code as ts_kernel_eval: the
+     * sparse model differences its input columns through this residual). */
+    if (k->root >= 0)
+        root_tow_inputs(k, &k->veh[k->root], u);
     /* Directions and strains from the positions: n = d / |d|, the strain
      * of an elastic link |d| / l - 1 (it sets only the bending lengths
      * here: the tensions are given). */
@@ -1743,6 +1766,18 @@ void tsi_kernel_vehicle_layout(const ts_kernel *k, int v, tsi_vehicle_layout *la
             imin = V->in_surf[c] < imin ? V->in_surf[c] : imin;
             imax = V->in_surf[c] > imax ? V->in_surf[c] : imax;
         }
+    }
+    if (V->root) {
+        /* A towing vehicle: its speed controller's integrator, and its
+         * propulsion inputs (thrust, force, moment, set speed). */
+        int x[3] = {V->spd_off, V->in_prop, V->in_spd};
+        if (x[0] >= 0) {
+            cmin = x[0] < cmin ? x[0] : cmin;
+            cmax = x[0] > cmax ? x[0] : cmax;
+        }
+        int last = x[2] >= 0 ? x[2] : x[1] + TSI_NPROP - 1;
+        imin = x[1] < imin ? x[1] : imin;
+        imax = last > imax ? last : imax;
     }
     if (cmax >= 0) {
         lay->c0 = cmin;

@@ -37,7 +37,10 @@ void tsi_vehicle_flow(const ts_frame *f, const ts_vehicle *d,
  * yv[nstate], a state whose vehicle angles, angle rates and controller
  * states are read (the links' coordinates are not), the vehicles' angle
  * accelerations thdd[3 nvehicles] (rad/s^2), and the inputs u[ninput]
- * (NULL: zero; the tow inputs are not read: the tow point is r_0, v_0).
+ * (NULL: zero). A prescribed tow point's inputs are not read (the tow
+ * point is r_0, v_0); with a towing vehicle at the root (node 0 its
+ * origin, free) the tow inputs move the points its cables start from
+ * relative to the body, by the kernel's own code (as in ts_kernel_eval).
  * Output R[3 nnodes + 3 nvehicles + ncontrol]:
  *   R_k = M_k (a_k + afr_k) - Q_k + t_l n_l - sum_c t_c n_c (+ R_b r6[0..2])
  * for every node k >= 1 (l the link ending at k, c the links leaving it,
@@ -54,7 +57,7 @@ void tsi_vehicle_flow(const ts_frame *f, const ts_vehicle *d,
  * f's). Uses the kernel's frame and bending scale; overwrites its
  * last-evaluation results. Returns TS_OK, TS_ESINGULAR when two ends of a
  * link coincide, TS_CHART (a vehicle at its chart's singularity), or
- * TS_EINVAL (a towing vehicle at the root: not covered). O(nlinks). */
+ * TS_EINVAL (vehicles without yv or thdd). O(nlinks). */
 int tsi_kernel_residual(ts_kernel *k, const double r[], const double v[],
                         const double a[], const double t[], const double yv[],
                         const double thdd[], const double u[], double R[]);

@@ -891,18 +891,23 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     if (o.model < TS_LIN_AUTO || o.model > TS_LIN_BOTH)
         return ts_fail(err, TS_EINVAL, "linearize: unknown model %d",
                        (int)o.model);
-    /* The sparse model covers cables, links, lumped bodies and towed
-     * vehicles (their attitude and controller states); a towing vehicle
-     * at the root only the dense one. */
-    int root = ts_kernel_root(k) >= 0;
-    if (root && o.model == TS_LIN_SPARSE)
-        return ts_fail(err, TS_EINVAL, "linearize: the sparse model does not "
-                       "cover a towing vehicle at the root; use model "
-                       "TS_LIN_DENSE or TS_LIN_AUTO");
+    /* The sparse model covers cables, links, lumped bodies, towed
+     * vehicles (their attitude and controller states) and a towing
+     * vehicle at the root (its position, attitude and controller
+     * states). */
     int dense = o.model == TS_LIN_DENSE || o.model == TS_LIN_BOTH ||
-                (o.model == TS_LIN_AUTO &&
-                 (n < o.dense_max_states || root));
-    int sparse = o.model != TS_LIN_DENSE && !root;
+                (o.model == TS_LIN_AUTO && n < o.dense_max_states);
+    int sparse = o.model != TS_LIN_DENSE;
+    ts_err derr = {0};
+    if (sparse && !lin->desc && !(lin->desc = tsi_desc_alloc(k, &derr))) {
+        /* A system the sparse model does not cover (a vehicle whose
+         * controller states are not one block of its own): the dense
+         * model, when the caller left the choice. */
+        if (derr.code != TS_EINVAL || o.model != TS_LIN_AUTO)
+            return ts_fail(err, derr.code, "%s", derr.msg);
+        sparse = 0;
+        dense = 1;
+    }
     memset(lin->u0, 0, (size_t)ni * sizeof(double));
     if (u0)
         memcpy(lin->u0, u0, (size_t)fin * sizeof(double));
@@ -1108,8 +1113,6 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         /* The kernel's last evaluation is the base point: the sparse model
          * starts from its positions, velocities, accelerations and
          * tensions. */
-        if (!lin->desc && !(lin->desc = tsi_desc_alloc(k, err)))
-            return err ? err->code : TS_ENOMEM;
         rc = tsi_desc_linearize(lin->desc, k, y0, u0, lin->f0, o.rel_step,
                                 o.estimate_error, nthreads, err);
         if (rc != TS_OK)

@@ -1,7 +1,10 @@
 /* report.c: JSON (jansson) and CSV output of results (towstab/report.h).
  * Files are written through tsi_outfile (lib/outfile.h): a regular file
  * under a temporary name renamed into place only when complete, so no
- * half-written file survives a failure, and a device or FIFO in place. */
+ * half-written file survives a failure, and a device or FIFO in place.
+ * JSON goes out through lib/jsonout.h; an equilibrium's node and link
+ * arrays can be left out of its tree and streamed in their place
+ * (lib/report_impl.h), each element's keys listed once for both forms. */
 #include "towstab/report.h"
 
 #include <errno.h>
@@ -9,7 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "jsonout.h"
 #include "outfile.h"
+#include "report_impl.h"
 #include "towstab/kernel.h"
 
 /* A JSON number, or null for a value that is not finite. */
@@ -118,13 +123,129 @@ int ts_report_trust_into(json_t *o, const ts_trust *t)
     return bad ? TS_ENOMEM : TS_OK;
 }
 
+/* One node's or one link's keys, written either into a tree (o) or to
+ * a stream (w): the two forms of the document share one list of keys. */
+typedef struct sink {
+    json_t *o;
+    tsi_json *w;
+} sink;
+
+static void put_num(sink *s, const char *key, double v)
+{
+    if (s->w) {
+        tsi_json_key(s->w, key);
+        tsi_json_num(s->w, v);
+    } else {
+        json_object_set_new(s->o, key, num(v));
+    }
+}
+
+static void put_int(sink *s, const char *key, int v)
+{
+    if (s->w) {
+        tsi_json_key(s->w, key);
+        tsi_json_int(s->w, v);
+    } else {
+        json_object_set_new(s->o, key, json_integer(v));
+    }
+}
+
+static void put_str(sink *s, const char *key, const char *v)
+{
+    if (s->w) {
+        tsi_json_key(s->w, key);
+        tsi_json_str(s->w, v);
+    } else {
+        json_object_set_new(s->o, key, json_string(v));
+    }
+}
+
+/* nodes[i]: {name, x, y, z}. */
+static void node_keys(sink *s, const ts_system *sys, const ts_equilibrium *eq,
+                      int i)
+{
+    char name[2 * TS_NAME_MAX];
+    const double *r = eq->positions + 3 * i;
+    ts_system_node_name(sys, i, name, sizeof name);
+    put_str(s, "name", name);
+    put_num(s, "x", r[0]);
+    put_num(s, "y", r[1]);
+    put_num(s, "z", r[2]);
+}
+
+/* links[l]: {cable, index, tension, theta1_deg, theta2_deg} and, for an
+ * elastic link, strain. */
+static void link_keys(sink *s, const ts_system *sys, const ts_equilibrium *eq,
+                      int l)
+{
+    const ts_link *L = &sys->links[l];
+    double t1, t2;
+    ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
+    put_str(s, "cable", sys->cables[L->cable].name);
+    put_int(s, "index", L->index);
+    put_num(s, "tension", eq->tensions[l]);
+    put_num(s, "theta1_deg", t1 * 180 / M_PI);
+    put_num(s, "theta2_deg", t2 * 180 / M_PI);
+    if (L->elastic)
+        put_num(s, "strain", ts_equilibrium_strain(sys, eq, l));
+}
+
+typedef void (*keys_fn)(sink *s, const ts_system *sys,
+                        const ts_equilibrium *eq, int i);
+
+/* An array of n objects, each made by keys, into tree a. */
+static void fill_array(json_t *a, keys_fn keys, const ts_system *sys,
+                       const ts_equilibrium *eq, int n)
+{
+    for (int i = 0; a && i < n; i++) {
+        json_t *o = json_object();
+        if (!o)
+            return;
+        keys(&(sink){o, NULL}, sys, eq, i);
+        json_array_append_new(a, o);
+    }
+}
+
+/* The same array written to a stream, one element at a time. */
+static void stream_array(tsi_json *w, keys_fn keys, const ts_system *sys,
+                         const ts_equilibrium *eq, int n)
+{
+    tsi_json_array_open(w);
+    for (int i = 0; i < n; i++) {
+        tsi_json_object_open(w);
+        keys(&(sink){NULL, w}, sys, eq, i);
+        tsi_json_object_close(w);
+    }
+    tsi_json_array_close(w);
+}
+
+static void stream_nodes(tsi_json *w, const void *sys, const void *eq)
+{
+    stream_array(w, node_keys, sys, eq, ((const ts_system *)sys)->nnodes);
+}
+
+static void stream_links(tsi_json *w, const void *sys, const void *eq)
+{
+    stream_array(w, link_keys, sys, eq, ((const ts_system *)sys)->nlinks);
+}
+
 json_t *ts_report_equilibrium_json(const ts_system *sys,
                                    const ts_equilibrium *eq, double wall_s,
                                    const ts_trust *trust)
 {
+    return tsi_report_equilibrium_tree(sys, eq, wall_s, trust, NULL);
+}
+
+json_t *tsi_report_equilibrium_tree(const ts_system *sys,
+                                    const ts_equilibrium *eq, double wall_s,
+                                    const ts_trust *trust,
+                                    tsi_json_defer *defer)
+{
     json_t *o = json_object();
     json_t *nodes = json_array(), *links = json_array(), *bodies = json_array();
-    if (!o || !nodes || !links || !bodies) {
+    if (!o || !nodes || !links || !bodies ||
+        tsi_json_defer_add(defer, nodes, stream_nodes, sys, eq) != 0 ||
+        tsi_json_defer_add(defer, links, stream_links, sys, eq) != 0) {
         json_decref(o);
         json_decref(nodes);
         json_decref(links);
@@ -149,27 +270,11 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     json_object_set_new(o, "tow_force",
                         json_pack("[o,o,o]", num(eq->tow_force[0]),
                                   num(eq->tow_force[1]), num(eq->tow_force[2])));
-    char name[2 * TS_NAME_MAX];
-    for (int i = 0; i < sys->nnodes; i++) {
-        const double *r = eq->positions + 3 * i;
-        ts_system_node_name(sys, i, name, sizeof name);
-        json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name", name,
-                                               "x", num(r[0]), "y", num(r[1]),
-                                               "z", num(r[2])));
-    }
-    for (int l = 0; l < sys->nlinks; l++) {
-        const ts_link *L = &sys->links[l];
-        double t1, t2;
-        ts_direction_angles(eq->directions + 3 * l, &t1, &t2);
-        json_t *lj = json_pack("{s:s,s:i,s:o,s:o,s:o}", "cable",
-                               sys->cables[L->cable].name, "index", L->index,
-                               "tension", num(eq->tensions[l]), "theta1_deg",
-                               num(t1 * 180 / M_PI), "theta2_deg",
-                               num(t2 * 180 / M_PI));
-        if (lj && L->elastic)
-            json_object_set_new(lj, "strain",
-                                num(ts_equilibrium_strain(sys, eq, l)));
-        json_array_append_new(links, lj);
+    /* Streamed, the node and link arrays stay empty here and are written
+     * in their place (defer); else they are filled now. */
+    if (!defer) {
+        fill_array(nodes, node_keys, sys, eq, sys->nnodes);
+        fill_array(links, link_keys, sys, eq, sys->nlinks);
     }
     /* Elastic cables: their lengths at rest and stretched. */
     json_t *cables = json_array();
@@ -216,21 +321,38 @@ json_t *ts_report_equilibrium_json(const ts_system *sys,
     return o;
 }
 
-int ts_report_write_json(const json_t *value, const char *path, ts_err *err)
+int tsi_report_dump_tree(const json_t *value, const tsi_json_defer *defer,
+                         FILE *f, int indent)
+{
+    tsi_json *w = tsi_json_open(f, indent);
+    if (!w) {
+        errno = ENOMEM;
+        return -1;
+    }
+    tsi_json_tree(w, value, defer);
+    return tsi_json_close(w);
+}
+
+int tsi_report_write_tree(const json_t *value, const tsi_json_defer *defer,
+                          const char *path, ts_err *err)
 {
     tsi_outfile out;
     int rc = tsi_outfile_open(&out, path, err);
     if (rc != TS_OK)
         return rc;
-    if (json_dumpf(value, out.f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) !=
-            0 ||
-        fputc('\n', out.f) == EOF) {
+    /* yajl ends an indented document with its newline. */
+    if (tsi_report_dump_tree(value, defer, out.f, 1) != 0) {
         int e = errno;
         tsi_outfile_abandon(&out);
-        return ts_fail(err, TS_EIO, "%s: write failed (%s)", path,
-                       strerror(e));
+        return ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
+                       "%s: write failed (%s)", path, strerror(e));
     }
     return tsi_outfile_commit(&out, err);
+}
+
+int ts_report_write_json(const json_t *value, const char *path, ts_err *err)
+{
+    return tsi_report_write_tree(value, NULL, path, err);
 }
 
 int ts_report_write_text(const char *text, size_t len, const char *path,

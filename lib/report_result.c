@@ -4,8 +4,11 @@
  * report_converge.c); the keys every result shares are added here, once. */
 #include "towstab/report_result.h"
 
+#include <errno.h>
 #include <math.h>
 #include <string.h>
+
+#include "report_impl.h"
 
 #include "towstab/report.h"
 #include "towstab/report_converge.h"
@@ -29,11 +32,14 @@ static void set_trust(json_t *o, const ts_trust *t)
     }
 }
 
-/* The equilibrium part, with its own verdict. */
-static json_t *eq_json(const ts_result *r, const ts_trust *t)
+/* The equilibrium part, with its own verdict; its nodes and links
+ * listed in defer when it is not NULL (report_impl.h). */
+static json_t *eq_json(const ts_result *r, const ts_trust *t,
+                       tsi_json_defer *defer)
 {
     return r->eq && r->eq_attempted
-               ? ts_report_equilibrium_json(r->sys, r->eq, r->eq_wall_s, t)
+               ? tsi_report_equilibrium_tree(r->sys, r->eq, r->eq_wall_s, t,
+                                             defer)
                : NULL;
 }
 
@@ -529,12 +535,15 @@ static void response_accuracy_json(json_t *j, const ts_result *r)
     json_object_set_new(j, "accurate_to_hz", num(r->accurate_to_hz));
 }
 
-json_t *ts_report_result_json(const ts_result *r, int flags)
+/* The result's document; with defer, its large arrays left to be
+ * streamed (report_impl.h). */
+static json_t *result_tree(const ts_result *r, int flags,
+                           tsi_json_defer *defer)
 {
     json_t *j = NULL;
     switch (r->kind) {
     case TS_ANALYSIS_EQUILIBRIUM:
-        j = eq_json(r, &r->trust);
+        j = eq_json(r, &r->trust, defer);
         if (!j)
             j = json_object();
         break;
@@ -552,7 +561,7 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
     if (!j)
         return NULL;
     if (r->kind == TS_ANALYSIS_MODES || r->kind == TS_ANALYSIS_RESPONSE) {
-        json_t *e = eq_json(r, &r->eq_trust);
+        json_t *e = eq_json(r, &r->eq_trust, defer);
         if (e)
             json_object_set_new(j, "equilibrium", e);
     }
@@ -574,6 +583,53 @@ json_t *ts_report_result_json(const ts_result *r, int flags)
                             json_string(ts_display_unit(si, (ts_quantity)q)));
     json_object_set_new(j, "units", units);
     return j;
+}
+
+json_t *ts_report_result_json(const ts_result *r, int flags)
+{
+    return result_tree(r, flags, NULL);
+}
+
+/* The streamed document with the keys of extra added last. */
+static json_t *stream_tree(const ts_result *r, int flags, const json_t *extra,
+                           tsi_json_defer *defer)
+{
+    json_t *j = result_tree(r, flags, defer);
+    if (j && extra && json_object_update(j, (json_t *)extra) != 0) {
+        json_decref(j);
+        return NULL;
+    }
+    return j;
+}
+
+int ts_report_result_write_json(const ts_result *r, int flags,
+                                const json_t *extra, const char *path,
+                                ts_err *err)
+{
+    tsi_json_defer defer = {0};
+    json_t *j = stream_tree(r, flags, extra, &defer);
+    if (!j)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON",
+                       path);
+    int rc = tsi_report_write_tree(j, &defer, path, err);
+    json_decref(j);
+    return rc;
+}
+
+int ts_report_result_dumpf(const ts_result *r, int flags, const json_t *extra,
+                           FILE *f, const char *name, ts_err *err)
+{
+    tsi_json_defer defer = {0};
+    json_t *j = stream_tree(r, flags, extra, &defer);
+    if (!j)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON",
+                       name);
+    int bad = tsi_report_dump_tree(j, &defer, f, 1) != 0;
+    int e = errno;
+    json_decref(j);
+    return bad ? ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
+                         "%s: write failed (%s)", name, strerror(e))
+               : TS_OK;
 }
 
 int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)

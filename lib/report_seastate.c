@@ -52,6 +52,12 @@ json_t *ts_report_seastate_json(const ts_seastate *r, const ts_seaway *w,
                                 int spectrum)
 {
     int d = r->disc_estimated;
+    /* The lever the RAO translation is taken at: the tow point's, or with
+     * a towing vehicle its origin O's (towstab/seastate.h). */
+    double lever[3];
+    for (int c = 0; c < 3; c++)
+        lever[c] = w->rotations ? w->origin[c] - w->reference[c]
+                                : w->lever[c];
     json_t *stats = json_pack(
         "{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "sigma",
         stat(r->sigma, d), "significant_amplitude", stat(r->significant, d),
@@ -65,8 +71,8 @@ json_t *ts_report_seastate_json(const ts_seastate *r, const ts_seaway *w,
         "{s:s,s:s,s:o,s:o,s:[o,o,o],s:{s:o,s:o,s:o,s:o},s:{s:i,s:o,s:o,s:I},"
         "s:o}",
         "output", r->output.name, "unit", r->unit, "mean", num(r->mean),
-        "speed", num(w->speed), "lever", num(w->lever[0]),
-        num(w->lever[1]), num(w->lever[2]), "band", "from_rad_s",
+        "speed", num(w->speed), "lever", num(lever[0]),
+        num(lever[1]), num(lever[2]), "band", "from_rad_s",
         num(r->band_lo), "to_rad_s", num(r->band_hi), "wave_m0_band",
         num(r->wave_m0_band), "wave_m0_outside", num(r->wave_m0_out),
         "grid", "intervals", r->npoints - 1, "order_m0", num(r->order_m0),

@@ -27,11 +27,13 @@ static json_t *series(const double *base, int n, size_t stride)
 json_t *ts_report_sim_stats_json(const ts_sim_stats *st, const char *method)
 {
     double ratio = st->wall_s > 0 ? st->t_reached / st->wall_s : NAN;
-    return json_pack("{s:s,s:I,s:I,s:I,s:I,s:I,s:I,s:o,s:o,s:o,s:o}",
+    static const char *const newton[] = {NULL, "dense", "sparse"};
+    return json_pack("{s:s,s:I,s:I,s:I,s:I,s:s?,s:I,s:I,s:o,s:o,s:o,s:o}",
                      "method", method, "steps", (json_int_t)st->steps,
                      "rejected", (json_int_t)st->rejected, "evaluations",
                      (json_int_t)st->evaluations, "jacobians",
-                     (json_int_t)st->jacobians, "recharts",
+                     (json_int_t)st->jacobians, "newton_matrix",
+                     newton[st->newton], "recharts",
                      (json_int_t)st->recharts, "restarts",
                      (json_int_t)st->restarts, "t_reached",
                      num(st->t_reached), "h_last", num(st->h_last), "wall_s",
@@ -175,31 +177,38 @@ json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
 
 json_t *ts_report_compare_json(const ts_compare *c)
 {
-    json_t *exc = c->periodic
-        ? json_pack("{s:s,s:s,s:o,s:o,s:o}", "axis",
-                    ts_axis_name(c->exc_axis), "type",
-                    ts_signal_type_name(c->exc_type), "amplitude",
-                    num(c->exc_amplitude), "frequency_hz",
+    json_t *exc = c->periodic || c->step
+        ? json_pack("{s:s,s:s,s:s,s:s,s:o,s:o,s:o}", "axis",
+                    ts_axis_name(c->exc_axis), "input", c->input, "unit",
+                    c->input_unit, "type", ts_signal_type_name(c->exc_type),
+                    "amplitude", num(c->exc_amplitude), "frequency_hz",
                     num(c->exc_frequency_hz), "fitted_amplitude",
                     num(c->exc_fit_amplitude))
-        : json_pack("{s:n,s:n,s:n,s:n}", "axis", "type", "amplitude",
-                    "frequency_hz");
+        : json_pack("{s:n,s:n,s:n,s:n,s:n,s:n}", "axis", "input", "unit",
+                    "type", "amplitude", "frequency_hz");
     json_t *runs[2];
     const ts_compare_run *r[2] = {&c->linear, &c->nonlinear};
     for (int i = 0; i < 2; i++)
-        runs[i] = json_pack("{s:o,s:o,s:o,s:o,s:o}", "amplitude_ratio",
+        runs[i] = json_pack("{s:o,s:o,s:o,s:o,s:o,s:o}", "amplitude_ratio",
                             num(r[i]->amplitude_ratio), "phase_deg",
                             num(r[i]->phase_deg), "mean_offset",
                             num(r[i]->mean_offset), "amplitude",
                             num(r[i]->amplitude), "half_range",
-                            num(r[i]->half_range));
+                            num(r[i]->half_range), "final_gain",
+                            num(r[i]->final_gain));
     return json_pack(
-        "{s:s,s:o,s:{s:o,s:o,s:i},s:o,s:o,s:o,s:{s:o,s:o},s:o,s:o,s:o,s:o}",
-        "output", c->output.name, "excitation", exc, "window", "from_s",
+        "{s:s,s:o,s:o,s:{s:o,s:o,s:i},s:o,s:o,s:o,s:{s:o,s:o,s:o,s:o},s:o,"
+        "s:o,s:o,s:o}",
+        "output", c->output.name, "ratio_unit",
+        c->ratio_unit[0] ? json_string(c->ratio_unit) : json_null(),
+        "excitation", exc, "window", "from_s",
         num(c->t_from), "to_s", num(c->t_to), "samples", c->nsamples,
         "equilibrium", num(c->equilibrium), "linear", runs[0], "nonlinear",
         runs[1], "response_prediction", "amplitude_ratio", num(c->pred_ratio),
-        "phase_deg", num(c->pred_phase_deg), "amplitude_difference_pct",
+        "phase_deg", num(c->pred_phase_deg), "static_gain",
+        num(c->static_gain), "static_note",
+        c->static_note[0] ? json_string(c->static_note) : json_null(),
+        "amplitude_difference_pct",
         num(c->amplitude_difference_pct), "mean_difference_pct",
         num(c->mean_difference_pct), "rms_difference",
         num(c->rms_difference), "rms_difference_ratio",

@@ -760,6 +760,30 @@ static double sparse_gain_error(tsi_shift *sh, int input,
             rb2 += 0.5 * a * a;
         }
     }
+    if (input < TS_NINPUT && d->root >= 0 && d->Gterr) {
+        /* A towing vehicle's tow input: its own columns' (Gt) truncation
+         * and rounding, at velocity s and acceleration s^2 per metre. */
+        size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
+        double complex s2 = s * s;
+        double hs[3] = {d->hu[TS_IN_DISP + input], d->hu[TS_IN_VEL + input],
+                        d->hu[TS_IN_ACC + input]};
+        const double *Ge[3] = {
+            d->Gterr + (size_t)(TS_IN_DISP + input) * nrow,
+            d->Gterr + (size_t)(TS_IN_VEL + input) * nrow,
+            d->Gterr + (size_t)(TS_IN_ACC + input) * nrow};
+        for (size_t i = 3 * (size_t)d->p0; i < nrow; i++) {
+            int x;
+            if (i < 3 * (size_t)d->np)
+                x = tsi_desc_xr(d, (int)(i / 3), (int)(i % 3));
+            else
+                x = tsi_desc_xc(d, (int)(i - 3 * (size_t)d->np));
+            double complex ge = Ge[0][i] + s * Ge[1][i] + s2 * Ge[2][i];
+            tb += w->wt[x] * (i < 3 * (size_t)d->np ? -ge : ge);
+            double a = cabs(w->wt[x]) * d->rnoise[i] *
+                       (1.0 / hs[0] + cabs(s) / hs[1] + cabs(s2) / hs[2]);
+            rb2 += 0.5 * a * a;
+        }
+    }
     double e = tr + cabs(tb) + sqrt(ro * ro + rb2);
     if (v >= 0) {
         local_vector(d, v, input, s, w->dr, w->z, w->zh);
@@ -876,7 +900,10 @@ static int ws_alloc(resp_ws *w, const ts_linear *lin, const ts_system *sys,
         w->zh = malloc(nz * sizeof(double));
         if (!w->wt || !w->z || !w->zh)
             return 0;
-    } else {
+    }
+    if (!lin->desc || lin->A) {
+        /* The dense way's work; with both models, for a towing vehicle's
+         * static gain (neutral_static). */
         w->b = malloc((size_t)lin->nstate * sizeof(double complex));
         w->x = malloc((size_t)lin->nstate * sizeof(double complex));
         w->c = malloc((size_t)lin->nstate * sizeof(double complex));
@@ -1010,7 +1037,16 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     int neutral0 = 0;
     for (int k = 0; k < lin->nneutral; k++)
         neutral0 |= lin->neutral[k].re == 0 && lin->neutral[k].im == 0;
-    if (neutral0 && !lin->desc) {
+    if (lin->desc && lin->root_qoff >= 0 && !lin->A) {
+        /* A towing vehicle with the sparse model alone: S(0) is singular
+         * on its neutral modes, which only the dense model finds. */
+        r->static_gain = r->static_error = NAN;
+        snprintf(r->static_note, sizeof r->static_note,
+                 "undefined with the sparse model alone: a towing "
+                 "vehicle's neutral modes by symmetry lie at 0 Hz, and "
+                 "the static gain needs the dense model to set them "
+                 "apart");
+    } else if (neutral0) {
         /* A towing vehicle's neutral modes at 0 (its position along and
          * across its track, its heading: doc/linear.md section 3a) make
          * A singular, exactly or to its rounding (in a turn the heading's

@@ -505,7 +505,7 @@ static void solution_points(const ts_descriptor *d, const double *x,
                             int stride, double *p, double *c)
 {
     p[0] = p[1] = p[2] = 0.0;
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
             p[3 * k + a] = x[stride * XR(k, a)];
     for (int j = 0; c && j < d->nc; j++)
@@ -545,7 +545,7 @@ static void rhs_part(const tsi_shift *sh, const double *w, double *u1,
     tsi_desc_to_points(d, sh->lin, w + nq, u2);
     tsi_desc_mass_mul(d, u2, mu);
     tsi_desc_block_mul(d, d->C, u1, mu, 1);
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
             rhs[stride * XR(k, a)] = mu[3 * k + a];
     taut_rates(sh, w, rhs, stride);
@@ -571,7 +571,7 @@ void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
     for (int i = 0; i < 2 * nq + nc; i++)
         w[i] = -b[i];
     rhs_part(sh, w, u1, mu, u2, sh->rhs, 1);
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
             sh->rhs[XR(k, a)] += s * mu[3 * k + a];
     klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
@@ -619,7 +619,7 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
         rhs_part(sh, w, u1 + part * m, mu + part * m, u2, rhs + part, 2);
     }
     const double *mr = mu, *mi = mu + m;
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++) {
             double complex v = s * (mr[3 * k + a] + I * mi[3 * k + a]);
             rhs[2 * XR(k, a)] += creal(v);
@@ -653,7 +653,7 @@ static void inf_solve(tsi_shift *sh, const double *f, const double *rhs_t,
 {
     const ts_descriptor *d = sh->d;
     size_t m = 3 * (size_t)d->np + (size_t)d->nc;
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
             sh->rhs[XR(k, a)] = -f[3 * k + a];
     for (int l = 0; l < d->nl; l++)
@@ -699,26 +699,65 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
     inf_solve(sh, f, rt, hc, y + nq, y + 2 * nq);
 }
 
-/* The tow point's displacement d[3] (M) per unit of tow input j (any of
- * the TS_NINPUT: a displacement, a velocity or an acceleration): e_a
- * for a translation along a, e_a x tow.point for a rotation about a (the
- * kernel's root_tow_inputs, M's origin the centre); the order 0, 1, 2
- * (displacement, velocity, acceleration) into *order. */
-static void tow_direction(const ts_system *sys, int j, double d[3],
-                          int *order)
+/* e[3 np] = the displacement of every point per unit of tow input j
+ * (any of the TS_NINPUT: a displacement, a velocity or an acceleration)
+ * with the coordinates fixed: ts_linear_tow_shift of its displacement
+ * channel (a translation e_a, a rotation e_a x the node's lever; node 0 of
+ * a towing vehicle and the vehicles' angle points stay), as the kernel's
+ * root_tow_inputs moves the points the cables start from. The order 0, 1,
+ * 2 (displacement, velocity, acceleration) into *order; returns the
+ * channel (TS_IN_DISP + a or TS_IN_ROT + a). */
+static int tow_shift(const tsi_shift *sh, int j, double *e, int *order)
 {
+    const ts_descriptor *d = sh->d;
     int rot = j >= TS_TOW_ROT, c = rot ? j - TS_TOW_ROT : j;
-    double e[3] = {0, 0, 0};
-    e[c % 3] = 1.0;
+    int chan = (rot ? TS_IN_ROT : TS_IN_DISP) + c % 3;
     *order = c / 3;
-    if (!rot) {
-        memcpy(d, e, sizeof e);
-        return;
+    memset(e, 0, 3 * (size_t)d->np * sizeof(double));
+    for (int k = 0; k < d->nn; k++)
+        ts_linear_tow_shift(sh->lin, k, chan, e + 3 * k);
+    return chan;
+}
+
+/* The right-hand side of a towing vehicle's harmonic tow input on
+ * displacement channel chan at s (its rate s, its acceleration s^2) into
+ * sh->rhs (interleaved complex; zeroed before), for the unknowns relative
+ * to it: every node but node 0 moves with the point its cable starts
+ * from, x_k = x'_k + e_k (tow_shift), so the link rows keep 0 and the
+ * point and controller rows take the input's own columns Gt and (K + s C
+ * + s^2 M) e, (Hr + s Hv) e. */
+static void root_tow_rhs(tsi_shift *sh, int chan)
+{
+    const ts_descriptor *d = sh->d;
+    double complex s = sh->s, s2 = s * s;
+    size_t n3 = 3 * (size_t)d->np, m = n3 + (size_t)d->nc;
+    double *e = sh->u2, *fk = sh->u2 + m, *fc = sh->u2 + 2 * m;
+    double *fm = sh->u2 + 3 * m, *hr = sh->u2 + 4 * m, *hv = sh->u2 + 5 * m;
+    int order;
+    tow_shift(sh, chan, e, &order);
+    tsi_desc_block_mul(d, d->K, e, fk, 0);
+    tsi_desc_block_mul(d, d->C, e, fc, 0);
+    tsi_desc_mass_mul(d, e, fm);
+    tsi_desc_local_mul(d, e, NULL, NULL, NULL, hr, NULL, 0);
+    tsi_desc_local_mul(d, NULL, e, NULL, NULL, hv, NULL, 0);
+    const double *Gd = d->Gt + (size_t)chan * m;
+    const double *Gv = d->Gt + (size_t)(chan + 3) * m;
+    const double *Ga = d->Gt + (size_t)(chan + 6) * m;
+    for (int k = d->p0; k < d->np; k++)
+        for (int a = 0; a < 3; a++) {
+            size_t i = 3 * (size_t)k + (size_t)a;
+            double complex v = -(Gd[i] + fk[i]) - s * (Gv[i] + fc[i]) -
+                               s2 * (Ga[i] + fm[i]);
+            sh->rhs[2 * XR(k, a)] = creal(v);
+            sh->rhs[2 * XR(k, a) + 1] = cimag(v);
+        }
+    for (int j = 0; j < d->nc; j++) {
+        size_t i = n3 + (size_t)j;
+        double complex v = Gd[i] + s * Gv[i] + s2 * Ga[i] + hr[j] +
+                           s * hv[j];
+        sh->rhs[2 * XC(j)] = creal(v);
+        sh->rhs[2 * XC(j) + 1] = cimag(v);
     }
-    const double *p = sys->tow.point;
-    d[0] = e[1] * p[2] - e[2] * p[1];
-    d[1] = e[2] * p[0] - e[0] * p[2];
-    d[2] = e[0] * p[1] - e[1] * p[0];
 }
 
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
@@ -730,6 +769,12 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
     int nx = d->nx;
     double *rhs = sh->rhs;
     memset(rhs, 0, 2 * (size_t)nx * sizeof(double));
+    int tow_root = -1;
+    if (input >= 0 && input < TS_NINPUT && d->root >= 0) {
+        root_tow_rhs(sh, input);
+        tow_root = input;
+        input = -1;
+    }
     if (input >= TS_NINPUT) {
         /* A vehicle's input: its own rows, -Ku in the force and
          * rotational rows, +Hu in the controller rows; the tow point
@@ -740,7 +785,7 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
         memset(u, 0, (size_t)d->nin * sizeof(double));
         u[input] = 1.0;
         tsi_desc_local_mul(d, NULL, NULL, NULL, u, hc, f, 0);
-        for (int k = 1; k < d->np; k++)
+        for (int k = d->p0; k < d->np; k++)
             for (int a = 0; a < 3; a++)
                 rhs[2 * XR(k, a)] = -f[3 * k + a];
         for (int j = 0; j < d->nc; j++)
@@ -750,9 +795,8 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
     /* A tow input moves the tow point by d0 (a rotation: about M's
      * origin, the tow point's translation). */
     double d0[3] = {0, 0, 0};
-    int order = 0;
     if (input >= 0)
-        tow_direction(sys, input, d0, &order);
+        ts_linear_tow_shift(sh->lin, 0, input, d0);
     /* Point rows: -(K_k0 + s C_k0) e_input, the tow point's displacement
      * and velocity seen by its neighbours. */
     for (int k = 1; input >= 0 && k < d->np; k++)
@@ -789,9 +833,17 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
         two_columns(sh);
     for (int c = 0; c < 3; c++)
         dr[c] = d0[c];
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int c = 0; c < 3; c++)
             dr[3 * k + c] = rhs[2 * XR(k, c)] + I * rhs[2 * XR(k, c) + 1];
+    /* A towing vehicle's tow input: the nodes move with the points their
+     * cables start from. */
+    if (tow_root >= 0) {
+        int order;
+        tow_shift(sh, tow_root, sh->u2, &order);
+        for (size_t i = 3; i < 3 * (size_t)d->nn; i++)
+            dr[i] += sh->u2[i];
+    }
     for (int j = 0; j < d->nc; j++)
         dr[3 * d->np + j] = rhs[2 * XC(j)] + I * rhs[2 * XC(j) + 1];
     for (int l = 0; l < d->nl; l++)
@@ -810,13 +862,13 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
     if (j < TS_NINPUT) {
         /* The force change of a tow input with the coordinates fixed:
          * every node moves with a tow displacement or velocity (the
-         * vehicles' angles do not). */
-        double d0[3];
+         * vehicles' angles do not). With a towing vehicle, every node
+         * but node 0 moves (displaced, moving or accelerating) with the
+         * point its cable starts from, the unknowns relative to that
+         * motion (so the link rows keep 0), and the residual's own
+         * column Gt adds what the input does there. */
         int order;
-        tow_direction(sh->sys, j, d0, &order);
-        for (int k = 0; k < d->nn; k++)
-            for (int c = 0; c < 3; c++)
-                e[3 * k + c] = d0[c];
+        tow_shift(sh, j, e, &order);
         if (order < 2) {
             const double *B = order == 0 ? (err ? d->Kerr : d->K)
                                          : (err ? d->Cerr : d->C);
@@ -830,6 +882,11 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
                 tsi_desc_mass_mul(d, e, f);
             memset(hc, 0, (size_t)nc * sizeof(double));
         }
+        const double *G = d->root >= 0 ? (err ? d->Gterr : d->Gt) : NULL;
+        for (size_t i = 0; G && i < n3; i++)
+            f[i] += G[(size_t)j * m + i];
+        for (int q = 0; G && q < nc; q++)
+            hc[q] += G[(size_t)j * m + n3 + (size_t)q];
     } else {
         /* A vehicle's input: its own rows only. */
         memset(u, 0, (size_t)d->nin * sizeof(double));
@@ -973,7 +1030,7 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         x[i] = u[i] + I * u[m + i];
     for (int j = 0; j < nc; j++)
         x[n3 + j] = v[2 * nq + j];
-    for (int k = 1; k < d->np; k++)
+    for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
             X[XR(k, a)] = x[3 * k + a];
     for (int j = 0; j < nc; j++)

@@ -473,6 +473,7 @@ struct ts_sim {
     ts_linear *lin;       /* Jacobian (implicit methods; sparse model for
                              esdirk) */
     tsi_shift sh;         /* esdirk: factored S(1 / gamma) */
+    ts_newton_matrix newton; /* the Newton matrix the method makes */
     ts_linearize_opts lopts;
     /* Statistics: evolve's counters are added in at each reset. */
     long steps0, rejected0, nfev, njac, nrechart, nrestart;
@@ -655,8 +656,18 @@ static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
     return esdirk_code(rhs(t, y, dydt, params));
 }
 
-/* esdirk's dense Jacobian: a system with a vehicle (its Newton matrix
- * from the sparse model is used without vehicles only). */
+/* Whether the sparse model covers kernel k's system (the descriptor
+ * can be laid out: O(nlinks), once per simulation). */
+static int desc_covers(const ts_kernel *k)
+{
+    ts_err e = {0};
+    ts_descriptor *d = tsi_desc_alloc(k, &e);
+    tsi_desc_free(d);
+    return d != NULL;
+}
+
+/* esdirk's dense Jacobian, where the sparse model does not cover the
+ * system (desc_covers). */
 static int jacobian_esdirk(double t, const double y[], double J[],
                            void *params)
 {
@@ -813,12 +824,13 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         ts_linearize_opts_default(&s->lopts);
         s->lopts.estimate_error = 0;
         s->lopts.threads = o->jacobian_threads;
-        /* GSL's implicit steppers take a dense Jacobian; esdirk solves
-         * with the sparse model where it covers the system (not with a
-         * vehicle). */
-        sparse = sundials_method(o->integrator) &&
-                 ts_kernel_nvehicles(k) == 0 && s->n == 2 * s->nq;
+        /* GSL's implicit steppers take a dense Jacobian; esdirk and bdf
+         * solve with the sparse model where it covers the system: towed
+         * and towing vehicles and their controllers too (a descriptor
+         * that cannot be laid out, TS_EINVAL, leaves the dense one). */
+        sparse = sundials_method(o->integrator) && desc_covers(k);
         s->lopts.model = sparse ? TS_LIN_SPARSE : TS_LIN_DENSE;
+        s->newton = sparse ? TS_NEWTON_SPARSE : TS_NEWTON_DENSE;
     }
     if (sundials_method(o->integrator)) {
         const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk};
@@ -919,6 +931,7 @@ void ts_sim_get_stats(const ts_sim *s, ts_sim_stats *st)
     }
     st->evaluations = s->nfev;
     st->jacobians = s->njac;
+    st->newton = s->newton;
     st->recharts = s->nrechart;
     st->restarts = s->nrestart;
     st->t_reached = s->t;

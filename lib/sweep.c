@@ -136,6 +136,47 @@ static int point_request(const ts_sweep *s, const int *idx, int axis,
     return TS_OK;
 }
 
+/* tow.speed and tow.turn_rate of a scene with a towing vehicle are only
+ * the start values of its equilibrium's V and Omega, which it solves
+ * (doc/towing-vehicle.md section 1): the speed from its propulsion, the
+ * turn rate at its deflections unless `turn_by` names the surface
+ * deflected to turn at tow.turn_rate. Varying one would give the same
+ * point at every value: refused, naming the key that sets it. */
+static int solved_by_towing(const ts_system *sys, const char *canon,
+                            ts_err *err)
+{
+    if (sys->tow.vehicle < 0)
+        return TS_OK;
+    const ts_body *b = &sys->bodies[sys->tow.vehicle];
+    if (!strcmp(canon, "tow.speed")) {
+        ts_propulsion_type t = b->vehicle->propulsion.type;
+        const char *key = t == TS_PROP_POWER   ? "power"
+                          : t == TS_PROP_SPEED ? "speed"
+                                               : "thrust";
+        const char *what =
+            t == TS_PROP_POWER   ? "its power: the speed is solved at it"
+            : t == TS_PROP_SPEED ? "its speed controller's set speed, which "
+                                   "the steady speed equals"
+                                 : "its thrust: the speed is solved at it";
+        return ts_fail(err, TS_EINVAL, "vary: tow.speed: the towing "
+                       "vehicle '%s' solves its speed from its propulsion, "
+                       "and tow.speed is only the solve's start value "
+                       "(every point would be the same); vary "
+                       "towing_vehicle.propulsion.%s (%s)", b->name, key,
+                       what);
+    }
+    if (!strcmp(canon, "tow.turn_rate") && sys->tow.turn_surface < 0)
+        return ts_fail(err, TS_EINVAL, "vary: tow.turn_rate: the towing "
+                       "vehicle '%s' solves its turn rate at its control "
+                       "deflections, and tow.turn_rate is only the solve's "
+                       "start value (every point would be the same); give "
+                       "it `turn_by: <rudder>` in the scene (the rudder's "
+                       "deflection is then solved at each turn rate), or "
+                       "vary towing_vehicle.components.<rudder>.deflection",
+                       b->name);
+    return TS_OK;
+}
+
 /* Path ends in ".links". */
 static int is_links(const char *path)
 {
@@ -206,6 +247,8 @@ static int check_spec(const ts_system *sys, const ts_sweep_spec *sp,
             (!strcmp(canon, "tow.turn_rate") && !isnan(su->turn_rate)))
             return ts_fail(err, TS_EINVAL, "vary: %s is also given as %s; "
                            "give it once", canon, canon + 4);
+        if ((rc = solved_by_towing(sys, canon, err)))
+            return rc;
         if (is_links(canon) && su->links > 0)
             return ts_fail(err, TS_EINVAL, "vary: %s and links (every cable) "
                            "both set links; give one", canon);

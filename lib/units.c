@@ -26,9 +26,15 @@
  * (udunits reads "mph" as milli-phot), and slug redefined exactly as
  * lbf s^2/ft (udunits rounds it to 14.5939 kg, 2e-7 off).
  *
+ * Start-up: a bare number needs no unit system; a unit whose words are all
+ * among the common ones below is read in a small system built in memory
+ * (no XML); any other unit in udunits2's whole XML database, read on first
+ * need. Each is made once per ts_units, when first needed.
+ *
  * Thread safety: udunits' parser (ut_parse) keeps global state and its
- * error handler is process-wide, so ts_units_parse and ts_units_from_si must
- * not run concurrently in several threads, even on distinct ts_units.
+ * error handler is process-wide, and a ts_units makes its systems on first
+ * use, so ts_units_parse and ts_units_from_si must not run concurrently in
+ * several threads, even on distinct ts_units.
  */
 #include "towstab/units.h"
 
@@ -39,8 +45,16 @@
 #include <string.h>
 #include <udunits2.h>
 
+#include "units_impl.h"
+
+/* The unit systems, read when a quantity first needs one. */
+typedef struct units_db {
+    ut_system *small; /* the units of the table below; NULL until needed */
+    ut_system *full;  /* udunits2's whole XML database; NULL until needed */
+} units_db;
+
 struct ts_units {
-    ut_system *sys;          /* owned; read-only after ts_units_alloc */
+    units_db *db; /* owned; the systems are filled in on first use */
 };
 
 /* Longest unit text and number lexeme we accept (a scene value longer than
@@ -51,7 +65,78 @@ struct ts_units {
 #define QUOTE_MAX 60
 
 /* ------------------------------------------------------------------ */
-/* Loading                                                              */
+/* The small system                                                     */
+
+/* The units most scenes and options use, built in memory with udunits'
+ * own calls instead of read from its XML database (reading the XML, about
+ * 280 units and their prefixes, costs a run about 2 ms: doc/performance.md,
+ * "Start-up"). Each definition is udunits2's own (udunits2-base, -derived,
+ * -accepted and -common.xml), parsed by udunits in this system, so a unit
+ * here converts exactly as in the whole database; test_units checks every
+ * word below against the whole database, bit for bit. A unit text is
+ * converted in this system only when each of its words (letters and '_')
+ * is one of these names, plurals, symbols or prefixed words; any other
+ * word sends the whole conversion to the whole database, so every unit
+ * udunits2 knows still works, with the same messages. */
+static const struct {
+    const char *name, *plural, *symbol, *symbol2, *definition;
+} small_units[] = {
+    /* Derived and accepted (base units and the radian are made below). */
+    {"hertz", "hertz", "Hz", NULL, "1/s"},
+    {"gram", "grams", "g", NULL, "1e-3 kg"},
+    {"newton", "newtons", "N", NULL, "m.kg/s^2"},
+    {"pascal", "pascals", "Pa", NULL, "N/m^2"},
+    {"joule", "joules", "J", NULL, "N.m"},
+    {"watt", "watts", "W", NULL, "J/s"},
+    {"minute", "minutes", "min", NULL, "60 s"},
+    {"hour", "hours", "h", "hr", "60 min"},
+    {"pi", NULL, NULL, NULL, "3.141592653589793238462643383279"},
+    {"degree", "degrees", NULL, NULL, "(pi/180) rad"},
+    {"nautical_mile", "nautical_miles", NULL, NULL, "1852 m"},
+    {"knot", "knots", "kt", "kts", "nautical_mile/hour"},
+    {"rotation", "rotations", NULL, NULL, "2 pi rad"},
+    {NULL, NULL, "rpm", NULL, "rotation/minute"},
+    {"pound", "pounds", "lb", NULL, "4.5359237e-1 kg"},
+    {"inch", "inches", "in", NULL, "2.54 cm"},
+    {"foot", "feet", "ft", NULL, "12 inches"},
+    {"mile", "miles", NULL, NULL, "5280 feet"},
+    {"standard_free_fall", NULL, NULL, NULL, "9.806650 m/s^2"},
+    {"kilogram_force", "kilograms_force", "kgf", NULL, "9.806650 N"},
+    {"pound_force", "pounds_force", "lbf", NULL, "4.4482216152605 N"},
+};
+
+/* Base units (name, plural, symbol) and the dimensionless radian. */
+static const char *const small_base[][3] = {
+    {"meter", "meters", "m"},    {"kilogram", "kilograms", "kg"},
+    {"second", "seconds", "s"},  {"kelvin", "kelvins", "K"},
+    {"radian", "radians", "rad"},
+};
+
+/* Words with an SI prefix the small system also takes (udunits resolves
+ * them by prefix, as the whole database does). */
+static const char *const small_prefixed[] = {
+    "km", "cm", "mm", "um", "kN", "MN", "kPa", "MPa", "GPa", "kW", "MW",
+    "ms", "mHz", "kHz", "mrad", "kilometer", "centimeter", "millimeter",
+    "kilonewton", "millisecond",
+};
+
+/* SI prefixes of udunits2-prefixes.xml that the prefixed words use. */
+static const struct {
+    const char *name, *symbol;
+    double value;
+} small_prefix[] = {
+    {"giga", "G", 1e9},  {"mega", "M", 1e6},  {"kilo", "k", 1e3},
+    {"centi", "c", .01}, {"milli", "m", 1e-3}, {"micro", "u", 1e-6},
+};
+
+/* Aliases added to both systems (see the file's head). */
+static const char *const alias[][2] = {
+    {"kn", "knot"},
+    {"deg", "degree"},
+    {"lbs", "lb"},
+    {"nmi", "nautical_mile"},
+    {"mph", "mile/hour"},
+};
 
 /* Map `alias` as a symbol for the unit `definition`. */
 static int add_alias(ut_system *sys, const char *alias, const char *definition,
@@ -59,13 +144,13 @@ static int add_alias(ut_system *sys, const char *alias, const char *definition,
 {
     ut_unit *unit = ut_parse(sys, definition, UT_ASCII);
     if (!unit)
-        return ts_fail(err, TS_EUNIT, "ts_units_alloc: the unit database "
-                       "has no unit '%s' (for alias '%s')", definition, alias);
+        return ts_fail(err, TS_EUNIT, "units: the unit database has no unit "
+                       "'%s' (for alias '%s')", definition, alias);
     ut_status st = ut_map_symbol_to_unit(alias, UT_ASCII, unit);
     ut_free(unit);
     if (st != UT_SUCCESS)
-        return ts_fail(err, TS_EUNIT, "ts_units_alloc: cannot add the alias "
-                       "'%s' for '%s' (udunits status %d)", alias, definition,
+        return ts_fail(err, TS_EUNIT, "units: cannot add the alias '%s' for "
+                       "'%s' (udunits status %d)", alias, definition,
                        (int)st);
     return TS_OK;
 }
@@ -76,8 +161,8 @@ static int redefine_name(ut_system *sys, const char *name, const char *plural,
 {
     ut_unit *unit = ut_parse(sys, definition, UT_ASCII);
     if (!unit)
-        return ts_fail(err, TS_EUNIT, "ts_units_alloc: the unit database "
-                       "cannot read '%s' (to define '%s')", definition, name);
+        return ts_fail(err, TS_EUNIT, "units: the unit database cannot read "
+                       "'%s' (to define '%s')", definition, name);
     /* Unmapping a name that is not mapped is not an error. */
     ut_unmap_name_to_unit(sys, name, UT_ASCII);
     ut_unmap_name_to_unit(sys, plural, UT_ASCII);
@@ -86,10 +171,213 @@ static int redefine_name(ut_system *sys, const char *name, const char *plural,
         st = ut_map_name_to_unit(plural, UT_ASCII, unit);
     ut_free(unit);
     if (st != UT_SUCCESS)
-        return ts_fail(err, TS_EUNIT, "ts_units_alloc: cannot redefine '%s' "
-                       "as '%s' (udunits status %d)", name, definition,
-                       (int)st);
+        return ts_fail(err, TS_EUNIT, "units: cannot redefine '%s' as '%s' "
+                       "(udunits status %d)", name, definition, (int)st);
     return TS_OK;
+}
+
+/* towstab's additions to a system: the aliases and the exact slug. */
+static int add_ours(ut_system *sys, ts_err *err)
+{
+    for (size_t i = 0; i < sizeof alias / sizeof alias[0]; i++)
+        if (add_alias(sys, alias[i][0], alias[i][1], err) != TS_OK)
+            return TS_EUNIT;
+    return redefine_name(sys, "slug", "slugs", "lbf*s^2/ft", err);
+}
+
+/* Map the name, plural and symbols to `unit`; the base units' symbols
+ * also the other way, so that a definition is written in them as the
+ * whole database writes it ("m-1.kg"). UT_SUCCESS or udunits' status. */
+static ut_status map_unit(ut_unit *unit, const char *name, const char *plural,
+                          const char *symbol, const char *symbol2, int base)
+{
+    ut_status st = UT_SUCCESS;
+    if (name)
+        st = ut_map_name_to_unit(name, UT_ASCII, unit);
+    if (st == UT_SUCCESS && plural && strcmp(plural, name) != 0)
+        st = ut_map_name_to_unit(plural, UT_ASCII, unit);
+    if (st == UT_SUCCESS && symbol)
+        st = ut_map_symbol_to_unit(symbol, UT_ASCII, unit);
+    if (st == UT_SUCCESS && symbol2)
+        st = ut_map_symbol_to_unit(symbol2, UT_ASCII, unit);
+    if (st == UT_SUCCESS && base) {
+        st = ut_map_unit_to_symbol(unit, symbol, UT_ASCII);
+        if (st == UT_SUCCESS)
+            st = ut_map_unit_to_name(unit, name, UT_ASCII);
+    }
+    return st;
+}
+
+/* The small system, or NULL (message in err). */
+static ut_system *build_small(ts_err *err)
+{
+    ut_system *sys = ut_new_system();
+    if (!sys) {
+        ts_fail(err, TS_ENOMEM, "units: cannot make a unit system");
+        return NULL;
+    }
+    ut_status st = UT_SUCCESS;
+    const char *what = "";
+    for (size_t i = 0;
+         st == UT_SUCCESS && i < sizeof small_base / sizeof small_base[0];
+         i++) {
+        /* The radian is dimensionless, as in udunits2-derived.xml. */
+        int radian = !strcmp(small_base[i][2], "rad");
+        ut_unit *u = radian ? ut_new_dimensionless_unit(sys)
+                            : ut_new_base_unit(sys);
+        what = small_base[i][0];
+        st = u ? map_unit(u, small_base[i][0], small_base[i][1],
+                          small_base[i][2], NULL, 1)
+               : ut_get_status();
+        ut_free(u);
+    }
+    for (size_t i = 0;
+         st == UT_SUCCESS && i < sizeof small_prefix / sizeof small_prefix[0];
+         i++) {
+        what = small_prefix[i].name;
+        st = ut_add_name_prefix(sys, small_prefix[i].name,
+                                small_prefix[i].value);
+        if (st == UT_SUCCESS)
+            st = ut_add_symbol_prefix(sys, small_prefix[i].symbol,
+                                      small_prefix[i].value);
+    }
+    for (size_t i = 0;
+         st == UT_SUCCESS && i < sizeof small_units / sizeof small_units[0];
+         i++) {
+        what = small_units[i].definition;
+        ut_unit *u = ut_parse(sys, small_units[i].definition, UT_ASCII);
+        st = u ? map_unit(u, small_units[i].name, small_units[i].plural,
+                          small_units[i].symbol, small_units[i].symbol2, 0)
+               : ut_get_status();
+        ut_free(u);
+    }
+    if (st != UT_SUCCESS) {
+        ts_fail(err, TS_EUNIT, "units: cannot make the unit '%s' (udunits "
+                "status %d)", what, (int)st);
+        ut_free_system(sys);
+        return NULL;
+    }
+    if (add_ours(sys, err) != TS_OK) {
+        ut_free_system(sys);
+        return NULL;
+    }
+    return sys;
+}
+
+/* udunits2's whole database (UDUNITS2_XML_PATH, else its default path)
+ * with towstab's additions, or NULL (message in err). */
+static ut_system *read_full(ts_err *err)
+{
+    ut_system *sys = ut_read_xml(NULL);
+    if (!sys) {
+        ut_status st = ut_get_status();
+        const char *env = getenv("UDUNITS2_XML_PATH");
+        ts_fail(err, st == UT_OS ? TS_EIO : TS_EUNIT,
+                "units: cannot read the udunits2 database (%s%s, udunits "
+                "status %d)",
+                env ? "UDUNITS2_XML_PATH=" : "default path", env ? env : "",
+                (int)st);
+        return NULL;
+    }
+    if (add_ours(sys, err) != TS_OK) {
+        ut_free_system(sys);
+        return NULL;
+    }
+    return sys;
+}
+
+const char *tsi_units_small_word(size_t i)
+{
+    size_t nb = sizeof small_base / sizeof small_base[0];
+    size_t nu = sizeof small_units / sizeof small_units[0];
+    size_t np = sizeof small_prefixed / sizeof small_prefixed[0];
+    size_t na = sizeof alias / sizeof alias[0];
+    static const char *const slug[] = {"slug", "slugs"};
+    if (i < 3 * nb)
+        return small_base[i / 3][i % 3];
+    i -= 3 * nb;
+    if (i < 4 * nu) {
+        /* A missing plural or symbol reads as its unit's name. */
+        const char *w[] = {small_units[i / 4].name, small_units[i / 4].plural,
+                           small_units[i / 4].symbol,
+                           small_units[i / 4].symbol2};
+        return w[i % 4] ? w[i % 4] : w[0] ? w[0] : w[2];
+    }
+    i -= 4 * nu;
+    if (i < np)
+        return small_prefixed[i];
+    i -= np;
+    if (i < na)
+        return alias[i][0];
+    i -= na;
+    return i < 2 ? slug[i] : NULL;
+}
+
+void tsi_units_made(const ts_units *u, int *small, int *full)
+{
+    *small = u->db->small != NULL;
+    *full = u->db->full != NULL;
+}
+
+/* 1 when `word` (len characters) is one of the small system's words. */
+static int small_word(const char *word, size_t len)
+{
+    for (size_t i = 0;; i++) {
+        const char *w = tsi_units_small_word(i);
+        if (!w)
+            return 0;
+        if (strlen(w) == len && memcmp(w, word, len) == 0)
+            return 1;
+    }
+}
+
+/* 1 when every word of `text` (runs of letters and '_'; NULL is none) is
+ * a word of the small system and the rest is digits and the operators of
+ * products, quotients and powers. Any other character ('%', a quote, '@',
+ * a byte beyond ASCII) is a unit of its own or udunits' syntax for
+ * something else: the whole database reads it. */
+static int small_covers(const char *text)
+{
+    if (!text)
+        return 1;
+    for (const char *p = text; *p;) {
+        if (!isalpha((unsigned char)*p) && *p != '_') {
+            if (!isdigit((unsigned char)*p) && !strchr(" \t.*/^()-+", *p))
+                return 0;
+            p++;
+            continue;
+        }
+        const char *w = p;
+        while (isalpha((unsigned char)*p) || *p == '_')
+            p++;
+        if (!small_word(w, (size_t)(p - w)))
+            return 0;
+    }
+    return 1;
+}
+
+/* The system in which to read the units `a` and `b` (either may be NULL)
+ * into *sys: the small one when it knows every word of both and
+ * UDUNITS2_XML_PATH does not name a database, else the whole one; read or
+ * built on first use. TS_OK, or the code of the failure (message in err). */
+static int system_for(const ts_units *u, const char *a, const char *b,
+                      ut_system **sys, ts_err *err)
+{
+    units_db *db = u->db;
+    ts_err own = {0};
+    const char *path = getenv("UDUNITS2_XML_PATH");
+    if (!(path && path[0]) && small_covers(a) && small_covers(b)) {
+        if (!db->small)
+            db->small = build_small(&own);
+        *sys = db->small;
+    } else {
+        if (!db->full)
+            db->full = read_full(&own);
+        *sys = db->full;
+    }
+    if (*sys)
+        return TS_OK;
+    return ts_fail(err, own.code, "%s", own.msg);
 }
 
 ts_units *ts_units_alloc(ts_err *err)
@@ -100,40 +388,15 @@ ts_units *ts_units_alloc(ts_err *err)
      * print, so we install ut_ignore for the whole process; every failure
      * is still seen through ut_get_status() and reported in err. */
     ut_set_error_message_handler(ut_ignore);
-
     ts_units *u = calloc(1, sizeof *u);
-    if (!u) {
+    units_db *db = calloc(1, sizeof *db);
+    if (!u || !db) {
+        free(u);
+        free(db);
         ts_fail(err, TS_ENOMEM, "ts_units_alloc: out of memory");
         return NULL;
     }
-    u->sys = ut_read_xml(NULL);
-    if (!u->sys) {
-        ut_status st = ut_get_status();
-        const char *env = getenv("UDUNITS2_XML_PATH");
-        ts_fail(err, st == UT_OS ? TS_EIO : TS_EUNIT,
-                "ts_units_alloc: cannot read the udunits2 database (%s%s, "
-                "udunits status %d)",
-                env ? "UDUNITS2_XML_PATH=" : "default path", env ? env : "",
-                (int)st);
-        free(u);
-        return NULL;
-    }
-    static const char *const alias[][2] = {
-        {"kn", "knot"},
-        {"deg", "degree"},
-        {"lbs", "lb"},
-        {"nmi", "nautical_mile"},
-        {"mph", "mile/hour"},
-    };
-    for (size_t i = 0; i < sizeof alias / sizeof alias[0]; i++)
-        if (add_alias(u->sys, alias[i][0], alias[i][1], err) != TS_OK) {
-            ts_units_free(u);
-            return NULL;
-        }
-    if (redefine_name(u->sys, "slug", "slugs", "lbf*s^2/ft", err) != TS_OK) {
-        ts_units_free(u);
-        return NULL;
-    }
+    u->db = db;
     return u;
 }
 
@@ -141,7 +404,9 @@ void ts_units_free(ts_units *u)
 {
     if (!u)
         return;
-    ut_free_system(u->sys);
+    ut_free_system(u->db->small);
+    ut_free_system(u->db->full);
+    free(u->db);
     free(u);
 }
 
@@ -491,23 +756,23 @@ static int mass_force_hint(const ut_system *sys, const ut_unit *given,
 /* ------------------------------------------------------------------ */
 /* Conversion                                                           */
 
-/* Parse a unit from the database, NUL-terminated ASCII. */
-static ut_unit *parse_unit(const ts_units *u, const char *text)
+/* Parse a unit in `sys`, NUL-terminated ASCII. */
+static ut_unit *parse_unit(ut_system *sys, const char *text)
 {
-    return ut_parse(u->sys, text, UT_ASCII);
+    return ut_parse(sys, text, UT_ASCII);
 }
 
 /* The wrong-dimension message; returns TS_EUNIT. */
-static int wrong_dimension(const ts_units *u, const ut_unit *given,
+static int wrong_dimension(const ut_system *sys, const ut_unit *given,
                            const ut_unit *want, const char *text,
                            const char *number, const char *unit,
                            const char *where, ts_err *err)
 {
     char q[QUOTE_BUF], dg[160], dw[160], hint[UNIT_TEXT_MAX + 128];
-    describe(u->sys, given, dg, sizeof dg);
-    describe(u->sys, want, dw, sizeof dw);
+    describe(sys, given, dg, sizeof dg);
+    describe(sys, want, dw, sizeof dw);
     hint[0] = '\0';
-    if (!mass_force_hint(u->sys, given, want, number, unit, hint, sizeof hint)
+    if (!mass_force_hint(sys, given, want, number, unit, hint, sizeof hint)
         && ut_are_convertible(given, want)) {
         /* Same dimension for udunits, but radians differ: an angle or
          * angular rate given as a pure number or a frequency, or the
@@ -537,7 +802,34 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
         return ts_fail(err, TS_EINVAL, "%s: no value; expected a number with "
                        "an optional unit", where);
 
-    ut_unit *want = parse_unit(u, si_unit);
+    /* A bare number (most values of most scenes) is SI and needs no unit
+     * system: read it here, with the checks below. */
+    const char *s = text;
+    while (is_space(*s))
+        s++;
+    size_t nlen = scan_number(s);
+    const char *after = s + nlen;
+    while (is_space(*after))
+        after++;
+    if (nlen > 0 && nlen < NUMBER_TEXT_MAX && *after == '\0' &&
+        small_covers(si_unit)) {
+        char number[NUMBER_TEXT_MAX];
+        memcpy(number, s, nlen);
+        number[nlen] = '\0';
+        char *end = NULL;
+        double x = strtod(number, &end);
+        if (end == number + nlen && isfinite(x)) {
+            *value = x;
+            return TS_OK;
+        }
+    }
+    /* Else the system that knows the words after the number (the unit,
+     * or the garbage a message quotes) and the SI unit. */
+    ut_system *sys;
+    int src = system_for(u, si_unit, s + nlen, &sys, err);
+    if (src != TS_OK)
+        return src;
+    ut_unit *want = parse_unit(sys, si_unit);
     if (!want)
         return ts_fail(err, TS_EINVAL, "%s: ts_units_parse called with an "
                        "unknown SI unit '%s'", where, si_unit);
@@ -545,9 +837,6 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
      * a few dozen ut_parse calls, so it is not done on success). */
     char dw[160];
 
-    const char *s = text;
-    while (is_space(*s))
-        s++;
     int rc = TS_OK;
     ut_unit *given = NULL;
     cv_converter *conv = NULL;
@@ -555,21 +844,20 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
     if (*s == '\0') {
         rc = ts_fail(err, TS_EINVAL, "%s: empty value; expected %s, e.g. "
                      "\"2.5 %s\"", where,
-                     describe(u->sys, want, dw, sizeof dw), si_unit);
+                     describe(sys, want, dw, sizeof dw), si_unit);
         goto done;
     }
     if (is_nonfinite_word(s)) {
         rc = ts_fail(err, TS_EINVAL, "%s: %s is not a finite number; expected "
                      "%s", where, quote(text, q, sizeof q),
-                     describe(u->sys, want, dw, sizeof dw));
+                     describe(sys, want, dw, sizeof dw));
         goto done;
     }
-    size_t nlen = scan_number(s);
     if (nlen == 0) {
         rc = ts_fail(err, TS_EINVAL, "%s: %s does not start with a number; "
                      "expected %s, e.g. \"2.5 %s\"", where,
                      quote(text, q, sizeof q),
-                     describe(u->sys, want, dw, sizeof dw), si_unit);
+                     describe(sys, want, dw, sizeof dw), si_unit);
         goto done;
     }
     if (nlen >= NUMBER_TEXT_MAX) {
@@ -582,7 +870,7 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
         isxdigit((unsigned char)s[nlen + 1])) {
         rc = ts_fail(err, TS_EINVAL, "%s: %s is not a decimal number; "
                      "expected %s", where, quote(text, q, sizeof q),
-                     describe(u->sys, want, dw, sizeof dw));
+                     describe(sys, want, dw, sizeof dw));
         goto done;
     }
     char number[NUMBER_TEXT_MAX];
@@ -651,7 +939,7 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
         goto done;
     }
 
-    given = parse_unit(u, unit);
+    given = parse_unit(sys, unit);
     if (!given) {
         char q2[QUOTE_BUF];
         ut_status st = ut_get_status();
@@ -663,16 +951,16 @@ int ts_units_parse(const ts_units *u, const char *text, const char *si_unit,
             rc = ts_fail(err, TS_EINVAL, "%s: cannot read %s after the number "
                          "in %s (not a unit expression); expected %s", where,
                          quote(unit, q2, sizeof q2), quote(text, q, sizeof q),
-                         describe(u->sys, want, dw, sizeof dw));
+                         describe(sys, want, dw, sizeof dw));
         else
             rc = ts_fail(err, TS_EUNIT, "%s: unknown unit %s in %s; expected "
                          "%s", where, quote(unit, q2, sizeof q2),
                          quote(text, q, sizeof q),
-                         describe(u->sys, want, dw, sizeof dw));
+                         describe(sys, want, dw, sizeof dw));
         goto done;
     }
     if (!units_match(given, want)) {
-        rc = wrong_dimension(u, given, want, text, number, unit, where, err);
+        rc = wrong_dimension(sys, given, want, text, number, unit, where, err);
         goto done;
     }
     conv = ut_get_converter(given, want);
@@ -728,8 +1016,12 @@ int ts_units_from_si(const ts_units *u, double value_si, const char *si_unit,
     if (bad)
         return ts_fail(err, TS_EUNIT, "ts_units_from_si: the unit %s %s",
                        quote(unit, q, sizeof q), bad);
-    ut_unit *from = parse_unit(u, si_unit);
-    ut_unit *to = parse_unit(u, unit);
+    ut_system *sys;
+    int src = system_for(u, si_unit, unit, &sys, err);
+    if (src != TS_OK)
+        return src;
+    ut_unit *from = parse_unit(sys, si_unit);
+    ut_unit *to = parse_unit(sys, unit);
     cv_converter *conv = NULL;
     int rc = TS_OK;
     if (!from || !to) {
@@ -741,8 +1033,8 @@ int ts_units_from_si(const ts_units *u, double value_si, const char *si_unit,
         char df[160], dt[160];
         rc = ts_fail(err, TS_EUNIT, "ts_units_from_si: cannot express %s in "
                      "%s: it is %s, not %s", si_unit, quote(unit, q, sizeof q),
-                     describe(u->sys, from, df, sizeof df),
-                     describe(u->sys, to, dt, sizeof dt));
+                     describe(sys, from, df, sizeof df),
+                     describe(sys, to, dt, sizeof dt));
         goto done;
     }
     conv = ut_get_converter(from, to);

@@ -28,6 +28,10 @@
  *     invert each other (1e-12).
  *  5. The number of residual evaluations does not grow with the links:
  *     the same groups at 20 and 2000 links.
+ *  6. A towing vehicle at the root (DOLPHIN with 6 degrees of freedom, a
+ *     surface ship with 3): section 2 with each column of B against its
+ *     own estimate, the sparse LU's fill, and the frequency response by
+ *     the sparse model against the dense one at four frequencies.
  */
 #include <complex.h>
 #include <float.h>
@@ -36,13 +40,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <klu.h>
+
 #include "descriptor.h"
 #include "kernel_impl.h"
 #include "shift.h"
 #include "lapack.h"
 #include "tcheck.h"
 #include "tscene.h"
+#include "towstab/eigen.h"
 #include "towstab/equilibrium.h"
+#include "towstab/response.h"
 #include "towstab/scene.h"
 
 static ts_units *units;
@@ -178,6 +186,44 @@ static double col_max(const double *x, int n)
     return m;
 }
 
+/* The largest difference between the columns of B from the sparse model
+ * (S_inf solves, acc) and the dense B, over the kernel's inputs (the tow
+ * heave columns left out at a kinked tow point), as a fraction of its
+ * allowance: ten times the two truncation estimates (the sparse column's,
+ * and the dense model's largest, b_trunc_err, or with own its column's
+ * Berr) plus ROUNDING of the column. The worst column into *wj (may be
+ * NULL). */
+static double b_worst(const ts_linear *lin, tsi_shift *acc, int own,
+                      int *wj)
+{
+    int n = lin->nstate, nlow = n - lin->nq;
+    double *col = malloc((size_t)n * sizeof(double));
+    double *ecol = malloc((size_t)n * sizeof(double));
+    double wb = 0;
+    for (int j = 0; j < lin->frame_input; j++) {
+        if (lin->kink_tow && j < TS_NINPUT && j % 3 == 2)
+            continue;
+        tsi_shift_apply_input(acc, j, col, 0);
+        tsi_shift_apply_input(acc, j, ecol, 1);
+        const double *Bd = lin->B + (size_t)j * n;
+        double diff = 0;
+        for (int i = 0; i < n; i++)
+            diff = fmax(diff, fabs(col[i] - Bd[i]));
+        double dense = own ? col_max(lin->Berr + (size_t)j * nlow, nlow)
+                           : lin->b_trunc_err;
+        double allow = 10.0 * (dense + col_max(ecol, n)) +
+                       ROUNDING * col_max(Bd, n);
+        if (diff / allow > wb) {
+            wb = diff / allow;
+            if (wj)
+                *wj = j;
+        }
+    }
+    free(col);
+    free(ecol);
+    return wb;
+}
+
 /* Section 2: A and B from the sparse model against the dense ones. */
 static void compare_dense(const char *name, const ts_system *sys)
 {
@@ -244,19 +290,8 @@ static void compare_dense(const char *name, const ts_system *sys)
           name, sys->nlinks, worst, wj);
     /* The kernel's inputs; the frame inputs after them are columns of
      * the dense B only (doc/linear.md, section 1). */
-    for (int j = 0; rc == TS_OK && j < lin->frame_input; j++) {
-        if (lin->kink_tow && j < TS_NINPUT && j % 3 == 2)
-            continue;
-        tsi_shift_apply_input(&acc, j, col, 0);
-        tsi_shift_apply_input(&acc, j, ecol, 1);
-        const double *Bd = lin->B + (size_t)j * n;
-        double diff = 0;
-        for (int i = 0; i < n; i++)
-            diff = fmax(diff, fabs(col[i] - Bd[i]));
-        double allow = 10.0 * (lin->b_trunc_err + col_max(ecol, n)) +
-                       ROUNDING * col_max(Bd, n);
-        wb = fmax(wb, diff / allow);
-    }
+    if (rc == TS_OK)
+        wb = b_worst(lin, &acc, 0, NULL);
     CHECK(rc == TS_OK && wb <= 1.0,
           "%s (%d links): the columns of B agree within their error "
           "estimates (largest difference %.3g of the allowance)",
@@ -465,31 +500,285 @@ static void test_groups(void)
           groups[2], groups[3], evals[2], evals[3]);
 }
 
-/* A towing vehicle at the root (its tow point free) is not covered: the
- * sparse model alone is refused, naming it; the default forms the dense
- * one. */
-static void test_towing_refused(void)
+/* A scene's linear model about its equilibrium with the model asked for
+ * (tensions for the dense tension Jacobians); NULL when it fails. */
+static ts_linear *linear_of(const ts_system *sys, ts_lin_model model,
+                            ts_kernel **kout)
 {
     ts_err err = {0};
-    ts_scene *sc = ts_scene_load("test/scenes/towing_sphere.yaml", units,
-                                 &err);
-    if (!CHECK(sc != NULL, "towing_sphere: %s", err.msg))
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(sys, &err);
+    ts_linear *lin = NULL;
+    if (k && eq && ts_equilibrium_solve(k, NULL, eq, &err) == TS_OK) {
+        ts_linearize_opts o;
+        ts_linearize_opts_default(&o);
+        o.model = model;
+        o.tensions = 1;
+        lin = ts_linear_alloc(k, &err);
+        if (lin && ts_linearize_equilibrium(k, eq, &o, lin, &err) != TS_OK) {
+            printf("  linearize: %s\n", err.msg);
+            ts_linear_free(lin);
+            lin = NULL;
+        }
+    } else {
+        printf("  equilibrium: %s\n", err.msg);
+    }
+    ts_equilibrium_free(eq);
+    *kout = k;
+    return lin;
+}
+
+/* The most entries of the sparse LU per entry of S(s): a cable's band
+ * fills about 2 times; AMD's ordering with node 0 free gave 6.9 times on
+ * dolphin_aurora at 30 links and 24 at 100 (the dense LU's). */
+#define FILL_MAX 4.0
+
+/* 6. A towing vehicle at the root (6 degrees of freedom, and a surface
+ * ship of 3): E^-1 F = A and E^-1 G = B (section 2's allowance: ten times
+ * the two models' truncation estimates plus ROUNDING of the column),
+ * here with each column of B judged against its own estimate (Berr) and
+ * the tow inputs' columns named; then the frequency response by the
+ * sparse model (one sparse complex solve per frequency) against the
+ * dense one's at four frequencies, for a position, a tension, a tow
+ * translation, a tow rotation (each cable's start point moved by its own
+ * theta x r) and a vehicle input: the difference within the sum of the two
+ * gains' error allowances (each ten times its model's error estimate,
+ * lib/response.c). */
+static void towing_case(const char *path, const char *pos_name,
+                        const char *out2, const char *tow_input,
+                        const char *rot_input, const char *input_name)
+{
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load(path, units, &err);
+    if (!CHECK(sc != NULL, "%s: %s", path, err.msg))
         return;
-    ts_kernel *k = ts_kernel_alloc(sc->system, &err);
-    ts_linear *lin = k ? ts_linear_alloc(k, &err) : NULL;
-    int n = k ? ts_kernel_nstate(k) : 0;
-    double *y = calloc((size_t)n + 1, sizeof(double));
-    ts_linearize_opts o;
-    ts_linearize_opts_default(&o);
-    o.model = TS_LIN_SPARSE;
-    int rc = lin && y ? ts_linearize(k, y, NULL, &o, lin, &err) : TS_ENOMEM;
-    CHECK(rc == TS_EINVAL && strstr(err.msg, "towing vehicle"),
-          "towing vehicle at the root: the sparse model alone refused: %s",
+    const ts_system *sys = sc->system;
+    ts_kernel *k, *kd;
+    ts_linear *lin = linear_of(sys, TS_LIN_BOTH, &k);
+    ts_linear *lsp = linear_of(sys, TS_LIN_SPARSE, &kd);
+    CHECK(lin && lin->desc && lin->A && lsp && lsp->desc && !lsp->A,
+          "%s: a towing vehicle at the root: the sparse model formed (alone "
+          "when asked)", path);
+    if (!lin || !lin->desc || !lsp) {
+        ts_linear_free(lin);
+        ts_linear_free(lsp);
+        ts_kernel_free(k);
+        ts_kernel_free(kd);
+        ts_scene_free(sc);
+        return;
+    }
+    tsi_shift acc;
+    int rc = tsi_shift_factor_inf(&acc, lin, &err);
+    int wj = -1;
+    double wb = rc == TS_OK ? b_worst(lin, &acc, 1, &wj) : INFINITY;
+    CHECK(rc == TS_OK && wb <= 1.0,
+          "%s: every column of B (%d inputs: the tow inputs, the vehicles') "
+          "within its own error estimates: largest %.3g of the allowance "
+          "(%s)", path, lin->frame_input, wb,
+          wj >= 0 ? lin->input_name[wj] : "-");
+    if (rc == TS_OK)
+        tsi_shift_free(&acc);
+
+    /* The factors stay sparse: L + U within FILL_MAX times S's entries
+     * at a frequency of the response. */
+    tsi_shift sh = {0};
+    rc = tsi_shift_factor(&sh, lin, I * 2.0 * M_PI * 0.33, &err);
+    if (rc == TS_OK) {
+        const klu_numeric *num = sh.numeric;
+        double fill = (double)(num->lnz + num->unz) / lin->desc->nnz;
+        CHECK(fill <= FILL_MAX, "%s: the sparse LU at 0.33 Hz holds %.2f "
+              "times the entries of S(s) (%d unknowns), <= %g", path, fill,
+              lin->desc->nx, FILL_MAX);
+        tsi_shift_free(&sh);
+    } else {
+        CHECK(0, "%s: factored at 0.33 Hz: %s", path, err.msg);
+    }
+
+    /* The response, sparse against dense. */
+    ts_kernel *kdd;
+    ts_linear *ld = linear_of(sys, TS_LIN_DENSE, &kdd);
+    static const double freq[4] = {0.0137, 0.071, 0.33, 1.9};
+    const char *outs[3] = {pos_name, out2, NULL};
+    int inputs[3] = {-1, -1, -1};
+    if (ts_response_input_lookup(k, tow_input, &inputs[0], &err) != TS_OK ||
+        ts_response_input_lookup(k, rot_input, &inputs[1], &err) != TS_OK ||
+        ts_response_input_lookup(k, input_name, &inputs[2], &err) != TS_OK)
+        CHECK(0, "%s: %s", path, err.msg);
+    double worst = 0, rel = 0;
+    int nchecks = 0;
+    for (int oi = 0; ld && oi < 2; oi++) {
+        ts_output out;
+        if (ts_response_output_lookup(k, outs[oi], &out, &err) != TS_OK) {
+            CHECK(0, "%s: %s", path, err.msg);
+            continue;
+        }
+        for (int ii = 0; ii < 3; ii++) {
+            if (inputs[ii] < 0)
+                continue;
+            ts_response *rs = NULL, *rd = NULL;
+            int r1 = ts_response_compute(sys, lsp, inputs[ii], &out, freq, 4,
+                                         &rs, &err);
+            int r2 = r1 == TS_OK ? ts_response_compute(sys, ld, inputs[ii],
+                                                       &out, freq, 4, &rd,
+                                                       &err)
+                                 : r1;
+            if (!CHECK(r1 == TS_OK && r2 == TS_OK, "%s: response of %s: %s",
+                       path, out.name, err.msg)) {
+                ts_response_free(rs);
+                ts_response_free(rd);
+                continue;
+            }
+            for (int i = 0; i < 4; i++) {
+                double d = hypot(rs->re[i] - rd->re[i], rs->im[i] - rd->im[i]);
+                double allow = rs->error[i] + rd->error[i];
+                worst = fmax(worst, d / allow);
+                rel = fmax(rel, allow / rd->magnitude[i]);
+                nchecks++;
+            }
+            ts_response_free(rs);
+            ts_response_free(rd);
+        }
+    }
+    /* With the sparse model alone: no static gain (the neutral modes are
+     * the dense model's), said so; no modes (refused, naming the dense
+     * model). */
+    ts_output o1;
+    ts_response *ra = NULL;
+    if (ts_response_output_lookup(k, pos_name, &o1, &err) == TS_OK &&
+        ts_response_compute(sys, lsp, inputs[0], &o1, freq, 1, &ra, &err) ==
+            TS_OK)
+        CHECK(isnan(ra->static_gain) && strstr(ra->static_note, "dense") &&
+                  isfinite(ra->re[0]),
+              "%s: the sparse model alone: the gain at %g Hz, no static "
+              "gain: %s", path, freq[0], ra->static_note);
+    else
+        CHECK(0, "%s: response with the sparse model alone: %s", path,
+              err.msg);
+    ts_response_free(ra);
+    ts_eigen *eg = NULL;
+    ts_err_clear(&err);
+    int erc = ts_eigen_solve(lsp, NULL, &eg, &err);
+    CHECK(erc == TS_EINVAL && !eg && strstr(err.msg, "dense model"),
+          "%s: modes with the sparse model alone refused: %s", path,
           err.msg);
-    free(y);
+    ts_eigen_free(eg);
+    CHECK(ld && nchecks == 24 && worst <= 1.0,
+          "%s: the sparse response equals the dense one at 4 frequencies "
+          "(%s and %s to %s, %s and %s, %d gains): largest difference "
+          "%.3g of the two error allowances (themselves at most %.2g of "
+          "the gain)", path, pos_name, out2, tow_input, rot_input,
+          input_name, nchecks, worst, rel);
+    ts_linear_free(ld);
     ts_linear_free(lin);
+    ts_linear_free(lsp);
     ts_kernel_free(k);
+    ts_kernel_free(kd);
+    ts_kernel_free(kdd);
     ts_scene_free(sc);
+}
+
+/* towing_sphere's tug with a PI speed controller (its integrator the
+ * first controller state, then its depth loop's). */
+static const char *pi_yaml =
+    "name: pi\n"
+    "tow: {speed: 2.5 m/s, point: [0, 0, 20 m]}\n"
+    "towing_vehicle:\n"
+    "  name: tug\n"
+    "  mass: 4126.1375 kg\n"
+    "  volume: 4.0255 m^3\n"
+    "  inertia: [330 kg*m^2, 22000 kg*m^2, 22000 kg*m^2]\n"
+    "  mass_centre: [0, 0, 0.05 m]\n"
+    "  tow_point: [-4 m, 0, 0]\n"
+    "  added_mass: spheroid\n"
+    "  components:\n"
+    "    - {name: hull, type: hull, length: 8 m, diameter: 0.8 m}\n"
+    "    - {name: foreplane, type: surface, position: [0.5 m, 0, 0],\n"
+    "       area: 0.4 m^2, span: 1.2 m, control: true, time_constant: 0.1 s}\n"
+    "    - {name: tailplane, type: surface, position: [-3.6 m, 0, 0],\n"
+    "       area: 0.6 m^2, span: 1.2 m}\n"
+    "    - {name: rudder, type: surface, position: [-3.6 m, 0, 0],\n"
+    "       area: 0.6 m^2, span: 1.2 m, roll: 90 deg, control: true}\n"
+    "  controllers:\n"
+    "    - {name: depth, measure: depth, setpoint: 20 m, kp: 0.05 rad/m,\n"
+    "       ki: 0.005 rad/(m*s), kd: 0.2 rad*s/m, surfaces: {foreplane: 1}}\n"
+    "  propulsion: {speed: 3 m/s, gain: 2000 N*s/m, integral_gain: 300 N/m,\n"
+    "               max_thrust: 1600 N}\n"
+    "cables:\n"
+    "  - {name: cable, from: tow, to: sphere, length: 50 m, diameter: 0.02 m,\n"
+    "     weight: 5 N/m, links: 8}\n"
+    "bodies:\n"
+    "  - {name: sphere, type: sphere, diameter: 0.5 m, wet_weight: 500 N}\n";
+
+static void test_towing(void)
+{
+    /* A PI speed controller: its integrator in the tug's local block
+     * (the speed set point among its inputs). */
+    ts_scene *pi = tscene_parse(units, pi_yaml);
+    if (CHECK(pi != NULL, "PI speed controller scene parsed")) {
+        ts_err err = {0};
+        ts_kernel *k = ts_kernel_alloc(pi->system, &err);
+        CHECK(k && ts_kernel_speed_integrator(k) == 0 &&
+                  ts_kernel_ncontrol(k) == 3,
+              "PI speed controller: its integrator the first of 3 "
+              "controller states (%d of %d)",
+              k ? ts_kernel_speed_integrator(k) : -1,
+              k ? ts_kernel_ncontrol(k) : -1);
+        ts_kernel_free(k);
+        compare_dense("PI speed controller", pi->system);
+    }
+    ts_scene_free(pi);
+
+    towing_case("examples/dolphin_aurora.yaml", "aurora.z",
+                "armoured.1.tension", "tow.heave", "tow.pitch",
+                "dolphin.thrust");
+    /* A straight tow is symmetric: the lateral outputs to the lateral
+     * inputs. */
+    towing_case("test/scenes/survey_ship.yaml", "depressor.y", "ship.yaw",
+                "tow.sway", "tow.roll", "ship.rudder");
+    /* DOLPHIN with a PI speed controller: its integrator is the first
+     * controller state, and DOLPHIN is the last vehicle; its own loops'
+     * states follow the integrator (lib/kernel.c, layout_controls), so
+     * that they are one block, AURORA's after them. Section 2 on it. */
+    ts_err err = {0};
+    ts_scene *sc = ts_scene_load("examples/dolphin_aurora.yaml", units, &err);
+    if (CHECK(sc != NULL, "dolphin_aurora: %s", err.msg)) {
+        ts_system *sys = sc->system;
+        ts_propulsion *pr = &sys->bodies[sys->tow.vehicle].vehicle->propulsion;
+        pr->type = TS_PROP_SPEED;
+        pr->speed = 5.0;
+        pr->gain = 2000.0;
+        pr->ki = 300.0;
+        pr->max_thrust = INFINITY;
+        ts_kernel *k = ts_kernel_alloc(sys, &err);
+        if (CHECK(k != NULL, "dolphin_aurora with a PI speed controller: %s",
+                  err.msg)) {
+            int root = ts_kernel_root(k), nv = ts_kernel_nvehicles(k);
+            tsi_vehicle_layout lr, lo;
+            tsi_kernel_vehicle_layout(k, root, &lr);
+            tsi_kernel_vehicle_layout(k, root == 0 ? 1 : 0, &lo);
+            CHECK(nv == 2 && root == nv - 1 &&
+                      ts_kernel_speed_integrator(k) == 0 && lr.c0 == 0 &&
+                      lr.nc >= 2 && lo.c0 == lr.nc,
+                  "dolphin_aurora with a PI speed controller: DOLPHIN (the "
+                  "last of %d vehicles) holds controller states 0..%d, its "
+                  "integrator first, AURORA's from %d", nv, lr.nc - 1,
+                  lo.c0);
+        }
+        ts_kernel_free(k);
+        compare_dense("dolphin_aurora with a PI speed controller", sys);
+        ts_scene_free(sc);
+    }
+    /* Section 2 on the test scenes with a towing vehicle. */
+    const char *scenes[2] = {"test/scenes/survey_ship.yaml",
+                             "test/scenes/towing_sphere.yaml"};
+    for (int i = 0; i < 2; i++) {
+        ts_err_clear(&err);
+        sc = ts_scene_load(scenes[i], units, &err);
+        if (!CHECK(sc != NULL, "%s: %s", scenes[i], err.msg))
+            continue;
+        compare_dense(scenes[i], sc->system);
+        ts_scene_free(sc);
+    }
 }
 
 int main(void)
@@ -501,7 +790,7 @@ int main(void)
     test_examples();
     test_shifted_solve();
     test_groups();
-    test_towing_refused();
+    test_towing();
     ts_units_free(units);
     return tc_done();
 }

@@ -474,7 +474,7 @@ static void test_controller(const ts_system *aurora)
  * foreplanes (20 deg) and two tanks of 130 kg (-400 kg per rad of the
  * loop's output). A tank's use is |fill - 65 kg| / 65 kg (1: empty or
  * full), plus its command's jump 400 kp step / 65 kg; the trim's fill
- * (11.84 kg) makes the tanks the largest use, 0.818 (the fins' 0.154).
+ * (11.89 kg) makes the tanks the largest use, 0.817 (the fins' 0.154).
  * With the depth integrator the trim does not depend on kp, so the
  * largest kp for a 1 m step is where the jump empties the tanks: kp* =
  * fill / (400 kg/rad x 1 m), by hand, against the study's optimum

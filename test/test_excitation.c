@@ -27,6 +27,7 @@
  *     breakpoint), no jump at t = 0 (ts_excitation_start_jump), the
  *     parser's default of two periods, ramp=0 for an impulsive start.
  * Tolerances are stated at each check. */
+#include "towstab/compare.h"
 #include "towstab/excitation.h"
 
 #include <math.h>
@@ -676,6 +677,20 @@ static void test_vehicle_inputs(void)
               fabs(ts_excitation_value(ex, 0, 2.5) - 2 * M_PI / 180) < 1e-16 &&
               fabs(ts_excitation_value(ex, 1, 2.0) - 2.5) < 1e-15,
           "values alone, tow input zero, no manoeuvre, not periodic");
+    /* The comparison fits the lone sine on the fin (the step beside it
+     * does not count); with a tow sine as well there are two, and none
+     * is fitted. */
+    idx = -1;
+    CHECK(ts_compare_periodic(ex, &idx) && idx == 0,
+          "compare: the fin's sine, signal 0, is the periodic excitation");
+    ts_excitation *two = ts_excitation_copy(ex, &err);
+    rc = two ? ts_excitation_parse(two, "tow.heave:amplitude=0.1m,"
+                                   "period=10s", units, "--excite", &err)
+             : TS_ENOMEM;
+    CHECK(rc == TS_OK && !ts_compare_periodic(two, &idx) &&
+              !ts_excitation_periodic(two, &idx),
+          "compare: a fin sine and a tow sine, none periodic (%s)", err.msg);
+    ts_excitation_free(two);
     const char *badspec[] = {"fish.wing:amplitude=1kg", "fish.wing:crank,"
                              "amplitude=1deg,frequency=1Hz,rod=1m",
                              "fish.wing:amplitude=1deg,to=2deg", "wing:step"};

@@ -671,7 +671,7 @@ static void test_towing_paths(const ts_units *u)
         {0, EQ, "towing_vehicle.components.keel.area",
          "towing_vehicle.components[keel].area", "0.65 m^2"},
         {0, EQ, "towing_vehicle.components.mast.drag",
-         "towing_vehicle.components[mast].drag", "0.1"},
+         "towing_vehicle.components[mast].drag", "0.137"},
         {0, EQ, "towing_vehicle.controllers.depth.setpoint",
          "towing_vehicle.controllers[depth].setpoint", "2.4 m"},
         {0, MO, "towing_vehicle.controllers.depth.kp",
@@ -788,7 +788,7 @@ static void test_towing_paths(const ts_units *u)
          * among them. */
         {0, "towing_vehicle.components.fin.area",
          "vehicle 'dolphin' has no component 'fin'; its components: hull "
-         "(hull), mast (mast), mast_drag (bluff)"},
+         "(hull), mast (mast), mast_wave (bluff)"},
         {0, "towing_vehicle.components.fin.area",
          "ballast_front (ballast tank), ballast_rear (ballast tank)"},
         {0, "bodies.dolphin.mass", "'dolphin' is the towing vehicle; its "

@@ -6,8 +6,11 @@
  * names follow the documented rule, angles are the directions' angles in
  * degrees, a non-finite number becomes null. Writing: a failed write
  * reports and leaves nothing (the rest of safe writing is
- * test_outfile.c). Files go to a fresh folder under $TMPDIR (default
- * /tmp). */
+ * test_outfile.c). Streaming (lib/jsonout.h): every number is the
+ * text jansson writes, checked against jansson itself over edge cases
+ * and random bit patterns, and a streamed document is byte for byte
+ * jansson's dump of the same tree, strings to escape included. Files go
+ * to a fresh folder under $TMPDIR (default /tmp). */
 #include "towstab/report.h"
 
 #include <errno.h>
@@ -18,6 +21,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "jsonout.h"
+#include "report_impl.h"
 #include "tcheck.h"
 #include "tfiles.h"
 
@@ -325,6 +330,127 @@ static void test_write(const ts_system *s, const ts_equilibrium *eq)
           "written (%s)", err.msg);
 }
 
+/* jansson's text of v with JSON_REAL_PRECISION(17), the reference. */
+static int jansson_text(double v, char *buf, size_t n)
+{
+    json_t *r = json_real(v);
+    char *t = r ? json_dumps(r, JSON_ENCODE_ANY | JSON_REAL_PRECISION(17))
+                : NULL;
+    int ok = t && strlen(t) < n;
+    if (ok)
+        snprintf(buf, n, "%s", t);
+    free(t);
+    json_decref(r);
+    return ok;
+}
+
+static void test_number_format(void)
+{
+    static const double edge[] = {0.0, -0.0, 1.0, -1.0, 0.1, 1e-5, 1e-4,
+                                  1e16, 1e17, 123456789012345678.0,
+                                  1e22, 1e100, -1e-100, 1e-300, 5e-324,
+                                  2.2250738585072014e-308, 1.7976931348623157e308,
+                                  1.0 / 3, 2.5435560000000002, 330.00518375772225};
+    char mine[32], ref[64];
+    int same = 1, exact = 1, n = 0;
+    const char *bad = "";
+    for (size_t i = 0; i < sizeof edge / sizeof edge[0]; i++, n++) {
+        tsi_json_format(mine, edge[i]);
+        if (!jansson_text(edge[i], ref, sizeof ref) || strcmp(mine, ref)) {
+            same = 0;
+            bad = ref;
+        }
+        exact &= strtod(mine, NULL) == edge[i] &&
+                 signbit(strtod(mine, NULL)) == signbit(edge[i]);
+    }
+    /* Random doubles over every exponent: 64 random bits each (a fixed
+     * xorshift sequence), the non-finite ones skipped. */
+    unsigned long long x = 0x9E3779B97F4A7C15ULL;
+    for (int k = 0; k < 200000; k++) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        double v;
+        memcpy(&v, &x, sizeof v);
+        if (!isfinite(v))
+            continue;
+        n++;
+        tsi_json_format(mine, v);
+        if (!jansson_text(v, ref, sizeof ref) || strcmp(mine, ref)) {
+            if (same)
+                bad = ref;
+            same = 0;
+        }
+        exact &= strtod(mine, NULL) == v;
+    }
+    CHECK(same, "stream: %d numbers printed as jansson prints them (%s)", n,
+          same ? "all" : bad);
+    CHECK(exact, "stream: every number reads back to the same double");
+    tsi_json_format(mine, NAN);
+    CHECK(!strcmp(mine, "null"), "stream: NaN is null (%s)", mine);
+}
+
+/* The equilibrium streamed, against jansson's dump of the whole tree. */
+static void test_stream(ts_system *s, ts_equilibrium *eq)
+{
+    /* Names with what JSON must escape: a quote, a backslash, a tab, a
+     * control character, and UTF-8 (written as it is). */
+    char keep[sizeof s->cables[1].name];
+    memcpy(keep, s->cables[1].name, sizeof keep);
+    snprintf(s->cables[1].name, sizeof s->cables[1].name,
+             "u\"p\\\t\x01\xc3\xa9/");
+    double kx = eq->positions[4];
+    eq->positions[4] = NAN;
+    ts_trust t = {0};
+    t.trustworthy = 1;
+    json_t *full = ts_report_equilibrium_json(s, eq, 0.5, &t);
+    char *ref = full ? json_dumps(full, JSON_INDENT(2) |
+                                            JSON_REAL_PRECISION(17))
+                     : NULL;
+    tsi_json_defer d = {0};
+    json_t *part = tsi_report_equilibrium_tree(s, eq, 0.5, &t, &d);
+    CHECK(part && d.n == 2 &&
+              json_array_size(json_object_get(part, "nodes")) == 0 &&
+              json_array_size(json_object_get(part, "links")) == 0,
+          "stream: nodes and links left out of the tree (%d deferred)", d.n);
+    char path[600];
+    snprintf(path, sizeof path, "%s/stream.json", tf_dir);
+    ts_err err = {0};
+    int rc = part ? tsi_report_write_tree(part, &d, path, &err) : -1;
+    char *text = tf_slurp(path);
+    size_t nref = ref ? strlen(ref) : 0;
+    CHECK(rc == TS_OK && ref && text && strlen(text) == nref + 1 &&
+              !strncmp(text, ref, nref) && text[nref] == '\n',
+          "stream: the file is byte for byte jansson's dump of the full "
+          "tree and a newline (%zu bytes)", nref);
+    json_t *back = text ? json_loads(text, 0, NULL) : NULL;
+    CHECK(back && json_equal(back, full), "stream: reads back equal");
+    json_decref(back);
+    unlink(path);
+
+    /* The whole tree through the streaming writer (the public
+     * ts_report_write_json) gives the same bytes. */
+    rc = ts_report_write_json(full, path, &err);
+    text = tf_slurp(path);
+    CHECK(rc == TS_OK && ref && text && strlen(text) == nref + 1 &&
+              !strncmp(text, ref, nref),
+          "stream: ts_report_write_json writes jansson's text");
+    unlink(path);
+
+    /* A device that refuses the bytes: TS_EIO naming it. */
+    if (tf_exists("/dev/full") && part) {
+        ts_err_clear(&err);
+        rc = tsi_report_write_tree(part, &d, "/dev/full", &err);
+        CHECK(rc == TS_EIO && strstr(err.msg, "/dev/full"),
+              "stream: /dev/full: TS_EIO (%s)", err.msg);
+    }
+    free(ref);
+    json_decref(full);
+    json_decref(part);
+    eq->positions[4] = kx;
+    memcpy(s->cables[1].name, keep, sizeof keep);
+}
+
 int main(void)
 {
     if (tf_begin("report") != 0) {
@@ -340,6 +466,8 @@ int main(void)
         test_json_nonfinite(s, eq);
         test_csv(s, eq);
         test_write(s, eq);
+        test_number_format();
+        test_stream(s, eq);
     }
     ts_equilibrium_free(eq);
     ts_system_free(s);

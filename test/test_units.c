@@ -4,14 +4,23 @@
  * 1 ft = 0.3048 m, 1 in = 0.0254 m, 1 lb = 0.45359237 kg,
  * 1 lbf = 1 lb * 9.80665 m/s^2, 1 knot = 1852 m / 3600 s,
  * 1 slug = 1 lbf s^2 / ft, 1 deg = pi/180 rad.
- * Every error path of ts_units_parse is provoked at least once. */
+ * Every error path of ts_units_parse is provoked at least once. The small
+ * unit system (the common units, built in memory) is checked against
+ * udunits2's whole XML database: every word it reads, in three spellings,
+ * against every SI unit, gives the same code and bit for bit the same
+ * value or the same message. */
 #include "towstab/units.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <ctype.h>
+#include <stdio.h>
+#include <udunits2.h>
+
 #include "tcheck.h"
+#include "units_impl.h"
 
 #define FT 0.3048
 #define INCH 0.0254
@@ -338,6 +347,142 @@ static void test_display(const ts_units *u)
     }
 }
 
+
+/* The SI units the checks convert to: each dimension the library asks
+ * for, and a few that no word has. */
+static const char *const si_targets[] = {
+    "m", "kg", "s", "N", "m/s", "m/s^2", "N/m", "kg/m", "rad", "rad/s",
+    "Hz", "kg/m^3", "Pa", "W", "N*m", "K", "1", "N*s^2/m", "m^2"};
+
+/* One conversion of `text` to `si` with `u`, in the small system (path
+ * NULL) or in the whole database at `path`: code, value and message. */
+static int convert(const ts_units *u, const char *path, const char *text,
+                   const char *si, double *v, ts_err *err)
+{
+    if (path)
+        setenv("UDUNITS2_XML_PATH", path, 1);
+    ts_err_clear(err);
+    *v = NAN;
+    int rc = ts_units_parse(u, text, si, "x", v, err);
+    if (path)
+        unsetenv("UDUNITS2_XML_PATH");
+    return rc;
+}
+
+/* 0 when `text` converts the same to every SI target in both systems;
+ * the number of differences otherwise (each one reported). */
+static int same_in_both(const ts_units *u, const char *full_path,
+                        const char *text)
+{
+    int differ = 0;
+    for (size_t t = 0; t < sizeof si_targets / sizeof si_targets[0]; t++) {
+        ts_err es, ef;
+        double vs, vf;
+        int rs = convert(u, NULL, text, si_targets[t], &vs, &es);
+        int rf = convert(u, full_path, text, si_targets[t], &vf, &ef);
+        int same = rs == rf && (rs == TS_OK ? memcmp(&vs, &vf, sizeof vs) == 0
+                                            : !strcmp(es.msg, ef.msg));
+        if (!same) {
+            differ++;
+            CHECK(0, "\"%s\" as %s: small system %d %.17g (%s), whole "
+                  "database %d %.17g (%s)", text, si_targets[t], rs, vs,
+                  es.msg, rf, vf, ef.msg);
+        }
+    }
+    return differ;
+}
+
+static void test_small_system(void)
+{
+    ut_status st;
+    const char *full_path = ut_get_path_xml(NULL, &st);
+    ts_err err;
+    ts_err_clear(&err);
+    ts_units *u = ts_units_alloc(&err);
+    if (!CHECK(u && full_path, "a second unit converter and the database's "
+               "path: %s", err.msg)) {
+        ts_units_free(u);
+        return;
+    }
+    int small, full;
+    tsi_units_made(u, &small, &full);
+    CHECK(!small && !full, "a new converter has made no unit system");
+    double v;
+    int rc = ts_units_parse(u, " 12.5 ", "m", "x", &v, &err);
+    tsi_units_made(u, &small, &full);
+    CHECK(rc == TS_OK && v == 12.5 && !small && !full,
+          "a bare number is read without a unit system (%d, %g)", rc, v);
+    rc = ts_units_parse(u, "8.345 ft/s", "m/s", "x", &v, &err);
+    tsi_units_made(u, &small, &full);
+    CHECK(rc == TS_OK && fabs(v - 8.345 * FT) <= RTOL * v && small && !full,
+          "\"8.345 ft/s\" is read in the small system only (%d, %.17g)", rc,
+          v);
+    rc = ts_units_parse(u, "1 furlong", "m", "x", &v, &err);
+    tsi_units_made(u, &small, &full);
+    /* udunits2's furlong is 660 US survey feet of 1200/3937 m. */
+    CHECK(rc == TS_OK && fabs(v - 660 * 1200.0 / 3937) <= RTOL * v && full,
+          "\"1 furlong\", not in the small system, is read in the whole "
+          "database (%d, %.17g m)", rc, v);
+
+    /* Every word, as written, in capitals and capitalised, alone; as
+     * written also squared and in a quotient. */
+    int words = 0, differ = 0;
+    for (size_t i = 0; tsi_units_small_word(i); i++, words++) {
+        const char *w = tsi_units_small_word(i);
+        char upper[64], cap[64], text[160];
+        size_t n = strlen(w);
+        if (n >= sizeof upper)
+            continue;
+        for (size_t k = 0; k <= n; k++) {
+            upper[k] = (char)toupper((unsigned char)w[k]);
+            cap[k] = k == 0 ? upper[0] : w[k];
+        }
+        const char *spell[] = {w, upper, cap};
+        for (int k = 0; k < 3; k++) {
+            static const char *const form[] = {"2.5 %s", "2.5 %s^2",
+                                               "2.5 %s/s", "2.5 m/%s"};
+            for (int f = 0; f < (k == 0 ? 4 : 1); f++) {
+                snprintf(text, sizeof text, form[f], spell[k]);
+                differ += same_in_both(u, full_path, text);
+            }
+        }
+    }
+    /* The documented compound units and the messages of a few wrong
+     * ones (doc/scene-format.md, "Quantities and units"). */
+    static const char *const compound[] = {
+        "1 lbf*s^2/ft", "1 slug/ft^3", "1 ft/s^2", "1 N*m^2", "1 lbf*ft^2",
+        "1 deg/s", "1 degree/s", "1 rpm", "1 m2", "1 s-1", "1 1/min",
+        "1 kg.m/s2", "1 lbf ft^2", "1.5 kN/m", "3 MPa", "1 hr", "50 lb",
+        "1 lb/ft", "0.1 Hz", "5 s", "2 ft//s", "1 ft)", "1 m m", "1 kgf",
+        "1 mph", "1 nmi/h", "1 km/hr", "1 in^3", "1 g/cm^3", "1 kW",
+        "1 %", "1 '", "2 s since 2000-01-01", "1 degC", "1 K"};
+    for (size_t i = 0; i < sizeof compound / sizeof compound[0]; i++)
+        differ += same_in_both(u, full_path, compound[i]);
+    CHECK(words > 80 && differ == 0,
+          "the small system's %d words (3 spellings alone, 4 forms as "
+          "written; %zu SI "
+          "units) and %zu compound units convert as in the whole database, "
+          "values bit for bit, messages the same (%d differences)", words,
+          sizeof si_targets / sizeof si_targets[0],
+          sizeof compound / sizeof compound[0], differ);
+    ts_units_free(u);
+
+    /* A database that cannot be read is reported by the conversion that
+     * needs it; a bare number needs none. */
+    ts_units *bad = ts_units_alloc(&err);
+    setenv("UDUNITS2_XML_PATH", "/nonexistent/udunits2.xml", 1);
+    rc = ts_units_parse(bad, "3", "m", "x", &v, &err);
+    CHECK(rc == TS_OK && v == 3, "an unreadable database: a bare number is "
+          "still read (%d)", rc);
+    rc = ts_units_parse(bad, "3 ft", "m", "x", &v, &err);
+    unsetenv("UDUNITS2_XML_PATH");
+    CHECK(rc != TS_OK && strstr(err.msg, "cannot read the udunits2 database")
+              && strstr(err.msg, "/nonexistent/udunits2.xml"),
+          "an unreadable database: a unit is refused naming it (%d: %s)", rc,
+          err.msg);
+    ts_units_free(bad);
+}
+
 int main(void)
 {
     ts_err err;
@@ -351,6 +496,7 @@ int main(void)
     test_from_si(u);
     test_display(u);
     ts_units_free(u);
+    test_small_system();
     ts_units_free(NULL);
     CHECK(1, "ts_units_free(NULL) does nothing");
     return tc_done();

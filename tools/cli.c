@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "towstab/report.h"
+#include "towstab/report_result.h"
 
 /* The descriptor JSON for "-" goes to, once standard output has been moved
  * to standard error (cli_stdout_for_json); -1 otherwise. The command line
@@ -29,22 +30,47 @@ void cli_stdout_for_json(void)
         dup2(STDERR_FILENO, STDOUT_FILENO);
 }
 
-int cli_write_json(const json_t *value, const char *path, ts_err *err)
+/* A stream onto the JSON's standard output, a duplicate of its
+ * descriptor (closing the stream leaves that open); NULL with err set. */
+static FILE *json_stdout(ts_err *err)
 {
-    if (strcmp(path, "-") != 0 || json_fd < 0)
-        return ts_report_write_json(value, path, err);
     int fd = dup(json_fd);
     FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
     if (!f) {
         if (fd >= 0)
             close(fd);
-        return ts_fail(err, TS_EIO, "standard output: cannot write JSON");
+        ts_fail(err, TS_EIO, "standard output: cannot write JSON");
     }
+    return f;
+}
+
+int cli_write_json(const json_t *value, const char *path, ts_err *err)
+{
+    if (strcmp(path, "-") != 0 || json_fd < 0)
+        return ts_report_write_json(value, path, err);
+    FILE *f = json_stdout(err);
+    if (!f)
+        return TS_EIO;
     int bad = json_dumpf(value, f, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) ||
               fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;
     return bad ? ts_fail(err, TS_EIO, "standard output: cannot write JSON")
                : TS_OK;
+}
+
+int cli_write_result(const ts_result *r, int flags, const json_t *extra,
+                     const char *path, ts_err *err)
+{
+    if (strcmp(path, "-") != 0 || json_fd < 0)
+        return ts_report_result_write_json(r, flags, extra, path, err);
+    FILE *f = json_stdout(err);
+    if (!f)
+        return TS_EIO;
+    int rc = ts_report_result_dumpf(r, flags, extra, f, "standard output",
+                                    err);
+    if (fclose(f) != 0 && rc == TS_OK)
+        rc = ts_fail(err, TS_EIO, "standard output: cannot write JSON");
+    return rc;
 }
 
 int cli_put_json(json_t *j, const char *path, int status)

@@ -224,6 +224,12 @@ void cli_stdout_for_json(void);
  * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
 
+/* Write result r's JSON with the keys of `extra` (may be NULL) to `path`
+ * as cli_write_json does, its node and link arrays streamed
+ * (ts_report_result_write_json). */
+int cli_write_result(const ts_result *r, int flags, const json_t *extra,
+                     const char *path, ts_err *err);
+
 /* Write j (taken over; NULL: it could not be made, out of memory) to
  * `path`, with "interrupted" when a signal stopped the run; prints a
  * failure. Returns `status`, or the failure's exit status when `status`

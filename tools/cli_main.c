@@ -190,7 +190,19 @@ int cli_execute(cli_run *c, json_t **result)
     }
     ts_err werr = {0};
     int write = status == 0 || has_partial(r);
-    if ((c->json && write) || result) {
+    if (c->json && write && !result) {
+        /* Streamed: the node and link arrays are never held whole. */
+        json_t *extra = json_object();
+        if (extra && cli_stop_signal_name())
+            json_object_set_new(extra, "interrupted",
+                                json_string(cli_stop_signal_name()));
+        if (cli_write_result(r, c->json_flags, extra, c->json, &werr) !=
+            TS_OK) {
+            int st = cli_report(&werr, werr.code);
+            status = status ? status : st;
+        }
+        json_decref(extra);
+    } else if ((c->json && write) || result) {
         json_t *j = ts_report_result_json(r, c->json_flags);
         if (j && cli_stop_signal_name())
             json_object_set_new(j, "interrupted",

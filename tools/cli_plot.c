@@ -21,9 +21,13 @@ int cli_plot_begin(cli_plot *p, const char *cmd)
     if (!p->dir)
         return 0;
     ts_err err = {0};
-    if (ts_plot_check(&err) != TS_OK) {
+    int check = ts_plot_check(&err);
+    if (check != TS_OK) {
         fprintf(stderr, "towstab: error: %s: --plot: %s\n", cmd, err.msg);
-        return EXIT_BADINPUT;
+        /* A drawing module that cannot be loaded is a fault of the
+         * installation (TS_EIO), a build without PLplot a request this
+         * towstab cannot serve (bad input). */
+        return check == TS_EIO ? EXIT_FAILED : EXIT_BADINPUT;
     }
     struct stat st;
     int existed = stat(p->dir, &st) == 0;

@@ -276,21 +276,15 @@ static void print_compare(const ts_compare *c, const ts_display *d)
 {
     char u[64], ru[160], label[192], eu[64];
     double k = ts_display_convert(d, c->output.si_unit, 1.0, u, sizeof u);
-    char gain[16];
-    snprintf(gain, sizeof gain, "%s/m", c->output.si_unit);
-    double kr = ts_display_convert(d, !strcmp(c->output.si_unit, "m")
-                                          ? "m/m" : gain,
-                                   1.0, ru, sizeof ru);
-    double ke = ts_display_convert(d, "m", 1.0, eu, sizeof eu);
-    /* A rotation of the ship: its amplitude an angle, the ratio the
-     * output per angle. */
-    int rot = c->exc_axis == TS_AXIS_ROLL || c->exc_axis == TS_AXIS_PITCH ||
-              c->exc_axis == TS_AXIS_YAW;
-    if (rot) {
-        snprintf(eu, sizeof eu, "%s", ts_display_unit(d, TS_QTY_ANGLE));
-        ke = ts_display_value(d, TS_QTY_ANGLE, 1.0);
-        kr = k / ke;
-        snprintf(ru, sizeof ru, "%s/%s", u, eu);
+    /* The ratio: the output's unit per the excited input's (m/m for a
+     * tow displacement, per an angle for a rotation of the ship or a
+     * fin, per N for a thrust); "-" without a periodic excitation. */
+    double kr = 1.0, ke = 1.0;
+    snprintf(ru, sizeof ru, "-");
+    snprintf(eu, sizeof eu, "-");
+    if (c->ratio_unit[0]) {
+        ke = ts_display_convert(d, c->input_unit, 1.0, eu, sizeof eu);
+        kr = ts_display_convert(d, c->ratio_unit, 1.0, ru, sizeof ru);
     }
     const char *tu = ts_display_unit(d, TS_QTY_TIME);
     printf("\ncomparison of %s over t = %.6g .. %.6g %s (%d samples; the "
@@ -298,21 +292,34 @@ static void print_compare(const ts_compare *c, const ts_display *d)
            c->output.name, ts_display_value(d, TS_QTY_TIME, c->t_from),
            ts_display_value(d, TS_QTY_TIME, c->t_to), tu, c->nsamples);
     if (c->periodic)
-        printf("excitation %s %s, amplitude %.6g %s, %.6g Hz\n",
-               ts_axis_name(c->exc_axis), ts_signal_type_name(c->exc_type),
-               ke * c->exc_amplitude, eu, c->exc_frequency_hz);
+        printf("excitation %s %s, amplitude %.6g %s, %.6g Hz\n", c->input,
+               ts_signal_type_name(c->exc_type), ke * c->exc_amplitude, eu,
+               c->exc_frequency_hz);
+    if (c->step)
+        printf("excitation %s %s, change %.6g %s (no amplitude or phase: "
+               "the gain is the output's final change over it)\n", c->input,
+               ts_signal_type_name(c->exc_type), ke * c->exc_amplitude, eu);
     printf("%-30s %16s %16s %16s\n", "", "linear", "nonlinear",
-           "freq. response");
-    snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
-    printf("%-30s", label);
-    cmp_cell(" %16.6g", kr * c->linear.amplitude_ratio);
-    cmp_cell(" %16.6g", kr * c->nonlinear.amplitude_ratio);
-    cmp_cell(" %16.6g", kr * c->pred_ratio);
-    printf("\n%-30s", "phase [deg]");
-    cmp_cell(" %16.4f", c->linear.phase_deg);
-    cmp_cell(" %16.4f", c->nonlinear.phase_deg);
-    cmp_cell(" %16.4f", c->pred_phase_deg);
-    printf("\n");
+           c->step ? "static gain" : "freq. response");
+    if (c->step) {
+        snprintf(label, sizeof label, "final-value gain [%s]", ru);
+        printf("%-30s", label);
+        cmp_cell(" %16.6g", kr * c->linear.final_gain);
+        cmp_cell(" %16.6g", kr * c->nonlinear.final_gain);
+        cmp_cell(" %16.6g", kr * c->static_gain);
+        printf("\n");
+    } else {
+        snprintf(label, sizeof label, "amplitude ratio [%s]", ru);
+        printf("%-30s", label);
+        cmp_cell(" %16.6g", kr * c->linear.amplitude_ratio);
+        cmp_cell(" %16.6g", kr * c->nonlinear.amplitude_ratio);
+        cmp_cell(" %16.6g", kr * c->pred_ratio);
+        printf("\n%-30s", "phase [deg]");
+        cmp_cell(" %16.4f", c->linear.phase_deg);
+        cmp_cell(" %16.4f", c->nonlinear.phase_deg);
+        cmp_cell(" %16.4f", c->pred_phase_deg);
+        printf("\n");
+    }
     snprintf(label, sizeof label, "mean offset [%s]", u);
     printf("%-30s %16.6g %16.6g\n", label, k * c->linear.mean_offset,
            k * c->nonlinear.mean_offset);
@@ -325,13 +332,15 @@ static void print_compare(const ts_compare *c, const ts_display *d)
            "nonlinear)\n", c->mean_difference_pct);
     if (!isfinite(c->rms_difference_ratio))
         printf("rms difference %.6g %s\n", k * c->rms_difference, u);
-    else if (!strcmp(c->output.si_unit, "m") && !rot)
+    else if (!strcmp(c->ratio_unit, "m/m"))
         printf("rms difference %.6g %s (%.4g %% of the excitation "
                "amplitude)\n", k * c->rms_difference, u,
                100 * c->rms_difference_ratio);
     else
         printf("rms difference %.6g %s (%.6g %s of excitation)\n",
                k * c->rms_difference, u, kr * c->rms_difference_ratio, ru);
+    if (c->step && c->static_note[0])
+        printf("static gain %s\n", c->static_note);
 }
 
 /* ---- pictures (--plot) ------------------------------------------------- */

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 
 packages="gcc libc6-dev meson ninja-build pkg-config \
   libgsl-dev liblapack-dev libopenblas-dev libarpack2-dev libnlopt-dev \
-  libyaml-dev libudunits2-dev libjansson-dev libsundials-dev libsuitesparse-dev \
+  libyaml-dev libudunits2-dev libjansson-dev libyajl-dev libsundials-dev libsuitesparse-dev \
   libplplot-dev plplot-driver-cairo libopenmpi-dev openmpi-bin \
   python3 python3-numpy python3-pytest python3-matplotlib \
   chromium"

@@ -17,8 +17,24 @@
  *   mean_difference_pct = 100 (offset_lin - offset_nl) / |offset_nl|,
  * and the RMS of x_lin - x_nl over the window (m). The linear
  * frequency-response prediction at f comes from ts_response_at
- * (towstab/response.h). Without a single periodic excitation the means
- * are plain window averages and the amplitude fields are NaN.
+ * (towstab/response.h). The periodic excitation is a sine or crank on a
+ * tow axis (ts_excitation_periodic) or a lone sine on a vehicle's input
+ * (ts_compare_periodic); the excitation is then that input's value (m,
+ * rad, N, ...) and a ratio is the output's unit per the input's
+ * (ratio_unit: "m/m", "m/rad", "N/m"). Without a single periodic
+ * excitation the means are plain window averages and the amplitude
+ * fields are NaN: an amplitude and a phase belong to a sinusoid.
+ *
+ * A step instead: when the excitation is a single step or ramp (on any
+ * axis, a manoeuvre's or a vehicle's input included) that has reached its
+ * final value by the end of the run, the final-value gain of each run,
+ *   final_gain = (x(t_end) - x_eq) / du,
+ * du the input's change (input_unit), estimates the steady-state gain; the
+ * linear model's static gain H(0) (ts_response.static_gain) is its
+ * prediction, NaN where a towing vehicle's neutral modes leave it
+ * undefined (static_note says why). The linear run's final gain reaches
+ * H(0) as the run settles: their difference says how far it is from
+ * settled. Otherwise final_gain and static_gain are NaN.
  */
 #ifndef TOWSTAB_COMPARE_H
 #define TOWSTAB_COMPARE_H
@@ -39,33 +55,57 @@ extern "C" {
 
 typedef struct ts_compare_run {
     double amplitude;        /* fitted output amplitude, m or N */
-    double amplitude_ratio;  /* amplitude / excitation amplitude (m/m,
-                                N/m) */
+    double amplitude_ratio;  /* amplitude / excitation amplitude
+                                (ratio_unit) */
     double phase_deg;        /* output phase less the excitation's, deg */
     double mean_offset;      /* mean (fitted constant) less equilibrium,
                                 m or N */
     double half_range;       /* (max - min) / 2 over the window, m or N */
+    double final_gain;       /* a step's (x(t_end) - equilibrium) / its
+                                change (ratio_unit); NaN otherwise */
 } ts_compare_run;
 
 typedef struct ts_compare {
     ts_output output;        /* what is compared */
-    int periodic;            /* 1: a single sine or crank excitation */
+    int periodic;            /* 1: a single periodic excitation
+                                (ts_compare_periodic) */
+    int step;                /* 1: a single step or ramp, finished by
+                                t_to (final_gain, static_gain) */
     ts_axis exc_axis;        /* its axis */
     ts_signal_type exc_type;
-    double exc_amplitude;    /* its nominal amplitude (crank radius), m */
+    char input[TS_IO_NAME];  /* the input it drives: "tow.heave",
+                                "tow.pitch", "aurora.wing", "tow.speed"
+                                ("" when neither periodic nor a step) */
+    char input_unit[16];     /* that input's SI unit: "m", "rad", "N" */
+    char ratio_unit[48];     /* the output's SI unit per the input's:
+                                "m/m", "N/m", "m/rad" (ts_response's) */
+    double exc_amplitude;    /* its nominal amplitude (crank radius);
+                                a step's change du; input_unit */
     double exc_frequency_hz; /* Hz */
-    double exc_fit_amplitude;/* fitted fundamental of the tow motion, m */
+    double exc_fit_amplitude;/* fitted fundamental of the input,
+                                input_unit */
     double t_from, t_to;     /* window, s */
     int nsamples;            /* samples in the window */
     double equilibrium;      /* output's equilibrium value, m or N */
     ts_compare_run linear, nonlinear;
     double pred_ratio;       /* |H(i w)| of the linear model */
     double pred_phase_deg;   /* arg H(i w), deg */
+    double static_gain;      /* a step's H(0) (ratio_unit), NaN when
+                                undefined or not a step */
+    char static_note[256];   /* why static_gain is NaN for a step, else
+                                "" (ts_response.static_note) */
     double amplitude_difference_pct;
     double mean_difference_pct;
     double rms_difference;   /* m or N */
-    double rms_difference_ratio; /* rms / excitation amplitude */
+    double rms_difference_ratio; /* rms / excitation amplitude
+                                    (ratio_unit) */
 } ts_compare;
+
+/* The single periodic excitation a comparison fits: ts_excitation_periodic's
+ * (one sine or crank, on a tow axis), or else exactly one sine of all
+ * the signals, on a vehicle's input (TS_AXIS_INPUT). Returns 1 and its
+ * index, else 0. */
+TS_API int ts_compare_periodic(const ts_excitation *ex, int *index);
 
 /* Least-squares fit x[i] ~ c + a sin(w t[i]) + b cos(w t[i]) over n
  * samples (w = 2 pi freq_hz, > 0): mean c, amplitude |(a, b)| and phase

@@ -86,13 +86,13 @@ typedef struct ts_descriptor ts_descriptor;
 /* Which linear models ts_linearize forms. */
 typedef enum {
     TS_LIN_AUTO = 0,   /* the sparse model always; the dense A and B too
-                          when nstate < dense_max_states. A towing
-                          vehicle at the root: the dense model only */
+                          when nstate < dense_max_states (or at any size
+                          when the sparse model does not cover the
+                          system: a vehicle whose controller states are
+                          not one block of its own) */
     TS_LIN_DENSE = 1,  /* the dense A and B only */
-    TS_LIN_SPARSE = 2, /* the sparse model only (refused with a towing
-                          vehicle at the root) */
-    TS_LIN_BOTH = 3    /* the dense model at any size, and the sparse one
-                          (except with a towing vehicle at the root) */
+    TS_LIN_SPARSE = 2, /* the sparse model only */
+    TS_LIN_BOTH = 3    /* the dense model at any size, and the sparse one */
 } ts_lin_model;
 
 /* A neutral mode by symmetry of a towing vehicle (ts_linear.neutral). */

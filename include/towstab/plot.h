@@ -22,10 +22,11 @@
  *
  * Return codes: TS_OK; TS_EINVAL for bad arguments (n < 1, NaN or
  * infinite data, a non-positive value on a log axis, a bad name or size,
- * DIR not a directory); TS_EIO when a file cannot be written; TS_EDOMAIN
- * when towstab was built without PLplot or PLplot's cairo driver is
- * missing (message says what to install), or the drawing module cannot
- * be loaded (message names its file and the dynamic loader's reason).
+ * DIR not a directory); TS_EIO when a file cannot be written, or the
+ * drawing module cannot be loaded (message names its file, the dynamic
+ * loader's reason and the repair); TS_EDOMAIN when towstab was built
+ * without PLplot or PLplot's cairo driver is missing (message says what
+ * to install).
  *
  * The drawing functions and ts_plot_check open the drawing module
  * (towstab-plot.so, which alone links PLplot) when called: a program
@@ -302,7 +303,9 @@ TS_API void ts_plot_opts_default(ts_plot_opts *o);
 
 /* TS_OK when pictures can be drawn: towstab was built with PLplot and
  * PLplot's pngcairo and svgcairo devices are installed. Else TS_EDOMAIN
- * with a message naming the packages to install. */
+ * with a message naming the packages to install, or TS_EIO when the
+ * drawing module cannot be loaded (missing, broken or of another build:
+ * the message names the file and the repair). */
 TS_API int ts_plot_check(ts_err *err);
 
 /* Create directory `dir` if it does not exist, with its missing parents

@@ -13,6 +13,7 @@
 #define TOWSTAB_REPORT_RESULT_H
 
 #include <jansson.h>
+#include <stdio.h>
 
 #include "towstab/analysis.h"
 #include "towstab/error.h"
@@ -26,6 +27,21 @@ extern "C" {
 
 /* The result as a new JSON object; NULL on allocation failure. */
 TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
+
+/* Write the result's JSON to `path` ("-": standard output), indented,
+ * as towstab/report.h describes: the document ts_report_result_json
+ * makes, with the keys of the object `extra` (NULL: none) added last.
+ * The per-node and per-link arrays are written as they are made, never
+ * held in memory whole. TS_OK, TS_ENOMEM, or TS_EIO naming path. */
+TS_API int ts_report_result_write_json(const ts_result *r, int flags,
+                                       const json_t *extra,
+                                       const char *path, ts_err *err);
+
+/* The same to the open stream f (flushed by the caller, not closed);
+ * `name` names f in messages. */
+TS_API int ts_report_result_dumpf(const ts_result *r, int flags,
+                                  const json_t *extra, FILE *f,
+                                  const char *name, ts_err *err);
 
 /* The result's table as CSV: an equilibrium's nodes (converged only),
  * the modes, the response, the histories (also of a failed run: the

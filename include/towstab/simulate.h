@@ -119,6 +119,16 @@ TS_API const char *ts_integrator_name(ts_integrator m);
  * or -1. */
 TS_API int ts_integrator_parse(const char *name, ts_integrator *m);
 
+/* The Newton matrix of an implicit method: none (an explicit method or
+ * a linear run), the dense Jacobian and its LU (GSL's implicit steppers,
+ * O(links^2) and O(n^3)), or the sparse model and its KLU factorisation
+ * (esdirk and bdf where it covers the system, O(links)). */
+typedef enum {
+    TS_NEWTON_NONE = 0,
+    TS_NEWTON_DENSE,
+    TS_NEWTON_SPARSE
+} ts_newton_matrix;
+
 /* Work statistics of a run. */
 typedef struct ts_sim_stats {
     long steps;         /* accepted steps (linear expm: discrete steps) */
@@ -126,6 +136,7 @@ typedef struct ts_sim_stats {
     long evaluations;   /* f evaluations by the integrator (linear: input
                            evaluations and matrix-vector products) */
     long jacobians;     /* Jacobian evaluations (implicit methods) */
+    ts_newton_matrix newton; /* which Newton matrix they made */
     long recharts;      /* links moved to a new chart */
     long restarts;      /* integrator restarts after re-charting */
     double t_reached;   /* s: the time the run got to */

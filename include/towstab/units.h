@@ -5,10 +5,13 @@
  * "5 knot"). It is converted to the SI unit the caller expects; a quantity
  * of another dimension is refused with a message naming both dimensions
  * (a mass given where a weight is expected says so and suggests lbf).
- * The unit system is read once by ts_units_alloc() and is read-only after.
- * udunits2 keeps process-wide parser state and a process-wide message
- * handler (towstab silences it): do not call these functions from several
- * threads at once, even on separate ts_units objects.
+ * The unit systems are made when a quantity first needs one (a bare number
+ * needs none; the common units are built in memory; any other unit reads
+ * udunits2's XML database), once per ts_units. udunits2 keeps
+ * process-wide parser state and a process-wide message handler (towstab
+ * silences it), and the systems are made on first use: do not call these
+ * functions from several threads at once, even on separate ts_units
+ * objects.
  */
 #ifndef TOWSTAB_UNITS_H
 #define TOWSTAB_UNITS_H
@@ -23,7 +26,9 @@ extern "C" {
 
 typedef struct ts_units ts_units;
 
-/* Load the unit database. NULL on failure (message in err). */
+/* A unit converter; its unit systems are made on first use, and a
+ * database that cannot be read is reported by the conversion that needed
+ * it. NULL on failure (out of memory; message in err). */
 TS_API ts_units *ts_units_alloc(ts_err *err);
 
 /* Release it. ts_units_free(NULL) does nothing. */

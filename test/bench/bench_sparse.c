@@ -12,6 +12,11 @@
  *    sparse model) at 100, 1000 and 10 000 links: modes as above (20
  *    modes, ARPACK at every size; the loop margins left out), and
  *    aurora.depth to aurora.wing at 100 frequencies;
+ *  - towing response: examples/dolphin_aurora.yaml (a towing vehicle at
+ *    the root, which tows the AURORA towfish) at 100 and 1000 links,
+ *    aurora.z to tow.heave at 100 frequencies, with the sparse model
+ *    (the default) and with the dense one (TS_LIN_DENSE: how such a
+ *    scene ran before the sparse model covered a towing vehicle);
  *  - esdirk: examples/kamman_ex1_elastic.yaml (EA 1e9 N) with 100 and 500
  *    links, heaved 0.1 ft at 0.25 Hz (smooth start over two periods, the
  *    default) for T_SIM simulated seconds, rtol 1e-6, atol 1e-9: wall
@@ -27,8 +32,9 @@
  * OpenBLAS on one thread, as towstab runs it (tools/towstab.c): meson
  * sets OPENBLAS_NUM_THREADS=1 for it.
  * Run from the project root: meson test -C build --benchmark sparse, or
- * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS [vehicle]]
- * (vehicle: the vehicle cases only). */
+ * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS [vehicle|towing]]
+ * (vehicle: the towed vehicle cases only; towing: the towing vehicle's
+ * only). */
 #define _GNU_SOURCE /* wait4 */
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,7 +52,7 @@
 #define REPS 3
 #define T_SIM 2.0
 
-enum { MODES, RESPONSE, ESDIRK, VMODES, VRESPONSE };
+enum { MODES, RESPONSE, ESDIRK, VMODES, VRESPONSE, TRESPONSE, TDENSE };
 
 /* What a child reports back through its pipe. */
 typedef struct figures {
@@ -64,8 +70,10 @@ static void run_case(int kind, int links, figures *f)
     ts_err err = {0};
     ts_units *u = ts_units_alloc(&err);
     int veh = kind == VMODES || kind == VRESPONSE;
+    int tow = kind == TRESPONSE || kind == TDENSE;
     const char *path = kind == ESDIRK ? "examples/kamman_ex1_elastic.yaml"
                        : veh          ? "examples/aurora_towfish.yaml"
+                       : tow          ? "examples/dolphin_aurora.yaml"
                                       : "examples/kamman_ex1_submerged.yaml";
     ts_scene *sc = u ? ts_scene_load(path, u, &err) : NULL;
     if (!sc) {
@@ -74,7 +82,7 @@ static void run_case(int kind, int links, figures *f)
     }
     ts_request rq;
     ts_request_init(&rq, kind == MODES || kind == VMODES ? TS_ANALYSIS_MODES
-                         : kind == RESPONSE || kind == VRESPONSE
+                         : kind == RESPONSE || kind == VRESPONSE || tow
                              ? TS_ANALYSIS_RESPONSE
                              : TS_ANALYSIS_SIMULATE);
     rq.setup.links = links;
@@ -86,6 +94,13 @@ static void run_case(int kind, int links, figures *f)
             snprintf(rq.response.input, sizeof rq.response.input,
                      "aurora.wing");
         rq.response.natural = 0;
+    }
+    if (tow) {
+        snprintf(rq.response.output, sizeof rq.response.output, "aurora.z");
+        snprintf(rq.response.input, sizeof rq.response.input, "tow.heave");
+        rq.response.natural = 0;
+        if (kind == TDENSE)
+            rq.modes.linearize.model = TS_LIN_DENSE;
     }
     if (kind == VMODES) {
         rq.modes.margins = 0;
@@ -189,7 +204,7 @@ static double measure(int kind, int links, int reps, figures *last,
         if (run_child(kind, links, last, &p, &c[n]) != 0 || !last->ok) {
             static const char *const names[] = {
                 "modes", "response", "esdirk", "vehicle modes",
-                "vehicle response"};
+                "vehicle response", "towing response", "towing dense"};
             printf("FAIL %s at %d links: %s\n", names[kind], links,
                    last->msg[0] ? last->msg : "child failed");
             failures++;
@@ -211,6 +226,7 @@ int main(int argc, char **argv)
 {
     int reps = argc > 1 ? atoi(argv[1]) : REPS;
     int only_vehicle = argc > 2 && strcmp(argv[2], "vehicle") == 0;
+    int only_towing = argc > 2 && strcmp(argv[2], "towing") == 0;
     if (reps < 1)
         reps = 1;
     figures f;
@@ -218,7 +234,7 @@ int main(int argc, char **argv)
     const int sizes[2] = {1000, 10000};
     printf("medians of %d runs; wall s of the whole analysis (equilibrium, "
            "linearization, solve)\n", reps);
-    for (int i = 0; i < 2 && !only_vehicle; i++) {
+    for (int i = 0; i < 2 && !only_vehicle && !only_towing; i++) {
         t[i] = measure(MODES, sizes[i], reps, &f, &mem[i], &cpu);
         if (isnan(t[i]))
             continue;
@@ -236,7 +252,7 @@ int main(int argc, char **argv)
         printf("modes    growth 1000 -> 10000: %.1fx time, %.1fx memory; "
                "target < 15x %s\n", t[1] / t[0], mem[1] / mem[0],
                met(t[1] / t[0] < 15 && mem[1] / mem[0] < 15));
-    for (int i = 0; i < 2 && !only_vehicle; i++) {
+    for (int i = 0; i < 2 && !only_vehicle && !only_towing; i++) {
         t[i] = measure(RESPONSE, sizes[i], reps, &f, &mem[i], &cpu);
         if (isnan(t[i]))
             continue;
@@ -250,6 +266,23 @@ int main(int argc, char **argv)
     if (!only_vehicle && !isnan(t[0]) && !isnan(t[1]))
         printf("response growth 1000 -> 10000: %.1fx; target < 15x %s\n",
                t[1] / t[0], met(t[1] / t[0] < 15));
+    const int tsizes[2] = {100, 1000};
+    for (int m = 0; m < 2 && !only_vehicle; m++)
+        for (int i = 0; i < 2; i++) {
+            int kind = m ? TDENSE : TRESPONSE;
+            double tt = measure(kind, tsizes[i], reps, &f, &mem[0], &cpu);
+            if (isnan(tt))
+                continue;
+            printf("towing response %s %5d links: %.3f s (equilibrium "
+                   "%.3f, linearize %.3f, 100 frequencies %.3f; CPU %.3f "
+                   "s), peak %.0f MB\n",
+                   m ? "dense " : "sparse", tsizes[i], tt, f.eq, f.lin,
+                   tt - f.eq - f.lin, cpu, mem[0]);
+        }
+    if (only_towing) {
+        printf("%d failed\n", failures);
+        return failures ? 1 : 0;
+    }
     const int vsizes[3] = {100, 1000, 10000};
     double tv[3];
     for (int i = 0; i < 3; i++) {

@@ -131,28 +131,31 @@ check "--plot: the run loads towstab-plot.so and libplplot" \
              grep -q 'file=[^ ]*libplplot' '$T/files'"
 
 # A module that cannot be loaded: --plot fails before anything is solved,
-# naming the file and the loader's reason; nothing is written. The
-# module's place is forced with TOWSTAB_PLOT_MODULE.
+# naming the file, the loader's reason and the repair; nothing is written.
+# An installation fault, not bad input: exit status 1. The module's place
+# is forced with TOWSTAB_PLOT_MODULE.
 plot_with_module() { # plot_with_module FILE
     TOWSTAB_PLOT_MODULE=$1 "$TOWSTAB" equilibrium "$EX1" --plot "$T/p/nomod" \
         >"$T/out" 2>"$T/err"
     status=$?
 }
 plot_with_module "$T/missing/towstab-plot.so"
-check "missing module: exit 2 (got $status)" [ $status -eq 2 ]
+check "missing module: exit 1 (got $status)" [ $status -eq 1 ]
 check "missing module: the message names the file and the reason ($(head -c 300 "$T/err"))" \
     grep -qF "cannot load the plotting module $T/missing/towstab-plot.so: $T/missing/towstab-plot.so: cannot open shared object file" "$T/err"
+check "missing module: the message says how to repair it" \
+    grep -qF "(TOWSTAB_PLOT_MODULE): unset TOWSTAB_PLOT_MODULE, or set it to the plotting module of this towstab" "$T/err"
 check "missing module: nothing solved, no directory made" \
     bash -c "! grep -q converged '$T/out' && [ ! -e '$T/p/nomod' ]"
 echo "not a shared object" >"$T/broken.so"
 plot_with_module "$T/broken.so"
-check "broken module: exit 2, the file named ($(head -c 300 "$T/err"))" \
-    bash -c "[ $status -eq 2 ] && grep -qF 'cannot load the plotting module $T/broken.so: ' '$T/err' && [ ! -e '$T/p/nomod' ]"
+check "broken module: exit 1, the file named ($(head -c 300 "$T/err"))" \
+    bash -c "[ $status -eq 1 ] && grep -qF 'cannot load the plotting module $T/broken.so: ' '$T/err' && [ ! -e '$T/p/nomod' ]"
 libm=$(ldd "$TOWSTAB" | awk '$1 ~ /^libm\.so/ {print $3}')
 if [ -n "$libm" ]; then
     plot_with_module "$libm"
     check "a library that is no plotting module: refused ($(head -c 300 "$T/err"))" \
-        bash -c "[ $status -eq 2 ] && grep -qF '$libm is not a towstab plotting module' '$T/err' && [ ! -e '$T/p/nomod' ]"
+        bash -c "[ $status -eq 1 ] && grep -qF '$libm is not a towstab plotting module' '$T/err' && [ ! -e '$T/p/nomod' ]"
 fi
 
 # Imperial units and an overlaid scene.

@@ -157,13 +157,44 @@ refuse "which a sea-state response has not" response "$EX" --output fish.z \
 "$TOWSTAB" response test/scenes/survey_ship.yaml --links 8 \
     --output depressor.z --sea Hs=2m,Tp=6s --rao examples/ship_rao.csv \
     --rao-reference "12 m,0,0" --no-discretisation-error --quiet \
-    --csv "$T/ship.csv" >"$T/ship.out" 2>"$T/ship.err"
+    --csv "$T/ship.csv" --json "$T/ship.json" >"$T/ship.out" 2>"$T/ship.err"
 st=$?
 if [ "$st" -eq 0 ] && head -1 "$T/ship.csv" | grep -q 'tow.pitch_re,tow.pitch_im' &&
     grep -q 'standard deviation sigma' "$T/ship.out"; then
     pass "towing ship with RAOs: its rotations are inputs (tow.pitch_re in the CSV)"
 else
     fail "towing ship with RAOs: exit $st, $(head -1 "$T/ship.err"), CSV header $(head -c 200 "$T/ship.csv" 2>/dev/null)"
+fi
+# Its JSON lever is the one the translation is taken at: the ship's
+# origin O less the reference point. O is the tow point (0, 0, -3) m less
+# the ship's tow_point (-12, 0, -3) m in a straight tow at zero yaw: (12,
+# 0, 0) m, the reference point itself, so the lever is 0 (the tow point's
+# would be (-12, 0, -3) m).
+if python3 - "$T/ship.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+def find(o):
+    if isinstance(o, dict):
+        if "lever" in o:
+            return o["lever"]
+        for v in o.values():
+            r = find(v)
+            if r is not None:
+                return r
+    elif isinstance(o, list):
+        for v in o:
+            r = find(v)
+            if r is not None:
+                return r
+    return None
+lev = find(d)
+print(lev)
+sys.exit(0 if lev is not None and max(abs(x) for x in lev) < 1e-6 else 1)
+PY
+then
+    pass "towing ship: the JSON lever is the ship's origin less the reference point (0 within 1e-6 m)"
+else
+    fail "towing ship: the JSON lever is not the origin's less the reference point"
 fi
 
 finish

@@ -220,6 +220,41 @@ for pair in "2:4 knot:3|2 knot:4 knot:3" "2,3,4 knot|2 knot,3 knot,4 knot"; do
     fi
 done
 
+# tow.speed and tow.turn_rate on a towing vehicle: only the start values of
+# the speed and turn rate its equilibrium solves, so every point would be
+# the same. Refused (exit 2, no file written), naming the key that sets
+# each: the propulsion's thrust, power or set speed, or turn_by.
+sed 's/^    thrust: "4500 N"$/    speed: "4.5 m\/s"\n    gain: "2000 N*s\/m"/' "$DA" \
+    >"$T/da_speed.yaml"
+for spec in "$DA|speed=4:5:2|propulsion.thrust" \
+            "$T/da_power.yaml|tow.speed=4:5:2|propulsion.power" \
+            "$T/da_speed.yaml|speed=4,5|propulsion.speed (its speed controller's set speed" \
+            "$DA|turn_rate=0:0.02:2|turn_by: <rudder>"; do
+    IFS='|' read -r scene vary want <<<"$spec"
+    rm -f "$T/tw.csv" "$T/tw.json"
+    ts sweep "$scene" --vary "$vary" --csv "$T/tw.csv" --json "$T/tw.json"
+    if [ "$status" -eq 2 ] && grep -qF -- "$want" "$T/err" &&
+       [ ! -e "$T/tw.csv" ] && [ ! -e "$T/tw.json" ] && [ "$(wc -l <"$T/err")" -eq 1 ]; then
+        pass "--vary $vary on a towing vehicle refused, naming $want: $(head -c 120 "$T/err")"
+    else
+        fail "--vary $vary on a towing vehicle: status $status, $(head -c 300 "$T/err")"
+    fi
+done
+# The keys named do vary the motion: the set speed (more thrust at 5 m/s
+# than at 4), and tow.turn_rate with turn_by (more rudder at 0.02 rad/s).
+sed 's/^  name: dolphin$/  name: dolphin\n  turn_by: rudder_upper/' "$DA" >"$T/da_turn.yaml"
+why="" vals=""
+for spec in "$T/da_speed.yaml|towing_vehicle.propulsion.speed=4:5:2|dolphin.thrust" \
+            "$T/da_turn.yaml|turn_rate=0.01:0.02:2|dolphin.rudder_upper.deflection"; do
+    IFS='|' read -r scene vary col <<<"$spec"
+    ts sweep "$scene" --vary "$vary" --links 10 --chain 1 --csv "$T/tw.csv" --quiet
+    a=$(csv_value "$T/tw.csv" 0 "$col") b=$(csv_value "$T/tw.csv" 1 "$col")
+    [ "$status" -eq 0 ] && awk -v a="$a" -v b="$b" 'BEGIN { if (a < 0) { a = -a; b = -b }
+        exit !(a != "" && b > 1.2 * a) }' || why="$why $vary: status $status, $col $a, $b;"
+    vals="$vals $col $a, $b;"
+done
+check "the keys named vary the towing vehicle's motion:$vals" "$why"
+
 # ---- bad input --------------------------------------------------------------
 bad() { # WHAT EXPECTED-TEXT ARGS...
     local what=$1 want=$2
