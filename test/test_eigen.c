@@ -392,6 +392,16 @@ static void test_arpack_small(void)
     snprintf(want, sizeof want, "the system has %d states", n);
     CHECK(ts_eigen_check(n, &o, &err) == TS_EINVAL && strstr(err.msg, want),
           "ts_eigen_check: a count above the states refused: %s", err.msg);
+    /* arpack_tol: >= 0, or the default TS_ARPACK_TOL_AUTO (the
+     * tolerance chosen by the model), nothing else. */
+    ts_eigen_opts_default(&o);
+    CHECK(o.arpack_tol == TS_ARPACK_TOL_AUTO &&
+              ts_eigen_check(n, &o, &err) == TS_OK,
+          "ts_eigen_check: the default arpack_tol (automatic) accepted");
+    o.arpack_tol = -0.5;
+    CHECK(ts_eigen_check(n, &o, &err) == TS_EINVAL &&
+              strstr(err.msg, "arpack_tol"),
+          "ts_eigen_check: arpack_tol -0.5 refused: %s", err.msg);
     ts_eigen_free(all);
     ts_linear_free(lin);
     ts_scene_free(sc);

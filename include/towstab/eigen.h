@@ -44,6 +44,9 @@ typedef enum {
     TS_EIG_ARPACK = 2
 } ts_eig_method;
 
+/* ts_eigen_opts.arpack_tol: the tolerance chosen by the model. */
+#define TS_ARPACK_TOL_AUTO (-1.0)
+
 typedef struct ts_eigen_opts {
     ts_eig_method method;  /* default TS_EIG_AUTO */
     int count;             /* modes wanted; 0 (default): all (lapack) */
@@ -52,9 +55,12 @@ typedef struct ts_eigen_opts {
     int arpack_min_states; /* auto uses arpack from this size on when
                               count > 0; default 1200 */
     double arpack_tol;     /* relative Ritz tolerance of the modes' runs
-                              (0: machine precision); default 1e-10; the
-                              rightmost search uses 1e-6 or this when
-                              looser */
+                              (0: machine precision); default
+                              TS_ARPACK_TOL_AUTO: 1e-6 with the sparse
+                              model's error estimate (each Ritz value's
+                              own error is then measured, ritz_error),
+                              1e-10 otherwise; the rightmost search uses
+                              1e-6 or this when looser */
     int arpack_max_iter;   /* restarts; default 1000 */
     int vectors;           /* 1 (default): keep the right eigenvectors */
     int rightmost;         /* 1 (default): with arpack, also search the
