@@ -985,12 +985,13 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
         return ts_fail(err, TS_EINVAL, "free_vehicle: needs every coupled "
                        "mode with its shape: eigen_method lapack or auto");
     /* LAPACK needs the dense A at any size; so do a towing vehicle's
-     * modes (its neutral modes are found in it). */
+     * modes (its neutral modes are found in it), with the sparse model
+     * beside it for ARPACK's rightmost search (its band tops). */
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
         lo.model = TS_LIN_BOTH;
     if (r->sys->tow.vehicle >= 0 && lo.model == TS_LIN_AUTO)
-        lo.model = TS_LIN_DENSE;
+        lo.model = TS_LIN_BOTH;
     int rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc != TS_OK)
         return rc;

@@ -1304,10 +1304,10 @@ static int sweep_run(const ts_linear *lin, const ts_eigen_opts *o,
  * the largest real parts climb: while the rightmost eigenvalue a run found
  * lies in the outer half of its disc, the next shift is at its frequency.
  * Adds the eigenvalues found to L (sweep = 1, repeats 2). */
-static int rightmost_search(const ts_linear *lin, const ts_eigen_opts *o,
-                            ts_eigen *e, cand_list *L, ts_err *err)
+static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
+                            const ts_eigen_opts *o, ts_eigen *e, cand_list *L,
+                            ts_err *err)
 {
-    const ts_descriptor *d = lin->desc;
     const ts_system *sys = d->sys;
     int nc = sys->ncables;
     double *top = calloc(2 * (size_t)nc + 64, sizeof(double));
@@ -1671,18 +1671,22 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
 
 /* ---- Driver -------------------------------------------------------------- */
 
-static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
-                       ts_eigen **out, ts_err *err);
+static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
+                       const ts_eigen_opts *opts, ts_eigen **out,
+                       ts_err *err);
 
 int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                    ts_eigen **out, ts_err *err)
 {
     ts_linear dense;
+    /* The sparse model's band tops set the rightmost search's shifts. */
+    const ts_descriptor *bands = lin->desc;
     if (lin->root_qoff >= 0 && lin->desc) {
         /* A towing vehicle: its modes come from the dense model, where
          * its neutral modes by symmetry are recognised and cut
          * (doc/linear.md section 3a); the sparse model serves the
-         * response and sweeps. */
+         * response and sweeps, and gives the search its band tops (its
+         * shifts then factor the dense A). */
         *out = NULL;
         if (!lin->A)
             return ts_fail(err, TS_EINVAL, "eigen: the modes of a scene "
@@ -1697,7 +1701,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     for (int k = 0; k < lin->nneutral; k++)
         ncyclic += lin->neutral[k].cyclic >= 0;
     if (ncyclic == 0 || !lin->A)
-        return eigen_solve(lin, opts, out, err);
+        return eigen_solve(lin, bands, opts, out, err);
     /* The cyclic states' integrator chains cut (cut_cyclic): the same
      * eigenvalues, each neutral mode a simple eigenvector. */
     *out = NULL;
@@ -1705,13 +1709,14 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     cut.A = cut_cyclic(lin);
     if (!cut.A)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
-    int rc = eigen_solve(&cut, opts, out, err);
+    int rc = eigen_solve(&cut, bands, opts, out, err);
     free(cut.A);
     return rc;
 }
 
-static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
-                       ts_eigen **out, ts_err *err)
+static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
+                       const ts_eigen_opts *opts, ts_eigen **out,
+                       ts_err *err)
 {
     ts_eigen_opts o;
     if (opts)
@@ -1773,8 +1778,8 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     }
 
     e->top_hz = NAN;
-    if (m == TS_EIG_ARPACK && o.rightmost && lin->desc)
-        rc = rightmost_search(lin, &o, e, &L, err);
+    if (m == TS_EIG_ARPACK && o.rightmost && bands)
+        rc = rightmost_search(lin, bands, &o, e, &L, err);
     if (rc != TS_OK) {
         cand_free(&L);
         ts_eigen_free(e);
@@ -1838,7 +1843,8 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
             if (best < 0)
                 break;
             L.c[best].checked = 0;
-            rc = batch_checks(lin, &acc, &es, &L, err);
+            rc = lin->desc ? batch_checks(lin, &acc, &es, &L, err)
+                           : dense_checks(lin, &L, err);
             if (L.c[best].ritz > SWEEP_RESIDUAL * cabs(L.c[best].lam)) {
                 L.c[best].sweep = 3;
                 e->sweep_rejected++;
@@ -1897,6 +1903,8 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     e->max_real = -INFINITY;
     e->max_real_error = 0.0;
     int any_unstable = 0, all_stable = 1, right = -1;
+    double reach = -INFINITY; /* the largest Re + bound */
+    e->undecided_real = e->undecided_error = NAN;
     for (int q = 0; q < ncover; q++) {
         const cand *c = &L.c[cover[q]];
         if (c->neutral >= 0)
@@ -1913,6 +1921,11 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
             any_unstable = 1;
         if (!(re + bound < 0))
             all_stable = 0;
+        if (re + bound > reach) {
+            reach = re + bound;
+            e->undecided_real = re;
+            e->undecided_error = bound;
+        }
     }
     free(cover);
     if (right >= 0)
@@ -1920,6 +1933,8 @@ static int eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     e->verdict = any_unstable ? TS_UNSTABLE
                               : (all_stable && right >= 0 ? TS_STABLE
                                                           : TS_MARGINAL);
+    if (e->verdict != TS_MARGINAL)
+        e->undecided_real = e->undecided_error = NAN;
 
     qsort(L.c, (size_t)keep, sizeof(cand), cmp_freq);
     e->nmodes = keep;

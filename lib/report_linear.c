@@ -120,6 +120,8 @@ json_t *ts_report_modes_json(const ts_system *sys, const ts_linear *lin,
     json_object_set_new(o, "verdict", json_string(ts_verdict_name(e->verdict)));
     json_object_set_new(o, "max_real", num(e->max_real));
     json_object_set_new(o, "max_real_error", num(e->max_real_error));
+    json_object_set_new(o, "undecided_real", num(e->undecided_real));
+    json_object_set_new(o, "undecided_error", num(e->undecided_error));
     json_object_set_new(o, "complete", json_boolean(e->complete));
     json_object_set_new(o, "neutral_modes", json_integer(e->nneutral));
     const ts_mode *r = &e->rightmost;

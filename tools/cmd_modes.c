@@ -99,10 +99,21 @@ static void print_verdict(const ts_result *r)
                    scope, e->max_real, e->max_real_error);
             break;
         default:
-            printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s is "
-                   "within its error bound %.2g 1/s of 0; the linear model "
-                   "does not decide stability (undamped or nearly so)\n",
-                   scope, e->max_real, e->max_real_error);
+            if (e->max_real + e->max_real_error < 0 &&
+                isfinite(e->undecided_real))
+                /* The rightmost is decided; another's bound is wider. */
+                printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s "
+                       "(error bound %.2g 1/s), but Re(lambda) = %.3g 1/s "
+                       "is within its error bound %.2g 1/s of 0; the "
+                       "linear model does not decide stability\n",
+                       scope, e->max_real, e->max_real_error,
+                       e->undecided_real, e->undecided_error);
+            else
+                printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s is "
+                       "within its error bound %.2g 1/s of 0; the linear "
+                       "model does not decide stability (undamped or "
+                       "nearly so)\n",
+                       scope, e->max_real, e->max_real_error);
         }
         printf("note: the verdict covers every mode, resolved or not (the "
                "discretisation error was not estimated); %d mode%s vary on "

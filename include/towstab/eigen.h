@@ -162,6 +162,11 @@ typedef struct ts_eigen {
                                verdict covers (every one but the neutral
                                modes by symmetry), 1/s */
     double max_real_error;  /* error_bound of that eigenvalue, 1/s */
+    double undecided_real;  /* TS_MARGINAL: the Re of the covered
+                               eigenvalue whose bound reaches 0 furthest
+                               (Re + bound largest), 1/s; it may not be the
+                               rightmost; NaN otherwise */
+    double undecided_error; /* its error bound, 1/s; NaN otherwise */
     ts_mode rightmost;      /* that eigenvalue (Im >= 0) as a mode: every
                                field but the shape's; with lapack the
                                rightmost of all */
