@@ -40,7 +40,7 @@ for f in "$SCENE" "$EXP"; do
         exit 1
     fi
 done
-TMP=$(mktemp -d "${TMPDIR:-/tmp}/towstab-expected-XXXXXX")
+TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 if ! OPENBLAS_NUM_THREADS=1 "$TOWSTAB" run "$SCENE" --quiet \
         --json "$TMP/run.json" >"$TMP/out" 2>&1; then
