@@ -656,18 +656,8 @@ static int rhs_esdirk(double t, const double y[], double dydt[], void *params)
     return esdirk_code(rhs(t, y, dydt, params));
 }
 
-/* Whether the sparse model covers kernel k's system (the descriptor
- * can be laid out: O(nlinks), once per simulation). */
-static int desc_covers(const ts_kernel *k)
-{
-    ts_err e = {0};
-    ts_descriptor *d = tsi_desc_alloc(k, &e);
-    tsi_desc_free(d);
-    return d != NULL;
-}
-
 /* esdirk's dense Jacobian, where the sparse model does not cover the
- * system (desc_covers). */
+ * system (the descriptor could not be laid out). */
 static int jacobian_esdirk(double t, const double y[], double J[],
                            void *params)
 {
@@ -826,9 +816,14 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         s->lopts.threads = o->jacobian_threads;
         /* GSL's implicit steppers take a dense Jacobian; esdirk and bdf
          * solve with the sparse model where it covers the system: towed
-         * and towing vehicles and their controllers too (a descriptor
-         * that cannot be laid out, TS_EINVAL, leaves the dense one). */
-        sparse = sundials_method(o->integrator) && desc_covers(k);
+         * and towing vehicles and their controllers too. Its descriptor
+         * is laid out here, once, for the linear model to keep; one that
+         * cannot be (TS_EINVAL) leaves the dense model. */
+        if (sundials_method(o->integrator)) {
+            ts_err derr = {0};
+            s->lin->desc = tsi_desc_alloc(k, &derr);
+            sparse = s->lin->desc != NULL;
+        }
         s->lopts.model = sparse ? TS_LIN_SPARSE : TS_LIN_DENSE;
         s->newton = sparse ? TS_NEWTON_SPARSE : TS_NEWTON_DENSE;
     }
