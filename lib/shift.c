@@ -837,13 +837,11 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
         for (int c = 0; c < 3; c++)
             dr[3 * k + c] = rhs[2 * XR(k, c)] + I * rhs[2 * XR(k, c) + 1];
     /* A towing vehicle's tow input: the nodes move with the points their
-     * cables start from. */
-    if (tow_root >= 0) {
-        int order;
-        tow_shift(sh, tow_root, sh->u2, &order);
+     * cables start from, e (tow_shift), still at the head of sh->u2 from
+     * root_tow_rhs (the solves work in sh->rhs and sh->cols). */
+    if (tow_root >= 0)
         for (size_t i = 3; i < 3 * (size_t)d->nn; i++)
             dr[i] += sh->u2[i];
-    }
     for (int j = 0; j < d->nc; j++)
         dr[3 * d->np + j] = rhs[2 * XC(j)] + I * rhs[2 * XC(j) + 1];
     for (int l = 0; l < d->nl; l++)
