@@ -105,6 +105,12 @@ const char *ts_verdict_name(int verdict)
     }
 }
 
+int ts_eigen_other_undecided(const ts_eigen *e)
+{
+    return e->verdict == TS_MARGINAL && isfinite(e->undecided_real) &&
+           e->max_real + e->max_real_error < 0;
+}
+
 void ts_eigen_free(ts_eigen *e)
 {
     if (!e)

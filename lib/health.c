@@ -329,8 +329,7 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
         double ratio = e->max_real_error > 0
                            ? fabs(e->max_real) / e->max_real_error
                            : INFINITY;
-        if (e->verdict == TS_MARGINAL && isfinite(e->undecided_real) &&
-            e->max_real + e->max_real_error < 0)
+        if (ts_eigen_other_undecided(e))
             ts_trust_note(t, "stability is not decided: Re(lambda) = %.3g "
                              "1/s is within its error bound %.2g 1/s of 0 "
                              "(the smallest damping, max Re(lambda) = %.3g "

@@ -200,6 +200,21 @@ static void compare(const char *name, const ts_system *sys)
               w ? "LAPACK" : "ARPACK", ts_verdict_name(e->verdict),
               e->undecided_real, e->undecided_error, e->max_real,
               e->max_real_error);
+        /* Another eigenvalue than the rightmost is named exactly when
+         * the rightmost is decided: it lies left of the rightmost. */
+        if (ts_eigen_other_undecided(e))
+            CHECK(e->undecided_real < e->max_real &&
+                      e->max_real + e->max_real_error < 0,
+                  "%s (%d links): %s: another eigenvalue, Re %.3g, named "
+                  "beside the rightmost %.3g +- %.2g", name, sys->nlinks,
+                  w ? "LAPACK" : "ARPACK", e->undecided_real, e->max_real,
+                  e->max_real_error);
+        else if (e->verdict == TS_MARGINAL)
+            CHECK(e->max_real + e->max_real_error >= 0,
+                  "%s (%d links): %s: marginal, the rightmost %.3g +- %.2g "
+                  "decided, yet no other eigenvalue named", name,
+                  sys->nlinks, w ? "LAPACK" : "ARPACK", e->max_real,
+                  e->max_real_error);
     }
     ts_eigen_free(all);
     ts_eigen_free(ar);

@@ -99,8 +99,7 @@ static void print_verdict(const ts_result *r)
                    scope, e->max_real, e->max_real_error);
             break;
         default:
-            if (e->max_real + e->max_real_error < 0 &&
-                isfinite(e->undecided_real))
+            if (ts_eigen_other_undecided(e))
                 /* The rightmost is decided; another's bound is wider. */
                 printf("verdict: marginal%s: max Re(lambda) = %.3g 1/s "
                        "(error bound %.2g 1/s), but Re(lambda) = %.3g 1/s "

@@ -220,6 +220,11 @@ TS_API void ts_eigen_free(ts_eigen *e);
 TS_API const char *ts_eig_method_name(ts_eig_method m);
 TS_API const char *ts_verdict_name(int verdict);
 
+/* 1 when e's verdict is marginal although its rightmost eigenvalue is
+ * decided (max_real + max_real_error < 0): another eigenvalue's bound,
+ * undecided_real +- undecided_error, reaches 0; else 0. */
+TS_API int ts_eigen_other_undecided(const ts_eigen *e);
+
 /* Node displacements of mode m: amp[3 nnodes] (m per unit of the
  * normalisation, >= 0) and phase[3 nnodes] (rad) for x, y, z of every
  * node, from the angle part of the eigenvector through the link geometry
