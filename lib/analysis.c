@@ -2245,16 +2245,22 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         if (rc) {
             ts_err_prefix(err, "simulate: the initial equilibrium: ");
         } else {
-            memcpy(y0, r->eq->y, (size_t)n * sizeof *y0);
+            /* The state rebuilt from the equilibrium's shape, as the
+             * linear model about it starts (ts_linearize_equilibrium):
+             * with the loops open or closed the runs start from the same
+             * bits (eq->y may differ from the rebuilt state by an ulp of
+             * a link angle, and a rebuilt level heading is -0). */
+            rc = ts_equilibrium_state(k, r->eq, y0, err);
             ts_trust_merge(&r->trust, "initial equilibrium: ", &r->eq_trust);
-            if (sea_later) {
+            if (rc == TS_OK && sea_later) {
                 rc = sea_realise(r, s, r->eq->speed, k, y0, err);
                 if (r->sea_excitation)
                     ex = r->excitation;
             }
             /* The loops open at the trim: the state loses their
              * integrators. */
-            if (rq->setup.open_loop && ts_control_nloops(k) > 0) {
+            if (rc == TS_OK && rq->setup.open_loop &&
+                ts_control_nloops(k) > 0) {
                 r->open_loop = 1;
                 rc = ts_control_open(k, r->eq, y0, err);
                 n = ts_kernel_nstate(k);
