@@ -18,6 +18,7 @@
 #include "towstab/equilibrium.h"
 
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multiroots.h>
 #include <stdlib.h>
 #include <string.h>
@@ -65,6 +66,11 @@
  * tolerance; they stop at the march's rounding, a residual of about
  * 1e-14. */
 #define VSHOOT_POLISH 1e-6
+/* Shooting with a towing vehicle: a central difference whose two values
+ * agree to this fraction of their size (about 64 machine epsilons) is
+ * rounding of an even function (a balance along the track against the
+ * roll, yaw or turn rate of a symmetric tow), and its entry is zero. */
+#define VSHOOT_EVEN_RTOL 1.5e-14
 /* A relative force residual this small is rounding in the sums of the
  * nodal balances (about 1000 machine epsilons): Newton stalling there has
  * converged as far as double precision goes. */
@@ -1329,8 +1335,20 @@ typedef struct vshoot {
     double *off;          /* [3 nlinks] starts of links on vehicles */
     double *strain;       /* [nlinks] */
     int *node_veh;        /* [nnodes] vehicle at the node, or -1 */
-    int nz, *zy;          /* outer unknown i is y[zy[i]] / zscale[i] */
+    int nz, *zy;          /* outer unknown i is y[zy[i]] / zscale[i], its
+                             residual the row of f of y[zy[i]]'s rate */
     double *zscale, *zw;  /* and its residual's weight */
+    /* A towing vehicle at the root: the outer unknowns at its x and y
+     * (held at the tow point) are its steady motion's parameters, as in
+     * Newton (newton_ws): zsp the speed or the speed controller's bias,
+     * ztr the turn rate or the turn surface's deflection; -1 without
+     * one. */
+    int zsp, ztr, x_is_bias, y_is_turn;
+    int nx;               /* the march's unknowns */
+    double *xsave, *nsave;/* [nx], [3 nlinks]: with a towing vehicle, the
+                             march's free ends and directions the outer
+                             Jacobian is entered with, every difference's
+                             start */
     double pos_tol;
     int max_iter;
     ts_equilibrium *eq;
@@ -1343,15 +1361,54 @@ static int vshoot_pull(void *ctx, int node, const double r[3], double F[3])
     return tsi_kernel_vehicle_pull(s->k, s->node_veh[node], s->y, r, F);
 }
 
+/* The value of the towing vehicle's steady-motion parameter that outer
+ * unknown i stands for (zsp or ztr), and setting it. */
+static double vshoot_param(const vshoot *s, int i)
+{
+    ts_frame f;
+    ts_kernel_get_frame(s->k, &f);
+    if (i == s->ztr)
+        return s->y_is_turn ? ts_kernel_turn_deflection(s->k) : f.turn_rate;
+    return s->x_is_bias ? ts_kernel_thrust_bias(s->k) : f.speed;
+}
+
+static void vshoot_set_param(vshoot *s, int i, double v)
+{
+    ts_frame f;
+    ts_kernel_get_frame(s->k, &f);
+    if (i == s->ztr && s->y_is_turn)
+        ts_kernel_set_turn_deflection(s->k, v);
+    else if (i == s->ztr)
+        f.turn_rate = v;
+    else if (s->x_is_bias)
+        ts_kernel_set_thrust_bias(s->k, v);
+    else
+        f.speed = v;
+    ts_kernel_set_frame(s->k, &f);
+}
+
 /* The outer residual res[nz] at the unknowns z[nz]; the state in s->y,
- * its f(y) in s->f. */
+ * its f(y) in s->f. With a towing vehicle the march runs in the frame of
+ * its steady motion, and its cables end at its tow point where its depth
+ * places it, each at its own point on the body as the attitude turns it
+ * (tsi_kernel_vehicle_lever, as for a towed vehicle's child cables). */
 static int vshoot_eval(vshoot *s, const double *z, double *res)
 {
     ts_kernel *k = s->k;
     const ts_system *sys = ts_kernel_system(k);
     int nq = ts_kernel_nq(k);
-    for (int i = 0; i < s->nz; i++)
-        s->y[s->zy[i]] = z[i] * s->zscale[i];
+    for (int i = 0; i < s->nz; i++) {
+        if (i == s->zsp || i == s->ztr)
+            vshoot_set_param(s, i, z[i] * s->zscale[i]);
+        else
+            s->y[s->zy[i]] = z[i] * s->zscale[i];
+    }
+    if (s->zsp >= 0) {
+        double r0[3];
+        ts_kernel_get_frame(k, &s->frame);
+        ts_kernel_root_position(k, s->y, r0);
+        tsi_march_set_root(s->m, r0);
+    }
     for (int l = 0; l < sys->nlinks; l++)
         if (sys->links[l].up_body >= 0)
             tsi_kernel_vehicle_lever(k, s->node_veh[sys->links[l].upper],
@@ -1384,29 +1441,68 @@ static int vshoot_f(const gsl_vector *z, void *par, gsl_vector *r)
                                                         : GSL_EDOM;
 }
 
-/* Forward differences, step NEWTON_FD_STEP of each unknown's size. */
+/* With a towing vehicle (restore nonzero), the march restarted from the
+ * state the Jacobian was entered with, so that each difference does not
+ * depend on the one before (a march ends within its tolerance of where
+ * it started from, and a symmetric tow would keep a lateral trace of the
+ * last lateral step). */
+static void vshoot_restart(vshoot *s, int restore)
+{
+    if (!restore)
+        return;
+    tsi_march_warm(s->m, s->nsave, s->x);
+    memcpy(s->x, s->xsave, (size_t)s->nx * sizeof(double));
+}
+
+/* Forward differences, step NEWTON_FD_STEP of each unknown's size; with
+ * a towing vehicle central ones, as Newton's: a residual even in an
+ * unknown (the balances along the track in the sideslip, roll and turn
+ * rate of a symmetric tow) then has an exactly zero column there, where a
+ * forward difference leaves one of the step's order, which couples the
+ * lateral unknowns to the residuals along the track and, where the
+ * lateral problem is nearly neutral (a vehicle of little directional
+ * stability), moves the solve off the straight tow to a slight turn. */
 static int vshoot_fdf(const gsl_vector *z, void *par, gsl_vector *r,
                       gsl_matrix *J)
 {
     vshoot *s = par;
-    int nz = s->nz;
-    double *zt = malloc(2 * (size_t)nz * sizeof(double)), *rt = zt + nz;
+    int nz = s->nz, central = s->zsp >= 0;
+    double *zt = malloc(3 * (size_t)nz * sizeof(double)), *rt = zt + nz;
+    double *rm = rt + nz;
     if (!zt)
         return GSL_ENOMEM;
     int status = GSL_SUCCESS;
     memcpy(zt, z->data, (size_t)nz * sizeof(double));
+    if (central) {
+        memcpy(s->xsave, s->x, (size_t)s->nx * sizeof(double));
+        memcpy(s->nsave, tsi_march_directions(s->m),
+               3 * (size_t)ts_kernel_system(s->k)->nlinks * sizeof(double));
+    }
     for (int j = 0; j < nz && status == GSL_SUCCESS; j++) {
         zt[j] = z->data[j] + NEWTON_FD_STEP;
+        vshoot_restart(s, central);
         if (vshoot_eval(s, zt, rt) != TS_OK)
             status = GSL_EDOM;
+        zt[j] = z->data[j] - NEWTON_FD_STEP;
+        vshoot_restart(s, central);
+        if (central && status == GSL_SUCCESS &&
+            vshoot_eval(s, zt, rm) != TS_OK)
+            status = GSL_EDOM;
         zt[j] = z->data[j];
-        for (int i = 0; i < nz && status == GSL_SUCCESS; i++)
-            gsl_matrix_set(J, (size_t)i, (size_t)j, rt[i]);
+        for (int i = 0; i < nz && status == GSL_SUCCESS; i++) {
+            double d = rt[i] - rm[i];
+            if (central &&
+                fabs(d) <= VSHOOT_EVEN_RTOL * fmax(fabs(rt[i]), fabs(rm[i])))
+                d = 0.0; /* even in z[j] to rounding */
+            gsl_matrix_set(J, (size_t)i, (size_t)j,
+                           central ? d / (2 * NEWTON_FD_STEP) : rt[i]);
+        }
     }
     /* Last, so that s->y and s->f are those of z. */
+    vshoot_restart(s, central);
     if (status == GSL_SUCCESS && vshoot_eval(s, z->data, r->data) != TS_OK)
         status = GSL_EDOM;
-    for (int j = 0; j < nz && status == GSL_SUCCESS; j++)
+    for (int j = 0; j < nz && status == GSL_SUCCESS && !central; j++)
         for (int i = 0; i < nz; i++)
             gsl_matrix_set(J, (size_t)i, (size_t)j,
                            (gsl_matrix_get(J, (size_t)i, (size_t)j) -
@@ -1484,13 +1580,116 @@ out:
     return rc;
 }
 
+/* The outer unknowns of shooting with vehicles into s (zy, zscale, zw,
+ * zsp, ztr; zy and zscale hold 3 nvehicles + 3 + ncontrol): every
+ * vehicle's angles (a surface ship's yaw alone), a towing vehicle's
+ * position coordinates (its depth, and at its held x and y the speed or
+ * bias and the turn rate or deflection, sized as Newton's), the
+ * controller states. Returns their number. */
+static int vshoot_layout(vshoot *s, const ts_kernel *k)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k), i = 0;
+    s->zsp = s->ztr = -1;
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        int na = v == ts_kernel_root(k) && root_npos(k) == 2 ? 1 : 3;
+        for (int j = 0; j < na; j++, i++) {
+            s->zy[i] = ts_kernel_vehicle_offset(k, v) + j;
+            s->zscale[i] = 1.0;
+            s->zw[i] = 1.0;
+        }
+    }
+    int ro = ts_kernel_root_offset(k);
+    if (ro >= 0) {
+        const ts_body *bd = &sys->bodies[sys->tow.vehicle];
+        s->x_is_bias = bd->vehicle->propulsion.type == TS_PROP_SPEED &&
+                       !(bd->vehicle->propulsion.ki > 0);
+        s->y_is_turn = sys->tow.turn_surface >= 0;
+        s->zsp = i;
+        s->ztr = i + 1;
+        for (int j = 0; j < root_npos(k); j++, i++) {
+            s->zy[i] = ro + j;
+            s->zscale[i] = 1.0; /* a depth, m */
+            s->zw[i] = 1.0;
+        }
+        s->zscale[s->zsp] = s->x_is_bias
+                                ? fmax(bd->mass * sys->env.gravity, 1.0)
+                                : fmax(fabs(sys->tow.speed), 1.0);
+        s->zscale[s->ztr] = 0.1; /* rad/s, or rad */
+    }
+    for (int c = 0; c < nc; c++, i++) {
+        s->zy[i] = 2 * nq + c;
+        s->zscale[i] = control_scale(k, c);
+        s->zw[i] = control_weight(k, c);
+    }
+    return i;
+}
+
+/* With a towing vehicle, the next outer Newton step of its steady
+ * motion's two unknowns at the solution z (a PI speed controller's:
+ * its integral term's), into eq->motion_step: their solver error to
+ * first order, as Newton's newton_health gives it. One outer Jacobian,
+ * nz marches. Left NaN when it cannot be formed. */
+static void vshoot_motion_step(vshoot *s, double *z)
+{
+    size_t nz = (size_t)s->nz;
+    gsl_matrix *J = gsl_matrix_alloc(nz, nz);
+    gsl_permutation *p = gsl_permutation_alloc(nz);
+    gsl_vector *r = gsl_vector_alloc(nz), *dz = gsl_vector_alloc(nz);
+    gsl_vector_view zv = gsl_vector_view_array(z, nz);
+    int sign = 0;
+    if (J && p && r && dz &&
+        vshoot_fdf(&zv.vector, s, r, J) == GSL_SUCCESS &&
+        gsl_linalg_LU_decomp(J, p, &sign) == GSL_SUCCESS &&
+        gsl_linalg_LU_solve(J, p, r, dz) == GSL_SUCCESS) {
+        const ts_system *sys = ts_kernel_system(s->k);
+        int zs = ts_kernel_speed_integrator(s->k), nq = ts_kernel_nq(s->k);
+        s->eq->motion_step[0] =
+            fabs(gsl_vector_get(dz, (size_t)s->zsp)) * s->zscale[s->zsp];
+        s->eq->motion_step[1] =
+            fabs(gsl_vector_get(dz, (size_t)s->ztr)) * s->zscale[s->ztr];
+        for (int i = 0; zs >= 0 && i < s->nz; i++)
+            if (s->zy[i] == 2 * nq + zs)
+                s->eq->motion_step[0] =
+                    sys->bodies[sys->tow.vehicle].vehicle->propulsion.ki *
+                    fabs(gsl_vector_get(dz, (size_t)i)) * s->zscale[i];
+    }
+    gsl_matrix_free(J);
+    gsl_permutation_free(p);
+    gsl_vector_free(r);
+    gsl_vector_free(dz);
+}
+
+/* A speed controller without integral gain holds its set speed through
+ * the bias, which is solved: the kernel's frame then moves at that
+ * speed, the tow point (M's origin) through the water at the set speed,
+ * V less the current (turns have no horizontal current). */
+static void hold_set_speed(ts_kernel *k)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    ts_frame f;
+    ts_kernel_get_frame(k, &f);
+    double sp = sys->bodies[sys->tow.vehicle].vehicle->propulsion.speed;
+    double c2 = sp * sp - f.current[1] * f.current[1] -
+                f.current[2] * f.current[2];
+    f.speed = f.current[0] + sqrt(fmax(c2, 0.0));
+    ts_kernel_set_frame(k, &f);
+}
+
 /* The equilibrium of a system with vehicles by shooting (no bending):
  * from the straight-tow march with each vehicle trimmed alone, with the
  * controllers idle at the set points that start gives (controls_start),
  * the outer solve at the frame and set points of the kernel; where that
  * fails, continuation from that start to them (turn rate and set points
- * together) in 4, then 16 steps. On TS_OK, y[n] is the equilibrium; the
- * kernel's frame and set points are then the targets again. */
+ * together) in 4, then 16 steps. A towing vehicle at the root starts
+ * level at the scene's tow point, at the scene's speed (or the set speed
+ * its controller holds) and turn rate; its speed, or bias, and turn rate,
+ * or turn deflection, are outer unknowns that no path moves (with
+ * turn_by, the path moves the turn rate the deflection is solved for).
+ * On TS_OK, y[n] is the equilibrium; the kernel's frame and set points
+ * are then the targets again, with a towing vehicle's steady motion in
+ * the frame, its bias and deflection as solved; on failure they are as
+ * on entry. */
 static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
                                   const ts_frame *frame,
                                   const ts_equilibrium_opts *o,
@@ -1498,60 +1697,63 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
                                   double *dvec, double *att, ts_err *err)
 {
     const ts_system *sys = ts_kernel_system(k);
-    int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
+    int nc = ts_kernel_ncontrol(k), ro = ts_kernel_root_offset(k);
     int n = ts_kernel_nstate(k), nv = sys->nvehicles, nl = sys->nlinks;
     int nx = tsi_march_nunknown(m), nloops = 0;
     for (int v = 0; v < nv; v++)
         nloops += sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle->nloops;
+    double bias0 = ts_kernel_thrust_bias(k);
+    double turn0 = ts_kernel_turn_deflection(k);
     vshoot s = {0};
     s.k = k;
     s.m = m;
     s.eq = eq;
-    s.nz = 3 * nv + nc;
     s.pos_tol = SHOOT_POS_RTOL * total_length(sys);
     s.max_iter = o->max_iter;
     s.y = y;
     s.f = dydt;
+    size_t maxz = 3 * (size_t)nv + 3 + (size_t)nc;
     s.x = malloc(2 * ((size_t)nx + 1) * sizeof(double));
+    s.nx = nx;
+    s.xsave = malloc(((size_t)nx + 1) * sizeof(double));
+    s.nsave = malloc((3 * (size_t)nl + 1) * sizeof(double));
     s.off = calloc(3 * (size_t)nl, sizeof(double));
     s.strain = calloc((size_t)nl, sizeof(double));
     s.node_veh = malloc((size_t)sys->nnodes * sizeof(int));
-    s.zy = malloc((size_t)s.nz * sizeof(int));
-    s.zscale = malloc(3 * (size_t)s.nz * sizeof(double));
+    s.zy = malloc(maxz * sizeof(int));
+    s.zscale = malloc(3 * maxz * sizeof(double));
     double *y0 = malloc((size_t)n * sizeof(double));
     double *sp = calloc(2 * (size_t)nloops + 1, sizeof(double));
     int rc = TS_ENOMEM;
-    if (!s.x || !s.off || !s.strain || !s.node_veh || !s.zy || !s.zscale ||
-        !y0 || !sp)
+    if (!s.x || !s.xsave || !s.nsave || !s.off || !s.strain ||
+        !s.node_veh || !s.zy || !s.zscale || !y0 || !sp)
         goto out;
-    s.zw = s.zscale + s.nz;
-    double *z = s.zscale + 2 * s.nz, *x0 = s.x + nx + 1;
+    s.zw = s.zscale + maxz;
+    double *z = s.zscale + 2 * maxz, *x0 = s.x + nx + 1;
     for (int i = 0; i < sys->nnodes; i++)
         s.node_veh[i] = -1;
-    for (int v = 0; v < nv; v++) {
+    for (int v = 0; v < nv; v++)
         s.node_veh[ts_system_body_node(sys, ts_kernel_vehicle_body(k, v))] =
             v;
-        for (int j = 0; j < 3; j++) {
-            s.zy[3 * v + j] = ts_kernel_vehicle_offset(k, v) + j;
-            s.zscale[3 * v + j] = 1.0;
-            s.zw[3 * v + j] = 1.0;
-        }
-    }
-    for (int i = 0; i < nc; i++) {
-        s.zy[3 * nv + i] = 2 * nq + i;
-        s.zscale[3 * nv + i] = control_scale(k, i);
-        s.zw[3 * nv + i] = control_weight(k, i);
-    }
+    s.nz = vshoot_layout(&s, k);
 
     /* The start, straight, the loops idle where it leaves them. */
     ts_frame f = *frame;
     f.turn_rate = 0.0;
     ts_kernel_set_frame(k, &f);
+    if (s.zsp >= 0 && s.x_is_bias) {
+        hold_set_speed(k);
+        ts_kernel_get_frame(k, &f);
+    }
+    tsi_march_set_root(m, sys->tow.point);
     rc = vehicle_start(sys, m, &f, s.pos_tol, o->max_iter, dvec, s.strain,
                        att, eq);
     if (rc != TS_OK)
         goto out;
     memset(y, 0, (size_t)n * sizeof(double));
+    if (ro >= 0)
+        memcpy(y + ro, sys->tow.point,
+               (size_t)root_npos(k) * sizeof(double));
     ts_kernel_set_shape(k, dvec, s.strain, NULL, NULL, TS_CHART_RECHART, y);
     for (int v = 0; v < nv; v++)
         ts_kernel_set_vehicle(k, v, att + 9 * v, NULL, TS_CHART_RECHART, y);
@@ -1562,6 +1764,17 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
     tsi_march_warm(m, dvec, x0);
     memcpy(y0, y, (size_t)n * sizeof(double));
     tsi_march_set_vehicles(m, vshoot_pull, &s, s.off);
+    /* The towing vehicle's steady motion starts at the scene's turn rate
+     * (an unknown), or straight (turn_by: the path's). */
+    double p0[2] = {0, 0};
+    if (s.zsp >= 0) {
+        if (!s.y_is_turn) {
+            f.turn_rate = frame->turn_rate;
+            ts_kernel_set_frame(k, &f);
+        }
+        p0[0] = vshoot_param(&s, s.zsp);
+        p0[1] = vshoot_param(&s, s.ztr);
+    }
 
     static const int schedule[] = {1, 4, 16};
     int nsched = frame->turn_rate != 0 || nloops > 0 ? 3 : 1;
@@ -1570,11 +1783,23 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
         int steps = schedule[sc];
         memcpy(y, y0, (size_t)n * sizeof(double));
         memcpy(s.x, x0, (size_t)nx * sizeof(double));
+        if (s.zsp >= 0) {
+            vshoot_set_param(&s, s.zsp, p0[0]);
+            vshoot_set_param(&s, s.ztr, p0[1]);
+        }
         rc = TS_OK;
         for (int j = 1; j <= steps && rc == TS_OK; j++) {
             double t = (double)j / steps;
+            ts_frame g;
+            ts_kernel_get_frame(k, &g);
             s.frame = *frame;
             s.frame.turn_rate = frame->turn_rate * t;
+            if (s.zsp >= 0) {
+                /* The steady motion's unknowns stay where they are. */
+                s.frame.speed = g.speed;
+                if (!s.y_is_turn)
+                    s.frame.turn_rate = g.turn_rate;
+            }
             ts_kernel_set_frame(k, &s.frame);
             for (int v = 0, i = 0; v < nv; v++) {
                 const ts_vehicle *d =
@@ -1584,11 +1809,15 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
                         k, v, l, sp[i] + t * (sp[nloops + i] - sp[i]));
             }
             for (int i = 0; i < s.nz; i++)
-                z[i] = y[s.zy[i]] / s.zscale[i];
+                z[i] = (i == s.zsp || i == s.ztr ? vshoot_param(&s, i)
+                                                  : y[s.zy[i]]) /
+                       s.zscale[i];
             rc = vshoot_solve(&s, z, o->tol, o->max_iter);
             eq->continuation_steps++;
         }
     }
+    if (rc == TS_OK && s.zsp >= 0)
+        vshoot_motion_step(&s, z);
     if (rc != TS_OK && rc != TS_ENOMEM)
         rc = ts_fail(err, TS_ECONV, "equilibrium: shooting with vehicles "
                      "did not converge (%d outer iterations)%s%s",
@@ -1597,8 +1826,24 @@ out:
     if (rc == TS_ENOMEM)
         ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
     tsi_march_set_vehicles(m, NULL, NULL, NULL);
-    ts_kernel_set_frame(k, frame);
+    if (rc == TS_OK && ro >= 0) {
+        /* The towing vehicle's steady motion as solved. */
+        ts_frame g;
+        ts_kernel_get_frame(k, &g);
+        f = *frame;
+        f.speed = g.speed;
+        f.turn_rate = g.turn_rate;
+        ts_kernel_set_frame(k, &f);
+    } else {
+        ts_kernel_set_frame(k, frame);
+        if (ro >= 0) {
+            ts_kernel_set_thrust_bias(k, bias0);
+            ts_kernel_set_turn_deflection(k, turn0);
+        }
+    }
     free(s.x);
+    free(s.xsave);
+    free(s.nsave);
     free(s.off);
     free(s.strain);
     free(s.node_veh);
@@ -1756,12 +2001,11 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         }
     }
 
-    /* Vehicles without bending: shooting, the vehicles' attitudes and the
-     * controllers as outer unknowns; else (or when it fails, or with a
-     * towing vehicle at the root, whose position the march cannot move)
-     * Newton. */
-    if (!sys->has_bending && nv > 0 && ts_kernel_root(k) < 0 &&
-        o.method != TS_EQ_NEWTON) {
+    /* Vehicles without bending: shooting, the vehicles' attitudes, a
+     * towing vehicle's depth and steady motion and the controllers as
+     * outer unknowns; else (or when it fails, or a towing vehicle without
+     * cables) Newton. */
+    if (!sys->has_bending && nv > 0 && m && o.method != TS_EQ_NEWTON) {
         ts_err serr = {0};
         ts_kernel_set_steady(k, 1);
         rc = solve_vehicle_shooting(k, m, &frame, &o, eq, y, dydt, dvec, att,
@@ -1781,6 +2025,9 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
                 ts_kernel_set_setpoint(k, v, l, sp_entry[i]);
         }
         memset(y, 0, (size_t)n * sizeof(double));
+        if (ro >= 0)
+            memcpy(y + ro, sys->tow.point,
+                   (size_t)root_npos(k) * sizeof(double));
     }
 
     /* General Newton, from the straight-tow march (no bending) or from the
@@ -1796,18 +2043,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     }
     w.progress = o.progress;
     w.progress_data = o.progress_data;
-    if (ro >= 0 && w.x_is_bias) {
-        /* A speed controller holds its set speed: the bias is solved. */
-        ts_frame f;
-        ts_kernel_get_frame(k, &f);
-        /* The tow point (M's origin) moves through the water at the set
-         * speed: V less the current (turns have no horizontal current). */
-        double sp = sys->bodies[sys->tow.vehicle].vehicle->propulsion.speed;
-        double c2 = sp * sp - f.current[1] * f.current[1] -
-                    f.current[2] * f.current[2];
-        f.speed = f.current[0] + sqrt(fmax(c2, 0.0));
-        ts_kernel_set_frame(k, &f);
-    }
+    if (ro >= 0 && w.x_is_bias)
+        hold_set_speed(k); /* the bias is solved */
     rc = TS_ECONV;
     /* Actuators settle smoothly: no rate limit in a steady state. */
     ts_kernel_set_steady(k, 1);

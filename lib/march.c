@@ -71,6 +71,8 @@ struct tsi_march {
     tsi_march_pull_fn pull; /* vehicles' loads, or NULL */
     void *pull_ctx;
     const double *up_off;   /* [3 nl] start of a link on a vehicle */
+    double root[3];     /* node 0's position: the tow point, or a towing
+                           vehicle's where its state places it */
     double mismatch;
 
     gsl_multiroot_fsolver *local;
@@ -83,6 +85,7 @@ tsi_march *tsi_march_alloc(const ts_system *sys, ts_err *err)
     if (!m)
         goto nomem;
     m->sys = sys;
+    memcpy(m->root, sys->tow.point, sizeof m->root);
     m->nl = sys->nlinks;
     m->nn = sys->nnodes;
     for (int i = 1; i < m->nn; i++)
@@ -205,6 +208,11 @@ void tsi_march_free(tsi_march *m)
 }
 
 int tsi_march_nunknown(const tsi_march *m) { return 3 * m->nleaf; }
+
+void tsi_march_set_root(tsi_march *m, const double r[3])
+{
+    memcpy(m->root, r, sizeof m->root);
+}
 const double *tsi_march_positions(const tsi_march *m) { return m->r; }
 
 void tsi_march_warm(tsi_march *m, const double *directions, double x[])
@@ -216,7 +224,7 @@ void tsi_march_warm(tsi_march *m, const double *directions, double x[])
     m->have_n = 1;
     /* Links run from the tow point down (every link after its parent):
      * each lower node is its upper node plus the link. */
-    memcpy(m->r, sys->tow.point, 3 * sizeof(double));
+    memcpy(m->r, m->root, 3 * sizeof(double));
     for (int l = 0; l < m->nl; l++) {
         const ts_link *L = &sys->links[l];
         for (int j = 0; j < 3; j++)
@@ -721,7 +729,7 @@ int tsi_march_eval(tsi_march *m, const ts_frame *f, const double x[],
                 rp[j] -= m->up_off[3 * l + j]; /* the vehicle's joint */
         int a = m->res_of_link[l];
         if (a >= 0) {
-            const double *target = p == 0 ? sys->tow.point : m->r + 3 * p;
+            const double *target = p == 0 ? m->root : m->r + 3 * p;
             for (int j = 0; j < 3; j++) {
                 e[3 * a + j] = rp[j] - target[j];
                 if (fabs(e[3 * a + j]) > big)
@@ -799,9 +807,9 @@ int tsi_march_solve(tsi_march *m, const ts_frame *f, double x[], int fresh,
             double depth = 0.0;
             for (int l = m->leaf_node[j] - 1; l >= 0; l = sys->links[l].parent)
                 depth += sys->links[l].length;
-            x[3 * j] = sys->tow.point[0];
-            x[3 * j + 1] = sys->tow.point[1];
-            x[3 * j + 2] = sys->tow.point[2] + depth;
+            x[3 * j] = m->root[0];
+            x[3 * j + 1] = m->root[1];
+            x[3 * j + 2] = m->root[2] + depth;
         }
     }
     /* Translation corrections first: they close a straight tow exactly. */

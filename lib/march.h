@@ -45,6 +45,12 @@ typedef int (*tsi_march_pull_fn)(void *ctx, int node, const double r[3],
 void tsi_march_set_vehicles(tsi_march *m, tsi_march_pull_fn pull, void *ctx,
                             const double *off);
 
+/* Node 0's position r[3] (m, M), where the cables from it must end:
+ * sys->tow.point until set; a towing vehicle's tow point where its state
+ * places it. The march's first guesses (fresh, tsi_march_warm) hang
+ * from it too. */
+void tsi_march_set_root(tsi_march *m, const double r[3]);
+
 /* Number of shooting unknowns and residuals: 3 per free end. */
 int tsi_march_nunknown(const tsi_march *m);
 
