@@ -7,10 +7,11 @@
  * the kernel at 10 to 10000 links, the solve at 10 to 1000. The vehicle
  * adds O(1) work per kernel call: the difference to the sphere stays flat
  * as the links grow; its trim is shooting, O(links) per outer
- * iteration. The kernel also with a towing vehicle at the root
+ * iteration. Both also with a towing vehicle at the root
  * (examples/dolphin_aurora.yaml: DOLPHIN, 7 control surfaces and a depth
- * loop, towing the AURORA-like fish; its trim is Newton's, not timed
- * here). Medians of 9 kernel samples and of 3 solves. */
+ * loop, towing the AURORA-like fish; its trim is shooting too, its
+ * attitude, depth and speed among the outer unknowns). Medians of 9
+ * kernel samples and of 3 solves. */
 #include "bench_common.h"
 #include "towstab/equilibrium.h"
 #include "towstab/kernel.h"
@@ -83,7 +84,7 @@ static ts_system *at_links(const ts_scene *sc, int n)
 
 int main(void)
 {
-    enum { NSCENES = 4, NSOLVED = 3 }; /* the solve: the first three */
+    enum { NSCENES = 4 };
     static const char *const scenes[NSCENES] = {
         "examples/kamman_ex1_submerged.yaml",
         "examples/kamman_ex1_vehicle.yaml", "examples/aurora_towfish.yaml",
@@ -115,7 +116,7 @@ int main(void)
     printf("\n%-18s %6s %12s %10s %6s  %s\n", "equilibrium", "links",
            "solve [ms]", "CPU [ms]", "iter", "method");
     for (int s = 0; s < 3 && !bad; s++)
-        for (int i = 0; i < NSOLVED; i++) {
+        for (int i = 0; i < NSCENES; i++) {
             ts_system *sys = at_links(sc[i], esizes[s]);
             int it = 0;
             const char *method = "";
