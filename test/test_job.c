@@ -8,7 +8,10 @@
  *     an option given overrides it (the histories end there), and both
  *     the scene key and the command-line spelling are accepted.
  *  3. The JSON text parses and its top tension is the result's key value
- *     to the last digit (17 significant digits, read back exactly).
+ *     to the last digit (17 significant digits, read back exactly); the
+ *     text, written as it is made, is byte for byte jansson's dump of
+ *     the result's tree (ts_report_result_json), the full state of both
+ *     runs and the links' force extremes included.
  *  4. Arrays without a copy: the nonlinear run's t, positions, tensions,
  *     tow force, energy and input are the history's own memory, with its
  *     shape; the linear run's tensions are finite and start at the
@@ -31,10 +34,12 @@
 
 #include <jansson.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "tcheck.h"
 #include "towstab/kernel.h"
+#include "towstab/report_result.h"
 
 /* A progress callback's record: reports seen, the last, when to stop. */
 typedef struct {
@@ -124,7 +129,8 @@ int main(void)
     j = ts_job_alloc(sc, u, "simulate", 1, &err);
     ts_err_clear(&err);
     CHECK(ts_job_give(j, "t-end", "3 s", &err) == TS_OK &&
-              ts_job_give(j, "compare", "true", &err) == TS_OK,
+              ts_job_give(j, "compare", "true", &err) == TS_OK &&
+              ts_job_give(j, "outputs", "all", &err) == TS_OK,
           "the command-line spelling and the scene key are taken");
     rc = ts_job_run(j, &err);
     r = ts_job_result(j);
@@ -151,6 +157,17 @@ int main(void)
           "the JSON's tension.max is the result's to the last digit (%.17g)",
           jv);
     json_decref(doc);
+    /* The text is streamed (histories and forces.links never a tree):
+     * byte for byte jansson's one-line dump of the result's tree. */
+    json_t *tree = r ? ts_report_result_json(r, 0) : NULL;
+    char *ref = tree ? json_dumps(tree, JSON_REAL_PRECISION(17)) : NULL;
+    CHECK(text && ref && !strcmp(text, ref) &&
+              strstr(text, "\"tensions\": [{\"cable\": ") &&
+              strstr(text, "\"links\": [{\"max\": "),
+          "ts_job_json is jansson's dump of the tree, full state and "
+          "forces.links included (%zu bytes)", ref ? strlen(ref) : 0);
+    free(ref);
+    json_decref(tree);
 
     if (h) {
         int rows, cols;
