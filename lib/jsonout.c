@@ -139,6 +139,8 @@ int tsi_json_close(tsi_json *w)
     return release(w);
 }
 
+int tsi_json_status(const tsi_json *w) { return w->failed ? w->err : 0; }
+
 tsi_json *tsi_json_open_tree(void) { return writer(0); }
 
 json_t *tsi_json_take_tree(tsi_json *w)

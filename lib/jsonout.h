@@ -44,6 +44,10 @@ typedef struct tsi_json tsi_json;
  * spaces). NULL when out of memory. */
 tsi_json *tsi_json_open(FILE *f, int indent);
 
+/* 0 while every call and write so far succeeded, else the errno of the
+ * first failure (ENOMEM, EINVAL for a misuse, a write's). */
+int tsi_json_status(const tsi_json *w);
+
 /* A writer that builds a jansson tree of what it is given, one value
  * (the root) in all; NULL when out of memory. */
 tsi_json *tsi_json_open_tree(void);

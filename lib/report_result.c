@@ -6,8 +6,10 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "report_impl.h"
 
 #include "towstab/report.h"
@@ -669,6 +671,140 @@ int ts_report_result_dumpf(const ts_result *r, int flags, const json_t *extra,
                            FILE *f, const char *name, ts_err *err)
 {
     return tsi_report_result_dump(r, flags, extra, f, 1, name, err);
+}
+
+struct ts_report_results {
+    char *name;       /* the target as given, for messages */
+    FILE *given;      /* the caller's stream, or NULL */
+    tsi_outfile out;  /* a file's temporary name beside it (out.f) */
+    FILE *spool;      /* where the document goes: out.f, or a temporary
+                         file copied to a direct target at the close */
+    tsi_json *w;
+};
+
+void ts_report_results_abandon(ts_report_results *d)
+{
+    if (!d)
+        return;
+    tsi_json_close(d->w);
+    if (d->spool && d->spool != d->out.f)
+        fclose(d->spool);
+    tsi_outfile_abandon(&d->out);
+    free(d->name);
+    free(d);
+}
+
+/* Fail with code (TS_ENOMEM when e is ENOMEM, else TS_EIO) naming d's
+ * target, after giving d up. */
+static int results_fail(ts_report_results *d, int e, ts_err *err)
+{
+    int rc = ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
+                     "%s: write failed (%s)", d->name, strerror(e));
+    ts_report_results_abandon(d);
+    return rc;
+}
+
+ts_report_results *ts_report_results_open(const char *path, FILE *f,
+                                          const char *scene, ts_err *err)
+{
+    ts_report_results *d = calloc(1, sizeof *d);
+    if (!d || !(d->name = strdup(path))) {
+        free(d);
+        ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON", path);
+        return NULL;
+    }
+    d->given = f;
+    tsi_outfile_id id;
+    if (!f && tsi_outfile_identify(path, &id, NULL) == TS_OK &&
+        id.kind == 0) {
+        /* A file: written under its temporary name from the start. */
+        if (tsi_outfile_open(&d->out, path, err) != TS_OK) {
+            ts_report_results_abandon(d);
+            return NULL;
+        }
+        d->spool = d->out.f;
+    } else {
+        /* Written in place: nothing goes there before the close. A path
+         * that does not resolve fails there, as a single result's. */
+        d->spool = tmpfile();
+    }
+    d->w = d->spool ? tsi_json_open(d->spool, 1) : NULL;
+    if (!d->w) {
+        results_fail(d, d->spool ? ENOMEM : errno, err);
+        return NULL;
+    }
+    tsi_json_object_open(d->w);
+    tsi_json_key(d->w, "scene");
+    tsi_json_str(d->w, scene);
+    tsi_json_key(d->w, "analyses");
+    tsi_json_array_open(d->w);
+    return d;
+}
+
+int ts_report_results_add(ts_report_results *d, const ts_result *r,
+                          int flags, const json_t *extra, ts_err *err)
+{
+    tsi_json_defer defer = {0};
+    json_t *j = stream_tree(r, flags, extra, &defer);
+    if (!j)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON",
+                       d->name);
+    tsi_json_tree(d->w, j, &defer);
+    json_decref(j);
+    int e = tsi_json_status(d->w);
+    return e ? ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
+                       "%s: write failed (%s)", d->name, strerror(e))
+             : TS_OK;
+}
+
+/* Copy the spooled document to f: 0, or -1 with errno set. */
+static int copy_spool(FILE *spool, FILE *f)
+{
+    char buf[TSI_JSON_BUFFER];
+    size_t n;
+    if (fflush(spool) != 0 || fseek(spool, 0, SEEK_SET) != 0)
+        return -1;
+    while ((n = fread(buf, 1, sizeof buf, spool)) > 0)
+        if (fwrite(buf, 1, n, f) != n)
+            return -1;
+    return ferror(spool) ? (errno = EIO, -1) : 0;
+}
+
+int ts_report_results_close(ts_report_results *d, const json_t *tail,
+                            ts_err *err)
+{
+    tsi_json_array_close(d->w);
+    const char *key;
+    json_t *v;
+    json_object_foreach((json_t *)tail, key, v)
+    {
+        tsi_json_key(d->w, key);
+        tsi_json_tree(d->w, v, NULL);
+    }
+    tsi_json_object_close(d->w);
+    int bad = tsi_json_close(d->w) != 0;
+    d->w = NULL;
+    if (bad)
+        return results_fail(d, errno, err);
+    if (d->spool == d->out.f) {
+        d->spool = NULL;
+        int rc = tsi_outfile_commit(&d->out, err);
+        ts_report_results_abandon(d);
+        return rc;
+    }
+    int rc = TS_OK;
+    if (d->given) {
+        if (copy_spool(d->spool, d->given) != 0 || fflush(d->given) != 0)
+            return results_fail(d, errno, err);
+    } else {
+        rc = tsi_outfile_open(&d->out, d->name, err);
+        if (rc == TS_OK && copy_spool(d->spool, d->out.f) != 0)
+            return results_fail(d, errno, err);
+        if (rc == TS_OK)
+            rc = tsi_outfile_commit(&d->out, err);
+    }
+    ts_report_results_abandon(d);
+    return rc;
 }
 
 int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)
