@@ -172,8 +172,8 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
  * "trustworthy": false after a failure; "interrupted" after a signal),
  * NULL only when out of memory. With `into` (not NULL) each result is
  * added to that document as it comes instead, and *all receives only
- * the keys after "analyses" (ts_report_results_close's tail). Returns
- * the exit status. */
+ * the keys after "analyses" (ts_report_results_close's tail). all NULL:
+ * no document (no tree is built). Returns the exit status. */
 int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
                       json_t **all, ts_report_results *into);
 

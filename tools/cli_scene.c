@@ -155,16 +155,20 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
                       json_t **all, ts_report_results *into)
 {
     int status = 0;
-    /* Streamed, the document here is only the keys after the list. */
-    json_t *doc = json_object(), *list = into ? NULL : json_array();
-    if (!doc || (!into && !list) ||
-        (!into && (json_object_set_new(doc, "scene",
+    /* The results as trees only for a document of them held here;
+     * streamed (into) or not asked for, the document is only the keys
+     * after the list. */
+    int trees = all && !into;
+    json_t *doc = json_object(), *list = trees ? json_array() : NULL;
+    if (!doc || (trees && !list) ||
+        (trees && (json_object_set_new(doc, "scene",
                                        json_string(scene->system->name)) ||
                    json_object_set(doc, "analyses", list)))) {
         json_decref(doc);
         json_decref(list);
         fprintf(stderr, "towstab: error: out of memory for the results\n");
-        *all = NULL;
+        if (all)
+            *all = NULL;
         return EXIT_FAILED;
     }
     json_decref(list); /* the document holds it */
@@ -175,7 +179,7 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
         json_t *j = NULL;
         double t0 = cli_wall_now();
         s->runs[i].into = into;
-        status = cli_execute(&s->runs[i], into ? NULL : &j);
+        status = cli_execute(&s->runs[i], trees ? &j : NULL);
         s->wall_s[i] = cli_wall_now() - t0;
         s->ran = i + 1;
         if (j)
@@ -200,6 +204,9 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
     if (cli_stop_signal_name())
         json_object_set_new(doc, "interrupted",
                             json_string(cli_stop_signal_name()));
-    *all = doc;
+    if (all)
+        *all = doc;
+    else
+        json_decref(doc);
     return status;
 }

@@ -95,7 +95,7 @@ static int run_main(int argc, char **argv)
                                          &stream, &werr)
                       : NULL;
         json_t *tail = NULL;
-        status = cli_scene_execute(scene, &s, &tail, doc);
+        status = cli_scene_execute(scene, &s, doc ? &tail : NULL, doc);
         /* After a failure the results so far, marked as incomplete with
          * the failed analysis' message; nothing after bad input. */
         if (json_path && (!doc || (tail && status != EXIT_BADINPUT))) {
