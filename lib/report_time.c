@@ -2,7 +2,10 @@
  * (towstab/report_time.h). Numbers are written with 17 significant digits
  * (CSV %.17g; JSON through ts_report_write_json) so a history read back
  * reproduces the run bit for bit; non-finite values are JSON null and CSV
- * "nan". */
+ * "nan". A history's keys and the extremes are emitted once, through
+ * lib/jsonout.h: into a tree for the public functions here, or straight
+ * to the file for a result's document (report_result.c), so that a
+ * history is never held as a tree there. */
 #include "towstab/report_time.h"
 
 #include <math.h>

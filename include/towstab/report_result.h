@@ -31,8 +31,8 @@ TS_API json_t *ts_report_result_json(const ts_result *r, int flags);
 /* Write the result's JSON to `path` ("-": standard output), indented,
  * as towstab/report.h describes: the document ts_report_result_json
  * makes, with the keys of the object `extra` (NULL: none) added last.
- * The per-node and per-link arrays are written as they are made, never
- * held in memory whole. TS_OK, TS_ENOMEM, or TS_EIO naming path. */
+ * The per-node and per-link arrays and a simulation's histories are
+ * written as they are made, never held in memory whole. TS_OK, TS_ENOMEM, or TS_EIO naming path. */
 TS_API int ts_report_result_write_json(const ts_result *r, int flags,
                                        const json_t *extra,
                                        const char *path, ts_err *err);
