@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "report_impl.h"
 #include "towstab/eigen.h"
 #include "towstab/kernel.h"
 #include "towstab/linearize.h"
@@ -167,11 +168,23 @@ const char *ts_job_json(ts_job *j, int flags, ts_err *err)
         ts_fail(err, TS_EINVAL, "the job has no result (it did not run)");
         return NULL;
     }
-    json_t *o = ts_report_result_json(j->result, flags);
-    char *text = o ? json_dumps(o, JSON_REAL_PRECISION(17)) : NULL;
-    json_decref(o);
-    if (!text) {
+    /* Written as the command line writes a file (the large arrays as
+     * they are made, never a whole tree), in jansson's one-line form,
+     * into memory. */
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    if (!f) {
         ts_fail(err, TS_ENOMEM, "the result's JSON: out of memory");
+        return NULL;
+    }
+    int rc = tsi_report_result_dump(j->result, flags, NULL, f,
+                                    TSI_JSON_SPACED, "the result's JSON",
+                                    err);
+    if (fclose(f) != 0 && rc == TS_OK)
+        rc = ts_fail(err, TS_ENOMEM, "the result's JSON: out of memory");
+    if (rc != TS_OK) {
+        free(text);
         return NULL;
     }
     free(j->json);

@@ -3,7 +3,11 @@
  * yajl's generator (yajl_gen: structure, separators, indentation, the
  * escaping of strings) prints each token through a callback that copies
  * it into the writer's buffer; the buffer goes to the stream with one
- * fwrite each time it fills and at the end. Numbers are formatted here
+ * fwrite each time it fills and at the end. jansson's one-line form
+ * (", " and ": ") is yajl's beautified form with no indentation and its
+ * newlines mapped in the callback. A tree-building writer has no
+ * generator: each call adds its value to a jansson tree instead, so that
+ * a document's parts are written by one function for both forms. Numbers are formatted here
  * (tsi_json_format) and handed to yajl_gen_number as text: yajl's own
  * yajl_gen_double prints 20 significant digits, jansson's 17, and the
  * files must stay as they were. */
@@ -16,16 +20,26 @@
 #include <yajl/yajl_gen.h>
 
 struct tsi_json {
-    yajl_gen g;
+    yajl_gen g;  /* NULL when building a tree */
     FILE *f;
     int failed;  /* a write or a generator call failed */
     int err;     /* errno of the failure */
+    int spaced;  /* TSI_JSON_SPACED: yajl's newlines become jansson's */
+    char last;   /* the last byte given to the buffer */
+    /* A tree being built (tsi_json_open_tree): the open containers,
+     * innermost last, and the key waiting for its value (owned). */
+    json_t *root;
+    json_t *open[TSI_JSON_DEPTH];
+    int depth;
+    char *key;
     size_t len;  /* bytes in buf */
-    char buf[TSI_JSON_BUFFER];
+    char buf[];  /* TSI_JSON_BUFFER bytes when writing text */
 };
 
 static void flush(tsi_json *w)
 {
+    if (!w->g)
+        return;
     if (w->len > 0 && !w->failed && fwrite(w->buf, 1, w->len, w->f) != w->len) {
         w->failed = 1;
         w->err = errno ? errno : EIO;
@@ -37,9 +51,20 @@ static void flush(tsi_json *w)
 static void put(void *ctx, const char *s, size_t n)
 {
     tsi_json *w = ctx;
-    if (w->len + n > sizeof w->buf)
+    if (w->spaced && n == 1 && s[0] == '\n') {
+        /* yajl prints every newline of its beautified form alone (a
+         * string's own are escaped): after a comma it becomes jansson's
+         * space, after an opening bracket, before a closing one and at
+         * the end nothing. */
+        if (w->last != ',')
+            return;
+        s = " ";
+    }
+    if (n > 0)
+        w->last = s[n - 1];
+    if (w->len + n > TSI_JSON_BUFFER)
         flush(w);
-    if (n > sizeof w->buf) {
+    if (n > TSI_JSON_BUFFER) {
         if (!w->failed && fwrite(s, 1, n, w->f) != n) {
             w->failed = 1;
             w->err = errno ? errno : EIO;
@@ -60,9 +85,18 @@ static void check(tsi_json *w, yajl_gen_status st)
     }
 }
 
+/* A writer of either kind, zeroed, with `buffer` bytes of buffer. */
+static tsi_json *writer(size_t buffer)
+{
+    tsi_json *w = malloc(sizeof *w + buffer);
+    if (w)
+        memset(w, 0, sizeof *w);
+    return w;
+}
+
 tsi_json *tsi_json_open(FILE *f, int indent)
 {
-    tsi_json *w = malloc(sizeof *w);
+    tsi_json *w = writer(TSI_JSON_BUFFER);
     if (!w)
         return NULL;
     w->g = yajl_gen_alloc(NULL);
@@ -71,14 +105,30 @@ tsi_json *tsi_json_open(FILE *f, int indent)
         return NULL;
     }
     w->f = f;
-    w->failed = w->err = 0;
-    w->len = 0;
     yajl_gen_config(w->g, yajl_gen_print_callback, put, (void *)w);
     if (indent) {
         yajl_gen_config(w->g, yajl_gen_beautify, 1);
-        yajl_gen_config(w->g, yajl_gen_indent_string, "  ");
+        yajl_gen_config(w->g, yajl_gen_indent_string,
+                        indent == TSI_JSON_SPACED ? "" : "  ");
+        w->spaced = indent == TSI_JSON_SPACED;
     }
     return w;
+}
+
+/* Release w; -1 with errno set when something failed, else 0. */
+static int release(tsi_json *w)
+{
+    int failed = w->failed, e = w->err;
+    if (w->g)
+        yajl_gen_free(w->g);
+    while (w->depth > 0)
+        json_decref(w->open[--w->depth]);
+    json_decref(w->root);
+    free(w->key);
+    free(w);
+    if (failed)
+        errno = e;
+    return failed ? -1 : 0;
 }
 
 int tsi_json_close(tsi_json *w)
@@ -86,12 +136,73 @@ int tsi_json_close(tsi_json *w)
     if (!w)
         return -1;
     flush(w);
-    int failed = w->failed, e = w->err;
-    yajl_gen_free(w->g);
-    free(w);
-    if (failed)
-        errno = e;
-    return failed ? -1 : 0;
+    return release(w);
+}
+
+int tsi_json_status(const tsi_json *w) { return w->failed ? w->err : 0; }
+
+tsi_json *tsi_json_open_tree(void) { return writer(0); }
+
+json_t *tsi_json_take_tree(tsi_json *w)
+{
+    if (!w)
+        return NULL;
+    json_t *root = NULL;
+    if (!w->failed && w->depth == 0) {
+        root = w->root;
+        w->root = NULL;
+    }
+    release(w);
+    return root;
+}
+
+json_t *tsi_json_build(tsi_json_emit_fn fn, const void *a, const void *b)
+{
+    tsi_json *w = tsi_json_open_tree();
+    if (!w)
+        return NULL;
+    fn(w, a, b);
+    return tsi_json_take_tree(w);
+}
+
+/* Tree mode: place value v (a new reference, NULL when it could not be
+ * made) in the open container, or as the root; `container` pushes it. */
+static void add(tsi_json *w, json_t *v, int container)
+{
+    json_t *parent = w->depth > 0 ? w->open[w->depth - 1] : NULL;
+    int bad = w->failed || !v;
+    if (!bad && !parent) {
+        bad = w->root != NULL;
+        if (!bad)
+            w->root = json_incref(v);
+    } else if (!bad && json_is_object(parent)) {
+        bad = !w->key || json_object_set(parent, w->key, v) != 0;
+        free(w->key);
+        w->key = NULL;
+    } else if (!bad) {
+        bad = json_array_append(parent, v) != 0;
+    }
+    if (!bad && container) {
+        bad = w->depth >= TSI_JSON_DEPTH;
+        if (!bad)
+            w->open[w->depth++] = json_incref(v);
+    }
+    json_decref(v);
+    if (bad && !w->failed) {
+        w->failed = 1;
+        w->err = v ? EINVAL : ENOMEM;
+    }
+}
+
+/* Tree mode: close the innermost container. */
+static void end(tsi_json *w)
+{
+    if (w->depth == 0 || w->key) {
+        w->failed = 1;
+        w->err = EINVAL;
+        return;
+    }
+    json_decref(w->open[--w->depth]);
 }
 
 int tsi_json_format(char buf[32], double v)
@@ -130,6 +241,13 @@ int tsi_json_format(char buf[32], double v)
 
 void tsi_json_key(tsi_json *w, const char *key)
 {
+    if (!w->g) {
+        if (w->key || !(w->key = strdup(key))) {
+            w->failed = 1;
+            w->err = w->key ? EINVAL : ENOMEM;
+        }
+        return;
+    }
     check(w, yajl_gen_string(w->g, (const unsigned char *)key, strlen(key)));
 }
 
@@ -139,6 +257,10 @@ void tsi_json_num(tsi_json *w, double v)
         tsi_json_null(w);
         return;
     }
+    if (!w->g) {
+        add(w, json_real(v), 0);
+        return;
+    }
     char buf[32];
     int n = tsi_json_format(buf, v);
     check(w, yajl_gen_number(w->g, buf, (size_t)n));
@@ -146,33 +268,69 @@ void tsi_json_num(tsi_json *w, double v)
 
 void tsi_json_int(tsi_json *w, long long v)
 {
-    check(w, yajl_gen_integer(w->g, v));
+    if (!w->g)
+        add(w, json_integer(v), 0);
+    else
+        check(w, yajl_gen_integer(w->g, v));
 }
 
-void tsi_json_str(tsi_json *w, const char *s)
+/* A string of n bytes. */
+static void str_n(tsi_json *w, const char *s, size_t n)
 {
-    check(w, yajl_gen_string(w->g, (const unsigned char *)s, strlen(s)));
+    if (!w->g)
+        add(w, json_stringn(s, n), 0);
+    else
+        check(w, yajl_gen_string(w->g, (const unsigned char *)s, n));
 }
+
+void tsi_json_str(tsi_json *w, const char *s) { str_n(w, s, strlen(s)); }
 
 void tsi_json_bool(tsi_json *w, int v)
 {
-    check(w, yajl_gen_bool(w->g, v));
+    if (!w->g)
+        add(w, json_boolean(v), 0);
+    else
+        check(w, yajl_gen_bool(w->g, v));
 }
 
-void tsi_json_null(tsi_json *w) { check(w, yajl_gen_null(w->g)); }
+void tsi_json_null(tsi_json *w)
+{
+    if (!w->g)
+        add(w, json_null(), 0);
+    else
+        check(w, yajl_gen_null(w->g));
+}
 
-void tsi_json_object_open(tsi_json *w) { check(w, yajl_gen_map_open(w->g)); }
+void tsi_json_object_open(tsi_json *w)
+{
+    if (!w->g)
+        add(w, json_object(), 1);
+    else
+        check(w, yajl_gen_map_open(w->g));
+}
 
 void tsi_json_object_close(tsi_json *w)
 {
-    check(w, yajl_gen_map_close(w->g));
+    if (!w->g)
+        end(w);
+    else
+        check(w, yajl_gen_map_close(w->g));
 }
 
-void tsi_json_array_open(tsi_json *w) { check(w, yajl_gen_array_open(w->g)); }
+void tsi_json_array_open(tsi_json *w)
+{
+    if (!w->g)
+        add(w, json_array(), 1);
+    else
+        check(w, yajl_gen_array_open(w->g));
+}
 
 void tsi_json_array_close(tsi_json *w)
 {
-    check(w, yajl_gen_array_close(w->g));
+    if (!w->g)
+        end(w);
+    else
+        check(w, yajl_gen_array_close(w->g));
 }
 
 int tsi_json_defer_add(tsi_json_defer *d, const json_t *at,
@@ -200,8 +358,8 @@ void tsi_json_tree(tsi_json *w, const json_t *v, const tsi_json_defer *d)
     /* yajl opens a container on a line of its own even when it stays
      * empty; "[]" and "{}" are handed over whole, as an atom, to write
      * them as jansson does. */
-    if ((json_is_object(v) && json_object_size(v) == 0) ||
-        (json_is_array(v) && json_array_size(v) == 0)) {
+    if (w->g && ((json_is_object(v) && json_object_size(v) == 0) ||
+                 (json_is_array(v) && json_array_size(v) == 0))) {
         check(w, yajl_gen_number(w->g, json_is_array(v) ? "[]" : "{}", 2));
         return;
     }
@@ -227,9 +385,7 @@ void tsi_json_tree(tsi_json *w, const json_t *v, const tsi_json_defer *d)
         break;
     }
     case JSON_STRING:
-        check(w, yajl_gen_string(w->g,
-                                 (const unsigned char *)json_string_value(v),
-                                 json_string_length(v)));
+        str_n(w, json_string_value(v), json_string_length(v));
         break;
     case JSON_INTEGER: tsi_json_int(w, json_integer_value(v)); break;
     case JSON_REAL: tsi_json_num(w, json_real_value(v)); break;

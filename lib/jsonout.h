@@ -14,6 +14,10 @@
  * The small parts of a document are still jansson trees: tsi_json_tree
  * emits one, and an element of it listed in a tsi_json_defer is replaced
  * by what that entry's function emits when the walk reaches it.
+ *
+ * A writer may also build a jansson tree from the same calls
+ * (tsi_json_open_tree): the public functions that return trees and the
+ * streamed documents share the functions that emit their parts.
  */
 #ifndef TOWSTAB_JSONOUT_H
 #define TOWSTAB_JSONOUT_H
@@ -25,12 +29,32 @@
 #define TSI_JSON_BUFFER 65536
 /* Deferred values of one document at most. */
 #define TSI_JSON_DEFER_MAX 8
+/* Containers open at once in a tree being built, at most. */
+#define TSI_JSON_DEPTH 64
+/* tsi_json_open's `indent` for jansson's one-line form, the form of
+ * json_dumps without JSON_INDENT: ", " between elements, ": " after a
+ * key, no newline (not even at the end). */
+#define TSI_JSON_SPACED 2
 
 typedef struct tsi_json tsi_json;
 
-/* A writer onto f (not closed by tsi_json_close), indented by two spaces
- * a level when `indent`, else compact. NULL when out of memory. */
+/* A writer onto f (not closed by tsi_json_close): `indent` 1 indents by
+ * two spaces a level (json_dumpf's JSON_INDENT(2), ending with a
+ * newline), TSI_JSON_SPACED is the one-line form above, 0 compact (no
+ * spaces). NULL when out of memory. */
 tsi_json *tsi_json_open(FILE *f, int indent);
+
+/* 0 while every call and write so far succeeded, else the errno of the
+ * first failure (ENOMEM, EINVAL for a misuse, a write's). */
+int tsi_json_status(const tsi_json *w);
+
+/* A writer that builds a jansson tree of what it is given, one value
+ * (the root) in all; NULL when out of memory. */
+tsi_json *tsi_json_open_tree(void);
+
+/* The tree built, a new reference, and release w; NULL when a value
+ * could not be made or the calls did not make one whole value. */
+json_t *tsi_json_take_tree(tsi_json *w);
 
 /* Write what is buffered and release w. 0, or -1 when a generator call
  * or a write failed (errno set by the write, ENOMEM or EINVAL else). */
@@ -64,6 +88,9 @@ typedef struct tsi_json_defer {
         const void *a, *b;
     } item[TSI_JSON_DEFER_MAX];
 } tsi_json_defer;
+
+/* fn(w, a, b)'s value as a new tree; NULL when out of memory. */
+json_t *tsi_json_build(tsi_json_emit_fn fn, const void *a, const void *b);
 
 /* Add an entry to d (d may be NULL: nothing is added). -1 when d is
  * full, else 0. */

@@ -4,14 +4,17 @@
  * A document is a jansson tree of its small parts in which each large
  * array (an equilibrium's nodes and links) is an empty array listed in a
  * tsi_json_defer: writing the tree writes those arrays element by
- * element in their place, so they are never held in memory whole. */
+ * element in their place, so they are never held in memory whole. So are
+ * a simulation's histories and its links' force extremes. */
 #ifndef TOWSTAB_REPORT_IMPL_H
 #define TOWSTAB_REPORT_IMPL_H
 
 #include <stdio.h>
 
 #include "jsonout.h"
+#include "towstab/analysis.h"
 #include "towstab/report.h"
+#include "towstab/report_time.h"
 
 /* ts_report_equilibrium_json; with defer (may be NULL: the arrays are
  * filled) its nodes and links left empty and listed in defer. NULL on
@@ -31,5 +34,26 @@ int tsi_report_dump_tree(const json_t *value, const tsi_json_defer *defer,
  * TS_OK, TS_ENOMEM or TS_EIO naming path. */
 int tsi_report_write_tree(const json_t *value, const tsi_json_defer *defer,
                           const char *path, ts_err *err);
+
+/* The keys of a time history's object (towstab/report_time.h), emitted
+ * into an open object: ts_report_channels_json's ("t", "outputs"), those
+ * ts_report_history_full adds ("nodes", "tensions", "energy",
+ * "vehicle_outputs", "tow_force", "frame"), and ts_report_extremes_json's
+ * ("max" ... "from_s"). */
+void tsi_report_channels_keys(tsi_json *w, const ts_system *sys,
+                              const ts_history *h, int n,
+                              const ts_output outs[]);
+void tsi_report_full_keys(tsi_json *w, const ts_system *sys,
+                          const ts_history *h);
+void tsi_report_extremes_keys(tsi_json *w, const ts_extremes *e);
+
+/* The result's document (ts_report_result_json, with the keys of extra
+ * added last) to stream f: `indent` as tsi_json_open's (1: the command
+ * line's files, TSI_JSON_SPACED: ts_job_json's text). Its large arrays
+ * are written as they are made. TS_OK, or TS_ENOMEM or TS_EIO naming
+ * `name`. */
+int tsi_report_result_dump(const ts_result *r, int flags, const json_t *extra,
+                           FILE *f, int indent, const char *name,
+                           ts_err *err);
 
 #endif

@@ -6,8 +6,10 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "outfile.h"
 #include "report_impl.h"
 
 #include "towstab/report.h"
@@ -194,24 +196,60 @@ static json_t *modes_json(const ts_result *r, int flags)
     return j;
 }
 
-/* A run's history: the channels reported, and the full state when it
- * was asked for. */
-static json_t *history_json(const ts_result *r, const ts_history *h)
+/* A value emitted by fn(w, a, b): with defer, a placeholder listed in
+ * it, to be written in its place (report_impl.h); else built now. */
+static json_t *deferred(tsi_json_defer *defer, tsi_json_emit_fn fn,
+                        const void *a, const void *b)
 {
-    json_t *o = ts_report_channels_json(r->sys, h, r->noutputs, r->outputs);
-    if (o && r->all_outputs && ts_report_history_full(o, r->sys, h)) {
-        json_decref(o);
+    if (!defer)
+        return tsi_json_build(fn, a, b);
+    json_t *at = json_object();
+    if (at && tsi_json_defer_add(defer, at, fn, a, b) != 0) {
+        json_decref(at);
         return NULL;
     }
-    return o;
+    return at;
+}
+
+/* A run's history h of result r: the channels reported, and the full
+ * state when it was asked for. */
+static void emit_history(tsi_json *w, const void *rv, const void *h)
+{
+    const ts_result *r = rv;
+    tsi_json_object_open(w);
+    tsi_report_channels_keys(w, r->sys, h, r->noutputs, r->outputs);
+    if (r->all_outputs)
+        tsi_report_full_keys(w, r->sys, h);
+    tsi_json_object_close(w);
+}
+
+/* forces.links: every link's tension extremes, with its cable and
+ * index. */
+static void emit_force_links(tsi_json *w, const void *rv, const void *unused)
+{
+    (void)unused;
+    const ts_result *r = rv;
+    const ts_system *sys = r->sys;
+    tsi_json_array_open(w);
+    for (int l = 0; l < sys->nlinks; l++) {
+        tsi_json_object_open(w);
+        tsi_report_extremes_keys(w, &r->tensions[l]);
+        tsi_json_key(w, "cable");
+        tsi_json_str(w, sys->cables[sys->links[l].cable].name);
+        tsi_json_key(w, "index");
+        tsi_json_int(w, sys->links[l].index);
+        tsi_json_object_close(w);
+    }
+    tsi_json_array_close(w);
 }
 
 /* The forces of the nonlinear run: the tow force, every link, the peak
  * and lowest links, the output's extremes, the links out of range. */
-static json_t *forces_json(const ts_result *r)
+static json_t *forces_json(const ts_result *r, tsi_json_defer *defer)
 {
     const ts_system *sys = r->sys;
-    json_t *f = json_object(), *links = json_array(), *slack = json_array();
+    json_t *f = json_object(), *slack = json_array();
+    json_t *links = deferred(defer, emit_force_links, r, NULL);
     if (!f || !links || !slack) {
         json_decref(f);
         json_decref(links);
@@ -220,13 +258,6 @@ static json_t *forces_json(const ts_result *r)
     }
     json_object_set_new(f, "from_s", num(r->forces_from));
     json_object_set_new(f, "tow", ts_report_extremes_json(&r->tow_force));
-    for (int l = 0; l < sys->nlinks; l++) {
-        json_t *e = ts_report_extremes_json(&r->tensions[l]);
-        json_object_set_new(e, "cable", json_string(
-                                sys->cables[sys->links[l].cable].name));
-        json_object_set_new(e, "index", json_integer(sys->links[l].index));
-        json_array_append_new(links, e);
-    }
     json_object_set_new(f, "links", links);
     int pick[2] = {r->peak_link, r->low_link};
     static const char *const key[2] = {"peak_link", "low_link"};
@@ -339,7 +370,8 @@ static json_t *waypoints_json(const ts_result *r, const ts_history *h)
     return j;
 }
 
-static json_t *simulate_json(const ts_result *r, int flags)
+static json_t *simulate_json(const ts_result *r, int flags,
+                             tsi_json_defer *defer)
 {
     (void)flags;
     const ts_system *sys = r->sys;
@@ -363,7 +395,8 @@ static json_t *simulate_json(const ts_result *r, int flags)
                                 ts_integrator_name(r->sim.integrator)));
         json_object_set_new(o, "rel_tol", json_real(r->sim.rel_tol));
         json_object_set_new(o, "abs_tol", json_real(r->sim.abs_tol));
-        json_object_set_new(o, "history", history_json(r, r->nonlinear));
+        json_object_set_new(o, "history",
+                            deferred(defer, emit_history, r, r->nonlinear));
         json_object_set_new(j, "nonlinear", o);
     }
     if (r->linear) {
@@ -379,7 +412,8 @@ static json_t *simulate_json(const ts_result *r, int flags)
                             json_string(r->sim.kinematics == TS_KIN_LINEAR
                                             ? "linear"
                                             : "nonlinear"));
-        json_object_set_new(o, "history", history_json(r, r->linear));
+        json_object_set_new(o, "history",
+                            deferred(defer, emit_history, r, r->linear));
         json_object_set_new(j, "linear", o);
     }
     json_t *outs = json_array();
@@ -396,7 +430,7 @@ static json_t *simulate_json(const ts_result *r, int flags)
         json_object_set_new(j, "output_extremes", oe);
     }
     if (r->tensions)
-        json_object_set_new(j, "forces", forces_json(r));
+        json_object_set_new(j, "forces", forces_json(r, defer));
     if (r->nonlinear && sys->tow.autopilot.on)
         json_object_set_new(j, "waypoints", waypoints_json(r, r->nonlinear));
     if (r->compared)
@@ -555,7 +589,7 @@ static json_t *result_tree(const ts_result *r, int flags,
         if (j && r->response && !r->has_sea)
             response_accuracy_json(j, r);
         break;
-    case TS_ANALYSIS_SIMULATE: j = simulate_json(r, flags); break;
+    case TS_ANALYSIS_SIMULATE: j = simulate_json(r, flags, defer); break;
     case TS_ANALYSIS_CONVERGE: j = converge_json(r); break;
     }
     if (!j)
@@ -616,20 +650,161 @@ int ts_report_result_write_json(const ts_result *r, int flags,
     return rc;
 }
 
-int ts_report_result_dumpf(const ts_result *r, int flags, const json_t *extra,
-                           FILE *f, const char *name, ts_err *err)
+int tsi_report_result_dump(const ts_result *r, int flags, const json_t *extra,
+                           FILE *f, int indent, const char *name,
+                           ts_err *err)
 {
     tsi_json_defer defer = {0};
     json_t *j = stream_tree(r, flags, extra, &defer);
     if (!j)
         return ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON",
                        name);
-    int bad = tsi_report_dump_tree(j, &defer, f, 1) != 0;
+    int bad = tsi_report_dump_tree(j, &defer, f, indent) != 0;
     int e = errno;
     json_decref(j);
     return bad ? ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
                          "%s: write failed (%s)", name, strerror(e))
                : TS_OK;
+}
+
+int ts_report_result_dumpf(const ts_result *r, int flags, const json_t *extra,
+                           FILE *f, const char *name, ts_err *err)
+{
+    return tsi_report_result_dump(r, flags, extra, f, 1, name, err);
+}
+
+struct ts_report_results {
+    char *name;       /* the target as given, for messages */
+    FILE *given;      /* the caller's stream, or NULL */
+    tsi_outfile out;  /* a file's temporary name beside it (out.f) */
+    FILE *spool;      /* where the document goes: out.f, or a temporary
+                         file copied to a direct target at the close */
+    tsi_json *w;
+};
+
+void ts_report_results_abandon(ts_report_results *d)
+{
+    if (!d)
+        return;
+    tsi_json_close(d->w);
+    if (d->spool && d->spool != d->out.f)
+        fclose(d->spool);
+    tsi_outfile_abandon(&d->out);
+    free(d->name);
+    free(d);
+}
+
+/* Fail with code (TS_ENOMEM when e is ENOMEM, else TS_EIO) naming d's
+ * target, after giving d up. */
+static int results_fail(ts_report_results *d, int e, ts_err *err)
+{
+    int rc = ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
+                     "%s: write failed (%s)", d->name, strerror(e));
+    ts_report_results_abandon(d);
+    return rc;
+}
+
+ts_report_results *ts_report_results_open(const char *path, FILE *f,
+                                          const char *scene, ts_err *err)
+{
+    ts_report_results *d = calloc(1, sizeof *d);
+    if (!d || !(d->name = strdup(path))) {
+        free(d);
+        ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON", path);
+        return NULL;
+    }
+    d->given = f;
+    tsi_outfile_id id;
+    if (!f && tsi_outfile_identify(path, &id, NULL) == TS_OK &&
+        id.kind == 0) {
+        /* A file: written under its temporary name from the start. */
+        if (tsi_outfile_open(&d->out, path, err) != TS_OK) {
+            ts_report_results_abandon(d);
+            return NULL;
+        }
+        d->spool = d->out.f;
+    } else {
+        /* Written in place: nothing goes there before the close. A path
+         * that does not resolve fails there, as a single result's. */
+        d->spool = tmpfile();
+    }
+    d->w = d->spool ? tsi_json_open(d->spool, 1) : NULL;
+    if (!d->w) {
+        results_fail(d, d->spool ? ENOMEM : errno, err);
+        return NULL;
+    }
+    tsi_json_object_open(d->w);
+    tsi_json_key(d->w, "scene");
+    tsi_json_str(d->w, scene);
+    tsi_json_key(d->w, "analyses");
+    tsi_json_array_open(d->w);
+    return d;
+}
+
+int ts_report_results_add(ts_report_results *d, const ts_result *r,
+                          int flags, const json_t *extra, ts_err *err)
+{
+    tsi_json_defer defer = {0};
+    json_t *j = stream_tree(r, flags, extra, &defer);
+    if (!j)
+        return ts_fail(err, TS_ENOMEM, "%s: out of memory for the JSON",
+                       d->name);
+    tsi_json_tree(d->w, j, &defer);
+    json_decref(j);
+    int e = tsi_json_status(d->w);
+    return e ? ts_fail(err, e == ENOMEM ? TS_ENOMEM : TS_EIO,
+                       "%s: write failed (%s)", d->name, strerror(e))
+             : TS_OK;
+}
+
+/* Copy the spooled document to f: 0, or -1 with errno set. */
+static int copy_spool(FILE *spool, FILE *f)
+{
+    char buf[TSI_JSON_BUFFER];
+    size_t n;
+    if (fflush(spool) != 0 || fseek(spool, 0, SEEK_SET) != 0)
+        return -1;
+    while ((n = fread(buf, 1, sizeof buf, spool)) > 0)
+        if (fwrite(buf, 1, n, f) != n)
+            return -1;
+    return ferror(spool) ? (errno = EIO, -1) : 0;
+}
+
+int ts_report_results_close(ts_report_results *d, const json_t *tail,
+                            ts_err *err)
+{
+    tsi_json_array_close(d->w);
+    const char *key;
+    json_t *v;
+    json_object_foreach((json_t *)tail, key, v)
+    {
+        tsi_json_key(d->w, key);
+        tsi_json_tree(d->w, v, NULL);
+    }
+    tsi_json_object_close(d->w);
+    int bad = tsi_json_close(d->w) != 0;
+    d->w = NULL;
+    if (bad)
+        return results_fail(d, errno, err);
+    if (d->spool == d->out.f) {
+        d->spool = NULL;
+        int rc = tsi_outfile_commit(&d->out, err);
+        ts_report_results_abandon(d);
+        return rc;
+    }
+    int rc = TS_OK;
+    if (d->given) {
+        if (copy_spool(d->spool, d->given) != 0 || fflush(d->given) != 0)
+            return results_fail(d, errno, err);
+    } else {
+        rc = tsi_outfile_open(&d->out, d->name, err);
+        if (rc == TS_OK && copy_spool(d->spool, d->out.f) != 0)
+            return results_fail(d, errno, err);
+        if (rc == TS_OK)
+            rc = tsi_outfile_commit(&d->out, err);
+    }
+    ts_report_results_abandon(d);
+    return rc;
 }
 
 int ts_report_result_csv(const ts_result *r, const char *path, ts_err *err)

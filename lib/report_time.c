@@ -2,7 +2,10 @@
  * (towstab/report_time.h). Numbers are written with 17 significant digits
  * (CSV %.17g; JSON through ts_report_write_json) so a history read back
  * reproduces the run bit for bit; non-finite values are JSON null and CSV
- * "nan". */
+ * "nan". A history's keys and the extremes are emitted once, through
+ * lib/jsonout.h: into a tree for the public functions here, or straight
+ * to the file for a result's document (report_result.c), so that a
+ * history is never held as a tree there. */
 #include "towstab/report_time.h"
 
 #include <math.h>
@@ -11,17 +14,26 @@
 #include <string.h>
 
 #include "outfile.h"
+#include "report_impl.h"
 #include "towstab/report.h"
 
 static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
 
 /* A JSON array of n values read with a stride. */
-static json_t *series(const double *base, int n, size_t stride)
+static void series(tsi_json *w, const double *base, int n, size_t stride)
 {
-    json_t *a = json_array();
-    for (int i = 0; a && i < n; i++)
-        json_array_append_new(a, num(base[stride * (size_t)i]));
-    return a;
+    tsi_json_array_open(w);
+    for (int i = 0; i < n; i++)
+        tsi_json_num(w, base[stride * (size_t)i]);
+    tsi_json_array_close(w);
+}
+
+/* key: series(...). */
+static void key_series(tsi_json *w, const char *key, const double *base,
+                       int n, size_t stride)
+{
+    tsi_json_key(w, key);
+    series(w, base, n, stride);
 }
 
 json_t *ts_report_sim_stats_json(const ts_sim_stats *st, const char *method)
@@ -56,123 +68,202 @@ static int gives(const ts_system *sys, const ts_history *h,
     return 0;
 }
 
-json_t *ts_report_channels_json(const ts_system *sys, const ts_history *h,
-                                int n, const ts_output outs[])
+void tsi_report_channels_keys(tsi_json *w, const ts_system *sys,
+                              const ts_history *h, int n,
+                              const ts_output outs[])
 {
-    json_t *o = json_object(), *ch = json_object();
-    if (!o || !ch) {
-        json_decref(o);
-        json_decref(ch);
-        return NULL;
-    }
-    json_object_set_new(o, "t", series(h->t, h->nsamples, 1));
+    key_series(w, "t", h->t, h->nsamples, 1);
+    tsi_json_key(w, "outputs");
+    tsi_json_object_open(w);
     for (int k = 0; k < n; k++) {
         if (!gives(sys, h, &outs[k]))
             continue;
-        json_t *a = json_array();
-        for (int i = 0; a && i < h->nsamples; i++)
-            json_array_append_new(a, num(ts_history_value(sys, h, &outs[k],
-                                                          i)));
-        json_object_set_new(ch, outs[k].name, a);
+        tsi_json_key(w, outs[k].name);
+        tsi_json_array_open(w);
+        for (int i = 0; i < h->nsamples; i++)
+            tsi_json_num(w, ts_history_value(sys, h, &outs[k], i));
+        tsi_json_array_close(w);
     }
-    json_object_set_new(o, "outputs", ch);
-    return o;
+    tsi_json_object_close(w);
 }
 
-/* Three interleaved series base[3 i + j] (j = 0, 1, 2) as an object of
- * arrays named key[j]. */
-static json_t *triple(const double *base, int n, const char *const key[3])
+/* The arguments of ts_report_channels_json. */
+typedef struct channels_args {
+    const ts_system *sys;
+    int n;
+    const ts_output *outs;
+} channels_args;
+
+static void emit_channels(tsi_json *w, const void *a, const void *h)
 {
-    return json_pack("{s:o,s:o,s:o}", key[0], series(base, n, 3), key[1],
-                     series(base + 1, n, 3), key[2], series(base + 2, n, 3));
+    const channels_args *c = a;
+    tsi_json_object_open(w);
+    tsi_report_channels_keys(w, c->sys, h, c->n, c->outs);
+    tsi_json_object_close(w);
 }
 
-int ts_report_history_full(json_t *o, const ts_system *sys,
-                           const ts_history *h)
+json_t *ts_report_channels_json(const ts_system *sys, const ts_history *h,
+                                int n, const ts_output outs[])
 {
-    json_t *full = ts_report_history_json(sys, h, -1);
-    if (!full)
-        return TS_ENOMEM;
-    if (has_forces(h)) {
-        int n = h->nsamples;
-        static const char *const xyz[3] = {"x", "y", "z"};
-        json_object_set_new(full, "tow_force", triple(h->tow_force, n, xyz));
-    }
-    if (h->nsamples > 0 && isfinite(h->frame[0])) {
-        /* The pose of M in the earth frame (towstab/track.h). */
-        int n = h->nsamples;
-        static const char *const pose[3] = {"x", "y", "heading"};
-        json_object_set_new(full, "frame", triple(h->frame, n, pose));
-    }
-    json_object_del(full, "t");
-    int rc = json_object_update(o, full) ? TS_ENOMEM : TS_OK;
-    json_decref(full);
-    return rc;
+    return tsi_json_build(emit_channels, &(channels_args){sys, n, outs}, h);
 }
 
-json_t *ts_report_extremes_json(const ts_extremes *e)
+/* Three interleaved series base[3 i + j] (j = 0, 1, 2) under key, as an
+ * object of arrays named name[j]. */
+static void triple(tsi_json *w, const char *key, const double *base, int n,
+                   const char *const name[3])
 {
-    return json_pack("{s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o,s:o}", "max",
-                     num(e->max), "t_max", num(e->t_max), "max_error",
-                     num(e->max_error), "min", num(e->min), "t_min",
-                     num(e->t_min), "min_error", num(e->min_error), "mean",
-                     num(e->mean), "static", num(e->reference),
-                     "amplification", num(e->amplification), "from_s",
-                     num(e->t_from));
+    tsi_json_key(w, key);
+    tsi_json_object_open(w);
+    for (int j = 0; j < 3; j++)
+        key_series(w, name[j], base + j, n, 3);
+    tsi_json_object_close(w);
 }
 
-json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
-                               int node)
+/* The keys of ts_report_history_json after "t": nodes (only `node` when
+ * >= 0), and with every node, for a nonlinear run, tensions and energy;
+ * the vehicles' outputs. */
+static void history_keys(tsi_json *w, const ts_system *sys,
+                         const ts_history *h, int node)
 {
-    json_t *o = json_object(), *nodes = json_array();
-    if (!o || !nodes) {
-        json_decref(o);
-        json_decref(nodes);
-        return NULL;
-    }
     int n = h->nsamples;
     size_t ps = 3 * (size_t)h->nnodes;
-    json_object_set_new(o, "t", series(h->t, n, 1));
     char name[2 * TS_NAME_MAX];
+    tsi_json_key(w, "nodes");
+    tsi_json_array_open(w);
     for (int k = 0; k < h->nnodes; k++) {
         if (node >= 0 && k != node)
             continue;
         ts_system_node_name(sys, k, name, sizeof name);
         const double *p = h->positions + 3 * (size_t)k;
-        json_array_append_new(nodes, json_pack("{s:s,s:o,s:o,s:o}", "name",
-                                               name, "x", series(p, n, ps),
-                                               "y", series(p + 1, n, ps), "z",
-                                               series(p + 2, n, ps)));
+        tsi_json_object_open(w);
+        tsi_json_key(w, "name");
+        tsi_json_str(w, name);
+        key_series(w, "x", p, n, ps);
+        key_series(w, "y", p + 1, n, ps);
+        key_series(w, "z", p + 2, n, ps);
+        tsi_json_object_close(w);
     }
-    json_object_set_new(o, "nodes", nodes);
+    tsi_json_array_close(w);
     int nonlinear = n > 0 && h->nlinks > 0 && isfinite(h->tensions[0]);
     if (node < 0 && nonlinear) {
-        json_t *ten = json_array();
-        for (int l = 0; ten && l < h->nlinks; l++) {
+        tsi_json_key(w, "tensions");
+        tsi_json_array_open(w);
+        for (int l = 0; l < h->nlinks; l++) {
             const ts_link *L = &sys->links[l];
-            json_array_append_new(
-                ten, json_pack("{s:s,s:i,s:o}", "cable",
-                               sys->cables[L->cable].name, "index", L->index,
-                               "tension", series(h->tensions + l, n,
-                                                 (size_t)h->nlinks)));
+            tsi_json_object_open(w);
+            tsi_json_key(w, "cable");
+            tsi_json_str(w, sys->cables[L->cable].name);
+            tsi_json_key(w, "index");
+            tsi_json_int(w, L->index);
+            key_series(w, "tension", h->tensions + l, n, (size_t)h->nlinks);
+            tsi_json_object_close(w);
         }
-        json_object_set_new(o, "tensions", ten);
-        json_object_set_new(o, "energy",
-                            json_pack("{s:o,s:o}", "kinetic",
-                                      series(h->energy, n, 2), "potential",
-                                      series(h->energy + 1, n, 2)));
+        tsi_json_array_close(w);
+        tsi_json_key(w, "energy");
+        tsi_json_object_open(w);
+        key_series(w, "kinetic", h->energy, n, 2);
+        key_series(w, "potential", h->energy + 1, n, 2);
+        tsi_json_object_close(w);
     }
     if (h->noutput > 0 && h->outputs) {
         /* The vehicles' depth, attitude, loop outputs and deflections. */
-        json_t *vo = json_array();
-        for (int j = 0; vo && j < h->noutput; j++)
-            json_array_append_new(
-                vo, json_pack("{s:s,s:s,s:o}", "name", h->output_name[j],
-                              "unit", h->output_unit[j], "value",
-                              series(h->outputs + j, n, (size_t)h->noutput)));
-        json_object_set_new(o, "vehicle_outputs", vo);
+        tsi_json_key(w, "vehicle_outputs");
+        tsi_json_array_open(w);
+        for (int j = 0; j < h->noutput; j++) {
+            tsi_json_object_open(w);
+            tsi_json_key(w, "name");
+            tsi_json_str(w, h->output_name[j]);
+            tsi_json_key(w, "unit");
+            tsi_json_str(w, h->output_unit[j]);
+            key_series(w, "value", h->outputs + j, n, (size_t)h->noutput);
+            tsi_json_object_close(w);
+        }
+        tsi_json_array_close(w);
     }
-    return o;
+}
+
+void tsi_report_full_keys(tsi_json *w, const ts_system *sys,
+                          const ts_history *h)
+{
+    history_keys(w, sys, h, -1);
+    if (has_forces(h)) {
+        static const char *const xyz[3] = {"x", "y", "z"};
+        triple(w, "tow_force", h->tow_force, h->nsamples, xyz);
+    }
+    if (h->nsamples > 0 && isfinite(h->frame[0])) {
+        /* The pose of M in the earth frame (towstab/track.h). */
+        static const char *const pose[3] = {"x", "y", "heading"};
+        triple(w, "frame", h->frame, h->nsamples, pose);
+    }
+}
+
+static void emit_full(tsi_json *w, const void *sys, const void *h)
+{
+    tsi_json_object_open(w);
+    tsi_report_full_keys(w, sys, h);
+    tsi_json_object_close(w);
+}
+
+int ts_report_history_full(json_t *o, const ts_system *sys,
+                           const ts_history *h)
+{
+    json_t *full = tsi_json_build(emit_full, sys, h);
+    if (!full)
+        return TS_ENOMEM;
+    int rc = json_object_update(o, full) ? TS_ENOMEM : TS_OK;
+    json_decref(full);
+    return rc;
+}
+
+void tsi_report_extremes_keys(tsi_json *w, const ts_extremes *e)
+{
+    static const char *const key[10] = {
+        "max", "t_max", "max_error", "min", "t_min", "min_error", "mean",
+        "static", "amplification", "from_s"};
+    const double v[10] = {e->max,  e->t_max,     e->max_error,
+                          e->min,  e->t_min,     e->min_error,
+                          e->mean, e->reference, e->amplification,
+                          e->t_from};
+    for (int k = 0; k < 10; k++) {
+        tsi_json_key(w, key[k]);
+        tsi_json_num(w, v[k]);
+    }
+}
+
+static void emit_extremes(tsi_json *w, const void *e, const void *unused)
+{
+    (void)unused;
+    tsi_json_object_open(w);
+    tsi_report_extremes_keys(w, e);
+    tsi_json_object_close(w);
+}
+
+json_t *ts_report_extremes_json(const ts_extremes *e)
+{
+    return tsi_json_build(emit_extremes, e, NULL);
+}
+
+/* The arguments of ts_report_history_json. */
+typedef struct history_args {
+    const ts_system *sys;
+    int node;
+} history_args;
+
+static void emit_history(tsi_json *w, const void *a, const void *hv)
+{
+    const history_args *ha = a;
+    const ts_history *h = hv;
+    tsi_json_object_open(w);
+    key_series(w, "t", h->t, h->nsamples, 1);
+    history_keys(w, ha->sys, h, ha->node);
+    tsi_json_object_close(w);
+}
+
+json_t *ts_report_history_json(const ts_system *sys, const ts_history *h,
+                               int node)
+{
+    return tsi_json_build(emit_history, &(history_args){sys, node}, h);
 }
 
 json_t *ts_report_compare_json(const ts_compare *c)

@@ -8,7 +8,10 @@
  *     an option given overrides it (the histories end there), and both
  *     the scene key and the command-line spelling are accepted.
  *  3. The JSON text parses and its top tension is the result's key value
- *     to the last digit (17 significant digits, read back exactly).
+ *     to the last digit (17 significant digits, read back exactly); the
+ *     text, written as it is made, is byte for byte jansson's dump of
+ *     the result's tree (ts_report_result_json), the full state of both
+ *     runs and the links' force extremes included.
  *  4. Arrays without a copy: the nonlinear run's t, positions, tensions,
  *     tow force, energy and input are the history's own memory, with its
  *     shape; the linear run's tensions are finite and start at the
@@ -26,15 +29,22 @@
  *     made and says so; refusals after the
  *     run and of a
  *     negative interval.
+ *  7. A document of several results (ts_report_results, `towstab run`)
+ *     written as they come is byte for byte jansson's dump of the whole
+ *     tree, to a file and to a stream, and nothing reaches either before
+ *     the close; abandoned it leaves nothing; /dev/full fails naming it.
  */
 #include "towstab/job.h"
 
 #include <jansson.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "tcheck.h"
+#include "tfiles.h"
 #include "towstab/kernel.h"
+#include "towstab/report_result.h"
 
 /* A progress callback's record: reports seen, the last, when to stop. */
 typedef struct {
@@ -68,6 +78,115 @@ static const char scene_text[] =
     "  - equilibrium\n"
     "  - {type: simulate, t_end: 1 s,\n"
     "     excite: \"tow.heave:amplitude=0.1,frequency=1Hz\"}\n";
+
+/* The whole text of a file (malloc'd), NULL when it cannot be read. */
+static char *read_all(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    char *text = NULL;
+    size_t n = 0;
+    FILE *m = f ? open_memstream(&text, &n) : NULL;
+    int c;
+    while (m && (c = getc(f)) != EOF)
+        putc(c, m);
+    if (m)
+        fclose(m);
+    if (f)
+        fclose(f);
+    return text;
+}
+
+/* 7. A document of several results written as they come: byte for byte
+ * jansson's dump of the whole tree, to a file and to a stream; nothing
+ * reaches the target before the close; abandoned, nothing is left; a
+ * device that refuses the bytes fails at the close naming it. */
+static void test_results(const ts_scene *sc, const ts_units *u)
+{
+    ts_err err = {0};
+    ts_job *job[2] = {ts_job_alloc(sc, u, "equilibrium", -1, &err),
+                      ts_job_alloc(sc, u, "simulate", 1, &err)};
+    ts_job_give(job[1], "outputs", "all", &err);
+    ts_job_give(job[1], "t_end", "3 s", &err);
+    ts_job_give(job[1], "compare", "true", &err);
+    ts_job_give(job[1], "discretisation_error", "false", &err);
+    const ts_result *r[2];
+    json_t *tree = json_pack("{s:s,s:[]}", "scene", "job", "analyses");
+    json_t *tail = json_pack("{s:b,s:s}", "completed", 0, "error", "a\"b");
+    for (int k = 0; k < 2; k++) {
+        ts_job_run(job[k], &err);
+        r[k] = ts_job_result(job[k]);
+        if (r[k])
+            json_array_append_new(json_object_get(tree, "analyses"),
+                                  ts_report_result_json(r[k], 0));
+    }
+    json_object_update(tree, tail);
+    char *ref = json_dumps(tree, JSON_INDENT(2) | JSON_REAL_PRECISION(17));
+    size_t nref = ref ? strlen(ref) : 0;
+
+    char path[600];
+    snprintf(path, sizeof path, "%s/run.json", tf_dir);
+    ts_report_results *d = ts_report_results_open(path, NULL, "job", &err);
+    int rc = d && r[0] && r[1] ? TS_OK : TS_ENOMEM;
+    for (int k = 0; k < 2 && rc == TS_OK; k++)
+        rc = ts_report_results_add(d, r[k], 0, NULL, &err);
+    int early = tf_exists(path);
+    if (rc == TS_OK)
+        rc = ts_report_results_close(d, tail, &err);
+    else
+        ts_report_results_abandon(d);
+    char *text = read_all(path);
+    CHECK(rc == TS_OK && !early && ref && text && strlen(text) == nref + 1 &&
+              !strncmp(text, ref, nref) && text[nref] == '\n',
+          "results: the file appears at the close, jansson's dump of the "
+          "tree and a newline (%zu bytes): %s", nref, err.msg);
+    free(text);
+    unlink(path);
+
+    char *mem = NULL;
+    size_t nmem = 0;
+    FILE *mf = open_memstream(&mem, &nmem);
+    d = mf ? ts_report_results_open("memory", mf, "job", &err) : NULL;
+    rc = d && r[0] && r[1] ? TS_OK : TS_ENOMEM;
+    for (int k = 0; k < 2 && rc == TS_OK; k++)
+        rc = ts_report_results_add(d, r[k], 0, NULL, &err);
+    if (mf)
+        fflush(mf);
+    size_t before = nmem;
+    if (rc == TS_OK)
+        rc = ts_report_results_close(d, tail, &err);
+    else
+        ts_report_results_abandon(d);
+    if (mf)
+        fclose(mf);
+    CHECK(rc == TS_OK && before == 0 && mem && ref &&
+              strlen(mem) == nref + 1 && !strncmp(mem, ref, nref),
+          "results: a stream gets nothing before the close, then the "
+          "same bytes (%zu before)", before);
+    free(mem);
+
+    d = ts_report_results_open(path, NULL, "job", &err);
+    if (d && r[0])
+        ts_report_results_add(d, r[0], 0, NULL, &err);
+    ts_report_results_abandon(d);
+    CHECK(d && !tf_exists(path) && tf_count("") == 2,
+          "results: abandoned, nothing is left");
+    ts_report_results_abandon(NULL);
+
+    if (tf_exists("/dev/full")) {
+        ts_err_clear(&err);
+        d = ts_report_results_open("/dev/full", NULL, "job", &err);
+        rc = d && r[0] ? ts_report_results_add(d, r[0], 0, NULL, &err)
+                       : TS_ENOMEM;
+        rc = d ? ts_report_results_close(d, tail, &err) : rc;
+        CHECK(rc == TS_EIO && strstr(err.msg, "/dev/full"),
+              "results: /dev/full: TS_EIO at the close (%s)", err.msg);
+    }
+    free(ref);
+    json_decref(tree);
+    json_decref(tail);
+    ts_job_free(job[0]);
+    ts_job_free(job[1]);
+}
 
 int main(void)
 {
@@ -124,7 +243,8 @@ int main(void)
     j = ts_job_alloc(sc, u, "simulate", 1, &err);
     ts_err_clear(&err);
     CHECK(ts_job_give(j, "t-end", "3 s", &err) == TS_OK &&
-              ts_job_give(j, "compare", "true", &err) == TS_OK,
+              ts_job_give(j, "compare", "true", &err) == TS_OK &&
+              ts_job_give(j, "outputs", "all", &err) == TS_OK,
           "the command-line spelling and the scene key are taken");
     rc = ts_job_run(j, &err);
     r = ts_job_result(j);
@@ -151,6 +271,17 @@ int main(void)
           "the JSON's tension.max is the result's to the last digit (%.17g)",
           jv);
     json_decref(doc);
+    /* The text is streamed (histories and forces.links never a tree):
+     * byte for byte jansson's one-line dump of the result's tree. */
+    json_t *tree = r ? ts_report_result_json(r, 0) : NULL;
+    char *ref = tree ? json_dumps(tree, JSON_REAL_PRECISION(17)) : NULL;
+    CHECK(text && ref && !strcmp(text, ref) &&
+              strstr(text, "\"tensions\": [{\"cable\": ") &&
+              strstr(text, "\"links\": [{\"max\": "),
+          "ts_job_json is jansson's dump of the tree, full state and "
+          "forces.links included (%zu bytes)", ref ? strlen(ref) : 0);
+    free(ref);
+    json_decref(tree);
 
     if (h) {
         int rows, cols;
@@ -307,6 +438,10 @@ int main(void)
           "rc %d %s)", sparse.calls, rc, err.msg);
     ts_job_free(j);
 
+    if (CHECK(tf_begin("job") == 0, "a folder under %s", tf_dir)) {
+        test_results(sc, u);
+        CHECK(tf_end(), "nothing left in the test folder");
+    }
     ts_scene_free(sc);
     ts_units_free(u);
     return tc_done();

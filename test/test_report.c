@@ -9,7 +9,9 @@
  * test_outfile.c). Streaming (lib/jsonout.h): every number is the
  * text jansson writes, checked against jansson itself over edge cases
  * and random bit patterns, and a streamed document is byte for byte
- * jansson's dump of the same tree, strings to escape included. Files go
+ * jansson's dump of the same tree, strings to escape included, indented
+ * and in jansson's one-line form; the same calls build the same tree, and
+ * a value where a key belongs builds none. Files go
  * to a fresh folder under $TMPDIR (default /tmp). */
 #include "towstab/report.h"
 
@@ -436,6 +438,42 @@ static void test_stream(ts_system *s, ts_equilibrium *eq)
               !strncmp(text, ref, nref),
           "stream: ts_report_write_json writes jansson's text");
     unlink(path);
+
+    /* The same calls building a tree: the full tree again. */
+    tsi_json *tw = tsi_json_open_tree();
+    if (tw && part)
+        tsi_json_tree(tw, part, &d);
+    json_t *built = tsi_json_take_tree(tw);
+    CHECK(built && json_equal(built, full),
+          "stream: a tree-building writer makes the full tree");
+    json_decref(built);
+
+    /* jansson's one-line form (json_dumps without JSON_INDENT), into
+     * memory, byte for byte. */
+    char *line = full ? json_dumps(full, JSON_REAL_PRECISION(17)) : NULL;
+    char *mem = NULL;
+    size_t nmem = 0;
+    FILE *mf = open_memstream(&mem, &nmem);
+    rc = mf && part ? tsi_report_dump_tree(part, &d, mf, TSI_JSON_SPACED)
+                    : -1;
+    if (mf)
+        fclose(mf);
+    CHECK(rc == 0 && line && mem && !strcmp(mem, line),
+          "stream: the one-line form is jansson's (%zu bytes)",
+          line ? strlen(line) : 0);
+    free(mem);
+    free(line);
+
+    /* A misuse (a value where a key belongs) makes no tree. */
+    tw = tsi_json_open_tree();
+    if (tw) {
+        tsi_json_object_open(tw);
+        tsi_json_num(tw, 1.0);
+        tsi_json_object_close(tw);
+    }
+    built = tsi_json_take_tree(tw);
+    CHECK(tw && !built, "stream: a value without its key makes no tree");
+    json_decref(built);
 
     /* A device that refuses the bytes: TS_EIO naming it. */
     if (tf_exists("/dev/full") && part) {

@@ -58,6 +58,33 @@ int cli_write_json(const json_t *value, const char *path, ts_err *err)
                : TS_OK;
 }
 
+ts_report_results *cli_results_open(const char *path, const char *scene,
+                                    FILE **stream, ts_err *err)
+{
+    *stream = NULL;
+    if (strcmp(path, "-") == 0 && json_fd >= 0) {
+        *stream = json_stdout(err);
+        if (!*stream)
+            return NULL;
+        path = "standard output";
+    }
+    ts_report_results *d = ts_report_results_open(path, *stream, scene, err);
+    if (!d && *stream) {
+        fclose(*stream);
+        *stream = NULL;
+    }
+    return d;
+}
+
+int cli_results_close(ts_report_results *d, FILE *stream, const json_t *tail,
+                      ts_err *err)
+{
+    int rc = ts_report_results_close(d, tail, err);
+    if (stream && fclose(stream) != 0 && rc == TS_OK)
+        rc = ts_fail(err, TS_EIO, "standard output: cannot write JSON");
+    return rc;
+}
+
 int cli_write_result(const ts_result *r, int flags, const json_t *extra,
                      const char *path, ts_err *err)
 {

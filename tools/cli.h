@@ -17,6 +17,7 @@
 #include "towstab/error.h"
 #include "towstab/options.h"
 #include "towstab/progress.h"
+#include "towstab/report_result.h"
 #include "towstab/scene.h"
 #include "towstab/system.h"
 #include "towstab/units.h"
@@ -63,6 +64,12 @@ typedef struct cli_run {
      * apart): what a command that records its settings keeps. */
     char **given;
     int ngiven;
+    /* `towstab run --json`: the document each result is added to as it
+     * comes (cli_execute), NULL when none; after the run, whether a
+     * result was added and, when it failed, its "error". */
+    ts_report_results *into;
+    int added, failed;
+    char error[TS_ERR_MSG_MAX];
 } cli_run;
 
 typedef struct cli_command {
@@ -163,9 +170,12 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
  * n: TYPE (SCENE) ==", until one fails. *all receives the JSON document
  * {"scene", "analyses": [result, ...], "completed"} (with "error" and
  * "trustworthy": false after a failure; "interrupted" after a signal),
- * NULL only when out of memory. Returns the exit status. */
+ * NULL only when out of memory. With `into` (not NULL) each result is
+ * added to that document as it comes instead, and *all receives only
+ * the keys after "analyses" (ts_report_results_close's tail). all NULL:
+ * no document (no tree is built). Returns the exit status. */
 int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
-                      json_t **all);
+                      json_t **all, ts_report_results *into);
 
 void cli_scene_free(cli_scene_runs *s);
 
@@ -223,6 +233,17 @@ void cli_stdout_for_json(void);
 /* Write JSON to `path` ("-": the JSON standard output), as
  * ts_report_write_json writes files. */
 int cli_write_json(const json_t *value, const char *path, ts_err *err);
+
+/* The document of several results (ts_report_results_open) for `path`
+ * ("-": the JSON standard output, *stream the stream opened for it, to
+ * pass to cli_results_close; else NULL). NULL with err set. */
+ts_report_results *cli_results_open(const char *path,
+                                           const char *scene, FILE **stream,
+                                           ts_err *err);
+
+/* Close d with the keys of tail (ts_report_results_close) and stream. */
+int cli_results_close(ts_report_results *d, FILE *stream,
+                      const json_t *tail, ts_err *err);
 
 /* Write result r's JSON with the keys of `extra` (may be NULL) to `path`
  * as cli_write_json does, its node and link arrays streamed

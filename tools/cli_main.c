@@ -202,9 +202,25 @@ int cli_execute(cli_run *c, json_t **result)
     }
     ts_err werr = {0};
     int write = status == 0 || has_partial(r);
-    if (c->json && write && !result) {
+    json_t *extra = NULL;
+    if (c->into) {
+        /* `towstab run --json`: added to the document as it comes. */
+        extra = json_object();
+        if (extra && cli_stop_signal_name())
+            json_object_set_new(extra, "interrupted",
+                                json_string(cli_stop_signal_name()));
+        c->added = 1;
+        c->failed = r->status != TS_OK;
+        snprintf(c->error, sizeof c->error, "%s", r->error);
+        if (ts_report_results_add(c->into, r, c->json_flags, extra,
+                                  &werr) != TS_OK) {
+            int st = cli_report(&werr, werr.code);
+            status = status ? status : st;
+        }
+        json_decref(extra);
+    } else if (c->json && write && !result) {
         /* Streamed: the node and link arrays are never held whole. */
-        json_t *extra = json_object();
+        extra = json_object();
         if (extra && cli_stop_signal_name())
             json_object_set_new(extra, "interrupted",
                                 json_string(cli_stop_signal_name()));

@@ -152,39 +152,50 @@ int cli_scene_prepare(const char *cmd, const ts_scene *scene,
 }
 
 int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
-                      json_t **all)
+                      json_t **all, ts_report_results *into)
 {
     int status = 0;
-    json_t *doc = json_object(), *list = json_array();
-    if (!doc || !list ||
-        json_object_set_new(doc, "scene",
-                            json_string(scene->system->name)) ||
-        json_object_set(doc, "analyses", list)) {
+    /* The results as trees only for a document of them held here;
+     * streamed (into) or not asked for, the document is only the keys
+     * after the list. */
+    int trees = all && !into;
+    json_t *doc = json_object(), *list = trees ? json_array() : NULL;
+    if (!doc || (trees && !list) ||
+        (trees && (json_object_set_new(doc, "scene",
+                                       json_string(scene->system->name)) ||
+                   json_object_set(doc, "analyses", list)))) {
         json_decref(doc);
         json_decref(list);
         fprintf(stderr, "towstab: error: out of memory for the results\n");
-        *all = NULL;
+        if (all)
+            *all = NULL;
         return EXIT_FAILED;
     }
     json_decref(list); /* the document holds it */
+    const cli_run *last = NULL; /* the last that gave a result */
     for (int i = 0; i < s->n && !status; i++) {
         printf("%s== analysis %d of %d: %s (%s) ==\n", i ? "\n" : "", i + 1,
                s->n, scene->analyses[i].type, scene->system->name);
         json_t *j = NULL;
         double t0 = cli_wall_now();
-        status = cli_execute(&s->runs[i], &j);
+        s->runs[i].into = into;
+        status = cli_execute(&s->runs[i], trees ? &j : NULL);
         s->wall_s[i] = cli_wall_now() - t0;
         s->ran = i + 1;
         if (j)
             json_array_append_new(list, j);
+        if (s->runs[i].added)
+            last = &s->runs[i];
     }
     /* After a failure the results so far, marked as incomplete with the
      * failed analysis' message. */
     size_t nres = json_array_size(list);
-    const char *msg = status && nres > 0
-                          ? json_string_value(json_object_get(
-                                json_array_get(list, nres - 1), "error"))
-                          : NULL;
+    const char *msg = NULL;
+    if (status && nres > 0)
+        msg = json_string_value(json_object_get(
+            json_array_get(list, nres - 1), "error"));
+    else if (status && last && last->failed)
+        msg = last->error;
     json_object_set_new(doc, "completed", json_boolean(status == 0));
     if (status) {
         json_object_set_new(doc, "error", json_string(msg ? msg : "failed"));
@@ -193,6 +204,9 @@ int cli_scene_execute(const ts_scene *scene, cli_scene_runs *s,
     if (cli_stop_signal_name())
         json_object_set_new(doc, "interrupted",
                             json_string(cli_stop_signal_name()));
-    *all = doc;
+    if (all)
+        *all = doc;
+    else
+        json_decref(doc);
     return status;
 }

@@ -584,7 +584,7 @@ static int report_run(int argc, char **argv, char **words)
         }
     json_t *all = NULL;
     if (!status)
-        status = cli_scene_execute(scene, &s, &all);
+        status = cli_scene_execute(scene, &s, &all, NULL);
     /* As `towstab run`: after a failure what ran, marked; nothing after
      * bad input. */
     if (all && status != EXIT_BADINPUT) {

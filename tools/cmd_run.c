@@ -85,18 +85,31 @@ static int run_main(int argc, char **argv)
     for (int i = 0; i < n && !status && plot_dir; i++)
         status = cli_plot_begin(&s.runs[i].plot, "run");
     if (!status) {
-        json_t *all = NULL;
-        status = cli_scene_execute(scene, &s, &all);
+        /* The results are written as they come; nothing reaches the
+         * file before the last (ts_report_results). A target that cannot
+         * be opened is reported after the run, as a write is. */
+        ts_err werr = {0};
+        FILE *stream = NULL;
+        ts_report_results *doc =
+            json_path ? cli_results_open(json_path, scene->system->name,
+                                         &stream, &werr)
+                      : NULL;
+        json_t *tail = NULL;
+        status = cli_scene_execute(scene, &s, doc ? &tail : NULL, doc);
         /* After a failure the results so far, marked as incomplete with
          * the failed analysis' message; nothing after bad input. */
-        if (json_path && all && status != EXIT_BADINPUT) {
-            ts_err werr = {0};
-            if (cli_write_json(all, json_path, &werr) != TS_OK) {
+        if (json_path && (!doc || (tail && status != EXIT_BADINPUT))) {
+            if (!doc || cli_results_close(doc, stream, tail, &werr) !=
+                            TS_OK) {
                 int st = cli_report(&werr, werr.code);
                 status = status ? status : st;
             }
+        } else if (doc) {
+            ts_report_results_abandon(doc);
+            if (stream)
+                fclose(stream);
         }
-        json_decref(all);
+        json_decref(tail);
     }
     free(what);
     free(paths);

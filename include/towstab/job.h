@@ -74,9 +74,11 @@ TS_API const char *ts_job_notes(const ts_job *j);
 TS_API const ts_result *ts_job_result(const ts_job *j);
 
 /* The result as the command line's JSON (ts_report_result_json with
- * `flags`, numbers to 17 significant digits): text owned by the job,
- * valid until the next call or ts_job_free. NULL with TS_EINVAL when
- * there is no result, TS_ENOMEM. */
+ * `flags`, numbers to 17 significant digits) on one line, as jansson's
+ * json_dumps writes it, made without building the tree: text owned by
+ * the job, valid until the next call or ts_job_free. NULL with TS_EINVAL
+ * when there is no result, TS_ENOMEM (or TS_EIO, a failed write into
+ * memory). */
 TS_API const char *ts_job_json(ts_job *j, int flags, ts_err *err);
 
 /* An array of the result, not copied (valid until ts_job_free), row-major
