@@ -24,7 +24,7 @@
 #include <string.h>
 
 #include "kernel_impl.h"
-#include "lapack.h"
+#include "lazylib.h"
 #include "march.h"
 #include "vec3.h"
 #include "vehicle.h"
@@ -326,6 +326,7 @@ typedef struct newton_ws {
     double *att;    /* [9 nvehicles] its attitudes */
     double *ctl;    /* [nc] its controller states */
     int *ipiv;
+    tsi_lapack la;  /* LAPACK, opened with the first Jacobian */
     /* A towing vehicle: the unknowns at its x and y positions (held at the
      * tow point) are the parameters of its steady motion instead
      * (doc/towing-vehicle.md, section 3): the speed, or the speed
@@ -484,7 +485,7 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
     int nu = w->nu, nq = w->nq, one = 1, info = 0;
     for (int i = 0; i < nu; i++)
         w->dq[i] = w->R[nq + i];
-    dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
+    w->la.dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
     if (info != 0)
         return;
     double big = 0.0;
@@ -650,13 +651,15 @@ static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
     if (prc != TS_OK)
         return prc;
     int info = 0;
-    w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
-    dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
+    if (!w->la.dgetrf_ && tsi_lapack_open(&w->la, err) != TS_OK)
+        return TS_EIO;
+    w->anorm = w->la.dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
+    w->la.dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
     w->have_lu = info == 0;
     if (info == 0) {
         int cinfo = 0;
-        dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
-                w->iwork, &cinfo, 1);
+        w->la.dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
+                      w->iwork, &cinfo, 1);
         if (cinfo != 0)
             w->rcond = NAN;
     }
@@ -720,7 +723,8 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
         for (int i = 0; i < nu; i++)
             w->dq[i] = -w->R[nq + i];
         if (info == 0)
-            dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
+            w->la.dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info,
+                          1);
         if (info != 0) {
             char place[2 * TS_NAME_MAX + 64];
             singular_place(k, unknown(w, info - 1), place, sizeof place);
