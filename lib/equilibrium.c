@@ -621,7 +621,9 @@ static int poll_progress(const newton_ws *w, int done, const ts_equilibrium *eq,
 }
 
 /* The Jacobian of (q'', c') at y by central differences, column by
- * column, and its LU and condition in w (w->R holds f(y)). */
+ * column, and its LU and condition in w (w->R holds f(y)). TS_OK,
+ * TS_ECANCEL, TS_ECONV (a column left the chart), TS_EIO (LAPACK cannot
+ * be opened), or -info of a singular dgetrf. */
 
 static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
                     ts_err *err)
@@ -685,8 +687,8 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             /* A start that is already the answer (a straight tow with
              * vehicles) still gets the Jacobian its health needs. */
             int jrc = w->have_lu ? TS_OK : jacobian(k, y, w, eq, err);
-            if (jrc == TS_ECANCEL)
-                return jrc;
+            if (jrc == TS_ECANCEL || jrc == TS_EIO)
+                return jrc; /* TS_EIO: LAPACK missing, err says so */
             if (jrc == TS_ECONV)
                 ts_err_clear(err);
             newton_health(k, y, w, eq);
@@ -717,7 +719,7 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                                             "at relative residual %.3g "
                                             "(tolerance %.3g)",
                            eq->iterations, rel, tol);
-        if (rc == TS_ECONV)
+        if (rc == TS_ECONV || rc == TS_EIO)
             return rc;
         int one = 1, info = -rc;
         for (int i = 0; i < nu; i++)
@@ -1000,7 +1002,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             dt *= 2.0;
             continue;
         }
-        if (rc == TS_ENOMEM || rc == TS_ECANCEL ||
+        if (rc == TS_ENOMEM || rc == TS_ECANCEL || rc == TS_EIO ||
             dt <= CONTINUATION_MIN_STEP)
             break;
         /* A path that keeps failing can halve its step ten times, each
@@ -1021,7 +1023,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
     }
     /* Name the continuation only where there was one: a straight tow has
      * no turn-rate path (its first Newton solve is the whole of it). */
-    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL && rc != TS_EIO) {
         ts_frame f;
         ts_kernel_get_frame(k, &f);
         if (path == bending_path)
@@ -2065,7 +2067,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
         eq->continuation_steps++;
     }
-    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL &&
+        rc != TS_EIO) {
         /* From the straight-tow march (bending ignored), or hanging. */
         ts_frame straight = frame;
         straight.turn_rate = 0;
