@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lapack.h"
+#include "lazylib.h"
 
 int ts_compare_fit_sinusoid(const double t[], const double x[], int n,
                             double freq_hz, double *mean, double *amplitude,
@@ -48,10 +48,13 @@ int ts_compare_fit_sinusoid(const double t[], const double x[], int n,
                 N[p + 3 * q] += ph[p] * ph[q];
         }
     }
+    tsi_lapack la;
+    if (tsi_lapack_open(&la, err) != TS_OK)
+        return TS_EIO;
     int three = 3, one = 1, ipiv[3], info = 0;
     double Ncopy[9];
     memcpy(Ncopy, N, sizeof N);
-    dgesv_(&three, &one, Ncopy, &three, ipiv, r, &three, &info);
+    la.dgesv_(&three, &one, Ncopy, &three, ipiv, r, &three, &info);
     /* Reject a numerically singular system too: the normal matrix of a
      * resolved sinusoid has a condition number of order 1. */
     double diag_min = fmin(N[0], fmin(N[4], N[8]));

@@ -188,7 +188,8 @@ void tsi_desc_free(ts_descriptor *d)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         free(arrays[i]);
     if (d->klu_symbolic)
-        klu_free_symbolic((klu_symbolic **)&d->klu_symbolic, d->klu_common);
+        d->klu.klu_free_symbolic((klu_symbolic **)&d->klu_symbolic,
+                                 d->klu_common);
     free(d->klu_common);
     free(d);
 }
@@ -375,6 +376,11 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
         ts_fail(err, TS_ENOMEM, "descriptor: out of memory");
         return NULL;
     }
+    /* KLU orders the pattern below and factors every shift of it. */
+    if (tsi_klu_open(&d->klu, err) != TS_OK) {
+        free(d);
+        return NULL;
+    }
     int nn = sys->nnodes, nl = sys->nlinks, nv = ts_kernel_nvehicles(kern);
     d->sys = sys;
     d->nn = nn;
@@ -516,7 +522,7 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
     if (ok) {
         klu_common *kc = malloc(sizeof *kc);
         d->klu_common = kc;
-        ok = kc && klu_defaults(kc);
+        ok = kc && d->klu.klu_defaults(kc);
         /* With a towing vehicle (node 0 free) AMD's symmetric ordering,
          * made for pivots on the diagonal, let partial pivoting leave the
          * rigid links' tension columns (zero on the diagonal) down the
@@ -526,7 +532,7 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
         if (ok && d->root >= 0)
             kc->ordering = 1;
         if (ok && d->nx > 0) {
-            d->klu_symbolic = klu_analyze(d->nx, d->Sp, d->Si, kc);
+            d->klu_symbolic = d->klu.klu_analyze(d->nx, d->Sp, d->Si, kc);
             ok = d->klu_symbolic != NULL;
         }
     }

@@ -64,6 +64,7 @@
 #include <complex.h>
 
 #include "kernel_impl.h"
+#include "lazylib.h"
 #include "towstab/linearize.h"
 
 /* Link kinds in the constraint rows. */
@@ -186,6 +187,7 @@ struct ts_descriptor {
                             node's displacement, its angles, its
                             controller states; -1 where S has none */
     int *lvp_off;        /* [nv + 1] offsets in pos_lv */
+    tsi_klu klu;         /* KLU, opened by tsi_desc_alloc */
     void *klu_symbolic;  /* KLU's ordering of the pattern (klu_symbolic *),
                             computed once by tsi_desc_alloc */
     void *klu_common;    /* KLU's default parameters (klu_common *); each

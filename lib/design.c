@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "lazylib.h"
 #include "towstab/eigen.h"
 #include "towstab/report_result.h"
 
@@ -438,6 +439,7 @@ typedef struct study {
     int ndir;
     int cap;
     nlopt_opt opt;
+    tsi_nlopt nl;      /* NLopt, opened by ts_design_run */
     /* SLSQP: the gradients at gu (scaled), by central differences. */
     double gu[TS_DESIGN_MAX_FREE];
     int have_grad;
@@ -640,7 +642,7 @@ static double objective(unsigned n, const double *u, double *grad,
     if (grad)
         memcpy(grad, st->gf, n * sizeof *grad);
     if (st->stop)
-        nlopt_force_stop(st->opt);
+        st->nl.nlopt_force_stop(st->opt);
     return st->f;
 }
 
@@ -660,7 +662,7 @@ static double constraint(unsigned n, const double *u, double *grad,
     if (grad)
         memcpy(grad, cd->st->gc[cd->i], n * sizeof *grad);
     if (cd->st->stop)
-        nlopt_force_stop(cd->st->opt);
+        cd->st->nl.nlopt_force_stop(cd->st->opt);
     return cd->st->c[cd->i];
 }
 
@@ -819,37 +821,42 @@ int ts_design_run(const ts_system *sys, const ts_design_spec *sp,
     memset(&st, 0, sizeof st);
     st.sys = sys;
     st.d = d;
+    if (tsi_nlopt_open(&st.nl, err) != TS_OK) {
+        ts_design_free(d);
+        return TS_EIO;
+    }
     double t0 = tsi_wall_now();
-    st.opt = nlopt_create(s->method == TS_DESIGN_BOBYQA  ? NLOPT_LN_BOBYQA
+    nlopt_algorithm alg = s->method == TS_DESIGN_BOBYQA  ? NLOPT_LN_BOBYQA
                           : s->method == TS_DESIGN_SLSQP ? NLOPT_LD_SLSQP
-                                                         : NLOPT_LN_COBYLA,
-                          (unsigned)n);
+                                                         : NLOPT_LN_COBYLA;
+    st.opt = st.nl.nlopt_create(alg, (unsigned)n);
     cdata cd[TS_DESIGN_MAX_CONSTRAINTS];
     int nrc = NLOPT_OUT_OF_MEMORY;
     if (st.opt) {
-        nlopt_set_lower_bounds(st.opt, lo);
-        nlopt_set_upper_bounds(st.opt, hi);
-        nlopt_set_min_objective(st.opt, objective, &st);
+        st.nl.nlopt_set_lower_bounds(st.opt, lo);
+        st.nl.nlopt_set_upper_bounds(st.opt, hi);
+        st.nl.nlopt_set_min_objective(st.opt, objective, &st);
         for (int i = 0; i < s->nconstraints; i++) {
             cd[i].st = &st;
             cd[i].i = i;
-            nlopt_add_inequality_constraint(st.opt, constraint, &cd[i], 0.0);
+            st.nl.nlopt_add_inequality_constraint(st.opt, constraint, &cd[i],
+                                                  0.0);
         }
-        nlopt_set_xtol_abs1(st.opt, s->xtol);
-        nlopt_set_maxeval(st.opt, s->max_evals);
+        st.nl.nlopt_set_xtol_abs1(st.opt, s->xtol);
+        st.nl.nlopt_set_maxeval(st.opt, s->max_evals);
         /* A target: stop once the misfit is well inside the tolerance. */
         if (s->goal.kind == TS_DESIGN_TARGET)
-            nlopt_set_stopval(st.opt, pow(0.1 * s->target_rtol, 2));
+            st.nl.nlopt_set_stopval(st.opt, pow(0.1 * s->target_rtol, 2));
         else if (s->goal.kind == TS_DESIGN_NONE)
-            nlopt_set_stopval(st.opt, 0.0);
+            st.nl.nlopt_set_stopval(st.opt, 0.0);
         /* A first step of a tenth of each range. */
         double step[TS_DESIGN_MAX_FREE];
         for (int i = 0; i < n; i++)
             step[i] = 0.1;
-        nlopt_set_initial_step(st.opt, step);
+        st.nl.nlopt_set_initial_step(st.opt, step);
         double f = 0;
-        nrc = nlopt_optimize(st.opt, u, &f);
-        nlopt_destroy(st.opt);
+        nrc = st.nl.nlopt_optimize(st.opt, u, &f);
+        st.nl.nlopt_destroy(st.opt);
     }
     d->nlopt_code = nrc;
     d->nlopt_reason = nlopt_reason(nrc);

@@ -39,7 +39,7 @@
 #include <string.h>
 
 #include "arpack.h"
-#include "lapack.h"
+#include "lazylib.h"
 #include "shift.h"
 #include "towstab/system.h"
 
@@ -446,6 +446,9 @@ static long clean_below_error(const ts_linear *lin, double *a, double *z)
 
 static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
 {
+    tsi_lapack la;
+    if (tsi_lapack_open(&la, err) != TS_OK)
+        return TS_EIO;
     int n = lin->nstate, info = 0, lwork = -1;
     size_t nn = (size_t)n * (size_t)n;
     double *a = malloc(nn * sizeof(double));
@@ -487,9 +490,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
         goto out;
     }
-    dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo, &ihi,
-            scale, &abnrm, rconde, rcondv, &wq, &lwork, NULL, &info, 1, 1, 1,
-            1);
+    la.dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo,
+               &ihi, scale, &abnrm, rconde, rcondv, &wq, &lwork, NULL, &info, 1,
+               1, 1, 1);
     lwork = info == 0 ? (int)wq : n * (n + 6);
     work = malloc((size_t)lwork * sizeof(double));
     if (!work) {
@@ -498,9 +501,9 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
                            "dgeevx's work of the %d x %d matrix", n, n);
         goto out;
     }
-    dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo, &ihi,
-            scale, &abnrm, rconde, rcondv, work, &lwork, NULL, &info, 1, 1, 1,
-            1);
+    la.dgeevx_("B", "V", "V", "E", &n, a, &n, wr, wi, vl, &n, vr, &n, &ilo,
+               &ihi, scale, &abnrm, rconde, rcondv, work, &lwork, NULL, &info,
+               1, 1, 1, 1);
     if (info != 0) {
         rc = ts_fail(err, TS_ELAPACK,
                      "eigen: LAPACK dgeevx info %d (%s) for the %d x %d "
@@ -520,8 +523,8 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
         ev = malloc((size_t)nlow * (size_t)n * sizeof(double));
         if (ev) {
             double pone = 1.0, zero = 0.0;
-            dgemm_("N", "N", &nlow, &n, &n, &pone, lin->Aerr, &nlow, vr, &n,
-                   &zero, ev, &nlow, 1, 1);
+            la.dgemm_("N", "N", &nlow, &n, &n, &pone, lin->Aerr, &nlow, vr, &n,
+                      &zero, ev, &nlow, 1, 1);
         }
     }
     /* EZ = Z VR: the entries zeroed, on every right eigenvector. */
@@ -532,8 +535,8 @@ static int solve_lapack(const ts_linear *lin, cand_list *L, ts_err *err)
             goto out;
         }
         double pone = 1.0, zero = 0.0;
-        dgemm_("N", "N", &nlow, &n, &n, &pone, z, &nlow, vr, &n, &zero, ez,
-               &nlow, 1, 1);
+        la.dgemm_("N", "N", &nlow, &n, &n, &pone, z, &nlow, vr, &n, &zero, ez,
+                  &nlow, 1, 1);
     }
     /* 1 / |u_k^H v_k| of every eigenvalue (unit vectors): O(n^2). */
     kap0 = malloc((size_t)n * sizeof(double));
@@ -652,6 +655,9 @@ static double set_residual(cand *c, const double complex *v,
 
 static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
 {
+    tsi_lapack la;
+    if (tsi_lapack_open(&la, err) != TS_OK)
+        return TS_EIO;
     int n = lin->nstate, nlow = n - lin->nq, m = 0;
     for (int c = 0; c < L->n; c++)
         m += L->c[c].checked ? 0 : 2;
@@ -678,11 +684,11 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
         j += 2;
     }
     double pone = 1.0, zero = 0.0;
-    dgemm_("N", "N", &n, &m, &n, &pone, lin->A, &n, W, &n, &zero, AW, &n, 1,
-           1);
+    la.dgemm_("N", "N", &n, &m, &n, &pone, lin->A, &n, W, &n, &zero, AW, &n, 1,
+              1);
     if (EW)
-        dgemm_("N", "N", &nlow, &m, &n, &pone, lin->Aerr, &nlow, W, &n, &zero,
-               EW, &nlow, 1, 1);
+        la.dgemm_("N", "N", &nlow, &m, &n, &pone, lin->Aerr, &nlow, W, &n,
+                  &zero, EW, &nlow, 1, 1);
     for (int c = 0, j = 0; c < L->n; c++) {
         if (L->c[c].checked)
             continue;
@@ -897,6 +903,9 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
                              ts_err *err)
 {
     int n = lin->nstate, nev, ncv, rc;
+    tsi_arpack ar;
+    if (tsi_arpack_open(&ar, err) != TS_OK)
+        return TS_EIO;
     if ((rc = arpack_sizes(n, o->count, &nev, &ncv, err)) != TS_OK)
         return rc;
     tsi_shift sh;
@@ -925,8 +934,8 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
     iparam[6] = 3;                  /* shift-invert */
     double tol = modes_tol(lin, o);
     for (;;) {
-        dnaupd_(&ido, "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
-                ipntr, workd, workl, &lworkl, &info, 1, 2);
+        ar.dnaupd_(&ido, "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
+                   ipntr, workd, workl, &lworkl, &info, 1, 2);
         if (ido != -1 && ido != 1)
             break;
         eig_poll pp = {o, "eigensolve", 0, NAN};
@@ -950,9 +959,9 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
         goto out;
     }
     int rvec = 1;
-    dneupd_(&rvec, "A", select, dr, di, z, &n, &sigma, &sigmai, workev, "I",
-            &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam, ipntr, workd,
-            workl, &lworkl, &info, 1, 1, 2);
+    ar.dneupd_(&rvec, "A", select, dr, di, z, &n, &sigma, &sigmai, workev, "I",
+               &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam, ipntr, workd,
+               workl, &lworkl, &info, 1, 1, 2);
     if (info != 0) {
         rc = ts_fail(err, TS_ELAPACK, "eigen: ARPACK dneupd info %d (%s)",
                      info, arpack_info_text(info));
@@ -1007,6 +1016,9 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
                        ts_err *err)
 {
     int n = lin->nstate, rc;
+    tsi_arpack ar;
+    if (tsi_arpack_open(&ar, err) != TS_OK)
+        return TS_EIO;
     tsi_shift sh;
     if ((rc = tsi_shift_factor(&sh, lin, sigma, err)) != TS_OK)
         return rc;
@@ -1032,8 +1044,8 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
     iparam[2] = maxiter;
     iparam[6] = 3;
     for (;;) {
-        znaupd_(&ido, "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
-                ipntr, workd, workl, &lworkl, rwork, &info, 1, 2);
+        ar.znaupd_(&ido, "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
+                   ipntr, workd, workl, &lworkl, rwork, &info, 1, 2);
         if (ido != -1 && ido != 1)
             break;
         if ((rc = eig_poll_check(pp, st->ops, err)) != TS_OK)
@@ -1062,9 +1074,9 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
         goto out;
     }
     int rvec = 1;
-    zneupd_(&rvec, "A", select, d, z, &n, &sigma, workev, "I", &n, "LM",
-            &nev, &tol, resid, &ncv, v, &n, iparam, ipntr, workd, workl,
-            &lworkl, rwork, &info, 1, 1, 2);
+    ar.zneupd_(&rvec, "A", select, d, z, &n, &sigma, workev, "I", &n, "LM",
+               &nev, &tol, resid, &ncv, v, &n, iparam, ipntr, workd, workl,
+               &lworkl, rwork, &info, 1, 1, 2);
     if (info != 0) {
         rc = ts_fail(err, TS_ELAPACK, "eigen: ARPACK zneupd info %d (%s)",
                      info, arpack_info_text(info));

@@ -24,7 +24,7 @@
 #include <string.h>
 
 #include "kernel_impl.h"
-#include "lapack.h"
+#include "lazylib.h"
 #include "march.h"
 #include "vec3.h"
 #include "vehicle.h"
@@ -326,6 +326,7 @@ typedef struct newton_ws {
     double *att;    /* [9 nvehicles] its attitudes */
     double *ctl;    /* [nc] its controller states */
     int *ipiv;
+    tsi_lapack la;  /* LAPACK, opened with the first Jacobian */
     /* A towing vehicle: the unknowns at its x and y positions (held at the
      * tow point) are the parameters of its steady motion instead
      * (doc/towing-vehicle.md, section 3): the speed, or the speed
@@ -484,7 +485,7 @@ static void newton_health(ts_kernel *k, const double *y, newton_ws *w,
     int nu = w->nu, nq = w->nq, one = 1, info = 0;
     for (int i = 0; i < nu; i++)
         w->dq[i] = w->R[nq + i];
-    dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
+    w->la.dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
     if (info != 0)
         return;
     double big = 0.0;
@@ -620,7 +621,9 @@ static int poll_progress(const newton_ws *w, int done, const ts_equilibrium *eq,
 }
 
 /* The Jacobian of (q'', c') at y by central differences, column by
- * column, and its LU and condition in w (w->R holds f(y)). */
+ * column, and its LU and condition in w (w->R holds f(y)). TS_OK,
+ * TS_ECANCEL, TS_ECONV (a column left the chart), TS_EIO (LAPACK cannot
+ * be opened), or -info of a singular dgetrf. */
 
 static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
                     ts_err *err)
@@ -650,13 +653,15 @@ static int jacobian(ts_kernel *k, double *y, newton_ws *w, ts_equilibrium *eq,
     if (prc != TS_OK)
         return prc;
     int info = 0;
-    w->anorm = dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
-    dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
+    if (!w->la.dgetrf_ && tsi_lapack_open(&w->la, err) != TS_OK)
+        return TS_EIO;
+    w->anorm = w->la.dlange_("1", &nu, &nu, w->J, &nu, w->work, 1);
+    w->la.dgetrf_(&nu, &nu, w->J, &nu, w->ipiv, &info);
     w->have_lu = info == 0;
     if (info == 0) {
         int cinfo = 0;
-        dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
-                w->iwork, &cinfo, 1);
+        w->la.dgecon_("1", &nu, w->J, &nu, &w->anorm, &w->rcond, w->work,
+                      w->iwork, &cinfo, 1);
         if (cinfo != 0)
             w->rcond = NAN;
     }
@@ -682,8 +687,8 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             /* A start that is already the answer (a straight tow with
              * vehicles) still gets the Jacobian its health needs. */
             int jrc = w->have_lu ? TS_OK : jacobian(k, y, w, eq, err);
-            if (jrc == TS_ECANCEL)
-                return jrc;
+            if (jrc == TS_ECANCEL || jrc == TS_EIO)
+                return jrc; /* TS_EIO: LAPACK missing, err says so */
             if (jrc == TS_ECONV)
                 ts_err_clear(err);
             newton_health(k, y, w, eq);
@@ -714,13 +719,14 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
                                             "at relative residual %.3g "
                                             "(tolerance %.3g)",
                            eq->iterations, rel, tol);
-        if (rc == TS_ECONV)
+        if (rc == TS_ECONV || rc == TS_EIO)
             return rc;
         int one = 1, info = -rc;
         for (int i = 0; i < nu; i++)
             w->dq[i] = -w->R[nq + i];
         if (info == 0)
-            dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info, 1);
+            w->la.dgetrs_("N", &nu, &one, w->J, &nu, w->ipiv, w->dq, &nu, &info,
+                          1);
         if (info != 0) {
             char place[2 * TS_NAME_MAX + 64];
             singular_place(k, unknown(w, info - 1), place, sizeof place);
@@ -996,7 +1002,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
             dt *= 2.0;
             continue;
         }
-        if (rc == TS_ENOMEM || rc == TS_ECANCEL ||
+        if (rc == TS_ENOMEM || rc == TS_ECANCEL || rc == TS_EIO ||
             dt <= CONTINUATION_MIN_STEP)
             break;
         /* A path that keeps failing can halve its step ten times, each
@@ -1017,7 +1023,7 @@ static int continuation(ts_kernel *k, double *y, newton_ws *w, path_fn path,
     }
     /* Name the continuation only where there was one: a straight tow has
      * no turn-rate path (its first Newton solve is the whole of it). */
-    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL && rc != TS_EIO) {
         ts_frame f;
         ts_kernel_get_frame(k, &f);
         if (path == bending_path)
@@ -2061,7 +2067,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
         eq->continuation_steps++;
     }
-    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL) {
+    if (rc != TS_OK && rc != TS_ENOMEM && rc != TS_ECANCEL &&
+        rc != TS_EIO) {
         /* From the straight-tow march (bending ignored), or hanging. */
         ts_frame straight = frame;
         straight.turn_rate = 0;

@@ -23,7 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lapack.h"
+#include "lazylib.h"
 
 /* Higham 2005, table 2.3 (double precision). */
 static const double theta[5] = {1.495585217958292e-2, 2.539398330063230e-1,
@@ -47,10 +47,11 @@ static const double b13[14] = {
     182.,               1.};
 
 /* C = A B (n x n, column-major). */
-static void mul(int n, const double *A, const double *B, double *C)
+static void mul(const tsi_lapack *la, int n, const double *A,
+                const double *B, double *C)
 {
     const double one = 1.0, zero = 0.0;
-    dgemm_("N", "N", &n, &n, &n, &one, A, &n, B, &n, &zero, C, &n, 1, 1);
+    la->dgemm_("N", "N", &n, &n, &n, &one, A, &n, B, &n, &zero, C, &n, 1, 1);
 }
 
 static double norm1(int n, const double *A)
@@ -78,6 +79,9 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
     if (!isfinite(anorm))
         return ts_fail(err, TS_EINVAL, "expm: the matrix has a non-finite "
                        "entry");
+    tsi_lapack la;
+    if (tsi_lapack_open(&la, err) != TS_OK)
+        return TS_EIO;
     size_t nn = (size_t)n * (size_t)n;
     double *work = malloc(6 * nn * sizeof(double));
     int *ipiv = malloc((size_t)n * sizeof(int));
@@ -108,23 +112,23 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
                 As[i] *= scale;
         }
     }
-    mul(n, As, As, A2);
+    mul(&la, n, As, As, A2);
     /* E temporarily holds the odd-power sum before U = A * sum. */
     if (degree[m] == 13) {
-        mul(n, A2, A2, A4);
-        mul(n, A4, A2, A6);
+        mul(&la, n, A2, A2, A4);
+        mul(&la, n, A4, A2, A6);
         const double *b = b13;
         for (size_t i = 0; i < nn; i++) {
             U[i] = b[13] * A6[i] + b[11] * A4[i] + b[9] * A2[i];
             V[i] = b[12] * A6[i] + b[10] * A4[i] + b[8] * A2[i];
         }
-        mul(n, A6, U, E);
+        mul(&la, n, A6, U, E);
         for (size_t i = 0; i < nn; i++)
             E[i] += b[7] * A6[i] + b[5] * A4[i] + b[3] * A2[i];
         for (int i = 0; i < n; i++)
             E[i + (size_t)i * n] += b[1];
-        mul(n, As, E, U);
-        mul(n, A6, V, E);
+        mul(&la, n, As, E, U);
+        mul(&la, n, A6, V, E);
         for (size_t i = 0; i < nn; i++)
             V[i] = E[i] + b[6] * A6[i] + b[4] * A4[i] + b[2] * A2[i];
         for (int i = 0; i < n; i++)
@@ -146,7 +150,7 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
             V[i + (size_t)i * n] += b[0];
         }
         for (int k = 4; k <= deg - 1; k += 2) {
-            mul(n, P, A2, Q);
+            mul(&la, n, P, A2, Q);
             double *t = P;
             P = Q;
             Q = t;
@@ -155,7 +159,7 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
                 V[i] += b[k] * P[i];
             }
         }
-        mul(n, As, E, U);
+        mul(&la, n, As, E, U);
     }
     /* Solve (V - U) X = (V + U). */
     for (size_t i = 0; i < nn; i++) {
@@ -164,7 +168,7 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
         E[i] = v + u;
     }
     int info = 0;
-    dgesv_(&n, &n, A2, &n, ipiv, E, &n, &info);
+    la.dgesv_(&n, &n, A2, &n, ipiv, E, &n, &info);
     if (info != 0) {
         free(work);
         free(ipiv);
@@ -173,7 +177,7 @@ int tsi_expm(int n, const double *A, double *E, int *squarings, ts_err *err)
                        anorm);
     }
     for (int k = 0; k < s; k++) {
-        mul(n, E, E, A2);
+        mul(&la, n, E, E, A2);
         memcpy(E, A2, nn * sizeof(double));
     }
     if (squarings)

@@ -44,7 +44,7 @@
 #include "descriptor.h"
 #include "vec3.h"
 #include "kernel_impl.h"
-#include "lapack.h"
+#include "lazylib.h"
 #include "vehicle.h"
 
 #ifdef _OPENMP
@@ -317,8 +317,11 @@ static int eval_into(col_ws *w, int slot, int nl)
 #define NOISE_REL 1e-4
 
 static int kernel_noise(ts_kernel *k, const double *y0, const double *u0,
-                        ts_linear *lin)
+                        ts_linear *lin, ts_err *err)
 {
+    tsi_lapack la;
+    if (tsi_lapack_open(&la, err) != TS_OK)
+        return TS_EIO;
     int n = lin->nstate, nq = lin->nq, nlow = n - nq;
     int nl = lin->nlinks, nout = lin->noutput, no = nl + nout;
     double *y = malloc((size_t)n * sizeof *y);
@@ -344,8 +347,8 @@ static int kernel_noise(ts_kernel *k, const double *y0, const double *u0,
             continue; /* a state off the chart: another sample */
         double one = 1.0, zero = 0.0;
         int inc = 1;
-        dgemv_("N", &nlow, &n, &one, lin->A + nq, &n, d, &inc, &zero, ad,
-               &inc, 1);
+        la.dgemv_("N", &nlow, &n, &one, lin->A + nq, &n, d, &inc, &zero, ad,
+                  &inc, 1);
         for (int i = 0; i < nlow; i++) {
             double r = f[nq + i] - lin->f0[nq + i] - ad[i];
             acc[i] += r * r;
@@ -1232,7 +1235,11 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
     lin->evaluations += (long)ncol * (estimate ? 4 : 2);
 
     /* The kernel's rounding noise (beside the truncation error). */
-    if (estimate && bad_col < 0 && kernel_noise(k, y0, u0, lin) == TS_OK) {
+    int noise_rc = estimate && bad_col < 0
+                       ? kernel_noise(k, y0, u0, lin, err) : TS_ECONV;
+    if (noise_rc == TS_EIO)
+        return noise_rc; /* LAPACK missing: err says so */
+    if (noise_rc == TS_OK) {
         double sr = 0, sh = 0;
         for (int i = 0; i < nlow; i++)
             sr += lin->fnoise[i] * lin->fnoise[i];

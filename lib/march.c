@@ -15,13 +15,13 @@
 #include "march.h"
 
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multiroots.h>
 #include <gsl/gsl_vector.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "forces.h"
-#include "lapack.h"
 #include "vec3.h"
 
 /* Local root: |H_perp| below this fraction of |H| (rounding is ~1e-16). */
@@ -269,6 +269,20 @@ static int fd_jacobian(tsi_march *m, const ts_frame *f, double x[],
     return rc;
 }
 
+/* The 1-norm (largest column sum of magnitudes) of the row-major n x n
+ * matrix a. */
+static double col_norm1(const double *a, int n)
+{
+    double big = 0.0;
+    for (int j = 0; j < n; j++) {
+        double sum = 0.0;
+        for (int i = 0; i < n; i++)
+            sum += fabs(a[(size_t)i * n + j]);
+        big = fmax(big, sum);
+    }
+    return big;
+}
+
 int tsi_march_condition(tsi_march *m, double *condition, double *shape_error,
                         long *marches)
 {
@@ -292,39 +306,48 @@ int tsi_march_condition(tsi_march *m, double *condition, double *shape_error,
     } else {
         memcpy(m->jlast, m->jac0, (size_t)n * n * sizeof(double));
     }
+    /* J has three rows per free end, a handful: its condition is taken
+     * exactly, ||J||_1 ||J^-1||_1 from the inverse of GSL's LU (what
+     * LAPACK's dgecon estimates from below), at no cost worth counting
+     * and without loading LAPACK for a shooting run (doc/performance.md,
+     * "Start-up"). J is row-major, as GSL's matrices are. */
     size_t nn = (size_t)n * (size_t)n;
-    double *a = malloc(nn * sizeof(double));
-    double *work = malloc(4 * (size_t)n * sizeof(double));
-    int *iwork = malloc((size_t)n * sizeof(int)), *ipiv = malloc((size_t)n * sizeof(int));
-    if (!a || !work || !iwork || !ipiv) {
-        free(a);
-        free(work);
-        free(iwork);
-        free(ipiv);
+    gsl_matrix *lu = gsl_matrix_alloc((size_t)n, (size_t)n);
+    gsl_matrix *inv = gsl_matrix_alloc((size_t)n, (size_t)n);
+    gsl_permutation *perm = gsl_permutation_alloc((size_t)n);
+    if (!lu || !inv || !perm) {
+        if (lu)
+            gsl_matrix_free(lu);
+        if (inv)
+            gsl_matrix_free(inv);
+        if (perm)
+            gsl_permutation_free(perm);
         return TS_ENOMEM;
     }
-    /* The row-major J read column-major is J^T, whose infinity-norm
-     * condition is J's 1-norm condition. */
-    memcpy(a, m->jlast, nn * sizeof(double));
-    double anorm = dlange_("I", &n, &n, a, &n, work, 1);
-    dgetrf_(&n, &n, a, &n, ipiv, &info);
-    double rcond = 0.0;
-    if (info == 0)
-        dgecon_("I", &n, a, &n, &anorm, &rcond, work, iwork, &info, 1);
+    memcpy(lu->data, m->jlast, nn * sizeof(double));
+    int signum = 0;
+    gsl_linalg_LU_decomp(lu, perm, &signum);
+    /* A zero pivot: J is singular (checked before inverting, which would
+     * call GSL's error handler). */
+    for (int k = 0; k < n; k++)
+        if (gsl_matrix_get(lu, (size_t)k, (size_t)k) == 0.0)
+            info = k + 1;
+    if (info == 0 && gsl_linalg_LU_invert(lu, perm, inv) != GSL_SUCCESS)
+        info = -1;
     if (info == 0) {
-        *condition = rcond > 0 ? 1.0 / rcond : INFINITY;
+        double anorm = col_norm1(m->jlast, n), inorm = col_norm1(inv->data, n);
+        *condition = anorm * inorm;
         /* Free-end positions move by about |J^-1| |mismatch|, at the
          * solution (the perturbed marches changed m->mismatch). */
         double mis = 0.0;
         for (int k = 0; k < n; k++)
             mis = fmax(mis, fabs(m->elast[k]));
-        *shape_error = rcond > 0 ? mis / (rcond * anorm) : INFINITY;
+        *shape_error = mis * inorm;
     }
-    free(a);
-    free(work);
-    free(iwork);
-    free(ipiv);
-    return info == 0 ? TS_OK : TS_ELAPACK;
+    gsl_matrix_free(lu);
+    gsl_matrix_free(inv);
+    gsl_permutation_free(perm);
+    return info == 0 ? TS_OK : TS_ESINGULAR;
 }
 
 /* The balance of one node, for the local root. */

@@ -33,7 +33,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lapack.h"
+#include "lazylib.h"
 #include "response_impl.h"
 #include "shift.h"
 #include "towstab/system.h"
@@ -328,7 +328,7 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
     if (sh->full) {
         /* H - sI singular: W from the whole (A - sI)^T. */
         memcpy(W, c, (size_t)n * sizeof(double complex));
-        zgetrs_("T", &n, &one, sh->full, &n, sh->fpiv, W, &n, &info, 1);
+        sh->la.zgetrs_("T", &n, &one, sh->full, &n, sh->fpiv, W, &n, &info, 1);
         memmove(W, W + nq, (size_t)nlow * sizeof(double complex));
     } else {
         double complex *w2 = W, *w3 = W + nq;
@@ -338,8 +338,8 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
             /* t = (H - sI)^-T c3; w2 -= (F + s G)^T t. */
             double complex *t = w->t3;
             memcpy(t, c + 2 * nq, (size_t)nc * sizeof(double complex));
-            zgetrs_("T", &nc, &one, sh->hlu, &nc, sh->hpiv, t, &nc, &info,
-                    1);
+            sh->la.zgetrs_("T", &nc, &one, sh->hlu, &nc, sh->hpiv, t, &nc,
+                           &info, 1);
             for (int i = 0; i < nq; i++) {
                 const double *Fi = A + (size_t)i * n + 2 * nq;
                 const double *Gi = A + (size_t)(nq + i) * n + 2 * nq;
@@ -350,18 +350,18 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
             }
         }
         if (sh->is_complex) {
-            zgetrs_("T", &nq, &one, sh->zlu, &nq, sh->ipiv, w2, &nq, &info,
-                    1);
+            sh->la.zgetrs_("T", &nq, &one, sh->zlu, &nq, sh->ipiv, w2, &nq,
+                           &info, 1);
         } else {
             double *re = sh->wr, *im = sh->wr + nq;
             for (int i = 0; i < nq; i++) {
                 re[i] = creal(w2[i]);
                 im[i] = cimag(w2[i]);
             }
-            dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, re, &nq, &info,
-                    1);
-            dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, im, &nq, &info,
-                    1);
+            sh->la.dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, re, &nq,
+                           &info, 1);
+            sh->la.dgetrs_("T", &nq, &one, sh->lu, &nq, sh->ipiv, im, &nq,
+                           &info, 1);
             for (int i = 0; i < nq; i++)
                 w2[i] = re[i] + I * im[i];
         }
@@ -374,8 +374,8 @@ static double gain_error(tsi_shift *sh, const ts_linear *lin, int input,
                     acc += Ek[i] * w2[i];
                 w3[k] = c[2 * nq + k] - acc;
             }
-            zgetrs_("T", &nc, &one, sh->hlu, &nc, sh->hpiv, w3, &nc, &info,
-                    1);
+            sh->la.zgetrs_("T", &nc, &one, sh->hlu, &nc, sh->hpiv, w3, &nc,
+                           &info, 1);
         }
     }
     return error_terms(lin, input, s, &o, w);
@@ -539,8 +539,12 @@ static double complex output_gain(const ts_system *sys, const ts_linear *lin,
  * TS_ESINGULAR. */
 static int neutral_static(const ts_system *sys, const ts_linear *lin,
                           int input, const ts_output *out, resp_ws *w,
-                          double *g, double *gerr, char *note, size_t size)
+                          double *g, double *gerr, char *note, size_t size,
+                          ts_err *err)
 {
+    tsi_lapack la;
+    if (tsi_lapack_open(&la, err) != TS_OK)
+        return TS_EIO;
     int n = lin->nstate, nq = lin->nq, nlow = n - nq;
     int idx[TS_NEUTRAL_MAX], k = 0;
     for (int j = 0; j < lin->nneutral && lin->neutral_re; j++)
@@ -603,10 +607,10 @@ static int neutral_static(const ts_system *sys, const ts_linear *lin,
         for (int i = 0; i < n; i++)
             z[i] -= creal(fac[q]) * Bq[i];
     }
-    double anorm = dlange_("1", &N, &N, M, &N, work, 1), rcond = 0;
-    dgetrf_(&N, &N, M, &N, piv, &info);
+    double anorm = la.dlange_("1", &N, &N, M, &N, work, 1), rcond = 0;
+    la.dgetrf_(&N, &N, M, &N, piv, &info);
     if (info == 0)
-        dgecon_("1", &N, M, &N, &anorm, &rcond, work, piv + N, &info, 1);
+        la.dgecon_("1", &N, M, &N, &anorm, &rcond, work, piv + N, &info, 1);
     if (info != 0 || !(rcond > BORDER_RCOND)) {
         snprintf(note, size, "undefined: the model is singular at 0 Hz "
                  "beyond the towing vehicle's neutral modes by symmetry "
@@ -615,7 +619,7 @@ static int neutral_static(const ts_system *sys, const ts_linear *lin,
         free(piv);
         return TS_ESINGULAR;
     }
-    dgetrs_("N", &N, &one, M, &N, piv, z, &N, &info, 1);
+    la.dgetrs_("N", &N, &one, M, &N, piv, z, &N, &info, 1);
     for (int i = 0; i < n; i++)
         w->x[i] = z[i];
     *g = creal(output_gain(sys, lin, input, out, w, ncols, cols, fac));
@@ -624,7 +628,7 @@ static int neutral_static(const ts_system *sys, const ts_linear *lin,
         !(o.J && (!o.Jerr || !(o.onoise >= 0)))) {
         for (int i = 0; i < N; i++)
             Wt[i] = i < n ? creal(w->c[i]) : 0.0;
-        dgetrs_("T", &N, &one, M, &N, piv, Wt, &N, &info, 1);
+        la.dgetrs_("T", &N, &one, M, &N, piv, Wt, &N, &info, 1);
         for (int i = 0; i < nlow; i++)
             w->W[i] = Wt[nq + i];
         *gerr = error_terms(lin, input, 0.0, &o, w);
@@ -1055,7 +1059,7 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
          * above 0 are regular. */
         rc = neutral_static(sys, lin, input, out, &w, &r->static_gain,
                             &r->static_error, r->static_note,
-                            sizeof r->static_note);
+                            sizeof r->static_note, err);
     } else {
         rc = gain_at(sys, lin, input, out, 0.0, &w, &sh, &g,
                      &r->static_error, err);

@@ -14,8 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lapack.h"
-
 #define XR(k, c) tsi_desc_xr(d, (k), (c))
 #define XT(l) TSI_XT(l)
 #define XC(j) tsi_desc_xc(d, (j))
@@ -26,9 +24,9 @@ static void free_numeric(tsi_shift *sh)
     if (sh->numeric) {
         klu_numeric *num = sh->numeric;
         if (sh->is_complex)
-            klu_z_free_numeric(&num, sh->common);
+            sh->klu.klu_z_free_numeric(&num, sh->common);
         else
-            klu_free_numeric(&num, sh->common);
+            sh->klu.klu_free_numeric(&num, sh->common);
     }
     sh->numeric = NULL;
 }
@@ -92,7 +90,7 @@ static int full_factor(tsi_shift *sh, ts_err *err)
         sh->full[i] = A[i];
     for (int i = 0; i < n; i++)
         sh->full[(size_t)i * n + i] -= sh->s;
-    zgetrf_(&n, &n, sh->full, &n, sh->fpiv, &info);
+    sh->la.zgetrf_(&n, &n, sh->full, &n, sh->fpiv, &info);
     if (info != 0) {
         double complex s = sh->s;
         tsi_shift_free(sh);
@@ -105,6 +103,8 @@ static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                         ts_err *err)
 {
     memset(sh, 0, sizeof *sh);
+    if (tsi_lapack_open(&sh->la, err) != TS_OK)
+        return TS_EIO;
     int nq = lin->nq, n = lin->nstate, nc = n - 2 * nq, info = 0;
     size_t nn = (size_t)nq * (size_t)nq;
     sh->lin = lin;
@@ -164,15 +164,15 @@ static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
                 sh->hlu[(size_t)j * nc + i] =
                     A[(size_t)(2 * nq + j) * n + 2 * nq + i] -
                     (i == j ? s : 0.0);
-        zgetrf_(&nc, &nc, sh->hlu, &nc, sh->hpiv, &info);
+        sh->la.zgetrf_(&nc, &nc, sh->hlu, &nc, sh->hpiv, &info);
         if (info == 0) {
             for (int j = 0; j < nq; j++)
                 for (int i = 0; i < nc; i++)
                     MF[(size_t)j * nc + i] =
                         A[(size_t)j * n + 2 * nq + i] +
                         s * A[(size_t)(nq + j) * n + 2 * nq + i];
-            zgetrs_("N", &nc, &nq, sh->hlu, &nc, sh->hpiv, MF, &nc, &info,
-                    1);
+            sh->la.zgetrs_("N", &nc, &nq, sh->hlu, &nc, sh->hpiv, MF, &nc,
+                           &info, 1);
         }
         for (int j = 0; info == 0 && j < nq; j++) {
             double complex *Pj = sh->zlu + (size_t)j * nq;
@@ -193,9 +193,9 @@ static int dense_factor(tsi_shift *sh, const ts_linear *lin, double complex s,
             return full_factor(sh, err);
     }
     if (sh->is_complex)
-        zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
+        sh->la.zgetrf_(&nq, &nq, sh->zlu, &nq, sh->ipiv, &info);
     else
-        dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
+        sh->la.dgetrf_(&nq, &nq, sh->lu, &nq, sh->ipiv, &info);
     if (info != 0) {
         const char *what = sh->is_complex ? "zgetrf" : "dgetrf";
         tsi_shift_free(sh);
@@ -231,9 +231,9 @@ static void dense_solve_real(tsi_shift *sh, const double *b, double *x)
     /* x1 = b2 + s b1 - C b1 */
     for (int i = 0; i < nq; i++)
         x1[i] = b2[i] + sr * b1[i];
-    dgemv_("N", &nq, &nq, &mone, sh->lin->A + (size_t)nq * n + nq, &n, b1,
-           &one, &pone, x1, &one, 1);
-    dgetrs_("N", &nq, &one, sh->lu, &nq, sh->ipiv, x1, &nq, &info, 1);
+    sh->la.dgemv_("N", &nq, &nq, &mone, sh->lin->A + (size_t)nq * n + nq, &n,
+                  b1, &one, &pone, x1, &one, 1);
+    sh->la.dgetrs_("N", &nq, &one, sh->lu, &nq, sh->ipiv, x1, &nq, &info, 1);
     for (int i = 0; i < nq; i++)
         x2[i] = b1[i] + sr * x1[i];
 }
@@ -259,7 +259,7 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
     int nq = sh->nq, n = sh->n, nc = sh->nc, one = 1, two = 2, info = 0;
     if (sh->full) {
         memcpy(x, b, (size_t)n * sizeof(double complex));
-        zgetrs_("N", &n, &one, sh->full, &n, sh->fpiv, x, &n, &info, 1);
+        sh->la.zgetrs_("N", &n, &one, sh->full, &n, sh->fpiv, x, &n, &info, 1);
         return;
     }
     double complex s = sh->s;
@@ -268,9 +268,9 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
     /* C b1 for complex b1 and real C: the interleaved (re, im) pairs form
      * a 2 x nq real matrix X, and (C b1) as pairs is X C^T. */
     double pone = 1.0, zero = 0.0;
-    dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
-           sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->zw, &two,
-           1, 1);
+    sh->la.dgemm_("N", "T", &two, &nq, &nq, &pone, (const double *)b1, &two,
+                  sh->lin->A + (size_t)nq * n + nq, &n, &zero, (double *)sh->zw,
+                  &two, 1, 1);
     for (int i = 0; i < nq; i++)
         x1[i] = b2[i] + s * b1[i] - sh->zw[i];
     if (nc > 0) {
@@ -279,7 +279,8 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
         ctl_rows(sh, nq, nq, b1, t3, 0);
         for (int i = 0; i < nc; i++)
             t3[i] = b3[i] - t3[i];
-        zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, t3, &nc, &info, 1);
+        sh->la.zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, t3, &nc, &info,
+                       1);
         const double *A = sh->lin->A;
         for (int k = 0; k < nc; k++) {
             const double *Ek = A + (size_t)(2 * nq + k) * n + nq;
@@ -288,7 +289,8 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
         }
     }
     if (sh->is_complex) {
-        zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info, 1);
+        sh->la.zgetrs_("N", &nq, &one, sh->zlu, &nq, sh->ipiv, x1, &nq, &info,
+                       1);
     } else {
         /* Real factors: solve the real and imaginary parts together. */
         double *r = sh->wr;
@@ -296,7 +298,7 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
             r[i] = creal(x1[i]);
             r[nq + i] = cimag(x1[i]);
         }
-        dgetrs_("N", &nq, &two, sh->lu, &nq, sh->ipiv, r, &nq, &info, 1);
+        sh->la.dgetrs_("N", &nq, &two, sh->lu, &nq, sh->ipiv, r, &nq, &info, 1);
         for (int i = 0; i < nq; i++)
             x1[i] = r[i] + I * r[nq + i];
     }
@@ -308,7 +310,8 @@ static void dense_solve(tsi_shift *sh, const double complex *b,
         ctl_rows(sh, nq, nq, x2, x3, 1);
         for (int i = 0; i < nc; i++)
             x3[i] = b3[i] - x3[i];
-        zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, x3, &nc, &info, 1);
+        sh->la.zgetrs_("N", &nc, &one, sh->hlu, &nc, sh->hpiv, x3, &nc, &info,
+                       1);
     }
 }
 
@@ -321,6 +324,8 @@ static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
         return ts_fail(err, TS_EINVAL, "shift: the linear model has no sparse "
                        "form (linearize with model TS_LIN_AUTO, SPARSE or "
                        "BOTH)");
+    if (tsi_klu_open(&sh->klu, err) != TS_OK)
+        return TS_EIO;
     const ts_descriptor *d = lin->desc;
     sh->lin = lin;
     sh->d = d;
@@ -370,14 +375,14 @@ static int factor(tsi_shift *sh, ts_err *err)
     klu_common *kc = sh->common;
     klu_symbolic *sym = d->klu_symbolic;
     if (sh->is_complex)
-        sh->numeric = klu_z_factor(d->Sp, d->Si, sh->Sx, sym, kc);
+        sh->numeric = sh->klu.klu_z_factor(d->Sp, d->Si, sh->Sx, sym, kc);
     else
-        sh->numeric = klu_factor(d->Sp, d->Si, sh->Sx, sym, kc);
+        sh->numeric = sh->klu.klu_factor(d->Sp, d->Si, sh->Sx, sym, kc);
     if (sh->numeric) {
         /* KLU's cheap estimate, min |u_ii| / max |u_ii|, against which a
          * refactorisation is judged. */
-        int ok = sh->is_complex ? klu_z_rcond(sym, sh->numeric, kc)
-                                : klu_rcond(sym, sh->numeric, kc);
+        int ok = sh->is_complex ? sh->klu.klu_z_rcond(sym, sh->numeric, kc)
+                                : sh->klu.klu_rcond(sym, sh->numeric, kc);
         sh->rcond = ok ? kc->rcond : 0.0;
         sh->rcond_raw = ok ? raw_rcond(sh) : 0.0;
         return TS_OK;
@@ -464,10 +469,11 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
     if (cplx == sh->is_complex) {
         int ok, scale = kc->scale;
         kc->scale = -1;
-        ok = cplx ? klu_z_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
-                        klu_z_rcond(sym, num, kc)
-                  : klu_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
-                        klu_rcond(sym, num, kc);
+        ok = cplx ? sh->klu.klu_z_refactor(d->Sp, d->Si, sh->Sx, sym, num,
+                                           kc) &&
+                        sh->klu.klu_z_rcond(sym, num, kc)
+                  : sh->klu.klu_refactor(d->Sp, d->Si, sh->Sx, sym, num, kc) &&
+                        sh->klu.klu_rcond(sym, num, kc);
         kc->scale = scale;
         /* The old pivots serve while the factors stay as well conditioned
          * as a fresh factorisation's, within SHIFT_REFACTOR_RCOND (both
@@ -574,7 +580,8 @@ void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
     for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
             sh->rhs[XR(k, a)] += s * mu[3 * k + a];
-    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
+    sh->klu.klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs,
+                      sh->common);
     solution_points(d, sh->rhs, 1, p, x + 2 * nq);
     tsi_shift_nodes_to_q(sh, p, x);
     for (int i = 0; i < nq; i++)
@@ -591,7 +598,8 @@ static void two_columns(tsi_shift *sh)
         cols[i] = rhs[2 * i];
         cols[nx + i] = rhs[2 * i + 1];
     }
-    klu_solve(sh->d->klu_symbolic, sh->numeric, nx, 2, cols, sh->common);
+    sh->klu.klu_solve(sh->d->klu_symbolic, sh->numeric, nx, 2, cols,
+                      sh->common);
     for (int i = 0; i < nx; i++) {
         rhs[2 * i] = cols[i];
         rhs[2 * i + 1] = cols[nx + i];
@@ -626,7 +634,8 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
             rhs[2 * XR(k, a) + 1] += cimag(v);
         }
     if (sh->is_complex) {
-        klu_z_solve(d->klu_symbolic, sh->numeric, d->nx, 1, rhs, sh->common);
+        sh->klu.klu_z_solve(d->klu_symbolic, sh->numeric, d->nx, 1, rhs,
+                            sh->common);
     } else {
         /* Real factors: the real and imaginary parts as two right-hand
          * sides. */
@@ -660,7 +669,8 @@ static void inf_solve(tsi_shift *sh, const double *f, const double *rhs_t,
         sh->rhs[XT(l)] = rhs_t ? rhs_t[l] : 0.0;
     for (int j = 0; j < d->nc; j++)
         sh->rhs[XC(j)] = hc[j];
-    klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs, sh->common);
+    sh->klu.klu_solve(d->klu_symbolic, sh->numeric, d->nx, 1, sh->rhs,
+                      sh->common);
     double *p = sh->u1 + m;
     solution_points(d, sh->rhs, 1, p, cd);
     tsi_shift_nodes_to_q(sh, p, qdd);
@@ -828,7 +838,8 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
         rhs[2 * XT(l) + 1] = cimag(gd);
     }
     if (sh->is_complex)
-        klu_z_solve(d->klu_symbolic, sh->numeric, nx, 1, rhs, sh->common);
+        sh->klu.klu_z_solve(d->klu_symbolic, sh->numeric, nx, 1, rhs,
+                            sh->common);
     else
         two_columns(sh);
     for (int c = 0; c < 3; c++)
@@ -900,8 +911,8 @@ void tsi_shift_tsolve(tsi_shift *sh, double complex *w)
     const ts_descriptor *d = sh->d;
     int nx = d->nx;
     if (sh->is_complex) {
-        klu_z_tsolve(d->klu_symbolic, sh->numeric, nx, 1, (double *)w, 0,
-                     sh->common);
+        sh->klu.klu_z_tsolve(d->klu_symbolic, sh->numeric, nx, 1, (double *)w,
+                             0, sh->common);
         return;
     }
     double *cols = sh->cols;
@@ -909,7 +920,7 @@ void tsi_shift_tsolve(tsi_shift *sh, double complex *w)
         cols[i] = creal(w[i]);
         cols[nx + i] = cimag(w[i]);
     }
-    klu_tsolve(d->klu_symbolic, sh->numeric, nx, 2, cols, sh->common);
+    sh->klu.klu_tsolve(d->klu_symbolic, sh->numeric, nx, 2, cols, sh->common);
     for (int i = 0; i < nx; i++)
         w[i] = cols[i] + I * cols[nx + i];
 }

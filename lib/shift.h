@@ -41,10 +41,13 @@
 #include <complex.h>
 
 #include "descriptor.h"
+#include "lazylib.h"
 #include "towstab/error.h"
 #include "towstab/linearize.h"
 
 typedef struct tsi_shift {
+    tsi_lapack la;         /* the dense backend's LAPACK */
+    tsi_klu klu;           /* the sparse backend's KLU */
     const ts_linear *lin;
     const ts_descriptor *d;
     const ts_system *sys;

@@ -65,7 +65,7 @@
 #include "esdirk.h"
 #include "expm.h"
 #include "kernel_impl.h"
-#include "lapack.h"
+#include "lazylib.h"
 #include "shift.h"
 
 /* Interpolation error constant of the cubic input hold (see above). */
@@ -1510,6 +1510,7 @@ typedef struct lin_sim {
     double *v;         /* [6 m]: four input samples, two for df/dt */
     double *p;         /* [4 m]: the cubic's coefficients */
     long nfev;
+    tsi_lapack la;     /* BLAS's dgemv */
 } lin_sim;
 
 /* 1 when a signal of ex drives a tow rotation (tow.roll ...). */
@@ -1589,8 +1590,9 @@ static int hold_compute(const ts_linear *lin, int m, double h, lin_hold *H,
 
 /* One exact step of length h: z <- Phi z + G p, the cubic through
  * v0..v3 (values at 0, h/3, 2h/3, h; v[k m + j]), p[4 m] scratch. */
-static void hold_step(const lin_hold *H, int n, int m, const double *v,
-                      double *p, double *z, double *tmp)
+static void hold_step(const tsi_lapack *la, const lin_hold *H, int n,
+                      int m, const double *v, double *p, double *z,
+                      double *tmp)
 {
     const int m4 = 4 * m, one = 1;
     double h = H->h;
@@ -1606,8 +1608,8 @@ static void hold_step(const lin_hold *H, int n, int m, const double *v,
         p[3 * m + j] = 6.0 * 27.0 * c3 / (h * h * h);
     }
     const double a1 = 1.0, b0 = 0.0;
-    dgemv_("N", &n, &n, &a1, H->Phi, &n, z, &one, &b0, tmp, &one, 1);
-    dgemv_("N", &n, &m4, &a1, H->G, &n, p, &one, &a1, tmp, &one, 1);
+    la->dgemv_("N", &n, &n, &a1, H->Phi, &n, z, &one, &b0, tmp, &one, 1);
+    la->dgemv_("N", &n, &m4, &a1, H->G, &n, p, &one, &a1, tmp, &one, 1);
     memcpy(z, tmp, (size_t)n * sizeof(double));
 }
 
@@ -1619,8 +1621,8 @@ static int lin_rhs(double t, const double z[], double dz[], void *params)
     double *v = L->v + 4 * m;
     L->nfev++;
     lin_input(L, t, v);
-    dgemv_("N", &n, &n, &a1, L->lin->A, &n, z, &one, &b0, dz, &one, 1);
-    dgemv_("N", &n, &m, &a1, L->lin->B, &n, v, &one, &a1, dz, &one, 1);
+    L->la.dgemv_("N", &n, &n, &a1, L->lin->A, &n, z, &one, &b0, dz, &one, 1);
+    L->la.dgemv_("N", &n, &m, &a1, L->lin->B, &n, v, &one, &a1, dz, &one, 1);
     return GSL_SUCCESS;
 }
 
@@ -1642,7 +1644,7 @@ static int lin_jac(double t, const double z[], double *dfdy, double dfdt[],
     for (int j = 0; j < m; j++)
         vp[j] = (vp[j] - vm[j]) / (2 * dt);
     const double a1 = 1.0, b0 = 0.0;
-    dgemv_("N", &n, &m, &a1, L->lin->B, &n, vp, &one, &b0, dfdt, &one, 1);
+    L->la.dgemv_("N", &n, &m, &a1, L->lin->B, &n, vp, &one, &b0, dfdt, &one, 1);
     return GSL_SUCCESS;
 }
 
@@ -1741,8 +1743,10 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
         const int no = lin->noutput, m = L->m, one = 1;
         const double a1 = 1.0;
         memcpy(out, lin->v0, (size_t)no * sizeof(double));
-        dgemv_("N", &no, &n, &a1, lin->Vy, &no, z, &one, &a1, out, &one, 1);
-        dgemv_("N", &no, &m, &a1, lin->Vu, &no, dv, &one, &a1, out, &one, 1);
+        L->la.dgemv_("N", &no, &n, &a1, lin->Vy, &no, z, &one, &a1, out, &one,
+                     1);
+        L->la.dgemv_("N", &no, &m, &a1, lin->Vu, &no, dv, &one, &a1, out, &one,
+                     1);
     }
     h->nsamples++;
     return TS_OK;
@@ -1800,7 +1804,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         H[c].G = malloc(sn * 4 * (size_t)m * sizeof(double));
     }
     lin_sim L = {lin,  ex,   n,           m, in_idx, manoeuvre,
-                 base, tmp,  vbuf, vbuf + 6 * m, 0};
+                 base, tmp,  vbuf, vbuf + 6 * m, 0, {0}};
     gsl_odeiv2_driver *drv = NULL;
     tsi_esdirk *sd = NULL;
     gsl_odeiv2_system gsys = {lin_rhs, lin_jac, sn, &L};
@@ -1810,6 +1814,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                      "%d states", n);
         goto done;
     }
+    if ((rc = tsi_lapack_open(&L.la, err)) != TS_OK)
+        goto done;
     if (z0)
         memcpy(z, z0, sn * sizeof(double));
     /* An impulsive start (ts_sim_start_state) to first order: the tow
@@ -1908,7 +1914,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                 double ts = t + (double)s * hs;
                 for (int j = 1; j <= 3; j++)
                     lin_input(&L, ts + j * hs / 3.0, v + j * m);
-                hold_step(Hc, n, m, v, L.p, z, tmp);
+                hold_step(&L.la, Hc, n, m, v, L.p, z, tmp);
                 memcpy(v, v + 3 * m, (size_t)m * sizeof(double));
                 L.nfev += 3;
                 stats.steps++;

@@ -12,6 +12,8 @@
 #   phase_deg; unknown input or output names exit 2 listing the valid ones;
 #   an empty or negative frequency range exits 2; an equilibrium that does
 #   not converge is not linearized (exit 1, no file).
+# start-up: LAPACK, BLAS, ARPACK, KLU and NLopt are loaded only by a run
+#   that uses them (LD_DEBUG=files).
 set -u
 if [ $# -ne 2 ]; then
     echo "usage: linear.sh TOWSTAB CHECK_JSON" >&2
@@ -286,6 +288,36 @@ for run in "modes $W --links 4" \
         fail "${run%% *} ($run): status $status, vehicle line $v m/s, header: $h"
     fi
 done
+
+# The numerical libraries are opened when a run first uses them
+# (lib/lazylib.h): the dynamic loader's list of the files it opens
+# (LD_DEBUG=files) names none of LAPACK, BLAS, ARPACK, KLU and NLopt for
+# --version, --help, a refused scene or a 20-link equilibrium solved by
+# shooting; modes with LAPACK loads LAPACK; modes with ARPACK loads ARPACK
+# and KLU (its shifts factor the sparse model).
+lazy_loaded() { grep -o 'file=[^ ]*\(liblapack\|libblas\|libopenblas\|libarpack\|libklu\|libnlopt\)[^ ]*' "$T/files" | sort -u | tr '\n' ' '; }
+for run in "--version" "--help" "equilibrium $T/absent.yaml" \
+           "equilibrium examples/kamman_ex1_submerged.yaml --links 20 --quiet"; do
+    # shellcheck disable=SC2086
+    LD_DEBUG=files "$TOWSTAB" $run >"$T/out" 2>"$T/files"
+    status=$?
+    want=0
+    [ "${run#equilibrium $T}" != "$run" ] && want=2
+    [ $status -eq $want ] && grep -q 'file=' "$T/files" && [ -z "$(lazy_loaded)" ] &&
+        pass "towstab $run (exit $status): none of LAPACK, BLAS, ARPACK, KLU, NLopt loaded" ||
+        fail "towstab $run (exit $status, want $want) loaded: $(lazy_loaded)"
+done
+LD_DEBUG=files "$TOWSTAB" modes examples/kamman_ex1_submerged.yaml --links 20 --eigen-method lapack --quiet >"$T/out" 2>"$T/files"
+status=$?
+[ $status -eq 0 ] && grep -q 'file=[^ ]*liblapack\.so\.3' "$T/files" &&
+    pass "modes --eigen-method lapack loads LAPACK: $(lazy_loaded)" ||
+    fail "modes --eigen-method lapack (exit $status) loaded: $(lazy_loaded)"
+LD_DEBUG=files "$TOWSTAB" modes examples/kamman_ex1_submerged.yaml --links 20 --eigen-method arpack --quiet >"$T/out" 2>"$T/files"
+status=$?
+[ $status -eq 0 ] && grep -q 'file=[^ ]*libarpack\.so\.2' "$T/files" &&
+    grep -q 'file=[^ ]*libklu\.so\.1' "$T/files" &&
+    pass "modes --eigen-method arpack loads ARPACK and KLU: $(lazy_loaded)" ||
+    fail "modes --eigen-method arpack (exit $status) loaded: $(lazy_loaded)"
 
 echo "$npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
