@@ -5,14 +5,13 @@
  * impossible configuration). Standard output and standard error are
  * checked when the command ends: a table that could not be written is a
  * failure too. The manual is doc/manual.md. */
-#define _GNU_SOURCE /* RTLD_DEFAULT */
-#include <dlfcn.h>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
+#define _POSIX_C_SOURCE 200809L /* setenv */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "cli.h"
 
@@ -65,17 +64,14 @@ static void usage(FILE *f)
  * vector operations (ARPACK's orthogonalisation, the error estimates'
  * products), where a second thread costs more in waking and spinning than
  * it saves; a large dense LAPACK eigen analysis may ask for more (doc/
- * performance.md). Looked up at run time, so that another BLAS does. */
+ * performance.md). LAPACK (OpenBLAS) is opened only when a run first uses
+ * it (lib/lazylib.h) and reads the variable then, as it starts: set here,
+ * before anything opens it, it starts no thread pool at all. Another
+ * BLAS ignores the variable. */
 static void blas_threads(void)
 {
-    if (getenv("OPENBLAS_NUM_THREADS") || getenv("GOTO_NUM_THREADS"))
-        return;
-    void *sym = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
-    if (sym) {
-        void (*set)(int);
-        memcpy(&set, &sym, sizeof set);
-        set(1);
-    }
+    if (!getenv("OPENBLAS_NUM_THREADS") && !getenv("GOTO_NUM_THREADS"))
+        setenv("OPENBLAS_NUM_THREADS", "1", 0);
 }
 
 /* glibc's allocator keeps freed memory for reuse up to 256 MB per
