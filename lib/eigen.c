@@ -144,6 +144,9 @@ typedef struct cand {
     double verr;          /* eigenvector error allowance, rad */
     int sweep;            /* found by the rightmost search, not among the
                              modes nearest the target */
+    double slack;         /* the search: how far a Ritz value of a loose
+                             run may lie from its eigenvalue (0 for the
+                             other runs), widening the repeats' match */
     int checked;          /* residual and error estimate computed */
     int neutral;          /* the lin->neutral it was recognised as, or -1 */
 } cand;
@@ -234,6 +237,7 @@ static cand *cand_new(cand_list *L, double complex lam, double cond,
     c->vcond = NAN;
     c->verr = NAN;
     c->sweep = 0;
+    c->slack = 0.0;
     c->checked = 0;
     c->neutral = -1;
     c->vec = L->n;
@@ -1012,8 +1016,8 @@ typedef struct arpack_stats {
  * double). */
 static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
                        int ncv, double tol, int maxiter, int partial,
-                       const eig_poll *pp, cand_list *L, arpack_stats *st,
-                       ts_err *err)
+                       const double complex *start, const eig_poll *pp,
+                       cand_list *L, arpack_stats *st, ts_err *err)
 {
     int n = lin->nstate, rc;
     tsi_arpack ar;
@@ -1040,6 +1044,10 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
         goto out;
     }
     int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
+    if (start) {
+        memcpy(resid, start, (size_t)n * szc);
+        info = 1; /* ARPACK starts from resid */
+    }
     iparam[0] = 1;
     iparam[2] = maxiter;
     iparam[6] = 3;
@@ -1135,8 +1143,8 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
     arpack_stats st = {0, 0, 0, 0};
     eig_poll pp = {o, "eigensolve", 0, NAN};
     rc = arpack_near(lin, I * 2.0 * M_PI * o->target_hz, nev, ncv,
-                     modes_tol(lin, o), o->arpack_max_iter, 0, &pp, L, &st,
-                     err);
+                     modes_tol(lin, o), o->arpack_max_iter, 0, NULL, &pp, L,
+                     &st, err);
     e->arpack_iterations = st.iterations;
     e->arpack_ops = st.ops;
     e->arpack_nconv = st.nconv;
@@ -1171,6 +1179,24 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
                               own error makes the rightmost's bound 400 to
                               650 times larger, or that are dropped as not
                               converged (doc/performance.md) */
+#define SWEEP_GRID_TOL 1e-2 /* relative Ritz tolerance of the grid's runs
+                              (SWEEP_TOL at the band tops and in the
+                              climbs): they sample the band's damping. A
+                              Ritz value of theirs that may be among the
+                              2 SWEEP_CHECKED rightmost found has its own
+                              error measured, and unless that is below
+                              SWEEP_GRID_ACCEPT of the model's error term
+                              its run is redone at SWEEP_TOL
+                              (rightmost_search): the bounds stay those
+                              of runs at SWEEP_TOL */
+#define SWEEP_GRID_ACCEPT 0.01 /* a grid run's Ritz value whose own error
+                              (ritz_error) is below this fraction of its
+                              error estimate's term (dlambda) stands as it
+                              is; otherwise its run is redone */
+#define SWEEP_GRID_SAFETY 10.0 /* a Ritz value at tolerance tol of a run
+                              of radius r lies within SWEEP_GRID_SAFETY
+                              tol r of its eigenvalue (its error is about
+                              tol |lambda - sigma|, times its condition) */
 /* Two eigenvectors with |v1^H v2| above this (unit vectors) are one. */
 #define SWEEP_SAME_VECTOR 0.99
 
@@ -1247,9 +1273,16 @@ static void zigzag_freq(const ts_descriptor *d, int k, double *wt,
     *wa = ka > 0 && mn > 0 ? sqrt(2 * ka / mn) : 0.0;
 }
 
-static int cmp_double(const void *a, const void *b)
+/* A shift of the search: its frequency (rad/s), and whether a band top
+ * lies there (1) or it is a point of the grid between them (0). */
+typedef struct sweep_seed {
+    double w;
+    int top;
+} sweep_seed;
+
+static int cmp_seed(const void *a, const void *b)
 {
-    double x = *(const double *)a, y = *(const double *)b;
+    double x = ((const sweep_seed *)a)->w, y = ((const sweep_seed *)b)->w;
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
@@ -1269,8 +1302,9 @@ static int sweep_new(cand_list *L, int from, double complex sigma,
         const double complex *vi = L->v + (size_t)c->vec * n;
         for (int j = 0; j < i && c->sweep == 1; j++) {
             const cand *o = &L->c[j];
-            if (o->sweep == 2 ||
-                cabs(o->lam - c->lam) > CONJ_MATCH_RTOL * cabs(c->lam))
+            if (o->sweep == 2 || o->sweep == 4 ||
+                cabs(o->lam - c->lam) >
+                    CONJ_MATCH_RTOL * cabs(c->lam) + o->slack + c->slack)
                 continue;
             const double complex *vj = L->v + (size_t)o->vec * n;
             double complex dot = 0;
@@ -1290,48 +1324,93 @@ static int sweep_new(cand_list *L, int from, double complex sigma,
     return best;
 }
 
-/* One run of the search at sigma; best and radius as sweep_new. A shift
+/* One run of the search at sigma, at the relative Ritz tolerance `tol`
+ * (or arpack_tol when looser); best and radius as sweep_new. A shift
  * exactly on an eigenvalue is moved by 1e-9 of itself once. */
 static int sweep_run(const ts_linear *lin, const ts_eigen_opts *o,
-                     double complex sigma, int shift, int shifts,
+                     double complex sigma, double tol,
+                     const double complex *start, int shift, int shifts,
                      cand_list *L, arpack_stats *st, int *best,
                      double *radius, ts_err *err)
 {
     int from = L->n, ncv = SWEEP_NCV < lin->nstate ? SWEEP_NCV : lin->nstate;
     int nev = SWEEP_NEV < ncv - 2 ? SWEEP_NEV : ncv - 2;
-    double tol = fmax(o->arpack_tol, SWEEP_TOL);
+    tol = fmax(o->arpack_tol, tol);
     eig_poll pp = {o, "rightmost search", shift, shifts};
-    int rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, &pp, L,
-                         st, err);
+    int rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, start,
+                         &pp, L, st, err);
     if (rc == TS_ESINGULAR) {
         sigma *= 1.0 + 1e-9;
-        rc = arpack_near(lin, sigma, nev, ncv, tol,
-                         SWEEP_RESTARTS, 1, &pp, L, st, err);
+        rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, start,
+                         &pp, L, st, err);
     }
     if (rc != TS_OK)
         return rc;
+    if (tol > SWEEP_TOL) {
+        /* The Ritz values' slack, before the repeats are matched. */
+        double r = 0;
+        for (int i = from; i < L->n; i++)
+            r = fmax(r, cabs(L->c[i].lam - sigma));
+        for (int i = from; i < L->n; i++)
+            L->c[i].slack = SWEEP_GRID_SAFETY * tol * r;
+    }
     *best = sweep_new(L, from, sigma, radius);
     return TS_OK;
+}
+
+/* The real part that the SWEEP_CHECKED rightmost eigenvalues found by the
+ * search must reach to be checked, and twice as many as a margin for
+ * those a check drops: the (2 SWEEP_CHECKED)-th largest real part among
+ * L's search candidates from `from` on (-inf when there are fewer). */
+static double sweep_threshold(const cand_list *L, int from)
+{
+    double top[2 * SWEEP_CHECKED];
+    int nt = 0;
+    for (int i = from; i < L->n; i++) {
+        if (L->c[i].sweep != 1)
+            continue;
+        double re = creal(L->c[i].lam);
+        int k;
+        if (nt < 2 * SWEEP_CHECKED)
+            k = nt++;
+        else if (re > top[nt - 1])
+            k = nt - 1;
+        else
+            continue;
+        top[k] = re;
+        for (; k > 0 && top[k] > top[k - 1]; k--) {
+            double t = top[k];
+            top[k] = top[k - 1];
+            top[k - 1] = t;
+        }
+    }
+    return nt == 2 * SWEEP_CHECKED ? top[nt - 1] : -INFINITY;
 }
 
 /* The rightmost search: shifts i w at the local band tops of every cable
  * (zigzag_freq: transverse, and axial for elastic cables) and on a grid of
  * ratio SWEEP_RATIO from the highest frequency among the modes already
  * found to the highest band top, the discretisation's top frequency; at
- * each, the SWEEP_NEV eigenvalues nearest. Then the SWEEP_CLIMBS runs with
- * the largest real parts climb: while the rightmost eigenvalue a run found
- * lies in the outer half of its disc, the next shift is at its frequency.
- * Adds the eigenvalues found to L (sweep = 1, repeats 2). */
+ * each, the SWEEP_NEV eigenvalues nearest (at SWEEP_GRID_TOL on the grid,
+ * SWEEP_TOL at the band tops; a grid run that holds a candidate for the
+ * checked rightmost eigenvalues is run again at SWEEP_TOL). Then the
+ * SWEEP_CLIMBS runs with the largest real parts climb: while the
+ * rightmost eigenvalue a run found lies in the outer half of its disc,
+ * the next shift is at its frequency. Adds the eigenvalues found to L
+ * (sweep = 1, repeats and a rerun grid run's first values 2). */
 static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                             const ts_eigen_opts *o, ts_eigen *e, cand_list *L,
                             ts_err *err)
 {
     const ts_system *sys = d->sys;
     int nc = sys->ncables;
-    double *top = calloc(2 * (size_t)nc + 64, sizeof(double));
-    if (!top)
+    double *top = calloc(2 * (size_t)nc, sizeof(double));
+    sweep_seed *seed = calloc(64, sizeof *seed);
+    if (!top || !seed) {
+        free(top);
+        free(seed);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
-    double *seed = top + 2 * nc;
+    }
     for (int k = 1; k < d->nn; k++) {
         double wt, wa;
         zigzag_freq(d, k, &wt, &wa);
@@ -1346,34 +1425,43 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         wlo = fmax(wlo, cimag(L->c[i].lam));
     e->top_hz = wtop / (2 * M_PI);
     int ns = 0;
-    for (int i = 0; i < 2 * nc; i++)
+    for (int i = 0; i < 2 * nc && ns < 32; i++)
         if (top[i] > 0)
-            seed[ns++] = top[i];
+            seed[ns++] = (sweep_seed){top[i], 1};
     if (!(wlo > 0))
         wlo = wtop / 1024;
     for (double w = wlo * SWEEP_RATIO; w < wtop && ns < 62; w *= SWEEP_RATIO)
-        seed[ns++] = w;
-    qsort(seed, (size_t)ns, sizeof(double), cmp_double);
+        seed[ns++] = (sweep_seed){w, 0};
+    qsort(seed, (size_t)ns, sizeof *seed, cmp_seed);
     int nu = 0;
-    for (int i = 0; i < ns; i++)
-        if (nu == 0 || seed[i] > seed[nu - 1] * (1 + SWEEP_SEED_RTOL))
+    for (int i = 0; i < ns; i++) {
+        if (nu == 0 || seed[i].w > seed[nu - 1].w * (1 + SWEEP_SEED_RTOL))
             seed[nu++] = seed[i];
+        else
+            seed[nu - 1].top |= seed[i].top; /* a band top: SWEEP_TOL */
+    }
     /* Room for every run's eigenvalues at once: the vectors are tens of
      * MB, and each growth copies them all. */
     if (cand_grow(L, (nu + SWEEP_CLIMBS * SWEEP_STEPS) * (SWEEP_NEV + 1)) !=
         TS_OK) {
         free(top);
+        free(seed);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
     arpack_stats st = {0, 0, 0, 0};
-    int rc = TS_OK, runs = 0;
+    int rc = TS_OK, runs = 0, first = L->n;
+    /* The grid's runs are loose only where each Ritz value's own error
+     * can be measured (the sparse model with its error estimate). */
+    double grid_tol = pencil_ritz(lin) ? SWEEP_GRID_TOL : SWEEP_TOL;
     double run_re[64], run_w[64], run_r[64];
-    int run_best[64];
+    int run_best[64], run_from[64], run_to[64], run_loose[64];
     for (int i = 0; i < nu && rc == TS_OK; i++) {
-        int best;
+        int best, from = L->n;
         double r;
-        rc = sweep_run(lin, o, I * seed[i], i, nu + SWEEP_CLIMBS * SWEEP_STEPS,
-                       L, &st, &best, &r, err);
+        rc = sweep_run(lin, o, I * seed[i].w,
+                       seed[i].top ? SWEEP_TOL : grid_tol, NULL, i,
+                       nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &best, &r,
+                       err);
         if (rc == TS_ECONV) {
             /* A run that did not converge leaves a gap, counted; it does
              * not make the analysis fail. */
@@ -1385,11 +1473,100 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         if (rc == TS_OK && best >= 0) {
             run_best[runs] = best;
             run_re[runs] = creal(L->c[best].lam);
-            run_w[runs] = seed[i];
+            run_w[runs] = seed[i].w;
             run_r[runs] = r;
+            run_from[runs] = from;
+            run_to[runs] = L->n;
+            run_loose[runs] = !seed[i].top;
             runs++;
         }
     }
+    /* A grid run's Ritz value that may be among the checked rightmost (its
+     * real part, with its slack, reaching the 2 SWEEP_CHECKED-th largest
+     * found) has its own error measured; unless that is negligible, the
+     * run is redone at SWEEP_TOL in its place, so that the rightmost
+     * eigenvalues' bounds are those of runs at SWEEP_TOL. Each run is
+     * redone at most once. */
+    tsi_shift es = {0};
+    double complex *start = malloc((size_t)L->nstate * sizeof *start);
+    if (!start)
+        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    for (int pass = 0; pass < runs && rc == TS_OK; pass++) {
+        double thr = sweep_threshold(L, first);
+        int redo = -1;
+        for (int j = 0; j < runs && redo < 0 && rc == TS_OK; j++)
+            for (int i = run_from[j]; run_loose[j] && i < run_to[j]; i++) {
+                cand *c = &L->c[i];
+                if (c->sweep != 1 || c->slack == 0 ||
+                    creal(c->lam) + c->slack < thr)
+                    continue;
+                /* Its own error decides: small against the model's
+                 * error, the value serves as a run at SWEEP_TOL would. */
+                double dlam, ritz;
+                rc = tsi_shift_eig_error(&es, lin, c->lam,
+                                         L->v + (size_t)c->vec * L->nstate,
+                                         &dlam, &ritz, err);
+                if (rc != TS_OK)
+                    break;
+                if (ritz <= SWEEP_GRID_ACCEPT * dlam) {
+                    c->slack = 0.0;
+                    continue;
+                }
+                redo = j;
+                break;
+            }
+        if (rc != TS_OK)
+            break;
+        if (redo < 0)
+            break;
+        /* The rerun starts from the sum of the run's Ritz vectors, each
+         * of unit length: near the eigenvectors it is to find. */
+        int nst = L->nstate;
+        memset(start, 0, (size_t)nst * sizeof *start);
+        for (int i = run_from[redo]; i < run_to[redo]; i++) {
+            if (L->c[i].sweep != 1)
+                continue;
+            L->c[i].sweep = 4; /* superseded if the rerun converges */
+            const double complex *v = L->v + (size_t)L->c[i].vec * nst;
+            double nv = 0;
+            for (int k = 0; k < nst; k++)
+                nv += creal(v[k]) * creal(v[k]) + cimag(v[k]) * cimag(v[k]);
+            nv = nv > 0 ? 1.0 / sqrt(nv) : 0.0;
+            for (int k = 0; k < nst; k++)
+                start[k] += nv * v[k];
+        }
+        run_loose[redo] = 0;
+        if (cand_grow(L, SWEEP_NEV + 1) != TS_OK) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+            break;
+        }
+        int best, from = L->n;
+        double r;
+        rc = sweep_run(lin, o, I * run_w[redo], SWEEP_TOL,
+                       start, redo,
+                       nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &best, &r,
+                       err);
+        /* A rerun that did not converge leaves the grid's values. */
+        int keep_loose = rc == TS_ECONV;
+        for (int i = run_from[redo]; i < run_to[redo]; i++)
+            if (L->c[i].sweep == 4)
+                L->c[i].sweep = keep_loose ? 1 : 2;
+        if (keep_loose) {
+            ts_err_clear(err);
+            rc = TS_OK;
+            continue;
+        }
+        run_re[redo] = NAN;
+        if (rc == TS_OK && best >= 0) {
+            run_best[redo] = best;
+            run_re[redo] = creal(L->c[best].lam);
+            run_r[redo] = r;
+            run_from[redo] = from;
+            run_to[redo] = L->n;
+        }
+    }
+    tsi_shift_free(&es);
+    free(start);
     int shifts = nu;
     for (int climb = 0; climb < SWEEP_CLIMBS && rc == TS_OK; climb++) {
         /* The run with the largest real part not climbed yet. */
@@ -1415,7 +1592,7 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                 break;
             w = cimag(lb);
             int nb;
-            rc = sweep_run(lin, o, I * w, shifts,
+            rc = sweep_run(lin, o, I * w, SWEEP_TOL, NULL, shifts,
                            nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &nb, &r,
                            err);
             shifts++;
@@ -1433,6 +1610,7 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         }
     }
     free(top);
+    free(seed);
     e->sweep_shifts = shifts;
     e->arpack_iterations += st.iterations;
     e->arpack_ops += st.ops;
