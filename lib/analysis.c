@@ -500,7 +500,9 @@ static int point_node(const ts_system *sys, int i)
  * to itself), into v[3 npoints + 1] (allocated by values_alloc: NAN
  * values and estimates). Solver error: EQ_NOISE_FACTOR times the
  * relative residual (at least EQ_NOISE_MIN_REL) of the length or the
- * largest force. eq may be NULL or not converged: names only. */
+ * largest force, for the points at least the solver's shape error
+ * (doc/equilibrium.md, "How far to trust it"). eq may be NULL or not
+ * converged: names only. */
 static void eq_values_into(const ts_system *sys, const ts_equilibrium *eq,
                            ts_value *v0)
 {
@@ -527,11 +529,17 @@ static void eq_values_into(const ts_system *sys, const ts_equilibrium *eq,
     if (!eq || !eq->converged)
         return;
     double rel = fmax(eq->residual, EQ_NOISE_MIN_REL);
+    /* A small residual is not a small error when the problem is
+     * ill-conditioned: the solver's first-order estimate of how far the
+     * nodes are from the solution (shape_error) bounds it from below. */
+    double pos_err = EQ_NOISE_FACTOR * rel * L;
+    if (eq->shape_error > pos_err)
+        pos_err = eq->shape_error;
     for (int i = 0; i < np; i++) {
         int node = point_node(sys, i);
         for (int j = 0; j < 3; j++) {
             v0[3 * i + j].value = eq->positions[3 * node + j];
-            v0[3 * i + j].error.solver = EQ_NOISE_FACTOR * rel * L;
+            v0[3 * i + j].error.solver = pos_err;
         }
     }
     v0[3 * np].value = eq->top_tension;

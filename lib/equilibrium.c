@@ -1631,24 +1631,46 @@ static int vshoot_layout(vshoot *s, const ts_kernel *k)
     return i;
 }
 
-/* With a towing vehicle, the next outer Newton step of its steady
- * motion's two unknowns at the solution z (a PI speed controller's:
- * its integral term's), into eq->motion_step: their solver error to
- * first order, as Newton's newton_health gives it. One outer Jacobian,
- * nz marches. Left NaN when it cannot be formed. */
-static void vshoot_motion_step(vshoot *s, double *z)
+/* How far to trust the solution z of the outer problem, with the vehicles
+ * still attached to the march (doc/equilibrium.md, "How far to trust
+ * it"). One outer Jacobian J at z (nz or 2 nz marches) and its LU give:
+ *  - with a towing vehicle, the next outer Newton step of its steady
+ *    motion's two unknowns (a PI speed controller's: its integral
+ *    term's) into eq->motion_step: their solver error to first order, as
+ *    Newton's newton_health gives it;
+ *  - eq->condition: J's 1-norm condition (exact: J is small) times the
+ *    march's (tsi_march_condition, its extra marches run with the
+ *    vehicles attached), the condition of the two problems nested;
+ *  - eq->shape_error: how far the next outer Newton step moves the
+ *    nodes (one march at z - J^-1 r, the largest node displacement) plus
+ *    the march's own shape error.
+ * Leaves s->y, s->f and the march at z. Each part stays NaN when it
+ * cannot be formed. */
+static void vshoot_health(vshoot *s, double *z)
 {
     size_t nz = (size_t)s->nz;
-    gsl_matrix *J = gsl_matrix_alloc(nz, nz);
+    const ts_system *sys = ts_kernel_system(s->k);
+    size_t np = 3 * (size_t)sys->nnodes, nl = (size_t)sys->nlinks;
+    gsl_matrix *J = gsl_matrix_alloc(nz, nz), *Ji = gsl_matrix_alloc(nz, nz);
     gsl_permutation *p = gsl_permutation_alloc(nz);
     gsl_vector *r = gsl_vector_alloc(nz), *dz = gsl_vector_alloc(nz);
+    double *pos = malloc((np + 2 * nz) * sizeof(double));
     gsl_vector_view zv = gsl_vector_view_array(z, nz);
-    int sign = 0;
-    if (J && p && r && dz &&
-        vshoot_fdf(&zv.vector, s, r, J) == GSL_SUCCESS &&
-        gsl_linalg_LU_decomp(J, p, &sign) == GSL_SUCCESS &&
-        gsl_linalg_LU_solve(J, p, r, dz) == GSL_SUCCESS) {
-        const ts_system *sys = ts_kernel_system(s->k);
+    int sign = 0, ok = J && Ji && p && r && dz && pos &&
+                       vshoot_fdf(&zv.vector, s, r, J) == GSL_SUCCESS;
+    double outer_cond = NAN, step = NAN;
+    if (ok) {
+        /* The march at z: every further march starts from it. */
+        memcpy(s->xsave, s->x, (size_t)s->nx * sizeof(double));
+        memcpy(s->nsave, tsi_march_directions(s->m), 3 * nl * sizeof(double));
+        memcpy(pos, ts_kernel_positions(s->k), np * sizeof(double));
+        double anorm = tsi_norm1(J->data, s->nz);
+        ok = gsl_linalg_LU_decomp(J, p, &sign) == GSL_SUCCESS &&
+             gsl_linalg_LU_solve(J, p, r, dz) == GSL_SUCCESS;
+        if (ok && gsl_linalg_LU_invert(J, p, Ji) == GSL_SUCCESS)
+            outer_cond = anorm * tsi_norm1(Ji->data, s->nz);
+    }
+    if (ok && s->zsp >= 0) {
         int zs = ts_kernel_speed_integrator(s->k), nq = ts_kernel_nq(s->k);
         s->eq->motion_step[0] =
             fabs(gsl_vector_get(dz, (size_t)s->zsp)) * s->zscale[s->zsp];
@@ -1660,10 +1682,34 @@ static void vshoot_motion_step(vshoot *s, double *z)
                     sys->bodies[sys->tow.vehicle].vehicle->propulsion.ki *
                     fabs(gsl_vector_get(dz, (size_t)i)) * s->zscale[i];
     }
+    if (ok) {
+        /* The nodes after the next outer Newton step, then back to z
+         * (from the march at z, so that z's state is as solved). */
+        double *zt = pos + np, *rt = zt + nz;
+        for (size_t i = 0; i < nz; i++)
+            zt[i] = z[i] - gsl_vector_get(dz, i);
+        vshoot_restart(s, 1);
+        if (vshoot_eval(s, zt, rt) == TS_OK) {
+            const double *q = ts_kernel_positions(s->k);
+            step = 0.0;
+            for (size_t i = 0; i < np; i++)
+                step = fmax(step, fabs(q[i] - pos[i]));
+        }
+        vshoot_restart(s, 1);
+        ok = vshoot_eval(s, z, rt) == TS_OK;
+    }
+    double mc = NAN, mshape = NAN;
+    if (ok && tsi_march_condition(s->m, &mc, &mshape,
+                                  &s->eq->evaluations) == TS_OK) {
+        s->eq->condition = outer_cond * mc;
+        s->eq->shape_error = step + mshape;
+    }
     gsl_matrix_free(J);
+    gsl_matrix_free(Ji);
     gsl_permutation_free(p);
     gsl_vector_free(r);
     gsl_vector_free(dz);
+    free(pos);
 }
 
 /* A speed controller without integral gain holds its set speed through
@@ -1822,8 +1868,8 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
             eq->continuation_steps++;
         }
     }
-    if (rc == TS_OK && s.zsp >= 0)
-        vshoot_motion_step(&s, z);
+    if (rc == TS_OK)
+        vshoot_health(&s, z);
     if (rc != TS_OK && rc != TS_ENOMEM)
         rc = ts_fail(err, TS_ECONV, "equilibrium: shooting with vehicles "
                      "did not converge (%d outer iterations)%s%s",
@@ -1862,7 +1908,8 @@ out:
 
 /* Record the shooting result in y (*rc: record's code) and accept it
  * when the kernel's force and controller residuals meet tol: then eq is
- * shooting's, with the march's condition, and the return 1. */
+ * shooting's, with the march's condition (m non-NULL; with vehicles
+ * vshoot_health has set it), and the return 1. */
 static int shooting_accept(ts_kernel *k, tsi_march *m, const double *y,
                            ts_equilibrium *eq, double *dydt, double tol,
                            int *rc)
@@ -1872,8 +1919,9 @@ static int shooting_accept(ts_kernel *k, tsi_march *m, const double *y,
         return 0;
     eq->method = TS_EQ_SHOOTING;
     eq->converged = 1;
-    tsi_march_condition(m, &eq->condition, &eq->shape_error,
-                        &eq->evaluations);
+    if (m)
+        tsi_march_condition(m, &eq->condition, &eq->shape_error,
+                            &eq->evaluations);
     return 1;
 }
 
@@ -2016,7 +2064,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
         ts_kernel_set_steady(k, 1);
         rc = solve_vehicle_shooting(k, m, &frame, &o, eq, y, dydt, dvec, att,
                                     &serr);
-        if (rc == TS_OK && shooting_accept(k, m, y, eq, dydt, o.tol, &rc))
+        if (rc == TS_OK &&
+            shooting_accept(k, NULL, y, eq, dydt, o.tol, &rc))
             goto out;
         if (o.method == TS_EQ_SHOOTING || rc == TS_ENOMEM) {
             rc = shooting_refuse(rc, &serr, eq, o.tol, err);

@@ -269,9 +269,7 @@ static int fd_jacobian(tsi_march *m, const ts_frame *f, double x[],
     return rc;
 }
 
-/* The 1-norm (largest column sum of magnitudes) of the row-major n x n
- * matrix a. */
-static double col_norm1(const double *a, int n)
+double tsi_norm1(const double *a, int n)
 {
     double big = 0.0;
     for (int j = 0; j < n; j++) {
@@ -335,7 +333,7 @@ int tsi_march_condition(tsi_march *m, double *condition, double *shape_error,
     if (info == 0 && gsl_linalg_LU_invert(lu, perm, inv) != GSL_SUCCESS)
         info = -1;
     if (info == 0) {
-        double anorm = col_norm1(m->jlast, n), inorm = col_norm1(inv->data, n);
+        double anorm = tsi_norm1(m->jlast, n), inorm = tsi_norm1(inv->data, n);
         *condition = anorm * inorm;
         /* Free-end positions move by about |J^-1| |mismatch|, at the
          * solution (the perturbed marches changed m->mismatch). */

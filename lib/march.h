@@ -92,6 +92,10 @@ void tsi_march_strains(const tsi_march *m, double *e);
 int tsi_march_condition(tsi_march *m, double *condition, double *shape_error,
                         long *marches);
 
+/* The 1-norm (largest column sum of magnitudes) of the row-major n x n
+ * matrix a. */
+double tsi_norm1(const double *a, int n);
+
 /* Largest |mismatch| of the last march, m. */
 double tsi_march_mismatch(const tsi_march *m);
 

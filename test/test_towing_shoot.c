@@ -34,6 +34,22 @@
  * forward-difference outer Jacobian led there, 5.6e-6 rad of yaw) fails,
  * and a thousand times above the largest difference seen (about 1e-10
  * of the scale, survey_ship's positions and tensions).
+ *
+ * Error bars. On every scene with vehicles that shooting answers (the
+ * four above, examples/aurora_towfish.yaml, kamman_ex1_vehicle.yaml and
+ * test/scenes/dolphin.yaml: towed vehicles), shooting at a residual of
+ * LOOSE_TOL and Newton at LOOSE_TOL and at SOLVE_TOL must differ, at
+ * every node and in the top tension, by at most the sum of their reported
+ * solver errors (ts_result_equilibrium_values): neither solution is
+ * exact, so the sum is what bounds their difference. The loose tolerance
+ * makes Newton's error measurable (2.2e-7 m on dolphin_waypoints);
+ * shooting polishes past it. And shooting's condition (the outer
+ * problem's times the march's) must be within CONDITION_FACTOR of
+ * Newton's: the two are conditions of different Jacobians in differently
+ * scaled unknowns (on a plain cable, kamman_ex1_submerged, Newton's is
+ * 2.4e3 where the march's is exactly right at 1), so only their order
+ * can agree; the largest ratio seen is 2.7e4 (survey_ship), and the
+ * march's condition alone (1) fails the check on three scenes.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,12 +57,15 @@
 
 #include "tcheck.h"
 #include "tscene.h"
+#include "towstab/analysis.h"
 #include "towstab/system.h"
 
 /* The comparison's tolerance, relative to each quantity's scale (see
  * above). */
 #define AGREE_RTOL 1e-7
 #define SOLVE_TOL 1e-12
+#define LOOSE_TOL 1e-8
+#define CONDITION_FACTOR 1e5
 
 typedef struct solved {
     ts_kernel *k;
@@ -54,20 +73,26 @@ typedef struct solved {
     int rc;
 } solved;
 
-static solved solve(const ts_system *sys, ts_eq_method method)
+static solved solve_at(const ts_system *sys, ts_eq_method method,
+                       double tol)
 {
     solved s = {0};
     ts_err err = {0};
     ts_equilibrium_opts o;
     ts_equilibrium_opts_default(&o);
     o.method = method;
-    o.tol = SOLVE_TOL;
+    o.tol = tol;
     s.k = ts_kernel_alloc(sys, &err);
     s.eq = s.k ? ts_equilibrium_alloc(sys, &err) : NULL;
     s.rc = s.eq ? ts_equilibrium_solve(s.k, &o, s.eq, &err) : TS_ENOMEM;
     if (s.rc != TS_OK)
         printf("  %s: %s\n", ts_eq_method_name(method), err.msg);
     return s;
+}
+
+static solved solve(const ts_system *sys, ts_eq_method method)
+{
+    return solve_at(sys, method, SOLVE_TOL);
 }
 
 static void solved_free(solved *s)
@@ -150,6 +175,71 @@ static void compare(const char *name, const ts_system *sys, double *turn)
     solved_free(&b);
 }
 
+/* The reported solver error of the points' positions and of the top
+ * tension of eq (ts_result_equilibrium_values: every point carries the
+ * same position error), into e[2]. */
+static void solver_errors(const ts_system *sys, ts_equilibrium *eq,
+                          double e[2])
+{
+    ts_result r;
+    memset(&r, 0, sizeof r);
+    r.sys = (ts_system *)sys;
+    r.eq = eq;
+    ts_value *v = NULL;
+    int n = 0;
+    ts_err err = {0};
+    e[0] = e[1] = NAN;
+    if (ts_result_equilibrium_values(&r, &v, &n, &err) == TS_OK && n >= 4) {
+        e[0] = v[0].error.solver;
+        for (int i = 0; i < n; i++)
+            if (!strcmp(v[i].name, "top_tension"))
+                e[1] = v[i].error.solver;
+    }
+    free(v);
+}
+
+/* Error bars (see the header): shooting at LOOSE_TOL against Newton at
+ * LOOSE_TOL and at SOLVE_TOL; every node's position and the top tension
+ * must differ by at most the sum of the two reported solver errors, and
+ * shooting's condition must be within CONDITION_FACTOR of Newton's at
+ * SOLVE_TOL. */
+static void error_bars(const char *name, const ts_system *sys)
+{
+    solved a = solve_at(sys, TS_EQ_AUTO, LOOSE_TOL);
+    solved b[2] = {solve_at(sys, TS_EQ_NEWTON, LOOSE_TOL),
+                   solve_at(sys, TS_EQ_NEWTON, SOLVE_TOL)};
+    if (CHECK(a.rc == TS_OK && b[0].rc == TS_OK && b[1].rc == TS_OK &&
+                  a.eq->converged && b[0].eq->converged &&
+                  b[1].eq->converged && a.eq->method == TS_EQ_SHOOTING,
+              "%s (%d links): shooting at %.0e, newton at %.0e and %.0e "
+              "converge",
+              name, sys->nlinks, LOOSE_TOL, LOOSE_TOL, SOLVE_TOL)) {
+        double es[2];
+        solver_errors(sys, a.eq, es);
+        for (int t = 0; t < 2; t++) {
+            const ts_equilibrium *n = b[t].eq;
+            double en[2];
+            solver_errors(sys, b[t].eq, en);
+            double dr = largest_diff(a.eq->positions, n->positions,
+                                     3 * sys->nnodes);
+            double dt = fabs(a.eq->top_tension - n->top_tension);
+            CHECK(dr <= es[0] + en[0] && dt <= es[1] + en[1],
+                  "%s: shooting's and Newton's (at %.0e) solver errors "
+                  "bound their difference: positions %.3g m <= %.3g + "
+                  "%.3g, top tension %.3g N <= %.3g + %.3g",
+                  name, n->tolerance, dr, es[0], en[0], dt, es[1], en[1]);
+        }
+        double cs = a.eq->condition, cn = b[1].eq->condition;
+        CHECK(cs >= cn / CONDITION_FACTOR && cs <= cn * CONDITION_FACTOR,
+              "%s: shooting's condition %.3g within %.0e of Newton's %.3g "
+              "(ratio %.3g)",
+              name, cs, CONDITION_FACTOR, cn, cn / cs);
+    }
+    solved_free(&a);
+    solved_free(&b[0]);
+    solved_free(&b[1]);
+}
+
 static ts_scene *variant(const ts_units *u, const ts_scene *base, int n,
                          const char *const *keys, const char *const *vals)
 {
@@ -164,14 +254,21 @@ int main(void)
     ts_units *u = tscene_units();
     if (!u)
         return 1;
+    /* Every scene with vehicles that shooting answers; the first four
+     * have a towing vehicle. */
     const char *files[] = {"examples/dolphin_aurora.yaml",
                            "test/scenes/towing_sphere.yaml",
                            "test/scenes/dolphin_waypoints.yaml",
-                           "test/scenes/survey_ship.yaml"};
-    for (int f = 0; f < 4; f++) {
+                           "test/scenes/survey_ship.yaml",
+                           "examples/aurora_towfish.yaml",
+                           "examples/kamman_ex1_vehicle.yaml",
+                           "test/scenes/dolphin.yaml"};
+    for (int f = 0; f < 7; f++) {
         ts_scene *sc = tscene_load(u, files[f]);
-        if (sc)
+        if (sc && f < 4)
             compare(files[f], sc->system, NULL);
+        if (sc)
+            error_bars(files[f], sc->system);
         ts_scene_free(sc);
     }
 

@@ -80,10 +80,14 @@ typedef struct ts_equilibrium {
     double min_tension;   /* smallest link tension, N (< 0: compression) */
     double condition;     /* 1-norm condition number of the solver's last
                              Jacobian (shooting: d mismatch / d free-end
-                             positions; Newton: d q'' / d q); NaN if none */
+                             positions, with vehicles times that of the
+                             outer problem's; Newton: d q'' / d q); NaN
+                             if none */
     double shape_error;   /* node position error it implies, m: Newton
                              |J^-1 q''| times the cable length, shooting
-                             |J^-1| |mismatch|; NaN if none */
+                             |J^-1| |mismatch|, with vehicles plus the
+                             nodes' move over the next outer Newton step
+                             (doc/equilibrium.md); NaN if none */
     int nvehicles;
     double *attitudes;    /* [9 nvehicles] each vehicle's attitude, body to
                              M, row-major (ts_kernel_vehicle_body order) */
