@@ -14,7 +14,6 @@
 #include "jsonout.h"
 #include "towstab/analysis.h"
 #include "towstab/report.h"
-#include "towstab/report_time.h"
 
 /* ts_report_equilibrium_json; with defer (may be NULL: the arrays are
  * filled) its nodes and links left empty and listed in defer. NULL on
@@ -34,18 +33,6 @@ int tsi_report_dump_tree(const json_t *value, const tsi_json_defer *defer,
  * TS_OK, TS_ENOMEM or TS_EIO naming path. */
 int tsi_report_write_tree(const json_t *value, const tsi_json_defer *defer,
                           const char *path, ts_err *err);
-
-/* The keys of a time history's object (towstab/report_time.h), emitted
- * into an open object: ts_report_channels_json's ("t", "outputs"), those
- * ts_report_history_full adds ("nodes", "tensions", "energy",
- * "vehicle_outputs", "tow_force", "frame"), and ts_report_extremes_json's
- * ("max" ... "from_s"). */
-void tsi_report_channels_keys(tsi_json *w, const ts_system *sys,
-                              const ts_history *h, int n,
-                              const ts_output outs[]);
-void tsi_report_full_keys(tsi_json *w, const ts_system *sys,
-                          const ts_history *h);
-void tsi_report_extremes_keys(tsi_json *w, const ts_extremes *e);
 
 /* The result's document (ts_report_result_json, with the keys of extra
  * added last) to stream f: `indent` as tsi_json_open's (1: the command

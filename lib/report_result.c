@@ -11,6 +11,7 @@
 
 #include "outfile.h"
 #include "report_impl.h"
+#include "report_time_impl.h"
 
 #include "towstab/report.h"
 #include "towstab/report_converge.h"

@@ -15,6 +15,7 @@
 
 #include "outfile.h"
 #include "report_impl.h"
+#include "report_time_impl.h"
 #include "towstab/report.h"
 
 static json_t *num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
