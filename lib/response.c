@@ -33,6 +33,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "lazylib.h"
 #include "response_impl.h"
 #include "shift.h"
@@ -979,6 +983,127 @@ int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
     return rc;
 }
 
+static void set_point(ts_response *r, int i, double f, double complex g)
+{
+    r->freq_hz[i] = f;
+    r->re[i] = creal(g);
+    r->im[i] = cimag(g);
+    r->magnitude[i] = cabs(g);
+    r->phase_deg[i] = carg(g) * 180.0 / M_PI;
+}
+
+/* The sweep in chunks from this many links on (the sparse model): each
+ * chunk of consecutive frequencies factors afresh at its first and
+ * refactors from there (tsi_shift_refactor), so the chunks are
+ * independent and run on the linearization's threads (ts_linear.threads).
+ * Their number is fixed by the sweep alone, never by the threads, so the
+ * results are the same on any number of threads. Below, one chunk: every
+ * frequency refactors the previous one's factors. */
+#define RESP_CHUNK_LINKS 200
+#define RESP_CHUNKS 4          /* chunks of a long sweep */
+#define RESP_CHUNK_MIN 4       /* frequencies a chunk holds at least */
+
+static int resp_chunks(const ts_linear *lin, int npoints)
+{
+    if (!lin->desc || lin->nlinks < RESP_CHUNK_LINKS)
+        return 1;
+    int c = npoints / RESP_CHUNK_MIN;
+    return c < 1 ? 1 : (c > RESP_CHUNKS ? RESP_CHUNKS : c);
+}
+
+/* The frequencies of r in `chunks` chunks (resp_chunks), each with its
+ * own factors and work, on up to lin->threads threads. A chunk that fails
+ * stops at its failure; the others run on, so the error reported is that
+ * of the lowest frequency that failed, whatever the threads. A stop asked
+ * for through progress (called by the first thread only, with the count
+ * of frequencies done) ends every chunk at its next frequency. */
+static int sweep_chunks(const ts_system *sys, const ts_linear *lin,
+                        int input, const ts_output *out,
+                        const double freq_hz[], int npoints, int chunks,
+                        ts_progress_fn progress, void *data, ts_response *r,
+                        ts_err *err)
+{
+    int *crc = calloc((size_t)chunks, sizeof *crc);
+    int *cat = calloc((size_t)chunks, sizeof *cat);
+    ts_err *cerr = calloc((size_t)chunks, sizeof *cerr);
+    if (!crc || !cat || !cerr) {
+        free(crc);
+        free(cat);
+        free(cerr);
+        return ts_fail(err, TS_ENOMEM, "response: out of memory");
+    }
+    int nthreads = lin->threads > 1 ? lin->threads : 1;
+    if (nthreads > chunks)
+        nthreads = chunks;
+    int done = 0, stop = 0;
+#ifdef _OPENMP
+#pragma omp parallel for num_threads(nthreads) schedule(dynamic, 1)
+#endif
+    for (int c = 0; c < chunks; c++) {
+        int i0 = (int)((long)npoints * c / chunks);
+        int i1 = (int)((long)npoints * (c + 1) / chunks);
+        resp_ws w;
+        tsi_shift sh = {0};
+        cat[c] = npoints;
+        if (!ws_alloc(&w, lin, NULL, out)) {
+            crc[c] = ts_fail(&cerr[c], TS_ENOMEM, "response: out of memory");
+            cat[c] = i0;
+            i1 = i0;
+        }
+        for (int i = i0; i < i1; i++) {
+            int halt;
+#ifdef _OPENMP
+#pragma omp atomic read
+#endif
+            halt = stop;
+            if (halt)
+                break;
+            double complex g = 0;
+            int rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w,
+                             &sh, &g, &r->error[i], &cerr[c]);
+            set_point(r, i, freq_hz[i], g);
+            if (rc != TS_OK) {
+                crc[c] = rc;
+                cat[c] = i;
+                break;
+            }
+            int n;
+#ifdef _OPENMP
+#pragma omp atomic capture
+#endif
+            n = ++done;
+            int first = 1;
+#ifdef _OPENMP
+            first = omp_get_thread_num() == 0;
+#endif
+            ts_progress p = {"response", n, npoints, "frequencies"};
+            if (first && progress && progress(&p, data)) {
+#ifdef _OPENMP
+#pragma omp atomic write
+#endif
+                stop = n;
+            }
+        }
+        tsi_shift_free(&sh);
+        ws_free(&w);
+    }
+    int rc = TS_OK, at = npoints;
+    for (int c = 0; c < chunks; c++)
+        if (crc[c] != TS_OK && cat[c] < at) {
+            rc = crc[c];
+            at = cat[c];
+            if (err)
+                *err = cerr[c];
+        }
+    if (rc == TS_OK && stop)
+        rc = ts_fail(err, TS_ECANCEL, "response: stopped on request after "
+                     "%d of %d frequencies", stop, npoints);
+    free(crc);
+    free(cat);
+    free(cerr);
+    return rc;
+}
+
 int ts_response_compute(const ts_system *sys, const ts_linear *lin,
                         int input, const ts_output *out,
                         const double freq_hz[], int npoints,
@@ -1087,14 +1212,11 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
                      "steady input may drift them without bound", names);
         }
     }
-    for (int i = 0; i < npoints && rc == TS_OK; i++) {
+    int chunks = resp_chunks(lin, npoints);
+    for (int i = 0; i < npoints && rc == TS_OK && chunks == 1; i++) {
         rc = gain_at(sys, lin, input, out, 2 * M_PI * freq_hz[i], &w, &sh, &g,
                      &r->error[i], err);
-        r->freq_hz[i] = freq_hz[i];
-        r->re[i] = creal(g);
-        r->im[i] = cimag(g);
-        r->magnitude[i] = cabs(g);
-        r->phase_deg[i] = carg(g) * 180.0 / M_PI;
+        set_point(r, i, freq_hz[i], g);
         ts_progress p = {"response", i + 1.0, npoints, "frequencies"};
         if (rc == TS_OK && progress && progress(&p, data))
             rc = ts_fail(err, TS_ECANCEL, "response: stopped on request "
@@ -1103,6 +1225,9 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     }
     tsi_shift_free(&sh);
     ws_free(&w);
+    if (rc == TS_OK && chunks > 1)
+        rc = sweep_chunks(sys, lin, input, out, freq_hz, npoints, chunks,
+                          progress, data, r, err);
     if (rc != TS_OK) {
         ts_response_free(r);
         return rc;

@@ -40,6 +40,7 @@
 #include <string.h>
 
 #include "lapack.h"
+#include "response_impl.h"
 #include "tcheck.h"
 #include "tscene.h"
 #include "towstab/eigen.h"
@@ -833,6 +834,84 @@ static void test_vehicle_allowance(void)
     ts_scene_free(sc);
 }
 
+/* A long sweep runs in chunks on the linearization's threads (lib/
+ * response.c, resp_chunks): from 200 links on. The result must not depend
+ * on the threads, bit for bit, and each gain must equal the one factored
+ * afresh at its own frequency (ts_response_at) within the gain's error
+ * allowance (the chunks differ from a single pass only in where the
+ * factors are fresh, a rounding difference). A stop asked for through the
+ * progress callback ends the sweep with TS_ECANCEL. */
+static int stop_after(const ts_progress *p, void *data)
+{
+    return p->done >= *(const int *)data;
+}
+
+static void test_chunked_sweep(void)
+{
+    ts_err err = {0};
+    ts_scene *sc = tscene_load(units, "examples/kamman_ex1_submerged.yaml");
+    ts_system *sys = sc ? ts_system_copy(sc->system, &err) : NULL;
+    if (!CHECK(sys && ts_system_set_links(sys, 240, &err) == TS_OK,
+               "chunked sweep: scene at 240 links (%s)", err.msg)) {
+        ts_system_free(sys);
+        ts_scene_free(sc);
+        return;
+    }
+    ts_linear *lin = linearize(sys, TS_LIN_SPARSE, NULL);
+    ts_kernel *k = ts_kernel_alloc(sys, &err);
+    ts_output out;
+    int in = -1, np = 37;
+    double freq[37];
+    ts_response_logspace(0.01, 3, np, freq, &err);
+    int ok = lin && k &&
+             ts_response_output_lookup(k, "sphere.z", &out, &err) == TS_OK &&
+             ts_response_input_lookup(k, "tow.heave", &in, &err) == TS_OK;
+    ts_response *r1 = NULL, *r2 = NULL;
+    if (ok) {
+        lin->threads = 1;
+        ok = ts_response_compute(sys, lin, in, &out, freq, np, &r1, &err) ==
+             TS_OK;
+        lin->threads = 2;
+        ok = ok && ts_response_compute(sys, lin, in, &out, freq, np, &r2,
+                                       &err) == TS_OK;
+    }
+    int same = ok, within = ok;
+    double worst = 0;
+    for (int i = 0; ok && i < np; i++) {
+        same &= r1->re[i] == r2->re[i] && r1->im[i] == r2->im[i] &&
+                r1->error[i] == r2->error[i];
+        double re, im;
+        if (ts_response_at(sys, lin, in, &out, 2 * M_PI * freq[i], &re, &im,
+                           &err) != TS_OK) {
+            ok = 0;
+            break;
+        }
+        double d = cabs((r1->re[i] - re) + I * (r1->im[i] - im));
+        within &= d <= r1->error[i];
+        worst = fmax(worst, d / r1->error[i]);
+    }
+    CHECK(ok && same, "240 links, %d frequencies in chunks: one thread and "
+          "two give the same gains and allowances, bit for bit (%s)", np,
+          ok ? "" : err.msg);
+    CHECK(ok && within, "240 links: every gain equals the one factored "
+          "afresh at its frequency within its allowance (largest %.3g of "
+          "it)", worst);
+    int stop = 5;
+    ts_response *r3 = NULL;
+    int rc = ok ? tsi_response_compute(sys, lin, in, &out, freq, np,
+                                       stop_after, &stop, &r3, &err)
+                : TS_EINVAL;
+    CHECK(rc == TS_ECANCEL && r3 == NULL && strstr(err.msg, "stopped"),
+          "240 links, chunked: a stop after %d frequencies ends the sweep "
+          "with TS_ECANCEL and no result (%s)", stop, err.msg);
+    ts_response_free(r1);
+    ts_response_free(r2);
+    ts_linear_free(lin);
+    ts_kernel_free(k);
+    ts_system_free(sys);
+    ts_scene_free(sc);
+}
+
 int main(void)
 {
     units = tscene_units();
@@ -844,6 +923,7 @@ int main(void)
     test_names();
     test_rounding();
     test_vehicle_allowance();
+    test_chunked_sweep();
     ts_units_free(units);
     return tc_done();
 }
