@@ -1551,13 +1551,13 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
     ts_kernel *k = s->k;
     const ts_system *sys = ts_kernel_system(k);
     int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
-    int nv = ts_kernel_nvehicles(k), iw = 0;
-    for (int i = 1; i < s->nz; i++)
-        if (fabs(res[i]) > fabs(res[iw]))
+    int nv = ts_kernel_nvehicles(k), iw = -1;
+    for (int i = 0; i < s->nz; i++)
+        if (isfinite(res[i]) && (iw < 0 || fabs(res[i]) > fabs(res[iw])))
             iw = i;
     ts_kernel_outputs(k, s->out);
     char worst[224] = "";
-    int zy = s->nz > 0 ? s->zy[iw] : -1;
+    int zy = iw >= 0 ? s->zy[iw] : -1, fin = 1;
     if (zy >= 2 * nq) {
         /* A controller state: its rate is what is unbalanced. */
         int c = zy - 2 * nq;
@@ -1566,6 +1566,7 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
         const ts_body *b = &sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)];
         const ts_vehicle *d = b->vehicle;
         double rate = s->f[zy];
+        fin = isfinite(rate);
         if (cs.actuator == TS_CONTROL_SPEED) {
             snprintf(worst, sizeof worst, "the speed controller of towing "
                      "vehicle '%s', its speed error %.3g m/s", b->name,
@@ -1592,6 +1593,8 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
             double f = depth ? 1.0 : 180 / M_PI;
             double sp = ts_kernel_setpoint(k, cs.vehicle, cs.index);
             const char *u = depth ? "m" : "deg";
+            double meas = s->out[o + (m >= 0 && m < 4 ? m : 0)];
+            fin = fin && isfinite(meas) && isfinite(sp);
             char target[64] = "";
             if (sp != lp->setpoint) /* on the path to the scene's */
                 snprintf(target, sizeof target, " on the way to %.4g %s",
@@ -1599,9 +1602,8 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
             snprintf(worst, sizeof worst, "loop '%s' of vehicle '%s', its "
                      "error %.4g %s (%s %.4g %s against the set point "
                      "%.4g %s in force%s)", lp->name, b->name, rate * f, u,
-                     m >= 0 && m < 4 ? measure[m] : "measure",
-                     s->out[o + (m >= 0 && m < 4 ? m : 0)] * f, u, sp * f,
-                     u, target);
+                     m >= 0 && m < 4 ? measure[m] : "measure", meas * f, u,
+                     sp * f, u, target);
         }
     } else if (zy >= 0) {
         int v = 0;
@@ -1609,6 +1611,7 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
             v++;
         int ro = ts_kernel_root_offset(k);
         double a = s->f[nq + zy];
+        fin = isfinite(a);
         if (ro >= 0 && zy >= ro && zy < ro + root_npos(k)) {
             static const char *const axis[3] = {"along the track",
                                                 "across the track",
@@ -1622,6 +1625,8 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
                      sys->bodies[ts_kernel_vehicle_body(k, v)].name, a);
         }
     }
+    if (!fin) /* no number that is not finite is shown */
+        worst[0] = '\0';
     /* The surfaces whose command (limited: an actuator's state plus its
      * lag times its rate) is at the limit. */
     char lim[160] = "";
