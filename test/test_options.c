@@ -63,18 +63,25 @@ static void quote(const char *text, char *buf, size_t size)
 }
 
 /* Apply set s (after giving it its texts with code rc) to rq and check
- * it against the system; the message names where the value came from.
+ * it against system sys; the message names where the value came from.
  * Frees s. */
-static int finish(ts_optset *s, int rc, ts_request *rq, ts_err *err)
+static int finish_on(const ts_system *sys, ts_optset *s, int rc,
+                     ts_request *rq, ts_err *err)
 {
     if (!rc)
         rc = ts_optset_apply(s, TS_OPTSET_COMMAND, units, rq, err);
     if (!rc)
-        rc = ts_analysis_check(base->system, rq, err);
+        rc = ts_analysis_check(sys, rq, err);
     if (rc)
         ts_optset_locate(s, err);
     ts_optset_free(s);
     return rc;
+}
+
+/* finish_on the test scene's system. */
+static int finish(ts_optset *s, int rc, ts_request *rq, ts_err *err)
+{
+    return finish_on(base->system, s, rc, rq, err);
 }
 
 /* The refusal of `text` for row o of kind from the command line: code and
@@ -422,14 +429,7 @@ static int vehicle_set(const ts_scene *sc, int entry, const char *text,
                                               "v.yaml", TS_OPTSET_SCENE, -1,
                                               err);
     ts_request_init(rq, TS_ANALYSIS_EQUILIBRIUM);
-    if (!rc)
-        rc = ts_optset_apply(s, TS_OPTSET_COMMAND, units, rq, err);
-    if (!rc)
-        rc = ts_analysis_check(sc->system, rq, err);
-    if (rc)
-        ts_optset_locate(s, err);
-    ts_optset_free(s);
-    return rc;
+    return finish_on(sc->system, s, rc, rq, err);
 }
 
 /* A vehicle loop's setpoint and gains given with a unit, from both
@@ -490,22 +490,23 @@ static void test_loop_units(void)
               "'3 deg/m' in rad and rad/m (%s)", name,
               rc ? err.msg : "ok");
         ts_request_clear(&rq);
-        rc = vehicle_set(sc, src ? first + 2 : -1, entries[2], &rq, &err);
-        CHECK(rc == TS_EUNIT &&
-                  strstr(err.msg, src ? "analyses[" : "--set: ") &&
-                  strstr(err.msg, "bodies.aurora.loops.pitch.setpoint: "
-                                  "'400 m' is in m") &&
-                  strstr(err.msg, "measures pitch: expected rad"),
-              "%s: a pitch setpoint of '400 m' refused: %s", name, err.msg);
-        ts_request_clear(&rq);
-        rc = vehicle_set(sc, src ? first + 3 : -1, entries[3], &rq, &err);
-        CHECK(rc == TS_EUNIT &&
-                  strstr(err.msg, src ? "analyses[" : "--set: ") &&
-                  strstr(err.msg, "bodies.aurora.loops.depth.setpoint: "
-                                  "'5 deg' is in rad") &&
-                  strstr(err.msg, "measures depth: expected m"),
-              "%s: a depth setpoint of '5 deg' refused: %s", name, err.msg);
-        ts_request_clear(&rq);
+        /* Entries 2 and 3: refused, naming the source, the path and
+         * value, what the loop measures and the unit expected. */
+        static const char *const want[2][2] = {
+            {"bodies.aurora.loops.pitch.setpoint: '400 m' is in m",
+             "measures pitch: expected rad"},
+            {"bodies.aurora.loops.depth.setpoint: '5 deg' is in rad",
+             "measures depth: expected m"}};
+        for (int e = 0; e < 2; e++) {
+            rc = vehicle_set(sc, src ? first + 2 + e : -1, entries[2 + e],
+                             &rq, &err);
+            CHECK(rc == TS_EUNIT &&
+                      strstr(err.msg, src ? "analyses[" : "--set: ") &&
+                      strstr(err.msg, want[e][0]) &&
+                      strstr(err.msg, want[e][1]),
+                  "%s: '%s' refused: %s", name, entries[2 + e], err.msg);
+            ts_request_clear(&rq);
+        }
     }
     /* A plain number is SI, as before, whatever the loop. */
     ts_request rq;

@@ -309,24 +309,33 @@ static void test_errors(const ts_units *u)
 
 /* Loops and surfaces of a vehicle, by name; units from what the loop
  * measures. */
+/* A system of one vehicle 'fish' with a depth loop and a pitch loop
+ * (named so), without components; *v its vehicle. */
+static ts_system *fish_loops(ts_vehicle **v, ts_err *err)
+{
+    ts_system *s = ts_system_alloc(1, 1, err);
+    snprintf(s->bodies[0].name, TS_NAME_MAX, "fish");
+    *v = ts_body_set_vehicle(s, 0, err);
+    (*v)->nloops = 2;
+    snprintf((*v)->loop[0].name, TS_VEHICLE_NAME_MAX, "depth");
+    (*v)->loop[0].measure = TS_MEASURE_DEPTH;
+    snprintf((*v)->loop[1].name, TS_VEHICLE_NAME_MAX, "pitch");
+    (*v)->loop[1].measure = TS_MEASURE_PITCH;
+    return s;
+}
+
 static void test_vehicle(void)
 {
     ts_err err = {0};
-    ts_system *s = ts_system_alloc(1, 1, &err);
-    snprintf(s->bodies[0].name, TS_NAME_MAX, "fish");
-    ts_vehicle *v = ts_body_set_vehicle(s, 0, &err);
+    ts_vehicle *v;
+    ts_system *s = fish_loops(&v, &err);
     v->ncomponents = 2;
     snprintf(v->component[0].name, TS_VEHICLE_NAME_MAX, "hull");
     v->component[0].type = TS_COMP_HULL;
     snprintf(v->component[1].name, TS_VEHICLE_NAME_MAX, "elevator");
     v->component[1].type = TS_COMP_SURFACE;
     v->component[1].limit = 0.3;
-    v->nloops = 2;
-    snprintf(v->loop[0].name, TS_VEHICLE_NAME_MAX, "depth");
-    v->loop[0].measure = TS_MEASURE_DEPTH;
     v->loop[0].kp = 0.25;
-    snprintf(v->loop[1].name, TS_VEHICLE_NAME_MAX, "pitch");
-    v->loop[1].measure = TS_MEASURE_PITCH;
     char unit[TS_PARAM_UNIT_MAX];
     double x = NAN;
     int rc = ts_param_get(s, "bodies.fish.loops.depth.kp", &x, &err);
@@ -900,14 +909,8 @@ static void test_loop_units(const ts_units *u)
     }
 
     ts_err err = {0};
-    ts_system *s = ts_system_alloc(1, 1, &err);
-    snprintf(s->bodies[0].name, TS_NAME_MAX, "fish");
-    ts_vehicle *v = ts_body_set_vehicle(s, 0, &err);
-    v->nloops = 2;
-    snprintf(v->loop[0].name, TS_VEHICLE_NAME_MAX, "depth");
-    v->loop[0].measure = TS_MEASURE_DEPTH;
-    snprintf(v->loop[1].name, TS_VEHICLE_NAME_MAX, "pitch");
-    v->loop[1].measure = TS_MEASURE_PITCH;
+    ts_vehicle *v;
+    ts_system *s = fish_loops(&v, &err);
     /* With the system: the loop's unit, and only it. */
     char unit[TS_PARAM_UNIT_MAX];
     double x = NAN;
