@@ -172,6 +172,12 @@ static int default_settings(ts_analysis_kind analysis, ts_conv_param *param,
 
 int ts_setup_set(ts_setup *s, const char *path, double value, ts_err *err)
 {
+    return ts_setup_set_in(s, path, value, NULL, NULL, err);
+}
+
+int ts_setup_set_in(ts_setup *s, const char *path, double value,
+                    const char *unit, const char *given, ts_err *err)
+{
     char canon[TS_PARAM_PATH_MAX], other[TS_PARAM_PATH_MAX];
     int rc = ts_param_canonical(path, canon, sizeof canon, err);
     if (rc)
@@ -185,8 +191,15 @@ int ts_setup_set(ts_setup *s, const char *path, double value, ts_err *err)
     if (i == TS_SETUP_MAX_SETS)
         return ts_fail(err, TS_EINVAL, "set: at most %d scene values",
                        TS_SETUP_MAX_SETS);
+    if (unit && strlen(unit) >= sizeof s->sets[i].unit)
+        return ts_fail(err, TS_EINVAL, "set: %s: unit '%s' longer than %zu "
+                       "characters", canon, unit, sizeof s->sets[i].unit - 1);
     snprintf(s->sets[i].path, sizeof s->sets[i].path, "%s", canon);
     s->sets[i].value = value;
+    snprintf(s->sets[i].unit, sizeof s->sets[i].unit, "%s",
+             unit ? unit : "");
+    snprintf(s->sets[i].given, sizeof s->sets[i].given, "%s",
+             unit && unit[0] && given ? given : "");
     if (i == s->nsets)
         s->nsets++;
     return TS_OK;
@@ -297,8 +310,12 @@ static ts_system *setup_system(const ts_system *sys, const ts_request *rq,
         ts_system_free(c);
         return NULL;
     }
+    /* A loop's key given with a unit: the unit must be the loop's (a
+     * length for depth, an angle else: towstab/param.h). */
     for (int i = 0; i < s->nsets; i++)
-        if (ts_param_set(c, s->sets[i].path, s->sets[i].value, err) !=
+        if (ts_param_fits(c, s->sets[i].path, s->sets[i].unit,
+                          s->sets[i].given, err) != TS_OK ||
+            ts_param_set(c, s->sets[i].path, s->sets[i].value, err) !=
             TS_OK) {
             ts_err_prefix(err, "set: ");
             ts_system_free(c);

@@ -71,6 +71,11 @@
  * rounding of an even function (a balance along the track against the
  * roll, yaw or turn rate of a symmetric tow), and its entry is zero. */
 #define VSHOOT_EVEN_RTOL 1.5e-14
+/* Characters of where a failed shooting with vehicles stood (its worst
+ * outer equation, the surfaces at their limits), with the zero: with
+ * Newton's message after it, a failure's message stays within
+ * TS_ERR_MSG_MAX. */
+#define VSHOOT_WHERE_MAX 384
 /* A relative force residual this small is rounding in the sums of the
  * nodal balances (about 1000 machine epsilons): Newton stalling there has
  * converged as far as double precision goes. */
@@ -1359,6 +1364,9 @@ typedef struct vshoot {
     int max_iter;
     ts_equilibrium *eq;
     ts_err merr;          /* the last march failure */
+    double *out;          /* [ts_kernel_noutput] the vehicles' outputs */
+    double where_merit;   /* the outer solve's least merit above tol */
+    char where[VSHOOT_WHERE_MAX]; /* where it stood then (vshoot_where) */
 } vshoot;
 
 static int vshoot_pull(void *ctx, int node, const double r[3], double F[3])
@@ -1529,6 +1537,141 @@ static int vshoot_df(const gsl_vector *z, void *par, gsl_matrix *J)
     return status;
 }
 
+/* Where the outer solve stands, for the message of a failure, into
+ * s->where: its merit (the kernel's relative force and weighted
+ * controller residuals, as vshoot_solve judges them), the outer equation
+ * whose weighted residual res[nz] is the largest, named with its value
+ * in its own unit (a loop's error, a vehicle's angular acceleration, a
+ * towing vehicle's force balance), and the control surfaces whose
+ * command sits at its deflection limit (the usual reason a set point is
+ * out of reach). Reads the kernel's last evaluation (s->y, s->f, its
+ * outputs) and changes nothing: O(outer unknowns + components). */
+static void vshoot_where(vshoot *s, const double *res, double merit)
+{
+    ts_kernel *k = s->k;
+    const ts_system *sys = ts_kernel_system(k);
+    int nq = ts_kernel_nq(k), nc = ts_kernel_ncontrol(k);
+    int nv = ts_kernel_nvehicles(k), iw = -1;
+    for (int i = 0; i < s->nz; i++)
+        if (isfinite(res[i]) && (iw < 0 || fabs(res[i]) > fabs(res[iw])))
+            iw = i;
+    ts_kernel_outputs(k, s->out);
+    char worst[224] = "";
+    int zy = iw >= 0 ? s->zy[iw] : -1, fin = 1;
+    if (zy >= 2 * nq) {
+        /* A controller state: its rate is what is unbalanced. */
+        int c = zy - 2 * nq;
+        ts_control_state cs;
+        ts_kernel_control_state(k, c, &cs);
+        const ts_body *b = &sys->bodies[ts_kernel_vehicle_body(k, cs.vehicle)];
+        const ts_vehicle *d = b->vehicle;
+        double rate = s->f[zy];
+        fin = isfinite(rate);
+        if (cs.actuator == TS_CONTROL_SPEED) {
+            snprintf(worst, sizeof worst, "the speed controller of towing "
+                     "vehicle '%s', its speed error %.3g m/s", b->name,
+                     rate);
+        } else if (cs.actuator) {
+            const ts_component *cp = &d->component[cs.index];
+            snprintf(worst, sizeof worst, "the actuator of surface '%s' of "
+                     "vehicle '%s', %.3g deg from its command", cp->name,
+                     b->name, rate * cp->time_constant * 180 / M_PI);
+        } else {
+            /* A loop's integrator: its rate is the loop's error. */
+            const ts_loop *lp = &d->loop[cs.index];
+            int o = 0;
+            for (int v = 0; v < cs.vehicle; v++) {
+                const ts_vehicle *dv =
+                    sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+                o += 4 + dv->nloops;
+                for (int j = 0; j < dv->ncomponents; j++)
+                    o += dv->component[j].control != 0;
+            }
+            static const char *const measure[4] = {"depth", "pitch", "roll",
+                                                   "heading"};
+            int m = (int)lp->measure, depth = m == TS_MEASURE_DEPTH;
+            double f = depth ? 1.0 : 180 / M_PI;
+            double sp = ts_kernel_setpoint(k, cs.vehicle, cs.index);
+            const char *u = depth ? "m" : "deg";
+            double meas = s->out[o + (m >= 0 && m < 4 ? m : 0)];
+            fin = fin && isfinite(meas) && isfinite(sp);
+            char target[64] = "";
+            if (sp != lp->setpoint) /* on the path to the scene's */
+                snprintf(target, sizeof target, " on the way to %.4g %s",
+                         lp->setpoint * f, u);
+            snprintf(worst, sizeof worst, "loop '%s' of vehicle '%s', its "
+                     "error %.4g %s (%s %.4g %s against the set point "
+                     "%.4g %s in force%s)", lp->name, b->name, rate * f, u,
+                     m >= 0 && m < 4 ? measure[m] : "measure", meas * f, u,
+                     sp * f, u, target);
+        }
+    } else if (zy >= 0) {
+        int v = 0;
+        while (v + 1 < nv && zy >= ts_kernel_vehicle_offset(k, v + 1))
+            v++;
+        int ro = ts_kernel_root_offset(k);
+        double a = s->f[nq + zy];
+        fin = isfinite(a);
+        if (ro >= 0 && zy >= ro && zy < ro + root_npos(k)) {
+            static const char *const axis[3] = {"along the track",
+                                                "across the track",
+                                                "vertically"};
+            snprintf(worst, sizeof worst, "the force balance of towing "
+                     "vehicle '%s' %s (acceleration %.3g m/s^2)",
+                     sys->bodies[sys->tow.vehicle].name, axis[zy - ro], a);
+        } else {
+            snprintf(worst, sizeof worst, "the moment balance of vehicle "
+                     "'%s' (angular acceleration %.3g rad/s^2)",
+                     sys->bodies[ts_kernel_vehicle_body(k, v)].name, a);
+        }
+    }
+    if (!fin) /* no number that is not finite is shown */
+        worst[0] = '\0';
+    /* The surfaces whose command (limited: an actuator's state plus its
+     * lag times its rate) is at the limit. */
+    char lim[160] = "";
+    size_t len = 0;
+    int nlim = 0, o = 0;
+    for (int v = 0; v < nv; v++) {
+        const ts_body *b = &sys->bodies[ts_kernel_vehicle_body(k, v)];
+        const ts_vehicle *d = b->vehicle;
+        int js = o + 4 + d->nloops;
+        for (int j = 0; j < d->ncomponents; j++) {
+            const ts_component *cp = &d->component[j];
+            if (!cp->control)
+                continue;
+            double dl = s->out[js++];
+            for (int c = 0; c < nc && cp->time_constant > 0; c++) {
+                ts_control_state cs;
+                ts_kernel_control_state(k, c, &cs);
+                if (cs.vehicle == v && cs.actuator == 1 && cs.index == j)
+                    dl = s->y[2 * nq + c] +
+                         cp->time_constant * s->f[2 * nq + c];
+            }
+            if (cp->type == TS_COMP_BALLAST || !isfinite(cp->limit) ||
+                !(fabs(dl) >= cp->limit * (1 - 1e-9)))
+                continue;
+            if (nlim++ < 2 && len < sizeof lim)
+                len += (size_t)snprintf(lim + len, sizeof lim - len,
+                                        "%s%s.%s (%.4g deg)",
+                                        nlim > 1 ? ", " : "", b->name,
+                                        cp->name, cp->limit * 180 / M_PI);
+        }
+        o = js;
+    }
+    if (nlim > 2 && len < sizeof lim)
+        snprintf(lim + len, sizeof lim - len, " and %d more", nlim - 2);
+    s->where_merit = merit;
+    snprintf(s->where, sizeof s->where, "%s%s%s%s%s",
+             worst[0] ? ", worst in " : "", worst, nlim ? ", with " : "",
+             lim,
+             nlim ? (nlim > 1 ? " at their deflection limits: a set point "
+                                "out of the surfaces' reach?"
+                              : " at its deflection limit: a set point out "
+                                "of the surfaces' reach?")
+                  : "");
+}
+
 /* The outer solve from z[nz] at the kernel's frame and set points, until
  * the kernel's verdict (force and controller residuals) is at most
  * VSHOOT_POLISH tol, or at most tol where the iterations stop improving
@@ -1543,6 +1686,7 @@ static int vshoot_solve(vshoot *s, double *z, double tol, int max_iter)
     double *r = malloc(2 * (size_t)s->nz * sizeof(double)), *best = r + s->nz;
     double best_merit = INFINITY;
     int rc = TS_ECONV;
+    s->where[0] = '\0';
     if (!solver || !r) {
         rc = TS_ENOMEM;
         goto out;
@@ -1561,6 +1705,8 @@ static int vshoot_solve(vshoot *s, double *z, double tol, int max_iter)
         if (merit < best_merit) {
             best_merit = merit;
             memcpy(best, z, (size_t)s->nz * sizeof(double));
+            if (merit > tol)
+                vshoot_where(s, r, merit);
         } else if (best_merit <= tol) {
             break; /* no better than the best, which will do */
         }
@@ -1774,11 +1920,12 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
     s.node_veh = malloc((size_t)sys->nnodes * sizeof(int));
     s.zy = malloc(maxz * sizeof(int));
     s.zscale = malloc(3 * maxz * sizeof(double));
+    s.out = malloc(((size_t)ts_kernel_noutput(k) + 1) * sizeof(double));
     double *y0 = malloc((size_t)n * sizeof(double));
     double *sp = calloc(2 * (size_t)nloops + 1, sizeof(double));
     int rc = TS_ENOMEM;
     if (!s.x || !s.xsave || !s.nsave || !s.off || !s.strain ||
-        !s.node_veh || !s.zy || !s.zscale || !y0 || !sp)
+        !s.node_veh || !s.zy || !s.zscale || !s.out || !y0 || !sp)
         goto out;
     s.zw = s.zscale + maxz;
     double *z = s.zscale + 2 * maxz, *x0 = s.x + nx + 1;
@@ -1830,9 +1977,10 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
 
     static const int schedule[] = {1, 4, 16};
     int nsched = frame->turn_rate != 0 || nloops > 0 ? 3 : 1;
+    int steps = 1, jfail = 0; /* the last path tried, its failed step */
     rc = TS_ECONV;
     for (int sc = 0; sc < nsched && rc != TS_OK; sc++) {
-        int steps = schedule[sc];
+        steps = schedule[sc];
         memcpy(y, y0, (size_t)n * sizeof(double));
         memcpy(s.x, x0, (size_t)nx * sizeof(double));
         if (s.zsp >= 0) {
@@ -1866,14 +2014,32 @@ static int solve_vehicle_shooting(ts_kernel *k, tsi_march *m,
                        s.zscale[i];
             rc = vshoot_solve(&s, z, o->tol, o->max_iter);
             eq->continuation_steps++;
+            jfail = j;
         }
     }
     if (rc == TS_OK)
         vshoot_health(&s, z);
-    if (rc != TS_OK && rc != TS_ENOMEM)
+    if (rc != TS_OK && rc != TS_ENOMEM) {
+        /* Where the last path stopped: how far it got, and where its
+         * failed solve stood at best (or why its march failed). */
+        char path[160] = "";
+        if (steps > 1)
+            snprintf(path, sizeof path, ": it got %.4g of the way from "
+                     "where the loops idle to their set points%s, and the "
+                     "next step's solve", (double)(jfail - 1) / steps,
+                     frame->turn_rate != 0 ? " and the turn rate" : "");
+        else
+            snprintf(path, sizeof path, ": its solve");
+        char where[VSHOOT_WHERE_MAX + 96] = "";
+        if (s.where[0])
+            snprintf(where, sizeof where, "%s got no closer than outer "
+                     "mismatch %.3g (tolerance %.3g)%s", path, s.where_merit,
+                     o->tol, s.where);
         rc = ts_fail(err, TS_ECONV, "equilibrium: shooting with vehicles "
-                     "did not converge (%d outer iterations)%s%s",
-                     eq->iterations, s.merr.msg[0] ? ": " : "", s.merr.msg);
+                     "did not converge (%d outer iterations)%s%s%.256s",
+                     eq->iterations, where,
+                     s.merr.msg[0] ? "; its last march: " : "", s.merr.msg);
+    }
 out:
     if (rc == TS_ENOMEM)
         ts_fail(err, TS_ENOMEM, "equilibrium: out of memory");
@@ -1901,6 +2067,7 @@ out:
     free(s.node_veh);
     free(s.zy);
     free(s.zscale);
+    free(s.out);
     free(y0);
     free(sp);
     return rc;
@@ -1939,6 +2106,30 @@ static int shooting_refuse(int rc, const ts_err *serr,
                      "residual is %.3g (target %.3g)",
                      eq->residual, tol);
     return rc;
+}
+
+/* The message of a vehicle scene whose shooting (serr) and Newton, its
+ * fallback (err), both failed: both reasons, shooting's first, in err.
+ * Shooting's takes at most half the message (VSHOOT_WHERE_MAX keeps it
+ * shorter); Newton's is cut to what is left, marked "...". */
+static void both_failed(const ts_err *serr, ts_err *err)
+{
+    if (!err)
+        return;
+    char newton[TS_ERR_MSG_MAX];
+    memcpy(newton, err->msg, sizeof newton);
+    newton[sizeof newton - 1] = '\0';
+    size_t size = sizeof err->msg;
+    int n = snprintf(err->msg, size, "%.*s; then Newton, the fallback, "
+                     "failed too: ", (int)(size / 2), serr->msg);
+    if (n < 0 || (size_t)n >= size - 4)
+        return;
+    size_t room = size - 1 - (size_t)n, len = strlen(newton);
+    if (len > room)
+        snprintf(err->msg + n, size - (size_t)n, "%.*s...",
+                 (int)(room - 3), newton);
+    else
+        memcpy(err->msg + n, newton, len + 1);
 }
 
 int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
@@ -2031,7 +2222,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     }
 
     /* Fast path. */
-    int have_guess = 0;
+    int have_guess = 0, vshoot_failed = 0;
+    ts_err serr = {0}; /* shooting's failure, with vehicles */
     if (!sys->has_bending && nv == 0 && o.method != TS_EQ_NEWTON) {
         ts_err serr = {0};
         rc = solve_shooting(k, m, &frame, &o, eq, &serr);
@@ -2060,7 +2252,6 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
      * outer unknowns; else (or when it fails, or a towing vehicle without
      * cables) Newton. */
     if (!sys->has_bending && nv > 0 && m && o.method != TS_EQ_NEWTON) {
-        ts_err serr = {0};
         ts_kernel_set_steady(k, 1);
         rc = solve_vehicle_shooting(k, m, &frame, &o, eq, y, dydt, dvec, att,
                                     &serr);
@@ -2071,6 +2262,9 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
             rc = shooting_refuse(rc, &serr, eq, o.tol, err);
             goto out;
         }
+        /* Why shooting failed, for the message should Newton fail too. */
+        shooting_refuse(rc, &serr, eq, o.tol, &serr);
+        vshoot_failed = 1;
         /* Newton starts afresh, at the targets. */
         ts_kernel_set_frame(k, &frame);
         for (int v = 0, i = 0; v < nv; v++) {
@@ -2194,6 +2388,9 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     if (rc == TS_OK)
         eq->converged = eq->residual <= o.tol &&
                         eq->control_residual <= o.tol;
+    else if (vshoot_failed && rc != TS_ENOMEM && rc != TS_ECANCEL &&
+             rc != TS_EIO)
+        both_failed(&serr, err);
 
 out:
     ts_kernel_set_frame(k, &frame);

@@ -64,10 +64,14 @@ void ts_err_prefix(ts_err *err, const char *fmt, ...)
     if ((size_t)n < sizeof err->msg - 1) {
         size_t room = sizeof err->msg - 1 - (size_t)n;
         size_t len = strlen(old);
+        /* A message cut to fit ends in "...". */
+        int cut = len > room && room > 3;
         if (len > room)
-            len = room;
+            len = cut ? room - 3 : room;
         memcpy(err->msg + n, old, len);
-        err->msg[(size_t)n + len] = '\0';
+        if (cut)
+            memcpy(err->msg + n + len, "...", 3);
+        err->msg[(size_t)n + len + (cut ? 3 : 0)] = '\0';
     }
 }
 

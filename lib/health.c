@@ -58,7 +58,10 @@ static void add(ts_trust *t, int reason, const char *prefix, const char *fmt,
         snprintf(list[*n], TS_TRUST_TEXT, "%s", prefix);
         len = strlen(list[*n]);
     }
-    vsnprintf(list[*n] + len, TS_TRUST_TEXT - len, fmt, ap);
+    int w = vsnprintf(list[*n] + len, TS_TRUST_TEXT - len, fmt, ap);
+    /* A longer text (a failed run's message) is cut visibly. */
+    if (w > 0 && (size_t)w >= TS_TRUST_TEXT - len && TS_TRUST_TEXT > 4)
+        memcpy(list[*n] + TS_TRUST_TEXT - 4, "...", 4);
     (*n)++;
 }
 

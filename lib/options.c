@@ -307,7 +307,9 @@ static int parse_integrators(const ts_option *o, ts_request *rq,
 /* Scene values by path: "PATH=VALUE", several separated by ';' (a
  * repeated --set adds more). The value has the path's unit
  * (towstab/param.h); a loop's gains and setpoint, whose unit depends on
- * what the loop measures, are plain SI numbers here. */
+ * what the loop measures, are a plain SI number or a value in the unit of
+ * a depth or an angle loop, checked against the loop with the system
+ * (ts_param_parse, ts_param_fits). */
 static int parse_set(const ts_option *o, ts_request *rq, const char *text,
                      const char *w, const ts_units *u, ts_err *err)
 {
@@ -337,28 +339,20 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
         const char *val = eq + 1;
         while (*val == ' ')
             val++;
-        char unit[TS_PARAM_UNIT_MAX], where[WHERE_MAX + TS_PARAM_PATH_MAX];
+        char own[TS_PARAM_UNIT_MAX], unit[TS_PARAM_UNIT_MAX];
+        char where[WHERE_MAX + TS_PARAM_PATH_MAX];
         snprintf(where, sizeof where, "%s: %s", w, p);
-        rc = ts_param_unit(NULL, p, unit, sizeof unit, err);
+        rc = ts_param_unit(NULL, p, own, sizeof own, err);
         if (rc) {
             ts_err_prefix(err, "%s: ", w);
             break;
         }
         double v;
-        if (unit[0]) {
-            rc = ts_units_parse(u, val, unit, where, &v, err);
-        } else {
-            char *num_end;
-            v = strtod(val, &num_end);
-            while (*num_end == ' ')
-                num_end++;
-            if (num_end == val || *num_end || !isfinite(v))
-                rc = ts_fail(err, TS_EINVAL, "%s: expected a plain number "
-                             "(SI: a loop's gains and setpoint take the unit "
-                             "of what it measures), got '%s'", where, val);
-        }
+        rc = ts_param_parse(NULL, u, p, val, where, &v, unit, sizeof unit,
+                            err);
         if (!rc)
-            rc = ts_setup_set(&rq->setup, p, v, err);
+            rc = ts_setup_set_in(&rq->setup, p, v, own[0] ? "" : unit, val,
+                                 err);
         n++;
     }
     free(copy);

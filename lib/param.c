@@ -909,6 +909,104 @@ int ts_param_unit(const ts_system *sys, const char *path, char *unit,
     return TS_OK;
 }
 
+/* A plain number: strtod's whole text but blanks, finite. */
+static int plain_number(const char *text, double *value)
+{
+    char *end;
+    double v = strtod(text, &end);
+    while (*end == ' ' || *end == '\t')
+        end++;
+    if (end == text || *end || !isfinite(v))
+        return 0;
+    *value = v;
+    return 1;
+}
+
+int ts_param_parse(const ts_system *sys, const ts_units *u, const char *path,
+                   const char *text, const char *where, double *value,
+                   char *unit, size_t size, ts_err *err)
+{
+    target tg;
+    int rc = resolve(sys, path, &tg, err);
+    if (rc)
+        return rc;
+    const char *own = target_unit(&tg);
+    if (!where)
+        where = path;
+    if (own[0]) {
+        snprintf(unit, size, "%s", own);
+        return ts_units_parse(u, text, own, where, value, err);
+    }
+    /* A loop's key without the system: the unit of a depth loop or of an
+     * angle loop, whichever the value's fits (their dimensions differ by
+     * a length: udunits takes rad as 1). */
+    unit[0] = '\0';
+    while (text && (*text == ' ' || *text == '\t'))
+        text++;
+    if (text && plain_number(text, value))
+        return TS_OK;
+    const char *cand[2] = {tsi_loop_unit(1, tg.r->key),
+                           tsi_loop_unit(0, tg.r->key)};
+    for (int k = 0; k < 2 && rc != TS_EINVAL; k++) {
+        rc = ts_units_parse(u, text, cand[k], where, value, NULL);
+        if (rc == TS_OK) {
+            snprintf(unit, size, "%s", cand[k]);
+            return TS_OK;
+        }
+    }
+    /* Not a number (TS_EINVAL), or a unit of neither kind of loop. */
+    return ts_fail(err, rc, "%s: expected a plain SI number or a number "
+                   "with the unit of what the loop measures, %s for depth "
+                   "or %s for an angle (pitch, roll, heading); got '%s'",
+                   where, cand[0], cand[1], text ? text : "");
+}
+
+int ts_param_fits(const ts_system *sys, const char *path, const char *unit,
+                  const char *given, ts_err *err)
+{
+    target tg;
+    int rc = resolve(sys, path, &tg, err);
+    if (rc || !unit || !unit[0])
+        return rc;
+    const char *own = target_unit(&tg);
+    if (!strcmp(own, unit))
+        return TS_OK;
+    if (tg.loop < 0 || !tg.base || tg.body < 0 || !sys)
+        return ts_fail(err, TS_EUNIT, "%s: the value is in %s; expected %s",
+                       path, unit, own);
+    static const char *const measures[4] = {"depth", "pitch", "roll",
+                                            "heading"};
+    const ts_loop *lp = (const ts_loop *)tg.base;
+    int depth = lp->measure == TS_MEASURE_DEPTH;
+    int mi = (int)lp->measure;
+    char shown[96];
+    if (given && given[0])
+        snprintf(shown, sizeof shown, "'%.40s' is in %s", given, unit);
+    else
+        snprintf(shown, sizeof shown, "the value is in %s", unit);
+    /* An example in the loop's unit, by key: setpoint, kp, ki, kd. */
+    static const char *const keys[4] = {"setpoint", "kp", "ki", "kd"};
+    static const char *const example[2][4] = {
+        {"'5 deg'", "'0.5'", "'0.1 1/s'", "'0.2 s'"},
+        {"'40 m'", "'2 deg/m'", "'0.1 deg/(m*s)'", "'1 deg*s/m'"}};
+    int ki = 0;
+    for (int k = 0; k < 4; k++)
+        if (!strcmp(tg.r->key, keys[k]))
+            ki = k;
+    char expected[96];
+    if (!strcmp(own, "1")) /* an angle per angle */
+        snprintf(expected, sizeof expected, "a plain number (rad per rad, "
+                 "e.g. %s)", example[depth][ki]);
+    else
+        snprintf(expected, sizeof expected, "%s (e.g. %s), or a plain "
+                 "number in %s", own, example[depth][ki], own);
+    return ts_fail(err, TS_EUNIT, "%s: %s, the unit of a loop measuring "
+                   "%s, but loop '%s' of vehicle '%s' measures %s: expected "
+                   "%s", path, shown, depth ? "an angle" : "depth", lp->name,
+                   sys->bodies[tg.body].name,
+                   mi >= 0 && mi < 4 ? measures[mi] : "?", expected);
+}
+
 int ts_param_canonical(const char *path, char *out, size_t size,
                        ts_err *err)
 {

@@ -63,18 +63,25 @@ static void quote(const char *text, char *buf, size_t size)
 }
 
 /* Apply set s (after giving it its texts with code rc) to rq and check
- * it against the system; the message names where the value came from.
+ * it against system sys; the message names where the value came from.
  * Frees s. */
-static int finish(ts_optset *s, int rc, ts_request *rq, ts_err *err)
+static int finish_on(const ts_system *sys, ts_optset *s, int rc,
+                     ts_request *rq, ts_err *err)
 {
     if (!rc)
         rc = ts_optset_apply(s, TS_OPTSET_COMMAND, units, rq, err);
     if (!rc)
-        rc = ts_analysis_check(base->system, rq, err);
+        rc = ts_analysis_check(sys, rq, err);
     if (rc)
         ts_optset_locate(s, err);
     ts_optset_free(s);
     return rc;
+}
+
+/* finish_on the test scene's system. */
+static int finish(ts_optset *s, int rc, ts_request *rq, ts_err *err)
+{
+    return finish_on(base->system, s, rc, rq, err);
 }
 
 /* The refusal of `text` for row o of kind from the command line: code and
@@ -407,6 +414,113 @@ static void test_tables(void)
           "the link limit is TS_MAX_LINKS = %d", TS_MAX_LINKS);
 }
 
+/* The request of a vehicle scene's equilibrium with `set` from the
+ * command line (entry < 0) or from the scene's entry analyses[entry],
+ * checked against its system. */
+static int vehicle_set(const ts_scene *sc, int entry, const char *text,
+                       ts_request *rq, ts_err *err)
+{
+    ts_optset *s = ts_optset_alloc(TS_ANALYSIS_EQUILIBRIUM, err);
+    if (!s)
+        return TS_ENOMEM;
+    int rc = entry < 0 ? ts_optset_give(s, "set", text, TS_OPTSET_COMMAND,
+                                        "--set", err)
+                       : ts_optset_give_entry(s, &sc->analyses[entry], entry,
+                                              "v.yaml", TS_OPTSET_SCENE, -1,
+                                              err);
+    ts_request_init(rq, TS_ANALYSIS_EQUILIBRIUM);
+    return finish_on(sc->system, s, rc, rq, err);
+}
+
+/* A vehicle loop's setpoint and gains given with a unit, from both
+ * sources: converted to SI as the plain number would be; a unit of the
+ * other kind of loop refused when checked against the system, naming
+ * the source, the path, what the loop measures and the unit expected. */
+static void test_loop_units(void)
+{
+    ts_err err = {0};
+    ts_scene *file = ts_scene_load("examples/aurora_towfish.yaml", units,
+                                   &err);
+    if (!CHECK(file, "the AURORA scene loads (%s)", err.msg))
+        return;
+    static const char *const entries[] = {
+        "bodies.aurora.loops.depth.setpoint=100 ft",
+        "bodies.aurora.controllers.pitch.setpoint=2 deg; "
+        "bodies.aurora.loops.depth.kp=3 deg/m",
+        "bodies.aurora.loops.pitch.setpoint=400 m",
+        "bodies.aurora.loops.depth.setpoint=5 deg",
+    };
+    size_t nentries = sizeof entries / sizeof entries[0];
+    /* The scene's text with one equilibrium entry per text above. */
+    size_t size = file->text_len + 4096;
+    char *yaml = malloc(size);
+    size_t n = yaml ? (size_t)snprintf(yaml, size, "%s", file->text) : 0;
+    for (size_t i = 0; yaml && i < nentries; i++) {
+        char q[256];
+        quote(entries[i], q, sizeof q);
+        n += (size_t)snprintf(yaml + n, size - n, "  - type: equilibrium\n"
+                              "    set: %s\n", q);
+    }
+    ts_scene *sc = yaml ? ts_scene_parse(yaml, n, "v.yaml", units, &err)
+                        : NULL;
+    free(yaml);
+    int first = sc ? sc->nanalyses - (int)nentries : 0;
+    if (!CHECK(sc && first >= 0, "the scene with set entries (%s)",
+               err.msg)) {
+        ts_scene_free(file);
+        return;
+    }
+    for (int src = 0; src < 2; src++) {
+        const char *name = src ? "the scene's entry" : "--set";
+        ts_request rq;
+        int rc = vehicle_set(sc, src ? first : -1, entries[0], &rq, &err);
+        CHECK(rc == TS_OK && rq.setup.nsets == 1 &&
+                  rq.setup.sets[0].value == 100 * 0.3048 &&
+                  !strcmp(rq.setup.sets[0].unit, "m"),
+              "%s: a depth setpoint of '100 ft' is %.17g m (%s)", name,
+              rc ? NAN : rq.setup.sets[0].value, rc ? err.msg : "ok");
+        ts_request_clear(&rq);
+        rc = vehicle_set(sc, src ? first + 1 : -1, entries[1], &rq, &err);
+        CHECK(rc == TS_OK && rq.setup.nsets == 2 &&
+                  fabs(rq.setup.sets[0].value - 2 * M_PI / 180) < 1e-15 &&
+                  !strcmp(rq.setup.sets[0].unit, "rad") &&
+                  fabs(rq.setup.sets[1].value - 3 * M_PI / 180) < 1e-15 &&
+                  !strcmp(rq.setup.sets[1].unit, "rad/m"),
+              "%s: a pitch setpoint of '2 deg' and a depth kp of "
+              "'3 deg/m' in rad and rad/m (%s)", name,
+              rc ? err.msg : "ok");
+        ts_request_clear(&rq);
+        /* Entries 2 and 3: refused, naming the source, the path and
+         * value, what the loop measures and the unit expected. */
+        static const char *const want[2][2] = {
+            {"bodies.aurora.loops.pitch.setpoint: '400 m' is in m",
+             "measures pitch: expected rad"},
+            {"bodies.aurora.loops.depth.setpoint: '5 deg' is in rad",
+             "measures depth: expected m"}};
+        for (int e = 0; e < 2; e++) {
+            rc = vehicle_set(sc, src ? first + 2 + e : -1, entries[2 + e],
+                             &rq, &err);
+            CHECK(rc == TS_EUNIT &&
+                      strstr(err.msg, src ? "analyses[" : "--set: ") &&
+                      strstr(err.msg, want[e][0]) &&
+                      strstr(err.msg, want[e][1]),
+                  "%s: '%s' refused: %s", name, entries[2 + e], err.msg);
+            ts_request_clear(&rq);
+        }
+    }
+    /* A plain number is SI, as before, whatever the loop. */
+    ts_request rq;
+    int rc = vehicle_set(sc, -1, "bodies.aurora.loops.pitch.setpoint=0.05",
+                         &rq, &err);
+    CHECK(rc == TS_OK && rq.setup.sets[0].value == 0.05 &&
+              !rq.setup.sets[0].unit[0],
+          "a plain number stays SI, no unit to check (%s)",
+          rc ? err.msg : "ok");
+    ts_request_clear(&rq);
+    ts_scene_free(sc);
+    ts_scene_free(file);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -420,6 +534,7 @@ int main(void)
         test_tables();
         test_property();
         test_good_and_precedence();
+        test_loop_units();
     }
     ts_scene_free(base);
     ts_units_free(units);

@@ -309,24 +309,33 @@ static void test_errors(const ts_units *u)
 
 /* Loops and surfaces of a vehicle, by name; units from what the loop
  * measures. */
+/* A system of one vehicle 'fish' with a depth loop and a pitch loop
+ * (named so), without components; *v its vehicle. */
+static ts_system *fish_loops(ts_vehicle **v, ts_err *err)
+{
+    ts_system *s = ts_system_alloc(1, 1, err);
+    snprintf(s->bodies[0].name, TS_NAME_MAX, "fish");
+    *v = ts_body_set_vehicle(s, 0, err);
+    (*v)->nloops = 2;
+    snprintf((*v)->loop[0].name, TS_VEHICLE_NAME_MAX, "depth");
+    (*v)->loop[0].measure = TS_MEASURE_DEPTH;
+    snprintf((*v)->loop[1].name, TS_VEHICLE_NAME_MAX, "pitch");
+    (*v)->loop[1].measure = TS_MEASURE_PITCH;
+    return s;
+}
+
 static void test_vehicle(void)
 {
     ts_err err = {0};
-    ts_system *s = ts_system_alloc(1, 1, &err);
-    snprintf(s->bodies[0].name, TS_NAME_MAX, "fish");
-    ts_vehicle *v = ts_body_set_vehicle(s, 0, &err);
+    ts_vehicle *v;
+    ts_system *s = fish_loops(&v, &err);
     v->ncomponents = 2;
     snprintf(v->component[0].name, TS_VEHICLE_NAME_MAX, "hull");
     v->component[0].type = TS_COMP_HULL;
     snprintf(v->component[1].name, TS_VEHICLE_NAME_MAX, "elevator");
     v->component[1].type = TS_COMP_SURFACE;
     v->component[1].limit = 0.3;
-    v->nloops = 2;
-    snprintf(v->loop[0].name, TS_VEHICLE_NAME_MAX, "depth");
-    v->loop[0].measure = TS_MEASURE_DEPTH;
     v->loop[0].kp = 0.25;
-    snprintf(v->loop[1].name, TS_VEHICLE_NAME_MAX, "pitch");
-    v->loop[1].measure = TS_MEASURE_PITCH;
     char unit[TS_PARAM_UNIT_MAX];
     double x = NAN;
     int rc = ts_param_get(s, "bodies.fish.loops.depth.kp", &x, &err);
@@ -837,6 +846,118 @@ static void test_towing_paths(const ts_units *u)
         ts_scene_free(scenes[s]);
 }
 
+/* A loop's gains and setpoint with a unit: without the system, in the
+ * unit of a depth loop or of an angle loop, whichever the value's
+ * dimension fits (a plain number stays SI, unit ""); with it, in the
+ * loop's own; a unit the loop does not take refused, naming the path,
+ * what the loop measures and the unit expected. */
+static void test_loop_units(const ts_units *u)
+{
+    static const struct {
+        const char *path, *text, *unit;
+        double value;
+    } ok[] = {
+        {"bodies.fish.loops.depth.setpoint", "400 ft", "m", 121.92},
+        {"bodies.fish.loops.depth.setpoint", "40", "", 40},
+        {"bodies.fish.loops.pitch.setpoint", "5 deg", "rad", 5 * M_PI / 180},
+        {"bodies.fish.loops.depth.kp", "2 deg/m", "rad/m", 2 * M_PI / 180},
+        {"bodies.fish.loops.pitch.kp", "0.5 deg/deg", "1", 0.5},
+        {"bodies.fish.loops.depth.ki", "0.1 deg/(m*s)", "rad/(m*s)",
+         0.1 * M_PI / 180},
+        {"bodies.fish.loops.pitch.ki", "6 1/min", "1/s", 0.1},
+        {"bodies.fish.loops.depth.kd", "1 deg*s/m", "rad*s/m", M_PI / 180},
+        {"bodies.fish.controllers.pitch.kd", "200 ms", "s", 0.2},
+    };
+    for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
+        ts_err err = {0};
+        char unit[TS_PARAM_UNIT_MAX] = "?";
+        double x = NAN;
+        int rc = ts_param_parse(NULL, u, ok[i].path, ok[i].text, NULL, &x,
+                                unit, sizeof unit, &err);
+        CHECK(rc == TS_OK && !strcmp(unit, ok[i].unit) &&
+                  fabs(x - ok[i].value) <= 1e-12 * fabs(ok[i].value),
+              "%s = '%s' without the system: %.12g in '%s' (%s)",
+              ok[i].path, ok[i].text, x, unit, rc ? err.msg : "ok");
+    }
+    static const struct {
+        const char *text;
+        int code;
+    } bad[] = {{"5 kg", TS_EUNIT}, {"abc", TS_EINVAL}, {"nan", TS_EINVAL},
+               {"5 furlongz", TS_EUNIT}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ts_err err = {0};
+        char unit[TS_PARAM_UNIT_MAX];
+        double x;
+        int rc = ts_param_parse(NULL, u, "bodies.fish.loops.depth.setpoint",
+                                bad[i].text, "--set: x", &x, unit,
+                                sizeof unit, &err);
+        CHECK(rc == bad[i].code && strstr(err.msg, "--set: x: ") &&
+                  strstr(err.msg, "m for depth or rad for an angle") &&
+                  strstr(err.msg, bad[i].text),
+              "setpoint '%s' refused without the system: %s", bad[i].text,
+              err.msg);
+    }
+    /* A key whose unit is its own: taken in it, named. */
+    {
+        ts_err err = {0};
+        char unit[TS_PARAM_UNIT_MAX];
+        double x = NAN;
+        int rc = ts_param_parse(NULL, u, "cables.main.length", "100 ft",
+                                NULL, &x, unit, sizeof unit, &err);
+        CHECK(rc == TS_OK && !strcmp(unit, "m") && fabs(x - 30.48) < 1e-12,
+              "cables.main.length = '100 ft': %.12g %s", x, unit);
+    }
+
+    ts_err err = {0};
+    ts_vehicle *v;
+    ts_system *s = fish_loops(&v, &err);
+    /* With the system: the loop's unit, and only it. */
+    char unit[TS_PARAM_UNIT_MAX];
+    double x = NAN;
+    int rc = ts_param_parse(s, u, "bodies.fish.loops.pitch.setpoint",
+                            "5 deg", NULL, &x, unit, sizeof unit, &err);
+    CHECK(rc == TS_OK && !strcmp(unit, "rad") &&
+              fabs(x - 5 * M_PI / 180) < 1e-15,
+          "a pitch setpoint of '5 deg' with the system: %g %s", x, unit);
+    rc = ts_param_parse(s, u, "bodies.fish.loops.pitch.setpoint", "400 m",
+                        NULL, &x, unit, sizeof unit, &err);
+    CHECK(rc == TS_EUNIT, "a pitch setpoint of '400 m' with the system "
+                          "refused: %s", err.msg);
+    /* The check once the system is known. */
+    static const struct {
+        const char *path, *unit, *given, *want[3];
+    } mis[] = {
+        {"bodies.fish.loops.pitch.setpoint", "m", "400 m",
+         {"'400 m' is in m", "loop 'pitch' of vehicle 'fish' measures "
+          "pitch", "expected rad"}},
+        {"bodies.fish.loops.depth.setpoint", "rad", "5 deg",
+         {"'5 deg' is in rad", "measures depth", "expected m (e.g. '40 m')"}},
+        {"bodies.fish.loops.depth.kp", "1", "0.5 deg/deg",
+         {"bodies.fish.loops.depth.kp", "measures depth", "expected rad/m"}},
+        {"bodies.fish.loops.pitch.kp", "rad/m", NULL,
+         {"the value is in rad/m", "measures pitch",
+          "expected a plain number"}},
+        {"bodies.fish.loops.pitch.kd", "rad*s/m", "1 deg*s/m",
+         {"bodies.fish.loops.pitch.kd", "measures pitch", "expected s"}},
+    };
+    for (size_t i = 0; i < sizeof mis / sizeof mis[0]; i++) {
+        rc = ts_param_fits(s, mis[i].path, mis[i].unit, mis[i].given, &err);
+        CHECK(rc == TS_EUNIT && !strncmp(err.msg, mis[i].path,
+                                         strlen(mis[i].path)) &&
+                  strstr(err.msg, mis[i].want[0]) &&
+                  strstr(err.msg, mis[i].want[1]) &&
+                  strstr(err.msg, mis[i].want[2]),
+              "%s in %s refused: %s", mis[i].path, mis[i].unit, err.msg);
+    }
+    rc = ts_param_fits(s, "bodies.fish.loops.depth.setpoint", "m", "40 m",
+                       &err);
+    int rc2 = ts_param_fits(s, "bodies.fish.loops.pitch.kp", "", "2", &err);
+    int rc3 = ts_param_fits(s, "bodies.fish.loops.pitch.kd", "s", NULL, &err);
+    CHECK(rc == TS_OK && rc2 == TS_OK && rc3 == TS_OK,
+          "the loop's own unit, and a plain number, fit");
+    ts_system_free(s);
+}
+
 int main(void)
 {
     ts_err err = {0};
@@ -849,6 +970,7 @@ int main(void)
         test_scene_spelling(u);
         test_scene_words(u);
         test_towing_paths(u);
+        test_loop_units(u);
     }
     test_vehicle();
     ts_units_free(u);

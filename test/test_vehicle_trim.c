@@ -450,6 +450,87 @@ static void test_shooting(void)
     }
 }
 
+/* The message of solving s by `method` into msg[TS_ERR_MSG_MAX]; the
+ * solve's code. */
+static int failure_of(const ts_system *s, ts_eq_method method, char *msg)
+{
+    ts_err err = {0};
+    ts_equilibrium_opts o;
+    ts_equilibrium_opts_default(&o);
+    o.method = method;
+    ts_kernel *k = ts_kernel_alloc(s, &err);
+    ts_equilibrium *eq = ts_equilibrium_alloc(s, &err);
+    int rc = k && eq ? ts_equilibrium_solve(k, &o, eq, &err) : -1;
+    memcpy(msg, err.msg, TS_ERR_MSG_MAX);
+    ts_equilibrium_free(eq);
+    ts_kernel_free(k);
+    return rc;
+}
+
+/* 6. Where shooting and then Newton both fail (a set point out of
+ * reach), the message gives both reasons, shooting's first, and says
+ * where shooting stopped: the worst outer equation (the depth loop and
+ * its error) and a surface at its deflection limit. A message that no
+ * longer fits when a place is put in front of it ends in "...". */
+static void test_unreachable(void)
+{
+    ts_system *s = load("examples/aurora_towfish.yaml", 0);
+    if (!CHECK(s, "the AURORA example loads"))
+        return;
+    ts_vehicle *v = s->bodies[s->cables[0].to_body].vehicle;
+    char msg[TS_ERR_MSG_MAX];
+    /* 400 m of depth on 150 m of cable. */
+    v->loop[0].setpoint = 400;
+    int rc = failure_of(s, TS_EQ_AUTO, msg);
+    const char *sh = strstr(msg, "equilibrium: shooting with vehicles did "
+                                 "not converge");
+    const char *nw = strstr(msg, "; then Newton, the fallback, failed too: ");
+    CHECK(rc == TS_ECONV && sh == msg && nw && nw > sh &&
+              strstr(msg, "of the way from where the loops idle to their "
+                          "set points") &&
+              strstr(msg, "got no closer than outer mismatch") &&
+              strstr(msg, "worst in loop 'depth' of vehicle 'aurora', its "
+                          "error ") &&
+              strstr(msg, "on the way to 400 m") &&
+              strstr(nw, "Newton stopped after") &&
+              strlen(msg) < TS_ERR_MSG_MAX - 1,
+          "400 m of depth on 150 m of cable: shooting's stop, then "
+          "Newton's (%zu characters): %s", strlen(msg), msg);
+    rc = failure_of(s, TS_EQ_SHOOTING, msg);
+    CHECK(rc == TS_ECONV && strstr(msg, "worst in loop 'depth'") &&
+              !strstr(msg, "Newton"),
+          "the same by shooting alone: its reason alone: %s", msg);
+    /* The wing limited to 0.05 rad: it sits at its limit. */
+    int wing = -1;
+    for (int c = 0; c < v->ncomponents; c++)
+        if (!strcmp(v->component[c].name, "wing"))
+            wing = c;
+    if (CHECK(wing >= 0, "the AURORA example has a wing")) {
+        v->component[wing].limit = 0.05;
+        v->loop[0].setpoint = 60;
+        rc = failure_of(s, TS_EQ_SHOOTING, msg);
+        CHECK(rc == TS_ECONV &&
+                  strstr(msg, "with aurora.wing (2.865 deg) at its "
+                              "deflection limit: a set point out of the "
+                              "surfaces' reach?"),
+              "60 m with the wing's limit at 0.05 rad: the wing named at "
+              "its limit: %s", msg);
+    }
+    ts_system_free(s);
+
+    ts_err err = {0};
+    char big[TS_ERR_MSG_MAX];
+    memset(big, 'x', sizeof big - 1);
+    big[sizeof big - 1] = '\0';
+    ts_fail(&err, TS_ECONV, "%s", big);
+    ts_err_prefix(&err, "%s: ", "examples/aurora_towfish.yaml");
+    size_t n = strlen(err.msg);
+    CHECK(n == TS_ERR_MSG_MAX - 1 && !strcmp(err.msg + n - 4, "x...") &&
+              !strncmp(err.msg, "examples/aurora_towfish.yaml: x", 31),
+          "a message cut by the place put in front ends in '...' (%zu "
+          "characters)", n);
+}
+
 int main(void)
 {
     gsl_set_error_handler_off();
@@ -458,5 +539,6 @@ int main(void)
     test_turn_limit();
     test_between();
     test_shooting();
+    test_unreachable();
     return tc_done();
 }

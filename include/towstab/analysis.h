@@ -70,10 +70,22 @@ TS_API int ts_analysis_find(const char *name);
 /* Scene values a request sets by path, at most. */
 #define TS_SETUP_MAX_SETS 16
 
+/* Characters of a setting's value as given (for messages), with the
+ * zero; a longer text is cut. */
+#define TS_SETTING_GIVEN_MAX 48
+
 /* One scene value set by path (towstab/param.h). */
 typedef struct ts_setting {
     char path[TS_PARAM_PATH_MAX]; /* "cables.main.length", "tow.speed" */
-    double value;                 /* SI, in ts_param_unit's unit */
+    double value;                 /* SI, in ts_param_unit's unit, or in
+                                     `unit` when it is given */
+    char unit[TS_PARAM_UNIT_MAX]; /* "" (the key's unit), or the SI unit
+                                     value is in when the key's depends on
+                                     the system (a loop's key given with a
+                                     unit, ts_param_parse): checked against
+                                     the loop when the request is */
+    char given[TS_SETTING_GIVEN_MAX]; /* the text given with `unit` ("400
+                                     m"), for messages; "" otherwise */
 } ts_setting;
 
 /* What every analysis shares. */
@@ -124,6 +136,18 @@ typedef struct ts_setup {
  * against the system). */
 TS_API int ts_setup_set(ts_setup *s, const char *path, double value,
                         ts_err *err);
+
+/* As ts_setup_set, with the value in the SI unit `unit` that
+ * ts_param_parse named without the system (a loop's gain or setpoint
+ * given with a unit: the unit of a depth loop or of an angle loop; NULL
+ * or "": the key's own) and the text it was given as (for messages; may
+ * be NULL). A value whose unit does not fit the loop the path names
+ * (a length for a pitch loop's setpoint) is refused when the request is
+ * checked (ts_analysis_check, TS_EUNIT naming the path, what the loop
+ * measures and the unit expected: ts_param_fits). */
+TS_API int ts_setup_set_in(ts_setup *s, const char *path, double value,
+                           const char *unit, const char *given,
+                           ts_err *err);
 
 /* Modes reported by default when the system has at least
  * ts_eigen_opts.arpack_min_states states (ARPACK finds a subset), and

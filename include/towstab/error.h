@@ -69,7 +69,8 @@ TS_API int ts_fail_nomem(ts_err *err, double bytes, const char *hint,
 #endif
     ;
 
-/* Prepend context to an existing message ("scene x.yaml: " + msg). */
+/* Prepend context to an existing message ("scene x.yaml: " + msg); a
+ * message that no longer fits TS_ERR_MSG_MAX is cut, ending in "...". */
 TS_API void ts_err_prefix(ts_err *err, const char *fmt, ...)
 #ifdef __GNUC__
     __attribute__((format(printf, 2, 3)))

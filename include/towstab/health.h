@@ -73,7 +73,7 @@ typedef struct ts_trust {
 TS_API void ts_trust_init(ts_trust *t);
 
 /* Add a reason (the result is not trustworthy) or a note, printf-style.
- * Texts longer than TS_TRUST_TEXT - 1 are cut. */
+ * Texts longer than TS_TRUST_TEXT - 1 are cut, ending in "...". */
 TS_API void ts_trust_fail(ts_trust *t, const char *fmt, ...)
 #ifdef __GNUC__
     __attribute__((format(printf, 2, 3)))

@@ -57,6 +57,7 @@
 
 #include "towstab/error.h"
 #include "towstab/system.h"
+#include "towstab/units.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -76,6 +77,34 @@ extern "C" {
  * those it has). */
 TS_API int ts_param_unit(const ts_system *sys, const char *path, char *unit,
                          size_t size, ts_err *err);
+
+/* Parse `text`, the value of path's key with an optional unit, into
+ * *value (SI) and the SI unit it is in into unit[size]. With sys, or for
+ * a key whose unit does not depend on the system, that is the key's unit
+ * (ts_param_unit; a plain number is taken in it). Without sys, a loop's
+ * gain or setpoint takes the unit of what the loop measures, not known
+ * yet: a plain number is SI and unit is "" (the loop's unit, whichever
+ * it is); a value with a unit is converted to the unit of a depth loop
+ * or of an angle loop (m or rad for the setpoint; rad/m or 1 for kp,
+ * rad/(m*s) or 1/s for ki, rad*s/m or s for kd), whichever its dimension
+ * fits, and unit names it: ts_param_fits checks it against the loop once
+ * the system is known. `where` names the value in messages. TS_OK,
+ * TS_EINVAL (a path of no known form, not a number) or TS_EUNIT (a unit
+ * of another dimension: without sys, for a loop's key, one that fits
+ * neither kind of loop). */
+TS_API int ts_param_parse(const ts_system *sys, const ts_units *u,
+                          const char *path, const char *text,
+                          const char *where, double *value, char *unit,
+                          size_t size, ts_err *err);
+
+/* Whether a value in the SI unit `unit` (ts_param_parse's) fits path's
+ * key in sys: unit "" or NULL (the key's own), or the key's unit. TS_OK;
+ * TS_EINVAL as ts_param_unit; TS_EUNIT when it does not fit, with
+ * "PATH: 'GIVEN' is in UNIT, the unit of a loop measuring depth (an
+ * angle), but loop 'NAME' of vehicle 'VEHICLE' measures pitch: expected
+ * rad ..." (given: the text as given, may be NULL). */
+TS_API int ts_param_fits(const ts_system *sys, const char *path,
+                         const char *unit, const char *given, ts_err *err);
 
 /* The value at `path`, SI. TS_OK or TS_EINVAL (as ts_param_unit). */
 TS_API int ts_param_get(const ts_system *sys, const char *path,
