@@ -2223,9 +2223,8 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
 
     /* Fast path. */
     int have_guess = 0, vshoot_failed = 0;
-    ts_err serr = {0}; /* shooting's failure, with vehicles */
+    ts_err serr = {0}; /* shooting's failure */
     if (!sys->has_bending && nv == 0 && o.method != TS_EQ_NEWTON) {
-        ts_err serr = {0};
         rc = solve_shooting(k, m, &frame, &o, eq, &serr);
         /* The verdict is the kernel's: a shooting run that stalled just
          * short of its mismatch target (rounding in the local solves of a
