@@ -902,9 +902,45 @@ static double modes_tol(const ts_linear *lin, const ts_eigen_opts *o)
     return pencil_ritz(lin) ? ARPACK_TOL_PENCIL : ARPACK_TOL;
 }
 
+/* ARPACK's start vector when none is given (info = 1: ARPACK starts from
+ * resid): x[n] uniform in [-1, 1) from a fixed linear congruential
+ * sequence. ARPACK's own random start (dgetv0) draws from a seed it keeps
+ * between runs, so a run's rounding would depend on the runs made before
+ * it in the process (the order of a sweep's points on its threads); this
+ * one depends on n alone. */
+static void start_vector(double *x, int n)
+{
+    unsigned long long r = 0x2545F4914F6CDD1DULL;
+    for (int i = 0; i < n; i++) {
+        r = r * 6364136223846793005ULL + 1442695040888963407ULL;
+        x[i] = (double)(r >> 11) * 0x1.0p-52 - 1.0;
+    }
+}
+
+/* ARPACK keeps the state of a run between its calls in SAVE variables
+ * (dnaupd, znaupd and the routines under them): one run at a time in a
+ * process. A run is therefore a critical section of its own, named
+ * ts_arpack, whatever calls it (a sweep's threads, each with its modes and
+ * rightmost search); the rest of an eigen analysis runs in parallel. */
+static int solve_arpack_real_run(const ts_linear *lin,
+                                 const ts_eigen_opts *o, double sigma,
+                                 ts_eigen *e, cand_list *L, ts_err *err);
+
 static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
                              double sigma, ts_eigen *e, cand_list *L,
                              ts_err *err)
+{
+    int rc;
+#ifdef _OPENMP
+#pragma omp critical(ts_arpack)
+#endif
+    rc = solve_arpack_real_run(lin, o, sigma, e, L, err);
+    return rc;
+}
+
+static int solve_arpack_real_run(const ts_linear *lin,
+                                 const ts_eigen_opts *o, double sigma,
+                                 ts_eigen *e, cand_list *L, ts_err *err)
 {
     int n = lin->nstate, nev, ncv, rc;
     tsi_arpack ar;
@@ -931,7 +967,8 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
-    int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
+    int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 1;
+    start_vector(resid, n);
     iparam[0] = 1;                  /* exact shifts */
     iparam[2] = o->arpack_max_iter; /* restarts */
     iparam[3] = 1;
@@ -1014,10 +1051,31 @@ typedef struct arpack_stats {
  * Eigenvalues in the lower half plane are conjugated; a conjugate pair
  * found whole is kept once (matched one to one, so double eigenvalues stay
  * double). */
+static int arpack_near_run(const ts_linear *lin, double complex sigma,
+                           int nev, int ncv, double tol, int maxiter,
+                           int partial, const double complex *start,
+                           const eig_poll *pp, cand_list *L,
+                           arpack_stats *st, ts_err *err);
+
 static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
                        int ncv, double tol, int maxiter, int partial,
                        const double complex *start, const eig_poll *pp,
                        cand_list *L, arpack_stats *st, ts_err *err)
+{
+    int rc;
+#ifdef _OPENMP
+#pragma omp critical(ts_arpack)
+#endif
+    rc = arpack_near_run(lin, sigma, nev, ncv, tol, maxiter, partial, start,
+                         pp, L, st, err);
+    return rc;
+}
+
+static int arpack_near_run(const ts_linear *lin, double complex sigma,
+                           int nev, int ncv, double tol, int maxiter,
+                           int partial, const double complex *start,
+                           const eig_poll *pp, cand_list *L,
+                           arpack_stats *st, ts_err *err)
 {
     int n = lin->nstate, rc;
     tsi_arpack ar;
@@ -1043,11 +1101,11 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
-    int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
-    if (start) {
+    int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 1;
+    if (start)
         memcpy(resid, start, (size_t)n * szc);
-        info = 1; /* ARPACK starts from resid */
-    }
+    else
+        start_vector((double *)resid, 2 * n);
     iparam[0] = 1;
     iparam[2] = maxiter;
     iparam[6] = 3;
@@ -1951,13 +2009,9 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
     if (m == TS_EIG_LAPACK) {
         rc = solve_lapack(lin, &L, err);
     } else {
-        /* ARPACK keeps its state between calls in SAVE variables: one
-         * solve at a time in a process (threads of a sweep). */
-#ifdef _OPENMP
-#pragma omp critical(ts_arpack)
-#endif
     {
-        /* Neutral modes at 0 make A singular there: shift just off it. */
+        /* (Each ARPACK run is a critical section: solve_arpack_real.)
+         * Neutral modes at 0 make A singular there: shift just off it. */
         double sigma = 0.0;
         for (int k = 0; k < lin->nneutral; k++)
             if (lin->neutral[k].re == 0.0 && lin->neutral[k].im == 0.0)

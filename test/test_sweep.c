@@ -8,7 +8,10 @@
  *     agrees with its single run within the sum of their solver error
  *     estimates (both meet the same force residual) and starts from its
  *     neighbour.
- *  2. Threads: the table on 1 and on 3 threads is the same, bit for bit.
+ *  2. Threads: the table on 1 and on 3 threads is the same, bit for bit;
+ *     so is a sweep of modes with ARPACK and its rightmost search on 1
+ *     and 2 threads (ARPACK's runs take turns, each from a start vector
+ *     of its own size alone: lib/eigen.c).
  *  3. Records: every chain written as a record and restored into a fresh
  *     sweep gives the same table bit for bit; a sweep stopped after some
  *     chains and resumed from their records equals one run in one go.
@@ -292,6 +295,47 @@ static int stop_soon(const ts_progress *p, void *data)
     return p->done >= 1;
 }
 
+/* Modes with ARPACK (the sparse model, the rightmost search) at 300
+ * links on 1 and 2 threads: ARPACK keeps a run's state in SAVE variables,
+ * so two runs at once corrupt each other (a crash, heap corruption), and
+ * its own random start vector depends on the runs before it. */
+static void test_threads_arpack(const ts_system *ex1)
+{
+    ts_err err = {0};
+    ts_system *sys = ts_system_copy(ex1, &err);
+    if (!CHECK(sys && ts_system_set_links(sys, 300, &err) == TS_OK,
+               "300 links (%s)", err.msg)) {
+        ts_system_free(sys);
+        return;
+    }
+    double v[4] = {2.0, 2.5, 3.0, 3.5};
+    ts_sweep *s[2] = {NULL, NULL};
+    for (int t = 0; t < 2; t++) {
+        ts_sweep_spec sp;
+        memset(&sp, 0, sizeof sp);
+        ts_request_init(&sp.rq, TS_ANALYSIS_MODES);
+        sp.rq.modes.eigen.method = TS_EIG_ARPACK;
+        sp.rq.modes.count = 6;
+        sp.rq.setup.discretisation_error = 0;
+        sp.naxes = 1;
+        snprintf(sp.axes[0].path, sizeof sp.axes[0].path, "speed");
+        sp.axes[0].n = 4;
+        sp.axes[0].values = v;
+        sp.chain = 1;
+        sp.threads = t + 1;
+        s[t] = ts_sweep_alloc(sys, &sp, &err);
+        if (!s[t])
+            printf("     sweep: %s\n", err.msg);
+    }
+    int ok = s[0] && s[1] && !run_all(s[0]) && !run_all(s[1]);
+    CHECK(ok && same_table(s[0], s[1]),
+          "modes with ARPACK and the rightmost search, 300 links, 4 points "
+          "on 1 and 2 threads: the same table bit for bit");
+    ts_sweep_free(s[0]);
+    ts_sweep_free(s[1]);
+    ts_system_free(sys);
+}
+
 static void test_stop(const ts_system *ex3)
 {
     double w[7] = {0.0, 0.3, 0.6, 0.9, 1.2, 1.5, 1.8};
@@ -430,6 +474,7 @@ int main(void)
     if (ex1 && above && ex3) {
         test_points(ex1->system, ex3->system);
         test_threads_and_records(ex3->system);
+        test_threads_arpack(ex1->system);
         test_stop(ex3->system);
         test_boundary(above->system);
         test_refusals(ex1->system);
