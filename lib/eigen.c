@@ -38,6 +38,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "arpack.h"
 #include "lazylib.h"
 #include "shift.h"
@@ -1968,6 +1972,77 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     return rc;
 }
 
+/* The rightmost search (thread 0) beside the checks of the modes, the
+ * `count` candidates of L nearest the target (another thread), on the
+ * linearization's threads: the checks read copies of the modes (the
+ * search grows L, which moves it), and their results are copied back.
+ * L is first sorted by distance to the target, as eigen_solve sorts it
+ * after the search (the search only appends). acc is factored here and
+ * es holds the checks' factors for the search's checks after them: the
+ * same sequence of factorisations as the search then the checks, so the
+ * results are the same, bit for bit, on one thread (where the checks run
+ * first) or two. *checked is set when the modes were checked. */
+static int search_beside_checks(const ts_linear *lin,
+                                const ts_descriptor *bands,
+                                const ts_eigen_opts *o, ts_eigen *e,
+                                cand_list *L, tsi_shift *acc, tsi_shift *es,
+                                int *checked, ts_err *err)
+{
+    *checked = 0;
+    double complex sigma = I * 2.0 * M_PI * o->target_hz;
+    for (int i = 0; i < L->n; i++)
+        L->c[i].dist = cabs(L->c[i].lam - sigma);
+    qsort(L->c, (size_t)L->n, sizeof(cand), cmp_dist);
+    int keep = o->count < L->n ? o->count : L->n;
+    if (keep < o->count) /* eigen_solve says so after the search */
+        return rightmost_search(lin, bands, o, e, L, err);
+    int n = L->nstate, rc = tsi_shift_factor_inf(acc, lin, err);
+    if (rc != TS_OK)
+        return rc;
+    cand_list M = {0};
+    if (cand_init(&M, keep, n) != TS_OK) {
+        cand_free(&M);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
+    for (int i = 0; i < keep; i++) {
+        M.c[i] = L->c[i];
+        M.c[i].vec = i;
+        M.c[i].checked = 0;
+        memcpy(M.v + (size_t)i * n, L->v + (size_t)L->c[i].vec * n,
+               (size_t)n * sizeof(double complex));
+    }
+    M.n = keep;
+    int nt = lin->threads > 1 ? 2 : 1, rs = TS_OK, rk = TS_OK;
+    ts_err ek = {0};
+#ifdef _OPENMP
+#pragma omp parallel num_threads(nt)
+#endif
+    {
+        int t = 0, team = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        team = omp_get_num_threads();
+#endif
+        if (t == (team > 1 ? 1 : 0))
+            rk = batch_checks(lin, acc, es, &M, &ek);
+        if (t == 0)
+            rs = rightmost_search(lin, bands, o, e, L, err);
+    }
+    if (rs == TS_OK && rk != TS_OK) {
+        rs = rk;
+        if (err)
+            *err = ek;
+    }
+    for (int i = 0; rs == TS_OK && i < keep; i++) {
+        int vec = L->c[i].vec;
+        L->c[i] = M.c[i];
+        L->c[i].vec = vec;
+    }
+    cand_free(&M);
+    *checked = rs == TS_OK;
+    return rs;
+}
+
 static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
                        const ts_eigen_opts *opts, ts_eigen **out,
                        ts_err *err)
@@ -2028,9 +2103,20 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
     }
 
     e->top_hz = NAN;
-    if (m == TS_EIG_ARPACK && o.rightmost && bands)
+    /* With the sparse model the modes' checks (their residuals and error
+     * estimates) run beside the rightmost search (search_beside_checks);
+     * es and acc then carry on to the search's own checks below. */
+    tsi_shift acc = {0}, es = {0};
+    int modes_checked = 0;
+    if (m == TS_EIG_ARPACK && o.rightmost && bands && lin->desc)
+        rc = search_beside_checks(lin, bands, &o, e, &L, &acc, &es,
+                                  &modes_checked, err);
+    else if (m == TS_EIG_ARPACK && o.rightmost && bands)
         rc = rightmost_search(lin, bands, &o, e, &L, err);
     if (rc != TS_OK) {
+        if (acc.numeric || acc.lu || acc.zlu)
+            tsi_shift_free(&acc);
+        tsi_shift_free(&es);
         cand_free(&L);
         ts_eigen_free(e);
         return rc;
@@ -2072,9 +2158,10 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
             cover[ncover++] = i;
     } else {
         for (int i = 0; i < L.n; i++)
-            L.c[i].checked = i < keep ? 0 : -1;
-        tsi_shift acc = {0}, es = {0};
-        if (lin->desc) {
+            L.c[i].checked = i < keep ? (modes_checked ? 1 : 0) : -1;
+        if (modes_checked) {
+            /* Done beside the search. */
+        } else if (lin->desc) {
             rc = tsi_shift_factor_inf(&acc, lin, err);
             if (rc == TS_OK)
                 rc = batch_checks(lin, &acc, &es, &L, err);

@@ -22,6 +22,9 @@
  *     (its bounds may be narrower: the dense bounds of ill-conditioned
  *     eigenvalues hold kappa eps ||A||, and a cable with bending has a
  *     large ||A||).
+ *  4. a marginal verdict names an eigenvalue whose bound reaches 0;
+ *  5. the sparse analysis on one thread and on two (the modes' checks
+ *     beside the search) gives the same result, bit for bit.
  *
  * Scenes with towed vehicles take the same path: the sparse model holds
  * their attitude, rates and controller states (doc/linear.md, section
@@ -215,6 +218,35 @@ static void compare(const char *name, const ts_system *sys)
                   "decided, yet no other eigenvalue named", name,
                   sys->nlinks, w ? "LAPACK" : "ARPACK", e->max_real,
                   e->max_real_error);
+    }
+    /* 5. The modes' checks run beside the search on the linearization's
+     * threads (lib/eigen.c, search_beside_checks): the same analysis on
+     * one thread and on two, bit for bit. */
+    if (!lin->A || sys->tow.vehicle < 0) {
+        ts_eigen *one = NULL, *two = NULL;
+        int threads = lin->threads;
+        lin->threads = 1;
+        rc = ts_eigen_solve(lin, &o, &one, &err);
+        lin->threads = 2;
+        if (rc == TS_OK)
+            rc = ts_eigen_solve(lin, &o, &two, &err);
+        lin->threads = threads;
+        int same = rc == TS_OK && one->nmodes == two->nmodes &&
+                   one->verdict == two->verdict &&
+                   one->rightmost.re == two->rightmost.re &&
+                   one->rightmost.im == two->rightmost.im &&
+                   one->rightmost.error_bound == two->rightmost.error_bound &&
+                   one->sweep_found == two->sweep_found;
+        for (int i = 0; same && i < one->nmodes; i++)
+            same = one->modes[i].re == two->modes[i].re &&
+                   one->modes[i].im == two->modes[i].im &&
+                   one->modes[i].error_bound == two->modes[i].error_bound &&
+                   one->modes[i].vector_error == two->modes[i].vector_error;
+        CHECK(same, "%s (%d links): ARPACK and the search on one thread and "
+              "on two: the same modes, bounds and rightmost, bit for bit "
+              "(%s)", name, sys->nlinks, rc == TS_OK ? "" : err.msg);
+        ts_eigen_free(one);
+        ts_eigen_free(two);
     }
     ts_eigen_free(all);
     ts_eigen_free(ar);
