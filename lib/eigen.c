@@ -724,7 +724,11 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
 }
 
 /* A Ritz pair of the search whose Ritz value's own error (ritz) exceeds
- * this fraction of |lambda| has not converged and is dropped. */
+ * this fraction of |lambda| has not converged and is dropped. On the
+ * dense A (no sparse model) ritz is the residual ||A v - lambda v|| / |v|,
+ * which a pair converged to ARPACK's tolerance tau on (A - sigma I)^-1
+ * keeps below tau ||A - sigma I||, not tau |lambda|: there the fraction is
+ * of |lambda| + max |A_ij| (a lower bound of ||A||). */
 #define SWEEP_RESIDUAL 1e-6
 
 /* The residuals and error estimates of L's unchecked candidates: A
@@ -2182,7 +2186,9 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
             L.c[best].checked = 0;
             rc = lin->desc ? batch_checks(lin, &acc, &es, &L, err)
                            : dense_checks(lin, &L, err);
-            if (L.c[best].ritz > SWEEP_RESIDUAL * cabs(L.c[best].lam)) {
+            double scale = cabs(L.c[best].lam) +
+                           (lin->desc ? 0.0 : lin->a_scale);
+            if (L.c[best].ritz > SWEEP_RESIDUAL * scale) {
                 L.c[best].sweep = 3;
                 e->sweep_rejected++;
             } else {
