@@ -160,25 +160,6 @@ int cli_check_outputs(const char *cmd, int n, const char *const what[],
     return 0;
 }
 
-int cli_finish(int status)
-{
-    int e = 0, bad = ferror(stdout);
-    if (fflush(stdout) != 0)
-        e = errno;
-    if (fclose(stdout) != 0 && !e)
-        e = errno;
-    if (bad || e) {
-        fprintf(stderr, "towstab: error: standard output: write failed%s%s%s"
-                        "\n",
-                e ? " (" : "", e ? strerror(e) : "", e ? ")" : "");
-        if (status == 0)
-            status = EXIT_FAILED;
-    }
-    if ((fflush(stderr) != 0 || ferror(stderr)) && status == 0)
-        status = EXIT_FAILED;
-    return status;
-}
-
 double cli_wall_now(void)
 {
     struct timespec t;
@@ -264,6 +245,33 @@ const char *cli_stop_signal_name(void)
     return stop_signal == SIGINT    ? "SIGINT"
            : stop_signal == SIGTERM ? "SIGTERM"
                                     : NULL;
+}
+
+int cli_finish(int status)
+{
+    /* A signal between the run's last stop point and its end: the run
+     * completed and its outputs are whole; say so. */
+    alarm(0);
+    if (stop_signal && status == 0)
+        fprintf(stderr, "towstab: note: %s arrived after the run's last "
+                        "stop point: the run completed and its outputs "
+                        "are complete\n",
+                cli_stop_signal_name() ? cli_stop_signal_name() : "a signal");
+    int e = 0, bad = ferror(stdout);
+    if (fflush(stdout) != 0)
+        e = errno;
+    if (fclose(stdout) != 0 && !e)
+        e = errno;
+    if (bad || e) {
+        fprintf(stderr, "towstab: error: standard output: write failed%s%s%s"
+                        "\n",
+                e ? " (" : "", e ? strerror(e) : "", e ? ")" : "");
+        if (status == 0)
+            status = EXIT_FAILED;
+    }
+    if ((fflush(stderr) != 0 || ferror(stderr)) && status == 0)
+        status = EXIT_FAILED;
+    return status;
 }
 
 /* A duration for the progress line: "42 s", "3.5 min", "2.1 h". */
