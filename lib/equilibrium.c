@@ -946,8 +946,48 @@ static void path_at(ts_kernel *k, const newton_ws *w, path_fn path,
     ts_kernel_set_turn_deflection(k, turn);
 }
 
+/* Appends to buf (holding len characters) the lifting surfaces in or
+ * past their stall at the kernel's last evaluation, |alpha| beyond stall
+ * - stall_width, where the lift curve bends over (a solve asking more
+ * lift than a surface gives stops at its maximum, inside that band):
+ * ", with <vehicle>.<surface> (angle of attack A deg, its stall S +- W
+ * deg) stalling", the first two named. A surface with tabulated curves
+ * has no stall angle and is not judged. Returns the new length.
+ * O(vehicles' components). */
+static size_t stalled(const ts_kernel *k, char *buf, size_t len, size_t size)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int n = 0;
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        ts_vehicle_result r;
+        ts_kernel_vehicle_result(k, v, &r);
+        const ts_body *b = &sys->bodies[r.body];
+        for (int c = 0; c < b->vehicle->ncomponents; c++) {
+            const ts_component *cp = &b->vehicle->component[c];
+            if (cp->type != TS_COMP_SURFACE || cp->curve == TS_CURVE_TABLE ||
+                !(fabs(r.load[c].alpha) > cp->stall - cp->stall_width))
+                continue;
+            if (n++ < 2 && len < size)
+                len += (size_t)snprintf(
+                    buf + len, size - len, "%s%s.%s (angle of attack %.3g "
+                    "deg, its stall %.3g +- %.3g deg)",
+                    n > 1 ? ", " : ", with ", b->name, cp->name,
+                    r.load[c].alpha * 180 / M_PI, cp->stall * 180 / M_PI,
+                    cp->stall_width * 180 / M_PI);
+        }
+    }
+    if (n > 2 && len < size)
+        len += (size_t)snprintf(buf + len, size - len, " and %d more", n - 2);
+    if (n > 0 && len < size)
+        len += (size_t)snprintf(buf + len, size - len, " stalling: more "
+                                "lift asked than %s gives?",
+                                n > 1 ? "they" : "it");
+    return len < size ? len : size - 1;
+}
+
 /* ", with <vehicle>.<surface> at its limit" for the first control
- * surface at its deflection limit in state y, else "". */
+ * surface at its deflection limit in state y, else "", then the surfaces
+ * past their stall (stalled). */
 static void saturated(ts_kernel *k, const double *y, char *buf, size_t size)
 {
     const ts_system *sys = ts_kernel_system(k);
@@ -981,6 +1021,7 @@ static void saturated(ts_kernel *k, const double *y, char *buf, size_t size)
             }
         }
     }
+    stalled(k, buf, strlen(buf), size);
 }
 
 /* Newton along a parameter path t in [0, 1] from y, a state near the
@@ -1662,7 +1703,7 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
     if (nlim > 2 && len < sizeof lim)
         snprintf(lim + len, sizeof lim - len, " and %d more", nlim - 2);
     s->where_merit = merit;
-    snprintf(s->where, sizeof s->where, "%s%s%s%s%s",
+    int w = snprintf(s->where, sizeof s->where, "%s%s%s%s%s",
              worst[0] ? ", worst in " : "", worst, nlim ? ", with " : "",
              lim,
              nlim ? (nlim > 1 ? " at their deflection limits: a set point "
@@ -1670,6 +1711,8 @@ static void vshoot_where(vshoot *s, const double *res, double merit)
                               : " at its deflection limit: a set point out "
                                 "of the surfaces' reach?")
                   : "");
+    if (w >= 0 && (size_t)w < sizeof s->where)
+        stalled(k, s->where, (size_t)w, sizeof s->where);
 }
 
 /* The outer solve from z[nz] at the kernel's frame and set points, until

@@ -515,6 +515,21 @@ static void test_unreachable(void)
                               "surfaces' reach?"),
               "60 m with the wing's limit at 0.05 rad: the wing named at "
               "its limit: %s", msg);
+        CHECK(!strstr(msg, "stalling"), "the wing at 2.9 deg, its stall 15 "
+              "deg: no stall named: %s", msg);
+        /* Its stall at 2 +- 0.5 deg: the solve stops at its lift's
+         * maximum, inside the stall's band, and says so. */
+        v->component[wing].stall = 2.0 * M_PI / 180;
+        v->component[wing].stall_width = 0.5 * M_PI / 180;
+        rc = failure_of(s, TS_EQ_SHOOTING, msg);
+        const char *w = strstr(msg, "with aurora.wing (angle of attack ");
+        double a = w ? atof(w + strlen("with aurora.wing (angle of attack "))
+                     : NAN;
+        CHECK(rc == TS_ECONV && w && fabs(a) > 1.5 && fabs(a) < 2.5 &&
+                  strstr(w, "deg, its stall 2 +- 0.5 deg) stalling: more "
+                            "lift asked than it gives?"),
+              "the wing's stall at 2 deg: the wing named stalling, its angle "
+              "of attack within the stall's band: %s", msg);
     }
     ts_system_free(s);
 

@@ -17,7 +17,8 @@
 #   loop and its error), then Newton's; the JSON written is marked
 #   "completed": false with that error. With the wing's limit at 0.05 rad
 #   and --equilibrium-method shooting the error says the wing is at its
-#   deflection limit, and names no Newton.
+#   deflection limit, and names no Newton; with its stall at 2 +- 0.5 deg
+#   as well, that the wing is stalling.
 # Prints one PASS/FAIL line per check and "N passed, N failed".
 set -u
 if [ $# -ne 1 ]; then
@@ -164,5 +165,19 @@ done
 case "$err" in *Newton*) why="$why names Newton;" ;; esac
 grep -q '"completed": false' "$T/o/s.json" 2>/dev/null || why="$why JSON not marked completed false;"
 check "method shooting, the wing's limit 0.05 rad, 60 m: the wing at its limit named" "$why"
+
+fresh
+ts equilibrium "$EX" --json "$T/o/st.json" --equilibrium-method shooting \
+    --set "bodies.aurora.components.wing.limit=0.05" --set "$D.setpoint=60" \
+    --set "bodies.aurora.components.wing.stall=2deg" \
+    --set "bodies.aurora.components.wing.stall_width=0.5deg"
+why=""
+[ "$status" -eq 1 ] || why="$why exit $status;"
+err=$(grep '^towstab: error: ' "$T/err")
+case "$err" in
+*"with aurora.wing (angle of attack "*" deg, its stall 2 +- 0.5 deg) stalling: more lift asked than it gives?"*) ;;
+*) why="$why the wing not named stalling in: $err;" ;;
+esac
+check "method shooting, the wing's stall at 2 deg: the wing named stalling" "$why"
 
 finish
