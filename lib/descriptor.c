@@ -1062,6 +1062,194 @@ void tsi_desc_error_terms(const ts_descriptor *d, const double complex w[],
     *round = sqrt(0.5 * r2);
 }
 
+double tsi_desc_motion_check(const ts_descriptor *d, double complex lam,
+                             const double complex p[],
+                             const double complex pv[],
+                             const double complex c[])
+{
+    const int est = d->Kerr && d->Cerr && d->rnoise &&
+                    (d->nv == 0 || d->Lerr);
+    const double rt = 8.0 * DBL_EPSILON;
+    size_t n3 = 3 * (size_t)d->np;
+    double worst = 0;
+    /* The inertia's part lam M pv, real and imaginary parts apart. */
+    double *pr = malloc(4 * n3 * sizeof(double));
+    if (!pr)
+        return INFINITY;
+    double *pi = pr + n3, *mr = pi + n3, *mi = mr + n3;
+    for (size_t i = 0; i < n3; i++) {
+        pr[i] = creal(pv[i]);
+        pi[i] = cimag(pv[i]);
+    }
+    tsi_desc_mass_mul(d, pr, mr);
+    tsi_desc_mass_mul(d, pi, mi);
+#define RATIO(r_, a_)                                                         \
+    do {                                                                      \
+        double q_ = cabs(r_) > 0 ? cabs(r_) / (a_) : 0.0;                     \
+        if (!(q_ <= worst))                                                   \
+            worst = q_ == q_ ? q_ : INFINITY;                                 \
+    } while (0)
+    for (int k = d->p0; k < d->np; k++) {
+        double complex r[3], mass[3];
+        double size[3], err[3] = {0, 0, 0}, xk = 0;
+        for (int a = 0; a < 3; a++) {
+            mass[a] = lam * (mr[3 * k + a] + I * mi[3 * k + a]);
+            r[a] = mass[a];
+            size[a] = cabs(mass[a]);
+        }
+        for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
+            int j = d->bcol[b];
+            const double *Kb = d->K + 9 * (size_t)b, *Cb = d->C + 9 * (size_t)b;
+            for (int a = 0; a < 3; a++)
+                for (int e = 0; e < 3; e++) {
+                    int i = 3 * a + e;
+                    double complex tk = Kb[i] * p[3 * j + e],
+                                   tc = Cb[i] * pv[3 * j + e];
+                    r[a] += tk + tc;
+                    size[a] += cabs(tk) + cabs(tc);
+                    if (est)
+                        err[a] += fabs(d->Kerr[9 * (size_t)b + i]) *
+                                      cabs(p[3 * j + e]) +
+                                  fabs(d->Cerr[9 * (size_t)b + i]) *
+                                      cabs(pv[3 * j + e]);
+                }
+            for (int e = 0; e < 3; e++) {
+                double hr = d->hr[3 * j + e], hv = d->hv[3 * j + e];
+                xk += cabs(p[3 * j + e]) / hr +
+                      (d->bdist[b] <= 1 ? cabs(pv[3 * j + e]) / hv : 0.0);
+            }
+        }
+        /* A vehicle's force and rotational rows on its controller
+         * states. */
+        int lc0, v = point_vehicle(d, k, &lc0);
+        if (v >= 0 && c) {
+            const tsi_vehicle_layout *L = &d->vl[v];
+            int ncol = TSI_LV_C + L->nc + L->nin, lr0 = lc0 == TSI_LV_R ? 0 : 3;
+            for (int m = 0; m < L->nc; m++) {
+                double complex cm = c[L->c0 + m];
+                for (int a = 0; a < 3; a++) {
+                    size_t at = (size_t)d->lv_off[v] +
+                                (size_t)(lr0 + a) * ncol + TSI_LV_C + m;
+                    r[a] += d->Lv[at] * cm;
+                    size[a] += cabs(d->Lv[at] * cm);
+                    if (est)
+                        err[a] += fabs(d->Lerr[at]) * cabs(cm);
+                }
+                xk += cabs(cm) / d->hc[L->c0 + m];
+            }
+        }
+        for (int a = 0; a < 3; a++) {
+            if (tsi_desc_held(d, k, a))
+                continue;
+            double allow = est ? err[a] + d->rnoise[3 * k + a] * xk / M_SQRT2
+                               : 1e-6 * size[a];
+            RATIO(r[a], allow + rt * size[a]);
+        }
+    }
+    /* Controller rows: lam c - (Hr p + Hv pv + Hc c). */
+    for (int v = 0; v < d->nv; v++) {
+        const tsi_vehicle_layout *L = &d->vl[v];
+        int ncol = TSI_LV_C + L->nc + L->nin;
+        for (int m = 0; m < L->nc; m++) {
+            size_t at = (size_t)d->lv_off[v] + (size_t)(6 + m) * ncol;
+            const double *row = d->Lv + at;
+            const double *erow = est ? d->Lerr + at : NULL;
+            double complex r = c ? lam * c[L->c0 + m] : 0.0;
+            double size = cabs(r), err = 0, xk = 0;
+            for (int lc = 0; lc < 6; lc++) {
+                int i;
+                double complex xp = lv_point(d, v, lc, p, &i),
+                               xv = lv_point(d, v, lc, pv, &i);
+                double complex t = row[lc] * xp + row[lc + TSI_LV_V] * xv;
+                r -= t;
+                size += cabs(row[lc] * xp) + cabs(row[lc + TSI_LV_V] * xv);
+                if (erow)
+                    err += fabs(erow[lc]) * cabs(xp) +
+                           fabs(erow[lc + TSI_LV_V]) * cabs(xv);
+                xk += cabs(xp) / d->hr[i] + cabs(xv) / d->hv[i];
+            }
+            for (int m2 = 0; c && m2 < L->nc; m2++) {
+                double complex cm = c[L->c0 + m2];
+                r -= row[TSI_LV_C + m2] * cm;
+                size += cabs(row[TSI_LV_C + m2] * cm);
+                if (erow)
+                    err += fabs(erow[TSI_LV_C + m2]) * cabs(cm);
+                xk += cabs(cm) / d->hc[L->c0 + m2];
+            }
+            double allow =
+                est ? err + d->rnoise[n3 + L->c0 + m] * xk / M_SQRT2
+                    : 1e-6 * size;
+            RATIO(r, allow + rt * size);
+        }
+    }
+#undef RATIO
+    free(pr);
+    return worst;
+}
+
+int tsi_desc_cut(const ts_descriptor *d, int root_qoff, const int comps[],
+                 int m, ts_descriptor *out)
+{
+    *out = *d;
+    out->ncut = 0;
+    size_t nk = 9 * (size_t)d->nblocks;
+    size_t nlv = d->nv > 0 ? (size_t)d->lv_off[d->nv] : 0;
+    out->K = malloc((nk + 1) * sizeof(double));
+    out->Lv = malloc((nlv + 1) * sizeof(double));
+    if (!out->K || !out->Lv) {
+        free(out->K);
+        free(out->Lv);
+        out->K = out->Lv = NULL;
+        return TS_ENOMEM;
+    }
+    memcpy(out->K, d->K, nk * sizeof(double));
+    if (nlv > 0)
+        memcpy(out->Lv, d->Lv, nlv * sizeof(double));
+    for (int t = 0; t < m && t < 2; t++) {
+        int e = comps[t];
+        out->cut[out->ncut] = root_qoff + e;
+        out->cut_comp[out->ncut++] = e;
+        /* Point rows: the translation's sum off the row's largest entry
+         * on a translated (node) column. */
+        for (int k = d->p0; k < d->np; k++)
+            for (int a = 0; a < 3; a++) {
+                if (tsi_desc_held(d, k, a))
+                    continue;
+                double sum = 0, big = -1;
+                size_t at = 0;
+                for (int b = d->bptr[k]; b < d->bptr[k + 1]; b++) {
+                    if (d->bcol[b] >= d->nn)
+                        continue;
+                    size_t i = 9 * (size_t)b + 3 * (size_t)a + (size_t)e;
+                    sum += out->K[i];
+                    if (fabs(out->K[i]) > big) {
+                        big = fabs(out->K[i]);
+                        at = i;
+                    }
+                }
+                if (big >= 0)
+                    out->K[at] -= sum;
+            }
+        /* Controller rows: their entries on the vehicle's node. */
+        for (int v = 0; v < d->nv; v++) {
+            const tsi_vehicle_layout *L = &d->vl[v];
+            int ncol = TSI_LV_C + L->nc + L->nin;
+            for (int j = 0; j < L->nc; j++)
+                out->Lv[(size_t)d->lv_off[v] + (size_t)(6 + j) * ncol +
+                        TSI_LV_R + e] = 0.0;
+        }
+    }
+    return TS_OK;
+}
+
+void tsi_desc_cut_free(ts_descriptor *cut)
+{
+    free(cut->K);
+    free(cut->Lv);
+    cut->K = cut->Lv = NULL;
+    cut->ncut = 0;
+}
+
 /* A surface ship's held components (tsi_desc_held): their rows' K the
  * identity, their C, inertia, tension coefficients, local blocks, tow
  * input columns, errors and noise zero, so that every product with them

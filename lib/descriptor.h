@@ -200,6 +200,14 @@ struct ts_descriptor {
     double k_err, c_err; /* max |Kerr|, max |Cerr| */
     double k_round, c_round; /* max rnoise_i / (sqrt(2) h_j) over the
                             entries of K and C */
+    /* A towing vehicle's cyclic states cut for the eigen analysis (its
+     * copy of the model, tsi_desc_cut; none in the linearization's own):
+     * the states cut[0 .. ncut) (the tow point's position along, across
+     * the track: kernel state root_qoff + cut_comp[i]) whose columns of
+     * A are zero. The solves of lib/shift.c then act with the cut A
+     * (doc/linear.md section 3a). */
+    int ncut;
+    int cut[2], cut_comp[2];
 };
 
 /* Unknown of point k's component c (k >= 1), of link l's tension, of
@@ -309,6 +317,39 @@ void tsi_desc_fill_parts(const ts_descriptor *d, double Sk[], double Sc[],
  * dr_lower (and -g on dr_upper), (EA/l + s Cv) n. */
 void tsi_desc_taut_row(const ts_descriptor *d, int l, double complex s,
                        double complex g[3]);
+
+/* A motion of the whole system with the tensions unchanged (a towing
+ * vehicle's neutral mode by symmetry, doc/linear.md section 3a) against
+ * the sparse model: with the point displacements p[3 np], their rates
+ * pv[3 np] and the controller states c[nc] (NULL: zero), all complex,
+ * and the eigenvalue lam, the residuals of the point rows, lam M pv +
+ * C pv + K p + Kc c, and of the controller rows, lam c - (Hr p + Hv pv
+ * + Hc c), each against its error allowance: sum_j (|Kerr_ij| + rnoise_i
+ * / (sqrt(2) hr_j)) |p_j| and the same of C on pv and of the local
+ * blocks on p, pv and c, plus the rounding of the products (8 eps times
+ * the sum of the terms' moduli); without the estimate, 1e-6 of that sum.
+ * Returns the largest ratio over the rows (a surface ship's held rows
+ * left out; 0 when every residual is 0). The link rows are left out:
+ * such a motion keeps every link's length by its construction.
+ * O(nlinks). */
+double tsi_desc_motion_check(const ts_descriptor *d, double complex lam,
+                             const double complex p[],
+                             const double complex pv[],
+                             const double complex c[]);
+
+/* The eigen analysis's copy of d with the cyclic states comps[0 .. m)
+ * (the tow point's translation components, 0 along and 1 across the
+ * track; the kernel states root_qoff + comps[i]) cut, into *out: d's
+ * arrays shared but for its own K and Lv, in which a translation of the
+ * whole system along each component is an exact null vector (every
+ * point row's sum over the translated columns, zero within its error
+ * where the column of A was found zero, taken off its largest entry
+ * there, and the controller rows' entries on the translated components
+ * zeroed), as the dense analysis zeroes the cyclic columns of A. Free
+ * with tsi_desc_cut_free (never tsi_desc_free). TS_OK or TS_ENOMEM. */
+int tsi_desc_cut(const ts_descriptor *d, int root_qoff, const int comps[],
+                 int m, ts_descriptor *out);
+void tsi_desc_cut_free(ts_descriptor *cut);
 
 /* y[3 np] = sum_j B[k, j] x[j] over the blocks of row points k >= 1
  * (B = K, C, Kerr or Cerr; x[3 np]; y_0 = 0); with acc, y += instead of

@@ -674,6 +674,62 @@ static int column_cyclic(const ts_linear *lin, int j)
     return 1;
 }
 
+/* The sparse model's test of a motion y (lambda, g; complex, kernel
+ * states) against its error: the point and controller rows
+ * (tsi_desc_motion_check) with the states of `cut` (NULL: none) taken as
+ * zero in the displacements, within NEUTRAL_SAFETY of their allowances.
+ * The upper rows (q' = q') are the caller's. */
+static int motion_confirmed(const ts_linear *lin, double complex lambda,
+                            const double complex *g, const char *cut)
+{
+    const ts_descriptor *d = lin->desc;
+    int nq = lin->nq;
+    size_t n3 = 3 * (size_t)d->np;
+    double *q = malloc(((size_t)nq + 1 + 2 * n3) * sizeof(double));
+    double complex *p = malloc((2 * n3 + (size_t)d->nc + 1) * sizeof *p);
+    if (!q || !p) {
+        free(q);
+        free(p);
+        return 0;
+    }
+    double *u = q + nq + 1;
+    double complex *pv = p + n3, *c = pv + n3;
+    for (int rate = 0; rate < 2; rate++) {
+        for (int part = 0; part < 2; part++) {
+            for (int i = 0; i < nq; i++) {
+                double complex z = g[rate * nq + i];
+                q[i] = !rate && cut && cut[i] ? 0.0
+                                              : (part ? cimag(z) : creal(z));
+            }
+            tsi_desc_to_points(d, lin, q, u + part * n3);
+        }
+        double complex *out = rate ? pv : p;
+        for (size_t i = 0; i < n3; i++)
+            out[i] = u[i] + I * u[n3 + i];
+    }
+    for (int j = 0; j < d->nc; j++)
+        c[j] = g[2 * nq + j];
+    double ratio = tsi_desc_motion_check(d, lambda, p, pv, c);
+    free(q);
+    free(p);
+    return ratio <= NEUTRAL_SAFETY;
+}
+
+/* column_cyclic on the sparse model (no dense A): the translation of the
+ * whole system by state j (every node moved alike, the angles kept)
+ * meets no force and no controller rate within the error. */
+static int column_cyclic_sparse(const ts_linear *lin, int j)
+{
+    int n = lin->nstate;
+    double complex *g = calloc((size_t)n, sizeof *g);
+    if (!g)
+        return 0;
+    g[j] = 1.0;
+    int ok = motion_confirmed(lin, 0.0, g, NULL);
+    free(g);
+    return ok;
+}
+
 /* Whether (lambda, g) is an eigenpair of A with the cyclic states' rows
  * and columns removed (the model the eigen analysis factors), within the
  * linearization's error. */
@@ -684,6 +740,16 @@ static int neutral_confirmed(const ts_linear *lin, double complex lambda,
     double gmax = 0;
     for (int j = 0; j < n; j++)
         gmax = fmax(gmax, cabs(g[j]));
+    if (!lin->A) {
+        /* The sparse model: the upper rows [0 I 0] here, exact; the
+         * lower ones as the point and controller rows' residuals. */
+        for (int i = 0; i < nq; i++)
+            if (!cyclic[i] && !(cabs(g[nq + i] - lambda * g[i]) <=
+                                8 * DBL_EPSILON * (1.0 + cabs(lambda)) *
+                                    gmax))
+                return 0;
+        return motion_confirmed(lin, lambda, g, cyclic);
+    }
     for (int i = 0; i < n; i++) {
         double complex r = cyclic[i] ? 0.0 : -lambda * g[i];
         double allow = 0;
@@ -803,7 +869,7 @@ static int neutral_modes(ts_kernel *k, const ts_frame *fr, ts_linear *lin,
     free(lin->neutral_re);
     free(lin->neutral_im);
     lin->neutral_re = lin->neutral_im = NULL;
-    if (lin->root_qoff < 0 || !lin->A)
+    if (lin->root_qoff < 0 || (!lin->A && !lin->desc))
         return TS_OK;
     int n = lin->nstate, nq = lin->nq, ro = lin->root_qoff;
     double complex *g = calloc((size_t)n, sizeof *g);
@@ -813,8 +879,11 @@ static int neutral_modes(ts_kernel *k, const ts_frame *fr, ts_linear *lin,
      * nowhere (no frame rotation to make them matter); their columns of A
      * are zero within the error and their rows [0 I] make each a pure
      * integrator of its rate. */
-    int straight = rc == TS_OK && column_cyclic(lin, ro) &&
-                   column_cyclic(lin, ro + 1);
+    int straight = rc == TS_OK &&
+                   (lin->A ? column_cyclic(lin, ro) &&
+                                 column_cyclic(lin, ro + 1)
+                           : column_cyclic_sparse(lin, ro) &&
+                                 column_cyclic_sparse(lin, ro + 1));
     if (straight) {
         cyclic[ro] = cyclic[ro + 1] = 1;
         static const char *const names[2] = {"along-track position",
