@@ -640,8 +640,8 @@ out:
  * (kappa = 1 without a left vector, exact for a normal matrix). The
  * residual itself is the rounding allowance (Bauer-Fike with kappa = 1):
  * an exact eigenpair of a matrix within ||r|| of A. */
-/* The same checks with the dense A and its error estimate (a system the
- * sparse model does not cover: a towing vehicle at the root), with one
+/* The same checks with the dense A and its error estimate (without the
+ * sparse model: TS_LIN_DENSE), with one
  * pass over A and one over E (BLAS dgemm on the real and imaginary parts
  * of all the unchecked vectors at once). */
 /* A candidate's residual ||A v - lam v|| / |v| (round) and relative to
@@ -1752,6 +1752,63 @@ static double *cut_cyclic(const ts_linear *lin)
     return a;
 }
 
+/* The largest |A g - s g| / |g| over the generators gk[0..m) of s on
+ * the sparse model (lin's, its cyclic states cut: lib/shift.c), A applied
+ * through S_inf, O(nlinks) per generator; INFINITY on failure. */
+static double generator_residual_sparse(const ts_linear *lin,
+                                        double complex s, const int *gk,
+                                        int m)
+{
+    int n = lin->nstate;
+    tsi_shift acc;
+    if (tsi_shift_factor_inf(&acc, lin, NULL) != TS_OK)
+        return INFINITY;
+    double *w = malloc(4 * (size_t)n * sizeof(double));
+    if (!w) {
+        tsi_shift_free(&acc);
+        return INFINITY;
+    }
+    double *ar = w + 2 * (size_t)n, *ai = ar + n;
+    double worst = 0;
+    for (int r = 0; r < m; r++) {
+        const double *gr = lin->neutral_re + (size_t)gk[r] * n;
+        const double *gi = lin->neutral_im + (size_t)gk[r] * n;
+        memcpy(w, gr, (size_t)n * sizeof(double));
+        memcpy(w + n, gi, (size_t)n * sizeof(double));
+        tsi_shift_apply(&acc, w, ar, 0);
+        tsi_shift_apply(&acc, w + n, ai, 0);
+        double g2 = 0, r2 = 0;
+        for (int i = 0; i < n; i++) {
+            double complex g = gr[i] + I * gi[i];
+            double complex d = ar[i] + I * ai[i] - s * g;
+            g2 += creal(g * conj(g));
+            r2 += creal(d * conj(d));
+        }
+        if (g2 > 0)
+            worst = fmax(worst, sqrt(r2 / g2));
+    }
+    free(w);
+    tsi_shift_free(&acc);
+    return worst;
+}
+
+/* max |A_ij| of the lower block (ts_linear.a_scale), or without the
+ * dense A an estimate from the sparse model: the largest local band top
+ * squared (zigzag_freq), the order of the largest entries of -M^-1 K. */
+static double a_scale_of(const ts_linear *lin)
+{
+    if (isfinite(lin->a_scale) || !lin->desc)
+        return lin->a_scale;
+    const ts_descriptor *d = lin->desc;
+    double w2 = 0;
+    for (int k = 1; k < d->nn; k++) {
+        double wt, wa;
+        zigzag_freq(d, k, &wt, &wa);
+        w2 = fmax(w2, fmax(wt * wt, wa * wa));
+    }
+    return w2;
+}
+
 /* The largest |A' g - s g| / |g| over the generators gk[0..m) of s, A'
  * the dense A with the cyclic states' rows and columns cut as the
  * eigensolvers see it (cut_cyclic), with `cleaned` also its entries below
@@ -1761,6 +1818,8 @@ static double *cut_cyclic(const ts_linear *lin)
 static double generator_residual(const ts_linear *lin, double complex s,
                                  const int *gk, int m, int cleaned)
 {
+    if (!lin->A && lin->desc)
+        return generator_residual_sparse(lin, s, gk, m);
     if (!lin->A)
         return INFINITY;
     int n = lin->nstate;
@@ -1807,6 +1866,8 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
     double dA = isfinite(lin->trunc_norm) ? lin->trunc_norm : 1e-6 * lin->a_norm;
     if (isfinite(lin->round_norm))
         dA += lin->round_norm;
+    if (!isfinite(dA)) /* the sparse model: the residual alone */
+        dA = INFINITY;
     double complex *q = malloc((size_t)n * (size_t)(ng > 0 ? ng : 1) *
                                sizeof *q);
     if (!q)
@@ -1849,9 +1910,12 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
             gk[m++] = k;
         }
         /* Near s: within the bound (or rounding of A) of it. */
-        double floor = 100.0 * DBL_EPSILON * lin->a_norm;
+        double floor = 100.0 * DBL_EPSILON *
+                       (isfinite(lin->a_norm) ? lin->a_norm : a_scale_of(lin));
         double gap = INFINITY;
         for (int c = 0; c < L->n; c++) {
+            if (L->c[c].sweep >= 2) /* a repeat, dropped or superseded */
+                continue;
             double b = ERROR_SAFETY * ((isfinite(L->c[c].dlam) ? L->c[c].dlam
                                                                : 0.0) +
                                        L->c[c].round);
@@ -1863,11 +1927,15 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
         if (!(NEUTRAL_SAFETY * fmin(dA, res + floor) / gap <=
               NEUTRAL_ANGLE_MAX))
             continue;
-        for (int taken = 0; taken < m;) {
+        /* The modes first, one per generator; then the search's
+         * eigenvalues (sweep 1), which may repeat them. */
+        for (int taken = 0, pass = 0; pass < 2;) {
             int best = -1;
             double bd = INFINITY;
             for (int c = 0; c < L->n; c++) {
                 cand *cc = &L->c[c];
+                if (cc->sweep != pass)
+                    continue;
                 double b = ERROR_SAFETY * ((isfinite(cc->dlam) ? cc->dlam
                                                                : 0.0) +
                                            cc->round);
@@ -1877,8 +1945,10 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
                 best = c;
                 bd = d;
             }
-            if (best < 0)
-                break;
+            if (best < 0 || (pass == 0 && taken >= m)) {
+                pass++;
+                continue;
+            }
             /* The angle to the span: |v - Q Q^H v| / |v|. */
             const double complex *v = L->v + (size_t)L->c[best].vec * n;
             double v2 = 0, p2 = 0;
@@ -1895,14 +1965,17 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
              * condition number that can exceed |dA g|, and the vector
              * moves with it. */
             double tol = NEUTRAL_SAFETY * fmin(dA, fmax(res, bd) + floor) / gap;
-            if (!(sin_angle <= tol && tol <= NEUTRAL_ANGLE_MAX))
-                break;
-            /* The generator it overlaps most, not yet taken. */
+            if (!(sin_angle <= tol && tol <= NEUTRAL_ANGLE_MAX)) {
+                pass++;
+                continue;
+            }
+            /* The generator it overlaps most, not yet taken by a mode
+             * (any, for a repeat found by the search). */
             int kb = -1;
             double ob = -1;
             for (int r = 0; r < m; r++) {
                 int used = 0;
-                for (int c = 0; c < L->n; c++)
+                for (int c = 0; pass == 0 && c < L->n; c++)
                     used |= L->c[c].neutral == gk[r];
                 if (used)
                     continue;
@@ -1931,6 +2004,54 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
     return TS_OK;
 }
 
+/* The bounds of L's recognised neutral modes on the sparse model: dlam
+ * = |dA v| / |v| (the error estimate applied through S_inf), round and
+ * ritz the residual |A v - lam v| / |v|, A the cut one. */
+static int neutral_bounds(const ts_linear *lin, cand_list *L, ts_err *err)
+{
+    int n = lin->nstate, any = 0;
+    for (int c = 0; c < L->n; c++)
+        any |= L->c[c].neutral >= 0;
+    if (!any)
+        return TS_OK;
+    tsi_shift acc;
+    int rc = tsi_shift_factor_inf(&acc, lin, err);
+    if (rc != TS_OK)
+        return rc;
+    double *w = malloc(4 * (size_t)n * sizeof(double));
+    if (!w) {
+        tsi_shift_free(&acc);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
+    double *vr = w, *vi = w + n, *ar = w + 2 * n, *ai = w + 3 * n;
+    int with_err = lin->desc_err == lin->desc_err; /* not NaN */
+    for (int c = 0; c < L->n; c++) {
+        cand *cc = &L->c[c];
+        if (cc->neutral < 0)
+            continue;
+        const double complex *v = L->v + (size_t)cc->vec * n;
+        for (int i = 0; i < n; i++) {
+            vr[i] = creal(v[i]);
+            vi[i] = cimag(v[i]);
+        }
+        tsi_shift_apply(&acc, vr, ar, 0);
+        tsi_shift_apply(&acc, vi, ai, 0);
+        double v2 = set_residual(cc, v, ar, ai, n);
+        cc->ritz = cc->round;
+        if (with_err) {
+            tsi_shift_apply(&acc, vr, ar, 1);
+            tsi_shift_apply(&acc, vi, ai, 1);
+            double e2 = 0;
+            for (int i = 0; i < n; i++)
+                e2 += ar[i] * ar[i] + ai[i] * ai[i];
+            cc->dlam = sqrt(e2 / v2);
+        }
+    }
+    free(w);
+    tsi_shift_free(&acc);
+    return TS_OK;
+}
+
 /* ---- Driver -------------------------------------------------------------- */
 
 static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
@@ -1940,30 +2061,51 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
 int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
                    ts_eigen **out, ts_err *err)
 {
-    ts_linear dense;
+    ts_eigen_opts o;
+    if (opts)
+        o = *opts;
+    else
+        ts_eigen_opts_default(&o);
     /* The sparse model's band tops set the rightmost search's shifts. */
     const ts_descriptor *bands = lin->desc;
-    if (lin->root_qoff >= 0 && lin->desc) {
-        /* A towing vehicle: its modes come from the dense model, where
-         * its neutral modes by symmetry are recognised and cut
-         * (doc/linear.md section 3a); the sparse model serves the
-         * response and sweeps, and gives the search its band tops (its
-         * shifts then factor the dense A). */
+    int ncyclic = 0, comps[2];
+    for (int k = 0; k < lin->nneutral; k++)
+        if (lin->neutral[k].cyclic >= 0 && ncyclic < 2)
+            comps[ncyclic++] = lin->neutral[k].cyclic - lin->root_qoff;
+    int n = lin->nstate;
+    ts_eig_method m = ts_eigen_method(n, &o);
+    if (o.method == TS_EIG_AUTO && m == TS_EIG_LAPACK && !lin->A &&
+        o.count > 0)
+        m = TS_EIG_ARPACK;
+    if (lin->root_qoff >= 0 && lin->desc && m == TS_EIG_ARPACK) {
+        /* A towing vehicle on the sparse model (doc/linear.md section
+         * 3a): its cyclic states cut in a copy of the model, their
+         * translations exact null vectors of its K; the shift-invert
+         * operator and A's action then act with the cut A (lib/shift.c). */
+        if (ncyclic == 0)
+            return eigen_solve(lin, bands, &o, out, err);
         *out = NULL;
-        if (!lin->A)
-            return ts_fail(err, TS_EINVAL, "eigen: the modes of a scene "
-                           "with a towing vehicle need the dense model "
-                           "(linearize with model TS_LIN_DENSE or BOTH)");
+        ts_descriptor dc;
+        if (tsi_desc_cut(lin->desc, lin->root_qoff, comps, ncyclic, &dc) !=
+            TS_OK)
+            return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+        ts_linear cut = *lin;
+        cut.desc = &dc;
+        int rc = eigen_solve(&cut, &dc, &o, out, err);
+        tsi_desc_cut_free(&dc);
+        return rc;
+    }
+    ts_linear dense;
+    if (lin->root_qoff >= 0 && lin->desc && lin->A) {
+        /* LAPACK (or ARPACK without the sparse model) on the dense A,
+         * where the neutral modes are cut as below. */
         dense = *lin;
         dense.desc = NULL;
         dense.desc_err = dense.desc_round = NAN;
         lin = &dense;
     }
-    int ncyclic = 0;
-    for (int k = 0; k < lin->nneutral; k++)
-        ncyclic += lin->neutral[k].cyclic >= 0;
     if (ncyclic == 0 || !lin->A)
-        return eigen_solve(lin, bands, opts, out, err);
+        return eigen_solve(lin, bands, &o, out, err);
     /* The cyclic states' integrator chains cut (cut_cyclic): the same
      * eigenvalues, each neutral mode a simple eigenvector. */
     *out = NULL;
@@ -1971,7 +2113,7 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     cut.A = cut_cyclic(lin);
     if (!cut.A)
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
-    int rc = eigen_solve(&cut, bands, opts, out, err);
+    int rc = eigen_solve(&cut, bands, &o, out, err);
     free(cut.A);
     return rc;
 }
@@ -2094,7 +2236,7 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
         double sigma = 0.0;
         for (int k = 0; k < lin->nneutral; k++)
             if (lin->neutral[k].re == 0.0 && lin->neutral[k].im == 0.0)
-                sigma = -NEUTRAL_SHIFT_REL * lin->a_scale;
+                sigma = -NEUTRAL_SHIFT_REL * a_scale_of(lin);
         rc = o.target_hz == 0.0
                  ? solve_arpack_real(lin, &o, sigma, e, &L, err)
                  : solve_arpack_complex(lin, &o, e, &L, err);
@@ -2242,6 +2384,18 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
 
+    /* On the sparse model a neutral mode's pencil estimate is that of
+     * the whole model, where the cut states' chains make 0 a multiple,
+     * defective eigenvalue (lib/shift.c keeps the pencil whole): its
+     * bound is the one without a left vector instead, the error
+     * estimate's ||dA v|| / |v| and the residual, A the cut one. */
+    if (lin->desc && lin->nneutral > 0 && m == TS_EIG_ARPACK &&
+        neutral_bounds(lin, &L, err) != TS_OK) {
+        free(cover);
+        cand_free(&L);
+        ts_eigen_free(e);
+        return TS_ENOMEM;
+    }
     /* Verdict and the rightmost eigenvalue over what is covered. */
     e->max_real = -INFINITY;
     e->max_real_error = 0.0;

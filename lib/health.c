@@ -285,7 +285,7 @@ int ts_health_modes(const ts_system *sys, const ts_linear *lin,
                 list[nbad] = m;
             nbad++;
         }
-        if (e->method == TS_EIG_ARPACK &&
+        if (e->method == TS_EIG_ARPACK && md->neutral < 0 &&
             !(md->ritz_error <= ARPACK_RESIDUAL_MAX * mag)) {
             x->trustworthy = 0;
             nres++;

@@ -1168,7 +1168,8 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
         neutral0 |= lin->neutral[k].re == 0 && lin->neutral[k].im == 0;
     if (lin->desc && lin->root_qoff >= 0 && !lin->A) {
         /* A towing vehicle with the sparse model alone: S(0) is singular
-         * on its neutral modes, which only the dense model finds. */
+         * on its neutral modes, and the bordered solve that sets them
+         * apart (neutral_static) is written on the dense A. */
         r->static_gain = r->static_error = NAN;
         snprintf(r->static_note, sizeof r->static_note,
                  "undefined with the sparse model alone: a towing "

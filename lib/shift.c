@@ -576,6 +576,11 @@ void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
     /* (A - s I) x = b  <=>  (s I - A) x = -b = w. */
     for (int i = 0; i < 2 * nq + nc; i++)
         w[i] = -b[i];
+    /* A cut state (d->cut): its column of A is zero, so the other
+     * unknowns are those of the whole system with its entry of b zero;
+     * its own row, cut to -s x_j = b_j, gives it. */
+    for (int t = 0; t < d->ncut; t++)
+        w[d->cut[t]] = 0.0;
     rhs_part(sh, w, u1, mu, u2, sh->rhs, 1);
     for (int k = d->p0; k < d->np; k++)
         for (int a = 0; a < 3; a++)
@@ -586,6 +591,8 @@ void tsi_shift_solve_real(tsi_shift *sh, const double *b, double *x)
     tsi_shift_nodes_to_q(sh, p, x);
     for (int i = 0; i < nq; i++)
         x[nq + i] = s * x[i] - w[i];
+    for (int t = 0; t < d->ncut; t++)
+        x[d->cut[t]] = s != 0.0 ? -b[d->cut[t]] / s : 0.0;
 }
 
 /* Solve with real factors for the interleaved complex right-hand side in
@@ -624,6 +631,8 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
     for (int part = 0; part < 2; part++) {
         for (int i = 0; i < n; i++)
             w[i] = part ? -cimag(b[i]) : -creal(b[i]);
+        for (int t = 0; t < d->ncut; t++) /* as tsi_shift_solve_real */
+            w[d->cut[t]] = 0.0;
         rhs_part(sh, w, u1 + part * m, mu + part * m, u2, rhs + part, 2);
     }
     const double *mr = mu, *mi = mu + m;
@@ -652,6 +661,11 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
     }
     for (int j = 0; j < nc; j++)
         x[2 * nq + j] = cr[j] + I * ci[j];
+    for (int t = 0; t < d->ncut; t++) {
+        int j = d->cut[t];
+        x[nq + j] = s * x[j]; /* its b_j taken as zero */
+        x[j] = s != 0.0 ? -b[j] / s : 0.0;
+    }
 }
 
 /* Solve with S_inf for the force change f[3 np] (rhs -f), the link rows
@@ -684,7 +698,15 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
     double *u1 = sh->u1, *u2 = sh->u2, *f = sh->u2 + m, *hc = sh->u2 + 2 * m;
     double *rt = sh->u2 + 3 * m;
     const double *K = err ? d->Kerr : d->K, *C = err ? d->Cerr : d->C;
-    tsi_desc_to_points(d, sh->lin, x, u1);
+    const double *xq = x;
+    if (d->ncut > 0) {
+        /* The cut A: the cut states' columns and rows zero. */
+        memcpy(sh->w, x, (size_t)nq * sizeof(double));
+        for (int t = 0; t < d->ncut; t++)
+            sh->w[d->cut[t]] = 0.0;
+        xq = sh->w;
+    }
+    tsi_desc_to_points(d, sh->lin, xq, u1);
     tsi_desc_to_points(d, sh->lin, x + nq, u2);
     if (K && C) {
         tsi_desc_block_mul(d, K, u1, f, 0);
@@ -706,6 +728,8 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err)
         rt[l] = -v;
     }
     memcpy(y, x + nq, (size_t)nq * sizeof(double));
+    for (int t = 0; t < d->ncut; t++)
+        y[d->cut[t]] = 0.0;
     inf_solve(sh, f, rt, hc, y + nq, y + 2 * nq);
 }
 
@@ -1032,6 +1056,15 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     for (int part = 0; part < 2; part++) {
         for (int i = 0; i < nq; i++)
             q[i] = part ? cimag(v[i]) : creal(v[i]);
+        /* A cut state (d->cut): the eigenvector of the whole model holds
+         * it as the integral of its rate, v_j = v_(nq+j) / lam (zero in
+         * the cut model's); the pencil is the whole model's. */
+        for (int t = 0; t < d->ncut && cabs(lam) > 0; t++) {
+            int j = d->cut[t];
+            double complex vj = v[nq + j] / lam;
+            if (isfinite(creal(vj)) && isfinite(cimag(vj)))
+                q[j] = part ? cimag(vj) : creal(vj);
+        }
         tsi_desc_to_points(d, lin, q, u + part * m);
     }
     size_t n3 = 3 * (size_t)d->np;

@@ -27,8 +27,15 @@
  * (q, q', c), the controller rows' right-hand side wc - Hv J wq, S_inf's
  * controller rows the identity (c' = Hr p + Hv p' + Hc c).
  *
- * Without the sparse model (a towing vehicle at the root: ts_linear.desc
- * NULL)
+ * Towing vehicles' cyclic states cut for the eigen analysis (ts_descriptor
+ * cut, the eigen analysis's copy of the model: doc/linear.md section 3a):
+ * the shifted solves take the cut states' entries of b as zero and set
+ * theirs to -b_j / s (their columns of A are zero, their rows cut to
+ * -s x_j = b_j), A's action zeroes them in its input and output, and
+ * tsi_shift_eig_error takes the whole model's eigenvector (v_j = v_(nq+j)
+ * / lam).
+ *
+ * Without the sparse model (ts_linear.desc NULL: TS_LIN_DENSE)
  * the same solves use the dense A = [[0, I, 0], [K, C, E], [F, G, H]]
  * (nc controller states last): with x = (x1, x2, x3), x2 = b1 + s x1,
  * x3 = (H - sI)^-1 (b3 - F x1 - G x2) and P(s) x1 = b2 - (C - sI) b1 -

@@ -120,11 +120,9 @@ typedef struct ts_linear {
     double *B;         /* [n * ninput] column-major; rows 0..nq-1 zero;
                           NULL with A */
     ts_descriptor *desc; /* the sparse model E x' = F x + G u of the node
-                          and towed vehicles' equations (O(nlinks)
-                          memory), NULL unless formed (never with a
-                          towing vehicle at the root); the eigen,
-                          response and stiff simulation solvers use it at
-                          any size */
+                          and vehicles' equations (O(nlinks) memory), NULL
+                          unless formed; the eigen, response and stiff
+                          simulation solvers use it at any size */
     double *y0;        /* [n] state linearized about (kernel's charts) */
     double *u0;        /* [ninput] input linearized about (its frame
                           inputs zero) */
@@ -248,10 +246,11 @@ typedef struct ts_linear {
      * turned about the vertical, the tow point moving sideways at V); in
      * a steady turn: the heading about the turn's centre (lambda 0) and
      * the position of that centre (lambda = i |Omega|). A candidate is
-     * kept only when the dense A confirms it, A g = lambda g within the
-     * linearization's error: a current, a heading loop or anything else
-     * that breaks the symmetry leaves it out. Empty without a towing
-     * vehicle or without the dense model. */
+     * kept only when the model confirms it, A g = lambda g within the
+     * linearization's error (the dense A's, or without it the sparse
+     * model's rows): a current, a heading loop or anything else that
+     * breaks the symmetry leaves it out. Empty without a towing
+     * vehicle. */
     int nneutral;                  /* 0 .. TS_NEUTRAL_MAX */
     ts_neutral neutral[TS_NEUTRAL_MAX];
     double *neutral_re, *neutral_im; /* [n * nneutral] g, column k for
