@@ -1009,13 +1009,9 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     if (m->free_vehicle && m->eigen.method == TS_EIG_ARPACK)
         return ts_fail(err, TS_EINVAL, "free_vehicle: needs every coupled "
                        "mode with its shape: eigen_method lapack or auto");
-    /* LAPACK needs the dense A at any size; so do a towing vehicle's
-     * modes (its neutral modes are found in it), with the sparse model
-     * beside it for ARPACK's rightmost search (its band tops). */
+    /* LAPACK needs the dense A at any size. */
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
-        lo.model = TS_LIN_BOTH;
-    if (r->sys->tow.vehicle >= 0 && lo.model == TS_LIN_AUTO)
         lo.model = TS_LIN_BOTH;
     int rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc != TS_OK)
@@ -2748,9 +2744,6 @@ static int check_window(ts_result *r, const ts_request *rq, ts_err *err)
     if (!lin) {
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
-        /* A towing vehicle's modes come from the dense model. */
-        if (r->sys->tow.vehicle >= 0)
-            lo.model = TS_LIN_DENSE;
         lo.estimate_error = 0;
         ts_kernel *k = ts_kernel_alloc(r->sys, err);
         own = k ? ts_linear_alloc(k, err) : NULL;

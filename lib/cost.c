@@ -204,8 +204,7 @@ int ts_cost_modes(const ts_system *sys, int n, ts_eig_method m,
         return rc;
     ts_linearize_opts lo;
     ts_linearize_opts_default(&lo);
-    int dense = m != TS_EIG_ARPACK || n < lo.dense_max_states ||
-                sys->tow.vehicle >= 0;
+    int dense = m != TS_EIG_ARPACK || n < lo.dense_max_states;
     if (dense) {
         e->evaluations = 2.0 * (n + 9);
         e->bytes = 8.0 * n * (double)n;
