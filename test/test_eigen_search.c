@@ -28,10 +28,9 @@
  *
  * Scenes with towed vehicles take the same path: the sparse model holds
  * their attitude, rates and controller states (doc/linear.md, section
- * 2b). A towing vehicle at the root keeps the dense model: ARPACK runs on
- * its dense A, the rightmost search too (its band tops from the sparse
- * model), and both methods must recognise the same neutral modes by
- * symmetry (section 3a).
+ * 2b); so does a towing vehicle at the root, its cyclic states cut in
+ * the pencil (section 3a), and both methods must recognise the same
+ * neutral modes by symmetry.
  *
  * The default run (suite unit) uses each scene's own size and 60 links;
  * suite slow runs 100, 200 and 400 links, suite huge 800 (doc/linear.md,
@@ -93,21 +92,19 @@ static void compare(const char *name, const ts_system *sys)
     }
 
     /* Every scene has the sparse model, towed vehicles and a towing
-     * vehicle at the root included; with a towing vehicle ARPACK still
-     * runs on the dense A (the sparse model serves its response and
-     * sweeps, and gives the rightmost search its band tops; the search's
-     * shifts factor the dense A), and both methods set its neutral modes
-     * by symmetry apart (doc/linear.md section 3a). */
+     * vehicle at the root included; with a towing vehicle ARPACK runs on
+     * the sparse model too, its cyclic states cut, and both methods set
+     * its neutral modes by symmetry apart (doc/linear.md section 3a). */
     if (sys->tow.vehicle >= 0)
         CHECK(lin->desc && ar->sweep_shifts > 0 && !ar->complete &&
                   all->nneutral == lin->nneutral &&
                   ar->nneutral == all->nneutral,
-              "%s (%d links): a towing vehicle: the sparse model formed, "
-              "ARPACK on the dense A with the rightmost search (%d shifts, "
-              "%d Ritz pairs dropped), not complete; %d and %d neutral "
-              "modes recognised (%d by symmetry)", name, sys->nlinks,
-              ar->sweep_shifts, ar->sweep_rejected, all->nneutral,
-              ar->nneutral, lin->nneutral);
+              "%s (%d links): a towing vehicle: ARPACK on the sparse model "
+              "with the rightmost search (%d shifts, %d Ritz pairs "
+              "dropped), not complete; %d and %d neutral modes recognised "
+              "(%d by symmetry)", name, sys->nlinks, ar->sweep_shifts,
+              ar->sweep_rejected, all->nneutral, ar->nneutral,
+              lin->nneutral);
     else
         CHECK(lin->desc && ar->sweep_shifts > 0,
               "%s (%d links): ARPACK on the sparse model with the rightmost "
@@ -223,7 +220,7 @@ static void compare(const char *name, const ts_system *sys)
     /* 5. The modes' checks run beside the search on the linearization's
      * threads (lib/eigen.c, search_beside_checks): the same analysis on
      * one thread and on two, bit for bit. */
-    if (!lin->A || sys->tow.vehicle < 0) {
+    {
         ts_eigen *one = NULL, *two = NULL;
         int threads = lin->threads;
         lin->threads = 1;

@@ -839,6 +839,124 @@ static char *read_text(const char *path)
     return t;
 }
 
+/* A model of s about its equilibrium: model TS_LIN_BOTH or SPARSE. */
+static ts_linear *model_of(const ts_system *s, ts_lin_model model)
+{
+    ts_err err = {0};
+    ts_kernel *k = NULL;
+    ts_equilibrium *eq = solve(s, &k);
+    ts_linear *lin = ts_linear_alloc(k, &err);
+    ts_linearize_opts lo;
+    ts_linearize_opts_default(&lo);
+    lo.model = model;
+    if (!lin || ts_linearize_equilibrium(k, eq, &lo, lin, &err) != TS_OK) {
+        printf("linearize: %s\n", err.msg);
+        ts_linear_free(lin);
+        lin = NULL;
+    }
+    ts_kernel_free(k);
+    ts_equilibrium_free(eq);
+    return lin;
+}
+
+/* The towing vehicle's modes on the sparse model alone (its neutral
+ * modes found there, ARPACK on the cut pencil with the rightmost search)
+ * against LAPACK on the dense model (doc/linear.md section 3a): the same
+ * neutral modes (names, cyclic states, eigenvalues), every other of the
+ * `count` sparse modes a distinct dense eigenvalue within the sum of the
+ * two bounds, the same rightmost eigenvalue within them (the real part
+ * alone where several tie), and the same verdict. */
+static void sparse_vs_dense(const char *what, const ts_system *s, int count)
+{
+    ts_linear *ld = model_of(s, TS_LIN_BOTH);
+    ts_linear *ls = model_of(s, TS_LIN_SPARSE);
+    ts_eigen *el = ld ? eigen_of(ld, TS_EIG_LAPACK, 0) : NULL;
+    ts_eigen *es = ls ? eigen_of(ls, TS_EIG_ARPACK, count) : NULL;
+    if (!CHECK(el && es && !ls->A && ls->desc, "%s: LAPACK on the dense "
+               "model, ARPACK on the sparse model alone", what)) {
+        ts_eigen_free(el);
+        ts_eigen_free(es);
+        ts_linear_free(ld);
+        ts_linear_free(ls);
+        return;
+    }
+    int same = ls->nneutral == ld->nneutral;
+    for (int k = 0; same && k < ld->nneutral; k++) {
+        int j = neutral_named(ls, ld->neutral[k].name);
+        same = j >= 0 && ls->neutral[j].cyclic == ld->neutral[k].cyclic &&
+               ls->neutral[j].re == ld->neutral[k].re &&
+               ls->neutral[j].im == ld->neutral[k].im;
+    }
+    /* The recognised ones: each of the dense analysis's by name, at the
+     * same exact eigenvalue. */
+    int seen = 0;
+    for (int m = 0; m < es->nmodes; m++) {
+        int kn = es->modes[m].neutral;
+        if (kn < 0)
+            continue;
+        for (int j = 0; j < el->nmodes; j++) {
+            int kd = el->modes[j].neutral;
+            if (kd >= 0 && !strcmp(ld->neutral[kd].name, ls->neutral[kn].name) &&
+                el->modes[j].re == es->modes[m].re &&
+                el->modes[j].im == es->modes[m].im)
+                seen++;
+        }
+    }
+    CHECK(same && ld->nneutral > 0 && es->nneutral == el->nneutral &&
+              seen == es->nneutral,
+          "%s: the sparse model finds the dense model's %d neutral modes "
+          "(%d), ARPACK recognises %d as LAPACK does (%d)", what,
+          ld->nneutral, ls->nneutral, es->nneutral, el->nneutral);
+    /* The other modes, matched one to one, nearest first. */
+    char *used = calloc((size_t)el->nmodes, 1);
+    double worst = 0, worst_f = 0, worst_z = 0;
+    int matched = 0;
+    for (int m = 0; used && m < es->nmodes; m++) {
+        const ts_mode *a = &es->modes[m];
+        if (a->neutral >= 0)
+            continue;
+        int best = -1;
+        double bq = INFINITY;
+        for (int j = 0; j < el->nmodes; j++) {
+            if (used[j] || el->modes[j].neutral >= 0)
+                continue;
+            double q = hypot(a->re - el->modes[j].re,
+                             a->im - el->modes[j].im) /
+                       (a->error_bound + el->modes[j].error_bound);
+            if (q < bq) {
+                bq = q;
+                best = j;
+            }
+        }
+        if (best < 0)
+            break;
+        used[best] = 1;
+        matched++;
+        worst = fmax(worst, bq);
+        worst_f = fmax(worst_f, fabs(a->freq_hz - el->modes[best].freq_hz));
+        worst_z = fmax(worst_z, fabs(a->damping_ratio -
+                                     el->modes[best].damping_ratio));
+    }
+    free(used);
+    CHECK(matched == es->nmodes - es->nneutral && worst <= 1.0,
+          "%s: the %d other modes nearest 0 Hz are LAPACK's within %.3g of "
+          "the sum of the bounds (frequencies within %.2g Hz, damping "
+          "ratios within %.2g)", what, matched, worst, worst_f, worst_z);
+    const ts_mode *ra = &es->rightmost, *rl = &el->rightmost;
+    double allow = ra->error_bound + rl->error_bound;
+    CHECK(es->sweep_shifts > 0 && fabs(ra->re - rl->re) <= allow &&
+              es->verdict == el->verdict,
+          "%s: rightmost %.9g%+.6gi +- %.2g (%d shifts), dense %.9g%+.6gi "
+          "+- %.2g (%.3g of the sum); verdicts %s, dense %s", what, ra->re,
+          ra->im, ra->error_bound, es->sweep_shifts, rl->re, rl->im,
+          rl->error_bound, fabs(ra->re - rl->re) / allow,
+          ts_verdict_name(es->verdict), ts_verdict_name(el->verdict));
+    ts_eigen_free(el);
+    ts_eigen_free(es);
+    ts_linear_free(ld);
+    ts_linear_free(ls);
+}
+
 static void test_neutral(void)
 {
     char *text = read_text("examples/dolphin_aurora.yaml");
@@ -958,6 +1076,23 @@ static void test_neutral(void)
     ts_eigen_free(ea);
     ts_linear_free(lin);
     ts_equilibrium_free(eq);
+    /* The sparse model alone, at the scene's 30 links, 60 and 120. */
+    sparse_vs_dense("dolphin_aurora (30 links)", sc->system, 20);
+    static const int sizes[2] = {60, 120};
+    for (int i = 0; i < 2; i++) {
+        char what[64];
+        snprintf(what, sizeof what, "dolphin_aurora (%d links)", sizes[i]);
+        ts_system *sys = sc->system;
+        for (int c = 0; c < sys->ncables; c++) {
+            sys->cables[c].nlinks = sizes[i] / sys->ncables;
+            free(sys->cables[c].link_fraction);
+            sys->cables[c].link_fraction = NULL;
+        }
+        ts_err berr = {0};
+        if (CHECK(ts_system_build(sys, &berr) == TS_OK, "%s: %s", what,
+                  berr.msg))
+            sparse_vs_dense(what, sys, 20);
+    }
     ts_scene_free(sc);
 
     /* A heading loop (proportional, on the rudders) restores the
@@ -984,6 +1119,8 @@ static void test_neutral(void)
                   el->nneutral == 2 && small > 1e-3,
               "with a heading loop: %d neutral modes (x, y), no heading; "
               "the smallest other |lambda| %.3g 1/s", el->nneutral, small);
+        /* The sparse model's check drops the heading too. */
+        sparse_vs_dense("with a heading loop", sc->system, 20);
     }
     ts_eigen_free(el);
     ts_linear_free(lin);
@@ -1050,6 +1187,11 @@ static void test_neutral(void)
     ts_eigen_free(el);
     ts_linear_free(lin);
     ts_equilibrium_free(eq);
+    ts_scene_free(sc);
+    /* The same turn with 30 links, on the sparse model alone. */
+    sc = tow_scene("thrust: 1500 N", 3.0, 30);
+    if (CHECK(sc != NULL, "3 deg rudder turn, 30 links"))
+        sparse_vs_dense("3 deg rudder turn (30 links)", sc->system, 20);
     ts_scene_free(sc);
 }
 
