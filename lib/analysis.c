@@ -2431,6 +2431,13 @@ static int map_output(const ts_system *sys, const ts_system *lev,
  * window checks; its output named at the same place; modes: every mode
  * below ARPACK's size, else more than the run kept, around the same
  * target. Returns 0, or -1 (with why) when the output has no place. */
+/* A coarser level of a modes run that took ARPACK takes ARPACK too from
+ * this many states on (LAPACK below: 0.17 s at 400 states), and when it
+ * has this many states per mode asked for (ARPACK's Arnoldi vectors,
+ * about twice the modes, with room to spare). */
+#define LEVEL_ARPACK_MIN_STATES 400
+#define LEVEL_ARPACK_ROOM 8
+
 static int level_request(const ts_result *r, const ts_request *rq,
                          const ts_system *lev, ts_request *sub, char *why,
                          size_t size)
@@ -2451,11 +2458,23 @@ static int level_request(const ts_result *r, const ts_request *rq,
     sub->modes.near = 0;
     sub->modes.oscillatory = 0;
     if (rq->kind == TS_ANALYSIS_MODES) {
-        int arpack = rq->modes.eigen.method == TS_EIG_ARPACK ||
+        /* A level of a run that took ARPACK takes it too where it has
+         * room (LEVEL_ARPACK_MIN_STATES), below arpack_min_states as
+         * well: LAPACK's O(n^3) at the coarser level of a large run costs
+         * more than the run (the 250-link level of a 1000-link run:
+         * seconds, the run a tenth of one). */
+        double nlev = r->lin->nstate / (double)r->sys->nlinks * lev->nlinks;
+        int count = r->nmodes_computed + 10;
+        int follow = rq->modes.eigen.method == TS_EIG_AUTO && r->eigen &&
+                     r->eigen->method == TS_EIG_ARPACK &&
+                     nlev >= LEVEL_ARPACK_MIN_STATES &&
+                     nlev >= LEVEL_ARPACK_ROOM * count;
+        int arpack = rq->modes.eigen.method == TS_EIG_ARPACK || follow ||
                      (rq->modes.eigen.method == TS_EIG_AUTO &&
-                      r->lin->nstate / (double)r->sys->nlinks * lev->nlinks >=
-                          rq->modes.eigen.arpack_min_states);
-        sub->modes.count = arpack ? r->nmodes_computed + 10 : 0;
+                      nlev >= rq->modes.eigen.arpack_min_states);
+        sub->modes.count = arpack ? count : 0;
+        if (follow)
+            sub->modes.eigen.method = TS_EIG_ARPACK;
     }
     const ts_output *out = rq->kind == TS_ANALYSIS_RESPONSE
                                ? &r->response->output
@@ -2504,6 +2523,8 @@ static int run_levels(ts_result *r, const ts_request *rq, levels *L,
     memset(L, 0, sizeof *L);
     L->n = 1;
     L->res[0] = r;
+    if (r->eigen)
+        a->eigen_method[0] = (int)r->eigen->method;
     int coarser = ts_accuracy_can_coarsen(r->sys);
     int want = coarser ? 3 : 2;
     const ts_system *from = r->sys;
@@ -2547,6 +2568,8 @@ static int run_levels(ts_result *r, const ts_request *rq, levels *L,
         L->sys[k] = lev;
         L->own[k] = lr;
         L->res[k] = lr;
+        if (lr->eigen)
+            a->eigen_method[k] = (int)lr->eigen->method;
         a->ratio[k - 1] = ratio;
         a->links[k] = ts_accuracy_max_links(lev);
         L->n = k + 1;

@@ -529,8 +529,17 @@ static json_t *accuracy_json(const ts_result *r)
         json_array_append_new(links, json_integer(a->links[k]));
     for (int k = 0; ratios && k + 1 < a->nlevels; k++)
         json_array_append_new(ratios, num(a->ratio[k]));
+    json_t *methods = json_null();
+    if (a->eigen_method[0] != TS_EIG_AUTO) {
+        methods = json_array();
+        for (int k = 0; methods && k < a->nlevels; k++)
+            json_array_append_new(
+                methods,
+                json_string(ts_eig_method_name(
+                    (ts_eig_method)a->eigen_method[k])));
+    }
     return json_pack(
-        "{s:o,s:b,s:o,s:o,s:o,s:o,s:o,s:I,s:o,s:o,s:o,s:o,s:o,s:o,s:i}",
+        "{s:o,s:b,s:o,s:o,s:o,s:o,s:o,s:I,s:o,s:o,s:o,s:o,s:o,s:o,s:i,s:o}",
         "accuracy", num(a->accuracy), "estimated", a->estimated,
         "not_estimated",
         a->not_estimated[0] ? json_string(a->not_estimated) : json_null(),
@@ -543,7 +552,7 @@ static json_t *accuracy_json(const ts_result *r)
         a->links_needed > 0 ? json_integer(a->links_needed) : json_null(),
         "refined_from",
         a->refined_from > 0 ? json_integer(a->refined_from) : json_null(),
-        "refinements", a->refinements);
+        "refinements", a->refinements, "eigen_methods", methods);
 }
 
 /* Every point's discretisation and linearization (solver) error, and

@@ -753,6 +753,57 @@ static void test_modes(const ts_scene *ex3)
     ts_result_free(r);
 }
 
+/* The coarser levels of a modes run that took ARPACK take ARPACK too
+ * where they have room, below the threshold of auto (analysis.c,
+ * level_request): ex. 1 at 200 links with auto's threshold at 600 states
+ * takes ARPACK (800 states), its 100-link level too (400), its 50-link
+ * level LAPACK (200). The errors are those of the same run on LAPACK at
+ * every level: the same eigenvalues to the solvers' error (about 1e-10
+ * relative), so the same discretisation errors to 1e-3 of themselves. */
+static void test_levels_follow(const ts_scene *ex1)
+{
+    ts_result *r[2] = {NULL, NULL};
+    for (int t = 0; t < 2; t++) {
+        ts_request rq;
+        ts_request_init(&rq, TS_ANALYSIS_MODES);
+        rq.setup.links = 200;
+        rq.modes.eigen.arpack_min_states = 600;
+        if (t == 1)
+            rq.modes.eigen.method = TS_EIG_LAPACK;
+        ts_err err = {0};
+        int rc = ts_analysis_run(ex1->system, &rq, &r[t], &err);
+        if (!CHECK(rc == TS_OK && r[t]->accuracy.nlevels == 3,
+                   "ex. 1, 200 links, %s: the modes and three levels (%s)",
+                   t ? "lapack" : "auto", err.msg))
+            goto out;
+    }
+    const int *m = r[0]->accuracy.eigen_method, *l = r[1]->accuracy.eigen_method;
+    CHECK(m[0] == TS_EIG_ARPACK && m[1] == TS_EIG_ARPACK &&
+              m[2] == TS_EIG_LAPACK && l[0] == TS_EIG_LAPACK &&
+              l[1] == TS_EIG_LAPACK && l[2] == TS_EIG_LAPACK,
+          "auto from 600 states: levels of 800, 400, 200 states by %s, %s, "
+          "%s (the lapack run: %s, %s, %s)",
+          ts_eig_method_name(m[0]), ts_eig_method_name(m[1]),
+          ts_eig_method_name(m[2]), ts_eig_method_name(l[0]),
+          ts_eig_method_name(l[1]), ts_eig_method_name(l[2]));
+    int nv = r[0]->nvalues < r[1]->nvalues ? r[0]->nvalues : r[1]->nvalues;
+    double worst = 0;
+    for (int v = 0; v < nv && v < 6; v++) {
+        double a = r[0]->values[v].error.discretisation,
+               b = r[1]->values[v].error.discretisation;
+        double d = fabs(a - b) /
+                   (fabs(b) + 1e-9 * fabs(r[1]->values[v].value));
+        worst = isnan(d) ? INFINITY : fmax(worst, d);
+    }
+    CHECK(nv >= 6 && worst < 1e-3,
+          "the first three modes' discretisation errors by arpack levels "
+          "and by lapack ones agree to %.2g of themselves (%d values)",
+          worst, nv);
+out:
+    ts_result_free(r[0]);
+    ts_result_free(r[1]);
+}
+
 /* ---- 11. turn radius -------------------------------------------------------------- */
 
 static void test_turn_note(const ts_scene *ex1)
@@ -789,6 +840,7 @@ int main(void)
         test_refined(ex1);
         test_under_resolved(ex1);
         test_turn_note(ex1);
+        test_levels_follow(ex1);
     }
     if (ex4) {
         test_window(ex4);

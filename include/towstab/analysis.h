@@ -418,6 +418,9 @@ typedef struct ts_result_accuracy {
     int refined_from;       /* --refine: the longest cable's links of the
                                first run; 0 when not refined */
     int refinements;        /* reruns --refine made */
+    int eigen_method[TS_ACCURACY_LEVELS]; /* modes: the eigensolver of each
+                               level (ts_eig_method), the run's first; 0
+                               for the other analyses */
 } ts_result_accuracy;
 
 /* What an analysis computed. The parts it does not compute, or did not
