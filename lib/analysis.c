@@ -2457,6 +2457,7 @@ static int level_request(const ts_result *r, const ts_request *rq,
     sub->simulate.linear = 0;
     sub->modes.near = 0;
     sub->modes.oscillatory = 0;
+    sub->modes.margins = 0; /* the run's alone are reported */
     if (rq->kind == TS_ANALYSIS_MODES) {
         /* A level of a run that took ARPACK takes it too where it has
          * room (LEVEL_ARPACK_MIN_STATES), below arpack_min_states as

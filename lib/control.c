@@ -29,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "response_impl.h"
 #include "towstab/response.h"
 
 /* Crossing refinement: relative accuracy in frequency, iterations. */
@@ -157,16 +158,18 @@ typedef struct loop_tf {
     const ts_linear *lin;
     int input;
     ts_output out;
+    tsi_gain *g;     /* its gain, one factorisation refactored along */
     int failed;
 } loop_tf;
 
 static double complex loop_at(loop_tf *t, double w)
 {
-    double re = NAN, im = NAN;
-    if (ts_response_at(t->sys, t->lin, t->input, &t->out, w, &re, &im,
-                       NULL) != TS_OK)
+    double complex v = NAN;
+    if (tsi_gain_at(t->g, w, &v, NULL) != TS_OK) {
         t->failed = 1;
-    return -(re + I * im);
+        v = NAN;
+    }
+    return -v;
 }
 
 static double cross_gain(double x, void *p)
@@ -277,7 +280,7 @@ int ts_loop_margins(ts_kernel *k, const ts_equilibrium *eq, double from_hz,
              * stays), its input set to the trim's output. */
             rc = ts_kernel_set_loop_mode(k, v, l, TS_LOOP_BROKEN, 0.0, err);
             loop_tf t = {sys, lin, ts_kernel_input_find(k, mi->name),
-                         {0}, 0};
+                         {0}, NULL, 0};
             snprintf(name, sizeof name, "%s.output", mi->name);
             if (rc == TS_OK)
                 rc = ts_response_output_lookup(k, name, &t.out, err);
@@ -286,6 +289,9 @@ int ts_loop_margins(ts_kernel *k, const ts_equilibrium *eq, double from_hz,
                 u0[t.input] = vout[i];
                 rc = ts_linearize(k, y, u0, NULL, lin, err);
             }
+            if (rc == TS_OK && !(t.g = tsi_gain_alloc(sys, lin, t.input,
+                                                      &t.out, err)))
+                rc = err && err->code ? err->code : TS_ENOMEM;
             if (rc == TS_OK) {
                 margins_of(&t, from_hz, to_hz, points, mi);
                 if (t.failed)
@@ -293,6 +299,7 @@ int ts_loop_margins(ts_kernel *k, const ts_equilibrium *eq, double from_hz,
                                  "loop transfer has a pole on the scanned "
                                  "imaginary axis", mi->name);
             }
+            tsi_gain_free(t.g);
             ts_kernel_set_loop_mode(k, v, l, TS_LOOP_CLOSED, 0.0, NULL);
         }
     }

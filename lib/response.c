@@ -956,30 +956,70 @@ static void ws_free(resp_ws *w)
     free(w->zh);
 }
 
-int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
-                   const ts_output *out, double omega, double *re, double *im,
-                   ts_err *err)
+struct tsi_gain {
+    const ts_system *sys;
+    const ts_linear *lin;
+    int input;
+    ts_output out;
+    resp_ws w;
+    tsi_shift sh;
+};
+
+tsi_gain *tsi_gain_alloc(const ts_system *sys, const ts_linear *lin,
+                         int input, const ts_output *out, ts_err *err)
 {
-    int rc = check_args(sys, lin, input, out, err);
-    if (rc != TS_OK)
-        return rc;
+    if (check_args(sys, lin, input, out, err) != TS_OK)
+        return NULL;
+    tsi_gain *g = calloc(1, sizeof *g);
+    if (!g) {
+        ts_fail(err, TS_ENOMEM, "response: out of memory");
+        return NULL;
+    }
+    g->sys = sys;
+    g->lin = lin;
+    g->input = input;
+    g->out = *out;
+    if (!ws_alloc(&g->w, lin, NULL, &g->out)) {
+        tsi_gain_free(g);
+        ts_fail(err, TS_ENOMEM, "response: out of memory");
+        return NULL;
+    }
+    return g;
+}
+
+int tsi_gain_at(tsi_gain *g, double omega, double complex *val, ts_err *err)
+{
+    *val = 0;
     if (!(omega >= 0) || !isfinite(omega))
         return ts_fail(err, TS_EINVAL,
                        "response: angular frequency must be >= 0 rad/s, got "
                        "%g",
                        omega);
-    resp_ws w;
-    if (!ws_alloc(&w, lin, NULL, out)) {
-        ws_free(&w);
-        return ts_fail(err, TS_ENOMEM, "response: out of memory");
-    }
-    double complex g = 0;
-    tsi_shift sh = {0};
-    rc = gain_at(sys, lin, input, out, omega, &w, &sh, &g, NULL, err);
-    tsi_shift_free(&sh);
-    ws_free(&w);
-    *re = creal(g);
-    *im = cimag(g);
+    return gain_at(g->sys, g->lin, g->input, &g->out, omega, &g->w, &g->sh,
+                   val, NULL, err);
+}
+
+void tsi_gain_free(tsi_gain *g)
+{
+    if (!g)
+        return;
+    tsi_shift_free(&g->sh);
+    ws_free(&g->w);
+    free(g);
+}
+
+int ts_response_at(const ts_system *sys, const ts_linear *lin, int input,
+                   const ts_output *out, double omega, double *re, double *im,
+                   ts_err *err)
+{
+    tsi_gain *g = tsi_gain_alloc(sys, lin, input, out, err);
+    if (!g)
+        return err && err->code ? err->code : TS_EINVAL;
+    double complex v = 0;
+    int rc = tsi_gain_at(g, omega, &v, err);
+    tsi_gain_free(g);
+    *re = creal(v);
+    *im = cimag(v);
     return rc;
 }
 

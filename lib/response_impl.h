@@ -3,6 +3,8 @@
 #ifndef TOWSTAB_RESPONSE_IMPL_H
 #define TOWSTAB_RESPONSE_IMPL_H
 
+#include <complex.h>
+
 #include "towstab/progress.h"
 #include "towstab/response.h"
 
@@ -20,5 +22,18 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
  * ts_kernel_output_name) to err's message, the list of valid names of
  * a bad output. Nothing without vehicles or err. */
 void tsi_response_list_vehicle_outputs(const ts_kernel *k, ts_err *err);
+
+/* The gain of one input to one output at many frequencies, one at a
+ * time (the loop margins' scan and its refinements): one work area and
+ * one factorisation kept from frequency to frequency, refactored with the
+ * last one's pivots while they serve (tsi_shift_refactor); the same gain
+ * as ts_response_at to rounding. NULL with err set on a bad input or
+ * output (ts_response_at's checks) or no memory. */
+typedef struct tsi_gain tsi_gain;
+tsi_gain *tsi_gain_alloc(const ts_system *sys, const ts_linear *lin,
+                         int input, const ts_output *out, ts_err *err);
+/* The gain at omega (rad/s, >= 0) into *val. */
+int tsi_gain_at(tsi_gain *g, double omega, double complex *val, ts_err *err);
+void tsi_gain_free(tsi_gain *g);
 
 #endif
