@@ -44,8 +44,9 @@ static const int integrator_values[] = {TS_INT_RK8PD, TS_INT_RKF45,
                                         TS_INT_RK4IMP, TS_INT_BSIMP,
                                         TS_INT_MSBDF, TS_INT_ESDIRK,
                                         TS_INT_BDF};
-static const char *const linear_methods[] = {"expm", "ode", NULL};
-static const int linear_method_values[] = {TS_LINSIM_EXPM, TS_LINSIM_ODE};
+static const char *const linear_methods[] = {"expm", "ode", "sparse", NULL};
+static const int linear_method_values[] = {TS_LINSIM_EXPM, TS_LINSIM_ODE,
+                                           TS_LINSIM_SPARSE};
 static const char *const kinematics[] = {"linear", "nonlinear", NULL};
 static const int kinematics_values[] = {TS_KIN_LINEAR, TS_KIN_NONLINEAR};
 static const char *const studies[] = {"equilibrium", "modes", "simulate",
