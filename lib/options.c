@@ -474,7 +474,8 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
      .section = TS_SEC_SIMULATE, NOLIM, .choices = linear_methods,            \
      .values = linear_method_values,                                          \
      .offset = OFF(simulate.sim.linear_method), .only = o, .arg = "M",        \
-     .help = "the linear model's integration"},                               \
+     .help = "the linear model's integration; sparse: esdirk on the "      \
+             "sparse model (any method above 1200 states)"},                  \
     {.name = "kinematics", .type = TS_OPT_ENUM, .section = TS_SEC_SIMULATE,   \
      NOLIM, .choices = kinematics, .values = kinematics_values,               \
      .offset = OFF(simulate.sim.kinematics), .only = o, .arg = "K",           \
