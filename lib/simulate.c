@@ -691,16 +691,21 @@ static int lsys_setup_esdirk(double t, const double y[], double gamma,
     return rc == TS_OK ? 0 : -1;
 }
 
-/* x = (I - gamma J)^-1 b = s (s I - J)^-1 b with s = 1 / gamma, and
- * tsi_shift_solve_real gives (J - s I)^-1. */
+/* x[n] = (I - gamma J)^-1 b = s (s I - J)^-1 b with s = 1 / gamma, the
+ * shift sh is factored at, and tsi_shift_solve_real gives (J - s I)^-1. */
+static int newton_solve(tsi_shift *sh, int n, const double b[], double x[])
+{
+    double s = creal(sh->s);
+    tsi_shift_solve_real(sh, b, x);
+    for (int i = 0; i < n; i++)
+        x[i] *= -s;
+    return 0;
+}
+
 static int lsys_solve_esdirk(double x[], const double b[], void *params)
 {
     ts_sim *s = params;
-    double sh = creal(s->sh.s);
-    tsi_shift_solve_real(&s->sh, b, x);
-    for (int i = 0; i < s->n; i++)
-        x[i] *= -sh;
-    return 0;
+    return newton_solve(&s->sh, s->n, b, x);
 }
 
 static const gsl_odeiv2_step_type *step_type(ts_integrator m)
@@ -1716,15 +1721,11 @@ static int lin_lsys_setup(double t, const double y[], double gamma, int jok,
     return 0;
 }
 
-/* x = (I - gamma A)^-1 b = -s (A - s I)^-1 b, s = 1 / gamma. */
+/* x = (I - gamma A)^-1 b. */
 static int lin_lsys_solve(double x[], const double b[], void *params)
 {
     lin_sim *L = params;
-    double s = creal(L->shs.s);
-    tsi_shift_solve_real(&L->shs, b, x);
-    for (int i = 0; i < L->n; i++)
-        x[i] *= -s;
-    return 0;
+    return newton_solve(&L->shs, L->n, b, x);
 }
 
 /* The sparse run's set-up: S_inf, and B's m columns with their tension
