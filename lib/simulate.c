@@ -835,7 +835,8 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         s->newton = sparse ? TS_NEWTON_SPARSE : TS_NEWTON_DENSE;
     }
     if (sundials_method(o->integrator)) {
-        const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk};
+        const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk,
+                                   0};
         s->sd = tsi_esdirk_alloc_method(
             s->n, rhs_esdirk, sparse ? NULL : jacobian_esdirk,
             sparse ? &lsys : NULL, s, o->rel_tol, o->abs_tol, s->h,
@@ -1988,7 +1989,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     if (sparse) {
         /* esdirk (bdf when chosen) with the sparse Newton solves, at the
          * run's tolerances. */
-        const tsi_ode_lsys lsys = {lin_lsys_setup, lin_lsys_solve};
+        const tsi_ode_lsys lsys = {lin_lsys_setup, lin_lsys_solve, 1};
         if ((rc = lin_sparse_setup(&L, err)))
             goto done;
         stats.newton = TS_NEWTON_SPARSE;
