@@ -1951,7 +1951,8 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                      "%d states", n);
         goto done;
     }
-    if ((rc = tsi_lapack_open(&L.la, err)) != TS_OK)
+    /* BLAS for the dense model's products only. */
+    if (!sparse && (rc = tsi_lapack_open(&L.la, err)) != TS_OK)
         goto done;
     if (z0)
         memcpy(z, z0, sn * sizeof(double));
