@@ -158,7 +158,8 @@ typedef struct ts_history {
     double *t;           /* [capacity] s */
     double *positions;   /* [capacity][3 nnodes] m, M frame, node 0 = tow */
     double *tensions;    /* [capacity][nlinks] N (linear runs: from the
-                            tension Jacobians, NaN without them) */
+                            tension Jacobians or the sparse model, NaN
+                            without either) */
     double *tow_force;   /* [capacity][3] N, the force on the tow point
                             (ts_kernel_tow_force; NaN in linear runs) */
     double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
