@@ -1733,6 +1733,12 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
                        "vehicles' outputs, so %s needs one of those (the "
                        "nonlinear run alone gives the others)", out->name,
                        lw);
+    if (use_linear && o->linear_method == TS_LINSIM_SPARSE && ex &&
+        ts_excitation_has_manoeuvre(ex))
+        return ts_fail(err, TS_EINVAL, "linear_method: sparse: a manoeuvre "
+                       "drives the frame's speed or turn rate, inputs of the "
+                       "dense linear model only: use expm or ode (the "
+                       "dense model is then formed at any size)");
     if (use_linear && s->initial != TS_INITIAL_EQUILIBRIUM)
         return ts_fail(err, TS_EINVAL, "initial: the linear model starts at "
                        "the equilibrium, so %s needs the initial state "
@@ -2312,9 +2318,18 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
         ts_linearize_opts lo;
         ts_linearize_opts_default(&lo);
         lo.tensions = 1; /* the linear run's tensions */
-        /* The linear run needs the dense A and B at any size. */
-        if (s->compare || s->linear)
+        /* The linear run: the dense A and B below the automatic size
+         * (dense_max_states, as the modes and the response), the sparse
+         * model alone above it (ts_simulate_linear integrates it in
+         * O(links) per step), or alone when linear_method sparse asks for
+         * it; at any size under a manoeuvre (the frame inputs are the
+         * dense model's only). */
+        int manoeuvre = ex && ts_excitation_has_manoeuvre(ex);
+        if ((s->compare || s->linear) && manoeuvre)
             lo.model = TS_LIN_BOTH;
+        else if ((s->compare || s->linear) &&
+                 o->linear_method == TS_LINSIM_SPARSE)
+            lo.model = TS_LIN_SPARSE;
         double t0 = tsi_wall_now();
         if (!r->lin)
             rc = err && err->code ? err->code : TS_ENOMEM;
@@ -2354,7 +2369,8 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
                                  "show");
     if (r->nonlinear)
         ts_health_simulation(o, &r->nonlinear_stats, &r->trust);
-    if (r->linear && o->linear_method != TS_LINSIM_EXPM)
+    if (r->linear &&
+        strcmp(ts_linear_method_name(o, &r->linear_stats), "expm"))
         ts_health_simulation(o, &r->linear_stats, &r->trust);
     if (rc == TS_OK && s->compare) {
         rc = ts_compare_histories(sys, r->lin, ex, r->nonlinear, r->linear,

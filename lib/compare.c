@@ -194,13 +194,15 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
     memset(c, 0, sizeof *c);
     c->output = *out;
     if (out->kind != TS_OUT_POSITION &&
-        !(out->kind == TS_OUT_TENSION && lin->Ty && lin->Tu) &&
+        !(out->kind == TS_OUT_TENSION && ((lin->Ty && lin->Tu) ||
+                                           lin->desc)) &&
         !(out->kind == TS_OUT_VEHICLE && out->index < lin->noutput))
         return ts_fail(err, TS_EINVAL, "compare: output '%s': the linear "
                        "model gives node positions, the vehicles' outputs "
-                       "and, linearized with its tension Jacobians, link "
-                       "tensions (choose <node>.x|y|z, <vehicle>.depth ... "
-                       "or <cable>.<k>.tension)", out->name);
+                       "and, with its tension Jacobians or its sparse "
+                       "form, link tensions (choose <node>.x|y|z, "
+                       "<vehicle>.depth ... or <cable>.<k>.tension)",
+                       out->name);
     if (nl->nsamples != li->nsamples || nl->nsamples < 1)
         return ts_fail(err, TS_EINVAL, "compare: the runs have %d and %d "
                        "samples; they must share their sample times",

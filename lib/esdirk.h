@@ -42,6 +42,11 @@ typedef struct tsi_ode_lsys {
     int (*setup)(double t, const double y[], double gamma, int jok,
                  int *jcur, void *params);
     int (*solve)(double x[], const double b[], void *params);
+    int linear;  /* 1: f is linear in y with a constant J (f = J y + g(t)),
+                    and setup makes the exact I - gamma J: the ESDIRK
+                    takes one Newton iteration per stage, without a
+                    convergence test (ARKStepSetLinear; bdf ignores it);
+                    0 (a brace initializer's default): Newton as usual */
 } tsi_ode_lsys;
 
 typedef struct tsi_esdirk tsi_esdirk;

@@ -11,7 +11,7 @@
 #include "esdirk.h"
 
 #define TSI_ESDIRK_MODULE_SYMBOL "towstab_sundials_module"
-#define TSI_ESDIRK_MODULE_VERSION 1
+#define TSI_ESDIRK_MODULE_VERSION 2
 #define TSI_ESDIRK_MODULE_FILE "towstab-sundials.so"
 
 typedef struct tsi_esdirk_impl tsi_esdirk_impl;

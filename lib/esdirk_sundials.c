@@ -415,6 +415,8 @@ stepper_alloc_method(int n, tsi_ode_fn f, tsi_ode_jac jac,
     bad |= ARKStepSetInitStep(s->mem, h_init);
     bad |= ARKStepSetNonlinCRDown(s->mem, 1.0);
     bad |= ARKStepSetMaxNonlinIters(s->mem, NEWTON_ITERS);
+    if (lsys && lsys->linear)
+        bad |= ARKStepSetLinear(s->mem, 0); /* J constant in time */
     if (bad) {
         ts_fail(err, TS_EINVAL, "esdirk: ARKODE refused the options (rtol "
                 "%g, atol %g, first step %g s): %s", rtol, atol, h_init,

@@ -44,8 +44,9 @@ static const int integrator_values[] = {TS_INT_RK8PD, TS_INT_RKF45,
                                         TS_INT_RK4IMP, TS_INT_BSIMP,
                                         TS_INT_MSBDF, TS_INT_ESDIRK,
                                         TS_INT_BDF};
-static const char *const linear_methods[] = {"expm", "ode", NULL};
-static const int linear_method_values[] = {TS_LINSIM_EXPM, TS_LINSIM_ODE};
+static const char *const linear_methods[] = {"expm", "ode", "sparse", NULL};
+static const int linear_method_values[] = {TS_LINSIM_EXPM, TS_LINSIM_ODE,
+                                           TS_LINSIM_SPARSE};
 static const char *const kinematics[] = {"linear", "nonlinear", NULL};
 static const int kinematics_values[] = {TS_KIN_LINEAR, TS_KIN_NONLINEAR};
 static const char *const studies[] = {"equilibrium", "modes", "simulate",
@@ -473,7 +474,8 @@ static int parse_set(const ts_option *o, ts_request *rq, const char *text,
      .section = TS_SEC_SIMULATE, NOLIM, .choices = linear_methods,            \
      .values = linear_method_values,                                          \
      .offset = OFF(simulate.sim.linear_method), .only = o, .arg = "M",        \
-     .help = "the linear model's integration"},                               \
+     .help = "the linear model's integration; sparse: esdirk on the "      \
+             "sparse model (any method above 1200 states)"},                  \
     {.name = "kinematics", .type = TS_OPT_ENUM, .section = TS_SEC_SIMULATE,   \
      NOLIM, .choices = kinematics, .values = kinematics_values,               \
      .offset = OFF(simulate.sim.kinematics), .only = o, .arg = "K",           \

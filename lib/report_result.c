@@ -405,10 +405,8 @@ static json_t *simulate_json(const ts_result *r, int flags,
         json_object_set_new(
             o, "stats",
             ts_report_sim_stats_json(&r->linear_stats,
-                                     r->sim.linear_method == TS_LINSIM_EXPM
-                                         ? "expm"
-                                         : ts_integrator_name(
-                                               r->sim.integrator)));
+                                     ts_linear_method_name(&r->sim,
+                                                           &r->linear_stats)));
         json_object_set_new(o, "kinematics",
                             json_string(r->sim.kinematics == TS_KIN_LINEAR
                                             ? "linear"

@@ -1091,3 +1091,62 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
     return TS_OK;
 }
+
+/* ---- The linear simulation's outputs ------------------------------------ */
+
+void tsi_shift_tensions(const tsi_shift *sh, double *dt)
+{
+    const ts_descriptor *d = sh->d;
+    for (int l = 0; l < d->nl; l++)
+        dt[l] = sh->rhs[XT(l)];
+}
+
+void tsi_shift_outputs(tsi_shift *sh, const double *z, const double *v,
+                       int m, double *out)
+{
+    const ts_descriptor *d = sh->d;
+    const ts_linear *lin = sh->lin;
+    int nq = lin->nq;
+    size_t n3 = 3 * (size_t)d->np + (size_t)d->nc;
+    double *p = sh->u1, *pv = sh->u1 + n3;
+    const double *c = z + 2 * nq;
+    tsi_desc_to_points(d, lin, z, p);
+    tsi_desc_to_points(d, lin, z + nq, pv);
+    for (int iv = 0; iv < d->nv; iv++) {
+        const tsi_vehicle_layout *L = &d->vl[iv];
+        int ncol = TSI_LV_C + L->nc + L->nin;
+        /* The tow inputs move the vehicle's node with the coordinates
+         * held (ts_linear_tow_shift), its displacement channels the
+         * displacement and its rate channels the velocity; its angles
+         * stay. */
+        double dn[3] = {0, 0, 0}, vn[3] = {0, 0, 0};
+        for (int j = 0; j < m && j < TS_NINPUT; j++) {
+            int rot = j >= TS_TOW_ROT, cj = rot ? j - TS_TOW_ROT : j;
+            int order = cj / 3;
+            if (v[j] == 0 || order > 1)
+                continue;
+            double e[3];
+            ts_linear_tow_shift(lin, L->node,
+                                (rot ? TS_IN_ROT : TS_IN_DISP) + cj % 3, e);
+            for (int a = 0; a < 3; a++)
+                (order ? vn : dn)[a] += e[a] * v[j];
+        }
+        for (int r = 0; r < L->nout; r++) {
+            const double *row = d->Ov + d->ov_off[iv] + r * ncol;
+            double acc = 0;
+            for (int lc = 0; lc < 3; lc++) {
+                int i = 3 * L->node + lc, th = 3 * (d->nn + iv) + lc;
+                acc += row[TSI_LV_R + lc] * (p[i] + dn[lc]) +
+                       row[TSI_LV_TH + lc] * p[th] +
+                       row[TSI_LV_V + lc] * (pv[i] + vn[lc]) +
+                       row[TSI_LV_W + lc] * pv[th];
+            }
+            for (int k = 0; k < L->nc; k++)
+                acc += row[TSI_LV_C + k] * c[L->c0 + k];
+            for (int k = 0; k < L->nin; k++)
+                if (L->in0 + k < m)
+                    acc += row[TSI_LV_C + L->nc + k] * v[L->in0 + k];
+            out[L->out0 + r] = acc;
+        }
+    }
+}

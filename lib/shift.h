@@ -192,4 +192,22 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
  * links' lengths). */
 void tsi_shift_nodes_to_q(const tsi_shift *sh, const double *dr, double *dq);
 
+/* The link tension changes dt[nlinks] (N) of the last tsi_shift_apply or
+ * tsi_shift_apply_input with S_inf: the tension unknowns of its solve, so
+ * that with x = (z, 0) they are the linear model's dT/dy z and with
+ * column j of B its dT/du_j. O(nlinks). */
+void tsi_shift_tensions(const tsi_shift *sh, double *dt);
+
+/* The vehicles' output changes out[noutput] (m, rad) of the sparse model
+ * at state z[n] and input deviations v[m] (the first m inputs, m at most
+ * the frame inputs' index: the sparse model has no frame inputs): the
+ * output rows Ov (lib/descriptor.h) on each vehicle's node displacement
+ * and velocity (the tow inputs' displacement and velocity channels move
+ * the node with the coordinates held, ts_linear_tow_shift), its angles
+ * and their rates, its controller states and its inputs; the linear
+ * model's Vy z + Vu v. Any factorisation of lin in sh (its work arrays).
+ * O(nlinks). */
+void tsi_shift_outputs(tsi_shift *sh, const double *z, const double *v,
+                       int m, double *out);
+
 #endif

@@ -157,7 +157,9 @@ int ts_sim_opts_check(const ts_sim_opts *o, ts_err *err)
     if (!(o->integrator >= TS_INT_RK8PD && o->integrator <= TS_INT_BDF))
         return ts_fail(err, TS_EINVAL, "simulate: unknown integrator %d",
                        (int)o->integrator);
-    if (o->linear_method != TS_LINSIM_EXPM && o->linear_method != TS_LINSIM_ODE)
+    if (o->linear_method != TS_LINSIM_EXPM &&
+        o->linear_method != TS_LINSIM_ODE &&
+        o->linear_method != TS_LINSIM_SPARSE)
         return ts_fail(err, TS_EINVAL, "simulate: unknown linear method %d",
                        (int)o->linear_method);
     if (o->kinematics != TS_KIN_LINEAR && o->kinematics != TS_KIN_NONLINEAR)
@@ -689,16 +691,21 @@ static int lsys_setup_esdirk(double t, const double y[], double gamma,
     return rc == TS_OK ? 0 : -1;
 }
 
-/* x = (I - gamma J)^-1 b = s (s I - J)^-1 b with s = 1 / gamma, and
- * tsi_shift_solve_real gives (J - s I)^-1. */
+/* x[n] = (I - gamma J)^-1 b = s (s I - J)^-1 b with s = 1 / gamma, the
+ * shift sh is factored at, and tsi_shift_solve_real gives (J - s I)^-1. */
+static int newton_solve(tsi_shift *sh, int n, const double b[], double x[])
+{
+    double s = creal(sh->s);
+    tsi_shift_solve_real(sh, b, x);
+    for (int i = 0; i < n; i++)
+        x[i] *= -s;
+    return 0;
+}
+
 static int lsys_solve_esdirk(double x[], const double b[], void *params)
 {
     ts_sim *s = params;
-    double sh = creal(s->sh.s);
-    tsi_shift_solve_real(&s->sh, b, x);
-    for (int i = 0; i < s->n; i++)
-        x[i] *= -sh;
-    return 0;
+    return newton_solve(&s->sh, s->n, b, x);
 }
 
 static const gsl_odeiv2_step_type *step_type(ts_integrator m)
@@ -828,7 +835,8 @@ ts_sim *ts_sim_alloc(ts_kernel *k, const ts_excitation *ex,
         s->newton = sparse ? TS_NEWTON_SPARSE : TS_NEWTON_DENSE;
     }
     if (sundials_method(o->integrator)) {
-        const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk};
+        const tsi_ode_lsys lsys = {lsys_setup_esdirk, lsys_solve_esdirk,
+                                   0};
         s->sd = tsi_esdirk_alloc_method(
             s->n, rhs_esdirk, sparse ? NULL : jacobian_esdirk,
             sparse ? &lsys : NULL, s, o->rel_tol, o->abs_tol, s->h,
@@ -1511,6 +1519,15 @@ typedef struct lin_sim {
     double *p;         /* [4 m]: the cubic's coefficients */
     long nfev;
     tsi_lapack la;     /* BLAS's dgemv */
+    /* The sparse model's run (lin_rhs_sparse): A's action by S_inf, the
+     * Newton solves by S(1 / gamma), B's m driven columns and their
+     * tension changes formed once, O(nlinks m). */
+    int sparse;
+    tsi_shift shi;     /* S_inf */
+    tsi_shift shs;     /* S(1 / gamma) */
+    double gamma;      /* of shs; 0: none yet */
+    double *Bc;        /* [n m] */
+    double *Tc;        /* [nlinks m] */
 } lin_sim;
 
 /* 1 when a signal of ex drives a tow rotation (tow.roll ...). */
@@ -1664,8 +1681,79 @@ static int lin_jac_esdirk(double t, const double z[], double J[],
     return 0;
 }
 
+/* z' = A z + B v(t) on the sparse model: O(nlinks) (m columns of B). */
+static int lin_rhs_sparse(double t, const double z[], double dz[],
+                          void *params)
+{
+    lin_sim *L = params;
+    const size_t n = (size_t)L->n;
+    double *v = L->v + 4 * L->m;
+    L->nfev++;
+    lin_input(L, t, v);
+    tsi_shift_apply(&L->shi, z, dz, 0);
+    for (int j = 0; j < L->m; j++)
+        if (v[j] != 0) {
+            const double *b = L->Bc + (size_t)j * n;
+            for (size_t i = 0; i < n; i++)
+                dz[i] += b[i] * v[j];
+        }
+    return 0;
+}
+
+/* esdirk's Newton matrix I - gamma A: S(1 / gamma) factored when gamma
+ * changes (A is constant: nothing to evaluate), refactored on KLU's
+ * pivot order (tsi_shift_refactor), O(nlinks). */
+static int lin_lsys_setup(double t, const double y[], double gamma, int jok,
+                          int *jcur, void *params)
+{
+    lin_sim *L = params;
+    (void)t;
+    (void)y;
+    *jcur = !jok;
+    if (L->gamma == gamma)
+        return 0;
+    L->gamma = 0.0;
+    int rc = tsi_shift_refactor(&L->shs, L->lin, 1.0 / gamma, NULL);
+    if (rc == TS_ESINGULAR)
+        return 1; /* ARKODE retries with another step */
+    if (rc != TS_OK)
+        return -1;
+    L->gamma = gamma;
+    return 0;
+}
+
+/* x = (I - gamma A)^-1 b. */
+static int lin_lsys_solve(double x[], const double b[], void *params)
+{
+    lin_sim *L = params;
+    return newton_solve(&L->shs, L->n, b, x);
+}
+
+/* The sparse run's set-up: S_inf, and B's m columns with their tension
+ * changes (tsi_shift_apply_input, tsi_shift_tensions). */
+static int lin_sparse_setup(lin_sim *L, ts_err *err)
+{
+    const ts_linear *lin = L->lin;
+    size_t n = (size_t)L->n, nl = (size_t)lin->nlinks;
+    L->Bc = malloc(n * (size_t)L->m * sizeof(double));
+    L->Tc = malloc(nl * (size_t)L->m * sizeof(double));
+    if (!L->Bc || !L->Tc)
+        return ts_fail(err, TS_ENOMEM, "simulate (linear): out of memory "
+                       "for %d input columns of %d states", L->m, L->n);
+    int rc = tsi_shift_factor_inf(&L->shi, lin, err);
+    if (rc) {
+        ts_err_prefix(err, "simulate (linear): ");
+        return rc;
+    }
+    for (int j = 0; j < L->m; j++) {
+        tsi_shift_apply_input(&L->shi, j, L->Bc + (size_t)j * n, 0);
+        tsi_shift_tensions(&L->shi, L->Tc + (size_t)j * nl);
+    }
+    return TS_OK;
+}
+
 /* Append a linear sample: positions from z. */
-static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
+static int lin_record(ts_kernel *k, const ts_linear *lin, lin_sim *L,
                       const ts_sim_opts *o, double t, const double *z,
                       ts_history *h, double *ywork, double *dr, ts_err *err)
 {
@@ -1715,12 +1803,24 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
         memcpy(pos, ts_kernel_positions(k), 3 * nn * sizeof(double));
     }
     h->t[i] = t;
-    /* Tensions T0 + dT/dy z + dT/du v: O(nlinks n) per sample, as the
-     * dense linear model itself. */
+    /* Tensions T0 + dT/dy z + dT/du v: O(nlinks n) per sample with the
+     * dense tension Jacobians; on the sparse model the tension unknowns
+     * of one solve with S_inf (A z) and B's columns', O(nlinks). */
     double *ten = h->tensions + nl * i;
-    for (size_t l = 0; l < nl; l++)
-        ten[l] = lin->Ty && lin->Tu ? lin->t0[l] : NAN;
-    if (lin->Ty && lin->Tu) {
+    if (L->sparse) {
+        tsi_shift_apply(&L->shi, z, L->tmp, 0);
+        tsi_shift_tensions(&L->shi, ten);
+        for (size_t l = 0; l < nl; l++)
+            ten[l] += lin->t0[l];
+        for (int j = 0; j < L->m; j++)
+            if (dv[j] != 0)
+                for (size_t l = 0; l < nl; l++)
+                    ten[l] += L->Tc[l + nl * (size_t)j] * dv[j];
+    } else {
+        for (size_t l = 0; l < nl; l++)
+            ten[l] = lin->Ty && lin->Tu ? lin->t0[l] : NAN;
+    }
+    if (!L->sparse && lin->Ty && lin->Tu) {
         int n = lin->nstate;
         for (int j = 0; j < n; j++)
             if (z[j] != 0)
@@ -1742,14 +1842,32 @@ static int lin_record(ts_kernel *k, const ts_linear *lin, const lin_sim *L,
             return TS_ENOMEM;
         const int no = lin->noutput, m = L->m, one = 1;
         const double a1 = 1.0;
-        memcpy(out, lin->v0, (size_t)no * sizeof(double));
-        L->la.dgemv_("N", &no, &n, &a1, lin->Vy, &no, z, &one, &a1, out, &one,
-                     1);
-        L->la.dgemv_("N", &no, &m, &a1, lin->Vu, &no, dv, &one, &a1, out, &one,
-                     1);
+        if (L->sparse) {
+            /* The output rows of the sparse model, O(nlinks). */
+            tsi_shift_outputs(&L->shi, z, dv, L->m, out);
+            for (int r = 0; r < no; r++)
+                out[r] += lin->v0[r];
+        } else {
+            memcpy(out, lin->v0, (size_t)no * sizeof(double));
+            L->la.dgemv_("N", &no, &n, &a1, lin->Vy, &no, z, &one, &a1, out,
+                         &one, 1);
+            L->la.dgemv_("N", &no, &m, &a1, lin->Vu, &no, dv, &one, &a1, out,
+                         &one, 1);
+        }
     }
     h->nsamples++;
     return TS_OK;
+}
+
+const char *ts_linear_method_name(const ts_sim_opts *o,
+                                  const ts_sim_stats *st)
+{
+    if (st->newton == TS_NEWTON_SPARSE)
+        return ts_integrator_name(o->integrator == TS_INT_BDF ? TS_INT_BDF
+                                                              : TS_INT_ESDIRK);
+    return o->linear_method == TS_LINSIM_EXPM
+               ? "expm"
+               : ts_integrator_name(o->integrator);
 }
 
 int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
@@ -1768,11 +1886,24 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EINVAL, "simulate (linear): the model has %d "
                        "states, the kernel %d and the history %d links", n,
                        ts_kernel_nstate(k), h->nlinks);
-    if (!lin->A || !lin->B)
-        return ts_fail(err, TS_EINVAL, "simulate (linear): the linear "
-                       "simulation needs the dense A and B (linearize with "
-                       "model TS_LIN_DENSE or BOTH)");
+    /* The sparse model when asked for, or when it is the only one. */
+    int sparse = lin->desc && (o->linear_method == TS_LINSIM_SPARSE ||
+                               !lin->A || !lin->B);
     int manoeuvre = ex && ts_excitation_has_manoeuvre(ex);
+    if (!sparse && (!lin->A || !lin->B))
+        return ts_fail(err, TS_EINVAL, "simulate (linear): the linear "
+                       "simulation needs a linear model, sparse or dense "
+                       "(linearize with model TS_LIN_AUTO, SPARSE, DENSE or "
+                       "BOTH)");
+    if (o->linear_method == TS_LINSIM_SPARSE && !lin->desc)
+        return ts_fail(err, TS_EINVAL, "simulate (linear): linear_method "
+                       "sparse needs the sparse model (linearize with model "
+                       "TS_LIN_AUTO, SPARSE or BOTH)");
+    if (sparse && manoeuvre)
+        return ts_fail(err, TS_EINVAL, "simulate (linear): a manoeuvre "
+                       "drives the frame inputs, which only the dense model "
+                       "has (linearize with model TS_LIN_DENSE or BOTH, and "
+                       "linear_method expm or ode)");
     ts_frame base;
     ts_kernel_get_frame(k, &base);
     if ((rc = ts_sim_check_linear_manoeuvre(k, ex, err)))
@@ -1788,9 +1919,13 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     /* Only the tow channels are driven unless a signal drives a vehicle's
      * input or the frame (the exponential's order is n + 4 m), and only
      * the translations' unless a signal drives a rotation. */
-    int m = in_idx || manoeuvre          ? lin->ninput
+    int m = manoeuvre               ? lin->ninput
+            : in_idx && sparse      ? lin->frame_input
+            : in_idx                ? lin->ninput
             : drives_rotation(ex) ? TS_NINPUT
-                                          : TS_TOW_ROT;
+                                    : TS_TOW_ROT;
+    /* The exponential's blocks: expm on the dense model only. */
+    int hold = !sparse && o->linear_method == TS_LINSIM_EXPM;
     double *z = calloc(sn, sizeof(double));
     double *tmp = calloc(sn, sizeof(double));
     /* y0 + z, f there, the whole input, and its deviation. */
@@ -1800,21 +1935,24 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
     lin_hold H[2];
     for (int c = 0; c < 2; c++) {
         H[c].h = 0.0;
-        H[c].Phi = malloc(sn * sn * sizeof(double));
-        H[c].G = malloc(sn * 4 * (size_t)m * sizeof(double));
+        H[c].Phi = hold ? malloc(sn * sn * sizeof(double)) : NULL;
+        H[c].G = hold ? malloc(sn * 4 * (size_t)m * sizeof(double)) : NULL;
     }
-    lin_sim L = {lin,  ex,   n,           m, in_idx, manoeuvre,
-                 base, tmp,  vbuf, vbuf + 6 * m, 0, {0}};
+    lin_sim L = {.lin = lin,   .ex = ex,         .n = n,
+                 .m = m,       .in_idx = in_idx, .manoeuvre = manoeuvre,
+                 .base = base, .tmp = tmp,       .v = vbuf,
+                 .p = vbuf + 6 * m, .sparse = sparse};
     gsl_odeiv2_driver *drv = NULL;
     tsi_esdirk *sd = NULL;
     gsl_odeiv2_system gsys = {lin_rhs, lin_jac, sn, &L};
-    if (!z || !tmp || !ywork || !dr || !vbuf || !H[0].Phi || !H[0].G ||
-        !H[1].Phi || !H[1].G) {
+    if (!z || !tmp || !ywork || !dr || !vbuf ||
+        (hold && (!H[0].Phi || !H[0].G || !H[1].Phi || !H[1].G))) {
         rc = ts_fail(err, TS_ENOMEM, "simulate (linear): out of memory for "
                      "%d states", n);
         goto done;
     }
-    if ((rc = tsi_lapack_open(&L.la, err)) != TS_OK)
+    /* BLAS for the dense model's products only. */
+    if (!sparse && (rc = tsi_lapack_open(&L.la, err)) != TS_OK)
         goto done;
     if (z0)
         memcpy(z, z0, sn * sizeof(double));
@@ -1849,7 +1987,22 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                 z[part * lin->nq + i] += tmp[i];
         }
     }
-    if (o->linear_method == TS_LINSIM_ODE && sundials_method(o->integrator)) {
+    if (sparse) {
+        /* esdirk (bdf when chosen) with the sparse Newton solves, at the
+         * run's tolerances. */
+        const tsi_ode_lsys lsys = {lin_lsys_setup, lin_lsys_solve, 1};
+        if ((rc = lin_sparse_setup(&L, err)))
+            goto done;
+        stats.newton = TS_NEWTON_SPARSE;
+        sd = tsi_esdirk_alloc_method(n, lin_rhs_sparse, NULL, &lsys, &L,
+                                     o->rel_tol, o->abs_tol, o->h_init,
+                                     o->integrator == TS_INT_BDF, err);
+        if (!sd || (rc = tsi_esdirk_reset(sd, 0.0, z, err))) {
+            rc = rc ? rc : TS_ENOMEM;
+            goto done;
+        }
+    } else if (o->linear_method == TS_LINSIM_ODE &&
+               sundials_method(o->integrator)) {
         sd = tsi_esdirk_alloc_method(n, lin_rhs_esdirk, lin_jac_esdirk, NULL,
                                      &L, o->rel_tol, o->abs_tol, o->h_init,
                                      o->integrator == TS_INT_BDF, err);
@@ -1880,7 +2033,7 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                     rc = TS_EINTEGRATOR;
             if (rc)
                 break;
-        } else if (o->linear_method == TS_LINSIM_ODE) {
+        } else if (!hold) {
             gsl_error_handler_t *old = gsl_set_error_handler_off();
             while (t < t1 && !rc) {
                 int s = gsl_odeiv2_evolve_apply(drv->e, drv->c, drv->s, &gsys,
@@ -1958,6 +2111,10 @@ done:
         free(H[c].Phi);
         free(H[c].G);
     }
+    tsi_shift_free(&L.shi);
+    tsi_shift_free(&L.shs);
+    free(L.Bc);
+    free(L.Tc);
     free(z);
     free(tmp);
     free(ywork);

@@ -925,11 +925,13 @@ static void sim_print(const cli_run *c, const ts_result *r)
                    "section 6)\n", lin->kinks, lin->kinks == 1 ? " sits" :
                    "s sit", lin->kink_tow ? "the tow point among them"
                                           : "not the tow point");
-        char method[64];
-        snprintf(method, sizeof method, "%s, %s kinematics",
-                 r->sim.linear_method == TS_LINSIM_EXPM
-                     ? "exact discretisation (expm)"
-                     : ts_integrator_name(r->sim.integrator),
+        char method[96];
+        const char *lm = ts_linear_method_name(&r->sim, &r->linear_stats);
+        snprintf(method, sizeof method, "%s%s, %s kinematics",
+                 strcmp(lm, "expm") ? lm : "exact discretisation (expm)",
+                 r->linear_stats.newton == TS_NEWTON_SPARSE
+                     ? " on the sparse model"
+                     : "",
                  r->sim.kinematics == TS_KIN_LINEAR ? "linear"
                                                     : "nonlinear");
         print_stats("linear", &r->linear_stats, method);

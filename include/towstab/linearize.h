@@ -122,7 +122,9 @@ typedef struct ts_linear {
     ts_descriptor *desc; /* the sparse model E x' = F x + G u of the node
                           and vehicles' equations (O(nlinks) memory), NULL
                           unless formed; the eigen, response and stiff
-                          simulation solvers use it at any size */
+                          simulation solvers use it at any size, the
+                          linear simulation without the dense A
+                          (ts_simulate_linear) */
     double *y0;        /* [n] state linearized about (kernel's charts) */
     double *u0;        /* [ninput] input linearized about (its frame
                           inputs zero) */

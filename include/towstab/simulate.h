@@ -62,8 +62,13 @@ typedef enum {
 } ts_integrator;
 
 typedef enum {
-    TS_LINSIM_EXPM = 0, /* exact discretisation with cubic input hold */
-    TS_LINSIM_ODE = 1   /* the GSL integrator of ts_sim_opts.integrator */
+    TS_LINSIM_EXPM = 0, /* exact discretisation with cubic input hold
+                           (the dense model) */
+    TS_LINSIM_ODE = 1,  /* the integrator of ts_sim_opts.integrator (the
+                           dense model) */
+    TS_LINSIM_SPARSE = 2 /* esdirk (bdf when ts_sim_opts.integrator is
+                           bdf) on the sparse model: O(nlinks) per step;
+                           what any method runs without the dense model */
 } ts_linsim_method;
 
 typedef enum {
@@ -153,7 +158,8 @@ typedef struct ts_history {
     double *t;           /* [capacity] s */
     double *positions;   /* [capacity][3 nnodes] m, M frame, node 0 = tow */
     double *tensions;    /* [capacity][nlinks] N (linear runs: from the
-                            tension Jacobians, NaN without them) */
+                            tension Jacobians or the sparse model, NaN
+                            without either) */
     double *tow_force;   /* [capacity][3] N, the force on the tow point
                             (ts_kernel_tow_force; NaN in linear runs) */
     double *energy;      /* [capacity][2] kinetic, potential, J (NaN in
@@ -296,8 +302,14 @@ TS_API int ts_sim_check_linear_manoeuvre(const ts_kernel *k,
 /* Simulate z' = A z + B (u(t) - u0) from z(0) = z0 (NULL: 0) over
  * [0, o->t_end], recording positions into h, and the link tensions
  * T0 + dT/dy z + dT/du (u - u0) when lin has the tension Jacobians
- * (ts_linearize_opts.tensions; else NaN); energies and the tow force are
- * NaN.
+ * (ts_linearize_opts.tensions; else NaN) or runs on the sparse model;
+ * energies and the tow force are NaN.
+ * The dense A and B with linear_method expm or ode; the sparse model
+ * (lin->desc) with linear_method sparse, or with any method when lin has
+ * no dense A: esdirk (bdf when o->integrator is bdf) at o's tolerances,
+ * A's action and the Newton solves by lib/shift.h, the tensions and the
+ * vehicles' outputs from the same model; a manoeuvre (the frame inputs)
+ * needs the dense model.
  * `k` must be the kernel lin was computed with, in the same charts (its
  * frame too, the base of the manoeuvres); it is used for the nonlinear
  * kinematics only. A manoeuvre drives the frame inputs with the frame's
@@ -306,11 +318,18 @@ TS_API int ts_sim_check_linear_manoeuvre(const ts_kernel *k,
  * the nonlinear run's (doc/simulate.md); refused as
  * ts_sim_check_linear_manoeuvre says. Cost per output interval: expm
  * O(n^2) per step plus one O((n + 4 m)^3) exponential per distinct step
- * size (m inputs driven); ode: O(n^2) per evaluation. */
+ * size (m inputs driven); ode: O(n^2) per evaluation; sparse: O(nlinks)
+ * per evaluation and per Newton solve, and O(nlinks m) memory. */
 TS_API int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
                               const ts_excitation *ex, const double z0[],
                               const ts_sim_opts *o, ts_history *h,
                               ts_sim_stats *st, ts_err *err);
+
+/* The name of the method a linear run used, from its statistics: "expm",
+ * or the integrator's name (esdirk or bdf on the sparse model,
+ * st->newton TS_NEWTON_SPARSE). */
+TS_API const char *ts_linear_method_name(const ts_sim_opts *o,
+                                         const ts_sim_stats *st);
 
 /* --- Initial states. --- */
 

@@ -20,7 +20,13 @@
  *  - esdirk: examples/kamman_ex1_elastic.yaml (EA 1e9 N) with 100 and 500
  *    links, heaved 0.1 ft at 0.25 Hz (smooth start over two periods, the
  *    default) for T_SIM simulated seconds, rtol 1e-6, atol 1e-9: wall
- *    seconds of the integration per simulated second.
+ *    seconds of the integration per simulated second;
+ *  - linear simulation: examples/kamman_ex1_submerged.yaml with 1000 and
+ *    10 000 links, the linear model alone (`simulate --linear`, the
+ *    default method: above 1200 states esdirk on the sparse model) heaved
+ *    as esdirk's case for T_SIM simulated seconds, sampled every 0.1 s:
+ *    wall seconds of the linear integration per simulated second, and
+ *    the whole analysis's.
  * Each case runs in a child process, so that its peak memory (the child's
  * maximum resident set, getrusage) is its own; the figure is the median
  * of REPS runs (peak: the largest). Targets (issue: stability, response
@@ -32,8 +38,9 @@
  * OpenBLAS on one thread, as towstab runs it (tools/towstab.c): meson
  * sets OPENBLAS_NUM_THREADS=1 for it.
  * Run from the project root: meson test -C build --benchmark sparse, or
- * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS [vehicle|towing]]
- * (vehicle: the towed vehicle cases only; towing: the towing vehicle's
+ * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS
+ * [vehicle|towing|linear]] (vehicle: the towed vehicle cases only;
+ * towing: the towing vehicle's only; linear: the linear simulation's
  * only). */
 #define _GNU_SOURCE /* wait4 */
 #include <stdio.h>
@@ -52,13 +59,16 @@
 #define REPS 3
 #define T_SIM 2.0
 
-enum { MODES, RESPONSE, ESDIRK, VMODES, VRESPONSE, TRESPONSE, TDENSE };
+enum { MODES, RESPONSE, ESDIRK, VMODES, VRESPONSE, TRESPONSE, TDENSE,
+       LINSIM };
 
 /* What a child reports back through its pipe. */
 typedef struct figures {
     int ok;
     double wall, eq, lin, eig;    /* s */
-    double per_sim;               /* esdirk: wall s per simulated s */
+    double per_sim;               /* esdirk, linear: wall s per
+                                     simulated s */
+    int sparse;                   /* linear: ran on the sparse model */
     double rightmost, top_hz;     /* modes */
     int nmodes, shifts, complete; /* modes */
     long steps;                   /* esdirk */
@@ -107,13 +117,15 @@ static void run_case(int kind, int links, figures *f)
         rq.modes.count = 20; /* ARPACK at every size, as at 10 000 */
         rq.modes.eigen.method = TS_EIG_ARPACK;
     }
-    if (kind == ESDIRK) {
+    if (kind == ESDIRK || kind == LINSIM) {
         ts_sim_opts *o = &rq.simulate.sim;
-        o->integrator = TS_INT_ESDIRK;
+        if (kind == ESDIRK)
+            o->integrator = TS_INT_ESDIRK;
         o->t_end = T_SIM;
         o->dt_sample = 0.1;
         o->rel_tol = 1e-6;
         o->abs_tol = 1e-9;
+        rq.simulate.linear = kind == LINSIM;
         rq.simulate.compare = 0;
         rq.simulate.check_window = 0;
         rq.simulate.excitation = ts_excitation_alloc(&err);
@@ -144,10 +156,12 @@ static void run_case(int kind, int links, figures *f)
             f->shifts = r->eigen->sweep_shifts;
             f->complete = r->eigen->complete;
         }
-        if (kind == ESDIRK) {
-            f->steps = r->nonlinear_stats.steps;
-            f->per_sim = r->nonlinear_stats.wall_s /
-                         r->nonlinear_stats.t_reached;
+        if (kind == ESDIRK || kind == LINSIM) {
+            const ts_sim_stats *st = kind == ESDIRK ? &r->nonlinear_stats
+                                                    : &r->linear_stats;
+            f->steps = st->steps;
+            f->per_sim = st->wall_s / st->t_reached;
+            f->sparse = st->newton == TS_NEWTON_SPARSE;
         }
     }
     ts_result_free(r);
@@ -203,14 +217,16 @@ static double measure(int kind, int links, int reps, figures *last,
         double p;
         if (run_child(kind, links, last, &p, &c[n]) != 0 || !last->ok) {
             static const char *const names[] = {
-                "modes", "response", "esdirk", "vehicle modes",
-                "vehicle response", "towing response", "towing dense"};
+                "modes",           "response",        "esdirk",
+                "vehicle modes",   "vehicle response", "towing response",
+                "towing dense",    "linear simulation"};
             printf("FAIL %s at %d links: %s\n", names[kind], links,
                    last->msg[0] ? last->msg : "child failed");
             failures++;
             return NAN;
         }
-        v[n++] = kind == ESDIRK ? last->per_sim : last->wall;
+        v[n++] = kind == ESDIRK || kind == LINSIM ? last->per_sim
+                                                  : last->wall;
         *peak = fmax(*peak, p);
     }
     *cpu = bench_median(c, n);
@@ -227,6 +243,7 @@ int main(int argc, char **argv)
     int reps = argc > 1 ? atoi(argv[1]) : REPS;
     int only_vehicle = argc > 2 && strcmp(argv[2], "vehicle") == 0;
     int only_towing = argc > 2 && strcmp(argv[2], "towing") == 0;
+    int only_linear = argc > 2 && strcmp(argv[2], "linear") == 0;
     if (reps < 1)
         reps = 1;
     figures f;
@@ -234,6 +251,25 @@ int main(int argc, char **argv)
     const int sizes[2] = {1000, 10000};
     printf("medians of %d runs; wall s of the whole analysis (equilibrium, "
            "linearization, solve)\n", reps);
+    for (int i = 0; i < 2 && (only_linear || argc <= 2); i++) {
+        t[i] = measure(LINSIM, sizes[i], reps, &f, &mem[i], &cpu);
+        if (isnan(t[i]))
+            continue;
+        printf("linear simulation %5d links: %.3f wall s per simulated s "
+               "(%ld steps over %g s, %s; the whole analysis %.3f s: "
+               "equilibrium %.3f, linearize %.3f; process CPU %.3f s), "
+               "peak %.0f MB\n",
+               sizes[i], t[i], f.steps, T_SIM,
+               f.sparse ? "esdirk on the sparse model" : "the dense model",
+               f.wall, f.eq, f.lin, cpu, mem[i]);
+    }
+    if (only_linear) {
+        if (!isnan(t[0]) && !isnan(t[1]))
+            printf("linear simulation growth 1000 -> 10000: %.1fx time, "
+                   "%.1fx memory\n", t[1] / t[0], mem[1] / mem[0]);
+        printf("%d failed\n", failures);
+        return failures ? 1 : 0;
+    }
     for (int i = 0; i < 2 && !only_vehicle && !only_towing; i++) {
         t[i] = measure(MODES, sizes[i], reps, &f, &mem[i], &cpu);
         if (isnan(t[i]))
