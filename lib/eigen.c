@@ -37,6 +37,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -926,10 +927,17 @@ static void start_vector(double *x, int n)
 }
 
 /* ARPACK keeps the state of a run between its calls in SAVE variables
- * (dnaupd, znaupd and the routines under them): one run at a time in a
- * process. A run is therefore a critical section of its own, named
- * ts_arpack, whatever calls it (a sweep's threads, each with its modes and
- * rightmost search); the rest of an eigen analysis runs in parallel. */
+ * (dnaupd, znaupd and the routines under them): one run of a family at a
+ * time in a process. A run is therefore a critical section of its own,
+ * whatever calls it (a sweep's threads, each with its modes and
+ * rightmost search): ts_arpack_real for the real family (dnaupd, dneupd
+ * and their routines: the modes nearest 0 Hz), ts_arpack_complex for the
+ * complex one (znaupd, zneupd: the search's and a complex target's runs).
+ * The two families share no SAVE variable; they share only the common
+ * block /timing/ of ARPACK's statistics (operation counts and timers,
+ * which a run writes and towstab never reads: iparam[8..10] are not
+ * used), so a real run and a complex run may run at once: the modes'
+ * run beside the rightmost search (modes_and_search). */
 static int solve_arpack_real_run(const ts_linear *lin,
                                  const ts_eigen_opts *o, double sigma,
                                  ts_eigen *e, cand_list *L, ts_err *err);
@@ -940,7 +948,7 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
 {
     int rc;
 #ifdef _OPENMP
-#pragma omp critical(ts_arpack)
+#pragma omp critical(ts_arpack_real)
 #endif
     rc = solve_arpack_real_run(lin, o, sigma, e, L, err);
     return rc;
@@ -1072,7 +1080,7 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
 {
     int rc;
 #ifdef _OPENMP
-#pragma omp critical(ts_arpack)
+#pragma omp critical(ts_arpack_complex)
 #endif
     rc = arpack_near_run(lin, sigma, nev, ncv, tol, maxiter, partial, start,
                          pp, L, st, err);
@@ -1223,6 +1231,9 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
 #define SWEEP_NEV 8        /* eigenvalues found around each shift */
 #define SWEEP_NCV 20       /* Arnoldi vectors of each shift's run */
 #define SWEEP_RATIO 4.0    /* frequency ratio of the grid of shifts */
+#define SWEEP_PRE_GRID 2   /* points of the grid, from the top down, run
+                              before the modes' highest frequency is known
+                              (beside the modes' run: modes_and_search) */
 #define SWEEP_RESTARTS 30  /* ARPACK restarts of a run; what converged by
                               then is kept */
 #define SWEEP_SEED_RTOL 0.05 /* seeds closer than this are one */
@@ -1466,6 +1477,7 @@ static double sweep_threshold(const cand_list *L, int from)
  * (sweep = 1, repeats and a rerun grid run's first values 2). */
 static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                             const ts_eigen_opts *o, ts_eigen *e, cand_list *L,
+                            double (*get_wlo)(void *), void *wctx,
                             ts_err *err)
 {
     const ts_system *sys = d->sys;
@@ -1484,20 +1496,22 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         top[2 * c] = fmax(top[2 * c], wt);
         top[2 * c + 1] = fmax(top[2 * c + 1], wa);
     }
-    double wtop = 0, wlo = 0;
+    double wtop = 0;
     for (int i = 0; i < 2 * nc; i++)
         wtop = fmax(wtop, top[i]);
-    for (int i = 0; i < L->n; i++)
-        wlo = fmax(wlo, cimag(L->c[i].lam));
     e->top_hz = wtop / (2 * M_PI);
+    /* First the band tops and the grid's top SWEEP_PRE_GRID points (down
+     * from the top in steps of SWEEP_RATIO), which need not know the
+     * modes; then (get_wlo, which may wait for the modes' run) the grid's
+     * points down to the highest frequency among the modes, the lowest
+     * of them within SWEEP_RATIO of it. */
     int ns = 0;
     for (int i = 0; i < 2 * nc && ns < 32; i++)
         if (top[i] > 0)
             seed[ns++] = (sweep_seed){top[i], 1};
-    if (!(wlo > 0))
-        wlo = wtop / 1024;
-    for (double w = wlo * SWEEP_RATIO; w < wtop && ns < 62; w *= SWEEP_RATIO)
-        seed[ns++] = (sweep_seed){w, 0};
+    double w = wtop;
+    for (int k = 0; k < SWEEP_PRE_GRID && ns < 62; k++)
+        seed[ns++] = (sweep_seed){w /= SWEEP_RATIO, 0};
     qsort(seed, (size_t)ns, sizeof *seed, cmp_seed);
     int nu = 0;
     for (int i = 0; i < ns; i++) {
@@ -1506,10 +1520,11 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         else
             seed[nu - 1].top |= seed[i].top; /* a band top: SWEEP_TOL */
     }
-    /* Room for every run's eigenvalues at once: the vectors are tens of
+    int npre = nu;
+    /* Room for the runs' eigenvalues at once: the vectors are tens of
      * MB, and each growth copies them all. */
-    if (cand_grow(L, (nu + SWEEP_CLIMBS * SWEEP_STEPS) * (SWEEP_NEV + 1)) !=
-        TS_OK) {
+    if (cand_grow(L, (nu + 4 + SWEEP_CLIMBS * SWEEP_STEPS) *
+                         (SWEEP_NEV + 1)) != TS_OK) {
         free(top);
         free(seed);
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
@@ -1521,7 +1536,32 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
     double grid_tol = pencil_ritz(lin) ? SWEEP_GRID_TOL : SWEEP_TOL;
     double run_re[64], run_w[64], run_r[64];
     int run_best[64], run_from[64], run_to[64], run_loose[64];
-    for (int i = 0; i < nu && rc == TS_OK; i++) {
+    for (int i = 0; (i < nu || i == npre) && rc == TS_OK; i++) {
+        if (i == npre) {
+            /* The rest of the grid, once the modes are known. */
+            double wlo = get_wlo(wctx);
+            if (isnan(wlo)) {
+                rc = TS_ECANCEL; /* the modes' run failed: its error */
+                break;
+            }
+            if (!(wlo > 0))
+                wlo = wtop / 1024;
+            for (; w / SWEEP_RATIO > wlo && nu < 62;) {
+                w /= SWEEP_RATIO;
+                int near = 0;
+                for (int j = 0; j < npre; j++)
+                    near |= fabs(w - seed[j].w) <= SWEEP_SEED_RTOL * seed[j].w;
+                if (!near)
+                    seed[nu++] = (sweep_seed){w, 0};
+            }
+            qsort(seed + npre, (size_t)(nu - npre), sizeof *seed, cmp_seed);
+            if (cand_grow(L, (nu - npre) * (SWEEP_NEV + 1)) != TS_OK) {
+                rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+                break;
+            }
+            if (i == nu)
+                break;
+        }
         int best, from = L->n;
         double r;
         rc = sweep_run(lin, o, I * seed[i].w,
@@ -2118,6 +2158,19 @@ int ts_eigen_solve(const ts_linear *lin, const ts_eigen_opts *opts,
     return rc;
 }
 
+/* The highest frequency (rad/s) among L's candidates: the modes, before
+ * the search adds to L. */
+static double modes_top(const cand_list *L)
+{
+    double w = 0;
+    for (int i = 0; i < L->n; i++)
+        w = fmax(w, cimag(L->c[i].lam));
+    return w;
+}
+
+/* rightmost_search's get_wlo for a search after the modes: a value. */
+static double wlo_given(void *ctx) { return *(const double *)ctx; }
+
 /* The rightmost search (thread 0) beside the checks of the modes, the
  * `count` candidates of L nearest the target (another thread), on the
  * linearization's threads: the checks read copies of the modes (the
@@ -2140,8 +2193,9 @@ static int search_beside_checks(const ts_linear *lin,
         L->c[i].dist = cabs(L->c[i].lam - sigma);
     qsort(L->c, (size_t)L->n, sizeof(cand), cmp_dist);
     int keep = o->count < L->n ? o->count : L->n;
+    double wlo = modes_top(L);
     if (keep < o->count) /* eigen_solve says so after the search */
-        return rightmost_search(lin, bands, o, e, L, err);
+        return rightmost_search(lin, bands, o, e, L, wlo_given, &wlo, err);
     int n = L->nstate, rc = tsi_shift_factor_inf(acc, lin, err);
     if (rc != TS_OK)
         return rc;
@@ -2172,7 +2226,7 @@ static int search_beside_checks(const ts_linear *lin,
         if (t == (team > 1 ? 1 : 0))
             rk = batch_checks(lin, acc, es, &M, &ek);
         if (t == 0)
-            rs = rightmost_search(lin, bands, o, e, L, err);
+            rs = rightmost_search(lin, bands, o, e, L, wlo_given, &wlo, err);
     }
     if (rs == TS_OK && rk != TS_OK) {
         rs = rk;
@@ -2187,6 +2241,209 @@ static int search_beside_checks(const ts_linear *lin,
     cand_free(&M);
     *checked = rs == TS_OK;
     return rs;
+}
+
+/* What the modes' run (modes_and_search) shares with the search beside
+ * it: its state (0 running, 1 done, -1 failed) and the highest frequency
+ * among its modes, and whether the search has stopped (its failure or a
+ * stop asked for), which stops the modes' run at its next poll. */
+typedef struct modes_share {
+    int state;
+    double wlo;
+    int stop;
+    const ts_eigen_opts *o; /* the caller's progress, polled while the
+                               search waits (share_wlo) */
+    int asked;              /* a stop asked for while it waited */
+} modes_share;
+
+/* The modes' run's poll beside the search: the search's stop. */
+static int share_poll(const ts_progress *p, void *data)
+{
+    (void)p;
+    modes_share *m = data;
+    int stop;
+#ifdef _OPENMP
+#pragma omp atomic read seq_cst
+#endif
+    stop = m->stop;
+    return stop;
+}
+
+/* rightmost_search's get_wlo beside the modes' run: waits for it,
+ * polling the caller's progress every 10 ms or so; NaN when it failed or
+ * a stop was asked for (asked set, and stop, which the modes' run then
+ * takes). */
+static double share_wlo(void *ctx)
+{
+    modes_share *m = ctx;
+    int state;
+    for (long k = 1;; k++) {
+#ifdef _OPENMP
+#pragma omp atomic read seq_cst
+#endif
+        state = m->state;
+        if (state)
+            break;
+        ts_progress p = {"rightmost search", 0, NAN, "shifts"};
+        if (k % 200 == 0 && m->o->progress &&
+            m->o->progress(&p, m->o->progress_data)) {
+            m->asked = 1;
+#ifdef _OPENMP
+#pragma omp atomic write seq_cst
+#endif
+            m->stop = 1;
+            return NAN;
+        }
+        struct timespec ts = {0, 50000};
+        nanosleep(&ts, NULL);
+    }
+    return state > 0 ? m->wlo : NAN;
+}
+
+/* Append the search's candidates S to L (the modes, the first n0), the
+ * vectors copied; one that repeats a mode (sweep_new's test) is marked
+ * a repeat (2). */
+static int merge_search(cand_list *L, const cand_list *S)
+{
+    int n0 = L->n, n = L->nstate;
+    if (cand_grow(L, S->n) != TS_OK)
+        return TS_ENOMEM;
+    for (int i = 0; i < S->n; i++) {
+        cand c = S->c[i];
+        memcpy(L->v + (size_t)L->n * n, S->v + (size_t)c.vec * n,
+               (size_t)n * sizeof(double complex));
+        c.vec = L->n;
+        L->c[L->n++] = c;
+        cand *a = &L->c[L->n - 1];
+        const double complex *va = L->v + (size_t)a->vec * n;
+        for (int j = 0; j < n0 && a->sweep == 1; j++) {
+            const cand *b = &L->c[j];
+            if (cabs(b->lam - a->lam) >
+                CONJ_MATCH_RTOL * cabs(a->lam) + b->slack + a->slack)
+                continue;
+            const double complex *vb = L->v + (size_t)b->vec * n;
+            double complex dot = 0;
+            double na = 0, nb = 0;
+            for (int r = 0; r < n; r++) {
+                dot += conj(vb[r]) * va[r];
+                na += creal(va[r] * conj(va[r]));
+                nb += creal(vb[r] * conj(vb[r]));
+            }
+            if (cabs(dot) > SWEEP_SAME_VECTOR * sqrt(na * nb))
+                a->sweep = 2;
+        }
+    }
+    return TS_OK;
+}
+
+/* The modes nearest 0 Hz (one real ARPACK run, solve_arpack_real at
+ * sigma) and the rightmost search at once on the linearization's threads:
+ * the search (thread 0) runs the band tops and the grid's top points
+ * while the modes' run (another thread) goes, then the rest of the grid
+ * once the modes' highest frequency is known (share_wlo), while the
+ * modes' residuals and error estimates are computed (the `count` nearest
+ * 0 Hz). The search fills a list of its own, merged into L after; the
+ * two runs are of ARPACK's two families (real and complex), which may
+ * run at once (solve_arpack_real). On one thread: the modes' run, their
+ * checks, the search, in that order, with the same results bit for bit
+ * (each ARPACK run starts from a fixed vector and factors afresh; the
+ * search never reads the modes' list). acc and es as for
+ * search_beside_checks; *checked is set when the modes were checked. */
+static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
+                            const ts_eigen_opts *o, double sigma,
+                            ts_eigen *e, cand_list *L, tsi_shift *acc,
+                            tsi_shift *es, int *checked, ts_err *err)
+{
+    *checked = 0;
+    int n = lin->nstate;
+    cand_list S = {0};
+    if (cand_init(&S, 1, n) != TS_OK) {
+        cand_free(&S);
+        return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    }
+    /* The search's statistics apart from the modes' run's. */
+    ts_eigen se;
+    memset(&se, 0, sizeof se);
+    modes_share share = {0, NAN, 0, o, 0};
+    int nt = lin->threads > 1 ? 2 : 1, rr = TS_OK, rs = TS_OK, rk = TS_OK;
+    int keep = 0;
+    ts_err er = {0}, ek = {0};
+#ifdef _OPENMP
+#pragma omp parallel num_threads(nt)
+#endif
+    {
+        int t = 0, team = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        team = omp_get_num_threads();
+#endif
+        if (t == (team > 1 ? 1 : 0)) {
+            ts_eigen_opts ro = *o;
+            if (team > 1) {
+                /* The search alone calls the caller's progress. */
+                ro.progress = share_poll;
+                ro.progress_data = &share;
+            }
+            rr = solve_arpack_real(lin, &ro, sigma, e, L, &er);
+            if (rr == TS_OK) {
+                share.wlo = modes_top(L);
+                double complex target = I * 2.0 * M_PI * o->target_hz;
+                for (int i = 0; i < L->n; i++)
+                    L->c[i].dist = cabs(L->c[i].lam - target);
+                qsort(L->c, (size_t)L->n, sizeof(cand), cmp_dist);
+                keep = o->count < L->n ? o->count : L->n;
+            }
+#ifdef _OPENMP
+#pragma omp atomic write seq_cst
+#endif
+            share.state = rr == TS_OK ? 1 : -1;
+            if (rr == TS_OK && keep == o->count) {
+                for (int i = 0; i < L->n; i++)
+                    L->c[i].checked = i < keep ? 0 : -1;
+                rk = tsi_shift_factor_inf(acc, lin, &ek);
+                if (rk == TS_OK)
+                    rk = batch_checks(lin, acc, es, L, &ek);
+            }
+        }
+        if (t == 0) {
+            rs = rightmost_search(lin, bands, o, &se, &S, share_wlo, &share,
+                                  err);
+            if (rs != TS_OK) {
+#ifdef _OPENMP
+#pragma omp atomic write seq_cst
+#endif
+                share.stop = 1;
+            }
+        }
+    }
+    int rc = TS_OK;
+    if (share.asked) {
+        rc = ts_fail(err, TS_ECANCEL, "eigen: stopped on request in the "
+                                      "rightmost search, waiting for the "
+                                      "modes' run");
+    } else if (rr != TS_OK && !(rr == TS_ECANCEL && rs != TS_OK)) {
+        /* The modes' run failed (not stopped by the search's stop). */
+        rc = rr;
+        if (err)
+            *err = er;
+    } else if (rs != TS_OK) {
+        rc = rs;
+    } else if (rk != TS_OK) {
+        rc = rk;
+        if (err)
+            *err = ek;
+    }
+    e->top_hz = se.top_hz;
+    e->sweep_failed += se.sweep_failed;
+    e->sweep_shifts = se.sweep_shifts;
+    e->arpack_iterations += se.arpack_iterations;
+    e->arpack_ops += se.arpack_ops;
+    e->arpack_nconv += se.arpack_nconv;
+    if (rc == TS_OK && merge_search(L, &S) != TS_OK)
+        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+    cand_free(&S);
+    *checked = rc == TS_OK && keep == o->count;
+    return rc;
 }
 
 static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
@@ -2227,21 +2484,24 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
     e->method = m;
     e->target_hz = o.target_hz;
     cand_list L = {0};
-    if (m == TS_EIG_LAPACK) {
+    /* The modes nearest 0 Hz with the sparse model: their run beside the
+     * rightmost search (modes_and_search, below). */
+    int together = m == TS_EIG_ARPACK && o.rightmost && bands && lin->desc &&
+                   o.target_hz == 0.0;
+    /* (Each ARPACK run is a critical section: solve_arpack_real.)
+     * Neutral modes at 0 make A singular there: shift just off it. */
+    double sigma0 = 0.0;
+    for (int k = 0; k < lin->nneutral; k++)
+        if (lin->neutral[k].re == 0.0 && lin->neutral[k].im == 0.0)
+            sigma0 = -NEUTRAL_SHIFT_REL * a_scale_of(lin);
+    if (m == TS_EIG_LAPACK)
         rc = solve_lapack(lin, &L, err);
-    } else {
-    {
-        /* (Each ARPACK run is a critical section: solve_arpack_real.)
-         * Neutral modes at 0 make A singular there: shift just off it. */
-        double sigma = 0.0;
-        for (int k = 0; k < lin->nneutral; k++)
-            if (lin->neutral[k].re == 0.0 && lin->neutral[k].im == 0.0)
-                sigma = -NEUTRAL_SHIFT_REL * a_scale_of(lin);
+    else if (together)
+        rc = TS_OK; /* modes_and_search fills L */
+    else
         rc = o.target_hz == 0.0
-                 ? solve_arpack_real(lin, &o, sigma, e, &L, err)
+                 ? solve_arpack_real(lin, &o, sigma0, e, &L, err)
                  : solve_arpack_complex(lin, &o, e, &L, err);
-    }
-    }
     if (rc != TS_OK) {
         cand_free(&L);
         ts_eigen_free(e);
@@ -2254,11 +2514,16 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
      * es and acc then carry on to the search's own checks below. */
     tsi_shift acc = {0}, es = {0};
     int modes_checked = 0;
-    if (m == TS_EIG_ARPACK && o.rightmost && bands && lin->desc)
+    if (together) {
+        rc = modes_and_search(lin, bands, &o, sigma0, e, &L, &acc, &es,
+                              &modes_checked, err);
+    } else if (m == TS_EIG_ARPACK && o.rightmost && bands && lin->desc) {
         rc = search_beside_checks(lin, bands, &o, e, &L, &acc, &es,
                                   &modes_checked, err);
-    else if (m == TS_EIG_ARPACK && o.rightmost && bands)
-        rc = rightmost_search(lin, bands, &o, e, &L, err);
+    } else if (m == TS_EIG_ARPACK && o.rightmost && bands) {
+        double wlo = modes_top(&L);
+        rc = rightmost_search(lin, bands, &o, e, &L, wlo_given, &wlo, err);
+    }
     if (rc != TS_OK) {
         if (acc.numeric || acc.lu || acc.zlu)
             tsi_shift_free(&acc);
