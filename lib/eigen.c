@@ -36,6 +36,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdatomic.h>
 #include <string.h>
 #include <time.h>
 
@@ -2244,56 +2245,55 @@ static int search_beside_checks(const ts_linear *lin,
 }
 
 /* What the modes' run (modes_and_search) shares with the search beside
- * it: its state (0 running, 1 done, -1 failed) and the highest frequency
- * among its modes, and whether the search has stopped (its failure or a
- * stop asked for), which stops the modes' run at its next poll. */
+ * it: its state (0 running, 1 done, -1 failed), the highest frequency
+ * among its modes, whether the caller asked it to stop (user_stop) and
+ * whether the search failed (stop: the modes' run then stops too). The
+ * caller's progress is called by one thread at a time: the modes' run
+ * while it goes (its operator applications, as "eigensolve"), the search
+ * once it is done (its shifts). */
 typedef struct modes_share {
-    int state;
+    atomic_int state;
     double wlo;
-    int stop;
-    const ts_eigen_opts *o; /* the caller's progress, polled while the
-                               search waits (share_wlo) */
-    int asked;              /* a stop asked for while it waited */
+    atomic_int user_stop;
+    atomic_int stop;
+    const ts_eigen_opts *o; /* the caller's progress */
 } modes_share;
 
-/* The modes' run's poll beside the search: the search's stop. */
-static int share_poll(const ts_progress *p, void *data)
+static int share_read(atomic_int *x) { return atomic_load(x); }
+
+static void share_set(atomic_int *x, int v) { atomic_store(x, v); }
+
+/* The modes' run's poll: the caller's progress, and the search's
+ * failure. */
+static int modes_poll(const ts_progress *p, void *data)
 {
-    (void)p;
     modes_share *m = data;
-    int stop;
-#ifdef _OPENMP
-#pragma omp atomic read seq_cst
-#endif
-    stop = m->stop;
-    return stop;
+    if (m->o->progress && m->o->progress(p, m->o->progress_data)) {
+        share_set(&m->user_stop, 1);
+        return 1;
+    }
+    return share_read(&m->stop);
 }
 
-/* rightmost_search's get_wlo beside the modes' run: waits for it,
- * polling the caller's progress every 10 ms or so; NaN when it failed or
- * a stop was asked for (asked set, and stop, which the modes' run then
- * takes). */
+/* The search's poll: a stop the caller asked of the modes' run; while
+ * that goes, nothing more; after, the caller's progress. */
+static int search_poll(const ts_progress *p, void *data)
+{
+    modes_share *m = data;
+    if (share_read(&m->user_stop))
+        return 1;
+    if (share_read(&m->state) == 0)
+        return 0;
+    return m->o->progress ? m->o->progress(p, m->o->progress_data) : 0;
+}
+
+/* rightmost_search's get_wlo beside the modes' run: waits for it (which
+ * polls the caller meanwhile); NaN when it failed or was stopped. */
 static double share_wlo(void *ctx)
 {
     modes_share *m = ctx;
     int state;
-    for (long k = 1;; k++) {
-#ifdef _OPENMP
-#pragma omp atomic read seq_cst
-#endif
-        state = m->state;
-        if (state)
-            break;
-        ts_progress p = {"rightmost search", 0, NAN, "shifts"};
-        if (k % 200 == 0 && m->o->progress &&
-            m->o->progress(&p, m->o->progress_data)) {
-            m->asked = 1;
-#ifdef _OPENMP
-#pragma omp atomic write seq_cst
-#endif
-            m->stop = 1;
-            return NAN;
-        }
+    while (!(state = share_read(&m->state))) {
         struct timespec ts = {0, 50000};
         nanosleep(&ts, NULL);
     }
@@ -2364,10 +2364,20 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
     /* The search's statistics apart from the modes' run's. */
     ts_eigen se;
     memset(&se, 0, sizeof se);
-    modes_share share = {0, NAN, 0, o, 0};
+    modes_share share;
+    atomic_init(&share.state, 0);
+    atomic_init(&share.user_stop, 0);
+    atomic_init(&share.stop, 0);
+    share.wlo = NAN;
+    share.o = o;
     int nt = lin->threads > 1 ? 2 : 1, rr = TS_OK, rs = TS_OK, rk = TS_OK;
     int keep = 0;
     ts_err er = {0}, ek = {0};
+    ts_eigen_opts ro = *o, so = *o;
+    ro.progress = modes_poll;
+    ro.progress_data = &share;
+    so.progress = search_poll;
+    so.progress_data = &share;
 #ifdef _OPENMP
 #pragma omp parallel num_threads(nt)
 #endif
@@ -2378,12 +2388,6 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
         team = omp_get_num_threads();
 #endif
         if (t == (team > 1 ? 1 : 0)) {
-            ts_eigen_opts ro = *o;
-            if (team > 1) {
-                /* The search alone calls the caller's progress. */
-                ro.progress = share_poll;
-                ro.progress_data = &share;
-            }
             rr = solve_arpack_real(lin, &ro, sigma, e, L, &er);
             if (rr == TS_OK) {
                 share.wlo = modes_top(L);
@@ -2393,10 +2397,7 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
                 qsort(L->c, (size_t)L->n, sizeof(cand), cmp_dist);
                 keep = o->count < L->n ? o->count : L->n;
             }
-#ifdef _OPENMP
-#pragma omp atomic write seq_cst
-#endif
-            share.state = rr == TS_OK ? 1 : -1;
+            share_set(&share.state, rr == TS_OK ? 1 : -1);
             if (rr == TS_OK && keep == o->count) {
                 for (int i = 0; i < L->n; i++)
                     L->c[i].checked = i < keep ? 0 : -1;
@@ -2406,23 +2407,17 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
             }
         }
         if (t == 0) {
-            rs = rightmost_search(lin, bands, o, &se, &S, share_wlo, &share,
-                                  err);
-            if (rs != TS_OK) {
-#ifdef _OPENMP
-#pragma omp atomic write seq_cst
-#endif
-                share.stop = 1;
-            }
+            rs = rightmost_search(lin, bands, &so, &se, &S, share_wlo,
+                                  &share, err);
+            /* A failure of its own (not a stop the caller asked for in
+             * the modes' run) stops the modes' run too. */
+            if (rs != TS_OK && !share_read(&share.user_stop))
+                share_set(&share.stop, 1);
         }
     }
     int rc = TS_OK;
-    if (share.asked) {
-        rc = ts_fail(err, TS_ECANCEL, "eigen: stopped on request in the "
-                                      "rightmost search, waiting for the "
-                                      "modes' run");
-    } else if (rr != TS_OK && !(rr == TS_ECANCEL && rs != TS_OK)) {
-        /* The modes' run failed (not stopped by the search's stop). */
+    if (rr != TS_OK && !(rr == TS_ECANCEL && share_read(&share.stop))) {
+        /* The modes' run failed, or the caller stopped it. */
         rc = rr;
         if (err)
             *err = er;
