@@ -1364,6 +1364,27 @@ static int cmp_seed(const void *a, const void *b)
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
+/* Whether candidates a and b of L are the same eigenpair: the same
+ * eigenvalue within CONJ_MATCH_RTOL (and their slack) and the same
+ * vector (|b^H a| > SWEEP_SAME_VECTOR |a| |b|). O(nstate). */
+static int same_pair(const cand_list *L, const cand *a, const cand *b)
+{
+    if (cabs(b->lam - a->lam) >
+        CONJ_MATCH_RTOL * cabs(a->lam) + b->slack + a->slack)
+        return 0;
+    int n = L->nstate;
+    const double complex *va = L->v + (size_t)a->vec * n;
+    const double complex *vb = L->v + (size_t)b->vec * n;
+    double complex dot = 0;
+    double na = 0, nb = 0;
+    for (int r = 0; r < n; r++) {
+        dot += conj(vb[r]) * va[r];
+        na += creal(va[r] * conj(va[r]));
+        nb += creal(vb[r] * conj(vb[r]));
+    }
+    return cabs(dot) > SWEEP_SAME_VECTOR * sqrt(na * nb);
+}
+
 /* Mark the candidates from `from` on that repeat an earlier one (the same
  * eigenvalue within CONJ_MATCH_RTOL and the same vector); returns the
  * index of the one with the largest real part among the new, -1 if none,
@@ -1371,28 +1392,15 @@ static int cmp_seed(const void *a, const void *b)
 static int sweep_new(cand_list *L, int from, double complex sigma,
                      double *radius)
 {
-    int n = L->nstate, best = -1;
+    int best = -1;
     *radius = 0;
     for (int i = from; i < L->n; i++) {
         cand *c = &L->c[i];
         c->sweep = 1;
         *radius = fmax(*radius, cabs(c->lam - sigma));
-        const double complex *vi = L->v + (size_t)c->vec * n;
         for (int j = 0; j < i && c->sweep == 1; j++) {
             const cand *o = &L->c[j];
-            if (o->sweep == 2 || o->sweep == 4 ||
-                cabs(o->lam - c->lam) >
-                    CONJ_MATCH_RTOL * cabs(c->lam) + o->slack + c->slack)
-                continue;
-            const double complex *vj = L->v + (size_t)o->vec * n;
-            double complex dot = 0;
-            double ni = 0, nj = 0;
-            for (int r = 0; r < n; r++) {
-                dot += conj(vj[r]) * vi[r];
-                ni += creal(vi[r] * conj(vi[r]));
-                nj += creal(vj[r] * conj(vj[r]));
-            }
-            if (cabs(dot) > SWEEP_SAME_VECTOR * sqrt(ni * nj))
+            if (o->sweep != 2 && o->sweep != 4 && same_pair(L, c, o))
                 c->sweep = 2;
         }
         if (c->sweep == 1 &&
@@ -2172,6 +2180,17 @@ static double modes_top(const cand_list *L)
 /* rightmost_search's get_wlo for a search after the modes: a value. */
 static double wlo_given(void *ctx) { return *(const double *)ctx; }
 
+/* This thread's number and its team's size (0 and 1 without OpenMP). */
+static void thread_ids(int *t, int *team)
+{
+    *t = 0;
+    *team = 1;
+#ifdef _OPENMP
+    *t = omp_get_thread_num();
+    *team = omp_get_num_threads();
+#endif
+}
+
 /* The rightmost search (thread 0) beside the checks of the modes, the
  * `count` candidates of L nearest the target (another thread), on the
  * linearization's threads: the checks read copies of the modes (the
@@ -2219,11 +2238,8 @@ static int search_beside_checks(const ts_linear *lin,
 #pragma omp parallel num_threads(nt)
 #endif
     {
-        int t = 0, team = 1;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-        team = omp_get_num_threads();
-#endif
+        int t, team;
+        thread_ids(&t, &team);
         if (t == (team > 1 ? 1 : 0))
             rk = batch_checks(lin, acc, es, &M, &ek);
         if (t == 0)
@@ -2315,23 +2331,9 @@ static int merge_search(cand_list *L, const cand_list *S)
         c.vec = L->n;
         L->c[L->n++] = c;
         cand *a = &L->c[L->n - 1];
-        const double complex *va = L->v + (size_t)a->vec * n;
-        for (int j = 0; j < n0 && a->sweep == 1; j++) {
-            const cand *b = &L->c[j];
-            if (cabs(b->lam - a->lam) >
-                CONJ_MATCH_RTOL * cabs(a->lam) + b->slack + a->slack)
-                continue;
-            const double complex *vb = L->v + (size_t)b->vec * n;
-            double complex dot = 0;
-            double na = 0, nb = 0;
-            for (int r = 0; r < n; r++) {
-                dot += conj(vb[r]) * va[r];
-                na += creal(va[r] * conj(va[r]));
-                nb += creal(vb[r] * conj(vb[r]));
-            }
-            if (cabs(dot) > SWEEP_SAME_VECTOR * sqrt(na * nb))
+        for (int j = 0; j < n0 && a->sweep == 1; j++)
+            if (same_pair(L, a, &L->c[j]))
                 a->sweep = 2;
-        }
     }
     return TS_OK;
 }
@@ -2382,11 +2384,8 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
 #pragma omp parallel num_threads(nt)
 #endif
     {
-        int t = 0, team = 1;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-        team = omp_get_num_threads();
-#endif
+        int t, team;
+        thread_ids(&t, &team);
         if (t == (team > 1 ? 1 : 0)) {
             rr = solve_arpack_real(lin, &ro, sigma, e, L, &er);
             if (rr == TS_OK) {
