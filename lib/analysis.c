@@ -2369,8 +2369,10 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
                                  "show");
     if (r->nonlinear)
         ts_health_simulation(o, &r->nonlinear_stats, &r->trust);
-    if (r->linear &&
-        strcmp(ts_linear_method_name(o, &r->linear_stats), "expm"))
+    /* The linear run's integration checked unless it was exact (expm on
+     * the dense model). */
+    if (r->linear && (o->linear_method != TS_LINSIM_EXPM ||
+                      r->linear_stats.newton == TS_NEWTON_SPARSE))
         ts_health_simulation(o, &r->linear_stats, &r->trust);
     if (rc == TS_OK && s->compare) {
         rc = ts_compare_histories(sys, r->lin, ex, r->nonlinear, r->linear,

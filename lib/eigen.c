@@ -2275,20 +2275,16 @@ typedef struct modes_share {
     const ts_eigen_opts *o; /* the caller's progress */
 } modes_share;
 
-static int share_read(atomic_int *x) { return atomic_load(x); }
-
-static void share_set(atomic_int *x, int v) { atomic_store(x, v); }
-
 /* The modes' run's poll: the caller's progress, and the search's
  * failure. */
 static int modes_poll(const ts_progress *p, void *data)
 {
     modes_share *m = data;
     if (m->o->progress && m->o->progress(p, m->o->progress_data)) {
-        share_set(&m->user_stop, 1);
+        atomic_store(&m->user_stop, 1);
         return 1;
     }
-    return share_read(&m->stop);
+    return atomic_load(&m->stop);
 }
 
 /* The search's poll: a stop the caller asked of the modes' run; while
@@ -2296,9 +2292,9 @@ static int modes_poll(const ts_progress *p, void *data)
 static int search_poll(const ts_progress *p, void *data)
 {
     modes_share *m = data;
-    if (share_read(&m->user_stop))
+    if (atomic_load(&m->user_stop))
         return 1;
-    if (share_read(&m->state) == 0)
+    if (atomic_load(&m->state) == 0)
         return 0;
     return m->o->progress ? m->o->progress(p, m->o->progress_data) : 0;
 }
@@ -2309,7 +2305,7 @@ static double share_wlo(void *ctx)
 {
     modes_share *m = ctx;
     int state;
-    while (!(state = share_read(&m->state))) {
+    while (!(state = atomic_load(&m->state))) {
         struct timespec ts = {0, 50000};
         nanosleep(&ts, NULL);
     }
@@ -2396,7 +2392,7 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
                 qsort(L->c, (size_t)L->n, sizeof(cand), cmp_dist);
                 keep = o->count < L->n ? o->count : L->n;
             }
-            share_set(&share.state, rr == TS_OK ? 1 : -1);
+            atomic_store(&share.state, rr == TS_OK ? 1 : -1);
             if (rr == TS_OK && keep == o->count) {
                 for (int i = 0; i < L->n; i++)
                     L->c[i].checked = i < keep ? 0 : -1;
@@ -2410,12 +2406,12 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
                                   &share, err);
             /* A failure of its own (not a stop the caller asked for in
              * the modes' run) stops the modes' run too. */
-            if (rs != TS_OK && !share_read(&share.user_stop))
-                share_set(&share.stop, 1);
+            if (rs != TS_OK && !atomic_load(&share.user_stop))
+                atomic_store(&share.stop, 1);
         }
     }
     int rc = TS_OK;
-    if (rr != TS_OK && !(rr == TS_ECANCEL && share_read(&share.stop))) {
+    if (rr != TS_OK && !(rr == TS_ECANCEL && atomic_load(&share.stop))) {
         /* The modes' run failed, or the caller stopped it. */
         rc = rr;
         if (err)

@@ -661,10 +661,14 @@ static double entry_allowance(const ts_linear *lin, int i, int j)
     return a;
 }
 
+static int column_cyclic_sparse(const ts_linear *lin, int j);
+
 /* Whether state column j of A is zero within its error: a state the
- * kernel does not read. */
+ * kernel does not read (without the dense A: column_cyclic_sparse). */
 static int column_cyclic(const ts_linear *lin, int j)
 {
+    if (!lin->A)
+        return column_cyclic_sparse(lin, j);
     int n = lin->nstate, nq = lin->nq;
     const double *col = lin->A + (size_t)j * n;
     for (int i = nq; i < n; i++)
@@ -880,10 +884,7 @@ static int neutral_modes(ts_kernel *k, const ts_frame *fr, ts_linear *lin,
      * are zero within the error and their rows [0 I] make each a pure
      * integrator of its rate. */
     int straight = rc == TS_OK &&
-                   (lin->A ? column_cyclic(lin, ro) &&
-                                 column_cyclic(lin, ro + 1)
-                           : column_cyclic_sparse(lin, ro) &&
-                                 column_cyclic_sparse(lin, ro + 1));
+                   column_cyclic(lin, ro) && column_cyclic(lin, ro + 1);
     if (straight) {
         cyclic[ro] = cyclic[ro + 1] = 1;
         static const char *const names[2] = {"along-track position",
