@@ -1055,8 +1055,9 @@ static int resp_chunks(const ts_linear *lin, int npoints)
  * own factors and work, on up to lin->threads threads. A chunk that fails
  * stops at its failure; the others run on, so the error reported is that
  * of the lowest frequency that failed, whatever the threads. A stop asked
- * for through progress (called by the first thread only, with the count
- * of frequencies done) ends every chunk at its next frequency. */
+ * for through progress (called by one thread at a time, whichever
+ * finished a frequency, with the count of frequencies done) ends every
+ * chunk at its next frequency. */
 static int sweep_chunks(const ts_system *sys, const ts_linear *lin,
                         int input, const ts_output *out,
                         const double freq_hz[], int npoints, int chunks,
@@ -1107,21 +1108,21 @@ static int sweep_chunks(const ts_system *sys, const ts_linear *lin,
                 cat[c] = i;
                 break;
             }
-            int n;
+            if (!progress)
+                continue;
+            /* Whichever thread did it reports (one at a time): with a
+             * dynamic schedule the first thread may get no chunk. */
 #ifdef _OPENMP
-#pragma omp atomic capture
+#pragma omp critical(ts_response_progress)
 #endif
-            n = ++done;
-            int first = 1;
-#ifdef _OPENMP
-            first = omp_get_thread_num() == 0;
-#endif
-            ts_progress p = {"response", n, npoints, "frequencies"};
-            if (first && progress && progress(&p, data)) {
+            {
+                ts_progress p = {"response", ++done, npoints, "frequencies"};
+                if (progress(&p, data)) {
 #ifdef _OPENMP
 #pragma omp atomic write
 #endif
-                stop = n;
+                    stop = done;
+                }
             }
         }
         tsi_shift_free(&sh);

@@ -12,7 +12,9 @@
  * step, the last finished run, the Newton iterate reached), keeps what it
  * has computed and returns TS_ECANCEL with a message saying
  * how far it got. The callback must be cheap (it may be called millions of
- * times) and must not call back into the run. Nothing is global: whatever
+ * times) and must not call back into the run. A run on several threads
+ * calls it from one thread at a time, not always the caller's. Nothing is
+ * global: whatever
  * the callback needs is in its `data`; a command line, for example, lets
  * its signal handler set a flag that its callback returns.
  */
