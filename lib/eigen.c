@@ -161,7 +161,17 @@ typedef struct cand_list {
     int n, cap, nstate;
     cand *c;
     double complex *v;    /* [nstate * cap] */
+    double complex *v2;   /* a second store, taken over from another list
+                             (merge_search): vec < 0 is its column
+                             -1 - vec */
 } cand_list;
+
+/* The vector of column vec. */
+static inline double complex *cand_v(const cand_list *L, int vec)
+{
+    return vec >= 0 ? L->v + (size_t)vec * L->nstate
+                    : L->v2 + (size_t)(-1 - vec) * L->nstate;
+}
 
 static int cand_init(cand_list *L, int cap, int nstate)
 {
@@ -196,6 +206,7 @@ static void cand_free(cand_list *L)
 {
     free(L->c);
     free(L->v);
+    free(L->v2);
 }
 
 /* Add an eigenvalue with its vector given as re/im parts (im may be NULL);
@@ -282,12 +293,21 @@ static void cand_add_complex(cand_list *L, double complex lam,
     L->n++;
 }
 
+/* Ties broken by the order of storage: L->v's columns, then those of
+ * the store taken over (merge_search). */
+static int cmp_vec(const cand *x, const cand *y)
+{
+    if ((x->vec < 0) != (y->vec < 0))
+        return x->vec < 0 ? 1 : -1;
+    return x->vec < 0 ? y->vec - x->vec : x->vec - y->vec;
+}
+
 static int cmp_dist(const void *a, const void *b)
 {
     const cand *x = a, *y = b;
     if (x->dist != y->dist)
         return x->dist < y->dist ? -1 : 1;
-    return x->vec - y->vec;
+    return cmp_vec(x, y);
 }
 
 static int cmp_freq(const void *a, const void *b)
@@ -299,7 +319,7 @@ static int cmp_freq(const void *a, const void *b)
     double ax = cabs(x->lam), ay = cabs(y->lam);
     if (ax != ay)
         return ax < ay ? -1 : 1;
-    return x->vec - y->vec;
+    return cmp_vec(x, y);
 }
 
 /* ---- LAPACK -------------------------------------------------------------- */
@@ -686,7 +706,7 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
     for (int c = 0, j = 0; c < L->n; c++) {
         if (L->c[c].checked)
             continue;
-        const double complex *v = L->v + (size_t)L->c[c].vec * n;
+        const double complex *v = cand_v(L, L->c[c].vec);
         for (int i = 0; i < n; i++) {
             W[(size_t)j * n + i] = creal(v[i]);
             W[(size_t)(j + 1) * n + i] = cimag(v[i]);
@@ -703,7 +723,7 @@ static int dense_checks(const ts_linear *lin, cand_list *L, ts_err *err)
         if (L->c[c].checked)
             continue;
         L->c[c].checked = 1;
-        const double complex *v = L->v + (size_t)L->c[c].vec * n;
+        const double complex *v = cand_v(L, L->c[c].vec);
         const double *ar = AW + (size_t)j * n, *ai = ar + n;
         double v2 = set_residual(&L->c[c], v, ar, ai, n), e2 = 0;
         L->c[c].ritz = L->c[c].round;
@@ -755,7 +775,7 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, tsi_shift *es,
             (cimag(L->c[c].lam) != 0.0) != (pass >= L->n))
             continue;
         L->c[c].checked = 1;
-        const double complex *v = L->v + (size_t)L->c[c].vec * n;
+        const double complex *v = cand_v(L, L->c[c].vec);
         for (int i = 0; i < n; i++) {
             vr[i] = creal(v[i]);
             vi[i] = cimag(v[i]);
@@ -1364,17 +1384,18 @@ static int cmp_seed(const void *a, const void *b)
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
-/* Whether candidates a and b of L are the same eigenpair: the same
+/* Whether candidate a of La and b of Lb are the same eigenpair: the same
  * eigenvalue within CONJ_MATCH_RTOL (and their slack) and the same
  * vector (|b^H a| > SWEEP_SAME_VECTOR |a| |b|). O(nstate). */
-static int same_pair(const cand_list *L, const cand *a, const cand *b)
+static int same_pair(const cand_list *La, const cand *a, const cand_list *Lb,
+                     const cand *b)
 {
     if (cabs(b->lam - a->lam) >
         CONJ_MATCH_RTOL * cabs(a->lam) + b->slack + a->slack)
         return 0;
-    int n = L->nstate;
-    const double complex *va = L->v + (size_t)a->vec * n;
-    const double complex *vb = L->v + (size_t)b->vec * n;
+    int n = La->nstate;
+    const double complex *va = cand_v(La, a->vec);
+    const double complex *vb = cand_v(Lb, b->vec);
     double complex dot = 0;
     double na = 0, nb = 0;
     for (int r = 0; r < n; r++) {
@@ -1400,7 +1421,7 @@ static int sweep_new(cand_list *L, int from, double complex sigma,
         *radius = fmax(*radius, cabs(c->lam - sigma));
         for (int j = 0; j < i && c->sweep == 1; j++) {
             const cand *o = &L->c[j];
-            if (o->sweep != 2 && o->sweep != 4 && same_pair(L, c, o))
+            if (o->sweep != 2 && o->sweep != 4 && same_pair(L, c, L, o))
                 c->sweep = 2;
         }
         if (c->sweep == 1 &&
@@ -1619,7 +1640,7 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                  * error, the value serves as a run at SWEEP_TOL would. */
                 double dlam, ritz;
                 rc = tsi_shift_eig_error(&es, lin, c->lam,
-                                         L->v + (size_t)c->vec * L->nstate,
+                                         cand_v(L, c->vec),
                                          &dlam, &ritz, err);
                 if (rc != TS_OK)
                     break;
@@ -1642,7 +1663,7 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
             if (L->c[i].sweep != 1)
                 continue;
             L->c[i].sweep = 4; /* superseded if the rerun converges */
-            const double complex *v = L->v + (size_t)L->c[i].vec * nst;
+            const double complex *v = cand_v(L, L->c[i].vec);
             double nv = 0;
             for (int k = 0; k < nst; k++)
                 nv += creal(v[k]) * creal(v[k]) + cimag(v[k]) * cimag(v[k]);
@@ -1999,7 +2020,7 @@ static int recognise_neutral(const ts_linear *lin, cand_list *L,
                 continue;
             }
             /* The angle to the span: |v - Q Q^H v| / |v|. */
-            const double complex *v = L->v + (size_t)L->c[best].vec * n;
+            const double complex *v = cand_v(L, L->c[best].vec);
             double v2 = 0, p2 = 0;
             for (int i = 0; i < n; i++)
                 v2 += creal(v[i] * conj(v[i]));
@@ -2078,7 +2099,7 @@ static int neutral_bounds(const ts_linear *lin, cand_list *L, ts_err *err)
         cand *cc = &L->c[c];
         if (cc->neutral < 0)
             continue;
-        const double complex *v = L->v + (size_t)cc->vec * n;
+        const double complex *v = cand_v(L, cc->vec);
         for (int i = 0; i < n; i++) {
             vr[i] = creal(v[i]);
             vi[i] = cimag(v[i]);
@@ -2228,7 +2249,7 @@ static int search_beside_checks(const ts_linear *lin,
         M.c[i] = L->c[i];
         M.c[i].vec = i;
         M.c[i].checked = 0;
-        memcpy(M.v + (size_t)i * n, L->v + (size_t)L->c[i].vec * n,
+        memcpy(M.v + (size_t)i * n, cand_v(L, L->c[i].vec),
                (size_t)n * sizeof(double complex));
     }
     M.n = keep;
@@ -2312,25 +2333,72 @@ static double share_wlo(void *ctx)
     return state > 0 ? m->wlo : NAN;
 }
 
-/* Append the search's candidates S to L (the modes, the first n0), the
- * vectors copied; one that repeats a mode (sweep_new's test) is marked
- * a repeat (2). */
-static int merge_search(cand_list *L, const cand_list *S)
+/* The rightmost of the search (L's candidates from `from` on), checked
+ * one by one until SWEEP_CHECKED stand: a Ritz pair whose own error shows
+ * it has not converged (a run stopped at its restart limit in a cluster)
+ * is no eigenvalue and is dropped (sweep 3, counted in *rejected). Those
+ * to check have checked -1. acc and es as for batch_checks (the sparse
+ * model; dense_checks without it). */
+static int check_rightmost(const ts_linear *lin, cand_list *L, int from,
+                           tsi_shift *acc, tsi_shift *es, int *rejected,
+                           ts_err *err)
 {
-    int n0 = L->n, n = L->nstate;
-    if (cand_grow(L, S->n) != TS_OK)
-        return TS_ENOMEM;
+    int rc = TS_OK;
+    for (int t = 0; rc == TS_OK && t < SWEEP_CHECKED;) {
+        int best = -1;
+        for (int i = from; i < L->n; i++)
+            if (L->c[i].sweep == 1 && L->c[i].checked == -1 &&
+                (best < 0 || creal(L->c[i].lam) > creal(L->c[best].lam)))
+                best = i;
+        if (best < 0)
+            break;
+        L->c[best].checked = 0;
+        rc = lin->desc ? batch_checks(lin, acc, es, L, err)
+                       : dense_checks(lin, L, err);
+        double scale = cabs(L->c[best].lam) +
+                       (lin->desc ? 0.0 : lin->a_scale);
+        if (L->c[best].ritz > SWEEP_RESIDUAL * scale) {
+            L->c[best].sweep = 3;
+            (*rejected)++;
+        } else {
+            t++;
+        }
+    }
+    return rc;
+}
+
+/* Mark the search's candidates S that repeat one of the modes L (the
+ * same eigenpair: same_pair) as repeats (sweep 2). */
+static void mark_repeats(cand_list *S, const cand_list *L)
+{
     for (int i = 0; i < S->n; i++) {
-        cand c = S->c[i];
-        memcpy(L->v + (size_t)L->n * n, S->v + (size_t)c.vec * n,
-               (size_t)n * sizeof(double complex));
-        c.vec = L->n;
-        L->c[L->n++] = c;
-        cand *a = &L->c[L->n - 1];
-        for (int j = 0; j < n0 && a->sweep == 1; j++)
-            if (same_pair(L, a, &L->c[j]))
+        cand *a = &S->c[i];
+        for (int j = 0; j < L->n && a->sweep == 1; j++)
+            if (same_pair(S, a, L, &L->c[j]))
                 a->sweep = 2;
     }
+}
+
+/* Append the search's candidates S (their repeats marked: mark_repeats)
+ * to L, taking over S's vector store (L's second, S's emptied: no
+ * copy). */
+static int merge_search(cand_list *L, cand_list *S)
+{
+    if (L->v2)
+        return TS_EINVAL; /* one store taken over at most */
+    cand *c = realloc(L->c, (size_t)(L->n + S->n + 1) * sizeof(cand));
+    if (!c)
+        return TS_ENOMEM;
+    L->c = c;
+    L->v2 = S->v;
+    S->v = NULL;
+    for (int i = 0; i < S->n; i++) {
+        cand *a = &L->c[L->n++];
+        *a = S->c[i];
+        a->vec = -1 - S->c[i].vec;
+    }
+    /* L->v holds the first columns only: no more candidates after. */
+    L->cap = L->n;
     return TS_OK;
 }
 
@@ -2340,19 +2408,26 @@ static int merge_search(cand_list *L, const cand_list *S)
  * while the modes' run (another thread) goes, then the rest of the grid
  * once the modes' highest frequency is known (share_wlo), while the
  * modes' residuals and error estimates are computed (the `count` nearest
- * 0 Hz). The search fills a list of its own, merged into L after; the
- * two runs are of ARPACK's two families (real and complex), which may
+ * 0 Hz); then the search's SWEEP_CHECKED rightmost are checked
+ * (check_rightmost, in shifts of the search's own), beside the modes'
+ * checks still. The search fills a list of its own, merged into L after;
+ * the two runs are of ARPACK's two families (real and complex), which may
  * run at once (solve_arpack_real). On one thread: the modes' run, their
- * checks, the search, in that order, with the same results bit for bit
- * (each ARPACK run starts from a fixed vector and factors afresh; the
- * search never reads the modes' list). acc and es as for
- * search_beside_checks; *checked is set when the modes were checked. */
+ * checks, the search, its checks, in that order, with the same results
+ * bit for bit (each ARPACK run starts from a fixed vector and factors
+ * afresh, each list's checks have shifts of their own, and the search
+ * reads of the modes only their eigenvalues and vectors, once their run
+ * is done, to mark its repeats). acc and es as for search_beside_checks;
+ * *checked is set when the modes were checked, *search_checked when the
+ * search's rightmost were. */
 static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
                             const ts_eigen_opts *o, double sigma,
                             ts_eigen *e, cand_list *L, tsi_shift *acc,
-                            tsi_shift *es, int *checked, ts_err *err)
+                            tsi_shift *es, int *checked, int *search_checked,
+                            ts_err *err)
 {
-    *checked = 0;
+    *checked = *search_checked = 0;
+    tsi_shift sacc = {0}, ses = {0}; /* the search's checks' */
     int n = lin->nstate;
     cand_list S = {0};
     if (cand_init(&S, 1, n) != TS_OK) {
@@ -2404,12 +2479,28 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
         if (t == 0) {
             rs = rightmost_search(lin, bands, &so, &se, &S, share_wlo,
                                   &share, err);
+            /* Its rightmost checked here, in shifts of its own, while the
+             * modes' checks go on: the modes are known once the search is
+             * done (it waited for them), and only their eigenvalues and
+             * vectors are read, which the checks leave. */
+            if (rs == TS_OK) {
+                mark_repeats(&S, L);
+                for (int i = 0; i < S.n; i++)
+                    S.c[i].checked = -1;
+                rs = tsi_shift_factor_inf(&sacc, lin, err);
+                if (rs == TS_OK)
+                    rs = check_rightmost(lin, &S, 0, &sacc, &ses,
+                                         &se.sweep_rejected, err);
+                *search_checked = rs == TS_OK;
+            }
             /* A failure of its own (not a stop the caller asked for in
              * the modes' run) stops the modes' run too. */
             if (rs != TS_OK && !atomic_load(&share.user_stop))
                 atomic_store(&share.stop, 1);
         }
     }
+    tsi_shift_free(&sacc);
+    tsi_shift_free(&ses);
     int rc = TS_OK;
     if (rr != TS_OK && !(rr == TS_ECANCEL && atomic_load(&share.stop))) {
         /* The modes' run failed, or the caller stopped it. */
@@ -2425,6 +2516,7 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
     }
     e->top_hz = se.top_hz;
     e->sweep_failed += se.sweep_failed;
+    e->sweep_rejected += se.sweep_rejected;
     e->sweep_shifts = se.sweep_shifts;
     e->arpack_iterations += se.arpack_iterations;
     e->arpack_ops += se.arpack_ops;
@@ -2503,10 +2595,10 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
      * estimates) run beside the rightmost search (search_beside_checks);
      * es and acc then carry on to the search's own checks below. */
     tsi_shift acc = {0}, es = {0};
-    int modes_checked = 0;
+    int modes_checked = 0, search_checked = 0;
     if (together) {
         rc = modes_and_search(lin, bands, &o, sigma0, e, &L, &acc, &es,
-                              &modes_checked, err);
+                              &modes_checked, &search_checked, err);
     } else if (m == TS_EIG_ARPACK && o.rightmost && bands && lin->desc) {
         rc = search_beside_checks(lin, bands, &o, e, &L, &acc, &es,
                                   &modes_checked, err);
@@ -2558,8 +2650,11 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
         for (int i = 0; i < L.n; i++)
             cover[ncover++] = i;
     } else {
+        /* (The search's own, when checked beside the modes' checks, as
+         * they are.) */
         for (int i = 0; i < L.n; i++)
-            L.c[i].checked = i < keep ? (modes_checked ? 1 : 0) : -1;
+            if (i < keep || !search_checked || !L.c[i].sweep)
+                L.c[i].checked = i < keep ? (modes_checked ? 1 : 0) : -1;
         if (modes_checked) {
             /* Done beside the search. */
         } else if (lin->desc) {
@@ -2569,29 +2664,9 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
         } else {
             rc = dense_checks(lin, &L, err);
         }
-        /* The rightmost of the search, checked one by one: a Ritz pair
-         * whose own error shows it has not converged (a run stopped at its
-         * restart limit in a cluster) is no eigenvalue and is dropped. */
-        for (int t = 0; rc == TS_OK && t < SWEEP_CHECKED;) {
-            int best = -1;
-            for (int i = keep; i < L.n; i++)
-                if (L.c[i].sweep == 1 && L.c[i].checked == -1 &&
-                    (best < 0 || creal(L.c[i].lam) > creal(L.c[best].lam)))
-                    best = i;
-            if (best < 0)
-                break;
-            L.c[best].checked = 0;
-            rc = lin->desc ? batch_checks(lin, &acc, &es, &L, err)
-                           : dense_checks(lin, &L, err);
-            double scale = cabs(L.c[best].lam) +
-                           (lin->desc ? 0.0 : lin->a_scale);
-            if (L.c[best].ritz > SWEEP_RESIDUAL * scale) {
-                L.c[best].sweep = 3;
-                e->sweep_rejected++;
-            } else {
-                t++;
-            }
-        }
+        if (rc == TS_OK && !search_checked)
+            rc = check_rightmost(lin, &L, keep, &acc, &es,
+                                 &e->sweep_rejected, err);
         if (acc.numeric || acc.lu || acc.zlu)
             tsi_shift_free(&acc);
         tsi_shift_free(&es);
@@ -2732,7 +2807,7 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
             e->nneutral++;
         }
         if (o.vectors) {
-            const double complex *v = L.v + (size_t)c->vec * n;
+            const double complex *v = cand_v(&L, c->vec);
             if (c->neutral >= 0) {
                 for (int k = 0; k < n; k++)
                     gv[k] = lin->neutral_re[(size_t)c->neutral * n + k] +
@@ -2741,7 +2816,7 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
             } else {
                 /* A cyclic state is the integral of its rate: its entry of
                  * the eigenvector of A is the rate's over lambda. */
-                double complex *vw = L.v + (size_t)c->vec * n;
+                double complex *vw = cand_v(&L, c->vec);
                 for (int k = 0; k < lin->nneutral; k++) {
                     int j = lin->neutral[k].cyclic;
                     if (j >= 0 && cabs(c->lam) > 0)
