@@ -436,10 +436,16 @@ static int ensure_parts(tsi_shift *sh, ts_err *err)
     return TS_OK;
 }
 
-int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
-                       ts_err *err)
+/* tsi_shift_refactor; with test 0 the old pivots serve whenever KLU's
+ * refactorisation succeeds (the caller judges its solves:
+ * tsi_shift_eig_error). *fresh (may be NULL) is set when it factored
+ * afresh. */
+static int refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                    int test, int *fresh, ts_err *err)
 {
     int cplx = cimag(s) != 0.0;
+    if (fresh)
+        *fresh = 1;
     if (!sh->numeric || sh->inf || sh->lin != lin) {
         tsi_shift_free(sh);
         return tsi_shift_factor(sh, lin, s, err);
@@ -478,14 +484,24 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
         /* The old pivots serve while the factors stay as well conditioned
          * as a fresh factorisation's, within SHIFT_REFACTOR_RCOND (both
          * unscaled). */
-        if (ok && kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond_raw)
+        if (ok && (!test ||
+                   kc->rcond >= SHIFT_REFACTOR_RCOND * sh->rcond_raw)) {
+            if (fresh)
+                *fresh = 0;
             return TS_OK;
+        }
     }
     /* Afresh, with pivoting and scaling (and of the other kind when s
      * crossed the real axis), in the arrays already held. */
     free_numeric(sh);
     sh->is_complex = cplx;
     return factor(sh, err);
+}
+
+int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
+                       ts_err *err)
+{
+    return refactor(sh, lin, s, 1, NULL, err);
 }
 
 int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err)
@@ -949,6 +965,41 @@ void tsi_shift_tsolve(tsi_shift *sh, double complex *w)
         w[i] = cols[i] + I * cols[nx + i];
 }
 
+/* The start of the left vector's inverse iteration (tsi_shift_eig_error):
+ * no multiple of a mode's left vector by any symmetry. */
+static void left_start(double complex *w, int nx)
+{
+    for (int i = 0; i < nx; i++)
+        w[i] = 1.0 + (double)(i % 7) / 7.0;
+}
+
+/* The componentwise backward error of w = S^-T b for b = left_start's
+ * (Oettli and Prager: max_j |S^T w - b|_j / (|S|^T |w| + |b|)_j, S the
+ * matrix sh factored, in sh->Sx): how far S must move, entry by entry,
+ * for w to solve it exactly. The moduli as |Re| + |Im| (within a factor
+ * sqrt 2 of them, and no hypot per entry). O(nnz). */
+static double left_backward(const tsi_shift *sh, const double complex *w)
+{
+    const ts_descriptor *d = sh->d;
+    const double *a = sh->Sx;
+    double om = 0;
+    for (int j = 0; j < d->nx; j++) {
+        double b = 1.0 + (double)(j % 7) / 7.0;
+        double rr = -b, ri = 0, den = b;
+        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++) {
+            double sr = sh->is_complex ? a[2 * p] : a[p];
+            double si = sh->is_complex ? a[2 * p + 1] : 0.0;
+            double wr = creal(w[d->Si[p]]), wi = cimag(w[d->Si[p]]);
+            rr += sr * wr - si * wi;
+            ri += sr * wi + si * wr;
+            den += (fabs(sr) + fabs(si)) * (fabs(wr) + fabs(wi));
+        }
+        if (den > 0)
+            om = fmax(om, (fabs(rr) + fabs(ri)) / den);
+    }
+    return om;
+}
+
 /* Scale w[m] to largest modulus 1 (w nonzero). */
 static void unit_max(double complex *w, int m)
 {
@@ -1010,18 +1061,38 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
     int nx = d->nx, nq = lin->nq, nc = d->nc;
     size_t m = 3 * (size_t)d->np + (size_t)nc;
     /* S(lam), or a shift beside it when lam is an eigenvalue to working
-     * precision (inverse iteration needs only to be near). */
-    int rc = TS_ESINGULAR;
+     * precision (inverse iteration needs only to be near), refactored
+     * with the previous eigenvalue's pivots; the first solve with them
+     * judges them: over SHIFT_NEAR_BACKWARD of backward error, S(lam)
+     * is factored afresh (doc/linear.md section 3). The work (w, z, X
+     * complex [nx + 1] each, x complex [m], q [nq + 1], u [2 m]) and S's
+     * parts are kept in sh for the next eigenvalue. */
+    int rc = TS_ESINGULAR, fresh = 1;
     double nudge = 1e-10 * (cabs(lam) > 0 ? cabs(lam) : 1.0);
-    for (int t = 0; t < 3 && rc == TS_ESINGULAR; t++, nudge *= 100.0)
-        rc = tsi_shift_refactor(sh, lin, t == 0 ? lam : lam + nudge, NULL);
-    /* The work (w, z, X complex [nx + 1] each, x complex [m], q [nq + 1],
-     * u [2 m]) and S's parts are kept in sh for the next eigenvalue. */
     size_t nw = 6 * ((size_t)nx + 1) + 4 * m + (size_t)nq + 1;
-    if (rc == TS_OK && !sh->ework && !(sh->ework = malloc(nw * sizeof(double))))
-        rc = TS_ENOMEM;
-    if (rc == TS_OK && ensure_parts(sh, NULL) != TS_OK)
-        rc = TS_ENOMEM;
+    for (int t = 0; t < 3 && rc == TS_ESINGULAR; t++, nudge *= 100.0) {
+        double complex st = t == 0 ? lam : lam + nudge;
+        rc = refactor(sh, lin, st, 0, &fresh, NULL);
+        if (rc == TS_OK && !sh->ework &&
+            !(sh->ework = malloc(nw * sizeof(double))))
+            rc = TS_ENOMEM;
+        if (rc == TS_OK && ensure_parts(sh, NULL) != TS_OK)
+            rc = TS_ENOMEM;
+        if (rc != TS_OK)
+            continue;
+        double complex *w0 = (double complex *)sh->ework;
+        left_start(w0, nx);
+        tsi_shift_tsolve(sh, w0);
+        if (fresh || left_backward(sh, w0) <= SHIFT_NEAR_BACKWARD)
+            break;
+        free_numeric(sh);
+        sh->is_complex = cimag(st) != 0.0;
+        rc = factor(sh, NULL); /* frees sh when it fails */
+        if (rc == TS_OK) {
+            left_start(w0, nx);
+            tsi_shift_tsolve(sh, w0);
+        }
+    }
     if (rc == TS_ENOMEM)
         return ts_fail(err, rc, "eigen: out of memory for the error "
                        "estimate");
@@ -1041,14 +1112,13 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
      * pencil's normalisation, never zero for a simple eigenvalue, while
      * w^T x itself may vanish: then S^-T w would not grow along w at
      * all). */
-    for (int i = 0; i < nx; i++)
-        w[i] = 1.0 + (double)(i % 7) / 7.0;
     for (int it = 0; it < 2; it++) {
         if (it > 0) {
+            /* (The first solve is done above.) */
             pencil_dtmul(sh, w, lam, z);
             memcpy(w, z, (size_t)nx * sizeof *w);
+            tsi_shift_tsolve(sh, w);
         }
-        tsi_shift_tsolve(sh, w);
         unit_max(w, nx);
     }
     /* The right vector as point displacements and controller states (x),
