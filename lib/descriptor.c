@@ -199,14 +199,32 @@ typedef struct entry {
     int col, row, tag;
 } entry;
 
-static int cmp_entry(const void *a, const void *b)
+/* Sort e[m] by column, then row (no two entries share both): two stable
+ * counting passes, by row and then by column, O(m + nx) (qsort took 27
+ * ms of the 80 of the linearization at 10 000 links). */
+static int sort_entries(entry *e, size_t m, int nx)
 {
-    const entry *x = a, *y = b;
-    if (x->col != y->col)
-        return x->col < y->col ? -1 : 1;
-    if (x->row != y->row)
-        return x->row < y->row ? -1 : 1;
-    return 0;
+    entry *t = malloc((m > 0 ? m : 1) * sizeof *t);
+    size_t *at = malloc(((size_t)nx + 1) * sizeof *at);
+    if (!t || !at) {
+        free(t);
+        free(at);
+        return TS_ENOMEM;
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        const entry *from = pass ? t : e;
+        entry *to = pass ? e : t;
+        memset(at, 0, ((size_t)nx + 1) * sizeof *at);
+        for (size_t i = 0; i < m; i++)
+            at[(pass ? from[i].col : from[i].row) + 1]++;
+        for (int c = 0; c < nx; c++)
+            at[c + 1] += at[c];
+        for (size_t i = 0; i < m; i++)
+            to[at[pass ? from[i].col : from[i].row]++] = from[i];
+    }
+    free(t);
+    free(at);
+    return TS_OK;
 }
 
 #define XR(k, c) tsi_desc_xr(d, (k), (c))
@@ -326,7 +344,10 @@ static int build_pattern(ts_descriptor *d)
                                  base_lv + p0 + nr * lr + c};
             }
     }
-    qsort(e, m, sizeof *e, cmp_entry);
+    if (sort_entries(e, m, d->nx) != TS_OK) {
+        free(e);
+        return TS_ENOMEM;
+    }
     d->nnz = (int)m;
     d->Sp = calloc((size_t)d->nx + 1, sizeof(int));
     d->Si = malloc((m > 0 ? m : 1) * sizeof(int));
