@@ -1249,7 +1249,8 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
 /* ---- The rightmost eigenvalues (sparse model) ---------------------------- */
 
 /* The search (doc/linear.md, section 3, "Rightmost eigenvalues"). */
-#define SWEEP_NEV 8        /* eigenvalues found around each shift */
+#define SWEEP_NEV 8        /* eigenvalues found around each shift (the
+                              grid's: SWEEP_GRID_NEV) */
 #define SWEEP_NCV 20       /* Arnoldi vectors of each shift's run */
 #define SWEEP_GRID_NEV 6   /* eigenvalues found around each grid point (at
                               SWEEP_GRID_TOL): as many as converge in the
@@ -1504,7 +1505,8 @@ static double sweep_threshold(const cand_list *L, int from)
  * (zigzag_freq: transverse, and axial for elastic cables) and on a grid of
  * ratio SWEEP_RATIO from the highest frequency among the modes already
  * found to the highest band top, the discretisation's top frequency; at
- * each, the SWEEP_NEV eigenvalues nearest (at SWEEP_GRID_TOL on the grid,
+ * each, the SWEEP_NEV eigenvalues nearest (SWEEP_GRID_NEV at
+ * SWEEP_GRID_TOL on the grid,
  * SWEEP_TOL at the band tops; a grid run that holds a candidate for the
  * checked rightmost eigenvalues is run again at SWEEP_TOL). Then the
  * SWEEP_CLIMBS runs with the largest real parts climb: while the
