@@ -1011,24 +1011,31 @@ static void unit_max(double complex *w, int m)
             w[i] /= big;
 }
 
-/* w^T S(lam) X from S's parts in sh (Sk, Sc, Sm: S(s) = Sk + s Sc +
- * s^2 Sm), X[nx] the unknowns (points and controller states; the
- * tensions' entries zero), summed against w[nx]. O(nnz). */
-static double complex pencil_form(const tsi_shift *sh,
-                                  const double complex *w,
-                                  const double complex *X, double complex lam)
+/* w^T S(lam) X and w^T S'(lam) X (S'(s) = Sc + 2 s Sm) from S's parts
+ * in sh (Sk, Sc, Sm: S(s) = Sk + s Sc + s^2 Sm), X[nx] the unknowns
+ * (points and controller states; the tensions' entries zero, skipped),
+ * summed against w[nx]: one pass, O(nnz). */
+static void pencil_forms(const tsi_shift *sh, const double complex *w,
+                         const double complex *X, double complex lam,
+                         double complex *form, double complex *dform)
 {
     const ts_descriptor *d = sh->d;
     const double *Sk = sh->Sk, *Sc = sh->Sc, *Sm = sh->Sm;
-    double complex sum = 0;
+    double complex sum = 0, dsum = 0, lam2 = 2.0 * lam;
     for (int j = 0; j < d->nx; j++) {
         if (X[j] == 0)
             continue;
-        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++)
-            sum += w[d->Si[p]] * (Sk[p] + lam * (Sc[p] + lam * Sm[p])) *
-                   X[j];
+        double complex a = 0, b = 0;
+        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++) {
+            double complex wi = w[d->Si[p]];
+            a += wi * (Sk[p] + lam * (Sc[p] + lam * Sm[p]));
+            b += wi * (Sc[p] + lam2 * Sm[p]);
+        }
+        sum += a * X[j];
+        dsum += b * X[j];
     }
-    return sum;
+    *form = sum;
+    *dform = dsum;
 }
 
 /* z[nx] = S'(lam)^T w[nx], S'(s) = Sc + 2 s Sm from S's parts in sh
@@ -1147,17 +1154,13 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
             X[XR(k, a)] = x[3 * k + a];
     for (int j = 0; j < nc; j++)
         X[XC(j)] = x[n3 + j];
-    /* w^T S'(lam) X, S'(s) = Sc + 2 s Sm. */
-    const double *Sc = sh->Sc, *Sm = sh->Sm;
-    double complex den = 0;
-    for (int col = 0; col < nx; col++)
-        for (int p = d->Sp[col]; p < d->Sp[col + 1]; p++)
-            den += w[d->Si[p]] * (Sc[p] + 2.0 * lam * Sm[p]) * X[col];
+    /* w^T S'(lam) X, the normalisation, and w^T S(lam) X. */
+    double complex num, den;
+    pencil_forms(sh, w, X, lam, &num, &den);
     double tr, ro;
     tsi_desc_error_terms(d, w, x, lam, &tr, &ro);
     *dlam = cabs(den) > 0 ? (tr + ro) / cabs(den) : INFINITY;
     /* The Ritz value's own error: the pencil's Newton correction. */
-    double complex num = pencil_form(sh, w, X, lam);
     *ritz = cabs(den) > 0 ? cabs(num) / cabs(den) : INFINITY;
     return TS_OK;
 }
