@@ -1539,39 +1539,45 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
 
 /* ---- Maps and products -------------------------------------------------- */
 
-/* dq of the links from node (point) displacements dr; with th, a cable
- * leaving a vehicle starts at P, displaced by (R E dtheta) x rho_P, the
- * vehicle's angles dtheta read from dq (set before). */
+/* dq of the links from node (point) displacements dr, for nv vectors;
+ * with th, a cable leaving a vehicle starts at P, displaced by (R E
+ * dtheta) x rho_P, the vehicle's angles dtheta read from dq (set
+ * before). */
 static void links_from_nodes(const ts_system *sys, const ts_linear *lin,
-                             const double dr[], double dq[], int th)
+                             int nv, const double *const dr[],
+                             double *const dq[], int th)
 {
     for (int l = 0; l < lin->nlinks; l++) {
         const ts_link *L = &sys->links[l];
         const double *d1 = lin->dn + 6 * l, *d2 = d1 + 3;
-        int o = lin->qoff[l];
-        const double *rk = dr + 3 * L->lower, *rp = dr + 3 * L->upper;
-        double dd[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
-        if (th && lin->up_qoff && lin->up_qoff[l] >= 0) {
-            const double *map = lin->up_map + 12 * l, *dth = dq + lin->up_qoff[l];
-            double om[3], x[3];
-            for (int i = 0; i < 3; i++)
-                om[i] = map[3 * i] * dth[0] + map[3 * i + 1] * dth[1] +
-                        map[3 * i + 2] * dth[2];
-            x[0] = om[1] * map[11] - om[2] * map[10];
-            x[1] = om[2] * map[9] - om[0] * map[11];
-            x[2] = om[0] * map[10] - om[1] * map[9];
-            for (int c = 0; c < 3; c++)
-                dd[c] -= x[c];
-        }
+        int o = lin->qoff[l], up = th && lin->up_qoff && lin->up_qoff[l] >= 0;
         double len = lin->len0[l];
-        dq[o] = (d1[0] * dd[0] + d1[1] * dd[1] + d1[2] * dd[2]) /
-                (len * (d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]));
-        dq[o + 1] = (d2[0] * dd[0] + d2[1] * dd[1] + d2[2] * dd[2]) /
-                    (len * (d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]));
-        if (lin->elastic[l]) {
-            const double *n = lin->n0 + 3 * l;
-            dq[o + 2] = (n[0] * dd[0] + n[1] * dd[1] + n[2] * dd[2]) /
-                        L->length;
+        double a1 = len * (d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]);
+        double a2 = len * (d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]);
+        for (int v = 0; v < nv; v++) {
+            const double *rk = dr[v] + 3 * L->lower, *rp = dr[v] + 3 * L->upper;
+            double *q = dq[v];
+            double dd[3] = {rk[0] - rp[0], rk[1] - rp[1], rk[2] - rp[2]};
+            if (up) {
+                const double *map = lin->up_map + 12 * l;
+                const double *dth = q + lin->up_qoff[l];
+                double om[3], x[3];
+                for (int i = 0; i < 3; i++)
+                    om[i] = map[3 * i] * dth[0] + map[3 * i + 1] * dth[1] +
+                            map[3 * i + 2] * dth[2];
+                x[0] = om[1] * map[11] - om[2] * map[10];
+                x[1] = om[2] * map[9] - om[0] * map[11];
+                x[2] = om[0] * map[10] - om[1] * map[9];
+                for (int c = 0; c < 3; c++)
+                    dd[c] -= x[c];
+            }
+            q[o] = (d1[0] * dd[0] + d1[1] * dd[1] + d1[2] * dd[2]) / a1;
+            q[o + 1] = (d2[0] * dd[0] + d2[1] * dd[1] + d2[2] * dd[2]) / a2;
+            if (lin->elastic[l]) {
+                const double *n = lin->n0 + 3 * l;
+                q[o + 2] = (n[0] * dd[0] + n[1] * dd[1] + n[2] * dd[2]) /
+                           L->length;
+            }
         }
     }
 }
@@ -1579,7 +1585,7 @@ static void links_from_nodes(const ts_system *sys, const ts_linear *lin,
 void tsi_desc_from_nodes(const ts_system *sys, const ts_linear *lin,
                          const double dr[], double dq[])
 {
-    links_from_nodes(sys, lin, dr, dq, 0);
+    links_from_nodes(sys, lin, 1, &dr, &dq, 0);
 }
 
 /* The coordinate of component c of vehicle v's angle point in q, -1 for
@@ -1591,34 +1597,51 @@ static int angle_coordinate(const ts_descriptor *d, int v, int c)
     return d->vl[v].qoff + c;
 }
 
+void tsi_desc_to_points_n(const ts_descriptor *d, const ts_linear *lin,
+                          int nv, const double *const dq[],
+                          double *const p[])
+{
+    tsi_node_displacements(d->sys, lin, nv, dq, p);
+    for (int k = 0; k < nv; k++)
+        for (int v = 0; v < d->nv; v++)
+            for (int c = 0; c < 3; c++) {
+                int q = angle_coordinate(d, v, c);
+                p[k][3 * (d->nn + v) + c] = q >= 0 ? dq[k][q] : 0.0;
+            }
+}
+
 void tsi_desc_to_points(const ts_descriptor *d, const ts_linear *lin,
                         const double dq[], double p[])
 {
-    ts_linear_node_displacements(d->sys, lin, dq, p);
-    for (int v = 0; v < d->nv; v++)
-        for (int c = 0; c < 3; c++) {
-            int q = angle_coordinate(d, v, c);
-            p[3 * (d->nn + v) + c] = q >= 0 ? dq[q] : 0.0;
+    tsi_desc_to_points_n(d, lin, 1, &dq, &p);
+}
+
+void tsi_desc_from_points_n(const ts_descriptor *d, const ts_linear *lin,
+                            int nv, const double *const p[],
+                            double *const dq[])
+{
+    for (int k = 0; k < nv; k++) {
+        for (int v = 0; v < d->nv; v++)
+            for (int c = 0; c < 3; c++) {
+                int q = angle_coordinate(d, v, c);
+                if (q >= 0)
+                    dq[k][q] = p[k][3 * (d->nn + v) + c];
+            }
+        if (d->root >= 0) {
+            /* The towing vehicle's position: node 0's displacement (a
+             * surface ship's x and y). */
+            int ro = lin->root_qoff, npos = d->rdof == 3 ? 2 : 3;
+            for (int c = 0; c < npos; c++)
+                dq[k][ro + c] = p[k][c];
         }
+    }
+    links_from_nodes(d->sys, lin, nv, p, dq, 1);
 }
 
 void tsi_desc_from_points(const ts_descriptor *d, const ts_linear *lin,
                           const double p[], double dq[])
 {
-    for (int v = 0; v < d->nv; v++)
-        for (int c = 0; c < 3; c++) {
-            int q = angle_coordinate(d, v, c);
-            if (q >= 0)
-                dq[q] = p[3 * (d->nn + v) + c];
-        }
-    if (d->root >= 0) {
-        /* The towing vehicle's position: node 0's displacement (a surface
-         * ship's x and y). */
-        int ro = lin->root_qoff, npos = d->rdof == 3 ? 2 : 3;
-        for (int c = 0; c < npos; c++)
-            dq[ro + c] = p[c];
-    }
-    links_from_nodes(d->sys, lin, p, dq, 1);
+    tsi_desc_from_points_n(d, lin, 1, &p, &dq);
 }
 
 void tsi_desc_block_mul(const ts_descriptor *d, const double *B,

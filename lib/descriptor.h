@@ -285,6 +285,20 @@ void tsi_desc_to_points(const ts_descriptor *d, const ts_linear *lin,
 void tsi_desc_from_points(const ts_descriptor *d, const ts_linear *lin,
                           const double p[], double dq[]);
 
+/* The same of nv vectors (1 or 2) at once: one walk of the links for
+ * all (the solves map the real and imaginary parts, or the coordinates
+ * and their rates, each time). tsi_node_displacements is
+ * ts_linear_node_displacements's (lib/linearize.c). */
+void tsi_node_displacements(const ts_system *sys, const ts_linear *lin,
+                            int nv, const double *const dq[],
+                            double *const dr[]);
+void tsi_desc_to_points_n(const ts_descriptor *d, const ts_linear *lin,
+                          int nv, const double *const dq[],
+                          double *const p[]);
+void tsi_desc_from_points_n(const ts_descriptor *d, const ts_linear *lin,
+                            int nv, const double *const p[],
+                            double *const dq[]);
+
 /* y[3 np] = M x: the nodal masses and the vehicles' inertia (x[3 np],
  * the accelerations of the points; rows of node 0 zero). */
 void tsi_desc_mass_mul(const ts_descriptor *d, const double x[], double y[]);

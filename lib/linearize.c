@@ -1412,36 +1412,48 @@ void ts_linear_tow_shift(const ts_linear *lin, int node, int input,
     }
 }
 
-void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,
-                                  const double dq[], double dr[])
+void tsi_node_displacements(const ts_system *sys, const ts_linear *lin,
+                            int nv, const double *const dq[],
+                            double *const dr[])
 {
-    dr[0] = dr[1] = dr[2] = 0.0;
-    if (lin->root_qoff >= 0)
-        for (int c = 0; c < (lin->root_dof == 3 ? 2 : 3); c++)
-            dr[c] = dq[lin->root_qoff + c];
+    for (int v = 0; v < nv; v++) {
+        dr[v][0] = dr[v][1] = dr[v][2] = 0.0;
+        if (lin->root_qoff >= 0)
+            for (int c = 0; c < (lin->root_dof == 3 ? 2 : 3); c++)
+                dr[v][c] = dq[v][lin->root_qoff + c];
+    }
     for (int l = 0; l < sys->nlinks; l++) {
         const ts_link *L = &sys->links[l];
         const double *d1 = lin->dn + 6 * l, *d2 = d1 + 3;
-        const double *rp = dr + 3 * L->upper;
-        double *rk = dr + 3 * L->lower;
-        int o = lin->qoff[l];
-        double de = lin->elastic[l] ? dq[o + 2] : 0.0, rP[3];
-        if (L->up_body >= 0) {
-            /* dr_P = dr_A + (R E dtheta) x rho_P */
-            const double *map = lin->up_map + 12 * l;
-            const double *dth = dq + lin->up_qoff[l];
-            double phi[3];
+        const double *map = L->up_body >= 0 ? lin->up_map + 12 * l : NULL;
+        int o = lin->qoff[l], el = lin->elastic[l];
+        double len = lin->len0[l], ln = L->length;
+        const double *n0 = lin->n0 + 3 * l;
+        for (int v = 0; v < nv; v++) {
+            const double *q = dq[v], *rp = dr[v] + 3 * L->upper;
+            double *rk = dr[v] + 3 * L->lower, rP[3];
+            double de = el ? q[o + 2] : 0.0;
+            if (map) {
+                /* dr_P = dr_A + (R E dtheta) x rho_P */
+                const double *dth = q + lin->up_qoff[l];
+                double phi[3];
+                for (int c = 0; c < 3; c++)
+                    phi[c] = map[3 * c] * dth[0] + map[3 * c + 1] * dth[1] +
+                             map[3 * c + 2] * dth[2];
+                rP[0] = rp[0] + phi[1] * map[11] - phi[2] * map[10];
+                rP[1] = rp[1] + phi[2] * map[9] - phi[0] * map[11];
+                rP[2] = rp[2] + phi[0] * map[10] - phi[1] * map[9];
+                rp = rP;
+            }
             for (int c = 0; c < 3; c++)
-                phi[c] = map[3 * c] * dth[0] + map[3 * c + 1] * dth[1] +
-                         map[3 * c + 2] * dth[2];
-            rP[0] = rp[0] + phi[1] * map[11] - phi[2] * map[10];
-            rP[1] = rp[1] + phi[2] * map[9] - phi[0] * map[11];
-            rP[2] = rp[2] + phi[0] * map[10] - phi[1] * map[9];
-            rp = rP;
+                rk[c] = rp[c] + len * (d1[c] * q[o] + d2[c] * q[o + 1]) +
+                        ln * n0[c] * de;
         }
-        for (int c = 0; c < 3; c++)
-            rk[c] = rp[c] +
-                    lin->len0[l] * (d1[c] * dq[o] + d2[c] * dq[o + 1]) +
-                    L->length * lin->n0[3 * l + c] * de;
     }
+}
+
+void ts_linear_node_displacements(const ts_system *sys, const ts_linear *lin,
+                                  const double dq[], double dr[])
+{
+    tsi_node_displacements(sys, lin, 1, &dq, &dr);
 }

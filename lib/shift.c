@@ -563,8 +563,9 @@ static void rhs_part(const tsi_shift *sh, const double *w, double *u1,
     int nq = sh->lin->nq;
     size_t n3 = 3 * (size_t)d->np;
     double *hc = u2 + n3;
-    tsi_desc_to_points(d, sh->lin, w, u1);
-    tsi_desc_to_points(d, sh->lin, w + nq, u2);
+    const double *wv[2] = {w, w + nq};
+    double *uv[2] = {u1, u2};
+    tsi_desc_to_points_n(d, sh->lin, 2, wv, uv);
     tsi_desc_mass_mul(d, u2, mu);
     tsi_desc_block_mul(d, d->C, u1, mu, 1);
     for (int k = d->p0; k < d->np; k++)
@@ -668,9 +669,10 @@ void tsi_shift_solve(tsi_shift *sh, const double complex *b,
     }
     double *xr = sh->w, *xi = sh->w + nq, *p = u2, *cr = u1, *ci = u1 + m;
     solution_points(d, rhs, 2, p, cr);
-    tsi_shift_nodes_to_q(sh, p, xr);
-    solution_points(d, rhs + 1, 2, p, ci);
-    tsi_shift_nodes_to_q(sh, p, xi);
+    solution_points(d, rhs + 1, 2, p + m, ci);
+    const double *pv[2] = {p, p + m};
+    double *xv[2] = {xr, xi};
+    tsi_desc_from_points_n(d, sh->lin, 2, pv, xv);
     for (int i = 0; i < nq; i++) {
         x[i] = xr[i] + I * xi[i];
         x[nq + i] = s * x[i] + b[i]; /* s x_q - w_q, w = -b */
