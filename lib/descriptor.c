@@ -200,8 +200,8 @@ typedef struct entry {
 } entry;
 
 /* Sort e[m] by column, then row (no two entries share both): two stable
- * counting passes, by row and then by column, O(m + nx) (qsort took 27
- * ms of the 80 of the linearization at 10 000 links). */
+ * counting passes, by row and then by column, O(m + nx) (qsort was
+ * O(m log m): doc/performance.md, "Less work beside the search"). */
 static int sort_entries(entry *e, size_t m, int nx)
 {
     entry *t = malloc((m > 0 ? m : 1) * sizeof *t);

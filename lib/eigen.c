@@ -1255,8 +1255,8 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
 #define SWEEP_GRID_NEV 6   /* eigenvalues found around each grid point (at
                               SWEEP_GRID_TOL): as many as converge in the
                               first SWEEP_NCV Arnoldi steps on Kamman's
-                              example 1 at 10 000 links (21 operator
-                              applications a run; 27 for 8: a restart) */
+                              example 1 at 10 000 links, where 8 need a
+                              restart (doc/linear.md section 3b, step 2) */
 #define SWEEP_RATIO 4.0    /* frequency ratio of the grid of shifts */
 #define SWEEP_PRE_GRID 2   /* points of the grid, from the top down, run
                               before the modes' highest frequency is known
@@ -2392,8 +2392,6 @@ static void mark_repeats(cand_list *S, const cand_list *L)
  * copy). */
 static int merge_search(cand_list *L, cand_list *S)
 {
-    if (L->v2)
-        return TS_EINVAL; /* one store taken over at most */
     cand *c = realloc(L->c, (size_t)(L->n + S->n + 1) * sizeof(cand));
     if (!c)
         return TS_ENOMEM;
@@ -2658,11 +2656,14 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
         for (int i = 0; i < L.n; i++)
             cover[ncover++] = i;
     } else {
-        /* (The search's own, when checked beside the modes' checks, as
-         * they are.) */
-        for (int i = 0; i < L.n; i++)
-            if (i < keep || !search_checked || !L.c[i].sweep)
-                L.c[i].checked = i < keep ? (modes_checked ? 1 : 0) : -1;
+        /* The modes checked or to check, the others not (the search's
+         * own kept as they are when it checked them itself). */
+        for (int i = 0; i < L.n; i++) {
+            if (i < keep)
+                L.c[i].checked = modes_checked;
+            else if (!(search_checked && L.c[i].sweep))
+                L.c[i].checked = -1;
+        }
         if (modes_checked) {
             /* Done beside the search. */
         } else if (lin->desc) {

@@ -436,6 +436,16 @@ static int ensure_parts(tsi_shift *sh, ts_err *err)
     return TS_OK;
 }
 
+/* S(sh->s), already in sh->Sx, factored afresh, with pivoting and scaling
+ * (real or complex as cplx), in the arrays sh holds; sh is freed when it
+ * fails (factor). */
+static int afresh(tsi_shift *sh, int cplx, ts_err *err)
+{
+    free_numeric(sh);
+    sh->is_complex = cplx;
+    return factor(sh, err);
+}
+
 /* tsi_shift_refactor; with test 0 the old pivots serve whenever KLU's
  * refactorisation succeeds (the caller judges its solves:
  * tsi_shift_eig_error). *fresh (may be NULL) is set when it factored
@@ -491,11 +501,7 @@ static int refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
             return TS_OK;
         }
     }
-    /* Afresh, with pivoting and scaling (and of the other kind when s
-     * crossed the real axis), in the arrays already held. */
-    free_numeric(sh);
-    sh->is_complex = cplx;
-    return factor(sh, err);
+    return afresh(sh, cplx, err);
 }
 
 int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
@@ -967,12 +973,18 @@ void tsi_shift_tsolve(tsi_shift *sh, double complex *w)
         w[i] = cols[i] + I * cols[nx + i];
 }
 
-/* The start of the left vector's inverse iteration (tsi_shift_eig_error):
- * no multiple of a mode's left vector by any symmetry. */
+/* Entry i of the start b of the left vector's inverse iteration
+ * (tsi_shift_eig_error): no multiple of a mode's left vector by any
+ * symmetry. */
+static inline double left_start_entry(int i)
+{
+    return 1.0 + (double)(i % 7) / 7.0;
+}
+
 static void left_start(double complex *w, int nx)
 {
     for (int i = 0; i < nx; i++)
-        w[i] = 1.0 + (double)(i % 7) / 7.0;
+        w[i] = left_start_entry(i);
 }
 
 /* The componentwise backward error of w = S^-T b for b = left_start's
@@ -986,7 +998,7 @@ static double left_backward(const tsi_shift *sh, const double complex *w)
     const double *a = sh->Sx;
     double om = 0;
     for (int j = 0; j < d->nx; j++) {
-        double b = 1.0 + (double)(j % 7) / 7.0;
+        double b = left_start_entry(j);
         double rr = -b, ri = 0, den = b;
         for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++) {
             double sr = sh->is_complex ? a[2 * p] : a[p];
@@ -1094,9 +1106,7 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         tsi_shift_tsolve(sh, w0);
         if (fresh || left_backward(sh, w0) <= SHIFT_NEAR_BACKWARD)
             break;
-        free_numeric(sh);
-        sh->is_complex = cimag(st) != 0.0;
-        rc = factor(sh, NULL); /* frees sh when it fails */
+        rc = afresh(sh, sh->is_complex, NULL);
         if (rc == TS_OK) {
             left_start(w0, nx);
             tsi_shift_tsolve(sh, w0);

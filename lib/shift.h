@@ -119,12 +119,11 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
                        ts_err *err);
 
 /* tsi_shift_eig_error's test of the old pivots at a new eigenvalue: the
- * componentwise backward error of its first solve. A fresh
- * factorisation's is 1e-14 to 3e-13 on Kamman's example 1 at 10 000
- * links, a refactorisation's 1e-14 to 4e-10; at 1e-10 the left vector is
- * the exact one of a pencil within 1e-10 of S(lambda) entry by entry,
- * which moves the estimates (first-order, themselves 1e-9 to 1e-6 of
- * |lambda|) by far less than their own size. */
+ * componentwise backward error of its first solve. At 1e-10 the left
+ * vector is the exact one of a pencil within 1e-10 of S(lambda) entry by
+ * entry, which moves the estimates (first-order, themselves 1e-9 to 1e-6
+ * of |lambda|) by far less than their own size (doc/linear.md section
+ * 3). */
 #define SHIFT_NEAR_BACKWARD 1e-10
 
 /* Factor S_inf, for tsi_shift_apply. Same codes. */
