@@ -1113,9 +1113,10 @@ static int rigid_strains(const ts_kernel *k, const double *n, double *strain,
     }
     int rc = ts_system_build(r, err);
     ts_kernel *kr = rc == TS_OK ? ts_kernel_alloc(r, err) : NULL;
-    double *y = kr ? calloc(4 * (size_t)sys->nlinks, sizeof(double)) : NULL;
-    double *dydt = kr ? malloc(4 * (size_t)sys->nlinks * sizeof(double))
-                      : NULL;
+    /* (The state holds the vehicles' angles and controllers too.) */
+    size_t ns = kr ? (size_t)ts_kernel_nstate(kr) : 0;
+    double *y = kr ? calloc(ns, sizeof(double)) : NULL;
+    double *dydt = kr ? malloc(ns * sizeof(double)) : NULL;
     if (!y || !dydt) {
         rc = rc == TS_OK ? ts_fail(err, TS_ENOMEM, "equilibrium: out of "
                                                    "memory")
