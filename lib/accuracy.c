@@ -37,14 +37,6 @@ double ts_accuracy_order(const ts_system *sys)
     return 2.0;
 }
 
-int ts_accuracy_can_coarsen(const ts_system *sys)
-{
-    for (int c = 0; c < sys->ncables; c++)
-        if (sys->cables[c].nlinks < 2)
-            return 0;
-    return sys->ncables > 0;
-}
-
 int ts_accuracy_max_links(const ts_system *sys)
 {
     int n = 0;
@@ -52,57 +44,6 @@ int ts_accuracy_max_links(const ts_system *sys)
         if (sys->cables[c].nlinks > n)
             n = sys->cables[c].nlinks;
     return n;
-}
-
-/* Cable c of s with its links merged in pairs (coarser) or split in two
- * (finer). */
-static int relink(ts_cable *c, int coarser, double *ratio, ts_err *err)
-{
-    int n = c->nlinks;
-    int m = coarser ? (n + 1) / 2 : 2 * n;
-    if (m > TS_MAX_LINKS)
-        return ts_fail(err, TS_EINVAL, "links: cable '%s' would need %d "
-                       "links (at most %d) for the error estimate",
-                       c->name, m, TS_MAX_LINKS);
-    if (c->link_fraction) {
-        double *f = malloc((size_t)m * sizeof *f);
-        if (!f)
-            return ts_fail(err, TS_ENOMEM, "accuracy: out of memory");
-        for (int i = 0; i < m; i++) {
-            if (coarser)
-                f[i] = c->link_fraction[2 * i] +
-                       (2 * i + 1 < n ? c->link_fraction[2 * i + 1] : 0.0);
-            else
-                f[i] = 0.5 * c->link_fraction[i / 2];
-        }
-        free(c->link_fraction);
-        c->link_fraction = f;
-    }
-    c->nlinks = m;
-    double r = (double)n / m;
-    if (coarser && r < *ratio)
-        *ratio = r;
-    return TS_OK;
-}
-
-ts_system *ts_accuracy_level(const ts_system *sys, int coarser,
-                             double *ratio, ts_err *err)
-{
-    ts_system *s = ts_system_copy(sys, err);
-    if (!s)
-        return NULL;
-    coarser = coarser && ts_accuracy_can_coarsen(sys);
-    *ratio = coarser ? INFINITY : 0.5;
-    int rc = TS_OK;
-    for (int c = 0; rc == TS_OK && c < s->ncables; c++)
-        rc = relink(&s->cables[c], coarser, ratio, err);
-    if (rc == TS_OK)
-        rc = ts_system_build(s, err);
-    if (rc != TS_OK) {
-        ts_system_free(s);
-        return NULL;
-    }
-    return s;
 }
 
 /* Fraction of its cable's length at the lower end of link `l`. */

@@ -2544,15 +2544,15 @@ static int run_levels(ts_result *r, const ts_request *rq, levels *L,
     L->res[0] = r;
     if (r->eigen)
         a->eigen_method[0] = (int)r->eigen->method;
-    int coarser = ts_accuracy_can_coarsen(r->sys);
+    int coarser = ts_system_can_coarsen(r->sys);
     int want = coarser ? 3 : 2;
     const ts_system *from = r->sys;
     for (int k = 1; k < want; k++) {
-        if (k > 1 && !ts_accuracy_can_coarsen(from))
+        if (k > 1 && !ts_system_can_coarsen(from))
             break;
         ts_err e = {0};
         double ratio;
-        ts_system *lev = ts_accuracy_level(from, coarser, &ratio, &e);
+        ts_system *lev = ts_system_level(from, coarser, &ratio, &e);
         if (!lev) {
             snprintf(why, size, "no %s discretisation: %.200s",
                      coarser ? "coarser" : "finer", e.msg);

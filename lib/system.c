@@ -168,6 +168,65 @@ int ts_system_set_links(ts_system *sys, int links, ts_err *err)
     return ts_system_build(sys, err);
 }
 
+int ts_system_can_coarsen(const ts_system *sys)
+{
+    for (int c = 0; c < sys->ncables; c++)
+        if (sys->cables[c].nlinks < 2)
+            return 0;
+    return sys->ncables > 0;
+}
+
+/* Cable c of s with its links merged in pairs (coarser) or split in two
+ * (finer). */
+static int relink(ts_cable *c, int coarser, double *ratio, ts_err *err)
+{
+    int n = c->nlinks;
+    int m = coarser ? (n + 1) / 2 : 2 * n;
+    if (m > TS_MAX_LINKS)
+        return ts_fail(err, TS_EINVAL, "links: cable '%s' would need %d "
+                       "links (at most %d) for the error estimate",
+                       c->name, m, TS_MAX_LINKS);
+    if (c->link_fraction) {
+        double *f = malloc((size_t)m * sizeof *f);
+        if (!f)
+            return ts_fail(err, TS_ENOMEM, "links: out of memory");
+        for (int i = 0; i < m; i++) {
+            if (coarser)
+                f[i] = c->link_fraction[2 * i] +
+                       (2 * i + 1 < n ? c->link_fraction[2 * i + 1] : 0.0);
+            else
+                f[i] = 0.5 * c->link_fraction[i / 2];
+        }
+        free(c->link_fraction);
+        c->link_fraction = f;
+    }
+    c->nlinks = m;
+    double r = (double)n / m;
+    if (coarser && r < *ratio)
+        *ratio = r;
+    return TS_OK;
+}
+
+ts_system *ts_system_level(const ts_system *sys, int coarser,
+                           double *ratio, ts_err *err)
+{
+    ts_system *s = ts_system_copy(sys, err);
+    if (!s)
+        return NULL;
+    coarser = coarser && ts_system_can_coarsen(sys);
+    *ratio = coarser ? INFINITY : 0.5;
+    int rc = TS_OK;
+    for (int c = 0; rc == TS_OK && c < s->ncables; c++)
+        rc = relink(&s->cables[c], coarser, ratio, err);
+    if (rc == TS_OK)
+        rc = ts_system_build(s, err);
+    if (rc != TS_OK) {
+        ts_system_free(s);
+        return NULL;
+    }
+    return s;
+}
+
 void ts_system_node_name(const ts_system *sys, int node, char *buf,
                          size_t size)
 {

@@ -165,9 +165,9 @@ static void test_levels(void)
         return;
     ts_err err = {0};
     double r1, r2, r3;
-    ts_system *c1 = ts_accuracy_level(sc->system, 1, &r1, &err);
-    ts_system *c2 = c1 ? ts_accuracy_level(c1, 1, &r2, &err) : NULL;
-    ts_system *c3 = c2 ? ts_accuracy_level(c2, 1, &r3, &err) : NULL;
+    ts_system *c1 = ts_system_level(sc->system, 1, &r1, &err);
+    ts_system *c2 = c1 ? ts_system_level(c1, 1, &r2, &err) : NULL;
+    ts_system *c3 = c2 ? ts_system_level(c2, 1, &r3, &err) : NULL;
     int ok = c3 && c1->cables[0].nlinks == 10 && c2->cables[0].nlinks == 5 &&
              c3->cables[0].nlinks == 3 && c1->cables[1].nlinks == 3;
     CHECK(ok && r1 == 5.0 / 3 && r2 == 1.5 && r3 == 5.0 / 3,
@@ -222,9 +222,9 @@ static void test_levels(void)
                     "  - {name: a, from: tow, length: 2, diameter: 0.01,\n"
                     "     mass_per_length: 0.5, links: 1}\n");
     double r;
-    ts_system *f = sc ? ts_accuracy_level(sc->system, 1, &r, &err) : NULL;
+    ts_system *f = sc ? ts_system_level(sc->system, 1, &r, &err) : NULL;
     CHECK(f && f->nlinks == 2 && r == 0.5 &&
-              !ts_accuracy_can_coarsen(sc->system),
+              !ts_system_can_coarsen(sc->system),
           "a one-link cable refines to 2 links (ratio 0.5)");
     ts_system_free(f);
     ts_scene_free(sc);

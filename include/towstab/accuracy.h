@@ -70,21 +70,6 @@ extern "C" {
 TS_API double ts_accuracy_order(const ts_system *sys);
 
 
-/* The next discretisation of `sys` (built): coarser when every cable has
- * at least 2 links (each cable's links halved, rounded up; link_lengths
- * merged in consecutive pairs, an odd last link kept), else finer (every
- * link split in two). *ratio receives the resolution ratio between the
- * two: the smallest ratio of a cable's links to its coarse links (>= 1.5;
- * a cable whose count is odd makes it smaller than 2, and the smallest
- * ratio gives the larger, safe estimate), or 2 when refined. *finer is 1
- * when refined. NULL on failure (TS_ENOMEM, or TS_EINVAL when the links
- * would exceed TS_MAX_LINKS). */
-TS_API ts_system *ts_accuracy_level(const ts_system *sys, int coarser,
-                                    double *ratio, ts_err *err);
-
-/* Whether sys can be coarsened (every cable has at least 2 links). */
-TS_API int ts_accuracy_can_coarsen(const ts_system *sys);
-
 /* The node of `other` (another discretisation of the same description)
  * at the place of node `node` of `sys`: the tow point, a body's node, a
  * free end, or a cable node at the same fraction of its cable's length;

@@ -207,6 +207,23 @@ TS_API int ts_system_body_node(const ts_system *sys, int b);
  * message starts with "links: " and names the cable), TS_ENOMEM. */
 TS_API int ts_system_set_links(ts_system *sys, int links, ts_err *err);
 
+/* The next discretisation of `sys` (built): coarser when every cable has
+ * at least 2 links (each cable's links halved, rounded up; link_lengths
+ * merged in consecutive pairs, an odd last link kept), else finer (every
+ * link split in two). *ratio receives the resolution ratio between the
+ * two: the smallest ratio of a cable's links to its coarse links (>= 1.5;
+ * a cable whose count is odd makes it smaller than 2, and the smallest
+ * ratio gives the larger, safe estimate), or 2 when refined. NULL on
+ * failure (TS_ENOMEM, or TS_EINVAL when the links would exceed
+ * TS_MAX_LINKS). The levels of the discretisation-error estimate
+ * (towstab/accuracy.h) and of the equilibrium's start with bending
+ * (towstab/equilibrium.h). */
+TS_API ts_system *ts_system_level(const ts_system *sys, int coarser,
+                                  double *ratio, ts_err *err);
+
+/* Whether sys can be coarsened (every cable has at least 2 links). */
+TS_API int ts_system_can_coarsen(const ts_system *sys);
+
 /* Name of node `node` (built system) into buf[size] (cut to fit): "tow"
  * for node 0, the body's name where a body sits, else "<cable>.<k>" for
  * the lower end of link k of that cable. The names every output uses
