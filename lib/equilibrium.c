@@ -55,6 +55,14 @@
  * leaves a factor of 10, and a path that cannot be followed fails in
  * seconds rather than a minute). */
 #define CONTINUATION_MAX_ITER 3
+/* Bending with more links than this (ts_equilibrium_opts.coarse_above's
+ * default): Newton starts from the equilibrium of a coarser copy (each
+ * cable's links halved, down to this size, where the continuation in
+ * bending runs) interpolated onto the links (coarse_start). The shipped
+ * two-part tows (35 links) solve directly; at 105 links (35 a cable) the
+ * continuation took 175 Newton iterations, and at 399 it did not reach
+ * the end of its path (doc/equilibrium.md). */
+#define BENDING_DIRECT_LINKS 64
 /* A vehicle's attitude alone on its joint in the straight tow (the
  * Newton start): moment residual relative to its weight and flow forces
  * times its lever, and the hybrid solver's iterations. */
@@ -87,6 +95,7 @@ void ts_equilibrium_opts_default(ts_equilibrium_opts *o)
     o->max_iter = 100;
     o->method = TS_EQ_AUTO;
     o->guess = NULL;
+    o->coarse_above = BENDING_DIRECT_LINKS;
     o->progress = NULL;
     o->progress_data = NULL;
 }
@@ -772,6 +781,22 @@ static int newton(ts_kernel *k, double *y, double tol, int max_iter,
             alpha *= 0.5;
         }
         if (!accepted) {
+            /* |q''| can stop falling at its rounding before the forces
+             * balance to the tolerance (many short links with bending:
+             * the two-part tow at 300 links). Then the full step is
+             * taken if it lowers the force residual, the acceptance
+             * test's measure, by the same margin. */
+            for (int i = 0; i < nu; i++)
+                uset(k, w, w->yt, i,
+                     (is_param(w, i) ? p0[i == w->uy] : y[unknown(w, i)]) +
+                         w->dq[i]);
+            rc = ts_kernel_eval(k, w->yt, NULL, w->f1);
+            eq->evaluations++;
+            double fscale, fworst = ts_kernel_unbalanced(k, &fscale);
+            double frel = fscale > 0 ? fworst / fscale : fworst;
+            accepted = rc == TS_OK && frel <= (1.0 - 1e-4) * rel;
+        }
+        if (!accepted) {
             if (w->ux >= 0) {
                 uset(k, w, y, w->ux, p0[0]);
                 uset(k, w, y, w->uy, p0[1]);
@@ -1140,6 +1165,153 @@ static int rigid_strains(const ts_kernel *k, const double *n, double *strain,
     free(dydt);
     ts_kernel_free(kr);
     ts_system_free(r);
+    return rc;
+}
+
+/* The fraction of its cable's length that link l of sys takes. */
+static double link_share(const ts_system *sys, int l)
+{
+    const ts_cable *cb = &sys->cables[sys->links[l].cable];
+    return cb->link_fraction ? cb->link_fraction[sys->links[l].index - 1]
+                             : 1.0 / cb->nlinks;
+}
+
+/* A walk along a cable of the coarse system cs (directions cd[3
+ * cs->nlinks]) for the unit tangent at increasing fractions s of its
+ * length: linear in s between the directions at the midpoints of its
+ * links, the end links' own beyond theirs (extrapolating from the last
+ * two instead started the two-part tow farther from its equilibrium: the
+ * shape bends hardest at its ends). O(its links) for the whole walk. */
+typedef struct tangent_walk {
+    const ts_system *cs;
+    const double *cd;
+    int a, b;         /* the coarse links around s (a -1 before the first
+                         midpoint) */
+    double ma, mb;    /* their midpoints' fractions */
+    double end;       /* where b ends */
+} tangent_walk;
+
+static void walk_start(tangent_walk *t, const ts_system *cs,
+                       const double *cd, int first)
+{
+    t->cs = cs;
+    t->cd = cd;
+    t->a = -1;
+    t->b = first;
+    t->ma = 0.0;
+    t->end = link_share(cs, first);
+    t->mb = 0.5 * t->end;
+}
+
+static void walk_tangent(tangent_walk *t, double s, double out[3])
+{
+    const ts_system *cs = t->cs;
+    while (s > t->mb && cs->links[t->b].next >= 0) {
+        t->a = t->b;
+        t->ma = t->mb;
+        t->b = cs->links[t->b].next;
+        double f = link_share(cs, t->b);
+        t->mb = t->end + 0.5 * f;
+        t->end += f;
+    }
+    const double *db = t->cd + 3 * t->b;
+    if (t->a < 0 || s >= t->mb) {
+        memcpy(out, db, 3 * sizeof(double));
+        return;
+    }
+    const double *da = t->cd + 3 * t->a;
+    double w = (s - t->ma) / (t->mb - t->ma);
+    for (int i = 0; i < 3; i++)
+        out[i] = (1 - w) * da[i] + w * db[i];
+    double nt = v3_norm(out);
+    for (int i = 0; i < 3; i++)
+        out[i] /= nt;
+}
+
+/* Newton's start with bending and many links (opts.coarse_above): the
+ * equilibrium of a coarser copy of the system (ts_system_level, each
+ * cable's links halved), solved by ts_equilibrium_solve, so recursively
+ * down to the direct size, at k's frame, set points, thrust bias and
+ * turn deflection; its link directions interpolated along each cable
+ * onto k's links (walk_tangent: a smooth shape's to second order in
+ * the link length), its vehicles' attitudes, controller states and a
+ * towing vehicle's steady motion as they are (ts_equilibrium_set_bodies).
+ * Sets the directions into dvec[3 nlinks], strains from a rigid copy
+ * (rigid_strains) into strain[nlinks], and y at rest. Adds the coarse
+ * solve's iterations, evaluations and steps to eq's. TS_OK; TS_ENOMEM;
+ * TS_ECANCEL (the caller asked to stop); else the coarse solve's failure,
+ * err saying why, for the caller to start otherwise (also TS_EINVAL for
+ * a loop that is not closed: its frozen output is not copied). Time and
+ * memory: the coarse levels', about an eighth of this level's dense
+ * Newton and less. */
+static int coarse_start(ts_kernel *k, const ts_equilibrium_opts *o,
+                        const ts_frame *frame, double *y, double *dvec,
+                        double *strain, ts_equilibrium *eq, ts_err *err)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    int nv = ts_kernel_nvehicles(k);
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        for (int l = 0; l < d->nloops; l++)
+            if (ts_kernel_loop_mode(k, v, l) != TS_LOOP_CLOSED)
+                return ts_fail(err, TS_EINVAL, "equilibrium: a loop that "
+                               "is not closed: no coarse start");
+    }
+    double ratio;
+    ts_system *cs = ts_system_level(sys, 1, &ratio, err);
+    ts_kernel *kc = cs ? ts_kernel_alloc(cs, err) : NULL;
+    ts_equilibrium *ec = kc ? ts_equilibrium_alloc(cs, err) : NULL;
+    int *first = cs ? malloc((size_t)cs->ncables * sizeof *first) : NULL;
+    int rc;
+    if (!ec || !first) {
+        rc = ts_fail(err, TS_ENOMEM, "equilibrium: out of memory for a "
+                     "coarser copy of %d links", sys->nlinks);
+        goto out;
+    }
+    ts_kernel_set_frame(kc, frame);
+    ts_kernel_set_thrust_bias(kc, ts_kernel_thrust_bias(k));
+    ts_kernel_set_turn_deflection(kc, ts_kernel_turn_deflection(k));
+    for (int v = 0; v < nv; v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        for (int l = 0; l < d->nloops; l++)
+            ts_kernel_set_setpoint(kc, v, l, ts_kernel_setpoint(k, v, l));
+    }
+    ts_equilibrium_opts oc = *o;
+    oc.guess = NULL;
+    rc = ts_equilibrium_solve(kc, &oc, ec, err);
+    eq->iterations += ec->iterations;
+    eq->evaluations += ec->evaluations;
+    eq->continuation_steps += ec->continuation_steps;
+    if (rc != TS_OK)
+        goto out;
+    for (int l = 0; l < cs->nlinks; l++)
+        if (cs->links[l].index == 1)
+            first[cs->links[l].cable] = l;
+    for (int l0 = 0; l0 < sys->nlinks; l0++) {
+        if (sys->links[l0].index != 1)
+            continue;
+        tangent_walk tw;
+        walk_start(&tw, cs, ec->directions, first[sys->links[l0].cable]);
+        double at = 0.0; /* where link l starts along its cable */
+        for (int l = l0; l >= 0; l = sys->links[l].next) {
+            double f = link_share(sys, l);
+            walk_tangent(&tw, at + 0.5 * f, dvec + 3 * l);
+            at += f;
+        }
+    }
+    memset(y, 0, (size_t)ts_kernel_nstate(k) * sizeof(double));
+    memset(strain, 0, (size_t)sys->nlinks * sizeof(double));
+    if (sys->has_elastic &&
+        (rc = rigid_strains(k, dvec, strain, err)) != TS_OK)
+        goto out;
+    ts_kernel_set_shape(k, dvec, sys->has_elastic ? strain : NULL, NULL,
+                        NULL, TS_CHART_RECHART, y);
+    rc = ts_equilibrium_set_bodies(k, ec, y, err);
+out:
+    free(first);
+    ts_equilibrium_free(ec);
+    ts_kernel_free(kc);
+    ts_system_free(cs);
     return rc;
 }
 
@@ -2340,6 +2512,19 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     rc = TS_ECONV;
     /* Actuators settle smoothly: no rate limit in a steady state. */
     ts_kernel_set_steady(k, 1);
+    if (!o.guess && !have_guess && sys->has_bending &&
+        o.coarse_above > 0 && nl > o.coarse_above &&
+        ts_system_can_coarsen(sys)) {
+        /* Many links with bending: from a coarser copy's equilibrium;
+         * should that fail, the continuation below. */
+        rc = coarse_start(k, &o, &frame, y, dvec, strain, eq, err);
+        if (rc == TS_ENOMEM || rc == TS_ECANCEL || rc == TS_EIO)
+            goto out;
+        if (rc == TS_OK) {
+            rc = newton(k, y, o.tol, o.max_iter, &w, eq, err);
+            eq->continuation_steps++;
+        }
+    }
     if (o.guess || have_guess) {
         /* Straight from the guess at the full turn rate and bending. */
         if (o.guess) {

@@ -25,7 +25,13 @@
  *     towstab equilibrium (Newton with continuation in bending stiffness)
  *     approaches it as the links are refined, in the rigid and the elastic
  *     model, at second order; the bending term is a fifth of the answer, so
- *     the comparison sees it.
+ *     the comparison sees it. At 80 links it starts from the equilibrium
+ *     of a coarser copy (5).
+ *  5. The start from a coarser copy (ts_equilibrium_opts.coarse_above)
+ *     against the continuation in bending alone, on the two-part tows
+ *     refined past its threshold (105 and 66 links): the same
+ *     equilibrium, node by node and vehicle attitude, in fewer Newton
+ *     iterations.
  * Tolerances are stated at each check with their reason. */
 #include "towstab/equilibrium.h"
 #include "towstab/kernel.h"
@@ -37,6 +43,7 @@
 #include "forces.h"
 #include "tcheck.h"
 #include "tmodel.h"
+#include "tscene.h"
 
 /* ---- helpers ------------------------------------------------------------ */
 
@@ -573,11 +580,83 @@ static void test_beam_string(void)
     }
 }
 
+/* 5. Equilibrium of scene `path` at `links` a cable, from a coarser
+ * copy (the default) and by the continuation alone (coarse_above 0). */
+static void coarse_case(const ts_units *u, const char *path, int links)
+{
+    ts_scene *sc = tscene_load(u, path);
+    ts_err err = {0};
+    if (!sc || ts_system_set_links(sc->system, links, &err) != TS_OK) {
+        CHECK(0, "%s at %d links a cable (%s)", path, links, err.msg);
+        ts_scene_free(sc);
+        return;
+    }
+    const ts_system *sys = sc->system;
+    ts_kernel *k[2];
+    ts_equilibrium *eq[2];
+    int rc[2];
+    for (int i = 0; i < 2; i++) {
+        ts_equilibrium_opts o;
+        ts_equilibrium_opts_default(&o);
+        if (i == 1)
+            o.coarse_above = 0;
+        k[i] = ts_kernel_alloc(sys, &err);
+        eq[i] = ts_equilibrium_alloc(sys, &err);
+        rc[i] = ts_equilibrium_solve(k[i], &o, eq[i], &err);
+        if (rc[i] != TS_OK)
+            printf("     %s: %s\n", i ? "continuation" : "coarse start",
+                   err.msg);
+    }
+    if (CHECK(rc[0] == TS_OK && rc[1] == TS_OK && eq[0]->converged &&
+                  eq[1]->converged,
+              "%s, %d links: both starts converge", path, sys->nlinks)) {
+        /* The two are roots of the same equations to the tolerance 1e-10
+         * of the largest force: their nodes agree to each one's shape
+         * error estimate (|J^-1 q''| times the length, about 1e-10 m
+         * here), with a factor of 100 for the estimate's first order and
+         * 1e-9 m for rounding in the positions. */
+        double dmax = 0, allow = 100 * (eq[0]->shape_error +
+                                        eq[1]->shape_error) + 1e-9;
+        for (int i = 0; i < 3 * sys->nnodes; i++)
+            dmax = fmax(dmax, fabs(eq[0]->positions[i] -
+                                   eq[1]->positions[i]));
+        double amax = 0;
+        for (int i = 0; i < 9 * eq[0]->nvehicles; i++)
+            amax = fmax(amax, fabs(eq[0]->attitudes[i] -
+                                   eq[1]->attitudes[i]));
+        CHECK(dmax <= allow && amax <= 1e-7,
+              "%s, %d links: the same equilibrium from both starts (nodes "
+              "%.2g m apart, within %.2g; attitudes %.2g apart, within "
+              "1e-7)", path, sys->nlinks, dmax, allow, amax);
+        CHECK(eq[0]->iterations < eq[1]->iterations,
+              "%s, %d links: the coarse start takes fewer Newton iterations "
+              "(%d, its coarse levels' included) than the continuation "
+              "(%d)", path, sys->nlinks, eq[0]->iterations,
+              eq[1]->iterations);
+    }
+    for (int i = 0; i < 2; i++) {
+        ts_equilibrium_free(eq[i]);
+        ts_kernel_free(k[i]);
+    }
+    ts_scene_free(sc);
+}
+
+static void test_coarse_start(void)
+{
+    ts_units *u = tscene_units();
+    if (!u)
+        return;
+    coarse_case(u, "examples/two_part_tow.yaml", 35);
+    coarse_case(u, "examples/two_part_tow_vehicle.yaml", 22);
+    ts_units_free(u);
+}
+
 int main(void)
 {
     test_joints();
     test_kernel_gradient();
     test_energy();
     test_beam_string();
+    test_coarse_start();
     return tc_done();
 }

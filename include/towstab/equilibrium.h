@@ -49,6 +49,15 @@ typedef struct ts_equilibrium_opts {
                              (elastic links at the strain of the tension
                              a rigid copy carries there) instead of the
                              straight-tow march */
+    int coarse_above;     /* with bending stiffness and no guess, more
+                             links than this: Newton starts from the
+                             equilibrium of a copy with each cable's
+                             links halved (solved the same way, so down
+                             to this many), its shape interpolated, at
+                             the full bending; should that fail, from
+                             the continuation in bending. 0: always
+                             the continuation. Default 64
+                             (doc/equilibrium.md) */
     ts_progress_fn progress; /* towstab/progress.h: called as the Newton
                              solver goes (what "equilibrium", done: the
                              columns of its Jacobian formed, of the
