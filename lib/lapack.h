@@ -16,6 +16,8 @@ void dgecon_(const char *norm, const int *n, const double *a, const int *lda,
              int *info, size_t norm_len);
 double dlange_(const char *norm, const int *m, const int *n, const double *a,
                const int *lda, double *work, size_t norm_len);
+void dlacn2_(const int *n, double *v, double *x, int *isgn, double *est,
+             int *kase, int *isave);
 void dgetrf_(const int *m, const int *n, double *a, const int *lda, int *ipiv,
              int *info);
 void dgetrs_(const char *trans, const int *n, const int *nrhs, const double *a,

@@ -87,11 +87,14 @@ typedef struct ts_equilibrium {
     double tow_force[3];  /* force of the cables on the tow point, N */
     double top_tension;   /* |tow_force|, N */
     double min_tension;   /* smallest link tension, N (< 0: compression) */
-    double condition;     /* 1-norm condition number of the solver's last
-                             Jacobian (shooting: d mismatch / d free-end
-                             positions, with vehicles times that of the
-                             outer problem's; Newton: d q'' / d q); NaN
-                             if none */
+    double condition;     /* condition number of the solver's last
+                             Jacobian (shooting: the 1-norm condition of
+                             d mismatch / d free-end positions, with
+                             vehicles times that of the outer problem's;
+                             Newton: the Skeel condition
+                             || |J^-1| |J| ||_inf of J = d q'' / d q,
+                             which the rows' scaling does not change);
+                             NaN if none */
     double shape_error;   /* node position error it implies, m: Newton
                              |J^-1 q''| times the cable length, shooting
                              |J^-1| |mismatch|, with vehicles plus the
