@@ -587,17 +587,28 @@ static void test_beam_string(void)
     }
 }
 
+/* Scene `path` at `links` a cable (its own with 0), or NULL after a FAIL
+ * line. */
+static ts_scene *load_at(const ts_units *u, const char *path, int links)
+{
+    ts_scene *sc = tscene_load(u, path);
+    ts_err err = {0};
+    if (sc && (links <= 0 ||
+               ts_system_set_links(sc->system, links, &err) == TS_OK))
+        return sc;
+    CHECK(0, "%s at %d links a cable (%s)", path, links, err.msg);
+    ts_scene_free(sc);
+    return NULL;
+}
+
 /* 5. Equilibrium of scene `path` at `links` a cable, from a coarser
  * copy (the default) and by the continuation alone (coarse_above 0). */
 static void coarse_case(const ts_units *u, const char *path, int links)
 {
-    ts_scene *sc = tscene_load(u, path);
-    ts_err err = {0};
-    if (!sc || ts_system_set_links(sc->system, links, &err) != TS_OK) {
-        CHECK(0, "%s at %d links a cable (%s)", path, links, err.msg);
-        ts_scene_free(sc);
+    ts_scene *sc = load_at(u, path, links);
+    if (!sc)
         return;
-    }
+    ts_err err = {0};
     const ts_system *sys = sc->system;
     ts_kernel *k[2];
     ts_equilibrium *eq[2];
@@ -648,15 +659,6 @@ static void coarse_case(const ts_units *u, const char *path, int links)
     ts_scene_free(sc);
 }
 
-static void test_coarse_start(void)
-{
-    ts_units *u = tscene_units();
-    if (!u)
-        return;
-    coarse_case(u, "examples/two_part_tow.yaml", 35);
-    coarse_case(u, "examples/two_part_tow_vehicle.yaml", 22);
-    ts_units_free(u);
-}
 
 /* 6. The Skeel condition of d q'' / d q at eq (no controllers, no
  * towing vehicle: the unknowns are q), from central differences with
@@ -729,14 +731,9 @@ out:
 
 static void condition_case(const ts_units *u, const char *path, int links)
 {
-    ts_scene *sc = tscene_load(u, path);
-    ts_err err = {0};
-    if (!sc || (links > 0 &&
-                ts_system_set_links(sc->system, links, &err) != TS_OK)) {
-        CHECK(0, "%s at %d links a cable (%s)", path, links, err.msg);
-        ts_scene_free(sc);
+    ts_scene *sc = load_at(u, path, links);
+    if (!sc)
         return;
-    }
     tscene_solved s;
     int rc = tscene_solve(sc->system, &s, TS_EQ_NEWTON);
     double here = rc == TS_OK ? skeel_here(s.k, s.eq) : NAN;
@@ -753,11 +750,14 @@ static void condition_case(const ts_units *u, const char *path, int links)
     ts_scene_free(sc);
 }
 
-static void test_condition(void)
+/* 5 and 6. */
+static void test_scenes(void)
 {
     ts_units *u = tscene_units();
     if (!u)
         return;
+    coarse_case(u, "examples/two_part_tow.yaml", 35);
+    coarse_case(u, "examples/two_part_tow_vehicle.yaml", 22);
     condition_case(u, "examples/two_part_tow.yaml", 35);
     condition_case(u, "examples/kamman_ex1_submerged.yaml", 0);
     ts_units_free(u);
@@ -769,7 +769,6 @@ int main(void)
     test_kernel_gradient();
     test_energy();
     test_beam_string();
-    test_coarse_start();
-    test_condition();
+    test_scenes();
     return tc_done();
 }
