@@ -717,6 +717,38 @@ static double complex sparse_gain(const ts_descriptor *d, int input,
  * truncation |Oerr z| and rounding onoise sqrt(sum |z_j|^2 / h_j^2) /
  * sqrt 2. The allowance is 10 times their sum, as the dense way's. NaN
  * without the estimate. Cost: one transposed solve, O(nlinks). */
+/* W = S(s)^-T c into w->wt, c the output's row in the sparse unknowns at
+ * s (a unit vector for a position or a tension, a vehicle output's Ov
+ * on its local columns) with sh's factors; *v the output's vehicle (-1),
+ * *row and *ncol its row and columns there. One transposed solve. */
+static void output_transposed(tsi_shift *sh, const ts_output *out,
+                              resp_ws *w, int *v, int *row, int *ncol)
+{
+    const ts_descriptor *d = sh->d;
+    double complex s = sh->s;
+    memset(w->wt, 0, (size_t)d->nx * sizeof(double complex));
+    *v = -1;
+    *row = *ncol = 0;
+    if (out->kind == TS_OUT_POSITION) {
+        w->wt[tsi_desc_xr(d, out->node, out->comp)] = 1.0;
+    } else if (out->kind == TS_OUT_TENSION) {
+        w->wt[TSI_XT(out->link)] = 1.0;
+    } else {
+        *v = output_vehicle(d, out->index, row);
+        const tsi_vehicle_layout *L = &d->vl[*v];
+        *ncol = TSI_LV_C + L->nc + L->nin;
+        const double *Ov = d->Ov + d->ov_off[*v] + *row * *ncol;
+        for (int a = 0; a < 3; a++) {
+            w->wt[tsi_desc_xr(d, L->node, a)] = Ov[a] + s * Ov[TSI_LV_V + a];
+            w->wt[tsi_desc_xr(d, d->nn + *v, a)] =
+                Ov[TSI_LV_TH + a] + s * Ov[TSI_LV_W + a];
+        }
+        for (int m = 0; m < L->nc; m++)
+            w->wt[tsi_desc_xc(d, L->c0 + m)] = Ov[TSI_LV_C + m];
+    }
+    tsi_shift_tsolve(sh, w->wt);
+}
+
 static double sparse_gain_error(tsi_shift *sh, int input,
                                 const ts_output *out, resp_ws *w)
 {
@@ -724,26 +756,8 @@ static double sparse_gain_error(tsi_shift *sh, int input,
     double complex s = sh->s;
     if (!d->Oerr || !d->onoise)
         return NAN;
-    memset(w->wt, 0, (size_t)d->nx * sizeof(double complex));
-    int row = 0, v = -1, ncol = 0;
-    if (out->kind == TS_OUT_POSITION) {
-        w->wt[tsi_desc_xr(d, out->node, out->comp)] = 1.0;
-    } else if (out->kind == TS_OUT_TENSION) {
-        w->wt[TSI_XT(out->link)] = 1.0;
-    } else {
-        v = output_vehicle(d, out->index, &row);
-        const tsi_vehicle_layout *L = &d->vl[v];
-        ncol = TSI_LV_C + L->nc + L->nin;
-        const double *Ov = d->Ov + d->ov_off[v] + row * ncol;
-        for (int a = 0; a < 3; a++) {
-            w->wt[tsi_desc_xr(d, L->node, a)] = Ov[a] + s * Ov[TSI_LV_V + a];
-            w->wt[tsi_desc_xr(d, d->nn + v, a)] =
-                Ov[TSI_LV_TH + a] + s * Ov[TSI_LV_W + a];
-        }
-        for (int m = 0; m < L->nc; m++)
-            w->wt[tsi_desc_xc(d, L->c0 + m)] = Ov[TSI_LV_C + m];
-    }
-    tsi_shift_tsolve(sh, w->wt);
+    int row, v, ncol;
+    output_transposed(sh, out, w, &v, &row, &ncol);
     double tr, ro;
     tsi_desc_error_terms(d, w->wt, w->dr, s, &tr, &ro);
     double complex tb = 0;
@@ -834,6 +848,115 @@ static int gain_at(const ts_system *sys, const ts_linear *lin, int input,
     } else {
         dense_gain(sys, lin, input, out, sh, w, g, gerr);
     }
+    return TS_OK;
+}
+
+/* The sparse model's static gain of a towing vehicle's scene (below). */
+#define SPARSE_STATIC_W0 1e-3   /* rad/s: the first frequency, at most */
+#define SPARSE_STATIC_LEVELS 8  /* frequencies, each half the last */
+/* The output sees a neutral mode when its transposed solution grows
+ * more than this from the first frequency to the last (2^7 apart: a
+ * 1 / w growth gives 128, a bounded one about 1). */
+#define SPARSE_STATIC_SEEN 8.0
+/* The extrapolation has settled when its move is below this fraction of
+ * the gain, or within the allowance. */
+#define SPARSE_STATIC_RTOL 1e-6
+
+/* The static gain of a towing vehicle's scene with the sparse model
+ * alone (doc/linear.md section 4a, "With the sparse model alone"): the
+ * limit w -> 0 of g(i w) from the sparse gains at w_k = w_0 2^-k, k = 0
+ * .. SPARSE_STATIC_LEVELS - 1, w_0 = SPARSE_STATIC_W0 or an eighth of a
+ * neutral mode's frequency (a turn's centre, i |Omega|) if lower.
+ *
+ * Whether the output sees a neutral mode of eigenvalue 0 (as the dense
+ * way's c^T g): near s = 0 the transposed solution W = S(s)^-T c of the
+ * output's row c is h (g^T c) / s plus a regular part (h, g the mode's
+ * left and right vectors in the sparse unknowns; with the heading's
+ * Jordan chain, 1 / s^2), so |W| grows like 1 / w exactly when c sees a
+ * mode; then the gain is undefined, as the dense way says. Otherwise the
+ * limit exists, Re g(i w) is even in w and analytic about 0 (the model
+ * is real: g(conj s) = conj g(s)), and Richardson extrapolation in w^2
+ * (Romberg's table) removes its w^2, w^4, ... terms. Of the table's
+ * diagonal entries T_kk the one with the least error estimate is taken:
+ * its move from T_(k-1)(k-1) plus 1.5 times the largest gain allowance
+ * up to w_k (the sum of the table's weights is below 1.5). The
+ * allowances grow like 1 / w (each multiplies the model's error
+ * estimate by the solution, whose neutral part grows so: the estimate
+ * does not know that the true model keeps the symmetry), so the entry
+ * taken is an early one, where the table has already settled. Returns
+ * TS_OK with *g, *gerr (NaN without the allowances); else note says why
+ * the gain is undefined and the return is TS_ESINGULAR; or a solve's
+ * failure. Cost: SPARSE_STATIC_LEVELS sparse complex factorisations and
+ * solves and 2 transposed solves, O(nlinks). */
+static int sparse_static(const ts_system *sys, const ts_linear *lin,
+                         int input, const ts_output *out, resp_ws *w,
+                         double *g, double *gerr, char *note, size_t size,
+                         ts_err *err)
+{
+    enum { K = SPARSE_STATIC_LEVELS };
+    double w0 = SPARSE_STATIC_W0;
+    for (int k = 0; k < lin->nneutral; k++)
+        if (lin->neutral[k].im > 0)
+            w0 = fmin(w0, 0.125 * lin->neutral[k].im);
+    double T[K][K], wn[2] = {0, 0}, emax = 0.0;
+    double best = NAN, best_err = INFINITY, best_move = INFINITY;
+    tsi_shift sh = {0};
+    int rc = TS_OK;
+    for (int k = 0; k < K && rc == TS_OK; k++) {
+        double complex gk;
+        double ek = NAN;
+        rc = gain_at(sys, lin, input, out, ldexp(w0, -k), w, &sh, &gk, &ek,
+                     err);
+        if (rc != TS_OK)
+            break;
+        if (k == 0 || k == K - 1) {
+            int v, row, ncol;
+            output_transposed(&sh, out, w, &v, &row, &ncol);
+            for (int i = 0; i < lin->desc->nx; i++)
+                wn[k > 0] = fmax(wn[k > 0], cabs(w->wt[i]));
+        }
+        T[k][0] = creal(gk);
+        emax = ek >= 0 ? fmax(emax, ek) : NAN;
+        for (int j = 1; j <= k; j++)
+            T[k][j] = T[k][j - 1] + (T[k][j - 1] - T[k - 1][j - 1]) /
+                                        (ldexp(1.0, 2 * j) - 1);
+        if (k == 0)
+            continue;
+        double move = fabs(T[k][k] - T[k - 1][k - 1]);
+        double ke = move + (isnan(emax) ? 0.0 : 1.5 * emax);
+        if (ke < best_err) {
+            best_err = ke;
+            best_move = move;
+            best = T[k][k];
+        }
+    }
+    tsi_shift_free(&sh);
+    if (rc != TS_OK)
+        return rc;
+    size_t len = 0;
+    if (!(wn[1] <= SPARSE_STATIC_SEEN * wn[0]))
+        len = (size_t)snprintf(
+            note, size, "undefined: the output drifts with the towing "
+            "vehicle's neutral modes by symmetry (its transposed solution "
+            "grows %.3g times from %.3g to %.3g Hz, as 1 / w)",
+            wn[1] / wn[0], w0 / (2 * M_PI), ldexp(w0, 1 - K) / (2 * M_PI));
+    else if (!(best_move <= SPARSE_STATIC_RTOL * fabs(best) ||
+               best_move <= best_err - best_move))
+        len = (size_t)snprintf(
+            note, size, "undefined: the gain does not settle as w -> 0 "
+            "(its extrapolation moved by %.3g at best, %.3g of it)",
+            best_move, best_move / fabs(best));
+    if (len) {
+        int n = 0;
+        for (int j = 0; j < lin->nneutral && len < size; j++)
+            if (lin->neutral[j].re == 0 && lin->neutral[j].im == 0)
+                len += (size_t)snprintf(note + len, size - len, "%s%s",
+                                        n++ ? ", " : "; the modes: ",
+                                        lin->neutral[j].name);
+        return TS_ESINGULAR;
+    }
+    *g = best;
+    *gerr = isnan(emax) ? NAN : best_err;
     return TS_OK;
 }
 
@@ -1210,13 +1333,11 @@ int tsi_response_compute(const ts_system *sys, const ts_linear *lin,
     if (lin->desc && lin->root_qoff >= 0 && !lin->A) {
         /* A towing vehicle with the sparse model alone: S(0) is singular
          * on its neutral modes, and the bordered solve that sets them
-         * apart (neutral_static) is written on the dense A. */
-        r->static_gain = r->static_error = NAN;
-        snprintf(r->static_note, sizeof r->static_note,
-                 "undefined with the sparse model alone: a towing "
-                 "vehicle's neutral modes by symmetry lie at 0 Hz, and "
-                 "the static gain needs the dense model to set them "
-                 "apart");
+         * apart (neutral_static) is written on the dense A: the limit
+         * w -> 0 by extrapolation instead. */
+        rc = sparse_static(sys, lin, input, out, &w, &r->static_gain,
+                           &r->static_error, r->static_note,
+                           sizeof r->static_note, err);
     } else if (neutral0) {
         /* A towing vehicle's neutral modes at 0 (its position along and
          * across its track, its heading: doc/linear.md section 3a) make

@@ -92,10 +92,12 @@ typedef struct ts_response {
     char static_note[256]; /* why static_gain is NaN ("" when it is a
                            number): the output drifts with a towing
                            vehicle's neutral modes by symmetry (named),
-                           or the model is singular at 0 Hz beyond them
-                           (doc/linear.md sections 3a, 4a); with them
-                           and an output they do not move, static_gain
-                           is the limit w -> 0 */
+                           or the model is singular at 0 Hz beyond them,
+                           or (the sparse model alone) the limit's
+                           extrapolation does not settle (doc/linear.md
+                           sections 3a, 4a); with them and an output
+                           they do not move, static_gain is the limit
+                           w -> 0 */
 } ts_response;
 
 /* Frequency response of output `out` to input channel `input` at
