@@ -1009,10 +1009,12 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     if (m->free_vehicle && m->eigen.method == TS_EIG_ARPACK)
         return ts_fail(err, TS_EINVAL, "free_vehicle: needs every coupled "
                        "mode with its shape: eigen_method lapack or auto");
-    /* LAPACK needs the dense A at any size. */
+    /* LAPACK needs the dense A at any size; the modes no input column of
+     * the sparse model's own (the frame inputs'). */
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
         lo.model = TS_LIN_BOTH;
+    lo.frame_inputs = 0;
     int rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc != TS_OK)
         return rc;
@@ -1195,6 +1197,7 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     snprintf(r->rao_file, sizeof r->rao_file, "%s", o->sea.rao_file);
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
+    lo.frame_inputs = 0; /* the tow inputs drive a sea state */
     rc = equilibrium_then_linear(r, rq, &lo, err);
     /* A towing vehicle's speed is solved: the waves meet it at that one
      * (the encounter frequency), not at the scene's starting value. */
@@ -1293,10 +1296,15 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
     }
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
-    /* The frame inputs are columns of the dense B only (doc/linear.md,
-     * section 1). */
-    if (input >= TS_NINPUT && (!strcmp(o->input, "tow.speed") ||
-                               !strcmp(o->input, "tow.turn_rate")) &&
+    lo.frame_inputs = input >= TS_NINPUT &&
+                      (!strcmp(o->input, "tow.speed") ||
+                       !strcmp(o->input, "tow.turn_rate"));
+    /* With a towing vehicle the frame inputs are columns of the dense B
+     * only; otherwise the sparse model has them too (its Gf, doc/linear.md
+     * section 2b). */
+    if (input >= TS_NINPUT && r->sys->tow.vehicle >= 0 &&
+        (!strcmp(o->input, "tow.speed") ||
+         !strcmp(o->input, "tow.turn_rate")) &&
         lo.model != TS_LIN_DENSE)
         lo.model = TS_LIN_DENSE;
     rc = equilibrium_then_linear(r, rq, &lo, err);
@@ -1734,11 +1742,12 @@ static int check_simulate(const ts_system *sys, const ts_simulate_opts *s,
                        "nonlinear run alone gives the others)", out->name,
                        lw);
     if (use_linear && o->linear_method == TS_LINSIM_SPARSE && ex &&
-        ts_excitation_has_manoeuvre(ex))
+        ts_excitation_has_manoeuvre(ex) && sys->tow.vehicle >= 0)
         return ts_fail(err, TS_EINVAL, "linear_method: sparse: a manoeuvre "
-                       "drives the frame's speed or turn rate, inputs of the "
-                       "dense linear model only: use expm or ode (the "
-                       "dense model is then formed at any size)");
+                       "drives the frame's speed or turn rate, which with a "
+                       "towing vehicle are inputs of the dense linear model "
+                       "only: use expm or ode (the dense model is then "
+                       "formed at any size)");
     if (use_linear && s->initial != TS_INITIAL_EQUILIBRIUM)
         return ts_fail(err, TS_EINVAL, "initial: the linear model starts at "
                        "the equilibrium, so %s needs the initial state "
@@ -2322,10 +2331,13 @@ static int pipeline_simulate(ts_result *r, const ts_request *rq, ts_err *err)
          * (dense_max_states, as the modes and the response), the sparse
          * model alone above it (ts_simulate_linear integrates it in
          * O(links) per step), or alone when linear_method sparse asks for
-         * it; at any size under a manoeuvre (the frame inputs are the
-         * dense model's only). */
+         * it; with a towing vehicle at any size under a manoeuvre (its
+         * frame inputs are the dense model's only; without one the sparse
+         * model has them too, its Gf). */
         int manoeuvre = ex && ts_excitation_has_manoeuvre(ex);
-        if ((s->compare || s->linear) && manoeuvre)
+        lo.frame_inputs = manoeuvre;
+        if ((s->compare || s->linear) && manoeuvre &&
+            r->sys->tow.vehicle >= 0)
             lo.model = TS_LIN_BOTH;
         else if ((s->compare || s->linear) &&
                  o->linear_method == TS_LINSIM_SPARSE)

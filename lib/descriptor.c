@@ -184,7 +184,8 @@ void tsi_desc_free(ts_descriptor *d)
                       d->Lv,     d->Lerr,   d->hc,      d->hu,   d->rnoise,
                       d->rcolour, d->vcolour, d->hr,    d->hv,   d->Sp,
                       d->Si,     d->pos,    d->lvp_off, d->ov_off, d->Ov,
-                      d->Oerr,   d->onoise, d->Gt,   d->Gterr};
+                      d->Oerr,   d->onoise, d->Gt,   d->Gterr, d->Gf,
+                      d->Gferr};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         free(arrays[i]);
     if (d->klu_symbolic)
@@ -389,6 +390,15 @@ static int layouts_disjoint(const ts_descriptor *d)
     return nc == d->nc && nin == d->nin;
 }
 
+/* The perturbation groups but the frame inputs': the colours' times x,
+ * y, z, the controller states' and inputs', a towing vehicle's tow
+ * inputs. */
+static int base_groups(const ts_descriptor *d)
+{
+    return 3 * (d->nrcolour + d->nvcolour) + d->ncgroups + d->nugroups +
+           (d->root >= 0 ? TS_NINPUT : 0);
+}
+
 ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
 {
     const ts_system *sys = ts_kernel_system(kern);
@@ -481,6 +491,10 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
         size_t ng = TS_NINPUT * (3 * snp + (size_t)d->nc);
         d->Gt = calloc(ng, sizeof(double));
         ok = d->Gt != NULL;
+    } else if (ok) {
+        size_t ng = TS_NFRAME_INPUT * (3 * snp + (size_t)d->nc);
+        d->Gf = calloc(ng, sizeof(double));
+        ok = d->Gf != NULL;
     }
     if (ok) {
         d->Lv = calloc((size_t)d->lv_off[nv] + 1, sizeof(double));
@@ -574,12 +588,35 @@ ts_descriptor *tsi_desc_alloc(const ts_kernel *kern, ts_err *err)
                     "links", nl);
         return NULL;
     }
-    d->groups = 3 * (d->nrcolour + d->nvcolour) + d->ncgroups + d->nugroups +
-                (d->root >= 0 ? TS_NINPUT : 0);
+    d->groups = base_groups(d);
     return d;
 }
 
 /* ---- Coloured central differences --------------------------------------- */
+
+double tsi_frame_input_scale(const ts_system *sys, const ts_frame *fr, int c)
+{
+    double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
+    double V = fabs(fr->speed);
+    double l0 = sys->nlinks > 0 ? sys->links[0].length : 1.0;
+    double reach = tsi_reach(sys);
+    switch (c) {
+    case TS_FRAME_SPEED: return sqrt(g * l0) + V;           /* m/s */
+    case TS_FRAME_TURN_RATE: return (sqrt(g * l0) + V) / reach; /* rad/s */
+    case TS_FRAME_SPEED_RATE: return g;                     /* m/s^2 */
+    default: return g / reach;                              /* rad/s^2 */
+    }
+}
+
+double tsi_reach(const ts_system *sys)
+{
+    double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
+                        sys->tow.point[1] * sys->tow.point[1] +
+                        sys->tow.point[2] * sys->tow.point[2]);
+    for (int l = 0; l < sys->nlinks; l++)
+        reach += sys->links[l].length;
+    return reach > 0 ? reach : 1.0;
+}
 
 /* The step rel * scale, rounded so that x + h is exact (then
  * (x + h) - x == h). */
@@ -759,6 +796,17 @@ static int local_group(ts_descriptor *d, grp_ws *w, int kind, int m,
     return TS_OK;
 }
 
+/* A whole-row input's column (a tow input's of Gt, a frame input's of
+ * Gf) and its estimate E (or NULL) from the group's evaluations at step
+ * h: every row. */
+static void row_column(const ts_descriptor *d, const grp_ws *w, double h,
+                       double *G, double *E)
+{
+    size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
+    for (size_t i = 0; i < nrow; i++)
+        central(w->R, i, h, G + i, E ? E + i : NULL);
+}
+
 /* A towing vehicle's tow input j alone: its column of Gt over every row
  * (the points stay; what the input moves, the residual says). */
 static int tow_group(ts_descriptor *d, grp_ws *w, int j, int estimate)
@@ -772,15 +820,45 @@ static int tow_group(ts_descriptor *d, grp_ws *w, int j, int estimate)
     if (rc != TS_OK)
         return rc;
     size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
-    double *G = d->Gt + (size_t)j * nrow;
-    double *E = d->Gterr ? d->Gterr + (size_t)j * nrow : NULL;
-    for (size_t i = 0; i < nrow; i++)
-        central(w->R, i, d->hu[j], G + i, E ? E + i : NULL);
+    row_column(d, w, d->hu[j], d->Gt + (size_t)j * nrow,
+               d->Gterr ? d->Gterr + (size_t)j * nrow : NULL);
+    return TS_OK;
+}
+
+/* Frame input c alone (towstab/linearize.h: the mean frame's speed, turn
+ * rate, their rates): its column of Gf over every row, the frame moved
+ * in the group's kernel for the evaluations (the points stay). */
+static int frame_group(ts_descriptor *d, grp_ws *w, int c, int estimate)
+{
+    int nev = estimate ? 4 : 2, rc = TS_OK;
+    ts_frame base, fr;
+    ts_kernel_get_frame(w->k, &base);
+    for (int s = 0; s < nev && rc == TS_OK; s++) {
+        fr = base;
+        double h = mult[s] * d->hf[c];
+        if (c == TS_FRAME_SPEED)
+            fr.speed += h;
+        else if (c == TS_FRAME_TURN_RATE)
+            fr.turn_rate += h;
+        else if (c == TS_FRAME_SPEED_RATE)
+            fr.speed_rate += h;
+        else
+            fr.turn_accel += h;
+        ts_kernel_set_frame(w->k, &fr);
+        rc = group_eval(d, w, s);
+    }
+    ts_kernel_set_frame(w->k, &base);
+    if (rc != TS_OK)
+        return rc;
+    size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
+    row_column(d, w, d->hf[c], d->Gf + (size_t)c * nrow,
+               d->Gferr ? d->Gferr + (size_t)c * nrow : NULL);
     return TS_OK;
 }
 
 /* Group g: kind (0 position, 1 velocity), colour, component; after them
- * the controller and input groups, then a towing vehicle's tow inputs. Evaluates the residual at the
+ * the controller and input groups, then a towing vehicle's tow inputs or
+ * the frame inputs. Evaluates the residual at the
  * perturbed states and writes the columns of the group's points into K
  * or C, and the controller rows' (and the error estimate). */
 static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
@@ -788,7 +866,9 @@ static int group(ts_descriptor *d, grp_ws *w, int g, int estimate)
     int nr = 3 * d->nrcolour, nv3 = 3 * d->nvcolour;
     int nlocal = d->ncgroups + d->nugroups;
     if (g >= nr + nv3 + nlocal)
-        return tow_group(d, w, g - nr - nv3 - nlocal, estimate);
+        return d->root >= 0
+                   ? tow_group(d, w, g - nr - nv3 - nlocal, estimate)
+                   : frame_group(d, w, g - nr - nv3 - nlocal, estimate);
     if (g >= nr + nv3) {
         int m = g - nr - nv3;
         return m < d->ncgroups ? local_group(d, w, 2, m, estimate)
@@ -1374,20 +1454,23 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
     size_t nlv = (size_t)d->lv_off[d->nv] + 1;
     size_t nov = (size_t)d->ov_off[d->nv] + 1;
     size_t ngt = d->root >= 0 ? TS_NINPUT * nr : 0;
+    size_t ngf = d->root >= 0 ? 0 : TS_NFRAME_INPUT * nr;
     if (estimate && (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr ||
-                     (ngt > 0 && !d->Gterr))) {
+                     (ngt > 0 && !d->Gterr) || (ngf > 0 && !d->Gferr))) {
         free(d->Kerr);
         free(d->Cerr);
         free(d->Lerr);
         free(d->Oerr);
         free(d->Gterr);
+        free(d->Gferr);
         d->Kerr = calloc(9 * (size_t)d->nblocks, sizeof(double));
         d->Cerr = calloc(9 * (size_t)d->nblocks, sizeof(double));
         d->Lerr = calloc(nlv, sizeof(double));
         d->Oerr = calloc(nov, sizeof(double));
         d->Gterr = ngt > 0 ? calloc(ngt, sizeof(double)) : NULL;
+        d->Gferr = ngf > 0 ? calloc(ngf, sizeof(double)) : NULL;
         if (!d->Kerr || !d->Cerr || !d->Lerr || !d->Oerr ||
-            (ngt > 0 && !d->Gterr))
+            (ngt > 0 && !d->Gterr) || (ngf > 0 && !d->Gferr))
             return ts_fail(err, TS_ENOMEM, "descriptor: out of memory for "
                            "the error estimate");
     }
@@ -1402,10 +1485,11 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
         free(d->Lerr);
         free(d->Oerr);
         free(d->Gterr);
+        free(d->Gferr);
         free(d->rnoise);
         free(d->onoise);
         d->Kerr = d->Cerr = d->Lerr = d->Oerr = d->rnoise = d->onoise = NULL;
-        d->Gterr = NULL;
+        d->Gterr = d->Gferr = NULL;
     }
     /* Steps. */
     ts_frame fr;
@@ -1444,6 +1528,11 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
     }
     for (int j = 0; j < d->nin; j++)
         d->hu[j] = step_for(d->u0[j], fmax(fabs(d->u0[j]), 1.0), rel_step);
+    const double fbase[TS_NFRAME_INPUT] = {fr.speed, fr.turn_rate,
+                                           fr.speed_rate, fr.turn_accel};
+    for (int c = 0; c < TS_NFRAME_INPUT; c++)
+        d->hf[c] = step_for(fbase[c], tsi_frame_input_scale(sys, &fr, c),
+                            rel_step);
     /* The base residual sets the mass matrices, the vehicles' inertia and
      * the coefficients of the links leaving a vehicle. */
     double *R = malloc(nr * sizeof(double));
@@ -1472,6 +1561,9 @@ int tsi_desc_linearize(ts_descriptor *d, ts_kernel *k, const double y0[],
             tsi_kernel_link_point(k, l, d->n + 3 * l, d->pg + 3 * l,
                                   d->pm + 3 * l);
 
+    /* The frame inputs' groups after the rest, when asked for. */
+    d->frame = d->frame && d->Gf;
+    d->groups = base_groups(d) + (d->frame ? TS_NFRAME_INPUT : 0);
     int ngroups = d->groups, nthreads = threads > 0 ? threads : 1;
 #ifdef _OPENMP
     if (nthreads > ngroups)

@@ -104,6 +104,22 @@ struct ts_descriptor {
                             tow inputs: the residual's change per unit
                             input at fixed points, and its estimate (NULL
                             without the towing vehicle / the estimate) */
+    double *Gf, *Gferr;  /* [TS_NFRAME_INPUT (3 np + nc)] the frame inputs
+                            (the mean frame's speed, turn rate and their
+                            rates, towstab/linearize.h) the same way:
+                            the residual's change per unit at fixed
+                            points, and its estimate (NULL with a towing
+                            vehicle, whose speed and turn rate are
+                            solved, not inputs / without the estimate);
+                            formed only when `frame` asks */
+    double hf[TS_NFRAME_INPUT]; /* their steps (m/s, rad/s, m/s^2,
+                            rad/s^2) */
+    int frame;           /* 1: Gf (and Gferr) hold the frame columns: set
+                            it before tsi_desc_linearize to ask for them
+                            (4 perturbation groups more; the caller's
+                            ts_linearize_opts.frame_inputs), which it
+                            clears with a towing vehicle; 0: Gf is not
+                            formed */
     /* The state linearized about. */
     double *r0, *v0, *a0; /* [3 np] node positions, velocities and
                             accelerations relative to M (m, m/s, m/s^2);
@@ -370,5 +386,17 @@ void tsi_desc_cut_free(ts_descriptor *cut);
  * =. */
 void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
                         const double x[], double y[], int acc);
+
+/* The system's reach, m: the tow point's distance from M's origin plus
+ * every link's length (1 m for none). A rotation theta moves a point
+ * by at most theta times it. */
+double tsi_reach(const ts_system *sys);
+
+/* The size of frame input c (TS_FRAME_*) whose change moves velocities
+ * and accelerations as much as the tow point's do: the speed sqrt(g l)
+ * + |V| (l the first link's length), the turn rate that over the reach,
+ * the speed rate g, the turn acceleration g over the reach. The dense
+ * and the sparse models step the frame inputs by rel_step times it. */
+double tsi_frame_input_scale(const ts_system *sys, const ts_frame *fr, int c);
 
 #endif

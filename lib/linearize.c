@@ -62,6 +62,7 @@ void ts_linearize_opts_default(ts_linearize_opts *o)
     o->tensions = 0;
     o->model = TS_LIN_AUTO;
     o->dense_max_states = 1200;
+    o->frame_inputs = 1;
 }
 
 ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)
@@ -501,13 +502,7 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
     double V = fabs(fr->speed);
     double l0 = sys->nlinks > 0 ? sys->links[0].length : 1.0;
     int c = j - n;
-    double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
-                        sys->tow.point[1] * sys->tow.point[1] +
-                        sys->tow.point[2] * sys->tow.point[2]);
-    for (int l = 0; l < sys->nlinks; l++)
-        reach += sys->links[l].length;
-    if (!(reach > 0))
-        reach = 1.0;
+    double reach = tsi_reach(sys);
     if (c < TS_IN_VEL)
         return l0;
     if (c < TS_IN_ACC)
@@ -522,14 +517,8 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
         return (sqrt(g * l0) + V) / reach;
     if (c < TS_NINPUT)
         return g / reach;
-    if (c >= fin && c < fin + TS_NFRAME_INPUT) {
-        switch (c - fin) {
-        case 0: return sqrt(g * l0) + V;           /* speed, m/s */
-        case 1: return (sqrt(g * l0) + V) / reach; /* turn rate, rad/s */
-        case 2: return g;                          /* speed rate, m/s^2 */
-        default: return g / reach;                 /* turn accel, rad/s^2 */
-        }
-    }
+    if (c >= fin && c < fin + TS_NFRAME_INPUT)
+        return tsi_frame_input_scale(sys, fr, c - fin);
     return 1.0; /* a deflection or a loop input, rad */
 }
 
@@ -1186,6 +1175,7 @@ int ts_linearize(ts_kernel *k, const double y0[], const double u0[],
         /* The kernel's last evaluation is the base point: the sparse model
          * starts from its positions, velocities, accelerations and
          * tensions. */
+        lin->desc->frame = o.frame_inputs;
         rc = tsi_desc_linearize(lin->desc, k, y0, u0, lin->f0, o.rel_step,
                                 o.estimate_error, nthreads, err);
         if (rc != TS_OK)

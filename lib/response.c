@@ -703,6 +703,32 @@ static double complex sparse_gain(const ts_descriptor *d, int input,
     return g;
 }
 
+/* The truncation (into *tb) and rounding (into *rb2, squared) of
+ * whole-row input columns in a gain: n columns with estimates Ge[q],
+ * factors fac[q] at s (1, s, s^2) and steps h[q] (a towing vehicle's
+ * tow input and its rates, Gt; a frame input and its rate, Gf), weighed
+ * by the transposed solution w->wt over every row but the tow point's. */
+static void row_column_terms(const ts_descriptor *d, const resp_ws *w,
+                             int n, const double *const Ge[],
+                             const double complex fac[], const double h[],
+                             double complex *tb, double *rb2)
+{
+    size_t n3 = 3 * (size_t)d->np, nrow = n3 + (size_t)d->nc;
+    double sh = 0.0;
+    for (int q = 0; q < n; q++)
+        sh += cabs(fac[q]) / h[q];
+    for (size_t i = 3 * (size_t)d->p0; i < nrow; i++) {
+        int x = i < n3 ? tsi_desc_xr(d, (int)(i / 3), (int)(i % 3))
+                       : tsi_desc_xc(d, (int)(i - n3));
+        double complex ge = 0;
+        for (int q = 0; q < n; q++)
+            ge += fac[q] * Ge[q][i];
+        *tb += w->wt[x] * (i < n3 ? -ge : ge);
+        double a = cabs(w->wt[x]) * d->rnoise[i] * sh;
+        *rb2 += 0.5 * a * a;
+    }
+}
+
 /* The sparse way's error allowance of the gain g = c^T x (+ a vehicle
  * output's input term), S(s) x = b (x the point displacements, link
  * tensions and controller states, c the output's row: a unit vector for
@@ -786,25 +812,26 @@ static double sparse_gain_error(tsi_shift *sh, int input,
         /* A towing vehicle's tow input: its own columns' (Gt) truncation
          * and rounding, at velocity s and acceleration s^2 per metre. */
         size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
-        double complex s2 = s * s;
-        double hs[3] = {d->hu[TS_IN_DISP + input], d->hu[TS_IN_VEL + input],
-                        d->hu[TS_IN_ACC + input]};
         const double *Ge[3] = {
             d->Gterr + (size_t)(TS_IN_DISP + input) * nrow,
             d->Gterr + (size_t)(TS_IN_VEL + input) * nrow,
             d->Gterr + (size_t)(TS_IN_ACC + input) * nrow};
-        for (size_t i = 3 * (size_t)d->p0; i < nrow; i++) {
-            int x;
-            if (i < 3 * (size_t)d->np)
-                x = tsi_desc_xr(d, (int)(i / 3), (int)(i % 3));
-            else
-                x = tsi_desc_xc(d, (int)(i - 3 * (size_t)d->np));
-            double complex ge = Ge[0][i] + s * Ge[1][i] + s2 * Ge[2][i];
-            tb += w->wt[x] * (i < 3 * (size_t)d->np ? -ge : ge);
-            double a = cabs(w->wt[x]) * d->rnoise[i] *
-                       (1.0 / hs[0] + cabs(s) / hs[1] + cabs(s2) / hs[2]);
-            rb2 += 0.5 * a * a;
-        }
+        const double complex fac[3] = {1.0, s, s * s};
+        const double hs[3] = {d->hu[TS_IN_DISP + input],
+                              d->hu[TS_IN_VEL + input],
+                              d->hu[TS_IN_ACC + input]};
+        row_column_terms(d, w, 3, Ge, fac, hs, &tb, &rb2);
+    }
+    if (d->frame && d->Gferr && input >= sh->lin->frame_input) {
+        /* A frame input: its column's and its rate's (Gf) truncation and
+         * rounding, the rate's at s per unit. */
+        size_t nrow = 3 * (size_t)d->np + (size_t)d->nc;
+        int c = input - sh->lin->frame_input;
+        const double *Ge[2] = {d->Gferr + (size_t)c * nrow,
+                               d->Gferr + (size_t)(c + 2) * nrow};
+        const double complex fac[2] = {1.0, s};
+        const double hs[2] = {d->hf[c], d->hf[c + 2]};
+        row_column_terms(d, w, 2, Ge, fac, hs, &tb, &rb2);
     }
     double e = tr + cabs(tb) + sqrt(ro * ro + rb2);
     if (v >= 0) {
@@ -979,10 +1006,15 @@ static int check_args(const ts_system *sys, const ts_linear *lin, int input,
                        "got %d",
                        TS_IN_ROT, TS_IN_ROT + 1, TS_IN_ROT + 2,
                        TS_NINPUT, lin->frame_input + 1, input);
-    if (lin->desc && input >= lin->frame_input)
-        return ts_fail(err, TS_EINVAL, "response: %s needs the dense "
-                       "model (linearize with TS_LIN_DENSE)",
-                       lin->input_name[input]);
+    if (lin->desc && !lin->desc->frame && input >= lin->frame_input)
+        return ts_fail(err, TS_EINVAL, "response: %s needs %s",
+                       lin->input_name[input],
+                       lin->desc->root >= 0
+                           ? "the dense model with a towing vehicle "
+                             "(linearize with TS_LIN_DENSE)"
+                           : "the sparse model's frame columns "
+                             "(linearize with frame_inputs 1) or the "
+                             "dense model (TS_LIN_DENSE)");
     if (!lin->desc && !lin->A)
         return ts_fail(err, TS_EINVAL,
                        "response: output %s needs a linear model (sparse, "

@@ -818,6 +818,33 @@ static void root_tow_rhs(tsi_shift *sh, int chan)
     }
 }
 
+/* A frame input's right-hand side (frame input c: TS_FRAME_SPEED or
+ * TS_FRAME_TURN_RATE): its column and its rate's at s, -(G_c + s
+ * G_c'), in the force and rotational rows, +(G_c + s G_c') in the
+ * controller rows (the residual's sign there, as root_tow_rhs); the
+ * points stay. */
+static void frame_rhs(tsi_shift *sh, int c)
+{
+    const ts_descriptor *d = sh->d;
+    double complex s = sh->s;
+    size_t n3 = 3 * (size_t)d->np, m = n3 + (size_t)d->nc;
+    const double *G = d->Gf + (size_t)c * m;
+    const double *Gr = d->Gf + (size_t)(c + 2) * m; /* its rate's */
+    for (int k = d->p0; k < d->np; k++)
+        for (int a = 0; a < 3; a++) {
+            size_t i = 3 * (size_t)k + (size_t)a;
+            double complex v = -(G[i] + s * Gr[i]);
+            sh->rhs[2 * XR(k, a)] = creal(v);
+            sh->rhs[2 * XR(k, a) + 1] = cimag(v);
+        }
+    for (int j = 0; j < d->nc; j++) {
+        size_t i = n3 + (size_t)j;
+        double complex v = G[i] + s * Gr[i];
+        sh->rhs[2 * XC(j)] = creal(v);
+        sh->rhs[2 * XC(j) + 1] = cimag(v);
+    }
+}
+
 void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
                      double complex *dt)
 {
@@ -831,6 +858,10 @@ void tsi_shift_input(tsi_shift *sh, int input, double complex *dr,
     if (input >= 0 && input < TS_NINPUT && d->root >= 0) {
         root_tow_rhs(sh, input);
         tow_root = input;
+        input = -1;
+    }
+    if (d->frame && input >= sh->lin->frame_input) {
+        frame_rhs(sh, input - sh->lin->frame_input);
         input = -1;
     }
     if (input >= TS_NINPUT) {
@@ -944,6 +975,15 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err)
             f[i] += G[(size_t)j * m + i];
         for (int q = 0; G && q < nc; q++)
             hc[q] += G[(size_t)j * m + n3 + (size_t)q];
+    } else if (j >= sh->lin->frame_input) {
+        /* A frame input (without a towing vehicle): the residual's own
+         * column Gf, every row. */
+        const double *G = !d->frame ? NULL : err ? d->Gferr : d->Gf;
+        size_t c = (size_t)(j - sh->lin->frame_input);
+        for (size_t i = 0; G && i < n3; i++)
+            f[i] = G[c * m + i];
+        for (int q = 0; q < nc; q++)
+            hc[q] = G ? G[c * m + n3 + (size_t)q] : 0.0;
     } else {
         /* A vehicle's input: its own rows only. */
         memset(u, 0, (size_t)d->nin * sizeof(double));

@@ -146,10 +146,12 @@ void tsi_shift_apply(tsi_shift *sh, const double *x, double *y, int err);
 
 /* With S_inf: column j of B (y-space, TS_NINPUT columns: tow
  * displacement, velocity, acceleration along x, y, z, then the same of a
- * rotation about them, which moves the tow point by e x tow.point), each
- * input alone
+ * rotation about them, which moves the tow point by e x tow.point; the
+ * vehicles' inputs; without a towing vehicle the frame inputs from
+ * ts_linear.frame_input on, the descriptor's Gf), each input alone
  * with the coordinates fixed, into col[n]; with err, its error estimate
- * (from the blocks' (D(2h) - D(h)) / 3). */
+ * (from the blocks' (D(2h) - D(h)) / 3; a frame input's with the
+ * estimate only). */
 void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err);
 
 /* The response to a unit harmonic tow-point displacement along input
@@ -158,7 +160,11 @@ void tsi_shift_apply_input(tsi_shift *sh, int j, double *col, int err);
  * tow point moves by d, with velocity s d and acceleration s^2 d; or to a
  * unit
  * harmonic vehicle input (input >= TS_NINPUT: a control surface, a loop,
- * a set point), the tow point at rest (dr_0 = 0). Writes the
+ * a set point), the tow point at rest (dr_0 = 0); or to a unit harmonic
+ * change of the mean frame's speed or turn rate (input
+ * ts_linear.frame_input + TS_FRAME_SPEED or TS_FRAME_TURN_RATE, with its
+ * rate s times it; the descriptor's Gf: without a towing vehicle), the
+ * tow point at rest in M. Writes the
  * absolute point displacements dr[3 np] (dr_0 = d; m per m; then
  * the vehicles' angles, rad per m) followed by the controller states
  * (dr[3 np + j]), and the link tensions dt[nlinks] (N per m), complex. */

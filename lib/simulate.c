@@ -1899,11 +1899,12 @@ int ts_simulate_linear(ts_kernel *k, const ts_linear *lin,
         return ts_fail(err, TS_EINVAL, "simulate (linear): linear_method "
                        "sparse needs the sparse model (linearize with model "
                        "TS_LIN_AUTO, SPARSE or BOTH)");
-    if (sparse && manoeuvre)
+    if (sparse && manoeuvre && !lin->desc->frame)
         return ts_fail(err, TS_EINVAL, "simulate (linear): a manoeuvre "
-                       "drives the frame inputs, which only the dense model "
-                       "has (linearize with model TS_LIN_DENSE or BOTH, and "
-                       "linear_method expm or ode)");
+                       "drives the frame inputs, which with a towing "
+                       "vehicle only the dense model has (linearize with "
+                       "model TS_LIN_DENSE or BOTH, and linear_method expm "
+                       "or ode)");
     ts_frame base;
     ts_kernel_get_frame(k, &base);
     if ((rc = ts_sim_check_linear_manoeuvre(k, ex, err)))
