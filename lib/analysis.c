@@ -1296,16 +1296,13 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
     }
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
-    lo.frame_inputs = input >= TS_NINPUT &&
-                      (!strcmp(o->input, "tow.speed") ||
-                       !strcmp(o->input, "tow.turn_rate"));
-    /* With a towing vehicle the frame inputs are columns of the dense B
-     * only; otherwise the sparse model has them too (its Gf, doc/linear.md
-     * section 2b). */
-    if (input >= TS_NINPUT && r->sys->tow.vehicle >= 0 &&
-        (!strcmp(o->input, "tow.speed") ||
-         !strcmp(o->input, "tow.turn_rate")) &&
-        lo.model != TS_LIN_DENSE)
+    /* A frame input: the sparse model's frame columns (its Gf,
+     * doc/linear.md section 2b), or with a towing vehicle the dense B's
+     * (the sparse model has none then). */
+    int frame = input >= TS_NINPUT && (!strcmp(o->input, "tow.speed") ||
+                                       !strcmp(o->input, "tow.turn_rate"));
+    lo.frame_inputs = frame;
+    if (frame && r->sys->tow.vehicle >= 0 && lo.model != TS_LIN_DENSE)
         lo.model = TS_LIN_DENSE;
     rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc == TS_OK)
