@@ -978,7 +978,8 @@ static int sparse_static(const ts_system *sys, const ts_linear *lin,
         for (int j = 0; j < lin->nneutral && len < size; j++)
             if (lin->neutral[j].re == 0 && lin->neutral[j].im == 0)
                 len += (size_t)snprintf(note + len, size - len, "%s%s",
-                                        n++ ? ", " : "; the modes: ",
+                                        n++ ? ", " : "; the neutral modes "
+                                                     "at 0 Hz: ",
                                         lin->neutral[j].name);
         return TS_ESINGULAR;
     }
