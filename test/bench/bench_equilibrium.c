@@ -2,12 +2,16 @@
  * residual <= 1e-10) of Kamman example 1 at 100 and 1000 links, straight
  * and in two turns (radius twice the cable length, Omega = V / (2 L), and
  * radius 0.6 L, shorter than the cable), and of example 3 (6 ft, 0.5 rad/s)
- * refined to 100 and 1000 links. Median of 9 runs, each from scratch. */
+ * refined to 100 and 1000 links. Median of 9 runs, each from scratch.
+ * Then the two-part tow with bending stiffness (examples/two_part_tow.yaml,
+ * Newton from a coarser copy, doc/equilibrium.md) at 35 and 100 links a
+ * cable: median of 3. */
 #include "bench_common.h"
 #include "towstab/equilibrium.h"
 #include "towstab/kernel.h"
+#include "towstab/scene.h"
 
-static int run(const char *label, ts_system *sys)
+static int run_reps(const char *label, ts_system *sys, int reps)
 {
     ts_kernel *k = ts_kernel_alloc(sys, NULL);
     ts_equilibrium *eq = ts_equilibrium_alloc(sys, NULL);
@@ -15,7 +19,7 @@ static int run(const char *label, ts_system *sys)
         return 1;
     double t[9];
     int conv = 1;
-    for (int r = 0; r < 9; r++) {
+    for (int r = 0; r < reps; r++) {
         ts_kernel_free(k);
         k = ts_kernel_alloc(sys, NULL);
         double t0 = bench_now();
@@ -24,12 +28,17 @@ static int run(const char *label, ts_system *sys)
         conv &= rc == TS_OK && eq->converged;
     }
     printf("%-34s %6d %10.3f %9.2e %6d %6ld %s\n", label, sys->nlinks,
-           bench_median(t, 9) * 1e3, eq->residual, eq->iterations,
+           bench_median(t, reps) * 1e3, eq->residual, eq->iterations,
            eq->evaluations, conv ? ts_eq_method_name(eq->method)
                                  : "NOT CONVERGED");
     ts_equilibrium_free(eq);
     ts_kernel_free(k);
     return conv ? 0 : 1;
+}
+
+static int run(const char *label, ts_system *sys)
+{
+    return run_reps(label, sys, 9);
 }
 
 /* Kamman example 3: 6 ft of 0.163 in cable, 0.008979 lbf/ft, 2 in sphere
@@ -69,5 +78,21 @@ int main(void)
         bad |= run("ex3 turn 0.5 rad/s", s);
         ts_system_free(s);
     }
+    ts_err err = {0};
+    ts_units *u = ts_units_alloc(&err);
+    ts_scene *sc = u ? ts_scene_load("examples/two_part_tow.yaml", u, &err)
+                     : NULL;
+    static const int per_cable[] = {35, 100};
+    for (int i = 0; sc && i < 2; i++) {
+        if (ts_system_set_links(sc->system, per_cable[i], &err) != TS_OK)
+            break;
+        bad |= run_reps("two-part tow, bending", sc->system, 3);
+    }
+    if (!sc || err.code) {
+        printf("two-part tow: %s\n", err.msg);
+        bad = 1;
+    }
+    ts_scene_free(sc);
+    ts_units_free(u);
     return bad;
 }
