@@ -305,9 +305,9 @@ int ts_compare_histories(const ts_system *sys, const ts_linear *lin,
         if (col >= 0)
             rc = ts_response_compute(sys, lin, col, out, &f1, 1, &res, err);
         /* A model singular at 0 Hz (an undamped neutral mode), or one
-         * whose response to this input is not formed (a turn rate needs
-         * the dense model), has no static gain here, but the runs still
-         * have their final values. */
+         * whose response to this input is not formed (the frame inputs'
+         * columns not asked for), has no static gain here, but the runs
+         * still have their final values. */
         if (col >= 0 && (rc == TS_ESINGULAR || rc == TS_EINVAL)) {
             c->step = 1;
             snprintf(c->static_note, sizeof c->static_note, "%s: %.200s",
