@@ -1009,12 +1009,10 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     if (m->free_vehicle && m->eigen.method == TS_EIG_ARPACK)
         return ts_fail(err, TS_EINVAL, "free_vehicle: needs every coupled "
                        "mode with its shape: eigen_method lapack or auto");
-    /* LAPACK needs the dense A at any size; the modes no input column of
-     * the sparse model's own (the frame inputs'). */
+    /* LAPACK needs the dense A at any size. */
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
         lo.model = TS_LIN_BOTH;
-    lo.frame_inputs = 0;
     int rc = equilibrium_then_linear(r, rq, &lo, err);
     if (rc != TS_OK)
         return rc;
@@ -1197,7 +1195,6 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     snprintf(r->rao_file, sizeof r->rao_file, "%s", o->sea.rao_file);
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
-    lo.frame_inputs = 0; /* the tow inputs drive a sea state */
     rc = equilibrium_then_linear(r, rq, &lo, err);
     /* A towing vehicle's speed is solved: the waves meet it at that one
      * (the encounter frequency), not at the scene's starting value. */

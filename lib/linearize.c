@@ -62,7 +62,7 @@ void ts_linearize_opts_default(ts_linearize_opts *o)
     o->tensions = 0;
     o->model = TS_LIN_AUTO;
     o->dense_max_states = 1200;
-    o->frame_inputs = 1;
+    o->frame_inputs = 0;
 }
 
 ts_linear *ts_linear_alloc(const ts_kernel *k, ts_err *err)

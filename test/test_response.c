@@ -331,7 +331,7 @@ static void test_frame_sparse(void)
               "at most %.2g of the gains not zero by symmetry)", sidx ? "in the turn" :
               "straight", n, worst, rel);
         /* Without the frame columns (ts_linearize_opts.frame_inputs 0,
-         * as the modes ask): 4 groups fewer, and tow.speed refused. */
+         * the default): 4 groups fewer, and tow.speed refused. */
         ts_linear *ln = linearize_at(sys, TS_LIN_SPARSE, 0.0, 0, NULL);
         int in = -1;
         ts_output out;

@@ -383,6 +383,7 @@ static void lin_case_open(lin_case *c, const char *text, const char *output)
     c->lin = ts_linear_alloc(c->k, &err);
     ts_linearize_opts lo;
     ts_linearize_opts_default(&lo);
+    lo.frame_inputs = 1; /* the manoeuvres' on the sparse model (6b) */
     if (!rc)
         rc = ts_linearize_equilibrium(c->k, c->eq, &lo, c->lin, &err);
     if (!rc)

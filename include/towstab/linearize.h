@@ -269,13 +269,13 @@ typedef struct ts_linearize_opts {
     ts_lin_model model;/* default TS_LIN_AUTO */
     int dense_max_states; /* TS_LIN_AUTO forms the dense model below this
                           many states; default 1200 (300 rigid links) */
-    int frame_inputs;  /* 1 (default): the sparse model has the frame
-                          inputs' columns too (tow.speed, tow.turn_rate
-                          and their rates; 4 perturbation groups more, 2
-                          or 4 residual evaluations each); 0: not (the
-                          modes need no input; a frame input's response
-                          or a manoeuvre then needs the dense model).
-                          Never with a towing vehicle */
+    int frame_inputs;  /* 1: the sparse model has the frame inputs'
+                          columns too (tow.speed, tow.turn_rate and their
+                          rates; 4 perturbation groups more, 2 or 4
+                          residual evaluations each), for a response to
+                          them or a manoeuvre; 0 (default): not (a frame
+                          input's response or a manoeuvre then needs the
+                          dense model). Never with a towing vehicle */
 } ts_linearize_opts;
 
 TS_API void ts_linearize_opts_default(ts_linearize_opts *o);
