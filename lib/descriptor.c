@@ -599,7 +599,9 @@ double tsi_frame_input_scale(const ts_system *sys, const ts_frame *fr, int c)
     double g = sys->env.gravity > 0 ? sys->env.gravity : 1.0;
     double V = fabs(fr->speed);
     double l0 = sys->nlinks > 0 ? sys->links[0].length : 1.0;
-    double reach = tsi_reach(sys);
+    double reach = ts_system_reach(sys);
+    if (!(reach > 0))
+        reach = 1.0;
     switch (c) {
     case TS_FRAME_SPEED: return sqrt(g * l0) + V;           /* m/s */
     case TS_FRAME_TURN_RATE: return (sqrt(g * l0) + V) / reach; /* rad/s */
@@ -608,15 +610,6 @@ double tsi_frame_input_scale(const ts_system *sys, const ts_frame *fr, int c)
     }
 }
 
-double tsi_reach(const ts_system *sys)
-{
-    double reach = sqrt(sys->tow.point[0] * sys->tow.point[0] +
-                        sys->tow.point[1] * sys->tow.point[1] +
-                        sys->tow.point[2] * sys->tow.point[2]);
-    for (int l = 0; l < sys->nlinks; l++)
-        reach += sys->links[l].length;
-    return reach > 0 ? reach : 1.0;
-}
 
 /* The step rel * scale, rounded so that x + h is exact (then
  * (x + h) - x == h). */

@@ -387,14 +387,10 @@ void tsi_desc_cut_free(ts_descriptor *cut);
 void tsi_desc_block_mul(const ts_descriptor *d, const double *B,
                         const double x[], double y[], int acc);
 
-/* The system's reach, m: the tow point's distance from M's origin plus
- * every link's length (1 m for none). A rotation theta moves a point
- * by at most theta times it. */
-double tsi_reach(const ts_system *sys);
-
 /* The size of frame input c (TS_FRAME_*) whose change moves velocities
  * and accelerations as much as the tow point's do: the speed sqrt(g l)
- * + |V| (l the first link's length), the turn rate that over the reach,
+ * + |V| (l the first link's length), the turn rate that over the reach
+ * (ts_system_reach; 1 m for none),
  * the speed rate g, the turn acceleration g over the reach. The dense
  * and the sparse models step the frame inputs by rel_step times it. */
 double tsi_frame_input_scale(const ts_system *sys, const ts_frame *fr, int c);

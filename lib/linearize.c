@@ -502,7 +502,9 @@ static double column_scale(const ts_system *sys, const ts_frame *fr, int j,
     double V = fabs(fr->speed);
     double l0 = sys->nlinks > 0 ? sys->links[0].length : 1.0;
     int c = j - n;
-    double reach = tsi_reach(sys);
+    double reach = ts_system_reach(sys);
+    if (!(reach > 0))
+        reach = 1.0;
     if (c < TS_IN_VEL)
         return l0;
     if (c < TS_IN_ACC)

@@ -1021,14 +1021,17 @@ static inline double left_start_entry(int i)
     return 1.0 + (double)(i % 7) / 7.0;
 }
 
-static void left_start(double complex *w, int nx)
+/* The left vector's first iterate w = S^-T b, b the start above, with
+ * sh's factors. */
+static void left_first(tsi_shift *sh, double complex *w, int nx)
 {
     for (int i = 0; i < nx; i++)
         w[i] = left_start_entry(i);
+    tsi_shift_tsolve(sh, w);
 }
 
-/* The componentwise backward error of w = S^-T b for b = left_start's
- * (Oettli and Prager: max_j |S^T w - b|_j / (|S|^T |w| + |b|)_j, S the
+/* The componentwise backward error of w = S^-T b, b the start
+ * (left_start_entry) (Oettli and Prager: max_j |S^T w - b|_j / (|S|^T |w| + |b|)_j, S the
  * matrix sh factored, in sh->Sx): how far S must move, entry by entry,
  * for w to solve it exactly. The moduli as |Re| + |Im| (within a factor
  * sqrt 2 of them, and no hypot per entry). O(nnz). */
@@ -1142,15 +1145,12 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
         if (rc != TS_OK)
             continue;
         double complex *w0 = (double complex *)sh->ework;
-        left_start(w0, nx);
-        tsi_shift_tsolve(sh, w0);
+        left_first(sh, w0, nx);
         if (fresh || left_backward(sh, w0) <= SHIFT_NEAR_BACKWARD)
             break;
         rc = afresh(sh, sh->is_complex, NULL);
-        if (rc == TS_OK) {
-            left_start(w0, nx);
-            tsi_shift_tsolve(sh, w0);
-        }
+        if (rc == TS_OK)
+            left_first(sh, w0, nx);
     }
     if (rc == TS_ENOMEM)
         return ts_fail(err, rc, "eigen: out of memory for the error "

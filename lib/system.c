@@ -370,14 +370,21 @@ static void part_cause(const ts_system *sys, const load_worst *w, char *buf,
                  B->diameter, w->body, B->name);
 }
 
+double ts_system_reach(const ts_system *sys)
+{
+    const double *p = sys->tow.point;
+    double R = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int k = 0; k < sys->ncables; k++)
+        R += sys->cables[k].length;
+    return R;
+}
+
 int ts_system_check_loads(const ts_system *sys, const ts_motion_bound *m,
                           ts_err *err)
 {
     const double rho = sys->env.water_density, g = fabs(sys->env.gravity);
-    const double *c = sys->env.current, *p = sys->tow.point;
-    double R = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    for (int k = 0; k < sys->ncables; k++)
-        R += sys->cables[k].length;
+    const double *c = sys->env.current;
+    double R = ts_system_reach(sys);
     double current = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     /* The flow speed bound and what makes it up, largest named. */
     /* A tow rotation moves a point at R by its rate times R. */

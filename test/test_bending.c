@@ -36,8 +36,9 @@
  *     (inf-norm) of its Jacobian: against the one computed here from a
  *     central-difference Jacobian at the solution and its explicit
  *     inverse (GSL), on the two-part tow at 105 links (whose plain
- *     1-norm condition, 3.6e13, was 500 times larger: the rows, link
- *     accelerations, differ by orders in scale) and on a plain cable.
+ *     1-norm condition, 3.6e13, is 500 times larger: the rows, link
+ *     accelerations, differ by orders in scale), at its own 35 and on a
+ *     plain cable; the plain condition printed beside it.
  * Tolerances are stated at each check with their reason. */
 #include "towstab/equilibrium.h"
 #include "towstab/kernel.h"
@@ -664,7 +665,8 @@ static void coarse_case(const ts_units *u, const char *path, int links)
  * towing vehicle: the unknowns are q), from central differences with
  * the solver's steps (1e-6 of 1 rad, of 1e-3 for a strain) and the
  * explicit inverse; NaN when it cannot be formed. O(nq^3). */
-static double skeel_here(ts_kernel *k, const ts_equilibrium *eq)
+static double skeel_here(ts_kernel *k, const ts_equilibrium *eq,
+                         double *plain)
 {
     const ts_system *sys = ts_kernel_system(k);
     int nq = ts_kernel_nq(k), n = ts_kernel_nstate(k);
@@ -698,16 +700,31 @@ static double skeel_here(ts_kernel *k, const ts_equilibrium *eq)
             gsl_matrix_set(J, (size_t)i, (size_t)j,
                            (f1[nq + i] - f2[nq + i]) / (2 * h));
     }
-    /* |J| e, then || |J^-1| |J| e ||_inf. */
+    /* |J| e, then || |J^-1| |J| e ||_inf; and the plain 1-norm
+     * condition ||J||_1 ||J^-1||_1 (what Newton reported before), into
+     * *plain. */
+    double n1 = 0;
     for (int i = 0; i < nq; i++) {
         f1[i] = 0;
-        for (int j = 0; j < nq; j++)
+        double colsum = 0;
+        for (int j = 0; j < nq; j++) {
             f1[i] += fabs(gsl_matrix_get(J, (size_t)i, (size_t)j));
+            colsum += fabs(gsl_matrix_get(J, (size_t)j, (size_t)i));
+        }
+        n1 = fmax(n1, colsum);
     }
     int sg;
     if (gsl_linalg_LU_decomp(J, p, &sg) != 0 ||
         gsl_linalg_LU_invert(J, p, Ji) != 0)
         goto out;
+    double ni1 = 0;
+    for (int j = 0; j < nq; j++) {
+        double colsum = 0;
+        for (int i = 0; i < nq; i++)
+            colsum += fabs(gsl_matrix_get(Ji, (size_t)i, (size_t)j));
+        ni1 = fmax(ni1, colsum);
+    }
+    *plain = n1 * ni1;
     cond = 0;
     for (int i = 0; i < nq; i++) {
         double r = 0;
@@ -736,7 +753,10 @@ static void condition_case(const ts_units *u, const char *path, int links)
         return;
     tscene_solved s;
     int rc = tscene_solve(sc->system, &s, TS_EQ_NEWTON);
-    double here = rc == TS_OK ? skeel_here(s.k, s.eq) : NAN;
+    double plain = NAN;
+    double here = rc == TS_OK ? skeel_here(s.k, s.eq, &plain) : NAN;
+    printf("     %s, %d links: Skeel condition %.3g here, the plain 1-norm "
+           "condition %.3g\n", path, sc->system->nlinks, here, plain);
     /* dlacn2 estimates from below and is usually exact; the solver's
      * Jacobian is the last iteration's, a step from the solution, and
      * rounding in either moves an ill-conditioned one's condition by a
@@ -759,6 +779,7 @@ static void test_scenes(void)
     coarse_case(u, "examples/two_part_tow.yaml", 35);
     coarse_case(u, "examples/two_part_tow_vehicle.yaml", 22);
     condition_case(u, "examples/two_part_tow.yaml", 35);
+    condition_case(u, "examples/two_part_tow.yaml", 0);
     condition_case(u, "examples/kamman_ex1_submerged.yaml", 0);
     ts_units_free(u);
 }

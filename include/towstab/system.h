@@ -239,6 +239,11 @@ TS_API double ts_cable_wet_weight(const ts_system *sys, int c);
  * 1e308) beyond it. Real towed systems stay below 1e9 N. */
 #define TS_LOAD_MAX 1e150
 
+/* The system's reach, m: the tow point's distance from the origin of M
+ * plus the length of every cable. A rotation theta about the origin
+ * moves no point by more than theta times it. */
+TS_API double ts_system_reach(const ts_system *sys);
+
 /* Bounds of the motion over an analysis (all >= 0; NaN or inf where an
  * input is). */
 typedef struct ts_motion_bound {
