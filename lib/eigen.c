@@ -16,7 +16,9 @@
  * eigenvalues lambda nearest sigma. Real sigma: dnaupd/dneupd, mode 3;
  * complex sigma: znaupd/zneupd, mode 3 in complex arithmetic. OP is applied
  * with the sparse model (lib/shift.h: one KLU factorisation of the shifted
- * node equations, O(nlinks) per application). ARPACK's Ritz vectors are
+ * node equations, O(nlinks) per application). The Ritz values come from
+ * dneupd/zneupd, their vectors from the Arnoldi factorisation ARPACK
+ * leaves (ritz_vectors_real: one dgemm). ARPACK's Ritz vectors are
  * checked by their residual ||A v - lambda v||, A applied through the
  * same model.
  *
@@ -975,13 +977,192 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
     return rc;
 }
 
+/* The Ritz vectors of the nconv Ritz values dr + i di that dneupd
+ * returned without vectors (rvec 0: lambda = sigma + 1/mu, mu a Ritz value
+ * of OP), from the Arnoldi factorisation OP V = V H + f e^T that dnaupd
+ * leaves: V [n x ncv], H [ncv x ncv] (hc, a copy taken before dneupd,
+ * which zeroes its entry (3, 1), where dnaupd keeps ||f||), f in resid.
+ * Each vector is x = V y with H y = mu y (dgeev on H; mu matched one to
+ * one to the nearest of H's eigenvalues), |y| = 1, purified by one step
+ * of inverse iteration as dneupd does it, x + f y_ncv / mu = OP x / mu.
+ * A real eigenvalue's vector fills one column of z [n x nconv], a pair's
+ * (di > 0 first, as dneupd orders them) two, its real and imaginary parts.
+ * One dgemm (BLAS 3, one pass over V) in place of dneupd's nconv
+ * Householder reflections applied to V one after another (dorm2r, each a
+ * pass over V): 0.12-0.14 s of the modes' run at 10 000 links, where this
+ * takes a few ms. TS_ELAPACK when a Ritz value is not among H's
+ * eigenvalues (the caller then asks dneupd for the vectors). */
+static int ritz_vectors_real(const tsi_lapack *la, int n, int ncv, int nconv,
+                             double sigma, const double *dr,
+                             const double *di, double *hc,
+                             const double *v, const double *f, double *z)
+{
+    int lwork = 4 * ncv, info = 0, one = 1, rc = TS_OK;
+    double *wr = malloc((size_t)ncv * (7 + (size_t)2 * ncv) * sizeof(double));
+    int *used = calloc((size_t)ncv, sizeof(int));
+    if (!wr || !used) {
+        free(wr);
+        free(used);
+        return TS_ENOMEM;
+    }
+    double *wi = wr + ncv, *work = wi + ncv, *vr = work + lwork,
+           *y = vr + (size_t)ncv * ncv, *c = y + (size_t)ncv * ncv;
+    la->dgeev_("N", "V", &ncv, hc, &ncv, wr, wi, NULL, &one, vr, &ncv, work,
+               &lwork, &info, 1, 1);
+    if (info != 0)
+        rc = TS_ELAPACK;
+    double big = 0;
+    for (int k = 0; k < ncv; k++)
+        big = fmax(big, hypot(wr[k], wi[k]));
+    for (int j = 0; rc == TS_OK && j < nconv; j++) {
+        double complex lam = dr[j] + I * di[j];
+        int pair = di[j] != 0.0;
+        if (pair && j + 1 >= nconv) {
+            rc = TS_ELAPACK; /* a pair's second value missing */
+            break;
+        }
+        double complex mu = 1.0 / (lam - sigma);
+        int best = -1;
+        double dist = INFINITY;
+        for (int k = 0; k < ncv; k++) {
+            double d = cabs(wr[k] + I * wi[k] - mu);
+            if (!used[k] && (wi[k] != 0.0) == pair && d < dist) {
+                best = k;
+                dist = d;
+            }
+        }
+        if (best < 0 || !(dist <= 1e-8 * big)) {
+            rc = TS_ELAPACK;
+            break;
+        }
+        used[best] = 1;
+        /* dgeev's pair: k (wi > 0) then k + 1, vectors vr_k +- i vr_(k+1)
+         * in that order. */
+        int k = best, sign = 1;
+        if (pair) {
+            if (wi[k] < 0.0) {
+                k--;
+                sign = -1;
+            }
+            used[k] = used[k + 1] = 1;
+        }
+        double *yr = y + (size_t)j * ncv, *yi = pair ? yr + ncv : NULL;
+        double s = 0;
+        for (int i = 0; i < ncv; i++) {
+            yr[i] = vr[(size_t)k * ncv + i];
+            s += yr[i] * yr[i];
+            if (pair) {
+                yi[i] = sign * vr[(size_t)(k + 1) * ncv + i];
+                s += yi[i] * yi[i];
+            }
+        }
+        s = s > 0 ? 1.0 / sqrt(s) : 0.0;
+        for (int i = 0; i < ncv; i++) {
+            yr[i] *= s;
+            if (pair)
+                yi[i] *= s;
+        }
+        double complex p = (yr[ncv - 1] + I * (pair ? yi[ncv - 1] : 0.0)) / mu;
+        c[j] = creal(p);
+        if (pair) {
+            c[j + 1] = cimag(p);
+            j++;
+        }
+    }
+    if (rc == TS_OK) {
+        double a1 = 1.0, b0 = 0.0;
+        la->dgemm_("N", "N", &n, &nconv, &ncv, &a1, v, &n, y, &ncv, &b0, z,
+                   &n, 1, 1);
+        for (int j = 0; j < nconv; j++) {
+            double *zj = z + (size_t)j * n;
+            for (int i = 0; i < n; i++)
+                zj[i] += c[j] * f[i];
+        }
+    }
+    free(wr);
+    free(used);
+    return rc;
+}
+
+/* ritz_vectors_real for a complex run (znaupd, zneupd without vectors):
+ * the nconv Ritz values d, each its own vector x = V y, H y = mu y (zgeev),
+ * purified as zneupd does it, into the columns of z [n x nconv]. */
+static int ritz_vectors_complex(const tsi_lapack *la, int n, int ncv,
+                                int nconv, double complex sigma,
+                                const double complex *d, double complex *hc,
+                                const double complex *v,
+                                const double complex *f, double complex *z)
+{
+    int lwork = 4 * ncv, info = 0, one = 1, rc = TS_OK;
+    double complex *w = malloc((size_t)ncv * (6 + (size_t)2 * ncv) *
+                               sizeof(double complex));
+    double *rwork = malloc(2 * (size_t)ncv * sizeof(double));
+    int *used = calloc((size_t)ncv, sizeof(int));
+    if (!w || !rwork || !used) {
+        free(w);
+        free(rwork);
+        free(used);
+        return TS_ENOMEM;
+    }
+    double complex *work = w + ncv, *vr = work + lwork,
+                   *y = vr + (size_t)ncv * ncv, *c = y + (size_t)ncv * ncv;
+    la->zgeev_("N", "V", &ncv, hc, &ncv, w, NULL, &one, vr, &ncv, work,
+               &lwork, rwork, &info, 1, 1);
+    if (info != 0)
+        rc = TS_ELAPACK;
+    double big = 0;
+    for (int k = 0; k < ncv; k++)
+        big = fmax(big, cabs(w[k]));
+    for (int j = 0; rc == TS_OK && j < nconv; j++) {
+        double complex mu = 1.0 / (d[j] - sigma);
+        int best = -1;
+        double dist = INFINITY;
+        for (int k = 0; k < ncv; k++)
+            if (!used[k] && cabs(w[k] - mu) < dist) {
+                best = k;
+                dist = cabs(w[k] - mu);
+            }
+        if (best < 0 || !(dist <= 1e-8 * big)) {
+            rc = TS_ELAPACK;
+            break;
+        }
+        used[best] = 1;
+        double complex *yj = y + (size_t)j * ncv;
+        double s = 0;
+        for (int i = 0; i < ncv; i++) {
+            yj[i] = vr[(size_t)best * ncv + i];
+            s += creal(yj[i]) * creal(yj[i]) + cimag(yj[i]) * cimag(yj[i]);
+        }
+        s = s > 0 ? 1.0 / sqrt(s) : 0.0;
+        for (int i = 0; i < ncv; i++)
+            yj[i] *= s;
+        c[j] = yj[ncv - 1] / mu;
+    }
+    if (rc == TS_OK) {
+        double complex a1 = 1.0, b0 = 0.0;
+        la->zgemm_("N", "N", &n, &nconv, &ncv, &a1, v, &n, y, &ncv, &b0, z,
+                   &n, 1, 1);
+        for (int j = 0; j < nconv; j++) {
+            double complex *zj = z + (size_t)j * n;
+            for (int i = 0; i < n; i++)
+                zj[i] += c[j] * f[i];
+        }
+    }
+    free(w);
+    free(rwork);
+    free(used);
+    return rc;
+}
+
 static int solve_arpack_real_run(const ts_linear *lin,
                                  const ts_eigen_opts *o, double sigma,
                                  ts_eigen *e, cand_list *L, ts_err *err)
 {
     int n = lin->nstate, nev, ncv, rc;
     tsi_arpack ar;
-    if (tsi_arpack_open(&ar, err) != TS_OK)
+    tsi_lapack la;
+    if (tsi_arpack_open(&ar, err) != TS_OK ||
+        tsi_lapack_open(&la, err) != TS_OK)
         return TS_EIO;
     if ((rc = arpack_sizes(n, o->count, &nev, &ncv, err)) != TS_OK)
         return rc;
@@ -998,9 +1179,10 @@ static int solve_arpack_real_run(const ts_linear *lin,
     double *di = malloc((size_t)(nev + 1) * sizeof(double));
     double *z = malloc((size_t)n * (size_t)(nev + 1) * sizeof(double));
     double *workev = malloc(3 * (size_t)ncv * sizeof(double));
+    double *hc = malloc((size_t)ncv * ncv * sizeof(double));
     int *select = calloc((size_t)ncv, sizeof(int));
     if (!resid || !v || !workd || !workl || !dr || !di || !z || !workev ||
-        !select) {
+        !hc || !select) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
@@ -1036,14 +1218,31 @@ static int solve_arpack_real_run(const ts_linear *lin,
                      info, arpack_info_text(info));
         goto out;
     }
-    int rvec = 1;
-    ar.dneupd_(&rvec, "A", select, dr, di, z, &n, &sigma, &sigmai, workev, "I",
-               &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam, ipntr, workd,
-               workl, &lworkl, &info, 1, 1, 2);
-    if (info != 0) {
-        rc = ts_fail(err, TS_ELAPACK, "eigen: ARPACK dneupd info %d (%s)",
-                     info, arpack_info_text(info));
-        goto out;
+    /* The Ritz values from dneupd, their vectors from H and V
+     * (ritz_vectors_real); dneupd's own vectors should H not hold one of
+     * its values. */
+    double *h = workl + ipntr[4] - 1, rnorm = h[2];
+    memcpy(hc, h, (size_t)ncv * ncv * sizeof(double));
+    hc[2] = 0.0;
+    int rvec = 0, vrc = TS_ELAPACK;
+    for (int pass = 0; pass < 2 && vrc == TS_ELAPACK; pass++, rvec = 1) {
+        h[2] = rnorm;
+        ar.dneupd_(&rvec, "A", select, dr, di, z, &n, &sigma, &sigmai, workev,
+                   "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
+                   ipntr, workd, workl, &lworkl, &info, 1, 1, 2);
+        if (info != 0) {
+            rc = ts_fail(err, TS_ELAPACK,
+                         "eigen: ARPACK dneupd info %d (%s)", info,
+                         arpack_info_text(info));
+            goto out;
+        }
+        vrc = rvec ? TS_OK
+                   : ritz_vectors_real(&la, n, ncv, iparam[4], sigma, dr, di,
+                                       hc, v, resid, z);
+        if (vrc == TS_ENOMEM) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
+            goto out;
+        }
     }
     int nconv = iparam[4];
     if (cand_init(L, nconv + 1, n) != TS_OK) {
@@ -1072,6 +1271,7 @@ out:
     free(di);
     free(z);
     free(workev);
+    free(hc);
     free(select);
     return rc;
 }
@@ -1116,7 +1316,9 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
 {
     int n = lin->nstate, rc;
     tsi_arpack ar;
-    if (tsi_arpack_open(&ar, err) != TS_OK)
+    tsi_lapack la;
+    if (tsi_arpack_open(&ar, err) != TS_OK ||
+        tsi_lapack_open(&la, err) != TS_OK)
         return TS_EIO;
     tsi_shift sh;
     if ((rc = tsi_shift_factor(&sh, lin, sigma, err)) != TS_OK)
@@ -1131,10 +1333,11 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
     double complex *z = malloc((size_t)n * (size_t)(nev + 1) * szc);
     double complex *workev = malloc(2 * (size_t)ncv * szc);
     double *rwork = malloc((size_t)ncv * sizeof(double));
+    double complex *hc = malloc((size_t)ncv * ncv * szc);
     int *select = calloc((size_t)ncv, sizeof(int));
     int *used = calloc((size_t)(nev + 1), sizeof(int));
     if (!resid || !v || !workd || !workl || !d || !z || !workev || !rwork ||
-        !select || !used) {
+        !hc || !select || !used) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
@@ -1176,14 +1379,30 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
                      info, arpack_info_text(info));
         goto out;
     }
-    int rvec = 1;
-    ar.zneupd_(&rvec, "A", select, d, z, &n, &sigma, workev, "I", &n, "LM",
-               &nev, &tol, resid, &ncv, v, &n, iparam, ipntr, workd, workl,
-               &lworkl, rwork, &info, 1, 1, 2);
-    if (info != 0) {
-        rc = ts_fail(err, TS_ELAPACK, "eigen: ARPACK zneupd info %d (%s)",
-                     info, arpack_info_text(info));
-        goto out;
+    /* As in solve_arpack_real_run: the values from zneupd, the vectors
+     * from H and V (ritz_vectors_complex), zneupd's own as the fallback. */
+    double complex *h = workl + ipntr[4] - 1, rnorm = h[2];
+    memcpy(hc, h, (size_t)ncv * ncv * sizeof(double complex));
+    hc[2] = 0.0;
+    int rvec = 0, vrc = TS_ELAPACK;
+    for (int pass = 0; pass < 2 && vrc == TS_ELAPACK; pass++, rvec = 1) {
+        h[2] = rnorm;
+        ar.zneupd_(&rvec, "A", select, d, z, &n, &sigma, workev, "I", &n,
+                   "LM", &nev, &tol, resid, &ncv, v, &n, iparam, ipntr,
+                   workd, workl, &lworkl, rwork, &info, 1, 1, 2);
+        if (info != 0) {
+            rc = ts_fail(err, TS_ELAPACK,
+                         "eigen: ARPACK zneupd info %d (%s)", info,
+                         arpack_info_text(info));
+            goto out;
+        }
+        vrc = rvec ? TS_OK
+                   : ritz_vectors_complex(&la, n, ncv, iparam[4], sigma, d,
+                                          hc, v, resid, z);
+        if (vrc == TS_ENOMEM) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
+            goto out;
+        }
     }
     int nconv = iparam[4];
     if (cand_grow(L, nconv) != TS_OK) {
@@ -1222,6 +1441,7 @@ out:
     free(z);
     free(workev);
     free(rwork);
+    free(hc);
     free(select);
     free(used);
     return rc;

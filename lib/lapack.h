@@ -34,6 +34,11 @@ void dgeevx_(const char *balanc, const char *jobvl, const char *jobvr,
              double *abnrm, double *rconde, double *rcondv, double *work,
              const int *lwork, int *iwork, int *info, size_t balanc_len,
              size_t jobvl_len, size_t jobvr_len, size_t sense_len);
+void zgeev_(const char *jobvl, const char *jobvr, const int *n,
+            double complex *a, const int *lda, double complex *w,
+            double complex *vl, const int *ldvl, double complex *vr,
+            const int *ldvr, double complex *work, const int *lwork,
+            double *rwork, int *info, size_t jobvl_len, size_t jobvr_len);
 void zgesv_(const int *n, const int *nrhs, double complex *a, const int *lda,
             int *ipiv, double complex *b, const int *ldb, int *info);
 void zgecon_(const char *norm, const int *n, const double complex *a,
@@ -55,5 +60,10 @@ void dgemm_(const char *transa, const char *transb, const int *m,
             const int *lda, const double *b, const int *ldb,
             const double *beta, double *c, const int *ldc, size_t transa_len,
             size_t transb_len);
+void zgemm_(const char *transa, const char *transb, const int *m,
+            const int *n, const int *k, const double complex *alpha,
+            const double complex *a, const int *lda, const double complex *b,
+            const int *ldb, const double complex *beta, double complex *c,
+            const int *ldc, size_t transa_len, size_t transb_len);
 
 #endif

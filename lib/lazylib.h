@@ -50,7 +50,8 @@
  * is both), and dlsym looks in a library's dependencies too. */
 #define TSI_LAPACK_FUNCS(X)                                                 \
     X(dgesv_) X(dgecon_) X(dlange_) X(dgetrf_) X(dgetrs_) X(dgeevx_)        \
-    X(dlacn2_) X(zgetrf_) X(zgetrs_) X(dgemv_) X(dgemm_)
+    X(dgeev_) X(dlacn2_) X(zgetrf_) X(zgetrs_) X(dgemv_) X(dgemm_)         \
+    X(zgeev_) X(zgemm_)
 #define TSI_ARPACK_FUNCS(X) X(dnaupd_) X(dneupd_) X(znaupd_) X(zneupd_)
 #define TSI_KLU_FUNCS(X)                                                    \
     X(klu_defaults) X(klu_analyze) X(klu_free_symbolic) X(klu_factor)       \

@@ -4,9 +4,11 @@
  * (sigma = 0: the modes of smallest |lambda|) and a complex shift (the 10
  * modes nearest 2 Hz). Two independent linearizations and two independent
  * eigensolvers must agree within the sum of their error bounds in every
- * shared eigenvalue, and ARPACK's Ritz vectors must have residuals below
- * 1e-9 of |lambda|. Kept apart from test_eigen for its run time (dense
- * 2000 x 2000 dgeevx). */
+ * shared eigenvalue, ARPACK's Ritz vectors must have residuals below
+ * 1e-6 of |lambda|, and each must lie within the two methods' vector
+ * error allowances of LAPACK's eigenvector (the angle between them; at
+ * the real shift within VECTOR_SLACK of them, below). Kept apart from
+ * test_eigen for its run time (dense 2000 x 2000 dgeevx). */
 #include "towstab/eigen.h"
 
 #include <math.h>
@@ -16,6 +18,15 @@
 #include "tcheck.h"
 #include "towstab/equilibrium.h"
 #include "towstab/scene.h"
+
+/* The slack of the vector comparison at the real shift: the dense
+ * model's first-order vector allowance, summed over the 8 nearest
+ * eigenvalues (towstab/eigen.h, vector_error), falls short of the angle
+ * between the two methods' vectors by up to 3.4 times on the slowest
+ * real modes here (5.4e-7 rad against 1.8e-7, the sparse side's
+ * allowance 2.5e-9): the allowance is an estimate there, not a bound.
+ * A wrong Ritz vector would be off by order 1. */
+#define VECTOR_SLACK 10.0
 
 static const char *yaml =
     "name: long\n"
@@ -55,7 +66,7 @@ int main(void)
     ts_eigen_opts o;
     ts_eigen_opts_default(&o);
     o.method = TS_EIG_LAPACK;
-    o.vectors = 0;
+    o.vectors = 1;
     ts_eigen *all = NULL;
     rc = ts_eigen_solve(lin, &o, &all, &err);
     CHECK(rc == TS_OK && all->complete, "500 links: lapack, all %d "
@@ -67,12 +78,11 @@ int main(void)
         o.count = 10;
         o.target_hz = target;
         o.method = TS_EIG_ARPACK;
-        o.vectors = 1;
         rc = ts_eigen_solve(lin, &o, &ar, &err);
-        o.vectors = 0;
         /* LAPACK's 10 modes nearest i 2 pi target, by frequency (the same
          * selection ts_eigen_solve makes; done here on the full set). */
         ts_mode lpm[10];
+        int lpi[10];
         int taken[2000] = {0};
         for (int s = 0; s < 10; s++) {
             int best = -1;
@@ -88,17 +98,36 @@ int main(void)
             taken[best] = 1;
         }
         for (int m = 0, s = 0; m < all->nmodes; m++)
-            if (taken[m])
+            if (taken[m]) {
+                lpi[s] = m;
                 lpm[s++] = all->modes[m];
+            }
         CHECK(rc == TS_OK && ar->nmodes == 10,
               "arpack, target %g Hz: 10 modes, %d restarts, %d solves (%s)",
               target, ar ? ar->arpack_iterations : 0,
               ar ? ar->arpack_ops : 0, err.msg);
-        double worst = 0, resid = 0;
+        double worst = 0, resid = 0, vworst = 0;
+        int n = lin->nstate;
         for (int m = 0; rc == TS_OK && m < 10; m++) {
             const ts_mode *a = &ar->modes[m], *b = &lpm[m];
             double d = hypot(a->re - b->re, a->im - b->im) /
                        (a->error_bound + b->error_bound);
+            /* The sine of the angle between the two unit vectors. */
+            const double *ar_ = ar->vec_re + (size_t)m * n,
+                         *ai_ = ar->vec_im + (size_t)m * n,
+                         *br_ = all->vec_re + (size_t)lpi[m] * n,
+                         *bi_ = all->vec_im + (size_t)lpi[m] * n;
+            double pr = 0, pi = 0;
+            for (int i = 0; i < n; i++) {
+                pr += ar_[i] * br_[i] + ai_[i] * bi_[i];
+                pi += ar_[i] * bi_[i] - ai_[i] * br_[i];
+            }
+            double sine = sqrt(fmax(0.0, 1.0 - (pr * pr + pi * pi)));
+            double vallow = a->vector_error + b->vector_error;
+            printf("  mode %2d: vectors %.3g rad apart, allowance %.3g "
+                   "(arpack %.3g, lapack %.3g)\n",
+                   m + 1, sine, vallow, a->vector_error, b->vector_error);
+            vworst = fmax(vworst, sine / vallow);
             printf("  mode %2d: arpack %.12g%+.12gi +- %.2g  lapack "
                    "%.12g%+.12gi +- %.2g\n",
                    m + 1, a->re, a->im, a->error_bound, b->re, b->im,
@@ -117,6 +146,12 @@ int main(void)
         CHECK(rc == TS_OK && resid < 1e-6,
               "target %g Hz: arpack residuals %.3g < 1e-6 of |lambda|",
               target, resid);
+        double slack = pass ? 1.0 : VECTOR_SLACK;
+        CHECK(rc == TS_OK && vworst <= slack,
+              "target %g Hz: arpack's Ritz vectors and lapack's "
+              "eigenvectors agree within %g times their vector error "
+              "allowances (largest angle %.3g of the allowance)",
+              target, slack, vworst);
         ts_eigen_free(ar);
     }
     ts_eigen_free(all);
