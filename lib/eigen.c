@@ -778,12 +778,18 @@ static int batch_checks(const ts_linear *lin, tsi_shift *acc, tsi_shift *es,
             continue;
         L->c[c].checked = 1;
         const double complex *v = cand_v(L, L->c[c].vec);
+        int real = 1;
         for (int i = 0; i < n; i++) {
             vr[i] = creal(v[i]);
             vi[i] = cimag(v[i]);
+            real &= vi[i] == 0.0;
         }
         tsi_shift_apply(acc, vr, ar, 0);
-        tsi_shift_apply(acc, vi, ai, 0);
+        /* A real vector's imaginary part maps to zero. */
+        if (real)
+            memset(ai, 0, (size_t)n * sizeof(double));
+        else
+            tsi_shift_apply(acc, vi, ai, 0);
         set_residual(&L->c[c], v, ar, ai, n);
         L->c[c].ritz = L->c[c].round;
         if (with_err) {
