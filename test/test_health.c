@@ -209,8 +209,10 @@ static void check_allowance(const char *what, double k2, double eps,
 static void test_vector_allowance(void)
 {
     /* Close modes, omega^2 = 4 and 4.0004: the coupling 2e-6 mixes them by
-     * about 2e-6 / 4e-4 = 5e-3 rad. */
-    check_allowance("close modes", 4.0004, 2e-6, 0.5, 2.0);
+     * about 2e-6 / 4e-4 = 5e-3 rad. The allowance is ten times the
+     * first-order turn (the safety of every error bound, lib/eigen.c),
+     * which is exact to first order here. */
+    check_allowance("close modes", 4.0004, 2e-6, 5.0, 20.0);
     /* Well separated, omega^2 = 4 and 9. */
     check_allowance("separated modes", 9.0, 2e-6, 0.0, 1e-5);
 

@@ -122,20 +122,20 @@ typedef struct ts_mode {
                                nearest neighbour (~ 1 / RCONDV of
                                dgeevx); NaN with arpack */
     double vector_error;    /* error allowance of the unit eigenvector (an
-                               angle, rad) from first-order perturbation
-                               theory: sqrt(sum |c_k|^2) over the 8
+                               angle, rad): 10 times (as error_bound is
+                               of the eigenvalue's) its first-order
+                               perturbation estimate, sqrt(sum |c_k|^2)
+                               over the 8
                                eigenvalues nearest (conjugates included),
                                c_k = |u_k^H E v| / (|lambda - lambda_k|
                                |u_k^H v_k|) with E the linearization's
                                error estimate, plus rounding (lapack);
                                (the first-order eigenvalue change + eps
                                ||A||_F) / distance to the nearest other
-                               computed eigenvalue (arpack). First
-                               order and over the nearest eigenvalues
-                               only, an estimate rather than a bound:
-                               on the slowest real modes of a 500-link
-                               cable the dense model's falls 3.4 times
-                               short (test_eigen_arpack). Large for
+                               computed eigenvalue (arpack). The
+                               estimate alone fell 3.4 times short on
+                               the slowest real modes of a 500-link
+                               cable (test_eigen_arpack). Large for
                                close modes, whose shapes can mix
                                (towstab/health.h); INFINITY for an
                                exactly double eigenvalue; for a neutral
