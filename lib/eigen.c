@@ -998,9 +998,8 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
  * (di > 0 first, as dneupd orders them) two, its real and imaginary parts.
  * One dgemm (BLAS 3, one pass over V) in place of dneupd's nconv
  * Householder reflections applied to V one after another (dorm2r, each a
- * pass over V): 0.12-0.14 s of the modes' run at 10 000 links, where this
- * takes a few ms. TS_ELAPACK when a Ritz value is not among H's
- * eigenvalues (the caller then asks dneupd for the vectors). */
+ * pass over V; doc/performance.md). TS_ELAPACK when a Ritz value is not
+ * among H's eigenvalues (the caller then asks dneupd for the vectors). */
 static int ritz_vectors_real(const tsi_lapack *la, int n, int ncv, int nconv,
                              double sigma, const double *dr,
                              const double *di, double *hc,
