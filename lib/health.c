@@ -22,6 +22,7 @@
 #include "towstab/health.h"
 
 #include <complex.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -186,13 +187,17 @@ void ts_health_equilibrium(const ts_system *sys, const ts_equilibrium *eq,
         L += sys->links[l].length;
     if (eq->condition > TS_HEALTH_CONDITION_FAIL)
         ts_trust_fail(t, "the solver's Jacobian is nearly singular "
-                         "(condition %.3g > %.3g): the shape is not "
-                         "determined to working accuracy",
+                         "(condition %.3g > %.3g): its solves keep less "
+                         "than one digit, and neither the shape nor its "
+                         "error estimate is determined",
                       eq->condition, TS_HEALTH_CONDITION_FAIL);
     else if (eq->condition > TS_HEALTH_CONDITION_NOTE)
         ts_trust_note(t, "the solver's Jacobian is ill-conditioned "
-                         "(condition %.3g)",
-                      eq->condition);
+                         "(condition %.3g: its solves keep about %.0f "
+                         "digits; the shape error estimate %.3g m stands)",
+                      eq->condition,
+                      floor(-log10(eq->condition * DBL_EPSILON)),
+                      eq->shape_error);
     if (eq->shape_error > TS_HEALTH_SHAPE_RTOL * L)
         ts_trust_fail(t, "node positions are uncertain by %.3g m, more than "
                          "%.3g of the cable length %.6g m",

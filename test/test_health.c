@@ -107,6 +107,35 @@ static void test_equilibrium_health(void)
     ts_health_equilibrium(sys, eq, &t);
     CHECK(t.trustworthy && t.nnotes == 1 && strstr(t.notes[0], "residual"),
           "a residual within 10x of its target is a note: %s", t.notes[0]);
+    /* The solver's condition: between 1e8 and 1 / (10 eps) a note, the
+     * shape error estimate deciding; above, untrustworthy. */
+    eq->residual = 1e-14;
+    eq->condition = 6.2e12;
+    eq->shape_error = 3.8e-10;
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(t.trustworthy && t.nnotes == 1 &&
+              strstr(t.notes[0], "ill-conditioned") &&
+              strstr(t.notes[0], "about 2 digits"),
+          "condition 6.2e12 with a shape error of 3.8e-10 m is a note: %s",
+          t.nnotes ? t.notes[0] : "none");
+    eq->shape_error = 1e-4; /* above 1e-6 of the 10 m cable */
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(!t.trustworthy && t.nreasons == 1 &&
+              strstr(t.reasons[0], "uncertain by 0.0001 m"),
+          "the same with a shape error of 1e-4 m: %s",
+          t.nreasons ? t.reasons[0] : "trustworthy");
+    eq->condition = 1e15;
+    eq->shape_error = 3.8e-10;
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(!t.trustworthy && t.nreasons == 1 &&
+              strstr(t.reasons[0], "nearly singular"),
+          "condition 1e15: its solves keep no digit: %s",
+          t.nreasons ? t.reasons[0] : "trustworthy");
+    eq->condition = NAN;
+    eq->shape_error = NAN;
     eq->converged = 0;
     eq->residual = 0.3;
     ts_trust_init(&t);
