@@ -1262,6 +1262,20 @@ static void walk_tangent(tangent_walk *t, double s, double out[3])
         out[i] /= nt;
 }
 
+/* Whether every controller loop of k's vehicles is closed (a coarse
+ * start copies only closed loops' states). */
+static int loops_closed(const ts_kernel *k)
+{
+    const ts_system *sys = ts_kernel_system(k);
+    for (int v = 0; v < ts_kernel_nvehicles(k); v++) {
+        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
+        for (int l = 0; l < d->nloops; l++)
+            if (ts_kernel_loop_mode(k, v, l) != TS_LOOP_CLOSED)
+                return 0;
+    }
+    return 1;
+}
+
 /* Newton's start with bending and many links (opts.coarse_above): the
  * equilibrium of a coarser copy of the system (ts_system_level, each
  * cable's links halved), solved by ts_equilibrium_solve, so recursively
@@ -1274,23 +1288,16 @@ static void walk_tangent(tangent_walk *t, double s, double out[3])
  * (rigid_strains) into strain[nlinks], and y at rest. Adds the coarse
  * solve's iterations, evaluations and steps to eq's. TS_OK; TS_ENOMEM;
  * TS_ECANCEL (the caller asked to stop); else the coarse solve's failure,
- * err saying why, for the caller to start otherwise (also TS_EINVAL for
- * a loop that is not closed: its frozen output is not copied). Time and
- * memory: the coarse levels', about an eighth of this level's dense
- * Newton and less. */
+ * err saying why, for the caller to start otherwise. Only with every
+ * loop closed (loops_closed: an open loop's frozen output is not copied).
+ * Time and memory: the coarse levels', about an eighth of this level's
+ * dense Newton and less. */
 static int coarse_start(ts_kernel *k, const ts_equilibrium_opts *o,
                         const ts_frame *frame, double *y, double *dvec,
                         double *strain, ts_equilibrium *eq, ts_err *err)
 {
     const ts_system *sys = ts_kernel_system(k);
     int nv = ts_kernel_nvehicles(k);
-    for (int v = 0; v < nv; v++) {
-        const ts_vehicle *d = sys->bodies[ts_kernel_vehicle_body(k, v)].vehicle;
-        for (int l = 0; l < d->nloops; l++)
-            if (ts_kernel_loop_mode(k, v, l) != TS_LOOP_CLOSED)
-                return ts_fail(err, TS_EINVAL, "equilibrium: a loop that "
-                               "is not closed: no coarse start");
-    }
     double ratio;
     ts_system *cs = ts_system_level(sys, 1, &ratio, err);
     ts_kernel *kc = cs ? ts_kernel_alloc(cs, err) : NULL;
@@ -2548,7 +2555,7 @@ int ts_equilibrium_solve(ts_kernel *k, const ts_equilibrium_opts *opts,
     ts_kernel_set_steady(k, 1);
     if (!o.guess && !have_guess && sys->has_bending &&
         o.coarse_above > 0 && nl > o.coarse_above &&
-        ts_system_can_coarsen(sys)) {
+        ts_system_can_coarsen(sys) && loops_closed(k)) {
         /* Many links with bending: from a coarser copy's equilibrium;
          * should that fail, the continuation below. */
         rc = coarse_start(k, &o, &frame, y, dvec, strain, eq, err);
