@@ -995,7 +995,8 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
  * one to the nearest of H's eigenvalues), |y| = 1, purified by one step
  * of inverse iteration as dneupd does it, x + f y_ncv / mu = OP x / mu.
  * A real eigenvalue's vector fills one column of z [n x nconv], a pair's
- * (di > 0 first, as dneupd orders them) two, its real and imaginary parts.
+ * two, z_j + i z_(j+1) the vector of dr_j + i di_j (either sign first),
+ * as dneupd's.
  * One dgemm (BLAS 3, one pass over V) in place of dneupd's nconv
  * Householder reflections applied to V one after another (dorm2r, each a
  * pass over V; doc/performance.md). TS_ELAPACK when a Ritz value is not
