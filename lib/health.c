@@ -191,13 +191,18 @@ void ts_health_equilibrium(const ts_system *sys, const ts_equilibrium *eq,
                          "than one digit, and neither the shape nor its "
                          "error estimate is determined",
                       eq->condition, TS_HEALTH_CONDITION_FAIL);
-    else if (eq->condition > TS_HEALTH_CONDITION_NOTE)
+    else if (eq->condition > TS_HEALTH_CONDITION_NOTE) {
+        char est[64] = "";
+        if (isfinite(eq->shape_error))
+            snprintf(est, sizeof est,
+                     "; the shape error estimate %.3g m stands",
+                     eq->shape_error);
         ts_trust_note(t, "the solver's Jacobian is ill-conditioned "
                          "(condition %.3g: its solves keep about %.0f "
-                         "digits; the shape error estimate %.3g m stands)",
+                         "digits%s)",
                       eq->condition,
-                      floor(-log10(eq->condition * DBL_EPSILON)),
-                      eq->shape_error);
+                      floor(-log10(eq->condition * DBL_EPSILON)), est);
+    }
     if (eq->shape_error > TS_HEALTH_SHAPE_RTOL * L)
         ts_trust_fail(t, "node positions are uncertain by %.3g m, more than "
                          "%.3g of the cable length %.6g m",

@@ -119,6 +119,14 @@ static void test_equilibrium_health(void)
               strstr(t.notes[0], "about 2 digits"),
           "condition 6.2e12 with a shape error of 3.8e-10 m is a note: %s",
           t.nnotes ? t.notes[0] : "none");
+    eq->shape_error = NAN; /* none: the note says the digits alone */
+    ts_trust_init(&t);
+    ts_health_equilibrium(sys, eq, &t);
+    CHECK(t.trustworthy && t.nnotes == 1 &&
+              strstr(t.notes[0], "about 2 digits)") &&
+              !strstr(t.notes[0], "estimate"),
+          "condition 6.2e12 without a shape error estimate: %s",
+          t.nnotes ? t.notes[0] : "none");
     eq->shape_error = 1e-4; /* above 1e-6 of the 10 m cable */
     ts_trust_init(&t);
     ts_health_equilibrium(sys, eq, &t);

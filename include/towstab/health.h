@@ -57,7 +57,7 @@ extern "C" {
  * itself) decides: above SHAPE_RTOL of the total cable length the shape
  * is untrustworthy. (FAIL was 1 / (1e3 eps) = 4.5e12, the solves' three
  * digits; the two-part tow at 798 links, condition 6.2e12, reaches the
- * same shape within 2.1e-10 m from a start moved by 1e-7 rad a link, its
+ * same shape within 2.2e-10 m from a start moved by 1e-7 rad a link, its
  * shape error estimate 3.8e-10 m: test_bending.) */
 #define TS_HEALTH_CONDITION_FAIL 4.5e14
 #define TS_HEALTH_CONDITION_NOTE 1e8
