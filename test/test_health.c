@@ -73,6 +73,17 @@ static void test_trust(void)
           "merge prefixes and carries the verdict: '%s'", d.reasons[0]);
 }
 
+/* The equilibrium health of eq with its solver's condition and shape
+ * error estimate set, into t. */
+static void health_at(const ts_system *sys, ts_equilibrium *eq,
+                      double condition, double shape_error, ts_trust *t)
+{
+    eq->condition = condition;
+    eq->shape_error = shape_error;
+    ts_trust_init(t);
+    ts_health_equilibrium(sys, eq, t);
+}
+
 static void test_equilibrium_health(void)
 {
     ts_err err = {0};
@@ -110,34 +121,24 @@ static void test_equilibrium_health(void)
     /* The solver's condition: between 1e8 and 1 / (10 eps) a note, the
      * shape error estimate deciding; above, untrustworthy. */
     eq->residual = 1e-14;
-    eq->condition = 6.2e12;
-    eq->shape_error = 3.8e-10;
-    ts_trust_init(&t);
-    ts_health_equilibrium(sys, eq, &t);
+    health_at(sys, eq, 6.2e12, 3.8e-10, &t);
     CHECK(t.trustworthy && t.nnotes == 1 &&
               strstr(t.notes[0], "ill-conditioned") &&
               strstr(t.notes[0], "about 2 digits"),
           "condition 6.2e12 with a shape error of 3.8e-10 m is a note: %s",
           t.nnotes ? t.notes[0] : "none");
-    eq->shape_error = NAN; /* none: the note says the digits alone */
-    ts_trust_init(&t);
-    ts_health_equilibrium(sys, eq, &t);
+    health_at(sys, eq, 6.2e12, NAN, &t); /* no estimate: the digits alone */
     CHECK(t.trustworthy && t.nnotes == 1 &&
               strstr(t.notes[0], "about 2 digits)") &&
               !strstr(t.notes[0], "estimate"),
           "condition 6.2e12 without a shape error estimate: %s",
           t.nnotes ? t.notes[0] : "none");
-    eq->shape_error = 1e-4; /* above 1e-6 of the 10 m cable */
-    ts_trust_init(&t);
-    ts_health_equilibrium(sys, eq, &t);
+    health_at(sys, eq, 6.2e12, 1e-4, &t); /* above 1e-6 of the 10 m cable */
     CHECK(!t.trustworthy && t.nreasons == 1 &&
               strstr(t.reasons[0], "uncertain by 0.0001 m"),
           "the same with a shape error of 1e-4 m: %s",
           t.nreasons ? t.reasons[0] : "trustworthy");
-    eq->condition = 1e15;
-    eq->shape_error = 3.8e-10;
-    ts_trust_init(&t);
-    ts_health_equilibrium(sys, eq, &t);
+    health_at(sys, eq, 1e15, 3.8e-10, &t);
     CHECK(!t.trustworthy && t.nreasons == 1 &&
               strstr(t.reasons[0], "nearly singular"),
           "condition 1e15: its solves keep no digit: %s",
