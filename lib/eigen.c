@@ -47,6 +47,7 @@
 #endif
 
 #include "arpack.h"
+#include "bigalloc.h"
 #include "lazylib.h"
 #include "shift.h"
 #include "towstab/system.h"
@@ -183,7 +184,8 @@ static int cand_init(cand_list *L, int cap, int nstate)
     L->cap = cap > 0 ? cap : 1;
     L->nstate = nstate;
     L->c = malloc((size_t)L->cap * sizeof(cand));
-    L->v = malloc((size_t)L->cap * (size_t)nstate * sizeof(double complex));
+    L->v = tsi_big_malloc((size_t)L->cap * (size_t)nstate *
+                          sizeof(double complex));
     return L->c && L->v ? TS_OK : TS_ENOMEM;
 }
 
@@ -197,8 +199,10 @@ static int cand_grow(cand_list *L, int extra)
     if (!c)
         return TS_ENOMEM;
     L->c = c;
-    double complex *v = realloc(L->v, (size_t)cap * (size_t)L->nstate *
-                                          sizeof(double complex));
+    /* The columns in use move; the rest, never written, stay unfaulted. */
+    size_t col = (size_t)L->nstate * sizeof(double complex);
+    double complex *v =
+        tsi_big_realloc(L->v, (size_t)L->n * col, (size_t)cap * col);
     if (!v)
         return TS_ENOMEM;
     L->v = v;
@@ -1181,12 +1185,13 @@ static int solve_arpack_real_run(const ts_linear *lin,
         return rc;
     int lworkl = 3 * ncv * ncv + 6 * ncv;
     double *resid = malloc((size_t)n * sizeof(double));
-    double *v = malloc((size_t)n * (size_t)ncv * sizeof(double));
+    double *v = tsi_big_malloc((size_t)n * (size_t)ncv * sizeof(double));
     double *workd = malloc(3 * (size_t)n * sizeof(double));
     double *workl = malloc((size_t)lworkl * sizeof(double));
     double *dr = malloc((size_t)(nev + 1) * sizeof(double));
     double *di = malloc((size_t)(nev + 1) * sizeof(double));
-    double *z = malloc((size_t)n * (size_t)(nev + 1) * sizeof(double));
+    double *z =
+        tsi_big_malloc((size_t)n * (size_t)(nev + 1) * sizeof(double));
     double *workev = malloc(3 * (size_t)ncv * sizeof(double));
     double *hc = malloc((size_t)ncv * ncv * sizeof(double));
     int *select = calloc((size_t)ncv, sizeof(int));
@@ -1335,11 +1340,11 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
     int lworkl = 3 * ncv * ncv + 5 * ncv;
     size_t szc = sizeof(double complex);
     double complex *resid = malloc((size_t)n * szc);
-    double complex *v = malloc((size_t)n * (size_t)ncv * szc);
+    double complex *v = tsi_big_malloc((size_t)n * (size_t)ncv * szc);
     double complex *workd = malloc(3 * (size_t)n * szc);
     double complex *workl = malloc((size_t)lworkl * szc);
     double complex *d = malloc((size_t)(nev + 1) * szc);
-    double complex *z = malloc((size_t)n * (size_t)(nev + 1) * szc);
+    double complex *z = tsi_big_malloc((size_t)n * (size_t)(nev + 1) * szc);
     double complex *workev = malloc(2 * (size_t)ncv * szc);
     double *rwork = malloc((size_t)ncv * sizeof(double));
     double complex *hc = malloc((size_t)ncv * ncv * szc);

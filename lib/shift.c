@@ -9,6 +9,8 @@
  */
 #include "shift.h"
 
+#include "bigalloc.h"
+
 #include <klu.h>
 #include <math.h>
 #include <stdlib.h>
@@ -332,7 +334,7 @@ static int setup(tsi_shift *sh, const ts_linear *lin, ts_err *err)
     sh->sys = d->sys;
     size_t n3 = 3 * (size_t)d->np + (size_t)d->nc;
     sh->common = malloc(sizeof(klu_common));
-    sh->Sx = malloc(2 * ((size_t)d->nnz + 1) * sizeof(double));
+    sh->Sx = tsi_big_malloc(2 * ((size_t)d->nnz + 1) * sizeof(double));
     sh->rhs = malloc(2 * ((size_t)d->nx + 1) * sizeof(double));
     sh->cols = malloc(2 * ((size_t)d->nx + 1) * sizeof(double));
     sh->u1 = malloc(2 * n3 * sizeof(double));
@@ -424,9 +426,9 @@ static int ensure_parts(tsi_shift *sh, ts_err *err)
         return TS_OK;
     const ts_descriptor *d = sh->d;
     size_t nz = (size_t)d->nnz + 1;
-    sh->Sk = malloc(nz * sizeof(double));
-    sh->Sc = malloc(nz * sizeof(double));
-    sh->Sm = malloc(nz * sizeof(double));
+    sh->Sk = tsi_big_malloc(nz * sizeof(double));
+    sh->Sc = tsi_big_malloc(nz * sizeof(double));
+    sh->Sm = tsi_big_malloc(nz * sizeof(double));
     if (!sh->Sk || !sh->Sc || !sh->Sm) {
         tsi_shift_free(sh);
         return ts_fail(err, TS_ENOMEM, "shift: out of memory for %d "
