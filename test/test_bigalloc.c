@@ -8,9 +8,8 @@
  * /sys/kernel/mm/transparent_hugepage/enabled), the mapping of an 8 MiB
  * array carries the advice (VmFlags "hg" in /proc/self/smaps), and how
  * much of it huge pages back once written is printed (the kernel gives
- * them when it finds them free: not a property of the code); elsewhere,
- * and under AddressSanitizer (whose allocator places the arrays), that
- * check is skipped and said so. */
+ * them when it finds them free: not a property of the code); elsewhere
+ * that check is skipped and said so. */
 #include "bigalloc.h"
 
 #include <stdint.h>
@@ -20,9 +19,10 @@
 
 #include "tcheck.h"
 
-/* Whether byte i of a pattern array holds its pattern. */
+/* Byte i of the test pattern. */
 static unsigned char pat(size_t i) { return (unsigned char)(i * 7 + 3); }
 
+/* Whether p[0..n) holds the pattern. */
 static int holds_pattern(const unsigned char *p, size_t n)
 {
     for (size_t i = 0; i < n; i++)
@@ -82,17 +82,6 @@ static int advised_at(const void *p, long *kb)
     return found;
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-#define UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define UNDER_ASAN 1
-#endif
-#endif
-#ifndef UNDER_ASAN
-#define UNDER_ASAN 0
-#endif
-
 int main(void)
 {
     /* Small: plain malloc, written and read back. */
@@ -123,7 +112,7 @@ int main(void)
     if (!g)
         return tc_done();
     CHECK(holds_pattern(g, nb), "growing keeps all %zu bytes", nb);
-    /* Only the bytes in use move: the rest is not read. */
+    /* Shrunk, moving only the first 1000 bytes (those in use). */
     unsigned char *h = tsi_big_realloc(g, 1000, nb);
     CHECK(h != NULL && holds_pattern(h, 1000),
           "a move of the first 1000 bytes keeps them");
@@ -134,11 +123,9 @@ int main(void)
     free(z);
 
     /* Huge pages where the kernel offers them. */
-    if (!thp_offered() || UNDER_ASAN) {
-        printf("SKIP huge-page backing: %s\n",
-               UNDER_ASAN ? "AddressSanitizer places the arrays"
-                          : "the kernel offers no transparent huge pages "
-                            "to advised memory");
+    if (!thp_offered()) {
+        printf("SKIP huge-page advice: the kernel offers no transparent "
+               "huge pages to advised memory\n");
     } else {
         size_t n8 = 4 * TSI_HUGE_PAGE;
         unsigned char *e = tsi_big_malloc(n8);
