@@ -9,11 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
-
 #include "cli.h"
+#include "malloc_policy.h"
 
 extern const cli_command cli_cmd_equilibrium, cli_cmd_run;
 extern const cli_command cli_cmd_modes, cli_cmd_response;
@@ -74,28 +71,10 @@ static void blas_threads(void)
         setenv("OPENBLAS_NUM_THREADS", "1", 0);
 }
 
-/* glibc's allocator keeps freed memory for reuse up to 256 MB per
- * allocation and 512 MB at the heap's top. By default it maps an
- * allocation above a threshold (moving up to 32 MB) afresh and returns it
- * when freed, and trims the heap above twice that: a long cable's eigen
- * analysis allocates and frees arrays of tens of MB per ARPACK run and
- * per eigenvalue (the Arnoldi vectors, the Ritz vectors, the factors),
- * and every page of each was faulted in again. At 10 000 links: 53 600
- * page faults against 33 200 (peak memory 132 against 142 MB), doc/
- * performance.md. A process-wide policy, so set here and not in the
- * library. */
-static void malloc_policy(void)
-{
-#ifdef __GLIBC__
-    mallopt(M_MMAP_THRESHOLD, 256 << 20);
-    mallopt(M_TRIM_THRESHOLD, 512 << 20);
-#endif
-}
-
 int main(int argc, char **argv)
 {
     blas_threads();
-    malloc_policy();
+    towstab_malloc_policy();
     if (argc < 2) {
         fprintf(stderr, "towstab: error: no command given (a COMMAND and a "
                         "SCENE file)\n");

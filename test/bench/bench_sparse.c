@@ -36,7 +36,8 @@
  * from 100 to 500 links < 8x. The targets are reported, met or missed; the
  * program fails only when an analysis fails.
  * OpenBLAS on one thread, as towstab runs it (tools/towstab.c): meson
- * sets OPENBLAS_NUM_THREADS=1 for it.
+ * sets OPENBLAS_NUM_THREADS=1 for it. glibc's allocator as towstab sets
+ * it (tools/malloc_policy.h), before the children are forked.
  * Run from the project root: meson test -C build --benchmark sparse, or
  * OPENBLAS_NUM_THREADS=1 build/test/bench_sparse [REPS
  * [vehicle|towing|linear|modes]] (vehicle: the towed vehicle cases only;
@@ -51,6 +52,7 @@
 #include <unistd.h>
 
 #include "bench_common.h"
+#include "malloc_policy.h"
 #include "towstab/analysis.h"
 #include "towstab/excitation.h"
 #include "towstab/scene.h"
@@ -240,6 +242,7 @@ static const char *met(int ok)
 
 int main(int argc, char **argv)
 {
+    towstab_malloc_policy();
     int reps = argc > 1 ? atoi(argv[1]) : REPS;
     int only_vehicle = argc > 2 && strcmp(argv[2], "vehicle") == 0;
     int only_towing = argc > 2 && strcmp(argv[2], "towing") == 0;
