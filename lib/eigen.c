@@ -1306,19 +1306,20 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
                            int nev, int ncv, double tol, int maxiter,
                            int partial, const double complex *start,
                            const eig_poll *pp, cand_list *L,
-                           arpack_stats *st, ts_err *err);
+                           arpack_stats *st, tsi_shift *fac, ts_err *err);
 
 static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
                        int ncv, double tol, int maxiter, int partial,
                        const double complex *start, const eig_poll *pp,
-                       cand_list *L, arpack_stats *st, ts_err *err)
+                       cand_list *L, arpack_stats *st, tsi_shift *fac,
+                       ts_err *err)
 {
     int rc;
 #ifdef _OPENMP
 #pragma omp critical(ts_arpack_complex)
 #endif
     rc = arpack_near_run(lin, sigma, nev, ncv, tol, maxiter, partial, start,
-                         pp, L, st, err);
+                         pp, L, st, fac, err);
     return rc;
 }
 
@@ -1326,7 +1327,7 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
                            int nev, int ncv, double tol, int maxiter,
                            int partial, const double complex *start,
                            const eig_poll *pp, cand_list *L,
-                           arpack_stats *st, ts_err *err)
+                           arpack_stats *st, tsi_shift *fac, ts_err *err)
 {
     int n = lin->nstate, rc;
     tsi_arpack ar;
@@ -1334,8 +1335,9 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
     if (tsi_arpack_open(&ar, err) != TS_OK ||
         tsi_lapack_open(&la, err) != TS_OK)
         return TS_EIO;
-    tsi_shift sh;
-    if ((rc = tsi_shift_factor(&sh, lin, sigma, err)) != TS_OK)
+    tsi_shift own, *sh = fac ? fac : &own;
+    if ((rc = fac ? tsi_shift_refactor_solved(fac, lin, sigma, NULL, err)
+                  : tsi_shift_factor(&own, lin, sigma, err)) != TS_OK)
         return rc;
     int lworkl = 3 * ncv * ncv + 5 * ncv;
     size_t szc = sizeof(double complex);
@@ -1370,7 +1372,7 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
             break;
         if ((rc = eig_poll_check(pp, st->ops, err)) != TS_OK)
             goto out;
-        tsi_shift_solve(&sh, workd + ipntr[0] - 1, workd + ipntr[1] - 1);
+        tsi_shift_solve(sh, workd + ipntr[0] - 1, workd + ipntr[1] - 1);
         st->ops++;
     }
     st->iterations += iparam[2];
@@ -1446,7 +1448,8 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
         cand_add_complex(L, d[j], z + (size_t)j * n);
     }
 out:
-    tsi_shift_free(&sh);
+    if (!fac)
+        tsi_shift_free(&own);
     free(resid);
     free(v);
     free(workd);
@@ -1473,7 +1476,7 @@ static int solve_arpack_complex(const ts_linear *lin, const ts_eigen_opts *o,
     eig_poll pp = {o, "eigensolve", 0, NAN};
     rc = arpack_near(lin, I * 2.0 * M_PI * o->target_hz, nev, ncv,
                      modes_tol(lin, o), o->arpack_max_iter, 0, NULL, &pp, L,
-                     &st, err);
+                     &st, NULL, err);
     e->arpack_iterations = st.iterations;
     e->arpack_ops = st.ops;
     e->arpack_nconv = st.nconv;
@@ -1677,8 +1680,8 @@ static int sweep_new(cand_list *L, int from, double complex sigma,
 static int sweep_run(const ts_linear *lin, const ts_eigen_opts *o,
                      double complex sigma, double tol,
                      const double complex *start, int shift, int shifts,
-                     cand_list *L, arpack_stats *st, int *best,
-                     double *radius, ts_err *err)
+                     cand_list *L, arpack_stats *st, tsi_shift *fac,
+                     int *best, double *radius, ts_err *err)
 {
     int from = L->n, ncv = SWEEP_NCV < lin->nstate ? SWEEP_NCV : lin->nstate;
     int want = tol > SWEEP_TOL ? SWEEP_GRID_NEV : SWEEP_NEV;
@@ -1686,11 +1689,11 @@ static int sweep_run(const ts_linear *lin, const ts_eigen_opts *o,
     tol = fmax(o->arpack_tol, tol);
     eig_poll pp = {o, "rightmost search", shift, shifts};
     int rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, start,
-                         &pp, L, st, err);
+                         &pp, L, st, fac, err);
     if (rc == TS_ESINGULAR) {
         sigma *= 1.0 + 1e-9;
         rc = arpack_near(lin, sigma, nev, ncv, tol, SWEEP_RESTARTS, 1, start,
-                         &pp, L, st, err);
+                         &pp, L, st, fac, err);
     }
     if (rc != TS_OK)
         return rc;
@@ -1802,6 +1805,10 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         return ts_fail(err, TS_ENOMEM, "eigen: out of memory");
     }
     arpack_stats st = {0, 0, 0, 0};
+    /* The runs' factorisation, refactored from shift to shift with the
+     * previous pivots while a solve's backward error stays small
+     * (tsi_shift_refactor_solved). */
+    tsi_shift fac = {0};
     int rc = TS_OK, runs = 0, first = L->n;
     /* The grid's runs are loose only where each Ritz value's own error
      * can be measured (the sparse model with its error estimate). */
@@ -1838,8 +1845,8 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         double r;
         rc = sweep_run(lin, o, I * seed[i].w,
                        seed[i].top ? SWEEP_TOL : grid_tol, NULL, i,
-                       nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &best, &r,
-                       err);
+                       nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &fac, &best,
+                       &r, err);
         if (rc == TS_ECONV) {
             /* A run that did not converge leaves a gap, counted; it does
              * not make the analysis fail. */
@@ -1922,8 +1929,8 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
         double r;
         rc = sweep_run(lin, o, I * run_w[redo], SWEEP_TOL,
                        start, redo,
-                       nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &best, &r,
-                       err);
+                       nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &fac, &best,
+                       &r, err);
         /* A rerun that did not converge leaves the grid's values. */
         int keep_loose = rc == TS_ECONV;
         for (int i = run_from[redo]; i < run_to[redo]; i++)
@@ -1971,8 +1978,8 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
             w = cimag(lb);
             int nb;
             rc = sweep_run(lin, o, I * w, SWEEP_TOL, NULL, shifts,
-                           nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &nb, &r,
-                           err);
+                           nu + SWEEP_CLIMBS * SWEEP_STEPS, L, &st, &fac,
+                           &nb, &r, err);
             shifts++;
             if (rc == TS_ECONV) {
                 e->sweep_failed++;
@@ -1987,6 +1994,7 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                 break;
         }
     }
+    tsi_shift_free(&fac);
     free(top);
     free(seed);
     e->sweep_shifts = shifts;
