@@ -54,6 +54,7 @@
 
 #include "clock.h"
 #include "csvtab.h"
+#include "lazylib.h"
 #include "response_impl.h"
 #include "towstab/kernel.h"
 #include "towstab/track.h"
@@ -739,10 +740,34 @@ static int run_linearize(ts_result *r, const ts_linearize_opts *lo,
 }
 
 /* The equilibrium stage of modes and response: solve, then linearize. */
-static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
-                                   const ts_linearize_opts *lo, ts_err *err)
+static ts_eigen_opts modes_eigen_opts(const ts_modes_opts *m, int n);
+
+/* The libraries the modes of a linear model of n states will open
+ * (lib/lazylib.h): LAPACK always (the dense eigen analysis, or the Ritz
+ * vectors of ARPACK's runs), ARPACK when the method at n is ARPACK, KLU
+ * with the sparse model (any model but the dense one alone). */
+static int modes_libraries(const ts_modes_opts *m,
+                           const ts_linearize_opts *lo, int n)
 {
+    ts_eigen_opts o = modes_eigen_opts(m, n);
+    return TSI_PRELOAD_LAPACK |
+           (ts_eigen_method(n, &o) == TS_EIG_ARPACK ? TSI_PRELOAD_ARPACK
+                                                    : 0) |
+           (lo->model != TS_LIN_DENSE ? TSI_PRELOAD_KLU : 0);
+}
+
+/* The equilibrium, then the linear model lo. With `modes` (the modes
+ * pipeline) the libraries the modes will need are opened ahead, beside
+ * the two (modes_libraries). */
+static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
+                                   const ts_linearize_opts *lo, int modes,
+                                   ts_err *err)
+{
+    tsi_preload pre = {0};
     ts_kernel *k = ts_kernel_alloc(r->sys, err);
+    if (k && modes)
+        tsi_preload_start(&pre, modes_libraries(&rq->modes, lo,
+                                                ts_kernel_nstate(k)));
     int rc = k ? run_equilibrium(r, k, rq, err)
                : (err && err->code ? err->code : TS_ENOMEM);
     ts_kernel_free(k);
@@ -750,10 +775,12 @@ static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
         if (r->eq && !r->eq->converged)
             ts_err_prefix(err, "the equilibrium did not converge, so it is "
                                "not linearized: ");
-        return rc;
+    } else {
+        ts_trust_merge(&r->trust, "equilibrium: ", &r->eq_trust);
+        rc = run_linearize(r, lo, rq->setup.open_loop, err);
     }
-    ts_trust_merge(&r->trust, "equilibrium: ", &r->eq_trust);
-    return run_linearize(r, lo, rq->setup.open_loop, err);
+    tsi_preload_join(&pre);
+    return rc;
 }
 
 static int pipeline_equilibrium(ts_result *r, const ts_request *rq,
@@ -1013,7 +1040,7 @@ static int pipeline_modes(ts_result *r, const ts_request *rq, ts_err *err)
     ts_linearize_opts lo = m->linearize;
     if (m->eigen.method == TS_EIG_LAPACK && lo.model == TS_LIN_AUTO)
         lo.model = TS_LIN_BOTH;
-    int rc = equilibrium_then_linear(r, rq, &lo, err);
+    int rc = equilibrium_then_linear(r, rq, &lo, 1, err);
     if (rc != TS_OK)
         return rc;
     ts_eigen_opts o = modes_eigen_opts(m, r->lin->nstate);
@@ -1195,7 +1222,7 @@ static int pipeline_response_sea(ts_result *r, const ts_request *rq,
     snprintf(r->rao_file, sizeof r->rao_file, "%s", o->sea.rao_file);
     ts_linearize_opts lo = rq->modes.linearize;
     lo.tensions = out.kind == TS_OUT_TENSION;
-    rc = equilibrium_then_linear(r, rq, &lo, err);
+    rc = equilibrium_then_linear(r, rq, &lo, 0, err);
     /* A towing vehicle's speed is solved: the waves meet it at that one
      * (the encounter frequency), not at the scene's starting value. */
     if (rc == TS_OK && r->sys->tow.vehicle >= 0)
@@ -1301,7 +1328,7 @@ static int pipeline_response(ts_result *r, const ts_request *rq, ts_err *err)
     lo.frame_inputs = frame;
     if (frame && r->sys->tow.vehicle >= 0 && lo.model != TS_LIN_DENSE)
         lo.model = TS_LIN_DENSE;
-    rc = equilibrium_then_linear(r, rq, &lo, err);
+    rc = equilibrium_then_linear(r, rq, &lo, 0, err);
     if (rc == TS_OK)
         rc = tsi_response_compute(r->sys, r->lin, input, &out, freq,
                                   o->points, rq->progress, rq->progress_data,

@@ -84,3 +84,36 @@ int tsi_nlopt_open(tsi_nlopt *t, ts_err *err)
                *package = "libnlopt0";
     OPEN_TABLE(TSI_NLOPT_FUNCS);
 }
+
+static void *preload_main(void *arg)
+{
+    const tsi_preload *p = arg;
+    ts_err err = {0};
+    if (p->what & TSI_PRELOAD_LAPACK) {
+        tsi_lapack t;
+        tsi_lapack_open(&t, &err);
+    }
+    if (p->what & TSI_PRELOAD_ARPACK) {
+        tsi_arpack t;
+        tsi_arpack_open(&t, &err);
+    }
+    if (p->what & TSI_PRELOAD_KLU) {
+        tsi_klu t;
+        tsi_klu_open(&t, &err);
+    }
+    return NULL;
+}
+
+void tsi_preload_start(tsi_preload *p, int what)
+{
+    p->what = what;
+    p->started = what != 0 &&
+                 pthread_create(&p->thread, NULL, preload_main, p) == 0;
+}
+
+void tsi_preload_join(tsi_preload *p)
+{
+    if (p->started)
+        pthread_join(p->thread, NULL);
+    p->started = 0;
+}

@@ -30,6 +30,7 @@
 
 #include <klu.h>
 #include <nlopt.h>
+#include <pthread.h>
 
 /* The sonames, Debian's (the build may pass others). */
 #ifndef TSI_LAPACK_SONAME
@@ -85,5 +86,28 @@ int tsi_lapack_open(tsi_lapack *t, ts_err *err);
 int tsi_arpack_open(tsi_arpack *t, ts_err *err);
 int tsi_klu_open(tsi_klu *t, ts_err *err);
 int tsi_nlopt_open(tsi_nlopt *t, ts_err *err);
+
+/* Opening ahead: a run that knows which of the libraries it will need
+ * opens them on a thread of its own while it computes what comes first
+ * (the equilibrium and the linearization), so that loading them (LAPACK
+ * with OpenBLAS about 5 ms, ARPACK and KLU about 1 ms each on the machine
+ * of doc/performance.md) is not on the path of the analysis that uses
+ * them. The thread only opens the libraries, as each tsi_<lib>_open
+ * does, and keeps nothing: the analysis opens them again where it uses
+ * them, which then only finds them, and reports a library that cannot be
+ * opened as before. tsi_preload_join waits for the thread; without one
+ * (pthread_create failed, or nothing asked) it returns at once. */
+enum {
+    TSI_PRELOAD_LAPACK = 1,
+    TSI_PRELOAD_ARPACK = 2,
+    TSI_PRELOAD_KLU = 4
+};
+typedef struct tsi_preload {
+    pthread_t thread;
+    int what;    /* TSI_PRELOAD_ flags */
+    int started; /* the thread runs, to be joined */
+} tsi_preload;
+void tsi_preload_start(tsi_preload *p, int what);
+void tsi_preload_join(tsi_preload *p);
 
 #endif

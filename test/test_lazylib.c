@@ -9,9 +9,14 @@
  * 3 solve (dgesv_) and a product (dgemm_, a BLAS routine found through
  * LAPACK's dependencies) against values worked by hand, and an NLopt
  * minimisation of a quadratic whose minimum is known. Opening a library
- * twice gives the same functions (it stays loaded). */
+ * twice gives the same functions (it stays loaded). Opening ahead
+ * (tsi_preload_start): LAPACK, not loaded before, is loaded once the
+ * thread is joined; the missing ARPACK and the wrong KLU are passed over
+ * in silence there, and still reported where they are opened. */
+#define _GNU_SOURCE /* RTLD_NOLOAD */
 #include "lazylib.h"
 
+#include <dlfcn.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -139,8 +144,31 @@ static void check_faults(void)
           "a NULL error record is allowed");
 }
 
+/* Before anything else opens LAPACK. */
+static void check_preload(void)
+{
+    void *h = dlopen(TSI_LAPACK_SONAME, RTLD_NOW | RTLD_NOLOAD);
+    CHECK(h == NULL, "LAPACK (%s) is not loaded before it is opened",
+          TSI_LAPACK_SONAME);
+    tsi_preload none = {0};
+    tsi_preload_start(&none, 0);
+    CHECK(!none.started, "nothing asked: no thread");
+    tsi_preload_join(&none);
+    tsi_preload p = {0};
+    tsi_preload_start(&p, TSI_PRELOAD_LAPACK | TSI_PRELOAD_ARPACK |
+                              TSI_PRELOAD_KLU);
+    tsi_preload_join(&p);
+    CHECK(!p.started, "joined");
+    h = dlopen(TSI_LAPACK_SONAME, RTLD_NOW | RTLD_NOLOAD);
+    CHECK(h != NULL, "LAPACK is loaded once the thread that opens it ahead "
+          "is joined (the missing ARPACK and the wrong KLU beside it)");
+    if (h)
+        dlclose(h);
+}
+
 int main(void)
 {
+    check_preload();
     check_lapack();
     check_nlopt();
     check_faults();
