@@ -1749,11 +1749,13 @@ static double sweep_threshold(const cand_list *L, int from)
  * SWEEP_CLIMBS runs with the largest real parts climb: while the
  * rightmost eigenvalue a run found lies in the outer half of its disc,
  * the next shift is at its frequency. Adds the eigenvalues found to L
- * (sweep = 1, repeats and a rerun grid run's first values 2). */
+ * (sweep = 1, repeats and a rerun grid run's first values 2). keep (may
+ * be NULL) takes over the runs' factorisation at the last shift, for the
+ * caller's checks to refactor (tsi_shift_eig_error); else it is freed. */
 static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                             const ts_eigen_opts *o, ts_eigen *e, cand_list *L,
                             double (*get_wlo)(void *), void *wctx,
-                            ts_err *err)
+                            tsi_shift *keep, ts_err *err)
 {
     const ts_system *sys = d->sys;
     int nc = sys->ncables;
@@ -1994,7 +1996,10 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                 break;
         }
     }
-    tsi_shift_free(&fac);
+    if (keep && rc == TS_OK)
+        *keep = fac; /* taken over, not freed */
+    else
+        tsi_shift_free(&fac);
     free(top);
     free(seed);
     e->sweep_shifts = shifts;
@@ -2486,7 +2491,8 @@ static int search_beside_checks(const ts_linear *lin,
     int keep = o->count < L->n ? o->count : L->n;
     double wlo = modes_top(L);
     if (keep < o->count) /* eigen_solve says so after the search */
-        return rightmost_search(lin, bands, o, e, L, wlo_given, &wlo, err);
+        return rightmost_search(lin, bands, o, e, L, wlo_given, &wlo, NULL,
+                                err);
     int n = L->nstate, rc = tsi_shift_factor_inf(acc, lin, err);
     if (rc != TS_OK)
         return rc;
@@ -2514,7 +2520,8 @@ static int search_beside_checks(const ts_linear *lin,
         if (t == (team > 1 ? 1 : 0))
             rk = batch_checks(lin, acc, es, &M, &ek);
         if (t == 0)
-            rs = rightmost_search(lin, bands, o, e, L, wlo_given, &wlo, err);
+            rs = rightmost_search(lin, bands, o, e, L, wlo_given, &wlo,
+                                  NULL, err);
     }
     if (rs == TS_OK && rk != TS_OK) {
         rs = rk;
@@ -2726,11 +2733,13 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
         }
         if (t == 0) {
             rs = rightmost_search(lin, bands, &so, &se, &S, share_wlo,
-                                  &share, err);
+                                  &share, &ses, err);
             /* Its rightmost checked here, in shifts of its own, while the
              * modes' checks go on: the modes are known once the search is
              * done (it waited for them), and only their eigenvalues and
-             * vectors are read, which the checks leave. */
+             * vectors are read, which the checks leave. The checks' first
+             * S(lambda) refactors the search's last shift (ses, taken
+             * over from the search), judged as each next one is. */
             if (rs == TS_OK) {
                 mark_repeats(&S, L);
                 for (int i = 0; i < S.n; i++)
@@ -2852,7 +2861,8 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
                                   &modes_checked, err);
     } else if (m == TS_EIG_ARPACK && o.rightmost && bands) {
         double wlo = modes_top(&L);
-        rc = rightmost_search(lin, bands, &o, e, &L, wlo_given, &wlo, err);
+        rc = rightmost_search(lin, bands, &o, e, &L, wlo_given, &wlo, NULL,
+                              err);
     }
     if (rc != TS_OK) {
         if (acc.numeric || acc.lu || acc.zlu)
