@@ -976,17 +976,21 @@ static void start_vector(double *x, int n)
  * run beside the rightmost search (modes_and_search). */
 static int solve_arpack_real_run(const ts_linear *lin,
                                  const ts_eigen_opts *o, double sigma,
-                                 ts_eigen *e, cand_list *L, ts_err *err);
+                                 ts_eigen *e, cand_list *L, tsi_shift *keep,
+                                 ts_err *err);
 
+/* keep (may be NULL) takes over the run's factorisation of S(sigma), for
+ * the caller's checks to refactor (tsi_shift_eig_error); else it is
+ * freed. */
 static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
                              double sigma, ts_eigen *e, cand_list *L,
-                             ts_err *err)
+                             tsi_shift *keep, ts_err *err)
 {
     int rc;
 #ifdef _OPENMP
 #pragma omp critical(ts_arpack_real)
 #endif
-    rc = solve_arpack_real_run(lin, o, sigma, e, L, err);
+    rc = solve_arpack_real_run(lin, o, sigma, e, L, keep, err);
     return rc;
 }
 
@@ -1169,7 +1173,8 @@ static int ritz_vectors_complex(const tsi_lapack *la, int n, int ncv,
 
 static int solve_arpack_real_run(const ts_linear *lin,
                                  const ts_eigen_opts *o, double sigma,
-                                 ts_eigen *e, cand_list *L, ts_err *err)
+                                 ts_eigen *e, cand_list *L, tsi_shift *keep,
+                                 ts_err *err)
 {
     int n = lin->nstate, nev, ncv, rc;
     tsi_arpack ar;
@@ -1276,7 +1281,10 @@ static int solve_arpack_real_run(const ts_linear *lin,
         }
     }
 out:
-    tsi_shift_free(&sh);
+    if (keep && rc == TS_OK)
+        *keep = sh; /* taken over, not freed */
+    else
+        tsi_shift_free(&sh);
     free(resid);
     free(v);
     free(workd);
@@ -2713,7 +2721,7 @@ static int modes_and_search(const ts_linear *lin, const ts_descriptor *bands,
         int t, team;
         thread_ids(&t, &team);
         if (t == (team > 1 ? 1 : 0)) {
-            rr = solve_arpack_real(lin, &ro, sigma, e, L, &er);
+            rr = solve_arpack_real(lin, &ro, sigma, e, L, es, &er);
             if (rr == TS_OK) {
                 share.wlo = modes_top(L);
                 double complex target = I * 2.0 * M_PI * o->target_hz;
@@ -2839,7 +2847,7 @@ static int eigen_solve(const ts_linear *lin, const ts_descriptor *bands,
         rc = TS_OK; /* modes_and_search fills L */
     else
         rc = o.target_hz == 0.0
-                 ? solve_arpack_real(lin, &o, sigma0, e, &L, err)
+                 ? solve_arpack_real(lin, &o, sigma0, e, &L, NULL, err)
                  : solve_arpack_complex(lin, &o, e, &L, err);
     if (rc != TS_OK) {
         cand_free(&L);
