@@ -994,6 +994,10 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
     return rc;
 }
 
+/* Rows of V per block of ritz_vectors_real's product (a block of the
+ * vectors, RITZ_ROWS x nconv, stays in cache). */
+#define RITZ_ROWS 256
+
 /* The Ritz vectors of the nconv Ritz values dr + i di that dneupd
  * returned without vectors (rvec 0: lambda = sigma + 1/mu, mu a Ritz value
  * of OP), from the Arnoldi factorisation OP V = V H + f e^T that dnaupd
@@ -1002,24 +1006,32 @@ static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
  * Each vector is x = V y with H y = mu y (dgeev on H; mu matched one to
  * one to the nearest of H's eigenvalues), |y| = 1, purified by one step
  * of inverse iteration as dneupd does it, x + f y_ncv / mu = OP x / mu.
- * A real eigenvalue's vector fills one column of z [n x nconv], a pair's
- * two, z_j + i z_(j+1) the vector of dr_j + i di_j (either sign first),
- * as dneupd's.
- * One dgemm (BLAS 3, one pass over V) in place of dneupd's nconv
- * Householder reflections applied to V one after another (dorm2r, each a
- * pass over V; doc/performance.md). TS_ELAPACK when a Ritz value is not
- * among H's eigenvalues (the caller then asks dneupd for the vectors). */
+ * Each becomes a candidate of L (room for nconv made by the caller),
+ * its vector formed straight into L's store: a real eigenvalue's from one
+ * column x_j, a pair's x_j + i x_(j+1) for dr_j + i di_j (either sign
+ * first), as dneupd's columns z_j, z_(j+1) would give it (cand_add).
+ * One pass over V by blocks of rows (a dgemm each, BLAS 3) in place of
+ * dneupd's nconv Householder reflections applied to V one after another
+ * (dorm2r, each a pass over V; doc/performance.md), and no n x nconv
+ * array of real vectors beside the candidates'. TS_ELAPACK when a Ritz
+ * value is not among H's eigenvalues (L is then left as it was, and the
+ * caller asks dneupd for the vectors), TS_ENOMEM. */
 static int ritz_vectors_real(const tsi_lapack *la, int n, int ncv, int nconv,
                              double sigma, const double *dr,
                              const double *di, double *hc,
-                             const double *v, const double *f, double *z)
+                             const double *v, const double *f, cand_list *L)
 {
     int lwork = 4 * ncv, info = 0, one = 1, rc = TS_OK;
     double *wr = malloc((size_t)ncv * (7 + (size_t)2 * ncv) * sizeof(double));
     int *used = calloc((size_t)ncv, sizeof(int));
-    if (!wr || !used) {
+    int *kcol = malloc(((size_t)nconv + 1) * 2 * sizeof(int));
+    double *t = malloc((size_t)RITZ_ROWS * ((size_t)nconv + 1) *
+                       sizeof(double));
+    if (!wr || !used || !kcol || !t) {
         free(wr);
         free(used);
+        free(kcol);
+        free(t);
         return TS_ENOMEM;
     }
     double *wi = wr + ncv, *work = wi + ncv, *vr = work + lwork,
@@ -1087,28 +1099,60 @@ static int ritz_vectors_real(const tsi_lapack *la, int n, int ncv, int nconv,
         }
     }
     if (rc == TS_OK) {
+        /* The candidates, then their vectors by blocks of RITZ_ROWS rows
+         * straight into L's store: the block's x_j = V y_j + c_j f in t,
+         * a real value's column as it is, a pair's x_j + i x_(j+1),
+         * conjugated with its value when di_j < 0 (as cand_add). */
+        int base = L->n, nk = 0, *kpair = kcol + nconv + 1;
+        for (int j = 0; j < nconv && L->n < L->cap; j++) {
+            kcol[nk] = j;
+            kpair[nk] = di[j] == 0.0 ? 0 : (di[j] < 0.0 ? -1 : 1);
+            cand_new(L, dr[j] + I * di[j], NAN, NAN, NAN);
+            L->n++;
+            nk++;
+            j += di[j] != 0.0;
+        }
         double a1 = 1.0, b0 = 0.0;
-        la->dgemm_("N", "N", &n, &nconv, &ncv, &a1, v, &n, y, &ncv, &b0, z,
-                   &n, 1, 1);
-        for (int j = 0; j < nconv; j++) {
-            double *zj = z + (size_t)j * n;
-            for (int i = 0; i < n; i++)
-                zj[i] += c[j] * f[i];
+        for (int r0 = 0; r0 < n; r0 += RITZ_ROWS) {
+            int nb = n - r0 < RITZ_ROWS ? n - r0 : RITZ_ROWS;
+            la->dgemm_("N", "N", &nb, &nconv, &ncv, &a1, v + r0, &n, y, &ncv,
+                       &b0, t, &nb, 1, 1);
+            for (int j = 0; j < nconv; j++)
+                for (int i = 0; i < nb; i++)
+                    t[(size_t)j * nb + i] += c[j] * f[r0 + i];
+            for (int k = 0; k < nk; k++) {
+                double complex *x = L->v + (size_t)(base + k) * n + r0;
+                const double *tr = t + (size_t)kcol[k] * nb, *ti = tr + nb;
+                double sg = kpair[k];
+                if (kpair[k] == 0)
+                    for (int i = 0; i < nb; i++)
+                        x[i] = tr[i];
+                else
+                    for (int i = 0; i < nb; i++)
+                        x[i] = tr[i] + I * (sg * ti[i]);
+            }
         }
     }
     free(wr);
     free(used);
+    free(kcol);
+    free(t);
     return rc;
 }
 
 /* ritz_vectors_real for a complex run (znaupd, zneupd without vectors):
  * the nconv Ritz values d, each its own vector x = V y, H y = mu y (zgeev),
- * purified as zneupd does it, into the columns of z [n x nconv]. */
+ * purified as zneupd does it; those not dropped (drop[j] >= 0) become
+ * candidates of L with the values lam[j] (room made by the caller), their
+ * vectors formed straight into L's store. TS_ELAPACK leaves L as it was
+ * (the caller then asks zneupd for the vectors), TS_ENOMEM. */
 static int ritz_vectors_complex(const tsi_lapack *la, int n, int ncv,
                                 int nconv, double complex sigma,
                                 const double complex *d, double complex *hc,
                                 const double complex *v,
-                                const double complex *f, double complex *z)
+                                const double complex *f,
+                                const double complex *lam, const int *drop,
+                                cand_list *L)
 {
     int lwork = 4 * ncv, info = 0, one = 1, rc = TS_OK;
     double complex *w = malloc((size_t)ncv * (6 + (size_t)2 * ncv) *
@@ -1156,13 +1200,35 @@ static int ritz_vectors_complex(const tsi_lapack *la, int n, int ncv,
         c[j] = yj[ncv - 1] / mu;
     }
     if (rc == TS_OK) {
-        double complex a1 = 1.0, b0 = 0.0;
-        la->zgemm_("N", "N", &n, &nconv, &ncv, &a1, v, &n, y, &ncv, &b0, z,
-                   &n, 1, 1);
+        /* The kept vectors' coefficients packed, then one product
+         * straight into L's store (its columns from L->n on), purified
+         * and conjugated there with their values (as cand_add_complex). */
+        int nk = 0;
         for (int j = 0; j < nconv; j++) {
-            double complex *zj = z + (size_t)j * n;
+            if (drop[j] < 0)
+                continue;
+            if (nk != j)
+                memcpy(y + (size_t)nk * ncv, y + (size_t)j * ncv,
+                       (size_t)ncv * sizeof *y);
+            c[nk++] = c[j];
+        }
+        int base = L->n;
+        double complex a1 = 1.0, b0 = 0.0;
+        if (nk > 0)
+            la->zgemm_("N", "N", &n, &nk, &ncv, &a1, v, &n, y, &ncv, &b0,
+                       L->v + (size_t)base * n, &n, 1, 1);
+        for (int j = 0, k = 0; j < nconv; j++) {
+            if (drop[j] < 0)
+                continue;
+            double complex *x = L->v + (size_t)(base + k) * n;
             for (int i = 0; i < n; i++)
-                zj[i] += c[j] * f[i];
+                x[i] += c[k] * f[i];
+            if (cimag(lam[j]) < 0)
+                for (int i = 0; i < n; i++)
+                    x[i] = conj(x[i]);
+            cand_new(L, lam[j], NAN, NAN, NAN);
+            L->n++;
+            k++;
         }
     }
     free(w);
@@ -1195,13 +1261,12 @@ static int solve_arpack_real_run(const ts_linear *lin,
     double *workl = malloc((size_t)lworkl * sizeof(double));
     double *dr = malloc((size_t)(nev + 1) * sizeof(double));
     double *di = malloc((size_t)(nev + 1) * sizeof(double));
-    double *z =
-        tsi_big_malloc((size_t)n * (size_t)(nev + 1) * sizeof(double));
+    double *z = NULL; /* dneupd's vectors, should ritz_vectors_real fail */
     double *workev = malloc(3 * (size_t)ncv * sizeof(double));
     double *hc = malloc((size_t)ncv * ncv * sizeof(double));
     int *select = calloc((size_t)ncv, sizeof(int));
-    if (!resid || !v || !workd || !workl || !dr || !di || !z || !workev ||
-        !hc || !select) {
+    if (!resid || !v || !workd || !workl || !dr || !di || !workev || !hc ||
+        !select) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
@@ -1244,11 +1309,22 @@ static int solve_arpack_real_run(const ts_linear *lin,
     memcpy(hc, h, (size_t)ncv * ncv * sizeof(double));
     hc[2] = 0.0;
     int rvec = 0, vrc = TS_ELAPACK;
+    if (cand_init(L, iparam[4] + 1, n) != TS_OK) {
+        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+        goto out;
+    }
     for (int pass = 0; pass < 2 && vrc == TS_ELAPACK; pass++, rvec = 1) {
         h[2] = rnorm;
-        ar.dneupd_(&rvec, "A", select, dr, di, z, &n, &sigma, &sigmai, workev,
-                   "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
-                   ipntr, workd, workl, &lworkl, &info, 1, 1, 2);
+        /* (Without vectors dneupd does not reference z: v stands in.) */
+        if (rvec && !(z = tsi_big_malloc((size_t)n * (size_t)(nev + 1) *
+                                         sizeof(double)))) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
+            goto out;
+        }
+        ar.dneupd_(&rvec, "A", select, dr, di, rvec ? z : v, &n, &sigma,
+                   &sigmai, workev, "I", &n, "LM", &nev, &tol, resid, &ncv,
+                   v, &n, iparam, ipntr, workd, workl, &lworkl, &info, 1, 1,
+                   2);
         if (info != 0) {
             rc = ts_fail(err, TS_ELAPACK,
                          "eigen: ARPACK dneupd info %d (%s)", info,
@@ -1257,18 +1333,15 @@ static int solve_arpack_real_run(const ts_linear *lin,
         }
         vrc = rvec ? TS_OK
                    : ritz_vectors_real(&la, n, ncv, iparam[4], sigma, dr, di,
-                                       hc, v, resid, z);
+                                       hc, v, resid, L);
         if (vrc == TS_ENOMEM) {
             rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
             goto out;
         }
     }
     int nconv = iparam[4];
-    if (cand_init(L, nconv + 1, n) != TS_OK) {
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
-        goto out;
-    }
-    for (int j = 0; j < nconv; j++) {
+    /* dneupd's vectors (the fallback): into the candidates here. */
+    for (int j = 0; z && j < nconv; j++) {
         const double *zj = z + (size_t)j * n;
         if (di[j] == 0.0) {
             cand_add(L, dr[j], zj, NULL, NAN, NAN, NAN);
@@ -1354,14 +1427,15 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
     double complex *workd = malloc(3 * (size_t)n * szc);
     double complex *workl = malloc((size_t)lworkl * szc);
     double complex *d = malloc((size_t)(nev + 1) * szc);
-    double complex *z = tsi_big_malloc((size_t)n * (size_t)(nev + 1) * szc);
+    double complex *z = NULL; /* zneupd's vectors, the fallback's */
+    double complex *lam = malloc((size_t)(nev + 1) * szc);
     double complex *workev = malloc(2 * (size_t)ncv * szc);
     double *rwork = malloc((size_t)ncv * sizeof(double));
     double complex *hc = malloc((size_t)ncv * ncv * szc);
     int *select = calloc((size_t)ncv, sizeof(int));
     int *used = calloc((size_t)(nev + 1), sizeof(int));
-    if (!resid || !v || !workd || !workl || !d || !z || !workev || !rwork ||
-        !hc || !select || !used) {
+    if (!resid || !v || !workd || !workl || !d || !lam || !workev ||
+        !rwork || !hc || !select || !used) {
         rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
         goto out;
     }
@@ -1408,52 +1482,65 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
     double complex *h = workl + ipntr[4] - 1, rnorm = h[2];
     memcpy(hc, h, (size_t)ncv * ncv * sizeof(double complex));
     hc[2] = 0.0;
-    int rvec = 0, vrc = TS_ELAPACK;
+    int rvec = 0, vrc = TS_ELAPACK, nconv = 0;
     for (int pass = 0; pass < 2 && vrc == TS_ELAPACK; pass++, rvec = 1) {
         h[2] = rnorm;
-        ar.zneupd_(&rvec, "A", select, d, z, &n, &sigma, workev, "I", &n,
-                   "LM", &nev, &tol, resid, &ncv, v, &n, iparam, ipntr,
-                   workd, workl, &lworkl, rwork, &info, 1, 1, 2);
+        /* (Without vectors zneupd does not reference z: v stands in.) */
+        if (rvec && !(z = tsi_big_malloc((size_t)n * (size_t)(nev + 1) *
+                                         szc))) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
+            goto out;
+        }
+        ar.zneupd_(&rvec, "A", select, d, rvec ? z : v, &n, &sigma, workev,
+                   "I", &n, "LM", &nev, &tol, resid, &ncv, v, &n, iparam,
+                   ipntr, workd, workl, &lworkl, rwork, &info, 1, 1, 2);
         if (info != 0) {
             rc = ts_fail(err, TS_ELAPACK,
                          "eigen: ARPACK zneupd info %d (%s)", info,
                          arpack_info_text(info));
             goto out;
         }
+        nconv = iparam[4];
+        if (cand_grow(L, nconv) != TS_OK) {
+            rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
+            goto out;
+        }
+        /* The candidates' values: rounding makes real eigenvalues slightly
+         * complex (snapped), and a conjugate pair found whole is kept
+         * once (used -1 on its lower member). */
+        for (int j = 0; j < nconv; j++) {
+            lam[j] = d[j];
+            used[j] = 0;
+            if (fabs(cimag(lam[j])) <= REAL_IM_RTOL * cabs(lam[j]))
+                lam[j] = creal(lam[j]);
+        }
+        for (int j = 0; j < nconv; j++) {
+            if (cimag(lam[j]) >= 0.0)
+                continue;
+            for (int k = 0; k < nconv; k++) {
+                if (used[k] || cimag(lam[k]) <= 0.0)
+                    continue;
+                if (cabs(lam[k] - conj(lam[j])) <=
+                    CONJ_MATCH_RTOL * cabs(lam[j])) {
+                    used[k] = 1;
+                    used[j] = -1;
+                    break;
+                }
+            }
+        }
         vrc = rvec ? TS_OK
-                   : ritz_vectors_complex(&la, n, ncv, iparam[4], sigma, d,
-                                          hc, v, resid, z);
+                   : ritz_vectors_complex(&la, n, ncv, nconv, sigma, d, hc,
+                                          v, resid, lam, used, L);
         if (vrc == TS_ENOMEM) {
             rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory for ARPACK");
             goto out;
         }
     }
-    int nconv = iparam[4];
-    if (cand_grow(L, nconv) != TS_OK) {
-        rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
-        goto out;
-    }
-    /* Rounding makes real eigenvalues slightly complex: snap them. */
-    for (int j = 0; j < nconv; j++)
-        if (fabs(cimag(d[j])) <= REAL_IM_RTOL * cabs(d[j]))
-            d[j] = creal(d[j]);
-    for (int j = 0; j < nconv; j++) {
-        if (cimag(d[j]) >= 0.0)
-            continue;
-        for (int k = 0; k < nconv; k++) {
-            if (used[k] || cimag(d[k]) <= 0.0)
-                continue;
-            if (cabs(d[k] - conj(d[j])) <= CONJ_MATCH_RTOL * cabs(d[j])) {
-                used[k] = 1;
-                used[j] = -1;
-                break;
-            }
-        }
-    }
-    for (int j = 0; j < nconv; j++) {
+    /* zneupd's vectors (the fallback): into the candidates here. */
+    for (int j = 0; z && j < nconv; j++) {
         if (used[j] < 0)
             continue;
-        cand_add_complex(L, d[j], z + (size_t)j * n);
+        cand_add_complex(L, lam[j], z + (size_t)j * n);
     }
 out:
     if (!fac)
@@ -1463,6 +1550,7 @@ out:
     free(workd);
     free(workl);
     free(d);
+    free(lam);
     free(z);
     free(workev);
     free(rwork);
