@@ -739,7 +739,6 @@ static int run_linearize(ts_result *r, const ts_linearize_opts *lo,
     return rc;
 }
 
-/* The equilibrium stage of modes and response: solve, then linearize. */
 static ts_eigen_opts modes_eigen_opts(const ts_modes_opts *m, int n);
 
 /* The libraries the modes of a linear model of n states will open
@@ -756,9 +755,10 @@ static int modes_libraries(const ts_modes_opts *m,
            (lo->model != TS_LIN_DENSE ? TSI_PRELOAD_KLU : 0);
 }
 
-/* The equilibrium, then the linear model lo. With `modes` (the modes
- * pipeline) the libraries the modes will need are opened ahead, beside
- * the two (modes_libraries). */
+/* The equilibrium stage of modes and response: solve, then linearize
+ * (the linear model lo). With `modes` (the modes pipeline) the libraries
+ * the modes will need are opened ahead, beside the two
+ * (modes_libraries). */
 static int equilibrium_then_linear(ts_result *r, const ts_request *rq,
                                    const ts_linearize_opts *lo, int modes,
                                    ts_err *err)

@@ -517,7 +517,7 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
 /* The componentwise backward error of sh's factors at b = (1 + (i mod
  * 7) / 7)_i (left_start_entry, as a right-hand side): x = S^-1 b solved,
  * then max_i |S x - b|_i / (|S| |x| + |b|)_i (Oettli and Prager, moduli
- * as |Re| + |Im|), S the matrix in sh->Sx. O(nnz). w [4 (nx + 1)]
+ * as |Re| + |Im|), S the matrix in sh->Sx. O(nnz). w [5 (nx + 1)]
  * work. */
 static double right_backward(tsi_shift *sh, double *w)
 {
