@@ -269,36 +269,51 @@ static cand *cand_new(cand_list *L, double complex lam, double cond,
     return c;
 }
 
+/* x[m] = vr + i sign vi (vi NULL: vr alone), rows of a candidate's
+ * vector from its real and imaginary parts, sign -1 where the value was
+ * conjugated into the upper half plane (cand_new). */
+static void pair_into(double complex *x, const double *vr, const double *vi,
+                      double sign, size_t m)
+{
+    for (size_t i = 0; i < m; i++)
+        x[i] = vr[i] + I * (vi ? sign * vi[i] : 0.0);
+}
+
 static void cand_add(cand_list *L, double complex lam, const double *vr,
                      const double *vi, double cond, double resid,
                      double dlam)
 {
     if (L->n >= L->cap)
         return;
-    int sign = cimag(lam) < 0 ? -1 : 1;
+    double sign = cimag(lam) < 0 ? -1 : 1;
     cand_new(L, lam, cond, resid, dlam);
-    double complex *v = L->v + (size_t)L->n * L->nstate;
-    for (int i = 0; i < L->nstate; i++)
-        v[i] = vr[i] + I * (vi ? sign * vi[i] : 0.0);
+    pair_into(L->v + (size_t)L->n * L->nstate, vr, vi, sign,
+              (size_t)L->nstate);
     L->n++;
 }
 
-/* cand_add with a complex vector z (ARPACK's complex runs): copied as it
- * is, or conjugated with lam. */
+/* A candidate for lam whose complex vector is already in L's store, at
+ * its next column L->n: conjugated there with lam when lam is in the
+ * lower half plane (cand_new conjugates lam). */
+static void cand_take(cand_list *L, double complex lam)
+{
+    double complex *v = L->v + (size_t)L->n * L->nstate;
+    if (cimag(lam) < 0)
+        for (int i = 0; i < L->nstate; i++)
+            v[i] = conj(v[i]);
+    cand_new(L, lam, NAN, NAN, NAN);
+    L->n++;
+}
+
+/* cand_add with a complex vector z (zneupd's): copied, then taken. */
 static void cand_add_complex(cand_list *L, double complex lam,
                              const double complex *z)
 {
     if (L->n >= L->cap)
         return;
-    cand_new(L, lam, NAN, NAN, NAN);
-    double complex *v = L->v + (size_t)L->n * L->nstate;
-    if (cimag(lam) < 0) {
-        for (int i = 0; i < L->nstate; i++)
-            v[i] = conj(z[i]);
-    } else {
-        memcpy(v, z, (size_t)L->nstate * sizeof *v);
-    }
-    L->n++;
+    memcpy(L->v + (size_t)L->n * L->nstate, z,
+           (size_t)L->nstate * sizeof *z);
+    cand_take(L, lam);
 }
 
 /* Ties broken by the order of storage: L->v's columns, then those of
@@ -979,9 +994,9 @@ static int solve_arpack_real_run(const ts_linear *lin,
                                  ts_eigen *e, cand_list *L, tsi_shift *keep,
                                  ts_err *err);
 
-/* keep (may be NULL) takes over the run's factorisation of S(sigma), for
- * the caller's checks to refactor (tsi_shift_eig_error); else it is
- * freed. */
+/* keep (may be NULL; zeroed, holding no factorisation) takes over the
+ * run's factorisation of S(sigma), for the caller's checks to refactor
+ * (tsi_shift_eig_error); else it is freed. */
 static int solve_arpack_real(const ts_linear *lin, const ts_eigen_opts *o,
                              double sigma, ts_eigen *e, cand_list *L,
                              tsi_shift *keep, ts_err *err)
@@ -1121,15 +1136,9 @@ static int ritz_vectors_real(const tsi_lapack *la, int n, int ncv, int nconv,
                 for (int i = 0; i < nb; i++)
                     t[(size_t)j * nb + i] += c[j] * f[r0 + i];
             for (int k = 0; k < nk; k++) {
-                double complex *x = L->v + (size_t)(base + k) * n + r0;
-                const double *tr = t + (size_t)kcol[k] * nb, *ti = tr + nb;
-                double sg = kpair[k];
-                if (kpair[k] == 0)
-                    for (int i = 0; i < nb; i++)
-                        x[i] = tr[i];
-                else
-                    for (int i = 0; i < nb; i++)
-                        x[i] = tr[i] + I * (sg * ti[i]);
+                const double *tr = t + (size_t)kcol[k] * nb;
+                pair_into(L->v + (size_t)(base + k) * n + r0, tr,
+                          kpair[k] ? tr + nb : NULL, kpair[k], (size_t)nb);
             }
         }
     }
@@ -1223,11 +1232,7 @@ static int ritz_vectors_complex(const tsi_lapack *la, int n, int ncv,
             double complex *x = L->v + (size_t)(base + k) * n;
             for (int i = 0; i < n; i++)
                 x[i] += c[k] * f[i];
-            if (cimag(lam[j]) < 0)
-                for (int i = 0; i < n; i++)
-                    x[i] = conj(x[i]);
-            cand_new(L, lam[j], NAN, NAN, NAN);
-            L->n++;
+            cand_take(L, lam[j]);
             k++;
         }
     }
@@ -1404,6 +1409,36 @@ static int arpack_near(const ts_linear *lin, double complex sigma, int nev,
     return rc;
 }
 
+/* The candidates' values lam[n] of a complex run's Ritz values d[n]:
+ * rounding makes real eigenvalues slightly complex (snapped to the real
+ * axis), and of a conjugate pair found whole the lower member is dropped
+ * (used -1; its partner used 1; the others 0), matched one to one so that
+ * double eigenvalues stay double. */
+static void complex_values(int n, const double complex *d,
+                           double complex *lam, int *used)
+{
+    for (int j = 0; j < n; j++) {
+        lam[j] = d[j];
+        used[j] = 0;
+        if (fabs(cimag(lam[j])) <= REAL_IM_RTOL * cabs(lam[j]))
+            lam[j] = creal(lam[j]);
+    }
+    for (int j = 0; j < n; j++) {
+        if (cimag(lam[j]) >= 0.0)
+            continue;
+        for (int k = 0; k < n; k++) {
+            if (used[k] || cimag(lam[k]) <= 0.0)
+                continue;
+            if (cabs(lam[k] - conj(lam[j])) <=
+                CONJ_MATCH_RTOL * cabs(lam[j])) {
+                used[k] = 1;
+                used[j] = -1;
+                break;
+            }
+        }
+    }
+}
+
 static int arpack_near_run(const ts_linear *lin, double complex sigma,
                            int nev, int ncv, double tol, int maxiter,
                            int partial, const double complex *start,
@@ -1417,8 +1452,8 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
         tsi_lapack_open(&la, err) != TS_OK)
         return TS_EIO;
     tsi_shift own, *sh = fac ? fac : &own;
-    if ((rc = fac ? tsi_shift_refactor_solved(fac, lin, sigma, NULL, err)
-                  : tsi_shift_factor(&own, lin, sigma, err)) != TS_OK)
+    if ((rc = fac ? tsi_shift_refactor_judged(sh, lin, sigma, NULL, err)
+                  : tsi_shift_factor(sh, lin, sigma, err)) != TS_OK)
         return rc;
     int lworkl = 3 * ncv * ncv + 5 * ncv;
     size_t szc = sizeof(double complex);
@@ -1505,29 +1540,7 @@ static int arpack_near_run(const ts_linear *lin, double complex sigma,
             rc = ts_fail(err, TS_ENOMEM, "eigen: out of memory");
             goto out;
         }
-        /* The candidates' values: rounding makes real eigenvalues slightly
-         * complex (snapped), and a conjugate pair found whole is kept
-         * once (used -1 on its lower member). */
-        for (int j = 0; j < nconv; j++) {
-            lam[j] = d[j];
-            used[j] = 0;
-            if (fabs(cimag(lam[j])) <= REAL_IM_RTOL * cabs(lam[j]))
-                lam[j] = creal(lam[j]);
-        }
-        for (int j = 0; j < nconv; j++) {
-            if (cimag(lam[j]) >= 0.0)
-                continue;
-            for (int k = 0; k < nconv; k++) {
-                if (used[k] || cimag(lam[k]) <= 0.0)
-                    continue;
-                if (cabs(lam[k] - conj(lam[j])) <=
-                    CONJ_MATCH_RTOL * cabs(lam[j])) {
-                    used[k] = 1;
-                    used[j] = -1;
-                    break;
-                }
-            }
-        }
+        complex_values(nconv, d, lam, used);
         vrc = rvec ? TS_OK
                    : ritz_vectors_complex(&la, n, ncv, nconv, sigma, d, hc,
                                           v, resid, lam, used, L);
@@ -1846,8 +1859,9 @@ static double sweep_threshold(const cand_list *L, int from)
  * rightmost eigenvalue a run found lies in the outer half of its disc,
  * the next shift is at its frequency. Adds the eigenvalues found to L
  * (sweep = 1, repeats and a rerun grid run's first values 2). keep (may
- * be NULL) takes over the runs' factorisation at the last shift, for the
- * caller's checks to refactor (tsi_shift_eig_error); else it is freed. */
+ * be NULL; zeroed) takes over the runs' factorisation at the last shift,
+ * for the caller's checks to refactor (tsi_shift_eig_error); else it is
+ * freed. */
 static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
                             const ts_eigen_opts *o, ts_eigen *e, cand_list *L,
                             double (*get_wlo)(void *), void *wctx,
@@ -1905,7 +1919,7 @@ static int rightmost_search(const ts_linear *lin, const ts_descriptor *d,
     arpack_stats st = {0, 0, 0, 0};
     /* The runs' factorisation, refactored from shift to shift with the
      * previous pivots while a solve's backward error stays small
-     * (tsi_shift_refactor_solved). */
+     * (tsi_shift_refactor_judged). */
     tsi_shift fac = {0};
     int rc = TS_OK, runs = 0, first = L->n;
     /* The grid's runs are loose only where each Ritz value's own error

@@ -91,11 +91,12 @@ int tsi_nlopt_open(tsi_nlopt *t, ts_err *err);
  * opens them on a thread of its own while it computes what comes first
  * (the equilibrium and the linearization), so that loading them (LAPACK
  * with OpenBLAS some milliseconds: doc/performance.md, "Start-up") is not
- * on the path of the analysis that uses them. The thread only opens the libraries, as each tsi_<lib>_open
- * does, and keeps nothing: the analysis opens them again where it uses
- * them, which then only finds them, and reports a library that cannot be
- * opened as before. tsi_preload_join waits for the thread; without one
- * (pthread_create failed, or nothing asked) it returns at once. */
+ * on the path of the analysis that uses them. The thread only opens the
+ * libraries, as each tsi_<lib>_open does, and keeps nothing: the analysis
+ * opens them again where it uses them, which then only finds them, and
+ * reports a library that cannot be opened as before. tsi_preload_join
+ * waits for the thread; without one (pthread_create failed, or nothing
+ * asked) it returns at once. */
 enum {
     TSI_PRELOAD_LAPACK = 1,
     TSI_PRELOAD_ARPACK = 2,

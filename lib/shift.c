@@ -448,8 +448,6 @@ static int afresh(tsi_shift *sh, int cplx, ts_err *err)
     return factor(sh, err);
 }
 
-static inline double left_start_entry(int i);
-
 /* tsi_shift_refactor; with test 0 the old pivots serve whenever KLU's
  * refactorisation succeeds (the caller judges its solves:
  * tsi_shift_eig_error). *fresh (may be NULL) is set when it factored
@@ -512,75 +510,6 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
                        ts_err *err)
 {
     return refactor(sh, lin, s, 1, NULL, err);
-}
-
-/* The componentwise backward error of sh's factors at b = (1 + (i mod
- * 7) / 7)_i (left_start_entry, as a right-hand side): x = S^-1 b solved,
- * then max_i |S x - b|_i / (|S| |x| + |b|)_i (Oettli and Prager, moduli
- * as |Re| + |Im|), S the matrix in sh->Sx. O(nnz). w [5 (nx + 1)]
- * work. */
-static double right_backward(tsi_shift *sh, double *w)
-{
-    const ts_descriptor *d = sh->d;
-    int nx = d->nx, cx = sh->is_complex;
-    double *x = w, *r = w + 2 * ((size_t)nx + 1), *den = r + 2 * (size_t)nx;
-    for (int i = 0; i < nx; i++) {
-        double b = left_start_entry(i);
-        if (cx) {
-            x[2 * i] = b;
-            x[2 * i + 1] = 0.0;
-        } else {
-            x[i] = b;
-        }
-        r[2 * i] = -b;
-        r[2 * i + 1] = 0.0;
-        den[i] = b;
-    }
-    if (cx)
-        sh->klu.klu_z_solve(d->klu_symbolic, sh->numeric, nx, 1, x,
-                            sh->common);
-    else
-        sh->klu.klu_solve(d->klu_symbolic, sh->numeric, nx, 1, x,
-                          sh->common);
-    /* r (interleaved) = S x - b and den = |S| |x| + |b|, by columns. */
-    const double *a = sh->Sx;
-    for (int j = 0; j < nx; j++) {
-        double xr = cx ? x[2 * j] : x[j], xi = cx ? x[2 * j + 1] : 0.0;
-        double ax = fabs(xr) + fabs(xi);
-        for (int p = d->Sp[j]; p < d->Sp[j + 1]; p++) {
-            int i = d->Si[p];
-            double sr = cx ? a[2 * p] : a[p], si = cx ? a[2 * p + 1] : 0.0;
-            r[2 * i] += sr * xr - si * xi;
-            r[2 * i + 1] += sr * xi + si * xr;
-            den[i] += (fabs(sr) + fabs(si)) * ax;
-        }
-    }
-    double om = 0.0;
-    for (int i = 0; i < nx; i++)
-        if (den[i] > 0)
-            om = fmax(om, (fabs(r[2 * i]) + fabs(r[2 * i + 1])) / den[i]);
-    return isnan(om) ? INFINITY : om;
-}
-
-int tsi_shift_refactor_solved(tsi_shift *sh, const ts_linear *lin,
-                              double complex s, int *fresh, ts_err *err)
-{
-    int f = 1, rc = refactor(sh, lin, s, 0, &f, err);
-    if (rc == TS_OK && !f) {
-        size_t nw = 5 * ((size_t)sh->d->nx + 1);
-        double *w = malloc(nw * sizeof(double));
-        if (!w)
-            return ts_fail(err, TS_ENOMEM, "shift: out of memory");
-        double om = right_backward(sh, w);
-        free(w);
-        if (!(om <= SHIFT_NEAR_BACKWARD)) {
-            f = 1;
-            rc = afresh(sh, sh->is_complex, err);
-        }
-    }
-    if (fresh)
-        *fresh = f;
-    return rc;
 }
 
 int tsi_shift_factor_inf(tsi_shift *sh, const ts_linear *lin, ts_err *err)
@@ -1130,6 +1059,55 @@ static double left_backward(const tsi_shift *sh, const double complex *w)
     return om;
 }
 
+/* The error estimates' work in sh->ework (tsi_shift_eig_error: w, z, X
+ * complex [nx + 1] each, x complex [m], q [nq + 1], u [2 m], m = 3 np +
+ * nc), kept for the next eigenvalue. */
+static int ensure_ework(tsi_shift *sh)
+{
+    if (sh->ework)
+        return TS_OK;
+    const ts_descriptor *d = sh->d;
+    size_t m = 3 * (size_t)d->np + (size_t)d->nc;
+    size_t nw = 6 * ((size_t)d->nx + 1) + 4 * m + (size_t)sh->lin->nq + 1;
+    sh->ework = malloc(nw * sizeof(double));
+    return sh->ework ? TS_OK : TS_ENOMEM;
+}
+
+/* Factor at s reusing the old pivots (refactor, test 0), judged by what
+ * they give: the componentwise backward error of the first iterate w0 =
+ * S^-T b of the left vector's inverse iteration (left_first,
+ * left_backward; w0 at the head of sh->ework). Over SHIFT_NEAR_BACKWARD,
+ * S(s) is factored afresh and w0 solved again. *fresh is set when it
+ * factored afresh. Codes as refactor's; err may be NULL. */
+static int refactor_judged(tsi_shift *sh, const ts_linear *lin,
+                           double complex s, int *fresh, ts_err *err)
+{
+    int rc = refactor(sh, lin, s, 0, fresh, err);
+    if (rc == TS_OK && ensure_ework(sh) != TS_OK)
+        rc = ts_fail(err, TS_ENOMEM, "shift: out of memory");
+    if (rc != TS_OK)
+        return rc;
+    double complex *w0 = (double complex *)sh->ework;
+    int nx = sh->d->nx;
+    left_first(sh, w0, nx);
+    if (*fresh || left_backward(sh, w0) <= SHIFT_NEAR_BACKWARD)
+        return TS_OK;
+    *fresh = 1;
+    rc = afresh(sh, sh->is_complex, err);
+    if (rc == TS_OK)
+        left_first(sh, w0, nx);
+    return rc;
+}
+
+int tsi_shift_refactor_judged(tsi_shift *sh, const ts_linear *lin,
+                              double complex s, int *fresh, ts_err *err)
+{
+    int f = 1, rc = refactor_judged(sh, lin, s, &f, err);
+    if (fresh)
+        *fresh = f;
+    return rc;
+}
+
 /* Scale w[m] to largest |Re| + |Im| 1 (w nonzero): the estimates are of
  * w's direction only, and this needs no hypot per entry. */
 static void unit_max(double complex *w, int m)
@@ -1207,24 +1185,11 @@ int tsi_shift_eig_error(tsi_shift *sh, const ts_linear *lin,
      * parts are kept in sh for the next eigenvalue. */
     int rc = TS_ESINGULAR, fresh = 1;
     double nudge = 1e-10 * (cabs(lam) > 0 ? cabs(lam) : 1.0);
-    size_t nw = 6 * ((size_t)nx + 1) + 4 * m + (size_t)nq + 1;
     for (int t = 0; t < 3 && rc == TS_ESINGULAR; t++, nudge *= 100.0) {
         double complex st = t == 0 ? lam : lam + nudge;
-        rc = refactor(sh, lin, st, 0, &fresh, NULL);
-        if (rc == TS_OK && !sh->ework &&
-            !(sh->ework = malloc(nw * sizeof(double))))
-            rc = TS_ENOMEM;
+        rc = refactor_judged(sh, lin, st, &fresh, NULL);
         if (rc == TS_OK && ensure_parts(sh, NULL) != TS_OK)
             rc = TS_ENOMEM;
-        if (rc != TS_OK)
-            continue;
-        double complex *w0 = (double complex *)sh->ework;
-        left_first(sh, w0, nx);
-        if (fresh || left_backward(sh, w0) <= SHIFT_NEAR_BACKWARD)
-            break;
-        rc = afresh(sh, sh->is_complex, NULL);
-        if (rc == TS_OK)
-            left_first(sh, w0, nx);
     }
     if (rc == TS_ENOMEM)
         return ts_fail(err, rc, "eigen: out of memory for the error "

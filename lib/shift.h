@@ -126,15 +126,17 @@ int tsi_shift_refactor(tsi_shift *sh, const ts_linear *lin, double complex s,
  * 3). */
 #define SHIFT_NEAR_BACKWARD 1e-10
 
-/* Factor at a new shift s as tsi_shift_refactor, with another test of
- * the old pivots: the componentwise backward error of a solve with the
- * refactored factors (a fixed right-hand side, Oettli and Prager), which
- * must stay within SHIFT_NEAR_BACKWARD; else S(s) is factored afresh.
- * For a sequence of shifts far apart (the rightmost search's, a factor 4
- * apart), where the rcond estimates of the two factorisations differ with
- * S(s) itself. One extra solve and an O(nnz) pass. *fresh (may be NULL)
- * is set when it factored afresh. Same codes. */
-int tsi_shift_refactor_solved(tsi_shift *sh, const ts_linear *lin,
+/* Factor at a new shift s as tsi_shift_refactor, with the old pivots
+ * judged as tsi_shift_eig_error judges them: by the componentwise
+ * backward error of the first step of its left vector's inverse
+ * iteration (a transposed solve of a fixed right-hand side, Oettli and
+ * Prager), which must stay within SHIFT_NEAR_BACKWARD; else S(s) is
+ * factored afresh. For a sequence of shifts far apart (the rightmost
+ * search's, a factor 4 apart), where the rcond estimates of the two
+ * factorisations differ with S(s) itself. One extra solve and an O(nnz)
+ * pass; sh then holds the estimates' work too. *fresh (may be NULL) is
+ * set when it factored afresh. Same codes. */
+int tsi_shift_refactor_judged(tsi_shift *sh, const ts_linear *lin,
                               double complex s, int *fresh, ts_err *err);
 
 /* Factor S_inf, for tsi_shift_apply. Same codes. */

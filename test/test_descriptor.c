@@ -515,14 +515,14 @@ static void test_eig_error_refactored(void)
     ts_scene_free(sc);
 }
 
-/* tsi_shift_refactor_solved over the rightmost search's kind of sequence,
+/* tsi_shift_refactor_judged over the rightmost search's kind of sequence,
  * imaginary shifts a factor 4 apart (the band top down the grid, then
  * back up): each solve equals a fresh factorisation's within 1e-9 of the
  * solution (the backward error of 1e-10 the refactorisation must keep,
  * times the modest condition away from the eigenvalues), and the old
  * pivots served at least once (else the test would compare fresh
  * factorisations with themselves). On the mixed scene. */
-static void test_refactor_solved(void)
+static void test_refactor_judged(void)
 {
     ts_scene *sc;
     ts_kernel *k;
@@ -541,7 +541,7 @@ static void test_refactor_solved(void)
         b[i] = sin(1.3 * i + 0.2) + I * cos(0.7 * i);
     for (int si = 0; rc == TS_OK && si < 7; si++) {
         int fresh = -1;
-        rc = tsi_shift_refactor_solved(&seq, lin, I * w[si], &fresh, &err);
+        rc = tsi_shift_refactor_judged(&seq, lin, I * w[si], &fresh, &err);
         tsi_shift one = {0};
         if (rc == TS_OK)
             rc = tsi_shift_factor(&one, lin, I * w[si], &err);
@@ -945,7 +945,7 @@ int main(void)
     test_examples();
     test_shifted_solve();
     test_eig_error_refactored();
-    test_refactor_solved();
+    test_refactor_judged();
     test_groups();
     test_towing();
     ts_units_free(units);
