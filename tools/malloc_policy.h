@@ -12,8 +12,8 @@
  *  - one arena: every thread (the linearization's, the modes' run beside
  *    the rightmost search, a sweep's points) allocates from the main heap,
  *    where glibc would give each thread a heap of its own, mapped apart;
- *  - the first TOWSTAB_HEAP_HUGE bytes of the heap advised to the kernel
- *    as transparent huge pages (madvise MADV_HUGEPAGE): one fault per
+ *  - the heap's next TOWSTAB_HEAP_HUGE bytes advised to the kernel as
+ *    transparent huge pages (madvise MADV_HUGEPAGE): one fault per
  *    2 MiB of memory first written, where there were 512, wherever it
  *    is allocated (KLU's factors, ARPACK's work, the descriptor's
  *    arrays). Only address space is reserved: a page is backed when first
