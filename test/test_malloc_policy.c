@@ -15,11 +15,16 @@
  *    returns to the top, which is not trimmed).
  * Elsewhere the policy is advice not taken, and those checks are skipped
  * and said so; an allocation of more than the advised heap (mapped apart)
- * works everywhere. */
+ * works everywhere. First, in a child process under a limit of its
+ * address space (RLIMIT_AS, 64 GiB), the policy reserves nothing and says
+ * so. */
 #include "malloc_policy.h"
 
 #include <pthread.h>
 #include <stdint.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -59,8 +64,27 @@ static void *thread_alloc(void *arg)
     return NULL;
 }
 
+/* The policy's answer in a child process whose address space is limited
+ * (RLIMIT_AS), -1 when the child could not be run. */
+static int limited_child(void)
+{
+    pid_t pid = fork();
+    if (pid == 0) {
+        struct rlimit as = {(rlim_t)64 << 30, (rlim_t)64 << 30};
+        if (setrlimit(RLIMIT_AS, &as) != 0)
+            _exit(3);
+        _exit(towstab_malloc_policy());
+    }
+    int st;
+    if (pid < 0 || waitpid(pid, &st, 0) != pid || !WIFEXITED(st))
+        return -1;
+    return WEXITSTATUS(st) <= 1 ? WEXITSTATUS(st) : -1;
+}
+
 int main(void)
 {
+    CHECK(limited_child() == 0, "under a limit of the address space the "
+                                "policy reserves and advises nothing");
     int advised = towstab_malloc_policy();
     int expect = thp_offered();
 #if !defined(__GLIBC__)

@@ -18,7 +18,9 @@
  *    is allocated (KLU's factors, ARPACK's work, the descriptor's
  *    arrays). Only address space is reserved: a page is backed when first
  *    written, as before. Memory beyond it, in another allocator (a
- *    sanitizer's) or on a kernel without huge pages stays as it was.
+ *    sanitizer's), on a kernel without huge pages or under a limit of
+ *    the address space or data segment (nothing reserved) stays as it
+ *    was.
  *    A huge page is cleared whole when first written (2 MiB, where a
  *    small run writes little of it): the advised heap costs a
  *    20-link equilibrium nothing measurable (doc/performance.md).
@@ -33,6 +35,7 @@
 #ifdef __GLIBC__
 #include <malloc.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #endif
 
@@ -41,6 +44,15 @@
  * threshold (an allocation of 256 MB or more is mapped apart). */
 #define TOWSTAB_HEAP_HUGE ((size_t)240 << 20)
 #define TOWSTAB_HUGE_PAGE ((uintptr_t)2 << 20)
+
+#ifdef __GLIBC__
+/* Whether the process's limit of resource (getrlimit) is infinite. */
+static inline int towstab_unlimited(int resource)
+{
+    struct rlimit r;
+    return getrlimit(resource, &r) == 0 && r.rlim_cur == RLIM_INFINITY;
+}
+#endif
 
 static inline int towstab_malloc_policy(void)
 {
@@ -57,7 +69,11 @@ static inline int towstab_malloc_policy(void)
      * even by MALLOC_PERTURB_, which fills the blocks given out), and
      * only when the heap's break moved by it (not mapped apart, not
      * another allocator's). The first block is larger than the top of a
-     * program that has allocated little yet, so that the top grows. */
+     * program that has allocated little yet, so that the top grows. Not
+     * under a limit of the address space or of the data segment (ulimit
+     * -v, -d), against which the reserved space would count. */
+    if (!towstab_unlimited(RLIMIT_AS) || !towstab_unlimited(RLIMIT_DATA))
+        return 0;
     char *brk0 = sbrk(0);
     mallopt(M_TOP_PAD, (int)TOWSTAB_HEAP_HUGE);
     char *p = malloc(1 << 20);
