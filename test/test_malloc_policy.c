@@ -2,8 +2,9 @@
  * (tools/malloc_policy.h).
  *
  * Set first, as towstab's main sets it. With glibc, on a kernel that
- * offers transparent huge pages to advised memory and without a
- * sanitizer's allocator, the policy says it advised the heap, and then:
+ * offers transparent huge pages to advised memory, without a sanitizer's
+ * allocator and without a limit of the address space or data segment,
+ * the policy says it advised the heap, and then:
  *  - a block of 8 MiB allocated after it, written and read back, lies
  *    (its middle: the advice starts at a huge-page boundary) in a mapping
  *    that carries the advice (VmFlags "hg" in /proc/self/smaps);
@@ -87,7 +88,11 @@ int main(void)
                                 "policy reserves and advises nothing");
     int advised = towstab_malloc_policy();
     int expect = thp_offered();
-#if !defined(__GLIBC__)
+#if defined(__GLIBC__)
+    /* (Under a limit the policy reserves nothing: checked above.) */
+    expect = expect && towstab_unlimited(RLIMIT_AS) &&
+             towstab_unlimited(RLIMIT_DATA);
+#else
     expect = 0;
 #endif
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
@@ -98,8 +103,9 @@ int main(void)
                             "(%d MiB)",
               (int)(TOWSTAB_HEAP_HUGE / MIB));
     else
-        printf("SKIP the heap's advice: no glibc heap, or no transparent "
-               "huge pages offered to advised memory (the policy says %d)\n",
+        printf("SKIP the heap's advice: no glibc heap, no transparent huge "
+               "pages offered to advised memory, or a limit of the address "
+               "space or data segment (the policy says %d)\n",
                advised);
 
     unsigned char *a = malloc(8 * MIB);
