@@ -71,9 +71,18 @@ static int limited_child(void)
 {
     pid_t pid = fork();
     if (pid == 0) {
-        struct rlimit as = {(rlim_t)64 << 30, (rlim_t)64 << 30};
-        if (setrlimit(RLIMIT_AS, &as) != 0)
+        /* The soft limit only (lowering it needs no privilege); one
+         * already set is kept. */
+        struct rlimit as;
+        if (getrlimit(RLIMIT_AS, &as) != 0)
             _exit(3);
+        if (as.rlim_cur == RLIM_INFINITY) {
+            as.rlim_cur = (rlim_t)64 << 30;
+            if (as.rlim_max != RLIM_INFINITY && as.rlim_cur > as.rlim_max)
+                as.rlim_cur = as.rlim_max;
+            if (setrlimit(RLIMIT_AS, &as) != 0)
+                _exit(3);
+        }
         _exit(towstab_malloc_policy());
     }
     int st;
